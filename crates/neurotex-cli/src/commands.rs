@@ -1,0 +1,333 @@
+//! The subcommands: each parses its options into library parameters, runs the library and
+//! writes or prints the result.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use neurotex::analysis::{evaluate as run_evaluation, Columns, FeatureTable, Outcome, Split};
+use neurotex::classify::CvParams;
+use neurotex::pipeline::{Encoded, Method, Pipeline};
+use neurotex::recording::{read_recording, same_speed, Dataset, LayoutFile};
+
+use crate::output::{progress, write_atomic};
+use crate::stage_args::StageArgs;
+
+/// Options of `neurotex encode`.
+#[derive(Args)]
+pub struct EncodeArgs {
+    /// The recording: `.npy` (f32/f64, `(T, rows, cols)` or `(T, channels)`) or `.csv`
+    /// (header row, optional `t_ms`/`t_s` time column, one column per channel).
+    pub input: PathBuf,
+    /// Where to write the spikes: u8 `.npy` of shape `(T, rows, cols)` at 1 kHz.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Sampling rate of the input in Hz (ignored when the CSV has a time column).
+    #[arg(long, default_value_t = 1000.0)]
+    pub fs: f64,
+    /// A `layout.toml` giving grid, channel map, mask or baseline for the input.
+    #[arg(long)]
+    pub layout: Option<PathBuf>,
+    /// Also write the spikes as address events `t_ms,row,col` to this CSV file.
+    #[arg(long)]
+    pub events: Option<PathBuf>,
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
+
+/// Options of `neurotex features`.
+#[derive(Args)]
+pub struct FeaturesArgs {
+    /// The dataset folder (with `manifest.csv`, optional `layout.toml`).
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// Feature set: `taxel` (MSR, CV_ISI, Fano of every taxel), `glcm2d` or `glcm3d`
+    /// (contrast, correlation, ASM).
+    #[arg(long)]
+    pub method: Method,
+    /// The CSV file to write: `file,label,speed_mm_s,trial` then the features.
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
+
+/// Options of `neurotex evaluate`.
+#[derive(Args)]
+pub struct EvaluateArgs {
+    /// The dataset folder.
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// Feature set: `taxel`, `glcm2d` or `glcm3d`.
+    #[arg(long)]
+    pub method: Method,
+    /// With `--method taxel`: the taxel to use, as `ROW,COL`. Without it every taxel is
+    /// evaluated and the mean over taxels is reported, with the best beside it.
+    #[arg(long)]
+    pub taxel: Option<String>,
+    /// Neighbours in KNN.
+    #[arg(long, default_value_t = 5)]
+    pub k: usize,
+    /// Cross-validation folds (stratified, shuffled).
+    #[arg(long, default_value_t = 5)]
+    pub folds: usize,
+    /// Seed of the fold shuffle (repeat r uses seed + r).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Cross-validation repeats with different shuffles.
+    #[arg(long, default_value_t = 1)]
+    pub repeats: usize,
+    /// Only recordings at these speeds (mm/s, comma-separated); default all.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, conflicts_with = "train_speeds")]
+    pub speeds: Option<Vec<f64>>,
+    /// Train on these speeds instead of cross-validating (needs --test-speeds).
+    #[arg(long = "train-speeds", value_delimiter = ',', allow_hyphen_values = true, requires = "test_speeds")]
+    pub train_speeds: Option<Vec<f64>>,
+    /// Test on these speeds (needs --train-speeds).
+    #[arg(long = "test-speeds", value_delimiter = ',', allow_hyphen_values = true, requires = "train_speeds")]
+    pub test_speeds: Option<Vec<f64>>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
+
+pub fn encode(args: EncodeArgs) -> Result<()> {
+    let params = args.stages.pipeline()?;
+    if !(args.fs.is_finite() && args.fs > 0.0) {
+        bail!("--fs must be a positive sampling rate in Hz, got {}", args.fs);
+    }
+    let mut layout = match &args.layout {
+        Some(path) => LayoutFile::read(path)?,
+        None => LayoutFile::default(),
+    };
+    layout.fs = Some(args.fs);
+    let rec = read_recording(&args.input, &layout)?;
+    let pipeline = Pipeline::new(params)?;
+    let encoded = pipeline.encode(&rec, layout.baseline.unwrap_or_default())?;
+    report_conditions(std::slice::from_ref(&encoded));
+    let spikes = &encoded.spikes;
+    let raster = ndarray::Array3::from_shape_vec((spikes.n_steps, spikes.rows, spikes.cols), spikes.to_raster())?;
+    if let Some(events) = &args.events {
+        write_atomic(events, |w| {
+            writeln!(w, "t_ms,row,col")?;
+            for (t, r, c) in spikes.events() {
+                writeln!(w, "{t},{r},{c}")?;
+            }
+            Ok(())
+        })?;
+    }
+    write_atomic(&args.out, |w| {
+        ndarray_npy::WriteNpyExt::write_npy(&raster, w).context("writing .npy")?;
+        Ok(())
+    })?;
+    eprintln!(
+        "{} spikes from {} taxels over {} ms -> {}",
+        spikes.total_spikes(),
+        spikes.present.iter().filter(|&&p| p).count(),
+        spikes.n_steps,
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Opens the dataset and encodes the recordings at `indices` with a progress bar.
+fn encode_selected(dataset: &Dataset, pipeline: &Pipeline, indices: &[usize]) -> Result<Vec<Encoded>> {
+    let bar = progress(indices.len(), "encoding");
+    let encoded = pipeline.encode_dataset(dataset, indices, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let encoded = encoded?;
+    report_conditions(&encoded);
+    Ok(encoded)
+}
+
+/// Says on standard error what conditioning did that the user should know.
+fn report_conditions(encoded: &[Encoded]) {
+    let resampled = encoded.iter().filter(|e| e.resampled).count();
+    if resampled > 0 {
+        eprintln!("note: {resampled} recording(s) resampled to the encoder's 1 kHz by linear interpolation");
+    }
+    for e in encoded.iter().filter(|e| e.flat) {
+        eprintln!(
+            "warning: {}: no positive signal in the selected phase; left at zero (no spikes)",
+            e.meta.file
+        );
+    }
+}
+
+/// Encodes the recordings at `indices` and extracts `method`'s features; also returns the
+/// grid (present cells, columns) of the first recording.
+fn feature_table(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+    method: Method,
+) -> Result<(FeatureTable, Vec<bool>, usize)> {
+    let encoded = encode_selected(dataset, pipeline, indices)?;
+    let first = &encoded[0].spikes;
+    if let Some(other) = encoded.iter().find(|e| e.spikes.present != first.present) {
+        bail!(
+            "{}: its taxel grid differs from that of {}; a dataset needs one layout",
+            other.meta.file,
+            encoded[0].meta.file
+        );
+    }
+    let extractor = pipeline.extractor(first.rows, first.cols, &first.present)?;
+    let table = FeatureTable::build(&encoded, &extractor, method)?;
+    Ok((table, first.present.clone(), first.cols))
+}
+
+pub fn features(args: FeaturesArgs) -> Result<()> {
+    let pipeline = Pipeline::new(args.stages.pipeline()?)?;
+    let dataset = Dataset::open(&args.dataset)?;
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    let (table, _, _) = feature_table(&dataset, &pipeline, &all, args.method)?;
+    write_atomic(&args.out, |w| {
+        let mut out = csv::Writer::from_writer(w);
+        let mut header = vec!["file".to_string(), "label".into(), "speed_mm_s".into(), "trial".into()];
+        header.extend(table.names.iter().cloned());
+        out.write_record(&header)?;
+        for (i, m) in table.metas.iter().enumerate() {
+            let mut rec = vec![m.file.clone(), m.label.clone(), m.speed_mm_s.to_string(), m.trial.to_string()];
+            rec.extend(table.row(i).iter().map(|v| v.to_string()));
+            out.write_record(&rec)?;
+        }
+        out.flush()?;
+        Ok(())
+    })?;
+    eprintln!(
+        "{} recordings x {} features -> {}",
+        table.metas.len(),
+        table.dims(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn parse_taxel(text: &str) -> Result<(usize, usize)> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    match parts.as_slice() {
+        [r, c] => match (r.parse(), c.parse()) {
+            (Ok(r), Ok(c)) => Ok((r, c)),
+            _ => bail!("--taxel must be ROW,COL with non-negative integers, got `{text}`"),
+        },
+        _ => bail!("--taxel must be ROW,COL, got `{text}`"),
+    }
+}
+
+pub fn evaluate(args: EvaluateArgs) -> Result<()> {
+    let pipeline = Pipeline::new(args.stages.pipeline()?)?;
+    let knn = args.stages.knn(args.k)?;
+    let cv = CvParams {
+        folds: args.folds,
+        seed: args.seed,
+        repeats: args.repeats,
+    };
+    cv.check()?;
+    let columns = match (args.method, &args.taxel) {
+        (Method::Taxel, Some(t)) => {
+            let (r, c) = parse_taxel(t)?;
+            Columns::Taxel(r, c)
+        }
+        (Method::Taxel, None) => Columns::EachTaxel,
+        (_, Some(_)) => bail!("--taxel applies only to --method taxel"),
+        (_, None) => Columns::All,
+    };
+    let dataset = Dataset::open(&args.dataset)?;
+    let split = match (&args.train_speeds, &args.test_speeds) {
+        (Some(train), Some(test)) => Split::ByCondition {
+            train: train.clone(),
+            test: test.clone(),
+        },
+        _ => Split::CrossValidation {
+            speeds: args.speeds.clone(),
+            cv,
+        },
+    };
+    let wanted: Vec<f64> = match &split {
+        Split::CrossValidation { speeds: Some(s), .. } => s.clone(),
+        Split::CrossValidation { speeds: None, .. } => dataset.speeds(),
+        Split::ByCondition { train, test } => train.iter().chain(test).copied().collect(),
+    };
+    let available = dataset.speeds();
+    for s in &wanted {
+        if !available.iter().any(|&a| same_speed(a, *s)) {
+            bail!(
+                "no recordings at {s} mm/s in {} (its speeds: {})",
+                dataset.root.display(),
+                available.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ")
+            );
+        }
+    }
+    let indices: Vec<usize> = (0..dataset.entries.len())
+        .filter(|&i| wanted.iter().any(|&s| same_speed(s, dataset.entries[i].speed_mm_s)))
+        .collect();
+    let (table, present, cols) = feature_table(&dataset, &pipeline, &indices, args.method)?;
+    if let Columns::Taxel(r, c) = columns {
+        let rows = present.len() / cols;
+        if r >= rows || c >= cols {
+            bail!("--taxel {r},{c} is outside the {rows}x{cols} grid");
+        }
+    }
+    let outcome = run_evaluation(&table, &present, cols, columns, &split, knn)?;
+    if args.json {
+        let mut value = serde_json::to_value(&outcome)?;
+        value["method"] = args.method.name().into();
+        println!("{}", serde_json::to_string(&value)?);
+    } else {
+        print_outcome(&outcome, args.method, &split, cols);
+    }
+    Ok(())
+}
+
+fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) {
+    let how = match split {
+        Split::CrossValidation { cv, .. } => format!(
+            "{}-fold stratified CV, seed {}, {} repeat(s)",
+            cv.folds, cv.seed, cv.repeats
+        ),
+        Split::ByCondition { train, test } => format!("train on {train:?} mm/s, test on {test:?} mm/s"),
+    };
+    println!("method {}: {} samples, {how}", method.name(), outcome.n);
+    if let (Some(per), Some(best)) = (&outcome.per_taxel, &outcome.best) {
+        println!("accuracy per taxel (%):");
+        let rows = per.iter().map(|t| t.row).max().unwrap_or(0) + 1;
+        for r in 0..rows {
+            let line: Vec<String> = (0..cols)
+                .map(|c| {
+                    per.iter()
+                        .find(|t| t.row == r && t.col == c)
+                        .map_or("    -".to_string(), |t| format!("{:5.1}", 100.0 * t.accuracy))
+                })
+                .collect();
+            println!("  {}", line.join(" "));
+        }
+        println!(
+            "accuracy {:.1}% (mean over taxels); best taxel r{}c{} {:.1}% (chosen after the fact)",
+            100.0 * outcome.accuracy,
+            best.row,
+            best.col,
+            100.0 * best.accuracy
+        );
+    } else if outcome.accuracy_std > 0.0 {
+        println!("accuracy {:.1}% ± {:.1}%", 100.0 * outcome.accuracy, 100.0 * outcome.accuracy_std);
+    } else {
+        println!("accuracy {:.1}%", 100.0 * outcome.accuracy);
+    }
+    let summed = if outcome.per_taxel.is_some() { ", summed over taxels" } else { "" };
+    println!("confusion (rows = true, columns = predicted{summed}):");
+    let width = outcome.labels.iter().map(|l| l.len()).max().unwrap_or(1).max(5);
+    print!("{:width$}", "");
+    for l in &outcome.labels {
+        print!(" {l:>width$}");
+    }
+    println!();
+    for (l, row) in outcome.labels.iter().zip(&outcome.confusion) {
+        print!("{l:width$}");
+        for v in row {
+            print!(" {v:>width$}");
+        }
+        println!();
+    }
+}

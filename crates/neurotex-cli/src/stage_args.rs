@@ -1,0 +1,78 @@
+//! Options shared by every command that runs the pipeline.
+
+use anyhow::{bail, Result};
+use clap::Args;
+use neurotex::classify::KnnParams;
+use neurotex::encode::IzhikevichParams;
+use neurotex::pipeline::PipelineParams;
+use neurotex::recording::Baseline;
+
+/// Stage parameters; defaults are the paper's values (or SPEC's choice where it gives none).
+#[derive(Args, Debug, Clone)]
+pub struct StageArgs {
+    /// Gain G from normalised signal to Izhikevich input current (paper: 8).
+    #[arg(long, default_value_t = 8.0)]
+    pub gain: f64,
+    /// Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ.
+    #[arg(long, default_value = "RS")]
+    pub preset: String,
+    /// Low-pass cutoff in Hz (zero-phase 2nd-order Butterworth); 0 turns the filter off.
+    #[arg(long, default_value_t = 50.0)]
+    pub cutoff: f64,
+    /// Baseline removal: `none`, or `min` (each taxel's minimum). Default: the dataset's layout.toml.
+    #[arg(long)]
+    pub baseline: Option<String>,
+    /// Use the whole recording instead of only its sliding phase.
+    #[arg(long)]
+    pub whole: bool,
+    /// Gray levels for GLCM quantisation.
+    #[arg(long, default_value_t = 16)]
+    pub levels: usize,
+    /// Rate-volume bin and Fano window in ms.
+    #[arg(long = "bin-ms", default_value_t = 200)]
+    pub bin_ms: usize,
+    /// GLCM offset distances, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,4,8")]
+    pub distances: Vec<usize>,
+    /// Count co-occurrences in both directions.
+    #[arg(long)]
+    pub symmetric: bool,
+    /// Do not z-score features with training-fold statistics before KNN.
+    #[arg(long = "no-standardize")]
+    pub no_standardize: bool,
+}
+
+impl StageArgs {
+    /// The pipeline parameters these options name, checked.
+    pub fn pipeline(&self) -> Result<PipelineParams> {
+        let Some(encoder) = IzhikevichParams::preset(&self.preset) else {
+            bail!("unknown --preset `{}`: expected one of RS, IB, CH, FS, LTS, TC, RZ", self.preset);
+        };
+        let mut p = PipelineParams::default();
+        p.encoder = encoder.with_gain(self.gain);
+        p.preprocess.cutoff_hz = self.cutoff;
+        p.preprocess.slide_only = !self.whole;
+        p.preprocess.baseline = match self.baseline.as_deref() {
+            None => None,
+            Some("none") => Some(Baseline::None),
+            Some("min") => Some(Baseline::Min),
+            Some(other) => bail!("unknown --baseline `{other}`: expected none or min"),
+        };
+        p.volume.levels = self.levels;
+        p.volume.bin_ms = self.bin_ms;
+        p.glcm.distances = self.distances.clone();
+        p.glcm.symmetric = self.symmetric;
+        p.check()?;
+        Ok(p)
+    }
+
+    /// KNN parameters with `k` neighbours.
+    pub fn knn(&self, k: usize) -> Result<KnnParams> {
+        let knn = KnnParams {
+            k,
+            standardize: !self.no_standardize,
+        };
+        knn.check()?;
+        Ok(knn)
+    }
+}

@@ -1,0 +1,120 @@
+//! The crate-level error type: one variant per stage, each wrapping that stage's error.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in neurotex, by stage.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Reading or validating recordings, manifests and layouts.
+    #[error(transparent)]
+    Data(#[from] DataError),
+    /// A parameter broke one of its rules.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// Classification or cross-validation could not run on the given data.
+    #[error(transparent)]
+    Classify(#[from] ClassifyError),
+}
+
+/// A shorthand for results with [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A parameter outside its allowed range; the message names the rule.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("invalid parameter `{name}`: {rule}, got {got}")]
+pub struct ParamError {
+    /// The parameter's name as the command line spells it.
+    pub name: &'static str,
+    /// The rule it must satisfy.
+    pub rule: &'static str,
+    /// The value that came.
+    pub got: String,
+}
+
+impl ParamError {
+    /// Builds the error for parameter `name` that broke `rule` with value `got`.
+    pub fn new(name: &'static str, rule: &'static str, got: impl ToString) -> Self {
+        Self {
+            name,
+            rule,
+            got: got.to_string(),
+        }
+    }
+}
+
+/// Bad or unreadable input data: each variant names the file and what was expected.
+#[derive(Debug, thiserror::Error)]
+pub enum DataError {
+    /// A file could not be opened or read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// A file was read but its content is not what was expected.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong and what was expected, with line and field where they apply.
+        message: String,
+    },
+}
+
+impl DataError {
+    /// An [`DataError::Invalid`] for `path` with `message`.
+    pub fn invalid(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        DataError::Invalid {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+
+    /// An [`DataError::Io`] for `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        DataError::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// Classification problems that come from the data given, not from a bug.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ClassifyError {
+    /// Fewer training samples than neighbours.
+    #[error("k = {k} neighbours needs at least {k} training samples, got {n_train}")]
+    KTooLarge {
+        /// Neighbours asked for.
+        k: usize,
+        /// Training samples available.
+        n_train: usize,
+    },
+    /// A class has fewer samples than folds, so stratified folds cannot hold it.
+    #[error("class `{label}` has {count} samples, fewer than the {folds} folds; use fewer folds or drop the class")]
+    ClassTooSmall {
+        /// The class.
+        label: String,
+        /// Its sample count.
+        count: usize,
+        /// Folds asked for.
+        folds: usize,
+    },
+    /// The test set holds a label the training set never saw.
+    #[error("test label `{label}` does not occur in the training set")]
+    UnknownTestLabel {
+        /// The label.
+        label: String,
+    },
+    /// Nothing to classify.
+    #[error("no samples to {what}")]
+    Empty {
+        /// What was to be done.
+        what: &'static str,
+    },
+    /// Feature rows of different lengths, or a non-finite feature.
+    #[error("{0}")]
+    BadFeatures(String),
+}

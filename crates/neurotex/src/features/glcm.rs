@@ -1,0 +1,200 @@
+//! Gray-level co-occurrence matrices over the quantised rate volume (paper section II-F,
+//! eq. 4 and table I; Haralick et al. 1973).
+//!
+//! Coordinates are (row, col, time). For each offset `(dr, dc, dt)` a pair is
+//! `(V[r, c, t] = i, V[r + dr, c + dc, t + dt] = j)`; pairs leaving the volume or touching a
+//! masked cell are skipped. The counts of all offsets are summed before normalising (the
+//! paper's averaging before normalising), so an offset with no pairs adds nothing.
+
+use crate::error::ParamError;
+
+/// The paper's 13 direction vectors (table I), as `(row, col, time)` for D = 1.
+pub const DIRECTIONS_13: [(i32, i32, i32); 13] = [
+    (0, 1, 0),
+    (-1, 1, 0),
+    (-1, 0, 0),
+    (-1, -1, 0),
+    (0, 1, -1),
+    (0, 0, -1),
+    (0, -1, -1),
+    (-1, 0, -1),
+    (1, 0, -1),
+    (-1, 1, -1),
+    (1, -1, -1),
+    (-1, -1, -1),
+    (1, 1, -1),
+];
+
+/// Co-occurrence parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlcmParams {
+    /// Offset distances D (the paper's 1, 2, 4, 8).
+    pub distances: Vec<usize>,
+    /// Count each pair in both orders (off by default, as in the paper).
+    pub symmetric: bool,
+}
+
+impl Default for GlcmParams {
+    fn default() -> Self {
+        GlcmParams {
+            distances: vec![1, 2, 4, 8],
+            symmetric: false,
+        }
+    }
+}
+
+impl GlcmParams {
+    /// Checks the rules: at least one distance, each between 1 and 1000.
+    ///
+    /// # Errors
+    /// The rule broken.
+    pub fn check(&self) -> Result<(), ParamError> {
+        if self.distances.is_empty() {
+            return Err(ParamError::new("distances", "at least one offset distance is needed", "none"));
+        }
+        if let Some(&d) = self.distances.iter().find(|&&d| d == 0 || d > 1000) {
+            return Err(ParamError::new("distances", "offset distances must be between 1 and 1000", d));
+        }
+        Ok(())
+    }
+}
+
+/// Which offsets a plan counts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GlcmKind {
+    /// The 13 directions of the 3D volume.
+    ThreeD,
+    /// The first four (in-plane) directions, for the time-collapsed image.
+    TwoD,
+}
+
+#[derive(Debug, Clone)]
+struct PlannedOffset {
+    /// Cell pairs `(from, to)` valid on the grid and the mask for this spatial offset.
+    pairs: Vec<(u32, u32)>,
+    /// Time step back (`t + dt` with `dt = -back`).
+    back: usize,
+}
+
+/// Offset tables for one grid, mask and parameter set, built once and applied to many volumes.
+#[derive(Debug, Clone)]
+pub struct GlcmPlan {
+    levels: usize,
+    cells: usize,
+    symmetric: bool,
+    offsets: Vec<PlannedOffset>,
+}
+
+impl GlcmPlan {
+    /// Plans the offsets of `kind` for a `rows x cols` grid with `present` cells.
+    ///
+    /// # Errors
+    /// Broken parameter rules, or fewer than 2 or more than 256 levels.
+    ///
+    /// # Panics
+    /// If `present` is not one flag per cell (a caller bug).
+    pub fn new(
+        rows: usize,
+        cols: usize,
+        present: &[bool],
+        levels: usize,
+        params: &GlcmParams,
+        kind: GlcmKind,
+    ) -> Result<Self, ParamError> {
+        params.check()?;
+        if !(2..=256).contains(&levels) {
+            return Err(ParamError::new("levels", "gray levels must be between 2 and 256", levels));
+        }
+        assert_eq!(present.len(), rows * cols);
+        let dirs: &[(i32, i32, i32)] = match kind {
+            GlcmKind::ThreeD => &DIRECTIONS_13,
+            GlcmKind::TwoD => &DIRECTIONS_13[..4],
+        };
+        let mut offsets = Vec::new();
+        for &d in &params.distances {
+            for &(dr, dc, dt) in dirs {
+                let (dr, dc) = (dr as i64 * d as i64, dc as i64 * d as i64);
+                let mut pairs = Vec::new();
+                for r in 0..rows as i64 {
+                    for c in 0..cols as i64 {
+                        let (r2, c2) = (r + dr, c + dc);
+                        if r2 < 0 || c2 < 0 || r2 >= rows as i64 || c2 >= cols as i64 {
+                            continue;
+                        }
+                        let (a, b) = ((r * cols as i64 + c) as usize, (r2 * cols as i64 + c2) as usize);
+                        if present[a] && present[b] {
+                            pairs.push((a as u32, b as u32));
+                        }
+                    }
+                }
+                if !pairs.is_empty() {
+                    offsets.push(PlannedOffset {
+                        pairs,
+                        back: if dt == 0 { 0 } else { d },
+                    });
+                }
+            }
+        }
+        Ok(GlcmPlan {
+            levels,
+            cells: rows * cols,
+            symmetric: params.symmetric,
+            offsets,
+        })
+    }
+
+    /// Gray levels of the matrices this plan counts.
+    pub fn levels(&self) -> usize {
+        self.levels
+    }
+
+    /// Sums the co-occurrence counts of every planned offset over a quantised volume
+    /// (`cells x bins`, cell-major, levels below `levels`) into `counts` (`levels x levels`,
+    /// row = first voxel's level), overwriting it.
+    ///
+    /// # Panics
+    /// If the volume is not `cells x bins` or `counts` is not `levels^2` (caller bugs).
+    pub fn count(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
+        let l = self.levels;
+        assert_eq!(quantised.len(), self.cells * bins, "volume must be cells x bins");
+        assert_eq!(counts.len(), l * l, "counts must be levels x levels");
+        counts.fill(0);
+        // Four interleaved sub-histograms break the store-to-load dependency between
+        // consecutive increments of the same bin (rate volumes have long constant runs).
+        let mut sub = vec![0u32; 4 * l * l];
+        let stride = l * l;
+        for off in &self.offsets {
+            if off.back >= bins {
+                continue;
+            }
+            let n = bins - off.back;
+            for &(a, b) in &off.pairs {
+                let first = &quantised[a as usize * bins + off.back..a as usize * bins + bins];
+                let second = &quantised[b as usize * bins..b as usize * bins + n];
+                let mut fa = first.chunks_exact(4);
+                let mut fb = second.chunks_exact(4);
+                for (x, y) in (&mut fa).zip(&mut fb) {
+                    sub[x[0] as usize * l + y[0] as usize] += 1;
+                    sub[stride + x[1] as usize * l + y[1] as usize] += 1;
+                    sub[2 * stride + x[2] as usize * l + y[2] as usize] += 1;
+                    sub[3 * stride + x[3] as usize * l + y[3] as usize] += 1;
+                }
+                for (&x, &y) in fa.remainder().iter().zip(fb.remainder()) {
+                    sub[x as usize * l + y as usize] += 1;
+                }
+            }
+        }
+        for (k, c) in counts.iter_mut().enumerate() {
+            *c = sub[k] + sub[stride + k] + sub[2 * stride + k] + sub[3 * stride + k];
+        }
+        if self.symmetric {
+            for i in 0..l {
+                for j in i..l {
+                    let s = counts[i * l + j] + counts[j * l + i];
+                    counts[i * l + j] = s;
+                    counts[j * l + i] = s;
+                }
+            }
+        }
+    }
+}

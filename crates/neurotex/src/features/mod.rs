@@ -1,0 +1,12 @@
+//! Features from spike trains (SPEC 3.7-3.11): single-taxel spike statistics, the rate
+//! volume and its quantisation, gray-level co-occurrence matrices and Haralick features.
+
+pub mod glcm;
+pub mod haralick;
+pub mod spike_stats;
+pub mod volume;
+
+pub use glcm::{GlcmParams, GlcmPlan, DIRECTIONS_13};
+pub use haralick::{haralick, Haralick};
+pub use spike_stats::{spike_stats, SpikeStats};
+pub use volume::{quantise, RateVolume, VolumeParams};

@@ -1,0 +1,23 @@
+//! neurotex: neuromorphic tactile texture classification.
+//!
+//! Taxel-array recordings become spikes of Izhikevich neurons, spikes become single-taxel
+//! statistics or 2D/3D gray-level co-occurrence features, and a KNN classifier scores them,
+//! as in Gupta, Nakagawa, Lepora and Thakor, "Spatio-temporal encoding improves
+//! neuromorphic tactile texture classification". Data flows down the modules:
+//! [`recording`] → [`signal`] → [`encode`] → [`features`] → [`classify`], joined by
+//! [`pipeline`] and [`analysis`].
+//!
+//! The library never prints and never exits: it returns [`Error`]s naming the file, line
+//! or parameter at fault.
+#![deny(missing_docs)]
+
+pub mod analysis;
+pub mod classify;
+pub mod encode;
+pub mod error;
+pub mod features;
+pub mod pipeline;
+pub mod recording;
+pub mod signal;
+
+pub use error::{Error, Result};

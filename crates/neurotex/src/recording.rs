@@ -1,0 +1,704 @@
+//! The data model (SPEC section 2): recordings, layouts, dataset folders and their I/O.
+//!
+//! A dataset is a folder with `manifest.csv` naming recordings (`.npy` or `.csv`) and an
+//! optional `layout.toml`. Recordings are loaded one at a time ([`Dataset::load`]) so a
+//! dataset's raw samples are never all in memory at once.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use ndarray::ArrayD;
+use ndarray_npy::ReadNpyExt;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{DataError, Result};
+
+/// The phase of the protocol a sample belongs to (paper section II-D).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[repr(u8)]
+pub enum Phase {
+    /// The sensor is off the surface.
+    Free,
+    /// Pressing onto the surface up to the target force.
+    Contact,
+    /// Held still at the target force.
+    Hold,
+    /// Sliding across the texture.
+    Slide,
+    /// Lifting off.
+    Retract,
+}
+
+/// Where the taxels sit: a `rows x cols` grid, the map from file channel to grid cell and
+/// the cells that hold no taxel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    /// Grid rows.
+    pub rows: usize,
+    /// Grid columns.
+    pub cols: usize,
+    /// For each file channel, its cell index `row * cols + col`.
+    pub channel_map: Vec<usize>,
+    /// For each cell, whether a taxel is there (`false` = masked).
+    pub present: Vec<bool>,
+}
+
+impl Layout {
+    /// A full grid whose channels fill the cells in row-major order.
+    pub fn grid(rows: usize, cols: usize) -> Self {
+        Layout {
+            rows,
+            cols,
+            channel_map: (0..rows * cols).collect(),
+            present: vec![true; rows * cols],
+        }
+    }
+
+    /// Number of grid cells (`rows * cols`).
+    pub fn cells(&self) -> usize {
+        self.rows * self.cols
+    }
+}
+
+/// A recording's descriptive fields, as in the manifest.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Meta {
+    /// The recording's file name relative to the dataset folder.
+    pub file: String,
+    /// Texture class.
+    pub label: String,
+    /// Sliding speed in mm/s (sign = direction where the rig records it).
+    pub speed_mm_s: f64,
+    /// Normal force in N.
+    pub force_n: f64,
+    /// Trial number.
+    pub trial: i64,
+    /// Start of the sliding phase in s from the recording's start, if known.
+    pub slide_start_s: Option<f64>,
+    /// End of the sliding phase in s, if known.
+    pub slide_end_s: Option<f64>,
+    /// Any further manifest columns.
+    pub extra: BTreeMap<String, String>,
+}
+
+/// One trial's samples, time-major `T x rows x cols`, with its sampling and metadata.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    /// Sampling rate in Hz (nominal when `times_s` is given).
+    pub fs: f64,
+    /// Grid and mask.
+    pub layout: Layout,
+    /// Samples, `T * rows * cols`, cell index fastest. Masked cells hold 0.
+    pub samples: Vec<f64>,
+    /// Per-sample time stamps in s for irregularly sampled recordings (strictly increasing).
+    pub times_s: Option<Vec<f64>>,
+    /// Per-sample protocol phase, where the source labels phases.
+    pub phases: Option<Vec<Phase>>,
+    /// Descriptive fields.
+    pub meta: Meta,
+}
+
+impl Recording {
+    /// Number of time samples.
+    pub fn len(&self) -> usize {
+        self.samples.len() / self.layout.cells().max(1)
+    }
+
+    /// Whether the recording holds no samples.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// Duration in seconds.
+    pub fn duration_s(&self) -> f64 {
+        match &self.times_s {
+            Some(t) if t.len() >= 2 => t[t.len() - 1] - t[0],
+            _ => self.len() as f64 / self.fs,
+        }
+    }
+}
+
+/// How to remove a taxel's resting value before encoding (SPEC 3.3).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum Baseline {
+    /// Leave the signal as it is (the paper's piezoresistive signal rests at zero).
+    #[default]
+    None,
+    /// Subtract each taxel's minimum over the recording.
+    Min,
+    /// Subtract each taxel's mean over `[start_s, end_s)` of the recording.
+    Mean {
+        /// Interval start in s.
+        start_s: f64,
+        /// Interval end in s.
+        end_s: f64,
+    },
+}
+
+/// `layout.toml`: how to read a dataset's recordings.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayoutFile {
+    /// Sampling rate in Hz (default 1000).
+    pub fs: Option<f64>,
+    /// Grid rows.
+    pub rows: Option<usize>,
+    /// Grid columns.
+    pub cols: Option<usize>,
+    /// For each file channel, `[row, col]`.
+    pub channel_map: Option<Vec<[usize; 2]>>,
+    /// One string per row, `1` for a taxel and `0` for a masked cell, e.g. `["1111", "1001"]`.
+    pub mask: Option<Vec<String>>,
+    /// Baseline removal.
+    pub baseline: Option<Baseline>,
+    /// CSV recordings: the time column's name.
+    pub time_column: Option<String>,
+    /// CSV recordings: the time column's unit, `ms` or `s`.
+    pub time_unit: Option<String>,
+    /// CSV recordings: the channel columns, in channel order (default: every other column).
+    pub channels: Option<Vec<String>>,
+}
+
+impl LayoutFile {
+    /// Reads and checks `layout.toml`.
+    ///
+    /// # Errors
+    /// The file is unreadable, not TOML of this form, or inconsistent.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, e))?;
+        let file: LayoutFile = toml::from_str(&text)
+            .map_err(|e| DataError::invalid(path, format!("not a valid layout file: {e}")))?;
+        file.check(path)?;
+        Ok(file)
+    }
+
+    fn check(&self, path: &Path) -> Result<()> {
+        let bad = |m: String| -> Result<()> { Err(DataError::invalid(path, m).into()) };
+        if let Some(fs) = self.fs {
+            if !(fs.is_finite() && fs > 0.0) {
+                return bad(format!("field `fs` must be a positive number of Hz, got {fs}"));
+            }
+        }
+        if self.rows.is_some() != self.cols.is_some() {
+            return bad("fields `rows` and `cols` must be given together".into());
+        }
+        if let (Some(r), Some(c)) = (self.rows, self.cols) {
+            if r == 0 || c == 0 {
+                return bad(format!("grid must be at least 1x1, got {r}x{c}"));
+            }
+            if let Some(map) = &self.channel_map {
+                let mut seen = vec![false; r * c];
+                for (ch, &[mr, mc]) in map.iter().enumerate() {
+                    if mr >= r || mc >= c {
+                        return bad(format!(
+                            "field `channel_map`: channel {ch} maps to [{mr}, {mc}], outside the {r}x{c} grid"
+                        ));
+                    }
+                    if std::mem::replace(&mut seen[mr * c + mc], true) {
+                        return bad(format!(
+                            "field `channel_map`: cell [{mr}, {mc}] is given twice"
+                        ));
+                    }
+                }
+            }
+            if let Some(mask) = &self.mask {
+                if mask.len() != r || mask.iter().any(|row| row.chars().count() != c) {
+                    return bad(format!(
+                        "field `mask` must have {r} strings of {c} characters"
+                    ));
+                }
+                if mask.iter().any(|row| row.chars().any(|ch| ch != '0' && ch != '1')) {
+                    return bad("field `mask` may hold only `0` and `1`".into());
+                }
+            }
+        } else if self.channel_map.is_some() || self.mask.is_some() {
+            return bad("fields `channel_map` and `mask` need `rows` and `cols`".into());
+        }
+        if let Some(unit) = &self.time_unit {
+            if unit != "ms" && unit != "s" {
+                return bad(format!("field `time_unit` must be `ms` or `s`, got `{unit}`"));
+            }
+        }
+        if let Some(Baseline::Mean { start_s, end_s }) = self.baseline {
+            if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
+                return bad(format!(
+                    "field `baseline`: mean interval must satisfy 0 <= start_s < end_s, got [{start_s}, {end_s}]"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The layout for a recording with `channels` channels (or a `rows x cols` array).
+    fn layout_for(&self, path: &Path, shape: Shape) -> Result<Layout> {
+        let (rows, cols) = match (self.rows, self.cols, shape) {
+            (Some(r), Some(c), _) => (r, c),
+            (_, _, Shape::Grid(r, c)) => (r, c),
+            (_, _, Shape::Channels(n)) => (1, n),
+        };
+        let present: Vec<bool> = match &self.mask {
+            Some(m) => m.iter().flat_map(|row| row.chars().map(|ch| ch == '1')).collect(),
+            None => vec![true; rows * cols],
+        };
+        let n_channels = match shape {
+            Shape::Grid(r, c) => {
+                if (r, c) != (rows, cols) {
+                    return Err(DataError::invalid(
+                        path,
+                        format!("recording is a {r}x{c} grid but layout.toml says {rows}x{cols}"),
+                    )
+                    .into());
+                }
+                r * c
+            }
+            Shape::Channels(n) => n,
+        };
+        let channel_map: Vec<usize> = match (&self.channel_map, shape) {
+            (Some(map), _) => map.iter().map(|&[r, c]| r * cols + c).collect(),
+            (None, Shape::Grid(..)) => (0..rows * cols).collect(),
+            (None, Shape::Channels(n)) => {
+                let taxels: Vec<usize> = (0..rows * cols).filter(|&i| present[i]).collect();
+                if taxels.len() != n {
+                    return Err(DataError::invalid(
+                        path,
+                        format!(
+                            "recording has {n} channels but the {rows}x{cols} layout has {} taxel cells",
+                            taxels.len()
+                        ),
+                    )
+                    .into());
+                }
+                taxels
+            }
+        };
+        if channel_map.len() != n_channels {
+            return Err(DataError::invalid(
+                path,
+                format!(
+                    "recording has {n_channels} channels but layout.toml maps {}",
+                    channel_map.len()
+                ),
+            )
+            .into());
+        }
+        if let Some(&cell) = channel_map.iter().find(|&&cell| !present[cell]) {
+            return Err(DataError::invalid(
+                path,
+                format!(
+                    "layout maps a channel to cell [{}, {}], which the mask marks empty",
+                    cell / cols,
+                    cell % cols
+                ),
+            )
+            .into());
+        }
+        Ok(Layout {
+            rows,
+            cols,
+            channel_map,
+            present,
+        })
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Shape {
+    Grid(usize, usize),
+    Channels(usize),
+}
+
+/// A dataset folder: its manifest, layout and where the recordings are.
+#[derive(Debug, Clone)]
+pub struct Dataset {
+    /// The folder.
+    pub root: PathBuf,
+    /// One entry per recording, in manifest order.
+    pub entries: Vec<Meta>,
+    /// The parsed `layout.toml` (all defaults when absent).
+    pub layout: LayoutFile,
+}
+
+/// The manifest's required columns.
+pub const MANIFEST_COLUMNS: [&str; 5] = ["file", "label", "speed_mm_s", "force_n", "trial"];
+
+impl Dataset {
+    /// Opens a dataset folder, reading and checking `manifest.csv` and `layout.toml`.
+    ///
+    /// # Errors
+    /// Missing or malformed manifest or layout; a manifest line naming a missing file.
+    pub fn open(root: impl AsRef<Path>) -> Result<Self> {
+        let root = root.as_ref().to_path_buf();
+        if !root.is_dir() {
+            return Err(DataError::invalid(&root, "is not a dataset folder (expected a folder with manifest.csv)").into());
+        }
+        let layout_path = root.join("layout.toml");
+        let layout = if layout_path.exists() {
+            LayoutFile::read(&layout_path)?
+        } else {
+            LayoutFile::default()
+        };
+        let manifest_path = root.join("manifest.csv");
+        let entries = read_manifest(&manifest_path)?;
+        for (i, m) in entries.iter().enumerate() {
+            if !root.join(&m.file).is_file() {
+                return Err(DataError::invalid(
+                    &manifest_path,
+                    format!("line {}: file `{}` does not exist in {}", i + 2, m.file, root.display()),
+                )
+                .into());
+            }
+        }
+        Ok(Dataset {
+            root,
+            entries,
+            layout,
+        })
+    }
+
+    /// The sampling rate of the dataset's recordings (default 1000 Hz, the paper's).
+    pub fn fs(&self) -> f64 {
+        self.layout.fs.unwrap_or(1000.0)
+    }
+
+    /// Loads recording `index` from disk.
+    ///
+    /// # Errors
+    /// Unreadable file, wrong shape, non-finite samples, non-increasing time stamps.
+    ///
+    /// # Panics
+    /// If `index` is out of range (a caller bug).
+    pub fn load(&self, index: usize) -> Result<Recording> {
+        let meta = &self.entries[index];
+        let path = self.root.join(&meta.file);
+        let mut rec = read_recording(&path, &self.layout)?;
+        rec.meta = meta.clone();
+        Ok(rec)
+    }
+
+    /// The distinct labels in order of first appearance.
+    pub fn labels(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for m in &self.entries {
+            if !out.contains(&m.label) {
+                out.push(m.label.clone());
+            }
+        }
+        out
+    }
+
+    /// The distinct speeds, ascending.
+    pub fn speeds(&self) -> Vec<f64> {
+        let mut out: Vec<f64> = Vec::new();
+        for m in &self.entries {
+            if !out.iter().any(|&s| same_speed(s, m.speed_mm_s)) {
+                out.push(m.speed_mm_s);
+            }
+        }
+        out.sort_by(f64::total_cmp);
+        out
+    }
+}
+
+/// Whether two speeds name the same condition (equal to within 1e-9 mm/s).
+pub fn same_speed(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9
+}
+
+/// Reads and checks a manifest.
+///
+/// # Errors
+/// Missing file, missing column, unparsable or non-finite field; each names the line.
+pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| csv_error(path, e))?;
+    let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
+    let col = |name: &str| headers.iter().position(|h| h == name);
+    let mut idx = [0usize; 5];
+    for (slot, name) in idx.iter_mut().zip(MANIFEST_COLUMNS) {
+        *slot = col(name).ok_or_else(|| {
+            DataError::invalid(
+                path,
+                format!(
+                    "missing column `{name}` (a manifest needs {})",
+                    MANIFEST_COLUMNS.join(",")
+                ),
+            )
+        })?;
+    }
+    let start = col("slide_start_s");
+    let end = col("slide_end_s");
+    let mut out = Vec::new();
+    for (i, record) in reader.records().enumerate() {
+        let line = i + 2;
+        let record = record.map_err(|e| csv_error(path, e))?;
+        let field = |j: usize| record.get(j).unwrap_or("");
+        let num = |j: usize, name: &str| -> Result<f64> {
+            let s = field(j);
+            s.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    DataError::invalid(
+                        path,
+                        format!("line {line}, field `{name}`: expected a finite number, got `{s}`"),
+                    )
+                    .into()
+                })
+        };
+        let opt = |j: Option<usize>, name: &str| -> Result<Option<f64>> {
+            match j {
+                Some(j) if !field(j).is_empty() => num(j, name).map(Some),
+                _ => Ok(None),
+            }
+        };
+        let file = field(idx[0]).to_string();
+        if file.is_empty() {
+            return Err(DataError::invalid(path, format!("line {line}, field `file` is empty")).into());
+        }
+        let label = field(idx[1]).to_string();
+        if label.is_empty() {
+            return Err(DataError::invalid(path, format!("line {line}, field `label` is empty")).into());
+        }
+        let trial_text = field(idx[4]);
+        let trial = trial_text.parse::<i64>().map_err(|_| {
+            DataError::invalid(
+                path,
+                format!("line {line}, field `trial`: expected an integer, got `{trial_text}`"),
+            )
+        })?;
+        let slide_start_s = opt(start, "slide_start_s")?;
+        let slide_end_s = opt(end, "slide_end_s")?;
+        if let (Some(a), Some(b)) = (slide_start_s, slide_end_s) {
+            if !(a >= 0.0 && b > a) {
+                return Err(DataError::invalid(
+                    path,
+                    format!("line {line}: slide interval must satisfy 0 <= slide_start_s < slide_end_s, got [{a}, {b}]"),
+                )
+                .into());
+            }
+        }
+        let known = |j: usize| idx.contains(&j) || Some(j) == start || Some(j) == end;
+        let extra = headers
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| !known(*j))
+            .map(|(j, h)| (h.to_string(), field(j).to_string()))
+            .collect();
+        out.push(Meta {
+            file,
+            label,
+            speed_mm_s: num(idx[2], "speed_mm_s")?,
+            force_n: num(idx[3], "force_n")?,
+            trial,
+            slide_start_s,
+            slide_end_s,
+            extra,
+        });
+    }
+    if out.is_empty() {
+        return Err(DataError::invalid(path, "the manifest lists no recordings").into());
+    }
+    Ok(out)
+}
+
+fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
+    match e.kind() {
+        csv::ErrorKind::Io(_) => {
+            let csv::ErrorKind::Io(io) = e.into_kind() else {
+                unreachable!()
+            };
+            DataError::io(path, io).into()
+        }
+        _ => {
+            let line = e.position().map(|p| format!("line {}: ", p.line())).unwrap_or_default();
+            DataError::invalid(path, format!("{line}malformed CSV: {e}")).into()
+        }
+    }
+}
+
+/// Reads one recording file (`.npy` or `.csv`) with the dataset's layout settings.
+///
+/// # Errors
+/// Unreadable file, unsupported dtype or shape, layout mismatch, non-finite samples,
+/// non-increasing time stamps.
+pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let (shape, raw, times_s) = match ext.as_str() {
+        "npy" => {
+            let (shape, raw) = read_npy(path)?;
+            (shape, raw, None)
+        }
+        "csv" => read_csv_samples(path, layout)?,
+        _ => {
+            return Err(DataError::invalid(
+                path,
+                "unsupported recording format: expected a .npy or .csv file",
+            )
+            .into())
+        }
+    };
+    let n_channels = match shape {
+        Shape::Grid(r, c) => r * c,
+        Shape::Channels(n) => n,
+    };
+    if n_channels == 0 {
+        return Err(DataError::invalid(path, "recording has no channels").into());
+    }
+    if let Some(pos) = raw.iter().position(|v| !v.is_finite()) {
+        return Err(DataError::invalid(
+            path,
+            format!(
+                "sample {} of channel {} is {} (every sample must be a finite number)",
+                pos / n_channels,
+                pos % n_channels,
+                raw[pos]
+            ),
+        )
+        .into());
+    }
+    let lay = layout.layout_for(path, shape)?;
+    let t = raw.len() / n_channels;
+    let samples = if lay.channel_map.iter().copied().eq(0..lay.cells()) {
+        raw
+    } else {
+        let cells = lay.cells();
+        let mut out = vec![0.0; t * cells];
+        for (frame_in, frame_out) in raw.chunks_exact(n_channels).zip(out.chunks_exact_mut(cells)) {
+            for (&v, &cell) in frame_in.iter().zip(&lay.channel_map) {
+                frame_out[cell] = v;
+            }
+        }
+        out
+    };
+    Ok(Recording {
+        fs: layout.fs.unwrap_or(1000.0),
+        layout: lay,
+        samples,
+        times_s,
+        phases: None,
+        meta: Meta {
+            file: path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(),
+            ..Meta::default()
+        },
+    })
+}
+
+fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    let array: ArrayD<f64> = match ArrayD::<f64>::read_npy(bytes.as_slice()) {
+        Ok(a) => a,
+        Err(_) => ArrayD::<f32>::read_npy(bytes.as_slice())
+            .map(|a| a.mapv(f64::from))
+            .map_err(|e| {
+                DataError::invalid(
+                    path,
+                    format!("not a readable .npy of float32 or float64 samples: {e}"),
+                )
+            })?,
+    };
+    let shape = match *array.shape() {
+        [_, r, c] => Shape::Grid(r, c),
+        [_, n] => Shape::Channels(n),
+        ref other => {
+            return Err(DataError::invalid(
+                path,
+                format!("expected shape (T, rows, cols) or (T, channels), got {other:?}"),
+            )
+            .into())
+        }
+    };
+    let std = array.as_standard_layout().into_owned();
+    Ok((shape, std.into_raw_vec_and_offset().0))
+}
+
+fn read_csv_samples(path: &Path, layout: &LayoutFile) -> Result<(Shape, Vec<f64>, Option<Vec<f64>>)> {
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| csv_error(path, e))?;
+    let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
+    let find = |name: &str| headers.iter().position(|h| h == name);
+    let (time_col, unit_scale) = match &layout.time_column {
+        Some(name) => {
+            let j = find(name).ok_or_else(|| {
+                DataError::invalid(path, format!("missing time column `{name}` named in layout.toml"))
+            })?;
+            let scale = if layout.time_unit.as_deref() == Some("s") { 1.0 } else { 1e-3 };
+            (Some(j), scale)
+        }
+        None => {
+            if let Some(j) = find("t_ms").or_else(|| find("time_ms")) {
+                (Some(j), 1e-3)
+            } else if let Some(j) = find("t_s").or_else(|| find("time_s")) {
+                (Some(j), 1.0)
+            } else {
+                (None, 1.0)
+            }
+        }
+    };
+    let channel_cols: Vec<usize> = match &layout.channels {
+        Some(names) => names
+            .iter()
+            .map(|n| {
+                find(n).ok_or_else(|| {
+                    crate::Error::from(DataError::invalid(
+                        path,
+                        format!("missing channel column `{n}` named in layout.toml"),
+                    ))
+                })
+            })
+            .collect::<Result<_>>()?,
+        None => (0..headers.len()).filter(|&j| Some(j) != time_col).collect(),
+    };
+    let n = channel_cols.len();
+    let mut samples = Vec::new();
+    let mut times = time_col.map(|_| Vec::new());
+    let mut record = csv::StringRecord::new();
+    let mut line = 1usize;
+    loop {
+        match reader.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(csv_error(path, e)),
+        }
+        line += 1;
+        let parse = |j: usize| -> Result<f64> {
+            let s = record.get(j).unwrap_or("");
+            match s.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(DataError::invalid(
+                    path,
+                    format!(
+                        "line {line}, column `{}`: expected a finite number, got `{s}`",
+                        &headers[j]
+                    ),
+                )
+                .into()),
+            }
+        };
+        for &j in &channel_cols {
+            samples.push(parse(j)?);
+        }
+        if let (Some(j), Some(times)) = (time_col, times.as_mut()) {
+            let t = parse(j)? * unit_scale;
+            if let Some(&prev) = times.last() {
+                if t <= prev {
+                    return Err(DataError::invalid(
+                        path,
+                        format!(
+                            "line {line}: time stamps must increase, got {} after {}",
+                            t / unit_scale,
+                            prev / unit_scale
+                        ),
+                    )
+                    .into());
+                }
+            }
+            times.push(t);
+        }
+    }
+    Ok((Shape::Channels(n), samples, times))
+}

@@ -1,0 +1,353 @@
+//! Signal conditioning before encoding (SPEC 3.1-3.5): sliding-phase selection,
+//! baseline removal, resampling to the encoder's 1 kHz, zero-phase Butterworth low-pass
+//! and global-max normalisation.
+
+use crate::error::{DataError, ParamError, Result};
+use crate::recording::{Baseline, Phase, Recording};
+
+/// The encoder's sampling rate: one Izhikevich step per millisecond (paper section II-E).
+pub const ENCODER_FS: f64 = 1000.0;
+
+/// Parameters of the conditioning stages.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PreprocessParams {
+    /// Low-pass cutoff in Hz; 0 turns the filter off. The paper gives none: 50 Hz.
+    pub cutoff_hz: f64,
+    /// Use only the sliding phase (the paper's choice); `false` keeps the whole recording.
+    pub slide_only: bool,
+    /// Baseline removal; `None` takes the dataset's `layout.toml` choice.
+    pub baseline: Option<Baseline>,
+}
+
+impl Default for PreprocessParams {
+    fn default() -> Self {
+        PreprocessParams {
+            cutoff_hz: 50.0,
+            slide_only: true,
+            baseline: None,
+        }
+    }
+}
+
+impl PreprocessParams {
+    /// Checks the rules: the cutoff is 0 or strictly between 0 and the Nyquist rate of 500 Hz.
+    ///
+    /// # Errors
+    /// The rule broken, as a [`ParamError`].
+    pub fn check(&self) -> Result<(), ParamError> {
+        let c = self.cutoff_hz;
+        if !c.is_finite() || c < 0.0 || c >= ENCODER_FS / 2.0 {
+            return Err(ParamError::new(
+                "cutoff",
+                "low-pass cutoff must be 0 (off) or between 0 and 500 Hz (half the 1 kHz encoder rate)",
+                c,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A second-order Butterworth low-pass as a biquad, designed by the bilinear transform
+/// with prewarping (the design of `scipy.signal.butter(2, fc, fs=fs)`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Butterworth2 {
+    /// Numerator `b0, b1, b2`.
+    pub b: [f64; 3],
+    /// Denominator `1, a1, a2`.
+    pub a: [f64; 3],
+}
+
+impl Butterworth2 {
+    /// Designs the low-pass for sampling rate `fs` and cutoff `cutoff_hz`.
+    ///
+    /// # Errors
+    /// The cutoff is not in `(0, fs/2)`.
+    pub fn lowpass(fs: f64, cutoff_hz: f64) -> Result<Self, ParamError> {
+        if !(cutoff_hz > 0.0 && cutoff_hz < fs / 2.0) {
+            return Err(ParamError::new(
+                "cutoff",
+                "low-pass cutoff must lie strictly between 0 and half the sampling rate",
+                cutoff_hz,
+            ));
+        }
+        let k = (std::f64::consts::PI * cutoff_hz / fs).tan();
+        let sqrt2 = std::f64::consts::SQRT_2;
+        let norm = 1.0 / (1.0 + sqrt2 * k + k * k);
+        let b0 = k * k * norm;
+        Ok(Butterworth2 {
+            b: [b0, 2.0 * b0, b0],
+            a: [1.0, 2.0 * (k * k - 1.0) * norm, (1.0 - sqrt2 * k + k * k) * norm],
+        })
+    }
+
+    /// Steady-state initial conditions for a unit step (as `scipy.signal.lfilter_zi`).
+    fn zi(&self) -> [f64; 2] {
+        let [b0, b1, b2] = self.b;
+        let [_, a1, a2] = self.a;
+        let (p, q) = (b1 - a1 * b0, b2 - a2 * b0);
+        let z0 = (p + q) / (1.0 + a1 + a2);
+        [z0, q - a2 * z0]
+    }
+
+    /// Runs the filter over `x` in place (direct form II transposed) from state `z`.
+    fn run(&self, x: &mut [f64], mut z: [f64; 2]) {
+        let [b0, b1, b2] = self.b;
+        let [_, a1, a2] = self.a;
+        for s in x.iter_mut() {
+            let xn = *s;
+            let y = b0 * xn + z[0];
+            z[0] = b1 * xn - a1 * y + z[1];
+            z[1] = b2 * xn - a2 * y;
+            *s = y;
+        }
+    }
+
+    /// Zero-phase forward-backward filtering as `scipy.signal.filtfilt(b, a, x)` with its
+    /// defaults: odd extension of 9 samples at each end (fewer for signals of 9 samples or
+    /// less), steady-state initial conditions. Signals shorter than 2 samples are left as they are.
+    pub fn filtfilt(&self, x: &mut [f64], scratch: &mut Vec<f64>) {
+        let n = x.len();
+        if n < 2 {
+            return;
+        }
+        let pad = 9.min(n - 1);
+        scratch.clear();
+        scratch.reserve(n + 2 * pad);
+        let (first, last) = (x[0], x[n - 1]);
+        scratch.extend((1..=pad).rev().map(|i| 2.0 * first - x[i]));
+        scratch.extend_from_slice(x);
+        scratch.extend((1..=pad).map(|i| 2.0 * last - x[n - 1 - i]));
+        let zi = self.zi();
+        let x0 = scratch[0];
+        self.run(scratch, [zi[0] * x0, zi[1] * x0]);
+        scratch.reverse();
+        let y0 = scratch[0];
+        self.run(scratch, [zi[0] * y0, zi[1] * y0]);
+        scratch.reverse();
+        x.copy_from_slice(&scratch[pad..pad + n]);
+    }
+}
+
+/// A recording conditioned for the encoder: `n_steps x cells` samples at 1 kHz, in `[.., 1]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Conditioned {
+    /// Samples, time-major, `n_steps * cells`.
+    pub samples: Vec<f64>,
+    /// Cells per frame (`rows * cols`).
+    pub cells: usize,
+    /// Whether the input was resampled to 1 kHz (the report says so).
+    pub resampled: bool,
+    /// Whether the recording's maximum was <= 0 so it was left at zero, not divided.
+    pub flat: bool,
+}
+
+impl Conditioned {
+    /// Number of 1 ms steps.
+    pub fn n_steps(&self) -> usize {
+        self.samples.len() / self.cells.max(1)
+    }
+}
+
+/// The conditioning stages, planned once (filter designed once) and applied to many recordings.
+#[derive(Debug, Clone)]
+pub struct Preprocessor {
+    params: PreprocessParams,
+    filter: Option<Butterworth2>,
+}
+
+impl Preprocessor {
+    /// Checks the parameters and designs the filter.
+    ///
+    /// # Errors
+    /// A broken parameter rule.
+    pub fn new(params: &PreprocessParams) -> Result<Self, ParamError> {
+        params.check()?;
+        let filter = if params.cutoff_hz > 0.0 {
+            Some(Butterworth2::lowpass(ENCODER_FS, params.cutoff_hz)?)
+        } else {
+            None
+        };
+        Ok(Preprocessor {
+            params: params.clone(),
+            filter,
+        })
+    }
+
+    /// The parameters this plan applies.
+    pub fn params(&self) -> &PreprocessParams {
+        &self.params
+    }
+
+    /// Conditions one recording; `dataset_baseline` is the dataset's layout choice, used
+    /// when the parameters do not override it.
+    ///
+    /// # Errors
+    /// The sliding phase is empty or outside the recording, or the baseline interval is.
+    pub fn apply(&self, rec: &Recording, dataset_baseline: Baseline) -> Result<Conditioned> {
+        let cells = rec.layout.cells();
+        let n = rec.len();
+        let file = &rec.meta.file;
+        if n == 0 {
+            return Err(DataError::invalid(file, "recording holds no samples").into());
+        }
+        let times: Vec<f64> = match &rec.times_s {
+            Some(t) => t.iter().map(|&x| x - t[0]).collect(),
+            None => (0..n).map(|i| i as f64 / rec.fs).collect(),
+        };
+        let offsets = baseline_offsets(rec, &times, self.params.baseline.unwrap_or(dataset_baseline))?;
+        let (lo, hi) = if self.params.slide_only {
+            slide_range(rec, &times)?
+        } else {
+            (0, n)
+        };
+        let uniform_1k = rec.times_s.is_none() && (rec.fs - ENCODER_FS).abs() < 1e-9;
+        let mut samples = if uniform_1k {
+            rec.samples[lo * cells..hi * cells].to_vec()
+        } else {
+            resample_linear(&rec.samples[lo * cells..hi * cells], cells, &times[lo..hi], ENCODER_FS)
+        };
+        if samples.is_empty() {
+            return Err(DataError::invalid(
+                file,
+                "the selected phase is shorter than one 1 ms encoder step",
+            )
+            .into());
+        }
+        for frame in samples.chunks_exact_mut(cells) {
+            for ((s, &o), &p) in frame.iter_mut().zip(&offsets).zip(&rec.layout.present) {
+                *s = if p { *s - o } else { 0.0 };
+            }
+        }
+        if let Some(filter) = &self.filter {
+            let steps = samples.len() / cells;
+            let mut channel = vec![0.0; steps];
+            let mut scratch = Vec::new();
+            for cell in (0..cells).filter(|&c| rec.layout.present[c]) {
+                for (dst, frame) in channel.iter_mut().zip(samples.chunks_exact(cells)) {
+                    *dst = frame[cell];
+                }
+                filter.filtfilt(&mut channel, &mut scratch);
+                for (src, frame) in channel.iter().zip(samples.chunks_exact_mut(cells)) {
+                    frame[cell] = *src;
+                }
+            }
+        }
+        let flat = normalise_global_max(&mut samples);
+        Ok(Conditioned {
+            samples,
+            cells,
+            resampled: !uniform_1k,
+            flat,
+        })
+    }
+}
+
+/// Divides every sample by the largest sample of all taxels (paper section II-E), so
+/// relative activation between taxels survives. Returns `true`, and sets everything to 0,
+/// when that maximum is <= 0 (a recording with no positive signal is never divided).
+pub fn normalise_global_max(samples: &mut [f64]) -> bool {
+    let max = samples.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if max > 0.0 {
+        let inv = 1.0 / max;
+        samples.iter_mut().for_each(|s| *s *= inv);
+        false
+    } else {
+        samples.iter_mut().for_each(|s| *s = 0.0);
+        true
+    }
+}
+
+/// Linear interpolation of `frames` (time-major, `cells` per frame, at `times` in s from the
+/// recording's start) onto a grid of `fs` starting at `times[0]`, up to the last time stamp.
+///
+/// # Panics
+/// If `times` does not have one entry per frame (a caller bug).
+pub fn resample_linear(frames: &[f64], cells: usize, times: &[f64], fs: f64) -> Vec<f64> {
+    assert_eq!(frames.len(), times.len() * cells, "one time stamp per frame");
+    if times.is_empty() {
+        return Vec::new();
+    }
+    let t0 = times[0];
+    let span = times[times.len() - 1] - t0;
+    let steps = (span * fs + 1e-9).floor() as usize + 1;
+    let mut out = Vec::with_capacity(steps * cells);
+    let mut k = 0usize;
+    for s in 0..steps {
+        let t = t0 + s as f64 / fs;
+        while k + 1 < times.len() - 1 && times[k + 1] <= t {
+            k += 1;
+        }
+        if times.len() == 1 {
+            out.extend_from_slice(&frames[..cells]);
+            continue;
+        }
+        let (ta, tb) = (times[k], times[k + 1]);
+        let w = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
+        let (fa, fb) = (&frames[k * cells..(k + 1) * cells], &frames[(k + 1) * cells..(k + 2) * cells]);
+        out.extend(fa.iter().zip(fb).map(|(&a, &b)| a + (b - a) * w));
+    }
+    out
+}
+
+/// The sample range `[lo, hi)` of the sliding phase: labelled phases first, then the
+/// manifest's `slide_start_s`/`slide_end_s`, else the whole recording.
+fn slide_range(rec: &Recording, times: &[f64]) -> Result<(usize, usize)> {
+    let n = times.len();
+    if let Some(phases) = &rec.phases {
+        let lo = phases.iter().position(|&p| p == Phase::Slide);
+        let hi = phases.iter().rposition(|&p| p == Phase::Slide);
+        return match (lo, hi) {
+            (Some(lo), Some(hi)) => Ok((lo, hi + 1)),
+            _ => Err(DataError::invalid(&rec.meta.file, "no sample is labelled as sliding").into()),
+        };
+    }
+    let start = rec.meta.slide_start_s.unwrap_or(0.0);
+    let end = rec.meta.slide_end_s.unwrap_or(f64::INFINITY);
+    let lo = times.partition_point(|&t| t < start - 1e-9);
+    let hi = times.partition_point(|&t| t < end - 1e-9);
+    if hi <= lo || lo >= n {
+        return Err(DataError::invalid(
+            &rec.meta.file,
+            format!(
+                "slide interval [{start}, {end}) s holds no samples of this {:.3} s recording",
+                rec.duration_s()
+            ),
+        )
+        .into());
+    }
+    Ok((lo, hi))
+}
+
+fn baseline_offsets(rec: &Recording, times: &[f64], baseline: Baseline) -> Result<Vec<f64>> {
+    let cells = rec.layout.cells();
+    match baseline {
+        Baseline::None => Ok(vec![0.0; cells]),
+        Baseline::Min => {
+            let mut lo = vec![f64::INFINITY; cells];
+            for frame in rec.samples.chunks_exact(cells) {
+                for (l, &s) in lo.iter_mut().zip(frame) {
+                    *l = l.min(s);
+                }
+            }
+            Ok(lo)
+        }
+        Baseline::Mean { start_s, end_s } => {
+            let a = times.partition_point(|&t| t < start_s);
+            let b = times.partition_point(|&t| t < end_s);
+            if b <= a {
+                return Err(DataError::invalid(
+                    &rec.meta.file,
+                    format!("baseline interval [{start_s}, {end_s}) s holds no samples"),
+                )
+                .into());
+            }
+            let mut sum = vec![0.0; cells];
+            for frame in rec.samples[a * cells..b * cells].chunks_exact(cells) {
+                for (acc, &s) in sum.iter_mut().zip(frame) {
+                    *acc += s;
+                }
+            }
+            Ok(sum.into_iter().map(|s| s / (b - a) as f64).collect())
+        }
+    }
+}
