@@ -78,13 +78,28 @@ pub struct EvaluateArgs {
     #[arg(long, default_value_t = 1)]
     pub repeats: usize,
     /// Only recordings at these speeds (mm/s, comma-separated); default all.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, conflicts_with = "train_speeds")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        conflicts_with = "train_speeds"
+    )]
     pub speeds: Option<Vec<f64>>,
     /// Train on these speeds instead of cross-validating (needs --test-speeds).
-    #[arg(long = "train-speeds", value_delimiter = ',', allow_hyphen_values = true, requires = "test_speeds")]
+    #[arg(
+        long = "train-speeds",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "test_speeds"
+    )]
     pub train_speeds: Option<Vec<f64>>,
     /// Test on these speeds (needs --train-speeds).
-    #[arg(long = "test-speeds", value_delimiter = ',', allow_hyphen_values = true, requires = "train_speeds")]
+    #[arg(
+        long = "test-speeds",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "train_speeds"
+    )]
     pub test_speeds: Option<Vec<f64>>,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -96,7 +111,10 @@ pub struct EvaluateArgs {
 pub fn encode(args: EncodeArgs) -> Result<()> {
     let params = args.stages.pipeline()?;
     if !(args.fs.is_finite() && args.fs > 0.0) {
-        bail!("--fs must be a positive sampling rate in Hz, got {}", args.fs);
+        bail!(
+            "--fs must be a positive sampling rate in Hz, got {}",
+            args.fs
+        );
     }
     let mut layout = match &args.layout {
         Some(path) => LayoutFile::read(path)?,
@@ -108,7 +126,10 @@ pub fn encode(args: EncodeArgs) -> Result<()> {
     let encoded = pipeline.encode(&rec, layout.baseline.unwrap_or_default())?;
     report_conditions(std::slice::from_ref(&encoded));
     let spikes = &encoded.spikes;
-    let raster = ndarray::Array3::from_shape_vec((spikes.n_steps, spikes.rows, spikes.cols), spikes.to_raster())?;
+    let raster = ndarray::Array3::from_shape_vec(
+        (spikes.n_steps, spikes.rows, spikes.cols),
+        spikes.to_raster(),
+    )?;
     if let Some(events) = &args.events {
         write_atomic(events, |w| {
             writeln!(w, "t_ms,row,col")?;
@@ -133,7 +154,11 @@ pub fn encode(args: EncodeArgs) -> Result<()> {
 }
 
 /// Opens the dataset and encodes the recordings at `indices` with a progress bar.
-fn encode_selected(dataset: &Dataset, pipeline: &Pipeline, indices: &[usize]) -> Result<Vec<Encoded>> {
+fn encode_selected(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+) -> Result<Vec<Encoded>> {
     let bar = progress(indices.len(), "encoding");
     let encoded = pipeline.encode_dataset(dataset, indices, &|| bar.inc(1));
     bar.finish_and_clear();
@@ -185,11 +210,21 @@ pub fn features(args: FeaturesArgs) -> Result<()> {
     let (table, _, _) = feature_table(&dataset, &pipeline, &all, args.method)?;
     write_atomic(&args.out, |w| {
         let mut out = csv::Writer::from_writer(w);
-        let mut header = vec!["file".to_string(), "label".into(), "speed_mm_s".into(), "trial".into()];
+        let mut header = vec![
+            "file".to_string(),
+            "label".into(),
+            "speed_mm_s".into(),
+            "trial".into(),
+        ];
         header.extend(table.names.iter().cloned());
         out.write_record(&header)?;
         for (i, m) in table.metas.iter().enumerate() {
-            let mut rec = vec![m.file.clone(), m.label.clone(), m.speed_mm_s.to_string(), m.trial.to_string()];
+            let mut rec = vec![
+                m.file.clone(),
+                m.label.clone(),
+                m.speed_mm_s.to_string(),
+                m.trial.to_string(),
+            ];
             rec.extend(table.row(i).iter().map(|v| v.to_string()));
             out.write_record(&rec)?;
         }
@@ -246,7 +281,9 @@ pub fn evaluate(args: EvaluateArgs) -> Result<()> {
         },
     };
     let wanted: Vec<f64> = match &split {
-        Split::CrossValidation { speeds: Some(s), .. } => s.clone(),
+        Split::CrossValidation {
+            speeds: Some(s), ..
+        } => s.clone(),
         Split::CrossValidation { speeds: None, .. } => dataset.speeds(),
         Split::ByCondition { train, test } => train.iter().chain(test).copied().collect(),
     };
@@ -256,12 +293,20 @@ pub fn evaluate(args: EvaluateArgs) -> Result<()> {
             bail!(
                 "no recordings at {s} mm/s in {} (its speeds: {})",
                 dataset.root.display(),
-                available.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ")
+                available
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             );
         }
     }
     let indices: Vec<usize> = (0..dataset.entries.len())
-        .filter(|&i| wanted.iter().any(|&s| same_speed(s, dataset.entries[i].speed_mm_s)))
+        .filter(|&i| {
+            wanted
+                .iter()
+                .any(|&s| same_speed(s, dataset.entries[i].speed_mm_s))
+        })
         .collect();
     let (table, present, cols) = feature_table(&dataset, &pipeline, &indices, args.method)?;
     if let Columns::Taxel(r, c) = columns {
@@ -287,7 +332,9 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
             "{}-fold stratified CV, seed {}, {} repeat(s)",
             cv.folds, cv.seed, cv.repeats
         ),
-        Split::ByCondition { train, test } => format!("train on {train:?} mm/s, test on {test:?} mm/s"),
+        Split::ByCondition { train, test } => {
+            format!("train on {train:?} mm/s, test on {test:?} mm/s")
+        }
     };
     println!("method {}: {} samples, {how}", method.name(), outcome.n);
     if let (Some(per), Some(best)) = (&outcome.per_taxel, &outcome.best) {
@@ -298,7 +345,9 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
                 .map(|c| {
                     per.iter()
                         .find(|t| t.row == r && t.col == c)
-                        .map_or("    -".to_string(), |t| format!("{:5.1}", 100.0 * t.accuracy))
+                        .map_or("    -".to_string(), |t| {
+                            format!("{:5.1}", 100.0 * t.accuracy)
+                        })
                 })
                 .collect();
             println!("  {}", line.join(" "));
@@ -311,13 +360,27 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
             100.0 * best.accuracy
         );
     } else if outcome.accuracy_std > 0.0 {
-        println!("accuracy {:.1}% ± {:.1}%", 100.0 * outcome.accuracy, 100.0 * outcome.accuracy_std);
+        println!(
+            "accuracy {:.1}% ± {:.1}%",
+            100.0 * outcome.accuracy,
+            100.0 * outcome.accuracy_std
+        );
     } else {
         println!("accuracy {:.1}%", 100.0 * outcome.accuracy);
     }
-    let summed = if outcome.per_taxel.is_some() { ", summed over taxels" } else { "" };
+    let summed = if outcome.per_taxel.is_some() {
+        ", summed over taxels"
+    } else {
+        ""
+    };
     println!("confusion (rows = true, columns = predicted{summed}):");
-    let width = outcome.labels.iter().map(|l| l.len()).max().unwrap_or(1).max(5);
+    let width = outcome
+        .labels
+        .iter()
+        .map(|l| l.len())
+        .max()
+        .unwrap_or(1)
+        .max(5);
     print!("{:width$}", "");
     for l in &outcome.labels {
         print!(" {l:>width$}");

@@ -11,13 +11,13 @@ use neurotex::recording::Baseline;
 #[derive(Args, Debug, Clone)]
 pub struct StageArgs {
     /// Gain G from normalised signal to Izhikevich input current (paper: 8).
-    #[arg(long, default_value_t = 8.0)]
+    #[arg(long, default_value_t = 8.0, allow_negative_numbers = true)]
     pub gain: f64,
     /// Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ.
     #[arg(long, default_value = "RS")]
     pub preset: String,
     /// Low-pass cutoff in Hz (zero-phase 2nd-order Butterworth); 0 turns the filter off.
-    #[arg(long, default_value_t = 50.0)]
+    #[arg(long, default_value_t = 50.0, allow_negative_numbers = true)]
     pub cutoff: f64,
     /// Baseline removal: `none`, or `min` (each taxel's minimum). Default: the dataset's layout.toml.
     #[arg(long)]
@@ -46,7 +46,10 @@ impl StageArgs {
     /// The pipeline parameters these options name, checked.
     pub fn pipeline(&self) -> Result<PipelineParams> {
         let Some(encoder) = IzhikevichParams::preset(&self.preset) else {
-            bail!("unknown --preset `{}`: expected one of RS, IB, CH, FS, LTS, TC, RZ", self.preset);
+            bail!(
+                "unknown --preset `{}`: expected one of RS, IB, CH, FS, LTS, TC, RZ",
+                self.preset
+            );
         };
         let mut p = PipelineParams::default();
         p.encoder = encoder.with_gain(self.gain);

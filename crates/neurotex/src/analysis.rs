@@ -28,7 +28,11 @@ impl FeatureTable {
     ///
     /// # Errors
     /// A recording too short for one bin.
-    pub fn build(encoded: &[Encoded], extractor: &FeatureExtractor, method: Method) -> Result<Self> {
+    pub fn build(
+        encoded: &[Encoded],
+        extractor: &FeatureExtractor,
+        method: Method,
+    ) -> Result<Self> {
         let rows: Vec<Vec<f64>> = encoded
             .par_iter()
             .map(|e| {
@@ -110,6 +114,9 @@ pub struct Outcome {
     pub best: Option<TaxelAccuracy>,
 }
 
+/// One column group's evaluation: `(cell, accuracy, accuracy_std, confusion, n)`.
+type GroupResult = (Option<usize>, f64, f64, Vec<Vec<usize>>, usize);
+
 /// Which feature columns to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Columns {
@@ -126,37 +133,68 @@ pub enum Columns {
 /// # Errors
 /// No recordings at the asked speeds, a class smaller than the fold count, `k` larger than
 /// the training set, a test label unseen in training, or a taxel outside the grid.
-pub fn evaluate(table: &FeatureTable, present: &[bool], cols: usize, columns: Columns, split: &Split, knn: KnnParams) -> Result<Outcome> {
+pub fn evaluate(
+    table: &FeatureTable,
+    present: &[bool],
+    cols: usize,
+    columns: Columns,
+    split: &Split,
+    knn: KnnParams,
+) -> Result<Outcome> {
     let in_speeds = |speeds: &[f64], m: &Meta| speeds.iter().any(|&s| same_speed(s, m.speed_mm_s));
     let taxels: Vec<usize> = taxel_cells(present).collect();
     let groups: Vec<(Option<usize>, Vec<usize>)> = match columns {
         Columns::All => vec![(None, (0..table.dims()).collect())],
         Columns::Taxel(r, c) => {
             let cell = r * cols + c;
-            let k = taxels.iter().position(|&t| t == cell && c < cols).ok_or_else(|| {
-                crate::error::ParamError::new("taxel", "taxel must be a present cell of the grid", format!("{r},{c}"))
-            })?;
+            let k = taxels
+                .iter()
+                .position(|&t| t == cell && c < cols)
+                .ok_or_else(|| {
+                    crate::error::ParamError::new(
+                        "taxel",
+                        "taxel must be a present cell of the grid",
+                        format!("{r},{c}"),
+                    )
+                })?;
             vec![(Some(cell), (3 * k..3 * k + 3).collect())]
         }
-        Columns::EachTaxel => taxels.iter().enumerate().map(|(k, &cell)| (Some(cell), (3 * k..3 * k + 3).collect())).collect(),
+        Columns::EachTaxel => taxels
+            .iter()
+            .enumerate()
+            .map(|(k, &cell)| (Some(cell), (3 * k..3 * k + 3).collect()))
+            .collect(),
     };
     let select = |rows: &[usize], cols_idx: &[usize]| -> Vec<f64> {
-        rows.iter().flat_map(|&i| cols_idx.iter().map(move |&j| table.row(i)[j])).collect()
+        rows.iter()
+            .flat_map(|&i| cols_idx.iter().map(move |&j| table.row(i)[j]))
+            .collect()
     };
     let (train_rows, test_rows): (Vec<usize>, Vec<usize>) = match split {
         Split::CrossValidation { speeds, .. } => {
             let rows: Vec<usize> = (0..table.metas.len())
-                .filter(|&i| speeds.as_ref().is_none_or(|s| in_speeds(s, &table.metas[i])))
+                .filter(|&i| {
+                    speeds
+                        .as_ref()
+                        .is_none_or(|s| in_speeds(s, &table.metas[i]))
+                })
                 .collect();
             (rows, Vec::new())
         }
         Split::ByCondition { train, test } => (
-            (0..table.metas.len()).filter(|&i| in_speeds(train, &table.metas[i])).collect(),
-            (0..table.metas.len()).filter(|&i| in_speeds(test, &table.metas[i])).collect(),
+            (0..table.metas.len())
+                .filter(|&i| in_speeds(train, &table.metas[i]))
+                .collect(),
+            (0..table.metas.len())
+                .filter(|&i| in_speeds(test, &table.metas[i]))
+                .collect(),
         ),
     };
     if train_rows.is_empty() {
-        return Err(ClassifyError::Empty { what: "evaluate: no recordings at the selected speeds" }.into());
+        return Err(ClassifyError::Empty {
+            what: "evaluate: no recordings at the selected speeds",
+        }
+        .into());
     }
     let mut labels: Vec<String> = Vec::new();
     for &i in train_rows.iter().chain(&test_rows) {
@@ -164,10 +202,15 @@ pub fn evaluate(table: &FeatureTable, present: &[bool], cols: usize, columns: Co
             labels.push(table.metas[i].label.clone());
         }
     }
-    let class = |i: usize| labels.iter().position(|l| *l == table.metas[i].label).unwrap_or(0);
+    let class = |i: usize| {
+        labels
+            .iter()
+            .position(|l| *l == table.metas[i].label)
+            .unwrap_or(0)
+    };
     let y_train: Vec<usize> = train_rows.iter().map(|&i| class(i)).collect();
     let y_test: Vec<usize> = test_rows.iter().map(|&i| class(i)).collect();
-    let results: Vec<(Option<usize>, f64, f64, Vec<Vec<usize>>, usize)> = groups
+    let results: Vec<GroupResult> = groups
         .par_iter()
         .map(|(cell, cols_idx)| -> Result<_> {
             let dims = cols_idx.len();
@@ -201,13 +244,20 @@ pub fn evaluate(table: &FeatureTable, present: &[bool], cols: usize, columns: Co
             .iter()
             .map(|r| {
                 let cell = r.0.unwrap_or(0);
-                TaxelAccuracy { row: cell / cols, col: cell % cols, accuracy: r.1 }
+                TaxelAccuracy {
+                    row: cell / cols,
+                    col: cell % cols,
+                    accuracy: r.1,
+                }
             })
             .collect();
-        let best = per.iter().copied().fold(None, |b: Option<TaxelAccuracy>, t| match b {
-            Some(b) if b.accuracy >= t.accuracy => Some(b),
-            _ => Some(t),
-        });
+        let best = per
+            .iter()
+            .copied()
+            .fold(None, |b: Option<TaxelAccuracy>, t| match b {
+                Some(b) if b.accuracy >= t.accuracy => Some(b),
+                _ => Some(t),
+            });
         (Some(per), best)
     } else {
         (None, None)

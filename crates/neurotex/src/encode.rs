@@ -74,16 +74,32 @@ impl IzhikevichParams {
     /// The rule broken.
     pub fn check(&self) -> Result<(), ParamError> {
         if !(self.gain.is_finite() && self.gain > 0.0 && self.gain <= 1e4) {
-            return Err(ParamError::new("gain", "gain must be a number in (0, 10000]", self.gain));
+            return Err(ParamError::new(
+                "gain",
+                "gain must be a number in (0, 10000]",
+                self.gain,
+            ));
         }
         if !(self.a.is_finite() && self.a > 0.0) {
-            return Err(ParamError::new("a", "recovery scale a must be positive", self.a));
+            return Err(ParamError::new(
+                "a",
+                "recovery scale a must be positive",
+                self.a,
+            ));
         }
         if !self.b.is_finite() || !self.d.is_finite() {
-            return Err(ParamError::new("b, d", "b and d must be finite", format!("{}, {}", self.b, self.d)));
+            return Err(ParamError::new(
+                "b, d",
+                "b and d must be finite",
+                format!("{}, {}", self.b, self.d),
+            ));
         }
         if !(self.c.is_finite() && self.c < V_PEAK) {
-            return Err(ParamError::new("c", "reset potential c must be below the 30 mV peak", self.c));
+            return Err(ParamError::new(
+                "c",
+                "reset potential c must be below the 30 mV peak",
+                self.c,
+            ));
         }
         Ok(())
     }
@@ -137,7 +153,12 @@ impl Encoder {
         for (frame, out) in input.chunks_exact(n).zip(raster.chunks_exact_mut(n)) {
             // Branch-free per neuron so the loop over neurons vectorises; the order of
             // every floating-point operation is that of the reference scheme.
-            for (((vi, ui), &x), o) in v.iter_mut().zip(u.iter_mut()).zip(frame).zip(out.iter_mut()) {
+            for (((vi, ui), &x), o) in v
+                .iter_mut()
+                .zip(u.iter_mut())
+                .zip(frame)
+                .zip(out.iter_mut())
+            {
                 let fired = *vi >= V_PEAK;
                 *o = fired as u8;
                 let mut vv = if fired { c } else { *vi };
@@ -218,7 +239,13 @@ impl SpikeTrains {
     ///
     /// # Panics
     /// If there is not one list per cell, or a list is unsorted or reaches `n_steps`.
-    pub fn from_lists(lists: &[Vec<u32>], rows: usize, cols: usize, present: &[bool], n_steps: usize) -> Self {
+    pub fn from_lists(
+        lists: &[Vec<u32>],
+        rows: usize,
+        cols: usize,
+        present: &[bool],
+        n_steps: usize,
+    ) -> Self {
         assert_eq!(lists.len(), rows * cols);
         let mut offsets = vec![0u32];
         let mut times = Vec::new();
@@ -255,9 +282,21 @@ impl SpikeTrains {
     /// The first `n_steps` steps only (for time-to-recognition).
     pub fn truncated(&self, n_steps: usize) -> SpikeTrains {
         let lists: Vec<Vec<u32>> = (0..self.cells())
-            .map(|c| self.train(c).iter().copied().filter(|&t| (t as usize) < n_steps).collect())
+            .map(|c| {
+                self.train(c)
+                    .iter()
+                    .copied()
+                    .filter(|&t| (t as usize) < n_steps)
+                    .collect()
+            })
             .collect();
-        SpikeTrains::from_lists(&lists, self.rows, self.cols, &self.present, n_steps.min(self.n_steps))
+        SpikeTrains::from_lists(
+            &lists,
+            self.rows,
+            self.cols,
+            &self.present,
+            n_steps.min(self.n_steps),
+        )
     }
 
     /// The trains with cells moved: cell `i`'s train goes to cell `perm[i]`.
@@ -290,7 +329,11 @@ impl SpikeTrains {
     /// Address events `(t_ms, row, col)` sorted by time, then row, then column.
     pub fn events(&self) -> Vec<(u32, usize, usize)> {
         let mut ev: Vec<(u32, usize, usize)> = (0..self.cells())
-            .flat_map(|cell| self.train(cell).iter().map(move |&t| (t, cell / self.cols, cell % self.cols)))
+            .flat_map(|cell| {
+                self.train(cell)
+                    .iter()
+                    .map(move |&t| (t, cell / self.cols, cell % self.cols))
+            })
             .collect();
         ev.sort_unstable();
         ev

@@ -8,7 +8,9 @@ use serde::{Deserialize, Serialize};
 use crate::encode::{encode, IzhikevichParams, SpikeTrains};
 use crate::error::{DataError, ParamError, Result};
 use crate::features::glcm::GlcmKind;
-use crate::features::{haralick, quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume, VolumeParams};
+use crate::features::{
+    haralick, quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume, VolumeParams,
+};
 use crate::recording::{Dataset, Meta, Recording};
 use crate::signal::{PreprocessParams, Preprocessor};
 
@@ -42,7 +44,11 @@ impl std::str::FromStr for Method {
             "taxel" => Ok(Method::Taxel),
             "glcm2d" => Ok(Method::Glcm2d),
             "glcm3d" => Ok(Method::Glcm3d),
-            _ => Err(ParamError::new("method", "method must be taxel, glcm2d or glcm3d", s)),
+            _ => Err(ParamError::new(
+                "method",
+                "method must be taxel, glcm2d or glcm3d",
+                s,
+            )),
         }
     }
 }
@@ -116,7 +122,11 @@ impl Pipeline {
     ///
     /// # Errors
     /// An empty sliding phase or a selected phase shorter than one bin.
-    pub fn encode(&self, rec: &Recording, dataset_baseline: crate::recording::Baseline) -> Result<Encoded> {
+    pub fn encode(
+        &self,
+        rec: &Recording,
+        dataset_baseline: crate::recording::Baseline,
+    ) -> Result<Encoded> {
         let cond = self.preprocessor.apply(rec, dataset_baseline)?;
         let bin = self.params.volume.bin_ms;
         if cond.n_steps() < bin {
@@ -130,7 +140,13 @@ impl Pipeline {
             .into());
         }
         let l = &rec.layout;
-        let spikes = encode(&cond.samples, l.rows, l.cols, &l.present, self.params.encoder)?;
+        let spikes = encode(
+            &cond.samples,
+            l.rows,
+            l.cols,
+            &l.present,
+            self.params.encoder,
+        )?;
         Ok(Encoded {
             meta: rec.meta.clone(),
             spikes,
@@ -167,7 +183,12 @@ impl Pipeline {
     ///
     /// # Errors
     /// A broken parameter rule.
-    pub fn extractor(&self, rows: usize, cols: usize, present: &[bool]) -> Result<FeatureExtractor, ParamError> {
+    pub fn extractor(
+        &self,
+        rows: usize,
+        cols: usize,
+        present: &[bool],
+    ) -> Result<FeatureExtractor, ParamError> {
         FeatureExtractor::new(&self.params, rows, cols, present)
     }
 }
@@ -189,7 +210,12 @@ impl FeatureExtractor {
     ///
     /// # Errors
     /// A broken parameter rule.
-    pub fn new(params: &PipelineParams, rows: usize, cols: usize, present: &[bool]) -> Result<Self, ParamError> {
+    pub fn new(
+        params: &PipelineParams,
+        rows: usize,
+        cols: usize,
+        present: &[bool],
+    ) -> Result<Self, ParamError> {
         params.volume.check()?;
         let levels = params.volume.levels;
         Ok(FeatureExtractor {
@@ -212,7 +238,9 @@ impl FeatureExtractor {
                     ["msr", "cv_isi", "fano"].map(|f| format!("r{r}c{c}_{f}"))
                 })
                 .collect(),
-            Method::Glcm2d | Method::Glcm3d => ["contrast", "correlation", "asm"].map(String::from).to_vec(),
+            Method::Glcm2d | Method::Glcm3d => ["contrast", "correlation", "asm"]
+                .map(String::from)
+                .to_vec(),
         }
     }
 
@@ -225,7 +253,10 @@ impl FeatureExtractor {
         let too_short = || -> crate::Error {
             DataError::invalid(
                 "spike trains",
-                format!("{} ms of spikes is shorter than one {bin} ms bin", spikes.n_steps),
+                format!(
+                    "{} ms of spikes is shorter than one {bin} ms bin",
+                    spikes.n_steps
+                ),
             )
             .into()
         };
@@ -243,14 +274,26 @@ impl FeatureExtractor {
                     RateVolume::collapsed(spikes)
                 }
                 .ok_or_else(too_short)?;
-                let same_grid = (spikes.rows, spikes.cols) == (self.rows, self.cols) && spikes.present == self.present;
-                let kind = if method == Method::Glcm3d { GlcmKind::ThreeD } else { GlcmKind::TwoD };
+                let same_grid = (spikes.rows, spikes.cols) == (self.rows, self.cols)
+                    && spikes.present == self.present;
+                let kind = if method == Method::Glcm3d {
+                    GlcmKind::ThreeD
+                } else {
+                    GlcmKind::TwoD
+                };
                 let replanned;
                 let plan = match (same_grid, kind) {
                     (true, GlcmKind::ThreeD) => &self.plan3d,
                     (true, GlcmKind::TwoD) => &self.plan2d,
                     (false, _) => {
-                        replanned = GlcmPlan::new(spikes.rows, spikes.cols, &spikes.present, self.volume.levels, &self.glcm, kind)?;
+                        replanned = GlcmPlan::new(
+                            spikes.rows,
+                            spikes.cols,
+                            &spikes.present,
+                            self.volume.levels,
+                            &self.glcm,
+                            kind,
+                        )?;
                         &replanned
                     }
                 };
@@ -267,5 +310,9 @@ impl FeatureExtractor {
 
 /// Row-major indices of the cells holding a taxel.
 pub fn taxel_cells(present: &[bool]) -> impl Iterator<Item = usize> + '_ {
-    present.iter().enumerate().filter(|(_, &p)| p).map(|(i, _)| i)
+    present
+        .iter()
+        .enumerate()
+        .filter(|(_, &p)| p)
+        .map(|(i, _)| i)
 }

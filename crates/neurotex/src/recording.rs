@@ -177,7 +177,9 @@ impl LayoutFile {
         let bad = |m: String| -> Result<()> { Err(DataError::invalid(path, m).into()) };
         if let Some(fs) = self.fs {
             if !(fs.is_finite() && fs > 0.0) {
-                return bad(format!("field `fs` must be a positive number of Hz, got {fs}"));
+                return bad(format!(
+                    "field `fs` must be a positive number of Hz, got {fs}"
+                ));
             }
         }
         if self.rows.is_some() != self.cols.is_some() {
@@ -208,7 +210,10 @@ impl LayoutFile {
                         "field `mask` must have {r} strings of {c} characters"
                     ));
                 }
-                if mask.iter().any(|row| row.chars().any(|ch| ch != '0' && ch != '1')) {
+                if mask
+                    .iter()
+                    .any(|row| row.chars().any(|ch| ch != '0' && ch != '1'))
+                {
                     return bad("field `mask` may hold only `0` and `1`".into());
                 }
             }
@@ -217,7 +222,9 @@ impl LayoutFile {
         }
         if let Some(unit) = &self.time_unit {
             if unit != "ms" && unit != "s" {
-                return bad(format!("field `time_unit` must be `ms` or `s`, got `{unit}`"));
+                return bad(format!(
+                    "field `time_unit` must be `ms` or `s`, got `{unit}`"
+                ));
             }
         }
         if let Some(Baseline::Mean { start_s, end_s }) = self.baseline {
@@ -238,7 +245,10 @@ impl LayoutFile {
             (_, _, Shape::Channels(n)) => (1, n),
         };
         let present: Vec<bool> = match &self.mask {
-            Some(m) => m.iter().flat_map(|row| row.chars().map(|ch| ch == '1')).collect(),
+            Some(m) => m
+                .iter()
+                .flat_map(|row| row.chars().map(|ch| ch == '1'))
+                .collect(),
             None => vec![true; rows * cols],
         };
         let n_channels = match shape {
@@ -330,7 +340,11 @@ impl Dataset {
     pub fn open(root: impl AsRef<Path>) -> Result<Self> {
         let root = root.as_ref().to_path_buf();
         if !root.is_dir() {
-            return Err(DataError::invalid(&root, "is not a dataset folder (expected a folder with manifest.csv)").into());
+            return Err(DataError::invalid(
+                &root,
+                "is not a dataset folder (expected a folder with manifest.csv)",
+            )
+            .into());
         }
         let layout_path = root.join("layout.toml");
         let layout = if layout_path.exists() {
@@ -344,7 +358,12 @@ impl Dataset {
             if !root.join(&m.file).is_file() {
                 return Err(DataError::invalid(
                     &manifest_path,
-                    format!("line {}: file `{}` does not exist in {}", i + 2, m.file, root.display()),
+                    format!(
+                        "line {}: file `{}` does not exist in {}",
+                        i + 2,
+                        m.file,
+                        root.display()
+                    ),
                 )
                 .into());
             }
@@ -456,11 +475,15 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
         };
         let file = field(idx[0]).to_string();
         if file.is_empty() {
-            return Err(DataError::invalid(path, format!("line {line}, field `file` is empty")).into());
+            return Err(
+                DataError::invalid(path, format!("line {line}, field `file` is empty")).into(),
+            );
         }
         let label = field(idx[1]).to_string();
         if label.is_empty() {
-            return Err(DataError::invalid(path, format!("line {line}, field `label` is empty")).into());
+            return Err(
+                DataError::invalid(path, format!("line {line}, field `label` is empty")).into(),
+            );
         }
         let trial_text = field(idx[4]);
         let trial = trial_text.parse::<i64>().map_err(|_| {
@@ -513,7 +536,10 @@ fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
             DataError::io(path, io).into()
         }
         _ => {
-            let line = e.position().map(|p| format!("line {}: ", p.line())).unwrap_or_default();
+            let line = e
+                .position()
+                .map(|p| format!("line {}: ", p.line()))
+                .unwrap_or_default();
             DataError::invalid(path, format!("{line}malformed CSV: {e}")).into()
         }
     }
@@ -525,7 +551,11 @@ fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
 /// Unreadable file, unsupported dtype or shape, layout mismatch, non-finite samples,
 /// non-increasing time stamps.
 pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     let (shape, raw, times_s) = match ext.as_str() {
         "npy" => {
             let (shape, raw) = read_npy(path)?;
@@ -566,7 +596,10 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
     } else {
         let cells = lay.cells();
         let mut out = vec![0.0; t * cells];
-        for (frame_in, frame_out) in raw.chunks_exact(n_channels).zip(out.chunks_exact_mut(cells)) {
+        for (frame_in, frame_out) in raw
+            .chunks_exact(n_channels)
+            .zip(out.chunks_exact_mut(cells))
+        {
             for (&v, &cell) in frame_in.iter().zip(&lay.channel_map) {
                 frame_out[cell] = v;
             }
@@ -580,7 +613,10 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
         times_s,
         phases: None,
         meta: Meta {
-            file: path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(),
+            file: path
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+                .unwrap_or_default(),
             ..Meta::default()
         },
     })
@@ -614,7 +650,10 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
     Ok((shape, std.into_raw_vec_and_offset().0))
 }
 
-fn read_csv_samples(path: &Path, layout: &LayoutFile) -> Result<(Shape, Vec<f64>, Option<Vec<f64>>)> {
+fn read_csv_samples(
+    path: &Path,
+    layout: &LayoutFile,
+) -> Result<(Shape, Vec<f64>, Option<Vec<f64>>)> {
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_path(path)
@@ -624,9 +663,16 @@ fn read_csv_samples(path: &Path, layout: &LayoutFile) -> Result<(Shape, Vec<f64>
     let (time_col, unit_scale) = match &layout.time_column {
         Some(name) => {
             let j = find(name).ok_or_else(|| {
-                DataError::invalid(path, format!("missing time column `{name}` named in layout.toml"))
+                DataError::invalid(
+                    path,
+                    format!("missing time column `{name}` named in layout.toml"),
+                )
             })?;
-            let scale = if layout.time_unit.as_deref() == Some("s") { 1.0 } else { 1e-3 };
+            let scale = if layout.time_unit.as_deref() == Some("s") {
+                1.0
+            } else {
+                1e-3
+            };
             (Some(j), scale)
         }
         None => {
@@ -651,7 +697,9 @@ fn read_csv_samples(path: &Path, layout: &LayoutFile) -> Result<(Shape, Vec<f64>
                 })
             })
             .collect::<Result<_>>()?,
-        None => (0..headers.len()).filter(|&j| Some(j) != time_col).collect(),
+        None => (0..headers.len())
+            .filter(|&j| Some(j) != time_col)
+            .collect(),
     };
     let n = channel_cols.len();
     let mut samples = Vec::new();

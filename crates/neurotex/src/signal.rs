@@ -36,7 +36,7 @@ impl PreprocessParams {
     /// The rule broken, as a [`ParamError`].
     pub fn check(&self) -> Result<(), ParamError> {
         let c = self.cutoff_hz;
-        if !c.is_finite() || c < 0.0 || c >= ENCODER_FS / 2.0 {
+        if !(0.0..ENCODER_FS / 2.0).contains(&c) {
             return Err(ParamError::new(
                 "cutoff",
                 "low-pass cutoff must be 0 (off) or between 0 and 500 Hz (half the 1 kHz encoder rate)",
@@ -76,7 +76,11 @@ impl Butterworth2 {
         let b0 = k * k * norm;
         Ok(Butterworth2 {
             b: [b0, 2.0 * b0, b0],
-            a: [1.0, 2.0 * (k * k - 1.0) * norm, (1.0 - sqrt2 * k + k * k) * norm],
+            a: [
+                1.0,
+                2.0 * (k * k - 1.0) * norm,
+                (1.0 - sqrt2 * k + k * k) * norm,
+            ],
         })
     }
 
@@ -194,7 +198,11 @@ impl Preprocessor {
             Some(t) => t.iter().map(|&x| x - t[0]).collect(),
             None => (0..n).map(|i| i as f64 / rec.fs).collect(),
         };
-        let offsets = baseline_offsets(rec, &times, self.params.baseline.unwrap_or(dataset_baseline))?;
+        let offsets = baseline_offsets(
+            rec,
+            &times,
+            self.params.baseline.unwrap_or(dataset_baseline),
+        )?;
         let (lo, hi) = if self.params.slide_only {
             slide_range(rec, &times)?
         } else {
@@ -204,7 +212,12 @@ impl Preprocessor {
         let mut samples = if uniform_1k {
             rec.samples[lo * cells..hi * cells].to_vec()
         } else {
-            resample_linear(&rec.samples[lo * cells..hi * cells], cells, &times[lo..hi], ENCODER_FS)
+            resample_linear(
+                &rec.samples[lo * cells..hi * cells],
+                cells,
+                &times[lo..hi],
+                ENCODER_FS,
+            )
         };
         if samples.is_empty() {
             return Err(DataError::invalid(
@@ -263,7 +276,11 @@ pub fn normalise_global_max(samples: &mut [f64]) -> bool {
 /// # Panics
 /// If `times` does not have one entry per frame (a caller bug).
 pub fn resample_linear(frames: &[f64], cells: usize, times: &[f64], fs: f64) -> Vec<f64> {
-    assert_eq!(frames.len(), times.len() * cells, "one time stamp per frame");
+    assert_eq!(
+        frames.len(),
+        times.len() * cells,
+        "one time stamp per frame"
+    );
     if times.is_empty() {
         return Vec::new();
     }
@@ -283,7 +300,10 @@ pub fn resample_linear(frames: &[f64], cells: usize, times: &[f64], fs: f64) -> 
         }
         let (ta, tb) = (times[k], times[k + 1]);
         let w = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
-        let (fa, fb) = (&frames[k * cells..(k + 1) * cells], &frames[(k + 1) * cells..(k + 2) * cells]);
+        let (fa, fb) = (
+            &frames[k * cells..(k + 1) * cells],
+            &frames[(k + 1) * cells..(k + 2) * cells],
+        );
         out.extend(fa.iter().zip(fb).map(|(&a, &b)| a + (b - a) * w));
     }
     out

@@ -36,10 +36,18 @@ impl CvParams {
     /// The rule broken.
     pub fn check(&self) -> Result<(), ParamError> {
         if self.folds < 2 {
-            return Err(ParamError::new("folds", "cross-validation needs at least 2 folds", self.folds));
+            return Err(ParamError::new(
+                "folds",
+                "cross-validation needs at least 2 folds",
+                self.folds,
+            ));
         }
         if self.repeats == 0 {
-            return Err(ParamError::new("repeats", "repeats must be at least 1", self.repeats));
+            return Err(ParamError::new(
+                "repeats",
+                "repeats must be at least 1",
+                self.repeats,
+            ));
         }
         Ok(())
     }
@@ -94,7 +102,10 @@ pub fn stratified_folds(
         }
         if members.len() < folds {
             return Err(ClassifyError::ClassTooSmall {
-                label: class_names.get(class).cloned().unwrap_or_else(|| class.to_string()),
+                label: class_names
+                    .get(class)
+                    .cloned()
+                    .unwrap_or_else(|| class.to_string()),
                 count: members.len(),
                 folds,
             });
@@ -179,15 +190,24 @@ pub fn cross_validate(
     knn: KnnParams,
     cv: CvParams,
 ) -> Result<CvResult, ClassifyError> {
-    cv.check().map_err(|e| ClassifyError::BadFeatures(e.to_string()))?;
+    cv.check()
+        .map_err(|e| ClassifyError::BadFeatures(e.to_string()))?;
     if y.is_empty() {
-        return Err(ClassifyError::Empty { what: "cross-validate" });
+        return Err(ClassifyError::Empty {
+            what: "cross-validate",
+        });
     }
     let n_classes = class_names.len().max(y.iter().max().map_or(0, |&m| m + 1));
     let mut per_repeat = Vec::with_capacity(cv.repeats);
     let mut confusion = vec![vec![0usize; n_classes]; n_classes];
     for r in 0..cv.repeats {
-        let fold_of = stratified_folds(y, n_classes, cv.folds, cv.seed.wrapping_add(r as u64), class_names)?;
+        let fold_of = stratified_folds(
+            y,
+            n_classes,
+            cv.folds,
+            cv.seed.wrapping_add(r as u64),
+            class_names,
+        )?;
         let predicted = predict_out_of_fold(x, dims, y, &fold_of, cv.folds, knn)?;
         let ev = evaluation(y, &predicted, n_classes);
         for (acc, row) in confusion.iter_mut().zip(&ev.confusion) {
@@ -231,9 +251,13 @@ pub fn train_test(
     }
     let model = Knn::new(knn).fit(x_train, dims, y_train)?;
     if x_test.len() != y_test.len() * dims || x_test.iter().any(|v| !v.is_finite()) {
-        return Err(ClassifyError::BadFeatures("test features are ragged or not finite".into()));
+        return Err(ClassifyError::BadFeatures(
+            "test features are ragged or not finite".into(),
+        ));
     }
     let predicted = model.predict(x_test);
-    let n_classes = class_names.len().max(1 + *y_train.iter().chain(y_test).max().unwrap_or(&0));
+    let n_classes = class_names
+        .len()
+        .max(1 + *y_train.iter().chain(y_test).max().unwrap_or(&0));
     Ok(evaluation(y_test, &predicted, n_classes))
 }

@@ -148,13 +148,21 @@ impl KnnModel {
     /// # Panics
     /// If `x` is not whole rows of the training dimension (a caller bug).
     pub fn predict(&self, x: &[f64]) -> Vec<usize> {
-        assert_eq!(x.len() % self.dims, 0, "samples must have the training dimension");
+        assert_eq!(
+            x.len() % self.dims,
+            0,
+            "samples must have the training dimension"
+        );
         let mut scaled = vec![0.0; self.dims];
         let mut best: Vec<(f64, usize)> = Vec::with_capacity(self.k + 1);
         let mut votes = vec![0usize; self.n_classes];
         x.chunks_exact(self.dims)
             .map(|row| {
-                for ((s, &v), (&m, &is)) in scaled.iter_mut().zip(row).zip(self.mean.iter().zip(&self.inv_std)) {
+                for ((s, &v), (&m, &is)) in scaled
+                    .iter_mut()
+                    .zip(row)
+                    .zip(self.mean.iter().zip(&self.inv_std))
+                {
                     *s = (v - m) * is;
                 }
                 best.clear();

@@ -5,7 +5,6 @@ pub mod cv;
 pub mod knn;
 
 pub use cv::{
-    confusion_matrix, cross_validate, stratified_folds, train_test, CvParams, CvResult,
-    Evaluation,
+    confusion_matrix, cross_validate, stratified_folds, train_test, CvParams, CvResult, Evaluation,
 };
 pub use knn::{Knn, KnnModel, KnnParams};

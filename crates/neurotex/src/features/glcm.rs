@@ -50,10 +50,18 @@ impl GlcmParams {
     /// The rule broken.
     pub fn check(&self) -> Result<(), ParamError> {
         if self.distances.is_empty() {
-            return Err(ParamError::new("distances", "at least one offset distance is needed", "none"));
+            return Err(ParamError::new(
+                "distances",
+                "at least one offset distance is needed",
+                "none",
+            ));
         }
         if let Some(&d) = self.distances.iter().find(|&&d| d == 0 || d > 1000) {
-            return Err(ParamError::new("distances", "offset distances must be between 1 and 1000", d));
+            return Err(ParamError::new(
+                "distances",
+                "offset distances must be between 1 and 1000",
+                d,
+            ));
         }
         Ok(())
     }
@@ -72,8 +80,8 @@ pub enum GlcmKind {
 struct PlannedOffset {
     /// Cell pairs `(from, to)` valid on the grid and the mask for this spatial offset.
     pairs: Vec<(u32, u32)>,
-    /// Time step back (`t + dt` with `dt = -back`).
-    back: usize,
+    /// Time offset `dt` of the second voxel.
+    dt: isize,
 }
 
 /// Offset tables for one grid, mask and parameter set, built once and applied to many volumes.
@@ -86,7 +94,8 @@ pub struct GlcmPlan {
 }
 
 impl GlcmPlan {
-    /// Plans the offsets of `kind` for a `rows x cols` grid with `present` cells.
+    /// Plans the offsets of `kind` (the paper's directions times each distance) for a
+    /// `rows x cols` grid with `present` cells.
     ///
     /// # Errors
     /// Broken parameter rules, or fewer than 2 or more than 256 levels.
@@ -102,44 +111,75 @@ impl GlcmPlan {
         kind: GlcmKind,
     ) -> Result<Self, ParamError> {
         params.check()?;
-        if !(2..=256).contains(&levels) {
-            return Err(ParamError::new("levels", "gray levels must be between 2 and 256", levels));
-        }
-        assert_eq!(present.len(), rows * cols);
         let dirs: &[(i32, i32, i32)] = match kind {
             GlcmKind::ThreeD => &DIRECTIONS_13,
             GlcmKind::TwoD => &DIRECTIONS_13[..4],
         };
-        let mut offsets = Vec::new();
-        for &d in &params.distances {
-            for &(dr, dc, dt) in dirs {
-                let (dr, dc) = (dr as i64 * d as i64, dc as i64 * d as i64);
+        let offsets: Vec<(isize, isize, isize)> = params
+            .distances
+            .iter()
+            .flat_map(|&d| {
+                dirs.iter().map(move |&(dr, dc, dt)| {
+                    (
+                        dr as isize * d as isize,
+                        dc as isize * d as isize,
+                        dt as isize * d as isize,
+                    )
+                })
+            })
+            .collect();
+        Self::from_offsets(rows, cols, present, levels, &offsets, params.symmetric)
+    }
+
+    /// Plans arbitrary `(dr, dc, dt)` offsets (for custom direction sets and for tests
+    /// against tools that report one matrix per offset).
+    ///
+    /// # Errors
+    /// Fewer than 2 or more than 256 levels.
+    ///
+    /// # Panics
+    /// If `present` is not one flag per cell (a caller bug).
+    pub fn from_offsets(
+        rows: usize,
+        cols: usize,
+        present: &[bool],
+        levels: usize,
+        offsets: &[(isize, isize, isize)],
+        symmetric: bool,
+    ) -> Result<Self, ParamError> {
+        if !(2..=256).contains(&levels) {
+            return Err(ParamError::new(
+                "levels",
+                "gray levels must be between 2 and 256",
+                levels,
+            ));
+        }
+        assert_eq!(present.len(), rows * cols);
+        let (rows_i, cols_i) = (rows as isize, cols as isize);
+        let planned = offsets
+            .iter()
+            .filter_map(|&(dr, dc, dt)| {
                 let mut pairs = Vec::new();
-                for r in 0..rows as i64 {
-                    for c in 0..cols as i64 {
+                for r in 0..rows_i {
+                    for c in 0..cols_i {
                         let (r2, c2) = (r + dr, c + dc);
-                        if r2 < 0 || c2 < 0 || r2 >= rows as i64 || c2 >= cols as i64 {
+                        if r2 < 0 || c2 < 0 || r2 >= rows_i || c2 >= cols_i {
                             continue;
                         }
-                        let (a, b) = ((r * cols as i64 + c) as usize, (r2 * cols as i64 + c2) as usize);
+                        let (a, b) = ((r * cols_i + c) as usize, (r2 * cols_i + c2) as usize);
                         if present[a] && present[b] {
                             pairs.push((a as u32, b as u32));
                         }
                     }
                 }
-                if !pairs.is_empty() {
-                    offsets.push(PlannedOffset {
-                        pairs,
-                        back: if dt == 0 { 0 } else { d },
-                    });
-                }
-            }
-        }
+                (!pairs.is_empty()).then_some(PlannedOffset { pairs, dt })
+            })
+            .collect();
         Ok(GlcmPlan {
             levels,
             cells: rows * cols,
-            symmetric: params.symmetric,
-            offsets,
+            symmetric,
+            offsets: planned,
         })
     }
 
@@ -156,7 +196,11 @@ impl GlcmPlan {
     /// If the volume is not `cells x bins` or `counts` is not `levels^2` (caller bugs).
     pub fn count(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
         let l = self.levels;
-        assert_eq!(quantised.len(), self.cells * bins, "volume must be cells x bins");
+        assert_eq!(
+            quantised.len(),
+            self.cells * bins,
+            "volume must be cells x bins"
+        );
         assert_eq!(counts.len(), l * l, "counts must be levels x levels");
         counts.fill(0);
         // Four interleaved sub-histograms break the store-to-load dependency between
@@ -164,13 +208,17 @@ impl GlcmPlan {
         let mut sub = vec![0u32; 4 * l * l];
         let stride = l * l;
         for off in &self.offsets {
-            if off.back >= bins {
+            let shift = off.dt.unsigned_abs();
+            if shift >= bins {
                 continue;
             }
-            let n = bins - off.back;
+            let n = bins - shift;
+            // The first voxel runs over t with t + dt inside the volume.
+            let (first_start, second_start) = if off.dt < 0 { (shift, 0) } else { (0, shift) };
             for &(a, b) in &off.pairs {
-                let first = &quantised[a as usize * bins + off.back..a as usize * bins + bins];
-                let second = &quantised[b as usize * bins..b as usize * bins + n];
+                let (a, b) = (a as usize * bins, b as usize * bins);
+                let first = &quantised[a + first_start..a + first_start + n];
+                let second = &quantised[b + second_start..b + second_start + n];
                 let mut fa = first.chunks_exact(4);
                 let mut fb = second.chunks_exact(4);
                 for (x, y) in (&mut fa).zip(&mut fb) {

@@ -48,7 +48,12 @@ pub fn haralick(counts: &[u32], levels: usize) -> Haralick {
             py[j] += p;
         }
     }
-    let mean = |m: &[f64]| m.iter().enumerate().map(|(i, &p)| i as f64 * p).sum::<f64>();
+    let mean = |m: &[f64]| {
+        m.iter()
+            .enumerate()
+            .map(|(i, &p)| i as f64 * p)
+            .sum::<f64>()
+    };
     let (mu_x, mu_y) = (mean(&px), mean(&py));
     let sd = |m: &[f64], mu: f64| {
         m.iter()

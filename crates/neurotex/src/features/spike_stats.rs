@@ -51,7 +51,11 @@ pub fn spike_stats(train: &[u32], n_steps: usize, window_ms: usize) -> SpikeStat
         let n = windows as f64;
         let mean = counts.iter().map(|&c| f64::from(c)).sum::<f64>() / n;
         if mean > 0.0 {
-            let var = counts.iter().map(|&c| (f64::from(c) - mean).powi(2)).sum::<f64>() / n;
+            let var = counts
+                .iter()
+                .map(|&c| (f64::from(c) - mean).powi(2))
+                .sum::<f64>()
+                / n;
             var / mean
         } else {
             0.0

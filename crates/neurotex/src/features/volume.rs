@@ -32,14 +32,26 @@ impl VolumeParams {
     /// The rule broken.
     pub fn check(&self) -> Result<(), ParamError> {
         if self.bin_ms == 0 {
-            return Err(ParamError::new("bin-ms", "bin width must be at least 1 ms", self.bin_ms));
+            return Err(ParamError::new(
+                "bin-ms",
+                "bin width must be at least 1 ms",
+                self.bin_ms,
+            ));
         }
         if !(2..=256).contains(&self.levels) {
-            return Err(ParamError::new("levels", "gray levels must be between 2 and 256", self.levels));
+            return Err(ParamError::new(
+                "levels",
+                "gray levels must be between 2 and 256",
+                self.levels,
+            ));
         }
         if let Some((lo, hi)) = self.range {
             if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-                return Err(ParamError::new("range", "quantisation range must satisfy lo < hi", format!("{lo}..{hi}")));
+                return Err(ParamError::new(
+                    "range",
+                    "quantisation range must satisfy lo < hi",
+                    format!("{lo}..{hi}"),
+                ));
             }
         }
         Ok(())
@@ -117,14 +129,17 @@ pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, o
             .flat_map(|(row, _)| row.iter().copied())
     };
     let (lo, hi) = range.unwrap_or_else(|| {
-        present_values().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)))
+        present_values().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        })
     });
     out.clear();
     out.resize(volume.data.len(), 0);
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return;
     }
-    let scale = levels as f64 / (hi - lo);
+    // Exactly the formula's order of operations, so levels at bin edges agree with it.
+    let (span, l) = (hi - lo, levels as f64);
     let top = (levels - 1) as f64;
     for ((q, x), p) in out
         .chunks_exact_mut(bins)
@@ -133,7 +148,7 @@ pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, o
     {
         if *p {
             for (q, &x) in q.iter_mut().zip(x) {
-                *q = ((x - lo) * scale).floor().clamp(0.0, top) as u8;
+                *q = ((x - lo) / span * l).floor().clamp(0.0, top) as u8;
             }
         }
     }

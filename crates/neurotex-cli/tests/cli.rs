@@ -1,0 +1,675 @@
+//! The real `neurotex` binary on small datasets written here: outputs, JSON keys, and bad
+//! input (clear message, non-zero exit, no output file).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use ndarray::Array3;
+use ndarray_npy::{read_npy, write_npy};
+use serde_json::Value;
+
+fn neurotex(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_neurotex"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = neurotex(args);
+    assert!(
+        out.status.success(),
+        "neurotex {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Runs a command that must fail; returns its standard error.
+fn fails(args: &[&str]) -> String {
+    let out = neurotex(args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "neurotex {args:?} should fail");
+    assert!(
+        !err.contains("panicked"),
+        "neurotex {args:?} panicked: {err}"
+    );
+    assert!(err.starts_with("error:") || err.contains("error:"), "{err}");
+    err
+}
+
+/// A texture-like 4x4 recording: a grating of `period_ms` sweeping across the rows, with
+/// noise from a small generator seeded by `seed`.
+fn recording(steps: usize, period_ms: f64, amp: f64, seed: u64) -> Array3<f32> {
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407)
+        | 1;
+    Array3::from_shape_fn((steps, 4, 4), |(t, r, c)| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let noise = (state % 1000) as f64 / 1000.0 - 0.5;
+        let phase = (t as f64 - 40.0 * r as f64 - 7.0 * c as f64) / period_ms;
+        (0.5 + amp * (std::f64::consts::TAU * phase).sin() + 0.2 * noise) as f32
+    })
+}
+
+/// A dataset of `labels` classes x `trials` at each speed, 1.2 s recordings.
+fn dataset(dir: &Path, labels: &[&str], speeds: &[f64], trials: usize) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut manifest =
+        String::from("file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s\n");
+    for (k, label) in labels.iter().enumerate() {
+        for &speed in speeds {
+            for trial in 0..trials {
+                let file = format!("{label}_{speed}_{trial}.npy");
+                let period = (60.0 + 70.0 * k as f64) * 5.0 / speed;
+                let rec = recording(
+                    1400,
+                    period,
+                    0.2 + 0.1 * k as f64,
+                    (k * 1000 + trial) as u64 + speed as u64,
+                );
+                write_npy(dir.join(&file), &rec).unwrap();
+                manifest.push_str(&format!("{file},{label},{speed},1,{trial},0.1,1.3\n"));
+            }
+        }
+    }
+    std::fs::write(dir.join("manifest.csv"), manifest).unwrap();
+    dir.to_path_buf()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn encode_writes_raster_and_events() {
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("in.npy");
+    write_npy(&input, &recording(500, 80.0, 0.3, 1)).unwrap();
+    let out = tmp.path().join("spikes.npy");
+    let events = tmp.path().join("events.csv");
+    ok(&[
+        "encode",
+        s(&input),
+        "--out",
+        s(&out),
+        "--events",
+        s(&events),
+    ]);
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape(), &[500, 4, 4]);
+    let spikes = raster.iter().filter(|&&v| v == 1).count();
+    assert!(spikes > 0 && raster.iter().all(|&v| v <= 1));
+    let text = std::fs::read_to_string(&events).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t_ms,row,col"));
+    let ev: Vec<Vec<usize>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(ev.len(), spikes);
+    assert!(ev.iter().all(|e| raster[[e[0], e[1], e[2]]] == 1));
+    // a CSV at 500 Hz is resampled onto 1 ms steps
+    let csv = tmp.path().join("in.csv");
+    let mut text = String::from("t_s,a,b\n");
+    for i in 0..400 {
+        text.push_str(&format!(
+            "{},{},{}\n",
+            i as f64 / 500.0,
+            (i as f64 / 10.0).sin() + 1.0,
+            0.5
+        ));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let out2 = tmp.path().join("csv.npy");
+    ok(&["encode", s(&csv), "--out", s(&out2)]);
+    let raster: Array3<u8> = read_npy(&out2).unwrap();
+    assert_eq!(raster.shape(), &[799, 1, 2]);
+}
+
+#[test]
+fn features_and_evaluate_on_a_dataset() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ds = dataset(&tmp.path().join("ds"), &["A", "B", "C"], &[5.0, 10.0], 10);
+    let out = tmp.path().join("f.csv");
+    ok(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ]);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.starts_with("file,label,speed_mm_s,trial,contrast,correlation,asm\n"),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 61);
+    ok(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "taxel",
+        "--out",
+        s(&out),
+    ]);
+    let header = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
+    assert!(
+        header.starts_with("file,label,speed_mm_s,trial,r0c0_msr,r0c0_cv_isi,r0c0_fano,r0c1_msr")
+    );
+    assert!(header.ends_with("r3c3_fano"));
+
+    let json: Value = serde_json::from_str(&ok(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--speeds",
+        "5",
+        "--json",
+    ]))
+    .unwrap();
+    let acc = json["accuracy"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&acc));
+    assert!(
+        acc > 0.6,
+        "three distinct gratings should be told apart, got {acc}"
+    );
+    assert_eq!(json["n"], 30);
+    assert_eq!(json["labels"], serde_json::json!(["A", "B", "C"]));
+    let total: u64 = json["confusion"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|r| r.as_array().unwrap())
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(total, 30);
+
+    let json: Value = serde_json::from_str(&ok(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "taxel",
+        "--json",
+        "--repeats",
+        "2",
+    ]))
+    .unwrap();
+    assert_eq!(json["per_taxel"].as_array().unwrap().len(), 16);
+    let mean = json["per_taxel"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["accuracy"].as_f64().unwrap())
+        .sum::<f64>()
+        / 16.0;
+    assert!((mean - json["accuracy"].as_f64().unwrap()).abs() < 1e-12);
+    assert!(json["best"]["accuracy"].as_f64().unwrap() >= mean);
+
+    let json: Value = serde_json::from_str(&ok(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "taxel",
+        "--taxel",
+        "1,2",
+        "--json",
+    ]))
+    .unwrap();
+    assert!(json.get("per_taxel").is_none());
+    let json: Value = serde_json::from_str(&ok(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm2d",
+        "--train-speeds",
+        "5",
+        "--test-speeds",
+        "10",
+        "--json",
+    ]))
+    .unwrap();
+    assert_eq!(json["n"], 30);
+    let text = ok(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--k",
+        "3",
+        "--folds",
+        "4",
+    ]);
+    assert!(
+        text.contains("accuracy") && text.contains("confusion"),
+        "{text}"
+    );
+}
+
+#[test]
+fn same_seed_same_result_and_seed_changes_folds() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ds = dataset(&tmp.path().join("ds"), &["A", "B"], &[5.0], 10);
+    let run = |seed: &str| {
+        ok(&[
+            "evaluate",
+            "--dataset",
+            s(&ds),
+            "--method",
+            "taxel",
+            "--seed",
+            seed,
+            "--json",
+        ])
+    };
+    assert_eq!(run("3"), run("3"));
+}
+
+#[test]
+fn bad_input_is_a_clear_error_with_no_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ds = dataset(&tmp.path().join("ds"), &["A", "B"], &[5.0, 10.0], 5);
+    let out = tmp.path().join("out.csv");
+    let d = s(&ds);
+    let o = s(&out);
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "features",
+                "--dataset",
+                "/nonexistent",
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+            ],
+            "not a dataset folder",
+        ),
+        (
+            vec!["features", "--dataset", d, "--method", "glcm4d", "--out", o],
+            "glcm4d",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+                "--gain",
+                "0",
+            ],
+            "gain",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+                "--gain",
+                "-3",
+            ],
+            "gain",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+                "--levels",
+                "1",
+            ],
+            "levels",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+                "--bin-ms",
+                "0",
+            ],
+            "bin",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+                "--distances",
+                "0",
+            ],
+            "distances",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+                "--cutoff",
+                "600",
+            ],
+            "cutoff",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+                "--preset",
+                "XX",
+            ],
+            "preset",
+        ),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                "/nonexistent/dir/f.csv",
+            ],
+            "does not exist",
+        ),
+        (
+            vec!["evaluate", "--dataset", d, "--method", "glcm3d", "--k", "0"],
+            "k must be at least 1",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--folds",
+                "1",
+            ],
+            "at least 2 folds",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--folds",
+                "6",
+                "--speeds",
+                "5",
+            ],
+            "fewer than the 6 folds",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--k",
+                "50",
+            ],
+            "k = 50 neighbours",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--speeds",
+                "7",
+            ],
+            "no recordings at 7 mm/s",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "taxel",
+                "--taxel",
+                "4,0",
+            ],
+            "outside the 4x4 grid",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "taxel",
+                "--taxel",
+                "a",
+            ],
+            "ROW,COL",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--taxel",
+                "1,1",
+            ],
+            "only to --method taxel",
+        ),
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--train-speeds",
+                "5",
+            ],
+            "test-speeds",
+        ),
+    ];
+    for (args, expected) in cases {
+        let err = fails(&args);
+        assert!(
+            err.contains(expected),
+            "{args:?}: expected `{expected}` in {err}"
+        );
+        assert!(!out.exists(), "{args:?} left an output file");
+    }
+    let no_tmp = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .contains("partial")
+        })
+        .count();
+    assert_eq!(no_tmp, 0, "temporary files left behind");
+}
+
+#[test]
+fn bad_recordings_and_layouts_are_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out.csv");
+    let base = |name: &str| dataset(&tmp.path().join(name), &["A", "B"], &[5.0], 5);
+
+    // a NaN sample in one CSV recording
+    let ds = base("nan");
+    std::fs::write(ds.join("bad.csv"), "a,b\n1,2\n3,NaN\n").unwrap();
+    let mut m = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    m.push_str("bad.csv,A,5,1,9,,\n");
+    std::fs::write(ds.join("manifest.csv"), &m).unwrap();
+    let err = fails(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ]);
+    assert!(
+        err.contains("bad.csv") && err.contains("line 3") && err.contains("NaN"),
+        "{err}"
+    );
+
+    // a recording shorter than one 200 ms bin
+    let ds = base("short");
+    write_npy(ds.join("A_5_0.npy"), &recording(150, 50.0, 0.3, 1)).unwrap();
+    let err = fails(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "taxel",
+        "--out",
+        s(&out),
+        "--whole",
+    ]);
+    assert!(
+        err.contains("A_5_0.npy") && err.contains("shorter than one 200 ms bin"),
+        "{err}"
+    );
+
+    // non-increasing time stamps
+    let ds = base("time");
+    std::fs::write(ds.join("t.csv"), "t_ms,a\n0,1\n1,2\n1,3\n").unwrap();
+    let mut m = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    m.push_str("t.csv,A,5,1,9,,\n");
+    std::fs::write(ds.join("manifest.csv"), &m).unwrap();
+    let err = fails(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ]);
+    assert!(
+        err.contains("t.csv") && err.contains("line 4") && err.contains("increase"),
+        "{err}"
+    );
+
+    // a layout that does not match the data
+    let ds = base("layout");
+    std::fs::write(ds.join("layout.toml"), "rows = 2\ncols = 2\n").unwrap();
+    let err = fails(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ]);
+    assert!(err.contains("4x4 grid") && err.contains("2x2"), "{err}");
+
+    // an unreadable .npy
+    let ds = base("garbage");
+    std::fs::write(ds.join("A_5_0.npy"), b"not an npy").unwrap();
+    let err = fails(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ]);
+    assert!(err.contains("A_5_0.npy") && err.contains(".npy"), "{err}");
+
+    // a test label the training speeds never saw
+    let ds = dataset(&tmp.path().join("unknown"), &["A", "B"], &[5.0], 5);
+    let extra = dataset(&tmp.path().join("unknown_c"), &["C"], &[10.0], 5);
+    let mut m = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    for line in std::fs::read_to_string(extra.join("manifest.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+    {
+        let file = line.split(',').next().unwrap();
+        std::fs::copy(extra.join(file), ds.join(file)).unwrap();
+        m.push_str(line);
+        m.push('\n');
+    }
+    std::fs::write(ds.join("manifest.csv"), &m).unwrap();
+    let err = fails(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--train-speeds",
+        "5",
+        "--test-speeds",
+        "10",
+    ]);
+    assert!(err.contains("test label `C`"), "{err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn help_explains_the_commands() {
+    let text = ok(&["--help"]);
+    for cmd in ["encode", "features", "evaluate"] {
+        assert!(text.contains(cmd), "{text}");
+    }
+    let text = ok(&["evaluate", "--help"]);
+    assert!(
+        text.contains("--train-speeds") && text.contains("mean over taxels"),
+        "{text}"
+    );
+}

@@ -1,0 +1,278 @@
+//! One test per parameter rule, and the data model's readers on good and bad files.
+
+use ndarray::{Array2, Array3};
+use ndarray_npy::write_npy;
+use neurotex::classify::{CvParams, KnnParams};
+use neurotex::encode::IzhikevichParams;
+use neurotex::features::{GlcmParams, VolumeParams};
+use neurotex::recording::{read_recording, Dataset, LayoutFile};
+use neurotex::signal::PreprocessParams;
+
+fn broken_rule<E: std::fmt::Display>(r: Result<(), E>) -> String {
+    r.err()
+        .map(|e| e.to_string())
+        .expect("the rule must be enforced")
+}
+
+#[test]
+fn cutoff_must_be_off_or_below_nyquist() {
+    for bad in [-1.0, 500.0, 800.0, f64::NAN] {
+        let msg = broken_rule(
+            PreprocessParams {
+                cutoff_hz: bad,
+                ..Default::default()
+            }
+            .check(),
+        );
+        assert!(msg.contains("cutoff"), "{msg}");
+    }
+    assert!(PreprocessParams {
+        cutoff_hz: 0.0,
+        ..Default::default()
+    }
+    .check()
+    .is_ok());
+}
+
+#[test]
+fn gain_must_be_positive_and_finite() {
+    for bad in [0.0, -8.0, f64::INFINITY, f64::NAN] {
+        assert!(broken_rule(IzhikevichParams::default().with_gain(bad).check()).contains("gain"));
+    }
+}
+
+#[test]
+fn recovery_scale_must_be_positive() {
+    let p = IzhikevichParams {
+        a: 0.0,
+        ..Default::default()
+    };
+    assert!(broken_rule(p.check()).contains("`a`"));
+}
+
+#[test]
+fn reset_must_be_below_peak() {
+    let p = IzhikevichParams {
+        c: 30.0,
+        ..Default::default()
+    };
+    assert!(broken_rule(p.check()).contains("`c`"));
+}
+
+#[test]
+fn presets_exist_and_unknown_is_none() {
+    for name in ["RS", "IB", "CH", "FS", "LTS", "TC", "RZ", "rs"] {
+        assert!(IzhikevichParams::preset(name).is_some(), "{name}");
+    }
+    assert!(IzhikevichParams::preset("XX").is_none());
+}
+
+#[test]
+fn bins_must_be_at_least_one_ms() {
+    assert!(broken_rule(
+        VolumeParams {
+            bin_ms: 0,
+            ..Default::default()
+        }
+        .check()
+    )
+    .contains("bin-ms"));
+}
+
+#[test]
+fn levels_must_be_between_2_and_256() {
+    for bad in [0, 1, 257] {
+        assert!(broken_rule(
+            VolumeParams {
+                levels: bad,
+                ..Default::default()
+            }
+            .check()
+        )
+        .contains("levels"));
+    }
+}
+
+#[test]
+fn fixed_range_must_be_ordered() {
+    let p = VolumeParams {
+        range: Some((5.0, 5.0)),
+        ..Default::default()
+    };
+    assert!(broken_rule(p.check()).contains("range"));
+}
+
+#[test]
+fn distances_must_be_given_and_positive() {
+    assert!(broken_rule(
+        GlcmParams {
+            distances: vec![],
+            symmetric: false
+        }
+        .check()
+    )
+    .contains("distances"));
+    assert!(broken_rule(
+        GlcmParams {
+            distances: vec![1, 0],
+            symmetric: false
+        }
+        .check()
+    )
+    .contains("distances"));
+}
+
+#[test]
+fn k_must_be_positive() {
+    assert!(broken_rule(
+        KnnParams {
+            k: 0,
+            standardize: true
+        }
+        .check()
+    )
+    .contains("`k`"));
+}
+
+#[test]
+fn folds_and_repeats_must_be_enough() {
+    assert!(broken_rule(
+        CvParams {
+            folds: 1,
+            ..Default::default()
+        }
+        .check()
+    )
+    .contains("folds"));
+    assert!(broken_rule(
+        CvParams {
+            repeats: 0,
+            ..Default::default()
+        }
+        .check()
+    )
+    .contains("repeats"));
+}
+
+#[test]
+fn npy_f32_and_f64_in_both_shapes_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = Array3::<f32>::from_shape_fn((5, 2, 3), |(t, r, c)| (t * 6 + r * 3 + c) as f32);
+    write_npy(dir.path().join("g.npy"), &grid).unwrap();
+    let rec = read_recording(&dir.path().join("g.npy"), &LayoutFile::default()).unwrap();
+    assert_eq!((rec.layout.rows, rec.layout.cols, rec.len()), (2, 3, 5));
+    assert_eq!(rec.samples[7], 7.0);
+    let chans = Array2::<f64>::from_shape_fn((4, 6), |(t, c)| (t * 10 + c) as f64);
+    write_npy(dir.path().join("c.npy"), &chans).unwrap();
+    // channels onto a 2x3 grid in reverse order
+    let layout = LayoutFile {
+        rows: Some(2),
+        cols: Some(3),
+        channel_map: Some(vec![[1, 2], [1, 1], [1, 0], [0, 2], [0, 1], [0, 0]]),
+        ..Default::default()
+    };
+    let rec = read_recording(&dir.path().join("c.npy"), &layout).unwrap();
+    assert_eq!(&rec.samples[6..12], &[15.0, 14.0, 13.0, 12.0, 11.0, 10.0]);
+}
+
+#[test]
+fn csv_with_time_column_keeps_irregular_stamps() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("r.csv");
+    std::fs::write(&p, "t_ms,a,b\n0,1,2\n1.5,3,4\n2.0,5,6\n").unwrap();
+    let rec = read_recording(&p, &LayoutFile::default()).unwrap();
+    assert_eq!(rec.times_s.as_deref(), Some(&[0.0, 0.0015, 0.002][..]));
+    assert_eq!(rec.samples, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+}
+
+#[test]
+fn bad_recordings_are_named_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &str, &str); 4] = [
+        ("nan.csv", "a,b\n1,2\nNaN,3\n", "line 3, column `a`"),
+        (
+            "time.csv",
+            "t_ms,a\n0,1\n2,1\n2,1\n",
+            "line 4: time stamps must increase",
+        ),
+        ("text.csv", "a,b\n1,x\n", "got `x`"),
+        ("r.txt", "a\n1\n", "expected a .npy or .csv"),
+    ];
+    for (name, content, expected) in cases {
+        let p = dir.path().join(name);
+        std::fs::write(&p, content).unwrap();
+        let msg = read_recording(&p, &LayoutFile::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains(name) && msg.contains(expected),
+            "{name}: {msg}"
+        );
+    }
+    let inf = Array2::<f64>::from_elem((3, 2), f64::INFINITY);
+    write_npy(dir.path().join("inf.npy"), &inf).unwrap();
+    let msg = read_recording(&dir.path().join("inf.npy"), &LayoutFile::default())
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("finite"), "{msg}");
+    let layout = LayoutFile {
+        rows: Some(4),
+        cols: Some(4),
+        ..Default::default()
+    };
+    write_npy(dir.path().join("wide.npy"), &Array2::<f64>::zeros((3, 5))).unwrap();
+    let msg = read_recording(&dir.path().join("wide.npy"), &layout)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("5 channels") && msg.contains("16 taxel cells"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn manifest_errors_name_line_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    write_npy(dir.path().join("a.npy"), &Array2::<f64>::zeros((300, 4))).unwrap();
+    let cases = [
+        ("file,label,speed_mm_s,trial\n", "missing column `force_n`"),
+        (
+            "file,label,speed_mm_s,force_n,trial\na.npy,X,fast,1,0\n",
+            "line 2, field `speed_mm_s`",
+        ),
+        (
+            "file,label,speed_mm_s,force_n,trial\na.npy,X,5,1,zero\n",
+            "line 2, field `trial`",
+        ),
+        (
+            "file,label,speed_mm_s,force_n,trial\nb.npy,X,5,1,0\n",
+            "line 2: file `b.npy` does not exist",
+        ),
+        (
+            "file,label,speed_mm_s,force_n,trial\n",
+            "lists no recordings",
+        ),
+    ];
+    for (manifest, expected) in cases {
+        std::fs::write(dir.path().join("manifest.csv"), manifest).unwrap();
+        let msg = Dataset::open(dir.path()).unwrap_err().to_string();
+        assert!(
+            msg.contains("manifest.csv") && msg.contains(expected),
+            "{msg}"
+        );
+    }
+    std::fs::write(dir.path().join("manifest.csv"), "file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s,site\na.npy,X,5,1,0,0.05,0.25,lab\n").unwrap();
+    let ds = Dataset::open(dir.path()).unwrap();
+    assert_eq!(ds.entries[0].slide_end_s, Some(0.25));
+    assert_eq!(
+        ds.entries[0].extra.get("site").map(String::as_str),
+        Some("lab")
+    );
+    std::fs::write(
+        dir.path().join("layout.toml"),
+        "rows = 2\ncols = 2\nmask = [\"11\", \"1x\"]\n",
+    )
+    .unwrap();
+    let msg = Dataset::open(dir.path()).unwrap_err().to_string();
+    assert!(msg.contains("layout.toml") && msg.contains("mask"), "{msg}");
+}

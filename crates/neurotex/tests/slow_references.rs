@@ -1,0 +1,281 @@
+//! Fast code against slow, evidently correct versions written from the definitions,
+//! on random inputs (proptest).
+
+use neurotex::classify::{Knn, KnnParams};
+use neurotex::encode::{Encoder, IzhikevichParams, SpikeTrains};
+use neurotex::features::glcm::GlcmKind;
+use neurotex::features::{quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume, DIRECTIONS_13};
+use proptest::prelude::*;
+
+/// Loop-built GLCM: every voxel, every direction times every distance, bounds and mask checked.
+#[allow(clippy::too_many_arguments)]
+fn slow_glcm(
+    q: &[u8],
+    rows: usize,
+    cols: usize,
+    bins: usize,
+    present: &[bool],
+    levels: usize,
+    distances: &[usize],
+    dirs: &[(i32, i32, i32)],
+    symmetric: bool,
+) -> Vec<u32> {
+    let mut m = vec![0u32; levels * levels];
+    let at =
+        |r: i64, c: i64, t: i64| q[((r * cols as i64 + c) * bins as i64 + t) as usize] as usize;
+    for &d in distances {
+        for &(dr, dc, dt) in dirs {
+            let (dr, dc, dt) = (
+                dr as i64 * d as i64,
+                dc as i64 * d as i64,
+                dt as i64 * d as i64,
+            );
+            for r in 0..rows as i64 {
+                for c in 0..cols as i64 {
+                    for t in 0..bins as i64 {
+                        let (r2, c2, t2) = (r + dr, c + dc, t + dt);
+                        if r2 < 0
+                            || c2 < 0
+                            || t2 < 0
+                            || r2 >= rows as i64
+                            || c2 >= cols as i64
+                            || t2 >= bins as i64
+                        {
+                            continue;
+                        }
+                        if !present[(r * cols as i64 + c) as usize]
+                            || !present[(r2 * cols as i64 + c2) as usize]
+                        {
+                            continue;
+                        }
+                        let (i, j) = (at(r, c, t), at(r2, c2, t2));
+                        m[i * levels + j] += 1;
+                        if symmetric {
+                            m[j * levels + i] += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    m
+}
+
+/// The encoder one neuron at a time, straight from the scheme.
+fn slow_encoder(input: &[f64], n: usize, p: IzhikevichParams) -> Vec<Vec<u32>> {
+    (0..n)
+        .map(|k| {
+            let (mut v, mut u) = (p.c, p.b * p.c);
+            let mut spikes = Vec::new();
+            for (t, frame) in input.chunks_exact(n).enumerate() {
+                let i = p.gain * frame[k];
+                if v >= 30.0 {
+                    spikes.push(t as u32);
+                    v = p.c;
+                    u += p.d;
+                }
+                v += 0.5 * (0.04 * (v * v) + 5.0 * v + 140.0 - u + i);
+                v += 0.5 * (0.04 * (v * v) + 5.0 * v + 140.0 - u + i);
+                u += p.a * (p.b * v - u);
+            }
+            spikes
+        })
+        .collect()
+}
+
+/// KNN by sorting every distance (stable, so earlier training samples win distance ties).
+fn slow_knn(
+    train: &[f64],
+    y: &[usize],
+    test: &[f64],
+    dims: usize,
+    k: usize,
+    standardize: bool,
+) -> Vec<usize> {
+    let n = y.len();
+    let (mut mean, mut sd) = (vec![0.0; dims], vec![1.0; dims]);
+    if standardize {
+        for j in 0..dims {
+            let col: Vec<f64> = (0..n).map(|i| train[i * dims + j]).collect();
+            mean[j] = col.iter().sum::<f64>() / n as f64;
+            let var = col.iter().map(|x| (x - mean[j]).powi(2)).sum::<f64>() / n as f64;
+            sd[j] = if var.sqrt() > 0.0 { var.sqrt() } else { 1.0 };
+        }
+    }
+    let scale = |row: &[f64]| -> Vec<f64> {
+        row.iter()
+            .enumerate()
+            .map(|(j, &x)| (x - mean[j]) * (1.0 / sd[j]))
+            .collect()
+    };
+    let classes = y.iter().max().unwrap() + 1;
+    test.chunks_exact(dims)
+        .map(|row| {
+            let s = scale(row);
+            let mut dist: Vec<(f64, usize)> = train
+                .chunks_exact(dims)
+                .enumerate()
+                .map(|(i, t)| {
+                    (
+                        scale(t)
+                            .iter()
+                            .zip(&s)
+                            .map(|(a, b)| (a - b) * (a - b))
+                            .sum(),
+                        i,
+                    )
+                })
+                .collect();
+            dist.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+            let near = &dist[..k];
+            let mut votes = vec![0; classes];
+            for &(_, i) in near {
+                votes[y[i]] += 1;
+            }
+            let top = *votes.iter().max().unwrap();
+            near.iter()
+                .map(|&(_, i)| y[i])
+                .find(|&c| votes[c] == top)
+                .unwrap()
+        })
+        .collect()
+}
+
+fn grid_and_volume() -> impl Strategy<Value = (usize, usize, usize, usize, Vec<bool>, Vec<u8>)> {
+    (1usize..6, 1usize..6, 1usize..25, 2usize..17).prop_flat_map(|(rows, cols, bins, levels)| {
+        (
+            Just(rows),
+            Just(cols),
+            Just(bins),
+            Just(levels),
+            proptest::collection::vec(proptest::bool::weighted(0.85), rows * cols),
+            proptest::collection::vec(0u8..levels as u8, rows * cols * bins),
+        )
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn glcm_plan_matches_loop_built_glcm(
+        (rows, cols, bins, levels, present, q) in grid_and_volume(),
+        distances in proptest::sample::subsequence(vec![1usize, 2, 3, 4, 8], 1..5),
+        symmetric in any::<bool>(),
+        two_d in any::<bool>(),
+    ) {
+        let params = GlcmParams { distances: distances.clone(), symmetric };
+        let (kind, dirs) = if two_d { (GlcmKind::TwoD, &DIRECTIONS_13[..4]) } else { (GlcmKind::ThreeD, &DIRECTIONS_13[..]) };
+        let plan = GlcmPlan::new(rows, cols, &present, levels, &params, kind).unwrap();
+        // masked cells carry arbitrary levels here: they must never be counted
+        let mut fast = vec![0u32; levels * levels];
+        plan.count(&q, bins, &mut fast);
+        let slow = slow_glcm(&q, rows, cols, bins, &present, levels, &distances, dirs, symmetric);
+        prop_assert_eq!(fast, slow);
+    }
+
+    #[test]
+    fn encoder_matches_step_by_step_and_chunks_do_not_matter(
+        n in 1usize..20,
+        steps in 1usize..600,
+        seed in any::<u64>(),
+        gain in 1.0f64..25.0,
+        split in 0.0f64..1.0,
+    ) {
+        let mut state = seed | 1;
+        let input: Vec<f64> = (0..n * steps).map(|_| {
+            state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+            (state % 10_000) as f64 / 10_000.0
+        }).collect();
+        let p = IzhikevichParams::default().with_gain(gain);
+        let mut whole = vec![0u8; input.len()];
+        Encoder::new(p, n).unwrap().run(&input, &mut whole);
+        let cut = ((steps as f64 * split) as usize) * n;
+        let mut chunked = vec![0u8; input.len()];
+        let mut enc = Encoder::new(p, n).unwrap();
+        enc.run(&input[..cut], &mut chunked[..cut]);
+        enc.run(&input[cut..], &mut chunked[cut..]);
+        prop_assert_eq!(&whole, &chunked);
+        let trains = SpikeTrains::from_raster(&whole, 1, n, &vec![true; n]);
+        let slow = slow_encoder(&input, n, p);
+        for (k, expected) in slow.iter().enumerate() {
+            prop_assert_eq!(trains.train(k), expected.as_slice());
+        }
+    }
+
+    #[test]
+    fn knn_matches_sorted_brute_force(
+        n in 5usize..40,
+        dims in 1usize..5,
+        k in 1usize..6,
+        classes in 2usize..5,
+        seed in any::<u64>(),
+        standardize in any::<bool>(),
+    ) {
+        let mut state = seed | 1;
+        let mut next = move || { state ^= state << 13; state ^= state >> 7; state ^= state << 17; state };
+        // coarse values so distance and vote ties happen often
+        let train: Vec<f64> = (0..n * dims).map(|_| (next() % 5) as f64).collect();
+        let y: Vec<usize> = (0..n).map(|i| if i < classes { i } else { (next() % classes as u64) as usize }).collect();
+        let test: Vec<f64> = (0..10 * dims).map(|_| (next() % 5) as f64).collect();
+        let model = Knn::new(KnnParams { k: k.min(n), standardize }).fit(&train, dims, &y).unwrap();
+        prop_assert_eq!(model.predict(&test), slow_knn(&train, &y, &test, dims, k.min(n), standardize));
+    }
+
+    #[test]
+    fn spike_stats_match_their_definitions(
+        mut train in proptest::collection::btree_set(0u32..3000, 0..80).prop_map(|s| s.into_iter().collect::<Vec<_>>()),
+        n_steps in 1usize..3000,
+        window in 1usize..500,
+    ) {
+        train.retain(|&t| (t as usize) < n_steps);
+        let s = spike_stats(&train, n_steps, window);
+        let msr = train.len() as f64 / (n_steps as f64 / 1000.0);
+        prop_assert!((s.msr - msr).abs() <= 1e-9 * msr.max(1.0));
+        let isi: Vec<f64> = train.windows(2).map(|w| (w[1] - w[0]) as f64).collect();
+        let cv = if isi.len() < 2 { 0.0 } else {
+            let m = isi.iter().sum::<f64>() / isi.len() as f64;
+            (isi.iter().map(|x| (x - m).powi(2)).sum::<f64>() / isi.len() as f64).sqrt() / m
+        };
+        prop_assert!((s.cv_isi - cv).abs() <= 1e-9);
+        let w = n_steps / window;
+        let counts: Vec<f64> = (0..w).map(|k| train.iter().filter(|&&t| t as usize / window == k).count() as f64).collect();
+        let fano = if w == 0 { 0.0 } else {
+            let m = counts.iter().sum::<f64>() / w as f64;
+            if m == 0.0 { 0.0 } else { counts.iter().map(|c| (c - m).powi(2)).sum::<f64>() / w as f64 / m }
+        };
+        prop_assert!((s.fano - fano).abs() <= 1e-9 * fano.max(1.0));
+        prop_assert!(s.msr.is_finite() && s.cv_isi.is_finite() && s.fano.is_finite());
+    }
+
+    #[test]
+    fn rate_volume_and_quantisation_match_definitions(
+        lists in proptest::collection::vec(proptest::collection::btree_set(0u32..2000, 0..60), 6),
+        n_steps in 200usize..2000,
+        bin in 50usize..400,
+        levels in 2usize..32,
+    ) {
+        let lists: Vec<Vec<u32>> = lists.into_iter().map(|s| s.into_iter().filter(|&t| (t as usize) < n_steps).collect()).collect();
+        let present = vec![true; 6];
+        let trains = SpikeTrains::from_lists(&lists, 2, 3, &present, n_steps);
+        let Some(vol) = RateVolume::from_spikes(&trains, bin) else {
+            prop_assert!(n_steps < bin);
+            return Ok(());
+        };
+        prop_assert_eq!(vol.bins, n_steps / bin);
+        for (cell, l) in lists.iter().enumerate() {
+            for b in 0..vol.bins {
+                let count = l.iter().filter(|&&t| t as usize / bin == b).count() as f64;
+                prop_assert!((vol.data[cell * vol.bins + b] - count * 1000.0 / bin as f64).abs() < 1e-9);
+            }
+        }
+        let mut q = Vec::new();
+        quantise(&vol, levels, None, &mut q);
+        let lo = vol.data.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = vol.data.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        for (&x, &level) in vol.data.iter().zip(&q) {
+            let expected = if hi > lo { (((x - lo) / (hi - lo) * levels as f64).floor() as usize).min(levels - 1) } else { 0 };
+            prop_assert_eq!(level as usize, expected);
+        }
+    }
+}
