@@ -51,8 +51,10 @@ impl StageArgs {
                 self.preset
             );
         };
-        let mut p = PipelineParams::default();
-        p.encoder = encoder.with_gain(self.gain);
+        let mut p = PipelineParams {
+            encoder: encoder.with_gain(self.gain),
+            ..PipelineParams::default()
+        };
         p.preprocess.cutoff_hz = self.cutoff;
         p.preprocess.slide_only = !self.whole;
         p.preprocess.baseline = match self.baseline.as_deref() {
