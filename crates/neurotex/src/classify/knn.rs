@@ -53,9 +53,32 @@ pub struct KnnModel {
     dims: usize,
     mean: Vec<f64>,
     inv_std: Vec<f64>,
-    train: Vec<f64>,
+    /// The scaled training set stored feature-major (`dims x n`), so the distances of one
+    /// query to every training sample are computed a feature at a time, vectorised.
+    columns: Vec<f64>,
     labels: Vec<usize>,
     n_classes: usize,
+    /// Step of the scattered visiting order, coprime to the training set's size.
+    stride: usize,
+}
+
+/// Whether `a` comes before `b` in the order (distance, training index).
+fn closer(a: (f64, usize), b: (f64, usize)) -> bool {
+    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
+}
+
+/// A step near `n / golden ratio` coprime to `n` (1 for tiny sets): `j -> j + step mod n`
+/// visits every index once, well scattered (a Weyl sequence).
+fn scatter_stride(n: usize) -> usize {
+    fn gcd(a: usize, b: usize) -> usize {
+        if b == 0 {
+            a
+        } else {
+            gcd(b, a % b)
+        }
+    }
+    let target = (n as f64 * 0.618_033_988_749_895) as usize;
+    (target..n).find(|&s| s > 1 && gcd(s, n) == 1).unwrap_or(1) % n.max(1)
 }
 
 impl Knn {
@@ -124,10 +147,10 @@ impl Knn {
         } else {
             (vec![0.0; dims], vec![1.0; dims])
         };
-        let mut train = x.to_vec();
-        for row in train.chunks_exact_mut(dims) {
-            for ((v, &m), &s) in row.iter_mut().zip(&mean).zip(&inv_std) {
-                *v = (*v - m) * s;
+        let mut columns = vec![0.0; n * dims];
+        for (i, row) in x.chunks_exact(dims).enumerate() {
+            for (j, &v) in row.iter().enumerate() {
+                columns[j * n + i] = (v - mean[j]) * inv_std[j];
             }
         }
         Ok(KnnModel {
@@ -135,8 +158,9 @@ impl Knn {
             dims,
             mean,
             inv_std,
-            train,
+            columns,
             labels: y.to_vec(),
+            stride: scatter_stride(n),
             n_classes: y.iter().max().map_or(0, |&m| m + 1),
         })
     }
@@ -153,28 +177,45 @@ impl KnnModel {
             0,
             "samples must have the training dimension"
         );
-        let mut scaled = vec![0.0; self.dims];
-        let mut best: Vec<(f64, usize)> = Vec::with_capacity(self.k + 1);
+        let n = self.labels.len();
+        let mut dist = vec![0.0f64; n];
+        let mut best: Vec<(f64, usize)> = Vec::with_capacity(self.k);
         let mut votes = vec![0usize; self.n_classes];
         x.chunks_exact(self.dims)
             .map(|row| {
-                for ((s, &v), (&m, &is)) in scaled
-                    .iter_mut()
-                    .zip(row)
-                    .zip(self.mean.iter().zip(&self.inv_std))
-                {
-                    *s = (v - m) * is;
+                dist.fill(0.0);
+                for (j, column) in self.columns.chunks_exact(n).enumerate() {
+                    let q = (row[j] - self.mean[j]) * self.inv_std[j];
+                    for (d, &t) in dist.iter_mut().zip(column) {
+                        *d += (t - q) * (t - q);
+                    }
                 }
+                // The k smallest under the total order (distance, training index): ties in
+                // distance go to the earlier training sample. Training samples are visited
+                // in a fixed scattered order (a stride coprime to n) so that a training set
+                // sorted by class, as manifests often are, does not make every sample an
+                // insertion; the result does not depend on the visiting order.
                 best.clear();
-                for (i, t) in self.train.chunks_exact(self.dims).enumerate() {
-                    let d: f64 = t.iter().zip(&scaled).map(|(a, b)| (a - b) * (a - b)).sum();
-                    if best.len() == self.k && d >= best[self.k - 1].0 {
+                let mut j = 0usize;
+                for _ in 0..n {
+                    let key = (dist[j], j);
+                    j += self.stride;
+                    if j >= n {
+                        j -= n;
+                    }
+                    if best.len() == self.k && !closer(key, best[self.k - 1]) {
                         continue;
                     }
-                    // Insert after every neighbour at distance <= d: earlier samples win ties.
-                    let pos = best.partition_point(|&(bd, _)| bd <= d);
-                    best.insert(pos, (d, i));
-                    best.truncate(self.k);
+                    if best.len() < self.k {
+                        best.push(key);
+                    } else {
+                        best[self.k - 1] = key;
+                    }
+                    let mut pos = best.len() - 1;
+                    while pos > 0 && closer(best[pos], best[pos - 1]) {
+                        best.swap(pos, pos - 1);
+                        pos -= 1;
+                    }
                 }
                 votes.fill(0);
                 for &(_, i) in &best {

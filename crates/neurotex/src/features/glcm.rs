@@ -203,37 +203,10 @@ impl GlcmPlan {
         );
         assert_eq!(counts.len(), l * l, "counts must be levels x levels");
         counts.fill(0);
-        // Four interleaved sub-histograms break the store-to-load dependency between
-        // consecutive increments of the same bin (rate volumes have long constant runs).
-        let mut sub = vec![0u32; 4 * l * l];
-        let stride = l * l;
-        for off in &self.offsets {
-            let shift = off.dt.unsigned_abs();
-            if shift >= bins {
-                continue;
-            }
-            let n = bins - shift;
-            // The first voxel runs over t with t + dt inside the volume.
-            let (first_start, second_start) = if off.dt < 0 { (shift, 0) } else { (0, shift) };
-            for &(a, b) in &off.pairs {
-                let (a, b) = (a as usize * bins, b as usize * bins);
-                let first = &quantised[a + first_start..a + first_start + n];
-                let second = &quantised[b + second_start..b + second_start + n];
-                let mut fa = first.chunks_exact(4);
-                let mut fb = second.chunks_exact(4);
-                for (x, y) in (&mut fa).zip(&mut fb) {
-                    sub[x[0] as usize * l + y[0] as usize] += 1;
-                    sub[stride + x[1] as usize * l + y[1] as usize] += 1;
-                    sub[2 * stride + x[2] as usize * l + y[2] as usize] += 1;
-                    sub[3 * stride + x[3] as usize * l + y[3] as usize] += 1;
-                }
-                for (&x, &y) in fa.remainder().iter().zip(fb.remainder()) {
-                    sub[x as usize * l + y as usize] += 1;
-                }
-            }
-        }
-        for (k, c) in counts.iter_mut().enumerate() {
-            *c = sub[k] + sub[stride + k] + sub[2 * stride + k] + sub[3 * stride + k];
+        if l <= 16 {
+            self.count_packed(quantised, bins, counts);
+        } else {
+            self.count_general(quantised, bins, counts);
         }
         if self.symmetric {
             for i in 0..l {
@@ -244,5 +217,74 @@ impl GlcmPlan {
                 }
             }
         }
+    }
+
+    /// Calls `visit(first, second)` with the two aligned level runs of every planned
+    /// offset and cell pair: the first voxel's levels and the second voxel's, for every
+    /// time step at which both lie inside the volume.
+    fn for_each_run(&self, quantised: &[u8], bins: usize, mut visit: impl FnMut(&[u8], &[u8])) {
+        for off in &self.offsets {
+            let shift = off.dt.unsigned_abs();
+            if shift >= bins {
+                continue;
+            }
+            let n = bins - shift;
+            let (first_start, second_start) = if off.dt < 0 { (shift, 0) } else { (0, shift) };
+            for &(a, b) in &off.pairs {
+                let (a, b) = (a as usize * bins, b as usize * bins);
+                visit(
+                    &quantised[a + first_start..a + first_start + n],
+                    &quantised[b + second_start..b + second_start + n],
+                );
+            }
+        }
+    }
+
+    /// Up to 16 levels: a pair's code `i << 4 | j` is one byte. The codes of every run are
+    /// written into one buffer (a vectorised loop), then counted in a single pass into
+    /// byte-indexed histograms, which need no bounds checks; four interleaved histograms
+    /// break the store-to-load dependency between increments of the same bin (rate volumes
+    /// have long constant runs).
+    fn count_packed(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
+        let mut codes: Vec<u8> = Vec::with_capacity(self.pairs_for(bins));
+        self.for_each_run(quantised, bins, |first, second| {
+            codes.extend(first.iter().zip(second).map(|(&x, &y)| (x << 4) | y));
+        });
+        let mut hist = [[0u32; 256]; 4];
+        let mut quads = codes.chunks_exact(4);
+        for q in &mut quads {
+            hist[0][q[0] as usize] += 1;
+            hist[1][q[1] as usize] += 1;
+            hist[2][q[2] as usize] += 1;
+            hist[3][q[3] as usize] += 1;
+        }
+        for &c in quads.remainder() {
+            hist[0][c as usize] += 1;
+        }
+        let l = self.levels;
+        for i in 0..l {
+            for j in 0..l {
+                let code = (i << 4) | j;
+                counts[i * l + j] = hist[0][code] + hist[1][code] + hist[2][code] + hist[3][code];
+            }
+        }
+    }
+
+    /// The number of voxel pairs the plan counts in a volume of `bins` time steps.
+    pub fn pairs_for(&self, bins: usize) -> usize {
+        self.offsets
+            .iter()
+            .map(|o| o.pairs.len() * bins.saturating_sub(o.dt.unsigned_abs()))
+            .sum()
+    }
+
+    /// Any number of levels: index `i * L + j` into the count matrix.
+    fn count_general(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
+        let l = self.levels;
+        self.for_each_run(quantised, bins, |first, second| {
+            for (&x, &y) in first.iter().zip(second) {
+                counts[x as usize * l + y as usize] += 1;
+            }
+        });
     }
 }
