@@ -108,6 +108,68 @@ pub struct EvaluateArgs {
     pub stages: StageArgs,
 }
 
+/// Options of `neurotex simulate`.
+#[derive(Args)]
+pub struct SimulateArgs {
+    /// The dataset folder to create (must not exist, or be empty).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Seed of every random draw: the same seed gives the same bits.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Trials per texture and speed (paper: 20).
+    #[arg(long, default_value_t = 20)]
+    pub trials: u32,
+    /// Sliding speeds in mm/s (paper: 5, 10, 15).
+    #[arg(long, value_delimiter = ',', default_value = "5,10,15")]
+    pub speeds: Vec<f64>,
+    /// Textures, by the paper's names: FT1, FT2, FT3, RT, TRug, SB, CP, STF (default all).
+    #[arg(long, value_delimiter = ',')]
+    pub textures: Option<Vec<String>>,
+}
+
+/// Parses texture names, naming the unknown one.
+pub fn parse_textures(names: Option<&[String]>) -> Result<Vec<neurotex::sim::Texture>> {
+    use neurotex::sim::{Texture, ALL_TEXTURES};
+    match names {
+        None => Ok(ALL_TEXTURES.to_vec()),
+        Some(names) => names
+            .iter()
+            .map(|n| {
+                Texture::from_name(n.trim()).with_context(|| {
+                    format!(
+                        "unknown texture `{n}`: expected FT1, FT2, FT3, RT, TRug, SB, CP or STF"
+                    )
+                })
+            })
+            .collect(),
+    }
+}
+
+pub fn simulate(args: SimulateArgs) -> Result<()> {
+    use neurotex::sim::{design, write_dataset, RigParams};
+    let textures = parse_textures(args.textures.as_deref())?;
+    if args.trials == 0 {
+        bail!("--trials must be at least 1");
+    }
+    if let Some(s) = args.speeds.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+        bail!("--speeds must be positive mm/s, got {s}");
+    }
+    let trials = design(&textures, &args.speeds, args.trials);
+    let bar = progress(trials.len(), "simulating");
+    let result = write_dataset(
+        &args.out,
+        &RigParams::default(),
+        &trials,
+        args.seed,
+        &|| bar.inc(1),
+    );
+    bar.finish_and_clear();
+    result?;
+    eprintln!("{} recordings -> {}", trials.len(), args.out.display());
+    Ok(())
+}
+
 pub fn encode(args: EncodeArgs) -> Result<()> {
     let params = args.stages.pipeline()?;
     if !(args.fs.is_finite() && args.fs > 0.0) {
@@ -393,4 +455,141 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
         }
         println!();
     }
+}
+
+/// Options of `neurotex reproduce`.
+#[derive(Args)]
+pub struct ReproduceArgs {
+    /// A dataset folder to run on; without it the built-in simulator generates the paper's
+    /// design (8 textures x 5, 10, 15 mm/s x 20 trials) in memory.
+    #[arg(long)]
+    pub dataset: Option<PathBuf>,
+    /// Folder for report.md, results.json and figures/.
+    #[arg(long, default_value = "report")]
+    pub out: PathBuf,
+    /// Seed of the simulation, the CV shuffles and the perturbations.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// A small run (10 trials per condition when simulating, fewer repeats, gains, fractions).
+    #[arg(long)]
+    pub quick: bool,
+    /// Simulated trials per texture and speed (default 20, or 10 with --quick).
+    #[arg(long)]
+    pub trials: Option<u32>,
+    /// Neighbours in KNN.
+    #[arg(long, default_value_t = 5)]
+    pub k: usize,
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
+
+pub fn reproduce(args: ReproduceArgs) -> Result<()> {
+    use neurotex::experiments::{prepare, run_all, Progress, ReproduceParams, Source};
+    use neurotex::report::{write_report, ReportContext};
+    use neurotex::sim::{design, RigParams, ALL_TEXTURES};
+    let started = std::time::Instant::now();
+    let mut params = if args.quick {
+        ReproduceParams::quick()
+    } else {
+        ReproduceParams::default()
+    };
+    params.pipeline = args.stages.pipeline()?;
+    params.knn = args.stages.knn(args.k)?;
+    params.seed = args.seed;
+    params.cv.seed = args.seed;
+    let dataset = match &args.dataset {
+        Some(dir) => Some(Dataset::open(dir)?),
+        None => None,
+    };
+    let trials_per = args.trials.unwrap_or(if args.quick { 10 } else { 20 });
+    if trials_per == 0 {
+        bail!("--trials must be at least 1");
+    }
+    let (source, description) = match &dataset {
+        Some(ds) => (
+            Source::Dataset(ds),
+            format!(
+                "Dataset folder `{}`: {} recordings as listed in its manifest{}.",
+                ds.root.display(),
+                ds.entries.len(),
+                match ds.layout.baseline {
+                    Some(b) => format!(", baseline removal {b:?} (layout.toml)"),
+                    None => String::new(),
+                }
+            ),
+        ),
+        None => {
+            let rig = RigParams::default();
+            let trials = design(&ALL_TEXTURES, &[5.0, 10.0, 15.0], trials_per);
+            let text = format!(
+                "Simulated in memory by neurotex's model of the rig (seed {}): 8 textures (FT1, FT2, FT3, RT, TRug, SB, CP, STF) x 5, 10, 15 mm/s x {trials_per} trials; a 4x4 array of {} mm taxels on {} mm, {} N under force control, {} s hold, {} mm slide, 1 kHz. Rig parameters: `{}`.",
+                args.seed,
+                rig.taxel_mm,
+                rig.active_mm,
+                rig.force_n,
+                rig.hold_s,
+                rig.slide_mm,
+                serde_json::to_string(&rig)?
+            );
+            (
+                Source::Simulated {
+                    rig,
+                    trials,
+                    seed: args.seed,
+                },
+                text,
+            )
+        }
+    };
+    let bar = std::sync::Mutex::new(progress(0, "starting"));
+    let on_progress = |p: Progress| {
+        let bar = bar.lock().expect("progress bar");
+        match p {
+            Progress::Stage(name, n) => {
+                bar.set_length(n as u64);
+                bar.set_position(0);
+                bar.set_message(name.to_string());
+            }
+            Progress::Tick => bar.inc(1),
+        }
+    };
+    let prepared = prepare(&source, &params, &on_progress)?;
+    let results = run_all(&prepared, &params, &on_progress)?;
+    bar.lock().expect("progress bar").finish_and_clear();
+    let p = &params.pipeline;
+    let parameters = vec![
+        format!("encoder: Izhikevich {:?}, gain G = {}", p.encoder, p.encoder.gain),
+        format!("low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only: {}", p.preprocess.cutoff_hz, p.preprocess.slide_only),
+        format!("rate volume: {} ms bins; {} gray levels; GLCM distances {:?}, 13 directions, symmetric {}", p.volume.bin_ms, p.volume.levels, p.glcm.distances, p.glcm.symmetric),
+        format!("KNN: k = {}, Euclidean, features z-scored on training folds: {}", params.knn.k, params.knn.standardize),
+        format!("CV: {}-fold stratified, shuffled with seed {}, {} repeats", params.cv.folds, params.cv.seed, params.cv.repeats),
+        format!("E3: {} draws per n, n in {:?}; E5 fractions {:?}; E7 gains {:?}; E8 k in {:?}", params.e3_repeats, params.e3_counts, params.e5_fractions, params.e7_gains, params.e8_ks),
+    ];
+    let command = std::env::args()
+        .map(|a| if a.contains(' ') { format!("'{a}'") } else { a })
+        .collect::<Vec<_>>()
+        .join(" ");
+    let ctx = ReportContext {
+        dataset: description,
+        parameters,
+        total_seconds: started.elapsed().as_secs_f64(),
+        command: command.replacen(&std::env::args().next().unwrap_or_default(), "neurotex", 1),
+    };
+    write_report(&args.out, &results, &ctx)?;
+    for (claim, holds, _) in neurotex::report::conclusions(&results) {
+        eprintln!(
+            "{} {claim}",
+            if holds {
+                "agrees:        "
+            } else {
+                "does not agree:"
+            }
+        );
+    }
+    eprintln!(
+        "report in {}/report.md ({:.1} s)",
+        args.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
 }

@@ -27,6 +27,11 @@ enum Command {
     Features(commands::FeaturesArgs),
     /// Classify a dataset's recordings with KNN and print accuracy and confusion matrix.
     Evaluate(commands::EvaluateArgs),
+    /// Simulate the paper's rig (8 textures, 4x4 taxels, 1 N, 90 mm slides) into a dataset folder.
+    Simulate(commands::SimulateArgs),
+    /// Run every analysis of the paper (E0-E8) and write a report with figures; without
+    /// --dataset, on the built-in simulated rig.
+    Reproduce(commands::ReproduceArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +40,8 @@ fn main() -> ExitCode {
         Command::Encode(args) => commands::encode(args),
         Command::Features(args) => commands::features(args),
         Command::Evaluate(args) => commands::evaluate(args),
+        Command::Simulate(args) => commands::simulate(args),
+        Command::Reproduce(args) => commands::reproduce(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

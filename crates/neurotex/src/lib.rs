@@ -15,9 +15,13 @@ pub mod analysis;
 pub mod classify;
 pub mod encode;
 pub mod error;
+pub mod experiments;
 pub mod features;
 pub mod pipeline;
 pub mod recording;
+pub mod report;
 pub mod signal;
+pub mod sim;
+mod svg;
 
 pub use error::{Error, Result};

@@ -11,8 +11,8 @@ use crate::features::glcm::GlcmKind;
 use crate::features::{
     haralick, quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume, VolumeParams,
 };
-use crate::recording::{Dataset, Meta, Recording};
-use crate::signal::{PreprocessParams, Preprocessor};
+use crate::recording::{Baseline, Dataset, Meta, Recording};
+use crate::signal::{Conditioned, PreprocessParams, Preprocessor};
 
 /// The feature sets the paper compares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -118,15 +118,12 @@ impl Pipeline {
         &self.params
     }
 
-    /// Conditions and encodes one recording.
+    /// Conditions one recording (sliding phase, 1 kHz, baseline, low-pass, normalised),
+    /// checking it lasts at least one bin.
     ///
     /// # Errors
     /// An empty sliding phase or a selected phase shorter than one bin.
-    pub fn encode(
-        &self,
-        rec: &Recording,
-        dataset_baseline: crate::recording::Baseline,
-    ) -> Result<Encoded> {
+    pub fn condition(&self, rec: &Recording, dataset_baseline: Baseline) -> Result<Conditioned> {
         let cond = self.preprocessor.apply(rec, dataset_baseline)?;
         let bin = self.params.volume.bin_ms;
         if cond.n_steps() < bin {
@@ -139,14 +136,35 @@ impl Pipeline {
             )
             .into());
         }
+        Ok(cond)
+    }
+
+    /// Encodes a conditioned recording with the pipeline's neurons, or with `gain` instead
+    /// of the pipeline's gain.
+    ///
+    /// # Errors
+    /// A gain that breaks the encoder's rules.
+    pub fn encode_conditioned(
+        &self,
+        rec: &Recording,
+        cond: &Conditioned,
+        gain: Option<f64>,
+    ) -> Result<SpikeTrains> {
         let l = &rec.layout;
-        let spikes = encode(
-            &cond.samples,
-            l.rows,
-            l.cols,
-            &l.present,
-            self.params.encoder,
-        )?;
+        let params = match gain {
+            Some(g) => self.params.encoder.with_gain(g),
+            None => self.params.encoder,
+        };
+        Ok(encode(&cond.samples, l.rows, l.cols, &l.present, params)?)
+    }
+
+    /// Conditions and encodes one recording.
+    ///
+    /// # Errors
+    /// An empty sliding phase or a selected phase shorter than one bin.
+    pub fn encode(&self, rec: &Recording, dataset_baseline: Baseline) -> Result<Encoded> {
+        let cond = self.condition(rec, dataset_baseline)?;
+        let spikes = self.encode_conditioned(rec, &cond, None)?;
         Ok(Encoded {
             meta: rec.meta.clone(),
             spikes,

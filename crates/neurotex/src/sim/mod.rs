@@ -1,0 +1,545 @@
+//! The paper's rig as a physical model (SPEC section 5): the built-in default dataset.
+//!
+//! A 4x4 array of 2x2 mm piezoresistive taxels on a 13x13 mm pad, under a soft cover, is
+//! pressed onto one of eight procedural textures with 1 N under force control, held 5 s,
+//! slid 90 mm at the given speed and lifted, sampled at 1 kHz with every phase labelled.
+//!
+//! Mechanics: each taxel's share of the pad rests on a Winkler foundation (pad and texture
+//! stiffness in series); the pad height is solved every millisecond so the contact force
+//! equals the commanded force. The texture height under a taxel is the surface averaged
+//! over the taxel and spread by the cover (a box of the taxel's length convolved with a
+//! Gaussian, and three lateral lines). The piezoresistive response saturates
+//! (`p / (p + p_sat)`), lags (first order), carries signal-dependent noise and a fixed
+//! per-taxel gain mismatch, and is read by an ADC. Every parameter is physical and
+//! documented in [`RigParams`]; none is tuned to reach the paper's accuracies.
+
+pub mod texture;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
+
+use crate::error::ParamError;
+use crate::recording::{Layout, Meta, Phase, Recording};
+use texture::hash3;
+pub use texture::{Texture, ALL_TEXTURES};
+
+/// Physical parameters of the sensor, the protocol and the trial-to-trial variation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RigParams {
+    /// Taxel rows (along the sliding direction; row 0 leads).
+    pub rows: usize,
+    /// Taxel columns (across the sliding direction).
+    pub cols: usize,
+    /// Side of one square taxel, mm (paper: 2).
+    pub taxel_mm: f64,
+    /// Side of the square active area, mm (paper: 13).
+    pub active_mm: f64,
+    /// Pad stiffness per unit area, N/mm³: the soft finger cuff and VHB cover in series.
+    pub pad_stiffness_n_per_mm3: f64,
+    /// Standard deviation of the cover's pressure spreading, mm (about the 1 mm cover's thickness / 2).
+    pub cover_spread_mm: f64,
+    /// Pressure at which the piezoresistive response is half its maximum, N/mm².
+    pub saturation_n_per_mm2: f64,
+    /// Time constant of the fabric's response lag, ms.
+    pub lag_ms: f64,
+    /// Noise: standard deviation `noise * sqrt(y)` on a response `y` in [0, 1].
+    pub noise: f64,
+    /// ADC resolution in bits; samples are ADC counts.
+    pub adc_bits: u32,
+    /// Relative standard deviation of the fixed per-taxel gain mismatch.
+    pub gain_mismatch: f64,
+    /// Seed of the sensor's own gain mismatch (the same sensor for every trial and seed).
+    pub sensor_seed: u64,
+    /// Commanded normal force, N (paper: 1).
+    pub force_n: f64,
+    /// Time off the surface before contact, s.
+    pub free_s: f64,
+    /// Force ramp from touch to full force, s.
+    pub contact_s: f64,
+    /// Hold at full force, s (paper: 5).
+    pub hold_s: f64,
+    /// Sliding distance, mm (paper: 90).
+    pub slide_mm: f64,
+    /// Force ramp down to lift-off, s.
+    pub retract_s: f64,
+    /// Time off the surface after lift-off, s.
+    pub after_s: f64,
+    /// Range of the random translation of each trial's patch of texture, mm.
+    pub patch_range_mm: f64,
+    /// Largest lateral offset of the sliding path, mm.
+    pub lateral_offset_mm: f64,
+    /// Largest rotation of the sensor against the texture, degrees.
+    pub rotation_deg: f64,
+    /// Relative standard deviation of the force actually applied per trial.
+    pub force_jitter: f64,
+    /// Relative standard deviation of the speed actually reached per trial.
+    pub speed_jitter: f64,
+    /// Spacing of the precomputed height profiles along the path, mm.
+    pub profile_step_mm: f64,
+}
+
+impl Default for RigParams {
+    fn default() -> Self {
+        RigParams {
+            rows: 4,
+            cols: 4,
+            taxel_mm: 2.0,
+            active_mm: 13.0,
+            pad_stiffness_n_per_mm3: 0.01,
+            cover_spread_mm: 0.5,
+            saturation_n_per_mm2: 0.02,
+            lag_ms: 8.0,
+            noise: 0.004,
+            adc_bits: 12,
+            gain_mismatch: 0.1,
+            sensor_seed: 0x5E45_0001,
+            force_n: 1.0,
+            free_s: 0.2,
+            contact_s: 0.5,
+            hold_s: 5.0,
+            slide_mm: 90.0,
+            retract_s: 0.3,
+            after_s: 0.2,
+            patch_range_mm: 1000.0,
+            lateral_offset_mm: 1.0,
+            rotation_deg: 3.0,
+            force_jitter: 0.03,
+            speed_jitter: 0.02,
+            profile_step_mm: 0.2,
+        }
+    }
+}
+
+impl RigParams {
+    /// Checks that every parameter is physical: positive sizes, times, stiffnesses.
+    ///
+    /// # Errors
+    /// The rule broken.
+    pub fn check(&self) -> Result<(), ParamError> {
+        let positive = [
+            ("taxel_mm", self.taxel_mm),
+            ("active_mm", self.active_mm),
+            ("pad_stiffness_n_per_mm3", self.pad_stiffness_n_per_mm3),
+            ("saturation_n_per_mm2", self.saturation_n_per_mm2),
+            ("lag_ms", self.lag_ms),
+            ("force_n", self.force_n),
+            ("hold_s", self.hold_s),
+            ("slide_mm", self.slide_mm),
+            ("profile_step_mm", self.profile_step_mm),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ParamError::new(name, "must be a positive number", v));
+            }
+        }
+        let non_negative = [
+            ("cover_spread_mm", self.cover_spread_mm),
+            ("noise", self.noise),
+            ("gain_mismatch", self.gain_mismatch),
+            ("free_s", self.free_s),
+            ("contact_s", self.contact_s),
+            ("retract_s", self.retract_s),
+            ("after_s", self.after_s),
+            ("patch_range_mm", self.patch_range_mm),
+            ("lateral_offset_mm", self.lateral_offset_mm),
+            ("rotation_deg", self.rotation_deg),
+            ("force_jitter", self.force_jitter),
+            ("speed_jitter", self.speed_jitter),
+        ];
+        for (name, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(ParamError::new(name, "must be a non-negative number", v));
+            }
+        }
+        if self.rows == 0 || self.cols == 0 {
+            return Err(ParamError::new(
+                "rows, cols",
+                "the array needs at least one taxel",
+                format!("{}x{}", self.rows, self.cols),
+            ));
+        }
+        if self.taxel_mm * self.rows.max(self.cols) as f64 > self.active_mm {
+            return Err(ParamError::new(
+                "taxel_mm",
+                "taxels must fit in the active area",
+                self.taxel_mm,
+            ));
+        }
+        if !(1..=24).contains(&self.adc_bits) {
+            return Err(ParamError::new(
+                "adc_bits",
+                "ADC resolution must be 1 to 24 bits",
+                self.adc_bits,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Centre-to-centre taxel spacing, mm.
+    pub fn pitch_mm(&self) -> f64 {
+        let n = self.rows.max(self.cols);
+        if n < 2 {
+            0.0
+        } else {
+            (self.active_mm - self.taxel_mm) / (n - 1) as f64
+        }
+    }
+}
+
+/// One simulated trial's conditions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trial {
+    /// The texture.
+    pub texture: Texture,
+    /// Nominal sliding speed, mm/s.
+    pub speed_mm_s: f64,
+    /// Trial number.
+    pub trial: u32,
+}
+
+/// A trial's random draws, from a generator seeded by the dataset seed and the trial's
+/// identity only (so results do not depend on thread count or order).
+fn trial_rng(seed: u64, t: &Trial) -> ChaCha8Rng {
+    let texture_index = ALL_TEXTURES
+        .iter()
+        .position(|&x| x == t.texture)
+        .unwrap_or(0) as i64;
+    let speed_key = (t.speed_mm_s * 1000.0).round() as i64;
+    ChaCha8Rng::seed_from_u64(hash3(
+        texture_index * 1_000_003 + speed_key,
+        i64::from(t.trial),
+        seed,
+    ))
+}
+
+/// The sensor's fixed per-taxel gains.
+fn taxel_gains(p: &RigParams) -> Vec<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(p.sensor_seed);
+    (0..p.rows * p.cols)
+        .map(|_| {
+            let z: f64 = rng.sample(StandardNormal);
+            (1.0 + p.gain_mismatch * z).max(0.2)
+        })
+        .collect()
+}
+
+/// Height profiles of every taxel along the sliding path, smoothed by the taxel and cover.
+struct Profiles {
+    start_mm: f64,
+    per_mm: f64,
+    /// `taxels x samples`.
+    heights: Vec<Vec<f64>>,
+}
+
+impl Profiles {
+    fn at(&self, taxel: usize, s_mm: f64) -> f64 {
+        let h = &self.heights[taxel];
+        let x = ((s_mm - self.start_mm) * self.per_mm).clamp(0.0, (h.len() - 2) as f64);
+        let k = x as usize;
+        let w = x - k as f64;
+        h[k] + (h[k + 1] - h[k]) * w
+    }
+}
+
+fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Profiles {
+    let texture_seed: u64 = rng.gen();
+    let origin = (
+        rng.gen::<f64>() * p.patch_range_mm,
+        rng.gen::<f64>() * p.patch_range_mm,
+    );
+    let lateral = (rng.gen::<f64>() * 2.0 - 1.0) * p.lateral_offset_mm;
+    let theta = (rng.gen::<f64>() * 2.0 - 1.0) * p.rotation_deg.to_radians();
+    let (u, n) = ((theta.cos(), theta.sin()), (-theta.sin(), theta.cos()));
+    // Along-track smoothing: the taxel's length as a box, convolved with the cover's Gaussian.
+    let step = p.profile_step_mm;
+    let half_box = (p.taxel_mm / 2.0 / step).round() as isize;
+    let sigma = p.cover_spread_mm / step;
+    let reach = half_box + (3.0 * sigma).ceil() as isize;
+    let kernel: Vec<f64> = {
+        let k: Vec<f64> = (-reach..=reach)
+            .map(|i| {
+                (-half_box..=half_box)
+                    .map(|b| {
+                        let d = (i - b) as f64;
+                        if sigma > 0.0 {
+                            (-0.5 * d * d / (sigma * sigma)).exp()
+                        } else if d == 0.0 {
+                            1.0
+                        } else {
+                            0.0
+                        }
+                    })
+                    .sum()
+            })
+            .collect();
+        let total: f64 = k.iter().sum();
+        k.into_iter().map(|v| v / total).collect()
+    };
+    let start_mm = -1.0;
+    let samples = ((p.slide_mm + 2.0) / step).ceil() as usize + 1;
+    let raw_len = samples + 2 * reach as usize;
+    let pitch = p.pitch_mm();
+    // Lateral spreading: three lines across the taxel, weighted as a coarse Gaussian.
+    let lines = [
+        (-p.taxel_mm / 3.0, 0.25),
+        (0.0, 0.5),
+        (p.taxel_mm / 3.0, 0.25),
+    ];
+    let mut heights = Vec::with_capacity(p.rows * p.cols);
+    let mut raw = vec![0.0; raw_len];
+    for r in 0..p.rows {
+        for c in 0..p.cols {
+            let along0 = ((p.rows - 1) as f64 / 2.0 - r as f64) * pitch;
+            let across0 = (c as f64 - (p.cols - 1) as f64 / 2.0) * pitch + lateral;
+            raw.fill(0.0);
+            for (k, h) in raw.iter_mut().enumerate() {
+                let along = along0 + start_mm + (k as f64 - reach as f64) * step;
+                for &(offset, weight) in &lines {
+                    let across = across0 + offset;
+                    let x = origin.0 + along * u.0 + across * n.0;
+                    let y = origin.1 + along * u.1 + across * n.1;
+                    *h += weight * texture.height(x, y, texture_seed);
+                }
+            }
+            let smooth: Vec<f64> = (0..samples)
+                .map(|k| kernel.iter().zip(&raw[k..]).map(|(w, h)| w * h).sum())
+                .collect();
+            heights.push(smooth);
+        }
+    }
+    Profiles {
+        start_mm,
+        per_mm: 1.0 / step,
+        heights,
+    }
+}
+
+/// Pad height `z` such that `sum max(0, h_i - z) = depth_sum`, by the sorted-prefix solution
+/// of the Winkler contact (exact; taxels below `z` carry no load).
+fn solve_contact(h: &[f64], depth_sum: f64, sorted: &mut Vec<f64>) -> f64 {
+    // Usually every taxel touches: then z is the plain mean solution, no sorting needed.
+    let all = (h.iter().sum::<f64>() - depth_sum) / h.len() as f64;
+    if h.iter().all(|&hi| hi >= all) {
+        return all;
+    }
+    sorted.clear();
+    sorted.extend_from_slice(h);
+    sorted.sort_unstable_by(|a, b| b.total_cmp(a));
+    let mut prefix = 0.0;
+    for m in 1..=sorted.len() {
+        prefix += sorted[m - 1];
+        let z = (prefix - depth_sum) / m as f64;
+        if m == sorted.len() || z >= sorted[m] {
+            return z;
+        }
+    }
+    f64::INFINITY
+}
+
+/// Simulates one trial of the protocol; samples are ADC counts, phases are labelled and
+/// the manifest fields (including the sliding interval) are filled in.
+///
+/// # Errors
+/// Unphysical parameters or a non-positive speed.
+pub fn simulate_trial(p: &RigParams, trial: &Trial, seed: u64) -> Result<Recording, ParamError> {
+    p.check()?;
+    if !(trial.speed_mm_s.is_finite() && trial.speed_mm_s > 0.0) {
+        return Err(ParamError::new(
+            "speeds",
+            "sliding speeds must be positive mm/s",
+            trial.speed_mm_s,
+        ));
+    }
+    let mut rng = trial_rng(seed, trial);
+    let profiles = build_profiles(p, trial.texture, &mut rng);
+    let force = p.force_n * (1.0 + p.force_jitter * rng.sample::<f64, _>(StandardNormal)).max(0.5);
+    let speed =
+        trial.speed_mm_s * (1.0 + p.speed_jitter * rng.sample::<f64, _>(StandardNormal)).max(0.5);
+    let gains = taxel_gains(p);
+    let cells = p.rows * p.cols;
+    let ms = |s: f64| (s * 1000.0).round() as usize;
+    let (n_free, n_contact, n_hold) = (ms(p.free_s), ms(p.contact_s), ms(p.hold_s));
+    let n_slide = ms(p.slide_mm / speed).max(1);
+    let (n_retract, n_after) = (ms(p.retract_s), ms(p.after_s));
+    let total = n_free + n_contact + n_hold + n_slide + n_retract + n_after;
+    let k_texture = trial.texture.stiffness_n_per_mm3();
+    let k = 1.0 / (1.0 / p.pad_stiffness_n_per_mm3 + 1.0 / k_texture);
+    let area = p.active_mm * p.active_mm / cells as f64;
+    let alpha = 1.0 - (-1.0 / p.lag_ms).exp();
+    let full_scale = ((1u64 << p.adc_bits) - 1) as f64;
+    let mut samples = Vec::with_capacity(total * cells);
+    let mut phases = Vec::with_capacity(total);
+    let (mut h, mut y, mut sorted) = (
+        vec![0.0; cells],
+        vec![0.0; cells],
+        Vec::with_capacity(cells),
+    );
+    for step in 0..total {
+        let (phase, f, s) = if step < n_free {
+            (Phase::Free, 0.0, 0.0)
+        } else if step < n_free + n_contact {
+            (
+                Phase::Contact,
+                force * (step - n_free + 1) as f64 / n_contact as f64,
+                0.0,
+            )
+        } else if step < n_free + n_contact + n_hold {
+            (Phase::Hold, force, 0.0)
+        } else if step < n_free + n_contact + n_hold + n_slide {
+            let k_slide = step - (n_free + n_contact + n_hold);
+            (Phase::Slide, force, speed * k_slide as f64 / 1000.0)
+        } else if step < total - n_after {
+            let k_up = step - (n_free + n_contact + n_hold + n_slide);
+            (
+                Phase::Retract,
+                force * (1.0 - (k_up + 1) as f64 / n_retract.max(1) as f64),
+                p.slide_mm,
+            )
+        } else {
+            (Phase::Free, 0.0, p.slide_mm)
+        };
+        phases.push(phase);
+        for (i, hi) in h.iter_mut().enumerate() {
+            *hi = profiles.at(i, s);
+        }
+        let z = if f > 0.0 {
+            solve_contact(&h, f / (k * area), &mut sorted)
+        } else {
+            f64::INFINITY
+        };
+        for i in 0..cells {
+            let pressure = k * (h[i] - z).max(0.0);
+            let target = gains[i] * pressure / (pressure + p.saturation_n_per_mm2);
+            y[i] += (target - y[i]) * alpha;
+            let noisy = if y[i] > 0.0 {
+                y[i] + p.noise * y[i].sqrt() * rng.sample::<f64, _>(StandardNormal)
+            } else {
+                0.0
+            };
+            // Rounds half up: the value is non-negative, so adding 0.5 and truncating is
+            // round-to-nearest without a call into libm.
+            samples.push(((noisy.clamp(0.0, 1.0) * full_scale + 0.5) as u32) as f64);
+        }
+    }
+    let slide_start = (n_free + n_contact + n_hold) as f64 / 1000.0;
+    Ok(Recording {
+        fs: 1000.0,
+        layout: Layout::grid(p.rows, p.cols),
+        samples,
+        times_s: None,
+        phases: Some(phases),
+        meta: Meta {
+            file: trial_file_name(trial),
+            label: trial.texture.name().to_string(),
+            speed_mm_s: trial.speed_mm_s,
+            force_n: p.force_n,
+            trial: i64::from(trial.trial),
+            slide_start_s: Some(slide_start),
+            slide_end_s: Some(slide_start + n_slide as f64 / 1000.0),
+            extra: Default::default(),
+        },
+    })
+}
+
+/// The file name a simulated trial is written under.
+pub fn trial_file_name(t: &Trial) -> String {
+    format!("{}_v{}_t{:02}.npy", t.texture.name(), t.speed_mm_s, t.trial)
+}
+
+/// The trials of a dataset: every texture x speed x trial, in that order (the paper's).
+pub fn design(textures: &[Texture], speeds: &[f64], trials: u32) -> Vec<Trial> {
+    let mut out = Vec::new();
+    for &texture in textures {
+        for &speed_mm_s in speeds {
+            for trial in 0..trials {
+                out.push(Trial {
+                    texture,
+                    speed_mm_s,
+                    trial,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Simulates `trials` in parallel and writes them as a dataset folder in the core format:
+/// one `.npy` (f32 ADC counts, `(T, rows, cols)`, exact) per trial and `manifest.csv`
+/// with `slide_start_s,slide_end_s`. Everything is written into a temporary folder beside
+/// `dir`, renamed to `dir` only when complete; `on_done` is called once per trial.
+///
+/// # Errors
+/// `dir` exists and is not empty, unphysical parameters, or a write failure.
+pub fn write_dataset(
+    dir: &std::path::Path,
+    p: &RigParams,
+    trials: &[Trial],
+    seed: u64,
+    on_done: &(dyn Fn() + Sync),
+) -> crate::Result<()> {
+    use crate::error::DataError;
+    use rayon::prelude::*;
+    p.check()?;
+    if dir.exists()
+        && std::fs::read_dir(dir)
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(true)
+    {
+        return Err(DataError::invalid(dir, "output folder exists and is not empty").into());
+    }
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "dataset".into());
+    let parent = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).map_err(|e| DataError::io(&tmp, e))?;
+    let result = (|| -> crate::Result<()> {
+        let metas: Vec<Meta> = trials
+            .par_iter()
+            .map(|t| -> crate::Result<Meta> {
+                let rec = simulate_trial(p, t, seed)?;
+                let array = ndarray::Array3::from_shape_vec(
+                    (rec.len(), p.rows, p.cols),
+                    rec.samples.iter().map(|&v| v as f32).collect(),
+                )
+                .map_err(|e| DataError::invalid(&rec.meta.file, e.to_string()))?;
+                let path = tmp.join(&rec.meta.file);
+                ndarray_npy::write_npy(&path, &array)
+                    .map_err(|e| DataError::invalid(&path, e.to_string()))?;
+                on_done();
+                Ok(rec.meta)
+            })
+            .collect::<crate::Result<_>>()?;
+        let manifest = tmp.join("manifest.csv");
+        let mut text =
+            String::from("file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s\n");
+        for m in &metas {
+            text.push_str(&format!(
+                "{},{},{},{},{},{},{}\n",
+                m.file,
+                m.label,
+                m.speed_mm_s,
+                m.force_n,
+                m.trial,
+                m.slide_start_s.unwrap_or(0.0),
+                m.slide_end_s.unwrap_or(0.0)
+            ));
+        }
+        std::fs::write(&manifest, text).map_err(|e| DataError::io(&manifest, e))?;
+        if dir.exists() {
+            std::fs::remove_dir(dir).map_err(|e| DataError::io(dir, e))?;
+        }
+        std::fs::rename(&tmp, dir).map_err(|e| DataError::io(dir, e))?;
+        Ok(())
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
+}
