@@ -533,7 +533,7 @@ pub fn reproduce(args: ReproduceArgs) -> Result<()> {
             );
             (
                 Source::Simulated {
-                    rig,
+                    rig: Box::new(rig),
                     trials,
                     seed: args.seed,
                 },
