@@ -871,7 +871,7 @@ pub fn run_all(
         } else {
             taxels[0]
         };
-    let psth_bin = 50usize;
+    let psth_bin = params.pipeline.volume.bin_ms;
     let examples = chosen
         .iter()
         .filter_map(|label| slow.iter().find(|e| &e.meta.label == label))

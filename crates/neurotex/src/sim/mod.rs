@@ -225,18 +225,25 @@ fn taxel_gains(p: &RigParams) -> Vec<f64> {
         .collect()
 }
 
-/// Height profiles of every taxel along the sliding path, smoothed by the taxel and cover.
+/// Height profiles along the sliding path, smoothed by the taxel and the cover. The taxels
+/// of one column lie on one line parallel to the sliding direction, so each column keeps
+/// one profile and each row reads it at its own offset along the line.
 struct Profiles {
     start_mm: f64,
     per_mm: f64,
-    /// `taxels x samples`.
-    heights: Vec<Vec<f64>>,
+    cols: usize,
+    /// Per column, heights from `start_mm` in steps of `1 / per_mm`.
+    columns: Vec<Vec<f64>>,
+    /// Per row, its offset along the sliding direction, mm.
+    row_offset_mm: Vec<f64>,
 }
 
 impl Profiles {
     fn at(&self, taxel: usize, s_mm: f64) -> f64 {
-        let h = &self.heights[taxel];
-        let x = ((s_mm - self.start_mm) * self.per_mm).clamp(0.0, (h.len() - 2) as f64);
+        let (r, c) = (taxel / self.cols, taxel % self.cols);
+        let h = &self.columns[c];
+        let x = ((s_mm + self.row_offset_mm[r] - self.start_mm) * self.per_mm)
+            .clamp(0.0, (h.len() - 2) as f64);
         let k = x as usize;
         let w = x - k as f64;
         h[k] + (h[k + 1] - h[k]) * w
@@ -277,25 +284,32 @@ fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Prof
         let total: f64 = k.iter().sum();
         k.into_iter().map(|v| v / total).collect()
     };
-    let start_mm = -1.0;
-    let samples = ((p.slide_mm + 2.0) / step).ceil() as usize + 1;
-    let raw_len = samples + 2 * reach as usize;
     let pitch = p.pitch_mm();
+    let row_offset_mm: Vec<f64> = (0..p.rows)
+        .map(|r| ((p.rows - 1) as f64 / 2.0 - r as f64) * pitch)
+        .collect();
+    let lowest = row_offset_mm.iter().copied().fold(f64::INFINITY, f64::min);
+    let highest = row_offset_mm
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    // The line covers every row's path from 1 mm before the start to 1 mm past the end.
+    let start_mm = lowest - 1.0;
+    let samples = ((highest - lowest + p.slide_mm + 2.0) / step).ceil() as usize + 2;
+    let raw_len = samples + 2 * reach as usize;
     // Lateral spreading: three lines across the taxel, weighted as a coarse Gaussian.
     let lines = [
         (-p.taxel_mm / 3.0, 0.25),
         (0.0, 0.5),
         (p.taxel_mm / 3.0, 0.25),
     ];
-    let mut heights = Vec::with_capacity(p.rows * p.cols);
     let mut raw = vec![0.0; raw_len];
-    for r in 0..p.rows {
-        for c in 0..p.cols {
-            let along0 = ((p.rows - 1) as f64 / 2.0 - r as f64) * pitch;
+    let columns = (0..p.cols)
+        .map(|c| {
             let across0 = (c as f64 - (p.cols - 1) as f64 / 2.0) * pitch + lateral;
             raw.fill(0.0);
             for (k, h) in raw.iter_mut().enumerate() {
-                let along = along0 + start_mm + (k as f64 - reach as f64) * step;
+                let along = start_mm + (k as f64 - reach as f64) * step;
                 for &(offset, weight) in &lines {
                     let across = across0 + offset;
                     let x = origin.0 + along * u.0 + across * n.0;
@@ -303,16 +317,17 @@ fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Prof
                     *h += weight * texture.height(x, y, texture_seed);
                 }
             }
-            let smooth: Vec<f64> = (0..samples)
+            (0..samples)
                 .map(|k| kernel.iter().zip(&raw[k..]).map(|(w, h)| w * h).sum())
-                .collect();
-            heights.push(smooth);
-        }
-    }
+                .collect()
+        })
+        .collect();
     Profiles {
         start_mm,
         per_mm: 1.0 / step,
-        heights,
+        cols: p.cols,
+        columns,
+        row_offset_mm,
     }
 }
 
@@ -344,6 +359,19 @@ fn solve_contact(h: &[f64], depth_sum: f64, sorted: &mut Vec<f64>) -> f64 {
 /// # Errors
 /// Unphysical parameters or a non-positive speed.
 pub fn simulate_trial(p: &RigParams, trial: &Trial, seed: u64) -> Result<Recording, ParamError> {
+    simulate_trial_traced(p, trial, seed).map(|(rec, _)| rec)
+}
+
+/// [`simulate_trial`] that also returns the contact force (N) of every step, recomputed
+/// from the solved pad height, and the force commanded.
+///
+/// # Errors
+/// Unphysical parameters or a non-positive speed.
+pub fn simulate_trial_traced(
+    p: &RigParams,
+    trial: &Trial,
+    seed: u64,
+) -> Result<(Recording, Vec<(f64, f64)>), ParamError> {
     p.check()?;
     if !(trial.speed_mm_s.is_finite() && trial.speed_mm_s > 0.0) {
         return Err(ParamError::new(
@@ -371,6 +399,7 @@ pub fn simulate_trial(p: &RigParams, trial: &Trial, seed: u64) -> Result<Recordi
     let full_scale = ((1u64 << p.adc_bits) - 1) as f64;
     let mut samples = Vec::with_capacity(total * cells);
     let mut phases = Vec::with_capacity(total);
+    let mut forces = Vec::with_capacity(total);
     let (mut h, mut y, mut sorted) = (
         vec![0.0; cells],
         vec![0.0; cells],
@@ -409,6 +438,12 @@ pub fn simulate_trial(p: &RigParams, trial: &Trial, seed: u64) -> Result<Recordi
         } else {
             f64::INFINITY
         };
+        forces.push((
+            f,
+            h.iter()
+                .map(|&hi| k * area * (hi - z).max(0.0))
+                .sum::<f64>(),
+        ));
         for i in 0..cells {
             let pressure = k * (h[i] - z).max(0.0);
             let target = gains[i] * pressure / (pressure + p.saturation_n_per_mm2);
@@ -424,7 +459,7 @@ pub fn simulate_trial(p: &RigParams, trial: &Trial, seed: u64) -> Result<Recordi
         }
     }
     let slide_start = (n_free + n_contact + n_hold) as f64 / 1000.0;
-    Ok(Recording {
+    let rec = Recording {
         fs: 1000.0,
         layout: Layout::grid(p.rows, p.cols),
         samples,
@@ -440,7 +475,8 @@ pub fn simulate_trial(p: &RigParams, trial: &Trial, seed: u64) -> Result<Recordi
             slide_end_s: Some(slide_start + n_slide as f64 / 1000.0),
             extra: Default::default(),
         },
-    })
+    };
+    Ok((rec, forces))
 }
 
 /// The file name a simulated trial is written under.

@@ -1,0 +1,232 @@
+//! The simulated rig's physics and determinism.
+
+use neurotex::recording::Phase;
+use neurotex::sim::{
+    design, simulate_trial, simulate_trial_traced, RigParams, Texture, Trial, ALL_TEXTURES,
+};
+
+fn trial(texture: Texture, speed: f64, n: u32) -> Trial {
+    Trial {
+        texture,
+        speed_mm_s: speed,
+        trial: n,
+    }
+}
+
+/// A shorter protocol so debug-profile tests stay quick: 1 s hold, 30 mm slide.
+fn short_rig() -> RigParams {
+    RigParams {
+        hold_s: 1.0,
+        slide_mm: 30.0,
+        ..RigParams::default()
+    }
+}
+
+#[test]
+fn force_is_held_at_the_commanded_value_during_hold_and_slide() {
+    let p = short_rig();
+    for texture in ALL_TEXTURES {
+        let (rec, forces) = simulate_trial_traced(&p, &trial(texture, 10.0, 3), 1).unwrap();
+        let phases = rec.phases.as_ref().unwrap();
+        for (&(commanded, actual), phase) in forces.iter().zip(phases) {
+            if matches!(phase, Phase::Hold | Phase::Slide) {
+                // the trial's force jitter is 3 % (one sigma); the contact solution is exact
+                assert!(
+                    (commanded - 1.0).abs() < 0.15,
+                    "{texture:?}: commanded {commanded}"
+                );
+                assert!(
+                    (actual - commanded).abs() < 1e-9 * commanded.max(1.0),
+                    "{texture:?}: {actual} vs {commanded}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn no_signal_before_contact_or_after_lift_off() {
+    let p = short_rig();
+    let rec = simulate_trial(&p, &trial(Texture::Rt, 15.0, 0), 0).unwrap();
+    let phases = rec.phases.as_ref().unwrap();
+    let cells = rec.layout.cells();
+    let first_contact = phases.iter().position(|&ph| ph == Phase::Contact).unwrap();
+    assert!(first_contact > 0);
+    assert!(
+        rec.samples[..first_contact * cells]
+            .iter()
+            .all(|&v| v == 0.0),
+        "signal before contact"
+    );
+    // the response lag (8 ms) has died out 100 ms after lift-off
+    let tail = &rec.samples[rec.samples.len() - 100 * cells..];
+    assert!(tail.iter().all(|&v| v == 0.0), "signal after lift-off");
+    let slide: Vec<f64> = rec
+        .samples
+        .chunks(cells)
+        .zip(phases)
+        .filter(|(_, &ph)| ph == Phase::Slide)
+        .flat_map(|(f, _)| f.to_vec())
+        .collect();
+    assert!(
+        slide.iter().filter(|&&v| v > 0.0).count() > slide.len() / 2,
+        "the taxels are loaded while sliding"
+    );
+}
+
+#[test]
+fn phases_follow_the_protocol_and_the_manifest_interval() {
+    let p = short_rig();
+    let rec = simulate_trial(&p, &trial(Texture::Cp, 10.0, 0), 0).unwrap();
+    let phases = rec.phases.as_ref().unwrap();
+    let order: Vec<Phase> = phases.iter().fold(Vec::new(), |mut acc, &ph| {
+        if acc.last() != Some(&ph) {
+            acc.push(ph);
+        }
+        acc
+    });
+    assert_eq!(
+        order,
+        vec![
+            Phase::Free,
+            Phase::Contact,
+            Phase::Hold,
+            Phase::Slide,
+            Phase::Retract,
+            Phase::Free
+        ]
+    );
+    let slide_steps = phases.iter().filter(|&&ph| ph == Phase::Slide).count() as f64;
+    // 30 mm at 10 mm/s with 2 % speed jitter
+    assert!((slide_steps - 3000.0).abs() < 300.0, "{slide_steps}");
+    let start = phases.iter().position(|&ph| ph == Phase::Slide).unwrap() as f64 / 1000.0;
+    assert!((rec.meta.slide_start_s.unwrap() - start).abs() < 1e-9);
+    assert!((rec.meta.slide_end_s.unwrap() - start - slide_steps / 1000.0).abs() < 1e-9);
+}
+
+#[test]
+fn a_surface_feature_reaches_the_next_row_after_pitch_over_speed() {
+    // Styrofoam's beads are random, so the cross-correlation of two rows has one peak: row
+    // r + 1 trails row r by pitch / speed = 3.667 mm / 5 mm/s = 733 ms. Rotation, speed
+    // jitter and noise are turned off to isolate the kinematics; lags near 0 (the common
+    // mode of force control, which moves every taxel at once) are not searched.
+    let p = RigParams {
+        noise: 0.0,
+        rotation_deg: 0.0,
+        speed_jitter: 0.0,
+        ..short_rig()
+    };
+    let speed = 5.0;
+    let rec = simulate_trial(&p, &trial(Texture::Stf, speed, 2), 5).unwrap();
+    let phases = rec.phases.as_ref().unwrap();
+    let cells = rec.layout.cells();
+    let series = |cell: usize| -> Vec<f64> {
+        rec.samples
+            .chunks(cells)
+            .zip(phases)
+            .filter(|(_, &ph)| ph == Phase::Slide)
+            .map(|(f, _)| f[cell])
+            .collect()
+    };
+    let expected = (p.pitch_mm() / speed * 1000.0).round() as i64;
+    let mut lags = Vec::new();
+    for col in 0..4 {
+        let (lead, trail) = (series(col), series(4 + col));
+        let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+        let (ml, mt) = (mean(&lead), mean(&trail));
+        let best = (300..1500i64)
+            .max_by(|&a, &b| {
+                let corr = |lag: i64| -> f64 {
+                    let n = lead.len() as i64 - lag;
+                    (0..n)
+                        .map(|t| (lead[t as usize] - ml) * (trail[(t + lag) as usize] - mt))
+                        .sum::<f64>()
+                        / n as f64
+                };
+                corr(a).total_cmp(&corr(b))
+            })
+            .unwrap();
+        lags.push(best);
+    }
+    // within 30 ms, 0.15 mm of travel: finer than the 0.2 mm spacing of the height profiles
+    for lag in &lags {
+        assert!(
+            (lag - expected).abs() <= 30,
+            "lags {lags:?}, expected {expected} ms"
+        );
+    }
+}
+
+#[test]
+fn same_seed_same_bits_and_trials_differ() {
+    let p = short_rig();
+    let t = trial(Texture::Sb, 15.0, 4);
+    let a = simulate_trial(&p, &t, 9).unwrap();
+    let b = simulate_trial(&p, &t, 9).unwrap();
+    assert_eq!(a.samples, b.samples);
+    let other_trial = simulate_trial(&p, &trial(Texture::Sb, 15.0, 5), 9).unwrap();
+    let other_seed = simulate_trial(&p, &t, 10).unwrap();
+    assert_ne!(a.samples, other_trial.samples);
+    assert_ne!(a.samples, other_seed.samples);
+}
+
+#[test]
+fn dataset_bits_do_not_depend_on_thread_count() {
+    let p = RigParams {
+        hold_s: 0.5,
+        slide_mm: 10.0,
+        ..RigParams::default()
+    };
+    let trials = design(&[Texture::Ft2, Texture::Stf], &[10.0, 15.0], 2);
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let out = dir.path().join(name);
+        pool.install(|| neurotex::sim::write_dataset(&out, &p, &trials, 3, &|| {}))
+            .unwrap();
+        out
+    };
+    let (one, two) = (write("one", 1), write("two", 2));
+    for entry in std::fs::read_dir(&one).unwrap() {
+        let name = entry.unwrap().file_name();
+        assert_eq!(
+            std::fs::read(one.join(&name)).unwrap(),
+            std::fs::read(two.join(&name)).unwrap(),
+            "{name:?}"
+        );
+    }
+    assert_eq!(std::fs::read_dir(&one).unwrap().count(), 9);
+}
+
+#[test]
+fn every_texture_has_relief_and_the_rig_rejects_unphysical_parameters() {
+    for texture in ALL_TEXTURES {
+        let heights: Vec<f64> = (0..400)
+            .map(|i| texture.height(i as f64 * 0.25, (i % 17) as f64 * 0.7, 1))
+            .collect();
+        let (lo, hi) = heights
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+                (l.min(x), h.max(x))
+            });
+        assert!(heights.iter().all(|h| h.is_finite()));
+        assert!(hi - lo > 0.1, "{texture:?} relief {lo}..{hi} mm");
+        assert_eq!(Texture::from_name(texture.name()), Some(texture));
+    }
+    assert!(RigParams {
+        force_n: 0.0,
+        ..RigParams::default()
+    }
+    .check()
+    .is_err());
+    assert!(RigParams {
+        taxel_mm: 5.0,
+        ..RigParams::default()
+    }
+    .check()
+    .is_err());
+    assert!(simulate_trial(&RigParams::default(), &trial(Texture::Cp, 0.0, 0), 0).is_err());
+}
