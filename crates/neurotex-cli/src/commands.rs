@@ -574,6 +574,7 @@ pub fn reproduce(args: ReproduceArgs) -> Result<()> {
         parameters,
         total_seconds: started.elapsed().as_secs_f64(),
         command: command.replacen(&std::env::args().next().unwrap_or_default(), "neurotex", 1),
+        paper_comparable: dataset.is_none(),
     };
     write_report(&args.out, &results, &ctx)?;
     for (claim, holds, _) in neurotex::report::conclusions(&results) {
@@ -591,5 +592,181 @@ pub fn reproduce(args: ReproduceArgs) -> Result<()> {
         args.out.display(),
         started.elapsed().as_secs_f64()
     );
+    Ok(())
+}
+
+/// `neurotex import`: bring recordings from other layouts into the dataset format.
+#[derive(clap::Subcommand)]
+pub enum ImportCommand {
+    /// Per-trial CSV logs (a header row, a time column, one column per channel), with
+    /// metadata taken from the file names.
+    Csv(ImportCsvArgs),
+    /// A stacked array `(N, ...)` with one label (and optionally one speed) per sample.
+    Stacked(ImportStackedArgs),
+}
+
+/// Options of `neurotex import csv`.
+#[derive(Args)]
+pub struct ImportCsvArgs {
+    /// CSV files, or folders whose .csv files are all imported.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// The dataset folder to create (must not exist, or be empty).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Fields from file names, e.g. `{label}_F{force}_V{speed}mmps_{trial}.csv`; `label`,
+    /// `speed` (mm/s), `force` and `trial` fill the manifest, other fields become columns.
+    /// Without it the label is the file name.
+    #[arg(long = "name-pattern")]
+    pub name_pattern: Option<String>,
+    /// The time-stamp column (irregular stamps are kept and resampled onto 1 ms later).
+    #[arg(long = "time-column")]
+    pub time_column: Option<String>,
+    /// Unit of the time column.
+    #[arg(long = "time-unit", default_value = "ms", value_parser = ["ms", "s"])]
+    pub time_unit: String,
+    /// Channel columns: a comma-separated list, or a regular expression such as `^channel\d+$`
+    /// (default: every column but the time column).
+    #[arg(long)]
+    pub channels: Option<String>,
+    /// Grid `ROWSxCOLS` to place the channels on, row-major (default one row).
+    #[arg(long)]
+    pub grid: Option<String>,
+    /// Each channel's cell as `row,col;row,col;...` (needs --grid).
+    #[arg(long = "channel-map")]
+    pub channel_map: Option<String>,
+    /// Nominal sampling rate in Hz (needed without a time column; else the median interval).
+    #[arg(long)]
+    pub fs: Option<f64>,
+    /// Baseline removal to record in layout.toml: `none` or `min` (capacitive sensors rest
+    /// at a large offset).
+    #[arg(long)]
+    pub baseline: Option<String>,
+    /// Leave out files with errors (each is reported) instead of stopping at the first.
+    #[arg(long = "skip-bad")]
+    pub skip_bad: bool,
+}
+
+/// Options of `neurotex import stacked`.
+#[derive(Args)]
+pub struct ImportStackedArgs {
+    /// The stacked samples, `.npy` of floats or integers.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// One label per sample, `.npy` of integers or strings.
+    #[arg(long)]
+    pub labels: PathBuf,
+    /// The data's axes in order, from n (sample), t (time), row, col, channel:
+    /// e.g. `n,row,col,t` for shape (N, rows, cols, T) or `n,t,channel`.
+    #[arg(long)]
+    pub axes: String,
+    /// Sampling rate in Hz.
+    #[arg(long)]
+    pub fs: f64,
+    /// One speed (mm/s) per sample, `.npy`.
+    #[arg(long)]
+    pub speeds: Option<PathBuf>,
+    /// With a channel axis: the grid `ROWSxCOLS` to place channels on, row-major.
+    #[arg(long)]
+    pub grid: Option<String>,
+    /// The dataset folder to create.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+fn parse_grid(text: &str) -> Result<(usize, usize)> {
+    let parts: Vec<&str> = text.split(['x', 'X']).collect();
+    match parts.as_slice() {
+        [r, c] => match (r.trim().parse::<usize>(), c.trim().parse::<usize>()) {
+            (Ok(r), Ok(c)) if r > 0 && c > 0 => Ok((r, c)),
+            _ => bail!("--grid must be ROWSxCOLS with positive integers, got `{text}`"),
+        },
+        _ => bail!("--grid must be ROWSxCOLS, e.g. 4x4, got `{text}`"),
+    }
+}
+
+pub fn import(cmd: ImportCommand) -> Result<()> {
+    use neurotex::import::{
+        csv_files, import_csv, import_stacked, ChannelSelect, CsvImportParams, NamePattern,
+        StackedParams,
+    };
+    match cmd {
+        ImportCommand::Csv(a) => {
+            let channel_map = match &a.channel_map {
+                None => None,
+                Some(text) => Some(
+                    text.split(';')
+                        .map(|pair| {
+                            let rc: Vec<&str> = pair.split(',').collect();
+                            match rc.as_slice() {
+                                [r, c] => match (r.trim().parse(), c.trim().parse()) {
+                                    (Ok(r), Ok(c)) => Ok([r, c]),
+                                    _ => bail!("--channel-map entries are row,col; got `{pair}`"),
+                                },
+                                _ => bail!("--channel-map entries are row,col separated by `;`, got `{pair}`"),
+                            }
+                        })
+                        .collect::<Result<Vec<_>>>()?,
+                ),
+            };
+            if channel_map.is_some() && a.grid.is_none() {
+                bail!("--channel-map needs --grid");
+            }
+            if let Some(fs) = a.fs {
+                if !(fs.is_finite() && fs > 0.0) {
+                    bail!("--fs must be a positive sampling rate in Hz, got {fs}");
+                }
+            }
+            let params = CsvImportParams {
+                pattern: a
+                    .name_pattern
+                    .as_deref()
+                    .map(NamePattern::parse)
+                    .transpose()?,
+                time_column: a.time_column.clone(),
+                time_unit_s: if a.time_unit == "s" { 1.0 } else { 1e-3 },
+                channels: match &a.channels {
+                    Some(text) => ChannelSelect::parse(text)?,
+                    None => ChannelSelect::All,
+                },
+                grid: a.grid.as_deref().map(parse_grid).transpose()?,
+                channel_map,
+                fs: a.fs,
+                baseline: match a.baseline.as_deref() {
+                    None | Some("none") => None,
+                    Some("min") => Some(neurotex::recording::Baseline::Min),
+                    Some(other) => bail!("unknown --baseline `{other}`: expected none or min"),
+                },
+                skip_bad: a.skip_bad,
+            };
+            let files = csv_files(&a.inputs)?;
+            let bar = progress(files.len(), "importing");
+            let summary = import_csv(&files, &params, &a.out, &|| bar.inc(1));
+            bar.finish_and_clear();
+            let summary = summary?;
+            for (_, why) in &summary.skipped {
+                eprintln!("warning: left out {why}");
+            }
+            eprintln!(
+                "{} recordings ({} left out) -> {}; {} channels on a {}x{} grid at {:.2} Hz nominal",
+                summary.written,
+                summary.skipped.len(),
+                a.out.display(),
+                summary.layout.channels.as_ref().map_or(0, Vec::len),
+                summary.layout.rows.unwrap_or(1),
+                summary.layout.cols.unwrap_or(1),
+                summary.layout.fs.unwrap_or(0.0)
+            );
+        }
+        ImportCommand::Stacked(a) => {
+            let params = StackedParams {
+                axes: a.axes.clone(),
+                fs: a.fs,
+                grid: a.grid.as_deref().map(parse_grid).transpose()?,
+            };
+            let n = import_stacked(&a.data, &a.labels, a.speeds.as_deref(), &params, &a.out)?;
+            eprintln!("{n} recordings -> {}", a.out.display());
+        }
+    }
     Ok(())
 }

@@ -32,6 +32,9 @@ enum Command {
     /// Run every analysis of the paper (E0-E8) and write a report with figures; without
     /// --dataset, on the built-in simulated rig.
     Reproduce(commands::ReproduceArgs),
+    /// Import CSV logs or stacked arrays into a dataset folder.
+    #[command(subcommand)]
+    Import(commands::ImportCommand),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
         Command::Evaluate(args) => commands::evaluate(args),
         Command::Simulate(args) => commands::simulate(args),
         Command::Reproduce(args) => commands::reproduce(args),
+        Command::Import(cmd) => commands::import(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -84,6 +84,29 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// Adds a CSV recording of label A at 5 mm/s to a dataset's manifest.
+fn add_csv(ds: &Path, name: &str, content: &str) {
+    std::fs::write(ds.join(name), content).unwrap();
+    let mut m = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    m.push_str(&format!("{name},A,5,1,9,,\n"));
+    std::fs::write(ds.join("manifest.csv"), &m).unwrap();
+}
+
+/// Runs `features` on a dataset, which must fail; returns standard error.
+fn features_fails(ds: &Path, out: &Path, method: &str, extra: &[&str]) -> String {
+    let mut args = vec![
+        "features",
+        "--dataset",
+        s(ds),
+        "--method",
+        method,
+        "--out",
+        s(out),
+    ];
+    args.extend_from_slice(extra);
+    fails(&args)
+}
+
 #[test]
 fn encode_writes_raster_and_events() {
     let tmp = tempfile::tempdir().unwrap();
@@ -288,6 +311,16 @@ fn bad_input_is_a_clear_error_with_no_output() {
     let out = tmp.path().join("out.csv");
     let d = s(&ds);
     let o = s(&out);
+    let feat = |extra: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["features", "--dataset", d, "--method", "glcm3d", "--out", o];
+        v.extend_from_slice(extra);
+        v
+    };
+    let eval = |method: &'static str, extra: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["evaluate", "--dataset", d, "--method", method];
+        v.extend_from_slice(extra);
+        v
+    };
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             vec![
@@ -305,104 +338,13 @@ fn bad_input_is_a_clear_error_with_no_output() {
             vec!["features", "--dataset", d, "--method", "glcm4d", "--out", o],
             "glcm4d",
         ),
-        (
-            vec![
-                "features",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--out",
-                o,
-                "--gain",
-                "0",
-            ],
-            "gain",
-        ),
-        (
-            vec![
-                "features",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--out",
-                o,
-                "--gain",
-                "-3",
-            ],
-            "gain",
-        ),
-        (
-            vec![
-                "features",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--out",
-                o,
-                "--levels",
-                "1",
-            ],
-            "levels",
-        ),
-        (
-            vec![
-                "features",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--out",
-                o,
-                "--bin-ms",
-                "0",
-            ],
-            "bin",
-        ),
-        (
-            vec![
-                "features",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--out",
-                o,
-                "--distances",
-                "0",
-            ],
-            "distances",
-        ),
-        (
-            vec![
-                "features",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--out",
-                o,
-                "--cutoff",
-                "600",
-            ],
-            "cutoff",
-        ),
-        (
-            vec![
-                "features",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--out",
-                o,
-                "--preset",
-                "XX",
-            ],
-            "preset",
-        ),
+        (feat(&["--gain", "0"]), "gain"),
+        (feat(&["--gain", "-3"]), "gain"),
+        (feat(&["--levels", "1"]), "levels"),
+        (feat(&["--bin-ms", "0"]), "bin"),
+        (feat(&["--distances", "0"]), "distances"),
+        (feat(&["--cutoff", "600"]), "cutoff"),
+        (feat(&["--preset", "XX"]), "preset"),
         (
             vec![
                 "features",
@@ -419,104 +361,23 @@ fn bad_input_is_a_clear_error_with_no_output() {
             vec!["evaluate", "--dataset", d, "--method", "glcm3d", "--k", "0"],
             "k must be at least 1",
         ),
+        (eval("glcm3d", &["--folds", "1"]), "at least 2 folds"),
         (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--folds",
-                "1",
-            ],
-            "at least 2 folds",
-        ),
-        (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--folds",
-                "6",
-                "--speeds",
-                "5",
-            ],
+            eval("glcm3d", &["--folds", "6", "--speeds", "5"]),
             "fewer than the 6 folds",
         ),
+        (eval("glcm3d", &["--k", "50"]), "k = 50 neighbours"),
         (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--k",
-                "50",
-            ],
-            "k = 50 neighbours",
-        ),
-        (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--speeds",
-                "7",
-            ],
+            eval("glcm3d", &["--speeds", "7"]),
             "no recordings at 7 mm/s",
         ),
+        (eval("taxel", &["--taxel", "4,0"]), "outside the 4x4 grid"),
+        (eval("taxel", &["--taxel", "a"]), "ROW,COL"),
         (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "taxel",
-                "--taxel",
-                "4,0",
-            ],
-            "outside the 4x4 grid",
-        ),
-        (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "taxel",
-                "--taxel",
-                "a",
-            ],
-            "ROW,COL",
-        ),
-        (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--taxel",
-                "1,1",
-            ],
+            eval("glcm3d", &["--taxel", "1,1"]),
             "only to --method taxel",
         ),
-        (
-            vec![
-                "evaluate",
-                "--dataset",
-                d,
-                "--method",
-                "glcm3d",
-                "--train-speeds",
-                "5",
-            ],
-            "test-speeds",
-        ),
+        (eval("glcm3d", &["--train-speeds", "5"]), "test-speeds"),
     ];
     for (args, expected) in cases {
         let err = fails(&args);
@@ -547,19 +408,15 @@ fn bad_recordings_and_layouts_are_named() {
 
     // a NaN sample in one CSV recording
     let ds = base("nan");
-    std::fs::write(ds.join("bad.csv"), "a,b\n1,2\n3,NaN\n").unwrap();
-    let mut m = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
-    m.push_str("bad.csv,A,5,1,9,,\n");
-    std::fs::write(ds.join("manifest.csv"), &m).unwrap();
-    let err = fails(&[
-        "features",
-        "--dataset",
-        s(&ds),
-        "--method",
-        "glcm3d",
-        "--out",
-        s(&out),
-    ]);
+    add_csv(
+        &ds,
+        "bad.csv",
+        "a,b
+1,2
+3,NaN
+",
+    );
+    let err = features_fails(&ds, &out, "glcm3d", &[]);
     assert!(
         err.contains("bad.csv") && err.contains("line 3") && err.contains("NaN"),
         "{err}"
@@ -568,16 +425,7 @@ fn bad_recordings_and_layouts_are_named() {
     // a recording shorter than one 200 ms bin
     let ds = base("short");
     write_npy(ds.join("A_5_0.npy"), &recording(150, 50.0, 0.3, 1)).unwrap();
-    let err = fails(&[
-        "features",
-        "--dataset",
-        s(&ds),
-        "--method",
-        "taxel",
-        "--out",
-        s(&out),
-        "--whole",
-    ]);
+    let err = features_fails(&ds, &out, "taxel", &["--whole"]);
     assert!(
         err.contains("A_5_0.npy") && err.contains("shorter than one 200 ms bin"),
         "{err}"
@@ -585,19 +433,16 @@ fn bad_recordings_and_layouts_are_named() {
 
     // non-increasing time stamps
     let ds = base("time");
-    std::fs::write(ds.join("t.csv"), "t_ms,a\n0,1\n1,2\n1,3\n").unwrap();
-    let mut m = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
-    m.push_str("t.csv,A,5,1,9,,\n");
-    std::fs::write(ds.join("manifest.csv"), &m).unwrap();
-    let err = fails(&[
-        "features",
-        "--dataset",
-        s(&ds),
-        "--method",
-        "glcm3d",
-        "--out",
-        s(&out),
-    ]);
+    add_csv(
+        &ds,
+        "t.csv",
+        "t_ms,a
+0,1
+1,2
+1,3
+",
+    );
+    let err = features_fails(&ds, &out, "glcm3d", &[]);
     assert!(
         err.contains("t.csv") && err.contains("line 4") && err.contains("increase"),
         "{err}"
@@ -606,29 +451,13 @@ fn bad_recordings_and_layouts_are_named() {
     // a layout that does not match the data
     let ds = base("layout");
     std::fs::write(ds.join("layout.toml"), "rows = 2\ncols = 2\n").unwrap();
-    let err = fails(&[
-        "features",
-        "--dataset",
-        s(&ds),
-        "--method",
-        "glcm3d",
-        "--out",
-        s(&out),
-    ]);
+    let err = features_fails(&ds, &out, "glcm3d", &[]);
     assert!(err.contains("4x4 grid") && err.contains("2x2"), "{err}");
 
     // an unreadable .npy
     let ds = base("garbage");
     std::fs::write(ds.join("A_5_0.npy"), b"not an npy").unwrap();
-    let err = fails(&[
-        "features",
-        "--dataset",
-        s(&ds),
-        "--method",
-        "glcm3d",
-        "--out",
-        s(&out),
-    ]);
+    let err = features_fails(&ds, &out, "glcm3d", &[]);
     assert!(err.contains("A_5_0.npy") && err.contains(".npy"), "{err}");
 
     // a test label the training speeds never saw

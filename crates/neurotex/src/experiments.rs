@@ -141,6 +141,18 @@ pub struct Prepared {
     pub seconds: f64,
 }
 
+/// The slowest condition: the smallest speed in magnitude (a positive one before its
+/// negative twin, for rigs that record direction as the sign).
+pub fn slowest_speed(speeds: impl Iterator<Item = f64>) -> f64 {
+    speeds
+        .min_by(|a, b| {
+            a.abs()
+                .total_cmp(&b.abs())
+                .then((*a < 0.0).cmp(&(*b < 0.0)))
+        })
+        .unwrap_or(0.0)
+}
+
 fn speed_key(s: f64) -> String {
     format!("{s}")
 }
@@ -174,10 +186,7 @@ pub fn prepare(
                 .collect(),
         ),
     };
-    let slowest = metas_speed_label
-        .iter()
-        .map(|m| m.0)
-        .fold(f64::INFINITY, f64::min);
+    let slowest = slowest_speed(metas_speed_label.iter().map(|m| m.0));
     let mut labels: Vec<String> = Vec::new();
     for (_, l) in &metas_speed_label {
         if !labels.contains(l) {
@@ -523,7 +532,7 @@ pub fn run_all(
         }
     }
     speeds.sort_by(f64::total_cmp);
-    let slowest = speeds[0];
+    let slowest = slowest_speed(speeds.iter().copied());
     let mut r = Results {
         speeds: speeds.clone(),
         labels: labels.clone(),

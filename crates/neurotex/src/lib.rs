@@ -17,6 +17,7 @@ pub mod encode;
 pub mod error;
 pub mod experiments;
 pub mod features;
+pub mod import;
 pub mod pipeline;
 pub mod recording;
 pub mod report;

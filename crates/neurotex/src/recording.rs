@@ -750,3 +750,93 @@ fn read_csv_samples(
     }
     Ok((Shape::Channels(n), samples, times))
 }
+
+/// Writes `manifest.csv` for `metas` into `dir`: the required columns, the sliding interval
+/// when any recording has one, then every extra field any recording carries.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_manifest(dir: &Path, metas: &[Meta]) -> Result<()> {
+    let path = dir.join("manifest.csv");
+    let with_slide = metas
+        .iter()
+        .any(|m| m.slide_start_s.is_some() || m.slide_end_s.is_some());
+    let mut extra: Vec<&String> = metas.iter().flat_map(|m| m.extra.keys()).collect();
+    extra.sort();
+    extra.dedup();
+    let mut w = csv::Writer::from_path(&path).map_err(|e| csv_error(&path, e))?;
+    let mut header: Vec<&str> = MANIFEST_COLUMNS.to_vec();
+    if with_slide {
+        header.extend(["slide_start_s", "slide_end_s"]);
+    }
+    header.extend(extra.iter().map(|k| k.as_str()));
+    w.write_record(&header).map_err(|e| csv_error(&path, e))?;
+    let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+    for m in metas {
+        let mut row = vec![
+            m.file.clone(),
+            m.label.clone(),
+            m.speed_mm_s.to_string(),
+            m.force_n.to_string(),
+            m.trial.to_string(),
+        ];
+        if with_slide {
+            row.extend([opt(m.slide_start_s), opt(m.slide_end_s)]);
+        }
+        row.extend(
+            extra
+                .iter()
+                .map(|k| m.extra.get(*k).cloned().unwrap_or_default()),
+        );
+        w.write_record(&row).map_err(|e| csv_error(&path, e))?;
+    }
+    w.flush().map_err(|e| DataError::io(&path, e))?;
+    Ok(())
+}
+
+/// Creates dataset folder `dir` whole or not at all: `fill` writes into a temporary folder
+/// beside it, which is renamed to `dir` only when `fill` succeeds (and removed otherwise).
+///
+/// # Errors
+/// `dir` exists and is not empty, or `fill` or the rename fails.
+pub fn create_dataset_dir<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
+    if dir.exists()
+        && std::fs::read_dir(dir)
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(true)
+    {
+        return Err(DataError::invalid(dir, "output folder exists and is not empty").into());
+    }
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "dataset".into());
+    let parent = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).map_err(|e| DataError::io(&tmp, e))?;
+    let result = fill(&tmp).and_then(|value| {
+        if dir.exists() {
+            std::fs::remove_dir(dir).map_err(|e| DataError::io(dir, e))?;
+        }
+        std::fs::rename(&tmp, dir).map_err(|e| DataError::io(dir, e))?;
+        Ok(value)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
+}
+
+/// Writes `layout.toml` into `dir`.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_layout(dir: &Path, layout: &LayoutFile) -> Result<()> {
+    let path = dir.join("layout.toml");
+    let text = toml::to_string(layout).map_err(|e| DataError::invalid(&path, e.to_string()))?;
+    std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
+    Ok(())
+}

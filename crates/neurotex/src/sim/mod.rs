@@ -518,24 +518,7 @@ pub fn write_dataset(
     use crate::error::DataError;
     use rayon::prelude::*;
     p.check()?;
-    if dir.exists()
-        && std::fs::read_dir(dir)
-            .map(|mut d| d.next().is_some())
-            .unwrap_or(true)
-    {
-        return Err(DataError::invalid(dir, "output folder exists and is not empty").into());
-    }
-    let name = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "dataset".into());
-    let parent = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).map_err(|e| DataError::io(&tmp, e))?;
-    let result = (|| -> crate::Result<()> {
+    crate::recording::create_dataset_dir(dir, |tmp| {
         let metas: Vec<Meta> = trials
             .par_iter()
             .map(|t| -> crate::Result<Meta> {
@@ -552,30 +535,6 @@ pub fn write_dataset(
                 Ok(rec.meta)
             })
             .collect::<crate::Result<_>>()?;
-        let manifest = tmp.join("manifest.csv");
-        let mut text =
-            String::from("file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s\n");
-        for m in &metas {
-            text.push_str(&format!(
-                "{},{},{},{},{},{},{}\n",
-                m.file,
-                m.label,
-                m.speed_mm_s,
-                m.force_n,
-                m.trial,
-                m.slide_start_s.unwrap_or(0.0),
-                m.slide_end_s.unwrap_or(0.0)
-            ));
-        }
-        std::fs::write(&manifest, text).map_err(|e| DataError::io(&manifest, e))?;
-        if dir.exists() {
-            std::fs::remove_dir(dir).map_err(|e| DataError::io(dir, e))?;
-        }
-        std::fs::rename(&tmp, dir).map_err(|e| DataError::io(dir, e))?;
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
-    }
-    result
+        crate::recording::write_manifest(tmp, &metas)
+    })
 }

@@ -1,0 +1,836 @@
+//! Importing recordings from other layouts into the dataset format: per-trial CSV logs from
+//! a DAQ (metadata from file names) and the stacked arrays machine-learning datasets ship.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use ndarray::{ArrayD, Axis, IxDyn};
+use ndarray_npy::ReadNpyExt;
+use rayon::prelude::*;
+
+use crate::error::{DataError, ParamError, Result};
+use crate::recording::{
+    create_dataset_dir, write_layout, write_manifest, Baseline, LayoutFile, Meta,
+};
+
+/// A file-name pattern such as `{label}_F{force}_V{speed}mmps_{trial}.csv`: literal text and
+/// `{field}`s. `label`, `speed` (mm/s), `force` (N) and `trial` fill the manifest's columns;
+/// any other field becomes an extra manifest column.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamePattern {
+    parts: Vec<Part>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Part {
+    Literal(String),
+    Field(String),
+}
+
+impl NamePattern {
+    /// Parses a pattern.
+    ///
+    /// # Errors
+    /// Unbalanced braces, an empty field name, or two fields with nothing between them.
+    pub fn parse(pattern: &str) -> Result<Self, ParamError> {
+        let bad = |rule| ParamError::new("name-pattern", rule, pattern);
+        let mut parts = Vec::new();
+        let mut rest = pattern;
+        while !rest.is_empty() {
+            match rest.find('{') {
+                Some(0) => {
+                    let end = rest
+                        .find('}')
+                        .ok_or_else(|| bad("every `{` needs a closing `}`"))?;
+                    let name = &rest[1..end];
+                    if name.is_empty() || name.contains('{') {
+                        return Err(bad("fields are written {name}, with a non-empty name"));
+                    }
+                    if matches!(parts.last(), Some(Part::Field(_))) {
+                        return Err(bad("two fields need literal text between them"));
+                    }
+                    parts.push(Part::Field(name.to_string()));
+                    rest = &rest[end + 1..];
+                }
+                Some(i) => {
+                    if rest[..i].contains('}') {
+                        return Err(bad("a `}` without its `{`"));
+                    }
+                    parts.push(Part::Literal(rest[..i].to_string()));
+                    rest = &rest[i..];
+                }
+                None => {
+                    if rest.contains('}') {
+                        return Err(bad("a `}` without its `{`"));
+                    }
+                    parts.push(Part::Literal(rest.to_string()));
+                    rest = "";
+                }
+            }
+        }
+        if !parts.iter().any(|p| matches!(p, Part::Field(_))) {
+            return Err(bad("the pattern names no {field}"));
+        }
+        Ok(NamePattern { parts })
+    }
+
+    /// The fields of `name`, or `None` when it does not match. Fields match as few
+    /// characters as possible (at least one) such that the rest still matches; `speed` and
+    /// `force` only match numbers and `trial` only integers, so a label may contain the
+    /// pattern's separators (`Denim_Flex_F150_...`).
+    pub fn matches(&self, name: &str) -> Option<BTreeMap<String, String>> {
+        let mut out = BTreeMap::new();
+        self.match_from(0, name, &mut out).then_some(out)
+    }
+
+    fn match_from(&self, k: usize, rest: &str, out: &mut BTreeMap<String, String>) -> bool {
+        match self.parts.get(k) {
+            None => rest.is_empty(),
+            Some(Part::Literal(lit)) => rest
+                .strip_prefix(lit.as_str())
+                .is_some_and(|r| self.match_from(k + 1, r, out)),
+            Some(Part::Field(field)) => {
+                for (end, _) in rest
+                    .char_indices()
+                    .skip(1)
+                    .chain(std::iter::once((rest.len(), ' ')))
+                {
+                    if end == 0 {
+                        continue;
+                    }
+                    let value = &rest[..end];
+                    let fits = match field.as_str() {
+                        "speed" | "force" => value.parse::<f64>().is_ok_and(f64::is_finite),
+                        "trial" => value.parse::<i64>().is_ok(),
+                        _ => true,
+                    };
+                    if fits && self.match_from(k + 1, &rest[end..], out) {
+                        out.insert(field.clone(), rest[..end].to_string());
+                        return true;
+                    }
+                }
+                false
+            }
+        }
+    }
+}
+
+/// How to pick the channel columns of a CSV log.
+#[derive(Debug, Clone)]
+pub enum ChannelSelect {
+    /// Every column but the time column.
+    All,
+    /// These columns, in this order.
+    Names(Vec<String>),
+    /// Columns whose names match, in file order.
+    Regex(regex::Regex),
+}
+
+impl ChannelSelect {
+    /// A comma-separated list of names, or a regular expression when the text holds one of
+    /// `^$*+?[]()|\`.
+    ///
+    /// # Errors
+    /// An invalid regular expression.
+    pub fn parse(text: &str) -> Result<Self, ParamError> {
+        if text.chars().any(|c| "^$*+?[]()|\\".contains(c)) {
+            regex::Regex::new(text)
+                .map(ChannelSelect::Regex)
+                .map_err(|e| {
+                    ParamError::new(
+                        "channels",
+                        "not a valid regular expression",
+                        format!("{text} ({e})"),
+                    )
+                })
+        } else {
+            Ok(ChannelSelect::Names(
+                text.split(',')
+                    .map(|s| s.trim().to_string())
+                    .filter(|s| !s.is_empty())
+                    .collect(),
+            ))
+        }
+    }
+}
+
+/// Options of a CSV import.
+#[derive(Debug, Clone)]
+pub struct CsvImportParams {
+    /// Metadata from file names; without it the label is the file stem.
+    pub pattern: Option<NamePattern>,
+    /// The time column; without it the sampling rate `fs` is used.
+    pub time_column: Option<String>,
+    /// Seconds per time unit (0.001 for ms).
+    pub time_unit_s: f64,
+    /// The channel columns.
+    pub channels: ChannelSelect,
+    /// Grid `rows x cols`; default one row of all channels.
+    pub grid: Option<(usize, usize)>,
+    /// For each channel, its `[row, col]`; default row-major.
+    pub channel_map: Option<Vec<[usize; 2]>>,
+    /// Nominal sampling rate in Hz (required without a time column; else estimated).
+    pub fs: Option<f64>,
+    /// Baseline removal recorded in `layout.toml`.
+    pub baseline: Option<Baseline>,
+    /// Leave out files that fail (they are listed in the summary) instead of stopping.
+    pub skip_bad: bool,
+}
+
+/// What an import did.
+#[derive(Debug, Clone, Default)]
+pub struct ImportSummary {
+    /// Recordings written.
+    pub written: usize,
+    /// Files left out, with the reason.
+    pub skipped: Vec<(PathBuf, String)>,
+    /// The layout written.
+    pub layout: LayoutFile,
+}
+
+struct ParsedCsv {
+    meta: Meta,
+    channel_names: Vec<String>,
+    times: Option<Vec<f64>>,
+    samples: Vec<f64>,
+}
+
+fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
+    DataError::invalid(path, message).into()
+}
+
+fn meta_from_name(path: &Path, pattern: Option<&NamePattern>) -> Result<Meta> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut meta = Meta {
+        file: name.clone(),
+        ..Meta::default()
+    };
+    let Some(pattern) = pattern else {
+        meta.label = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        return Ok(meta);
+    };
+    let fields = pattern
+        .matches(&name)
+        .ok_or_else(|| invalid(path, "file name does not match --name-pattern"))?;
+    for (key, value) in fields {
+        let number = |what: &str| -> Result<f64> {
+            value
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    invalid(
+                        path,
+                        format!("field {{{key}}} of the file name must be {what}, got `{value}`"),
+                    )
+                })
+        };
+        match key.as_str() {
+            "label" => meta.label = value.clone(),
+            "speed" => meta.speed_mm_s = number("a number of mm/s")?,
+            "force" => meta.force_n = number("a number")?,
+            "trial" => {
+                meta.trial = value.parse().map_err(|_| {
+                    invalid(
+                        path,
+                        format!(
+                            "field {{trial}} of the file name must be an integer, got `{value}`"
+                        ),
+                    )
+                })?
+            }
+            _ => {
+                meta.extra.insert(key, value);
+            }
+        }
+    }
+    if meta.label.is_empty() {
+        return Err(invalid(path, "the pattern gives no {label}"));
+    }
+    Ok(meta)
+}
+
+fn parse_csv(path: &Path, p: &CsvImportParams) -> Result<ParsedCsv> {
+    let meta = meta_from_name(path, p.pattern.as_ref())?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| invalid(path, format!("cannot read: {e}")))?;
+    let headers = reader
+        .headers()
+        .map_err(|e| invalid(path, format!("no header row: {e}")))?
+        .clone();
+    let time_col = match &p.time_column {
+        Some(name) => Some(headers.iter().position(|h| h == name).ok_or_else(|| {
+            invalid(
+                path,
+                format!(
+                    "missing time column `{name}` (columns: {})",
+                    headers.iter().collect::<Vec<_>>().join(", ")
+                ),
+            )
+        })?),
+        None => None,
+    };
+    let channel_cols: Vec<usize> = match &p.channels {
+        ChannelSelect::All => (0..headers.len())
+            .filter(|&j| Some(j) != time_col)
+            .collect(),
+        ChannelSelect::Names(names) => names
+            .iter()
+            .map(|n| {
+                headers
+                    .iter()
+                    .position(|h| h == n)
+                    .ok_or_else(|| invalid(path, format!("missing channel column `{n}`")))
+            })
+            .collect::<Result<_>>()?,
+        ChannelSelect::Regex(re) => (0..headers.len())
+            .filter(|&j| Some(j) != time_col && re.is_match(&headers[j]))
+            .collect(),
+    };
+    if channel_cols.is_empty() {
+        return Err(invalid(path, "no channel columns selected"));
+    }
+    let mut samples = Vec::new();
+    let mut times = time_col.map(|_| Vec::new());
+    let mut record = csv::ByteRecord::new();
+    let mut line = 1usize;
+    let field = |record: &csv::ByteRecord, j: usize, line: usize| -> Result<f64> {
+        let raw = record.get(j).unwrap_or(b"");
+        std::str::from_utf8(raw)
+            .ok()
+            .and_then(|s| s.parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                invalid(
+                    path,
+                    format!(
+                        "line {line}, column `{}`: expected a finite number, got `{}`",
+                        &headers[j],
+                        String::from_utf8_lossy(raw)
+                    ),
+                )
+            })
+    };
+    loop {
+        match reader.read_byte_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(invalid(path, format!("malformed CSV: {e}"))),
+        }
+        line += 1;
+        for &j in &channel_cols {
+            samples.push(field(&record, j, line)?);
+        }
+        if let (Some(j), Some(times)) = (time_col, times.as_mut()) {
+            // kept in the file's own unit, so whole milliseconds stay whole
+            let t = field(&record, j, line)?;
+            if let Some(&prev) = times.last() {
+                if t <= prev {
+                    return Err(invalid(
+                        path,
+                        format!("line {line}: time stamps must increase, got {t} after {prev}"),
+                    ));
+                }
+            }
+            times.push(t);
+        }
+    }
+    if samples.is_empty() {
+        return Err(invalid(path, "no data rows"));
+    }
+    Ok(ParsedCsv {
+        meta,
+        channel_names: channel_cols
+            .iter()
+            .map(|&j| headers[j].to_string())
+            .collect(),
+        times,
+        samples,
+    })
+}
+
+/// The `.csv` files among `inputs` (folders are searched one level deep), sorted.
+///
+/// # Errors
+/// An input that does not exist or a folder that cannot be read.
+pub fn csv_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let entries = std::fs::read_dir(input).map_err(|e| DataError::io(input, e))?;
+            for e in entries {
+                let path = e.map_err(|e| DataError::io(input, e))?.path();
+                if path
+                    .extension()
+                    .is_some_and(|x| x.eq_ignore_ascii_case("csv"))
+                {
+                    out.push(path);
+                }
+            }
+        } else if input.is_file() {
+            out.push(input.clone());
+        } else {
+            return Err(invalid(input, "does not exist"));
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Imports CSV logs into a new dataset folder `out`: one CSV per recording with a `t_ms`
+/// column (time stamps kept, relative to the first) and the selected channels, a manifest
+/// from the file names, and `layout.toml`. Files are parsed in parallel; `on_done` is
+/// called once per file.
+///
+/// # Errors
+/// A bad file (unless `skip_bad`), channels that differ between files, a grid that does
+/// not fit the channels, or `out` not empty.
+pub fn import_csv(
+    files: &[PathBuf],
+    p: &CsvImportParams,
+    out: &Path,
+    on_done: &(dyn Fn() + Sync),
+) -> Result<ImportSummary> {
+    if files.is_empty() {
+        return Err(DataError::invalid(out, "no .csv files to import").into());
+    }
+    if p.time_column.is_none() && p.fs.is_none() {
+        return Err(ParamError::new(
+            "fs",
+            "without --time-column the sampling rate --fs is needed",
+            "none",
+        )
+        .into());
+    }
+    let parsed: Vec<(PathBuf, Result<ParsedCsv>)> = files
+        .par_iter()
+        .map(|f| {
+            let r = parse_csv(f, p);
+            on_done();
+            (f.clone(), r)
+        })
+        .collect();
+    let mut summary = ImportSummary::default();
+    let mut good = Vec::new();
+    for (f, r) in parsed {
+        match r {
+            Ok(c) => good.push(c),
+            Err(e) if p.skip_bad => summary.skipped.push((f, e.to_string())),
+            Err(e) => return Err(e),
+        }
+    }
+    let Some(first) = good.first() else {
+        return Err(DataError::invalid(out, "every file was left out").into());
+    };
+    let names = first.channel_names.clone();
+    if let Some(other) = good.iter().find(|c| c.channel_names != names) {
+        return Err(invalid(
+            Path::new(&other.meta.file),
+            format!(
+                "its channels {:?} differ from {:?} of {}",
+                other.channel_names, names, first.meta.file
+            ),
+        ));
+    }
+    let n = names.len();
+    let (rows, cols) = p.grid.unwrap_or((1, n));
+    let fs = match p.fs {
+        Some(fs) => fs,
+        None => {
+            // the median interval over all files gives the nominal rate
+            let mut dts: Vec<f64> = good
+                .iter()
+                .filter_map(|c| c.times.as_ref())
+                .flat_map(|t| t.windows(2).map(|w| (w[1] - w[0]) * p.time_unit_s))
+                .collect();
+            if dts.is_empty() {
+                return Err(DataError::invalid(
+                    out,
+                    "cannot estimate the sampling rate from single-row files; give --fs",
+                )
+                .into());
+            }
+            let mid = dts.len() / 2;
+            let (_, median, _) = dts.select_nth_unstable_by(mid, f64::total_cmp);
+            1.0 / *median
+        }
+    };
+    if rows * cols < n {
+        return Err(ParamError::new(
+            "grid",
+            "the grid must have a cell for every channel",
+            format!("{rows}x{cols} for {n} channels"),
+        )
+        .into());
+    }
+    // Channels fill the grid row-major unless mapped; cells no channel reaches are masked.
+    let map: Vec<[usize; 2]> = p
+        .channel_map
+        .clone()
+        .unwrap_or_else(|| (0..n).map(|k| [k / cols, k % cols]).collect());
+    if map.len() != n {
+        return Err(ParamError::new(
+            "channel-map",
+            "the map needs one cell per channel",
+            format!("{} cells for {n} channels", map.len()),
+        )
+        .into());
+    }
+    let mut used = vec![false; rows * cols];
+    for &[r, c] in &map {
+        if r < rows && c < cols {
+            used[r * cols + c] = true;
+        }
+    }
+    let full = used.iter().all(|&u| u);
+    let layout = LayoutFile {
+        fs: Some(fs),
+        rows: Some(rows),
+        cols: Some(cols),
+        channel_map: (p.channel_map.is_some() || !full).then_some(map),
+        mask: (!full).then(|| {
+            (0..rows)
+                .map(|r| {
+                    (0..cols)
+                        .map(|c| if used[r * cols + c] { '1' } else { '0' })
+                        .collect()
+                })
+                .collect()
+        }),
+        baseline: p.baseline,
+        time_column: good[0].times.as_ref().map(|_| "t_ms".to_string()),
+        time_unit: good[0].times.as_ref().map(|_| "ms".to_string()),
+        channels: Some(names.clone()),
+    };
+    create_dataset_dir(out, |tmp| {
+        write_layout(tmp, &layout)?;
+        // validates the layout before anything else is written
+        LayoutFile::read(&tmp.join("layout.toml"))?;
+        let ms_per_unit = p.time_unit_s * 1000.0;
+        let metas: Vec<Meta> = good
+            .par_iter()
+            .map(|c| -> Result<Meta> {
+                let path = tmp.join(&c.meta.file);
+                let mut text = String::with_capacity(c.samples.len() * 8);
+                if c.times.is_some() {
+                    text.push_str("t_ms,");
+                }
+                text.push_str(&names.join(","));
+                text.push('\n');
+                let t0 = c.times.as_ref().map_or(0.0, |t| t[0]);
+                for (k, frame) in c.samples.chunks_exact(n).enumerate() {
+                    if let Some(t) = &c.times {
+                        text.push_str(&format!("{},", (t[k] - t0) * ms_per_unit));
+                    }
+                    let values: Vec<String> = frame.iter().map(|v| v.to_string()).collect();
+                    text.push_str(&values.join(","));
+                    text.push('\n');
+                }
+                std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
+                Ok(c.meta.clone())
+            })
+            .collect::<Result<_>>()?;
+        write_manifest(tmp, &metas)
+    })?;
+    summary.written = good.len();
+    summary.layout = layout;
+    Ok(summary)
+}
+
+/// The axes of a stacked array.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum AxisName {
+    N,
+    T,
+    Row,
+    Col,
+    Channel,
+}
+
+/// Parses axes such as `n,row,col,t` or `n,t,channel`.
+fn parse_axes(text: &str) -> Result<Vec<AxisName>, ParamError> {
+    let axes: Vec<AxisName> = text
+        .split(',')
+        .map(|a| match a.trim() {
+            "n" => Ok(AxisName::N),
+            "t" => Ok(AxisName::T),
+            "row" => Ok(AxisName::Row),
+            "col" => Ok(AxisName::Col),
+            "channel" => Ok(AxisName::Channel),
+            other => Err(ParamError::new(
+                "axes",
+                "axes are named n, t, row, col or channel",
+                other,
+            )),
+        })
+        .collect::<Result<_, _>>()?;
+    let count = |a| axes.iter().filter(|&&x| x == a).count();
+    let grid =
+        count(AxisName::Row) == 1 && count(AxisName::Col) == 1 && count(AxisName::Channel) == 0;
+    let chans =
+        count(AxisName::Channel) == 1 && count(AxisName::Row) == 0 && count(AxisName::Col) == 0;
+    if count(AxisName::N) != 1 || count(AxisName::T) != 1 || !(grid || chans) {
+        return Err(ParamError::new(
+            "axes",
+            "axes must name n and t once each, and either row and col or channel",
+            text,
+        ));
+    }
+    Ok(axes)
+}
+
+/// Reads a `.npy` of numbers as f64 (f64, f32, or any integer type).
+fn read_numbers(path: &Path) -> Result<ArrayD<f64>> {
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    macro_rules! try_as {
+        ($($t:ty),*) => {$(
+            if let Ok(a) = ArrayD::<$t>::read_npy(bytes.as_slice()) {
+                return Ok(a.mapv(|v| v as f64));
+            }
+        )*};
+    }
+    try_as!(f64, f32, i64, i32, i16, i8, u64, u32, u16, u8);
+    Err(invalid(
+        path,
+        "not a .npy array of numbers (float or integer)",
+    ))
+}
+
+/// Reads labels: integers, or fixed-width strings (`<U` or `|S`), one per sample.
+fn read_labels(path: &Path) -> Result<Vec<String>> {
+    if let Ok(a) = read_numbers(path) {
+        if a.iter().any(|v| v.fract() != 0.0) {
+            return Err(invalid(
+                path,
+                "labels must be integers or strings, got non-integer numbers",
+            ));
+        }
+        return Ok(a.iter().map(|v| format!("{}", *v as i64)).collect());
+    }
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    let bad = || invalid(path, "not a .npy array of integer or string labels");
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return Err(bad());
+    }
+    let (header_len, start) = if bytes[6] == 1 {
+        (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10)
+    } else {
+        if bytes.len() < 12 {
+            return Err(bad());
+        }
+        (
+            u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
+            12,
+        )
+    };
+    let header = std::str::from_utf8(bytes.get(start..start + header_len).ok_or_else(bad)?)
+        .map_err(|_| bad())?;
+    let descr = header
+        .split("'descr':")
+        .nth(1)
+        .and_then(|s| s.split('\'').nth(1))
+        .ok_or_else(bad)?;
+    let shape = header
+        .split("'shape':")
+        .nth(1)
+        .and_then(|s| s.split(')').next())
+        .ok_or_else(bad)?;
+    let dims: Vec<usize> = shape
+        .trim_start_matches([' ', '('])
+        .split(',')
+        .filter_map(|d| d.trim().parse().ok())
+        .collect();
+    let n: usize = dims.iter().product();
+    let data = &bytes[start + header_len..];
+    let (kind, width) = (
+        descr.chars().nth(1).ok_or_else(bad)?,
+        descr[2..].parse::<usize>().map_err(|_| bad())?,
+    );
+    let labels: Vec<String> = match (&descr[..1], kind) {
+        ("<" | "|" | "=", 'U') => (0..n)
+            .map(|i| {
+                let chunk = data
+                    .get(i * width * 4..(i + 1) * width * 4)
+                    .ok_or_else(bad)?;
+                Ok(chunk
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .take_while(|&c| c != 0)
+                    .filter_map(char::from_u32)
+                    .collect())
+            })
+            .collect::<Result<_>>()?,
+        ("|", 'S') => (0..n)
+            .map(|i| {
+                let chunk = data.get(i * width..(i + 1) * width).ok_or_else(bad)?;
+                Ok(String::from_utf8_lossy(chunk)
+                    .trim_end_matches('\0')
+                    .to_string())
+            })
+            .collect::<Result<_>>()?,
+        _ => return Err(bad()),
+    };
+    if labels.iter().any(|l| l.is_empty()) {
+        return Err(invalid(path, "a label is empty"));
+    }
+    Ok(labels)
+}
+
+/// Options of a stacked-array import.
+#[derive(Debug, Clone)]
+pub struct StackedParams {
+    /// The data's axes, e.g. `n,row,col,t` or `n,t,channel`.
+    pub axes: String,
+    /// Sampling rate, Hz.
+    pub fs: f64,
+    /// With a channel axis: the grid to place channels on (row-major); default `1 x channels`.
+    pub grid: Option<(usize, usize)>,
+}
+
+/// Imports `data` (`N` samples stacked along one axis) with `labels` (and optional speeds)
+/// into a new dataset folder: one `.npy` (f32, `(T, rows, cols)`) per sample, the manifest
+/// and `layout.toml`.
+///
+/// # Errors
+/// Axes that do not fit the data, labels or speeds of the wrong length, bad values, or
+/// `out` not empty.
+pub fn import_stacked(
+    data: &Path,
+    labels: &Path,
+    speeds: Option<&Path>,
+    p: &StackedParams,
+    out: &Path,
+) -> Result<usize> {
+    let axes = parse_axes(&p.axes)?;
+    if !(p.fs.is_finite() && p.fs > 0.0) {
+        return Err(ParamError::new("fs", "sampling rate must be positive", p.fs).into());
+    }
+    let array = read_numbers(data)?;
+    if array.ndim() != axes.len() {
+        return Err(invalid(
+            data,
+            format!(
+                "--axes names {} axes but the data has {} (shape {:?})",
+                axes.len(),
+                array.ndim(),
+                array.shape()
+            ),
+        ));
+    }
+    if let Some(pos) = array.iter().position(|v| !v.is_finite()) {
+        return Err(invalid(
+            data,
+            format!("value {pos} (flat index) is not finite"),
+        ));
+    }
+    let find = |a: AxisName| axes.iter().position(|&x| x == a);
+    let has_grid = find(AxisName::Row).is_some();
+    let order: Vec<usize> = if has_grid {
+        [AxisName::N, AxisName::T, AxisName::Row, AxisName::Col]
+            .iter()
+            .filter_map(|&a| find(a))
+            .collect()
+    } else {
+        [AxisName::N, AxisName::T, AxisName::Channel]
+            .iter()
+            .filter_map(|&a| find(a))
+            .collect()
+    };
+    let arr = array
+        .permuted_axes(IxDyn(&order))
+        .as_standard_layout()
+        .into_owned();
+    let shape = arr.shape().to_vec();
+    let (n, t) = (shape[0], shape[1]);
+    let (rows, cols) = if has_grid {
+        (shape[2], shape[3])
+    } else {
+        let ch = shape[2];
+        match p.grid {
+            Some((r, c)) if r * c == ch => (r, c),
+            Some((r, c)) => {
+                return Err(ParamError::new(
+                    "grid",
+                    "the grid must have as many cells as channels",
+                    format!("{r}x{c} for {ch} channels"),
+                )
+                .into())
+            }
+            None => (1, ch),
+        }
+    };
+    if n == 0 || t == 0 {
+        return Err(invalid(
+            data,
+            format!("no samples or no time steps (shape {shape:?})"),
+        ));
+    }
+    let labels = read_labels(labels)?.into_iter().collect::<Vec<_>>();
+    if labels.len() != n {
+        return Err(
+            DataError::invalid(data, format!("{} labels for {n} samples", labels.len())).into(),
+        );
+    }
+    let speeds: Vec<f64> = match speeds {
+        Some(path) => {
+            let s = read_numbers(path)?;
+            if s.len() != n {
+                return Err(invalid(path, format!("{} speeds for {n} samples", s.len())));
+            }
+            s.iter().copied().collect()
+        }
+        None => vec![0.0; n],
+    };
+    let mut trial_of: BTreeMap<(String, u64), i64> = BTreeMap::new();
+    create_dataset_dir(out, |tmp| {
+        let metas: Vec<Meta> = (0..n)
+            .map(|i| {
+                let trial = trial_of
+                    .entry((labels[i].clone(), speeds[i].to_bits()))
+                    .or_insert(0);
+                let meta = Meta {
+                    file: format!("sample_{i:05}.npy"),
+                    label: labels[i].clone(),
+                    speed_mm_s: speeds[i],
+                    force_n: 0.0,
+                    trial: *trial,
+                    ..Meta::default()
+                };
+                *trial += 1;
+                meta
+            })
+            .collect();
+        metas
+            .par_iter()
+            .enumerate()
+            .try_for_each(|(i, m)| -> Result<()> {
+                let sample = arr.index_axis(Axis(0), i);
+                let values: Vec<f32> = sample.iter().map(|&v| v as f32).collect();
+                let a = ndarray::Array3::from_shape_vec((t, rows, cols), values)
+                    .map_err(|e| DataError::invalid(data, e.to_string()))?;
+                let path = tmp.join(&m.file);
+                ndarray_npy::write_npy(&path, &a)
+                    .map_err(|e| DataError::invalid(&path, e.to_string()))?;
+                Ok(())
+            })?;
+        write_layout(
+            tmp,
+            &LayoutFile {
+                fs: Some(p.fs),
+                rows: Some(rows),
+                cols: Some(cols),
+                ..LayoutFile::default()
+            },
+        )?;
+        write_manifest(tmp, &metas)
+    })?;
+    Ok(n)
+}

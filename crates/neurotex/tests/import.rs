@@ -1,0 +1,336 @@
+//! Importing CSV logs and stacked arrays.
+
+use std::path::{Path, PathBuf};
+
+use ndarray::{Array, Array1, ArrayD, IxDyn};
+use ndarray_npy::write_npy;
+use neurotex::import::{
+    csv_files, import_csv, import_stacked, ChannelSelect, CsvImportParams, NamePattern,
+    StackedParams,
+};
+use neurotex::recording::{Baseline, Dataset};
+use neurotex::signal::{PreprocessParams, Preprocessor};
+
+fn params() -> CsvImportParams {
+    CsvImportParams {
+        pattern: Some(NamePattern::parse("{label}_V{speed}_{trial}.csv").unwrap()),
+        time_column: Some("stamp".into()),
+        time_unit_s: 1e-3,
+        channels: ChannelSelect::All,
+        grid: None,
+        channel_map: None,
+        fs: None,
+        baseline: None,
+        skip_bad: false,
+    }
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn name_patterns_take_fields_from_file_names() {
+    let p = NamePattern::parse("{label}_F{force}_V{speed}mmps_{trial}.csv").unwrap();
+    let f = p.matches("BeigeCotton_F120_V-100mmps_2.csv").unwrap();
+    assert_eq!(f["label"], "BeigeCotton");
+    assert_eq!(f["force"], "120");
+    assert_eq!(f["speed"], "-100");
+    assert_eq!(f["trial"], "2");
+    // a label with the separator in it still matches: fields take as little as possible
+    let f = p.matches("Denim_Flex_F150_V20mmps_0.csv").unwrap();
+    assert_eq!(f["label"], "Denim_Flex");
+    assert!(p.matches("BeigeCotton_F120_100mmps_2.csv").is_none());
+    assert!(p.matches("BeigeCotton_F120_V-100mmps_2.txt").is_none());
+    for bad in ["{label", "label}", "{}_x", "{a}{b}", "plain.csv"] {
+        assert!(NamePattern::parse(bad).is_err(), "{bad}");
+    }
+}
+
+#[test]
+fn irregular_stamps_and_gaps_are_kept_then_resampled_to_1_ms() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir(&src).unwrap();
+    // jittered 25 ms stamps with a 100 ms gap; channel a rises linearly with time
+    let stamps = [
+        1000.0, 1026.0, 1049.0, 1075.0, 1175.0, 1201.0, 1224.0, 1250.0, 1276.0, 1300.0,
+    ];
+    let mut text = String::from("stamp,a,b\n");
+    for t in stamps {
+        text.push_str(&format!("{t},{},{}\n", (t - 1000.0) / 10.0, 5));
+    }
+    write(&src, "X_V5_0.csv", &text);
+    write(&src, "Y_V5_0.csv", &text);
+    let out = dir.path().join("ds");
+    let summary = import_csv(&csv_files(&[src]).unwrap(), &params(), &out, &|| {}).unwrap();
+    assert_eq!(summary.written, 2);
+    let ds = Dataset::open(&out).unwrap();
+    assert_eq!(ds.entries[0].speed_mm_s, 5.0);
+    let rec = ds.load(0).unwrap();
+    let times = rec.times_s.as_ref().unwrap();
+    assert_eq!(times.len(), stamps.len());
+    assert!((times[4] - times[3] - 0.1).abs() < 1e-12, "the gap is kept");
+    let pre = Preprocessor::new(&PreprocessParams {
+        cutoff_hz: 0.0,
+        ..Default::default()
+    })
+    .unwrap();
+    let cond = pre.apply(&rec, Baseline::None).unwrap();
+    assert!(cond.resampled);
+    assert_eq!(cond.n_steps(), 301, "300 ms on the 1 ms grid");
+    // linear interpolation: a(t) = t / 10 ms, normalised by its maximum 30 at 300 ms;
+    // b = 5 everywhere (the maximum is over all taxels, so b/30).
+    for step in [0usize, 13, 100, 120, 299] {
+        let a = cond.samples[step * 2];
+        assert!(
+            (a - step as f64 / 10.0 / 30.0).abs() < 1e-9,
+            "step {step}: {a}"
+        );
+        assert!((cond.samples[step * 2 + 1] - 5.0 / 30.0).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn channels_by_list_or_regex_and_a_masked_6x10_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir(&src).unwrap();
+    let names: Vec<String> = (0..52).map(|k| format!("tax{k}")).collect();
+    let mut text = format!("stamp,temp,{}\n", names.join(","));
+    for t in 0..20 {
+        let values: Vec<String> = (0..52).map(|k| format!("{}", k * 100 + t)).collect();
+        text.push_str(&format!("{},{},{}\n", t * 10, 36.6, values.join(",")));
+    }
+    write(&src, "A_V10_0.csv", &text);
+    // a regular expression picks the 52 taxels and leaves the temperature out;
+    // 52 channels on a 6x10 grid: the last 8 cells are masked
+    let mut p = params();
+    p.channels = ChannelSelect::parse(r"^tax\d+$").unwrap();
+    p.grid = Some((6, 10));
+    let out = dir.path().join("grid");
+    let summary = import_csv(
+        &csv_files(std::slice::from_ref(&src)).unwrap(),
+        &p,
+        &out,
+        &|| {},
+    )
+    .unwrap();
+    let mask = summary.layout.mask.clone().unwrap();
+    assert_eq!(mask[5], "1100000000");
+    assert_eq!(mask[4], "1111111111");
+    let rec = Dataset::open(&out).unwrap().load(0).unwrap();
+    assert_eq!((rec.layout.rows, rec.layout.cols), (6, 10));
+    assert_eq!(rec.layout.present.iter().filter(|&&x| x).count(), 52);
+    assert_eq!(
+        rec.samples[60 + 51],
+        5101.0,
+        "frame 1, channel 51 at row 5, col 1"
+    );
+    // a list picks channels in the given order
+    let mut p = params();
+    p.channels = ChannelSelect::parse("tax3, tax1").unwrap();
+    let out = dir.path().join("list");
+    import_csv(&csv_files(&[src]).unwrap(), &p, &out, &|| {}).unwrap();
+    let rec = Dataset::open(&out).unwrap().load(0).unwrap();
+    assert_eq!(&rec.samples[..2], &[300.0, 100.0]);
+}
+
+#[test]
+fn bad_csv_files_are_named_or_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir(&src).unwrap();
+    write(&src, "A_V5_0.csv", "stamp,a\n0,1\n10,2\n20,3\n");
+    write(&src, "A_V5_1.csv", "stamp,a\n0,1\n10,NaN\n20,3\n");
+    let files = csv_files(std::slice::from_ref(&src)).unwrap();
+    let err = import_csv(&files, &params(), &dir.path().join("x"), &|| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("A_V5_1.csv") && err.contains("line 3") && err.contains("NaN"),
+        "{err}"
+    );
+    assert!(!dir.path().join("x").exists());
+    let mut p = params();
+    p.skip_bad = true;
+    let s = import_csv(&files, &p, &dir.path().join("y"), &|| {}).unwrap();
+    assert_eq!((s.written, s.skipped.len()), (1, 1));
+    std::fs::remove_file(src.join("A_V5_1.csv")).unwrap();
+    write(&src, "wrong.csv", "stamp,a\n0,1\n");
+    let err = import_csv(
+        &csv_files(&[src]).unwrap(),
+        &params(),
+        &dir.path().join("z"),
+        &|| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("wrong.csv") && err.contains("does not match"),
+        "{err}"
+    );
+}
+
+/// A stacked array `(N, T, rows, cols)` whose value encodes its own indices.
+fn reference(n: usize, t: usize, r: usize, c: usize) -> ArrayD<f32> {
+    Array::from_shape_fn(IxDyn(&[n, t, r, c]), |i| {
+        (i[0] * 1000 + i[1] * 100 + i[2] * 10 + i[3]) as f32
+    })
+}
+
+#[test]
+fn every_axes_order_gives_the_same_recordings() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = reference(4, 5, 2, 3);
+    let labels = Array1::from(vec![1i64, 2, 1, 2]);
+    write_npy(dir.path().join("labels.npy"), &labels).unwrap();
+    let names = ["n", "t", "row", "col"];
+    let mut orders = Vec::new();
+    for a in 0..4 {
+        for b in 0..4 {
+            for c in 0..4 {
+                for d in 0..4 {
+                    let o = [a, b, c, d];
+                    if (0..4).all(|k| o.contains(&k)) {
+                        orders.push(o);
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(orders.len(), 24);
+    for (k, order) in orders.iter().enumerate() {
+        // stored with axis j of the file being axis order[j] of the reference
+        let data = base
+            .clone()
+            .permuted_axes(IxDyn(order))
+            .as_standard_layout()
+            .into_owned();
+        let data_path = dir.path().join(format!("data{k}.npy"));
+        write_npy(&data_path, &data).unwrap();
+        let axes = order
+            .iter()
+            .map(|&a| names[a])
+            .collect::<Vec<_>>()
+            .join(",");
+        let out = dir.path().join(format!("ds{k}"));
+        let p = StackedParams {
+            axes: axes.clone(),
+            fs: 1000.0,
+            grid: None,
+        };
+        import_stacked(&data_path, &dir.path().join("labels.npy"), None, &p, &out).unwrap();
+        let ds = Dataset::open(&out).unwrap();
+        assert_eq!(ds.labels(), vec!["1", "2"]);
+        for i in 0..4 {
+            let rec = ds.load(i).unwrap();
+            assert_eq!(
+                (rec.len(), rec.layout.rows, rec.layout.cols),
+                (5, 2, 3),
+                "{axes}"
+            );
+            let expected: Vec<f64> = (0..5)
+                .flat_map(|t| {
+                    (0..2).flat_map(move |r| {
+                        (0..3).map(move |c| (i * 1000 + t * 100 + r * 10 + c) as f64)
+                    })
+                })
+                .collect();
+            assert_eq!(rec.samples, expected, "{axes}, sample {i}");
+        }
+    }
+    // channel axes in both orders, placed on a grid
+    let chans = Array::from_shape_fn(IxDyn(&[2, 6, 4]), |i| {
+        (i[0] * 100 + i[1] * 10 + i[2]) as f32
+    });
+    write_npy(dir.path().join("labels2.npy"), &Array1::from(vec![0i32, 1])).unwrap();
+    for (k, axes) in ["n,t,channel", "n,channel,t"].iter().enumerate() {
+        let data = if k == 0 {
+            chans.clone()
+        } else {
+            chans
+                .clone()
+                .permuted_axes(IxDyn(&[0, 2, 1]))
+                .as_standard_layout()
+                .into_owned()
+        };
+        let path = dir.path().join(format!("chan{k}.npy"));
+        write_npy(&path, &data).unwrap();
+        let out = dir.path().join(format!("chan_ds{k}"));
+        let p = StackedParams {
+            axes: axes.to_string(),
+            fs: 500.0,
+            grid: Some((2, 2)),
+        };
+        import_stacked(&path, &dir.path().join("labels2.npy"), None, &p, &out).unwrap();
+        let rec = Dataset::open(&out).unwrap().load(1).unwrap();
+        assert_eq!((rec.layout.rows, rec.layout.cols, rec.fs), (2, 2, 500.0));
+        assert_eq!(&rec.samples[4..8], &[110.0, 111.0, 112.0, 113.0], "{axes}");
+    }
+}
+
+#[test]
+fn string_labels_and_speeds_and_bad_stacks() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = reference(3, 4, 1, 2);
+    write_npy(dir.path().join("x.npy"), &data).unwrap();
+    // numpy.save("labels.npy", numpy.array(["silk", "wool", "silk"])) writes '<U4'
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    let mut header = "{'descr': '<U4', 'fortran_order': False, 'shape': (3,), }".to_string();
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    npy.extend((header.len() as u16).to_le_bytes());
+    npy.extend(header.as_bytes());
+    for word in ["silk", "wool", "silk"] {
+        for ch in word.chars() {
+            npy.extend((ch as u32).to_le_bytes());
+        }
+    }
+    std::fs::write(dir.path().join("labels.npy"), &npy).unwrap();
+    write_npy(
+        dir.path().join("speeds.npy"),
+        &Array1::from(vec![5.0f64, 5.0, 10.0]),
+    )
+    .unwrap();
+    let p = StackedParams {
+        axes: "n,t,row,col".into(),
+        fs: 1000.0,
+        grid: None,
+    };
+    let out = dir.path().join("ds");
+    import_stacked(
+        &dir.path().join("x.npy"),
+        &dir.path().join("labels.npy"),
+        Some(&dir.path().join("speeds.npy")),
+        &p,
+        &out,
+    )
+    .unwrap();
+    let ds = Dataset::open(&out).unwrap();
+    assert_eq!(ds.labels(), vec!["silk", "wool"]);
+    assert_eq!(ds.speeds(), vec![5.0, 10.0]);
+    // bad: axes count, axes names, label count
+    let x = dir.path().join("x.npy");
+    let lab = dir.path().join("labels.npy");
+    let err = |axes: &str, labels: &Path, out: &str| {
+        let p = StackedParams {
+            axes: axes.into(),
+            fs: 1000.0,
+            grid: None,
+        };
+        import_stacked(&x, labels, None, &p, &dir.path().join(out))
+            .unwrap_err()
+            .to_string()
+    };
+    assert!(err("n,t,channel", &lab, "a").contains("names 3 axes but the data has 4"));
+    assert!(err("n,t,row,row", &lab, "b").contains("axes must name"));
+    assert!(err("n,t,x,col", &lab, "c").contains("n, t, row, col or channel"));
+    write_npy(dir.path().join("two.npy"), &Array1::from(vec![1i64, 2])).unwrap();
+    assert!(err("n,t,row,col", &dir.path().join("two.npy"), "d").contains("2 labels for 3 samples"));
+    assert!(!dir.path().join("d").exists());
+}
