@@ -619,3 +619,227 @@ fn simulate_writes_a_dataset_the_pipeline_reads() {
     assert!(err.contains("positive"), "{err}");
     assert!(!tmp.path().join("x").exists() && !tmp.path().join("y").exists());
 }
+
+fn fabricslide() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/fabricslide/fabric");
+    dir.is_dir().then_some(dir)
+}
+
+const FABRIC_PATTERN: &str = "{label}_F{force}_V{speed}mmps_{trial}.csv";
+
+#[test]
+fn fabricslide_subset_imports_and_classifies_well_above_chance() {
+    let Some(src) = fabricslide() else {
+        eprintln!("skipped: ../shared/data/fabricslide is not beside the repository");
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    // every fabric at 10 mm/s in both directions, every force and repeat
+    let subset = tmp.path().join("subset");
+    std::fs::create_dir(&subset).unwrap();
+    let mut at_10 = 0;
+    for entry in std::fs::read_dir(&src).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if name.contains("_V10mmps_") || name.contains("_V-10mmps_") {
+            std::fs::copy(src.join(&name), subset.join(&name)).unwrap();
+            at_10 += usize::from(name.contains("_V10mmps_"));
+        }
+    }
+    let out = tmp.path().join("ds");
+    ok(&[
+        "import",
+        "csv",
+        s(&subset),
+        "--out",
+        s(&out),
+        "--name-pattern",
+        FABRIC_PATTERN,
+        "--time-column",
+        "timestamp",
+        "--channels",
+        r"^channel\d+$",
+        "--grid",
+        "4x4",
+        "--baseline",
+        "min",
+    ]);
+    let layout = std::fs::read_to_string(out.join("layout.toml")).unwrap();
+    assert!(
+        layout.contains("kind = \"min\"") && layout.contains("rows = 4"),
+        "{layout}"
+    );
+    let json: Value = serde_json::from_str(&ok(&[
+        "evaluate",
+        "--dataset",
+        s(&out),
+        "--method",
+        "glcm3d",
+        "--speeds",
+        "10",
+        "--json",
+    ]))
+    .unwrap();
+    assert_eq!(json["n"].as_u64(), Some(at_10 as u64));
+    let acc = json["accuracy"].as_f64().unwrap();
+    // chance is 1/7 for seven fabrics
+    assert!(
+        acc > 0.4,
+        "3D-GLCM accuracy {acc} on seven fabrics at 10 mm/s"
+    );
+    let json: Value = serde_json::from_str(&ok(&[
+        "evaluate",
+        "--dataset",
+        s(&out),
+        "--method",
+        "taxel",
+        "--json",
+    ]))
+    .unwrap();
+    assert!(json["best"]["accuracy"].as_f64().unwrap() > 0.4);
+}
+
+#[test]
+fn import_bad_input_is_named_through_the_binary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let src = tmp.path().join("src");
+    std::fs::create_dir(&src).unwrap();
+    std::fs::write(
+        src.join("Silk_F1_V5mmps_0.csv"),
+        "timestamp,channel1,channel2\n0,1,2\n28,1,NaN\n",
+    )
+    .unwrap();
+    std::fs::write(
+        src.join("Silk_F1_V5mmps_1.csv"),
+        "timestamp,channel1,channel2\n0,1,2\n28,1,3\n",
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let o = s(&out);
+    let csv = |extra: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["import", "csv", s(&src), "--out", o];
+        v.extend_from_slice(extra);
+        v
+    };
+    // every case but the time-column ones reads the time stamps from `timestamp`
+    let timed = |extra: &[&'static str]| -> Vec<&str> {
+        let mut v = csv(&["--time-column", "timestamp"]);
+        v.extend_from_slice(extra);
+        v
+    };
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            timed(&["--name-pattern", "{label}-{trial}.csv"]),
+            "does not match --name-pattern",
+        ),
+        (timed(&["--name-pattern", "{label"]), "name-pattern"),
+        (
+            timed(&[
+                "--name-pattern",
+                FABRIC_PATTERN,
+                "--channels",
+                "channel1,channel9",
+            ]),
+            "missing channel column `channel9`",
+        ),
+        (
+            csv(&["--time-column", "time", "--name-pattern", FABRIC_PATTERN]),
+            "missing time column `time`",
+        ),
+        (
+            timed(&["--name-pattern", FABRIC_PATTERN]),
+            "line 3, column `channel2`",
+        ),
+        (
+            timed(&[
+                "--name-pattern",
+                FABRIC_PATTERN,
+                "--grid",
+                "1x1",
+                "--skip-bad",
+            ]),
+            "grid",
+        ),
+        (
+            timed(&["--name-pattern", FABRIC_PATTERN, "--grid", "four"]),
+            "ROWSxCOLS",
+        ),
+        (csv(&["--name-pattern", FABRIC_PATTERN]), "--fs"),
+    ];
+    for (args, expected) in cases {
+        let err = fails(&args);
+        assert!(
+            err.contains(expected),
+            "{args:?}: expected `{expected}` in {err}"
+        );
+        assert!(!out.exists(), "{args:?} left an output folder");
+    }
+    // --skip-bad leaves the NaN file out with a warning and imports the rest
+    let run = neurotex(&timed(&["--name-pattern", FABRIC_PATTERN, "--skip-bad"]));
+    assert!(run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("left out"));
+    assert_eq!(
+        std::fs::read_to_string(out.join("manifest.csv"))
+            .unwrap()
+            .lines()
+            .count(),
+        2
+    );
+
+    // stacked: shape/axes mismatch and labels of the wrong length
+    let data = ndarray::Array::from_elem(ndarray::IxDyn(&[3, 10, 2, 2]), 1.0f32);
+    write_npy(tmp.path().join("x.npy"), &data).unwrap();
+    write_npy(
+        tmp.path().join("y.npy"),
+        &ndarray::Array1::from(vec![0i64, 1]),
+    )
+    .unwrap();
+    let x = tmp.path().join("x.npy");
+    let y = tmp.path().join("y.npy");
+    let st = tmp.path().join("st");
+    let err = fails(&[
+        "import",
+        "stacked",
+        "--data",
+        s(&x),
+        "--labels",
+        s(&y),
+        "--axes",
+        "n,t,channel",
+        "--fs",
+        "100",
+        "--out",
+        s(&st),
+    ]);
+    assert!(err.contains("names 3 axes but the data has 4"), "{err}");
+    let err = fails(&[
+        "import",
+        "stacked",
+        "--data",
+        s(&x),
+        "--labels",
+        s(&y),
+        "--axes",
+        "n,t,row,col",
+        "--fs",
+        "100",
+        "--out",
+        s(&st),
+    ]);
+    assert!(err.contains("2 labels for 3 samples"), "{err}");
+    let err = fails(&[
+        "import",
+        "stacked",
+        "--data",
+        s(&x),
+        "--labels",
+        s(&y),
+        "--axes",
+        "n,t,row,col",
+        "--fs",
+        "0",
+        "--out",
+        s(&st),
+    ]);
+    assert!(err.contains("fs"), "{err}");
+    assert!(!st.exists());
+}
