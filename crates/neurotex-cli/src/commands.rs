@@ -22,9 +22,10 @@ pub struct EncodeArgs {
     /// Where to write the spikes: u8 `.npy` of shape `(T, rows, cols)` at 1 kHz.
     #[arg(long)]
     pub out: PathBuf,
-    /// Sampling rate of the input in Hz (ignored when the CSV has a time column).
-    #[arg(long, default_value_t = 1000.0)]
-    pub fs: f64,
+    /// Sampling rate of the input in Hz (default: the layout's, else 1000; ignored when the
+    /// CSV has a time column).
+    #[arg(long, allow_negative_numbers = true)]
+    pub fs: Option<f64>,
     /// A `layout.toml` giving grid, channel map, mask or baseline for the input.
     #[arg(long)]
     pub layout: Option<PathBuf>,
@@ -172,17 +173,16 @@ pub fn simulate(args: SimulateArgs) -> Result<()> {
 
 pub fn encode(args: EncodeArgs) -> Result<()> {
     let params = args.stages.pipeline()?;
-    if !(args.fs.is_finite() && args.fs > 0.0) {
-        bail!(
-            "--fs must be a positive sampling rate in Hz, got {}",
-            args.fs
-        );
-    }
     let mut layout = match &args.layout {
         Some(path) => LayoutFile::read(path)?,
         None => LayoutFile::default(),
     };
-    layout.fs = Some(args.fs);
+    if let Some(fs) = args.fs {
+        if !(fs.is_finite() && fs > 0.0) {
+            bail!("--fs must be a positive sampling rate in Hz, got {fs}");
+        }
+        layout.fs = Some(fs);
+    }
     let rec = read_recording(&args.input, &layout)?;
     let pipeline = Pipeline::new(params)?;
     let encoded = pipeline.encode(&rec, layout.baseline.unwrap_or_default())?;
@@ -636,7 +636,7 @@ pub struct ImportCsvArgs {
     #[arg(long = "channel-map")]
     pub channel_map: Option<String>,
     /// Nominal sampling rate in Hz (needed without a time column; else the median interval).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub fs: Option<f64>,
     /// Baseline removal to record in layout.toml: `none` or `min` (capacitive sensors rest
     /// at a large offset).
@@ -661,7 +661,7 @@ pub struct ImportStackedArgs {
     #[arg(long)]
     pub axes: String,
     /// Sampling rate in Hz.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub fs: f64,
     /// One speed (mm/s) per sample, `.npy`.
     #[arg(long)]

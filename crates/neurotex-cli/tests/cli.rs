@@ -843,3 +843,37 @@ fn import_bad_input_is_named_through_the_binary() {
     assert!(err.contains("fs"), "{err}");
     assert!(!st.exists());
 }
+
+#[test]
+fn encode_takes_the_rate_from_a_layout_unless_fs_is_given() {
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("in.npy");
+    write_npy(&input, &recording(400, 80.0, 0.3, 2)).unwrap();
+    let layout = tmp.path().join("layout.toml");
+    std::fs::write(&layout, "fs = 500.0\n").unwrap();
+    let out = tmp.path().join("a.npy");
+    ok(&[
+        "encode",
+        s(&input),
+        "--out",
+        s(&out),
+        "--layout",
+        s(&layout),
+    ]);
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape()[0], 799, "400 samples at 500 Hz span 798 ms");
+    ok(&[
+        "encode",
+        s(&input),
+        "--out",
+        s(&out),
+        "--layout",
+        s(&layout),
+        "--fs",
+        "1000",
+    ]);
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape()[0], 400);
+    let err = fails(&["encode", s(&input), "--out", s(&out), "--fs", "-5"]);
+    assert!(err.contains("--fs"), "{err}");
+}
