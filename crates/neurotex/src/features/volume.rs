@@ -126,18 +126,20 @@ impl RateVolume {
 /// all level 0. Masked cells get level 0 and are never paired by the GLCM.
 pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, out: &mut Vec<u8>) {
     let bins = volume.bins;
-    let present_values = || {
-        volume
+    let (lo, hi) = range.unwrap_or_else(|| {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for (row, _) in volume
             .data
             .chunks_exact(bins)
             .zip(&volume.present)
             .filter(|(_, &p)| p)
-            .flat_map(|(row, _)| row.iter().copied())
-    };
-    let (lo, hi) = range.unwrap_or_else(|| {
-        present_values().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-            (lo.min(x), hi.max(x))
-        })
+        {
+            for &x in row {
+                lo = lo.min(x);
+                hi = hi.max(x);
+            }
+        }
+        (lo, hi)
     });
     out.clear();
     out.resize(volume.data.len(), 0);
@@ -156,7 +158,7 @@ pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, o
             for (q, &x) in q.iter_mut().zip(x) {
                 // Clamped into [0, L-1] first, where truncation equals floor; written without
                 // branches or a call to floor so the loop vectorises.
-                let v = ((x - lo) / span * l).clamp(0.0, top);
+                let v = ((x - lo) / span * l).max(0.0).min(top);
                 *q = v as i32 as u8;
             }
         }
