@@ -796,50 +796,27 @@ fn import_bad_input_is_named_through_the_binary() {
     let x = tmp.path().join("x.npy");
     let y = tmp.path().join("y.npy");
     let st = tmp.path().join("st");
-    let err = fails(&[
-        "import",
-        "stacked",
-        "--data",
-        s(&x),
-        "--labels",
-        s(&y),
-        "--axes",
-        "n,t,channel",
-        "--fs",
-        "100",
-        "--out",
-        s(&st),
-    ]);
+    let stacked = |axes: &str, fs: &str| {
+        fails(&[
+            "import",
+            "stacked",
+            "--data",
+            s(&x),
+            "--labels",
+            s(&y),
+            "--axes",
+            axes,
+            "--fs",
+            fs,
+            "--out",
+            s(&st),
+        ])
+    };
+    let err = stacked("n,t,channel", "100");
     assert!(err.contains("names 3 axes but the data has 4"), "{err}");
-    let err = fails(&[
-        "import",
-        "stacked",
-        "--data",
-        s(&x),
-        "--labels",
-        s(&y),
-        "--axes",
-        "n,t,row,col",
-        "--fs",
-        "100",
-        "--out",
-        s(&st),
-    ]);
+    let err = stacked("n,t,row,col", "100");
     assert!(err.contains("2 labels for 3 samples"), "{err}");
-    let err = fails(&[
-        "import",
-        "stacked",
-        "--data",
-        s(&x),
-        "--labels",
-        s(&y),
-        "--axes",
-        "n,t,row,col",
-        "--fs",
-        "0",
-        "--out",
-        s(&st),
-    ]);
+    let err = stacked("n,t,row,col", "0");
     assert!(err.contains("fs"), "{err}");
     assert!(!st.exists());
 }
