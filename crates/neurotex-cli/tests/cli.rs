@@ -286,7 +286,7 @@ fn features_and_evaluate_on_a_dataset() {
 }
 
 #[test]
-fn same_seed_same_result_and_seed_changes_folds() {
+fn same_seed_gives_the_same_result() {
     let tmp = tempfile::tempdir().unwrap();
     let ds = dataset(&tmp.path().join("ds"), &["A", "B"], &[5.0], 10);
     let run = |seed: &str| {

@@ -4,6 +4,19 @@ use neurotex::encode::{encode, IzhikevichParams, SpikeTrains};
 use neurotex::features::glcm::GlcmKind;
 use neurotex::features::{haralick, quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume};
 
+/// The paper's 3D plan (13 directions x 1, 2, 4, 8) on a full 4x4 grid, 16 levels.
+fn paper_plan_4x4() -> GlcmPlan {
+    GlcmPlan::new(
+        4,
+        4,
+        &[true; 16],
+        16,
+        &GlcmParams::default(),
+        GlcmKind::ThreeD,
+    )
+    .unwrap()
+}
+
 fn counts_of(plan: &GlcmPlan, q: &[u8], bins: usize) -> Vec<u32> {
     let l = plan.levels();
     let mut c = vec![0u32; l * l];
@@ -27,15 +40,7 @@ fn constant_volume_is_one_gray_level() {
         q.iter().all(|&l| l == 0),
         "a constant volume is all level 0"
     );
-    let plan = GlcmPlan::new(
-        4,
-        4,
-        &[true; 16],
-        16,
-        &GlcmParams::default(),
-        GlcmKind::ThreeD,
-    )
-    .unwrap();
+    let plan = paper_plan_4x4();
     let c = counts_of(&plan, &q, vol.bins);
     let h = haralick(&c, 16);
     assert_eq!((h.contrast, h.correlation, h.asm), (0.0, 1.0, 1.0));
@@ -95,15 +100,7 @@ fn paper_offsets_on_4x4x90_count_23160_pairs() {
     // D = 1: 1080 + 810 + 1080 + 810 + 1068 + 1424 + 3 x 1068 + 4 x 801 = 12680
     // D = 2:  720 + 360 +  720 + 360 +  704 + 1408 + 3 x  704 + 4 x 352 =  7792
     // D = 4: 16 x 86 = 1376;  D = 8: 16 x 82 = 1312.  Total 23160.
-    let plan = GlcmPlan::new(
-        4,
-        4,
-        &[true; 16],
-        16,
-        &GlcmParams::default(),
-        GlcmKind::ThreeD,
-    )
-    .unwrap();
+    let plan = paper_plan_4x4();
     let q = vec![3u8; 16 * 90];
     let c = counts_of(&plan, &q, 90);
     assert_eq!(c.iter().sum::<u32>(), 23160);
