@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
-    create_dataset_dir, write_layout, write_manifest, Baseline, LayoutFile, Meta,
+    create_dataset_dir, read_csv_columns, write_layout, write_manifest, Baseline, LayoutFile, Meta,
 };
 
 /// A file-name pattern such as `{label}_F{force}_V{speed}mmps_{trial}.csv`: literal text and
@@ -298,51 +298,7 @@ fn parse_csv(path: &Path, p: &CsvImportParams) -> Result<ParsedCsv> {
     if channel_cols.is_empty() {
         return Err(invalid(path, "no channel columns selected"));
     }
-    let mut samples = Vec::new();
-    let mut times = time_col.map(|_| Vec::new());
-    let mut record = csv::ByteRecord::new();
-    let mut line = 1usize;
-    let field = |record: &csv::ByteRecord, j: usize, line: usize| -> Result<f64> {
-        let raw = record.get(j).unwrap_or(b"");
-        std::str::from_utf8(raw)
-            .ok()
-            .and_then(|s| s.parse::<f64>().ok())
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                invalid(
-                    path,
-                    format!(
-                        "line {line}, column `{}`: expected a finite number, got `{}`",
-                        &headers[j],
-                        String::from_utf8_lossy(raw)
-                    ),
-                )
-            })
-    };
-    loop {
-        match reader.read_byte_record(&mut record) {
-            Ok(false) => break,
-            Ok(true) => {}
-            Err(e) => return Err(invalid(path, format!("malformed CSV: {e}"))),
-        }
-        line += 1;
-        for &j in &channel_cols {
-            samples.push(field(&record, j, line)?);
-        }
-        if let (Some(j), Some(times)) = (time_col, times.as_mut()) {
-            // kept in the file's own unit, so whole milliseconds stay whole
-            let t = field(&record, j, line)?;
-            if let Some(&prev) = times.last() {
-                if t <= prev {
-                    return Err(invalid(
-                        path,
-                        format!("line {line}: time stamps must increase, got {t} after {prev}"),
-                    ));
-                }
-            }
-            times.push(t);
-        }
-    }
+    let (samples, times) = read_csv_columns(path, &mut reader, &headers, time_col, &channel_cols)?;
     if samples.is_empty() {
         return Err(invalid(path, "no data rows"));
     }

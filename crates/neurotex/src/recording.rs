@@ -702,45 +702,64 @@ fn read_csv_samples(
             .collect(),
     };
     let n = channel_cols.len();
+    let (samples, times) = read_csv_columns(path, &mut reader, &headers, time_col, &channel_cols)?;
+    let times = times.map(|t| t.into_iter().map(|x| x * unit_scale).collect());
+    Ok((Shape::Channels(n), samples, times))
+}
+
+/// Reads the data rows of an opened CSV file: the `channels` columns of every row, frame
+/// after frame, and the `time` column in the file's own unit, which must increase strictly.
+/// Every cell must be a finite number; errors name the file, line and column. Rows are read
+/// as bytes into one reused record, so no value allocates.
+///
+/// # Errors
+/// A malformed row, a cell that is not a finite number, or a time stamp that does not increase.
+pub(crate) fn read_csv_columns<R: std::io::Read>(
+    path: &Path,
+    reader: &mut csv::Reader<R>,
+    headers: &csv::StringRecord,
+    time: Option<usize>,
+    channels: &[usize],
+) -> Result<(Vec<f64>, Option<Vec<f64>>)> {
     let mut samples = Vec::new();
-    let mut times = time_col.map(|_| Vec::new());
-    let mut record = csv::StringRecord::new();
+    let mut times = time.map(|_| Vec::new());
+    let mut record = csv::ByteRecord::new();
     let mut line = 1usize;
     loop {
-        match reader.read_record(&mut record) {
+        match reader.read_byte_record(&mut record) {
             Ok(false) => break,
             Ok(true) => {}
             Err(e) => return Err(csv_error(path, e)),
         }
         line += 1;
         let parse = |j: usize| -> Result<f64> {
-            let s = record.get(j).unwrap_or("");
-            match s.parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(DataError::invalid(
-                    path,
-                    format!(
-                        "line {line}, column `{}`: expected a finite number, got `{s}`",
-                        &headers[j]
-                    ),
-                )
-                .into()),
-            }
+            let raw = record.get(j).unwrap_or(b"");
+            std::str::from_utf8(raw)
+                .ok()
+                .and_then(|s| s.trim().parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    DataError::invalid(
+                        path,
+                        format!(
+                            "line {line}, column `{}`: expected a finite number, got `{}`",
+                            &headers[j],
+                            String::from_utf8_lossy(raw)
+                        ),
+                    )
+                    .into()
+                })
         };
-        for &j in &channel_cols {
+        for &j in channels {
             samples.push(parse(j)?);
         }
-        if let (Some(j), Some(times)) = (time_col, times.as_mut()) {
-            let t = parse(j)? * unit_scale;
+        if let (Some(j), Some(times)) = (time, times.as_mut()) {
+            let t = parse(j)?;
             if let Some(&prev) = times.last() {
                 if t <= prev {
                     return Err(DataError::invalid(
                         path,
-                        format!(
-                            "line {line}: time stamps must increase, got {} after {}",
-                            t / unit_scale,
-                            prev / unit_scale
-                        ),
+                        format!("line {line}: time stamps must increase, got {t} after {prev}"),
                     )
                     .into());
                 }
@@ -748,7 +767,7 @@ fn read_csv_samples(
             times.push(t);
         }
     }
-    Ok((Shape::Channels(n), samples, times))
+    Ok((samples, times))
 }
 
 /// Writes `manifest.csv` for `metas` into `dir`: the required columns, the sliding interval
