@@ -8,9 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::encode::{encode, IzhikevichParams, SpikeTrains};
 use crate::error::{DataError, ParamError, Result};
 use crate::features::glcm::GlcmKind;
-use crate::features::{
-    haralick, quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume, VolumeParams,
-};
+use crate::features::{haralick, spike_stats, CountVolume, GlcmParams, GlcmPlan, VolumeParams};
 use crate::recording::{Baseline, Dataset, Meta, Recording};
 use crate::signal::{Conditioned, PreprocessParams, Preprocessor};
 
@@ -287,9 +285,9 @@ impl FeatureExtractor {
                 .collect()),
             Method::Glcm2d | Method::Glcm3d => {
                 let volume = if method == Method::Glcm3d {
-                    RateVolume::from_spikes(spikes, bin)
+                    CountVolume::from_spikes(spikes, bin)
                 } else {
-                    RateVolume::collapsed(spikes)
+                    CountVolume::collapsed(spikes)
                 }
                 .ok_or_else(too_short)?;
                 let same_grid = (spikes.rows, spikes.cols) == (self.rows, self.cols)
@@ -316,7 +314,7 @@ impl FeatureExtractor {
                     }
                 };
                 let mut q = Vec::new();
-                quantise(&volume, self.volume.levels, self.volume.range, &mut q);
+                volume.quantise(self.volume.levels, self.volume.range, &mut q);
                 let l = self.volume.levels;
                 let mut counts = vec![0u32; l * l];
                 plan.count(&q, volume.bins, &mut counts);

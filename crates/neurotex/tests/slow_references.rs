@@ -4,7 +4,10 @@
 use neurotex::classify::{Knn, KnnParams};
 use neurotex::encode::{Encoder, IzhikevichParams, SpikeTrains};
 use neurotex::features::glcm::GlcmKind;
-use neurotex::features::{quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume, DIRECTIONS_13};
+use neurotex::features::{
+    haralick, quantise, spike_stats, CountVolume, Counting, GlcmParams, GlcmPlan, RateVolume,
+    DIRECTIONS_13,
+};
 use proptest::prelude::*;
 
 /// Loop-built GLCM: every voxel, every direction times every distance, bounds and mask checked.
@@ -83,6 +86,40 @@ fn slow_encoder(input: &[f64], n: usize, p: IzhikevichParams) -> Vec<Vec<u32>> {
         .collect()
 }
 
+/// Haralick's features in two floating-point passes over the normalised matrix, straight
+/// from eqs. 5-8 (means and deviations of the marginals first, then the covariance).
+fn slow_haralick(counts: &[u32], levels: usize) -> [f64; 3] {
+    let total: f64 = counts.iter().map(|&c| c as f64).sum();
+    if total == 0.0 {
+        return [0.0, 1.0, 0.0];
+    }
+    let p = |i: usize, j: usize| counts[i * levels + j] as f64 / total;
+    let (mut contrast, mut asm, mut mu_x, mut mu_y) = (0.0, 0.0, 0.0, 0.0);
+    for i in 0..levels {
+        for j in 0..levels {
+            contrast += p(i, j) * (i as f64 - j as f64).powi(2);
+            asm += p(i, j) * p(i, j);
+            mu_x += i as f64 * p(i, j);
+            mu_y += j as f64 * p(i, j);
+        }
+    }
+    let (mut var_x, mut var_y, mut cov) = (0.0, 0.0, 0.0);
+    for i in 0..levels {
+        for j in 0..levels {
+            var_x += p(i, j) * (i as f64 - mu_x).powi(2);
+            var_y += p(i, j) * (j as f64 - mu_y).powi(2);
+            cov += p(i, j) * (i as f64 - mu_x) * (j as f64 - mu_y);
+        }
+    }
+    let (sd_x, sd_y) = (var_x.sqrt(), var_y.sqrt());
+    let correlation = if sd_x < 1e-15 || sd_y < 1e-15 {
+        1.0
+    } else {
+        cov / (sd_x * sd_y)
+    };
+    [contrast, correlation, asm]
+}
+
 /// KNN by sorting every distance (stable, so earlier training samples win distance ties).
 fn slow_knn(
     train: &[f64],
@@ -141,6 +178,34 @@ fn slow_knn(
         .collect()
 }
 
+/// Volumes like real rate volumes: each cell keeps to a few levels of its own, over up to
+/// 300 bins (more than one 128-bin mask block), so every counting method is exercised.
+fn few_levels_volume() -> impl Strategy<Value = (usize, usize, usize, usize, Vec<bool>, Vec<u8>)> {
+    (1usize..5, 1usize..5, 1usize..300, 2usize..40).prop_flat_map(|(rows, cols, bins, levels)| {
+        let cells = rows * cols;
+        (
+            Just(rows),
+            Just(cols),
+            Just(bins),
+            Just(levels),
+            proptest::collection::vec(proptest::bool::weighted(0.9), cells),
+            proptest::collection::vec(proptest::collection::vec(0u8..levels as u8, 1..5), cells),
+            proptest::collection::vec(any::<u8>(), cells * bins),
+        )
+            .prop_map(|(rows, cols, bins, levels, present, own, picks)| {
+                let q = picks
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &pick)| {
+                        let mine = &own[k / bins];
+                        mine[pick as usize % mine.len()]
+                    })
+                    .collect();
+                (rows, cols, bins, levels, present, q)
+            })
+    })
+}
+
 fn grid_and_volume() -> impl Strategy<Value = (usize, usize, usize, usize, Vec<bool>, Vec<u8>)> {
     (1usize..6, 1usize..6, 1usize..25, 2usize..17).prop_flat_map(|(rows, cols, bins, levels)| {
         (
@@ -171,7 +236,46 @@ proptest! {
         let mut fast = vec![0u32; levels * levels];
         plan.count(&q, bins, &mut fast);
         let slow = slow_glcm(&q, rows, cols, bins, &present, levels, &distances, dirs, symmetric);
-        prop_assert_eq!(fast, slow);
+        prop_assert_eq!(&fast, &slow);
+        for counting in [Counting::Histogram, Counting::LevelMasks] {
+            plan.count_with(&q, bins, &mut fast, counting);
+            prop_assert_eq!(&fast, &slow, "{:?}", counting);
+        }
+    }
+
+    #[test]
+    fn every_counting_method_matches_loop_built_glcm_on_few_level_volumes(
+        (rows, cols, bins, levels, present, q) in few_levels_volume(),
+        distances in proptest::sample::subsequence(vec![1usize, 2, 3, 4, 8, 130], 1..5),
+        symmetric in any::<bool>(),
+    ) {
+        let params = GlcmParams { distances: distances.clone(), symmetric };
+        let plan = GlcmPlan::new(rows, cols, &present, levels, &params, GlcmKind::ThreeD).unwrap();
+        let slow = slow_glcm(&q, rows, cols, bins, &present, levels, &distances, &DIRECTIONS_13, symmetric);
+        let mut fast = vec![0u32; levels * levels];
+        for counting in [Counting::Auto, Counting::Histogram, Counting::LevelMasks] {
+            plan.count_with(&q, bins, &mut fast, counting);
+            prop_assert_eq!(&fast, &slow, "{:?}", counting);
+        }
+    }
+
+    #[test]
+    fn haralick_matches_two_pass_definitions(
+        levels in 2usize..20,
+        seed in any::<u64>(),
+        zeros in 0.0f64..1.0,
+        scale in prop_oneof![Just(3u64), Just(1000), Just(u32::MAX as u64)],
+    ) {
+        let mut state = seed | 1;
+        let counts: Vec<u32> = (0..levels * levels).map(|_| {
+            state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+            if (state % 1000) as f64 / 1000.0 < zeros { 0 } else { ((state >> 20) % scale) as u32 }
+        }).collect();
+        let fast = haralick(&counts, levels).to_array();
+        let slow = slow_haralick(&counts, levels);
+        for (f, s) in fast.iter().zip(&slow) {
+            prop_assert!((f - s).abs() <= 1e-9 * s.abs().max(1e-3), "{:?} vs {:?}", fast, slow);
+        }
     }
 
     #[test]
@@ -252,7 +356,7 @@ proptest! {
     fn rate_volume_and_quantisation_match_definitions(
         lists in proptest::collection::vec(proptest::collection::btree_set(0u32..2000, 0..60), 6),
         n_steps in 200usize..2000,
-        bin in 50usize..400,
+        bin in prop_oneof![1usize..4, 50usize..400, 2000usize..2100],
         levels in 2usize..32,
     ) {
         let lists: Vec<Vec<u32>> = lists.into_iter().map(|s| s.into_iter().filter(|&t| (t as usize) < n_steps).collect()).collect();
@@ -271,6 +375,17 @@ proptest! {
         }
         let mut q = Vec::new();
         quantise(&vol, levels, None, &mut q);
+        // The count volume quantises to the same levels, with or without a fixed range.
+        let counted = CountVolume::from_spikes(&trains, bin).unwrap();
+        prop_assert_eq!(&counted.rates(), &vol);
+        let mut from_counts = Vec::new();
+        counted.quantise(levels, None, &mut from_counts);
+        prop_assert_eq!(&from_counts, &q);
+        let range = Some((5.0, 5.0 + 37.5 * levels as f64));
+        let mut fixed = Vec::new();
+        quantise(&vol, levels, range, &mut fixed);
+        counted.quantise(levels, range, &mut from_counts);
+        prop_assert_eq!(&from_counts, &fixed);
         let lo = vol.data.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = vol.data.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         for (&x, &level) in vol.data.iter().zip(&q) {

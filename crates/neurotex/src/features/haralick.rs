@@ -23,61 +23,74 @@ impl Haralick {
 /// Features of the `levels x levels` count matrix `counts`, normalised by its total.
 /// An all-zero matrix (no pairs at all) gives contrast 0, correlation 1, ASM 0.
 ///
+/// Every sum is taken over the integer counts exactly (the marginals' means and variances
+/// as `N * sum(i^2 r_i) - (sum(i r_i))^2` over `N^2`, and so on); only the final ratios are
+/// rounded, so the features are as exact as f64 allows and one pass suffices.
+///
 /// # Panics
 /// If `counts` is not square in `levels` (a caller bug).
 pub fn haralick(counts: &[u32], levels: usize) -> Haralick {
     assert_eq!(counts.len(), levels * levels);
-    let total: f64 = counts.iter().map(|&c| f64::from(c)).sum();
-    if total == 0.0 {
+    let (mut total, mut contrast, mut square, mut cross) = (0u64, 0u128, 0u128, 0u128);
+    let mut column = vec![0u64; levels];
+    let (mut s_i, mut s_ii) = (0u128, 0u128);
+    for (i, row) in counts.chunks_exact(levels).enumerate() {
+        let mut row_total = 0u64;
+        let mut row_cross = 0u64;
+        for (j, (&c, col)) in row.iter().zip(column.iter_mut()).enumerate() {
+            let c = u64::from(c);
+            let d = i.abs_diff(j) as u64;
+            row_total += c;
+            row_cross += c * j as u64;
+            contrast += u128::from(c * d * d);
+            square += u128::from(c * c);
+            *col += c;
+        }
+        let i = i as u128;
+        total += row_total;
+        cross += i * u128::from(row_cross);
+        s_i += i * u128::from(row_total);
+        s_ii += i * i * u128::from(row_total);
+    }
+    if total == 0 {
         return Haralick {
             contrast: 0.0,
             correlation: 1.0,
             asm: 0.0,
         };
     }
-    let inv = 1.0 / total;
-    let (mut px, mut py) = (vec![0.0; levels], vec![0.0; levels]);
-    let (mut contrast, mut asm) = (0.0, 0.0);
-    for i in 0..levels {
-        for j in 0..levels {
-            let p = f64::from(counts[i * levels + j]) * inv;
-            let d = i as f64 - j as f64;
-            contrast += p * d * d;
-            asm += p * p;
-            px[i] += p;
-            py[j] += p;
-        }
-    }
-    let mean = |m: &[f64]| {
-        m.iter()
-            .enumerate()
-            .map(|(i, &p)| i as f64 * p)
-            .sum::<f64>()
-    };
-    let (mu_x, mu_y) = (mean(&px), mean(&py));
-    let sd = |m: &[f64], mu: f64| {
-        m.iter()
-            .enumerate()
-            .map(|(i, &p)| p * (i as f64 - mu).powi(2))
-            .sum::<f64>()
-            .sqrt()
-    };
-    let (sd_x, sd_y) = (sd(&px, mu_x), sd(&py, mu_y));
+    let (s_j, s_jj) = column
+        .iter()
+        .enumerate()
+        .fold((0u128, 0u128), |(s, ss), (j, &c)| {
+            let j = j as u128;
+            (s + j * u128::from(c), ss + j * j * u128::from(c))
+        });
+    let n = total as f64;
+    let big_n = u128::from(total);
+    // N^2 times the covariance and the variances, exact: with u32 counts and at most 256
+    // levels, N < 2^48 and every product below stays under 2^113.
+    let cov = signed_difference(big_n * cross, s_i * s_j);
+    let var_x = signed_difference(big_n * s_ii, s_i * s_i);
+    let var_y = signed_difference(big_n * s_jj, s_j * s_j);
+    let (sd_x, sd_y) = (var_x.max(0.0).sqrt() / n, var_y.max(0.0).sqrt() / n);
     let correlation = if sd_x < 1e-15 || sd_y < 1e-15 {
         1.0
     } else {
-        let mut cov = 0.0;
-        for i in 0..levels {
-            for j in 0..levels {
-                let p = f64::from(counts[i * levels + j]) * inv;
-                cov += p * (i as f64 - mu_x) * (j as f64 - mu_y);
-            }
-        }
-        cov / (sd_x * sd_y)
+        cov / (var_x.sqrt() * var_y.sqrt())
     };
     Haralick {
-        contrast,
+        contrast: contrast as f64 / n,
         correlation,
-        asm,
+        asm: square as f64 / (n * n),
+    }
+}
+
+/// `a - b` of two exact integers, as f64 (rounded once).
+fn signed_difference(a: u128, b: u128) -> f64 {
+    if a >= b {
+        (a - b) as f64
+    } else {
+        -((b - a) as f64)
     }
 }

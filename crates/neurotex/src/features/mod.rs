@@ -6,7 +6,7 @@ pub mod haralick;
 pub mod spike_stats;
 pub mod volume;
 
-pub use glcm::{GlcmParams, GlcmPlan, DIRECTIONS_13};
+pub use glcm::{Counting, GlcmParams, GlcmPlan, DIRECTIONS_13};
 pub use haralick::{haralick, Haralick};
 pub use spike_stats::{spike_stats, SpikeStats};
-pub use volume::{quantise, RateVolume, VolumeParams};
+pub use volume::{quantise, CountVolume, RateVolume, VolumeParams};

@@ -77,47 +77,177 @@ impl RateVolume {
     /// Bins the trains into `bin_ms` bins; a last bin shorter than `bin_ms` is dropped.
     /// Returns `None` when not one whole bin fits.
     pub fn from_spikes(spikes: &SpikeTrains, bin_ms: usize) -> Option<Self> {
-        let bins = spikes.n_steps / bin_ms.max(1);
-        if bins == 0 {
-            return None;
-        }
-        Some(Self::binned(spikes, bin_ms, bins))
+        CountVolume::from_spikes(spikes, bin_ms).map(|c| c.rates())
     }
 
     /// One bin spanning the whole train (the time-collapsed image of the 2D-GLCM).
     /// Returns `None` for an empty train.
+    pub fn collapsed(spikes: &SpikeTrains) -> Option<Self> {
+        CountVolume::collapsed(spikes).map(|c| c.rates())
+    }
+}
+
+/// Spike counts per bin, the rate volume before scaling to Hz. Its quantisation equals the
+/// rate volume's exactly and is cheaper: a volume holds few distinct counts, so each
+/// count's level is computed once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CountVolume {
+    /// Grid rows.
+    pub rows: usize,
+    /// Grid columns.
+    pub cols: usize,
+    /// Time bins.
+    pub bins: usize,
+    /// Bin width in ms.
+    pub bin_ms: usize,
+    /// Which cells hold a taxel.
+    pub present: Vec<bool>,
+    /// `rows * cols * bins` counts, index `cell * bins + bin`.
+    pub counts: Vec<u32>,
+}
+
+impl CountVolume {
+    /// Counts the trains' spikes in `bin_ms` bins; a last bin shorter than `bin_ms` is
+    /// dropped. Returns `None` when not one whole bin fits.
+    pub fn from_spikes(spikes: &SpikeTrains, bin_ms: usize) -> Option<Self> {
+        let bins = spikes.n_steps / bin_ms.max(1);
+        (bins > 0).then(|| Self::binned(spikes, bin_ms, bins))
+    }
+
+    /// One bin spanning the whole train. Returns `None` for an empty train.
     pub fn collapsed(spikes: &SpikeTrains) -> Option<Self> {
         (spikes.n_steps > 0).then(|| Self::binned(spikes, spikes.n_steps, 1))
     }
 
     fn binned(spikes: &SpikeTrains, bin_ms: usize, bins: usize) -> Self {
         let cells = spikes.cells();
-        let mut data = vec![0.0; cells * bins];
-        let scale = 1000.0 / bin_ms as f64;
-        for cell in 0..cells {
-            let row = &mut data[cell * bins..(cell + 1) * bins];
-            // Trains are sorted: walk the bin edges instead of dividing each spike time.
-            let (mut b, mut edge) = (0usize, bin_ms as u64);
-            for &t in spikes.train(cell) {
-                while u64::from(t) >= edge {
-                    b += 1;
-                    edge += bin_ms as u64;
-                }
-                if b >= bins {
-                    break;
-                }
-                row[b] += 1.0;
+        let mut counts = vec![0u32; cells * bins];
+        // Spike times are u32; a bin wider than any time holds everything in bin 0.
+        let divide = FastDivide::new(u32::try_from(bin_ms).unwrap_or(u32::MAX));
+        let end = (bins as u64) * (bin_ms as u64);
+        for (cell, out) in counts.chunks_exact_mut(bins).enumerate() {
+            let train = spikes.train(cell);
+            let train = &train[..train.partition_point(|&t| u64::from(t) < end)];
+            // Trains are sorted, so the last spike of each bin writes the number of
+            // spikes up to and including that bin; stores only, no chain of increments
+            // on the same bin.
+            for (k, &t) in train.iter().enumerate() {
+                out[divide.quotient(t) as usize] = k as u32 + 1;
             }
-            row.iter_mut().for_each(|x| *x *= scale);
+            let mut before = 0;
+            for c in out.iter_mut() {
+                let upto = (*c).max(before);
+                *c = upto - before;
+                before = upto;
+            }
         }
-        RateVolume {
+        CountVolume {
             rows: spikes.rows,
             cols: spikes.cols,
             bins,
+            bin_ms,
             present: spikes.present.clone(),
-            data,
+            counts,
         }
     }
+
+    /// The rates in Hz: `count * 1000 / bin_ms`.
+    pub fn rates(&self) -> RateVolume {
+        let scale = 1000.0 / self.bin_ms as f64;
+        RateVolume {
+            rows: self.rows,
+            cols: self.cols,
+            bins: self.bins,
+            present: self.present.clone(),
+            data: self.counts.iter().map(|&c| f64::from(c) * scale).collect(),
+        }
+    }
+
+    /// The levels [`quantise`] gives for [`CountVolume::rates`], bit for bit.
+    pub fn quantise(&self, levels: usize, range: Option<(f64, f64)>, out: &mut Vec<u8>) {
+        out.clear();
+        out.resize(self.counts.len(), 0);
+        let present_counts = || {
+            self.counts
+                .chunks_exact(self.bins)
+                .zip(&self.present)
+                .filter(|(_, &p)| p)
+                .flat_map(|(c, _)| c.iter().copied())
+        };
+        let (Some(min), Some(max)) = (present_counts().min(), present_counts().max()) else {
+            return;
+        };
+        let scale = 1000.0 / self.bin_ms as f64;
+        let rate = |c: u32| f64::from(c) * scale;
+        let (lo, hi) = range.unwrap_or((rate(min), rate(max)));
+        let table: Vec<u8> = (min..=max)
+            .map(|c| level_of(rate(c), lo, hi, levels))
+            .collect();
+        for ((q, c), &p) in out
+            .chunks_exact_mut(self.bins)
+            .zip(self.counts.chunks_exact(self.bins))
+            .zip(&self.present)
+        {
+            if p {
+                for (q, &c) in q.iter_mut().zip(c) {
+                    *q = table[(c - min) as usize];
+                }
+            }
+        }
+    }
+}
+
+/// Division of u32 values by a fixed divisor as a multiply and a shift (Lemire, Kaser and
+/// Kurz, "Faster remainder by direct computation", 2019): exact for every u32 numerator.
+#[derive(Debug, Clone, Copy)]
+struct FastDivide {
+    /// `ceil(2^64 / d)`, or 0 for `d = 1`.
+    multiplier: u64,
+}
+
+impl FastDivide {
+    fn new(divisor: u32) -> Self {
+        let multiplier = if divisor <= 1 {
+            0
+        } else {
+            u64::MAX / u64::from(divisor) + 1
+        };
+        FastDivide { multiplier }
+    }
+
+    fn quotient(self, n: u32) -> u32 {
+        if self.multiplier == 0 {
+            n
+        } else {
+            ((u128::from(self.multiplier) * u128::from(n)) >> 64) as u32
+        }
+    }
+}
+
+/// SPEC 3.9's level of one rate: `min(L-1, floor((x - lo) / (hi - lo) * L))`, clamped at
+/// 0; 0 when `hi <= lo` (a constant volume).
+fn level_of(x: f64, lo: f64, hi: f64, levels: usize) -> u8 {
+    if is_constant(lo, hi) {
+        0
+    } else {
+        level_in(x, lo, hi, levels)
+    }
+}
+
+/// `lo..hi` is empty (or NaN): every rate gets level 0.
+fn is_constant(lo: f64, hi: f64) -> bool {
+    hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater)
+}
+
+/// [`level_of`] for `lo < hi`, without branches so that loops over it vectorise.
+#[inline(always)]
+fn level_in(x: f64, lo: f64, hi: f64, levels: usize) -> u8 {
+    // Exactly the formula's order of operations, so levels at bin edges agree with it;
+    // clamped into [0, L-1] first, where truncation equals floor.
+    let v = ((x - lo) / (hi - lo) * levels as f64)
+        .max(0.0)
+        .min((levels - 1) as f64);
+    v as i32 as u8
 }
 
 /// Quantises the volume to `levels` gray levels (SPEC 3.9):
@@ -126,29 +256,41 @@ impl RateVolume {
 /// all level 0. Masked cells get level 0 and are never paired by the GLCM.
 pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, out: &mut Vec<u8>) {
     let bins = volume.bins;
-    let (lo, hi) = range.unwrap_or_else(|| {
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for (row, _) in volume
+    let present_rows = || {
+        volume
             .data
             .chunks_exact(bins)
             .zip(&volume.present)
             .filter(|(_, &p)| p)
-        {
-            for &x in row {
-                lo = lo.min(x);
-                hi = hi.max(x);
+            .map(|(row, _)| row)
+    };
+    let (lo, hi) = range.unwrap_or_else(|| {
+        // Four running extremes break the dependency chain of one; comparisons rather
+        // than f64::min, whose NaN rule keeps the loop scalar. Rates are finite.
+        let (mut lo, mut hi) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
+        for row in present_rows() {
+            let quads = row.chunks_exact(4);
+            for &x in quads.remainder() {
+                lo[0] = if x < lo[0] { x } else { lo[0] };
+                hi[0] = if x > hi[0] { x } else { hi[0] };
+            }
+            for q in quads {
+                for k in 0..4 {
+                    lo[k] = if q[k] < lo[k] { q[k] } else { lo[k] };
+                    hi[k] = if q[k] > hi[k] { q[k] } else { hi[k] };
+                }
             }
         }
-        (lo, hi)
+        (
+            lo.into_iter().fold(f64::INFINITY, f64::min),
+            hi.into_iter().fold(f64::NEG_INFINITY, f64::max),
+        )
     });
     out.clear();
     out.resize(volume.data.len(), 0);
-    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+    if is_constant(lo, hi) {
         return;
     }
-    // Exactly the formula's order of operations, so levels at bin edges agree with it.
-    let (span, l) = (hi - lo, levels as f64);
-    let top = (levels - 1) as f64;
     for ((q, x), p) in out
         .chunks_exact_mut(bins)
         .zip(volume.data.chunks_exact(bins))
@@ -156,10 +298,45 @@ pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, o
     {
         if *p {
             for (q, &x) in q.iter_mut().zip(x) {
-                // Clamped into [0, L-1] first, where truncation equals floor; written without
-                // branches or a call to floor so the loop vectorises.
-                let v = ((x - lo) / span * l).max(0.0).min(top);
-                *q = v as i32 as u8;
+                *q = level_in(x, lo, hi, levels);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FastDivide;
+
+    #[test]
+    fn fast_division_is_exact_for_every_u32() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state as u32
+        };
+        let divisors = [
+            1,
+            2,
+            3,
+            7,
+            100,
+            200,
+            641,
+            65_537,
+            u32::MAX / 3,
+            u32::MAX - 1,
+            u32::MAX,
+        ];
+        let random: Vec<u32> = (0..200).map(|_| next() | 1).collect();
+        for d in divisors.into_iter().chain(random) {
+            let divide = FastDivide::new(d);
+            let edges = [0, 1, d - 1, d, d.saturating_add(1), u32::MAX - 1, u32::MAX];
+            let numerators: Vec<u32> = (0..2000).map(|_| next()).collect();
+            for n in edges.into_iter().chain(numerators) {
+                assert_eq!(divide.quotient(n), n / d, "{n} / {d}");
             }
         }
     }

@@ -6,7 +6,10 @@
 //! masked cell are skipped. The counts of all offsets are summed before normalising (the
 //! paper's averaging before normalising), so an offset with no pairs adds nothing.
 
+mod masks;
+
 use crate::error::ParamError;
+use masks::LevelMasks;
 
 /// The paper's 13 direction vectors (table I), as `(row, col, time)` for D = 1.
 pub const DIRECTIONS_13: [(i32, i32, i32); 13] = [
@@ -76,12 +79,36 @@ pub enum GlcmKind {
     TwoD,
 }
 
-#[derive(Debug, Clone)]
-struct PlannedOffset {
-    /// Cell pairs `(from, to)` valid on the grid and the mask for this spatial offset.
-    pairs: Vec<(u32, u32)>,
-    /// Time offset `dt` of the second voxel.
+/// How [`GlcmPlan::count_with`] counts the pairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Counting {
+    /// Per volume, whichever of the two below needs fewer operations (estimated from the
+    /// number of levels each cell takes).
+    Auto,
+    /// One histogram increment per voxel pair.
+    Histogram,
+    /// Popcounts of per-level time masks: fast when each cell takes few levels, as the
+    /// cells of rate volumes do.
+    LevelMasks,
+}
+
+/// All pairs of one cell pair at one time offset: `(V[a, t], V[b, t + dt])` for every `t`
+/// at which both voxels lie inside the volume.
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    /// First cell.
+    a: u32,
+    /// Second cell.
+    b: u32,
+    /// The second voxel's time offset.
     dt: isize,
+}
+
+impl Run {
+    /// Pairs in the run over `bins` time bins.
+    fn len(&self, bins: usize) -> usize {
+        bins.saturating_sub(self.dt.unsigned_abs())
+    }
 }
 
 /// Offset tables for one grid, mask and parameter set, built once and applied to many volumes.
@@ -90,7 +117,10 @@ pub struct GlcmPlan {
     levels: usize,
     cells: usize,
     symmetric: bool,
-    offsets: Vec<PlannedOffset>,
+    /// Every cell pair and time offset of the planned offsets, sorted by time offset.
+    runs: Vec<Run>,
+    /// Cells in at least one pair.
+    paired: Vec<bool>,
 }
 
 impl GlcmPlan {
@@ -156,30 +186,38 @@ impl GlcmPlan {
         }
         assert_eq!(present.len(), rows * cols);
         let (rows_i, cols_i) = (rows as isize, cols as isize);
-        let planned = offsets
-            .iter()
-            .filter_map(|&(dr, dc, dt)| {
-                let mut pairs = Vec::new();
-                for r in 0..rows_i {
-                    for c in 0..cols_i {
-                        let (r2, c2) = (r + dr, c + dc);
-                        if r2 < 0 || c2 < 0 || r2 >= rows_i || c2 >= cols_i {
-                            continue;
-                        }
-                        let (a, b) = ((r * cols_i + c) as usize, (r2 * cols_i + c2) as usize);
-                        if present[a] && present[b] {
-                            pairs.push((a as u32, b as u32));
-                        }
+        let mut runs = Vec::new();
+        for &(dr, dc, dt) in offsets {
+            for r in 0..rows_i {
+                for c in 0..cols_i {
+                    let (r2, c2) = (r + dr, c + dc);
+                    if r2 < 0 || c2 < 0 || r2 >= rows_i || c2 >= cols_i {
+                        continue;
+                    }
+                    let (a, b) = ((r * cols_i + c) as usize, (r2 * cols_i + c2) as usize);
+                    if present[a] && present[b] {
+                        runs.push(Run {
+                            a: a as u32,
+                            b: b as u32,
+                            dt,
+                        });
                     }
                 }
-                (!pairs.is_empty()).then_some(PlannedOffset { pairs, dt })
-            })
-            .collect();
+            }
+        }
+        // Grouped by time offset, each level mask is shifted once per offset.
+        runs.sort_by_key(|r| r.dt);
+        let mut paired = vec![false; rows * cols];
+        for r in &runs {
+            paired[r.a as usize] = true;
+            paired[r.b as usize] = true;
+        }
         Ok(GlcmPlan {
             levels,
             cells: rows * cols,
             symmetric,
-            offsets: planned,
+            runs,
+            paired,
         })
     }
 
@@ -190,11 +228,27 @@ impl GlcmPlan {
 
     /// Sums the co-occurrence counts of every planned offset over a quantised volume
     /// (`cells x bins`, cell-major, levels below `levels`) into `counts` (`levels x levels`,
-    /// row = first voxel's level), overwriting it.
+    /// row = first voxel's level), overwriting it. Same as [`GlcmPlan::count_with`] with
+    /// [`Counting::Auto`].
     ///
     /// # Panics
-    /// If the volume is not `cells x bins` or `counts` is not `levels^2` (caller bugs).
+    /// If the volume is not `cells x bins`, `counts` is not `levels^2`, or a voxel's level
+    /// is not below `levels` (caller bugs).
     pub fn count(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
+        self.count_with(quantised, bins, counts, Counting::Auto);
+    }
+
+    /// [`GlcmPlan::count`] with a chosen counting method; every method gives the same counts.
+    ///
+    /// # Panics
+    /// As [`GlcmPlan::count`].
+    pub fn count_with(
+        &self,
+        quantised: &[u8],
+        bins: usize,
+        counts: &mut [u32],
+        counting: Counting,
+    ) {
         let l = self.levels;
         assert_eq!(
             quantised.len(),
@@ -203,10 +257,26 @@ impl GlcmPlan {
         );
         assert_eq!(counts.len(), l * l, "counts must be levels x levels");
         counts.fill(0);
-        if l <= 16 {
-            self.count_packed(quantised, bins, counts);
-        } else {
-            self.count_general(quantised, bins, counts);
+        // Runs whose time offset leaves the volume have no pairs.
+        let first = self.runs.partition_point(|r| r.dt <= -(bins as isize));
+        let last = self.runs.partition_point(|r| r.dt < bins as isize);
+        let runs = &self.runs[first..last];
+        match counting {
+            Counting::Histogram => self.count_histogram(quantised, bins, runs, counts),
+            Counting::LevelMasks => {
+                let mut masks = LevelMasks::new(quantised, bins, l, &self.paired);
+                masks.fill(quantised);
+                masks.count_runs(runs, l, counts);
+            }
+            Counting::Auto => {
+                let mut masks = LevelMasks::new(quantised, bins, l, &self.paired);
+                if masks.cheaper_than_histogram(runs) {
+                    masks.fill(quantised);
+                    masks.count_runs(runs, l, counts);
+                } else {
+                    self.count_histogram(quantised, bins, runs, counts);
+                }
+            }
         }
         if self.symmetric {
             for i in 0..l {
@@ -219,37 +289,42 @@ impl GlcmPlan {
         }
     }
 
-    /// Calls `visit(first, second)` with the two aligned level runs of every planned
-    /// offset and cell pair: the first voxel's levels and the second voxel's, for every
-    /// time step at which both lie inside the volume.
-    fn for_each_run(&self, quantised: &[u8], bins: usize, mut visit: impl FnMut(&[u8], &[u8])) {
-        for off in &self.offsets {
-            let shift = off.dt.unsigned_abs();
-            if shift >= bins {
-                continue;
+    /// Adds the counts of `runs` to `counts`, one increment per pair.
+    fn count_histogram(&self, quantised: &[u8], bins: usize, runs: &[Run], counts: &mut [u32]) {
+        let l = self.levels;
+        let aligned = |run: &Run| {
+            let shift = run.dt.unsigned_abs();
+            let (first_start, second_start) = if run.dt < 0 { (shift, 0) } else { (0, shift) };
+            let (a, b, n) = (run.a as usize * bins, run.b as usize * bins, run.len(bins));
+            (
+                &quantised[a + first_start..a + first_start + n],
+                &quantised[b + second_start..b + second_start + n],
+            )
+        };
+        if l > 16 {
+            for run in runs {
+                let (first, second) = aligned(run);
+                for (&x, &y) in first.iter().zip(second) {
+                    counts[x as usize * l + y as usize] += 1;
+                }
             }
-            let n = bins - shift;
-            let (first_start, second_start) = if off.dt < 0 { (shift, 0) } else { (0, shift) };
-            for &(a, b) in &off.pairs {
-                let (a, b) = (a as usize * bins, b as usize * bins);
-                visit(
-                    &quantised[a + first_start..a + first_start + n],
-                    &quantised[b + second_start..b + second_start + n],
-                );
-            }
+            return;
         }
-    }
-
-    /// Up to 16 levels: a pair's code `i << 4 | j` is one byte. The codes of every run are
-    /// written into one buffer (a vectorised loop), then counted in a single pass into
-    /// byte-indexed histograms, which need no bounds checks; four interleaved histograms
-    /// break the store-to-load dependency between increments of the same bin (rate volumes
-    /// have long constant runs).
-    fn count_packed(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
-        let mut codes: Vec<u8> = Vec::with_capacity(self.pairs_for(bins));
-        self.for_each_run(quantised, bins, |first, second| {
-            codes.extend(first.iter().zip(second).map(|(&x, &y)| (x << 4) | y));
-        });
+        // Up to 16 levels a pair's code `i << 4 | j` is one byte. The codes of every run
+        // are written into one buffer (a vectorised loop), then counted in a single pass
+        // into byte-indexed histograms, which need no bounds checks; four interleaved
+        // histograms break the store-to-load dependency between increments of the same
+        // bin (rate volumes have long constant runs).
+        let mut codes = vec![0u8; runs.iter().map(|r| r.len(bins)).sum()];
+        let mut rest = &mut codes[..];
+        for run in runs {
+            let (first, second) = aligned(run);
+            let (now, later) = rest.split_at_mut(first.len());
+            for ((c, &x), &y) in now.iter_mut().zip(first).zip(second) {
+                *c = (x << 4) | y;
+            }
+            rest = later;
+        }
         let mut hist = [[0u32; 256]; 4];
         let mut quads = codes.chunks_exact(4);
         for q in &mut quads {
@@ -261,30 +336,16 @@ impl GlcmPlan {
         for &c in quads.remainder() {
             hist[0][c as usize] += 1;
         }
-        let l = self.levels;
         for i in 0..l {
             for j in 0..l {
                 let code = (i << 4) | j;
-                counts[i * l + j] = hist[0][code] + hist[1][code] + hist[2][code] + hist[3][code];
+                counts[i * l + j] += hist[0][code] + hist[1][code] + hist[2][code] + hist[3][code];
             }
         }
     }
 
     /// The number of voxel pairs the plan counts in a volume of `bins` time steps.
     pub fn pairs_for(&self, bins: usize) -> usize {
-        self.offsets
-            .iter()
-            .map(|o| o.pairs.len() * bins.saturating_sub(o.dt.unsigned_abs()))
-            .sum()
-    }
-
-    /// Any number of levels: index `i * L + j` into the count matrix.
-    fn count_general(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
-        let l = self.levels;
-        self.for_each_run(quantised, bins, |first, second| {
-            for (&x, &y) in first.iter().zip(second) {
-                counts[x as usize * l + y as usize] += 1;
-            }
-        });
+        self.runs.iter().map(|r| r.len(bins)).sum()
     }
 }
