@@ -153,35 +153,38 @@ impl CountVolume {
 
     /// The rates in Hz: `count * 1000 / bin_ms`.
     pub fn rates(&self) -> RateVolume {
-        let scale = 1000.0 / self.bin_ms as f64;
         RateVolume {
             rows: self.rows,
             cols: self.cols,
             bins: self.bins,
             present: self.present.clone(),
-            data: self.counts.iter().map(|&c| f64::from(c) * scale).collect(),
+            data: self.counts.iter().map(|&c| self.rate(c)).collect(),
         }
+    }
+
+    /// One count's rate in Hz, computed one way for [`CountVolume::rates`] and
+    /// [`CountVolume::quantise`] so that their levels agree bit for bit.
+    fn rate(&self, count: u32) -> f64 {
+        f64::from(count) * (1000.0 / self.bin_ms as f64)
     }
 
     /// The levels [`quantise`] gives for [`CountVolume::rates`], bit for bit.
     pub fn quantise(&self, levels: usize, range: Option<(f64, f64)>, out: &mut Vec<u8>) {
         out.clear();
         out.resize(self.counts.len(), 0);
-        let present_counts = || {
-            self.counts
-                .chunks_exact(self.bins)
-                .zip(&self.present)
-                .filter(|(_, &p)| p)
-                .flat_map(|(c, _)| c.iter().copied())
-        };
-        let (Some(min), Some(max)) = (present_counts().min(), present_counts().max()) else {
-            return;
-        };
-        let scale = 1000.0 / self.bin_ms as f64;
-        let rate = |c: u32| f64::from(c) * scale;
-        let (lo, hi) = range.unwrap_or((rate(min), rate(max)));
+        let (min, max) = self
+            .counts
+            .chunks_exact(self.bins)
+            .zip(&self.present)
+            .filter(|(_, &p)| p)
+            .flat_map(|(c, _)| c.iter().copied())
+            .fold((u32::MAX, 0), |(lo, hi), c| (lo.min(c), hi.max(c)));
+        if min > max {
+            return; // no present cell
+        }
+        let (lo, hi) = range.unwrap_or((self.rate(min), self.rate(max)));
         let table: Vec<u8> = (min..=max)
-            .map(|c| level_of(rate(c), lo, hi, levels))
+            .map(|c| level_of(self.rate(c), lo, hi, levels))
             .collect();
         for ((q, c), &p) in out
             .chunks_exact_mut(self.bins)

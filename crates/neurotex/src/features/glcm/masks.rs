@@ -58,14 +58,10 @@ impl LevelMasks {
     /// Whether counting `runs` with masks costs fewer operations than one histogram
     /// increment per pair.
     pub(super) fn cheaper_than_histogram(&self, runs: &[Run]) -> bool {
-        let slots: Vec<usize> = self
-            .cell_start
-            .windows(2)
-            .map(|w| (w[1] - w[0]) as usize)
-            .collect();
         let (mut masks, mut pairs) = (0, 0);
         for run in runs {
-            let (first, second) = (slots[run.a as usize], slots[run.b as usize]);
+            let first = self.slots(run.a as usize).len();
+            let second = self.slots(run.b as usize).len();
             masks += (first.saturating_sub(1) * second * self.blocks + second) * BLOCK_PAIR_COST;
             pairs += run.len(self.bins);
         }
@@ -182,12 +178,8 @@ impl LevelMasks {
             // bins <= 128, so the shift is below 128. The window holds the first voxel's
             // steps at which the second voxel exists too.
             let shift = dt.unsigned_abs() as u32;
-            let (lo, hi) = if dt >= 0 {
-                (0, self.bins - shift as usize)
-            } else {
-                (shift as usize, self.bins)
-            };
-            let window = range_bits(lo, hi, 0);
+            let steps = group[0].first_steps(self.bins);
+            let window = range_bits(steps.start, steps.end, 0);
             let per_slot = self
                 .bits
                 .iter()
@@ -248,14 +240,9 @@ impl LevelMasks {
         let mut window = vec![0u128; blocks];
         for group in runs.chunk_by(|x, y| x.dt == y.dt) {
             let dt = group[0].dt;
-            let shift = dt.unsigned_abs();
-            let (lo, hi) = if dt >= 0 {
-                (0, self.bins - shift)
-            } else {
-                (shift, self.bins)
-            };
+            let steps = group[0].first_steps(self.bins);
             for (k, w) in window.iter_mut().enumerate() {
-                *w = range_bits(lo, hi, k * BLOCK);
+                *w = range_bits(steps.start, steps.end, k * BLOCK);
             }
             for ((mask, out), t) in self
                 .bits

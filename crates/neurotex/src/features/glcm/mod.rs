@@ -109,6 +109,17 @@ impl Run {
     fn len(&self, bins: usize) -> usize {
         bins.saturating_sub(self.dt.unsigned_abs())
     }
+
+    /// The first voxel's time steps at which the second voxel lies inside a volume of
+    /// `bins` bins too.
+    fn first_steps(&self, bins: usize) -> std::ops::Range<usize> {
+        let start = if self.dt < 0 {
+            self.dt.unsigned_abs()
+        } else {
+            0
+        };
+        start..start + self.len(bins)
+    }
 }
 
 /// Offset tables for one grid, mask and parameter set, built once and applied to many volumes.
@@ -263,14 +274,9 @@ impl GlcmPlan {
         let runs = &self.runs[first..last];
         match counting {
             Counting::Histogram => self.count_histogram(quantised, bins, runs, counts),
-            Counting::LevelMasks => {
+            Counting::LevelMasks | Counting::Auto => {
                 let mut masks = LevelMasks::new(quantised, bins, l, &self.paired);
-                masks.fill(quantised);
-                masks.count_runs(runs, l, counts);
-            }
-            Counting::Auto => {
-                let mut masks = LevelMasks::new(quantised, bins, l, &self.paired);
-                if masks.cheaper_than_histogram(runs) {
+                if counting == Counting::LevelMasks || masks.cheaper_than_histogram(runs) {
                     masks.fill(quantised);
                     masks.count_runs(runs, l, counts);
                 } else {
@@ -293,12 +299,12 @@ impl GlcmPlan {
     fn count_histogram(&self, quantised: &[u8], bins: usize, runs: &[Run], counts: &mut [u32]) {
         let l = self.levels;
         let aligned = |run: &Run| {
-            let shift = run.dt.unsigned_abs();
-            let (first_start, second_start) = if run.dt < 0 { (shift, 0) } else { (0, shift) };
-            let (a, b, n) = (run.a as usize * bins, run.b as usize * bins, run.len(bins));
+            let steps = run.first_steps(bins);
+            let (a, b) = (run.a as usize * bins, run.b as usize * bins);
+            let second = (steps.start as isize + run.dt) as usize;
             (
-                &quantised[a + first_start..a + first_start + n],
-                &quantised[b + second_start..b + second_start + n],
+                &quantised[a + steps.start..a + steps.end],
+                &quantised[b + second..b + second + steps.len()],
             )
         };
         if l > 16 {
