@@ -3,7 +3,7 @@
 //!
 //! Three volumes: a simulated trial of the richest texture (CP, whose taxels take the most
 //! gray levels), fixed synthetic trains, and uniform random levels (the worst case for the
-//! level-mask counting, where `Counting::Auto` counts one increment per pair instead).
+//! level-mask counting). Each counting method is timed alone too.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use neurotex::encode::SpikeTrains;
@@ -68,7 +68,7 @@ fn bench(c: &mut Criterion) {
         });
         let mut q = Vec::new();
         quantise(&volume, 16, None, &mut q);
-        for counting in [Counting::Histogram, Counting::LevelMasks] {
+        for counting in [Counting::Histogram, Counting::LevelMasks, Counting::OneHot] {
             let id = BenchmarkId::new(format!("count_{counting:?}"), &size);
             group.bench_function(id, |b| {
                 let mut counts = vec![0u32; 256];
@@ -86,7 +86,7 @@ fn bench(c: &mut Criterion) {
             (state >> 60) as u8
         })
         .collect();
-    for counting in [Counting::Auto, Counting::Histogram] {
+    for counting in [Counting::Histogram, Counting::OneHot] {
         let id = BenchmarkId::new(format!("count_{counting:?}"), "random_4x4x90");
         group.bench_function(id, |b| {
             let mut counts = vec![0u32; 256];

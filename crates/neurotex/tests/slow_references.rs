@@ -237,7 +237,7 @@ proptest! {
         plan.count(&q, bins, &mut fast);
         let slow = slow_glcm(&q, rows, cols, bins, &present, levels, &distances, dirs, symmetric);
         prop_assert_eq!(&fast, &slow);
-        for counting in [Counting::Histogram, Counting::LevelMasks] {
+        for counting in [Counting::Histogram, Counting::LevelMasks, Counting::OneHot] {
             plan.count_with(&q, bins, &mut fast, counting);
             prop_assert_eq!(&fast, &slow, "{:?}", counting);
         }
@@ -253,7 +253,7 @@ proptest! {
         let plan = GlcmPlan::new(rows, cols, &present, levels, &params, GlcmKind::ThreeD).unwrap();
         let slow = slow_glcm(&q, rows, cols, bins, &present, levels, &distances, &DIRECTIONS_13, symmetric);
         let mut fast = vec![0u32; levels * levels];
-        for counting in [Counting::Auto, Counting::Histogram, Counting::LevelMasks] {
+        for counting in [Counting::Auto, Counting::Histogram, Counting::LevelMasks, Counting::OneHot] {
             plan.count_with(&q, bins, &mut fast, counting);
             prop_assert_eq!(&fast, &slow, "{:?}", counting);
         }
@@ -392,5 +392,85 @@ proptest! {
             let expected = if hi > lo { (((x - lo) / (hi - lo) * levels as f64).floor() as usize).min(levels - 1) } else { 0 };
             prop_assert_eq!(level as usize, expected);
         }
+    }
+}
+
+/// Uniform random levels below `levels` (xorshift).
+fn random_levels(n: usize, levels: u8, seed: u64) -> Vec<u8> {
+    let mut state = seed | 1;
+    (0..n)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % u64::from(levels)) as u8
+        })
+        .collect()
+}
+
+#[test]
+fn one_hot_counting_handles_more_runs_per_cell_than_a_byte_counts() {
+    // 300 distances on a 2x2 grid: about 300 runs start at each cell, and as nearly all
+    // voxels share level 0, most steps have more partners of that level than a byte
+    // counts, so the runs must be summed in batches.
+    let (rows, cols, bins, levels) = (2, 2, 400, 16);
+    let distances: Vec<usize> = (1..=300).collect();
+    let present = [true; 4];
+    let mut q = random_levels(rows * cols * bins, levels as u8, 7);
+    for (k, x) in q.iter_mut().enumerate() {
+        if k % 50 != 0 {
+            *x = 0;
+        }
+    }
+    let params = GlcmParams {
+        distances: distances.clone(),
+        symmetric: false,
+    };
+    let plan = GlcmPlan::new(rows, cols, &present, levels, &params, GlcmKind::ThreeD).unwrap();
+    let slow = slow_glcm(
+        &q,
+        rows,
+        cols,
+        bins,
+        &present,
+        levels,
+        &distances,
+        &DIRECTIONS_13,
+        false,
+    );
+    let mut fast = vec![0u32; levels * levels];
+    plan.count_with(&q, bins, &mut fast, Counting::OneHot);
+    assert_eq!(fast, slow);
+}
+
+#[test]
+fn one_hot_counting_of_a_long_volume_overflows_no_partial_count() {
+    // 20000 bins of 16 cells: each count reaches far beyond the u16 partial counts, which
+    // must be moved into the u32 counts in time.
+    let (rows, cols, bins, levels) = (4, 4, 20_000, 16);
+    let mut q = random_levels(rows * cols * bins, levels as u8, 11);
+    // One level dominates, so that a single count grows fastest.
+    for x in q.iter_mut().step_by(3) {
+        *x = 5;
+    }
+    let present = [true; 16];
+    let params = GlcmParams::default();
+    let plan = GlcmPlan::new(rows, cols, &present, levels, &params, GlcmKind::ThreeD).unwrap();
+    let slow = slow_glcm(
+        &q,
+        rows,
+        cols,
+        bins,
+        &present,
+        levels,
+        &params.distances,
+        &DIRECTIONS_13,
+        false,
+    );
+    assert!(slow[5 * levels + 5] > 3 * u32::from(u16::MAX));
+    for counting in [Counting::OneHot, Counting::Auto] {
+        let mut fast = vec![0u32; levels * levels];
+        plan.count_with(&q, bins, &mut fast, counting);
+        assert_eq!(fast, slow, "{counting:?}");
     }
 }

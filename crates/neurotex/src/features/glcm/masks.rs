@@ -55,17 +55,15 @@ impl LevelMasks {
         masks
     }
 
-    /// Whether counting `runs` with masks costs fewer operations than one histogram
-    /// increment per pair.
-    pub(super) fn cheaper_than_histogram(&self, runs: &[Run]) -> bool {
-        let (mut masks, mut pairs) = (0, 0);
-        for run in runs {
-            let first = self.slots(run.a as usize).len();
-            let second = self.slots(run.b as usize).len();
-            masks += (first.saturating_sub(1) * second * self.blocks + second) * BLOCK_PAIR_COST;
-            pairs += run.len(self.bins);
-        }
-        masks <= pairs
+    /// The estimated cost of counting `runs` with masks, in histogram increments.
+    pub(super) fn cost(&self, runs: &[Run]) -> usize {
+        runs.iter()
+            .map(|run| {
+                let first = self.slots(run.a as usize).len();
+                let second = self.slots(run.b as usize).len();
+                (first.saturating_sub(1) * second * self.blocks + second) * BLOCK_PAIR_COST
+            })
+            .sum()
     }
 
     /// Builds the masks of every slot.

@@ -7,6 +7,7 @@
 //! paper's averaging before normalising), so an offset with no pairs adds nothing.
 
 mod masks;
+mod onehot;
 
 use crate::error::ParamError;
 use masks::LevelMasks;
@@ -82,14 +83,20 @@ pub enum GlcmKind {
 /// How [`GlcmPlan::count_with`] counts the pairs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Counting {
-    /// Per volume, whichever of the two below needs fewer operations (estimated from the
-    /// number of levels each cell takes).
+    /// [`Counting::OneHot`] where it runs and the volume has at most 128 time bins (where
+    /// it was fastest on every simulated and recorded volume measured); otherwise, per
+    /// volume, whichever of the others needs the fewest operations, estimated from the
+    /// number of levels each cell takes.
     Auto,
     /// One histogram increment per voxel pair.
     Histogram,
     /// Popcounts of per-level time masks: fast when each cell takes few levels, as the
     /// cells of rate volumes do.
     LevelMasks,
+    /// Sums of one-hot level rows, two time steps per vector operation, whatever the
+    /// levels (x86_64 with AVX2 and at most 16 levels; elsewhere this counts as
+    /// [`Counting::Histogram`]).
+    OneHot,
 }
 
 /// All pairs of one cell pair at one time offset: `(V[a, t], V[b, t + dt])` for every `t`
@@ -130,6 +137,8 @@ pub struct GlcmPlan {
     symmetric: bool,
     /// Every cell pair and time offset of the planned offsets, sorted by time offset.
     runs: Vec<Run>,
+    /// The same runs sorted by first cell.
+    by_cell: Vec<Run>,
     /// Cells in at least one pair.
     paired: Vec<bool>,
 }
@@ -216,6 +225,8 @@ impl GlcmPlan {
                 }
             }
         }
+        let mut by_cell = runs.clone();
+        by_cell.sort_by_key(|r| (r.a, r.dt));
         // Grouped by time offset, each level mask is shifted once per offset.
         runs.sort_by_key(|r| r.dt);
         let mut paired = vec![false; rows * cols];
@@ -228,6 +239,7 @@ impl GlcmPlan {
             cells: rows * cols,
             symmetric,
             runs,
+            by_cell,
             paired,
         })
     }
@@ -272,11 +284,28 @@ impl GlcmPlan {
         let first = self.runs.partition_point(|r| r.dt <= -(bins as isize));
         let last = self.runs.partition_point(|r| r.dt < bins as isize);
         let runs = &self.runs[first..last];
+        let one_hot = onehot::available(l);
+        let count_one_hot = |counts: &mut [u32]| {
+            onehot::count(quantised, bins, self.cells, &self.by_cell, l, counts);
+        };
         match counting {
-            Counting::Histogram => self.count_histogram(quantised, bins, runs, counts),
+            Counting::OneHot if one_hot => count_one_hot(counts),
+            Counting::Auto if one_hot && bins <= 128 => count_one_hot(counts),
+            Counting::Histogram | Counting::OneHot => {
+                self.count_histogram(quantised, bins, runs, counts);
+            }
             Counting::LevelMasks | Counting::Auto => {
                 let mut masks = LevelMasks::new(quantised, bins, l, &self.paired);
-                if counting == Counting::LevelMasks || masks.cheaper_than_histogram(runs) {
+                let pairs: usize = runs.iter().map(|r| r.len(bins)).sum();
+                let masks_cost = masks.cost(runs);
+                let one_hot_cost = if one_hot {
+                    onehot::cost(runs, bins, self.cells)
+                } else {
+                    usize::MAX
+                };
+                if counting == Counting::Auto && one_hot_cost < masks_cost.min(pairs) {
+                    count_one_hot(counts);
+                } else if counting == Counting::LevelMasks || masks_cost <= pairs {
                     masks.fill(quantised);
                     masks.count_runs(runs, l, counts);
                 } else {
