@@ -2,7 +2,9 @@
 
 use neurotex::encode::{encode, IzhikevichParams, SpikeTrains};
 use neurotex::features::glcm::GlcmKind;
-use neurotex::features::{haralick, quantise, spike_stats, GlcmParams, GlcmPlan, RateVolume};
+use neurotex::features::{
+    haralick, quantise, spike_stats, Counting, GlcmParams, GlcmPlan, RateVolume,
+};
 
 /// The paper's 3D plan (13 directions x 1, 2, 4, 8) on a full 4x4 grid, 16 levels.
 fn paper_plan_4x4() -> GlcmPlan {
@@ -44,6 +46,21 @@ fn constant_volume_is_one_gray_level() {
     let c = counts_of(&plan, &q, vol.bins);
     let h = haralick(&c, 16);
     assert_eq!((h.contrast, h.correlation, h.asm), (0.0, 1.0, 1.0));
+}
+
+#[test]
+fn a_volume_without_bins_has_no_pairs() {
+    let plan = paper_plan_4x4();
+    for counting in [
+        Counting::Auto,
+        Counting::Histogram,
+        Counting::LevelMasks,
+        Counting::OneHot,
+    ] {
+        let mut c = vec![1u32; 256];
+        plan.count_with(&[], 0, &mut c, counting);
+        assert!(c.iter().all(|&n| n == 0), "{counting:?}");
+    }
 }
 
 #[test]

@@ -280,6 +280,9 @@ impl GlcmPlan {
         );
         assert_eq!(counts.len(), l * l, "counts must be levels x levels");
         counts.fill(0);
+        if bins == 0 {
+            return;
+        }
         // Runs whose time offset leaves the volume have no pairs.
         let first = self.runs.partition_point(|r| r.dt <= -(bins as isize));
         let last = self.runs.partition_point(|r| r.dt < bins as isize);
