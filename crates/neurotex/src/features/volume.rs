@@ -297,11 +297,11 @@ fn is_constant(lo: f64, hi: f64) -> bool {
 fn level_in(x: f64, lo: f64, hi: f64, levels: usize) -> u8 {
     // Exactly the formula's order of operations, so levels at bin edges agree with it;
     // clamped into [0, L-1] first, where truncation equals floor. `max` and `min` return
-    // the number when one side is NaN, so `v` is a number in [0, 255].
-    let v = ((x - lo) / (hi - lo) * levels as f64)
-        .max(0.0)
-        .min((levels - 1) as f64);
-    // SAFETY: `v` is finite and within i32 (just above). The checked `as` conversion would
+    // the number when one side is NaN, and L is at most 256 (at least 1 here, whatever
+    // the caller passed), so `v` is a number in [0, 255].
+    let top = (levels.clamp(1, 256) - 1) as f64;
+    let v = ((x - lo) / (hi - lo) * levels as f64).max(0.0).min(top);
+    // SAFETY: `v` is a number in [0, 255] (just above). The checked `as` conversion would
     // test for NaN and overflow voxel by voxel, which keeps the loop scalar.
     unsafe { v.to_int_unchecked::<i32>() as u8 }
 }
