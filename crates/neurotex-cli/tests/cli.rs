@@ -38,6 +38,19 @@ fn fails(args: &[&str]) -> String {
     err
 }
 
+/// Runs every case, each expected to fail with its message and to leave `out` (an output
+/// file or folder) unwritten.
+fn fails_each(cases: &[(Vec<&str>, &str)], out: &Path) {
+    for (args, expected) in cases {
+        let err = fails(args);
+        assert!(
+            err.contains(expected),
+            "{args:?}: expected `{expected}` in {err}"
+        );
+        assert!(!out.exists(), "{args:?} left output behind at {out:?}");
+    }
+}
+
 /// A texture-like 4x4 recording: a grating of `period_ms` sweeping across the rows, with
 /// noise from a small generator seeded by `seed`.
 fn recording(steps: usize, period_ms: f64, amp: f64, seed: u64) -> Array3<f32> {
@@ -379,14 +392,7 @@ fn bad_input_is_a_clear_error_with_no_output() {
         ),
         (eval("glcm3d", &["--train-speeds", "5"]), "test-speeds"),
     ];
-    for (args, expected) in cases {
-        let err = fails(&args);
-        assert!(
-            err.contains(expected),
-            "{args:?}: expected `{expected}` in {err}"
-        );
-        assert!(!out.exists(), "{args:?} left an output file");
-    }
+    fails_each(&cases, &out);
     let no_tmp = std::fs::read_dir(tmp.path())
         .unwrap()
         .filter(|e| {
@@ -765,14 +771,7 @@ fn import_bad_input_is_named_through_the_binary() {
         ),
         (csv(&["--name-pattern", FABRIC_PATTERN]), "--fs"),
     ];
-    for (args, expected) in cases {
-        let err = fails(&args);
-        assert!(
-            err.contains(expected),
-            "{args:?}: expected `{expected}` in {err}"
-        );
-        assert!(!out.exists(), "{args:?} left an output folder");
-    }
+    fails_each(&cases, &out);
     // --skip-bad leaves the NaN file out with a warning and imports the rest
     let run = neurotex(&timed(&["--name-pattern", FABRIC_PATTERN, "--skip-bad"]));
     assert!(run.status.success());

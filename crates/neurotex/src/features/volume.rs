@@ -180,25 +180,13 @@ impl CountVolume {
     pub fn quantise(&self, levels: usize, range: Option<(f64, f64)>, out: &mut Vec<u8>) {
         out.clear();
         out.resize(self.counts.len(), 0);
-        let present_rows = || {
-            self.counts
-                .chunks_exact(self.bins)
-                .zip(&self.present)
-                .filter(|(_, &p)| p)
-                .map(|(row, _)| row)
-        };
-        let (min, max) = count_range(present_rows());
+        let (min, max) = count_range(present_rows(&self.counts, self.bins, &self.present));
         if min > max {
             return; // no present cell
         }
         let (lo, hi) = range.unwrap_or((self.rate(min), self.rate(max)));
         let level = |c: u32| level_of(self.rate(c), lo, hi, levels);
-        let rows = out
-            .chunks_exact_mut(self.bins)
-            .zip(self.counts.chunks_exact(self.bins))
-            .zip(&self.present)
-            .filter(|(_, &p)| p)
-            .map(|(rows, _)| rows);
+        let rows = present_levels(out, &self.counts, self.bins, &self.present);
         if max - min < 256 {
             // The usual case: a table indexed by a byte needs no bounds checks.
             let mut table = [0u8; 256];
@@ -312,19 +300,11 @@ fn level_in(x: f64, lo: f64, hi: f64, levels: usize) -> u8 {
 /// all level 0. Masked cells get level 0 and are never paired by the GLCM.
 pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, out: &mut Vec<u8>) {
     let bins = volume.bins;
-    let present_rows = || {
-        volume
-            .data
-            .chunks_exact(bins)
-            .zip(&volume.present)
-            .filter(|(_, &p)| p)
-            .map(|(row, _)| row)
-    };
     let (lo, hi) = range.unwrap_or_else(|| {
         // Four running extremes break the dependency chain of one; comparisons rather
         // than f64::min, whose NaN rule keeps the loop scalar. Rates are finite.
         let (mut lo, mut hi) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
-        for row in present_rows() {
+        for row in present_rows(&volume.data, bins, &volume.present) {
             let quads = row.chunks_exact(4);
             for &x in quads.remainder() {
                 lo[0] = if x < lo[0] { x } else { lo[0] };
@@ -347,17 +327,38 @@ pub fn quantise(volume: &RateVolume, levels: usize, range: Option<(f64, f64)>, o
     if is_constant(lo, hi) {
         return;
     }
-    for ((q, x), p) in out
-        .chunks_exact_mut(bins)
-        .zip(volume.data.chunks_exact(bins))
-        .zip(&volume.present)
-    {
-        if *p {
-            for (q, &x) in q.iter_mut().zip(x) {
-                *q = level_in(x, lo, hi, levels);
-            }
+    for (q, x) in present_levels(out, &volume.data, bins, &volume.present) {
+        for (q, &x) in q.iter_mut().zip(x) {
+            *q = level_in(x, lo, hi, levels);
         }
     }
+}
+
+/// The `bins`-long rows of the present cells of a cell-major volume.
+fn present_rows<'a, T>(
+    data: &'a [T],
+    bins: usize,
+    present: &'a [bool],
+) -> impl Iterator<Item = &'a [T]> {
+    data.chunks_exact(bins)
+        .zip(present)
+        .filter(|(_, &p)| p)
+        .map(|(row, _)| row)
+}
+
+/// The present cells' rows of a volume, each beside its row of `levels` to fill.
+fn present_levels<'a, T>(
+    levels: &'a mut [u8],
+    data: &'a [T],
+    bins: usize,
+    present: &'a [bool],
+) -> impl Iterator<Item = (&'a mut [u8], &'a [T])> {
+    levels
+        .chunks_exact_mut(bins)
+        .zip(data.chunks_exact(bins))
+        .zip(present)
+        .filter(|(_, &p)| p)
+        .map(|(rows, _)| rows)
 }
 
 #[cfg(test)]
