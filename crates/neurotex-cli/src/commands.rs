@@ -577,14 +577,15 @@ pub fn reproduce(args: ReproduceArgs) -> Result<()> {
         paper_comparable: dataset.is_none(),
     };
     write_report(&args.out, &results, &ctx)?;
-    for (claim, holds, _) in neurotex::report::conclusions(&results) {
+    for claim in neurotex::experiments::claims(&results) {
         eprintln!(
-            "{} {claim}",
-            if holds {
+            "{} {}",
+            if claim.verdict.holds() {
                 "agrees:        "
             } else {
                 "does not agree:"
-            }
+            },
+            claim.statement
         );
     }
     eprintln!(

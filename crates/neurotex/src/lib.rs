@@ -18,11 +18,14 @@ pub mod error;
 pub mod experiments;
 pub mod features;
 pub mod import;
+pub mod io;
 pub mod pipeline;
 pub mod recording;
 pub mod report;
 pub mod signal;
 pub mod sim;
 mod svg;
+pub mod values;
 
 pub use error::{Error, Result};
+pub use values::{BySpeed, Cell, Grid, Speed};

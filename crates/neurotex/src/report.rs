@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::{DataError, Result};
-use crate::experiments::Results;
+use crate::experiments::{claims, Results};
 use crate::svg::{heat, Panel, Svg, PALETTE};
 
 /// The paper's E1 accuracies (%), single taxel and 3D-GLCM, by speed (table II).
@@ -76,135 +76,6 @@ pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Resul
     Ok(())
 }
 
-/// The judgement of each of the paper's conclusions on these results.
-pub fn conclusions(r: &Results) -> Vec<(String, bool, String)> {
-    let mut out = Vec::new();
-    let e1: Vec<_> = r
-        .speeds
-        .iter()
-        .filter_map(|s| r.e1.get(&format!("{s}")).map(|e| (*s, e)))
-        .collect();
-    if !e1.is_empty() {
-        let ahead = e1.iter().all(|(_, e)| e.glcm3d > e.taxel_mean);
-        let detail = e1
-            .iter()
-            .map(|(s, e)| format!("{s} mm/s: {} vs {} %", pct(e.glcm3d), pct(e.taxel_mean)))
-            .collect::<Vec<_>>()
-            .join("; ");
-        out.push((
-            "E1: 3D-GLCM beats the single taxel (mean over taxels) at every speed".into(),
-            ahead,
-            detail,
-        ));
-        let beats_best = e1.iter().all(|(_, e)| e.glcm3d > e.taxel_best);
-        out.push((
-            "E1: 3D-GLCM beats even the best taxel chosen after the fact".into(),
-            beats_best,
-            e1.iter()
-                .map(|(s, e)| format!("{s} mm/s: best taxel {} %", pct(e.taxel_best)))
-                .collect::<Vec<_>>()
-                .join("; "),
-        ));
-        if e1.len() >= 2 {
-            let margins: Vec<f64> = e1.iter().map(|(_, e)| e.glcm3d - e.taxel_mean).collect();
-            let shrinking = margins.first() > margins.last();
-            out.push((
-                "E1: the margin shrinks from the slowest to the fastest speed".into(),
-                shrinking,
-                margins
-                    .iter()
-                    .map(|m| format!("{:+.1}", 100.0 * m))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-                    + " points",
-            ));
-        }
-    }
-    if let Some(e2) = &r.e2 {
-        let idx = |name: &str| e2.labels.iter().position(|l| l.eq_ignore_ascii_case(name));
-        if let (Some(rug), Some(sb), Some(stf)) = (idx("TRug"), idx("SB"), idx("STF")) {
-            let frac = |m: &Vec<Vec<usize>>, row: usize| {
-                m[row][rug] as f64 / m[row].iter().sum::<usize>().max(1) as f64
-            };
-            let t = (frac(&e2.taxel, sb) + frac(&e2.taxel, stf)) / 2.0;
-            let g = (frac(&e2.glcm3d, sb) + frac(&e2.glcm3d, stf)) / 2.0;
-            out.push((
-                "E2: the single taxel mistakes scotch brite and styrofoam for rug more than 3D-GLCM does".into(),
-                t > g,
-                format!("share of SB and STF predicted as TRug: single taxel {} %, 3D-GLCM {} %", pct(t), pct(g)),
-            ));
-        }
-    }
-    if let Some(e3) = &r.e3 {
-        if let (Some(&last), Some(&n)) = (e3.mean.last(), e3.n.last()) {
-            out.push((
-                "E3: moving taxels lowers 3D-GLCM accuracy towards or below the single taxel"
-                    .into(),
-                last < e3.glcm3d && last <= e3.taxel_mean + 0.05,
-                format!(
-                    "unperturbed {} %, {n} moved {} %, single taxel {} %",
-                    pct(e3.glcm3d),
-                    pct(last),
-                    pct(e3.taxel_mean)
-                ),
-            ));
-        }
-    }
-    if !r.e4.is_empty() {
-        let below =
-            r.e4.values()
-                .all(|e| e.glcm2d < e.taxel_mean && e.glcm2d < e.glcm3d);
-        out.push((
-            "E4: without time (2D-GLCM) accuracy falls below both the single taxel and 3D-GLCM"
-                .into(),
-            below,
-            r.e4.iter()
-                .map(|(s, e)| format!("{s} mm/s: 2D {} %", pct(e.glcm2d)))
-                .collect::<Vec<_>>()
-                .join("; "),
-        ));
-    }
-    if !r.e5.is_empty() {
-        let early =
-            r.e5.values()
-                .all(|e| e.first_match.is_some_and(|p| p < 1.0));
-        out.push((
-            "E5: 3D-GLCM matches the single taxel's full-slide accuracy with part of the slide"
-                .into(),
-            early,
-            r.e5.iter()
-                .map(|(s, e)| {
-                    format!(
-                        "{s} mm/s: {}",
-                        e.first_match
-                            .map_or("never".to_string(), |p| format!("{:.0} %", 100.0 * p))
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join("; "),
-        ));
-    }
-    if !r.e6.is_empty() {
-        let ahead = r.e6.values().all(|e| e.glcm3d > e.taxel_mean);
-        out.push((
-            "E6: trained on the other speeds, 3D-GLCM generalises to a held-out speed better than the single taxel".into(),
-            ahead,
-            r.e6.iter().map(|(s, e)| format!("test {s} mm/s: {} vs {} %", pct(e.glcm3d), pct(e.taxel_mean))).collect::<Vec<_>>().join("; "),
-        ));
-    }
-    if !r.e8.is_empty() {
-        let ahead =
-            r.e8.values()
-                .all(|e| e.glcm3d.iter().zip(&e.taxel_mean).all(|(g, t)| g > t));
-        out.push((
-            "E8: 3D-GLCM stays ahead for every k".into(),
-            ahead,
-            String::new(),
-        ));
-    }
-    out
-}
-
 fn markdown(r: &Results, ctx: &ReportContext) -> String {
     let comparable = ctx.paper_comparable;
     let paper_e1 = |s: f64| {
@@ -268,7 +139,8 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
         }
     );
     let _ = writeln!(w, "## Summary: where we agree with the paper\n");
-    for (claim, holds, detail) in conclusions(r) {
+    for c in claims(r) {
+        let (claim, holds, detail) = (c.statement, c.verdict.holds(), c.detail);
         let _ = writeln!(
             w,
             "- {} **{}**{}",
@@ -288,8 +160,8 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
     let _ = writeln!(w, "| speed (mm/s) | single taxel, mean (%) | best taxel (%) | 3D-GLCM (%) | paper: single (%) | paper: 3D-GLCM (%) |");
     let _ = writeln!(w, "|---|---|---|---|---|---|");
     for s in &r.speeds {
-        if let Some(e) = r.e1.get(&format!("{s}")) {
-            let paper = paper_e1(*s);
+        if let Some(e) = r.e1.get(*s) {
+            let paper = paper_e1(s.mm_s());
             let _ = writeln!(
                 w,
                 "| {s} | {} | {} ({}) | {} ± {} | {} | {} |",
@@ -343,8 +215,8 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
     let _ = writeln!(w, "| speed (mm/s) | single taxel (%) | 2D-GLCM (%) | 3D-GLCM (%) | paper: single | paper: 2D | paper: 3D |");
     let _ = writeln!(w, "|---|---|---|---|---|---|---|");
     for s in &r.speeds {
-        if let Some(e) = r.e4.get(&format!("{s}")) {
-            let p1 = paper_e1(*s);
+        if let Some(e) = r.e4.get(*s) {
+            let p1 = paper_e1(s.mm_s());
             let _ = writeln!(
                 w,
                 "| {s} | {} | {} | {} | {} | {} | {} |",
@@ -352,7 +224,7 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
                 pct(e.glcm2d),
                 pct(e.glcm3d),
                 p1.map_or("-".into(), |p| p.1.to_string()),
-                paper_of(&PAPER_E4_2D, *s).map_or("-".into(), |v| v.to_string()),
+                paper_of(&PAPER_E4_2D, s.mm_s()).map_or("-".into(), |v| v.to_string()),
                 p1.map_or("-".into(), |p| p.2.to_string())
             );
         }
@@ -362,7 +234,7 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
     let _ = writeln!(w, "## E5: time to recognition\n");
     let _ = writeln!(w, "3D-GLCM on the first part of the slide against the single taxel (mean over taxels) on all of it. The paper: 3D-GLCM matches at 30 % of the slide at 5 mm/s and 70 % at 15 mm/s.\n");
     for s in &r.speeds {
-        if let Some(e) = r.e5.get(&format!("{s}")) {
+        if let Some(e) = r.e5.get(*s) {
             let cells: Vec<String> = e
                 .fractions
                 .iter()
@@ -376,7 +248,7 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
                 cells.join(", "),
                 e.first_match
                     .map_or("never".to_string(), |p| format!("{:.0} %", 100.0 * p)),
-                paper_lookup(&PAPER_E5, *s)
+                paper_lookup(&PAPER_E5, s.mm_s())
                     .map_or("not stated".into(), |p| format!("{:.0} %", 100.0 * p))
             );
         }
@@ -399,8 +271,8 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
         let _ = writeln!(w, "| test speed (mm/s) | trained on | single taxel (%) | 3D-GLCM (%) | paper: single | paper: 3D |");
         let _ = writeln!(w, "|---|---|---|---|---|---|");
         for s in &r.speeds {
-            if let Some(e) = r.e6.get(&format!("{s}")) {
-                let p = paper_e6(*s);
+            if let Some(e) = r.e6.get(*s) {
+                let p = paper_e6(s.mm_s());
                 let _ = writeln!(
                     w,
                     "| {s} | {} | {} | {} | {} | {} |",
@@ -442,7 +314,7 @@ fn markdown(r: &Results, ctx: &ReportContext) -> String {
     let _ = writeln!(w, "| speed (mm/s) | k | single taxel (%) | 3D-GLCM (%) |");
     let _ = writeln!(w, "|---|---|---|---|");
     for s in &r.speeds {
-        if let Some(e) = r.e8.get(&format!("{s}")) {
+        if let Some(e) = r.e8.get(*s) {
             for ((k, t), g) in e.k.iter().zip(&e.taxel_mean).zip(&e.glcm3d) {
                 let _ = writeln!(w, "| {s} | {k} | {} | {} |", pct(*t), pct(*g));
             }
@@ -521,10 +393,10 @@ fn fig_e1(r: &Results, comparable: bool) -> String {
     ];
     let group = panel.w / r.speeds.len().max(1) as f64;
     for (k, s) in r.speeds.iter().enumerate() {
-        let e = r.e1.get(&format!("{s}"));
+        let e = r.e1.get(*s);
         let paper = PAPER_E1
             .iter()
-            .find(|p| comparable && (p.0 - s).abs() < 1e-9);
+            .find(|p| comparable && (p.0 - s.mm_s()).abs() < 1e-9);
         let values = [
             e.map(|e| 100.0 * e.taxel_mean),
             e.map(|e| 100.0 * e.glcm3d),
@@ -726,7 +598,7 @@ fn fig_e5(r: &Results) -> String {
     let speeds: Vec<(f64, &crate::experiments::E5Speed)> = r
         .speeds
         .iter()
-        .filter_map(|s| r.e5.get(&format!("{s}")).map(|e| (*s, e)))
+        .filter_map(|s| r.e5.get(*s).map(|e| (s.mm_s(), e)))
         .collect();
     let h = 250.0;
     let mut svg = Svg::new(720.0, 40.0 + h * speeds.len().max(1) as f64);

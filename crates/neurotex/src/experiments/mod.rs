@@ -2,7 +2,13 @@
 //! parameters to result structs, and the single pass that produces the encoded recordings
 //! from the simulator or a dataset folder.
 
+mod claims;
+
+pub use claims::{claims, Claim, Verdict};
+
 use std::collections::BTreeMap;
+
+use crate::values::{BySpeed, Speed};
 use std::time::Instant;
 
 use rand::seq::SliceRandom;
@@ -151,10 +157,6 @@ pub fn slowest_speed(speeds: impl Iterator<Item = f64>) -> f64 {
                 .then((*a < 0.0).cmp(&(*b < 0.0)))
         })
         .unwrap_or(0.0)
-}
-
-fn speed_key(s: f64) -> String {
-    format!("{s}")
 }
 
 /// One pass over the recordings: condition, encode at the pipeline's gain, and for the
@@ -317,7 +319,7 @@ pub struct E1Speed {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E2 {
     /// Speed, mm/s.
-    pub speed: f64,
+    pub speed: Speed,
     /// Labels in matrix order.
     pub labels: Vec<String>,
     /// Single taxel, summed over taxels and repeats (row = true).
@@ -330,7 +332,7 @@ pub struct E2 {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E3 {
     /// Speed, mm/s.
-    pub speed: f64,
+    pub speed: Speed,
     /// Random draws per n.
     pub repeats: usize,
     /// Taxels moved.
@@ -373,7 +375,7 @@ pub struct E5Speed {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E6Speed {
     /// Training speeds.
-    pub train: Vec<f64>,
+    pub train: Vec<Speed>,
     /// Single taxel mean.
     pub taxel_mean: f64,
     /// 3D-GLCM.
@@ -384,7 +386,7 @@ pub struct E6Speed {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E7 {
     /// Speed, mm/s.
-    pub speed: f64,
+    pub speed: Speed,
     /// The histograms.
     pub sweep: IsiSweep,
     /// `gains x labels` mean firing rate per taxel, Hz.
@@ -408,7 +410,7 @@ pub struct E8Speed {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E0 {
     /// Speed, mm/s.
-    pub speed: f64,
+    pub speed: Speed,
     /// The taxel shown, `[row, col]`.
     pub taxel: [usize; 2],
     /// PSTH bin, ms.
@@ -434,7 +436,7 @@ pub struct E0Example {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Results {
     /// Speeds found, ascending.
-    pub speeds: Vec<f64>,
+    pub speeds: Vec<Speed>,
     /// Labels in order.
     pub labels: Vec<String>,
     /// Recordings used.
@@ -446,21 +448,21 @@ pub struct Results {
     /// E0.
     pub e0: Option<E0>,
     /// E1 by speed.
-    pub e1: BTreeMap<String, E1Speed>,
+    pub e1: BySpeed<E1Speed>,
     /// E2.
     pub e2: Option<E2>,
     /// E3.
     pub e3: Option<E3>,
     /// E4 by speed.
-    pub e4: BTreeMap<String, E4Speed>,
+    pub e4: BySpeed<E4Speed>,
     /// E5 by speed.
-    pub e5: BTreeMap<String, E5Speed>,
+    pub e5: BySpeed<E5Speed>,
     /// E6 by held-out speed.
-    pub e6: BTreeMap<String, E6Speed>,
+    pub e6: BySpeed<E6Speed>,
     /// E7.
     pub e7: Option<E7>,
     /// E8 by speed.
-    pub e8: BTreeMap<String, E8Speed>,
+    pub e8: BySpeed<E8Speed>,
     /// Analyses skipped, with the reason.
     pub skipped: BTreeMap<String, String>,
     /// Wall-clock seconds per analysis.
@@ -521,18 +523,15 @@ pub fn run_all(
         params,
     };
     let enc = &prepared.encoded;
-    let mut speeds: Vec<f64> = Vec::new();
+    let speeds = Speed::distinct(enc.iter().map(|e| Speed::of(e.meta.speed_mm_s)));
     let mut labels: Vec<String> = Vec::new();
     for e in enc {
-        if !speeds.iter().any(|&s| same_speed(s, e.meta.speed_mm_s)) {
-            speeds.push(e.meta.speed_mm_s);
-        }
         if !labels.contains(&e.meta.label) {
             labels.push(e.meta.label.clone());
         }
     }
-    speeds.sort_by(f64::total_cmp);
-    let slowest = slowest_speed(speeds.iter().copied());
+    let slowest_s = Speed::slowest(speeds.iter().copied()).unwrap_or(Speed::of(0.0));
+    let slowest = slowest_s.mm_s();
     let mut r = Results {
         speeds: speeds.clone(),
         labels: labels.clone(),
@@ -540,14 +539,14 @@ pub fn run_all(
         resampled: enc.iter().filter(|e| e.resampled).count(),
         flat: enc.iter().filter(|e| e.flat).count(),
         e0: None,
-        e1: BTreeMap::new(),
+        e1: BySpeed::new(),
         e2: None,
         e3: None,
-        e4: BTreeMap::new(),
-        e5: BTreeMap::new(),
-        e6: BTreeMap::new(),
+        e4: BySpeed::new(),
+        e5: BySpeed::new(),
+        e6: BySpeed::new(),
         e7: None,
-        e8: BTreeMap::new(),
+        e8: BySpeed::new(),
         skipped: BTreeMap::new(),
         timing_s: BTreeMap::new(),
     };
@@ -566,12 +565,13 @@ pub fn run_all(
 
     // E1 and E2
     let mut slow_outcomes = None;
-    for &s in &speeds {
+    for &sp in &speeds {
+        let s = sp.mm_s();
         let t = ctx.cv(&taxel, Columns::EachTaxel, s, params.knn)?;
         let g = ctx.cv(&g3, Columns::All, s, params.knn)?;
         let best = t.best.expect("every taxel evaluated");
         r.e1.insert(
-            speed_key(s),
+            sp,
             E1Speed {
                 taxel_mean: t.accuracy,
                 taxel_best: best.accuracy,
@@ -589,7 +589,7 @@ pub fn run_all(
     progress(Progress::Tick);
     if let Some((t, g)) = slow_outcomes {
         r.e2 = Some(E2 {
-            speed: slowest,
+            speed: slowest_s,
             labels: g.labels.clone(),
             taxel: t.confusion,
             glcm3d: g.confusion,
@@ -666,9 +666,9 @@ pub fn run_all(
                 (accs.iter().map(|a| (a - m).powi(2)).sum::<f64>() / accs.len() as f64).sqrt(),
             );
         }
-        let e1 = &r.e1[&speed_key(slowest)];
+        let e1 = r.e1.get(slowest_s).expect("E1 ran at every speed");
         r.e3 = Some(E3 {
-            speed: slowest,
+            speed: slowest_s,
             repeats: params.e3_repeats,
             n: counts,
             mean,
@@ -681,11 +681,12 @@ pub fn run_all(
     progress(Progress::Tick);
 
     // E4
-    for &s in &speeds {
+    for &sp in &speeds {
+        let s = sp.mm_s();
         let g = ctx.cv(&g2, Columns::All, s, params.knn)?;
-        let e1 = &r.e1[&speed_key(s)];
+        let e1 = r.e1.get(sp).expect("E1 ran at every speed");
         r.e4.insert(
-            speed_key(s),
+            sp,
             E4Speed {
                 taxel_mean: e1.taxel_mean,
                 glcm2d: g.accuracy,
@@ -697,7 +698,8 @@ pub fn run_all(
     progress(Progress::Tick);
 
     // E5
-    for &s in &speeds {
+    for &sp in &speeds {
+        let s = sp.mm_s();
         let at_speed: Vec<&Encoded> = enc
             .iter()
             .filter(|e| same_speed(e.meta.speed_mm_s, s))
@@ -723,7 +725,7 @@ pub fn run_all(
             let table = ctx.table(&truncated, Method::Glcm3d)?;
             accs.push(Some(ctx.cv(&table, Columns::All, s, params.knn)?.accuracy));
         }
-        let taxel_full = r.e1[&speed_key(s)].taxel_mean;
+        let taxel_full = r.e1.get(sp).expect("E1 ran at every speed").taxel_mean;
         let first_match = params
             .e5_fractions
             .iter()
@@ -731,7 +733,7 @@ pub fn run_all(
             .find(|(_, a)| a.is_some_and(|a| a >= taxel_full))
             .map(|(&p, _)| p);
         r.e5.insert(
-            speed_key(s),
+            sp,
             E5Speed {
                 fractions: params.e5_fractions.clone(),
                 glcm3d: accs,
@@ -750,14 +752,11 @@ pub fn run_all(
             "the dataset has only one speed; E6 needs at least two".into(),
         );
     } else {
-        for &s in &speeds {
-            let train: Vec<f64> = speeds
-                .iter()
-                .copied()
-                .filter(|&x| !same_speed(x, s))
-                .collect();
+        for &sp in &speeds {
+            let s = sp.mm_s();
+            let train: Vec<Speed> = speeds.iter().copied().filter(|&x| x != sp).collect();
             let split = Split::ByCondition {
-                train: train.clone(),
+                train: train.iter().map(|s| s.mm_s()).collect(),
                 test: vec![s],
             };
             let t = evaluate(
@@ -777,7 +776,7 @@ pub fn run_all(
                 params.knn,
             )?;
             r.e6.insert(
-                speed_key(s),
+                sp,
                 E6Speed {
                     train,
                     taxel_mean: t.accuracy,
@@ -822,7 +821,7 @@ pub fn run_all(
         })
         .collect();
     r.e7 = Some(E7 {
-        speed: slowest,
+        speed: slowest_s,
         sweep,
         rate_hz,
         median_isi_ms,
@@ -831,7 +830,8 @@ pub fn run_all(
     progress(Progress::Tick);
 
     // E8
-    for &s in &speeds {
+    for &sp in &speeds {
+        let s = sp.mm_s();
         let (mut tm, mut gm) = (Vec::new(), Vec::new());
         let mut ks = Vec::new();
         for &k in &params.e8_ks {
@@ -852,7 +852,7 @@ pub fn run_all(
             }
         }
         r.e8.insert(
-            speed_key(s),
+            sp,
             E8Speed {
                 k: ks,
                 taxel_mean: tm,
@@ -904,7 +904,7 @@ pub fn run_all(
         })
         .collect();
     r.e0 = Some(E0 {
-        speed: slowest,
+        speed: slowest_s,
         taxel: [taxel_cell / prepared.cols, taxel_cell % prepared.cols],
         psth_bin_ms: psth_bin,
         examples,

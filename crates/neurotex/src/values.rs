@@ -1,0 +1,428 @@
+//! Typed values that travel between stages and across the command line: a taxel [`Grid`]
+//! with its mask, a grid [`Cell`], and a sliding [`Speed`] with a total order, plus
+//! [`BySpeed`], results keyed by speed in numeric order.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::error::ParamError;
+
+/// Largest number of grid cells accepted from a user (a 1024 x 1024 skin); more is a typo
+/// or a hostile file, and would allocate per-cell state for nothing.
+pub const MAX_CELLS: usize = 1 << 20;
+
+/// A `rows x cols` taxel grid and which of its cells hold a taxel.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Grid {
+    rows: usize,
+    cols: usize,
+    present: Vec<bool>,
+}
+
+impl Grid {
+    /// A full grid (every cell holds a taxel).
+    ///
+    /// # Errors
+    /// An empty grid or one of more than [`MAX_CELLS`] cells.
+    pub fn full(rows: usize, cols: usize) -> Result<Self, ParamError> {
+        Self::masked(rows, cols, vec![true; cells_checked(rows, cols)?])
+    }
+
+    /// A grid with a mask: `present[row * cols + col]` tells whether that cell holds a taxel.
+    ///
+    /// # Errors
+    /// An empty grid, more than [`MAX_CELLS`] cells, a mask of the wrong length, or a mask
+    /// without any taxel.
+    pub fn masked(rows: usize, cols: usize, present: Vec<bool>) -> Result<Self, ParamError> {
+        let cells = cells_checked(rows, cols)?;
+        if present.len() != cells {
+            return Err(ParamError::new(
+                "mask",
+                "the mask must have one entry per grid cell",
+                format!("{} entries for {rows}x{cols}", present.len()),
+            ));
+        }
+        if !present.contains(&true) {
+            return Err(ParamError::new(
+                "mask",
+                "the mask must leave at least one taxel",
+                format!("{rows}x{cols} all masked"),
+            ));
+        }
+        Ok(Grid {
+            rows,
+            cols,
+            present,
+        })
+    }
+
+    /// Rows.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Columns.
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+
+    /// Cells, `rows * cols`, masked ones included.
+    pub fn cells(&self) -> usize {
+        self.present.len()
+    }
+
+    /// Per cell (row-major), whether it holds a taxel.
+    pub fn present(&self) -> &[bool] {
+        &self.present
+    }
+
+    /// The row-major indices of the cells that hold a taxel, in order.
+    pub fn taxels(&self) -> impl Iterator<Item = usize> + '_ {
+        self.present
+            .iter()
+            .enumerate()
+            .filter(|(_, &p)| p)
+            .map(|(i, _)| i)
+    }
+
+    /// Number of cells that hold a taxel.
+    pub fn n_taxels(&self) -> usize {
+        self.present.iter().filter(|&&p| p).count()
+    }
+
+    /// The cell at row-major index `index`.
+    pub fn cell(&self, index: usize) -> Cell {
+        Cell {
+            row: index / self.cols,
+            col: index % self.cols,
+        }
+    }
+
+    /// The row-major index of `cell` when it lies in the grid and holds a taxel.
+    pub fn taxel_index(&self, cell: Cell) -> Option<usize> {
+        let index = cell.row * self.cols + cell.col;
+        (cell.row < self.rows && cell.col < self.cols && self.present[index]).then_some(index)
+    }
+}
+
+fn cells_checked(rows: usize, cols: usize) -> Result<usize, ParamError> {
+    match rows.checked_mul(cols) {
+        Some(cells) if cells > 0 && cells <= MAX_CELLS => Ok(cells),
+        _ => Err(ParamError::new(
+            "grid",
+            "a grid needs at least one row and column and at most 1048576 cells",
+            format!("{rows}x{cols}"),
+        )),
+    }
+}
+
+impl fmt::Display for Grid {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}x{}", self.rows, self.cols)
+    }
+}
+
+impl FromStr for Grid {
+    type Err = ParamError;
+
+    /// Parses `ROWSxCOLS` (for example `4x4`) into a full grid.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        let bad = || ParamError::new("grid", "a grid is ROWSxCOLS, for example 4x4", text);
+        let (rows, cols) = text.trim().split_once(['x', 'X']).ok_or_else(bad)?;
+        let rows = rows.trim().parse().map_err(|_| bad())?;
+        let cols = cols.trim().parse().map_err(|_| bad())?;
+        Grid::full(rows, cols)
+    }
+}
+
+/// One grid cell, by row and column from 0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct Cell {
+    /// Row from 0.
+    pub row: usize,
+    /// Column from 0.
+    pub col: usize,
+}
+
+impl fmt::Display for Cell {
+    /// `r{row}c{col}`, the name feature columns and reports use.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "r{}c{}", self.row, self.col)
+    }
+}
+
+impl FromStr for Cell {
+    type Err = ParamError;
+
+    /// Parses `ROW,COL` (for example `1,2`).
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        let bad = || {
+            ParamError::new(
+                "taxel",
+                "a taxel is ROW,COL with non-negative integers",
+                text,
+            )
+        };
+        let (row, col) = text.split_once(',').ok_or_else(bad)?;
+        Ok(Cell {
+            row: row.trim().parse().map_err(|_| bad())?,
+            col: col.trim().parse().map_err(|_| bad())?,
+        })
+    }
+}
+
+/// A sliding speed in mm/s; the sign is the direction where a rig records it.
+///
+/// Speeds are conditions, so they need equality and order: two speeds are the same
+/// condition when they are equal as numbers (`-0` is `0`), and they order numerically.
+/// "Slowest" is by magnitude ([`Speed::slowest`]). Written as the shortest decimal that
+/// reads back to the same number (`5`, `2.5`, `-150`), as manifests and `results.json` do.
+#[derive(Debug, Clone, Copy)]
+pub struct Speed(f64);
+
+impl Speed {
+    /// A speed of `mm_s` mm/s.
+    ///
+    /// # Errors
+    /// A value that is not finite.
+    pub fn new(mm_s: f64) -> Result<Self, ParamError> {
+        if mm_s.is_finite() {
+            Ok(Speed(mm_s + 0.0))
+        } else {
+            Err(ParamError::new(
+                "speed",
+                "a speed must be a finite number of mm/s",
+                mm_s,
+            ))
+        }
+    }
+
+    /// The speed of a value already known to be finite (manifest fields are checked on
+    /// reading); a non-finite value becomes 0 rather than breaking the order.
+    pub fn of(mm_s: f64) -> Self {
+        Speed::new(mm_s).unwrap_or(Speed(0.0))
+    }
+
+    /// mm/s.
+    pub fn mm_s(self) -> f64 {
+        self.0
+    }
+
+    /// The slowest of `speeds` by magnitude (a positive speed before its negative twin),
+    /// `None` when there is none.
+    pub fn slowest(speeds: impl IntoIterator<Item = Speed>) -> Option<Speed> {
+        speeds.into_iter().min_by(|a, b| {
+            a.0.abs()
+                .total_cmp(&b.0.abs())
+                .then((a.0 < 0.0).cmp(&(b.0 < 0.0)))
+        })
+    }
+
+    /// The distinct speeds of `speeds`, ascending.
+    pub fn distinct(speeds: impl IntoIterator<Item = Speed>) -> Vec<Speed> {
+        let mut out: Vec<Speed> = speeds.into_iter().collect();
+        out.sort();
+        out.dedup();
+        out
+    }
+}
+
+impl PartialEq for Speed {
+    fn eq(&self, other: &Self) -> bool {
+        self.0 == other.0
+    }
+}
+
+impl Eq for Speed {}
+
+impl PartialOrd for Speed {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Speed {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+impl std::hash::Hash for Speed {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.0.to_bits().hash(state);
+    }
+}
+
+impl fmt::Display for Speed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl FromStr for Speed {
+    type Err = ParamError;
+
+    /// Parses a number of mm/s (`5`, `-150`, `2.5`).
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        let value: f64 = text.trim().parse().map_err(|_| {
+            ParamError::new("speed", "a speed is a number of mm/s, for example 5", text)
+        })?;
+        Speed::new(value)
+    }
+}
+
+impl Serialize for Speed {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_f64(self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for Speed {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let value = f64::deserialize(deserializer)?;
+        Speed::new(value).map_err(serde::de::Error::custom)
+    }
+}
+
+/// Results keyed by speed, in ascending numeric order; serialised as a map whose keys are
+/// the speeds written as [`Speed`]'s `Display` (`"5"`, `"-150"`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BySpeed<T>(Vec<(Speed, T)>);
+
+impl<T> Default for BySpeed<T> {
+    fn default() -> Self {
+        BySpeed(Vec::new())
+    }
+}
+
+impl<T> BySpeed<T> {
+    /// An empty map.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sets the value at `speed`, keeping the order.
+    pub fn insert(&mut self, speed: Speed, value: T) {
+        match self.0.binary_search_by(|(s, _)| s.cmp(&speed)) {
+            Ok(i) => self.0[i].1 = value,
+            Err(i) => self.0.insert(i, (speed, value)),
+        }
+    }
+
+    /// The value at `speed`.
+    pub fn get(&self, speed: Speed) -> Option<&T> {
+        self.0
+            .binary_search_by(|(s, _)| s.cmp(&speed))
+            .ok()
+            .map(|i| &self.0[i].1)
+    }
+
+    /// `(speed, value)` pairs in ascending speed.
+    pub fn iter(&self) -> impl Iterator<Item = (Speed, &T)> {
+        self.0.iter().map(|(s, v)| (*s, v))
+    }
+
+    /// The values in ascending speed.
+    pub fn values(&self) -> impl Iterator<Item = &T> {
+        self.0.iter().map(|(_, v)| v)
+    }
+
+    /// Number of speeds.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Whether there is no speed.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+impl<T> FromIterator<(Speed, T)> for BySpeed<T> {
+    fn from_iter<I: IntoIterator<Item = (Speed, T)>>(iter: I) -> Self {
+        let mut map = BySpeed::new();
+        for (s, v) in iter {
+            map.insert(s, v);
+        }
+        map
+    }
+}
+
+impl<T: Serialize> Serialize for BySpeed<T> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_map(self.0.iter().map(|(s, v)| (s.to_string(), v)))
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for BySpeed<T> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let map = std::collections::BTreeMap::<String, T>::deserialize(deserializer)?;
+        map.into_iter()
+            .map(|(k, v)| {
+                k.parse::<Speed>()
+                    .map(|s| (s, v))
+                    .map_err(serde::de::Error::custom)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn speeds_order_numerically_and_slowest_is_by_magnitude() {
+        let speeds: Vec<Speed> = ["-10", "-100", "5", "-5", "120", "0.5"]
+            .iter()
+            .map(|s| s.parse().unwrap())
+            .collect();
+        let sorted: Vec<String> = Speed::distinct(speeds.clone())
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        assert_eq!(sorted, ["-100", "-10", "-5", "0.5", "5", "120"]);
+        assert_eq!(Speed::slowest(speeds).unwrap().mm_s(), 0.5);
+        let twins = [Speed::of(-3.0), Speed::of(3.0)];
+        assert_eq!(Speed::slowest(twins).unwrap().mm_s(), 3.0);
+        assert_eq!(Speed::of(-0.0), Speed::of(0.0));
+        assert!("inf".parse::<Speed>().is_err());
+    }
+
+    #[test]
+    fn by_speed_keys_serialise_as_today_and_read_back() {
+        let map: BySpeed<u32> = [
+            (Speed::of(15.0), 3),
+            (Speed::of(5.0), 1),
+            (Speed::of(-2.5), 0),
+        ]
+        .into_iter()
+        .collect();
+        let text = serde_json::to_string(&map).unwrap();
+        assert_eq!(text, r#"{"-2.5":0,"5":1,"15":3}"#);
+        let back: BySpeed<u32> = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, map);
+        assert_eq!(back.get(Speed::of(5.0)), Some(&1));
+    }
+
+    #[test]
+    fn grids_and_cells_parse_and_reject_what_cannot_be() {
+        let g: Grid = "4x4".parse().unwrap();
+        assert_eq!((g.rows(), g.cols(), g.n_taxels()), (4, 4, 16));
+        assert!("0x4".parse::<Grid>().is_err());
+        assert!("4by4".parse::<Grid>().is_err());
+        assert!("100000x100000".parse::<Grid>().is_err());
+        assert!(format!("{}x{}", usize::MAX, 2).parse::<Grid>().is_err());
+        let masked = Grid::masked(2, 2, vec![true, false, true, true]).unwrap();
+        assert_eq!(masked.taxels().collect::<Vec<_>>(), [0, 2, 3]);
+        assert_eq!(masked.taxel_index(Cell { row: 0, col: 1 }), None);
+        assert_eq!(masked.taxel_index(Cell { row: 1, col: 0 }), Some(2));
+        assert_eq!(masked.taxel_index(Cell { row: 2, col: 0 }), None);
+        assert!(Grid::masked(1, 2, vec![false, false]).is_err());
+        let c: Cell = " 1, 2".parse().unwrap();
+        assert_eq!(c.to_string(), "r1c2");
+        assert!("1;2".parse::<Cell>().is_err());
+    }
+}
