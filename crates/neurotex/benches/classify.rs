@@ -24,9 +24,11 @@ fn bench(c: &mut Criterion) {
         })
         .collect::<Vec<f64>>();
     let names: Vec<String> = (0..8).map(|k| format!("T{k}")).collect();
+    let knn = KnnParams::default().check().unwrap();
+    let cv = CvParams::default().check().unwrap();
     c.bench_function("classify/knn_cv5/160x3", |b| {
         b.iter(|| {
-            cross_validate(&x, 3, &y, &names, KnnParams::default(), CvParams::default())
+            cross_validate(&knn, &x, 3, &y, &names, cv)
                 .unwrap()
                 .accuracy
         })

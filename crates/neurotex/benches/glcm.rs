@@ -46,7 +46,8 @@ fn bench(c: &mut Criterion) {
         GlcmKind::ThreeD,
     )
     .unwrap();
-    let extractor = FeatureExtractor::new(&PipelineParams::default(), 4, 4, &[true; 16]).unwrap();
+    let extractor =
+        FeatureExtractor::new(&PipelineParams::default(), &"4x4".parse().unwrap()).unwrap();
     let mut group = c.benchmark_group("glcm3d");
     for (name, spikes) in [
         ("simulated_CP", simulated_trains()),

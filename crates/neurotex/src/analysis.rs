@@ -5,16 +5,19 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::classify::{cross_validate, train_test, CvParams, KnnParams};
-use crate::error::{ClassifyError, Result};
-use crate::pipeline::{taxel_cells, Encoded, FeatureExtractor, Method};
-use crate::recording::{same_speed, Meta};
+use crate::classify::{cross_validate, train_test, Classifier, ConfusionMatrix, ValidCv};
+use crate::error::{ClassifyError, ParamError, Result};
+use crate::pipeline::{Encoded, FeatureExtractor, Method};
+use crate::recording::Meta;
+use crate::values::{Cell, Grid, Speed};
 
 /// Feature rows of many recordings, one per recording.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeatureTable {
     /// The method that made the features.
     pub method: Method,
+    /// The taxel grid of every recording (the single-taxel columns follow its taxels).
+    pub grid: Grid,
     /// Column names.
     pub names: Vec<String>,
     /// Each row's recording.
@@ -27,7 +30,7 @@ impl FeatureTable {
     /// Extracts `method`'s features from every encoded recording, in parallel.
     ///
     /// # Errors
-    /// A recording too short for one bin.
+    /// A recording too short for one bin (named by its file).
     pub fn build(
         encoded: &[Encoded],
         extractor: &FeatureExtractor,
@@ -36,16 +39,14 @@ impl FeatureTable {
         let rows: Vec<Vec<f64>> = encoded
             .par_iter()
             .map(|e| {
-                extractor.row(&e.spikes, method).map_err(|err| match err {
-                    crate::Error::Data(crate::error::DataError::Invalid { message, .. }) => {
-                        crate::error::DataError::invalid(&e.meta.file, message).into()
-                    }
-                    other => other,
-                })
+                extractor
+                    .row(&e.spikes, method)
+                    .map_err(|err| err.in_recording(&e.meta.file))
             })
             .collect::<Result<_>>()?;
         Ok(FeatureTable {
             method,
+            grid: extractor.grid().clone(),
             names: extractor.names(method),
             metas: encoded.iter().map(|e| e.meta.clone()).collect(),
             values: rows.concat(),
@@ -61,6 +62,20 @@ impl FeatureTable {
     pub fn row(&self, i: usize) -> &[f64] {
         &self.values[i * self.dims()..(i + 1) * self.dims()]
     }
+
+    /// The indices of the rows recorded at one of `speeds`.
+    pub fn rows_at(&self, speeds: &[Speed]) -> Vec<usize> {
+        (0..self.metas.len())
+            .filter(|&i| speeds.contains(&Speed::of(self.metas[i].speed_mm_s)))
+            .collect()
+    }
+
+    /// The values of rows `rows` and columns `columns`, row-major.
+    fn select(&self, rows: &[usize], columns: &[usize]) -> Vec<f64> {
+        rows.iter()
+            .flat_map(|&i| columns.iter().map(move |&j| self.row(i)[j]))
+            .collect()
+    }
 }
 
 /// How to split recordings for evaluation.
@@ -69,16 +84,16 @@ pub enum Split {
     /// Stratified k-fold cross-validation over the recordings at these speeds (all when `None`).
     CrossValidation {
         /// Speeds to include.
-        speeds: Option<Vec<f64>>,
+        speeds: Option<Vec<Speed>>,
         /// Folds, seed, repeats.
-        cv: CvParams,
+        cv: ValidCv,
     },
     /// Train on recordings at `train` speeds, test on those at `test` speeds.
     ByCondition {
         /// Training speeds.
-        train: Vec<f64>,
+        train: Vec<Speed>,
         /// Test speeds.
-        test: Vec<f64>,
+        test: Vec<Speed>,
     },
 }
 
@@ -93,7 +108,8 @@ pub struct TaxelAccuracy {
     pub accuracy: f64,
 }
 
-/// The result of an evaluation.
+/// The result of evaluating a feature table (the analysis level; a classifier's own result
+/// is [`crate::classify::Evaluation`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
     /// Accuracy 0..1 (for all taxels: the mean over taxels).
@@ -103,7 +119,7 @@ pub struct Outcome {
     /// Class names in confusion-matrix order.
     pub labels: Vec<String>,
     /// Row = true label; summed over repeats, and over taxels when every taxel was evaluated.
-    pub confusion: Vec<Vec<usize>>,
+    pub confusion: ConfusionMatrix,
     /// Test samples per evaluation.
     pub n: usize,
     /// Every taxel's accuracy, when every taxel was evaluated.
@@ -114,81 +130,82 @@ pub struct Outcome {
     pub best: Option<TaxelAccuracy>,
 }
 
-/// One column group's evaluation: `(cell, accuracy, accuracy_std, confusion, n)`.
-type GroupResult = (Option<usize>, f64, f64, Vec<Vec<usize>>, usize);
-
 /// Which feature columns to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Columns {
     /// All of them (GLCM methods).
     All,
-    /// The three of one taxel, by row and column.
-    Taxel(usize, usize),
+    /// The three of one taxel.
+    Taxel(Cell),
     /// Each taxel in turn, reporting the mean and the best.
     EachTaxel,
 }
 
-/// Evaluates a feature table with KNN.
+/// One column group's evaluation: the taxel it belongs to (none for all columns) and the
+/// classifier's result.
+struct GroupResult {
+    cell: Option<usize>,
+    evaluation: crate::classify::Evaluation,
+}
+
+/// The column groups `columns` names: `(taxel cell, column indices)`.
+fn column_groups(
+    table: &FeatureTable,
+    columns: Columns,
+) -> Result<Vec<(Option<usize>, Vec<usize>)>> {
+    let taxels: Vec<usize> = table.grid.taxels().collect();
+    let of_taxel = |k: usize| (Some(taxels[k]), (3 * k..3 * k + 3).collect());
+    Ok(match columns {
+        Columns::All => vec![(None, (0..table.dims()).collect())],
+        Columns::Taxel(cell) => {
+            let index = table.grid.taxel_index(cell).ok_or_else(|| {
+                ParamError::new(
+                    "taxel",
+                    "taxel must be a present cell of the grid",
+                    format!("{},{} in the {} grid", cell.row, cell.col, table.grid),
+                )
+            })?;
+            let k = taxels.iter().position(|&t| t == index).unwrap_or(0);
+            vec![of_taxel(k)]
+        }
+        Columns::EachTaxel => (0..taxels.len()).map(of_taxel).collect(),
+    })
+}
+
+/// The class names in order of first appearance over `rows`, and each row's class index.
+fn classes(table: &FeatureTable, rows: &[usize]) -> (Vec<String>, Vec<usize>) {
+    let mut labels: Vec<String> = Vec::new();
+    let y = rows
+        .iter()
+        .map(|&i| {
+            let label = &table.metas[i].label;
+            labels.iter().position(|l| l == label).unwrap_or_else(|| {
+                labels.push(label.clone());
+                labels.len() - 1
+            })
+        })
+        .collect();
+    (labels, y)
+}
+
+/// Evaluates a feature table with `classifier`.
 ///
 /// # Errors
-/// No recordings at the asked speeds, a class smaller than the fold count, `k` larger than
-/// the training set, a test label unseen in training, or a taxel outside the grid.
-pub fn evaluate(
+/// No recordings at the asked speeds, a class smaller than the fold count, a training set
+/// the classifier cannot fit, a test label unseen in training, or a taxel outside the grid.
+pub fn evaluate<C: Classifier>(
     table: &FeatureTable,
-    present: &[bool],
-    cols: usize,
     columns: Columns,
     split: &Split,
-    knn: KnnParams,
+    classifier: &C,
 ) -> Result<Outcome> {
-    let in_speeds = |speeds: &[f64], m: &Meta| speeds.iter().any(|&s| same_speed(s, m.speed_mm_s));
-    let taxels: Vec<usize> = taxel_cells(present).collect();
-    let groups: Vec<(Option<usize>, Vec<usize>)> = match columns {
-        Columns::All => vec![(None, (0..table.dims()).collect())],
-        Columns::Taxel(r, c) => {
-            let cell = r * cols + c;
-            let k = taxels
-                .iter()
-                .position(|&t| t == cell && c < cols)
-                .ok_or_else(|| {
-                    crate::error::ParamError::new(
-                        "taxel",
-                        "taxel must be a present cell of the grid",
-                        format!("{r},{c}"),
-                    )
-                })?;
-            vec![(Some(cell), (3 * k..3 * k + 3).collect())]
-        }
-        Columns::EachTaxel => taxels
-            .iter()
-            .enumerate()
-            .map(|(k, &cell)| (Some(cell), (3 * k..3 * k + 3).collect()))
-            .collect(),
-    };
-    let select = |rows: &[usize], cols_idx: &[usize]| -> Vec<f64> {
-        rows.iter()
-            .flat_map(|&i| cols_idx.iter().map(move |&j| table.row(i)[j]))
-            .collect()
-    };
-    let (train_rows, test_rows): (Vec<usize>, Vec<usize>) = match split {
-        Split::CrossValidation { speeds, .. } => {
-            let rows: Vec<usize> = (0..table.metas.len())
-                .filter(|&i| {
-                    speeds
-                        .as_ref()
-                        .is_none_or(|s| in_speeds(s, &table.metas[i]))
-                })
-                .collect();
-            (rows, Vec::new())
-        }
-        Split::ByCondition { train, test } => (
-            (0..table.metas.len())
-                .filter(|&i| in_speeds(train, &table.metas[i]))
-                .collect(),
-            (0..table.metas.len())
-                .filter(|&i| in_speeds(test, &table.metas[i]))
-                .collect(),
-        ),
+    let groups = column_groups(table, columns)?;
+    let (train_rows, test_rows) = match split {
+        Split::CrossValidation { speeds: None, .. } => ((0..table.metas.len()).collect(), vec![]),
+        Split::CrossValidation {
+            speeds: Some(s), ..
+        } => (table.rows_at(s), vec![]),
+        Split::ByCondition { train, test } => (table.rows_at(train), table.rows_at(test)),
     };
     if train_rows.is_empty() {
         return Err(ClassifyError::Empty {
@@ -196,79 +213,80 @@ pub fn evaluate(
         }
         .into());
     }
-    let mut labels: Vec<String> = Vec::new();
-    for &i in train_rows.iter().chain(&test_rows) {
-        if !labels.contains(&table.metas[i].label) {
-            labels.push(table.metas[i].label.clone());
-        }
-    }
-    let class = |i: usize| {
-        labels
-            .iter()
-            .position(|l| *l == table.metas[i].label)
-            .unwrap_or(0)
-    };
-    let y_train: Vec<usize> = train_rows.iter().map(|&i| class(i)).collect();
-    let y_test: Vec<usize> = test_rows.iter().map(|&i| class(i)).collect();
+    let all_rows: Vec<usize> = train_rows.iter().chain(&test_rows).copied().collect();
+    let (labels, y) = classes(table, &all_rows);
+    let (y_train, y_test) = y.split_at(train_rows.len());
     let results: Vec<GroupResult> = groups
         .par_iter()
-        .map(|(cell, cols_idx)| -> Result<_> {
-            let dims = cols_idx.len();
-            let x_train = select(&train_rows, cols_idx);
-            Ok(match split {
+        .map(|(cell, cols)| -> Result<GroupResult> {
+            let x_train = table.select(&train_rows, cols);
+            let evaluation = match split {
                 Split::CrossValidation { cv, .. } => {
-                    let r = cross_validate(&x_train, dims, &y_train, &labels, knn, *cv)?;
-                    (*cell, r.accuracy, r.accuracy_std, r.confusion, r.n)
+                    cross_validate(classifier, &x_train, cols.len(), y_train, &labels, *cv)?
                 }
                 Split::ByCondition { .. } => {
-                    let x_test = select(&test_rows, cols_idx);
-                    let r = train_test(&x_train, &y_train, &x_test, &y_test, dims, &labels, knn)?;
-                    (*cell, r.accuracy, 0.0, r.confusion, r.n)
+                    let x_test = table.select(&test_rows, cols);
+                    let (train, test) = ((&x_train[..], y_train), (&x_test[..], y_test));
+                    train_test(classifier, train, test, cols.len(), &labels)?
                 }
+            };
+            Ok(GroupResult {
+                cell: *cell,
+                evaluation,
             })
         })
         .collect::<Result<_>>()?;
+    Ok(combine(
+        results,
+        labels,
+        columns == Columns::EachTaxel,
+        &table.grid,
+    ))
+}
+
+/// One outcome from the groups' results: mean accuracy and spread, summed confusion, and
+/// per-taxel accuracies with the best when every taxel was evaluated.
+fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Grid) -> Outcome {
     let n_groups = results.len() as f64;
-    let mut confusion = vec![vec![0usize; labels.len()]; labels.len()];
-    for (_, _, _, m, _) in &results {
-        for (acc, row) in confusion.iter_mut().zip(m) {
-            for (a, &v) in acc.iter_mut().zip(row) {
-                *a += v;
-            }
-        }
+    let mut confusion = ConfusionMatrix::zeros(labels.len());
+    for r in &results {
+        confusion.add(&r.evaluation.confusion);
     }
-    let accuracy = results.iter().map(|r| r.1).sum::<f64>() / n_groups;
-    let accuracy_std = results.iter().map(|r| r.2).sum::<f64>() / n_groups;
-    let (per_taxel, best) = if columns == Columns::EachTaxel {
-        let per: Vec<TaxelAccuracy> = results
+    let accuracy = results.iter().map(|r| r.evaluation.accuracy).sum::<f64>() / n_groups;
+    let accuracy_std = results
+        .iter()
+        .map(|r| r.evaluation.accuracy_std)
+        .sum::<f64>()
+        / n_groups;
+    let per_taxel: Option<Vec<TaxelAccuracy>> = each.then(|| {
+        results
             .iter()
             .map(|r| {
-                let cell = r.0.unwrap_or(0);
+                let cell = grid.cell(r.cell.unwrap_or(0));
                 TaxelAccuracy {
-                    row: cell / cols,
-                    col: cell % cols,
-                    accuracy: r.1,
+                    row: cell.row,
+                    col: cell.col,
+                    accuracy: r.evaluation.accuracy,
                 }
             })
-            .collect();
-        let best = per
-            .iter()
+            .collect()
+    });
+    // The first taxel of the highest accuracy, in grid order.
+    let best = per_taxel.as_ref().and_then(|per| {
+        per.iter()
             .copied()
             .fold(None, |b: Option<TaxelAccuracy>, t| match b {
                 Some(b) if b.accuracy >= t.accuracy => Some(b),
                 _ => Some(t),
-            });
-        (Some(per), best)
-    } else {
-        (None, None)
-    };
-    Ok(Outcome {
+            })
+    });
+    Outcome {
         accuracy,
         accuracy_std,
         labels,
         confusion,
-        n: results[0].4,
+        n: results[0].evaluation.n,
         per_taxel,
         best,
-    })
+    }
 }

@@ -319,6 +319,11 @@ impl SpikeTrains {
         }
     }
 
+    /// The grid the trains were encoded on.
+    pub fn grid(&self) -> crate::values::Grid {
+        crate::values::Grid::from_parts(self.rows, self.cols, &self.present)
+    }
+
     /// Number of cells.
     pub fn cells(&self) -> usize {
         self.rows * self.cols

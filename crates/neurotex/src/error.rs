@@ -14,6 +14,30 @@ pub enum Error {
     /// Classification or cross-validation could not run on the given data.
     #[error(transparent)]
     Classify(#[from] ClassifyError),
+    /// An error while working on one recording's data after it was read, naming the
+    /// recording (the inner error has no file of its own).
+    #[error("{file}: {source}")]
+    InRecording {
+        /// The recording's file, as the manifest names it.
+        file: String,
+        /// What went wrong.
+        source: Box<Error>,
+    },
+}
+
+impl Error {
+    /// This error with the recording `file` named (see [`Error::InRecording`]); errors that
+    /// already name a file are returned as they are.
+    pub fn in_recording(self, file: &str) -> Error {
+        match self {
+            Error::Data(DataError::Io { .. } | DataError::Invalid { .. })
+            | Error::InRecording { .. } => self,
+            other => Error::InRecording {
+                file: file.to_string(),
+                source: Box::new(other),
+            },
+        }
+    }
 }
 
 /// A shorthand for results with [`Error`].
@@ -52,6 +76,14 @@ pub enum DataError {
         path: PathBuf,
         /// The operating system's reason.
         source: std::io::Error,
+    },
+    /// Spike trains (or a part of them) shorter than one rate-volume bin.
+    #[error("{n_ms} ms of spikes is shorter than one {bin_ms} ms bin")]
+    TooShort {
+        /// Milliseconds of spikes.
+        n_ms: usize,
+        /// The bin, ms.
+        bin_ms: usize,
     },
     /// A file was read but its content is not what was expected.
     #[error("{path}: {message}")]

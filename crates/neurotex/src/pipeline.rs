@@ -11,6 +11,7 @@ use crate::features::glcm::GlcmKind;
 use crate::features::{haralick, spike_stats, CountVolume, GlcmParams, GlcmPlan, VolumeParams};
 use crate::recording::{Baseline, Dataset, Meta, Recording};
 use crate::signal::{Conditioned, PreprocessParams, Preprocessor};
+use crate::values::Grid;
 
 /// The feature sets the paper compares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -199,13 +200,8 @@ impl Pipeline {
     ///
     /// # Errors
     /// A broken parameter rule.
-    pub fn extractor(
-        &self,
-        rows: usize,
-        cols: usize,
-        present: &[bool],
-    ) -> Result<FeatureExtractor, ParamError> {
-        FeatureExtractor::new(&self.params, rows, cols, present)
+    pub fn extractor(&self, grid: &Grid) -> Result<FeatureExtractor, ParamError> {
+        FeatureExtractor::new(&self.params, grid)
     }
 }
 
@@ -214,44 +210,43 @@ impl Pipeline {
 pub struct FeatureExtractor {
     volume: VolumeParams,
     glcm: GlcmParams,
-    rows: usize,
-    cols: usize,
-    present: Vec<bool>,
+    grid: Grid,
     plan3d: GlcmPlan,
     plan2d: GlcmPlan,
 }
 
 impl FeatureExtractor {
-    /// Plans the extractor for a `rows x cols` grid with `present` cells.
+    /// Plans the extractor for `grid`.
     ///
     /// # Errors
     /// A broken parameter rule.
-    pub fn new(
-        params: &PipelineParams,
-        rows: usize,
-        cols: usize,
-        present: &[bool],
-    ) -> Result<Self, ParamError> {
+    pub fn new(params: &PipelineParams, grid: &Grid) -> Result<Self, ParamError> {
         params.volume.check()?;
         let levels = params.volume.levels;
+        let (rows, cols, present) = (grid.rows(), grid.cols(), grid.present());
         Ok(FeatureExtractor {
             volume: params.volume.clone(),
             glcm: params.glcm.clone(),
-            rows,
-            cols,
-            present: present.to_vec(),
+            grid: grid.clone(),
             plan3d: GlcmPlan::new(rows, cols, present, levels, &params.glcm, GlcmKind::ThreeD)?,
             plan2d: GlcmPlan::new(rows, cols, present, levels, &params.glcm, GlcmKind::TwoD)?,
         })
     }
 
+    /// The grid the extractor was planned for.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
     /// Column names of `method`'s features for this grid.
     pub fn names(&self, method: Method) -> Vec<String> {
         match method {
-            Method::Taxel => taxel_cells(&self.present)
+            Method::Taxel => self
+                .grid
+                .taxels()
                 .flat_map(|cell| {
-                    let (r, c) = (cell / self.cols, cell % self.cols);
-                    ["msr", "cv_isi", "fano"].map(|f| format!("r{r}c{c}_{f}"))
+                    let cell = self.grid.cell(cell);
+                    ["msr", "cv_isi", "fano"].map(|f| format!("{cell}_{f}"))
                 })
                 .collect(),
             Method::Glcm2d | Method::Glcm3d => ["contrast", "correlation", "asm"]
@@ -267,13 +262,10 @@ impl FeatureExtractor {
     pub fn row(&self, spikes: &SpikeTrains, method: Method) -> Result<Vec<f64>> {
         let bin = self.volume.bin_ms;
         let too_short = || -> crate::Error {
-            DataError::invalid(
-                "spike trains",
-                format!(
-                    "{} ms of spikes is shorter than one {bin} ms bin",
-                    spikes.n_steps
-                ),
-            )
+            DataError::TooShort {
+                n_ms: spikes.n_steps,
+                bin_ms: bin,
+            }
             .into()
         };
         if spikes.n_steps < bin {
@@ -290,8 +282,8 @@ impl FeatureExtractor {
                     CountVolume::collapsed(spikes)
                 }
                 .ok_or_else(too_short)?;
-                let same_grid = (spikes.rows, spikes.cols) == (self.rows, self.cols)
-                    && spikes.present == self.present;
+                let same_grid = (spikes.rows, spikes.cols) == (self.grid.rows(), self.grid.cols())
+                    && spikes.present == self.grid.present();
                 let kind = if method == Method::Glcm3d {
                     GlcmKind::ThreeD
                 } else {

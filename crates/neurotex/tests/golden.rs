@@ -30,7 +30,9 @@ fn small_simulated_design_matches_the_stored_results() {
         e7_gains: vec![5.0, 8.0],
         e8_ks: vec![1, 5],
         ..ReproduceParams::default()
-    };
+    }
+    .check()
+    .unwrap();
     let source = Source::Simulated {
         rig: Box::new(rig),
         trials,

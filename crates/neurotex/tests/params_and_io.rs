@@ -8,7 +8,7 @@ use neurotex::features::{GlcmParams, VolumeParams};
 use neurotex::recording::{read_recording, Dataset, LayoutFile};
 use neurotex::signal::PreprocessParams;
 
-fn broken_rule<E: std::fmt::Display>(r: Result<(), E>) -> String {
+fn broken_rule<T, E: std::fmt::Display>(r: Result<T, E>) -> String {
     r.err()
         .map(|e| e.to_string())
         .expect("the rule must be enforced")

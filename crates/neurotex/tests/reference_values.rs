@@ -207,18 +207,13 @@ fn knn_matches_scikit_learn_on_fixed_folds() {
     let mut compared = 0;
     for case in r["cases"].as_array().unwrap() {
         let k = case["k"].as_u64().unwrap() as usize;
-        let ours = predict_out_of_fold(
-            &x,
-            3,
-            &y,
-            &folds,
-            5,
-            KnnParams {
-                k,
-                standardize: true,
-            },
-        )
+        let knn = KnnParams {
+            k,
+            standardize: true,
+        }
+        .check()
         .unwrap();
+        let ours = predict_out_of_fold(&knn, &x, 3, &y, &folds, 5).unwrap();
         let theirs = ints(&case["predicted"]);
         let tied: Vec<bool> = case["vote_tie"]
             .as_array()

@@ -1,7 +1,7 @@
 //! Fast code against slow, evidently correct versions written from the definitions,
 //! on random inputs (proptest).
 
-use neurotex::classify::{Knn, KnnParams};
+use neurotex::classify::{Classifier, KnnParams, Predict};
 use neurotex::encode::{Encoder, IzhikevichParams, SpikeTrains};
 use neurotex::features::glcm::GlcmKind;
 use neurotex::features::{
@@ -322,7 +322,8 @@ proptest! {
         let train: Vec<f64> = (0..n * dims).map(|_| (next() % 5) as f64).collect();
         let y: Vec<usize> = (0..n).map(|i| if i < classes { i } else { (next() % classes as u64) as usize }).collect();
         let test: Vec<f64> = (0..10 * dims).map(|_| (next() % 5) as f64).collect();
-        let model = Knn::new(KnnParams { k: k.min(n), standardize }).fit(&train, dims, &y).unwrap();
+        let knn = KnnParams { k: k.min(n), standardize }.check().unwrap();
+        let model = knn.fit(&train, dims, &y).unwrap();
         prop_assert_eq!(model.predict(&test), slow_knn(&train, &y, &test, dims, k.min(n), standardize));
     }
 

@@ -1,11 +1,12 @@
-//! Stratified shuffled k-fold cross-validation and train/test evaluation.
+//! Stratified shuffled k-fold cross-validation and train/test evaluation, over any
+//! [`Classifier`].
 
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::knn::{Knn, KnnParams};
+use super::{Classifier, ConfusionMatrix, Predict};
 use crate::error::{ClassifyError, ParamError};
 
 /// Cross-validation parameters.
@@ -30,11 +31,12 @@ impl Default for CvParams {
 }
 
 impl CvParams {
-    /// Checks the rules: at least 2 folds and 1 repeat.
+    /// Checks the rules (at least 2 folds and 1 repeat) and returns the validated form
+    /// that cross-validation takes.
     ///
     /// # Errors
     /// The rule broken.
-    pub fn check(&self) -> Result<(), ParamError> {
+    pub fn check(self) -> Result<ValidCv, ParamError> {
         if self.folds < 2 {
             return Err(ParamError::new(
                 "folds",
@@ -49,34 +51,51 @@ impl CvParams {
                 self.repeats,
             ));
         }
-        Ok(())
+        Ok(ValidCv(self))
     }
 }
 
-/// Accuracy and confusion of one evaluation.
+/// Cross-validation parameters that passed [`CvParams::check`] (the default is the
+/// default parameters, which pass).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ValidCv(CvParams);
+
+impl std::ops::Deref for ValidCv {
+    type Target = CvParams;
+    fn deref(&self) -> &CvParams {
+        &self.0
+    }
+}
+
+/// Accuracy and confusion of an evaluation: one train/test split, or cross-validation over
+/// repeats (mean and spread over repeats, confusion summed over them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Evaluation {
-    /// Fraction of correct predictions, 0..1.
+    /// Mean accuracy over repeats, 0..1.
     pub accuracy: f64,
-    /// `n_classes x n_classes` counts, row = true class, column = predicted class.
-    pub confusion: Vec<Vec<usize>>,
-    /// Samples evaluated.
+    /// Population standard deviation of accuracy over repeats (0 for one).
+    pub accuracy_std: f64,
+    /// Each repeat's accuracy (one entry for a train/test split).
+    pub per_repeat: Vec<f64>,
+    /// Row = true class; summed over repeats.
+    pub confusion: ConfusionMatrix,
+    /// Samples evaluated per repeat.
     pub n: usize,
 }
 
-/// Cross-validation over repeats: the first repeat's pooled evaluation and the spread.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CvResult {
-    /// Mean accuracy over repeats.
-    pub accuracy: f64,
-    /// Population standard deviation of accuracy over repeats (0 for one repeat).
-    pub accuracy_std: f64,
-    /// Each repeat's accuracy.
-    pub per_repeat: Vec<f64>,
-    /// Confusion matrix summed over repeats (row = true class).
-    pub confusion: Vec<Vec<usize>>,
-    /// Samples per repeat.
-    pub n: usize,
+impl Evaluation {
+    fn of_repeats(per_repeat: Vec<f64>, confusion: ConfusionMatrix, n: usize) -> Self {
+        let mean = per_repeat.iter().sum::<f64>() / per_repeat.len().max(1) as f64;
+        let var = per_repeat.iter().map(|a| (a - mean).powi(2)).sum::<f64>()
+            / per_repeat.len().max(1) as f64;
+        Evaluation {
+            accuracy: mean,
+            accuracy_std: var.sqrt(),
+            per_repeat,
+            confusion,
+            n,
+        }
+    }
 }
 
 /// Assigns each sample a fold so every class is spread evenly: the samples of each class are
@@ -119,35 +138,17 @@ pub fn stratified_folds(
     Ok(fold_of)
 }
 
-/// Counts `(true, predicted)` pairs into an `n_classes` square matrix.
-pub fn confusion_matrix(truth: &[usize], predicted: &[usize], n_classes: usize) -> Vec<Vec<usize>> {
-    let mut m = vec![vec![0usize; n_classes]; n_classes];
-    for (&t, &p) in truth.iter().zip(predicted) {
-        m[t][p] += 1;
-    }
-    m
-}
-
-fn evaluation(truth: &[usize], predicted: &[usize], n_classes: usize) -> Evaluation {
-    let correct = truth.iter().zip(predicted).filter(|(a, b)| a == b).count();
-    Evaluation {
-        accuracy: correct as f64 / truth.len().max(1) as f64,
-        confusion: confusion_matrix(truth, predicted, n_classes),
-        n: truth.len(),
-    }
-}
-
-/// Out-of-fold predictions of KNN under a given fold assignment.
+/// Out-of-fold predictions of `classifier` under a given fold assignment.
 ///
 /// # Errors
-/// A fold's training set smaller than `k`, or bad features.
-pub fn predict_out_of_fold(
+/// A fold's training set the classifier cannot fit.
+pub fn predict_out_of_fold<C: Classifier>(
+    classifier: &C,
     x: &[f64],
     dims: usize,
     y: &[usize],
     fold_of: &[usize],
     folds: usize,
-    knn: KnnParams,
 ) -> Result<Vec<usize>, ClassifyError> {
     let mut predicted = vec![0usize; y.len()];
     let (mut xtr, mut ytr, mut xte, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -169,7 +170,7 @@ pub fn predict_out_of_fold(
         if idx.is_empty() {
             continue;
         }
-        let model = Knn::new(knn).fit(&xtr, dims, &ytr)?;
+        let model = classifier.fit(&xtr, dims, &ytr)?;
         for (&i, p) in idx.iter().zip(model.predict(&xte)) {
             predicted[i] = p;
         }
@@ -177,21 +178,20 @@ pub fn predict_out_of_fold(
     Ok(predicted)
 }
 
-/// Stratified k-fold cross-validation of KNN, repeated with seeds `seed, seed + 1, ...`.
+/// Stratified k-fold cross-validation of `classifier`, repeated with seeds `seed, seed + 1,
+/// ...`; accuracy over the pooled out-of-fold predictions of each repeat.
 ///
 /// # Errors
-/// Bad parameters, a class smaller than the fold count, `k` larger than a training fold,
-/// bad features, or no samples.
-pub fn cross_validate(
+/// No samples, a class smaller than the fold count, or a training fold the classifier
+/// cannot fit.
+pub fn cross_validate<C: Classifier>(
+    classifier: &C,
     x: &[f64],
     dims: usize,
     y: &[usize],
     class_names: &[String],
-    knn: KnnParams,
-    cv: CvParams,
-) -> Result<CvResult, ClassifyError> {
-    cv.check()
-        .map_err(|e| ClassifyError::BadFeatures(e.to_string()))?;
+    cv: ValidCv,
+) -> Result<Evaluation, ClassifyError> {
     if y.is_empty() {
         return Err(ClassifyError::Empty {
             what: "cross-validate",
@@ -199,48 +199,31 @@ pub fn cross_validate(
     }
     let n_classes = class_names.len().max(y.iter().max().map_or(0, |&m| m + 1));
     let mut per_repeat = Vec::with_capacity(cv.repeats);
-    let mut confusion = vec![vec![0usize; n_classes]; n_classes];
+    let mut confusion = ConfusionMatrix::zeros(n_classes);
     for r in 0..cv.repeats {
-        let fold_of = stratified_folds(
-            y,
-            n_classes,
-            cv.folds,
-            cv.seed.wrapping_add(r as u64),
-            class_names,
-        )?;
-        let predicted = predict_out_of_fold(x, dims, y, &fold_of, cv.folds, knn)?;
-        let ev = evaluation(y, &predicted, n_classes);
-        for (acc, row) in confusion.iter_mut().zip(&ev.confusion) {
-            for (a, &v) in acc.iter_mut().zip(row) {
-                *a += v;
-            }
-        }
-        per_repeat.push(ev.accuracy);
+        let seed = cv.seed.wrapping_add(r as u64);
+        let fold_of = stratified_folds(y, n_classes, cv.folds, seed, class_names)?;
+        let predicted = predict_out_of_fold(classifier, x, dims, y, &fold_of, cv.folds)?;
+        let matrix = ConfusionMatrix::from_predictions(y, &predicted, n_classes);
+        per_repeat.push(matrix.accuracy());
+        confusion.add(&matrix);
     }
-    let mean = per_repeat.iter().sum::<f64>() / per_repeat.len() as f64;
-    let var = per_repeat.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / per_repeat.len() as f64;
-    Ok(CvResult {
-        accuracy: mean,
-        accuracy_std: var.sqrt(),
-        per_repeat,
-        confusion,
-        n: y.len(),
-    })
+    Ok(Evaluation::of_repeats(per_repeat, confusion, y.len()))
 }
 
 /// Trains on one set and tests on another (for example train on two speeds, test on the third).
 ///
 /// # Errors
-/// A test class absent from training, `k` larger than the training set, bad features.
-pub fn train_test(
-    x_train: &[f64],
-    y_train: &[usize],
-    x_test: &[f64],
-    y_test: &[usize],
+/// No test samples, a test class absent from training, ragged or non-finite test features,
+/// or a training set the classifier cannot fit.
+pub fn train_test<C: Classifier>(
+    classifier: &C,
+    train: (&[f64], &[usize]),
+    test: (&[f64], &[usize]),
     dims: usize,
     class_names: &[String],
-    knn: KnnParams,
 ) -> Result<Evaluation, ClassifyError> {
+    let ((x_train, y_train), (x_test, y_test)) = (train, test);
     if y_test.is_empty() {
         return Err(ClassifyError::Empty { what: "test" });
     }
@@ -249,7 +232,7 @@ pub fn train_test(
             label: class_names.get(c).cloned().unwrap_or_else(|| c.to_string()),
         });
     }
-    let model = Knn::new(knn).fit(x_train, dims, y_train)?;
+    let model = classifier.fit(x_train, dims, y_train)?;
     if x_test.len() != y_test.len() * dims || x_test.iter().any(|v| !v.is_finite()) {
         return Err(ClassifyError::BadFeatures(
             "test features are ragged or not finite".into(),
@@ -259,5 +242,10 @@ pub fn train_test(
     let n_classes = class_names
         .len()
         .max(1 + *y_train.iter().chain(y_test).max().unwrap_or(&0));
-    Ok(evaluation(y_test, &predicted, n_classes))
+    let confusion = ConfusionMatrix::from_predictions(y_test, &predicted, n_classes);
+    Ok(Evaluation::of_repeats(
+        vec![confusion.accuracy()],
+        confusion,
+        y_test.len(),
+    ))
 }

@@ -5,6 +5,7 @@
 //! member wins. Features are z-scored with the training set's mean and population standard
 //! deviation (a feature constant in training is only centred).
 
+use super::{Classifier, Predict};
 use crate::error::{ClassifyError, ParamError};
 
 /// KNN parameters.
@@ -27,23 +28,22 @@ impl Default for KnnParams {
 }
 
 impl KnnParams {
-    /// Checks the rule: at least one neighbour.
+    /// Checks the rule (at least one neighbour) and returns the unfitted classifier.
     ///
     /// # Errors
     /// The rule broken.
-    pub fn check(&self) -> Result<(), ParamError> {
+    pub fn check(self) -> Result<Knn, ParamError> {
         if self.k == 0 {
             return Err(ParamError::new("k", "k must be at least 1", self.k));
         }
-        Ok(())
+        Ok(Knn { params: self })
     }
 }
 
-/// The unfitted classifier.
+/// The unfitted classifier, with parameters that passed [`KnnParams::check`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Knn {
-    /// Its parameters.
-    pub params: KnnParams,
+    params: KnnParams,
 }
 
 /// A fitted KNN: the scaled training set and its labels.
@@ -82,19 +82,20 @@ fn scatter_stride(n: usize) -> usize {
 }
 
 impl Knn {
-    /// A classifier with `params`.
-    pub fn new(params: KnnParams) -> Self {
-        Knn { params }
+    /// The parameters.
+    pub fn params(&self) -> KnnParams {
+        self.params
     }
+}
 
-    /// Fits on `x` (row-major, `dims` features per sample) with class indices `y`.
+impl Classifier for Knn {
+    type Model = KnnModel;
+
+    /// Stores the z-scored training set.
     ///
     /// # Errors
     /// `k` larger than the training set, empty or ragged input, non-finite features.
-    pub fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<KnnModel, ClassifyError> {
-        self.params
-            .check()
-            .map_err(|e| ClassifyError::BadFeatures(e.to_string()))?;
+    fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<KnnModel, ClassifyError> {
         let n = y.len();
         if n == 0 || dims == 0 {
             return Err(ClassifyError::Empty { what: "train on" });
@@ -166,12 +167,12 @@ impl Knn {
     }
 }
 
-impl KnnModel {
-    /// Predicts the class of each row of `x`.
-    ///
-    /// # Panics
-    /// If `x` is not whole rows of the training dimension (a caller bug).
-    pub fn predict(&self, x: &[f64]) -> Vec<usize> {
+impl Predict for KnnModel {
+    fn dims(&self) -> usize {
+        self.dims
+    }
+
+    fn predict(&self, x: &[f64]) -> Vec<usize> {
         assert_eq!(
             x.len() % self.dims,
             0,

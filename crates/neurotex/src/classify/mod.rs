@@ -1,10 +1,38 @@
-//! Classification (SPEC 3.12-3.13): k-nearest neighbours with training-fold z-scoring,
-//! stratified shuffled k-fold cross-validation and train/test evaluation.
+//! Classification (SPEC 3.12-3.13): a [`Classifier`] trait (fit, then predict), k-nearest
+//! neighbours with training-fold z-scoring, stratified shuffled k-fold cross-validation and
+//! train/test evaluation over any classifier, and the [`ConfusionMatrix`] they fill.
 
+pub mod confusion;
 pub mod cv;
 pub mod knn;
 
-pub use cv::{
-    confusion_matrix, cross_validate, stratified_folds, train_test, CvParams, CvResult, Evaluation,
-};
+pub use confusion::ConfusionMatrix;
+pub use cv::{cross_validate, stratified_folds, train_test, CvParams, Evaluation, ValidCv};
 pub use knn::{Knn, KnnModel, KnnParams};
+
+use crate::error::ClassifyError;
+
+/// An unfitted classifier with validated parameters (linfa's `Fit`): fitting stores what
+/// prediction needs and checks the training data.
+pub trait Classifier: Sync {
+    /// The fitted model.
+    type Model: Predict;
+
+    /// Fits on `x` (row-major, `dims` features per sample) with class indices `y`.
+    ///
+    /// # Errors
+    /// Training data this classifier cannot use (empty, ragged, non-finite, too small).
+    fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<Self::Model, ClassifyError>;
+}
+
+/// A fitted classifier (linfa's `Predict`).
+pub trait Predict {
+    /// The features per sample the model was fitted on.
+    fn dims(&self) -> usize;
+
+    /// The predicted class index of each row of `x` (row-major, [`Predict::dims`] per row).
+    ///
+    /// # Panics
+    /// If `x` is not whole rows of the training dimension (a caller bug).
+    fn predict(&self, x: &[f64]) -> Vec<usize>;
+}

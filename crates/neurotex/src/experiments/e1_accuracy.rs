@@ -1,0 +1,69 @@
+//! E1: accuracy per speed, single taxel (mean over taxels, and the best taxel chosen after
+//! the fact) against 3D-GLCM (paper section IV-A).
+
+use serde::{Deserialize, Serialize};
+
+use super::{Context, Stop};
+use crate::values::BySpeed;
+
+/// E1 at one speed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct E1Speed {
+    /// Single taxel, mean over taxels.
+    pub taxel_mean: f64,
+    /// The best taxel (chosen after the fact).
+    pub taxel_best: f64,
+    /// Which taxel was best, `r{row}c{col}`.
+    pub taxel_best_cell: String,
+    /// 3D-GLCM.
+    pub glcm3d: f64,
+    /// 3D-GLCM standard deviation over CV repeats.
+    pub glcm3d_std: f64,
+    /// Samples.
+    pub n: usize,
+}
+
+/// E1 at every speed, from the headline evaluations.
+///
+/// # Errors
+/// None of its own: the evaluations ran when the tables were built.
+pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
+    Ok(c.tables
+        .headline
+        .iter()
+        .map(|(speed, h)| {
+            let best = h.taxel.best.unwrap_or(crate::analysis::TaxelAccuracy {
+                row: 0,
+                col: 0,
+                accuracy: h.taxel.accuracy,
+            });
+            let e1 = E1Speed {
+                taxel_mean: h.taxel.accuracy,
+                taxel_best: best.accuracy,
+                taxel_best_cell: format!("r{}c{}", best.row, best.col),
+                glcm3d: h.glcm3d.accuracy,
+                glcm3d_std: h.glcm3d.accuracy_std,
+                n: h.glcm3d.n,
+            };
+            (speed, e1)
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::small_run;
+    use super::*;
+
+    #[test]
+    fn one_entry_per_speed_with_the_best_taxel_at_least_the_mean() {
+        let run = small_run();
+        let e1 = e1_accuracy(&run.context()).unwrap();
+        assert_eq!(e1.len(), run.prepared.speeds.len());
+        for e in e1.values() {
+            assert!(e.taxel_best >= e.taxel_mean);
+            assert!((0.0..=1.0).contains(&e.glcm3d) && e.n > 0);
+            assert!(e.taxel_best_cell.starts_with('r'));
+        }
+    }
+}

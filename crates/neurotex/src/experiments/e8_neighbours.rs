@@ -1,0 +1,74 @@
+//! E8: robustness of E1 to the number of neighbours k (paper section IV-A).
+
+use serde::{Deserialize, Serialize};
+
+use super::tables::cv_at;
+use super::{Context, Skip, Stop};
+use crate::analysis::Columns;
+use crate::values::BySpeed;
+
+/// E8 at one speed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct E8Speed {
+    /// Neighbour counts.
+    pub k: Vec<usize>,
+    /// Single taxel mean per k.
+    pub taxel_mean: Vec<f64>,
+    /// 3D-GLCM per k.
+    pub glcm3d: Vec<f64>,
+}
+
+/// E8 at every speed, and the `(speed, k)` pairs the data could not support (a training
+/// fold smaller than k, say) with their reasons.
+///
+/// # Errors
+/// None of its own: a `k` that cannot run is skipped, not failed.
+pub fn e8_neighbours(c: &Context) -> Result<(BySpeed<E8Speed>, Vec<Skip>), Stop> {
+    let (mut out, mut skipped) = (BySpeed::new(), Vec::new());
+    for &speed in &c.prepared.speeds {
+        let mut e8 = E8Speed {
+            k: Vec::new(),
+            taxel_mean: Vec::new(),
+            glcm3d: Vec::new(),
+        };
+        for &k in &c.params.e8_ks {
+            let knn = c.params.knn_with_k(k);
+            let cv = c.params.cv();
+            match (
+                cv_at(&c.tables.taxel, Columns::EachTaxel, speed, &knn, cv),
+                cv_at(&c.tables.glcm3d, Columns::All, speed, &knn, cv),
+            ) {
+                (Ok(t), Ok(g)) => {
+                    e8.k.push(k);
+                    e8.taxel_mean.push(t.accuracy);
+                    e8.glcm3d.push(g.accuracy);
+                }
+                (Err(e), _) | (_, Err(e)) => skipped.push(Skip::Neighbours {
+                    k,
+                    speed,
+                    reason: e.to_string(),
+                }),
+            }
+        }
+        out.insert(speed, e8);
+    }
+    Ok((out, skipped))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::small_run;
+    use super::*;
+
+    #[test]
+    fn every_k_at_every_speed_and_the_run_k_equals_e1() {
+        let run = small_run();
+        let c = run.context();
+        let (e8, skipped) = e8_neighbours(&c).unwrap();
+        assert!(skipped.is_empty());
+        for (speed, e) in e8.iter() {
+            assert_eq!(e.k, [1, 5]);
+            assert_eq!(e.glcm3d[1], c.tables.at(speed).glcm3d.accuracy);
+        }
+    }
+}

@@ -1,0 +1,246 @@
+//! Parameters of a reproduction run and their validated form (linfa's `ParamGuard`).
+
+use crate::classify::{CvParams, Knn, KnnParams, ValidCv};
+use crate::error::ParamError;
+use crate::pipeline::{Pipeline, PipelineParams};
+
+/// Largest number of repeats (CV shuffles, E3 draws) accepted; beyond it a run would take
+/// days on the paper's design, so a larger value is a typo.
+pub const MAX_REPEATS: usize = 10_000;
+
+/// Parameters of a reproduction run; defaults are the paper's values and SPEC's choices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReproduceParams {
+    /// The pipeline (gain 8, 200 ms bins, 16 levels, distances 1, 2, 4, 8, ...).
+    pub pipeline: PipelineParams,
+    /// KNN (k = 5, z-scored).
+    pub knn: KnnParams,
+    /// Cross-validation (5 folds, seed, repeats).
+    pub cv: CvParams,
+    /// E3: random perturbations per n.
+    pub e3_repeats: usize,
+    /// E3: the numbers of taxels moved.
+    pub e3_counts: Vec<usize>,
+    /// E5: fractions of the slide used.
+    pub e5_fractions: Vec<f64>,
+    /// E7: gains swept.
+    pub e7_gains: Vec<f64>,
+    /// E7: ISI histogram bin, ms.
+    pub e7_bin_ms: u32,
+    /// E7: ISI histogram range, ms (longer intervals share one last bin).
+    pub e7_max_ms: u32,
+    /// E8: neighbour counts.
+    pub e8_ks: Vec<usize>,
+    /// Seed of E3's perturbations.
+    pub seed: u64,
+}
+
+impl Default for ReproduceParams {
+    fn default() -> Self {
+        ReproduceParams {
+            pipeline: PipelineParams::default(),
+            knn: KnnParams::default(),
+            cv: CvParams {
+                folds: 5,
+                seed: 0,
+                repeats: 10,
+            },
+            e3_repeats: 10,
+            e3_counts: (2..=16).collect(),
+            e5_fractions: (1..=10).map(|k| k as f64 / 10.0).collect(),
+            e7_gains: (5..=20).map(f64::from).collect(),
+            e7_bin_ms: 5,
+            e7_max_ms: 300,
+            e8_ks: vec![1, 3, 5, 7, 9],
+            seed: 0,
+        }
+    }
+}
+
+impl ReproduceParams {
+    /// A smaller run for tests and CI: fewer repeats, perturbation counts, fractions and gains.
+    pub fn quick() -> Self {
+        ReproduceParams {
+            cv: CvParams {
+                folds: 5,
+                seed: 0,
+                repeats: 2,
+            },
+            e3_repeats: 3,
+            e3_counts: vec![2, 4, 8, 16],
+            e5_fractions: vec![0.2, 0.5, 1.0],
+            e7_gains: vec![5.0, 8.0, 12.0, 20.0],
+            e8_ks: vec![1, 5, 9],
+            ..Self::default()
+        }
+    }
+
+    /// Checks every rule and plans the pipeline: the form the analyses take.
+    ///
+    /// # Errors
+    /// The first rule broken, named by its option.
+    pub fn check(self) -> Result<ValidReproduceParams, ParamError> {
+        let pipeline = Pipeline::new(self.pipeline.clone())?;
+        let knn = self.knn.check()?;
+        let cv = self.cv.check()?;
+        if cv.repeats > MAX_REPEATS {
+            return Err(ParamError::new(
+                "repeats",
+                "repeats must be at most 10000",
+                cv.repeats,
+            ));
+        }
+        if !(1..=MAX_REPEATS).contains(&self.e3_repeats) {
+            let rule = "E3 draws per n must be between 1 and 10000";
+            return Err(ParamError::new("e3_repeats", rule, self.e3_repeats));
+        }
+        if let Some(&p) = self
+            .e5_fractions
+            .iter()
+            .find(|p| !(**p > 0.0 && **p <= 1.0))
+        {
+            let rule = "E5 fractions of the slide must lie in (0, 1]";
+            return Err(ParamError::new("e5_fractions", rule, p));
+        }
+        for &g in &self.e7_gains {
+            self.pipeline.encoder.with_gain(g).check()?;
+        }
+        if self.e7_bin_ms == 0 || self.e7_max_ms < self.e7_bin_ms {
+            let rule =
+                "the E7 histogram needs a bin of at least 1 ms and a range of at least one bin";
+            let got = format!("bin {} ms, range {} ms", self.e7_bin_ms, self.e7_max_ms);
+            return Err(ParamError::new("e7_bin_ms", rule, got));
+        }
+        for &k in &self.e8_ks {
+            KnnParams { k, ..self.knn }.check()?;
+        }
+        Ok(ValidReproduceParams {
+            params: self,
+            pipeline,
+            knn,
+            cv,
+        })
+    }
+}
+
+/// Parameters that passed [`ReproduceParams::check`], with the pipeline planned once and
+/// the classifier and cross-validation in their validated forms.
+#[derive(Debug, Clone)]
+pub struct ValidReproduceParams {
+    params: ReproduceParams,
+    pipeline: Pipeline,
+    knn: Knn,
+    cv: ValidCv,
+}
+
+impl ValidReproduceParams {
+    /// The planned pipeline.
+    pub fn pipeline(&self) -> &Pipeline {
+        &self.pipeline
+    }
+
+    /// The classifier at the run's `k`.
+    pub fn knn(&self) -> &Knn {
+        &self.knn
+    }
+
+    /// The classifier with `k` neighbours (E8); `k` was checked with the others.
+    pub fn knn_with_k(&self, k: usize) -> Knn {
+        KnnParams {
+            k,
+            ..self.knn.params()
+        }
+        .check()
+        .unwrap_or(self.knn)
+    }
+
+    /// Cross-validation.
+    pub fn cv(&self) -> ValidCv {
+        self.cv
+    }
+
+    /// Cross-validation with a single repeat (E3, E5 draw their spread elsewhere).
+    pub fn cv_once(&self) -> ValidCv {
+        CvParams {
+            repeats: 1,
+            ..*self.cv
+        }
+        .check()
+        .unwrap_or(self.cv)
+    }
+}
+
+impl std::ops::Deref for ValidReproduceParams {
+    type Target = ReproduceParams;
+    fn deref(&self) -> &ReproduceParams {
+        &self.params
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rule_of(params: ReproduceParams) -> &'static str {
+        params.check().err().map_or("none", |e| e.name)
+    }
+
+    #[test]
+    fn each_rule_is_named_by_its_option() {
+        let base = ReproduceParams::quick;
+        assert_eq!(rule_of(base()), "none");
+        assert_eq!(
+            rule_of(ReproduceParams {
+                e3_repeats: 0,
+                ..base()
+            }),
+            "e3_repeats"
+        );
+        let e5_fractions = vec![0.5, 0.0];
+        assert_eq!(
+            rule_of(ReproduceParams {
+                e5_fractions,
+                ..base()
+            }),
+            "e5_fractions"
+        );
+        assert_eq!(
+            rule_of(ReproduceParams {
+                e5_fractions: vec![1.5],
+                ..base()
+            }),
+            "e5_fractions"
+        );
+        assert_eq!(
+            rule_of(ReproduceParams {
+                e7_gains: vec![f64::NAN],
+                ..base()
+            }),
+            "gain"
+        );
+        assert_eq!(
+            rule_of(ReproduceParams {
+                e7_bin_ms: 0,
+                ..base()
+            }),
+            "e7_bin_ms"
+        );
+        assert_eq!(
+            rule_of(ReproduceParams {
+                e8_ks: vec![1, 0],
+                ..base()
+            }),
+            "k"
+        );
+        let cv = CvParams {
+            repeats: 0,
+            ..CvParams::default()
+        };
+        assert_eq!(rule_of(ReproduceParams { cv, ..base() }), "repeats");
+        let cv = CvParams {
+            repeats: MAX_REPEATS + 1,
+            ..CvParams::default()
+        };
+        assert_eq!(rule_of(ReproduceParams { cv, ..base() }), "repeats");
+    }
+}

@@ -1,0 +1,258 @@
+//! The one pass over the recordings that every analysis starts from: condition, encode at
+//! the pipeline's gain and, at the slowest speed, at every E7 gain.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::{Progress, ValidReproduceParams};
+use crate::error::{DataError, Result};
+use crate::pipeline::Encoded;
+use crate::recording::{Baseline, Dataset, Recording};
+use crate::signal::Conditioned;
+use crate::sim::{simulate_trial, RigParams, Trial};
+use crate::values::{Grid, Speed};
+
+/// Where the recordings come from.
+pub enum Source<'a> {
+    /// The built-in simulator, trials generated in memory and never written.
+    Simulated {
+        /// Rig parameters.
+        rig: Box<RigParams>,
+        /// The trials.
+        trials: Vec<Trial>,
+        /// Simulation seed.
+        seed: u64,
+    },
+    /// A dataset folder.
+    Dataset(&'a Dataset),
+}
+
+impl Source<'_> {
+    /// Number of recordings.
+    fn len(&self) -> usize {
+        match self {
+            Source::Simulated { trials, .. } => trials.len(),
+            Source::Dataset(ds) => ds.entries.len(),
+        }
+    }
+
+    /// Recording `i`'s speed and label, known before it is loaded.
+    fn condition(&self, i: usize) -> (Speed, String) {
+        match self {
+            Source::Simulated { trials, .. } => (
+                Speed::of(trials[i].speed_mm_s),
+                trials[i].texture.name().to_string(),
+            ),
+            Source::Dataset(ds) => (
+                Speed::of(ds.entries[i].speed_mm_s),
+                ds.entries[i].label.clone(),
+            ),
+        }
+    }
+
+    fn baseline(&self) -> Baseline {
+        match self {
+            Source::Dataset(ds) => ds.layout.baseline.unwrap_or_default(),
+            Source::Simulated { .. } => Baseline::None,
+        }
+    }
+
+    fn load(&self, i: usize) -> Result<Recording> {
+        match self {
+            Source::Simulated { rig, trials, seed } => Ok(simulate_trial(rig, &trials[i], *seed)?),
+            Source::Dataset(ds) => ds.load(i),
+        }
+    }
+}
+
+/// ISI histograms of the gain sweep, accumulated over trials and taxels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IsiSweep {
+    /// Gains, in order.
+    pub gains: Vec<f64>,
+    /// Texture labels, in order.
+    pub labels: Vec<String>,
+    /// Histogram bin, ms.
+    pub bin_ms: u32,
+    /// `gains x labels x bins` counts of ISIs (the last bin collects longer ones).
+    pub counts: Vec<Vec<Vec<u64>>>,
+    /// `gains x labels` spike totals.
+    pub spikes: Vec<Vec<u64>>,
+    /// `gains x labels` total encoded taxel-seconds.
+    pub taxel_seconds: Vec<Vec<f64>>,
+}
+
+/// One recording's contribution to the sweep at one gain.
+struct GainPoint {
+    histogram: Vec<u64>,
+    spikes: u64,
+    taxel_seconds: f64,
+}
+
+impl IsiSweep {
+    fn empty(params: &ValidReproduceParams, labels: Vec<String>) -> Self {
+        let (gains, classes) = (params.e7_gains.len(), labels.len());
+        IsiSweep {
+            gains: params.e7_gains.clone(),
+            bin_ms: params.e7_bin_ms,
+            counts: vec![vec![vec![0; histogram_bins(params)]; classes]; gains],
+            spikes: vec![vec![0; classes]; gains],
+            taxel_seconds: vec![vec![0.0; classes]; gains],
+            labels,
+        }
+    }
+
+    fn add(&mut self, label: &str, points: Vec<GainPoint>) {
+        let li = self.labels.iter().position(|l| l == label).unwrap_or(0);
+        for (g, point) in points.into_iter().enumerate() {
+            for (acc, v) in self.counts[g][li].iter_mut().zip(point.histogram) {
+                *acc += v;
+            }
+            self.spikes[g][li] += point.spikes;
+            self.taxel_seconds[g][li] += point.taxel_seconds;
+        }
+    }
+}
+
+fn histogram_bins(params: &ValidReproduceParams) -> usize {
+    (params.e7_max_ms / params.e7_bin_ms) as usize + 1
+}
+
+/// Everything the analyses need, from one pass over the recordings.
+pub struct Prepared {
+    /// Every recording's spikes at the pipeline's gain (the sliding phase).
+    pub encoded: Vec<Encoded>,
+    /// The gain sweep at the slowest speed.
+    pub isi: IsiSweep,
+    /// The taxel grid, the same for every recording.
+    pub grid: Grid,
+    /// The distinct speeds, ascending.
+    pub speeds: Vec<Speed>,
+    /// The slowest speed by magnitude.
+    pub slowest: Speed,
+    /// The labels in order of first appearance.
+    pub labels: Vec<String>,
+    /// Seconds the pass took.
+    pub seconds: f64,
+}
+
+impl Prepared {
+    /// The recordings at `speed`.
+    pub fn at(&self, speed: Speed) -> impl Iterator<Item = &Encoded> {
+        self.encoded
+            .iter()
+            .filter(move |e| Speed::of(e.meta.speed_mm_s) == speed)
+    }
+}
+
+/// One pass over the recordings: condition, encode at the pipeline's gain, and for the
+/// slowest speed also at every E7 gain (accumulating ISI histograms). Parallel across
+/// recordings; a recording's raw samples are dropped as soon as it is encoded.
+///
+/// # Errors
+/// No recordings, a recording that cannot be read or conditioned, or recordings of
+/// different grids.
+pub fn prepare(
+    source: &Source,
+    params: &ValidReproduceParams,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Prepared> {
+    let start = Instant::now();
+    let n = source.len();
+    let conditions: Vec<(Speed, String)> = (0..n).map(|i| source.condition(i)).collect();
+    let slowest = Speed::slowest(conditions.iter().map(|c| c.0))
+        .ok_or_else(|| DataError::invalid("dataset", "no recordings"))?;
+    let mut labels: Vec<String> = Vec::new();
+    for (_, l) in &conditions {
+        if !labels.contains(l) {
+            labels.push(l.clone());
+        }
+    }
+    progress(Progress::Stage("recordings", n));
+    let results: Vec<(Encoded, Option<Vec<GainPoint>>)> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let out = encode_one(source, i, conditions[i].0 == slowest, params);
+            progress(Progress::Tick);
+            out
+        })
+        .collect::<Result<_>>()?;
+    let mut isi = IsiSweep::empty(params, labels.clone());
+    let mut encoded = Vec::with_capacity(n);
+    for (e, sweep) in results {
+        if let Some(points) = sweep {
+            isi.add(&e.meta.label, points);
+        }
+        encoded.push(e);
+    }
+    let grid = encoded[0].spikes.grid();
+    if let Some(e) = encoded.iter().find(|e| e.spikes.present != grid.present()) {
+        let message = "its taxel grid differs from the first recording's";
+        return Err(DataError::invalid(&e.meta.file, message).into());
+    }
+    Ok(Prepared {
+        speeds: Speed::distinct(conditions.iter().map(|c| c.0)),
+        encoded,
+        isi,
+        grid,
+        slowest,
+        labels,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Loads, conditions and encodes recording `i`; with `sweep`, also encodes it at every E7
+/// gain and returns its ISI histograms.
+fn encode_one(
+    source: &Source,
+    i: usize,
+    sweep: bool,
+    params: &ValidReproduceParams,
+) -> Result<(Encoded, Option<Vec<GainPoint>>)> {
+    let pipeline = params.pipeline();
+    let rec = source.load(i)?;
+    let cond = pipeline.condition(&rec, source.baseline())?;
+    let spikes = pipeline.encode_conditioned(&rec, &cond, None)?;
+    let points = if sweep {
+        Some(gain_sweep(&rec, &cond, params)?)
+    } else {
+        None
+    };
+    let encoded = Encoded {
+        meta: rec.meta.clone(),
+        spikes,
+        resampled: cond.resampled,
+        flat: cond.flat,
+    };
+    Ok((encoded, points))
+}
+
+fn gain_sweep(
+    rec: &Recording,
+    cond: &Conditioned,
+    params: &ValidReproduceParams,
+) -> Result<Vec<GainPoint>> {
+    let bins = histogram_bins(params);
+    params
+        .e7_gains
+        .iter()
+        .map(|&g| {
+            let trains = params.pipeline().encode_conditioned(rec, cond, Some(g))?;
+            let mut histogram = vec![0u64; bins];
+            for cell in 0..trains.cells() {
+                for w in trains.train(cell).windows(2) {
+                    let b = ((w[1] - w[0]) / params.e7_bin_ms) as usize;
+                    histogram[b.min(bins - 1)] += 1;
+                }
+            }
+            let taxels = trains.present.iter().filter(|&&p| p).count();
+            Ok(GainPoint {
+                histogram,
+                spikes: trains.total_spikes() as u64,
+                taxel_seconds: taxels as f64 * trains.n_steps as f64 / 1000.0,
+            })
+        })
+        .collect()
+}

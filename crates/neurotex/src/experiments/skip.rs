@@ -1,0 +1,52 @@
+//! Why an analysis did not run, and how an analysis stops.
+
+use crate::values::Speed;
+
+/// A reason the data cannot support an analysis (or part of one).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Skip {
+    /// E3 needs at least two taxels to move.
+    #[error("fewer than 2 taxels to move")]
+    TooFewTaxels,
+    /// E6 trains on other speeds.
+    #[error("the dataset has only one speed; E6 needs at least two")]
+    OneSpeed,
+    /// E8: this `k` cannot be evaluated at this speed.
+    #[error("{reason}")]
+    Neighbours {
+        /// Neighbours.
+        k: usize,
+        /// Speed.
+        speed: Speed,
+        /// The classifier's reason.
+        reason: String,
+    },
+}
+
+impl Skip {
+    /// The key under which `results.json` lists the skip (`e3`, `e6`, `e8 k=9 at 5 mm/s`).
+    pub fn key(&self) -> String {
+        match self {
+            Skip::TooFewTaxels => "e3".into(),
+            Skip::OneSpeed => "e6".into(),
+            Skip::Neighbours { k, speed, .. } => format!("e8 k={k} at {speed} mm/s"),
+        }
+    }
+}
+
+/// How an analysis stops early: skipped for a reason of the data, or failed.
+#[derive(Debug, thiserror::Error)]
+pub enum Stop {
+    /// The data cannot support the analysis; the run goes on.
+    #[error("skipped: {0}")]
+    Skipped(Skip),
+    /// The analysis failed; the run stops.
+    #[error(transparent)]
+    Failed(#[from] crate::Error),
+}
+
+impl From<Skip> for Stop {
+    fn from(skip: Skip) -> Self {
+        Stop::Skipped(skip)
+    }
+}

@@ -1,0 +1,105 @@
+//! The feature tables every analysis reads, built once, and the headline evaluations (the
+//! paper's two approaches at each speed) that several analyses compare against.
+
+use super::{Prepared, ValidReproduceParams};
+use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split};
+use crate::classify::{Knn, ValidCv};
+use crate::error::Result;
+use crate::pipeline::{Encoded, Method};
+use crate::values::{BySpeed, Speed};
+
+/// The paper's two approaches evaluated by cross-validation at one speed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Headline {
+    /// Single taxel, every taxel in turn (mean, per taxel, best).
+    pub taxel: Outcome,
+    /// 3D-GLCM.
+    pub glcm3d: Outcome,
+}
+
+/// Feature tables over all recordings, and the headline evaluations per speed.
+#[derive(Debug, Clone)]
+pub struct Tables {
+    /// Single-taxel statistics of every taxel.
+    pub taxel: FeatureTable,
+    /// 3D-GLCM features.
+    pub glcm3d: FeatureTable,
+    /// 2D-GLCM features.
+    pub glcm2d: FeatureTable,
+    /// Both approaches by cross-validation at each speed.
+    pub headline: BySpeed<Headline>,
+}
+
+impl Tables {
+    /// Builds the three tables and the headline evaluations.
+    ///
+    /// # Errors
+    /// A recording too short for one bin, or a classification that cannot run.
+    pub fn build(prepared: &Prepared, params: &ValidReproduceParams) -> Result<Self> {
+        let encoded = &prepared.encoded;
+        let taxel = table(encoded, Method::Taxel, params)?;
+        let glcm3d = table(encoded, Method::Glcm3d, params)?;
+        let glcm2d = table(encoded, Method::Glcm2d, params)?;
+        let headline = prepared
+            .speeds
+            .iter()
+            .map(|&s| {
+                let knn = params.knn();
+                Ok((
+                    s,
+                    Headline {
+                        taxel: cv_at(&taxel, Columns::EachTaxel, s, knn, params.cv())?,
+                        glcm3d: cv_at(&glcm3d, Columns::All, s, knn, params.cv())?,
+                    },
+                ))
+            })
+            .collect::<Result<_>>()?;
+        Ok(Tables {
+            taxel,
+            glcm3d,
+            glcm2d,
+            headline,
+        })
+    }
+
+    /// The headline evaluations at `speed`, a speed of the prepared data.
+    ///
+    /// # Panics
+    /// If `speed` is not one of the prepared speeds (a caller bug).
+    pub fn at(&self, speed: Speed) -> &Headline {
+        self.headline
+            .get(speed)
+            .expect("headline evaluations exist at every prepared speed")
+    }
+}
+
+/// `method`'s features of `encoded` (recordings of one grid).
+///
+/// # Errors
+/// A recording too short for one bin.
+pub fn table(
+    encoded: &[Encoded],
+    method: Method,
+    params: &ValidReproduceParams,
+) -> Result<FeatureTable> {
+    let extractor = params.pipeline().extractor(&encoded[0].spikes.grid())?;
+    FeatureTable::build(encoded, &extractor, method)
+}
+
+/// Cross-validation of `table`'s `columns` over the recordings at `speed`.
+///
+/// # Errors
+/// A classification that cannot run.
+pub fn cv_at(
+    table: &FeatureTable,
+    columns: Columns,
+    speed: Speed,
+    knn: &Knn,
+    cv: ValidCv,
+) -> Result<Outcome> {
+    let split = Split::CrossValidation {
+        speeds: Some(vec![speed]),
+        cv,
+    };
+    evaluate(table, columns, &split, knn)
+}
