@@ -387,11 +387,8 @@ pub fn simulate_trial_traced(
         trial.speed_mm_s * (1.0 + p.speed_jitter * rng.sample::<f64, _>(StandardNormal)).max(0.5);
     let gains = taxel_gains(p);
     let cells = p.rows * p.cols;
-    let ms = |s: f64| (s * 1000.0).round() as usize;
-    let (n_free, n_contact, n_hold) = (ms(p.free_s), ms(p.contact_s), ms(p.hold_s));
-    let n_slide = ms(p.slide_mm / speed).max(1);
-    let (n_retract, n_after) = (ms(p.retract_s), ms(p.after_s));
-    let total = n_free + n_contact + n_hold + n_slide + n_retract + n_after;
+    let schedule = Schedule::with_force(p, speed, force);
+    let total = schedule.total();
     let k_texture = trial.texture.stiffness_n_per_mm3();
     let k = 1.0 / (1.0 / p.pad_stiffness_n_per_mm3 + 1.0 / k_texture);
     let area = p.active_mm * p.active_mm / cells as f64;
@@ -406,29 +403,7 @@ pub fn simulate_trial_traced(
         Vec::with_capacity(cells),
     );
     for step in 0..total {
-        let (phase, f, s) = if step < n_free {
-            (Phase::Free, 0.0, 0.0)
-        } else if step < n_free + n_contact {
-            (
-                Phase::Contact,
-                force * (step - n_free + 1) as f64 / n_contact as f64,
-                0.0,
-            )
-        } else if step < n_free + n_contact + n_hold {
-            (Phase::Hold, force, 0.0)
-        } else if step < n_free + n_contact + n_hold + n_slide {
-            let k_slide = step - (n_free + n_contact + n_hold);
-            (Phase::Slide, force, speed * k_slide as f64 / 1000.0)
-        } else if step < total - n_after {
-            let k_up = step - (n_free + n_contact + n_hold + n_slide);
-            (
-                Phase::Retract,
-                force * (1.0 - (k_up + 1) as f64 / n_retract.max(1) as f64),
-                p.slide_mm,
-            )
-        } else {
-            (Phase::Free, 0.0, p.slide_mm)
-        };
+        let (phase, f, s) = schedule.at(step);
         phases.push(phase);
         for (i, hi) in h.iter_mut().enumerate() {
             *hi = profiles.at(i, s);
@@ -458,8 +433,84 @@ pub fn simulate_trial_traced(
             samples.push(((noisy.clamp(0.0, 1.0) * full_scale + 0.5) as u32) as f64);
         }
     }
-    let slide_start = (n_free + n_contact + n_hold) as f64 / 1000.0;
-    let rec = Recording {
+    let slide_start = schedule.slide_start() as f64 / 1000.0;
+    let slide_s = (slide_start, slide_start + schedule.slide as f64 / 1000.0);
+    let rec = trial_recording(p, trial, samples, phases, slide_s);
+    Ok((rec, forces))
+}
+
+/// The protocol's phases in 1 ms steps: free, contact (force ramps up), hold, slide,
+/// retract (force ramps down), free.
+struct Schedule {
+    free: usize,
+    contact: usize,
+    hold: usize,
+    slide: usize,
+    retract: usize,
+    after: usize,
+    force: f64,
+    speed: f64,
+    slide_mm: f64,
+}
+
+impl Schedule {
+    fn with_force(p: &RigParams, speed: f64, force: f64) -> Self {
+        let ms = |s: f64| (s * 1000.0).round() as usize;
+        Schedule {
+            free: ms(p.free_s),
+            contact: ms(p.contact_s),
+            hold: ms(p.hold_s),
+            slide: ms(p.slide_mm / speed).max(1),
+            retract: ms(p.retract_s),
+            after: ms(p.after_s),
+            force,
+            speed,
+            slide_mm: p.slide_mm,
+        }
+    }
+
+    fn total(&self) -> usize {
+        self.slide_start() + self.slide + self.retract + self.after
+    }
+
+    fn slide_start(&self) -> usize {
+        self.free + self.contact + self.hold
+    }
+
+    /// The phase, the commanded force (N) and the distance slid (mm) at `step`.
+    fn at(&self, step: usize) -> (Phase, f64, f64) {
+        let force = self.force;
+        let slide_start = self.slide_start();
+        if step < self.free {
+            (Phase::Free, 0.0, 0.0)
+        } else if step < self.free + self.contact {
+            let ramped = force * (step - self.free + 1) as f64 / self.contact as f64;
+            (Phase::Contact, ramped, 0.0)
+        } else if step < slide_start {
+            (Phase::Hold, force, 0.0)
+        } else if step < slide_start + self.slide {
+            let k_slide = step - slide_start;
+            (Phase::Slide, force, self.speed * k_slide as f64 / 1000.0)
+        } else if step < self.total() - self.after {
+            let k_up = step - (slide_start + self.slide);
+            let ramp = 1.0 - (k_up + 1) as f64 / self.retract.max(1) as f64;
+            (Phase::Retract, force * ramp, self.slide_mm)
+        } else {
+            (Phase::Free, 0.0, self.slide_mm)
+        }
+    }
+}
+
+/// The recording of a simulated trial from its samples and phases; `slide_s` is the
+/// sliding phase's start and end in s.
+fn trial_recording(
+    p: &RigParams,
+    trial: &Trial,
+    samples: Vec<f64>,
+    phases: Vec<Phase>,
+    slide_s: (f64, f64),
+) -> Recording {
+    Recording {
         fs: 1000.0,
         layout: Layout::grid(p.rows, p.cols),
         samples,
@@ -471,12 +522,11 @@ pub fn simulate_trial_traced(
             speed_mm_s: trial.speed_mm_s,
             force_n: p.force_n,
             trial: i64::from(trial.trial),
-            slide_start_s: Some(slide_start),
-            slide_end_s: Some(slide_start + n_slide as f64 / 1000.0),
+            slide_start_s: Some(slide_s.0),
+            slide_end_s: Some(slide_s.1),
             extra: Default::default(),
         },
-    };
-    Ok((rec, forces))
+    }
 }
 
 /// The file name a simulated trial is written under.
