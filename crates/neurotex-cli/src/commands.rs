@@ -9,6 +9,7 @@ use neurotex::analysis::{evaluate as run_evaluation, Columns, FeatureTable, Outc
 use neurotex::classify::CvParams;
 use neurotex::pipeline::{Encoded, Method, Pipeline};
 use neurotex::recording::{read_recording, same_speed, Dataset, LayoutFile};
+use neurotex::Speed;
 
 use crate::output::{progress, write_atomic};
 use crate::stage_args::StageArgs;
@@ -260,7 +261,7 @@ fn feature_table(
             encoded[0].meta.file
         );
     }
-    let extractor = pipeline.extractor(first.rows, first.cols, &first.present)?;
+    let extractor = pipeline.extractor(&first.grid())?;
     let table = FeatureTable::build(&encoded, &extractor, method)?;
     Ok((table, first.present.clone(), first.cols))
 }
@@ -320,12 +321,12 @@ pub fn evaluate(args: EvaluateArgs) -> Result<()> {
         folds: args.folds,
         seed: args.seed,
         repeats: args.repeats,
-    };
-    cv.check()?;
+    }
+    .check()?;
     let columns = match (args.method, &args.taxel) {
         (Method::Taxel, Some(t)) => {
-            let (r, c) = parse_taxel(t)?;
-            Columns::Taxel(r, c)
+            let (row, col) = parse_taxel(t)?;
+            Columns::Taxel(neurotex::Cell { row, col })
         }
         (Method::Taxel, None) => Columns::EachTaxel,
         (_, Some(_)) => bail!("--taxel applies only to --method taxel"),
@@ -334,20 +335,23 @@ pub fn evaluate(args: EvaluateArgs) -> Result<()> {
     let dataset = Dataset::open(&args.dataset)?;
     let split = match (&args.train_speeds, &args.test_speeds) {
         (Some(train), Some(test)) => Split::ByCondition {
-            train: train.clone(),
-            test: test.clone(),
+            train: train.iter().map(|&s| Speed::of(s)).collect(),
+            test: test.iter().map(|&s| Speed::of(s)).collect(),
         },
         _ => Split::CrossValidation {
-            speeds: args.speeds.clone(),
+            speeds: args
+                .speeds
+                .as_ref()
+                .map(|s| s.iter().map(|&s| Speed::of(s)).collect()),
             cv,
         },
     };
     let wanted: Vec<f64> = match &split {
         Split::CrossValidation {
             speeds: Some(s), ..
-        } => s.clone(),
+        } => s.iter().map(|s| s.mm_s()).collect(),
         Split::CrossValidation { speeds: None, .. } => dataset.speeds(),
-        Split::ByCondition { train, test } => train.iter().chain(test).copied().collect(),
+        Split::ByCondition { train, test } => train.iter().chain(test).map(|s| s.mm_s()).collect(),
     };
     let available = dataset.speeds();
     for s in &wanted {
@@ -371,13 +375,17 @@ pub fn evaluate(args: EvaluateArgs) -> Result<()> {
         })
         .collect();
     let (table, present, cols) = feature_table(&dataset, &pipeline, &indices, args.method)?;
-    if let Columns::Taxel(r, c) = columns {
+    if let Columns::Taxel(cell) = columns {
         let rows = present.len() / cols;
-        if r >= rows || c >= cols {
-            bail!("--taxel {r},{c} is outside the {rows}x{cols} grid");
+        if cell.row >= rows || cell.col >= cols {
+            bail!(
+                "--taxel {},{} is outside the {rows}x{cols} grid",
+                cell.row,
+                cell.col
+            );
         }
     }
-    let outcome = run_evaluation(&table, &present, cols, columns, &split, knn)?;
+    let outcome = run_evaluation(&table, columns, &split, &knn.check()?)?;
     if args.json {
         let mut value = serde_json::to_value(&outcome)?;
         value["method"] = args.method.name().into();
@@ -395,7 +403,17 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
             cv.folds, cv.seed, cv.repeats
         ),
         Split::ByCondition { train, test } => {
-            format!("train on {train:?} mm/s, test on {test:?} mm/s")
+            let list = |s: &[Speed]| {
+                s.iter()
+                    .map(|s| s.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            format!(
+                "train on [{}] mm/s, test on [{}] mm/s",
+                list(train),
+                list(test)
+            )
         }
     };
     println!("method {}: {} samples, {how}", method.name(), outcome.n);
@@ -448,7 +466,7 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
         print!(" {l:>width$}");
     }
     println!();
-    for (l, row) in outcome.labels.iter().zip(&outcome.confusion) {
+    for (l, row) in outcome.labels.iter().zip(outcome.confusion.rows()) {
         print!("{l:width$}");
         for v in row {
             print!(" {v:>width$}");
@@ -553,6 +571,7 @@ pub fn reproduce(args: ReproduceArgs) -> Result<()> {
             Progress::Tick => bar.inc(1),
         }
     };
+    let params = params.check()?;
     let prepared = prepare(&source, &params, &on_progress)?;
     let results = run_all(&prepared, &params, &on_progress)?;
     bar.lock().expect("progress bar").finish_and_clear();

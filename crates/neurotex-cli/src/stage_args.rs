@@ -71,7 +71,7 @@ impl StageArgs {
         Ok(p)
     }
 
-    /// KNN parameters with `k` neighbours.
+    /// KNN parameters with `k` neighbours, checked.
     pub fn knn(&self, k: usize) -> Result<KnnParams> {
         let knn = KnnParams {
             k,
