@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+pub use crate::recording::DatasetError;
+
 /// Everything that can go wrong in neurotex, by stage.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -14,6 +16,9 @@ pub enum Error {
     /// Classification or cross-validation could not run on the given data.
     #[error(transparent)]
     Classify(#[from] ClassifyError),
+    /// A dataset cannot serve what was asked of it (speeds, one grid).
+    #[error(transparent)]
+    Dataset(#[from] DatasetError),
 }
 
 /// A shorthand for results with [`Error`].
