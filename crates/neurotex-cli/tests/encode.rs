@@ -58,28 +58,22 @@ fn encode_takes_the_rate_from_a_layout_unless_fs_is_given() {
     let layout = dir.join("layout.toml");
     std::fs::write(&layout, "fs = 500.0\n").unwrap();
     let out = dir.join("a.npy");
-    dir.ok(&[
-        "encode",
-        s(&input),
-        "--out",
-        s(&out),
-        "--layout",
-        s(&layout),
-    ]);
-    let raster: Array3<u8> = read_npy(&out).unwrap();
-    assert_eq!(raster.shape()[0], 799, "400 samples at 500 Hz span 798 ms");
-    dir.ok(&[
-        "encode",
-        s(&input),
-        "--out",
-        s(&out),
-        "--layout",
-        s(&layout),
-        "--fs",
-        "1000",
-    ]);
-    let raster: Array3<u8> = read_npy(&out).unwrap();
-    assert_eq!(raster.shape()[0], 400);
+    // encodes with the layout and `extra`; returns the raster's time steps
+    let steps = |extra: &[&str]| {
+        let mut args = vec![
+            "encode",
+            s(&input),
+            "--out",
+            s(&out),
+            "--layout",
+            s(&layout),
+        ];
+        args.extend_from_slice(extra);
+        dir.ok(&args);
+        read_npy::<_, Array3<u8>>(&out).unwrap().shape()[0]
+    };
+    assert_eq!(steps(&[]), 799, "400 samples at 500 Hz span 798 ms");
+    assert_eq!(steps(&["--fs", "1000"]), 400);
     let err = dir.fails(&["encode", s(&input), "--out", s(&out), "--fs", "-5"]);
     assert!(err.contains("--fs"), "{err}");
 }

@@ -1,7 +1,5 @@
 //! `neurotex features` and `neurotex evaluate` on a dataset, and their bad options.
 
-use serde_json::Value;
-
 use crate::util::{s, Dir};
 
 #[test]
@@ -34,16 +32,7 @@ fn features_and_evaluate_on_a_dataset() {
     );
     assert!(header.ends_with("r3c3_fano"));
 
-    let evaluate = |method: &str, extra: &[&str]| -> String {
-        let mut args = vec!["evaluate", "--dataset", s(&ds), "--method", method];
-        args.extend_from_slice(extra);
-        dir.ok(&args)
-    };
-    let json = |method: &str, extra: &[&str]| -> Value {
-        let mut args = extra.to_vec();
-        args.push("--json");
-        serde_json::from_str(&evaluate(method, &args)).unwrap()
-    };
+    let json = |method: &str, extra: &[&str]| dir.evaluate_json(&ds, method, extra);
     let v = json("glcm3d", &["--speeds", "5"]);
     let acc = v["accuracy"].as_f64().unwrap();
     assert!((0.0..=1.0).contains(&acc));
@@ -78,7 +67,17 @@ fn features_and_evaluate_on_a_dataset() {
     assert!(v.get("per_taxel").is_none());
     let v = json("glcm2d", &["--train-speeds", "5", "--test-speeds", "10"]);
     assert_eq!(v["n"], 30);
-    let text = evaluate("glcm3d", &["--k", "3", "--folds", "4"]);
+    let text = dir.ok(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--k",
+        "3",
+        "--folds",
+        "4",
+    ]);
     assert!(
         text.contains("accuracy") && text.contains("confusion"),
         "{text}"

@@ -1,11 +1,29 @@
 //! `neurotex import csv` and `neurotex import stacked`.
 
+use std::path::Path;
+
 use ndarray_npy::write_npy;
-use serde_json::Value;
 
 use crate::util::{fabricslide, s, Dir};
 
 const FABRIC_PATTERN: &str = "{label}_F{force}_V{speed}mmps_{trial}.csv";
+
+/// `import csv SRC --out OUT` of FabricSlide-named logs stamped in `timestamp`, then `extra`.
+fn fabric_import<'a>(src: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "import",
+        "csv",
+        s(src),
+        "--out",
+        s(out),
+        "--name-pattern",
+        FABRIC_PATTERN,
+        "--time-column",
+        "timestamp",
+    ];
+    args.extend_from_slice(extra);
+    args
+}
 
 #[test]
 #[ignore = "needs the FabricSlide data in ../shared beside the repository; .ci/run runs it with --ignored"]
@@ -24,39 +42,24 @@ fn fabricslide_subset_imports_and_classifies_well_above_chance() {
         }
     }
     let out = dir.join("ds");
-    dir.ok(&[
-        "import",
-        "csv",
-        s(&subset),
-        "--out",
-        s(&out),
-        "--name-pattern",
-        FABRIC_PATTERN,
-        "--time-column",
-        "timestamp",
-        "--channels",
-        r"^channel\d+$",
-        "--grid",
-        "4x4",
-        "--baseline",
-        "min",
-    ]);
+    dir.ok(&fabric_import(
+        &subset,
+        &out,
+        &[
+            "--channels",
+            r"^channel\d+$",
+            "--grid",
+            "4x4",
+            "--baseline",
+            "min",
+        ],
+    ));
     let layout = std::fs::read_to_string(out.join("layout.toml")).unwrap();
     assert!(
         layout.contains("kind = \"min\"") && layout.contains("rows = 4"),
         "{layout}"
     );
-    let json: Value = serde_json::from_str(&dir.ok(&[
-        "evaluate",
-        "--dataset",
-        s(&out),
-        "--method",
-        "glcm3d",
-        "--speeds",
-        "10",
-        "--json",
-    ]))
-    .unwrap();
+    let json = dir.evaluate_json(&out, "glcm3d", &["--speeds", "10"]);
     assert_eq!(json["n"].as_u64(), Some(at_10 as u64));
     let acc = json["accuracy"].as_f64().unwrap();
     // chance is 1/7 for seven fabrics
@@ -64,15 +67,7 @@ fn fabricslide_subset_imports_and_classifies_well_above_chance() {
         acc > 0.4,
         "3D-GLCM accuracy {acc} on seven fabrics at 10 mm/s"
     );
-    let json: Value = serde_json::from_str(&dir.ok(&[
-        "evaluate",
-        "--dataset",
-        s(&out),
-        "--method",
-        "taxel",
-        "--json",
-    ]))
-    .unwrap();
+    let json = dir.evaluate_json(&out, "taxel", &[]);
     assert!(json["best"]["accuracy"].as_f64().unwrap() > 0.4);
 }
 
@@ -89,32 +84,25 @@ fn import_csv_writes_the_layout_it_was_given() {
         .unwrap();
     }
     let out = dir.join("ds");
-    let stderr = dir.run(&[
-        "import",
-        "csv",
-        s(&src),
-        "--out",
-        s(&out),
-        "--name-pattern",
-        FABRIC_PATTERN,
-        "--time-column",
-        "timestamp",
-        "--time-unit",
-        "s",
-        "--grid",
-        "2x2",
-        "--channel-map",
-        "1,1;1,0;0,1;0,0",
-        "--baseline",
-        "none",
-    ]);
-    assert!(stderr.status.success(), "{}", stderr.stderr);
+    let run = dir.run(&fabric_import(
+        &src,
+        &out,
+        &[
+            "--time-unit",
+            "s",
+            "--grid",
+            "2x2",
+            "--channel-map",
+            "1,1;1,0;0,1;0,0",
+            "--baseline",
+            "none",
+        ],
+    ));
+    assert!(run.status.success(), "{}", run.stderr);
     assert!(
-        stderr
-            .stderr
-            .contains("4 channels on a 2x2 grid at 34.48 Hz"),
+        run.stderr.contains("4 channels on a 2x2 grid at 34.48 Hz"),
         "{}",
-        stderr.stderr
+        run.stderr
     );
     let layout = std::fs::read_to_string(out.join("layout.toml")).unwrap();
     assert!(

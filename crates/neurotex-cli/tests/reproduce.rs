@@ -1,5 +1,7 @@
 //! `neurotex reproduce` on a dataset folder.
 
+use std::path::Path;
+
 use serde_json::Value;
 
 use crate::util::{s, Dir};
@@ -9,16 +11,12 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 6);
     let out = dir.join("report");
-    dir.ok(&[
-        "reproduce",
-        "--dataset",
-        s(&ds),
-        "--out",
-        s(&out),
-        "--quick",
-    ]);
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    // a quick run on a dataset; returns its results.json
+    let reproduce = |ds: &Path, out: &Path| -> Value {
+        dir.ok(&["reproduce", "--dataset", s(ds), "--out", s(out), "--quick"]);
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap()
+    };
+    let json = reproduce(&ds, &out);
     for speed in ["5", "10"] {
         for key in ["taxel_mean", "taxel_best", "glcm3d"] {
             let v = json["e1"][speed][key].as_f64().unwrap();
@@ -61,17 +59,7 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
     }
     // one speed only: E6 is skipped with a reason, not an error
     let one = dir.dataset("one", &["A", "B"], &[5.0], 5);
-    let out1 = dir.join("r1");
-    dir.ok(&[
-        "reproduce",
-        "--dataset",
-        s(&one),
-        "--out",
-        s(&out1),
-        "--quick",
-    ]);
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(out1.join("results.json")).unwrap()).unwrap();
+    let json = reproduce(&one, &dir.join("r1"));
     assert!(json["skipped"]["e6"]
         .as_str()
         .unwrap()

@@ -1,7 +1,5 @@
 //! `neurotex simulate`.
 
-use serde_json::Value;
-
 use crate::util::{s, Dir};
 
 #[test]
@@ -22,16 +20,7 @@ fn simulate_writes_a_dataset_the_pipeline_reads() {
     let manifest = std::fs::read_to_string(out.join("manifest.csv")).unwrap();
     assert!(manifest.starts_with("file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s\n"));
     assert_eq!(manifest.lines().count(), 11);
-    let json: Value = serde_json::from_str(&dir.ok(&[
-        "evaluate",
-        "--dataset",
-        s(&out),
-        "--method",
-        "glcm3d",
-        "--json",
-    ]))
-    .unwrap();
-    assert_eq!(json["n"], 10);
+    assert_eq!(dir.evaluate_json(&out, "glcm3d", &[])["n"], 10);
     let err = dir.fails(&["simulate", "--out", s(&out), "--trials", "5"]);
     assert!(err.contains("not empty"), "{err}");
     let (x, y) = (dir.join("x"), dir.join("y"));

@@ -7,6 +7,7 @@ use std::process::{Command, ExitStatus};
 
 use ndarray::Array3;
 use ndarray_npy::write_npy;
+use serde_json::Value;
 
 /// A temporary folder, removed when dropped, in which `neurotex` runs.
 pub struct Dir {
@@ -64,6 +65,15 @@ impl Dir {
             run.stderr
         );
         run.stdout
+    }
+
+    /// Runs `neurotex evaluate --dataset DATASET --method METHOD EXTRA... --json`, which
+    /// must succeed; returns the JSON it prints.
+    pub fn evaluate_json(&self, dataset: &Path, method: &str, extra: &[&str]) -> Value {
+        let mut args = vec!["evaluate", "--dataset", s(dataset), "--method", method];
+        args.extend_from_slice(extra);
+        args.push("--json");
+        serde_json::from_str(&self.ok(&args)).expect("evaluate --json prints JSON")
     }
 
     /// Runs a command that must fail with an error, not a panic: exit code 1 (the run

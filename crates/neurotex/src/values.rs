@@ -283,15 +283,20 @@ impl fmt::Display for Speed {
     }
 }
 
+/// `text` as a number, or a [`ParamError`] for parameter `name` with `rule`.
+fn number(text: &str, name: &'static str, rule: &'static str) -> Result<f64, ParamError> {
+    text.trim()
+        .parse()
+        .map_err(|_| ParamError::new(name, rule, text))
+}
+
 impl FromStr for Speed {
     type Err = ParamError;
 
     /// Parses a number of mm/s (`5`, `-150`, `2.5`).
     fn from_str(text: &str) -> Result<Self, ParamError> {
-        let value: f64 = text.trim().parse().map_err(|_| {
-            ParamError::new("speed", "a speed is a number of mm/s, for example 5", text)
-        })?;
-        Speed::new(value)
+        let rule = "a speed is a number of mm/s, for example 5";
+        Speed::new(number(text, "speed", rule)?)
     }
 }
 
@@ -346,14 +351,8 @@ impl FromStr for SampleRate {
 
     /// Parses a number of Hz (`1000`, `34.5`).
     fn from_str(text: &str) -> Result<Self, ParamError> {
-        let hz: f64 = text.trim().parse().map_err(|_| {
-            ParamError::new(
-                "fs",
-                "a sampling rate is a number of Hz, for example 1000",
-                text,
-            )
-        })?;
-        SampleRate::new(hz)
+        let rule = "a sampling rate is a number of Hz, for example 1000";
+        SampleRate::new(number(text, "fs", rule)?)
     }
 }
 
