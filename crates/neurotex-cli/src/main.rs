@@ -9,6 +9,7 @@ mod stage_args;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use commands::{encode, evaluate, features, import, reproduce, simulate};
 
 /// Neuromorphic tactile texture classification: taxel recordings → Izhikevich spikes →
 /// single-taxel statistics or 2D/3D GLCM features → KNN.
@@ -22,30 +23,30 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Encode one recording into spikes (u8 raster `(T, rows, cols)` at 1 kHz, .npy).
-    Encode(commands::EncodeArgs),
+    Encode(encode::EncodeArgs),
     /// Extract one feature row per recording of a dataset into a CSV file.
-    Features(commands::FeaturesArgs),
+    Features(features::FeaturesArgs),
     /// Classify a dataset's recordings with KNN and print accuracy and confusion matrix.
-    Evaluate(commands::EvaluateArgs),
+    Evaluate(evaluate::EvaluateArgs),
     /// Simulate the paper's rig (8 textures, 4x4 taxels, 1 N, 90 mm slides) into a dataset folder.
-    Simulate(commands::SimulateArgs),
+    Simulate(simulate::SimulateArgs),
     /// Run every analysis of the paper (E0-E8) and write a report with figures; without
     /// --dataset, on the built-in simulated rig.
-    Reproduce(commands::ReproduceArgs),
+    Reproduce(reproduce::ReproduceArgs),
     /// Import CSV logs or stacked arrays into a dataset folder.
     #[command(subcommand)]
-    Import(commands::ImportCommand),
+    Import(import::ImportCommand),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Encode(args) => commands::encode(args),
-        Command::Features(args) => commands::features(args),
-        Command::Evaluate(args) => commands::evaluate(args),
-        Command::Simulate(args) => commands::simulate(args),
-        Command::Reproduce(args) => commands::reproduce(args),
-        Command::Import(cmd) => commands::import(cmd),
+        Command::Encode(args) => encode::run(args),
+        Command::Features(args) => features::run(args),
+        Command::Evaluate(args) => evaluate::run(args),
+        Command::Simulate(args) => simulate::run(args),
+        Command::Reproduce(args) => reproduce::run(args),
+        Command::Import(command) => import::run(command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

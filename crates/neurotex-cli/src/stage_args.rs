@@ -1,9 +1,9 @@
 //! Options shared by every command that runs the pipeline.
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 use neurotex::classify::KnnParams;
-use neurotex::encode::IzhikevichParams;
+use neurotex::encode::FiringType;
 use neurotex::pipeline::PipelineParams;
 use neurotex::recording::Baseline;
 
@@ -15,13 +15,13 @@ pub struct StageArgs {
     pub gain: f64,
     /// Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ.
     #[arg(long, default_value = "RS")]
-    pub preset: String,
+    pub preset: FiringType,
     /// Low-pass cutoff in Hz (zero-phase 2nd-order Butterworth); 0 turns the filter off.
     #[arg(long, default_value_t = 50.0, allow_negative_numbers = true)]
     pub cutoff: f64,
     /// Baseline removal: `none`, or `min` (each taxel's minimum). Default: the dataset's layout.toml.
     #[arg(long)]
-    pub baseline: Option<String>,
+    pub baseline: Option<Baseline>,
     /// Use the whole recording instead of only its sliding phase.
     #[arg(long)]
     pub whole: bool,
@@ -45,24 +45,13 @@ pub struct StageArgs {
 impl StageArgs {
     /// The pipeline parameters these options name, checked.
     pub fn pipeline(&self) -> Result<PipelineParams> {
-        let Some(encoder) = IzhikevichParams::preset(&self.preset) else {
-            bail!(
-                "unknown --preset `{}`: expected one of RS, IB, CH, FS, LTS, TC, RZ",
-                self.preset
-            );
-        };
         let mut p = PipelineParams {
-            encoder: encoder.with_gain(self.gain),
+            encoder: self.preset.params().with_gain(self.gain),
             ..PipelineParams::default()
         };
         p.preprocess.cutoff_hz = self.cutoff;
         p.preprocess.slide_only = !self.whole;
-        p.preprocess.baseline = match self.baseline.as_deref() {
-            None => None,
-            Some("none") => Some(Baseline::None),
-            Some("min") => Some(Baseline::Min),
-            Some(other) => bail!("unknown --baseline `{other}`: expected none or min"),
-        };
+        p.preprocess.baseline = self.baseline;
         p.volume.levels = self.levels;
         p.volume.bin_ms = self.bin_ms;
         p.glcm.distances = self.distances.clone();

@@ -47,19 +47,85 @@ pub const PRESETS: [(&str, f64, f64, f64, f64); 7] = [
     ("RZ", 0.1, 0.26, -65.0, 2.0),
 ];
 
+/// A firing type of Izhikevich (2003), figure 2, in the order of [`PRESETS`]; parses from
+/// its name in any case (`RS`, `fs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum FiringType {
+    /// Regular spiking, the paper's slowly adapting type I.
+    #[default]
+    Rs,
+    /// Intrinsically bursting.
+    Ib,
+    /// Chattering.
+    Ch,
+    /// Fast spiking.
+    Fs,
+    /// Low-threshold spiking.
+    Lts,
+    /// Thalamo-cortical.
+    Tc,
+    /// Resonator.
+    Rz,
+}
+
+impl FiringType {
+    /// Every firing type, in the order of [`PRESETS`].
+    pub const ALL: [FiringType; 7] = [
+        FiringType::Rs,
+        FiringType::Ib,
+        FiringType::Ch,
+        FiringType::Fs,
+        FiringType::Lts,
+        FiringType::Tc,
+        FiringType::Rz,
+    ];
+
+    /// The name in [`PRESETS`] (`RS`).
+    pub fn name(self) -> &'static str {
+        PRESETS[self as usize].0
+    }
+
+    /// The neuron parameters of this type with gain 8.
+    pub fn params(self) -> IzhikevichParams {
+        let (_, a, b, c, d) = PRESETS[self as usize];
+        IzhikevichParams {
+            a,
+            b,
+            c,
+            d,
+            gain: 8.0,
+        }
+    }
+}
+
+impl std::fmt::Display for FiringType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for FiringType {
+    type Err = ParamError;
+
+    /// Parses a name of [`PRESETS`], in any case.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        FiringType::ALL
+            .into_iter()
+            .find(|t| t.name().eq_ignore_ascii_case(text.trim()))
+            .ok_or_else(|| {
+                ParamError::new(
+                    "preset",
+                    "a firing type is one of RS, IB, CH, FS, LTS, TC, RZ",
+                    text,
+                )
+            })
+    }
+}
+
 impl IzhikevichParams {
     /// A named firing type from [`PRESETS`] with gain 8, or `None` for an unknown name.
     pub fn preset(name: &str) -> Option<Self> {
-        PRESETS
-            .iter()
-            .find(|p| p.0.eq_ignore_ascii_case(name))
-            .map(|&(_, a, b, c, d)| IzhikevichParams {
-                a,
-                b,
-                c,
-                d,
-                gain: 8.0,
-            })
+        name.parse().ok().map(FiringType::params)
     }
 
     /// Sets the gain.

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+pub use crate::recording::DatasetError;
+
 /// Everything that can go wrong in neurotex, by stage.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -23,6 +25,9 @@ pub enum Error {
         /// What went wrong.
         source: Box<Error>,
     },
+    /// A dataset cannot serve what was asked of it (speeds, one grid).
+    #[error(transparent)]
+    Dataset(#[from] DatasetError),
 }
 
 impl Error {

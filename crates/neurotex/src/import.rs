@@ -1,8 +1,13 @@
 //! Importing recordings from other layouts into the dataset format: per-trial CSV logs from
 //! a DAQ (metadata from file names) and the stacked arrays machine-learning datasets ship.
+//!
+//! The options a user types ([`NamePattern`], [`ChannelSelect`], [`Axes`]) parse from text
+//! with `FromStr`.
 
 use std::collections::BTreeMap;
+use std::fmt;
 use std::path::{Path, PathBuf};
+use std::str::FromStr;
 
 use ndarray::{ArrayD, Axis, IxDyn};
 use ndarray_npy::ReadNpyExt;
@@ -10,8 +15,10 @@ use rayon::prelude::*;
 
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
-    create_dataset_dir, read_csv_columns, write_layout, write_manifest, Baseline, LayoutFile, Meta,
+    create_dataset_dir, read_csv_columns, write_layout, write_manifest, Baseline, ChannelMap,
+    LayoutFile, Meta, TimeUnit,
 };
+use crate::values::{Grid, Speed};
 
 /// A file-name pattern such as `{label}_F{force}_V{speed}mmps_{trial}.csv`: literal text and
 /// `{field}`s. `label`, `speed` (mm/s), `force` (N) and `trial` fill the manifest's columns;
@@ -115,6 +122,15 @@ impl NamePattern {
     }
 }
 
+impl FromStr for NamePattern {
+    type Err = ParamError;
+
+    /// As [`NamePattern::parse`].
+    fn from_str(pattern: &str) -> Result<Self, ParamError> {
+        NamePattern::parse(pattern)
+    }
+}
+
 /// How to pick the channel columns of a CSV log.
 #[derive(Debug, Clone)]
 pub enum ChannelSelect {
@@ -154,6 +170,15 @@ impl ChannelSelect {
     }
 }
 
+impl FromStr for ChannelSelect {
+    type Err = ParamError;
+
+    /// As [`ChannelSelect::parse`].
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        ChannelSelect::parse(text)
+    }
+}
+
 /// Options of a CSV import.
 #[derive(Debug, Clone)]
 pub struct CsvImportParams {
@@ -161,14 +186,14 @@ pub struct CsvImportParams {
     pub pattern: Option<NamePattern>,
     /// The time column; without it the sampling rate `fs` is used.
     pub time_column: Option<String>,
-    /// Seconds per time unit (0.001 for ms).
-    pub time_unit_s: f64,
+    /// The time column's unit.
+    pub time_unit: TimeUnit,
     /// The channel columns.
     pub channels: ChannelSelect,
-    /// Grid `rows x cols`; default one row of all channels.
-    pub grid: Option<(usize, usize)>,
-    /// For each channel, its `[row, col]`; default row-major.
-    pub channel_map: Option<Vec<[usize; 2]>>,
+    /// The grid to place channels on; default one row of all channels.
+    pub grid: Option<Grid>,
+    /// Each channel's cell; default row-major.
+    pub channel_map: Option<ChannelMap>,
     /// Nominal sampling rate in Hz (required without a time column; else estimated).
     pub fs: Option<f64>,
     /// Baseline removal recorded in `layout.toml`.
@@ -397,7 +422,7 @@ pub fn import_csv(
         ));
     }
     let n = names.len();
-    let (rows, cols) = p.grid.unwrap_or((1, n));
+    let (rows, cols) = p.grid.as_ref().map_or((1, n), |g| (g.rows(), g.cols()));
     let fs = match p.fs {
         Some(fs) => fs,
         None => {
@@ -405,7 +430,7 @@ pub fn import_csv(
             let mut dts: Vec<f64> = good
                 .iter()
                 .filter_map(|c| c.times.as_ref())
-                .flat_map(|t| t.windows(2).map(|w| (w[1] - w[0]) * p.time_unit_s))
+                .flat_map(|t| t.windows(2).map(|w| (w[1] - w[0]) * p.time_unit.seconds()))
                 .collect();
             if dts.is_empty() {
                 return Err(DataError::invalid(
@@ -428,10 +453,10 @@ pub fn import_csv(
         .into());
     }
     // Channels fill the grid row-major unless mapped; cells no channel reaches are masked.
-    let map: Vec<[usize; 2]> = p
-        .channel_map
-        .clone()
-        .unwrap_or_else(|| (0..n).map(|k| [k / cols, k % cols]).collect());
+    let map: Vec<[usize; 2]> = match &p.channel_map {
+        Some(map) => map.to_pairs(),
+        None => (0..n).map(|k| [k / cols, k % cols]).collect(),
+    };
     if map.len() != n {
         return Err(ParamError::new(
             "channel-map",
@@ -463,14 +488,14 @@ pub fn import_csv(
         }),
         baseline: p.baseline,
         time_column: good[0].times.as_ref().map(|_| "t_ms".to_string()),
-        time_unit: good[0].times.as_ref().map(|_| "ms".to_string()),
+        time_unit: good[0].times.as_ref().map(|_| TimeUnit::Milliseconds),
         channels: Some(names.clone()),
     };
     create_dataset_dir(out, |tmp| {
         write_layout(tmp, &layout)?;
         // validates the layout before anything else is written
         LayoutFile::read(&tmp.join("layout.toml"))?;
-        let ms_per_unit = p.time_unit_s * 1000.0;
+        let ms_per_unit = p.time_unit.milliseconds();
         let metas: Vec<Meta> = good
             .par_iter()
             .map(|c| -> Result<Meta> {
@@ -509,6 +534,39 @@ enum AxisName {
     Row,
     Col,
     Channel,
+}
+
+impl AxisName {
+    fn name(self) -> &'static str {
+        match self {
+            AxisName::N => "n",
+            AxisName::T => "t",
+            AxisName::Row => "row",
+            AxisName::Col => "col",
+            AxisName::Channel => "channel",
+        }
+    }
+}
+
+/// The axes of a stacked array in order, such as `n,row,col,t` or `n,t,channel`: `n` and
+/// `t` once each, and either `row` and `col` or `channel`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Axes(Vec<AxisName>);
+
+impl FromStr for Axes {
+    type Err = ParamError;
+
+    /// Parses comma-separated axis names.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        parse_axes(text).map(Axes)
+    }
+}
+
+impl fmt::Display for Axes {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<&str> = self.0.iter().map(|a| a.name()).collect();
+        f.write_str(&names.join(","))
+    }
 }
 
 /// Parses axes such as `n,row,col,t` or `n,t,channel`.
@@ -644,11 +702,11 @@ fn read_labels(path: &Path) -> Result<Vec<String>> {
 #[derive(Debug, Clone)]
 pub struct StackedParams {
     /// The data's axes, e.g. `n,row,col,t` or `n,t,channel`.
-    pub axes: String,
+    pub axes: Axes,
     /// Sampling rate, Hz.
     pub fs: f64,
     /// With a channel axis: the grid to place channels on (row-major); default `1 x channels`.
-    pub grid: Option<(usize, usize)>,
+    pub grid: Option<Grid>,
 }
 
 /// Imports `data` (`N` samples stacked along one axis) with `labels` (and optional speeds)
@@ -665,7 +723,7 @@ pub fn import_stacked(
     p: &StackedParams,
     out: &Path,
 ) -> Result<usize> {
-    let axes = parse_axes(&p.axes)?;
+    let axes = &p.axes.0;
     if !(p.fs.is_finite() && p.fs > 0.0) {
         return Err(ParamError::new("fs", "sampling rate must be positive", p.fs).into());
     }
@@ -710,13 +768,13 @@ pub fn import_stacked(
         (shape[2], shape[3])
     } else {
         let ch = shape[2];
-        match p.grid {
-            Some((r, c)) if r * c == ch => (r, c),
-            Some((r, c)) => {
+        match &p.grid {
+            Some(g) if g.cells() == ch => (g.rows(), g.cols()),
+            Some(g) => {
                 return Err(ParamError::new(
                     "grid",
                     "the grid must have as many cells as channels",
-                    format!("{r}x{c} for {ch} channels"),
+                    format!("{g} for {ch} channels"),
                 )
                 .into())
             }
@@ -745,12 +803,12 @@ pub fn import_stacked(
         }
         None => vec![0.0; n],
     };
-    let mut trial_of: BTreeMap<(String, u64), i64> = BTreeMap::new();
+    let mut trial_of: BTreeMap<(String, Speed), i64> = BTreeMap::new();
     create_dataset_dir(out, |tmp| {
         let metas: Vec<Meta> = (0..n)
             .map(|i| {
                 let trial = trial_of
-                    .entry((labels[i].clone(), speeds[i].to_bits()))
+                    .entry((labels[i].clone(), Speed::of(speeds[i])))
                     .or_insert(0);
                 let meta = Meta {
                     file: format!("sample_{i:05}.npy"),

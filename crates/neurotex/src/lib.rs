@@ -28,4 +28,4 @@ mod svg;
 pub mod values;
 
 pub use error::{Error, Result};
-pub use values::{BySpeed, Cell, Grid, Speed};
+pub use values::{BySpeed, Cell, Grid, SampleRate, Speed};

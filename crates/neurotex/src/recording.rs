@@ -3,15 +3,21 @@
 //! A dataset is a folder with `manifest.csv` naming recordings (`.npy` or `.csv`) and an
 //! optional `layout.toml`. Recordings are loaded one at a time ([`Dataset::load`]) so a
 //! dataset's raw samples are never all in memory at once.
+//!
+//! The layout's settings a user also types on a command line ([`Baseline`], [`TimeUnit`],
+//! [`ChannelMap`]) parse from text with `FromStr`.
 
 use std::collections::BTreeMap;
+use std::fmt;
 use std::path::{Path, PathBuf};
+use std::str::FromStr;
 
 use ndarray::ArrayD;
 use ndarray_npy::ReadNpyExt;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{DataError, Result};
+use crate::error::{DataError, ParamError, Result};
+use crate::values::{Cell, Grid, Speed};
 
 /// The phase of the protocol a sample belongs to (paper section II-D).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -81,6 +87,13 @@ pub struct Meta {
     pub extra: BTreeMap<String, String>,
 }
 
+impl Meta {
+    /// The sliding speed as a condition.
+    pub fn speed(&self) -> Speed {
+        Speed::of(self.speed_mm_s)
+    }
+}
+
 /// One trial's samples, time-major `T x rows x cols`, with its sampling and metadata.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recording {
@@ -136,6 +149,130 @@ pub enum Baseline {
     },
 }
 
+impl FromStr for Baseline {
+    type Err = ParamError;
+
+    /// Parses `none` or `min`; a mean over an interval is set in `layout.toml`.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        match text.trim() {
+            "none" => Ok(Baseline::None),
+            "min" => Ok(Baseline::Min),
+            _ => Err(ParamError::new(
+                "baseline",
+                "a baseline is `none` or `min` (a mean over an interval is set in layout.toml)",
+                text,
+            )),
+        }
+    }
+}
+
+/// The unit of a CSV recording's time column; written `ms` or `s` (in `layout.toml` too).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum TimeUnit {
+    /// Milliseconds, `ms`.
+    #[default]
+    #[serde(rename = "ms")]
+    Milliseconds,
+    /// Seconds, `s`.
+    #[serde(rename = "s")]
+    Seconds,
+}
+
+impl TimeUnit {
+    /// Seconds per unit.
+    pub fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::Milliseconds => 1e-3,
+            TimeUnit::Seconds => 1.0,
+        }
+    }
+
+    /// Milliseconds per unit.
+    pub fn milliseconds(self) -> f64 {
+        match self {
+            TimeUnit::Milliseconds => 1.0,
+            TimeUnit::Seconds => 1e3,
+        }
+    }
+}
+
+impl fmt::Display for TimeUnit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            TimeUnit::Milliseconds => "ms",
+            TimeUnit::Seconds => "s",
+        })
+    }
+}
+
+impl FromStr for TimeUnit {
+    type Err = ParamError;
+
+    /// Parses `ms` or `s`.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        match text.trim() {
+            "ms" => Ok(TimeUnit::Milliseconds),
+            "s" => Ok(TimeUnit::Seconds),
+            _ => Err(ParamError::new(
+                "time-unit",
+                "a time unit is `ms` or `s`",
+                text,
+            )),
+        }
+    }
+}
+
+/// Each file channel's grid cell, in channel order: written `row,col;row,col;...`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChannelMap(Vec<Cell>);
+
+impl ChannelMap {
+    /// The map of `cells`, channel `k` to `cells[k]`.
+    pub fn new(cells: Vec<Cell>) -> Self {
+        ChannelMap(cells)
+    }
+
+    /// The cells in channel order.
+    pub fn cells(&self) -> &[Cell] {
+        &self.0
+    }
+
+    /// The map as `layout.toml` writes it, one `[row, col]` per channel.
+    pub fn to_pairs(&self) -> Vec<[usize; 2]> {
+        self.0.iter().map(|c| [c.row, c.col]).collect()
+    }
+}
+
+impl fmt::Display for ChannelMap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (k, c) in self.0.iter().enumerate() {
+            let sep = if k == 0 { "" } else { ";" };
+            write!(f, "{sep}{},{}", c.row, c.col)?;
+        }
+        Ok(())
+    }
+}
+
+impl FromStr for ChannelMap {
+    type Err = ParamError;
+
+    /// Parses `row,col;row,col;...` (for example `0,0;0,1;1,0`).
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        text.split(';')
+            .map(|entry| {
+                entry.parse::<Cell>().map_err(|_| {
+                    ParamError::new(
+                        "channel-map",
+                        "a channel map is row,col entries separated by `;`, for example 0,0;0,1",
+                        format!("`{entry}` in {text}"),
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()
+            .map(ChannelMap)
+    }
+}
+
 /// `layout.toml`: how to read a dataset's recordings.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -155,7 +292,7 @@ pub struct LayoutFile {
     /// CSV recordings: the time column's name.
     pub time_column: Option<String>,
     /// CSV recordings: the time column's unit, `ms` or `s`.
-    pub time_unit: Option<String>,
+    pub time_unit: Option<TimeUnit>,
     /// CSV recordings: the channel columns, in channel order (default: every other column).
     pub channels: Option<Vec<String>>,
 }
@@ -219,13 +356,6 @@ impl LayoutFile {
             }
         } else if self.channel_map.is_some() || self.mask.is_some() {
             return bad("fields `channel_map` and `mask` need `rows` and `cols`".into());
-        }
-        if let Some(unit) = &self.time_unit {
-            if unit != "ms" && unit != "s" {
-                return bad(format!(
-                    "field `time_unit` must be `ms` or `s`, got `{unit}`"
-                ));
-            }
         }
         if let Some(Baseline::Mean { start_s, end_s }) = self.baseline {
             if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
@@ -407,15 +537,77 @@ impl Dataset {
     }
 
     /// The distinct speeds, ascending.
-    pub fn speeds(&self) -> Vec<f64> {
-        let mut out: Vec<f64> = Vec::new();
-        for m in &self.entries {
-            if !out.iter().any(|&s| same_speed(s, m.speed_mm_s)) {
-                out.push(m.speed_mm_s);
+    pub fn speeds(&self) -> Vec<Speed> {
+        Speed::distinct(self.entries.iter().map(Meta::speed))
+    }
+
+    /// The indices of the recordings at any of `speeds`, in manifest order.
+    ///
+    /// # Errors
+    /// [`DatasetError::NoRecordingsAt`] for the first of `speeds` at which the dataset
+    /// holds no recording, naming the speeds it has.
+    pub fn indices_at(&self, speeds: &[Speed]) -> Result<Vec<usize>> {
+        let available = self.speeds();
+        if let Some(&speed) = speeds.iter().find(|s| !available.contains(s)) {
+            return Err(DatasetError::NoRecordingsAt {
+                speed,
+                root: self.root.clone(),
+                available,
             }
+            .into());
         }
-        out.sort_by(f64::total_cmp);
-        out
+        Ok((0..self.entries.len())
+            .filter(|&i| speeds.contains(&self.entries[i].speed()))
+            .collect())
+    }
+}
+
+/// A dataset that cannot serve what was asked of it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DatasetError {
+    /// No recording at a speed that was asked for.
+    #[error("no recordings at {speed} mm/s in {} (its speeds: {})", .root.display(), comma_separated(.available))]
+    NoRecordingsAt {
+        /// The speed asked for.
+        speed: Speed,
+        /// The dataset folder.
+        root: PathBuf,
+        /// The speeds the dataset has, ascending.
+        available: Vec<Speed>,
+    },
+    /// Two recordings on different taxel grids (size or mask).
+    #[error("{file}: its taxel grid differs from that of {first}; a dataset needs one layout")]
+    MixedGrids {
+        /// The first recording whose grid differs.
+        file: String,
+        /// The recording whose grid the others must share.
+        first: String,
+    },
+    /// No recording was selected.
+    #[error("no recordings selected")]
+    Empty,
+}
+
+fn comma_separated(speeds: &[Speed]) -> String {
+    let texts: Vec<String> = speeds.iter().map(Speed::to_string).collect();
+    texts.join(", ")
+}
+
+/// The one grid that recordings share, from `(file, grid)` pairs in dataset order.
+///
+/// # Errors
+/// [`DatasetError::MixedGrids`] naming the first recording whose grid (size or mask)
+/// differs from the first one's; [`DatasetError::Empty`] when there is no pair.
+pub fn one_grid<'a>(grids: impl IntoIterator<Item = (&'a str, Grid)>) -> Result<Grid> {
+    let mut grids = grids.into_iter();
+    let (first, first_grid) = grids.next().ok_or(DatasetError::Empty)?;
+    match grids.find(|(_, grid)| *grid != first_grid) {
+        Some((file, _)) => Err(DatasetError::MixedGrids {
+            file: file.to_string(),
+            first: first.to_string(),
+        }
+        .into()),
+        None => Ok(first_grid),
     }
 }
 
@@ -668,12 +860,7 @@ fn read_csv_samples(
                     format!("missing time column `{name}` named in layout.toml"),
                 )
             })?;
-            let scale = if layout.time_unit.as_deref() == Some("s") {
-                1.0
-            } else {
-                1e-3
-            };
-            (Some(j), scale)
+            (Some(j), layout.time_unit.unwrap_or_default().seconds())
         }
         None => {
             if let Some(j) = find("t_ms").or_else(|| find("time_ms")) {

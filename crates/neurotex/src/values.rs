@@ -1,6 +1,7 @@
 //! Typed values that travel between stages and across the command line: a taxel [`Grid`]
-//! with its mask, a grid [`Cell`], and a sliding [`Speed`] with a total order, plus
-//! [`BySpeed`], results keyed by speed in numeric order.
+//! with its mask, a grid [`Cell`], a sliding [`Speed`] with a total order, a
+//! [`SampleRate`], plus [`BySpeed`], results keyed by speed in numeric order. Each parses
+//! from the text a user types (`FromStr`), failing with a [`ParamError`] that names the rule.
 
 use std::fmt;
 use std::str::FromStr;
@@ -115,6 +116,27 @@ impl Grid {
     pub fn taxel_index(&self, cell: Cell) -> Option<usize> {
         let index = cell.row * self.cols + cell.col;
         (cell.row < self.rows && cell.col < self.cols && self.present[index]).then_some(index)
+    }
+
+    /// The row-major index of the taxel a user named at `cell`.
+    ///
+    /// # Errors
+    /// A [`ParamError`] for `taxel` when `cell` lies outside the grid or on a masked cell,
+    /// naming the cell and the grid.
+    pub fn locate(&self, cell: Cell) -> Result<usize, ParamError> {
+        self.taxel_index(cell).ok_or_else(|| {
+            let (row, col) = (cell.row, cell.col);
+            let got = if row < self.rows && col < self.cols {
+                format!("{row},{col}, a masked cell of the {self} grid")
+            } else {
+                format!("{row},{col}, outside the {self} grid")
+            };
+            ParamError::new(
+                "taxel",
+                "a taxel must be a grid cell that holds a taxel",
+                got,
+            )
+        })
     }
 }
 
@@ -272,15 +294,20 @@ impl fmt::Display for Speed {
     }
 }
 
+/// `text` as a number, or a [`ParamError`] for parameter `name` with `rule`.
+fn number(text: &str, name: &'static str, rule: &'static str) -> Result<f64, ParamError> {
+    text.trim()
+        .parse()
+        .map_err(|_| ParamError::new(name, rule, text))
+}
+
 impl FromStr for Speed {
     type Err = ParamError;
 
     /// Parses a number of mm/s (`5`, `-150`, `2.5`).
     fn from_str(text: &str) -> Result<Self, ParamError> {
-        let value: f64 = text.trim().parse().map_err(|_| {
-            ParamError::new("speed", "a speed is a number of mm/s, for example 5", text)
-        })?;
-        Speed::new(value)
+        let rule = "a speed is a number of mm/s, for example 5";
+        Speed::new(number(text, "speed", rule)?)
     }
 }
 
@@ -294,6 +321,49 @@ impl<'de> Deserialize<'de> for Speed {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let value = f64::deserialize(deserializer)?;
         Speed::new(value).map_err(serde::de::Error::custom)
+    }
+}
+
+/// A sampling rate in Hz: a positive, finite number.
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
+pub struct SampleRate(f64);
+
+impl SampleRate {
+    /// A rate of `hz` Hz.
+    ///
+    /// # Errors
+    /// A rate that is not a positive, finite number.
+    pub fn new(hz: f64) -> Result<Self, ParamError> {
+        if hz.is_finite() && hz > 0.0 {
+            Ok(SampleRate(hz))
+        } else {
+            Err(ParamError::new(
+                "fs",
+                "a sampling rate must be a positive number of Hz",
+                hz,
+            ))
+        }
+    }
+
+    /// Hz.
+    pub fn hz(self) -> f64 {
+        self.0
+    }
+}
+
+impl fmt::Display for SampleRate {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl FromStr for SampleRate {
+    type Err = ParamError;
+
+    /// Parses a number of Hz (`1000`, `34.5`).
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        let rule = "a sampling rate is a number of Hz, for example 1000";
+        SampleRate::new(number(text, "fs", rule)?)
     }
 }
 
@@ -435,5 +505,42 @@ mod tests {
         let c: Cell = " 1, 2".parse().unwrap();
         assert_eq!(c.to_string(), "r1c2");
         assert!("1;2".parse::<Cell>().is_err());
+        assert!("1,x".parse::<Cell>().is_err());
+        assert!("-1,2".parse::<Cell>().is_err());
+    }
+
+    #[test]
+    fn parse_errors_name_the_parameter() {
+        let name = |e: ParamError| e.name;
+        assert_eq!("4by4".parse::<Grid>().map_err(name), Err("grid"));
+        assert_eq!("a".parse::<Cell>().map_err(name), Err("taxel"));
+        assert_eq!("fast".parse::<Speed>().map_err(name), Err("speed"));
+        assert_eq!("-5".parse::<SampleRate>().map_err(name), Err("fs"));
+    }
+
+    #[test]
+    fn a_taxel_is_located_only_on_a_cell_that_holds_one() {
+        let grid = Grid::masked(2, 2, vec![true, false, true, true]).unwrap();
+        assert_eq!(grid.locate(Cell { row: 1, col: 1 }), Ok(3));
+        let outside = grid.locate(Cell { row: 2, col: 0 }).unwrap_err();
+        assert_eq!(outside.name, "taxel");
+        assert!(
+            outside.to_string().contains("2,0, outside the 2x2 grid"),
+            "{outside}"
+        );
+        let masked = grid.locate(Cell { row: 0, col: 1 }).unwrap_err();
+        assert!(
+            masked.to_string().contains("a masked cell of the 2x2 grid"),
+            "{masked}"
+        );
+    }
+
+    #[test]
+    fn sample_rates_are_positive_and_finite() {
+        assert_eq!("500".parse::<SampleRate>().unwrap().hz(), 500.0);
+        for bad in ["0", "-5", "inf", "NaN", "fast", ""] {
+            assert!(bad.parse::<SampleRate>().is_err(), "{bad}");
+        }
+        assert_eq!(SampleRate::new(34.5).unwrap().to_string(), "34.5");
     }
 }

@@ -5,17 +5,18 @@ use std::path::{Path, PathBuf};
 use ndarray::{Array, Array1, ArrayD, IxDyn};
 use ndarray_npy::write_npy;
 use neurotex::import::{
-    csv_files, import_csv, import_stacked, ChannelSelect, CsvImportParams, NamePattern,
+    csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, NamePattern,
     StackedParams,
 };
-use neurotex::recording::{Baseline, Dataset};
+use neurotex::recording::{Baseline, Dataset, TimeUnit};
 use neurotex::signal::{PreprocessParams, Preprocessor};
+use neurotex::Speed;
 
 fn params() -> CsvImportParams {
     CsvImportParams {
         pattern: Some(NamePattern::parse("{label}_V{speed}_{trial}.csv").unwrap()),
         time_column: Some("stamp".into()),
-        time_unit_s: 1e-3,
+        time_unit: TimeUnit::Milliseconds,
         channels: ChannelSelect::All,
         grid: None,
         channel_map: None,
@@ -109,7 +110,7 @@ fn channels_by_list_or_regex_and_a_masked_6x10_grid() {
     // 52 channels on a 6x10 grid: the last 8 cells are masked
     let mut p = params();
     p.channels = ChannelSelect::parse(r"^tax\d+$").unwrap();
-    p.grid = Some((6, 10));
+    p.grid = Some("6x10".parse().unwrap());
     let out = dir.path().join("grid");
     let summary = import_csv(
         &csv_files(std::slice::from_ref(&src)).unwrap(),
@@ -218,7 +219,7 @@ fn every_axes_order_gives_the_same_recordings() {
             .join(",");
         let out = dir.path().join(format!("ds{k}"));
         let p = StackedParams {
-            axes: axes.clone(),
+            axes: axes.parse().unwrap(),
             fs: 1000.0,
             grid: None,
         };
@@ -261,9 +262,9 @@ fn every_axes_order_gives_the_same_recordings() {
         write_npy(&path, &data).unwrap();
         let out = dir.path().join(format!("chan_ds{k}"));
         let p = StackedParams {
-            axes: axes.to_string(),
+            axes: axes.parse().unwrap(),
             fs: 500.0,
-            grid: Some((2, 2)),
+            grid: Some("2x2".parse().unwrap()),
         };
         import_stacked(&path, &dir.path().join("labels2.npy"), None, &p, &out).unwrap();
         let rec = Dataset::open(&out).unwrap().load(1).unwrap();
@@ -298,7 +299,7 @@ fn string_labels_and_speeds_and_bad_stacks() {
     )
     .unwrap();
     let p = StackedParams {
-        axes: "n,t,row,col".into(),
+        axes: "n,t,row,col".parse().unwrap(),
         fs: 1000.0,
         grid: None,
     };
@@ -313,13 +314,13 @@ fn string_labels_and_speeds_and_bad_stacks() {
     .unwrap();
     let ds = Dataset::open(&out).unwrap();
     assert_eq!(ds.labels(), vec!["silk", "wool"]);
-    assert_eq!(ds.speeds(), vec![5.0, 10.0]);
+    assert_eq!(ds.speeds(), vec![Speed::of(5.0), Speed::of(10.0)]);
     // bad: axes count, axes names, label count
     let x = dir.path().join("x.npy");
     let lab = dir.path().join("labels.npy");
     let err = |axes: &str, labels: &Path, out: &str| {
         let p = StackedParams {
-            axes: axes.into(),
+            axes: axes.parse().unwrap(),
             fs: 1000.0,
             grid: None,
         };
@@ -328,8 +329,19 @@ fn string_labels_and_speeds_and_bad_stacks() {
             .to_string()
     };
     assert!(err("n,t,channel", &lab, "a").contains("names 3 axes but the data has 4"));
-    assert!(err("n,t,row,row", &lab, "b").contains("axes must name"));
-    assert!(err("n,t,x,col", &lab, "c").contains("n, t, row, col or channel"));
+    // axes that cannot describe a stack do not parse, naming the rule
+    for (axes, rule) in [
+        ("n,t,row,row", "axes must name"),
+        ("n,t,x,col", "n, t, row, col or channel"),
+    ] {
+        let e = axes.parse::<Axes>().unwrap_err();
+        assert_eq!(e.name, "axes");
+        assert!(e.to_string().contains(rule), "{e}");
+    }
+    assert_eq!(
+        "n, row,col ,t".parse::<Axes>().unwrap().to_string(),
+        "n,row,col,t"
+    );
     write_npy(dir.path().join("two.npy"), &Array1::from(vec![1i64, 2])).unwrap();
     assert!(err("n,t,row,col", &dir.path().join("two.npy"), "d").contains("2 labels for 3 samples"));
     assert!(!dir.path().join("d").exists());

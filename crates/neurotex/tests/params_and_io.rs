@@ -2,11 +2,17 @@
 
 use ndarray::{Array2, Array3};
 use ndarray_npy::write_npy;
+use std::path::Path;
+
 use neurotex::classify::{CvParams, KnnParams};
-use neurotex::encode::IzhikevichParams;
+use neurotex::encode::{FiringType, IzhikevichParams, PRESETS};
+use neurotex::error::{DatasetError, ParamError};
 use neurotex::features::{GlcmParams, VolumeParams};
-use neurotex::recording::{read_recording, Dataset, LayoutFile};
+use neurotex::recording::{
+    one_grid, read_recording, write_layout, Baseline, ChannelMap, Dataset, LayoutFile, TimeUnit,
+};
 use neurotex::signal::PreprocessParams;
+use neurotex::{Cell, Error, Grid, Speed};
 
 fn broken_rule<T, E: std::fmt::Display>(r: Result<T, E>) -> String {
     r.err()
@@ -65,6 +71,21 @@ fn presets_exist_and_unknown_is_none() {
         assert!(IzhikevichParams::preset(name).is_some(), "{name}");
     }
     assert!(IzhikevichParams::preset("XX").is_none());
+}
+
+#[test]
+fn firing_types_are_the_presets_in_order() {
+    for (t, preset) in FiringType::ALL.iter().zip(PRESETS) {
+        assert_eq!(t.name(), preset.0);
+        assert_eq!(t.to_string().parse::<FiringType>(), Ok(*t));
+        assert_eq!(Some(t.params()), IzhikevichParams::preset(preset.0));
+    }
+    assert_eq!("lts".parse::<FiringType>(), Ok(FiringType::Lts));
+    assert_eq!(FiringType::default().params(), IzhikevichParams::default());
+    assert!(matches!(
+        "XX".parse::<FiringType>(),
+        Err(ParamError { name: "preset", .. })
+    ));
 }
 
 #[test]
@@ -275,4 +296,124 @@ fn manifest_errors_name_line_and_field() {
     .unwrap();
     let msg = Dataset::open(dir.path()).unwrap_err().to_string();
     assert!(msg.contains("layout.toml") && msg.contains("mask"), "{msg}");
+}
+
+#[test]
+fn baselines_time_units_and_channel_maps_parse_from_what_users_type() {
+    assert_eq!("none".parse::<Baseline>(), Ok(Baseline::None));
+    assert_eq!("min".parse::<Baseline>(), Ok(Baseline::Min));
+    for bad in ["max", "mean", ""] {
+        assert!(matches!(
+            bad.parse::<Baseline>(),
+            Err(ParamError {
+                name: "baseline",
+                ..
+            })
+        ));
+    }
+    assert_eq!("ms".parse::<TimeUnit>(), Ok(TimeUnit::Milliseconds));
+    assert_eq!("s".parse::<TimeUnit>(), Ok(TimeUnit::Seconds));
+    assert_eq!(TimeUnit::Seconds.to_string(), "s");
+    assert!(matches!(
+        "min".parse::<TimeUnit>(),
+        Err(ParamError {
+            name: "time-unit",
+            ..
+        })
+    ));
+    let map: ChannelMap = "1,1; 1,0;0,1".parse().unwrap();
+    assert_eq!(map.cells()[1], Cell { row: 1, col: 0 });
+    assert_eq!(map.to_pairs(), vec![[1, 1], [1, 0], [0, 1]]);
+    assert_eq!(map.to_string(), "1,1;1,0;0,1");
+    for bad in ["0,0;0", "0,0;0,x", "", "0,0,0"] {
+        let e = bad.parse::<ChannelMap>().unwrap_err();
+        assert_eq!(e.name, "channel-map", "{bad}");
+    }
+}
+
+#[test]
+fn layout_files_keep_the_time_unit_as_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let layout = LayoutFile {
+        time_column: Some("stamp".into()),
+        time_unit: Some(TimeUnit::Seconds),
+        ..Default::default()
+    };
+    write_layout(dir.path(), &layout).unwrap();
+    let path = dir.path().join("layout.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("time_unit = \"s\""), "{text}");
+    assert_eq!(LayoutFile::read(&path).unwrap(), layout);
+    std::fs::write(&path, "time_unit = \"min\"\n").unwrap();
+    let msg = LayoutFile::read(&path).unwrap_err().to_string();
+    assert!(msg.contains("layout.toml") && msg.contains("`ms`"), "{msg}");
+}
+
+/// A dataset folder with one short recording per entry of `speeds` (as the manifest
+/// writes them), labels alternating `A`, `B`.
+fn dataset_at_speeds(dir: &Path, speeds: &[&str]) -> Dataset {
+    let mut manifest = String::from("file,label,speed_mm_s,force_n,trial\n");
+    for (i, speed) in speeds.iter().enumerate() {
+        let file = format!("r{i}.npy");
+        write_npy(dir.join(&file), &Array2::<f64>::zeros((10, 4))).unwrap();
+        let label = ["A", "B"][i % 2];
+        manifest.push_str(&format!("{file},{label},{speed},1,{i}\n"));
+    }
+    std::fs::write(dir.join("manifest.csv"), manifest).unwrap();
+    Dataset::open(dir).unwrap()
+}
+
+#[test]
+fn recordings_are_selected_by_speed_and_a_missing_speed_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let ds = dataset_at_speeds(dir.path(), &["10", "5", "-5", "5.0", "10", "2.5"]);
+    let speeds: Vec<f64> = ds.speeds().iter().map(|s| s.mm_s()).collect();
+    assert_eq!(speeds, [-5.0, 2.5, 5.0, 10.0]);
+    assert_eq!(ds.indices_at(&[Speed::of(5.0)]).unwrap(), [1, 3]);
+    assert_eq!(
+        ds.indices_at(&[Speed::of(10.0), Speed::of(-5.0)]).unwrap(),
+        [0, 2, 4]
+    );
+    assert!(ds.indices_at(&[]).unwrap().is_empty());
+    let err = ds
+        .indices_at(&[Speed::of(5.0), Speed::of(7.0)])
+        .unwrap_err();
+    assert!(matches!(
+        &err,
+        Error::Dataset(DatasetError::NoRecordingsAt { speed, available, .. })
+            if *speed == Speed::of(7.0) && available.len() == 4
+    ));
+    let msg = err.to_string();
+    assert!(
+        msg.contains("no recordings at 7 mm/s") && msg.contains("(its speeds: -5, 2.5, 5, 10)"),
+        "{msg}"
+    );
+    // a speed near but not at a recorded one is not that condition
+    assert!(ds.indices_at(&[Speed::of(5.0 + 1e-12)]).is_err());
+}
+
+#[test]
+fn recordings_of_one_dataset_share_one_grid() {
+    let full: Grid = "2x2".parse().unwrap();
+    let masked = Grid::masked(2, 2, vec![true, true, false, true]).unwrap();
+    let wide: Grid = "1x4".parse().unwrap();
+    assert_eq!(
+        one_grid([("a", full.clone()), ("b", full.clone())]).unwrap(),
+        full
+    );
+    for other in [masked, wide] {
+        let err = one_grid([("a", full.clone()), ("b", full.clone()), ("c", other)]).unwrap_err();
+        assert!(matches!(
+            &err,
+            Error::Dataset(DatasetError::MixedGrids { file, first }) if file == "c" && first == "a"
+        ));
+        assert!(
+            err.to_string().contains("a dataset needs one layout"),
+            "{err}"
+        );
+    }
+    assert!(matches!(
+        one_grid([]),
+        Err(Error::Dataset(DatasetError::Empty))
+    ));
 }

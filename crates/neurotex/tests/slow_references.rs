@@ -10,6 +10,9 @@ use neurotex::features::{
 };
 use proptest::prelude::*;
 
+mod support;
+use support::{few_levels_volume, spike_train, uniform_volume, Volume, XorShift};
+
 /// Loop-built GLCM: every voxel, every direction times every distance, bounds and mask checked.
 #[allow(clippy::too_many_arguments)]
 fn slow_glcm(
@@ -178,53 +181,12 @@ fn slow_knn(
         .collect()
 }
 
-/// Volumes like real rate volumes: each cell keeps to a few levels of its own, over up to
-/// 300 bins (more than one 128-bin mask block), so every counting method is exercised.
-fn few_levels_volume() -> impl Strategy<Value = (usize, usize, usize, usize, Vec<bool>, Vec<u8>)> {
-    (1usize..5, 1usize..5, 1usize..300, 2usize..40).prop_flat_map(|(rows, cols, bins, levels)| {
-        let cells = rows * cols;
-        (
-            Just(rows),
-            Just(cols),
-            Just(bins),
-            Just(levels),
-            proptest::collection::vec(proptest::bool::weighted(0.9), cells),
-            proptest::collection::vec(proptest::collection::vec(0u8..levels as u8, 1..5), cells),
-            proptest::collection::vec(any::<u8>(), cells * bins),
-        )
-            .prop_map(|(rows, cols, bins, levels, present, own, picks)| {
-                let q = picks
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &pick)| {
-                        let mine = &own[k / bins];
-                        mine[pick as usize % mine.len()]
-                    })
-                    .collect();
-                (rows, cols, bins, levels, present, q)
-            })
-    })
-}
-
-fn grid_and_volume() -> impl Strategy<Value = (usize, usize, usize, usize, Vec<bool>, Vec<u8>)> {
-    (1usize..6, 1usize..6, 1usize..25, 2usize..17).prop_flat_map(|(rows, cols, bins, levels)| {
-        (
-            Just(rows),
-            Just(cols),
-            Just(bins),
-            Just(levels),
-            proptest::collection::vec(proptest::bool::weighted(0.85), rows * cols),
-            proptest::collection::vec(0u8..levels as u8, rows * cols * bins),
-        )
-    })
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
     #[test]
     fn glcm_plan_matches_loop_built_glcm(
-        (rows, cols, bins, levels, present, q) in grid_and_volume(),
+        Volume { rows, cols, bins, levels, present, q } in uniform_volume(),
         distances in proptest::sample::subsequence(vec![1usize, 2, 3, 4, 8], 1..5),
         symmetric in any::<bool>(),
         two_d in any::<bool>(),
@@ -245,7 +207,7 @@ proptest! {
 
     #[test]
     fn every_counting_method_matches_loop_built_glcm_on_few_level_volumes(
-        (rows, cols, bins, levels, present, q) in few_levels_volume(),
+        Volume { rows, cols, bins, levels, present, q } in few_levels_volume(),
         distances in proptest::sample::subsequence(vec![1usize, 2, 3, 4, 8, 130], 1..5),
         symmetric in any::<bool>(),
     ) {
@@ -266,10 +228,10 @@ proptest! {
         zeros in 0.0f64..1.0,
         scale in prop_oneof![Just(3u64), Just(1000), Just(u32::MAX as u64)],
     ) {
-        let mut state = seed | 1;
+        let mut rng = XorShift::new(seed);
         let counts: Vec<u32> = (0..levels * levels).map(|_| {
-            state ^= state << 13; state ^= state >> 7; state ^= state << 17;
-            if (state % 1000) as f64 / 1000.0 < zeros { 0 } else { ((state >> 20) % scale) as u32 }
+            let x = rng.next_u64();
+            if (x % 1000) as f64 / 1000.0 < zeros { 0 } else { ((x >> 20) % scale) as u32 }
         }).collect();
         let fast = haralick(&counts, levels).to_array();
         let slow = slow_haralick(&counts, levels);
@@ -286,11 +248,8 @@ proptest! {
         gain in 1.0f64..25.0,
         split in 0.0f64..1.0,
     ) {
-        let mut state = seed | 1;
-        let input: Vec<f64> = (0..n * steps).map(|_| {
-            state ^= state << 13; state ^= state >> 7; state ^= state << 17;
-            (state % 10_000) as f64 / 10_000.0
-        }).collect();
+        let mut rng = XorShift::new(seed);
+        let input: Vec<f64> = (0..n * steps).map(|_| rng.fraction(10_000)).collect();
         let p = IzhikevichParams::default().with_gain(gain);
         let mut whole = vec![0u8; input.len()];
         Encoder::new(p, n).unwrap().run(&input, &mut whole);
@@ -316,12 +275,11 @@ proptest! {
         seed in any::<u64>(),
         standardize in any::<bool>(),
     ) {
-        let mut state = seed | 1;
-        let mut next = move || { state ^= state << 13; state ^= state >> 7; state ^= state << 17; state };
+        let mut rng = XorShift::new(seed);
         // coarse values so distance and vote ties happen often
-        let train: Vec<f64> = (0..n * dims).map(|_| (next() % 5) as f64).collect();
-        let y: Vec<usize> = (0..n).map(|i| if i < classes { i } else { (next() % classes as u64) as usize }).collect();
-        let test: Vec<f64> = (0..10 * dims).map(|_| (next() % 5) as f64).collect();
+        let train: Vec<f64> = (0..n * dims).map(|_| rng.below(5) as f64).collect();
+        let y: Vec<usize> = (0..n).map(|i| if i < classes { i } else { rng.below(classes as u64) as usize }).collect();
+        let test: Vec<f64> = (0..10 * dims).map(|_| rng.below(5) as f64).collect();
         let knn = KnnParams { k: k.min(n), standardize }.check().unwrap();
         let model = knn.fit(&train, dims, &y).unwrap();
         prop_assert_eq!(model.predict(&test), slow_knn(&train, &y, &test, dims, k.min(n), standardize));
@@ -329,7 +287,7 @@ proptest! {
 
     #[test]
     fn spike_stats_match_their_definitions(
-        mut train in proptest::collection::btree_set(0u32..3000, 0..80).prop_map(|s| s.into_iter().collect::<Vec<_>>()),
+        mut train in spike_train(3000, 0..80),
         n_steps in 1usize..3000,
         window in 1usize..500,
     ) {
@@ -355,12 +313,12 @@ proptest! {
 
     #[test]
     fn rate_volume_and_quantisation_match_definitions(
-        lists in proptest::collection::vec(proptest::collection::btree_set(0u32..2000, 0..60), 6),
+        lists in proptest::collection::vec(spike_train(2000, 0..60), 6),
         n_steps in 200usize..2000,
         bin in prop_oneof![1usize..4, 50usize..400, 2000usize..2100],
         levels in 2usize..32,
     ) {
-        let lists: Vec<Vec<u32>> = lists.into_iter().map(|s| s.into_iter().filter(|&t| (t as usize) < n_steps).collect()).collect();
+        let lists: Vec<Vec<u32>> = lists.into_iter().map(|l| l.into_iter().filter(|&t| (t as usize) < n_steps).collect()).collect();
         let present = vec![true; 6];
         let trains = SpikeTrains::from_lists(&lists, 2, 3, &present, n_steps);
         let Some(vol) = RateVolume::from_spikes(&trains, bin) else {
@@ -396,17 +354,10 @@ proptest! {
     }
 }
 
-/// Uniform random levels below `levels` (xorshift).
+/// Uniform random levels below `levels`.
 fn random_levels(n: usize, levels: u8, seed: u64) -> Vec<u8> {
-    let mut state = seed | 1;
-    (0..n)
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % u64::from(levels)) as u8
-        })
-        .collect()
+    let mut rng = XorShift::new(seed);
+    (0..n).map(|_| rng.below(u64::from(levels)) as u8).collect()
 }
 
 #[test]

@@ -1,0 +1,223 @@
+//! `neurotex evaluate`: KNN on a dataset's features, by cross-validation or by training on
+//! some speeds and testing on others; prints accuracy and confusion matrix.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+use neurotex::analysis::{evaluate, Columns, Outcome, Split, TaxelAccuracy};
+use neurotex::classify::CvParams;
+use neurotex::pipeline::{Method, Pipeline};
+use neurotex::recording::Dataset;
+use neurotex::{Cell, Speed};
+
+use super::feature_table;
+use crate::stage_args::StageArgs;
+
+/// Options of `neurotex evaluate`.
+#[derive(Args)]
+pub struct EvaluateArgs {
+    /// The dataset folder.
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// Feature set: `taxel`, `glcm2d` or `glcm3d`.
+    #[arg(long)]
+    pub method: Method,
+    /// With `--method taxel`: the taxel to use, as `ROW,COL`. Without it every taxel is
+    /// evaluated and the mean over taxels is reported, with the best beside it.
+    #[arg(long)]
+    pub taxel: Option<Cell>,
+    /// Neighbours in KNN.
+    #[arg(long, default_value_t = 5)]
+    pub k: usize,
+    /// Cross-validation folds (stratified, shuffled).
+    #[arg(long, default_value_t = 5)]
+    pub folds: usize,
+    /// Seed of the fold shuffle (repeat r uses seed + r).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Cross-validation repeats with different shuffles.
+    #[arg(long, default_value_t = 1)]
+    pub repeats: usize,
+    /// Only recordings at these speeds (mm/s, comma-separated); default all.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        conflicts_with = "train_speeds"
+    )]
+    pub speeds: Option<Vec<Speed>>,
+    /// Train on these speeds instead of cross-validating (needs --test-speeds).
+    #[arg(
+        long = "train-speeds",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "test_speeds"
+    )]
+    pub train_speeds: Option<Vec<Speed>>,
+    /// Test on these speeds (needs --train-speeds).
+    #[arg(
+        long = "test-speeds",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "train_speeds"
+    )]
+    pub test_speeds: Option<Vec<Speed>>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
+
+impl EvaluateArgs {
+    /// Cross-validation, or training and testing on the given speeds.
+    fn split(&self) -> Result<Split> {
+        let cv = CvParams {
+            folds: self.folds,
+            seed: self.seed,
+            repeats: self.repeats,
+        }
+        .check()?;
+        Ok(match (&self.train_speeds, &self.test_speeds) {
+            (Some(train), Some(test)) => Split::ByCondition {
+                train: train.clone(),
+                test: test.clone(),
+            },
+            _ => Split::CrossValidation {
+                speeds: self.speeds.clone(),
+                cv,
+            },
+        })
+    }
+
+    /// The speeds whose recordings the split uses; `None` for all.
+    fn speeds_used(&self) -> Option<Vec<Speed>> {
+        match (&self.train_speeds, &self.test_speeds) {
+            (Some(train), Some(test)) => Some([&train[..], test].concat()),
+            _ => self.speeds.clone(),
+        }
+    }
+
+    /// The feature columns to classify with.
+    fn columns(&self) -> Result<Columns> {
+        Ok(match (self.method, self.taxel) {
+            (Method::Taxel, Some(cell)) => Columns::Taxel(cell),
+            (Method::Taxel, None) => Columns::EachTaxel,
+            (_, Some(_)) => bail!("--taxel applies only to --method taxel"),
+            (_, None) => Columns::All,
+        })
+    }
+}
+
+/// Runs `neurotex evaluate`.
+pub fn run(args: EvaluateArgs) -> Result<()> {
+    let pipeline = Pipeline::new(args.stages.pipeline()?)?;
+    let knn = args.stages.knn(args.k)?;
+    let split = args.split()?;
+    let columns = args.columns()?;
+    let dataset = Dataset::open(&args.dataset)?;
+    let indices = match args.speeds_used() {
+        Some(speeds) => dataset.indices_at(&speeds)?,
+        None => (0..dataset.entries.len()).collect(),
+    };
+    let (table, grid) = feature_table(&dataset, &pipeline, &indices, args.method)?;
+    if let Some(cell) = args.taxel {
+        grid.locate(cell)?;
+    }
+    let outcome = evaluate(&table, columns, &split, &knn.check()?)?;
+    if args.json {
+        let mut value = serde_json::to_value(&outcome)?;
+        value["method"] = args.method.name().into();
+        println!("{}", serde_json::to_string(&value)?);
+    } else {
+        print_outcome(&outcome, args.method, &split, grid.cols());
+    }
+    Ok(())
+}
+
+/// Prints the outcome as text: what was run, the accuracy (per taxel when every taxel was
+/// evaluated) and the confusion matrix.
+fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) {
+    let how = match split {
+        Split::CrossValidation { cv, .. } => format!(
+            "{}-fold stratified CV, seed {}, {} repeat(s)",
+            cv.folds, cv.seed, cv.repeats
+        ),
+        Split::ByCondition { train, test } => {
+            let list = |s: &[Speed]| s.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+            format!(
+                "train on [{}] mm/s, test on [{}] mm/s",
+                list(train).join(", "),
+                list(test).join(", ")
+            )
+        }
+    };
+    println!("method {}: {} samples, {how}", method.name(), outcome.n);
+    if let (Some(per), Some(best)) = (&outcome.per_taxel, &outcome.best) {
+        print_taxel_grid(per, cols);
+        println!(
+            "accuracy {:.1}% (mean over taxels); best taxel r{}c{} {:.1}% (chosen after the fact)",
+            100.0 * outcome.accuracy,
+            best.row,
+            best.col,
+            100.0 * best.accuracy
+        );
+    } else if outcome.accuracy_std > 0.0 {
+        println!(
+            "accuracy {:.1}% ± {:.1}%",
+            100.0 * outcome.accuracy,
+            100.0 * outcome.accuracy_std
+        );
+    } else {
+        println!("accuracy {:.1}%", 100.0 * outcome.accuracy);
+    }
+    print_confusion(outcome);
+}
+
+/// Prints each taxel's accuracy in its place on the grid; `-` for cells without a taxel.
+fn print_taxel_grid(per: &[TaxelAccuracy], cols: usize) {
+    println!("accuracy per taxel (%):");
+    let rows = per.iter().map(|t| t.row).max().unwrap_or(0) + 1;
+    for r in 0..rows {
+        let line: Vec<String> = (0..cols)
+            .map(|c| {
+                per.iter()
+                    .find(|t| t.row == r && t.col == c)
+                    .map_or("    -".to_string(), |t| {
+                        format!("{:5.1}", 100.0 * t.accuracy)
+                    })
+            })
+            .collect();
+        println!("  {}", line.join(" "));
+    }
+}
+
+/// Prints the confusion matrix, rows the true labels.
+fn print_confusion(outcome: &Outcome) {
+    let summed = if outcome.per_taxel.is_some() {
+        ", summed over taxels"
+    } else {
+        ""
+    };
+    println!("confusion (rows = true, columns = predicted{summed}):");
+    let width = outcome
+        .labels
+        .iter()
+        .map(|l| l.len())
+        .max()
+        .unwrap_or(1)
+        .max(5);
+    print!("{:width$}", "");
+    for l in &outcome.labels {
+        print!(" {l:>width$}");
+    }
+    println!();
+    for (l, row) in outcome.labels.iter().zip(outcome.confusion.rows()) {
+        print!("{l:width$}");
+        for v in row {
+            print!(" {v:>width$}");
+        }
+        println!();
+    }
+}

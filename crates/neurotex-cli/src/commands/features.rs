@@ -1,0 +1,65 @@
+//! `neurotex features`: one feature row per recording of a dataset, into a CSV file.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use neurotex::analysis::FeatureTable;
+use neurotex::pipeline::{Method, Pipeline};
+use neurotex::recording::Dataset;
+
+use super::feature_table;
+use crate::output::write_file;
+use crate::stage_args::StageArgs;
+
+/// Options of `neurotex features`.
+#[derive(Args)]
+pub struct FeaturesArgs {
+    /// The dataset folder (with `manifest.csv`, optional `layout.toml`).
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// Feature set: `taxel` (MSR, CV_ISI, Fano of every taxel), `glcm2d` or `glcm3d`
+    /// (contrast, correlation, ASM).
+    #[arg(long)]
+    pub method: Method,
+    /// The CSV file to write: `file,label,speed_mm_s,trial` then the features.
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
+
+/// Runs `neurotex features`.
+pub fn run(args: FeaturesArgs) -> Result<()> {
+    let pipeline = Pipeline::new(args.stages.pipeline()?)?;
+    let dataset = Dataset::open(&args.dataset)?;
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    let (table, _) = feature_table(&dataset, &pipeline, &all, args.method)?;
+    write_file(&args.out, "the feature table", |w| write_table(w, &table))?;
+    eprintln!(
+        "{} recordings x {} features -> {}",
+        table.metas.len(),
+        table.dims(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Writes the table as CSV: `file,label,speed_mm_s,trial`, then one column per feature.
+fn write_table(w: &mut dyn Write, table: &FeatureTable) -> std::io::Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    let ids = ["file", "label", "speed_mm_s", "trial"].map(String::from);
+    out.write_record(ids.iter().chain(&table.names))?;
+    for (i, m) in table.metas.iter().enumerate() {
+        let ids = [
+            m.file.clone(),
+            m.label.clone(),
+            m.speed_mm_s.to_string(),
+            m.trial.to_string(),
+        ];
+        let values = table.row(i).iter().map(f64::to_string);
+        out.write_record(ids.into_iter().chain(values))?;
+    }
+    out.flush()
+}

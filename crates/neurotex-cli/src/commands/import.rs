@@ -1,0 +1,148 @@
+//! `neurotex import`: recordings from other layouts into the dataset format.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::{Args, Subcommand};
+use neurotex::import::{
+    csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, NamePattern,
+    StackedParams,
+};
+use neurotex::recording::{Baseline, ChannelMap, TimeUnit};
+use neurotex::{Grid, SampleRate};
+
+use crate::output::progress;
+
+/// `neurotex import`: bring recordings from other layouts into the dataset format.
+#[derive(Subcommand)]
+pub enum ImportCommand {
+    /// Per-trial CSV logs (a header row, a time column, one column per channel), with
+    /// metadata taken from the file names.
+    Csv(ImportCsvArgs),
+    /// A stacked array `(N, ...)` with one label (and optionally one speed) per sample.
+    Stacked(ImportStackedArgs),
+}
+
+/// Options of `neurotex import csv`.
+#[derive(Args)]
+pub struct ImportCsvArgs {
+    /// CSV files, or folders whose .csv files are all imported.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// The dataset folder to create (must not exist, or be empty).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Fields from file names, e.g. `{label}_F{force}_V{speed}mmps_{trial}.csv`; `label`,
+    /// `speed` (mm/s), `force` and `trial` fill the manifest, other fields become columns.
+    /// Without it the label is the file name.
+    #[arg(long = "name-pattern")]
+    pub name_pattern: Option<NamePattern>,
+    /// The time-stamp column (irregular stamps are kept and resampled onto 1 ms later).
+    #[arg(long = "time-column")]
+    pub time_column: Option<String>,
+    /// Unit of the time column: `ms` or `s`.
+    #[arg(long = "time-unit", default_value = "ms")]
+    pub time_unit: TimeUnit,
+    /// Channel columns: a comma-separated list, or a regular expression such as `^channel\d+$`
+    /// (default: every column but the time column).
+    #[arg(long)]
+    pub channels: Option<ChannelSelect>,
+    /// Grid `ROWSxCOLS` to place the channels on, row-major (default one row).
+    #[arg(long)]
+    pub grid: Option<Grid>,
+    /// Each channel's cell as `row,col;row,col;...` (needs --grid).
+    #[arg(long = "channel-map", requires = "grid")]
+    pub channel_map: Option<ChannelMap>,
+    /// Nominal sampling rate in Hz (needed without a time column; else the median interval).
+    #[arg(long, allow_negative_numbers = true)]
+    pub fs: Option<SampleRate>,
+    /// Baseline removal to record in layout.toml: `none` or `min` (capacitive sensors rest
+    /// at a large offset).
+    #[arg(long)]
+    pub baseline: Option<Baseline>,
+    /// Leave out files with errors (each is reported) instead of stopping at the first.
+    #[arg(long = "skip-bad")]
+    pub skip_bad: bool,
+}
+
+/// Options of `neurotex import stacked`.
+#[derive(Args)]
+pub struct ImportStackedArgs {
+    /// The stacked samples, `.npy` of floats or integers.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// One label per sample, `.npy` of integers or strings.
+    #[arg(long)]
+    pub labels: PathBuf,
+    /// The data's axes in order, from n (sample), t (time), row, col, channel:
+    /// e.g. `n,row,col,t` for shape (N, rows, cols, T) or `n,t,channel`.
+    #[arg(long)]
+    pub axes: Axes,
+    /// Sampling rate in Hz.
+    #[arg(long, allow_negative_numbers = true)]
+    pub fs: SampleRate,
+    /// One speed (mm/s) per sample, `.npy`.
+    #[arg(long)]
+    pub speeds: Option<PathBuf>,
+    /// With a channel axis: the grid `ROWSxCOLS` to place channels on, row-major.
+    #[arg(long)]
+    pub grid: Option<Grid>,
+    /// The dataset folder to create.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs `neurotex import csv` or `neurotex import stacked`.
+pub fn run(command: ImportCommand) -> Result<()> {
+    match command {
+        ImportCommand::Csv(args) => csv(args),
+        ImportCommand::Stacked(args) => stacked(args),
+    }
+}
+
+fn csv(args: ImportCsvArgs) -> Result<()> {
+    let params = CsvImportParams {
+        pattern: args.name_pattern,
+        time_column: args.time_column,
+        time_unit: args.time_unit,
+        channels: args.channels.unwrap_or(ChannelSelect::All),
+        grid: args.grid,
+        channel_map: args.channel_map,
+        fs: args.fs.map(SampleRate::hz),
+        // `none` is what a layout without a baseline means; it is not written out
+        baseline: args.baseline.filter(|b| *b != Baseline::None),
+        skip_bad: args.skip_bad,
+    };
+    let files = csv_files(&args.inputs)?;
+    let bar = progress(files.len(), "importing");
+    let summary = import_csv(&files, &params, &args.out, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let summary = summary?;
+    for (_, why) in &summary.skipped {
+        eprintln!("warning: left out {why}");
+    }
+    let layout = &summary.layout;
+    eprintln!(
+        "{} recordings ({} left out) -> {}; {} channels on a {}x{} grid at {:.2} Hz nominal",
+        summary.written,
+        summary.skipped.len(),
+        args.out.display(),
+        layout.channels.as_ref().map_or(0, Vec::len),
+        layout.rows.unwrap_or(1),
+        layout.cols.unwrap_or(1),
+        layout.fs.unwrap_or(0.0)
+    );
+    Ok(())
+}
+
+fn stacked(args: ImportStackedArgs) -> Result<()> {
+    let params = StackedParams {
+        axes: args.axes,
+        fs: args.fs.hz(),
+        grid: args.grid,
+    };
+    let speeds = args.speeds.as_deref();
+    let n = import_stacked(&args.data, &args.labels, speeds, &params, &args.out)?;
+    eprintln!("{n} recordings -> {}", args.out.display());
+    Ok(())
+}

@@ -1,0 +1,60 @@
+//! The subcommands, one module each: every one parses its options into the library's typed
+//! values and parameters, runs the library, and writes or prints the result.
+
+pub mod encode;
+pub mod evaluate;
+pub mod features;
+pub mod import;
+pub mod reproduce;
+pub mod simulate;
+
+use anyhow::Result;
+use neurotex::analysis::FeatureTable;
+use neurotex::pipeline::{Encoded, Method, Pipeline};
+use neurotex::recording::{one_grid, Dataset};
+use neurotex::Grid;
+
+use crate::output::progress;
+
+/// Encodes the dataset's recordings at `indices` (with a progress bar) and extracts
+/// `method`'s features; also returns the grid the recordings share.
+fn feature_table(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+    method: Method,
+) -> Result<(FeatureTable, Grid)> {
+    let bar = progress(indices.len(), "encoding");
+    let encoded = pipeline.encode_dataset(dataset, indices, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let encoded = encoded?;
+    report_conditions(&encoded);
+    let grids = encoded
+        .iter()
+        .map(|e| {
+            let s = &e.spikes;
+            Ok((
+                e.meta.file.as_str(),
+                Grid::masked(s.rows, s.cols, s.present.clone())?,
+            ))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let grid = one_grid(grids)?;
+    let extractor = pipeline.extractor(&grid)?;
+    let table = FeatureTable::build(&encoded, &extractor, method)?;
+    Ok((table, grid))
+}
+
+/// Says on standard error what conditioning did that the user should know.
+fn report_conditions(encoded: &[Encoded]) {
+    let resampled = encoded.iter().filter(|e| e.resampled).count();
+    if resampled > 0 {
+        eprintln!("note: {resampled} recording(s) resampled to the encoder's 1 kHz by linear interpolation");
+    }
+    for e in encoded.iter().filter(|e| e.flat) {
+        eprintln!(
+            "warning: {}: no positive signal in the selected phase; left at zero (no spikes)",
+            e.meta.file
+        );
+    }
+}

@@ -1,0 +1,62 @@
+//! `neurotex simulate`: the paper's rig, simulated into a dataset folder.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+use neurotex::sim::{design, write_dataset, RigParams, Texture, ALL_TEXTURES};
+use neurotex::Speed;
+
+use crate::output::progress;
+
+/// Options of `neurotex simulate`.
+#[derive(Args)]
+pub struct SimulateArgs {
+    /// The dataset folder to create (must not exist, or be empty).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Seed of every random draw: the same seed gives the same bits.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Trials per texture and speed (paper: 20).
+    #[arg(long, default_value_t = 20)]
+    pub trials: u32,
+    /// Sliding speeds in mm/s (paper: 5, 10, 15).
+    #[arg(long, value_delimiter = ',', default_value = "5,10,15")]
+    pub speeds: Vec<Speed>,
+    /// Textures, by the paper's names: FT1, FT2, FT3, RT, TRug, SB, CP, STF (default all).
+    #[arg(long, value_delimiter = ',', value_parser = texture)]
+    pub textures: Option<Vec<Texture>>,
+}
+
+/// A texture by the paper's name, in any case.
+pub fn texture(name: &str) -> Result<Texture, String> {
+    Texture::from_name(name.trim()).ok_or_else(|| {
+        format!("unknown texture `{name}`: expected FT1, FT2, FT3, RT, TRug, SB, CP or STF")
+    })
+}
+
+/// Runs `neurotex simulate`.
+pub fn run(args: SimulateArgs) -> Result<()> {
+    if args.trials == 0 {
+        bail!("--trials must be at least 1");
+    }
+    if let Some(s) = args.speeds.iter().find(|s| s.mm_s() <= 0.0) {
+        bail!("--speeds must be positive mm/s, got {s}");
+    }
+    let textures = args.textures.unwrap_or_else(|| ALL_TEXTURES.to_vec());
+    let speeds: Vec<f64> = args.speeds.iter().map(|s| s.mm_s()).collect();
+    let trials = design(&textures, &speeds, args.trials);
+    let bar = progress(trials.len(), "simulating");
+    let result = write_dataset(
+        &args.out,
+        &RigParams::default(),
+        &trials,
+        args.seed,
+        &|| bar.inc(1),
+    );
+    bar.finish_and_clear();
+    result?;
+    eprintln!("{} recordings -> {}", trials.len(), args.out.display());
+    Ok(())
+}

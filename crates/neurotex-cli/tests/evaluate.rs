@@ -1,0 +1,189 @@
+//! `neurotex features` and `neurotex evaluate` on a dataset, and their bad options.
+
+use crate::util::{s, Dir};
+
+#[test]
+fn features_and_evaluate_on_a_dataset() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 10);
+    let out = dir.join("f.csv");
+    let features = |method: &str| {
+        dir.ok(&[
+            "features",
+            "--dataset",
+            s(&ds),
+            "--method",
+            method,
+            "--out",
+            s(&out),
+        ]);
+        std::fs::read_to_string(&out).unwrap()
+    };
+    let text = features("glcm3d");
+    assert!(
+        text.starts_with("file,label,speed_mm_s,trial,contrast,correlation,asm\n"),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 61);
+    let text = features("taxel");
+    let header = text.lines().next().unwrap();
+    assert!(
+        header.starts_with("file,label,speed_mm_s,trial,r0c0_msr,r0c0_cv_isi,r0c0_fano,r0c1_msr")
+    );
+    assert!(header.ends_with("r3c3_fano"));
+
+    let json = |method: &str, extra: &[&str]| dir.evaluate_json(&ds, method, extra);
+    let v = json("glcm3d", &["--speeds", "5"]);
+    let acc = v["accuracy"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&acc));
+    assert!(
+        acc > 0.6,
+        "three distinct gratings should be told apart, got {acc}"
+    );
+    assert_eq!(v["n"], 30);
+    assert_eq!(v["labels"], serde_json::json!(["A", "B", "C"]));
+    let total: u64 = v["confusion"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|r| r.as_array().unwrap())
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(total, 30);
+
+    let v = json("taxel", &["--repeats", "2"]);
+    assert_eq!(v["per_taxel"].as_array().unwrap().len(), 16);
+    let mean = v["per_taxel"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["accuracy"].as_f64().unwrap())
+        .sum::<f64>()
+        / 16.0;
+    assert!((mean - v["accuracy"].as_f64().unwrap()).abs() < 1e-12);
+    assert!(v["best"]["accuracy"].as_f64().unwrap() >= mean);
+
+    let v = json("taxel", &["--taxel", "1,2"]);
+    assert!(v.get("per_taxel").is_none());
+    let v = json("glcm2d", &["--train-speeds", "5", "--test-speeds", "10"]);
+    assert_eq!(v["n"], 30);
+    let text = dir.ok(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--k",
+        "3",
+        "--folds",
+        "4",
+    ]);
+    assert!(
+        text.contains("accuracy") && text.contains("confusion"),
+        "{text}"
+    );
+}
+
+#[test]
+fn same_seed_gives_the_same_result() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 10);
+    let run = |seed: &str| {
+        dir.ok(&[
+            "evaluate",
+            "--dataset",
+            s(&ds),
+            "--method",
+            "taxel",
+            "--seed",
+            seed,
+            "--json",
+        ])
+    };
+    assert_eq!(run("3"), run("3"));
+}
+
+#[test]
+fn bad_input_is_a_clear_error_with_no_output() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0, 10.0], 5);
+    let out = dir.join("out.csv");
+    let d = s(&ds);
+    let o = s(&out);
+    let feat = |extra: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["features", "--dataset", d, "--method", "glcm3d", "--out", o];
+        v.extend_from_slice(extra);
+        v
+    };
+    let eval = |method: &'static str, extra: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["evaluate", "--dataset", d, "--method", method];
+        v.extend_from_slice(extra);
+        v
+    };
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "features",
+                "--dataset",
+                "/nonexistent",
+                "--method",
+                "glcm3d",
+                "--out",
+                o,
+            ],
+            "not a dataset folder",
+        ),
+        (
+            vec!["features", "--dataset", d, "--method", "glcm4d", "--out", o],
+            "glcm4d",
+        ),
+        (feat(&["--gain", "0"]), "gain"),
+        (feat(&["--gain", "-3"]), "gain"),
+        (feat(&["--levels", "1"]), "levels"),
+        (feat(&["--bin-ms", "0"]), "bin"),
+        (feat(&["--distances", "0"]), "distances"),
+        (feat(&["--cutoff", "600"]), "cutoff"),
+        (feat(&["--preset", "XX"]), "preset"),
+        (feat(&["--baseline", "max"]), "`none` or `min`"),
+        (
+            vec![
+                "features",
+                "--dataset",
+                d,
+                "--method",
+                "glcm3d",
+                "--out",
+                "/nonexistent/dir/f.csv",
+            ],
+            "does not exist",
+        ),
+        (
+            vec!["evaluate", "--dataset", d, "--method", "glcm3d", "--k", "0"],
+            "k must be at least 1",
+        ),
+        (eval("glcm3d", &["--folds", "1"]), "at least 2 folds"),
+        (
+            eval("glcm3d", &["--folds", "6", "--speeds", "5"]),
+            "fewer than the 6 folds",
+        ),
+        (eval("glcm3d", &["--k", "50"]), "k = 50 neighbours"),
+        (
+            eval("glcm3d", &["--speeds", "7"]),
+            "no recordings at 7 mm/s",
+        ),
+        (
+            eval("glcm3d", &["--train-speeds", "5", "--test-speeds", "7,10"]),
+            "no recordings at 7 mm/s in",
+        ),
+        (eval("glcm3d", &["--speeds", "fast"]), "a speed is a number"),
+        (eval("taxel", &["--taxel", "4,0"]), "outside the 4x4 grid"),
+        (eval("taxel", &["--taxel", "a"]), "ROW,COL"),
+        (
+            eval("glcm3d", &["--taxel", "1,1"]),
+            "only to --method taxel",
+        ),
+        (eval("glcm3d", &["--train-speeds", "5"]), "test-speeds"),
+    ];
+    dir.fails_each(&cases, &out);
+    assert!(!dir.partial_left(), "temporary files left behind");
+}

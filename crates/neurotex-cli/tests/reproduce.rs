@@ -1,0 +1,67 @@
+//! `neurotex reproduce` on a dataset folder.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::util::{s, Dir};
+
+#[test]
+fn reproduce_on_a_dataset_writes_report_json_and_figures() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 6);
+    let out = dir.join("report");
+    // a quick run on a dataset; returns its results.json
+    let reproduce = |ds: &Path, out: &Path| -> Value {
+        dir.ok(&["reproduce", "--dataset", s(ds), "--out", s(out), "--quick"]);
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap()
+    };
+    let json = reproduce(&ds, &out);
+    for speed in ["5", "10"] {
+        for key in ["taxel_mean", "taxel_best", "glcm3d"] {
+            let v = json["e1"][speed][key].as_f64().unwrap();
+            assert!((0.0..=1.0).contains(&v), "e1 {speed} {key} = {v}");
+        }
+        for key in ["taxel_mean", "glcm2d", "glcm3d"] {
+            assert!(
+                json["e4"][speed][key].as_f64().is_some(),
+                "e4 {speed} {key}"
+            );
+        }
+        for key in ["taxel_mean", "glcm3d"] {
+            assert!(
+                json["e6"][speed][key].as_f64().is_some(),
+                "e6 {speed} {key}"
+            );
+        }
+        assert!(json["e5"][speed]["glcm3d"].is_array());
+        assert!(json["e8"][speed]["glcm3d"].is_array());
+    }
+    assert!(json["e3"]["mean"].is_array() && json["e7"]["sweep"]["counts"].is_array());
+    for key in ["prepare", "e1", "e3", "e5", "e7", "e8"] {
+        assert!(json["timing_s"][key].as_f64().is_some(), "timing {key}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## E1") && report.contains("| 5 |") && report.contains("paper"));
+    for fig in [
+        "e0_psth_volume",
+        "e1_accuracy",
+        "e2_confusion",
+        "e3_perturbation",
+        "e5_time_to_recognition",
+        "e7_isi",
+    ] {
+        let svg = std::fs::read_to_string(out.join("figures").join(format!("{fig}.svg"))).unwrap();
+        assert!(
+            svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{fig}"
+        );
+    }
+    // one speed only: E6 is skipped with a reason, not an error
+    let one = dir.dataset("one", &["A", "B"], &[5.0], 5);
+    let json = reproduce(&one, &dir.join("r1"));
+    assert!(json["skipped"]["e6"]
+        .as_str()
+        .unwrap()
+        .contains("one speed"));
+}

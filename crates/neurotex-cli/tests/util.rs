@@ -1,0 +1,185 @@
+//! What every CLI test needs (after ripgrep's `tests/util.rs`): a temporary folder to run
+//! the real `neurotex` binary in, its exit status and output, and small datasets written
+//! there.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus};
+
+use ndarray::Array3;
+use ndarray_npy::write_npy;
+use serde_json::Value;
+
+/// A temporary folder, removed when dropped, in which `neurotex` runs.
+pub struct Dir {
+    tmp: tempfile::TempDir,
+}
+
+/// One run of the binary.
+pub struct Run {
+    /// How it exited.
+    pub status: ExitStatus,
+    /// Standard output.
+    pub stdout: String,
+    /// Standard error.
+    pub stderr: String,
+}
+
+impl Dir {
+    /// A new, empty temporary folder.
+    pub fn new() -> Dir {
+        Dir {
+            tmp: tempfile::tempdir().expect("a temporary folder"),
+        }
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        self.tmp.path()
+    }
+
+    /// `name` inside the folder.
+    pub fn join(&self, name: &str) -> PathBuf {
+        self.path().join(name)
+    }
+
+    /// Runs `neurotex args...` in the folder.
+    pub fn run(&self, args: &[&str]) -> Run {
+        let out = Command::new(env!("CARGO_BIN_EXE_neurotex"))
+            .args(args)
+            .current_dir(self.path())
+            .output()
+            .expect("the binary runs");
+        Run {
+            status: out.status,
+            stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+            stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+        }
+    }
+
+    /// Runs a command that must succeed; returns its standard output.
+    pub fn ok(&self, args: &[&str]) -> String {
+        let run = self.run(args);
+        assert!(
+            run.status.success(),
+            "neurotex {args:?} failed: {}",
+            run.stderr
+        );
+        run.stdout
+    }
+
+    /// Runs `neurotex evaluate --dataset DATASET --method METHOD EXTRA... --json`, which
+    /// must succeed; returns the JSON it prints.
+    pub fn evaluate_json(&self, dataset: &Path, method: &str, extra: &[&str]) -> Value {
+        let mut args = vec!["evaluate", "--dataset", s(dataset), "--method", method];
+        args.extend_from_slice(extra);
+        args.push("--json");
+        serde_json::from_str(&self.ok(&args)).expect("evaluate --json prints JSON")
+    }
+
+    /// Runs a command that must fail with an error, not a panic: exit code 1 (the run
+    /// failed) or 2 (the command line is wrong), a message after `error:`. Returns standard
+    /// error.
+    pub fn fails(&self, args: &[&str]) -> String {
+        let run = self.run(args);
+        let err = run.stderr;
+        assert!(!run.status.success(), "neurotex {args:?} should fail");
+        assert!(
+            matches!(run.status.code(), Some(1 | 2)),
+            "neurotex {args:?} exited with {:?}: {err}",
+            run.status.code()
+        );
+        assert!(
+            !err.contains("panicked"),
+            "neurotex {args:?} panicked: {err}"
+        );
+        assert!(err.starts_with("error:") || err.contains("error:"), "{err}");
+        err
+    }
+
+    /// Runs every case, each expected to fail with its message and to leave `out` (an
+    /// output file or folder) unwritten.
+    pub fn fails_each(&self, cases: &[(Vec<&str>, &str)], out: &Path) {
+        for (args, expected) in cases {
+            let err = self.fails(args);
+            assert!(
+                err.contains(expected),
+                "{args:?}: expected `{expected}` in {err}"
+            );
+            assert!(!out.exists(), "{args:?} left output behind at {out:?}");
+        }
+    }
+
+    /// Writes a dataset folder `name` of `labels` classes x `trials` at each speed, 1.4 s
+    /// recordings of [`recording`] gratings whose period grows with the class and
+    /// shrinks with the speed, with the sliding phase from 0.1 s to 1.3 s.
+    pub fn dataset(&self, name: &str, labels: &[&str], speeds: &[f64], trials: usize) -> PathBuf {
+        let dir = self.join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut manifest =
+            String::from("file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s\n");
+        for (k, label) in labels.iter().enumerate() {
+            for &speed in speeds {
+                for trial in 0..trials {
+                    let file = format!("{label}_{speed}_{trial}.npy");
+                    let period = (60.0 + 70.0 * k as f64) * 5.0 / speed;
+                    let seed = (k * 1000 + trial) as u64 + speed as u64;
+                    let rec = recording(1400, period, 0.2 + 0.1 * k as f64, seed);
+                    write_npy(dir.join(&file), &rec).unwrap();
+                    manifest.push_str(&format!("{file},{label},{speed},1,{trial},0.1,1.3\n"));
+                }
+            }
+        }
+        std::fs::write(dir.join("manifest.csv"), manifest).unwrap();
+        dir
+    }
+
+    /// Whether any temporary `.partial` file or folder is left in the folder.
+    pub fn partial_left(&self) -> bool {
+        std::fs::read_dir(self.path())
+            .unwrap()
+            .any(|e| e.unwrap().file_name().to_string_lossy().contains("partial"))
+    }
+}
+
+/// A texture-like 4x4 recording: a grating of `period_ms` sweeping across the rows, with
+/// noise from a small generator seeded by `seed`.
+pub fn recording(steps: usize, period_ms: f64, amp: f64, seed: u64) -> Array3<f32> {
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407)
+        | 1;
+    Array3::from_shape_fn((steps, 4, 4), |(t, r, c)| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let noise = (state % 1000) as f64 / 1000.0 - 0.5;
+        let phase = (t as f64 - 40.0 * r as f64 - 7.0 * c as f64) / period_ms;
+        (0.5 + amp * (std::f64::consts::TAU * phase).sin() + 0.2 * noise) as f32
+    })
+}
+
+/// Adds a CSV recording of label A at 5 mm/s to a dataset's manifest.
+pub fn add_csv(dataset: &Path, name: &str, content: &str) {
+    std::fs::write(dataset.join(name), content).unwrap();
+    let mut m = std::fs::read_to_string(dataset.join("manifest.csv")).unwrap();
+    m.push_str(&format!("{name},A,5,1,9,,\n"));
+    std::fs::write(dataset.join("manifest.csv"), &m).unwrap();
+}
+
+/// A path as the `&str` argument the binary takes.
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("a UTF-8 path")
+}
+
+/// The FabricSlide fabric logs in `../shared` beside the repository. Tests that need them
+/// are `#[ignore]`d and run by `.ci/run` with `--ignored`, so when the data is absent this
+/// fails, saying so, rather than letting such a test pass without running.
+pub fn fabricslide() -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/fabricslide/fabric");
+    assert!(
+        dir.is_dir(),
+        "FabricSlide data not found at {}: this test needs ../shared beside the repository",
+        dir.display()
+    );
+    dir
+}
