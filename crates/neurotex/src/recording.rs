@@ -611,11 +611,6 @@ pub fn one_grid<'a>(grids: impl IntoIterator<Item = (&'a str, Grid)>) -> Result<
     }
 }
 
-/// Whether two speeds name the same condition (equal to within 1e-9 mm/s).
-pub fn same_speed(a: f64, b: f64) -> bool {
-    (a - b).abs() <= 1e-9
-}
-
 /// Reads and checks a manifest.
 ///
 /// # Errors
