@@ -6,7 +6,8 @@ use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
     category_labels, error_bar, hline, labels_fit, labels_height, legend, legend_size, mesh,
-    number, render, text, Key, Swatch, BEST, FONT, GLCM2D, GLCM3D, GREY, LABEL, SINGLE, TITLE,
+    number, percent, render, text, Key, Swatch, BEST, FONT, GLCM2D, GLCM3D, GREY, LABEL, SINGLE,
+    TITLE,
 };
 use super::{chance, FigureError};
 use crate::experiments::Results;
@@ -77,11 +78,11 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
     let slot = (series.len() as i32 * 15 + 20).max(48);
     let plot_w = (slot * n as i32).max(360);
     let level = labels_fit(&g.groups, plot_w / n as i32);
-    let bottom = labels_height(&g.groups, level) + 30;
+    let bottom = labels_height(&g.groups, level) + 26;
     let mut keys: Vec<Key> = series.iter().map(|s| s.key.clone()).collect();
     if let Some(c) = g.chance {
         keys.push(Key::new(
-            format!("chance, all classes ({} %)", number(c)),
+            format!("chance, all classes ({} %)", percent(c)),
             Swatch::Dashed(GREY),
         ));
     }

@@ -1,28 +1,42 @@
 //! E7: the gain sweep, as firing rate against gain and as ISI distributions per gain.
 
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
     legend, legend_size, line_with_markers, mesh, multiples, number, panel_chart, render, series,
-    text, vline, Key, Multiples, Swatch, FONT, GREY, LIGHT, TICK, TITLE,
+    vline, Key, Multiples, Swatch, FONT, GREY, LIGHT, TITLE,
 };
 use super::FigureError;
 use crate::experiments::E7;
 use crate::report::paper::PAPER_GAIN;
 
-fn class_keys(labels: &[String]) -> Vec<Key> {
-    labels
+/// The classes recorded at the sweep's speed, by index: a class with no encoded taxel time
+/// at any gain was not recorded there and is left out, rather than drawn as silent.
+fn recorded(e: &E7) -> Vec<usize> {
+    (0..e.sweep.labels.len())
+        .filter(|&l| {
+            e.sweep
+                .taxel_seconds
+                .iter()
+                .any(|row| row.get(l).is_some_and(|&t| t > 0.0))
+        })
+        .collect()
+}
+
+/// One legend entry per recorded class, lines with markers or plain lines.
+fn class_keys(e: &E7, shown: &[usize], markers: bool) -> Vec<Key> {
+    shown
         .iter()
         .enumerate()
-        .map(|(k, l)| {
+        .map(|(k, &l)| {
             let (colour, dashed) = series(k);
-            let swatch = if dashed {
-                Swatch::DashedPoints(colour)
-            } else {
-                Swatch::Points(colour)
+            let swatch = match (markers, dashed) {
+                (true, false) => Swatch::Points(colour),
+                (true, true) => Swatch::DashedPoints(colour),
+                (false, false) => Swatch::Line(colour),
+                (false, true) => Swatch::DashedLine(colour),
             };
-            Key::new(l.as_str(), swatch)
+            Key::new(e.sweep.labels[l].as_str(), swatch)
         })
         .collect()
 }
@@ -30,7 +44,8 @@ fn class_keys(labels: &[String]) -> Vec<Key> {
 /// E7: mean firing rate per taxel against gain, one line per class.
 pub(crate) fn e7_rate(e: &E7) -> Result<String, FigureError> {
     let gains = &e.sweep.gains;
-    let mut keys = class_keys(&e.sweep.labels);
+    let shown = recorded(e);
+    let mut keys = class_keys(e, &shown, true);
     keys.push(Key::new(
         format!("paper's choice, G = {PAPER_GAIN}"),
         Swatch::Dashed(GREY),
@@ -78,11 +93,11 @@ pub(crate) fn e7_rate(e: &E7) -> Result<String, FigureError> {
             .y_desc("mean firing rate per taxel (Hz)")
             .draw()?;
         vline(&mut chart, PAPER_GAIN, GREY, 9)?;
-        for (k, _) in e.sweep.labels.iter().enumerate() {
+        for (k, &l) in shown.iter().enumerate() {
             let points: Vec<(f64, f64)> = gains
                 .iter()
                 .zip(&e.rate_hz)
-                .filter_map(|(&g, rates)| rates.get(k).map(|&r| (g, r)))
+                .filter_map(|(&g, rates)| rates.get(l).map(|&r| (g, r)))
                 .collect();
             let (colour, dashed) = series(k);
             line_with_markers(&mut chart, &points, colour, dashed)?;
@@ -121,7 +136,8 @@ pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
     let bin = f64::from(e.sweep.bin_ms.max(1));
     let range = bin * (bins - 1) as f64;
     let band = (range / 8.0).max(bin);
-    let mut keys = class_keys(&e.sweep.labels);
+    let shown = recorded(e);
+    let mut keys = class_keys(e, &shown, false);
     keys.push(Key::new(
         format!("ISIs of {} ms or more", number(range)),
         Swatch::Band(LIGHT),
@@ -136,11 +152,18 @@ pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
     };
     multiples(&layout, |g, area| {
         let gain = e.sweep.gains[g];
-        let title = if gain == PAPER_GAIN {
-            format!("G = {} (paper's choice)", number(gain))
-        } else {
-            format!("G = {}", number(gain))
-        };
+        let lines: Vec<Option<Vec<f64>>> = shown
+            .iter()
+            .map(|&l| e.sweep.counts[g].get(l).and_then(|h| cumulative(h)))
+            .collect();
+        let silent = lines.iter().filter(|c| c.is_none()).count();
+        let mut title = format!("G = {}", number(gain));
+        if gain == PAPER_GAIN {
+            title += " (paper's choice)";
+        }
+        if silent > 0 {
+            title += &format!(", {silent} silent");
+        }
         let mut chart = panel_chart(area, &title, 0.0..range + band, 0.0..100.0)?;
         chart.draw_series([Rectangle::new(
             [(range, 0.0), (range + band, 100.0)],
@@ -152,12 +175,8 @@ pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
             .x_label_formatter(&|v| number(*v))
             .y_label_formatter(&|v| number(*v))
             .draw()?;
-        let mut silent = 0;
-        for (k, hist) in e.sweep.counts[g].iter().enumerate() {
-            let Some(cum) = cumulative(hist) else {
-                silent += 1;
-                continue;
-            };
+        for (k, cum) in lines.iter().enumerate() {
+            let Some(cum) = cum else { continue };
             let mut points = vec![(0.0, 0.0)];
             points.extend(
                 cum.iter()
@@ -174,29 +193,35 @@ pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
                 chart.draw_series(LineSeries::new(points, style))?;
             }
         }
-        if silent > 0 {
-            let n = e.sweep.counts[g].len();
-            let note = format!("no ISIs: {silent} of {n} classes");
-            let at = chart.backend_coord(&(range / 2.0, 92.0));
-            let style = text(TICK - 1.0, HPos::Center, VPos::Top);
-            area.draw(&Text::new(
-                note,
-                (
-                    at.0 - area.get_base_pixel().0,
-                    at.1 - area.get_base_pixel().1,
-                ),
-                style,
-            ))?;
-        }
         Ok(())
     })
+}
+
+/// The classes of the dataset not recorded at the sweep's speed, for the captions.
+fn absent_note(e: &E7) -> String {
+    let shown = recorded(e);
+    let absent: Vec<&str> = (0..e.sweep.labels.len())
+        .filter(|l| !shown.contains(l))
+        .map(|l| e.sweep.labels[l].as_str())
+        .collect();
+    if absent.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " Not recorded at {} mm/s, so not drawn: {}.",
+            e.speed,
+            absent.join(", ")
+        )
+    }
 }
 
 /// E7's caption for the rate figure.
 pub(crate) fn e7_rate_caption(e: &E7) -> String {
     format!(
-        "Mean firing rate per taxel (spikes per taxel-second of the slide) against the gain G, one line per class, at {} mm/s; the dashed line marks the paper's choice, G = {}.",
-        e.speed, PAPER_GAIN
+        "Mean firing rate per taxel (spikes per taxel-second of the slide) against the gain G, one line per class, at {} mm/s; the dashed line marks the paper's choice, G = {}.{}",
+        e.speed,
+        PAPER_GAIN,
+        absent_note(e)
     )
 }
 
@@ -213,8 +238,11 @@ pub(crate) fn e7_isi_caption(e: &E7) -> String {
         .max(1);
     let range = e.sweep.bin_ms as usize * (bins - 1);
     format!(
-        "Cumulative distribution of inter-spike intervals at {} mm/s, pooled over trials and taxels, one panel per gain on one scale and one line per class ({} ms bins). The grey band on the right holds the ISIs of {} ms or more: each line's rise across it is their share. A class without two spikes in a taxel has no line.",
-        e.speed, e.sweep.bin_ms, range
+        "Cumulative distribution of inter-spike intervals at {} mm/s, pooled over trials and taxels, one panel per gain on one scale and one line per class ({} ms bins). The grey band on the right holds the ISIs of {} ms or more: each line's rise across it is their share. A class with fewer than two spikes in every taxel has no ISI and no line; the panel's title counts such silent classes.{}",
+        e.speed,
+        e.sweep.bin_ms,
+        range,
+        absent_note(e)
     )
 }
 

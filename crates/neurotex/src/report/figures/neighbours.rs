@@ -1,8 +1,8 @@
 //! E8: accuracy against the number of neighbours k, one panel per speed on one scale.
 
 use super::plot::{
-    hline, line_with_markers, mesh, multiples, number, panel_chart, Key, Multiples, Swatch, GLCM3D,
-    GREY, SINGLE,
+    hline, line_with_markers, mesh, multiples, number, panel_chart, percent, x_ticks_at, Key,
+    Multiples, Swatch, GLCM3D, GREY, SINGLE,
 };
 use super::{chance, FigureError};
 use crate::experiments::Results;
@@ -16,7 +16,7 @@ pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
     ];
     if let Some(c) = chance {
         keys.push(Key::new(
-            format!("chance, all classes ({} %)", number(c)),
+            format!("chance, all classes ({} %)", percent(c)),
             Swatch::Dashed(GREY),
         ));
     }
@@ -42,11 +42,13 @@ pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
         let x = lo - 1.0..hi + 1.0;
         let mut chart = panel_chart(area, &format!("{speed} mm/s"), x, 0.0..100.0)?;
         mesh(&mut chart)
-            .x_labels(((hi - lo) as usize + 3).min(12))
+            .disable_x_mesh()
+            .x_labels(0)
             .y_labels(6)
-            .x_label_formatter(&|v| number(*v))
             .y_label_formatter(&|v| number(*v))
             .draw()?;
+        let ks: Vec<f64> = e.k.iter().map(|&k| k as f64).collect();
+        x_ticks_at(area, &chart, &ks)?;
         if let Some(c) = chance {
             hline(&mut chart, c, GREY, 6)?;
         }

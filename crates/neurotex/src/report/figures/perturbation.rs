@@ -3,8 +3,8 @@
 use plotters::prelude::*;
 
 use super::plot::{
-    error_bar, hline, legend, legend_size, line_with_markers, mesh, number, render, Key, Swatch,
-    FONT, GLCM3D, GREY, SINGLE, TITLE,
+    error_bar, hline, legend, legend_size, line_with_markers, mesh, number, percent, render, Key,
+    Swatch, FONT, GLCM3D, GREY, SINGLE, TITLE,
 };
 use super::FigureError;
 use crate::experiments::{E2, E3};
@@ -36,7 +36,7 @@ pub(crate) fn e3(e: &E3, e2: Option<&E2>, all_chance: Option<f64>) -> Result<Str
     ];
     if let Some(c) = chance {
         keys.push(Key::new(
-            format!("chance ({} %)", number(c)),
+            format!("chance ({} %)", percent(c)),
             Swatch::Dashed(GREY),
         ));
     }

@@ -102,6 +102,15 @@ pub(crate) fn number(v: f64) -> String {
     }
 }
 
+/// A percentage for a legend: whole numbers as such, others to one decimal (`20`, `14.3`).
+pub(crate) fn percent(v: f64) -> String {
+    if (v - v.round()).abs() < 1e-9 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.1}")
+    }
+}
+
 /// The mesh every numeric chart uses: grey grid lines at the labelled ticks only, tick
 /// labels and axis descriptions in the figure's sizes.
 pub(crate) fn mesh<'a, 'b, DB, X, Y, XT, YT>(
@@ -158,6 +167,24 @@ pub(crate) fn error_bar(chart: &mut Chart, x: f64, lo: f64, hi: f64, cap: f64) -
     Ok(())
 }
 
+/// Tick marks and labels at the data's own x values (as `k` in 1, 3, 5), in place of
+/// plotters' evenly spaced ticks.
+pub(crate) fn x_ticks_at(canvas: &Canvas, chart: &Chart, values: &[f64]) -> Drawn {
+    let base = canvas.get_base_pixel();
+    let y0 = chart.y_range().start;
+    for &v in values {
+        let (x, y) = chart.backend_coord(&(v, y0));
+        let (x, y) = (x - base.0, y - base.1);
+        canvas.draw(&PathElement::new(
+            vec![(x, y), (x, y + 5)],
+            BLACK.stroke_width(1),
+        ))?;
+        let style = text(TICK, HPos::Center, VPos::Top);
+        canvas.draw(&Text::new(number(v), (x, y + 7), style))?;
+    }
+    Ok(())
+}
+
 /// A line through `points` with a marker at each, dashed when `dashed`.
 pub(crate) fn line_with_markers(
     chart: &mut Chart,
@@ -184,6 +211,10 @@ pub(crate) enum Swatch {
     Hollow(RGBColor),
     /// A bar with an error bar.
     BarError(RGBColor),
+    /// A solid line.
+    Line(RGBColor),
+    /// A dashed line with no marker, for a series.
+    DashedLine(RGBColor),
     /// A solid line with a marker.
     Points(RGBColor),
     /// A dashed line with a marker.
@@ -248,16 +279,20 @@ pub(crate) fn legend(canvas: &Canvas, (x, y): (i32, i32), keys: &[Key]) -> Drawn
                     canvas.draw(&PathElement::new(points, BLACK.stroke_width(1)))?;
                 }
             }
-            Swatch::Points(c) | Swatch::DashedPoints(c) | Swatch::Dashed(c) => {
+            Swatch::Line(c)
+            | Swatch::DashedLine(c)
+            | Swatch::Points(c)
+            | Swatch::DashedPoints(c)
+            | Swatch::Dashed(c) => {
                 let style = c.stroke_width(2);
-                if matches!(key.swatch, Swatch::Points(_)) {
+                if matches!(key.swatch, Swatch::Points(_) | Swatch::Line(_)) {
                     canvas.draw(&PathElement::new(vec![(x0, cy), (x1, cy)], style))?;
                 } else {
                     for dash in [(x0, x0 + 8), (x0 + 11, x0 + 18), (x0 + 21, x1)] {
                         canvas.draw(&PathElement::new(vec![(dash.0, cy), (dash.1, cy)], style))?;
                     }
                 }
-                if !matches!(key.swatch, Swatch::Dashed(_)) {
+                if matches!(key.swatch, Swatch::Points(_) | Swatch::DashedPoints(_)) {
                     canvas.draw(&Circle::new(((x0 + x1) / 2, cy), 3, c.filled()))?;
                 }
             }
@@ -345,7 +380,7 @@ pub(crate) fn dark(f: f64) -> bool {
 }
 
 /// The width a colour bar with its labels takes.
-pub(crate) const COLOUR_BAR_W: i32 = 96;
+pub(crate) const COLOUR_BAR_W: i32 = 84;
 
 /// Draws a vertical colour bar of [`heat`] from 0 (bottom) to `max` (top) in the box at
 /// `(x, y)` of `height` pixels, with ticks and the description `desc` on its right.
@@ -363,7 +398,7 @@ pub(crate) fn colour_bar(
     let mut chart = ChartBuilder::on(&area)
         .margin_top(8)
         .margin_bottom(8)
-        .right_y_label_area_size(COLOUR_BAR_W - 18)
+        .right_y_label_area_size(COLOUR_BAR_W - 22)
         .build_cartesian_2d(0.0..1.0, 0.0..max)?;
     let steps = 64;
     chart.draw_series((0..steps).map(|k| {

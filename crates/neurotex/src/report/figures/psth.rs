@@ -5,7 +5,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
-    colour_bar, heat, mesh, number, render, text, COLOUR_BAR_W, FONT, LABEL, SINGLE, TICK,
+    colour_bar, heat, mesh, number, render, text, BEST, COLOUR_BAR_W, FONT, LABEL, SINGLE, TICK,
 };
 use super::FigureError;
 use crate::experiments::{E0Example, E0};
@@ -17,6 +17,18 @@ const VOLUME_W: i32 = 470;
 /// Seconds spanned by `bins` bins of `bin_ms`.
 fn seconds(bins: usize, bin_ms: usize) -> f64 {
     (bins * bin_ms) as f64 / 1000.0
+}
+
+/// Runs of equal values in `row`, as `(first bin, bin after the last, value)`.
+fn runs(row: &[f64]) -> Vec<(usize, usize, f64)> {
+    let mut out: Vec<(usize, usize, f64)> = Vec::new();
+    for (b, &v) in row.iter().enumerate() {
+        match out.last_mut() {
+            Some(run) if run.2 == v => run.1 = b + 1,
+            _ => out.push((b, b + 1, v)),
+        }
+    }
+    out
 }
 
 /// The largest rate (Hz) of any volume, the colour scale's top.
@@ -52,11 +64,12 @@ fn volume_panel(
         .y_desc("cell (row-major)")
         .draw()?;
     let step = bin_ms as f64 / 1000.0;
+    // one rectangle per run of equal bins keeps a long, sparse recording's SVG small
     chart.draw_series(ex.volume.iter().enumerate().flat_map(|(c, row)| {
-        row.iter().enumerate().map(move |(b, &v)| {
+        runs(row).into_iter().map(move |(start, end, v)| {
             let corners = [
-                (step * b as f64, c as f64),
-                (step * (b + 1) as f64, c as f64 + 1.0),
+                (step * start as f64, c as f64),
+                (step * end as f64, c as f64 + 1.0),
             ];
             Rectangle::new(corners, heat(v / vmax).filled())
         })
@@ -87,7 +100,13 @@ fn psth_panel(
     let top = f64::from(count_max.max(1));
     let mut chart = ChartBuilder::on(area)
         .caption(
-            format!("{}: PSTH of taxel r{}c{}", ex.label, e.taxel[0], e.taxel[1]),
+            format!(
+                "{}: PSTH of taxel r{}c{} ({} spikes)",
+                ex.label,
+                e.taxel[0],
+                e.taxel[1],
+                ex.psth.iter().map(|&v| u64::from(v)).sum::<u64>()
+            ),
             (FONT, LABEL),
         )
         .margin(6)
@@ -103,6 +122,8 @@ fn psth_panel(
         .x_desc("time in the slide (s)")
         .y_desc(format!("spikes per {} ms", e.psth_bin_ms))
         .draw()?;
+    // bars in a light tone under a dark outline stay legible when hundreds of bins leave
+    // each bar a pixel wide
     chart.draw_series(
         ex.psth
             .iter()
@@ -111,10 +132,17 @@ fn psth_panel(
             .map(|(b, &v)| {
                 Rectangle::new(
                     [(bin * b as f64, 0.0), (bin * (b + 1) as f64, f64::from(v))],
-                    SINGLE.filled(),
+                    BEST.filled(),
                 )
             }),
     )?;
+    let mut outline = vec![(0.0, 0.0)];
+    for (b, &v) in ex.psth.iter().enumerate() {
+        outline.push((bin * b as f64, f64::from(v)));
+        outline.push((bin * (b + 1) as f64, f64::from(v)));
+    }
+    outline.push((t, 0.0));
+    chart.draw_series(LineSeries::new(outline, SINGLE.stroke_width(1)))?;
     Ok(())
 }
 
@@ -183,4 +211,18 @@ pub(crate) fn e0_caption(e: &E0) -> String {
         e.psth_bin_ms,
         number(seconds(bins, e.psth_bin_ms)),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_join_equal_neighbours() {
+        assert_eq!(
+            runs(&[0.0, 0.0, 5.0, 0.0]),
+            vec![(0, 2, 0.0), (2, 3, 5.0), (3, 4, 0.0)]
+        );
+        assert!(runs(&[]).is_empty());
+    }
 }

@@ -3,8 +3,8 @@
 use plotters::prelude::*;
 
 use super::plot::{
-    hline, line_with_markers, mesh, multiples, number, panel_chart, vline, Key, Multiples, Swatch,
-    GLCM3D, GREY, SINGLE,
+    hline, line_with_markers, mesh, multiples, number, panel_chart, percent, vline, Key, Multiples,
+    Swatch, GLCM3D, GREY, SINGLE,
 };
 use super::{chance, FigureError};
 use crate::experiments::Results;
@@ -27,7 +27,7 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
     ];
     if let Some(c) = chance {
         keys.push(Key::new(
-            format!("chance, all classes ({} %)", number(c)),
+            format!("chance, all classes ({} %)", percent(c)),
             Swatch::Dashed(GREY),
         ));
     }
