@@ -6,8 +6,8 @@ use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
     category_labels, error_bar, hline, labels_fit, labels_height, legend, legend_size, mesh,
-    number, percent, render, text, Key, Swatch, BEST, FONT, GLCM2D, GLCM3D, GREY, LABEL, SINGLE,
-    TITLE,
+    number, percent, render, text, Chart, Drawn, Key, Swatch, BEST, FONT, GLCM2D, GLCM3D, GREY,
+    LABEL, SINGLE, TITLE,
 };
 use super::{chance, FigureError};
 use crate::experiments::Results;
@@ -64,6 +64,32 @@ fn speed_desc(speeds: &[Speed], what: &str) -> String {
     }
 }
 
+/// Draws each series' bars side by side within each group's unit of x, with error bars
+/// where the series has a spread.
+fn bars(chart: &mut Chart, series: &[&Bars]) -> Drawn {
+    let width = 0.8 / series.len().max(1) as f64;
+    for (k, s) in series.iter().enumerate() {
+        for (i, v) in s.values.iter().enumerate() {
+            let Some(v) = *v else { continue };
+            let x0 = i as f64 + 0.1 + width * k as f64;
+            let x1 = x0 + width * 0.88;
+            if s.hollow {
+                chart.draw_series([
+                    Rectangle::new([(x0, 0.0), (x1, v)], WHITE.filled()),
+                    Rectangle::new([(x0, 0.0), (x1, v)], s.colour.stroke_width(2)),
+                ])?;
+            } else {
+                chart.draw_series([Rectangle::new([(x0, 0.0), (x1, v)], s.colour.filled())])?;
+            }
+            if let Some(&e) = s.errors.get(i).filter(|e| **e > 0.0) {
+                let x = (x0 + x1) / 2.0;
+                error_bar(chart, x, (v - e).max(0.0), (v + e).min(100.0), width * 0.25)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 const PLOT_H: i32 = 300;
 const LEFT: i32 = 64;
 const TOP: i32 = 40;
@@ -106,32 +132,7 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
             .x_desc(g.x_desc.as_str())
             .y_desc("accuracy (%)")
             .draw()?;
-        let width = 0.8 / series.len().max(1) as f64;
-        for (k, s) in series.iter().enumerate() {
-            for (i, v) in s.values.iter().enumerate() {
-                let Some(v) = *v else { continue };
-                let x0 = i as f64 + 0.1 + width * k as f64;
-                let x1 = x0 + width * 0.88;
-                if s.hollow {
-                    chart.draw_series([
-                        Rectangle::new([(x0, 0.0), (x1, v)], WHITE.filled()),
-                        Rectangle::new([(x0, 0.0), (x1, v)], s.colour.stroke_width(2)),
-                    ])?;
-                } else {
-                    chart.draw_series([Rectangle::new([(x0, 0.0), (x1, v)], s.colour.filled())])?;
-                }
-                if let Some(&e) = s.errors.get(i).filter(|e| **e > 0.0) {
-                    let x = (x0 + x1) / 2.0;
-                    error_bar(
-                        &mut chart,
-                        x,
-                        (v - e).max(0.0),
-                        (v + e).min(100.0),
-                        width * 0.25,
-                    )?;
-                }
-            }
-        }
+        bars(&mut chart, &series)?;
         if let Some(c) = g.chance {
             hline(&mut chart, c, GREY, 9)?;
         }
@@ -289,7 +290,7 @@ fn paper_note(paper: Option<&Paper>) -> &'static str {
 /// E1's caption.
 pub(crate) fn e1_caption(r: &Results, paper: Option<&Paper>) -> String {
     format!(
-        "Accuracy of {} classes per speed (5-fold CV, mean over repeats): the single taxel as the mean over all taxels (dark blue) and the best taxel, chosen after the fact (light blue), against 3D-GLCM (vermillion, error bar ± 1 std over CV repeats).{} {}",
+        "Accuracy over {} classes per speed (cross-validated, mean over repeats): the single taxel as the mean over all taxels (dark blue) and the best taxel, chosen after the fact (light blue), against 3D-GLCM (vermillion, error bar ± 1 std over CV repeats).{} {}",
         r.labels.len(),
         paper_note(paper),
         chance_note(r)
