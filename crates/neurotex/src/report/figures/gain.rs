@@ -159,7 +159,7 @@ pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
         let silent = lines.iter().filter(|c| c.is_none()).count();
         let mut title = format!("G = {}", number(gain));
         if gain == PAPER_GAIN {
-            title += " (paper's choice)";
+            title += " (paper)";
         }
         if silent > 0 {
             title += &format!(", {silent} silent");
@@ -238,7 +238,7 @@ pub(crate) fn e7_isi_caption(e: &E7) -> String {
         .max(1);
     let range = e.sweep.bin_ms as usize * (bins - 1);
     format!(
-        "Cumulative distribution of inter-spike intervals at {} mm/s, pooled over trials and taxels, one panel per gain on one scale and one line per class ({} ms bins). The grey band on the right holds the ISIs of {} ms or more: each line's rise across it is their share. A class with fewer than two spikes in every taxel has no ISI and no line; the panel's title counts such silent classes.{}",
+        "Cumulative distribution of inter-spike intervals at {} mm/s, pooled over trials and taxels, one panel per gain on one scale and one line per class ({} ms bins). The grey band on the right holds the ISIs of {} ms or more: each line's rise across it is their share. A class with fewer than two spikes in every taxel has no ISI and no line; the panel's title counts such silent classes and marks the paper's choice of G.{}",
         e.speed,
         e.sweep.bin_ms,
         range,

@@ -511,6 +511,7 @@ pub(crate) fn panel_chart<'a, 'b>(
     ChartBuilder::on(area)
         .caption(title, (FONT, LABEL))
         .margin(4)
+        .margin_top(10)
         .margin_right(14)
         .x_label_area_size(24)
         .y_label_area_size(40)

@@ -52,6 +52,7 @@ fn volume_panel(
     let mut chart = ChartBuilder::on(area)
         .caption(format!("{}: rate volume", ex.label), (FONT, LABEL))
         .margin(6)
+        .margin_top(12)
         .x_label_area_size(44)
         .y_label_area_size(70)
         .build_cartesian_2d(0.0..t, cells as f64..0.0)?;
@@ -110,9 +111,11 @@ fn psth_panel(
             (FONT, LABEL),
         )
         .margin(6)
+        .margin_top(12)
         .x_label_area_size(44)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.0..t, 0.0..top)?;
+        // headroom keeps the top tick label clear of the title
+        .build_cartesian_2d(0.0..t, 0.0..top * 1.12)?;
     mesh(&mut chart)
         .disable_x_mesh()
         .x_labels(8)

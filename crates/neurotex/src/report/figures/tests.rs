@@ -290,11 +290,68 @@ pub(crate) fn assert_well_formed(name: &str, svg: &str) {
     assert!(stack.is_empty(), "{name}: unclosed {stack:?}");
 }
 
+/// A level text's box `(x0, y0, x1, y1)` in pixels, from plotters' own size estimate (0.7 em
+/// a character, em = SVG font size / 1.24) and its anchors.
+fn text_box(tag: &str, content: &str) -> Option<(f64, f64, f64, f64)> {
+    let attr = |key: &str| -> Option<&str> {
+        let k = format!(" {key}=\"");
+        let s = tag.find(&k)? + k.len();
+        Some(&tag[s..s + tag[s..].find('"')?])
+    };
+    if attr("transform").is_some() {
+        return None;
+    }
+    let (x, y): (f64, f64) = (attr("x")?.parse().ok()?, attr("y")?.parse().ok()?);
+    let size: f64 = attr("font-size")?.parse().ok()?;
+    let w = 0.7 * size / 1.24 * content.chars().count() as f64;
+    let x0 = match attr("text-anchor")? {
+        "start" => x,
+        "end" => x - w,
+        _ => x - w / 2.0,
+    };
+    let y0 = match attr("dy")? {
+        "0.76em" => y,
+        "-0.5ex" => y - size,
+        _ => y - size / 2.0,
+    };
+    Some((x0, y0, x0 + w, y0 + size))
+}
+
+/// Checks that no two level texts of `svg` overlap (by more than a pixel each way).
+pub(crate) fn assert_no_overprint(name: &str, svg: &str) {
+    let boxes: Vec<(String, (f64, f64, f64, f64))> = svg
+        .split("<text")
+        .skip(1)
+        .filter_map(|part| {
+            let close = part.find('>')?;
+            let content = part[close + 1..part.find("</text>")?]
+                .trim()
+                .replace("&apos;", "'")
+                .replace("&quot;", "\"")
+                .replace("&lt;", "<")
+                .replace("&gt;", ">")
+                .replace("&amp;", "&");
+            text_box(&part[..close], &content).map(|b| (content, b))
+        })
+        .collect();
+    for (i, (a, p)) in boxes.iter().enumerate() {
+        for (b, q) in &boxes[i + 1..] {
+            let overlap_x = p.2.min(q.2) - p.0.max(q.0);
+            let overlap_y = p.3.min(q.3) - p.1.max(q.1);
+            assert!(
+                overlap_x <= 1.0 || overlap_y <= 1.0,
+                "{name}: \"{a}\" overprints \"{b}\""
+            );
+        }
+    }
+}
+
 fn check_all(r: &Results, paper: Option<&Paper>) -> Vec<&'static str> {
     let figures = all(r, paper);
     for (name, svg) in &figures {
         let svg = svg.as_ref().unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_well_formed(name, svg);
+        assert_no_overprint(name, svg);
     }
     figures.iter().map(|(n, _)| *n).collect()
 }
@@ -358,8 +415,7 @@ fn e7_labels_the_overflow_band_and_notes_silent_classes() {
     assert_well_formed("e7 isi", &isi);
     assert!(isi.contains("ISIs of 300 ms or more"));
     assert!(
-        isi.contains("G = 5, 1 silent") && isi.contains("G = 8 (paper&apos;s choice), 1 silent")
-            || isi.contains("G = 8 (paper's choice), 1 silent"),
+        isi.contains("G = 5, 1 silent") && isi.contains("G = 8 (paper), 1 silent"),
         "{isi}"
     );
     assert_well_formed("e7 rate", &gain::e7_rate(e7).unwrap());
@@ -391,4 +447,24 @@ fn e0_caption_comes_from_the_data() {
         "{caption}"
     );
     assert_well_formed("e0 small", &psth::e0(small().e0.as_ref().unwrap()).unwrap());
+}
+
+/// The same checks on a written report's figures, for reports of real data:
+/// `NEUROTEX_FIGURES=report/figures cargo test -p neurotex --lib -- --ignored figures_in`.
+#[test]
+#[ignore]
+fn figures_in_a_folder_are_well_formed() {
+    let dir = std::env::var("NEUROTEX_FIGURES").expect("NEUROTEX_FIGURES names a folder");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "svg") {
+            let svg = std::fs::read_to_string(&path).unwrap();
+            let name = path.display().to_string();
+            assert_well_formed(&name, &svg);
+            assert_no_overprint(&name, &svg);
+            checked += 1;
+        }
+    }
+    assert!(checked > 0, "no SVG in {dir}");
 }
