@@ -380,7 +380,7 @@ pub(crate) fn dark(f: f64) -> bool {
 }
 
 /// The width a colour bar with its labels takes.
-pub(crate) const COLOUR_BAR_W: i32 = 84;
+pub(crate) const COLOUR_BAR_W: i32 = 72;
 
 /// Draws a vertical colour bar of [`heat`] from 0 (bottom) to `max` (top) in the box at
 /// `(x, y)` of `height` pixels, with ticks and the description `desc` on its right.
