@@ -35,6 +35,20 @@ struct Layout {
     annotate: bool,
 }
 
+impl Layout {
+    /// Cells shrink with the class count down to 20 px; below 26 px the numbers no longer
+    /// fit and only the colour remains.
+    fn for_classes(n: usize) -> Self {
+        let n = n.max(1) as i32;
+        let cell = (340 / n).clamp(20, 64);
+        Layout {
+            cell,
+            size: cell * n,
+            annotate: cell >= 26,
+        }
+    }
+}
+
 fn matrix(canvas: &Canvas, (x, y): (i32, i32), l: &Layout, title: &str, m: &[Vec<f64>]) -> Drawn {
     canvas.draw(&Text::new(
         title,
@@ -66,12 +80,8 @@ fn matrix(canvas: &Canvas, (x, y): (i32, i32), l: &Layout, title: &str, m: &[Vec
 /// 3D-GLCM, rows true and columns predicted, with one colour bar.
 pub(crate) fn e2(e: &E2) -> Result<String, FigureError> {
     let n = e.labels.len().max(1) as i32;
-    let cell = (340 / n).clamp(20, 64);
-    let layout = Layout {
-        cell,
-        size: cell * n,
-        annotate: cell >= 26,
-    };
+    let layout = Layout::for_classes(e.labels.len());
+    let cell = layout.cell;
     let level = labels_fit(&e.labels, cell);
     let row_w = e
         .labels
@@ -127,8 +137,13 @@ pub(crate) fn e2(e: &E2) -> Result<String, FigureError> {
 
 /// E2's caption.
 pub(crate) fn e2_caption(e: &E2) -> String {
+    let numbers = if Layout::for_classes(e.labels.len()).annotate {
+        " (empty cells are 0; a 0 is a share under 0.5 %)"
+    } else {
+        ""
+    };
     format!(
-        "Confusion matrices at {} mm/s for the {} classes recorded at that speed: rows are the true class, columns the prediction, each cell the share (%) of the row's predictions (cells without a number are 0), pooled over CV repeats and, for the single taxel, over all taxels. One colour scale for both.",
+        "Confusion matrices at {} mm/s for the {} classes recorded at that speed: rows are the true class, columns the prediction, each cell the share (%) of the row's predictions{numbers}, pooled over CV repeats and, for the single taxel, over all taxels. One colour scale for both.",
         e.speed,
         e.labels.len()
     )

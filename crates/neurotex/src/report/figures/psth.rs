@@ -45,10 +45,9 @@ fn volume_panel(
     ex: &E0Example,
     bin_ms: usize,
     vmax: f64,
+    t: f64,
 ) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
     let cells = ex.volume.len().max(1);
-    let bins = ex.volume.first().map_or(0, Vec::len).max(1);
-    let t = seconds(bins, bin_ms);
     let mut chart = ChartBuilder::on(area)
         .caption(format!("{}: rate volume", ex.label), (FONT, LABEL))
         .margin(6)
@@ -95,9 +94,9 @@ fn psth_panel(
     ex: &E0Example,
     e: &E0,
     count_max: u32,
+    t: f64,
 ) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
     let bin = e.psth_bin_ms as f64 / 1000.0;
-    let t = seconds(ex.psth.len().max(1), e.psth_bin_ms);
     let top = f64::from(count_max.max(1));
     let mut chart = ChartBuilder::on(area)
         .caption(
@@ -144,7 +143,7 @@ fn psth_panel(
         outline.push((bin * b as f64, f64::from(v)));
         outline.push((bin * (b + 1) as f64, f64::from(v)));
     }
-    outline.push((t, 0.0));
+    outline.push((seconds(ex.psth.len(), e.psth_bin_ms), 0.0));
     chart.draw_series(LineSeries::new(outline, SINGLE.stroke_width(1)))?;
     Ok(())
 }
@@ -162,6 +161,15 @@ pub(crate) fn e0(e: &E0) -> Result<String, FigureError> {
         .max()
         .unwrap_or(0);
     let vmax = max_rate(e);
+    // one time axis for every panel, so the examples compare bin by bin
+    let bins = e
+        .examples
+        .iter()
+        .map(|x| x.psth.len())
+        .max()
+        .unwrap_or(0)
+        .max(1);
+    let t = seconds(bins, e.psth_bin_ms);
     render((width as u32, height as u32), |root| {
         let title = format!("E0: PSTH and rate volume at {} mm/s", e.speed);
         root.draw(&Text::new(
@@ -172,13 +180,14 @@ pub(crate) fn e0(e: &E0) -> Result<String, FigureError> {
         for (k, ex) in e.examples.iter().enumerate() {
             let y = 40 + ROW_H * k as i32;
             let left = root.clone().shrink((0, y), (PSTH_W, ROW_H));
-            psth_panel(&left, ex, e, count_max)?;
+            psth_panel(&left, ex, e, count_max, t)?;
             let right = root.clone().shrink((PSTH_W + 10, y), (VOLUME_W, ROW_H));
             volume_panel(
                 &right,
                 ex,
                 e.psth_bin_ms,
                 if vmax > 0.0 { vmax } else { 1.0 },
+                t,
             )?;
         }
         let bar_x = PSTH_W + VOLUME_W + 18;
@@ -203,7 +212,7 @@ pub(crate) fn e0_caption(e: &E0) -> String {
         .and_then(|x| x.volume.first())
         .map_or(0, Vec::len);
     format!(
-        "Taxel r{}c{} at {} mm/s, first recording of {}: left, the taxel's PSTH (spikes per {} ms bin, one count scale); right, the rate volume of all {} cells of the array (rows, in row-major order) over {} bins of {} ms ({} s of the slide), on one colour scale in Hz. The paper: the volumes differ more than the PSTHs.",
+        "Taxel r{}c{} at {} mm/s, first recording of {}: left, the taxel's PSTH (spikes per {} ms bin, one count scale; a last, shorter bin is kept); right, the rate volume of all {} cells of the array (rows, in row-major order) over {} bins of {} ms ({} s of the slide; a last, shorter bin is dropped), on one colour scale in Hz; all panels share one time axis. The paper: the volumes differ more than the PSTHs.",
         e.taxel[0],
         e.taxel[1],
         e.speed,

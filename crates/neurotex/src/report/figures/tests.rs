@@ -468,3 +468,42 @@ fn figures_in_a_folder_are_well_formed() {
     }
     assert!(checked > 0, "no SVG in {dir}");
 }
+
+#[test]
+fn thirty_classes_still_lay_out() {
+    let labels: Vec<String> = (0..30).map(|i| format!("texture number {i}")).collect();
+    let m: Vec<Vec<usize>> = (0..30)
+        .map(|i| {
+            (0..30)
+                .map(|j| usize::from(i == j) * 9 + (i + j) % 2)
+                .collect()
+        })
+        .collect();
+    let e2 = E2 {
+        speed: Speed::of(5.0),
+        labels: labels.clone(),
+        taxel: m.clone(),
+        glcm3d: m,
+    };
+    let svg = confusion::e2(&e2).unwrap();
+    assert_well_formed("e2, 30 classes", &svg);
+    assert_no_overprint("e2, 30 classes", &svg);
+    assert!(
+        !e2_caption(&e2).contains("a 0 is"),
+        "no numbers in 20 px cells"
+    );
+    let mut r = wide();
+    let e7 = r.e7.as_mut().unwrap();
+    e7.sweep.labels = labels;
+    for per_gain in &mut e7.sweep.counts {
+        per_gain.resize(30, vec![1; 61]);
+    }
+    for row in e7.sweep.taxel_seconds.iter_mut().chain(&mut e7.rate_hz) {
+        row.resize(30, 1.0);
+    }
+    for (name, svg) in [("e7 isi", gain::e7_isi(e7)), ("e7 rate", gain::e7_rate(e7))] {
+        let svg = svg.unwrap();
+        assert_well_formed(name, &svg);
+        assert_no_overprint(name, &svg);
+    }
+}
