@@ -24,7 +24,6 @@ pub mod recording;
 pub mod report;
 pub mod signal;
 pub mod sim;
-mod svg;
 pub mod values;
 
 pub use error::{Error, Result};

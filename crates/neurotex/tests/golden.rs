@@ -1,62 +1,92 @@
-//! Golden results: the analyses on a small simulated design with a fixed seed. A change
-//! that moves them must regenerate them on purpose (`NEUROTEX_BLESS=1 cargo test --test
-//! golden`) and say why in its commit.
+//! Golden outputs of the analyses on a small simulated design with a fixed seed: the
+//! results (`golden_small_design.json`) and the report rendered from them
+//! (`golden_report.md`, with a fixed context and no timings). A change that moves either
+//! must regenerate it on purpose (`NEUROTEX_BLESS=1 cargo test -p neurotex --test golden`)
+//! and say why in its commit.
+
+use std::sync::OnceLock;
 
 use neurotex::classify::CvParams;
-use neurotex::experiments::{prepare, run_all, ReproduceParams, Source};
+use neurotex::experiments::{prepare, run_all, ReproduceParams, Results, Source};
+use neurotex::report::{markdown, ReportContext};
 use neurotex::sim::{design, RigParams, Texture};
+
+/// The analyses on 4 textures x 10, 20 mm/s x 6 trials of 20 mm slides, seed 7, without
+/// timings (wall-clock times differ from run to run); computed once per test binary.
+fn small_design_results() -> &'static Results {
+    static RESULTS: OnceLock<Results> = OnceLock::new();
+    RESULTS.get_or_init(|| {
+        let rig = RigParams {
+            hold_s: 0.5,
+            slide_mm: 20.0,
+            ..RigParams::default()
+        };
+        let textures = [Texture::Ft1, Texture::Sb, Texture::Stf, Texture::Cp];
+        let params = ReproduceParams {
+            cv: CvParams {
+                folds: 3,
+                seed: 0,
+                repeats: 2,
+            },
+            e3_repeats: 2,
+            e3_counts: vec![4, 16],
+            e5_fractions: vec![0.5, 1.0],
+            e7_gains: vec![5.0, 8.0],
+            e8_ks: vec![1, 5],
+            ..ReproduceParams::default()
+        }
+        .check()
+        .unwrap();
+        let source = Source::Simulated {
+            rig: Box::new(rig),
+            trials: design(&textures, &[10.0, 20.0], 6),
+            seed: 7,
+        };
+        let prepared = prepare(&source, &params, &|_| {}).unwrap();
+        let mut results = run_all(&prepared, &params, &|_| {}).unwrap();
+        results.timing_s.clear();
+        results
+    })
+}
+
+/// Compares `text` with the stored file `name` under `tests/data`, writing it first when
+/// `NEUROTEX_BLESS` is set.
+fn matches_stored(name: &str, text: &str) {
+    let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    if std::env::var_os("NEUROTEX_BLESS").is_some() {
+        std::fs::write(&path, text).unwrap();
+    }
+    let stored = std::fs::read_to_string(&path).expect("golden file (NEUROTEX_BLESS=1 writes it)");
+    assert_eq!(
+        text, stored,
+        "{name} moved: if on purpose, regenerate with NEUROTEX_BLESS=1 and say why"
+    );
+}
 
 #[test]
 fn small_simulated_design_matches_the_stored_results() {
-    let rig = RigParams {
-        hold_s: 0.5,
-        slide_mm: 20.0,
-        ..RigParams::default()
-    };
-    let trials = design(
-        &[Texture::Ft1, Texture::Sb, Texture::Stf, Texture::Cp],
-        &[10.0, 20.0],
-        6,
-    );
-    let params = ReproduceParams {
-        cv: CvParams {
-            folds: 3,
-            seed: 0,
-            repeats: 2,
-        },
-        e3_repeats: 2,
-        e3_counts: vec![4, 16],
-        e5_fractions: vec![0.5, 1.0],
-        e7_gains: vec![5.0, 8.0],
-        e8_ks: vec![1, 5],
-        ..ReproduceParams::default()
-    }
-    .check()
-    .unwrap();
-    let source = Source::Simulated {
-        rig: Box::new(rig),
-        trials,
-        seed: 7,
-    };
-    let prepared = prepare(&source, &params, &|_| {}).unwrap();
-    let mut results = run_all(&prepared, &params, &|_| {}).unwrap();
-    results.timing_s.clear();
-    let value = serde_json::to_value(&results).unwrap();
+    let value = serde_json::to_value(small_design_results()).unwrap();
     // accuracies and rates rounded so the file reads well; the bits are checked by the
     // determinism tests
     let text = serde_json::to_string_pretty(&round(value)).unwrap() + "\n";
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/golden_small_design.json"
-    );
-    if std::env::var_os("NEUROTEX_BLESS").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    let stored = std::fs::read_to_string(path).expect("golden file (NEUROTEX_BLESS=1 writes it)");
-    assert_eq!(
-        text, stored,
-        "results moved: if on purpose, regenerate with NEUROTEX_BLESS=1 and say why"
-    );
+    matches_stored("golden_small_design.json", &text);
+}
+
+#[test]
+fn small_simulated_design_renders_the_stored_report() {
+    let results = small_design_results();
+    let ctx = ReportContext {
+        dataset:
+            "The golden test's small simulated design: 4 textures x 10, 20 mm/s x 6 trials, seed 7."
+                .into(),
+        parameters: vec!["CV: 3-fold, 2 repeats".into()],
+        total_seconds: 1.0,
+        command: "cargo test --test golden_report".into(),
+        paper_comparable: true,
+    };
+    let text = markdown(results, &ctx);
+    assert_eq!(text, markdown(results, &ctx), "rendering twice differs");
+    matches_stored("golden_report.md", &text);
 }
 
 fn round(v: serde_json::Value) -> serde_json::Value {

@@ -1,0 +1,316 @@
+//! E1, E4 and E6: accuracy per speed as grouped bars, one group per speed, ours filled and
+//! the paper's outlined beside them, a chance line across.
+
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, VPos};
+
+use super::plot::{
+    category_labels, error_bar, hline, labels_fit, labels_height, legend, legend_size, mesh,
+    number, percent, render, text, Chart, Drawn, Key, Swatch, BEST, FONT, GLCM2D, GLCM3D, GREY,
+    LABEL, SINGLE, TITLE,
+};
+use super::{chance, FigureError};
+use crate::experiments::Results;
+use crate::report::paper::Paper;
+use crate::values::Speed;
+
+/// One series of bars: a value (%) per group, or none.
+struct Bars {
+    key: Key,
+    colour: RGBColor,
+    hollow: bool,
+    values: Vec<Option<f64>>,
+    /// Standard deviations (%) per group, empty when the series has no spread.
+    errors: Vec<f64>,
+}
+
+impl Bars {
+    fn ours(label: &str, colour: RGBColor, values: Vec<Option<f64>>) -> Self {
+        Bars {
+            key: Key::new(label, Swatch::Bar(colour)),
+            colour,
+            hollow: false,
+            values,
+            errors: Vec::new(),
+        }
+    }
+
+    fn paper(label: &str, colour: RGBColor, values: Vec<Option<f64>>) -> Self {
+        Bars {
+            key: Key::new(label, Swatch::Hollow(colour)),
+            colour,
+            hollow: true,
+            values,
+            errors: Vec::new(),
+        }
+    }
+}
+
+/// A grouped bar chart of accuracies (%).
+struct Grouped {
+    title: String,
+    x_desc: String,
+    groups: Vec<String>,
+    series: Vec<Bars>,
+    chance: Option<f64>,
+}
+
+/// The x description for speeds: signed speeds are directions, and say so.
+fn speed_desc(speeds: &[Speed], what: &str) -> String {
+    if speeds.iter().any(|s| s.mm_s() < 0.0) {
+        format!("{what} (mm/s; the sign is the direction)")
+    } else {
+        format!("{what} (mm/s)")
+    }
+}
+
+/// Draws each series' bars side by side within each group's unit of x, with error bars
+/// where the series has a spread.
+fn bars(chart: &mut Chart, series: &[&Bars]) -> Drawn {
+    let width = 0.8 / series.len().max(1) as f64;
+    for (k, s) in series.iter().enumerate() {
+        for (i, v) in s.values.iter().enumerate() {
+            let Some(v) = *v else { continue };
+            let x0 = i as f64 + 0.1 + width * k as f64;
+            let x1 = x0 + width * 0.88;
+            if s.hollow {
+                chart.draw_series([
+                    Rectangle::new([(x0, 0.0), (x1, v)], WHITE.filled()),
+                    Rectangle::new([(x0, 0.0), (x1, v)], s.colour.stroke_width(2)),
+                ])?;
+            } else {
+                chart.draw_series([Rectangle::new([(x0, 0.0), (x1, v)], s.colour.filled())])?;
+            }
+            if let Some(&e) = s.errors.get(i).filter(|e| **e > 0.0) {
+                let x = (x0 + x1) / 2.0;
+                error_bar(chart, x, (v - e).max(0.0), (v + e).min(100.0), width * 0.25)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+const PLOT_H: i32 = 300;
+const LEFT: i32 = 64;
+const TOP: i32 = 40;
+
+fn draw(g: &Grouped) -> Result<String, FigureError> {
+    let series: Vec<&Bars> = g
+        .series
+        .iter()
+        .filter(|s| s.values.iter().any(Option::is_some))
+        .collect();
+    let n = g.groups.len().max(1);
+    let slot = (series.len() as i32 * 15 + 20).max(48);
+    let plot_w = (slot * n as i32).max(360);
+    let level = labels_fit(&g.groups, plot_w / n as i32);
+    let bottom = labels_height(&g.groups, level) + 26;
+    let mut keys: Vec<Key> = series.iter().map(|s| s.key.clone()).collect();
+    if let Some(c) = g.chance {
+        keys.push(Key::new(
+            format!("chance, all classes ({} %)", percent(c)),
+            Swatch::Dashed(GREY),
+        ));
+    }
+    let (legend_w, legend_h) = legend_size(&keys);
+    let width = LEFT + plot_w + 28 + legend_w + 12;
+    let height = TOP + PLOT_H.max(legend_h) + bottom + 8;
+    render((width as u32, height as u32), |root| {
+        let (area, _) = root.split_horizontally(LEFT + plot_w + 12);
+        let mut chart = ChartBuilder::on(&area)
+            .caption(&g.title, (FONT, TITLE))
+            .margin_top(6)
+            .margin_right(12)
+            .x_label_area_size(bottom)
+            .y_label_area_size(LEFT)
+            .build_cartesian_2d(0.0..n as f64, 0.0..100.0)?;
+        mesh(&mut chart)
+            .disable_x_mesh()
+            .x_labels(0)
+            .y_labels(11)
+            .y_label_formatter(&|v| number(*v))
+            .x_desc(g.x_desc.as_str())
+            .y_desc("accuracy (%)")
+            .draw()?;
+        bars(&mut chart, &series)?;
+        if let Some(c) = g.chance {
+            hline(&mut chart, c, GREY, 9)?;
+        }
+        let xs: Vec<i32> = (0..n)
+            .map(|i| chart.backend_coord(&(i as f64 + 0.5, 0.0)).0)
+            .collect();
+        let axis_y = chart.backend_coord(&(0.0, 0.0)).1;
+        category_labels(root, &g.groups, &xs, axis_y, level)?;
+        legend(root, (LEFT + plot_w + 28, TOP + 4), &keys)?;
+        if g.series.iter().any(|s| !s.errors.is_empty()) {
+            let note = "error bars: ± 1 std over CV repeats";
+            let y = TOP + legend_h + 14;
+            root.draw(&Text::new(
+                note,
+                (LEFT + plot_w + 28, y),
+                text(LABEL - 2.0, HPos::Left, VPos::Top),
+            ))?;
+        }
+        Ok(())
+    })
+}
+
+fn pct(v: f64) -> Option<f64> {
+    Some(100.0 * v)
+}
+
+/// E1: single taxel (mean over taxels and the best taxel) and 3D-GLCM ± std, per speed.
+pub(crate) fn e1(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
+    let speeds: Vec<Speed> = r.e1.iter().map(|(s, _)| s).collect();
+    let at = |f: &dyn Fn(&crate::experiments::E1Speed) -> Option<f64>| -> Vec<Option<f64>> {
+        r.e1.values().map(f).collect()
+    };
+    let paper_at = |f: &dyn Fn(crate::report::paper::PaperPair) -> f64| -> Vec<Option<f64>> {
+        speeds
+            .iter()
+            .map(|&s| paper.and_then(|p| p.e1_at(s)).map(f))
+            .collect()
+    };
+    let mut glcm3d = Bars::ours("ours: 3D-GLCM", GLCM3D, at(&|e| pct(e.glcm3d)));
+    glcm3d.key.swatch = Swatch::BarError(GLCM3D);
+    glcm3d.errors = r.e1.values().map(|e| 100.0 * e.glcm3d_std).collect();
+    let series = vec![
+        Bars::ours(
+            "ours: single taxel, mean over taxels",
+            SINGLE,
+            at(&|e| pct(e.taxel_mean)),
+        ),
+        Bars::paper("paper: single taxel", SINGLE, paper_at(&|p| p.taxel)),
+        Bars::ours(
+            "ours: best taxel (chosen after the fact)",
+            BEST,
+            at(&|e| pct(e.taxel_best)),
+        ),
+        glcm3d,
+        Bars::paper("paper: 3D-GLCM", GLCM3D, paper_at(&|p| p.glcm3d)),
+    ];
+    draw(&Grouped {
+        title: "E1: accuracy per speed".into(),
+        x_desc: speed_desc(&speeds, "speed"),
+        groups: speeds.iter().map(ToString::to_string).collect(),
+        series,
+        chance: chance(r),
+    })
+}
+
+/// E4: single taxel, 2D-GLCM (time collapsed) and 3D-GLCM, per speed.
+pub(crate) fn e4(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
+    let speeds: Vec<Speed> = r.e4.iter().map(|(s, _)| s).collect();
+    let ours = |f: &dyn Fn(&crate::experiments::E4Speed) -> f64| -> Vec<Option<f64>> {
+        r.e4.values().map(|e| pct(f(e))).collect()
+    };
+    let paper_e1 = |f: &dyn Fn(crate::report::paper::PaperPair) -> f64| -> Vec<Option<f64>> {
+        speeds
+            .iter()
+            .map(|&s| paper.and_then(|p| p.e1_at(s)).map(f))
+            .collect()
+    };
+    let paper_2d = speeds
+        .iter()
+        .map(|&s| paper.and_then(|p| p.e4_2d_at(s)))
+        .collect();
+    let series = vec![
+        Bars::ours(
+            "ours: single taxel, mean over taxels",
+            SINGLE,
+            ours(&|e| e.taxel_mean),
+        ),
+        Bars::paper("paper: single taxel", SINGLE, paper_e1(&|p| p.taxel)),
+        Bars::ours(
+            "ours: 2D-GLCM (time collapsed)",
+            GLCM2D,
+            ours(&|e| e.glcm2d),
+        ),
+        Bars::paper("paper: 2D-GLCM", GLCM2D, paper_2d),
+        Bars::ours("ours: 3D-GLCM", GLCM3D, ours(&|e| e.glcm3d)),
+        Bars::paper("paper: 3D-GLCM", GLCM3D, paper_e1(&|p| p.glcm3d)),
+    ];
+    draw(&Grouped {
+        title: "E4: temporal information removed".into(),
+        x_desc: speed_desc(&speeds, "speed"),
+        groups: speeds.iter().map(ToString::to_string).collect(),
+        series,
+        chance: chance(r),
+    })
+}
+
+/// E6: trained on the other speeds, tested on one: single taxel and 3D-GLCM.
+pub(crate) fn e6(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
+    let speeds: Vec<Speed> = r.e6.iter().map(|(s, _)| s).collect();
+    let paper_at = |f: &dyn Fn(crate::report::paper::PaperPair) -> f64| -> Vec<Option<f64>> {
+        speeds
+            .iter()
+            .map(|&s| paper.and_then(|p| p.e6_at(s)).map(f))
+            .collect()
+    };
+    let series = vec![
+        Bars::ours(
+            "ours: single taxel, mean over taxels",
+            SINGLE,
+            r.e6.values().map(|e| pct(e.taxel_mean)).collect(),
+        ),
+        Bars::paper("paper: single taxel", SINGLE, paper_at(&|p| p.taxel)),
+        Bars::ours(
+            "ours: 3D-GLCM",
+            GLCM3D,
+            r.e6.values().map(|e| pct(e.glcm3d)).collect(),
+        ),
+        Bars::paper("paper: 3D-GLCM", GLCM3D, paper_at(&|p| p.glcm3d)),
+    ];
+    draw(&Grouped {
+        title: "E6: speed invariance".into(),
+        x_desc: speed_desc(&speeds, "test speed, trained on the others"),
+        groups: speeds.iter().map(ToString::to_string).collect(),
+        series,
+        chance: chance(r),
+    })
+}
+
+/// The chance line's caveat: it is drawn for all classes of the dataset.
+fn chance_note(r: &Results) -> String {
+    format!(
+        "The dashed grey line is chance with all {n} classes present (1/{n}); a speed recorded with fewer classes has a higher chance level.",
+        n = r.labels.len()
+    )
+}
+
+fn paper_note(paper: Option<&Paper>) -> &'static str {
+    if paper.is_some() {
+        " Outlined bars are the paper's values at the speeds it reports."
+    } else {
+        ""
+    }
+}
+
+/// E1's caption.
+pub(crate) fn e1_caption(r: &Results, paper: Option<&Paper>) -> String {
+    format!(
+        "Accuracy over {} classes per speed (cross-validated, mean over repeats): the single taxel as the mean over all taxels (dark blue) and the best taxel, chosen after the fact (light blue), against 3D-GLCM (vermillion, error bar ± 1 std over CV repeats).{} {}",
+        r.labels.len(),
+        paper_note(paper),
+        chance_note(r)
+    )
+}
+
+/// E4's caption.
+pub(crate) fn e4_caption(r: &Results, paper: Option<&Paper>) -> String {
+    format!(
+        "Accuracy per speed without the time axis: 2D-GLCM on the time-collapsed rate image (green) beside the single taxel (mean over taxels, blue) and 3D-GLCM (vermillion).{} {}",
+        paper_note(paper),
+        chance_note(r)
+    )
+}
+
+/// E6's caption.
+pub(crate) fn e6_caption(r: &Results, paper: Option<&Paper>) -> String {
+    format!(
+        "Speed invariance: trained on every other speed and tested on the one on the x axis; single taxel (mean over taxels, blue) against 3D-GLCM (vermillion).{} {}",
+        paper_note(paper),
+        chance_note(r)
+    )
+}

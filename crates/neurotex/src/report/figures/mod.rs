@@ -1,0 +1,97 @@
+//! The report's figures, one function per figure, each drawn with plotters' SVG backend and
+//! laid out for any number of speeds, classes, taxels and gains; each figure's caption is
+//! written beside its drawing so that the two change together.
+
+mod accuracy;
+mod confusion;
+mod gain;
+mod neighbours;
+mod perturbation;
+mod plot;
+mod psth;
+mod recognition;
+
+use crate::experiments::Results;
+
+use super::paper::Paper;
+
+pub(crate) use accuracy::{e1_caption, e4_caption, e6_caption};
+pub(crate) use confusion::e2_caption;
+pub(crate) use gain::{e7_isi_caption, e7_rate_caption};
+pub(crate) use neighbours::e8_caption;
+pub(crate) use perturbation::e3_caption;
+pub(crate) use psth::e0_caption;
+pub(crate) use recognition::e5_caption;
+
+/// A figure could not be drawn.
+#[derive(Debug, thiserror::Error)]
+#[error("drawing a figure failed: {0}")]
+pub struct FigureError(String);
+
+impl<E: std::error::Error + Send + Sync> From<plotters::drawing::DrawingAreaErrorKind<E>>
+    for FigureError
+{
+    fn from(e: plotters::drawing::DrawingAreaErrorKind<E>) -> Self {
+        FigureError(e.to_string())
+    }
+}
+
+/// File names of the figures, as `report.md` links them.
+pub(crate) mod file {
+    /// E0.
+    pub(crate) const E0: &str = "e0_psth_volume.svg";
+    /// E1.
+    pub(crate) const E1: &str = "e1_accuracy.svg";
+    /// E2.
+    pub(crate) const E2: &str = "e2_confusion.svg";
+    /// E3.
+    pub(crate) const E3: &str = "e3_perturbation.svg";
+    /// E4.
+    pub(crate) const E4: &str = "e4_temporal.svg";
+    /// E5.
+    pub(crate) const E5: &str = "e5_time_to_recognition.svg";
+    /// E6.
+    pub(crate) const E6: &str = "e6_speed_invariance.svg";
+    /// E7, firing rates.
+    pub(crate) const E7_RATE: &str = "e7_rate.svg";
+    /// E7, ISI distributions.
+    pub(crate) const E7_ISI: &str = "e7_isi.svg";
+    /// E8.
+    pub(crate) const E8: &str = "e8_k.svg";
+}
+
+/// Chance level (%) with every class of the dataset present.
+fn chance(r: &Results) -> Option<f64> {
+    (!r.labels.is_empty()).then(|| 100.0 / r.labels.len() as f64)
+}
+
+/// Every figure these results have, as `(file name, SVG)`, in the report's order.
+pub(crate) fn all(
+    r: &Results,
+    paper: Option<&Paper>,
+) -> Vec<(&'static str, Result<String, FigureError>)> {
+    let mut out = vec![(file::E1, accuracy::e1(r, paper))];
+    if let Some(e2) = &r.e2 {
+        out.push((file::E2, confusion::e2(e2)));
+    }
+    if let Some(e3) = &r.e3 {
+        out.push((file::E3, perturbation::e3(e3, r.e2.as_ref(), chance(r))));
+    }
+    out.push((file::E4, accuracy::e4(r, paper)));
+    out.push((file::E5, recognition::e5(r, paper)));
+    if !r.e6.is_empty() {
+        out.push((file::E6, accuracy::e6(r, paper)));
+    }
+    if let Some(e7) = &r.e7 {
+        out.push((file::E7_RATE, gain::e7_rate(e7)));
+        out.push((file::E7_ISI, gain::e7_isi(e7)));
+    }
+    out.push((file::E8, neighbours::e8(r)));
+    if let Some(e0) = &r.e0 {
+        out.push((file::E0, psth::e0(e0)));
+    }
+    out
+}
+
+#[cfg(test)]
+pub(crate) mod tests;

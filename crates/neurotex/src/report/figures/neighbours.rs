@@ -1,0 +1,72 @@
+//! E8: accuracy against the number of neighbours k, one panel per speed on one scale.
+
+use super::plot::{
+    hline, line_with_markers, mesh, multiples, number, panel_chart, percent, x_ticks_at, Key,
+    Multiples, Swatch, GLCM3D, GREY, SINGLE,
+};
+use super::{chance, FigureError};
+use crate::experiments::Results;
+
+/// E8: single taxel and 3D-GLCM against k, one panel per speed.
+pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
+    let chance = chance(r);
+    let mut keys = vec![
+        Key::new("single taxel, mean over taxels", Swatch::Points(SINGLE)),
+        Key::new("3D-GLCM", Swatch::Points(GLCM3D)),
+    ];
+    if let Some(c) = chance {
+        keys.push(Key::new(
+            format!("chance, all classes ({} %)", percent(c)),
+            Swatch::Dashed(GREY),
+        ));
+    }
+    let speeds: Vec<_> = r.e8.iter().collect();
+    let ks = || {
+        speeds
+            .iter()
+            .flat_map(|(_, e)| e.k.iter().map(|&k| k as f64))
+    };
+    let lo = ks().fold(f64::INFINITY, f64::min);
+    let hi = ks().fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (1.0, 1.0) };
+    let layout = Multiples {
+        n: speeds.len(),
+        panel: (230, 190),
+        title: "E8: robustness to the number of neighbours k",
+        x_desc: "neighbours k",
+        y_desc: "accuracy (%)",
+        keys: &keys,
+    };
+    multiples(&layout, |i, area| {
+        let (speed, e) = speeds[i];
+        let x = lo - 1.0..hi + 1.0;
+        let mut chart = panel_chart(area, &format!("{speed} mm/s"), x, 0.0..100.0)?;
+        mesh(&mut chart)
+            .disable_x_mesh()
+            .x_labels(0)
+            .y_labels(6)
+            .y_label_formatter(&|v| number(*v))
+            .draw()?;
+        let ks: Vec<f64> = e.k.iter().map(|&k| k as f64).collect();
+        x_ticks_at(area, &chart, &ks)?;
+        if let Some(c) = chance {
+            hline(&mut chart, c, GREY, 6)?;
+        }
+        let at = |values: &[f64]| -> Vec<(f64, f64)> {
+            e.k.iter()
+                .zip(values)
+                .map(|(&k, &a)| (k as f64, 100.0 * a))
+                .collect()
+        };
+        line_with_markers(&mut chart, &at(&e.taxel_mean), SINGLE, false)?;
+        line_with_markers(&mut chart, &at(&e.glcm3d), GLCM3D, false)
+    })
+}
+
+/// E8's caption.
+pub(crate) fn e8_caption(r: &Results) -> String {
+    format!(
+        "Accuracy against the number of neighbours k of the KNN classifier, one panel per speed on one scale: single taxel (mean over taxels, blue) and 3D-GLCM (vermillion); grey dashed: chance with all {} classes.",
+        r.labels.len()
+    )
+}

@@ -1,0 +1,455 @@
+//! `report.md`, one function per section. Sections only render: the verdicts come from
+//! [`claims`], the numbers from [`Results`], and the paper's values from [`Paper`].
+
+use super::figures::{self, file};
+use super::paper::{Paper, PAPER};
+use super::table::Table;
+use super::ReportContext;
+use crate::experiments::{claims, Results};
+use crate::values::Speed;
+
+fn pct(a: f64) -> String {
+    format!("{:.1}", 100.0 * a)
+}
+
+fn list<T: ToString>(items: impl IntoIterator<Item = T>) -> String {
+    items
+        .into_iter()
+        .map(|i| i.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// An embedded figure with its alt text and caption.
+fn figure(name: &str, alt: &str, caption: &str) -> String {
+    format!("![{alt}](figures/{name})\n\n**Figure.** {caption}\n\n")
+}
+
+/// The paper's value in a table cell, or `-` where it gives none.
+fn paper_cell(v: Option<f64>) -> String {
+    v.map_or("-".into(), |v| v.to_string())
+}
+
+/// The whole report for `r`; deterministic for a given `r` and `ctx`.
+pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
+    let paper = ctx.paper();
+    [
+        header(ctx),
+        data(r, ctx),
+        summary(r),
+        e1(r, paper),
+        e2(r),
+        e3(r),
+        e4(r, paper),
+        e5(r, paper),
+        e6(r, paper),
+        e7(r),
+        e8(r),
+        e0(r),
+        skipped(r),
+        parameters(ctx),
+        timing(r),
+    ]
+    .concat()
+}
+
+fn header(ctx: &ReportContext) -> String {
+    format!(
+        "# neurotex reproduction of Gupta, Nakagawa, Lepora and Thakor\n\n\
+         \"Spatio-temporal encoding improves neuromorphic tactile texture classification\": every analysis (E0-E8) run on the data below. **Our numbers are not the paper's**: we do not have its recordings, so the paper's values stand beside ours for comparison only; nothing was tuned to approach them.\n\n\
+         Produced by `{}` in {:.1} s.\n\n",
+        ctx.command, ctx.total_seconds
+    )
+}
+
+fn paper_design() -> String {
+    let e1: Vec<String> = PAPER
+        .e1
+        .iter()
+        .map(|(_, t, g)| format!("{t}/{g}"))
+        .collect();
+    format!(
+        "{} textures at {} mm/s on its own rig; E1 {} % single taxel/3D-GLCM",
+        PAPER.textures,
+        list(PAPER.speeds()),
+        e1.join(", ")
+    )
+}
+
+fn data(r: &Results, ctx: &ReportContext) -> String {
+    let mut out = format!("## Data\n\n{}\n\n", ctx.dataset);
+    if !ctx.paper_comparable {
+        out += &format!("These are not the paper's recordings or its design, so the paper's values ({}) are not set beside ours speed by speed; the summary below compares conclusions only.\n\n", paper_design());
+    }
+    out += &format!(
+        "{} recordings, {} classes ({}), speeds {} mm/s.",
+        r.recordings,
+        r.labels.len(),
+        r.labels.join(", "),
+        list(&r.speeds)
+    );
+    if r.resampled > 0 {
+        out += &format!(
+            " {} recordings were resampled to 1 kHz by linear interpolation.",
+            r.resampled
+        );
+    }
+    if r.flat > 0 {
+        out += &format!(
+            " {} recordings had no positive signal and gave no spikes.",
+            r.flat
+        );
+    }
+    out + "\n\n"
+}
+
+fn summary(r: &Results) -> String {
+    let mut out = "## Summary: where we agree with the paper\n\n".to_string();
+    for c in claims(r) {
+        let verdict = if c.verdict.holds() {
+            "Agrees:"
+        } else {
+            "Does not agree:"
+        };
+        let detail = if c.detail.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", c.detail)
+        };
+        out += &format!("- {verdict} **{}**{detail}\n", c.statement);
+    }
+    out + "\n"
+}
+
+fn e1(r: &Results, paper: Option<&Paper>) -> String {
+    let mut out = "## E1: accuracy per speed, single taxel vs 3D-GLCM\n\n\
+        Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline and the best taxel beside it (chosen after the fact, so optimistic). Stratified cross-validation, mean over repeats (folds and repeats under Parameters).\n\n"
+        .to_string();
+    let mut header = vec![
+        "speed (mm/s)",
+        "single taxel, mean (%)",
+        "best taxel (%)",
+        "3D-GLCM (%)",
+    ];
+    if paper.is_some() {
+        header.extend(["paper: single (%)", "paper: 3D-GLCM (%)"]);
+    }
+    let mut t = Table::new(header);
+    for (s, e) in r.e1.iter() {
+        let mut row = vec![
+            s.to_string(),
+            pct(e.taxel_mean),
+            format!("{} ({})", pct(e.taxel_best), e.taxel_best_cell),
+            format!("{} ± {}", pct(e.glcm3d), pct(e.glcm3d_std)),
+        ];
+        if let Some(p) = paper {
+            let v = p.e1_at(s);
+            row.extend([
+                paper_cell(v.map(|v| v.taxel)),
+                paper_cell(v.map(|v| v.glcm3d)),
+            ]);
+        }
+        t.row(row);
+    }
+    out += &t.render();
+    out += "\n";
+    out += &figure(
+        file::E1,
+        "E1: bar chart of accuracy per speed, single taxel and 3D-GLCM",
+        &figures::e1_caption(r, paper),
+    );
+    out
+}
+
+fn e2(r: &Results) -> String {
+    let Some(e2) = &r.e2 else {
+        return String::new();
+    };
+    let mut out = format!("## E2: confusion matrices at {} mm/s\n\n\
+        Rows are the true texture, columns the prediction; counts summed over CV repeats (and over taxels for the single taxel). The paper: the single taxel confuses scotch brite (SB) and styrofoam (STF) with the rug (TRug).\n\n", e2.speed);
+    for (name, m) in [
+        ("single taxel (all taxels)", &e2.taxel),
+        ("3D-GLCM", &e2.glcm3d),
+    ] {
+        out += &format!("{name}, row percentages:\n\n");
+        let mut t = Table::new(
+            std::iter::once("true \\ predicted").chain(e2.labels.iter().map(String::as_str)),
+        );
+        for (label, row) in e2.labels.iter().zip(m) {
+            let total = row.iter().sum::<usize>().max(1) as f64;
+            let cells = row
+                .iter()
+                .map(|&v| format!("{:.0}", 100.0 * v as f64 / total));
+            t.row(std::iter::once(label.clone()).chain(cells));
+        }
+        out += &t.render();
+        out += "\n";
+    }
+    out + &figure(
+        file::E2,
+        "E2: confusion matrices of the single taxel and 3D-GLCM as heat maps",
+        &figures::e2_caption(e2),
+    )
+}
+
+fn e3(r: &Results) -> String {
+    let Some(e3) = &r.e3 else {
+        return String::new();
+    };
+    let mut out = format!("## E3: spatial perturbation at {} mm/s\n\n\
+        For each recording, n taxels chosen at random swap places among themselves (every chosen taxel moves; each recording gets its own draw); 3D-GLCM accuracy, mean ± std over {} draws. Unperturbed 3D-GLCM {} %, single taxel {} %. The paper: accuracy falls towards or below the single taxel as n grows.\n\n",
+        e3.speed, e3.repeats, pct(e3.glcm3d), pct(e3.taxel_mean));
+    let mut t = Table::new(["taxels moved", "3D-GLCM (%)"]);
+    for ((n, m), s) in e3.n.iter().zip(&e3.mean).zip(&e3.std) {
+        t.row([n.to_string(), format!("{} ± {}", pct(*m), pct(*s))]);
+    }
+    out += &t.render();
+    out += "\n";
+    out + &figure(
+        file::E3,
+        "E3: line chart of 3D-GLCM accuracy against the number of taxels moved",
+        &figures::e3_caption(e3),
+    )
+}
+
+fn e4(r: &Results, paper: Option<&Paper>) -> String {
+    let mut out = "## E4: temporal information removed (2D-GLCM)\n\n".to_string();
+    let mut header = vec![
+        "speed (mm/s)",
+        "single taxel (%)",
+        "2D-GLCM (%)",
+        "3D-GLCM (%)",
+    ];
+    if paper.is_some() {
+        header.extend(["paper: single", "paper: 2D", "paper: 3D"]);
+    }
+    let mut t = Table::new(header);
+    for (s, e) in r.e4.iter() {
+        let mut row = vec![
+            s.to_string(),
+            pct(e.taxel_mean),
+            pct(e.glcm2d),
+            pct(e.glcm3d),
+        ];
+        if let Some(p) = paper {
+            let e1 = p.e1_at(s);
+            row.extend([
+                paper_cell(e1.map(|v| v.taxel)),
+                paper_cell(p.e4_2d_at(s)),
+                paper_cell(e1.map(|v| v.glcm3d)),
+            ]);
+        }
+        t.row(row);
+    }
+    out += &t.render();
+    out += "\n";
+    out + &figure(
+        file::E4,
+        "E4: bar chart of single taxel, 2D-GLCM and 3D-GLCM accuracy per speed",
+        &figures::e4_caption(r, paper),
+    )
+}
+
+/// The fractions of the slide E5 used at any speed, ascending.
+fn e5_fractions(r: &Results) -> Vec<f64> {
+    let mut all: Vec<f64> =
+        r.e5.values()
+            .flat_map(|e| e.fractions.iter().copied())
+            .collect();
+    all.sort_by(f64::total_cmp);
+    all.dedup();
+    all
+}
+
+fn e5(r: &Results, paper: Option<&Paper>) -> String {
+    let stated: Vec<String> = PAPER
+        .e5_first_match
+        .iter()
+        .map(|(s, p)| format!("{:.0} % of the slide at {s} mm/s", 100.0 * p))
+        .collect();
+    let mut out = format!("## E5: time to recognition\n\n\
+        3D-GLCM on the first part of the slide against the single taxel (mean over taxels) on all of it; accuracy (%) per share of the slide used, \"short\" where that part is shorter than one bin. The paper: 3D-GLCM matches at {}.\n\n", stated.join(" and "));
+    let fractions = e5_fractions(r);
+    let mut header = vec![
+        "speed (mm/s)".to_string(),
+        "single taxel, whole slide".into(),
+    ];
+    header.extend(fractions.iter().map(|p| format!("{:.0} %", 100.0 * p)));
+    header.push("first match".into());
+    if paper.is_some() {
+        header.push("paper: first match".into());
+    }
+    let mut t = Table::new(header);
+    for (s, e) in r.e5.iter() {
+        let mut row = vec![s.to_string(), pct(e.taxel_full)];
+        row.extend(fractions.iter().map(|&p| {
+            let at = e.fractions.iter().position(|&q| q == p);
+            match at.map(|i| e.glcm3d.get(i).copied().flatten()) {
+                Some(Some(a)) => pct(a),
+                Some(None) => "short".into(),
+                None => "-".into(),
+            }
+        }));
+        row.push(
+            e.first_match
+                .map_or("never".into(), |p| format!("{:.0} %", 100.0 * p)),
+        );
+        if let Some(p) = paper {
+            let v = p.e5_first_match_at(s);
+            row.push(v.map_or("not stated".into(), |p| format!("{:.0} %", 100.0 * p)));
+        }
+        t.row(row);
+    }
+    out += &t.render();
+    out += "\n";
+    out + &figure(
+        file::E5,
+        "E5: one line chart per speed of 3D-GLCM accuracy against the share of the slide used",
+        &figures::e5_caption(r, paper),
+    )
+}
+
+/// The training speeds of an E6 row: "all others" when that is what they are.
+fn trained_on(all: &[Speed], test: Speed, train: &[Speed]) -> String {
+    let others: Vec<Speed> = all.iter().copied().filter(|&s| s != test).collect();
+    if others == train && train.len() > 2 {
+        format!("the other {}", train.len())
+    } else {
+        list(train)
+    }
+}
+
+fn e6(r: &Results, paper: Option<&Paper>) -> String {
+    let mut out =
+        "## E6: speed invariance (train on the other speeds, test on one)\n\n".to_string();
+    if r.e6.is_empty() {
+        let why = r
+            .skipped
+            .get("e6")
+            .map_or("no second speed", String::as_str);
+        return out + &format!("Skipped: {why}\n\n");
+    }
+    let mut header = vec![
+        "test speed (mm/s)",
+        "trained on (mm/s)",
+        "single taxel (%)",
+        "3D-GLCM (%)",
+    ];
+    if paper.is_some() {
+        header.extend(["paper: single", "paper: 3D"]);
+    }
+    let mut t = Table::new(header);
+    for (s, e) in r.e6.iter() {
+        let mut row = vec![
+            s.to_string(),
+            trained_on(&r.speeds, s, &e.train),
+            pct(e.taxel_mean),
+            pct(e.glcm3d),
+        ];
+        if let Some(p) = paper {
+            let v = p.e6_at(s);
+            row.extend([
+                paper_cell(v.map(|v| v.taxel)),
+                paper_cell(v.map(|v| v.glcm3d)),
+            ]);
+        }
+        t.row(row);
+    }
+    out += &t.render();
+    out += "\n";
+    out + &figure(
+        file::E6,
+        "E6: bar chart of accuracy per held-out speed, single taxel and 3D-GLCM",
+        &figures::e6_caption(r, paper),
+    )
+}
+
+fn e7(r: &Results) -> String {
+    let Some(e7) = &r.e7 else {
+        return String::new();
+    };
+    let mut out = format!("## E7: gain sweep at {} mm/s\n\n\
+        Mean firing rate per taxel (Hz) for each gain and texture; the paper chose G = {} as the balance between sparse responses (low G) and saturated, less discriminative ones (high G).\n\n",
+        e7.speed, super::paper::PAPER_GAIN);
+    let mut t = Table::new(std::iter::once("G").chain(e7.sweep.labels.iter().map(String::as_str)));
+    for (g, rates) in e7.sweep.gains.iter().zip(&e7.rate_hz) {
+        t.row(std::iter::once(g.to_string()).chain(rates.iter().map(|r| format!("{r:.1}"))));
+    }
+    out += &t.render();
+    out += "\n";
+    out += &figure(
+        file::E7_RATE,
+        "E7: line chart of firing rate against gain, one line per texture",
+        &figures::e7_rate_caption(e7),
+    );
+    out + &figure(
+        file::E7_ISI,
+        "E7: one panel per gain of the cumulative ISI distribution of each texture",
+        &figures::e7_isi_caption(e7),
+    )
+}
+
+fn e8(r: &Results) -> String {
+    let mut out = "## E8: robustness to k\n\nSingle taxel (mean over taxels) / 3D-GLCM accuracy (%) for each number of neighbours k. The paper: the outperformance is robust to k.\n\n".to_string();
+    let mut ks: Vec<usize> = r.e8.values().flat_map(|e| e.k.iter().copied()).collect();
+    ks.sort_unstable();
+    ks.dedup();
+    let header =
+        std::iter::once("speed (mm/s)".to_string()).chain(ks.iter().map(|k| format!("k = {k}")));
+    let mut t = Table::new(header);
+    for (s, e) in r.e8.iter() {
+        let cells = ks.iter().map(|k| match e.k.iter().position(|x| x == k) {
+            Some(i) => format!("{} / {}", pct(e.taxel_mean[i]), pct(e.glcm3d[i])),
+            None => "-".into(),
+        });
+        t.row(std::iter::once(s.to_string()).chain(cells));
+    }
+    out += &t.render();
+    out += "\n";
+    out + &figure(
+        file::E8,
+        "E8: one line chart per speed of accuracy against k",
+        &figures::e8_caption(r),
+    )
+}
+
+fn e0(r: &Results) -> String {
+    let Some(e0) = &r.e0 else {
+        return String::new();
+    };
+    "## E0: PSTH and rate volume\n\n".to_string()
+        + &figure(
+            file::E0,
+            "E0: PSTH of one taxel beside the rate volume of the array, for two textures",
+            &figures::e0_caption(e0),
+        )
+}
+
+fn skipped(r: &Results) -> String {
+    if r.skipped.is_empty() {
+        return String::new();
+    }
+    let lines: String = r
+        .skipped
+        .iter()
+        .map(|(k, v)| format!("- {k}: {v}\n"))
+        .collect();
+    format!("## Skipped\n\n{lines}\n")
+}
+
+fn parameters(ctx: &ReportContext) -> String {
+    let lines: String = ctx.parameters.iter().map(|p| format!("- {p}\n")).collect();
+    format!("## Parameters\n\n{lines}\n")
+}
+
+fn timing(r: &Results) -> String {
+    if r.timing_s.is_empty() {
+        return String::new();
+    }
+    let lines: String = r
+        .timing_s
+        .iter()
+        .map(|(k, v)| format!("- {k}: {v:.3}\n"))
+        .collect();
+    format!("## Timing (wall clock, s)\n\n{lines}")
+}
