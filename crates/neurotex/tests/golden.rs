@@ -81,7 +81,7 @@ fn small_simulated_design_renders_the_stored_report() {
                 .into(),
         parameters: vec!["CV: 3-fold, 2 repeats".into()],
         total_seconds: 1.0,
-        command: "cargo test --test golden_report".into(),
+        command: "cargo test --test golden".into(),
         paper_comparable: true,
     };
     let text = markdown(results, &ctx);

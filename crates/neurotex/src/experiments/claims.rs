@@ -92,13 +92,20 @@ fn e1_claims(r: &Results) -> Vec<Claim> {
             .join("; "),
     ));
     if r.e1.len() >= 2 {
-        let margins: Vec<f64> = r.e1.values().map(|e| e.glcm3d - e.taxel_mean).collect();
+        // Slow to fast by magnitude: signed speeds are directions, not slower conditions.
+        let mut by_magnitude: Vec<_> = r.e1.iter().collect();
+        by_magnitude.sort_by(|a, b| a.0.mm_s().abs().total_cmp(&b.0.mm_s().abs()));
+        let margins: Vec<f64> = by_magnitude
+            .iter()
+            .map(|(_, e)| e.glcm3d - e.taxel_mean)
+            .collect();
         out.push(Claim::new(
             "E1: the margin shrinks from the slowest to the fastest speed",
             margins.first() > margins.last(),
-            margins
+            by_magnitude
                 .iter()
-                .map(|m| format!("{:+.1}", 100.0 * m))
+                .zip(&margins)
+                .map(|((s, _), m)| format!("{s} mm/s: {:+.1}", 100.0 * m))
                 .collect::<Vec<_>>()
                 .join(", ")
                 + " points",
