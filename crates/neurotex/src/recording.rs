@@ -621,38 +621,65 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
         .from_path(path)
         .map_err(|e| csv_error(path, e))?;
     let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
-    let col = |name: &str| headers.iter().position(|h| h == name);
-    let mut idx = [0usize; 5];
-    for (slot, name) in idx.iter_mut().zip(MANIFEST_COLUMNS) {
-        *slot = col(name).ok_or_else(|| {
-            DataError::invalid(
-                path,
-                format!(
-                    "missing column `{name}` (a manifest needs {})",
-                    MANIFEST_COLUMNS.join(",")
-                ),
-            )
-        })?;
-    }
-    let start = col("slide_start_s");
-    let end = col("slide_end_s");
+    let columns = ManifestColumns::find(path, &headers)?;
     let mut out = Vec::new();
     for (i, record) in reader.records().enumerate() {
-        let line = i + 2;
         let record = record.map_err(|e| csv_error(path, e))?;
+        out.push(columns.row(path, i + 2, &headers, &record)?);
+    }
+    if out.is_empty() {
+        return Err(DataError::invalid(path, "the manifest lists no recordings").into());
+    }
+    Ok(out)
+}
+
+/// Where a manifest's columns are: the required ones in [`MANIFEST_COLUMNS`] order, and
+/// the optional sliding interval.
+struct ManifestColumns {
+    required: [usize; 5],
+    start: Option<usize>,
+    end: Option<usize>,
+}
+
+impl ManifestColumns {
+    fn find(path: &Path, headers: &csv::StringRecord) -> Result<Self> {
+        let col = |name: &str| headers.iter().position(|h| h == name);
+        let mut required = [0usize; 5];
+        for (slot, name) in required.iter_mut().zip(MANIFEST_COLUMNS) {
+            *slot = col(name).ok_or_else(|| {
+                let needed = MANIFEST_COLUMNS.join(",");
+                let message = format!("missing column `{name}` (a manifest needs {needed})");
+                DataError::invalid(path, message)
+            })?;
+        }
+        Ok(ManifestColumns {
+            required,
+            start: col("slide_start_s"),
+            end: col("slide_end_s"),
+        })
+    }
+
+    /// The recording that manifest line `line` describes.
+    fn row(
+        &self,
+        path: &Path,
+        line: usize,
+        headers: &csv::StringRecord,
+        record: &csv::StringRecord,
+    ) -> Result<Meta> {
+        let idx = &self.required;
         let field = |j: usize| record.get(j).unwrap_or("");
+        let bad = |message: String| -> crate::Error {
+            DataError::invalid(path, format!("line {line}{message}")).into()
+        };
         let num = |j: usize, name: &str| -> Result<f64> {
             let s = field(j);
-            s.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    DataError::invalid(
-                        path,
-                        format!("line {line}, field `{name}`: expected a finite number, got `{s}`"),
-                    )
-                    .into()
-                })
+            let value = s.parse::<f64>().ok().filter(|v| v.is_finite());
+            value.ok_or_else(|| {
+                bad(format!(
+                    ", field `{name}`: expected a finite number, got `{s}`"
+                ))
+            })
         };
         let opt = |j: Option<usize>, name: &str| -> Result<Option<f64>> {
             match j {
@@ -660,44 +687,34 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
                 _ => Ok(None),
             }
         };
-        let file = field(idx[0]).to_string();
-        if file.is_empty() {
-            return Err(
-                DataError::invalid(path, format!("line {line}, field `file` is empty")).into(),
-            );
-        }
-        let label = field(idx[1]).to_string();
-        if label.is_empty() {
-            return Err(
-                DataError::invalid(path, format!("line {line}, field `label` is empty")).into(),
-            );
-        }
+        let non_empty = |j: usize, name: &str| -> Result<String> {
+            match field(j) {
+                "" => Err(bad(format!(", field `{name}` is empty"))),
+                text => Ok(text.to_string()),
+            }
+        };
+        let (file, label) = (non_empty(idx[0], "file")?, non_empty(idx[1], "label")?);
         let trial_text = field(idx[4]);
         let trial = trial_text.parse::<i64>().map_err(|_| {
-            DataError::invalid(
-                path,
-                format!("line {line}, field `trial`: expected an integer, got `{trial_text}`"),
-            )
+            bad(format!(
+                ", field `trial`: expected an integer, got `{trial_text}`"
+            ))
         })?;
-        let slide_start_s = opt(start, "slide_start_s")?;
-        let slide_end_s = opt(end, "slide_end_s")?;
+        let slide_start_s = opt(self.start, "slide_start_s")?;
+        let slide_end_s = opt(self.end, "slide_end_s")?;
         if let (Some(a), Some(b)) = (slide_start_s, slide_end_s) {
             if !(a >= 0.0 && b > a) {
-                return Err(DataError::invalid(
-                    path,
-                    format!("line {line}: slide interval must satisfy 0 <= slide_start_s < slide_end_s, got [{a}, {b}]"),
-                )
-                .into());
+                return Err(bad(format!(": slide interval must satisfy 0 <= slide_start_s < slide_end_s, got [{a}, {b}]")));
             }
         }
-        let known = |j: usize| idx.contains(&j) || Some(j) == start || Some(j) == end;
+        let known = |j: usize| idx.contains(&j) || Some(j) == self.start || Some(j) == self.end;
         let extra = headers
             .iter()
             .enumerate()
             .filter(|(j, _)| !known(*j))
             .map(|(j, h)| (h.to_string(), field(j).to_string()))
             .collect();
-        out.push(Meta {
+        Ok(Meta {
             file,
             label,
             speed_mm_s: num(idx[2], "speed_mm_s")?,
@@ -706,12 +723,8 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
             slide_start_s,
             slide_end_s,
             extra,
-        });
+        })
     }
-    if out.is_empty() {
-        return Err(DataError::invalid(path, "the manifest lists no recordings").into());
-    }
-    Ok(out)
 }
 
 fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
