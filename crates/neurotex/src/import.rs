@@ -384,30 +384,11 @@ pub fn import_csv(
         return Err(DataError::invalid(out, "no .csv files to import").into());
     }
     if p.time_column.is_none() && p.fs.is_none() {
-        return Err(ParamError::new(
-            "fs",
-            "without --time-column the sampling rate --fs is needed",
-            "none",
-        )
-        .into());
+        let rule = "without --time-column the sampling rate --fs is needed";
+        return Err(ParamError::new("fs", rule, "none").into());
     }
-    let parsed: Vec<(PathBuf, Result<ParsedCsv>)> = files
-        .par_iter()
-        .map(|f| {
-            let r = parse_csv(f, p);
-            on_done();
-            (f.clone(), r)
-        })
-        .collect();
     let mut summary = ImportSummary::default();
-    let mut good = Vec::new();
-    for (f, r) in parsed {
-        match r {
-            Ok(c) => good.push(c),
-            Err(e) if p.skip_bad => summary.skipped.push((f, e.to_string())),
-            Err(e) => return Err(e),
-        }
-    }
+    let good = parse_all(files, p, on_done, &mut summary.skipped)?;
     let Some(first) = good.first() else {
         return Err(DataError::invalid(out, "every file was left out").into());
     };
@@ -421,49 +402,87 @@ pub fn import_csv(
             ),
         ));
     }
-    let n = names.len();
-    let (rows, cols) = p.grid.as_ref().map_or((1, n), |g| (g.rows(), g.cols()));
     let fs = match p.fs {
         Some(fs) => fs,
-        None => {
-            // the median interval over all files gives the nominal rate
-            let mut dts: Vec<f64> = good
-                .iter()
-                .filter_map(|c| c.times.as_ref())
-                .flat_map(|t| t.windows(2).map(|w| (w[1] - w[0]) * p.time_unit.seconds()))
-                .collect();
-            if dts.is_empty() {
-                return Err(DataError::invalid(
-                    out,
-                    "cannot estimate the sampling rate from single-row files; give --fs",
-                )
-                .into());
-            }
-            let mid = dts.len() / 2;
-            let (_, median, _) = dts.select_nth_unstable_by(mid, f64::total_cmp);
-            1.0 / *median
-        }
+        None => nominal_fs(&good, p, out)?,
     };
-    if rows * cols < n {
-        return Err(ParamError::new(
-            "grid",
-            "the grid must have a cell for every channel",
-            format!("{rows}x{cols} for {n} channels"),
-        )
-        .into());
+    let layout = csv_layout(p, &names, fs, first.times.is_some())?;
+    create_dataset_dir(out, |tmp| {
+        write_layout(tmp, &layout)?;
+        // validates the layout before anything else is written
+        LayoutFile::read(&tmp.join("layout.toml"))?;
+        let metas: Vec<Meta> = good
+            .par_iter()
+            .map(|c| write_imported(tmp, c, &names, p.time_unit.milliseconds()))
+            .collect::<Result<_>>()?;
+        write_manifest(tmp, &metas)
+    })?;
+    summary.written = good.len();
+    summary.layout = layout;
+    Ok(summary)
+}
+
+/// Parses every file in parallel; a bad file is an error, or with `skip_bad` is listed in
+/// `skipped` with its reason.
+fn parse_all(
+    files: &[PathBuf],
+    p: &CsvImportParams,
+    on_done: &(dyn Fn() + Sync),
+    skipped: &mut Vec<(PathBuf, String)>,
+) -> Result<Vec<ParsedCsv>> {
+    let parsed: Vec<(PathBuf, Result<ParsedCsv>)> = files
+        .par_iter()
+        .map(|f| {
+            let r = parse_csv(f, p);
+            on_done();
+            (f.clone(), r)
+        })
+        .collect();
+    let mut good = Vec::new();
+    for (f, r) in parsed {
+        match r {
+            Ok(c) => good.push(c),
+            Err(e) if p.skip_bad => skipped.push((f, e.to_string())),
+            Err(e) => return Err(e),
+        }
     }
-    // Channels fill the grid row-major unless mapped; cells no channel reaches are masked.
+    Ok(good)
+}
+
+/// The nominal sampling rate: one over the median interval of all files' time stamps.
+fn nominal_fs(good: &[ParsedCsv], p: &CsvImportParams, out: &Path) -> Result<f64> {
+    let mut dts: Vec<f64> = good
+        .iter()
+        .filter_map(|c| c.times.as_ref())
+        .flat_map(|t| t.windows(2).map(|w| (w[1] - w[0]) * p.time_unit.seconds()))
+        .collect();
+    if dts.is_empty() {
+        let message = "cannot estimate the sampling rate from single-row files; give --fs";
+        return Err(DataError::invalid(out, message).into());
+    }
+    let mid = dts.len() / 2;
+    let (_, median, _) = dts.select_nth_unstable_by(mid, f64::total_cmp);
+    Ok(1.0 / *median)
+}
+
+/// The layout of the imported dataset: channels fill the grid row-major unless mapped, and
+/// cells no channel reaches are masked.
+fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Result<LayoutFile> {
+    let n = names.len();
+    let (rows, cols) = p.grid.as_ref().map_or((1, n), |g| (g.rows(), g.cols()));
+    if rows * cols < n {
+        let rule = "the grid must have a cell for every channel";
+        let got = format!("{rows}x{cols} for {n} channels");
+        return Err(ParamError::new("grid", rule, got).into());
+    }
     let map: Vec<[usize; 2]> = match &p.channel_map {
         Some(map) => map.to_pairs(),
         None => (0..n).map(|k| [k / cols, k % cols]).collect(),
     };
     if map.len() != n {
-        return Err(ParamError::new(
-            "channel-map",
-            "the map needs one cell per channel",
-            format!("{} cells for {n} channels", map.len()),
-        )
-        .into());
+        let got = format!("{} cells for {n} channels", map.len());
+        let rule = "the map needs one cell per channel";
+        return Err(ParamError::new("channel-map", rule, got).into());
     }
     let mut used = vec![false; rows * cols];
     for &[r, c] in &map {
@@ -472,58 +491,45 @@ pub fn import_csv(
         }
     }
     let full = used.iter().all(|&u| u);
-    let layout = LayoutFile {
+    let mask_row = |r: usize| -> String {
+        (0..cols)
+            .map(|c| if used[r * cols + c] { '1' } else { '0' })
+            .collect()
+    };
+    Ok(LayoutFile {
         fs: Some(fs),
         rows: Some(rows),
         cols: Some(cols),
         channel_map: (p.channel_map.is_some() || !full).then_some(map),
-        mask: (!full).then(|| {
-            (0..rows)
-                .map(|r| {
-                    (0..cols)
-                        .map(|c| if used[r * cols + c] { '1' } else { '0' })
-                        .collect()
-                })
-                .collect()
-        }),
+        mask: (!full).then(|| (0..rows).map(mask_row).collect()),
         baseline: p.baseline,
-        time_column: good[0].times.as_ref().map(|_| "t_ms".to_string()),
-        time_unit: good[0].times.as_ref().map(|_| TimeUnit::Milliseconds),
-        channels: Some(names.clone()),
-    };
-    create_dataset_dir(out, |tmp| {
-        write_layout(tmp, &layout)?;
-        // validates the layout before anything else is written
-        LayoutFile::read(&tmp.join("layout.toml"))?;
-        let ms_per_unit = p.time_unit.milliseconds();
-        let metas: Vec<Meta> = good
-            .par_iter()
-            .map(|c| -> Result<Meta> {
-                let path = tmp.join(&c.meta.file);
-                let mut text = String::with_capacity(c.samples.len() * 8);
-                if c.times.is_some() {
-                    text.push_str("t_ms,");
-                }
-                text.push_str(&names.join(","));
-                text.push('\n');
-                let t0 = c.times.as_ref().map_or(0.0, |t| t[0]);
-                for (k, frame) in c.samples.chunks_exact(n).enumerate() {
-                    if let Some(t) = &c.times {
-                        text.push_str(&format!("{},", (t[k] - t0) * ms_per_unit));
-                    }
-                    let values: Vec<String> = frame.iter().map(|v| v.to_string()).collect();
-                    text.push_str(&values.join(","));
-                    text.push('\n');
-                }
-                std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
-                Ok(c.meta.clone())
-            })
-            .collect::<Result<_>>()?;
-        write_manifest(tmp, &metas)
-    })?;
-    summary.written = good.len();
-    summary.layout = layout;
-    Ok(summary)
+        time_column: timed.then(|| "t_ms".to_string()),
+        time_unit: timed.then_some(TimeUnit::Milliseconds),
+        channels: Some(names.to_vec()),
+    })
+}
+
+/// Writes one parsed file into the dataset folder `dir`: `t_ms` relative to its first time
+/// stamp (when it has time stamps), then the channels.
+fn write_imported(dir: &Path, c: &ParsedCsv, names: &[String], ms_per_unit: f64) -> Result<Meta> {
+    let path = dir.join(&c.meta.file);
+    let mut text = String::with_capacity(c.samples.len() * 8);
+    if c.times.is_some() {
+        text.push_str("t_ms,");
+    }
+    text.push_str(&names.join(","));
+    text.push('\n');
+    let t0 = c.times.as_ref().map_or(0.0, |t| t[0]);
+    for (k, frame) in c.samples.chunks_exact(names.len()).enumerate() {
+        if let Some(t) = &c.times {
+            text.push_str(&format!("{},", (t[k] - t0) * ms_per_unit));
+        }
+        let values: Vec<String> = frame.iter().map(|v| v.to_string()).collect();
+        text.push_str(&values.join(","));
+        text.push('\n');
+    }
+    std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
+    Ok(c.meta.clone())
 }
 
 /// The axes of a stacked array.
