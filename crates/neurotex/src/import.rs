@@ -729,105 +729,13 @@ pub fn import_stacked(
     p: &StackedParams,
     out: &Path,
 ) -> Result<usize> {
-    let axes = &p.axes.0;
     if !(p.fs.is_finite() && p.fs > 0.0) {
         return Err(ParamError::new("fs", "sampling rate must be positive", p.fs).into());
     }
-    let array = read_numbers(data)?;
-    if array.ndim() != axes.len() {
-        return Err(invalid(
-            data,
-            format!(
-                "--axes names {} axes but the data has {} (shape {:?})",
-                axes.len(),
-                array.ndim(),
-                array.shape()
-            ),
-        ));
-    }
-    if let Some(pos) = array.iter().position(|v| !v.is_finite()) {
-        return Err(invalid(
-            data,
-            format!("value {pos} (flat index) is not finite"),
-        ));
-    }
-    let find = |a: AxisName| axes.iter().position(|&x| x == a);
-    let has_grid = find(AxisName::Row).is_some();
-    let order: Vec<usize> = if has_grid {
-        [AxisName::N, AxisName::T, AxisName::Row, AxisName::Col]
-            .iter()
-            .filter_map(|&a| find(a))
-            .collect()
-    } else {
-        [AxisName::N, AxisName::T, AxisName::Channel]
-            .iter()
-            .filter_map(|&a| find(a))
-            .collect()
-    };
-    let arr = array
-        .permuted_axes(IxDyn(&order))
-        .as_standard_layout()
-        .into_owned();
-    let shape = arr.shape().to_vec();
-    let (n, t) = (shape[0], shape[1]);
-    let (rows, cols) = if has_grid {
-        (shape[2], shape[3])
-    } else {
-        let ch = shape[2];
-        match &p.grid {
-            Some(g) if g.cells() == ch => (g.rows(), g.cols()),
-            Some(g) => {
-                return Err(ParamError::new(
-                    "grid",
-                    "the grid must have as many cells as channels",
-                    format!("{g} for {ch} channels"),
-                )
-                .into())
-            }
-            None => (1, ch),
-        }
-    };
-    if n == 0 || t == 0 {
-        return Err(invalid(
-            data,
-            format!("no samples or no time steps (shape {shape:?})"),
-        ));
-    }
-    let labels = read_labels(labels)?.into_iter().collect::<Vec<_>>();
-    if labels.len() != n {
-        return Err(
-            DataError::invalid(data, format!("{} labels for {n} samples", labels.len())).into(),
-        );
-    }
-    let speeds: Vec<f64> = match speeds {
-        Some(path) => {
-            let s = read_numbers(path)?;
-            if s.len() != n {
-                return Err(invalid(path, format!("{} speeds for {n} samples", s.len())));
-            }
-            s.iter().copied().collect()
-        }
-        None => vec![0.0; n],
-    };
-    let mut trial_of: BTreeMap<(String, Speed), i64> = BTreeMap::new();
+    let (arr, (rows, cols)) = stacked_samples(data, p)?;
+    let (n, t) = (arr.shape()[0], arr.shape()[1]);
+    let metas = stacked_metas(data, labels, speeds, n)?;
     create_dataset_dir(out, |tmp| {
-        let metas: Vec<Meta> = (0..n)
-            .map(|i| {
-                let trial = trial_of
-                    .entry((labels[i].clone(), Speed::of(speeds[i])))
-                    .or_insert(0);
-                let meta = Meta {
-                    file: format!("sample_{i:05}.npy"),
-                    label: labels[i].clone(),
-                    speed_mm_s: speeds[i],
-                    force_n: 0.0,
-                    trial: *trial,
-                    ..Meta::default()
-                };
-                *trial += 1;
-                meta
-            })
-            .collect();
         metas
             .par_iter()
             .enumerate()
@@ -841,16 +749,102 @@ pub fn import_stacked(
                     .map_err(|e| DataError::invalid(&path, e.to_string()))?;
                 Ok(())
             })?;
-        write_layout(
-            tmp,
-            &LayoutFile {
-                fs: Some(p.fs),
-                rows: Some(rows),
-                cols: Some(cols),
-                ..LayoutFile::default()
-            },
-        )?;
+        let layout = LayoutFile {
+            fs: Some(p.fs),
+            rows: Some(rows),
+            cols: Some(cols),
+            ..LayoutFile::default()
+        };
+        write_layout(tmp, &layout)?;
         write_manifest(tmp, &metas)
     })?;
     Ok(n)
+}
+
+/// The stacked array read and checked, its axes put in the order `n, t, cells...`, and the
+/// grid each sample is laid out on.
+fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usize, usize))> {
+    let axes = &p.axes.0;
+    let array = read_numbers(data)?;
+    if array.ndim() != axes.len() {
+        let (named, has, shape) = (axes.len(), array.ndim(), array.shape());
+        let message = format!("--axes names {named} axes but the data has {has} (shape {shape:?})");
+        return Err(invalid(data, message));
+    }
+    if let Some(pos) = array.iter().position(|v| !v.is_finite()) {
+        return Err(invalid(
+            data,
+            format!("value {pos} (flat index) is not finite"),
+        ));
+    }
+    let find = |a: AxisName| axes.iter().position(|&x| x == a);
+    let has_grid = find(AxisName::Row).is_some();
+    let wanted: &[AxisName] = if has_grid {
+        &[AxisName::N, AxisName::T, AxisName::Row, AxisName::Col]
+    } else {
+        &[AxisName::N, AxisName::T, AxisName::Channel]
+    };
+    let order: Vec<usize> = wanted.iter().filter_map(|&a| find(a)).collect();
+    let arr = array
+        .permuted_axes(IxDyn(&order))
+        .as_standard_layout()
+        .into_owned();
+    let shape = arr.shape().to_vec();
+    let grid = if has_grid {
+        (shape[2], shape[3])
+    } else {
+        let ch = shape[2];
+        match &p.grid {
+            Some(g) if g.cells() == ch => (g.rows(), g.cols()),
+            Some(g) => {
+                let rule = "the grid must have as many cells as channels";
+                let got = format!("{g} for {ch} channels");
+                return Err(ParamError::new("grid", rule, got).into());
+            }
+            None => (1, ch),
+        }
+    };
+    if shape[0] == 0 || shape[1] == 0 {
+        let message = format!("no samples or no time steps (shape {shape:?})");
+        return Err(invalid(data, message));
+    }
+    Ok((arr, grid))
+}
+
+/// One manifest row per stacked sample: its label, its speed (0 without a speeds file), and
+/// a trial number counting the samples of each label and speed.
+fn stacked_metas(data: &Path, labels: &Path, speeds: Option<&Path>, n: usize) -> Result<Vec<Meta>> {
+    let labels = read_labels(labels)?.into_iter().collect::<Vec<_>>();
+    if labels.len() != n {
+        let message = format!("{} labels for {n} samples", labels.len());
+        return Err(DataError::invalid(data, message).into());
+    }
+    let speeds: Vec<f64> = match speeds {
+        Some(path) => {
+            let s = read_numbers(path)?;
+            if s.len() != n {
+                return Err(invalid(path, format!("{} speeds for {n} samples", s.len())));
+            }
+            s.iter().copied().collect()
+        }
+        None => vec![0.0; n],
+    };
+    let mut trial_of: BTreeMap<(String, Speed), i64> = BTreeMap::new();
+    Ok((0..n)
+        .map(|i| {
+            let trial = trial_of
+                .entry((labels[i].clone(), Speed::of(speeds[i])))
+                .or_insert(0);
+            let meta = Meta {
+                file: format!("sample_{i:05}.npy"),
+                label: labels[i].clone(),
+                speed_mm_s: speeds[i],
+                force_n: 0.0,
+                trial: *trial,
+                ..Meta::default()
+            };
+            *trial += 1;
+            meta
+        })
+        .collect())
 }
