@@ -12,7 +12,6 @@ use neurotex::experiments::{
 };
 use neurotex::recording::Dataset;
 use neurotex::report::{write_report, ReportContext};
-use neurotex::sim::{design, RigParams, ALL_TEXTURES};
 
 use crate::output::progress;
 use crate::stage_args::StageArgs;
@@ -58,41 +57,16 @@ impl ReproduceArgs {
         Ok(params.check()?)
     }
 
-    /// The data to run on, with the paragraph the report gives it.
-    fn source<'a>(&self, dataset: Option<&'a Dataset>) -> Result<(Source<'a>, String)> {
+    /// The data to run on: the dataset folder, or the paper's design on the simulator.
+    fn source<'a>(&self, dataset: Option<&'a Dataset>) -> Result<Source<'a>> {
         let trials_per = self.trials.unwrap_or(if self.quick { 10 } else { 20 });
         if trials_per == 0 {
             bail!("--trials must be at least 1");
         }
-        if let Some(ds) = dataset {
-            let baseline = match ds.layout.baseline {
-                Some(b) => format!(", baseline removal {b:?} (layout.toml)"),
-                None => String::new(),
-            };
-            let text = format!(
-                "Dataset folder `{}`: {} recordings as listed in its manifest{baseline}.",
-                ds.root.display(),
-                ds.entries.len(),
-            );
-            return Ok((Source::Dataset(ds), text));
-        }
-        let rig = RigParams::default();
-        let text = format!(
-            "Simulated in memory by neurotex's model of the rig (seed {}): 8 textures (FT1, FT2, FT3, RT, TRug, SB, CP, STF) x 5, 10, 15 mm/s x {trials_per} trials; a 4x4 array of {} mm taxels on {} mm, {} N under force control, {} s hold, {} mm slide, 1 kHz. Rig parameters: `{}`.",
-            self.seed,
-            rig.taxel_mm,
-            rig.active_mm,
-            rig.force_n,
-            rig.hold_s,
-            rig.slide_mm,
-            serde_json::to_string(&rig)?
-        );
-        let source = Source::Simulated {
-            rig: Box::new(rig),
-            trials: design(&ALL_TEXTURES, &[5.0, 10.0, 15.0], trials_per),
-            seed: self.seed,
-        };
-        Ok((source, text))
+        Ok(match dataset {
+            Some(ds) => Source::Dataset(ds),
+            None => Source::paper_design(trials_per, self.seed),
+        })
     }
 }
 
@@ -104,15 +78,15 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         Some(dir) => Some(Dataset::open(dir)?),
         None => None,
     };
-    let (source, description) = args.source(dataset.as_ref())?;
+    let source = args.source(dataset.as_ref())?;
     let bar = Mutex::new(progress(0, "starting"));
     let on_progress = |p: Progress| show_progress(&bar.lock().expect("progress bar"), p);
     let prepared = prepare(&source, &params, &on_progress)?;
     let results = run_all(&prepared, &params, &on_progress)?;
     bar.lock().expect("progress bar").finish_and_clear();
     let ctx = ReportContext {
-        dataset: description,
-        parameters: parameter_lines(&params),
+        dataset: source.describe(),
+        parameters: params.describe(),
         total_seconds: started.elapsed().as_secs_f64(),
         command: command_line(),
         paper_comparable: dataset.is_none(),
@@ -144,19 +118,6 @@ fn show_progress(bar: &ProgressBar, event: Progress) {
         }
         Progress::Tick => bar.inc(1),
     }
-}
-
-/// The parameters as the report lists them, one `name: value` line each.
-fn parameter_lines(params: &ReproduceParams) -> Vec<String> {
-    let p = &params.pipeline;
-    vec![
-        format!("encoder: Izhikevich {:?}, gain G = {}", p.encoder, p.encoder.gain),
-        format!("low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only: {}", p.preprocess.cutoff_hz, p.preprocess.slide_only),
-        format!("rate volume: {} ms bins; {} gray levels; GLCM distances {:?}, 13 directions, symmetric {}", p.volume.bin_ms, p.volume.levels, p.glcm.distances, p.glcm.symmetric),
-        format!("KNN: k = {}, Euclidean, features z-scored on training folds: {}", params.knn.k, params.knn.standardize),
-        format!("CV: {}-fold stratified, shuffled with seed {}, {} repeats", params.cv.folds, params.cv.seed, params.cv.repeats),
-        format!("E3: {} draws per n, n in {:?}; E5 fractions {:?}; E7 gains {:?}; E8 k in {:?}", params.e3_repeats, params.e3_counts, params.e5_fractions, params.e7_gains, params.e8_ks),
-    ]
 }
 
 /// The command line that produced the report, as `neurotex ...` with quoted arguments.

@@ -75,6 +75,35 @@ impl ReproduceParams {
         }
     }
 
+    /// The parameters as the report lists them, one `name: value` line each.
+    pub fn describe(&self) -> Vec<String> {
+        let p = &self.pipeline;
+        let (pre, enc, vol, glcm) = (&p.preprocess, &p.encoder, &p.volume, &p.glcm);
+        vec![
+            format!("encoder: Izhikevich {enc:?}, gain G = {}", enc.gain),
+            format!(
+                "low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only: {}",
+                pre.cutoff_hz, pre.slide_only
+            ),
+            format!(
+                "rate volume: {} ms bins; {} gray levels; GLCM distances {:?}, 13 directions, symmetric {}",
+                vol.bin_ms, vol.levels, glcm.distances, glcm.symmetric
+            ),
+            format!(
+                "KNN: k = {}, Euclidean, features z-scored on training folds: {}",
+                self.knn.k, self.knn.standardize
+            ),
+            format!(
+                "CV: {}-fold stratified, shuffled with seed {}, {} repeats",
+                self.cv.folds, self.cv.seed, self.cv.repeats
+            ),
+            format!(
+                "E3: {} draws per n, n in {:?}; E5 fractions {:?}; E7 gains {:?}; E8 k in {:?}",
+                self.e3_repeats, self.e3_counts, self.e5_fractions, self.e7_gains, self.e8_ks
+            ),
+        ]
+    }
+
     /// Checks every rule and plans the pipeline: the form the analyses take.
     ///
     /// # Errors

@@ -11,7 +11,7 @@ use crate::error::{DataError, Result};
 use crate::pipeline::Encoded;
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
-use crate::sim::{simulate_trial, RigParams, Trial};
+use crate::sim::{design, simulate_trial, RigParams, Trial, ALL_TEXTURES};
 use crate::values::{Grid, Speed};
 
 /// Where the recordings come from.
@@ -30,6 +30,33 @@ pub enum Source<'a> {
 }
 
 impl Source<'_> {
+    /// The paper's design on the built-in simulator: its 8 textures x 5, 10, 15 mm/s x
+    /// `trials` trials, on the default rig, generated with `seed`.
+    pub fn paper_design(trials: u32, seed: u64) -> Self {
+        Source::Simulated {
+            rig: Box::new(RigParams::default()),
+            trials: design(&ALL_TEXTURES, &[5.0, 10.0, 15.0], trials),
+            seed,
+        }
+    }
+
+    /// One paragraph saying where the recordings come from, for the report.
+    pub fn describe(&self) -> String {
+        match self {
+            Source::Dataset(ds) => {
+                let baseline = match ds.layout.baseline {
+                    Some(b) => format!(", baseline removal {b:?} (layout.toml)"),
+                    None => String::new(),
+                };
+                let (root, n) = (ds.root.display(), ds.entries.len());
+                format!(
+                    "Dataset folder `{root}`: {n} recordings as listed in its manifest{baseline}."
+                )
+            }
+            Source::Simulated { rig, trials, seed } => describe_simulated(rig, trials, *seed),
+        }
+    }
+
     /// Number of recordings.
     fn len(&self) -> usize {
         match self {
@@ -65,6 +92,32 @@ impl Source<'_> {
             Source::Dataset(ds) => ds.load(i),
         }
     }
+}
+
+fn describe_simulated(rig: &RigParams, trials: &[Trial], seed: u64) -> String {
+    let mut textures: Vec<&str> = Vec::new();
+    for t in trials {
+        if !textures.contains(&t.texture.name()) {
+            textures.push(t.texture.name());
+        }
+    }
+    let speeds = Speed::distinct(trials.iter().map(|t| Speed::of(t.speed_mm_s)));
+    let speeds: Vec<String> = speeds.iter().map(|s| s.to_string()).collect();
+    let per_condition = trials.len() / (textures.len() * speeds.len()).max(1);
+    let rig_json = serde_json::to_string(rig).unwrap_or_default();
+    format!(
+        "Simulated in memory by neurotex's model of the rig (seed {seed}): {} textures ({}) x {} mm/s x {per_condition} trials; a {}x{} array of {} mm taxels on {} mm, {} N under force control, {} s hold, {} mm slide, 1 kHz. Rig parameters: `{rig_json}`.",
+        textures.len(),
+        textures.join(", "),
+        speeds.join(", "),
+        rig.rows,
+        rig.cols,
+        rig.taxel_mm,
+        rig.active_mm,
+        rig.force_n,
+        rig.hold_s,
+        rig.slide_mm,
+    )
 }
 
 /// ISI histograms of the gain sweep, accumulated over trials and taxels.
