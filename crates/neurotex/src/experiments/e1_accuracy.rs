@@ -11,6 +11,9 @@ use crate::values::BySpeed;
 pub struct E1Speed {
     /// Single taxel, mean over taxels.
     pub taxel_mean: f64,
+    /// Single taxel, mean over the responsive taxels (neither silent nor at the ceiling in
+    /// most recordings); `None` when no taxel responds.
+    pub taxel_mean_responsive: Option<f64>,
     /// The best taxel (chosen after the fact).
     pub taxel_best: f64,
     /// Which taxel was best, `r{row}c{col}`.
@@ -21,6 +24,12 @@ pub struct E1Speed {
     pub glcm3d_std: f64,
     /// Samples.
     pub n: usize,
+    /// Classes recorded at this speed.
+    pub classes: usize,
+    /// Chance by guessing uniformly among those classes, `1 / classes`.
+    pub chance: f64,
+    /// Chance by always answering the most frequent class at this speed.
+    pub majority: f64,
 }
 
 /// E1 at every speed, from the headline evaluations.
@@ -37,17 +46,42 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
                 col: 0,
                 accuracy: h.taxel.accuracy,
             });
+            let truth: Vec<usize> = h
+                .glcm3d
+                .confusion
+                .rows()
+                .iter()
+                .map(|r| r.iter().sum())
+                .collect();
+            let total = truth.iter().sum::<usize>().max(1) as f64;
+            let classes = truth.iter().filter(|&&n| n > 0).count();
             let e1 = E1Speed {
                 taxel_mean: h.taxel.accuracy,
+                taxel_mean_responsive: responsive_mean(c, &h.taxel),
                 taxel_best: best.accuracy,
                 taxel_best_cell: format!("r{}c{}", best.row, best.col),
                 glcm3d: h.glcm3d.accuracy,
                 glcm3d_std: h.glcm3d.accuracy_std,
                 n: h.glcm3d.n,
+                classes,
+                chance: 1.0 / classes.max(1) as f64,
+                majority: truth.iter().copied().max().unwrap_or(0) as f64 / total,
             };
             (speed, e1)
         })
         .collect())
+}
+
+/// The mean accuracy over the taxels that respond, from an every-taxel evaluation.
+fn responsive_mean(c: &Context, taxel: &crate::analysis::Outcome) -> Option<f64> {
+    let diagnostics = &c.prepared.taxels;
+    let per = taxel.per_taxel.as_deref().unwrap_or_default();
+    let responsive: Vec<f64> = per
+        .iter()
+        .filter(|t| diagnostics.responsive(&format!("r{}c{}", t.row, t.col)))
+        .map(|t| t.accuracy)
+        .collect();
+    (!responsive.is_empty()).then(|| responsive.iter().sum::<f64>() / responsive.len() as f64)
 }
 
 #[cfg(test)]
@@ -64,6 +98,10 @@ mod tests {
             assert!(e.taxel_best >= e.taxel_mean);
             assert!((0.0..=1.0).contains(&e.glcm3d) && e.n > 0);
             assert!(e.taxel_best_cell.starts_with('r'));
+            // 4 textures x 6 trials at each speed
+            assert_eq!((e.classes, e.chance, e.majority), (4, 0.25, 0.25));
+            let responsive = e.taxel_mean_responsive.expect("the rig's taxels respond");
+            assert!((0.0..=1.0).contains(&responsive));
         }
     }
 }

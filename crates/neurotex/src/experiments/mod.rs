@@ -7,6 +7,7 @@
 //! judged here ([`claims`]); the report only renders.
 
 mod claims;
+mod diagnostics;
 mod e0_psth;
 mod e1_accuracy;
 mod e2_confusion;
@@ -29,6 +30,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 pub use claims::{claims, Claim, Verdict};
+pub use diagnostics::{taxel_diagnostics, TaxelDiagnostics, TaxelResponse, SATURATION_SHARE};
 pub use e0_psth::{e0_psth, E0Example, E0};
 pub use e1_accuracy::{e1_accuracy, E1Speed};
 pub use e2_confusion::{e2_confusion, E2};
@@ -79,6 +81,8 @@ pub struct Results {
     pub resampled: usize,
     /// Recordings with no positive signal.
     pub flat: usize,
+    /// Taxels silent or at the encoder's ceiling in most recordings.
+    pub taxels: TaxelDiagnostics,
     /// E0.
     pub e0: Option<E0>,
     /// E1 by speed.
@@ -112,6 +116,7 @@ impl Results {
             recordings: encoded.len(),
             resampled: encoded.iter().filter(|e| e.resampled).count(),
             flat: encoded.iter().filter(|e| e.flat).count(),
+            taxels: prepared.taxels.clone(),
             e0: None,
             e1: BySpeed::new(),
             e2: None,

@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::{Progress, ValidReproduceParams};
+use super::{taxel_diagnostics, Progress, TaxelDiagnostics, ValidReproduceParams};
 use crate::error::{DataError, Result};
 use crate::pipeline::Encoded;
 use crate::recording::{Baseline, Dataset, Recording};
@@ -187,6 +187,8 @@ pub struct Prepared {
     pub slowest: Speed,
     /// The labels in order of first appearance.
     pub labels: Vec<String>,
+    /// Taxels silent or at the encoder's ceiling in most recordings.
+    pub taxels: TaxelDiagnostics,
     /// Seconds the pass took.
     pub seconds: f64,
 }
@@ -245,8 +247,10 @@ pub fn prepare(
         let message = "its taxel grid differs from the first recording's";
         return Err(DataError::invalid(&e.meta.file, message).into());
     }
+    let taxels = taxel_diagnostics(&encoded, &grid, params)?;
     Ok(Prepared {
         speeds: Speed::distinct(conditions.iter().map(|c| c.0)),
+        taxels,
         encoded,
         isi,
         grid,

@@ -53,6 +53,9 @@ struct Grouped {
     groups: Vec<String>,
     series: Vec<Bars>,
     chance: Option<f64>,
+    /// Chance (%) at each group, drawn as a dashed segment across its slot instead of one
+    /// line for all classes, when the groups hold different classes.
+    chance_per_group: Option<Vec<f64>>,
 }
 
 /// The x description for speeds: signed speeds are directions, and say so.
@@ -106,7 +109,10 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
     let level = labels_fit(&g.groups, plot_w / n as i32);
     let bottom = labels_height(&g.groups, level) + 26;
     let mut keys: Vec<Key> = series.iter().map(|s| s.key.clone()).collect();
-    if let Some(c) = g.chance {
+    if g.chance_per_group.is_some() {
+        let text = "chance at each speed (1 / classes there)";
+        keys.push(Key::new(text.to_string(), Swatch::Dashed(GREY)));
+    } else if let Some(c) = g.chance {
         keys.push(Key::new(
             format!("chance, all classes ({} %)", percent(c)),
             Swatch::Dashed(GREY),
@@ -133,8 +139,17 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
             .y_desc("accuracy (%)")
             .draw()?;
         bars(&mut chart, &series)?;
-        if let Some(c) = g.chance {
-            hline(&mut chart, c, GREY, 9)?;
+        match (&g.chance_per_group, g.chance) {
+            (Some(per), _) => {
+                for (i, &c) in per.iter().enumerate() {
+                    let (x0, x1) = (i as f64 + 0.02, i as f64 + 0.98);
+                    let segment =
+                        DashedLineSeries::new([(x0, c), (x1, c)], 9, 6, GREY.stroke_width(2));
+                    chart.draw_series(segment)?;
+                }
+            }
+            (None, Some(c)) => hline(&mut chart, c, GREY, 9)?,
+            (None, None) => {}
         }
         let xs: Vec<i32> = (0..n)
             .map(|i| chart.backend_coord(&(i as f64 + 0.5, 0.0)).0)
@@ -195,6 +210,7 @@ pub(crate) fn e1(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         groups: speeds.iter().map(ToString::to_string).collect(),
         series,
         chance: chance(r),
+        chance_per_group: Some(r.e1.values().map(|e| 100.0 * e.chance).collect()),
     })
 }
 
@@ -236,6 +252,7 @@ pub(crate) fn e4(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         groups: speeds.iter().map(ToString::to_string).collect(),
         series,
         chance: chance(r),
+        chance_per_group: None,
     })
 }
 
@@ -268,6 +285,7 @@ pub(crate) fn e6(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         groups: speeds.iter().map(ToString::to_string).collect(),
         series,
         chance: chance(r),
+        chance_per_group: None,
     })
 }
 
@@ -288,12 +306,10 @@ fn paper_note(paper: Option<&Paper>) -> &'static str {
 }
 
 /// E1's caption.
-pub(crate) fn e1_caption(r: &Results, paper: Option<&Paper>) -> String {
+pub(crate) fn e1_caption(paper: Option<&Paper>) -> String {
     format!(
-        "Accuracy over {} classes per speed (cross-validated, mean over repeats): the single taxel as the mean over all taxels (dark blue) and the best taxel, chosen after the fact (light blue), against 3D-GLCM (vermillion, error bar ± 1 std over CV repeats).{} {}",
-        r.labels.len(),
+        "Accuracy per speed (cross-validated, mean over repeats): the single taxel as the mean over all taxels (dark blue) and the best taxel, chosen after the fact (light blue), against 3D-GLCM (vermillion, error bar ± 1 std over CV repeats).{} The dashed grey segment over each speed is chance there, one over the classes recorded at that speed.",
         paper_note(paper),
-        chance_note(r)
     )
 }
 

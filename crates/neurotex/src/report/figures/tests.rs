@@ -6,7 +6,8 @@ use std::collections::BTreeMap;
 
 use super::*;
 use crate::experiments::{
-    E0Example, E1Speed, E4Speed, E5Speed, E6Speed, E8Speed, IsiSweep, E0, E2, E3, E7,
+    E0Example, E1Speed, E4Speed, E5Speed, E6Speed, E8Speed, IsiSweep, TaxelDiagnostics,
+    TaxelResponse, E0, E2, E3, E7,
 };
 use crate::report::paper::PAPER;
 use crate::values::{BySpeed, Speed};
@@ -58,6 +59,11 @@ pub(crate) fn wide() -> Results {
                     glcm3d: acc[i],
                     glcm3d_std: 0.03,
                     n: 69,
+                    // FabricSlide records 5 of its 7 fabrics at the positive speeds
+                    classes: if s.mm_s() > 0.0 { 5 } else { 7 },
+                    chance: if s.mm_s() > 0.0 { 0.2 } else { 1.0 / 7.0 },
+                    majority: if s.mm_s() > 0.0 { 0.22 } else { 0.16 },
+                    taxel_mean_responsive: Some(acc[i] * 0.8),
                 },
             )
         })
@@ -192,6 +198,16 @@ pub(crate) fn wide() -> Results {
         recordings: 962,
         resampled: 962,
         flat: 0,
+        taxels: TaxelDiagnostics {
+            ceiling_hz: 63.0,
+            taxels: (0..16)
+                .map(|i| TaxelResponse {
+                    taxel: format!("r{}c{}", i / 4, i % 4),
+                    silent_share: if i == 0 { 0.98 } else { 0.3 },
+                    saturated_share: 0.0,
+                })
+                .collect(),
+        },
         e0: Some(E0 {
             speed: Speed::of(10.0),
             taxel: [1, 1],
