@@ -19,6 +19,7 @@ mod e7_gain;
 mod e8_neighbours;
 mod params;
 mod prepare;
+mod sensitivity;
 mod skip;
 mod tables;
 #[cfg(test)]
@@ -42,6 +43,7 @@ pub use e7_gain::{e7_gain_sweep, E7};
 pub use e8_neighbours::{e8_neighbours, E8Speed};
 pub use params::{ReproduceParams, ValidReproduceParams, MAX_REPEATS};
 pub use prepare::{prepare, IsiSweep, Prepared, Source};
+pub use sensitivity::{sensitivity, Sensitivity, SensitivitySpeed};
 pub use skip::{Skip, Stop};
 pub use tables::{Headline, Tables};
 
@@ -101,6 +103,8 @@ pub struct Results {
     pub e7: Option<E7>,
     /// E8 by speed.
     pub e8: BySpeed<E8Speed>,
+    /// The headline accuracies on an input changed by a rounding-level amount.
+    pub sensitivity: Option<Sensitivity>,
     /// Analyses skipped, with the reason.
     pub skipped: BTreeMap<String, String>,
     /// Wall-clock seconds per analysis.
@@ -126,6 +130,7 @@ impl Results {
             e6: BySpeed::new(),
             e7: None,
             e8: BySpeed::new(),
+            sensitivity: None,
             skipped: BTreeMap::new(),
             timing_s: BTreeMap::new(),
         }
@@ -146,7 +151,7 @@ pub struct Analysis {
 
 /// The analyses in the order they run (E0 last: it shows examples, and the paper's own
 /// order puts the accuracies first).
-pub const ANALYSES: [Analysis; 9] = [
+pub const ANALYSES: [Analysis; 10] = [
     Analysis {
         id: "e1",
         run: |c, r| {
@@ -202,6 +207,13 @@ pub const ANALYSES: [Analysis; 9] = [
             let (e8, skipped) = e8_neighbours(c)?;
             skipped.iter().for_each(|s| r.skip(s));
             r.e8 = e8;
+            Ok(())
+        },
+    },
+    Analysis {
+        id: "sensitivity",
+        run: |c, r| {
+            r.sensitivity = sensitivity(c)?;
             Ok(())
         },
     },

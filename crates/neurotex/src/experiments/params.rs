@@ -33,6 +33,10 @@ pub struct ReproduceParams {
     pub e8_ks: Vec<usize>,
     /// Seed of E3's perturbations.
     pub seed: u64,
+    /// Numerical sensitivity: the relative change applied to every encoder input (the
+    /// conditioned signal times `1 + this`) before the headline evaluations are repeated;
+    /// `None` skips it. Default 1e-12, a rounding-level change.
+    pub sensitivity: Option<f64>,
 }
 
 impl Default for ReproduceParams {
@@ -53,6 +57,7 @@ impl Default for ReproduceParams {
             e7_max_ms: 300,
             e8_ks: vec![1, 3, 5, 7, 9],
             seed: 0,
+            sensitivity: Some(1e-12),
         }
     }
 }
@@ -101,6 +106,10 @@ impl ReproduceParams {
                 "E3: {} draws per n, n in {:?}; E5 fractions {:?}; E7 gains {:?}; E8 k in {:?}",
                 self.e3_repeats, self.e3_counts, self.e5_fractions, self.e7_gains, self.e8_ks
             ),
+            format!(
+                "numerical sensitivity: encoder input times 1 + {}",
+                self.sensitivity.map_or("(not run)".to_string(), |e| format!("{e:e}"))
+            ),
         ]
     }
 
@@ -142,6 +151,13 @@ impl ReproduceParams {
         }
         for &k in &self.e8_ks {
             KnnParams { k, ..self.knn }.check()?;
+        }
+        if let Some(eps) = self
+            .sensitivity
+            .filter(|e| !(e.is_finite() && e.abs() < 1e-3))
+        {
+            let rule = "the sensitivity change must be a finite relative change below 1e-3";
+            return Err(ParamError::new("sensitivity", rule, eps));
         }
         Ok(ValidReproduceParams {
             params: self,

@@ -189,6 +189,9 @@ pub struct Prepared {
     pub labels: Vec<String>,
     /// Taxels silent or at the encoder's ceiling in most recordings.
     pub taxels: TaxelDiagnostics,
+    /// With a sensitivity check: every recording's spikes from its input changed by the
+    /// relative amount asked, in the order of `encoded`.
+    pub perturbed: Option<Vec<Encoded>>,
     /// Seconds the pass took.
     pub seconds: f64,
 }
@@ -226,7 +229,7 @@ pub fn prepare(
         }
     }
     progress(Progress::Stage("recordings", n));
-    let results: Vec<(Encoded, Option<Vec<GainPoint>>)> = (0..n)
+    let results: Vec<EncodedOne> = (0..n)
         .into_par_iter()
         .map(|i| {
             let out = encode_one(source, i, conditions[i].0 == slowest, params);
@@ -236,11 +239,15 @@ pub fn prepare(
         .collect::<Result<_>>()?;
     let mut isi = IsiSweep::empty(params, labels.clone());
     let mut encoded = Vec::with_capacity(n);
-    for (e, sweep) in results {
-        if let Some(points) = sweep {
-            isi.add(&e.meta.label, points);
+    let mut perturbed = params.sensitivity.map(|_| Vec::with_capacity(n));
+    for one in results {
+        if let Some(points) = one.sweep {
+            isi.add(&one.encoded.meta.label, points);
         }
-        encoded.push(e);
+        if let (Some(all), Some(p)) = (perturbed.as_mut(), one.perturbed) {
+            all.push(p);
+        }
+        encoded.push(one.encoded);
     }
     let grid = encoded[0].spikes.grid();
     if let Some(e) = encoded.iter().find(|e| e.spikes.present != grid.present()) {
@@ -251,6 +258,7 @@ pub fn prepare(
     Ok(Prepared {
         speeds: Speed::distinct(conditions.iter().map(|c| c.0)),
         taxels,
+        perturbed,
         encoded,
         isi,
         grid,
@@ -260,19 +268,29 @@ pub fn prepare(
     })
 }
 
+/// One recording's share of the pass.
+struct EncodedOne {
+    encoded: Encoded,
+    /// The E7 sweep's histograms, at the slowest speed.
+    sweep: Option<Vec<GainPoint>>,
+    /// The spikes of the perturbed input, with a sensitivity check.
+    perturbed: Option<Encoded>,
+}
+
 /// Loads, conditions and encodes recording `i`; with `sweep`, also encodes it at every E7
-/// gain and returns its ISI histograms.
+/// gain and returns its ISI histograms; with a sensitivity check, also encodes its input
+/// changed by that relative amount.
 fn encode_one(
     source: &Source,
     i: usize,
     sweep: bool,
     params: &ValidReproduceParams,
-) -> Result<(Encoded, Option<Vec<GainPoint>>)> {
+) -> Result<EncodedOne> {
     let pipeline = params.pipeline();
     let rec = source.load(i)?;
-    let cond = pipeline.condition(&rec, source.baseline())?;
+    let mut cond = pipeline.condition(&rec, source.baseline())?;
     let spikes = pipeline.encode_conditioned(&rec, &cond, None)?;
-    let points = if sweep {
+    let sweep = if sweep {
         Some(gain_sweep(&rec, &cond, params)?)
     } else {
         None
@@ -283,7 +301,22 @@ fn encode_one(
         resampled: cond.resampled,
         flat: cond.flat,
     };
-    Ok((encoded, points))
+    let perturbed = match params.sensitivity {
+        Some(eps) => {
+            cond.samples.iter_mut().for_each(|x| *x *= 1.0 + eps);
+            let spikes = pipeline.encode_conditioned(&rec, &cond, None)?;
+            Some(Encoded {
+                spikes,
+                ..encoded.clone()
+            })
+        }
+        None => None,
+    };
+    Ok(EncodedOne {
+        encoded,
+        sweep,
+        perturbed,
+    })
 }
 
 fn gain_sweep(

@@ -247,6 +247,7 @@ pub(crate) fn wide() -> Results {
             median_isi_ms: vec![vec![None; n]; gains.len()],
         }),
         e8,
+        sensitivity: None,
         skipped: BTreeMap::new(),
         timing_s: BTreeMap::new(),
     }
