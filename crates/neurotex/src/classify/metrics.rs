@@ -515,6 +515,12 @@ mod tests {
         let none = wilson_interval(0, 10).unwrap();
         assert_eq!((none.lower, none.estimate), (0.0, 0.0));
         assert!(none.upper > 0.2);
+        let json = serde_json::to_value(&none).unwrap();
+        assert_eq!(
+            (json["method"].as_str(), json["n"].as_u64()),
+            (Some("wilson"), Some(10))
+        );
+        assert_eq!(serde_json::from_value::<Interval>(json).unwrap(), none);
         let all = wilson_interval(10, 10).unwrap();
         assert_eq!((all.estimate, all.upper), (1.0, 1.0));
         assert!(all.lower < 0.8);
