@@ -1,14 +1,24 @@
 //! Classification (SPEC 3.12-3.13): a [`Classifier`] trait (fit, then predict), k-nearest
 //! neighbours with training-fold z-scoring, stratified shuffled k-fold cross-validation and
-//! train/test evaluation over any classifier, and the [`ConfusionMatrix`] they fill.
+//! train/test evaluation over any classifier, and the [`ConfusionMatrix`] they fill; then
+//! what the results mean (SPEC 9): [`Metrics`] with chance levels, 95 % intervals for an
+//! accuracy, and McNemar's paired test of two methods ([`metrics`], on [`stats`]).
 
 pub mod confusion;
 pub mod cv;
 pub mod knn;
+pub mod metrics;
+pub mod stats;
 
 pub use confusion::ConfusionMatrix;
 pub use cv::{cross_validate, stratified_folds, train_test, CvParams, Evaluation, ValidCv};
 pub use knn::{Knn, KnnModel, KnnParams};
+pub use metrics::{
+    bootstrap_accuracy, bootstrap_mean_share, mcnemar_exact, mcnemar_exact_p,
+    t_interval_over_repeats, wilson_interval, BootstrapParams, ClassMetrics, Interval,
+    IntervalMethod, Metrics, PairedTest, PairedVerdict, Side, ValidBootstrap,
+};
+pub use stats::StatsError;
 
 use crate::error::ClassifyError;
 
