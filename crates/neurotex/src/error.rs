@@ -25,6 +25,9 @@ pub enum Error {
         /// What went wrong.
         source: Box<Error>,
     },
+    /// A statistic could not be computed from what it was given.
+    #[error(transparent)]
+    Stats(#[from] crate::classify::stats::StatsError),
     /// A dataset cannot serve what was asked of it (speeds, one grid).
     #[error(transparent)]
     Dataset(#[from] DatasetError),
