@@ -261,8 +261,10 @@ impl Preprocessor {
 pub fn normalise_global_max(samples: &mut [f64]) -> bool {
     let max = samples.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if max > 0.0 {
-        let inv = 1.0 / max;
-        samples.iter_mut().for_each(|s| *s *= inv);
+        // A true division, not a multiplication by `1 / max`: that rounds twice and can
+        // differ in the last bit, which the encoder's threshold can turn into a spike more
+        // or less; dividing gives numpy's `x / x.max()` bit for bit.
+        samples.iter_mut().for_each(|s| *s /= max);
         false
     } else {
         samples.iter_mut().for_each(|s| *s = 0.0);
