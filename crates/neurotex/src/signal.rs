@@ -2,6 +2,8 @@
 //! baseline removal, resampling to the encoder's 1 kHz, zero-phase Butterworth low-pass
 //! and global-max normalisation.
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{Baseline, Phase, Recording};
 
@@ -9,7 +11,7 @@ use crate::recording::{Baseline, Phase, Recording};
 pub const ENCODER_FS: f64 = 1000.0;
 
 /// Parameters of the conditioning stages.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PreprocessParams {
     /// Low-pass cutoff in Hz; 0 turns the filter off. The paper gives none: 50 Hz.
     pub cutoff_hz: f64,
