@@ -7,7 +7,9 @@ pub mod cv;
 pub mod knn;
 
 pub use confusion::ConfusionMatrix;
-pub use cv::{cross_validate, stratified_folds, train_test, CvParams, Evaluation, ValidCv};
+pub use cv::{
+    cross_validate, stratified_folds, train_test, CvParams, Evaluation, RepeatPredictions, ValidCv,
+};
 pub use knn::{Knn, KnnModel, KnnParams};
 
 use crate::error::ClassifyError;
