@@ -5,8 +5,10 @@ pub mod encode;
 pub mod evaluate;
 pub mod features;
 pub mod import;
+pub mod predict;
 pub mod reproduce;
 pub mod simulate;
+pub mod train;
 
 use anyhow::Result;
 use neurotex::analysis::FeatureTable;
