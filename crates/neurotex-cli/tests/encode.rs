@@ -3,7 +3,7 @@
 use ndarray::Array3;
 use ndarray_npy::{read_npy, write_npy};
 
-use crate::util::{recording, s, Dir};
+use crate::util::{recording, s, xorshift, Dir};
 
 #[test]
 fn encode_writes_raster_and_events() {
@@ -143,14 +143,9 @@ fn encode_feeds_the_neurons_x_over_its_maximum() {
         .map(|k| 0.7 + 0.0137 * k as f64)
         .find_map(|max| knife_edge(max, gain).map(|x| (max, x)))
         .expect("a sample on the threshold for one of the maxima tried");
-    let mut state = 7u64;
+    let mut random = xorshift(7);
     let mut x: Vec<f64> = (0..steps * channels)
-        .map(|_| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            max * (state % 1_000_000) as f64 / 1_000_000.0
-        })
+        .map(|_| max * (random() % 1_000_000) as f64 / 1_000_000.0)
         .collect();
     x[0] = edge;
     x[5 * channels + 2] = max;

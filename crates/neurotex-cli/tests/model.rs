@@ -28,6 +28,22 @@ fn simulated(dir: &Dir, name: &str, seed: &str) -> PathBuf {
     out
 }
 
+/// The JSON in `path`.
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Runs `neurotex predict --model MODEL --dataset DATASET --out OUT --json`, which must
+/// succeed; returns the score it prints.
+fn scored(dir: &Dir, model: &Path, dataset: &Path, out: &Path) -> Value {
+    let json = dir.ok(&predict(
+        s(model),
+        s(out),
+        &["--dataset", s(dataset), "--json"],
+    ));
+    serde_json::from_str(&json).expect("predict --json prints JSON")
+}
+
 /// The rows of a CSV file as fields, header first.
 fn csv_rows(path: &Path) -> Vec<Vec<String>> {
     std::fs::read_to_string(path)
@@ -43,7 +59,7 @@ fn a_model_trained_on_one_seed_predicts_another() {
     let (a, b) = (simulated(&dir, "A", "1"), simulated(&dir, "B", "2"));
     let model = dir.join("model.json");
     dir.ok(&["train", "--dataset", s(&a), "--out", s(&model)]);
-    let file: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let file = read_json(&model);
     assert_eq!(file["format"], "neurotex-model");
     assert_eq!(file["version"], 1);
     assert_eq!(file["features"]["method"], "glcm3d");
@@ -53,17 +69,7 @@ fn a_model_trained_on_one_seed_predicts_another() {
     assert!(fingerprint.starts_with("sha256:") && fingerprint.len() == 7 + 64);
 
     let out = dir.join("predictions.csv");
-    let json = dir.ok(&[
-        "predict",
-        "--model",
-        s(&model),
-        "--dataset",
-        s(&b),
-        "--out",
-        s(&out),
-        "--json",
-    ]);
-    let score: Value = serde_json::from_str(&json).unwrap();
+    let score = scored(&dir, &model, &b, &out);
     let accuracy = score["accuracy"].as_f64().unwrap();
     assert!(accuracy > 0.6, "chance is 1/3, got {accuracy}");
     assert_eq!(score["n"], 18);
@@ -97,15 +103,11 @@ fn a_model_trained_on_one_seed_predicts_another() {
     // plain files: the label is unknown
     let plain = dir.join("plain.csv");
     let files = [b.join("FT1_v5_t00.npy"), b.join("CP_v5_t03.npy")];
-    dir.ok(&[
-        "predict",
-        "--model",
+    dir.ok(&predict(
         s(&model),
-        s(&files[0]),
-        s(&files[1]),
-        "--out",
         s(&plain),
-    ]);
+        &[s(&files[0]), s(&files[1])],
+    ));
     let rows = csv_rows(&plain);
     assert_eq!(rows.len(), 3);
     assert_eq!(rows[1][0], s(&files[0]));
@@ -136,21 +138,11 @@ fn predict_applies_the_models_pipeline_not_the_defaults() {
         "--out",
         s(&model),
     ]);
-    let file: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let file = read_json(&model);
     assert_eq!(file["pipeline"]["encoder"]["gain"], 12.0);
     assert_eq!(file["features"]["columns"].as_array().unwrap().len(), 48);
     let out = dir.join("p.csv");
-    let json = dir.ok(&[
-        "predict",
-        "--model",
-        s(&model),
-        "--dataset",
-        s(&a),
-        "--out",
-        s(&out),
-        "--json",
-    ]);
-    let score: Value = serde_json::from_str(&json).unwrap();
+    let score = scored(&dir, &model, &a, &out);
     assert_eq!(score["accuracy"], 1.0, "{score}");
 }
 

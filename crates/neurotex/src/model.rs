@@ -575,17 +575,11 @@ mod tests {
     use crate::encode::SpikeTrains;
     use crate::recording::Meta;
 
-    /// A small generator for feature values (xorshift).
+    /// `n` feature values in [0, 10), seeded.
     fn values(seed: u64, n: usize) -> Vec<f64> {
-        let mut state = seed | 1;
-        (0..n)
-            .map(|_| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state % 10_000) as f64 / 997.0
-            })
-            .collect()
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..n).map(|_| 10.0 * rng.gen::<f64>()).collect()
     }
 
     /// A `method` table of three classes x 6 recordings on a 2x2 grid whose class shifts

@@ -130,11 +130,8 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         bail!("--predictions needs one classifier, not one per taxel: add --taxel ROW,COL");
     }
     let dataset = Dataset::open(&args.dataset)?;
-    let indices = match args.speeds_used() {
-        Some(speeds) => dataset.indices_at(&speeds)?,
-        None => (0..dataset.entries.len()).collect(),
-    };
-    let (table, grid) = feature_table(&dataset, &pipeline, &indices, args.method)?;
+    let speeds = args.speeds_used();
+    let (table, grid) = feature_table(&dataset, &pipeline, speeds.as_deref(), args.method)?;
     if let Some(cell) = args.taxel {
         grid.locate(cell)?;
     }

@@ -52,11 +52,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         (_, None) => Columns::All,
     };
     let dataset = Dataset::open(&args.dataset)?;
-    let indices = match &args.speeds {
-        Some(speeds) => dataset.indices_at(speeds)?,
-        None => (0..dataset.entries.len()).collect(),
-    };
-    let (table, grid) = feature_table(&dataset, &pipeline, &indices, args.method)?;
+    let (table, grid) = feature_table(&dataset, &pipeline, args.speeds.as_deref(), args.method)?;
     if let Some(cell) = args.taxel {
         grid.locate(cell)?;
     }
