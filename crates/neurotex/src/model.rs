@@ -401,7 +401,7 @@ impl Model {
     }
 
     /// Predicts the class of each feature row of `x` (row-major, the model's columns,
-    /// [`Model::feature_names`], per row).
+    /// `columns` of [`Model::features`], per row).
     ///
     /// # Errors
     /// Rows of another length, or a feature that is not finite.
