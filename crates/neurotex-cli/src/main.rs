@@ -9,7 +9,7 @@ mod stage_args;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use commands::{encode, evaluate, features, import, reproduce, simulate};
+use commands::{encode, evaluate, features, import, predict, reproduce, simulate, train};
 
 /// Neuromorphic tactile texture classification: taxel recordings → Izhikevich spikes →
 /// single-taxel statistics or 2D/3D GLCM features → KNN.
@@ -28,6 +28,12 @@ enum Command {
     Features(features::FeaturesArgs),
     /// Classify a dataset's recordings with KNN and print accuracy and confusion matrix.
     Evaluate(evaluate::EvaluateArgs),
+    /// Train a KNN on a dataset and save it as a model file (pipeline, features, grid,
+    /// classifier, training data's fingerprint) for `neurotex predict`.
+    Train(train::TrainArgs),
+    /// Predict the texture of new recordings (a dataset or files) with a saved model,
+    /// applying the model's own pipeline; writes one CSV row per recording.
+    Predict(predict::PredictArgs),
     /// Simulate the paper's rig (8 textures, 4x4 taxels, 1 N, 90 mm slides) into a dataset folder.
     Simulate(simulate::SimulateArgs),
     /// Run every analysis of the paper (E0-E8) and write a report with figures; without
@@ -44,6 +50,8 @@ fn main() -> ExitCode {
         Command::Encode(args) => encode::run(args),
         Command::Features(args) => features::run(args),
         Command::Evaluate(args) => evaluate::run(args),
+        Command::Train(args) => train::run(args),
+        Command::Predict(args) => predict::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Reproduce(args) => reproduce::run(args),
         Command::Import(command) => import::run(command),

@@ -6,6 +6,7 @@ mod encode;
 mod evaluate;
 mod features;
 mod import;
+mod model;
 mod reproduce;
 mod simulate;
 mod util;
@@ -23,6 +24,8 @@ fn help_explains_the_commands() {
         "simulate",
         "reproduce",
         "import",
+        "train",
+        "predict",
     ] {
         assert!(text.contains(cmd), "{text}");
     }

@@ -3,7 +3,7 @@
 use ndarray::Array3;
 use ndarray_npy::{read_npy, write_npy};
 
-use crate::util::{recording, s, Dir};
+use crate::util::{recording, s, xorshift, Dir};
 
 #[test]
 fn encode_writes_raster_and_events() {
@@ -76,4 +76,113 @@ fn encode_takes_the_rate_from_a_layout_unless_fs_is_given() {
     assert_eq!(steps(&["--fs", "1000"]), 400);
     let err = dir.fails(&["encode", s(&input), "--out", s(&out), "--fs", "-5"]);
     assert!(err.contains("--fs"), "{err}");
+}
+
+/// Izhikevich's regular-spiking neuron (a, b, c, d = 0.02, 0.2, -65, 8) written out step by
+/// step as in his 2003 listing (spike check and reset first, then two 0.5 ms half-steps of
+/// `v` and one 1 ms step of `u`), one neuron per column of the time-major `x` (`n` per
+/// frame) driven by `gain * x`. Returns the raster, 1 where a neuron spiked.
+fn reference_spikes(x: &[f64], n: usize, gain: f64) -> Vec<u8> {
+    let (a, b, c, d) = (0.02, 0.2, -65.0, 8.0);
+    let mut v = vec![c; n];
+    let mut u = vec![b * c; n];
+    let mut raster = Vec::with_capacity(x.len());
+    for frame in x.chunks_exact(n) {
+        for j in 0..n {
+            let fired = v[j] >= 30.0;
+            raster.push(u8::from(fired));
+            if fired {
+                v[j] = c;
+                u[j] += d;
+            }
+            let i = gain * frame[j];
+            for _ in 0..2 {
+                v[j] += 0.5 * (0.04 * (v[j] * v[j]) + 5.0 * v[j] + 140.0 - u[j] + i);
+            }
+            u[j] += a * (b * v[j] - u[j]);
+        }
+    }
+    raster
+}
+
+/// A sample `x` for a recording whose largest sample is `max` such that a neuron at rest
+/// driven by `gain * x / max` fires at the next step and one driven by `gain * x * (1 /
+/// max)` does not, or the reverse; `None` when no sample within 64 ULPs of the threshold
+/// rounds differently under the two.
+fn knife_edge(max: f64, gain: f64) -> Option<f64> {
+    let fires_from_rest = |q: f64| reference_spikes(&[q, 0.0], 1, gain)[1] == 1;
+    // The threshold input by bisection over the bit patterns of positive floats, which
+    // order like the floats.
+    let (mut lo, mut hi) = (0f64.to_bits(), 1f64.to_bits());
+    assert!(
+        fires_from_rest(1.0),
+        "the gain must make a full input fire at once"
+    );
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if fires_from_rest(f64::from_bits(mid)) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let centre = (f64::from_bits(hi) * max).to_bits();
+    (centre - 64..centre + 64)
+        .map(f64::from_bits)
+        .find(|&x| fires_from_rest(x / max) != fires_from_rest(x * (1.0 / max)))
+}
+
+#[test]
+fn encode_feeds_the_neurons_x_over_its_maximum() {
+    // numpy's `x / x.max()` rounds each sample once; multiplying by `1 / max` rounds twice
+    // and differs in the last bit for some samples. One sample placed on the firing
+    // threshold of a neuron at rest makes that last bit visible in the spikes.
+    let gain = 100.0;
+    let (steps, channels) = (300, 3);
+    let (max, edge) = (0..200)
+        .map(|k| 0.7 + 0.0137 * k as f64)
+        .find_map(|max| knife_edge(max, gain).map(|x| (max, x)))
+        .expect("a sample on the threshold for one of the maxima tried");
+    let mut random = xorshift(7);
+    let mut x: Vec<f64> = (0..steps * channels)
+        .map(|_| max * (random() % 1_000_000) as f64 / 1_000_000.0)
+        .collect();
+    x[0] = edge;
+    x[5 * channels + 2] = max;
+    let by_division: Vec<f64> = x.iter().map(|s| s / max).collect();
+    let by_inverse: Vec<f64> = x.iter().map(|s| s * (1.0 / max)).collect();
+    let expected = reference_spikes(&by_division, channels, gain);
+    assert_ne!(
+        expected,
+        reference_spikes(&by_inverse, channels, gain),
+        "the recording must tell the two normalisations apart"
+    );
+
+    let dir = Dir::new();
+    let input = dir.join("x.npy");
+    write_npy(
+        &input,
+        &Array3::from_shape_vec((steps, 1, channels), x).unwrap(),
+    )
+    .unwrap();
+    let out = dir.join("spikes.npy");
+    dir.ok(&[
+        "encode",
+        s(&input),
+        "--out",
+        s(&out),
+        "--cutoff",
+        "0",
+        "--gain",
+        "100",
+    ]);
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape(), &[steps, 1, channels]);
+    let raster = raster.into_raw_vec_and_offset().0;
+    let first = raster.iter().zip(&expected).position(|(a, b)| a != b);
+    assert_eq!(
+        first.map(|i| (i / channels, i % channels)),
+        None,
+        "first spike that differs from x / x.max(), as (step, neuron)"
+    );
 }

@@ -85,6 +85,69 @@ fn features_and_evaluate_on_a_dataset() {
 }
 
 #[test]
+fn evaluate_writes_each_recordings_out_of_fold_prediction() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 5);
+    let out = dir.join("oof.csv");
+    let rows = |method: &str, extra: &[&str]| -> (serde_json::Value, Vec<Vec<String>>) {
+        let mut args = vec!["--predictions", s(&out)];
+        args.extend_from_slice(extra);
+        let json = dir.evaluate_json(&ds, method, &args);
+        let text = std::fs::read_to_string(&out).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("file,label,predicted,fold,repeat"));
+        let rows = lines
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect();
+        (json, rows)
+    };
+    let (json, cv) = rows("glcm3d", &["--repeats", "3"]);
+    assert_eq!(cv.len(), 30 * 3, "one row per recording per repeat");
+    for repeat in 0..3 {
+        let of_repeat: Vec<&Vec<String>> =
+            cv.iter().filter(|r| r[4] == repeat.to_string()).collect();
+        let mut files: Vec<&str> = of_repeat.iter().map(|r| r[0].as_str()).collect();
+        files.sort();
+        files.dedup();
+        assert_eq!(files.len(), 30, "repeat {repeat}: every recording once");
+        assert!(of_repeat.iter().all(|r| r[3].parse::<usize>().unwrap() < 5));
+        assert!(
+            of_repeat.iter().all(|r| r[0].starts_with(&r[1])),
+            "file and its label"
+        );
+    }
+    let right = cv.iter().filter(|r| r[1] == r[2]).count();
+    let accuracy = json["accuracy"].as_f64().unwrap();
+    assert!(
+        (right as f64 / 90.0 - accuracy).abs() < 1e-12,
+        "{right} of 90 vs {accuracy}"
+    );
+
+    let (json, split) = rows("glcm3d", &["--train-speeds", "5", "--test-speeds", "10"]);
+    assert_eq!(split.len(), 15, "the test recordings");
+    assert!(split
+        .iter()
+        .all(|r| r[3] == "test" && r[4] == "0" && r[0].contains("_10_")));
+    let right = split.iter().filter(|r| r[1] == r[2]).count();
+    assert!((right as f64 / 15.0 - json["accuracy"].as_f64().unwrap()).abs() < 1e-12);
+
+    std::fs::remove_file(&out).unwrap();
+    let err = dir.fails(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "taxel",
+        "--predictions",
+        s(&out),
+    ]);
+    assert!(err.contains("--taxel ROW,COL"), "{err}");
+    assert!(!out.exists());
+    let (_, taxel) = rows("taxel", &["--taxel", "1,1"]);
+    assert_eq!(taxel.len(), 30);
+}
+
+#[test]
 fn same_seed_gives_the_same_result() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[5.0], 10);

@@ -144,18 +144,27 @@ impl Dir {
 /// A texture-like 4x4 recording: a grating of `period_ms` sweeping across the rows, with
 /// noise from a small generator seeded by `seed`.
 pub fn recording(steps: usize, period_ms: f64, amp: f64, seed: u64) -> Array3<f32> {
+    let mut random = xorshift(seed);
+    Array3::from_shape_fn((steps, 4, 4), |(t, r, c)| {
+        let noise = (random() % 1000) as f64 / 1000.0 - 0.5;
+        let phase = (t as f64 - 40.0 * r as f64 - 7.0 * c as f64) / period_ms;
+        (0.5 + amp * (std::f64::consts::TAU * phase).sin() + 0.2 * noise) as f32
+    })
+}
+
+/// A small xorshift generator seeded by `seed` (any value, 0 included): each call returns
+/// the next 64 random bits.
+pub fn xorshift(seed: u64) -> impl FnMut() -> u64 {
     let mut state = seed
         .wrapping_mul(6364136223846793005)
         .wrapping_add(1442695040888963407)
         | 1;
-    Array3::from_shape_fn((steps, 4, 4), |(t, r, c)| {
+    move || {
         state ^= state << 13;
         state ^= state >> 7;
         state ^= state << 17;
-        let noise = (state % 1000) as f64 / 1000.0 - 0.5;
-        let phase = (t as f64 - 40.0 * r as f64 - 7.0 * c as f64) / period_ms;
-        (0.5 + amp * (std::f64::consts::TAU * phase).sin() + 0.2 * noise) as f32
-    })
+        state
+    }
 }
 
 /// Adds a CSV recording of label A at 5 mm/s to a dataset's manifest.

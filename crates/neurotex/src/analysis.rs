@@ -71,7 +71,7 @@ impl FeatureTable {
     }
 
     /// The values of rows `rows` and columns `columns`, row-major.
-    fn select(&self, rows: &[usize], columns: &[usize]) -> Vec<f64> {
+    pub(crate) fn select(&self, rows: &[usize], columns: &[usize]) -> Vec<f64> {
         rows.iter()
             .flat_map(|&i| columns.iter().map(move |&j| self.row(i)[j]))
             .collect()
@@ -128,6 +128,45 @@ pub struct Outcome {
     /// The best taxel, chosen after the fact, when every taxel was evaluated.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub best: Option<TaxelAccuracy>,
+    /// Every evaluated recording's prediction in every repeat, repeat by repeat in table
+    /// order; `None` when several taxels were evaluated in turn (one prediction each). Left out of
+    /// the serialised form, whose readers want the summary.
+    #[serde(skip)]
+    pub predictions: Option<Vec<OutOfFold>>,
+}
+
+/// One recording's out-of-fold prediction in one evaluation repeat.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OutOfFold {
+    /// The recording, as a row of the evaluated [`FeatureTable`].
+    pub row: usize,
+    /// The cross-validation repeat (0 for a train/test split).
+    pub repeat: usize,
+    /// The fold the recording was tested in; `None` for a train/test split.
+    pub fold: Option<usize>,
+    /// The predicted class, an index into [`Outcome::labels`].
+    pub predicted: usize,
+}
+
+impl OutOfFold {
+    /// The predictions of `evaluation` whose samples are the table rows `rows`.
+    fn of(evaluation: &crate::classify::Evaluation, rows: &[usize]) -> Vec<Self> {
+        let mut out = Vec::new();
+        for (repeat, p) in evaluation.predictions.iter().enumerate() {
+            out.extend(
+                p.predicted
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &predicted)| OutOfFold {
+                        row: rows[i],
+                        repeat,
+                        fold: p.fold_of.as_ref().map(|f| f[i]),
+                        predicted,
+                    }),
+            );
+        }
+        out
+    }
 }
 
 /// Which feature columns to use.
@@ -148,21 +187,23 @@ struct GroupResult {
     evaluation: crate::classify::Evaluation,
 }
 
-/// The column groups `columns` names: `(taxel cell, column indices)`.
-fn column_groups(
-    table: &FeatureTable,
+/// The column groups `columns` names among the `dims` columns of a table on `grid`:
+/// `(taxel cell, column indices)`.
+pub(crate) fn column_groups(
+    grid: &Grid,
+    dims: usize,
     columns: Columns,
 ) -> Result<Vec<(Option<usize>, Vec<usize>)>> {
-    let taxels: Vec<usize> = table.grid.taxels().collect();
+    let taxels: Vec<usize> = grid.taxels().collect();
     let of_taxel = |k: usize| (Some(taxels[k]), (3 * k..3 * k + 3).collect());
     Ok(match columns {
-        Columns::All => vec![(None, (0..table.dims()).collect())],
+        Columns::All => vec![(None, (0..dims).collect())],
         Columns::Taxel(cell) => {
-            let index = table.grid.taxel_index(cell).ok_or_else(|| {
+            let index = grid.taxel_index(cell).ok_or_else(|| {
                 ParamError::new(
                     "taxel",
                     "taxel must be a present cell of the grid",
-                    format!("{},{} in the {} grid", cell.row, cell.col, table.grid),
+                    format!("{},{} in the {} grid", cell.row, cell.col, grid),
                 )
             })?;
             let k = taxels.iter().position(|&t| t == index).unwrap_or(0);
@@ -199,7 +240,7 @@ pub fn evaluate<C: Classifier>(
     split: &Split,
     classifier: &C,
 ) -> Result<Outcome> {
-    let groups = column_groups(table, columns)?;
+    let groups = column_groups(&table.grid, table.dims(), columns)?;
     let (train_rows, test_rows) = match split {
         Split::CrossValidation { speeds: None, .. } => ((0..table.metas.len()).collect(), vec![]),
         Split::CrossValidation {
@@ -236,12 +277,18 @@ pub fn evaluate<C: Classifier>(
             })
         })
         .collect::<Result<_>>()?;
-    Ok(combine(
-        results,
-        labels,
-        columns == Columns::EachTaxel,
-        &table.grid,
-    ))
+    let evaluated = match split {
+        Split::CrossValidation { .. } => &train_rows,
+        Split::ByCondition { .. } => &test_rows,
+    };
+    let predictions = match &results[..] {
+        [one] => Some(OutOfFold::of(&one.evaluation, evaluated)),
+        _ => None,
+    };
+    Ok(Outcome {
+        predictions,
+        ..combine(results, labels, columns == Columns::EachTaxel, &table.grid)
+    })
 }
 
 /// One outcome from the groups' results: mean accuracy and spread, summed confusion, and
@@ -288,5 +335,6 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
         n: results[0].evaluation.n,
         per_taxel,
         best,
+        predictions: None,
     }
 }

@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+pub use crate::model::ModelError;
 pub use crate::recording::DatasetError;
 
 /// Everything that can go wrong in neurotex, by stage.
@@ -31,6 +32,9 @@ pub enum Error {
     /// A dataset cannot serve what was asked of it (speeds, one grid).
     #[error(transparent)]
     Dataset(#[from] DatasetError),
+    /// A model file cannot be used, or recordings do not fit a model.
+    #[error(transparent)]
+    Model(#[from] ModelError),
 }
 
 impl Error {

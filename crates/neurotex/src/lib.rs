@@ -5,7 +5,8 @@
 //! as in Gupta, Nakagawa, Lepora and Thakor, "Spatio-temporal encoding improves
 //! neuromorphic tactile texture classification". Data flows down the modules:
 //! [`recording`] → [`signal`] → [`encode`] → [`features`] → [`classify`], joined by
-//! [`pipeline`] and [`analysis`].
+//! [`pipeline`] and [`analysis`]; [`model`] saves a trained classifier and applies it to
+//! new recordings.
 //!
 //! The library never prints and never exits: it returns [`Error`]s naming the file, line
 //! or parameter at fault.
@@ -19,6 +20,7 @@ pub mod experiments;
 pub mod features;
 pub mod import;
 pub mod io;
+pub mod model;
 pub mod pipeline;
 pub mod recording;
 pub mod report;

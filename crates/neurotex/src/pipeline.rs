@@ -53,7 +53,7 @@ impl std::str::FromStr for Method {
 }
 
 /// All stage parameters, each with the paper's value (or SPEC's choice) as default.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct PipelineParams {
     /// Conditioning.
     pub preprocess: PreprocessParams,

@@ -166,6 +166,17 @@ impl FromStr for Baseline {
     }
 }
 
+impl fmt::Display for Baseline {
+    /// `none`, `min` (as typed on a command line), or `mean over [START, END) s`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Baseline::None => f.write_str("none"),
+            Baseline::Min => f.write_str("min"),
+            Baseline::Mean { start_s, end_s } => write!(f, "mean over [{start_s}, {end_s}) s"),
+        }
+    }
+}
+
 /// The unit of a CSV recording's time column; written `ms` or `s` (in `layout.toml` too).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum TimeUnit {
@@ -523,6 +534,39 @@ impl Dataset {
         let mut rec = read_recording(&path, &self.layout)?;
         rec.meta = meta.clone();
         Ok(rec)
+    }
+
+    /// A fingerprint of the dataset as its manifest lists it, `sha256:` and 64 hex digits:
+    /// SHA-256 over the manifest's length in bytes (8 bytes, little-endian), the bytes of
+    /// `manifest.csv`, then each listed file's size in bytes (8 bytes, little-endian) in
+    /// manifest order. File sizes, not contents, keep it cheap on large datasets; so a
+    /// recording rewritten with different samples of the same size keeps the fingerprint.
+    /// In Python: `h = hashlib.sha256(); h.update(len(m).to_bytes(8, "little")); h.update(m)`,
+    /// then `h.update(os.path.getsize(f).to_bytes(8, "little"))` for each file.
+    ///
+    /// # Errors
+    /// The manifest or a listed file can no longer be read.
+    pub fn fingerprint(&self) -> Result<String> {
+        use sha2::{Digest, Sha256};
+        let manifest_path = self.root.join("manifest.csv");
+        let manifest =
+            std::fs::read(&manifest_path).map_err(|e| DataError::io(&manifest_path, e))?;
+        let mut hasher = Sha256::new();
+        hasher.update((manifest.len() as u64).to_le_bytes());
+        hasher.update(&manifest);
+        for meta in &self.entries {
+            let path = self.root.join(&meta.file);
+            let size = std::fs::metadata(&path)
+                .map_err(|e| DataError::io(&path, e))?
+                .len();
+            hasher.update(size.to_le_bytes());
+        }
+        let hex: String = hasher
+            .finalize()
+            .iter()
+            .map(|byte| format!("{byte:02x}"))
+            .collect();
+        Ok(format!("sha256:{hex}"))
     }
 
     /// The distinct labels in order of first appearance.

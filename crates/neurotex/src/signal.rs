@@ -2,6 +2,8 @@
 //! baseline removal, resampling to the encoder's 1 kHz, zero-phase Butterworth low-pass
 //! and global-max normalisation.
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{Baseline, Phase, Recording};
 
@@ -9,7 +11,7 @@ use crate::recording::{Baseline, Phase, Recording};
 pub const ENCODER_FS: f64 = 1000.0;
 
 /// Parameters of the conditioning stages.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PreprocessParams {
     /// Low-pass cutoff in Hz; 0 turns the filter off. The paper gives none: 50 Hz.
     pub cutoff_hz: f64,
@@ -261,8 +263,10 @@ impl Preprocessor {
 pub fn normalise_global_max(samples: &mut [f64]) -> bool {
     let max = samples.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if max > 0.0 {
-        let inv = 1.0 / max;
-        samples.iter_mut().for_each(|s| *s *= inv);
+        // A true division, not a multiplication by `1 / max`: that rounds twice and can
+        // differ in the last bit, which the encoder's threshold can turn into a spike more
+        // or less; dividing gives numpy's `x / x.max()` bit for bit.
+        samples.iter_mut().for_each(|s| *s /= max);
         false
     } else {
         samples.iter_mut().for_each(|s| *s = 0.0);

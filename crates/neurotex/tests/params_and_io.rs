@@ -417,3 +417,35 @@ fn recordings_of_one_dataset_share_one_grid() {
         Err(Error::Dataset(DatasetError::Empty))
     ));
 }
+
+#[test]
+fn a_dataset_fingerprint_hashes_the_manifest_and_the_file_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = "file,label,speed_mm_s,force_n,trial\na.npy,A,5,1,0\nb.npy,B,5,1,0\n";
+    let write = |root: &Path, b_size: usize| {
+        std::fs::create_dir_all(root).unwrap();
+        std::fs::write(root.join("manifest.csv"), manifest).unwrap();
+        std::fs::write(root.join("a.npy"), vec![0u8; 200]).unwrap();
+        std::fs::write(root.join("b.npy"), vec![7u8; b_size]).unwrap();
+        Dataset::open(root).unwrap().fingerprint().unwrap()
+    };
+    // From Python 3.11's hashlib, as Dataset::fingerprint documents it:
+    //   m = b"file,label,speed_mm_s,force_n,trial\na.npy,A,5,1,0\nb.npy,B,5,1,0\n"
+    //   h = hashlib.sha256(); h.update(len(m).to_bytes(8, "little")); h.update(m)
+    //   for size in (200, 1000): h.update(size.to_bytes(8, "little"))
+    //   h.hexdigest()
+    let expected = "sha256:a4773520efb0eb82feab86a42a00ab037abd3d36ef6ad32d17c24f69d5280f7d";
+    assert_eq!(write(&dir.path().join("one"), 1000), expected);
+    assert_eq!(
+        write(&dir.path().join("elsewhere"), 1000),
+        expected,
+        "the folder's name is not part of the data"
+    );
+    assert_ne!(write(&dir.path().join("bigger"), 1001), expected);
+    let root = dir.path().join("one");
+    std::fs::write(root.join("manifest.csv"), manifest.replace("B,5", "B,10")).unwrap();
+    assert_ne!(
+        Dataset::open(&root).unwrap().fingerprint().unwrap(),
+        expected
+    );
+}

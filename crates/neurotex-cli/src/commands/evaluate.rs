@@ -1,17 +1,21 @@
 //! `neurotex evaluate`: KNN on a dataset's features, by cross-validation or by training on
 //! some speeds and testing on others; prints accuracy and confusion matrix.
 
+use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
-use neurotex::analysis::{evaluate, Columns, Outcome, Split, TaxelAccuracy};
+use neurotex::analysis::{
+    evaluate, Columns, FeatureTable, OutOfFold, Outcome, Split, TaxelAccuracy,
+};
 use neurotex::classify::CvParams;
 use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::Dataset;
 use neurotex::{Cell, Speed};
 
 use super::feature_table;
+use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex evaluate`.
@@ -66,6 +70,12 @@ pub struct EvaluateArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Write each recording's out-of-fold prediction to this CSV file:
+    /// `file,label,predicted,fold,repeat`, one row per recording and CV repeat (folds and
+    /// repeats count from 0; `fold` is `test` with --train-speeds/--test-speeds). Needs one
+    /// classifier: a GLCM method, or --method taxel with --taxel.
+    #[arg(long)]
+    pub predictions: Option<PathBuf>,
     #[command(flatten)]
     pub stages: StageArgs,
 }
@@ -116,16 +126,25 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     let knn = args.stages.knn(args.k)?;
     let split = args.split()?;
     let columns = args.columns()?;
+    if args.predictions.is_some() && columns == Columns::EachTaxel {
+        bail!("--predictions needs one classifier, not one per taxel: add --taxel ROW,COL");
+    }
     let dataset = Dataset::open(&args.dataset)?;
-    let indices = match args.speeds_used() {
-        Some(speeds) => dataset.indices_at(&speeds)?,
-        None => (0..dataset.entries.len()).collect(),
-    };
-    let (table, grid) = feature_table(&dataset, &pipeline, &indices, args.method)?;
+    let speeds = args.speeds_used();
+    let (table, grid) = feature_table(&dataset, &pipeline, speeds.as_deref(), args.method)?;
     if let Some(cell) = args.taxel {
         grid.locate(cell)?;
     }
     let outcome = evaluate(&table, columns, &split, &knn.check()?)?;
+    if let Some(path) = &args.predictions {
+        let predictions = outcome
+            .predictions
+            .as_deref()
+            .context("one classifier's predictions for --predictions")?;
+        write_file(path, "out-of-fold predictions", |w| {
+            write_out_of_fold(w, &table, &outcome.labels, predictions)
+        })?;
+    }
     if args.json {
         let mut value = serde_json::to_value(&outcome)?;
         value["method"] = args.method.name().into();
@@ -220,4 +239,27 @@ fn print_confusion(outcome: &Outcome) {
         }
         println!();
     }
+}
+
+/// Writes `file,label,predicted,fold,repeat`, one row per prediction.
+fn write_out_of_fold(
+    w: &mut dyn Write,
+    table: &FeatureTable,
+    labels: &[String],
+    predictions: &[OutOfFold],
+) -> std::io::Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    out.write_record(["file", "label", "predicted", "fold", "repeat"])?;
+    for p in predictions {
+        let meta = &table.metas[p.row];
+        let fold = p.fold.map_or("test".to_string(), |f| f.to_string());
+        out.write_record([
+            meta.file.as_str(),
+            meta.label.as_str(),
+            labels[p.predicted].as_str(),
+            fold.as_str(),
+            p.repeat.to_string().as_str(),
+        ])?;
+    }
+    out.flush()
 }

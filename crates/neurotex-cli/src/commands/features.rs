@@ -34,8 +34,7 @@ pub struct FeaturesArgs {
 pub fn run(args: FeaturesArgs) -> Result<()> {
     let pipeline = Pipeline::new(args.stages.pipeline()?)?;
     let dataset = Dataset::open(&args.dataset)?;
-    let all: Vec<usize> = (0..dataset.entries.len()).collect();
-    let (table, _) = feature_table(&dataset, &pipeline, &all, args.method)?;
+    let (table, _) = feature_table(&dataset, &pipeline, None, args.method)?;
     write_file(&args.out, "the feature table", |w| write_table(w, &table))?;
     eprintln!(
         "{} recordings x {} features -> {}",

@@ -5,27 +5,33 @@ pub mod encode;
 pub mod evaluate;
 pub mod features;
 pub mod import;
+pub mod predict;
 pub mod reproduce;
 pub mod simulate;
+pub mod train;
 
 use anyhow::Result;
 use neurotex::analysis::FeatureTable;
 use neurotex::pipeline::{Encoded, Method, Pipeline};
 use neurotex::recording::{one_grid, Dataset};
-use neurotex::Grid;
+use neurotex::{Grid, Speed};
 
 use crate::output::progress;
 
-/// Encodes the dataset's recordings at `indices` (with a progress bar) and extracts
-/// `method`'s features; also returns the grid the recordings share.
+/// Encodes the dataset's recordings at `speeds` (all when `None`) with a progress bar and
+/// extracts `method`'s features; also returns the grid the recordings share.
 fn feature_table(
     dataset: &Dataset,
     pipeline: &Pipeline,
-    indices: &[usize],
+    speeds: Option<&[Speed]>,
     method: Method,
 ) -> Result<(FeatureTable, Grid)> {
+    let indices = match speeds {
+        Some(speeds) => dataset.indices_at(speeds)?,
+        None => (0..dataset.entries.len()).collect(),
+    };
     let bar = progress(indices.len(), "encoding");
-    let encoded = pipeline.encode_dataset(dataset, indices, &|| bar.inc(1));
+    let encoded = pipeline.encode_dataset(dataset, &indices, &|| bar.inc(1));
     bar.finish_and_clear();
     let encoded = encoded?;
     report_conditions(&encoded);

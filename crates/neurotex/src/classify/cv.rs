@@ -81,10 +81,28 @@ pub struct Evaluation {
     pub confusion: ConfusionMatrix,
     /// Samples evaluated per repeat.
     pub n: usize,
+    /// Each repeat's prediction of every evaluated sample, so that results can be traced
+    /// back to recordings (SPEC 9).
+    pub predictions: Vec<RepeatPredictions>,
+}
+
+/// One repeat's out-of-fold predictions: for every evaluated sample, in sample order, its
+/// predicted class and the fold it was tested in.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RepeatPredictions {
+    /// Each sample's fold; `None` for a train/test split, where every sample is tested once.
+    pub fold_of: Option<Vec<usize>>,
+    /// Each sample's predicted class index.
+    pub predicted: Vec<usize>,
 }
 
 impl Evaluation {
-    fn of_repeats(per_repeat: Vec<f64>, confusion: ConfusionMatrix, n: usize) -> Self {
+    fn of_repeats(
+        per_repeat: Vec<f64>,
+        confusion: ConfusionMatrix,
+        n: usize,
+        predictions: Vec<RepeatPredictions>,
+    ) -> Self {
         let mean = per_repeat.iter().sum::<f64>() / per_repeat.len().max(1) as f64;
         let var = per_repeat.iter().map(|a| (a - mean).powi(2)).sum::<f64>()
             / per_repeat.len().max(1) as f64;
@@ -94,6 +112,7 @@ impl Evaluation {
             per_repeat,
             confusion,
             n,
+            predictions,
         }
     }
 }
@@ -199,6 +218,7 @@ pub fn cross_validate<C: Classifier>(
     }
     let n_classes = class_names.len().max(y.iter().max().map_or(0, |&m| m + 1));
     let mut per_repeat = Vec::with_capacity(cv.repeats);
+    let mut predictions = Vec::with_capacity(cv.repeats);
     let mut confusion = ConfusionMatrix::zeros(n_classes);
     for r in 0..cv.repeats {
         let seed = cv.seed.wrapping_add(r as u64);
@@ -207,8 +227,17 @@ pub fn cross_validate<C: Classifier>(
         let matrix = ConfusionMatrix::from_predictions(y, &predicted, n_classes);
         per_repeat.push(matrix.accuracy());
         confusion.add(&matrix);
+        predictions.push(RepeatPredictions {
+            fold_of: Some(fold_of),
+            predicted,
+        });
     }
-    Ok(Evaluation::of_repeats(per_repeat, confusion, y.len()))
+    Ok(Evaluation::of_repeats(
+        per_repeat,
+        confusion,
+        y.len(),
+        predictions,
+    ))
 }
 
 /// Trains on one set and tests on another (for example train on two speeds, test on the third).
@@ -247,5 +276,9 @@ pub fn train_test<C: Classifier>(
         vec![confusion.accuracy()],
         confusion,
         y_test.len(),
+        vec![RepeatPredictions {
+            fold_of: None,
+            predicted,
+        }],
     ))
 }

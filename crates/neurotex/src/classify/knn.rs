@@ -5,11 +5,13 @@
 //! member wins. Features are z-scored with the training set's mean and population standard
 //! deviation (a feature constant in training is only centred).
 
+use serde::{Deserialize, Serialize};
+
 use super::{Classifier, Predict};
 use crate::error::{ClassifyError, ParamError};
 
 /// KNN parameters.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct KnnParams {
     /// Neighbours (the paper's 5).
     pub k: usize,
@@ -167,12 +169,21 @@ impl Classifier for Knn {
     }
 }
 
-impl Predict for KnnModel {
-    fn dims(&self) -> usize {
-        self.dims
+impl KnnModel {
+    /// The predicted class of each row of `x` (row-major, [`Predict::dims`] per row) with
+    /// the votes of each class among its `k` neighbours, indexed by class.
+    ///
+    /// # Panics
+    /// If `x` is not whole rows of the training dimension (a caller bug).
+    pub fn predict_with_votes(&self, x: &[f64]) -> Vec<(usize, Vec<usize>)> {
+        let mut out = Vec::with_capacity(x.len() / self.dims.max(1));
+        self.classify(x, |predicted, votes| out.push((predicted, votes.to_vec())));
+        out
     }
 
-    fn predict(&self, x: &[f64]) -> Vec<usize> {
+    /// Finds each row's `k` nearest training samples and calls `on_row` with the predicted
+    /// class and the votes per class.
+    fn classify(&self, x: &[f64], mut on_row: impl FnMut(usize, &[usize])) {
         assert_eq!(
             x.len() % self.dims,
             0,
@@ -182,53 +193,65 @@ impl Predict for KnnModel {
         let mut dist = vec![0.0f64; n];
         let mut best: Vec<(f64, usize)> = Vec::with_capacity(self.k);
         let mut votes = vec![0usize; self.n_classes];
-        x.chunks_exact(self.dims)
-            .map(|row| {
-                dist.fill(0.0);
-                for (j, column) in self.columns.chunks_exact(n).enumerate() {
-                    let q = (row[j] - self.mean[j]) * self.inv_std[j];
-                    for (d, &t) in dist.iter_mut().zip(column) {
-                        *d += (t - q) * (t - q);
-                    }
+        for row in x.chunks_exact(self.dims) {
+            dist.fill(0.0);
+            for (j, column) in self.columns.chunks_exact(n).enumerate() {
+                let q = (row[j] - self.mean[j]) * self.inv_std[j];
+                for (d, &t) in dist.iter_mut().zip(column) {
+                    *d += (t - q) * (t - q);
                 }
-                // The k smallest under the total order (distance, training index): ties in
-                // distance go to the earlier training sample. Training samples are visited
-                // in a fixed scattered order (a stride coprime to n) so that a training set
-                // sorted by class, as manifests often are, does not make every sample an
-                // insertion; the result does not depend on the visiting order.
-                best.clear();
-                let mut j = 0usize;
-                for _ in 0..n {
-                    let key = (dist[j], j);
-                    j += self.stride;
-                    if j >= n {
-                        j -= n;
-                    }
-                    if best.len() == self.k && !closer(key, best[self.k - 1]) {
-                        continue;
-                    }
-                    if best.len() < self.k {
-                        best.push(key);
-                    } else {
-                        best[self.k - 1] = key;
-                    }
-                    let mut pos = best.len() - 1;
-                    while pos > 0 && closer(best[pos], best[pos - 1]) {
-                        best.swap(pos, pos - 1);
-                        pos -= 1;
-                    }
+            }
+            // The k smallest under the total order (distance, training index): ties in
+            // distance go to the earlier training sample. Training samples are visited
+            // in a fixed scattered order (a stride coprime to n) so that a training set
+            // sorted by class, as manifests often are, does not make every sample an
+            // insertion; the result does not depend on the visiting order.
+            best.clear();
+            let mut j = 0usize;
+            for _ in 0..n {
+                let key = (dist[j], j);
+                j += self.stride;
+                if j >= n {
+                    j -= n;
                 }
-                votes.fill(0);
-                for &(_, i) in &best {
-                    votes[self.labels[i]] += 1;
+                if best.len() == self.k && !closer(key, best[self.k - 1]) {
+                    continue;
                 }
-                let top = *votes.iter().max().unwrap_or(&0);
-                // Nearest-first order: the first neighbour of a top-voted class wins.
-                best.iter()
-                    .map(|&(_, i)| self.labels[i])
-                    .find(|&c| votes[c] == top)
-                    .unwrap_or(0)
-            })
-            .collect()
+                if best.len() < self.k {
+                    best.push(key);
+                } else {
+                    best[self.k - 1] = key;
+                }
+                let mut pos = best.len() - 1;
+                while pos > 0 && closer(best[pos], best[pos - 1]) {
+                    best.swap(pos, pos - 1);
+                    pos -= 1;
+                }
+            }
+            votes.fill(0);
+            for &(_, i) in &best {
+                votes[self.labels[i]] += 1;
+            }
+            let top = *votes.iter().max().unwrap_or(&0);
+            // Nearest-first order: the first neighbour of a top-voted class wins.
+            let predicted = best
+                .iter()
+                .map(|&(_, i)| self.labels[i])
+                .find(|&c| votes[c] == top)
+                .unwrap_or(0);
+            on_row(predicted, &votes);
+        }
+    }
+}
+
+impl Predict for KnnModel {
+    fn dims(&self) -> usize {
+        self.dims
+    }
+
+    fn predict(&self, x: &[f64]) -> Vec<usize> {
+        let mut out = Vec::with_capacity(x.len() / self.dims.max(1));
+        self.classify(x, |predicted, _| out.push(predicted));
+        out
     }
 }

@@ -11,7 +11,9 @@ pub mod metrics;
 pub mod stats;
 
 pub use confusion::ConfusionMatrix;
-pub use cv::{cross_validate, stratified_folds, train_test, CvParams, Evaluation, ValidCv};
+pub use cv::{
+    cross_validate, stratified_folds, train_test, CvParams, Evaluation, RepeatPredictions, ValidCv,
+};
 pub use knn::{Knn, KnnModel, KnnParams};
 pub use metrics::{
     bootstrap_accuracy, bootstrap_mean_share, mcnemar_exact, mcnemar_exact_p,

@@ -1,11 +1,13 @@
 //! The rate volume (paper section II-F): mean spike rate of every taxel in consecutive
 //! 200 ms bins, and its quantisation to gray levels.
 
+use serde::{Deserialize, Serialize};
+
 use crate::encode::SpikeTrains;
 use crate::error::ParamError;
 
 /// Binning and quantisation parameters.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct VolumeParams {
     /// Bin width in ms (the paper's 200).
     pub bin_ms: usize,

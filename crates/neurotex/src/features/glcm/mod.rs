@@ -9,6 +9,8 @@
 mod masks;
 mod onehot;
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::ParamError;
 use masks::LevelMasks;
 
@@ -30,7 +32,7 @@ pub const DIRECTIONS_13: [(i32, i32, i32); 13] = [
 ];
 
 /// Co-occurrence parameters.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GlcmParams {
     /// Offset distances D (the paper's 1, 2, 4, 8).
     pub distances: Vec<usize>,

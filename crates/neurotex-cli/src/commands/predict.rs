@@ -1,0 +1,144 @@
+//! `neurotex predict`: a saved model applied to new recordings, a dataset folder or plain
+//! files, with its own pipeline; one CSV row per recording, and the accuracy when the
+//! labels are known.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use neurotex::model::{Model, Prediction};
+use neurotex::pipeline::Encoded;
+use neurotex::recording::{read_recording, Dataset, LayoutFile};
+use rayon::prelude::*;
+
+use super::report_conditions;
+use crate::output::{progress, write_file};
+
+/// Options of `neurotex predict`.
+#[derive(Args)]
+pub struct PredictArgs {
+    /// The model file written by `neurotex train`. Its pipeline (filter, neurons, bins,
+    /// GLCM offsets, baseline) is applied to the recordings, not this command's defaults.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// A dataset folder to predict; its manifest's labels are written beside the
+    /// predictions and scored with --json.
+    #[arg(long, required_unless_present = "files", conflicts_with_all = ["files", "layout"])]
+    pub dataset: Option<PathBuf>,
+    /// Recordings to predict instead of a dataset (`.npy` or `.csv`); their labels are
+    /// unknown. They must have the model's taxel grid.
+    pub files: Vec<PathBuf>,
+    /// With FILES: a `layout.toml` giving their sampling rate, grid, channel map or mask.
+    #[arg(long)]
+    pub layout: Option<PathBuf>,
+    /// The CSV file to write: `file,label,predicted`, then `share_<class>` for each class
+    /// of the model (its share of the votes among the k neighbours); `label` is empty
+    /// when unknown.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also print `{"accuracy", "n", "labels", "confusion"}` (rows = true label) as JSON;
+    /// needs --dataset, and every label there must be a class of the model.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `neurotex predict`.
+pub fn run(args: PredictArgs) -> Result<()> {
+    if args.json && args.dataset.is_none() {
+        bail!("--json scores the predictions against known labels: it needs --dataset");
+    }
+    let model = Model::load(&args.model)?;
+    let (encoded, known) = match &args.dataset {
+        Some(dir) => (encode_dataset(&model, dir)?, true),
+        None => (
+            encode_files(&model, &args.files, args.layout.as_deref())?,
+            false,
+        ),
+    };
+    report_conditions(&encoded);
+    let predictions = model.predict(&encoded)?;
+    let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
+    // Scored before anything is written, so that a label the model cannot score leaves no
+    // predictions file behind a failed run.
+    let score = match args.json {
+        true => Some(model.score(&truth, &predictions)?),
+        false => None,
+    };
+    write_file(&args.out, "predictions", |w| {
+        write_predictions(w, &model, &encoded, &predictions, known)
+    })?;
+    if let Some(score) = score {
+        println!("{}", serde_json::to_string(&score)?);
+    }
+    eprintln!(
+        "{} recordings predicted with {} -> {}",
+        predictions.len(),
+        args.model.display(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Encodes every recording of the dataset at `dir` with the model's pipeline.
+fn encode_dataset(model: &Model, dir: &Path) -> Result<Vec<Encoded>> {
+    let dataset = Dataset::open(dir)?;
+    let layout_baseline = dataset.layout.baseline.unwrap_or_default();
+    if layout_baseline != model.baseline() {
+        eprintln!(
+            "note: the model removes baseline `{}` as in training; {} says `{layout_baseline}`",
+            model.baseline(),
+            dir.join("layout.toml").display()
+        );
+    }
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    let bar = progress(all.len(), "encoding");
+    let encoded = model
+        .pipeline()
+        .encode_dataset(&dataset, &all, &|| bar.inc(1));
+    bar.finish_and_clear();
+    Ok(encoded?)
+}
+
+/// Reads and encodes the recordings `files` with the model's pipeline; each is named by
+/// its path as given.
+fn encode_files(model: &Model, files: &[PathBuf], layout: Option<&Path>) -> Result<Vec<Encoded>> {
+    let layout = match layout {
+        Some(path) => LayoutFile::read(path)?,
+        None => LayoutFile::default(),
+    };
+    files
+        .par_iter()
+        .map(|path| {
+            let mut recording = read_recording(path, &layout)?;
+            recording.meta.file = path.display().to_string();
+            model
+                .encode(&recording)
+                .with_context(|| format!("encoding {}", path.display()))
+        })
+        .collect()
+}
+
+/// Writes one row per recording: `file,label,predicted`, then each class's vote share.
+fn write_predictions(
+    w: &mut dyn Write,
+    model: &Model,
+    encoded: &[Encoded],
+    predictions: &[Prediction],
+    known: bool,
+) -> std::io::Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    let shares = model.labels().iter().map(|l| format!("share_{l}"));
+    let header: Vec<String> = ["file", "label", "predicted"]
+        .map(String::from)
+        .into_iter()
+        .chain(shares)
+        .collect();
+    out.write_record(&header)?;
+    for (e, p) in encoded.iter().zip(predictions) {
+        let label = if known { e.meta.label.as_str() } else { "" };
+        let ids = [e.meta.file.as_str(), label, p.predicted.as_str()].map(String::from);
+        out.write_record(ids.into_iter().chain(p.shares.iter().map(f64::to_string)))?;
+    }
+    out.flush()
+}

@@ -1,0 +1,73 @@
+//! `neurotex train`: a KNN trained on a dataset's features, saved as a model file that
+//! `neurotex predict` applies to new recordings.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+use neurotex::analysis::Columns;
+use neurotex::model::{Model, Provenance};
+use neurotex::pipeline::{Method, Pipeline};
+use neurotex::recording::Dataset;
+use neurotex::{Cell, Speed};
+
+use super::feature_table;
+use crate::stage_args::StageArgs;
+
+/// Options of `neurotex train`.
+#[derive(Args)]
+pub struct TrainArgs {
+    /// The training dataset folder (with `manifest.csv`, optional `layout.toml`).
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// Train only on recordings at these speeds (mm/s, comma-separated); default all.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub speeds: Option<Vec<Speed>>,
+    /// Feature set: `taxel`, `glcm2d` or `glcm3d` (the paper's spatio-temporal approach).
+    #[arg(long, default_value = "glcm3d")]
+    pub method: Method,
+    /// With `--method taxel`: classify with this one taxel's statistics, as `ROW,COL`.
+    /// Without it, every taxel's three statistics together form one feature row.
+    #[arg(long)]
+    pub taxel: Option<Cell>,
+    /// Neighbours in KNN; at most the number of training recordings.
+    #[arg(short = 'k', long = "k", default_value_t = 5)]
+    pub k: usize,
+    /// The model file to write (JSON: pipeline, features, grid, classifier, training rows,
+    /// the dataset's fingerprint).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
+
+/// Runs `neurotex train`.
+pub fn run(args: TrainArgs) -> Result<()> {
+    let params = args.stages.pipeline()?;
+    let pipeline = Pipeline::new(params.clone())?;
+    let knn = args.stages.knn(args.k)?;
+    let columns = match (args.method, args.taxel) {
+        (Method::Taxel, Some(cell)) => Columns::Taxel(cell),
+        (_, Some(_)) => bail!("--taxel applies only to --method taxel"),
+        (_, None) => Columns::All,
+    };
+    let dataset = Dataset::open(&args.dataset)?;
+    let (table, grid) = feature_table(&dataset, &pipeline, args.speeds.as_deref(), args.method)?;
+    if let Some(cell) = args.taxel {
+        grid.locate(cell)?;
+    }
+    let provenance = Provenance::of(&dataset, args.speeds.clone())?;
+    let model = Model::train(&params, &table, columns, knn, provenance)?;
+    model.save(&args.out)?;
+    eprintln!(
+        "KNN (k = {}) on {} recordings of {} classes, {} {} features on the {} grid -> {}",
+        knn.k,
+        model.n_training(),
+        model.labels().len(),
+        model.features().columns.len(),
+        args.method.name(),
+        grid,
+        args.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,221 @@
+//! `neurotex train` and `neurotex predict`: a model trained on one simulated dataset,
+//! applied to another; damaged and foreign model files; recordings of another grid.
+
+use std::path::{Path, PathBuf};
+
+use ndarray::Array3;
+use ndarray_npy::write_npy;
+use serde_json::Value;
+
+use crate::util::{recording, s, Dir};
+
+/// Simulates `name`: FT1, SB and CP x 6 trials at 5 mm/s with `seed`.
+fn simulated(dir: &Dir, name: &str, seed: &str) -> PathBuf {
+    let out = dir.join(name);
+    dir.ok(&[
+        "simulate",
+        "--out",
+        s(&out),
+        "--seed",
+        seed,
+        "--trials",
+        "6",
+        "--speeds",
+        "5",
+        "--textures",
+        "FT1,SB,CP",
+    ]);
+    out
+}
+
+/// The JSON in `path`.
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Runs `neurotex predict --model MODEL --dataset DATASET --out OUT --json`, which must
+/// succeed; returns the score it prints.
+fn scored(dir: &Dir, model: &Path, dataset: &Path, out: &Path) -> Value {
+    let json = dir.ok(&predict(
+        s(model),
+        s(out),
+        &["--dataset", s(dataset), "--json"],
+    ));
+    serde_json::from_str(&json).expect("predict --json prints JSON")
+}
+
+/// The rows of a CSV file as fields, header first.
+fn csv_rows(path: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+#[test]
+fn a_model_trained_on_one_seed_predicts_another() {
+    let dir = Dir::new();
+    let (a, b) = (simulated(&dir, "A", "1"), simulated(&dir, "B", "2"));
+    let model = dir.join("model.json");
+    dir.ok(&["train", "--dataset", s(&a), "--out", s(&model)]);
+    let file = read_json(&model);
+    assert_eq!(file["format"], "neurotex-model");
+    assert_eq!(file["version"], 1);
+    assert_eq!(file["features"]["method"], "glcm3d");
+    assert_eq!(file["classifier"]["k"], 5);
+    assert_eq!(file["labels"], serde_json::json!(["FT1", "SB", "CP"]));
+    let fingerprint = file["training"]["dataset"]["fingerprint"].as_str().unwrap();
+    assert!(fingerprint.starts_with("sha256:") && fingerprint.len() == 7 + 64);
+
+    let out = dir.join("predictions.csv");
+    let score = scored(&dir, &model, &b, &out);
+    let accuracy = score["accuracy"].as_f64().unwrap();
+    assert!(accuracy > 0.6, "chance is 1/3, got {accuracy}");
+    assert_eq!(score["n"], 18);
+    assert_eq!(score["labels"], file["labels"]);
+    let rows = csv_rows(&out);
+    assert_eq!(
+        rows[0],
+        [
+            "file",
+            "label",
+            "predicted",
+            "share_FT1",
+            "share_SB",
+            "share_CP"
+        ]
+    );
+    assert_eq!(rows.len(), 1 + 18, "one row per recording");
+    let mut right = 0;
+    for row in &rows[1..] {
+        let shares: Vec<f64> = row[3..].iter().map(|v| v.parse().unwrap()).collect();
+        assert!((shares.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{row:?}");
+        let top = ["FT1", "SB", "CP"]
+            .iter()
+            .position(|l| *l == row[2])
+            .unwrap();
+        assert!(shares.iter().all(|&v| v <= shares[top]), "{row:?}");
+        right += usize::from(row[1] == row[2]);
+    }
+    assert!((right as f64 / 18.0 - accuracy).abs() < 1e-12);
+
+    // plain files: the label is unknown
+    let plain = dir.join("plain.csv");
+    let files = [b.join("FT1_v5_t00.npy"), b.join("CP_v5_t03.npy")];
+    dir.ok(&predict(
+        s(&model),
+        s(&plain),
+        &[s(&files[0]), s(&files[1])],
+    ));
+    let rows = csv_rows(&plain);
+    assert_eq!(rows.len(), 3);
+    assert_eq!(rows[1][0], s(&files[0]));
+    assert_eq!(rows[1][1], "", "no label for a plain file");
+}
+
+#[test]
+fn predict_applies_the_models_pipeline_not_the_defaults() {
+    // With k = 1 every training recording is its own nearest neighbour, but only when it
+    // is conditioned, encoded and binned exactly as in training.
+    let dir = Dir::new();
+    let a = simulated(&dir, "A", "1");
+    let model = dir.join("model.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&a),
+        "--method",
+        "taxel",
+        "-k",
+        "1",
+        "--gain",
+        "12",
+        "--cutoff",
+        "20",
+        "--bin-ms",
+        "100",
+        "--out",
+        s(&model),
+    ]);
+    let file = read_json(&model);
+    assert_eq!(file["pipeline"]["encoder"]["gain"], 12.0);
+    assert_eq!(file["features"]["columns"].as_array().unwrap().len(), 48);
+    let out = dir.join("p.csv");
+    let score = scored(&dir, &model, &a, &out);
+    assert_eq!(score["accuracy"], 1.0, "{score}");
+}
+
+#[test]
+fn bad_models_and_recordings_are_named_errors() {
+    let dir = Dir::new();
+    let a = simulated(&dir, "A", "1");
+    let model = dir.join("model.json");
+    dir.ok(&["train", "--dataset", s(&a), "--out", s(&model)]);
+    let text = std::fs::read_to_string(&model).unwrap();
+    let damaged = dir.join("damaged.json");
+    std::fs::write(&damaged, &text[..text.len() * 2 / 3]).unwrap();
+    let future = dir.join("future.json");
+    std::fs::write(
+        &future,
+        text.replacen("\"version\": 1", "\"version\": 99", 1),
+    )
+    .unwrap();
+    let other = dir.join("other.json");
+    std::fs::write(&other, r#"{"format": "something-else", "version": 1}"#).unwrap();
+    let grid = dir.join("grid2x3.npy");
+    write_npy(&grid, &Array3::<f32>::from_elem((1400, 2, 3), 0.5)).unwrap();
+    let fine = dir.join("fine.npy");
+    write_npy(&fine, &recording(1400, 80.0, 0.3, 1)).unwrap();
+    let labelled = dir.dataset("letters", &["A", "B"], &[5.0], 2);
+
+    let out = dir.join("p.csv");
+    let (o, m, a) = (s(&out), s(&model), s(&a));
+    let damaged_error = format!("{}: damaged or truncated model file", s(&damaged));
+    let grid_error = format!("{}: its taxel grid (2x3, 6 taxels) differs", s(&grid));
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (predict(s(&damaged), o, &["--dataset", a]), &damaged_error),
+        (
+            predict(s(&future), o, &["--dataset", a]),
+            "model file version 99 is not supported",
+        ),
+        (
+            predict(s(&other), o, &["--dataset", a]),
+            "not a neurotex model file",
+        ),
+        (predict(m, o, &[s(&fine), s(&grid)]), &grid_error),
+        (
+            predict(m, o, &["--dataset", s(&labelled), "--json"]),
+            "test label `A`",
+        ),
+        (predict(m, o, &[s(&fine), "--json"]), "--dataset"),
+        (
+            vec![
+                "train",
+                "--dataset",
+                a,
+                "--method",
+                "glcm3d",
+                "--taxel",
+                "1,1",
+                "--out",
+                o,
+            ],
+            "only to --method taxel",
+        ),
+        (
+            vec!["train", "--dataset", a, "-k", "19", "--out", o],
+            "k = 19 neighbours needs at least 19",
+        ),
+    ];
+    dir.fails_each(&cases, &out);
+    assert!(!dir.partial_left(), "temporary files left behind");
+}
+
+/// `neurotex predict --model MODEL WHAT... --out OUT`.
+fn predict<'a>(model: &'a str, out: &'a str, what: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["predict", "--model", model];
+    args.extend_from_slice(what);
+    args.extend(["--out", out]);
+    args
+}

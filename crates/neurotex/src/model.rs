@@ -1,0 +1,823 @@
+//! Saved models (SPEC 10): a classifier trained on one dataset, with everything needed to
+//! apply it to new recordings, in one self-describing, versioned JSON file: the validated
+//! pipeline, the feature method and columns, the taxel grid, the classifier's parameters
+//! and training set, the class labels, and the training data's fingerprint.
+//!
+//! The fitted KNN is kept in the file as its training feature rows and their labels, and
+//! re-fitted on load, rather than as [`KnnModel`]'s internal state (z-scored columns stored
+//! feature-major, scaling factors, a visiting stride). Fitting is deterministic, so the
+//! re-fitted model predicts exactly what the saved one did; the raw rows mean the same to
+//! any reader (Python fits scikit-learn's KNN on them), stay valid when the fast layout
+//! changes, and pass through every check of [`Classifier::fit`] when a file is loaded,
+//! where stored internals could hold a stride or a scale that no fit would produce.
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::analysis::{column_groups, Columns, FeatureTable};
+use crate::classify::{Classifier, ConfusionMatrix, KnnModel, KnnParams};
+use crate::error::{ClassifyError, DataError, ParamError, Result};
+use crate::pipeline::{Encoded, FeatureExtractor, Method, Pipeline, PipelineParams};
+use crate::recording::{Baseline, Dataset, Recording};
+use crate::values::{Cell, Grid, Speed};
+
+/// The `format` field of every model file.
+pub const FORMAT: &str = "neurotex-model";
+
+/// The version of the model file format this neurotex writes and reads.
+pub const VERSION: u64 = 1;
+
+/// A model file that cannot be used, or recordings a model cannot take.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// The file is JSON but not a neurotex model.
+    #[error("{}: not a neurotex model file (its `format` is {found}, expected \"{FORMAT}\")", .path.display())]
+    NotAModel {
+        /// The file.
+        path: PathBuf,
+        /// What its `format` field holds, as JSON, or that it has none.
+        found: String,
+    },
+    /// A model file of a format version this neurotex does not read.
+    #[error("{}: model file version {found} is not supported; neurotex {} reads version {VERSION}", .path.display(), env!("CARGO_PKG_VERSION"))]
+    UnsupportedVersion {
+        /// The file.
+        path: PathBuf,
+        /// Its `version` field, as JSON, or that it has none.
+        found: String,
+    },
+    /// The file is truncated, not JSON, or its content breaks a rule.
+    #[error("{}: damaged or truncated model file: {reason}", .path.display())]
+    Damaged {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A model's parts disagree with each other (only a damaged file can make them).
+    #[error("{0}")]
+    Inconsistent(String),
+    /// A recording on another taxel grid than the model's.
+    #[error("{file}: its taxel grid ({}) differs from the model's ({}); a model applies only to recordings of the grid it was trained on", grid_text(.found, .expected), grid_text(.expected, .found))]
+    OtherGrid {
+        /// The recording.
+        file: String,
+        /// The model's grid.
+        expected: Grid,
+        /// The recording's grid.
+        found: Grid,
+    },
+}
+
+/// `4x4, 16 taxels`, saying when the mask is all that differs from `other`.
+fn grid_text(grid: &Grid, other: &Grid) -> String {
+    let same_shape = (grid.rows(), grid.cols(), grid.n_taxels())
+        == (other.rows(), other.cols(), other.n_taxels());
+    let mask = if same_shape { ", another mask" } else { "" };
+    format!("{grid}, {} taxels{mask}", grid.n_taxels())
+}
+
+/// Which features a model classifies.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FeatureSpec {
+    /// The feature set.
+    pub method: Method,
+    /// For [`Method::Taxel`], the one taxel whose statistics are used; `None` for all of
+    /// the method's columns (every taxel's three statistics together).
+    pub taxel: Option<Cell>,
+    /// The column names, in order.
+    pub columns: Vec<String>,
+}
+
+/// The classifier and its parameters, tagged by `kind` in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+enum ClassifierSpec {
+    /// k-nearest neighbours.
+    Knn(KnnParams),
+}
+
+/// Where a model's training data came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// [`Dataset::fingerprint`] of the training dataset.
+    pub fingerprint: String,
+    /// The dataset's baseline from `layout.toml` (`none` when it gives none): the baseline
+    /// the recordings were conditioned with unless the pipeline set its own.
+    pub baseline: Baseline,
+    /// The speeds trained on; `None` for all of the dataset's.
+    pub speeds: Option<Vec<Speed>>,
+}
+
+impl Provenance {
+    /// The provenance of training on `dataset` at `speeds` (all when `None`).
+    ///
+    /// # Errors
+    /// The manifest or a listed file can no longer be read.
+    pub fn of(dataset: &Dataset, speeds: Option<Vec<Speed>>) -> Result<Self> {
+        Ok(Provenance {
+            fingerprint: dataset.fingerprint()?,
+            baseline: dataset.layout.baseline.unwrap_or_default(),
+            speeds,
+        })
+    }
+}
+
+/// The training set as stored: one feature row and one label per training recording.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct TrainingSet {
+    dataset: Provenance,
+    labels: Vec<String>,
+    rows: Vec<Vec<f64>>,
+}
+
+/// The file's form. Fields are written in this order, so the file reads from what it is
+/// to how it was made, with the long training rows last.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct ModelFile {
+    format: String,
+    version: u64,
+    neurotex_version: String,
+    pipeline: PipelineParams,
+    features: FeatureSpec,
+    grid: Grid,
+    classifier: ClassifierSpec,
+    labels: Vec<String>,
+    training: TrainingSet,
+}
+
+/// The two fields read before the rest, so that a file of another format or version is
+/// named as such rather than as damaged.
+#[derive(Deserialize)]
+struct Header {
+    format: Option<serde_json::Value>,
+    version: Option<serde_json::Value>,
+}
+
+/// One recording's prediction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Prediction {
+    /// The predicted class.
+    pub predicted: String,
+    /// Each class's share of the votes among the `k` neighbours, in the order of
+    /// [`Model::labels`]; the shares sum to 1.
+    pub shares: Vec<f64>,
+}
+
+/// Predictions scored against known labels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Score {
+    /// Share of recordings predicted right, 0..1.
+    pub accuracy: f64,
+    /// Recordings scored.
+    pub n: usize,
+    /// The model's classes, in confusion-matrix order.
+    pub labels: Vec<String>,
+    /// Row = true label, column = predicted label.
+    pub confusion: ConfusionMatrix,
+}
+
+/// A trained model: what its file holds, with the pipeline, the feature extractor and the
+/// classifier made ready from it.
+#[derive(Debug, Clone)]
+pub struct Model {
+    file: ModelFile,
+    pipeline: Pipeline,
+    extractor: FeatureExtractor,
+    columns: Vec<usize>,
+    knn: KnnModel,
+}
+
+impl PartialEq for Model {
+    /// Models are equal when their files are: everything else is made from the file.
+    fn eq(&self, other: &Self) -> bool {
+        self.file == other.file
+    }
+}
+
+impl Model {
+    /// Trains a KNN on `columns` of `table` (the features of the training recordings,
+    /// conditioned and encoded with `params`).
+    ///
+    /// # Errors
+    /// [`Columns::EachTaxel`] (a model classifies with one set of columns), a taxel outside
+    /// the grid, broken parameters, or a training set the classifier cannot fit (`k`
+    /// larger than the training set, non-finite features).
+    pub fn train(
+        params: &PipelineParams,
+        table: &FeatureTable,
+        columns: Columns,
+        knn: KnnParams,
+        provenance: Provenance,
+    ) -> Result<Model> {
+        let taxel = match columns {
+            Columns::All => None,
+            Columns::Taxel(cell) => Some(cell),
+            Columns::EachTaxel => {
+                return Err(ParamError::new(
+                    "taxel",
+                    "a model classifies with one set of columns: all of them, or one taxel's",
+                    "every taxel in turn",
+                )
+                .into())
+            }
+        };
+        let groups = column_groups(&table.grid, table.dims(), columns)?;
+        let selected = &groups[0].1;
+        let row_labels: Vec<String> = table.metas.iter().map(|m| m.label.clone()).collect();
+        let mut labels: Vec<String> = Vec::new();
+        for label in &row_labels {
+            if !labels.contains(label) {
+                labels.push(label.clone());
+            }
+        }
+        let file = ModelFile {
+            format: FORMAT.to_string(),
+            version: VERSION,
+            neurotex_version: env!("CARGO_PKG_VERSION").to_string(),
+            pipeline: params.clone(),
+            features: FeatureSpec {
+                method: table.method,
+                taxel,
+                columns: selected.iter().map(|&j| table.names[j].clone()).collect(),
+            },
+            grid: table.grid.clone(),
+            classifier: ClassifierSpec::Knn(knn),
+            labels,
+            training: TrainingSet {
+                dataset: provenance,
+                labels: row_labels,
+                rows: (0..table.metas.len())
+                    .map(|i| table.select(&[i], selected))
+                    .collect(),
+            },
+        };
+        Model::assemble(file)
+    }
+
+    /// Checks a model file's content and makes its pipeline, extractor and classifier.
+    ///
+    /// # Errors
+    /// A broken parameter rule, parts that disagree, or a training set that cannot be fit.
+    fn assemble(file: ModelFile) -> Result<Model> {
+        let inconsistent = |what: String| -> crate::Error { ModelError::Inconsistent(what).into() };
+        let grid = &file.grid;
+        let grid = Grid::masked(grid.rows(), grid.cols(), grid.present().to_vec())?;
+        // The model conditions new recordings as it did its training set, whatever the
+        // baseline of their dataset's layout.
+        let mut resolved = file.pipeline.clone();
+        let baseline = resolved.preprocess.baseline;
+        resolved.preprocess.baseline = Some(baseline.unwrap_or(file.training.dataset.baseline));
+        let pipeline = Pipeline::new(resolved)?;
+        let extractor = pipeline.extractor(&grid)?;
+        let spec = &file.features;
+        let columns = match (spec.method, spec.taxel) {
+            (Method::Taxel, Some(cell)) => Columns::Taxel(cell),
+            (_, None) => Columns::All,
+            (method, Some(_)) => {
+                return Err(inconsistent(format!(
+                    "a taxel is given for method {}, which has no per-taxel columns",
+                    method.name()
+                )))
+            }
+        };
+        let names = extractor.names(spec.method);
+        let columns = column_groups(&grid, names.len(), columns)?.remove(0).1;
+        let expected: Vec<&String> = columns.iter().map(|&j| &names[j]).collect();
+        if spec.columns.iter().collect::<Vec<_>>() != expected {
+            return Err(inconsistent(format!(
+                "feature columns {:?} are not those of method {} on the {grid} grid",
+                spec.columns,
+                spec.method.name()
+            )));
+        }
+        let knn = fit(&file, columns.len())?;
+        Ok(Model {
+            file,
+            pipeline,
+            extractor,
+            columns,
+            knn,
+        })
+    }
+
+    /// Writes the model to `path` as pretty-printed JSON, whole or not at all.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        crate::io::write_atomic(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &self.file).map_err(std::io::Error::other)?;
+            writeln!(w)
+        })
+    }
+
+    /// Reads a model file written by [`Model::save`].
+    ///
+    /// # Errors
+    /// [`DataError::Io`] for an unreadable file; [`ModelError::NotAModel`] for JSON of
+    /// another format, [`ModelError::UnsupportedVersion`] for another format version, and
+    /// [`ModelError::Damaged`] for a truncated file, one that is not JSON, or content that
+    /// breaks a rule.
+    pub fn load(path: &Path) -> Result<Model> {
+        let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+        let damaged = |reason: String| -> crate::Error {
+            ModelError::Damaged {
+                path: path.to_path_buf(),
+                reason,
+            }
+            .into()
+        };
+        let header: Header = serde_json::from_slice(&bytes).map_err(|e| match e.classify() {
+            serde_json::error::Category::Data => ModelError::NotAModel {
+                path: path.to_path_buf(),
+                found: "missing (the file is not a JSON object)".into(),
+            }
+            .into(),
+            _ => damaged(e.to_string()),
+        })?;
+        let text =
+            |field: Option<serde_json::Value>| field.map_or("missing".into(), |v| v.to_string());
+        if header.format.as_ref().and_then(|f| f.as_str()) != Some(FORMAT) {
+            return Err(ModelError::NotAModel {
+                path: path.to_path_buf(),
+                found: text(header.format),
+            }
+            .into());
+        }
+        if header.version.as_ref().and_then(|v| v.as_u64()) != Some(VERSION) {
+            return Err(ModelError::UnsupportedVersion {
+                path: path.to_path_buf(),
+                found: text(header.version),
+            }
+            .into());
+        }
+        let file: ModelFile = serde_json::from_slice(&bytes).map_err(|e| damaged(e.to_string()))?;
+        Model::assemble(file).map_err(|e| damaged(e.to_string()))
+    }
+
+    /// Conditions and encodes one recording as the training recordings were (the model's
+    /// pipeline and baseline).
+    ///
+    /// # Errors
+    /// A recording the pipeline cannot take (empty sliding phase, shorter than one bin).
+    pub fn encode(&self, recording: &Recording) -> Result<Encoded> {
+        self.pipeline.encode(recording, self.baseline())
+    }
+
+    /// Predicts the class of each encoded recording, in parallel.
+    ///
+    /// # Errors
+    /// [`ModelError::OtherGrid`] naming the first recording on another grid than the
+    /// model's; a recording shorter than one bin.
+    pub fn predict(&self, encoded: &[Encoded]) -> Result<Vec<Prediction>> {
+        for e in encoded {
+            let s = &e.spikes;
+            let found = Grid::masked(s.rows, s.cols, s.present.clone())
+                .map_err(|err| crate::Error::from(err).in_recording(&e.meta.file))?;
+            if found != self.file.grid {
+                return Err(ModelError::OtherGrid {
+                    file: e.meta.file.clone(),
+                    expected: self.file.grid.clone(),
+                    found,
+                }
+                .into());
+            }
+        }
+        let method = self.file.features.method;
+        let rows: Vec<Vec<f64>> = encoded
+            .par_iter()
+            .map(|e| {
+                let row = self
+                    .extractor
+                    .row(&e.spikes, method)
+                    .map_err(|err| err.in_recording(&e.meta.file))?;
+                Ok(self.columns.iter().map(|&j| row[j]).collect())
+            })
+            .collect::<Result<_>>()?;
+        self.predict_rows(&rows.concat())
+    }
+
+    /// Predicts the class of each feature row of `x` (row-major, the model's columns,
+    /// `columns` of [`Model::features`], per row).
+    ///
+    /// # Errors
+    /// Rows of another length, or a feature that is not finite.
+    pub fn predict_rows(&self, x: &[f64]) -> Result<Vec<Prediction>> {
+        let dims = self.columns.len();
+        if x.len() % dims != 0 {
+            return Err(ClassifyError::BadFeatures(format!(
+                "{} feature values are not whole rows of the model's {dims} features",
+                x.len()
+            ))
+            .into());
+        }
+        if let Some(pos) = x.iter().position(|v| !v.is_finite()) {
+            return Err(ClassifyError::BadFeatures(format!(
+                "feature {} of row {} is not finite",
+                pos % dims,
+                pos / dims
+            ))
+            .into());
+        }
+        let k = self.knn_params().k as f64;
+        let n_classes = self.file.labels.len();
+        Ok(self
+            .knn
+            .predict_with_votes(x)
+            .into_iter()
+            .map(|(class, votes)| Prediction {
+                predicted: self.file.labels[class].clone(),
+                shares: (0..n_classes)
+                    .map(|c| votes.get(c).copied().unwrap_or(0) as f64 / k)
+                    .collect(),
+            })
+            .collect())
+    }
+
+    /// Scores `predictions` against the true labels `truth`, one per prediction.
+    ///
+    /// # Errors
+    /// No predictions, or a true label that is not one of the model's classes (named).
+    ///
+    /// # Panics
+    /// If `truth` and `predictions` differ in length (a caller bug).
+    pub fn score(&self, truth: &[String], predictions: &[Prediction]) -> Result<Score> {
+        assert_eq!(
+            truth.len(),
+            predictions.len(),
+            "one true label per prediction"
+        );
+        if truth.is_empty() {
+            return Err(ClassifyError::Empty { what: "score" }.into());
+        }
+        let labels = &self.file.labels;
+        let index = |label: &str| labels.iter().position(|l| l == label);
+        let y = truth
+            .iter()
+            .map(|t| index(t).ok_or_else(|| ClassifyError::UnknownTestLabel { label: t.clone() }))
+            .collect::<Result<Vec<_>, _>>()?;
+        let predicted: Vec<usize> = predictions
+            .iter()
+            .map(|p| index(&p.predicted).unwrap_or(0))
+            .collect();
+        let confusion = ConfusionMatrix::from_predictions(&y, &predicted, labels.len());
+        Ok(Score {
+            accuracy: confusion.accuracy(),
+            n: y.len(),
+            labels: labels.clone(),
+            confusion,
+        })
+    }
+
+    /// The class labels, in the order of [`Prediction::shares`].
+    pub fn labels(&self) -> &[String] {
+        &self.file.labels
+    }
+
+    /// The feature method, the taxel and the column names.
+    pub fn features(&self) -> &FeatureSpec {
+        &self.file.features
+    }
+
+    /// The taxel grid recordings must have.
+    pub fn grid(&self) -> &Grid {
+        &self.file.grid
+    }
+
+    /// The pipeline parameters as trained (the baseline `None` when the training dataset's
+    /// layout chose it; see [`Model::baseline`]).
+    pub fn params(&self) -> &PipelineParams {
+        &self.file.pipeline
+    }
+
+    /// The planned pipeline, with the baseline resolved to [`Model::baseline`].
+    pub fn pipeline(&self) -> &Pipeline {
+        &self.pipeline
+    }
+
+    /// The baseline applied to every recording: the pipeline's own, else the training
+    /// dataset's.
+    pub fn baseline(&self) -> Baseline {
+        self.file
+            .pipeline
+            .preprocess
+            .baseline
+            .unwrap_or(self.file.training.dataset.baseline)
+    }
+
+    /// The classifier's parameters.
+    pub fn knn_params(&self) -> KnnParams {
+        let ClassifierSpec::Knn(params) = self.file.classifier;
+        params
+    }
+
+    /// Where the training data came from.
+    pub fn provenance(&self) -> &Provenance {
+        &self.file.training.dataset
+    }
+
+    /// Training recordings.
+    pub fn n_training(&self) -> usize {
+        self.file.training.rows.len()
+    }
+
+    /// The neurotex version that wrote the model.
+    pub fn neurotex_version(&self) -> &str {
+        &self.file.neurotex_version
+    }
+}
+
+/// Fits the file's classifier on its training rows of `dims` features.
+///
+/// # Errors
+/// Rows of another length, labels that are not classes of the model, or a training set
+/// the classifier cannot fit.
+fn fit(file: &ModelFile, dims: usize) -> Result<KnnModel> {
+    let training = &file.training;
+    let inconsistent = |what: String| -> crate::Error { ModelError::Inconsistent(what).into() };
+    if training.labels.len() != training.rows.len() {
+        return Err(inconsistent(format!(
+            "{} training labels for {} training rows",
+            training.labels.len(),
+            training.rows.len()
+        )));
+    }
+    if let Some(i) = training.rows.iter().position(|r| r.len() != dims) {
+        return Err(inconsistent(format!(
+            "training row {i} has {} features, expected {dims}",
+            training.rows[i].len()
+        )));
+    }
+    for (i, label) in file.labels.iter().enumerate() {
+        if file.labels[..i].contains(label) {
+            return Err(inconsistent(format!("class `{label}` is listed twice")));
+        }
+    }
+    let y = training
+        .labels
+        .iter()
+        .map(|l| {
+            file.labels.iter().position(|c| c == l).ok_or_else(|| {
+                inconsistent(format!("training label `{l}` is not one of the classes"))
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let ClassifierSpec::Knn(params) = file.classifier;
+    Ok(params.check()?.fit(&training.rows.concat(), dims, &y)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::encode::SpikeTrains;
+    use crate::recording::Meta;
+
+    /// `n` feature values in [0, 10), seeded.
+    fn values(seed: u64, n: usize) -> Vec<f64> {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..n).map(|_| 10.0 * rng.gen::<f64>()).collect()
+    }
+
+    /// A `method` table of three classes x 6 recordings on a 2x2 grid whose class shifts
+    /// every feature, so that the classes are told apart.
+    fn table(method: Method) -> FeatureTable {
+        let grid = Grid::full(2, 2).unwrap();
+        let extractor = FeatureExtractor::new(&PipelineParams::default(), &grid).unwrap();
+        let names = extractor.names(method);
+        let labels = ["rough", "smooth", "ribbed"];
+        let metas: Vec<Meta> = (0..18)
+            .map(|i| Meta {
+                file: format!("r{i}.npy"),
+                label: labels[i % 3].to_string(),
+                ..Meta::default()
+            })
+            .collect();
+        let noise = values(7, metas.len() * names.len());
+        let values = noise
+            .chunks(names.len())
+            .enumerate()
+            .flat_map(|(i, row)| row.iter().map(move |v| v + 20.0 * (i % 3) as f64))
+            .collect();
+        FeatureTable {
+            method,
+            grid,
+            names,
+            metas,
+            values,
+        }
+    }
+
+    fn provenance() -> Provenance {
+        Provenance {
+            fingerprint: "sha256:00".into(),
+            baseline: Baseline::Min,
+            speeds: Some(vec![Speed::of(5.0)]),
+        }
+    }
+
+    fn trained(method: Method, columns: Columns) -> Model {
+        let params = PipelineParams::default();
+        let knn = KnnParams {
+            k: 3,
+            standardize: true,
+        };
+        Model::train(&params, &table(method), columns, knn, provenance()).unwrap()
+    }
+
+    #[test]
+    fn a_saved_model_loads_equal_and_predicts_the_same() {
+        let dir = tempfile::tempdir().unwrap();
+        for (method, columns) in [
+            (Method::Glcm3d, Columns::All),
+            (Method::Taxel, Columns::All),
+            (Method::Taxel, Columns::Taxel(Cell { row: 1, col: 0 })),
+        ] {
+            let model = trained(method, columns);
+            let dims = model.features().columns.len();
+            let queries = values(99, 40 * dims);
+            let before = model.predict_rows(&queries).unwrap();
+            let path = dir.path().join("model.json");
+            model.save(&path).unwrap();
+            let loaded = Model::load(&path).unwrap();
+            assert_eq!(loaded, model);
+            assert_eq!(loaded.predict_rows(&queries).unwrap(), before);
+            assert_eq!(loaded.baseline(), Baseline::Min, "the training layout's");
+            for p in &before {
+                assert!((p.shares.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                let top = model
+                    .labels()
+                    .iter()
+                    .position(|l| *l == p.predicted)
+                    .unwrap();
+                assert!(p.shares.iter().all(|&s| s <= p.shares[top]));
+            }
+        }
+    }
+
+    #[test]
+    fn the_file_describes_itself() {
+        let model = trained(Method::Taxel, Columns::Taxel(Cell { row: 0, col: 1 }));
+        let value = serde_json::to_value(&model.file).unwrap();
+        assert_eq!(value["format"], "neurotex-model");
+        assert_eq!(value["version"], 1);
+        assert_eq!(value["neurotex_version"], env!("CARGO_PKG_VERSION"));
+        assert_eq!(value["pipeline"]["preprocess"]["cutoff_hz"], 50.0);
+        assert_eq!(value["pipeline"]["encoder"]["gain"], 8.0);
+        assert_eq!(
+            value["pipeline"]["glcm"]["distances"],
+            serde_json::json!([1, 2, 4, 8])
+        );
+        assert_eq!(
+            value["features"]["columns"],
+            serde_json::json!(["r0c1_msr", "r0c1_cv_isi", "r0c1_fano"])
+        );
+        assert_eq!(
+            value["classifier"],
+            serde_json::json!({"kind": "knn", "k": 3, "standardize": true})
+        );
+        assert_eq!(
+            value["labels"],
+            serde_json::json!(["rough", "smooth", "ribbed"])
+        );
+        assert_eq!(value["training"]["dataset"]["baseline"]["kind"], "min");
+        assert_eq!(value["training"]["rows"].as_array().unwrap().len(), 18);
+    }
+
+    #[test]
+    fn the_training_rows_are_one_set_of_columns() {
+        let params = PipelineParams::default();
+        let err = Model::train(
+            &params,
+            &table(Method::Taxel),
+            Columns::EachTaxel,
+            KnnParams::default(),
+            provenance(),
+        )
+        .unwrap_err();
+        assert!(matches!(
+            err,
+            crate::Error::Param(ParamError { name: "taxel", .. })
+        ));
+        let err = Model::train(
+            &params,
+            &table(Method::Glcm3d),
+            Columns::All,
+            KnnParams {
+                k: 19,
+                standardize: true,
+            },
+            provenance(),
+        )
+        .unwrap_err();
+        assert!(matches!(
+            err,
+            crate::Error::Classify(ClassifyError::KTooLarge { k: 19, n_train: 18 })
+        ));
+    }
+
+    /// Writes `text` to a file and loads it as a model.
+    fn load_text(text: &str) -> crate::Error {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.json");
+        std::fs::write(&path, text).unwrap();
+        Model::load(&path).unwrap_err()
+    }
+
+    #[test]
+    fn files_of_another_format_or_version_or_damaged_are_named_errors() {
+        let model = trained(Method::Glcm3d, Columns::All);
+        let text = serde_json::to_string_pretty(&model.file).unwrap();
+        let err = load_text(&text.replacen("\"version\": 1", "\"version\": 99", 1));
+        assert!(
+            matches!(&err, crate::Error::Model(ModelError::UnsupportedVersion { found, .. }) if found == "99"),
+            "{err}"
+        );
+        assert!(
+            err.to_string().contains("version 99 is not supported"),
+            "{err}"
+        );
+        let err = load_text(&text.replacen("neurotex-model", "other-model", 1));
+        assert!(
+            matches!(err, crate::Error::Model(ModelError::NotAModel { .. })),
+            "{err}"
+        );
+        let err = load_text("[1, 2]");
+        assert!(
+            matches!(err, crate::Error::Model(ModelError::NotAModel { .. })),
+            "{err}"
+        );
+        for damaged in [
+            &text[..text.len() / 2],
+            "",
+            "not json",
+            &text.replacen("\"kind\": \"knn\"", "\"kind\": \"forest\"", 1),
+            &text.replacen("\"levels\": 16", "\"levels\": 1", 1),
+            &text.replacen("\"rows\": 2,", "\"rows\": 3,", 1),
+            &text.replacen("\"asm\"", "\"energy\"", 1),
+            &text.replacen("\"k\": 3", "\"k\": 0", 1),
+        ] {
+            let err = load_text(damaged);
+            assert!(
+                matches!(err, crate::Error::Model(ModelError::Damaged { .. })),
+                "{err}"
+            );
+        }
+        let missing = Model::load(Path::new("/nonexistent/model.json")).unwrap_err();
+        assert!(matches!(missing, crate::Error::Data(DataError::Io { .. })));
+    }
+
+    #[test]
+    fn recordings_of_another_grid_are_named() {
+        let model = trained(Method::Glcm3d, Columns::All);
+        let encoded = |file: &str, rows: usize, cols: usize| Encoded {
+            meta: Meta {
+                file: file.into(),
+                ..Meta::default()
+            },
+            spikes: SpikeTrains::from_raster(
+                &vec![0; 400 * rows * cols],
+                rows,
+                cols,
+                &vec![true; rows * cols],
+            ),
+            resampled: false,
+            flat: false,
+        };
+        assert_eq!(model.predict(&[encoded("a.npy", 2, 2)]).unwrap().len(), 1);
+        let err = model
+            .predict(&[encoded("a.npy", 2, 2), encoded("b.npy", 3, 3)])
+            .unwrap_err();
+        assert!(
+            matches!(&err, crate::Error::Model(ModelError::OtherGrid { file, .. }) if file == "b.npy"),
+            "{err}"
+        );
+        assert!(err.to_string().contains("3x3, 9 taxels"), "{err}");
+    }
+
+    #[test]
+    fn scores_count_true_labels_against_predictions() {
+        let model = trained(Method::Glcm3d, Columns::All);
+        let p = |label: &str| Prediction {
+            predicted: label.into(),
+            shares: vec![],
+        };
+        let truth: Vec<String> = ["rough", "smooth", "ribbed"].map(String::from).to_vec();
+        let score = model
+            .score(&truth, &[p("rough"), p("rough"), p("ribbed")])
+            .unwrap();
+        assert_eq!(score.n, 3);
+        assert!((score.accuracy - 2.0 / 3.0).abs() < 1e-15);
+        assert_eq!(score.confusion.rows()[1], vec![1, 0, 0]);
+        let err = model
+            .score(&["felt".to_string()], &[p("rough")])
+            .unwrap_err();
+        assert!(matches!(
+            err,
+            crate::Error::Classify(ClassifyError::UnknownTestLabel { .. })
+        ));
+    }
+}
