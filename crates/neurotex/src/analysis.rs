@@ -133,6 +133,11 @@ pub struct Outcome {
     /// the serialised form, whose readers want the summary.
     #[serde(skip)]
     pub predictions: Option<Vec<OutOfFold>>,
+    /// Per evaluated recording `(table row, share of its predictions that were right)`,
+    /// over repeats and, when several taxels were evaluated in turn, over taxels: what
+    /// intervals and paired comparisons resample. Left out of the serialised form.
+    #[serde(skip)]
+    pub correct_shares: Vec<(usize, f64)>,
 }
 
 /// One recording's out-of-fold prediction in one evaluation repeat.
@@ -285,10 +290,36 @@ pub fn evaluate<C: Classifier>(
         [one] => Some(OutOfFold::of(&one.evaluation, evaluated)),
         _ => None,
     };
+    let truth = match split {
+        Split::CrossValidation { .. } => y_train,
+        Split::ByCondition { .. } => y_test,
+    };
+    let correct_shares = correct_shares(&results, evaluated, truth);
     Ok(Outcome {
         predictions,
+        correct_shares,
         ..combine(results, labels, columns == Columns::EachTaxel, &table.grid)
     })
+}
+
+/// Per evaluated recording, the share of all groups' predictions in all repeats that were
+/// right (`truth[i]` is row `rows[i]`'s class).
+fn correct_shares(results: &[GroupResult], rows: &[usize], truth: &[usize]) -> Vec<(usize, f64)> {
+    let mut right = vec![0usize; rows.len()];
+    let mut made = 0usize;
+    for r in results {
+        for repeat in &r.evaluation.predictions {
+            made += 1;
+            for (i, &p) in repeat.predicted.iter().enumerate() {
+                right[i] += usize::from(p == truth[i]);
+            }
+        }
+    }
+    let made = made.max(1) as f64;
+    rows.iter()
+        .zip(right)
+        .map(|(&row, k)| (row, k as f64 / made))
+        .collect()
 }
 
 /// One outcome from the groups' results: mean accuracy and spread, summed confusion, and
@@ -336,5 +367,6 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
         per_taxel,
         best,
         predictions: None,
+        correct_shares: Vec::new(),
     }
 }

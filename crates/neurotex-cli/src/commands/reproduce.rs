@@ -93,12 +93,7 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
     };
     write_report(&args.out, &results, &ctx)?;
     for claim in claims(&results) {
-        let verdict = if claim.verdict.holds() {
-            "agrees:        "
-        } else {
-            "does not agree:"
-        };
-        eprintln!("{verdict} {}", claim.statement);
+        eprintln!("{:<40} {}", claim.verdict.describe(), claim.statement);
     }
     eprintln!(
         "report in {}/report.md ({:.1} s)",

@@ -3,30 +3,62 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::Results;
+use super::{Comparison, Results};
+use crate::classify::PairedVerdict;
 
-/// Whether a claim of the paper holds on these results.
+/// Whether a claim of the paper holds on these results: by a paired comparison on the same
+/// recordings where the analysis has one, else by point estimates only (and says so).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
-    /// Our results agree with the claim.
+    /// Significant in the paper's direction wherever it is tested.
     Holds,
-    /// Our results do not agree with the claim.
-    DoesNotHold,
+    /// Within noise somewhere, and significant against it nowhere.
+    NotShown,
+    /// Significant against the paper's direction somewhere.
+    Contradicted,
+    /// No test: our point estimates agree with the claim.
+    PointAgrees,
+    /// No test: our point estimates disagree with the claim.
+    PointDisagrees,
 }
 
 impl Verdict {
     fn of(holds: bool) -> Self {
         if holds {
-            Verdict::Holds
+            Verdict::PointAgrees
         } else {
-            Verdict::DoesNotHold
+            Verdict::PointDisagrees
         }
     }
 
-    /// Whether the claim holds.
+    /// The verdict of a claim tested at several conditions, from each condition's paired
+    /// comparison.
+    fn tested(verdicts: impl IntoIterator<Item = PairedVerdict>) -> Self {
+        let all: Vec<PairedVerdict> = verdicts.into_iter().collect();
+        if all.contains(&PairedVerdict::Contradicted) {
+            Verdict::Contradicted
+        } else if !all.is_empty() && all.iter().all(|v| *v == PairedVerdict::Supported) {
+            Verdict::Holds
+        } else {
+            Verdict::NotShown
+        }
+    }
+
+    /// Whether the claim holds (by test, or in point estimates where there is none).
     pub fn holds(self) -> bool {
-        self == Verdict::Holds
+        matches!(self, Verdict::Holds | Verdict::PointAgrees)
+    }
+
+    /// How the report and the command line say it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Verdict::Holds => "Holds (paired test)",
+            Verdict::NotShown => "Not shown (within noise)",
+            Verdict::Contradicted => "Contradicted (paired test)",
+            Verdict::PointAgrees => "Agrees in point estimates (no test)",
+            Verdict::PointDisagrees => "Disagrees in point estimates (no test)",
+        }
     }
 }
 
@@ -43,12 +75,26 @@ pub struct Claim {
 
 impl Claim {
     fn new(statement: &str, holds: bool, detail: String) -> Self {
+        Self::judged(statement, Verdict::of(holds), detail)
+    }
+
+    fn judged(statement: &str, verdict: Verdict, detail: String) -> Self {
         Claim {
             statement: statement.to_string(),
-            verdict: Verdict::of(holds),
+            verdict,
             detail,
         }
     }
+}
+
+/// `a - b` with its interval, in points.
+fn difference(c: &Comparison) -> String {
+    format!(
+        "{:+.1} points [{:+.1}, {:+.1}]",
+        100.0 * c.difference,
+        100.0 * c.lower,
+        100.0 * c.upper
+    )
 }
 
 fn pct(a: f64) -> String {
@@ -72,15 +118,22 @@ fn e1_claims(r: &Results) -> Vec<Claim> {
     if r.e1.is_empty() {
         return Vec::new();
     }
-    let ahead = r.e1.values().all(|e| e.glcm3d > e.taxel_mean);
+    let verdict = Verdict::tested(r.e1.values().map(|e| e.glcm3d_vs_taxel.verdict));
     let detail =
         r.e1.iter()
-            .map(|(s, e)| format!("{s} mm/s: {} vs {} %", pct(e.glcm3d), pct(e.taxel_mean)))
+            .map(|(s, e)| {
+                let d = difference(&e.glcm3d_vs_taxel);
+                format!(
+                    "{s} mm/s: {} vs {} %, {d}",
+                    pct(e.glcm3d),
+                    pct(e.taxel_mean)
+                )
+            })
             .collect::<Vec<_>>()
             .join("; ");
-    let mut out = vec![Claim::new(
+    let mut out = vec![Claim::judged(
         "E1: 3D-GLCM beats the single taxel (mean over taxels) at every speed",
-        ahead,
+        verdict,
         detail,
     )];
     out.push(Claim::new(
@@ -153,12 +206,23 @@ fn e4_claim(r: &Results) -> Option<Claim> {
     if r.e4.is_empty() {
         return None;
     }
-    Some(Claim::new(
-        "E4: without time (2D-GLCM) accuracy falls below both the single taxel and 3D-GLCM",
+    let verdicts =
         r.e4.values()
-            .all(|e| e.glcm2d < e.taxel_mean && e.glcm2d < e.glcm3d),
+            .flat_map(|e| [e.taxel_vs_glcm2d.verdict, e.glcm3d_vs_glcm2d.verdict]);
+    Some(Claim::judged(
+        "E4: without time (2D-GLCM) accuracy falls below both the single taxel and 3D-GLCM",
+        Verdict::tested(verdicts),
         r.e4.iter()
-            .map(|(s, e)| format!("{s} mm/s: 2D {} %", pct(e.glcm2d)))
+            .map(|(s, e)| {
+                let (t, g) = (
+                    difference(&e.taxel_vs_glcm2d),
+                    difference(&e.glcm3d_vs_glcm2d),
+                );
+                format!(
+                    "{s} mm/s: 2D {} %; single taxel {t}, 3D {g} above it",
+                    pct(e.glcm2d)
+                )
+            })
             .collect::<Vec<_>>()
             .join("; "),
     ))
@@ -188,11 +252,14 @@ fn e6_claim(r: &Results) -> Option<Claim> {
     if r.e6.is_empty() {
         return None;
     }
-    Some(Claim::new(
+    Some(Claim::judged(
         "E6: trained on the other speeds, 3D-GLCM generalises to a held-out speed better than the single taxel",
-        r.e6.values().all(|e| e.glcm3d > e.taxel_mean),
+        Verdict::tested(r.e6.values().map(|e| e.glcm3d_vs_taxel.verdict)),
         r.e6.iter()
-            .map(|(s, e)| format!("test {s} mm/s: {} vs {} %", pct(e.glcm3d), pct(e.taxel_mean)))
+            .map(|(s, e)| {
+                let d = difference(&e.glcm3d_vs_taxel);
+                format!("test {s} mm/s: {} vs {} %, {d}", pct(e.glcm3d), pct(e.taxel_mean))
+            })
             .collect::<Vec<_>>()
             .join("; "),
     ))
@@ -208,4 +275,22 @@ fn e8_claim(r: &Results) -> Option<Claim> {
             .all(|e| e.glcm3d.iter().zip(&e.taxel_mean).all(|(g, t)| g > t)),
         String::new(),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use PairedVerdict::{Contradicted, NotShown, Supported};
+
+    #[test]
+    fn a_tested_claim_holds_only_when_supported_everywhere() {
+        assert_eq!(Verdict::tested([Supported, Supported]), Verdict::Holds);
+        assert_eq!(Verdict::tested([Supported, NotShown]), Verdict::NotShown);
+        assert_eq!(
+            Verdict::tested([Supported, Contradicted]),
+            Verdict::Contradicted
+        );
+        assert_eq!(Verdict::tested([]), Verdict::NotShown);
+        assert!(Verdict::PointAgrees.holds() && !Verdict::NotShown.holds());
+    }
 }

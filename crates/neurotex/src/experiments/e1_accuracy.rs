@@ -3,7 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Stop};
+use super::{accuracy_interval, compare, Comparison, Context, Stop};
+use crate::classify::Interval;
 use crate::values::BySpeed;
 
 /// E1 at one speed.
@@ -30,6 +31,12 @@ pub struct E1Speed {
     pub chance: f64,
     /// Chance by always answering the most frequent class at this speed.
     pub majority: f64,
+    /// 95 % interval of the 3D-GLCM accuracy (bootstrap over recordings).
+    pub glcm3d_interval: Interval,
+    /// 95 % interval of the single taxel's mean over taxels (bootstrap over recordings).
+    pub taxel_mean_interval: Interval,
+    /// 3D-GLCM against the single taxel (mean over taxels) on the same recordings.
+    pub glcm3d_vs_taxel: Comparison,
 }
 
 /// E1 at every speed, from the headline evaluations.
@@ -37,10 +44,10 @@ pub struct E1Speed {
 /// # Errors
 /// None of its own: the evaluations ran when the tables were built.
 pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
-    Ok(c.tables
+    c.tables
         .headline
         .iter()
-        .map(|(speed, h)| {
+        .map(|(speed, h)| -> Result<_, Stop> {
             let best = h.taxel.best.unwrap_or(crate::analysis::TaxelAccuracy {
                 row: 0,
                 col: 0,
@@ -66,10 +73,17 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
                 classes,
                 chance: 1.0 / classes.max(1) as f64,
                 majority: truth.iter().copied().max().unwrap_or(0) as f64 / total,
+                glcm3d_interval: accuracy_interval(&h.glcm3d, c.params)?,
+                taxel_mean_interval: accuracy_interval(&h.taxel, c.params)?,
+                glcm3d_vs_taxel: compare(
+                    ("3D-GLCM", &h.glcm3d),
+                    ("single taxel", &h.taxel),
+                    c.params,
+                )?,
             };
-            (speed, e1)
+            Ok((speed, e1))
         })
-        .collect())
+        .collect()
 }
 
 /// The mean accuracy over the taxels that respond, from an every-taxel evaluation.
@@ -101,6 +115,10 @@ mod tests {
             // 4 textures x 6 trials at each speed
             assert_eq!((e.classes, e.chance, e.majority), (4, 0.25, 0.25));
             let responsive = e.taxel_mean_responsive.expect("the rig's taxels respond");
+            assert_eq!(e.glcm3d_interval.estimate, e.glcm3d);
+            assert!((e.taxel_mean_interval.estimate - e.taxel_mean).abs() < 1e-12);
+            let diff = e.glcm3d - e.taxel_mean;
+            assert!((e.glcm3d_vs_taxel.difference - diff).abs() < 1e-12);
             assert!((0.0..=1.0).contains(&responsive));
         }
     }

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::tables::cv_at;
-use super::{Context, Stop};
+use super::{compare, Comparison, Context, Stop};
 use crate::analysis::Columns;
 use crate::values::BySpeed;
 
@@ -17,6 +17,10 @@ pub struct E4Speed {
     pub glcm2d: f64,
     /// 3D-GLCM.
     pub glcm3d: f64,
+    /// The single taxel (mean over taxels) against 2D-GLCM, on the same recordings.
+    pub taxel_vs_glcm2d: Comparison,
+    /// 3D-GLCM against 2D-GLCM, on the same recordings.
+    pub glcm3d_vs_glcm2d: Comparison,
 }
 
 /// E4 at every speed.
@@ -39,6 +43,8 @@ pub fn e4_temporal(c: &Context) -> Result<BySpeed<E4Speed>, Stop> {
                 taxel_mean: h.taxel.accuracy,
                 glcm2d: g2.accuracy,
                 glcm3d: h.glcm3d.accuracy,
+                taxel_vs_glcm2d: compare(("single taxel", &h.taxel), ("2D-GLCM", &g2), c.params)?,
+                glcm3d_vs_glcm2d: compare(("3D-GLCM", &h.glcm3d), ("2D-GLCM", &g2), c.params)?,
             },
         );
     }

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Skip, Stop};
+use super::{compare, Comparison, Context, Skip, Stop};
 use crate::analysis::{evaluate, Columns, Split};
 use crate::values::{BySpeed, Speed};
 
@@ -15,6 +15,8 @@ pub struct E6Speed {
     pub taxel_mean: f64,
     /// 3D-GLCM.
     pub glcm3d: f64,
+    /// 3D-GLCM against the single taxel (mean over taxels) on the held-out recordings.
+    pub glcm3d_vs_taxel: Comparison,
 }
 
 /// E6 with every speed held out in turn.
@@ -41,6 +43,7 @@ pub fn e6_speed_invariance(c: &Context) -> Result<BySpeed<E6Speed>, Stop> {
             train,
             taxel_mean: taxel.accuracy,
             glcm3d: glcm3d.accuracy,
+            glcm3d_vs_taxel: compare(("3D-GLCM", &glcm3d), ("single taxel", &taxel), c.params)?,
         };
         out.insert(test, e6);
     }

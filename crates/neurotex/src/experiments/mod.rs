@@ -7,6 +7,7 @@
 //! judged here ([`claims`]); the report only renders.
 
 mod claims;
+mod comparison;
 mod diagnostics;
 mod e0_psth;
 mod e1_accuracy;
@@ -31,6 +32,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 pub use claims::{claims, Claim, Verdict};
+pub use comparison::{accuracy_interval, compare, Comparison};
 pub use diagnostics::{taxel_diagnostics, TaxelDiagnostics, TaxelResponse, SATURATION_SHARE};
 pub use e0_psth::{e0_psth, E0Example, E0};
 pub use e1_accuracy::{e1_accuracy, E1Speed};

@@ -26,6 +26,11 @@ fn figure(name: &str, alt: &str, caption: &str) -> String {
 }
 
 /// The paper's value in a table cell, or `-` where it gives none.
+/// An interval as `[lower, upper]` in percent.
+fn bracket(i: &crate::classify::Interval) -> String {
+    format!("[{}, {}]", pct(i.lower), pct(i.upper))
+}
+
 fn paper_cell(v: Option<f64>) -> String {
     v.map_or("-".into(), |v| v.to_string())
 }
@@ -135,13 +140,11 @@ fn taxel_diagnostics(r: &Results) -> String {
 }
 
 fn summary(r: &Results) -> String {
-    let mut out = "## Summary: where we agree with the paper\n\n".to_string();
+    let mut out = "## Summary: where we agree with the paper\n\n\
+        A claim *holds* only when a paired comparison on the same recordings (95 % bootstrap interval of the per-recording difference, resampling recordings) puts it on the paper's side at every speed; it is *not shown* when an interval holds 0, and *contradicted* when one lies on the other side. Claims without such a comparison are judged on point estimates and say so. Intervals are in brackets.\n\n"
+        .to_string();
     for c in claims(r) {
-        let verdict = if c.verdict.holds() {
-            "Agrees:"
-        } else {
-            "Does not agree:"
-        };
+        let verdict = format!("{}:", c.verdict.describe());
         let detail = if c.detail.is_empty() {
             String::new()
         } else {
@@ -154,15 +157,15 @@ fn summary(r: &Results) -> String {
 
 fn e1(r: &Results, paper: Option<&Paper>) -> String {
     let mut out = "## E1: accuracy per speed, single taxel vs 3D-GLCM\n\n\
-        Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline, the mean over the responsive taxels (neither silent nor at the encoder's ceiling in most recordings; see Data) and the best taxel beside it (chosen after the fact, so optimistic). Chance is one over the classes recorded at that speed. Stratified cross-validation, mean over repeats (folds and repeats under Parameters).\n\n"
+        Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline, the mean over the responsive taxels (neither silent nor at the encoder's ceiling in most recordings; see Data) and the best taxel beside it (chosen after the fact, so optimistic). Chance is one over the classes recorded at that speed. Stratified cross-validation, mean over repeats (folds and repeats under Parameters); the 95 % intervals come from a percentile bootstrap over recordings (2000 resamples), each recording's predictions over repeats (and taxels) kept together.\n\n"
         .to_string();
     let mut header = vec![
         "speed (mm/s)",
         "classes (chance %)",
-        "single taxel, mean (%)",
+        "single taxel, mean (%) [95 % interval]",
         "responsive taxels, mean (%)",
         "best taxel (%)",
-        "3D-GLCM (%)",
+        "3D-GLCM (%) [95 % interval]",
     ];
     if paper.is_some() {
         header.extend(["paper: single (%)", "paper: 3D-GLCM (%)"]);
@@ -172,10 +175,10 @@ fn e1(r: &Results, paper: Option<&Paper>) -> String {
         let mut row = vec![
             s.to_string(),
             format!("{} ({})", e.classes, pct(e.chance)),
-            pct(e.taxel_mean),
+            format!("{} {}", pct(e.taxel_mean), bracket(&e.taxel_mean_interval)),
             e.taxel_mean_responsive.map_or("-".into(), pct),
             format!("{} ({})", pct(e.taxel_best), e.taxel_best_cell),
-            format!("{} ± {}", pct(e.glcm3d), pct(e.glcm3d_std)),
+            format!("{} {}", pct(e.glcm3d), bracket(&e.glcm3d_interval)),
         ];
         if let Some(p) = paper {
             let v = p.e1_at(s);

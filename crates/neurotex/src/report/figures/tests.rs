@@ -64,6 +64,9 @@ pub(crate) fn wide() -> Results {
                     chance: if s.mm_s() > 0.0 { 0.2 } else { 1.0 / 7.0 },
                     majority: if s.mm_s() > 0.0 { 0.22 } else { 0.16 },
                     taxel_mean_responsive: Some(acc[i] * 0.8),
+                    glcm3d_interval: interval(acc[i]),
+                    taxel_mean_interval: interval(acc[i] * 0.6),
+                    glcm3d_vs_taxel: comparison(acc[i] * 0.4),
                 },
             )
         })
@@ -78,6 +81,8 @@ pub(crate) fn wide() -> Results {
                     taxel_mean: acc[i] * 0.6,
                     glcm2d: acc[i] * 0.7,
                     glcm3d: acc[i],
+                    taxel_vs_glcm2d: comparison(-acc[i] * 0.1),
+                    glcm3d_vs_glcm2d: comparison(acc[i] * 0.3),
                 },
             )
         })
@@ -113,6 +118,7 @@ pub(crate) fn wide() -> Results {
                     train,
                     taxel_mean: 0.3,
                     glcm3d: acc[i] * 0.8,
+                    glcm3d_vs_taxel: comparison(acc[i] * 0.8 - 0.3),
                 },
             )
         })
@@ -522,5 +528,41 @@ fn thirty_classes_still_lay_out() {
         let svg = svg.unwrap();
         assert_well_formed(name, &svg);
         assert_no_overprint(name, &svg);
+    }
+}
+
+/// A hand-made 95 % interval of ±5 points around `a`.
+fn interval(a: f64) -> crate::classify::Interval {
+    crate::classify::Interval {
+        estimate: a,
+        lower: (a - 0.05).max(0.0),
+        upper: (a + 0.05).min(1.0),
+        level: 0.95,
+        method: crate::classify::IntervalMethod::PercentileBootstrap {
+            n: 69,
+            resamples: 2000,
+            seed: 0,
+        },
+    }
+}
+
+/// A hand-made comparison with difference `d` and an interval of ±8 points.
+fn comparison(d: f64) -> crate::experiments::Comparison {
+    let (lower, upper) = (d - 0.08, d + 0.08);
+    let verdict = if lower > 0.0 {
+        crate::classify::PairedVerdict::Supported
+    } else if upper < 0.0 {
+        crate::classify::PairedVerdict::Contradicted
+    } else {
+        crate::classify::PairedVerdict::NotShown
+    };
+    crate::experiments::Comparison {
+        first: "a".into(),
+        second: "b".into(),
+        difference: d,
+        lower,
+        upper,
+        verdict,
+        recordings: 69,
     }
 }

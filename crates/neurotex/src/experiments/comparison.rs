@@ -1,0 +1,142 @@
+//! Uncertainty of the analyses' accuracies: a 95 % interval for each from a bootstrap over
+//! recordings, and paired comparisons of two methods on the same recordings.
+//!
+//! Both resample recordings (Efron's percentile bootstrap), keeping each recording's
+//! predictions over CV repeats, and over taxels for the single taxel, together: they are
+//! not independent. A paired comparison takes, per recording, the difference between the
+//! two methods' shares of right predictions, and asks whether the bootstrap interval of its
+//! mean excludes 0. Unlike McNemar's test this works when a method's answer per recording is
+//! a share (the mean over taxels), and it compares the methods on exactly the same folds.
+
+use serde::{Deserialize, Serialize};
+
+use super::ValidReproduceParams;
+use crate::analysis::Outcome;
+use crate::classify::{bootstrap_mean_share, BootstrapParams, Interval, PairedVerdict};
+use crate::error::{DataError, Result};
+
+/// Two methods compared on the same recordings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Comparison {
+    /// The method expected to be better.
+    pub first: String,
+    /// The other method.
+    pub second: String,
+    /// Mean over recordings of the first's share of right predictions minus the second's.
+    pub difference: f64,
+    /// 95 % percentile-bootstrap interval of `difference`, lower end.
+    pub lower: f64,
+    /// Upper end.
+    pub upper: f64,
+    /// Supported when the interval lies above 0, contradicted when below, not shown when
+    /// it holds 0.
+    pub verdict: PairedVerdict,
+    /// Recordings compared.
+    pub recordings: usize,
+}
+
+fn bootstrap(shares: &[f64], params: &ValidReproduceParams) -> Result<Interval> {
+    let bootstrap = BootstrapParams {
+        seed: params.seed,
+        ..BootstrapParams::default()
+    }
+    .check()?;
+    Ok(bootstrap_mean_share(shares, &bootstrap)?)
+}
+
+/// The 95 % interval of an outcome's accuracy, by a bootstrap over its recordings.
+///
+/// # Errors
+/// An outcome without per-recording results.
+pub fn accuracy_interval(outcome: &Outcome, params: &ValidReproduceParams) -> Result<Interval> {
+    let shares: Vec<f64> = outcome.correct_shares.iter().map(|&(_, s)| s).collect();
+    bootstrap(&shares, params)
+}
+
+/// `first` against `second`, evaluated on the same recordings.
+///
+/// # Errors
+/// The outcomes were evaluated on different recordings.
+pub fn compare(
+    first: (&str, &Outcome),
+    second: (&str, &Outcome),
+    params: &ValidReproduceParams,
+) -> Result<Comparison> {
+    let (a, b) = (&first.1.correct_shares, &second.1.correct_shares);
+    if a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.0 != y.0) {
+        let message = format!(
+            "{} and {} were not evaluated on the same recordings",
+            first.0, second.0
+        );
+        return Err(DataError::invalid("comparison", message).into());
+    }
+    // The difference lies in [-1, 1]; the bootstrap takes shares in [0, 1], so it resamples
+    // (d + 1) / 2 and the interval is mapped back, which is exact for a mean.
+    let shifted: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x.1 - y.1 + 1.0) / 2.0)
+        .collect();
+    let interval = bootstrap(&shifted, params)?;
+    let back = |v: f64| 2.0 * v - 1.0;
+    let (lower, upper) = (back(interval.lower), back(interval.upper));
+    let verdict = if lower > 0.0 {
+        PairedVerdict::Supported
+    } else if upper < 0.0 {
+        PairedVerdict::Contradicted
+    } else {
+        PairedVerdict::NotShown
+    };
+    Ok(Comparison {
+        first: first.0.to_string(),
+        second: second.0.to_string(),
+        difference: back(interval.estimate),
+        lower,
+        upper,
+        verdict,
+        recordings: a.len(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::small_run;
+    use super::*;
+
+    fn outcome(shares: &[f64]) -> Outcome {
+        let mut o = small_run()
+            .tables
+            .headline
+            .values()
+            .next()
+            .unwrap()
+            .glcm3d
+            .clone();
+        o.correct_shares = shares.iter().copied().enumerate().collect();
+        o
+    }
+
+    #[test]
+    fn clear_differences_are_supported_or_contradicted_and_equal_ones_not_shown() {
+        let params = &small_run().params;
+        let better = outcome(&[1.0; 40]);
+        let worse = outcome(&[0.0; 40]);
+        let mixed = outcome(&(0..40).map(|i| f64::from(i % 2)).collect::<Vec<_>>());
+        let up = compare(("a", &better), ("b", &worse), params).unwrap();
+        assert_eq!((up.difference, up.verdict), (1.0, PairedVerdict::Supported));
+        let down = compare(("b", &worse), ("a", &better), params).unwrap();
+        assert_eq!(
+            (down.difference, down.verdict),
+            (-1.0, PairedVerdict::Contradicted)
+        );
+        let same = compare(("m", &mixed), ("m2", &mixed), params).unwrap();
+        assert_eq!(
+            (same.difference, same.verdict),
+            (0.0, PairedVerdict::NotShown)
+        );
+        let interval = accuracy_interval(&mixed, params).unwrap();
+        assert_eq!(interval.estimate, 0.5);
+        assert!(interval.lower < 0.5 && interval.upper > 0.5);
+        assert!(compare(("a", &better), ("short", &outcome(&[1.0; 3])), params).is_err());
+    }
+}
