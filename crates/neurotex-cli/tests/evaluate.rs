@@ -50,6 +50,27 @@ fn features_and_evaluate_on_a_dataset() {
         .map(|v| v.as_u64().unwrap())
         .sum();
     assert_eq!(total, 30);
+    // metrics and the interval: 10 recordings of each of 3 classes
+    let m = &v["metrics"];
+    assert_eq!(m["chance_uniform"].as_f64().unwrap(), 1.0 / 3.0);
+    assert_eq!(m["chance_majority"].as_f64().unwrap(), 1.0 / 3.0);
+    let recalls: Vec<f64> = m["per_class"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["recall"].as_f64().unwrap())
+        .collect();
+    let balanced = recalls.iter().sum::<f64>() / 3.0;
+    assert!((m["balanced_accuracy"].as_f64().unwrap() - balanced).abs() < 1e-12);
+    // balanced classes: balanced accuracy equals accuracy
+    assert!((balanced - acc).abs() < 1e-12);
+    let interval = &v["accuracy_interval"];
+    assert_eq!(interval["estimate"].as_f64().unwrap(), acc);
+    let (lower, upper) = (
+        interval["lower"].as_f64().unwrap(),
+        interval["upper"].as_f64().unwrap(),
+    );
+    assert!(lower <= acc && acc <= upper && (0.0..=1.0).contains(&lower) && upper <= 1.0);
 
     let v = json("taxel", &["--repeats", "2"]);
     assert_eq!(v["per_taxel"].as_array().unwrap().len(), 16);

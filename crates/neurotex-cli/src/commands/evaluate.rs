@@ -9,7 +9,7 @@ use clap::Args;
 use neurotex::analysis::{
     evaluate, Columns, FeatureTable, OutOfFold, Outcome, Split, TaxelAccuracy,
 };
-use neurotex::classify::CvParams;
+use neurotex::classify::{bootstrap_mean_share, BootstrapParams, CvParams, Metrics};
 use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::Dataset;
 use neurotex::{Cell, Speed};
@@ -148,6 +148,18 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     if args.json {
         let mut value = serde_json::to_value(&outcome)?;
         value["method"] = args.method.name().into();
+        // Balanced accuracy, per-class recall and precision and both chance levels from the
+        // confusion matrix; the interval resamples recordings, keeping each one's
+        // predictions over repeats (and taxels) together.
+        value["metrics"] = serde_json::to_value(Metrics::from_confusion(&outcome.confusion))?;
+        let shares: Vec<f64> = outcome.correct_shares.iter().map(|&(_, s)| s).collect();
+        let bootstrap = BootstrapParams {
+            seed: args.seed,
+            ..BootstrapParams::default()
+        }
+        .check()?;
+        let interval = bootstrap_mean_share(&shares, &bootstrap)?;
+        value["accuracy_interval"] = serde_json::to_value(interval)?;
         println!("{}", serde_json::to_string(&value)?);
     } else {
         print_outcome(&outcome, args.method, &split, grid.cols());
