@@ -20,6 +20,7 @@ mod e7_gain;
 mod e8_neighbours;
 mod params;
 mod prepare;
+mod provenance;
 mod sensitivity;
 mod skip;
 mod tables;
@@ -45,6 +46,7 @@ pub use e7_gain::{e7_gain_sweep, E7};
 pub use e8_neighbours::{e8_neighbours, E8Speed};
 pub use params::{ReproduceParams, ValidReproduceParams, MAX_REPEATS};
 pub use prepare::{prepare, IsiSweep, Prepared, Source};
+pub use provenance::Provenance;
 pub use sensitivity::{sensitivity, Sensitivity, SensitivitySpeed};
 pub use skip::{Skip, Stop};
 pub use tables::{Headline, Tables};
@@ -107,6 +109,9 @@ pub struct Results {
     pub e8: BySpeed<E8Speed>,
     /// The headline accuracies on an input changed by a rounding-level amount.
     pub sensitivity: Option<Sensitivity>,
+    /// The code, parameters, data and date of the run (left out of golden comparisons,
+    /// whose date and commit change).
+    pub provenance: Option<Provenance>,
     /// Analyses skipped, with the reason.
     pub skipped: BTreeMap<String, String>,
     /// Wall-clock seconds per analysis.
@@ -133,6 +138,7 @@ impl Results {
             e7: None,
             e8: BySpeed::new(),
             sensitivity: None,
+            provenance: Some(prepared.provenance.clone()),
             skipped: BTreeMap::new(),
             timing_s: BTreeMap::new(),
         }

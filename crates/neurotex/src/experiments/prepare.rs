@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::{taxel_diagnostics, Progress, TaxelDiagnostics, ValidReproduceParams};
+use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidReproduceParams};
 use crate::error::{DataError, Result};
 use crate::pipeline::Encoded;
 use crate::recording::{Baseline, Dataset, Recording};
@@ -189,6 +189,8 @@ pub struct Prepared {
     pub labels: Vec<String>,
     /// Taxels silent or at the encoder's ceiling in most recordings.
     pub taxels: TaxelDiagnostics,
+    /// The code, parameters, data and date of the run.
+    pub provenance: Provenance,
     /// With a sensitivity check: every recording's spikes from its input changed by the
     /// relative amount asked, in the order of `encoded`.
     pub perturbed: Option<Vec<Encoded>>,
@@ -256,6 +258,7 @@ pub fn prepare(
     }
     let taxels = taxel_diagnostics(&encoded, &grid, params)?;
     Ok(Prepared {
+        provenance: Provenance::of(source, params)?,
         speeds: Speed::distinct(conditions.iter().map(|c| c.0)),
         taxels,
         perturbed,

@@ -53,7 +53,7 @@ pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
         e0(r),
         sensitivity(r),
         skipped(r),
-        parameters(ctx),
+        parameters(r, ctx),
         timing(r),
     ]
     .concat()
@@ -505,9 +505,19 @@ fn skipped(r: &Results) -> String {
     format!("## Skipped\n\n{lines}\n")
 }
 
-fn parameters(ctx: &ReportContext) -> String {
+fn parameters(r: &Results, ctx: &ReportContext) -> String {
     let lines: String = ctx.parameters.iter().map(|p| format!("- {p}\n")).collect();
-    format!("## Parameters\n\n{lines}\n")
+    let provenance = r.provenance.as_ref().map_or(String::new(), |p| {
+        let commit = p
+            .git_commit
+            .as_deref()
+            .unwrap_or("not built from a checkout");
+        format!(
+            "\nneurotex {} (commit {commit}), started {}; data: {}.\n",
+            p.neurotex_version, p.created_utc, p.data
+        )
+    });
+    format!("## Parameters\n\n{lines}{provenance}\n")
 }
 
 fn timing(r: &Results) -> String {
