@@ -169,6 +169,62 @@ fn evaluate_writes_each_recordings_out_of_fold_prediction() {
 }
 
 #[test]
+fn grouped_folds_never_split_a_group() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 4);
+    let manifest = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    let mut lines = manifest.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let (file_col, trial_col) = (0, header.iter().position(|h| *h == "trial").unwrap());
+    let trial_of: std::collections::HashMap<String, String> = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[file_col].to_string(), f[trial_col].to_string())
+        })
+        .collect();
+    let out = dir.join("grouped.csv");
+    for folds in ["3", "5"] {
+        let args = [
+            "--group-by",
+            "trial",
+            "--folds",
+            folds,
+            "--repeats",
+            "2",
+            "--predictions",
+            s(&out),
+        ];
+        let json = dir.evaluate_json(&ds, "glcm3d", &args);
+        assert!((0.0..=1.0).contains(&json["accuracy"].as_f64().unwrap()));
+        let text = std::fs::read_to_string(&out).unwrap();
+        let mut fold_of_group = std::collections::HashMap::new();
+        for row in text.lines().skip(1) {
+            let f: Vec<&str> = row.split(',').collect();
+            let key = (trial_of[f[0]].clone(), f[4].to_string());
+            let fold = fold_of_group.entry(key).or_insert_with(|| f[3].to_string());
+            assert_eq!(fold, f[3], "trial {} split across folds", trial_of[f[0]]);
+        }
+        // 4 trials: with 5 folds asked, each trial is held out on its own
+        let folds_used = text
+            .lines()
+            .skip(1)
+            .map(|r| r.split(',').nth(3).unwrap().to_string());
+        let distinct: std::collections::BTreeSet<String> = folds_used.collect();
+        assert_eq!(distinct.len(), if folds == "3" { 3 } else { 4 });
+    }
+    let err = dir.fails(&[
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--group-by",
+        "session",
+    ]);
+    assert!(err.contains("group-by") && err.contains("session"), "{err}");
+}
+
+#[test]
 fn same_seed_gives_the_same_result() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[5.0], 10);

@@ -5,7 +5,9 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::classify::{cross_validate, train_test, Classifier, ConfusionMatrix, ValidCv};
+use crate::classify::{
+    cross_validate, cross_validate_grouped, train_test, Classifier, ConfusionMatrix, ValidCv,
+};
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method};
 use crate::recording::Meta;
@@ -87,6 +89,9 @@ pub enum Split {
         speeds: Option<Vec<Speed>>,
         /// Folds, seed, repeats.
         cv: ValidCv,
+        /// A manifest column (`trial`, `force_n`, or any further column) whose groups no
+        /// fold may split; `None` for stratified folds.
+        group_by: Option<String>,
     },
     /// Train on recordings at `train` speeds, test on those at `test` speeds.
     ByCondition {
@@ -234,6 +239,41 @@ fn classes(table: &FeatureTable, rows: &[usize]) -> (Vec<String>, Vec<usize>) {
     (labels, y)
 }
 
+/// Each row's group under the manifest column `column`, as indices from 0.
+///
+/// # Errors
+/// A column the manifest does not have, or a single group (nothing to test on).
+fn group_indices(table: &FeatureTable, rows: &[usize], column: &str) -> Result<Vec<usize>> {
+    let mut names: Vec<String> = Vec::new();
+    let mut out = Vec::with_capacity(rows.len());
+    for &i in rows {
+        let meta = &table.metas[i];
+        let value = match column {
+            "label" => meta.label.clone(),
+            "file" => meta.file.clone(),
+            "speed_mm_s" => meta.speed_mm_s.to_string(),
+            "force_n" => meta.force_n.to_string(),
+            "trial" => meta.trial.to_string(),
+            other => meta.extra.get(other).cloned().ok_or_else(|| {
+                let rule = "--group-by must name a manifest column";
+                ParamError::new("group-by", rule, format!("{other} (not in {})", meta.file))
+            })?,
+        };
+        let index = names.iter().position(|n| *n == value).unwrap_or_else(|| {
+            names.push(value);
+            names.len() - 1
+        });
+        out.push(index);
+    }
+    if names.len() < 2 {
+        let rule = "grouped cross-validation needs at least two groups";
+        return Err(
+            ParamError::new("group-by", rule, format!("{column}: {} group", names.len())).into(),
+        );
+    }
+    Ok(out)
+}
+
 /// Evaluates a feature table with `classifier`.
 ///
 /// # Errors
@@ -262,11 +302,27 @@ pub fn evaluate<C: Classifier>(
     let all_rows: Vec<usize> = train_rows.iter().chain(&test_rows).copied().collect();
     let (labels, y) = classes(table, &all_rows);
     let (y_train, y_test) = y.split_at(train_rows.len());
+    let row_groups = match split {
+        Split::CrossValidation {
+            group_by: Some(column),
+            ..
+        } => Some(group_indices(table, &train_rows, column)?),
+        _ => None,
+    };
     let results: Vec<GroupResult> = groups
         .par_iter()
         .map(|(cell, cols)| -> Result<GroupResult> {
             let x_train = table.select(&train_rows, cols);
             let evaluation = match split {
+                Split::CrossValidation {
+                    cv,
+                    group_by: Some(_),
+                    ..
+                } => {
+                    let groups = row_groups.as_deref().unwrap_or_default();
+                    let d = cols.len();
+                    cross_validate_grouped(classifier, &x_train, d, y_train, &labels, *cv, groups)?
+                }
                 Split::CrossValidation { cv, .. } => {
                     cross_validate(classifier, &x_train, cols.len(), y_train, &labels, *cv)?
                 }

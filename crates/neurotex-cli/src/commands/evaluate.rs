@@ -67,6 +67,11 @@ pub struct EvaluateArgs {
         requires = "train_speeds"
     )]
     pub test_speeds: Option<Vec<Speed>>,
+    /// Cross-validation folds never split a group of this manifest column (`trial`,
+    /// `force_n`, or any further column such as a session or subject); with fewer groups
+    /// than folds, each group is held out in turn.
+    #[arg(long = "group-by", conflicts_with = "train_speeds")]
+    pub group_by: Option<String>,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -97,6 +102,7 @@ impl EvaluateArgs {
             _ => Split::CrossValidation {
                 speeds: self.speeds.clone(),
                 cv,
+                group_by: self.group_by.clone(),
             },
         })
     }
@@ -171,6 +177,14 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
 /// evaluated) and the confusion matrix.
 fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) {
     let how = match split {
+        Split::CrossValidation {
+            cv,
+            group_by: Some(column),
+            ..
+        } => format!(
+            "up to {}-fold CV keeping each `{column}` group in one fold, seed {}, {} repeat(s)",
+            cv.folds, cv.seed, cv.repeats
+        ),
         Split::CrossValidation { cv, .. } => format!(
             "{}-fold stratified CV, seed {}, {} repeat(s)",
             cv.folds, cv.seed, cv.repeats

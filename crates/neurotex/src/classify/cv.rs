@@ -211,6 +211,64 @@ pub fn cross_validate<C: Classifier>(
     class_names: &[String],
     cv: ValidCv,
 ) -> Result<Evaluation, ClassifyError> {
+    cross_validate_with(classifier, (x, dims), y, class_names, cv, None)
+}
+
+/// Cross-validation whose folds never split a group: `groups[i]` is sample `i`'s group
+/// (a session, a subject, the repeats of one run). Groups are shuffled with each repeat's
+/// seed and dealt, largest first, to the fold holding fewest samples; with fewer groups
+/// than folds, each group is a fold of its own (leave one group out). Folds are not
+/// stratified: keeping a group whole comes first.
+///
+/// # Errors
+/// As [`cross_validate`], and `groups` of another length than `y`.
+pub fn cross_validate_grouped<C: Classifier>(
+    classifier: &C,
+    x: &[f64],
+    dims: usize,
+    y: &[usize],
+    class_names: &[String],
+    cv: ValidCv,
+    groups: &[usize],
+) -> Result<Evaluation, ClassifyError> {
+    if groups.len() != y.len() {
+        let message = format!("{} groups for {} samples", groups.len(), y.len());
+        return Err(ClassifyError::BadFeatures(message));
+    }
+    cross_validate_with(classifier, (x, dims), y, class_names, cv, Some(groups))
+}
+
+/// Assigns each sample a fold so that no group is split (see [`cross_validate_grouped`]);
+/// returns the fold of each sample and the number of folds used.
+pub fn group_folds(groups: &[usize], folds: usize, seed: u64) -> (Vec<usize>, usize) {
+    let n_groups = groups.iter().max().map_or(0, |&g| g + 1);
+    let mut size = vec![0usize; n_groups];
+    for &g in groups {
+        size[g] += 1;
+    }
+    let mut order: Vec<usize> = (0..n_groups).filter(|&g| size[g] > 0).collect();
+    let folds = folds.min(order.len()).max(1);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    order.shuffle(&mut rng);
+    // A stable sort keeps the shuffled order among groups of one size.
+    order.sort_by(|a, b| size[*b].cmp(&size[*a]));
+    let (mut fold_of_group, mut load) = (vec![0usize; n_groups], vec![0usize; folds]);
+    for g in order {
+        let fold = (0..folds).min_by_key(|&f| (load[f], f)).unwrap_or(0);
+        fold_of_group[g] = fold;
+        load[fold] += size[g];
+    }
+    (groups.iter().map(|&g| fold_of_group[g]).collect(), folds)
+}
+
+fn cross_validate_with<C: Classifier>(
+    classifier: &C,
+    (x, dims): (&[f64], usize),
+    y: &[usize],
+    class_names: &[String],
+    cv: ValidCv,
+    groups: Option<&[usize]>,
+) -> Result<Evaluation, ClassifyError> {
     if y.is_empty() {
         return Err(ClassifyError::Empty {
             what: "cross-validate",
@@ -222,8 +280,14 @@ pub fn cross_validate<C: Classifier>(
     let mut confusion = ConfusionMatrix::zeros(n_classes);
     for r in 0..cv.repeats {
         let seed = cv.seed.wrapping_add(r as u64);
-        let fold_of = stratified_folds(y, n_classes, cv.folds, seed, class_names)?;
-        let predicted = predict_out_of_fold(classifier, x, dims, y, &fold_of, cv.folds)?;
+        let (fold_of, folds) = match groups {
+            Some(groups) => group_folds(groups, cv.folds, seed),
+            None => (
+                stratified_folds(y, n_classes, cv.folds, seed, class_names)?,
+                cv.folds,
+            ),
+        };
+        let predicted = predict_out_of_fold(classifier, x, dims, y, &fold_of, folds)?;
         let matrix = ConfusionMatrix::from_predictions(y, &predicted, n_classes);
         per_repeat.push(matrix.accuracy());
         confusion.add(&matrix);
@@ -281,4 +345,35 @@ pub fn train_test<C: Classifier>(
             predicted,
         }],
     ))
+}
+
+#[cfg(test)]
+mod group_tests {
+    use super::*;
+
+    #[test]
+    fn no_group_is_split_and_few_groups_are_held_out_one_by_one() {
+        // 7 groups of uneven size over 30 samples, into 5 folds
+        let groups: Vec<usize> = (0..30).map(|i| (i * 7 / 30 + i % 2) % 7).collect();
+        for seed in 0..20 {
+            let (fold_of, folds) = group_folds(&groups, 5, seed);
+            assert_eq!(folds, 5);
+            for g in 0..7 {
+                let mut of_group = (0..30).filter(|&i| groups[i] == g).map(|i| fold_of[i]);
+                let first = of_group.next().unwrap();
+                assert!(
+                    of_group.all(|f| f == first),
+                    "group {g} split (seed {seed})"
+                );
+            }
+            assert!((0..5).all(|f| fold_of.contains(&f)), "an empty fold");
+        }
+        // three groups, five folds asked: leave one group out
+        let (fold_of, folds) = group_folds(&[0, 0, 1, 1, 2, 2], 5, 0);
+        assert_eq!(folds, 3);
+        let mut distinct = fold_of.clone();
+        distinct.sort();
+        distinct.dedup();
+        assert_eq!(distinct, [0, 1, 2]);
+    }
 }

@@ -12,7 +12,8 @@ pub mod stats;
 
 pub use confusion::ConfusionMatrix;
 pub use cv::{
-    cross_validate, stratified_folds, train_test, CvParams, Evaluation, RepeatPredictions, ValidCv,
+    cross_validate, cross_validate_grouped, group_folds, stratified_folds, train_test, CvParams,
+    Evaluation, RepeatPredictions, ValidCv,
 };
 pub use knn::{Knn, KnnModel, KnnParams};
 pub use metrics::{

@@ -101,6 +101,7 @@ fn perturbed_accuracy(
     let split = Split::CrossValidation {
         speeds: None,
         cv: c.params.cv_once(),
+        group_by: None,
     };
     Ok(evaluate(&features, Columns::All, &split, c.params.knn())?.accuracy)
 }

@@ -100,6 +100,7 @@ pub fn cv_at(
     let split = Split::CrossValidation {
         speeds: Some(vec![speed]),
         cv,
+        group_by: None,
     };
     evaluate(table, columns, &split, knn)
 }
