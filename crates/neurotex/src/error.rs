@@ -158,6 +158,14 @@ pub enum ClassifyError {
         /// What was to be done.
         what: &'static str,
     },
+    /// Two evaluations to be compared recording by recording cover different recordings.
+    #[error("{first} and {second} were not evaluated on the same recordings")]
+    Unpaired {
+        /// The first evaluation.
+        first: String,
+        /// The second evaluation.
+        second: String,
+    },
     /// Feature rows of different lengths, or a non-finite feature.
     #[error("{0}")]
     BadFeatures(String),

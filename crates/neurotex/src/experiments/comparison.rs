@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use super::ValidReproduceParams;
 use crate::analysis::Outcome;
 use crate::classify::{bootstrap_mean_share, BootstrapParams, Interval, PairedVerdict};
-use crate::error::{DataError, Result};
+use crate::error::{ClassifyError, Result};
 
 /// Two methods compared on the same recordings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -64,11 +64,8 @@ pub fn compare(
 ) -> Result<Comparison> {
     let (a, b) = (&first.1.correct_shares, &second.1.correct_shares);
     if a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.0 != y.0) {
-        let message = format!(
-            "{} and {} were not evaluated on the same recordings",
-            first.0, second.0
-        );
-        return Err(DataError::invalid("comparison", message).into());
+        let (first, second) = (first.0.to_string(), second.0.to_string());
+        return Err(ClassifyError::Unpaired { first, second }.into());
     }
     // The difference lies in [-1, 1]; the bootstrap takes shares in [0, 1], so it resamples
     // (d + 1) / 2 and the interval is mapped back, which is exact for a mean.
@@ -137,6 +134,10 @@ mod tests {
         let interval = accuracy_interval(&mixed, params).unwrap();
         assert_eq!(interval.estimate, 0.5);
         assert!(interval.lower < 0.5 && interval.upper > 0.5);
-        assert!(compare(("a", &better), ("short", &outcome(&[1.0; 3])), params).is_err());
+        let unpaired = compare(("a", &better), ("short", &outcome(&[1.0; 3])), params);
+        assert!(matches!(
+            unpaired,
+            Err(crate::Error::Classify(ClassifyError::Unpaired { .. }))
+        ));
     }
 }

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidReproduceParams};
-use crate::error::{DataError, Result};
+use crate::error::{DataError, DatasetError, Result};
 use crate::pipeline::Encoded;
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
@@ -222,8 +222,7 @@ pub fn prepare(
     let start = Instant::now();
     let n = source.len();
     let conditions: Vec<(Speed, String)> = (0..n).map(|i| source.condition(i)).collect();
-    let slowest = Speed::slowest(conditions.iter().map(|c| c.0))
-        .ok_or_else(|| DataError::invalid("dataset", "no recordings"))?;
+    let slowest = Speed::slowest(conditions.iter().map(|c| c.0)).ok_or(DatasetError::Empty)?;
     let mut labels: Vec<String> = Vec::new();
     for (_, l) in &conditions {
         if !labels.contains(l) {

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::tables::{cv_at, table};
 use super::{Context, Stop};
 use crate::analysis::Columns;
-use crate::error::DataError;
+use crate::error::ClassifyError;
 use crate::pipeline::Method;
 use crate::values::BySpeed;
 
@@ -49,9 +49,9 @@ pub fn sensitivity(c: &Context) -> Result<Option<Sensitivity>, Stop> {
         return Ok(None);
     };
     if perturbed.len() != c.prepared.encoded.len() {
-        let message = "perturbed spikes do not cover every recording";
+        let (first, second) = ("the run".to_string(), "its perturbed twin".to_string());
         return Err(Stop::Failed(
-            DataError::invalid("sensitivity", message).into(),
+            ClassifyError::Unpaired { first, second }.into(),
         ));
     }
     let glcm3d = table(perturbed, Method::Glcm3d, c.params)?;
