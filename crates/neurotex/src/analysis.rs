@@ -6,7 +6,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::classify::{
-    cross_validate, cross_validate_grouped, train_test, Classifier, ConfusionMatrix, ValidCv,
+    bootstrap_mean_share, cross_validate, cross_validate_grouped, train_test, BootstrapParams,
+    Classifier, ConfusionMatrix, Interval, ValidCv,
 };
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method};
@@ -143,6 +144,33 @@ pub struct Outcome {
     /// intervals and paired comparisons resample. Left out of the serialised form.
     #[serde(skip)]
     pub correct_shares: Vec<(usize, f64)>,
+}
+
+impl Outcome {
+    /// The 95 % interval of the accuracy by a percentile bootstrap over the evaluated
+    /// recordings (2000 resamples seeded by `seed`), each recording's predictions over
+    /// repeats, and taxels, kept together.
+    ///
+    /// # Errors
+    /// An outcome without per-recording results.
+    pub fn accuracy_interval(&self, seed: u64) -> Result<Interval> {
+        let shares: Vec<f64> = self.correct_shares.iter().map(|&(_, s)| s).collect();
+        seeded_bootstrap(&shares, seed)
+    }
+}
+
+/// The percentile bootstrap of the mean of `shares` (each in 0..1) with the default number
+/// of resamples, seeded by `seed`.
+///
+/// # Errors
+/// No shares, or one outside 0..1.
+pub(crate) fn seeded_bootstrap(shares: &[f64], seed: u64) -> Result<Interval> {
+    let params = BootstrapParams {
+        seed,
+        ..BootstrapParams::default()
+    }
+    .check()?;
+    Ok(bootstrap_mean_share(shares, &params)?)
 }
 
 /// One recording's out-of-fold prediction in one evaluation repeat.

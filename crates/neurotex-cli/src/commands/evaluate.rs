@@ -9,7 +9,7 @@ use clap::Args;
 use neurotex::analysis::{
     evaluate, Columns, FeatureTable, OutOfFold, Outcome, Split, TaxelAccuracy,
 };
-use neurotex::classify::{bootstrap_mean_share, BootstrapParams, CvParams, Metrics};
+use neurotex::classify::{CvParams, Metrics};
 use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::Dataset;
 use neurotex::{Cell, Speed};
@@ -158,13 +158,7 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         // confusion matrix; the interval resamples recordings, keeping each one's
         // predictions over repeats (and taxels) together.
         value["metrics"] = serde_json::to_value(Metrics::from_confusion(&outcome.confusion))?;
-        let shares: Vec<f64> = outcome.correct_shares.iter().map(|&(_, s)| s).collect();
-        let bootstrap = BootstrapParams {
-            seed: args.seed,
-            ..BootstrapParams::default()
-        }
-        .check()?;
-        let interval = bootstrap_mean_share(&shares, &bootstrap)?;
+        let interval = outcome.accuracy_interval(args.seed)?;
         value["accuracy_interval"] = serde_json::to_value(interval)?;
         println!("{}", serde_json::to_string(&value)?);
     } else {

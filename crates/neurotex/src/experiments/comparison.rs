@@ -11,8 +11,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::ValidReproduceParams;
-use crate::analysis::Outcome;
-use crate::classify::{bootstrap_mean_share, BootstrapParams, Interval, PairedVerdict};
+use crate::analysis::{seeded_bootstrap, Outcome};
+use crate::classify::PairedVerdict;
 use crate::error::{ClassifyError, Result};
 
 /// Two methods compared on the same recordings.
@@ -33,24 +33,6 @@ pub struct Comparison {
     pub verdict: PairedVerdict,
     /// Recordings compared.
     pub recordings: usize,
-}
-
-fn bootstrap(shares: &[f64], params: &ValidReproduceParams) -> Result<Interval> {
-    let bootstrap = BootstrapParams {
-        seed: params.seed,
-        ..BootstrapParams::default()
-    }
-    .check()?;
-    Ok(bootstrap_mean_share(shares, &bootstrap)?)
-}
-
-/// The 95 % interval of an outcome's accuracy, by a bootstrap over its recordings.
-///
-/// # Errors
-/// An outcome without per-recording results.
-pub fn accuracy_interval(outcome: &Outcome, params: &ValidReproduceParams) -> Result<Interval> {
-    let shares: Vec<f64> = outcome.correct_shares.iter().map(|&(_, s)| s).collect();
-    bootstrap(&shares, params)
 }
 
 /// `first` against `second`, evaluated on the same recordings.
@@ -74,7 +56,7 @@ pub fn compare(
         .zip(b)
         .map(|(x, y)| (x.1 - y.1 + 1.0) / 2.0)
         .collect();
-    let interval = bootstrap(&shifted, params)?;
+    let interval = seeded_bootstrap(&shifted, params.seed)?;
     let back = |v: f64| 2.0 * v - 1.0;
     let (lower, upper) = (back(interval.lower), back(interval.upper));
     let verdict = if lower > 0.0 {
@@ -131,7 +113,7 @@ mod tests {
             (same.difference, same.verdict),
             (0.0, PairedVerdict::NotShown)
         );
-        let interval = accuracy_interval(&mixed, params).unwrap();
+        let interval = mixed.accuracy_interval(params.seed).unwrap();
         assert_eq!(interval.estimate, 0.5);
         assert!(interval.lower < 0.5 && interval.upper > 0.5);
         let unpaired = compare(("a", &better), ("short", &outcome(&[1.0; 3])), params);

@@ -3,9 +3,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{accuracy_interval, compare, Comparison, Context, Stop};
+use super::{compare, Comparison, Context, Stop};
 use crate::classify::Interval;
 use crate::values::BySpeed;
+use crate::values::Cell;
 
 /// E1 at one speed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -73,8 +74,8 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
                 classes,
                 chance: 1.0 / classes.max(1) as f64,
                 majority: truth.iter().copied().max().unwrap_or(0) as f64 / total,
-                glcm3d_interval: accuracy_interval(&h.glcm3d, c.params)?,
-                taxel_mean_interval: accuracy_interval(&h.taxel, c.params)?,
+                glcm3d_interval: h.glcm3d.accuracy_interval(c.params.seed)?,
+                taxel_mean_interval: h.taxel.accuracy_interval(c.params.seed)?,
                 glcm3d_vs_taxel: compare(
                     ("3D-GLCM", &h.glcm3d),
                     ("single taxel", &h.taxel),
@@ -92,7 +93,15 @@ fn responsive_mean(c: &Context, taxel: &crate::analysis::Outcome) -> Option<f64>
     let per = taxel.per_taxel.as_deref().unwrap_or_default();
     let responsive: Vec<f64> = per
         .iter()
-        .filter(|t| diagnostics.responsive(&format!("r{}c{}", t.row, t.col)))
+        .filter(|t| {
+            diagnostics.responsive(
+                &Cell {
+                    row: t.row,
+                    col: t.col,
+                }
+                .to_string(),
+            )
+        })
         .map(|t| t.accuracy)
         .collect();
     (!responsive.is_empty()).then(|| responsive.iter().sum::<f64>() / responsive.len() as f64)

@@ -121,18 +121,16 @@ fn cumulative(hist: &[u64]) -> Option<Vec<f64>> {
     })
 }
 
+/// Bins of the sweep's ISI histograms (the last one holds the longer intervals).
+fn histogram_bins(e: &E7) -> usize {
+    let lengths = e.sweep.counts.iter().flatten().map(Vec::len);
+    lengths.max().unwrap_or(1).max(1)
+}
+
 /// E7: the cumulative ISI distribution per gain, one panel per gain on one scale, the ISIs
 /// beyond the histogram's range shown in a labelled band at the right.
 pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
-    let bins = e
-        .sweep
-        .counts
-        .iter()
-        .flatten()
-        .map(Vec::len)
-        .max()
-        .unwrap_or(1)
-        .max(1);
+    let bins = histogram_bins(e);
     let bin = f64::from(e.sweep.bin_ms.max(1));
     let range = bin * (bins - 1) as f64;
     let band = (range / 8.0).max(bin);
@@ -227,15 +225,7 @@ pub(crate) fn e7_rate_caption(e: &E7) -> String {
 
 /// E7's caption for the ISI figure.
 pub(crate) fn e7_isi_caption(e: &E7) -> String {
-    let bins = e
-        .sweep
-        .counts
-        .iter()
-        .flatten()
-        .map(Vec::len)
-        .max()
-        .unwrap_or(1)
-        .max(1);
+    let bins = histogram_bins(e);
     let range = e.sweep.bin_ms as usize * (bins - 1);
     format!(
         "Cumulative distribution of inter-spike intervals at {} mm/s, pooled over trials and taxels, one panel per gain on one scale and one line per class ({} ms bins). The grey band on the right holds the ISIs of {} ms or more: each line's rise across it is their share. A class with fewer than two spikes in every taxel has no ISI and no line; the panel's title counts such silent classes and marks the paper's choice of G.{}",
