@@ -65,3 +65,76 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
         .unwrap()
         .contains("one speed"));
 }
+
+#[test]
+fn reproduce_over_simulator_seeds_reports_each_accuracy_over_datasets() {
+    let dir = Dir::new();
+    let run = |out: &str, seeds: &str| -> Value {
+        let out = dir.join(out);
+        let args = ["reproduce", "--quick", "--trials", "5", "--seed", "3"];
+        dir.ok(&[&args[..], &["--seeds", seeds, "--out", s(&out)]].concat());
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap()
+    };
+    let one = run("one", "1");
+    let two = run("two", "2");
+    assert!(one.get("across_seeds").is_none(), "one dataset, no table");
+    // The first dataset's analyses do not depend on how many further datasets ran.
+    assert_eq!(one["e1"], two["e1"]);
+    let across = &two["across_seeds"];
+    assert_eq!(across["seeds"], serde_json::json!([3, 4]));
+    let rows = across["accuracies"].as_array().unwrap();
+    let e1 = rows
+        .iter()
+        .find(|r| r["analysis"] == "E1" && r["method"] == "3D-GLCM" && r["condition"] == "5 mm/s")
+        .expect("E1 3D-GLCM at 5 mm/s");
+    let values: Vec<f64> = serde_json::from_value(e1["values"].clone()).unwrap();
+    assert_eq!(values.len(), 2);
+    assert_eq!(values[0], two["e1"]["5"]["glcm3d"].as_f64().unwrap());
+    let mean = (values[0] + values[1]) / 2.0;
+    assert!((e1["interval"]["estimate"].as_f64().unwrap() - mean).abs() < 1e-12);
+    for claim in across["claims"].as_array().unwrap() {
+        assert_eq!(claim["verdicts"].as_array().unwrap().len(), 2);
+    }
+    let report = std::fs::read_to_string(dir.join("two").join("report.md")).unwrap();
+    assert!(report.contains("## Across simulated datasets") && report.contains("seeds 4"));
+}
+
+#[test]
+fn reproduce_rejects_seeds_it_cannot_run() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 5);
+    let out = dir.join("r");
+    dir.fails_each(
+        &[
+            (
+                vec!["reproduce", "--out", s(&out), "--seeds", "0"],
+                "--seeds",
+            ),
+            (
+                vec![
+                    "reproduce",
+                    "--out",
+                    s(&out),
+                    "--seeds",
+                    "2",
+                    "--dataset",
+                    s(&ds),
+                ],
+                "--dataset",
+            ),
+            (
+                vec![
+                    "reproduce",
+                    "--out",
+                    s(&out),
+                    "--seeds",
+                    "3",
+                    "--seed",
+                    "18446744073709551614",
+                ],
+                "overflows",
+            ),
+        ],
+        &out,
+    );
+}

@@ -21,6 +21,7 @@ mod e8_neighbours;
 mod params;
 mod prepare;
 mod provenance;
+mod seeds;
 mod sensitivity;
 mod skip;
 mod tables;
@@ -47,6 +48,7 @@ pub use e8_neighbours::{e8_neighbours, E8Speed};
 pub use params::{ReproduceParams, ValidReproduceParams, MAX_REPEATS};
 pub use prepare::{prepare, IsiSweep, Prepared, Source};
 pub use provenance::Provenance;
+pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
 pub use sensitivity::{sensitivity, Sensitivity, SensitivitySpeed};
 pub use skip::{Skip, Stop};
 pub use tables::{Headline, Tables};
@@ -109,6 +111,9 @@ pub struct Results {
     pub e8: BySpeed<E8Speed>,
     /// The headline accuracies on an input changed by a rounding-level amount.
     pub sensitivity: Option<Sensitivity>,
+    /// The headline accuracies and claims over several simulated datasets (`--seeds`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub across_seeds: Option<AcrossSeeds>,
     /// The code, parameters, data and date of the run (left out of golden comparisons,
     /// whose date and commit change).
     pub provenance: Option<Provenance>,
@@ -138,6 +143,7 @@ impl Results {
             e7: None,
             e8: BySpeed::new(),
             sensitivity: None,
+            across_seeds: None,
             provenance: Some(prepared.provenance.clone()),
             skipped: BTreeMap::new(),
             timing_s: BTreeMap::new(),

@@ -213,6 +213,14 @@ impl ValidReproduceParams {
         .check()
         .unwrap_or(self.cv)
     }
+
+    /// The same parameters without the numerical sensitivity check (the further datasets
+    /// of a run over several simulator seeds: the check speaks of one dataset's numerics).
+    pub fn without_sensitivity(&self) -> Self {
+        let mut quiet = self.clone();
+        quiet.params.sensitivity = None;
+        quiet
+    }
 }
 
 impl std::ops::Deref for ValidReproduceParams {

@@ -42,6 +42,7 @@ pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
         header(ctx),
         data(r, ctx),
         summary(r),
+        across_seeds(r),
         e1(r, paper),
         e2(r),
         e3(r),
@@ -153,6 +154,66 @@ fn summary(r: &Results) -> String {
         out += &format!("- {verdict} **{}**{detail}\n", c.statement);
     }
     out + "\n"
+}
+
+/// The headline accuracies and claims over several simulated datasets; empty with one.
+fn across_seeds(r: &Results) -> String {
+    let Some(a) = &r.across_seeds else {
+        return String::new();
+    };
+    let n = a.seeds.len();
+    let mut out = format!(
+        "## Across simulated datasets\n\n\
+         The analyses ran on {n} independent simulated datasets of the same design (simulation seeds {}); the sections below show the first. Each headline accuracy is given here as its mean over the {n} datasets with a 95 % Student-t interval over them (the spread a new dataset of this design would see; narrower than the range when datasets agree), the first dataset's value and the range. Each claim is judged on every dataset separately.\n\n",
+        list(&a.seeds)
+    );
+    let mut t = Table::new([
+        "analysis",
+        "condition",
+        "method",
+        "first dataset (%)",
+        "mean (%) [95 % interval]",
+        "range (%)",
+    ]);
+    for row in &a.accuracies {
+        let interval = row.interval.as_ref().map_or(String::new(), bracket);
+        let (lo, hi) = row.range();
+        t.row([
+            row.analysis.clone(),
+            row.condition.clone(),
+            row.method.clone(),
+            row.values.first().map_or("-".into(), |v| pct(*v)),
+            format!("{} {interval}", pct(row.mean())),
+            format!("{}-{}", pct(lo), pct(hi)),
+        ]);
+    }
+    out += &t.render();
+    out += "\n";
+    let mut t = Table::new(["claim", "holds on", "verdicts"]);
+    for c in &a.claims {
+        t.row([
+            c.statement.clone(),
+            format!("{} of {n}", c.holds_on()),
+            verdict_counts(&c.verdicts),
+        ]);
+    }
+    out + &t.render() + "\n"
+}
+
+/// `Holds (paired test) x3, Not shown (within noise) x2`, in first-seen order.
+fn verdict_counts(verdicts: &[crate::experiments::Verdict]) -> String {
+    let mut seen: Vec<(crate::experiments::Verdict, usize)> = Vec::new();
+    for v in verdicts {
+        match seen.iter_mut().find(|(w, _)| w == v) {
+            Some((_, count)) => *count += 1,
+            None => seen.push((*v, 1)),
+        }
+    }
+    let parts: Vec<String> = seen
+        .iter()
+        .map(|(v, count)| format!("{} x{count}", v.describe()))
+        .collect();
+    parts.join(", ")
 }
 
 fn e1(r: &Results, paper: Option<&Paper>) -> String {

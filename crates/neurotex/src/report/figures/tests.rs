@@ -254,6 +254,7 @@ pub(crate) fn wide() -> Results {
         }),
         e8,
         sensitivity: None,
+        across_seeds: None,
         provenance: None,
         skipped: BTreeMap::new(),
         timing_s: BTreeMap::new(),
