@@ -2,17 +2,20 @@
 
 use anyhow::Result;
 use clap::Args;
+use neurotex::calibrate::GainChoice;
 use neurotex::classify::KnnParams;
-use neurotex::encode::FiringType;
+use neurotex::encode::{FiringType, IzhikevichParams};
 use neurotex::pipeline::PipelineParams;
 use neurotex::recording::Baseline;
 
 /// Stage parameters; defaults are the paper's values (or SPEC's choice where it gives none).
 #[derive(Args, Debug, Clone)]
 pub struct StageArgs {
-    /// Gain G from normalised signal to Izhikevich input current (paper: 8).
-    #[arg(long, default_value_t = 8.0, allow_negative_numbers = true)]
-    pub gain: f64,
+    /// Gain G from normalised signal to Izhikevich input current (paper: 8). `auto` chooses
+    /// it on the training recordings (labels unused) so that the median taxel with any
+    /// signal fires at 20 Hz during the slide; `auto:HZ` sets another target rate.
+    #[arg(long, default_value = "8", allow_negative_numbers = true)]
+    pub gain: GainChoice,
     /// Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ.
     #[arg(long, default_value = "RS")]
     pub preset: FiringType,
@@ -46,7 +49,11 @@ impl StageArgs {
     /// The pipeline parameters these options name, checked.
     pub fn pipeline(&self) -> Result<PipelineParams> {
         let mut p = PipelineParams {
-            encoder: self.preset.params().with_gain(self.gain),
+            encoder: self.preset.params().with_gain(match self.gain {
+                GainChoice::Fixed(g) => g,
+                // Replaced by the calibrated gain before anything is encoded.
+                GainChoice::Auto { .. } => IzhikevichParams::default().gain,
+            }),
             ..PipelineParams::default()
         };
         p.preprocess.cutoff_hz = self.cutoff;
@@ -58,6 +65,14 @@ impl StageArgs {
         p.glcm.symmetric = self.symmetric;
         p.check()?;
         Ok(p)
+    }
+
+    /// The target rate of `--gain auto`, or `None` for a fixed gain.
+    pub fn gain_target(&self) -> Option<f64> {
+        match self.gain {
+            GainChoice::Auto { target_hz } => Some(target_hz),
+            GainChoice::Fixed(_) => None,
+        }
     }
 
     /// KNN parameters with `k` neighbours, checked.

@@ -219,3 +219,50 @@ fn predict<'a>(model: &'a str, out: &'a str, what: &[&'a str]) -> Vec<&'a str> {
     args.extend(["--out", out]);
     args
 }
+
+#[test]
+fn gain_auto_is_calibrated_on_the_training_set_and_kept_in_the_model() {
+    let dir = Dir::new();
+    let (a, b) = (simulated(&dir, "A", "1"), simulated(&dir, "B", "2"));
+    let model = dir.join("auto.json");
+    let train = |gain: &str, out: &Path| {
+        dir.run(&["train", "--dataset", s(&a), "--gain", gain, "--out", s(out)])
+    };
+    let run = train("auto:30", &model);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(run.stderr.contains("--gain auto: G = "), "{}", run.stderr);
+    let file = read_json(&model);
+    let calibration = &file["training"]["dataset"]["gain_calibration"];
+    let gain = calibration["gain"].as_f64().unwrap();
+    assert_eq!(file["pipeline"]["encoder"]["gain"].as_f64(), Some(gain));
+    assert_eq!(calibration["target_hz"].as_f64(), Some(30.0));
+    assert!(calibration["median_hz"].as_f64().unwrap() >= 30.0);
+    // A higher target needs a higher gain on the same recordings.
+    let higher = dir.join("auto60.json");
+    assert!(train("auto:60", &higher).status.success());
+    let g60 = read_json(&higher)["pipeline"]["encoder"]["gain"]
+        .as_f64()
+        .unwrap();
+    assert!(g60 > gain, "{g60} <= {gain}");
+    // The model applies its calibrated gain to new recordings.
+    let score = scored(&dir, &model, &b, &dir.join("p.csv"));
+    assert!(score["accuracy"].as_f64().is_some());
+    // A fixed gain records no calibration.
+    let fixed = dir.join("fixed.json");
+    assert!(train("8", &fixed).status.success());
+    assert!(read_json(&fixed)["training"]["dataset"]
+        .get("gain_calibration")
+        .is_none());
+    for bad in ["auto:0", "auto:x", "loud"] {
+        let err = dir.fails(&[
+            "train",
+            "--dataset",
+            s(&a),
+            "--gain",
+            bad,
+            "--out",
+            s(&fixed),
+        ]);
+        assert!(err.contains("--gain"), "{bad}: {err}");
+    }
+}

@@ -13,6 +13,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::calibrate::GainCalibration;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -109,6 +110,10 @@ pub struct Provenance {
     pub baseline: Baseline,
     /// The speeds trained on; `None` for all of the dataset's.
     pub speeds: Option<Vec<Speed>>,
+    /// How `--gain auto` chose the pipeline's gain on the training recordings; `None` for a
+    /// gain given as a number.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gain_calibration: Option<GainCalibration>,
 }
 
 impl Provenance {
@@ -121,6 +126,7 @@ impl Provenance {
             fingerprint: dataset.fingerprint()?,
             baseline: dataset.layout.baseline.unwrap_or_default(),
             speeds,
+            gain_calibration: None,
         })
     }
 }
@@ -616,6 +622,7 @@ mod tests {
             fingerprint: "sha256:00".into(),
             baseline: Baseline::Min,
             speeds: Some(vec![Speed::of(5.0)]),
+            gain_calibration: None,
         }
     }
 

@@ -12,11 +12,13 @@ pub mod train;
 
 use anyhow::Result;
 use neurotex::analysis::FeatureTable;
-use neurotex::pipeline::{Encoded, Method, Pipeline};
+use neurotex::calibrate::{calibrate_gain, GainCalibration};
+use neurotex::pipeline::{Encoded, Method, Pipeline, PipelineParams};
 use neurotex::recording::{one_grid, Dataset};
 use neurotex::{Grid, Speed};
 
 use crate::output::progress;
+use crate::stage_args::StageArgs;
 
 /// Encodes the dataset's recordings at `speeds` (all when `None`) with a progress bar and
 /// extracts `method`'s features; also returns the grid the recordings share.
@@ -49,6 +51,40 @@ fn feature_table(
     let extractor = pipeline.extractor(&grid)?;
     let table = FeatureTable::build(&encoded, &extractor, method)?;
     Ok((table, grid))
+}
+
+/// The pipeline the options name; with `--gain auto`, its gain calibrated on `dataset`'s
+/// recordings `indices` (the training recordings: never a test one), said on standard error
+/// and returned.
+fn calibrated_pipeline(
+    stages: &StageArgs,
+    dataset: &Dataset,
+    indices: &[usize],
+) -> Result<(PipelineParams, Option<GainCalibration>)> {
+    let mut params = stages.pipeline()?;
+    let Some(target_hz) = stages.gain_target() else {
+        return Ok((params, None));
+    };
+    let pipeline = Pipeline::new(params.clone())?;
+    let baseline = dataset.layout.baseline.unwrap_or_default();
+    let load = |i: usize| dataset.load(i);
+    let calibration = calibrate_gain(&pipeline, &load, indices, baseline, target_hz)?;
+    say_calibration(&calibration);
+    params.encoder.gain = calibration.gain;
+    Ok((params, Some(calibration)))
+}
+
+/// Says on standard error which gain `--gain auto` chose.
+fn say_calibration(c: &GainCalibration) {
+    let reached = if c.clamped {
+        " (target out of reach: the end of the searched range)"
+    } else {
+        ""
+    };
+    eprintln!(
+        "--gain auto: G = {} gives a median of {:.1} Hz (target {} Hz) over {} taxel x recording pairs with signal in {} training recording(s){reached}",
+        c.gain, c.median_hz, c.target_hz, c.pairs, c.recordings
+    );
 }
 
 /// Says on standard error what conditioning did that the user should know.

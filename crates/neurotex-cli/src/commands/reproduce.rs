@@ -7,12 +7,15 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::ProgressBar;
+use neurotex::calibrate::GainCalibration;
 use neurotex::experiments::{
     claims, prepare, run_all, run_seeds, Progress, ReproduceParams, Source, ValidReproduceParams,
 };
+use neurotex::pipeline::Pipeline;
 use neurotex::recording::Dataset;
 use neurotex::report::{write_report, ReportContext};
 
+use super::say_calibration;
 use crate::output::progress;
 use crate::stage_args::StageArgs;
 
@@ -52,8 +55,9 @@ pub struct ReproduceArgs {
 }
 
 impl ReproduceArgs {
-    /// The analyses' parameters these options name, checked.
-    fn params(&self) -> Result<ValidReproduceParams> {
+    /// The analyses' parameters these options name (the gain still to be calibrated with
+    /// `--gain auto`).
+    fn params(&self) -> Result<ReproduceParams> {
         let mut params = if self.quick {
             ReproduceParams::quick()
         } else {
@@ -63,7 +67,27 @@ impl ReproduceArgs {
         params.knn = self.stages.knn(self.k)?;
         params.seed = self.seed;
         params.cv.seed = self.seed;
-        Ok(params.check()?)
+        Ok(params)
+    }
+
+    /// The checked parameters, with the gain calibrated on `first` (the dataset, or the first
+    /// simulated one) under `--gain auto`.
+    fn calibrated(
+        &self,
+        first: &Source,
+    ) -> Result<(ValidReproduceParams, Option<GainCalibration>)> {
+        let mut params = self.params()?;
+        let calibration = match self.stages.gain_target() {
+            Some(target) => {
+                let pipeline = Pipeline::new(params.pipeline.clone())?;
+                let c = first.calibrate_gain(&pipeline, target)?;
+                say_calibration(&c);
+                params.pipeline.encoder.gain = c.gain;
+                Some(c)
+            }
+            None => None,
+        };
+        Ok((params.check()?, calibration))
     }
 
     /// Simulated trials per texture and speed.
@@ -88,33 +112,42 @@ impl ReproduceArgs {
 /// Runs `neurotex reproduce`.
 pub fn run(args: ReproduceArgs) -> Result<()> {
     let started = Instant::now();
-    let params = args.params()?;
     let dataset = match &args.dataset {
         Some(dir) => Some(Dataset::open(dir)?),
         None => None,
     };
     let bar = Mutex::new(progress(0, "starting"));
     let on_progress = |p: Progress| show_progress(&bar.lock().expect("progress bar"), p);
-    let (results, described) = match &dataset {
+    let (results, described, params) = match &dataset {
         Some(ds) => {
             let source = Source::Dataset(ds);
+            let (params, calibration) = args.calibrated(&source)?;
             let prepared = prepare(&source, &params, &on_progress)?;
-            (
-                run_all(&prepared, &params, &on_progress)?,
-                source.describe(),
-            )
+            let mut results = run_all(&prepared, &params, &on_progress)?;
+            results.gain_calibration = calibration;
+            (results, source.describe(), params)
         }
         None => {
             let (trials, seeds) = (args.trials_per()?, args.simulation_seeds()?);
             let simulate = |seed| Source::paper_design(trials, seed);
-            let results = run_seeds(&simulate, &seeds, &params, &on_progress)?;
-            (results, describe_seeds(&simulate(seeds[0]), &seeds))
+            let (params, calibration) = args.calibrated(&simulate(seeds[0]))?;
+            let mut results = run_seeds(&simulate, &seeds, &params, &on_progress)?;
+            results.gain_calibration = calibration;
+            (results, describe_seeds(&simulate(seeds[0]), &seeds), params)
         }
     };
     bar.lock().expect("progress bar").finish_and_clear();
+    let mut parameters = params.describe();
+    if let Some(c) = &results.gain_calibration {
+        parameters.push(format!(
+            "gain: --gain auto chose G = {} so that the median taxel with signal fires at {} Hz (median {:.1} Hz over {} taxel x recording pairs of {} recordings; labels unused{})",
+            c.gain, c.target_hz, c.median_hz, c.pairs, c.recordings,
+            if results.across_seeds.is_some() { "; calibrated on the first simulated dataset and used for all" } else { "" }
+        ));
+    }
     let ctx = ReportContext {
         dataset: described,
-        parameters: params.describe(),
+        parameters,
         total_seconds: started.elapsed().as_secs_f64(),
         command: command_line(),
         paper_comparable: dataset.is_none(),

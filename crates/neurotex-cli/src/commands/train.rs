@@ -11,7 +11,7 @@ use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::Dataset;
 use neurotex::{Cell, Speed};
 
-use super::feature_table;
+use super::{calibrated_pipeline, feature_table};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex train`.
@@ -43,7 +43,12 @@ pub struct TrainArgs {
 
 /// Runs `neurotex train`.
 pub fn run(args: TrainArgs) -> Result<()> {
-    let params = args.stages.pipeline()?;
+    let dataset = Dataset::open(&args.dataset)?;
+    let indices = match &args.speeds {
+        Some(speeds) => dataset.indices_at(speeds)?,
+        None => (0..dataset.entries.len()).collect(),
+    };
+    let (params, calibration) = calibrated_pipeline(&args.stages, &dataset, &indices)?;
     let pipeline = Pipeline::new(params.clone())?;
     let knn = args.stages.knn(args.k)?;
     let columns = match (args.method, args.taxel) {
@@ -51,12 +56,14 @@ pub fn run(args: TrainArgs) -> Result<()> {
         (_, Some(_)) => bail!("--taxel applies only to --method taxel"),
         (_, None) => Columns::All,
     };
-    let dataset = Dataset::open(&args.dataset)?;
     let (table, grid) = feature_table(&dataset, &pipeline, args.speeds.as_deref(), args.method)?;
     if let Some(cell) = args.taxel {
         grid.locate(cell)?;
     }
-    let provenance = Provenance::of(&dataset, args.speeds.clone())?;
+    let provenance = Provenance {
+        gain_calibration: calibration,
+        ..Provenance::of(&dataset, args.speeds.clone())?
+    };
     let model = Model::train(&params, &table, columns, knn, provenance)?;
     model.save(&args.out)?;
     eprintln!(

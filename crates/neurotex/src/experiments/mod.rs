@@ -53,6 +53,7 @@ pub use sensitivity::{sensitivity, Sensitivity, SensitivitySpeed};
 pub use skip::{Skip, Stop};
 pub use tables::{Headline, Tables};
 
+use crate::calibrate::GainCalibration;
 use crate::error::Result;
 use crate::values::{BySpeed, Speed};
 
@@ -111,6 +112,10 @@ pub struct Results {
     pub e8: BySpeed<E8Speed>,
     /// The headline accuracies on an input changed by a rounding-level amount.
     pub sensitivity: Option<Sensitivity>,
+    /// How `--gain auto` chose the gain (on the first dataset's recordings, labels unused);
+    /// `None` for a gain given as a number.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gain_calibration: Option<GainCalibration>,
     /// The headline accuracies and claims over several simulated datasets (`--seeds`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub across_seeds: Option<AcrossSeeds>,
@@ -144,6 +149,7 @@ impl Results {
             e8: BySpeed::new(),
             sensitivity: None,
             across_seeds: None,
+            gain_calibration: None,
             provenance: Some(prepared.provenance.clone()),
             skipped: BTreeMap::new(),
             timing_s: BTreeMap::new(),

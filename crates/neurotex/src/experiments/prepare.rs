@@ -7,8 +7,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidReproduceParams};
+use crate::calibrate::{calibrate_gain, GainCalibration};
 use crate::error::{DataError, DatasetError, Result};
-use crate::pipeline::Encoded;
+use crate::pipeline::{Encoded, Pipeline};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
 use crate::sim::{design, simulate_trial, RigParams, Trial, ALL_TEXTURES};
@@ -55,6 +56,17 @@ impl Source<'_> {
             }
             Source::Simulated { rig, trials, seed } => describe_simulated(rig, trials, *seed),
         }
+    }
+
+    /// `--gain auto` on this source's recordings, all of them (labels unused): every
+    /// analysis cross-validates over them, so there is no training set apart from the rest.
+    ///
+    /// # Errors
+    /// A recording that cannot be loaded or conditioned, or no taxel with any signal.
+    pub fn calibrate_gain(&self, pipeline: &Pipeline, target_hz: f64) -> Result<GainCalibration> {
+        let indices: Vec<usize> = (0..self.len()).collect();
+        let load = |i: usize| self.load(i);
+        calibrate_gain(pipeline, &load, &indices, self.baseline(), target_hz)
     }
 
     /// Number of recordings.

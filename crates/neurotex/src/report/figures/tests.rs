@@ -255,6 +255,7 @@ pub(crate) fn wide() -> Results {
         e8,
         sensitivity: None,
         across_seeds: None,
+        gain_calibration: None,
         provenance: None,
         skipped: BTreeMap::new(),
         timing_s: BTreeMap::new(),
