@@ -103,6 +103,7 @@ pub(crate) fn wide() -> Results {
                     glcm3d,
                     taxel_full: acc[i] * 0.6,
                     first_match: Some(0.3),
+                    longest_vs_shortest: None,
                 },
             )
         })
@@ -139,6 +140,7 @@ pub(crate) fn wide() -> Results {
                     k: ks.clone(),
                     taxel_mean: shift(0.6),
                     glcm3d: shift(1.0),
+                    glcm3d_vs_taxel: Vec::new(),
                 },
             )
         })
@@ -226,6 +228,7 @@ pub(crate) fn wide() -> Results {
             labels: labels.clone(),
             taxel: confusion(30),
             glcm3d: confusion(60),
+            glcm3d_vs_taxel_by_class: Vec::new(),
         }),
         e3: Some(E3 {
             speed: Speed::of(10.0),
@@ -235,6 +238,7 @@ pub(crate) fn wide() -> Results {
             std: (2..=16).map(|k| 0.02 + 0.002 * k as f64).collect(),
             glcm3d: 0.71,
             taxel_mean: 0.36,
+            unperturbed_vs_moved: Vec::new(),
         }),
         e4,
         e5,
@@ -508,6 +512,7 @@ fn thirty_classes_still_lay_out() {
         labels: labels.clone(),
         taxel: m.clone(),
         glcm3d: m,
+        glcm3d_vs_taxel_by_class: Vec::new(),
     };
     let svg = confusion::e2(&e2).unwrap();
     assert_well_formed("e2, 30 classes", &svg);
