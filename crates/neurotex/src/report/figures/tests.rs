@@ -436,6 +436,48 @@ fn e3_e5_e8_draw_on_both_designs() {
 }
 
 #[test]
+fn e4_e5_e6_e8_draw_chance_per_speed_from_the_classes_recorded_there() {
+    let figures = |r: &Results| -> Vec<(&str, String)> {
+        vec![
+            ("e4", accuracy::e4(r, None).unwrap()),
+            ("e5", recognition::e5(r, None).unwrap()),
+            ("e6", accuracy::e6(r, None).unwrap()),
+            ("e8", neighbours::e8(r).unwrap()),
+        ]
+    };
+    // FabricSlide's design: 5 classes at the positive speeds, 7 at the negative ones
+    let wide = wide();
+    for (name, svg) in figures(&wide) {
+        assert!(svg.contains("chance, 1 / classes at each speed"), "{name}");
+        assert!(!svg.contains("chance, all classes"), "{name}");
+        if let Some(dump) = std::env::var_os("NEUROTEX_DUMP_FIGURES") {
+            let path = std::path::Path::new(&dump).join(format!("wide_{name}.svg"));
+            std::fs::write(path, &svg).unwrap();
+        }
+    }
+    let captions = [
+        accuracy::e4_caption(&wide, None),
+        accuracy::e6_caption(&wide, None),
+        recognition::e5_caption(&wide, None),
+        neighbours::e8_caption(&wide),
+    ];
+    assert!(captions
+        .iter()
+        .all(|c| c.contains("chance there") || c.contains("chance at that speed")));
+    // the same number of classes everywhere: one value in the key
+    for (name, svg) in figures(&small()) {
+        assert!(svg.contains("chance, 1 / classes at the speed ("), "{name}");
+    }
+    assert!(!neighbours::e8_caption(&small()).contains("% at"));
+    // without E1 the classes per speed are unknown: one line for all classes
+    let mut without_e1 = small();
+    without_e1.e1 = BySpeed::new();
+    for (name, svg) in figures(&without_e1) {
+        assert!(svg.contains("chance, all classes"), "{name}");
+    }
+}
+
+#[test]
 fn e7_labels_the_overflow_band_and_notes_silent_classes() {
     let r = wide();
     let e7 = r.e7.as_ref().unwrap();
