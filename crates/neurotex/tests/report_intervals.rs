@@ -68,8 +68,8 @@ fn close(what: &str, ours: f64, reference: f64) {
     );
 }
 
-#[test]
-fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bootstrap() {
+/// A small simulated run: its headline tables, its report, and the bootstrap seed.
+fn small_run() -> (Tables, neurotex::experiments::Results, String, u64) {
     let rig = RigParams {
         hold_s: 0.5,
         slide_mm: 20.0,
@@ -108,6 +108,12 @@ fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bo
         paper_comparable: false,
     };
     let report = markdown(&results, &context);
+    (tables, results, report, params.seed)
+}
+
+#[test]
+fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bootstrap() {
+    let (tables, results, report, seed) = small_run();
     let resamples = BootstrapParams::default().resamples;
     let pct = |v: f64| format!("{:.1}", 100.0 * v);
 
@@ -141,7 +147,7 @@ fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bo
         close("3D-GLCM accuracy", e1.glcm3d, mean(&glcm3d));
         close("single taxel accuracy", e1.taxel_mean, mean(&taxel));
 
-        let (lo, hi) = reference_bootstrap(&glcm3d, params.seed, resamples);
+        let (lo, hi) = reference_bootstrap(&glcm3d, seed, resamples);
         close("3D-GLCM interval, lower", e1.glcm3d_interval.lower, lo);
         close("3D-GLCM interval, upper", e1.glcm3d_interval.upper, hi);
         let printed = format!("{} [{}, {}]", pct(e1.glcm3d), pct(lo), pct(hi));
@@ -150,7 +156,7 @@ fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bo
             "{speed} mm/s: {printed} not in the report"
         );
 
-        let (lo, hi) = reference_bootstrap(&taxel, params.seed, resamples);
+        let (lo, hi) = reference_bootstrap(&taxel, seed, resamples);
         close("taxel interval, lower", e1.taxel_mean_interval.lower, lo);
         close("taxel interval, upper", e1.taxel_mean_interval.upper, hi);
         let printed = format!("{} [{}, {}]", pct(e1.taxel_mean), pct(lo), pct(hi));
@@ -160,7 +166,7 @@ fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bo
         );
 
         let differences: Vec<f64> = glcm3d.iter().zip(&taxel).map(|(g, t)| g - t).collect();
-        let (lo, hi) = reference_bootstrap(&differences, params.seed, resamples);
+        let (lo, hi) = reference_bootstrap(&differences, seed, resamples);
         let paired = &e1.glcm3d_vs_taxel;
         close("paired difference", paired.difference, mean(&differences));
         close("paired interval, lower", paired.lower, lo);
