@@ -44,7 +44,25 @@ pub fn compare(
     second: (&str, &Outcome),
     params: &ValidReproduceParams,
 ) -> Result<Comparison> {
-    let (a, b) = (&first.1.correct_shares, &second.1.correct_shares);
+    compare_shares(
+        (first.0, &first.1.correct_shares),
+        (second.0, &second.1.correct_shares),
+        params,
+    )
+}
+
+/// `first` against `second` from per-recording `(table row, share right)` lists, as
+/// [`Outcome::correct_shares`] holds them; for analyses that pool several evaluations per
+/// recording (E3's perturbation draws) or look at a subset of recordings (E2's classes).
+///
+/// # Errors
+/// The lists name different recordings, or are empty.
+pub fn compare_shares(
+    first: (&str, &[(usize, f64)]),
+    second: (&str, &[(usize, f64)]),
+    params: &ValidReproduceParams,
+) -> Result<Comparison> {
+    let (a, b) = (first.1, second.1);
     if a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.0 != y.0) {
         let (first, second) = (first.0.to_string(), second.0.to_string());
         return Err(ClassifyError::Unpaired { first, second }.into());

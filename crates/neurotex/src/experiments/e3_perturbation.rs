@@ -9,8 +9,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::tables::table;
-use super::{Context, Skip, Stop};
-use crate::analysis::{evaluate, Columns, Split};
+use super::{compare_shares, Comparison, Context, Skip, Stop};
+use crate::analysis::{evaluate, Columns, Outcome, Split};
 use crate::error::Result;
 use crate::pipeline::{Encoded, Method};
 use crate::values::Speed;
@@ -32,6 +32,10 @@ pub struct E3 {
     pub glcm3d: f64,
     /// Single taxel mean (E1).
     pub taxel_mean: f64,
+    /// Per n, the unperturbed 3D-GLCM against 3D-GLCM with n taxels moved, on the same
+    /// recordings (each recording's share right pooled over its draws).
+    #[serde(default)]
+    pub unperturbed_vs_moved: Vec<Comparison>,
 }
 
 /// E3 for every asked n the grid allows (2 up to its taxel count), each over
@@ -53,17 +57,27 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
         return Err(Skip::TooFewTaxels.into());
     }
     let slow: Vec<&Encoded> = c.prepared.at(speed).collect();
-    let (mut mean, mut std) = (Vec::new(), Vec::new());
+    let h = c.tables.at(speed);
+    // The perturbed tables hold only this speed's recordings; E1's rows name them in the
+    // table of all recordings, in the same order.
+    let rows = c.tables.glcm3d.rows_at(&[speed]);
+    let (mut mean, mut std, mut unperturbed_vs_moved) = (Vec::new(), Vec::new(), Vec::new());
     for &n in &counts {
-        let accs = (0..c.params.e3_repeats)
-            .map(|rep| perturbed_accuracy(c, &slow, &taxels, n, rep))
-            .collect::<Result<Vec<f64>>>()?;
+        let outcomes = (0..c.params.e3_repeats)
+            .map(|rep| perturbed(c, &slow, &taxels, n, rep))
+            .collect::<Result<Vec<Outcome>>>()?;
+        let accs: Vec<f64> = outcomes.iter().map(|o| o.accuracy).collect();
         let m = accs.iter().sum::<f64>() / accs.len() as f64;
         let var = accs.iter().map(|a| (a - m).powi(2)).sum::<f64>() / accs.len() as f64;
         mean.push(m);
         std.push(var.sqrt());
+        let moved = pooled_shares(&outcomes, &rows);
+        unperturbed_vs_moved.push(compare_shares(
+            ("unperturbed 3D-GLCM", &h.glcm3d.correct_shares),
+            (&format!("3D-GLCM, {n} taxels moved"), &moved),
+            c.params,
+        )?);
     }
-    let h = c.tables.at(speed);
     Ok(E3 {
         speed,
         repeats: c.params.e3_repeats,
@@ -72,18 +86,35 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
         std,
         glcm3d: h.glcm3d.accuracy,
         taxel_mean: h.taxel.accuracy,
+        unperturbed_vs_moved,
     })
 }
 
-/// 3D-GLCM accuracy (one CV shuffle) after draw `rep` of moving `n` taxels in every
+/// Each recording's share of right predictions over all `outcomes` (evaluations of the
+/// same recordings), named by `rows[i]` for the outcomes' row `i`.
+fn pooled_shares(outcomes: &[Outcome], rows: &[usize]) -> Vec<(usize, f64)> {
+    let mut sums = vec![0.0; rows.len()];
+    for o in outcomes {
+        for &(i, share) in &o.correct_shares {
+            sums[i] += share;
+        }
+    }
+    let draws = outcomes.len().max(1) as f64;
+    rows.iter()
+        .zip(sums)
+        .map(|(&r, s)| (r, s / draws))
+        .collect()
+}
+
+/// 3D-GLCM evaluated (one CV shuffle) after draw `rep` of moving `n` taxels in every
 /// recording; each recording gets its own seeded draw.
-fn perturbed_accuracy(
+fn perturbed(
     c: &Context,
     slow: &[&Encoded],
     taxels: &[usize],
     n: usize,
     rep: usize,
-) -> Result<f64> {
+) -> Result<Outcome> {
     let perturbed: Vec<Encoded> = slow
         .par_iter()
         .enumerate()
@@ -103,7 +134,7 @@ fn perturbed_accuracy(
         cv: c.params.cv_once(),
         group_by: None,
     };
-    Ok(evaluate(&features, Columns::All, &split, c.params.knn())?.accuracy)
+    evaluate(&features, Columns::All, &split, c.params.knn())
 }
 
 /// A permutation of the cells that moves `n` randomly chosen taxels: their positions are
@@ -145,5 +176,11 @@ mod tests {
         assert_eq!(e3.n, vec![4, 16]);
         assert_eq!((e3.mean.len(), e3.std.len()), (2, 2));
         assert!(e3.mean.iter().all(|a| (0.0..=1.0).contains(a)));
+        // paired on the slowest speed's recordings, the drop is the difference of the means
+        assert_eq!(e3.unperturbed_vs_moved.len(), 2);
+        for (c, m) in e3.unperturbed_vs_moved.iter().zip(&e3.mean) {
+            assert_eq!(c.recordings, run.prepared.at(e3.speed).count());
+            assert!((c.difference - (e3.glcm3d - m)).abs() < 1e-12);
+        }
     }
 }

@@ -5,8 +5,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::tables::{cv_at, table};
-use super::{Context, Stop};
-use crate::analysis::Columns;
+use super::{compare, Comparison, Context, Stop};
+use crate::analysis::{Columns, Outcome};
 use crate::error::Result;
 use crate::pipeline::{Encoded, Method};
 use crate::values::{BySpeed, Speed};
@@ -22,6 +22,10 @@ pub struct E5Speed {
     pub taxel_full: f64,
     /// Smallest fraction at which 3D-GLCM reaches the single taxel's accuracy.
     pub first_match: Option<f64>,
+    /// 3D-GLCM on the largest fraction against the smallest one longer than a bin, on the
+    /// same recordings; `None` with fewer than two such fractions.
+    #[serde(default)]
+    pub longest_vs_shortest: Option<Comparison>,
 }
 
 /// E5 at every speed.
@@ -31,12 +35,16 @@ pub struct E5Speed {
 pub fn e5_time_to_recognition(c: &Context) -> Result<BySpeed<E5Speed>, Stop> {
     let mut out = BySpeed::new();
     for &speed in &c.prepared.speeds {
-        let accs = c
+        let outcomes = c
             .params
             .e5_fractions
             .iter()
-            .map(|&p| accuracy_on_part(c, speed, p))
+            .map(|&p| outcome_on_part(c, speed, p))
             .collect::<Result<Vec<_>>>()?;
+        let accs: Vec<Option<f64>> = outcomes
+            .iter()
+            .map(|o| o.as_ref().map(|o| o.accuracy))
+            .collect();
         let taxel_full = c.tables.at(speed).taxel.accuracy;
         let first_match = c
             .params
@@ -50,15 +58,44 @@ pub fn e5_time_to_recognition(c: &Context) -> Result<BySpeed<E5Speed>, Stop> {
             glcm3d: accs,
             taxel_full,
             first_match,
+            longest_vs_shortest: longest_vs_shortest(c, &c.params.e5_fractions, &outcomes)?,
         };
         out.insert(speed, e5);
     }
     Ok(out)
 }
 
-/// 3D-GLCM accuracy on the first `fraction` of every slide at `speed`; `None` when a
+/// The paired comparison of the largest fraction's evaluation with the smallest's, among
+/// the fractions that could be evaluated.
+fn longest_vs_shortest(
+    c: &Context,
+    fractions: &[f64],
+    outcomes: &[Option<Outcome>],
+) -> Result<Option<Comparison>> {
+    let mut evaluated: Vec<(f64, &Outcome)> = fractions
+        .iter()
+        .zip(outcomes)
+        .filter_map(|(&p, o)| o.as_ref().map(|o| (p, o)))
+        .collect();
+    evaluated.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (Some(&(short, shortest)), Some(&(long, longest))) = (evaluated.first(), evaluated.last())
+    else {
+        return Ok(None);
+    };
+    if short == long {
+        return Ok(None);
+    }
+    let name = |p: f64| format!("{:.0} % of the slide", 100.0 * p);
+    Ok(Some(compare(
+        (&name(long), longest),
+        (&name(short), shortest),
+        c.params,
+    )?))
+}
+
+/// 3D-GLCM evaluated on the first `fraction` of every slide at `speed`; `None` when a
 /// recording's part is shorter than one bin.
-fn accuracy_on_part(c: &Context, speed: Speed, fraction: f64) -> Result<Option<f64>> {
+fn outcome_on_part(c: &Context, speed: Speed, fraction: f64) -> Result<Option<Outcome>> {
     let at_speed: Vec<&Encoded> = c.prepared.at(speed).collect();
     let truncated: Vec<Encoded> = at_speed
         .par_iter()
@@ -81,7 +118,7 @@ fn accuracy_on_part(c: &Context, speed: Speed, fraction: f64) -> Result<Option<f
         c.params.knn(),
         c.params.cv(),
     )?;
-    Ok(Some(outcome.accuracy))
+    Ok(Some(outcome))
 }
 
 #[cfg(test)]
@@ -98,6 +135,12 @@ mod tests {
             assert_eq!(e.fractions, [0.5, 1.0]);
             let whole = e.glcm3d[1].expect("the whole slide is longer than a bin");
             assert_eq!(whole, c.tables.at(speed).glcm3d.accuracy);
+            let paired = e
+                .longest_vs_shortest
+                .as_ref()
+                .expect("two fractions evaluated");
+            let half = e.glcm3d[0].expect("half the slide is longer than a bin");
+            assert!((paired.difference - (whole - half)).abs() < 1e-12);
             if let Some(p) = e.first_match {
                 let i = e.fractions.iter().position(|&f| f == p).unwrap();
                 assert!(e.glcm3d[i].unwrap() >= e.taxel_full);

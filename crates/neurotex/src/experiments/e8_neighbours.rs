@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::tables::cv_at;
-use super::{Context, Skip, Stop};
+use super::{compare, Comparison, Context, Skip, Stop};
 use crate::analysis::Columns;
 use crate::values::BySpeed;
 
@@ -16,6 +16,9 @@ pub struct E8Speed {
     pub taxel_mean: Vec<f64>,
     /// 3D-GLCM per k.
     pub glcm3d: Vec<f64>,
+    /// Per k, 3D-GLCM against the single taxel (mean over taxels) on the same recordings.
+    #[serde(default)]
+    pub glcm3d_vs_taxel: Vec<Comparison>,
 }
 
 /// E8 at every speed, and the `(speed, k)` pairs the data could not support (a training
@@ -30,6 +33,7 @@ pub fn e8_neighbours(c: &Context) -> Result<(BySpeed<E8Speed>, Vec<Skip>), Stop>
             k: Vec::new(),
             taxel_mean: Vec::new(),
             glcm3d: Vec::new(),
+            glcm3d_vs_taxel: Vec::new(),
         };
         for &k in &c.params.e8_ks {
             let knn = c.params.knn_with_k(k);
@@ -39,9 +43,11 @@ pub fn e8_neighbours(c: &Context) -> Result<(BySpeed<E8Speed>, Vec<Skip>), Stop>
                 cv_at(&c.tables.glcm3d, Columns::All, speed, &knn, cv),
             ) {
                 (Ok(t), Ok(g)) => {
+                    let paired = compare(("3D-GLCM", &g), ("single taxel", &t), c.params)?;
                     e8.k.push(k);
                     e8.taxel_mean.push(t.accuracy);
                     e8.glcm3d.push(g.accuracy);
+                    e8.glcm3d_vs_taxel.push(paired);
                 }
                 (Err(e), _) | (_, Err(e)) => skipped.push(Skip::Neighbours {
                     k,
@@ -69,6 +75,10 @@ mod tests {
         for (speed, e) in e8.iter() {
             assert_eq!(e.k, [1, 5]);
             assert_eq!(e.glcm3d[1], c.tables.at(speed).glcm3d.accuracy);
+            assert_eq!(e.glcm3d_vs_taxel.len(), 2);
+            for ((p, g), t) in e.glcm3d_vs_taxel.iter().zip(&e.glcm3d).zip(&e.taxel_mean) {
+                assert!((p.difference - (g - t)).abs() < 1e-12);
+            }
         }
     }
 }

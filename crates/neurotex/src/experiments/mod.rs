@@ -34,7 +34,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 pub use claims::{claims, Claim, Verdict};
-pub use comparison::{compare, Comparison};
+pub use comparison::{compare, compare_shares, Comparison};
 pub use diagnostics::{taxel_diagnostics, TaxelDiagnostics, TaxelResponse, SATURATION_SHARE};
 pub use e0_psth::{e0_psth, E0Example, E0};
 pub use e1_accuracy::{e1_accuracy, E1Speed};

@@ -9,7 +9,7 @@ use super::plot::{
     number, percent, render, text, Chart, Drawn, Key, Swatch, BEST, FONT, GLCM2D, GLCM3D, GREY,
     LABEL, SINGLE, TITLE,
 };
-use super::{chance, FigureError};
+use super::{chance, chance_key, chance_per_speed, chance_values, FigureError};
 use crate::experiments::Results;
 use crate::report::paper::Paper;
 use crate::values::Speed;
@@ -109,9 +109,8 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
     let level = labels_fit(&g.groups, plot_w / n as i32);
     let bottom = labels_height(&g.groups, level) + 26;
     let mut keys: Vec<Key> = series.iter().map(|s| s.key.clone()).collect();
-    if g.chance_per_group.is_some() {
-        let text = "chance at each speed (1 / classes there)";
-        keys.push(Key::new(text.to_string(), Swatch::Dashed(GREY)));
+    if let Some(per) = &g.chance_per_group {
+        keys.push(Key::new(chance_key(per), Swatch::Dashed(GREY)));
     } else if let Some(c) = g.chance {
         keys.push(Key::new(
             format!("chance, all classes ({} %)", percent(c)),
@@ -252,7 +251,7 @@ pub(crate) fn e4(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         groups: speeds.iter().map(ToString::to_string).collect(),
         series,
         chance: chance(r),
-        chance_per_group: None,
+        chance_per_group: chance_per_speed(r, &speeds),
     })
 }
 
@@ -285,16 +284,24 @@ pub(crate) fn e6(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         groups: speeds.iter().map(ToString::to_string).collect(),
         series,
         chance: chance(r),
-        chance_per_group: None,
+        chance_per_group: chance_per_speed(r, &speeds),
     })
 }
 
-/// The chance line's caveat: it is drawn for all classes of the dataset.
-fn chance_note(r: &Results) -> String {
-    format!(
-        "The dashed grey line is chance with all {n} classes present (1/{n}); a speed recorded with fewer classes has a higher chance level.",
-        n = r.labels.len()
-    )
+/// How chance is drawn: per speed from the classes recorded there when E1 knows every
+/// speed of `speeds`, else one line for all classes of the dataset, with its caveat.
+fn chance_note(r: &Results, speeds: &[Speed], speed: &str) -> String {
+    if chance_per_speed(r, speeds).is_some() {
+        format!(
+            "The dashed grey segment over each {speed} is chance there, one over the classes recorded at that speed{}.",
+            chance_values(r, speeds)
+        )
+    } else {
+        format!(
+            "The dashed grey line is chance with all {n} classes present (1/{n}); a speed recorded with fewer classes has a higher chance level.",
+            n = r.labels.len()
+        )
+    }
 }
 
 fn paper_note(paper: Option<&Paper>) -> &'static str {
@@ -318,7 +325,7 @@ pub(crate) fn e4_caption(r: &Results, paper: Option<&Paper>) -> String {
     format!(
         "Accuracy per speed without the time axis: 2D-GLCM on the time-collapsed rate image (green) beside the single taxel (mean over taxels, blue) and 3D-GLCM (vermillion).{} {}",
         paper_note(paper),
-        chance_note(r)
+        chance_note(r, &r.e4.iter().map(|(s, _)| s).collect::<Vec<_>>(), "speed")
     )
 }
 
@@ -327,6 +334,6 @@ pub(crate) fn e6_caption(r: &Results, paper: Option<&Paper>) -> String {
     format!(
         "Speed invariance: trained on every other speed and tested on the one on the x axis; single taxel (mean over taxels, blue) against 3D-GLCM (vermillion).{} {}",
         paper_note(paper),
-        chance_note(r)
+        chance_note(r, &r.e6.iter().map(|(s, _)| s).collect::<Vec<_>>(), "test speed")
     )
 }

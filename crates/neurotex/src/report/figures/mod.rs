@@ -12,6 +12,8 @@ mod psth;
 mod recognition;
 
 use crate::experiments::Results;
+use crate::values::Speed;
+use plot::{percent, Key, Swatch, GREY};
 
 use super::paper::Paper;
 
@@ -63,6 +65,84 @@ pub(crate) mod file {
 /// Chance level (%) with every class of the dataset present.
 fn chance(r: &Results) -> Option<f64> {
     (!r.labels.is_empty()).then(|| 100.0 / r.labels.len() as f64)
+}
+
+/// Chance (%) at each of `speeds`, one over the classes E1 found recorded there; `None`
+/// unless E1 ran at every one of them.
+pub(crate) fn chance_per_speed(r: &Results, speeds: &[Speed]) -> Option<Vec<f64>> {
+    speeds
+        .iter()
+        .map(|&s| r.e1.get(s).map(|e| 100.0 * e.chance))
+        .collect()
+}
+
+/// The legend key of chance lines drawn per speed: with its value when it is the same at
+/// every speed.
+pub(crate) fn chance_key(per_speed: &[f64]) -> String {
+    match per_speed {
+        [first, rest @ ..] if rest.iter().all(|c| (c - first).abs() < 1e-9) => {
+            format!("chance, 1 / classes at the speed ({} %)", percent(*first))
+        }
+        _ => "chance, 1 / classes at each speed".to_string(),
+    }
+}
+
+/// Chance (%) in each panel of `speeds`: per speed when E1 knows every one (its key added
+/// to `keys`), else the all-class level in each (with that key).
+pub(crate) fn panel_chances(
+    r: &Results,
+    speeds: &[Speed],
+    keys: &mut Vec<Key>,
+) -> Vec<Option<f64>> {
+    if let Some(per) = chance_per_speed(r, speeds) {
+        keys.push(Key::new(chance_key(&per), Swatch::Dashed(GREY)));
+        return per.into_iter().map(Some).collect();
+    }
+    let all = chance(r);
+    if let Some(c) = all {
+        keys.push(Key::new(
+            format!("chance, all classes ({} %)", percent(c)),
+            Swatch::Dashed(GREY),
+        ));
+    }
+    vec![all; speeds.len()]
+}
+
+/// The chance levels per speed grouped by value, for a caption (` (14.3 % at -150, -10
+/// mm/s; 20 % at 10 mm/s)`); empty when E1 does not know every speed or the level is the
+/// same at all of them (the key gives it then).
+pub(crate) fn chance_values(r: &Results, speeds: &[Speed]) -> String {
+    let Some(per) = chance_per_speed(r, speeds) else {
+        return String::new();
+    };
+    let mut groups: Vec<(String, Vec<String>)> = Vec::new();
+    for (speed, c) in speeds.iter().zip(&per) {
+        let value = percent(*c);
+        match groups.iter_mut().find(|(v, _)| *v == value) {
+            Some((_, at)) => at.push(speed.to_string()),
+            None => groups.push((value, vec![speed.to_string()])),
+        }
+    }
+    if groups.len() < 2 {
+        return String::new();
+    }
+    let parts: Vec<String> = groups
+        .iter()
+        .map(|(v, at)| format!("{v} % at {} mm/s", at.join(", ")))
+        .collect();
+    format!(" ({})", parts.join("; "))
+}
+
+/// What the grey dashed line of a panel-per-speed figure is.
+pub(crate) fn panel_chance_note(r: &Results, speeds: &[Speed]) -> String {
+    if chance_per_speed(r, speeds).is_some() {
+        format!(
+            "grey dashed: chance at that speed, one over the classes recorded there{}",
+            chance_values(r, speeds)
+        )
+    } else {
+        format!("grey dashed: chance with all {} classes", r.labels.len())
+    }
 }
 
 /// Every figure these results have, as `(file name, SVG)`, in the report's order.

@@ -1,26 +1,25 @@
 //! E8: accuracy against the number of neighbours k, one panel per speed on one scale.
 
 use super::plot::{
-    hline, line_with_markers, mesh, multiples, number, panel_chart, percent, x_ticks_at, Key,
-    Multiples, Swatch, GLCM3D, GREY, SINGLE,
+    hline, line_with_markers, mesh, multiples, number, panel_chart, x_ticks_at, Key, Multiples,
+    Swatch, GLCM3D, GREY, SINGLE,
 };
-use super::{chance, FigureError};
+use super::{panel_chance_note, panel_chances, FigureError};
 use crate::experiments::Results;
+use crate::values::Speed;
 
 /// E8: single taxel and 3D-GLCM against k, one panel per speed.
 pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
-    let chance = chance(r);
     let mut keys = vec![
         Key::new("single taxel, mean over taxels", Swatch::Points(SINGLE)),
         Key::new("3D-GLCM", Swatch::Points(GLCM3D)),
     ];
-    if let Some(c) = chance {
-        keys.push(Key::new(
-            format!("chance, all classes ({} %)", percent(c)),
-            Swatch::Dashed(GREY),
-        ));
-    }
     let speeds: Vec<_> = r.e8.iter().collect();
+    let chances = panel_chances(
+        r,
+        &speeds.iter().map(|(s, _)| *s).collect::<Vec<_>>(),
+        &mut keys,
+    );
     let ks = || {
         speeds
             .iter()
@@ -49,7 +48,7 @@ pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
             .draw()?;
         let ks: Vec<f64> = e.k.iter().map(|&k| k as f64).collect();
         x_ticks_at(area, &chart, &ks)?;
-        if let Some(c) = chance {
+        if let Some(c) = chances[i] {
             hline(&mut chart, c, GREY, 6)?;
         }
         let at = |values: &[f64]| -> Vec<(f64, f64)> {
@@ -65,8 +64,9 @@ pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
 
 /// E8's caption.
 pub(crate) fn e8_caption(r: &Results) -> String {
+    let speeds: Vec<Speed> = r.e8.iter().map(|(s, _)| s).collect();
     format!(
-        "Accuracy against the number of neighbours k of the KNN classifier, one panel per speed on one scale: single taxel (mean over taxels, blue) and 3D-GLCM (vermillion); grey dashed: chance with all {} classes.",
-        r.labels.len()
+        "Accuracy against the number of neighbours k of the KNN classifier, one panel per speed on one scale: single taxel (mean over taxels, blue) and 3D-GLCM (vermillion); {}.",
+        panel_chance_note(r, &speeds)
     )
 }

@@ -3,17 +3,16 @@
 use plotters::prelude::*;
 
 use super::plot::{
-    hline, line_with_markers, mesh, multiples, number, panel_chart, percent, vline, Key, Multiples,
-    Swatch, GLCM3D, GREY, SINGLE,
+    hline, line_with_markers, mesh, multiples, number, panel_chart, vline, Key, Multiples, Swatch,
+    GLCM3D, GREY, SINGLE,
 };
-use super::{chance, FigureError};
+use super::{panel_chance_note, panel_chances, FigureError};
 use crate::experiments::Results;
 use crate::report::paper::Paper;
 
 /// E5: 3D-GLCM on the first part of the slide against the single taxel on all of it, one
 /// panel per speed.
 pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
-    let chance = chance(r);
     let too_short = r.e5.values().any(|e| e.glcm3d.iter().any(Option::is_none));
     let paper_marks =
         r.e5.iter()
@@ -25,12 +24,12 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         ),
         Key::new("single taxel on the whole slide", Swatch::Dashed(SINGLE)),
     ];
-    if let Some(c) = chance {
-        keys.push(Key::new(
-            format!("chance, all classes ({} %)", percent(c)),
-            Swatch::Dashed(GREY),
-        ));
-    }
+    let speeds: Vec<_> = r.e5.iter().collect();
+    let chances = panel_chances(
+        r,
+        &speeds.iter().map(|(s, _)| *s).collect::<Vec<_>>(),
+        &mut keys,
+    );
     if paper_marks {
         keys.push(Key::new(
             "paper: 3D-GLCM matches here",
@@ -43,7 +42,6 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
             Swatch::Cross(GREY),
         ));
     }
-    let speeds: Vec<_> = r.e5.iter().collect();
     let layout = Multiples {
         n: speeds.len(),
         panel: (250, 200),
@@ -61,7 +59,7 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
             .x_label_formatter(&|v| number(*v))
             .y_label_formatter(&|v| number(*v))
             .draw()?;
-        if let Some(c) = chance {
+        if let Some(c) = chances[i] {
             hline(&mut chart, c, GREY, 6)?;
         }
         hline(&mut chart, 100.0 * e.taxel_full, SINGLE, 6)?;
@@ -100,8 +98,8 @@ pub(crate) fn e5_caption(r: &Results, paper: Option<&Paper>) -> String {
             })
             .collect();
     format!(
-        "Time to recognition, one panel per speed on one scale: 3D-GLCM accuracy using only the first part of each slide (vermillion) against the single taxel's accuracy on the whole slide (mean over taxels, dashed blue); grey dashed: chance with all {} classes.{} 3D-GLCM first reaches the single taxel at {}.",
-        r.labels.len(),
+        "Time to recognition, one panel per speed on one scale: 3D-GLCM accuracy using only the first part of each slide (vermillion) against the single taxel's accuracy on the whole slide (mean over taxels, dashed blue); {}.{} 3D-GLCM first reaches the single taxel at {}.",
+        panel_chance_note(r, &r.e5.iter().map(|(s, _)| s).collect::<Vec<_>>()),
         if paper.is_some() {
             " Black dashed: the share at which the paper's 3D-GLCM matched its single taxel, where the paper states it."
         } else {

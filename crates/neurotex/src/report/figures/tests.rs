@@ -103,6 +103,7 @@ pub(crate) fn wide() -> Results {
                     glcm3d,
                     taxel_full: acc[i] * 0.6,
                     first_match: Some(0.3),
+                    longest_vs_shortest: None,
                 },
             )
         })
@@ -139,6 +140,7 @@ pub(crate) fn wide() -> Results {
                     k: ks.clone(),
                     taxel_mean: shift(0.6),
                     glcm3d: shift(1.0),
+                    glcm3d_vs_taxel: Vec::new(),
                 },
             )
         })
@@ -226,6 +228,7 @@ pub(crate) fn wide() -> Results {
             labels: labels.clone(),
             taxel: confusion(30),
             glcm3d: confusion(60),
+            glcm3d_vs_taxel_by_class: Vec::new(),
         }),
         e3: Some(E3 {
             speed: Speed::of(10.0),
@@ -235,6 +238,7 @@ pub(crate) fn wide() -> Results {
             std: (2..=16).map(|k| 0.02 + 0.002 * k as f64).collect(),
             glcm3d: 0.71,
             taxel_mean: 0.36,
+            unperturbed_vs_moved: Vec::new(),
         }),
         e4,
         e5,
@@ -434,6 +438,48 @@ fn e3_e5_e8_draw_on_both_designs() {
 }
 
 #[test]
+fn e4_e5_e6_e8_draw_chance_per_speed_from_the_classes_recorded_there() {
+    let figures = |r: &Results| -> Vec<(&str, String)> {
+        vec![
+            ("e4", accuracy::e4(r, None).unwrap()),
+            ("e5", recognition::e5(r, None).unwrap()),
+            ("e6", accuracy::e6(r, None).unwrap()),
+            ("e8", neighbours::e8(r).unwrap()),
+        ]
+    };
+    // FabricSlide's design: 5 classes at the positive speeds, 7 at the negative ones
+    let wide = wide();
+    for (name, svg) in figures(&wide) {
+        assert!(svg.contains("chance, 1 / classes at each speed"), "{name}");
+        assert!(!svg.contains("chance, all classes"), "{name}");
+        if let Some(dump) = std::env::var_os("NEUROTEX_DUMP_FIGURES") {
+            let path = std::path::Path::new(&dump).join(format!("wide_{name}.svg"));
+            std::fs::write(path, &svg).unwrap();
+        }
+    }
+    let captions = [
+        accuracy::e4_caption(&wide, None),
+        accuracy::e6_caption(&wide, None),
+        recognition::e5_caption(&wide, None),
+        neighbours::e8_caption(&wide),
+    ];
+    assert!(captions
+        .iter()
+        .all(|c| c.contains("chance there") || c.contains("chance at that speed")));
+    // the same number of classes everywhere: one value in the key
+    for (name, svg) in figures(&small()) {
+        assert!(svg.contains("chance, 1 / classes at the speed ("), "{name}");
+    }
+    assert!(!neighbours::e8_caption(&small()).contains("% at"));
+    // without E1 the classes per speed are unknown: one line for all classes
+    let mut without_e1 = small();
+    without_e1.e1 = BySpeed::new();
+    for (name, svg) in figures(&without_e1) {
+        assert!(svg.contains("chance, all classes"), "{name}");
+    }
+}
+
+#[test]
 fn e7_labels_the_overflow_band_and_notes_silent_classes() {
     let r = wide();
     let e7 = r.e7.as_ref().unwrap();
@@ -510,6 +556,7 @@ fn thirty_classes_still_lay_out() {
         labels: labels.clone(),
         taxel: m.clone(),
         glcm3d: m,
+        glcm3d_vs_taxel_by_class: Vec::new(),
     };
     let svg = confusion::e2(&e2).unwrap();
     assert_well_formed("e2, 30 classes", &svg);

@@ -1,0 +1,185 @@
+//! The intervals the report prints, recomputed independently from the analyses'
+//! per-recording results: E1's accuracy intervals (`Outcome::accuracy_interval`) and its
+//! paired comparison of 3D-GLCM with the single taxel (`experiments::compare`).
+//!
+//! The statistics layer itself is checked against scipy, statsmodels and numpy in
+//! `stats_reference.rs`; this file checks the path from predictions to the numbers in
+//! report.md. A seeded bootstrap has no outside value to compare with (scipy's bootstrap
+//! draws other resamples), so the reference here redraws the same resamples (the same
+//! ChaCha8 generator and seed, one uniform index in 0..n per draw, as `bootstrap_mean_share`
+//! documents) and does everything else its own slow, evident way:
+//! - each recording's share of right predictions from the out-of-fold predictions and the
+//!   table's labels (3D-GLCM);
+//! - the resampled means by plain loops, sorted, and read at the 2.5th and 97.5th percentiles
+//!   by numpy's default linear interpolation, written out here;
+//! - the paired interval by resampling the per-recording differences themselves, not the
+//!   library's shifted `(d + 1) / 2`;
+//! - the printed text by formatting those values as report.md does (one decimal, percent).
+//!
+//! Tolerance: 1e-12 absolute on shares and interval ends, which differ from the library's
+//! only in the order of floating-point operations; a wrong seed, a resample drawn
+//! differently, a shifted percentile, a share counted over the wrong predictions or a
+//! mis-mapped paired interval moves them by 1e-3 or more.
+
+use std::collections::BTreeMap;
+
+use neurotex::classify::{BootstrapParams, CvParams};
+use neurotex::experiments::{prepare, run_all, ReproduceParams, Source, Tables};
+use neurotex::report::{markdown, ReportContext};
+use neurotex::sim::{design, RigParams, Texture};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const TOLERANCE: f64 = 1e-12;
+
+/// The `q` quantile of ascending `sorted` by linear interpolation between order statistics
+/// (numpy's `np.quantile` default, Hyndman and Fan definition 7).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let h = (sorted.len() - 1) as f64 * q;
+    let below = h.floor() as usize;
+    if below + 1 < sorted.len() {
+        sorted[below] + (h - below as f64) * (sorted[below + 1] - sorted[below])
+    } else {
+        sorted[below]
+    }
+}
+
+/// The 95 % percentile-bootstrap interval of the mean of `values`, drawn with the library's
+/// generator and seed but computed step by step.
+fn reference_bootstrap(values: &[f64], seed: u64, resamples: usize) -> (f64, f64) {
+    let n = values.len();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut means = Vec::with_capacity(resamples);
+    for _ in 0..resamples {
+        let mut sum = 0.0;
+        for _ in 0..n {
+            sum += values[rng.gen_range(0..n as u64) as usize];
+        }
+        means.push(sum / n as f64);
+    }
+    means.sort_by(|a, b| a.partial_cmp(b).expect("no NaN"));
+    (quantile(&means, 0.025), quantile(&means, 0.975))
+}
+
+fn close(what: &str, ours: f64, reference: f64) {
+    assert!(
+        (ours - reference).abs() <= TOLERANCE,
+        "{what}: neurotex {ours}, reference {reference}"
+    );
+}
+
+/// A small simulated run: its headline tables, its report, and the bootstrap seed.
+fn small_run() -> (Tables, neurotex::experiments::Results, String, u64) {
+    let rig = RigParams {
+        hold_s: 0.5,
+        slide_mm: 20.0,
+        ..RigParams::default()
+    };
+    let textures = [Texture::Ft1, Texture::Sb, Texture::Stf, Texture::Cp];
+    let params = ReproduceParams {
+        cv: CvParams {
+            folds: 3,
+            seed: 0,
+            repeats: 3,
+        },
+        e3_counts: vec![4],
+        e3_repeats: 1,
+        e5_fractions: vec![1.0],
+        e7_gains: vec![8.0],
+        e8_ks: vec![5],
+        seed: 11,
+        ..ReproduceParams::default()
+    }
+    .check()
+    .unwrap();
+    let source = Source::Simulated {
+        rig: Box::new(rig),
+        trials: design(&textures, &[10.0, 20.0], 6),
+        seed: 3,
+    };
+    let prepared = prepare(&source, &params, &|_| {}).unwrap();
+    let tables = Tables::build(&prepared, &params).unwrap();
+    let results = run_all(&prepared, &params, &|_| {}).unwrap();
+    let context = ReportContext {
+        dataset: "a small simulated design".into(),
+        parameters: Vec::new(),
+        total_seconds: 1.0,
+        command: "cargo test --test report_intervals".into(),
+        paper_comparable: false,
+    };
+    let report = markdown(&results, &context);
+    (tables, results, report, params.seed)
+}
+
+#[test]
+fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bootstrap() {
+    let (tables, results, report, seed) = small_run();
+    let resamples = BootstrapParams::default().resamples;
+    let pct = |v: f64| format!("{:.1}", 100.0 * v);
+
+    for (speed, h) in tables.headline.iter() {
+        let e1 = results.e1.get(speed).expect("E1 at every speed");
+        // each recording's share of right 3D-GLCM predictions, from the predictions
+        let mut right: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
+        for p in h
+            .glcm3d
+            .predictions
+            .as_ref()
+            .expect("3D-GLCM keeps its predictions")
+        {
+            let truth = &tables.glcm3d.metas[p.row].label;
+            let entry = right.entry(p.row).or_default();
+            entry.0 += usize::from(h.glcm3d.labels[p.predicted] == *truth);
+            entry.1 += 1;
+        }
+        let glcm3d: Vec<f64> = right.values().map(|&(k, n)| k as f64 / n as f64).collect();
+        assert_eq!(right.len(), h.glcm3d.correct_shares.len());
+        for ((row, share), (&ref_row, &reference)) in h.glcm3d.correct_shares.iter().zip(&right) {
+            assert_eq!(*row, ref_row);
+            close(
+                "3D-GLCM share",
+                *share,
+                reference.0 as f64 / reference.1 as f64,
+            );
+        }
+        let taxel: Vec<f64> = h.taxel.correct_shares.iter().map(|s| s.1).collect();
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        close("3D-GLCM accuracy", e1.glcm3d, mean(&glcm3d));
+        close("single taxel accuracy", e1.taxel_mean, mean(&taxel));
+
+        let (lo, hi) = reference_bootstrap(&glcm3d, seed, resamples);
+        close("3D-GLCM interval, lower", e1.glcm3d_interval.lower, lo);
+        close("3D-GLCM interval, upper", e1.glcm3d_interval.upper, hi);
+        let printed = format!("{} [{}, {}]", pct(e1.glcm3d), pct(lo), pct(hi));
+        assert!(
+            report.contains(&printed),
+            "{speed} mm/s: {printed} not in the report"
+        );
+
+        let (lo, hi) = reference_bootstrap(&taxel, seed, resamples);
+        close("taxel interval, lower", e1.taxel_mean_interval.lower, lo);
+        close("taxel interval, upper", e1.taxel_mean_interval.upper, hi);
+        let printed = format!("{} [{}, {}]", pct(e1.taxel_mean), pct(lo), pct(hi));
+        assert!(
+            report.contains(&printed),
+            "{speed} mm/s: {printed} not in the report"
+        );
+
+        let differences: Vec<f64> = glcm3d.iter().zip(&taxel).map(|(g, t)| g - t).collect();
+        let (lo, hi) = reference_bootstrap(&differences, seed, resamples);
+        let paired = &e1.glcm3d_vs_taxel;
+        close("paired difference", paired.difference, mean(&differences));
+        close("paired interval, lower", paired.lower, lo);
+        close("paired interval, upper", paired.upper, hi);
+        let printed = format!(
+            "{:+.1} points [{:+.1}, {:+.1}]",
+            100.0 * mean(&differences),
+            100.0 * lo,
+            100.0 * hi
+        );
+        assert!(
+            report.contains(&printed),
+            "{speed} mm/s: {printed} not in the report"
+        );
+    }
+}
