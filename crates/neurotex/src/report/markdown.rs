@@ -189,6 +189,11 @@ fn across_seeds(r: &Results) -> String {
     }
     out += &t.render();
     out += "\n";
+    out += &figure(
+        file::SEEDS,
+        "E1 and E6 accuracies on each simulated dataset, with their means and intervals",
+        &figures::across_seeds_caption(a),
+    );
     let mut t = Table::new(["claim", "holds on", "verdicts"]);
     for c in &a.claims {
         t.row([

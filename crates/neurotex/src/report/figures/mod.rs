@@ -10,6 +10,7 @@ mod perturbation;
 mod plot;
 mod psth;
 mod recognition;
+mod seeds;
 
 use crate::experiments::Results;
 use crate::values::Speed;
@@ -24,6 +25,7 @@ pub(crate) use neighbours::e8_caption;
 pub(crate) use perturbation::e3_caption;
 pub(crate) use psth::e0_caption;
 pub(crate) use recognition::e5_caption;
+pub(crate) use seeds::across_seeds_caption;
 
 /// A figure could not be drawn.
 #[derive(Debug, thiserror::Error)]
@@ -60,6 +62,8 @@ pub(crate) mod file {
     pub(crate) const E7_ISI: &str = "e7_isi.svg";
     /// E8.
     pub(crate) const E8: &str = "e8_k.svg";
+    /// E1 and E6 over several simulated datasets.
+    pub(crate) const SEEDS: &str = "across_seeds.svg";
 }
 
 /// Chance level (%) with every class of the dataset present.
@@ -150,7 +154,11 @@ pub(crate) fn all(
     r: &Results,
     paper: Option<&Paper>,
 ) -> Vec<(&'static str, Result<String, FigureError>)> {
-    let mut out = vec![(file::E1, accuracy::e1(r, paper))];
+    let mut out = Vec::new();
+    if let Some(svg) = seeds::across_seeds(r) {
+        out.push((file::SEEDS, svg));
+    }
+    out.push((file::E1, accuracy::e1(r, paper)));
     if let Some(e2) = &r.e2 {
         out.push((file::E2, confusion::e2(e2)));
     }

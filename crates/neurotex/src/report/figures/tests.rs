@@ -616,3 +616,28 @@ fn comparison(d: f64) -> crate::experiments::Comparison {
         recordings: 69,
     }
 }
+
+#[test]
+fn across_seeds_draws_every_dataset_and_only_with_several() {
+    for r in [small(), wide()] {
+        assert!(super::seeds::across_seeds(&r).is_none(), "one dataset: no figure");
+        let mut other = r.clone();
+        for e in other.e1.values().cloned().collect::<Vec<_>>().iter().zip(r.speeds.iter()) {
+            let mut e1 = e.0.clone();
+            e1.glcm3d = (e1.glcm3d - 0.05).max(0.0);
+            other.e1.insert(*e.1, e1);
+        }
+        let runs = [(0, &r), (1, &other), (2, &r)];
+        let mut with = r.clone();
+        with.across_seeds = Some(crate::experiments::across_seeds(&runs).unwrap());
+        let svg = super::seeds::across_seeds(&with).unwrap().unwrap();
+        assert_well_formed("across_seeds", &svg);
+        assert_no_overprint("across_seeds", &svg);
+        // Three dots per method and group (E1 and E6 at every speed), and one marker per
+        // method in the legend.
+        let groups = r.e1.len() + r.e6.len();
+        assert_eq!(svg.matches("<circle").count(), 3 * 2 * groups + 2, "dots");
+        let names = check_all(&with, None);
+        assert!(names.contains(&"across_seeds.svg"), "{names:?}");
+    }
+}
