@@ -138,3 +138,43 @@ fn reproduce_rejects_seeds_it_cannot_run() {
         &out,
     );
 }
+
+#[test]
+fn reproduce_group_by_keeps_groups_in_folds_and_names_a_missing_column() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 6);
+    let out = dir.join("grouped");
+    let run = dir.run(&[
+        "reproduce",
+        "--dataset",
+        s(&ds),
+        "--quick",
+        "--group-by",
+        "trial",
+        "--out",
+        s(&out),
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("keeping each `trial` group in one fold"),
+        "parameters line"
+    );
+    let missing = dir.join("missing");
+    dir.fails_each(
+        &[(
+            vec![
+                "reproduce",
+                "--dataset",
+                s(&ds),
+                "--quick",
+                "--group-by",
+                "session",
+                "--out",
+                s(&missing),
+            ],
+            "session",
+        )],
+        &missing,
+    );
+}

@@ -50,6 +50,11 @@ pub struct ReproduceArgs {
     /// Neighbours in KNN.
     #[arg(long, default_value_t = 5)]
     pub k: usize,
+    /// Every cross-validation of the analyses keeps each group of this manifest column in
+    /// one fold (`trial` for repeats of one run, or a session or subject column); with fewer
+    /// groups than folds at a speed, each group is held out in turn.
+    #[arg(long = "group-by")]
+    pub group_by: Option<String>,
     #[command(flatten)]
     pub stages: StageArgs,
 }
@@ -67,6 +72,7 @@ impl ReproduceArgs {
         params.knn = self.stages.knn(self.k)?;
         params.seed = self.seed;
         params.cv.seed = self.seed;
+        params.group_by = self.group_by.clone();
         Ok(params)
     }
 

@@ -132,7 +132,7 @@ fn perturbed(
     let split = Split::CrossValidation {
         speeds: None,
         cv: c.params.cv_once(),
-        group_by: None,
+        group_by: c.params.group_by.clone(),
     };
     evaluate(&features, Columns::All, &split, c.params.knn())
 }

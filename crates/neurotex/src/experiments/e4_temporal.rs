@@ -35,7 +35,7 @@ pub fn e4_temporal(c: &Context) -> Result<BySpeed<E4Speed>, Stop> {
             Columns::All,
             speed,
             c.params.knn(),
-            c.params.cv(),
+            c.params.folds(),
         )?;
         out.insert(
             speed,

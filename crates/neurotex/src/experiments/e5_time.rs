@@ -116,7 +116,7 @@ fn outcome_on_part(c: &Context, speed: Speed, fraction: f64) -> Result<Option<Ou
         Columns::All,
         speed,
         c.params.knn(),
-        c.params.cv(),
+        c.params.folds(),
     )?;
     Ok(Some(outcome))
 }

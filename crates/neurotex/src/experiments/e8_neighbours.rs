@@ -37,7 +37,7 @@ pub fn e8_neighbours(c: &Context) -> Result<(BySpeed<E8Speed>, Vec<Skip>), Stop>
         };
         for &k in &c.params.e8_ks {
             let knn = c.params.knn_with_k(k);
-            let cv = c.params.cv();
+            let cv = c.params.folds();
             match (
                 cv_at(&c.tables.taxel, Columns::EachTaxel, speed, &knn, cv),
                 cv_at(&c.tables.glcm3d, Columns::All, speed, &knn, cv),

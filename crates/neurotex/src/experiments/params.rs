@@ -37,6 +37,9 @@ pub struct ReproduceParams {
     /// conditioned signal times `1 + this`) before the headline evaluations are repeated;
     /// `None` skips it. Default 1e-12, a rounding-level change.
     pub sensitivity: Option<f64>,
+    /// Cross-validation folds keep every group of this manifest column together (a run,
+    /// a session, a subject); `None` folds recordings freely.
+    pub group_by: Option<String>,
 }
 
 impl Default for ReproduceParams {
@@ -58,6 +61,7 @@ impl Default for ReproduceParams {
             e8_ks: vec![1, 3, 5, 7, 9],
             seed: 0,
             sensitivity: Some(1e-12),
+            group_by: None,
         }
     }
 }
@@ -98,10 +102,16 @@ impl ReproduceParams {
                 "KNN: k = {}, Euclidean, features z-scored on training folds: {}",
                 self.knn.k, self.knn.standardize
             ),
-            format!(
-                "CV: {}-fold stratified, shuffled with seed {}, {} repeats",
-                self.cv.folds, self.cv.seed, self.cv.repeats
-            ),
+            match &self.group_by {
+                None => format!(
+                    "CV: {}-fold stratified, shuffled with seed {}, {} repeats",
+                    self.cv.folds, self.cv.seed, self.cv.repeats
+                ),
+                Some(column) => format!(
+                    "CV: up to {} folds keeping each `{column}` group in one fold (each group held out in turn when there are fewer), seed {}, {} repeats",
+                    self.cv.folds, self.cv.seed, self.cv.repeats
+                ),
+            },
             format!(
                 "E3: {} draws per n, n in {:?}; E5 fractions {:?}; E7 gains {:?}; E8 k in {:?}",
                 self.e3_repeats, self.e3_counts, self.e5_fractions, self.e7_gains, self.e8_ks
@@ -202,6 +212,14 @@ impl ValidReproduceParams {
     /// Cross-validation.
     pub fn cv(&self) -> ValidCv {
         self.cv
+    }
+
+    /// Cross-validation and the group column its folds keep together, as [`cv_at`] takes
+    /// them.
+    ///
+    /// [`cv_at`]: super::tables::cv_at
+    pub fn folds(&self) -> (ValidCv, Option<&str>) {
+        (self.cv, self.params.group_by.as_deref())
     }
 
     /// Cross-validation with a single repeat (E3, E5 draw their spread elsewhere).

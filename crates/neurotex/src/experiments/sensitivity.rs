@@ -56,7 +56,7 @@ pub fn sensitivity(c: &Context) -> Result<Option<Sensitivity>, Stop> {
     }
     let glcm3d = table(perturbed, Method::Glcm3d, c.params)?;
     let taxel = table(perturbed, Method::Taxel, c.params)?;
-    let (knn, cv) = (c.params.knn(), c.params.cv());
+    let (knn, cv) = (c.params.knn(), c.params.folds());
     let mut speeds = BySpeed::new();
     let mut largest_move: f64 = 0.0;
     for (speed, h) in c.tables.headline.iter() {

@@ -48,8 +48,8 @@ impl Tables {
                 Ok((
                     s,
                     Headline {
-                        taxel: cv_at(&taxel, Columns::EachTaxel, s, knn, params.cv())?,
-                        glcm3d: cv_at(&glcm3d, Columns::All, s, knn, params.cv())?,
+                        taxel: cv_at(&taxel, Columns::EachTaxel, s, knn, params.folds())?,
+                        glcm3d: cv_at(&glcm3d, Columns::All, s, knn, params.folds())?,
                     },
                 ))
             })
@@ -86,21 +86,22 @@ pub fn table(
     FeatureTable::build(encoded, &extractor, method)
 }
 
-/// Cross-validation of `table`'s `columns` over the recordings at `speed`.
+/// Cross-validation of `table`'s `columns` over the recordings at `speed`, folds keeping
+/// each group of manifest column `group_by` together when given.
 ///
 /// # Errors
-/// A classification that cannot run.
+/// A classification that cannot run, or a missing group column.
 pub fn cv_at(
     table: &FeatureTable,
     columns: Columns,
     speed: Speed,
     knn: &Knn,
-    cv: ValidCv,
+    (cv, group_by): (ValidCv, Option<&str>),
 ) -> Result<Outcome> {
     let split = Split::CrossValidation {
         speeds: Some(vec![speed]),
         cv,
-        group_by: None,
+        group_by: group_by.map(str::to_string),
     };
     evaluate(table, columns, &split, knn)
 }

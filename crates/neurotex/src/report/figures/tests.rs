@@ -620,9 +620,19 @@ fn comparison(d: f64) -> crate::experiments::Comparison {
 #[test]
 fn across_seeds_draws_every_dataset_and_only_with_several() {
     for r in [small(), wide()] {
-        assert!(super::seeds::across_seeds(&r).is_none(), "one dataset: no figure");
+        assert!(
+            super::seeds::across_seeds(&r).is_none(),
+            "one dataset: no figure"
+        );
         let mut other = r.clone();
-        for e in other.e1.values().cloned().collect::<Vec<_>>().iter().zip(r.speeds.iter()) {
+        for e in other
+            .e1
+            .values()
+            .cloned()
+            .collect::<Vec<_>>()
+            .iter()
+            .zip(r.speeds.iter())
+        {
             let mut e1 = e.0.clone();
             e1.glcm3d = (e1.glcm3d - 0.05).max(0.0);
             other.e1.insert(*e.1, e1);
