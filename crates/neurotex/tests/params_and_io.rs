@@ -550,3 +550,39 @@ fn selections_compare_numbers_as_numbers_and_name_what_is_missing() {
         assert!(bad.parse::<Selection>().is_err(), "{bad}");
     }
 }
+
+#[test]
+fn a_recording_in_both_the_training_and_the_test_set_is_an_error() {
+    use neurotex::analysis::{evaluate, Columns, FeatureTable, Split};
+    use neurotex::pipeline::Method;
+    let metas = session_metas(&["s1", "s2", "s1", "s2"]);
+    let table = FeatureTable {
+        method: Method::Glcm3d,
+        grid: "1x1".parse().unwrap(),
+        names: vec!["x".into()],
+        values: vec![0.0, 1.0, 2.0, 3.0],
+        metas,
+    };
+    let knn = KnnParams {
+        k: 1,
+        ..Default::default()
+    }
+    .check()
+    .unwrap();
+    let split = |train: &str, test: &str| Split::Where {
+        train: train.parse().unwrap(),
+        test: test.parse().unwrap(),
+    };
+    let both = evaluate(&table, Columns::All, &split("trial=0,1", "trial=1,2"), &knn);
+    match both {
+        Err(Error::Dataset(DatasetError::InBothSets { file, .. })) => assert_eq!(file, "file1"),
+        other => panic!("{other:?}"),
+    }
+    let apart = evaluate(
+        &table,
+        Columns::All,
+        &split("session=s1", "session=s2"),
+        &knn,
+    );
+    assert_eq!(apart.unwrap().n, 2);
+}
