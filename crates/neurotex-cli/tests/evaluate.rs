@@ -21,15 +21,17 @@ fn features_and_evaluate_on_a_dataset() {
     };
     let text = features("glcm3d");
     assert!(
-        text.starts_with("file,label,speed_mm_s,trial,contrast,correlation,asm\n"),
+        text.starts_with(
+            "file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s,contrast,correlation,asm\n"
+        ),
         "{text}"
     );
     assert_eq!(text.lines().count(), 61);
     let text = features("taxel");
     let header = text.lines().next().unwrap();
-    assert!(
-        header.starts_with("file,label,speed_mm_s,trial,r0c0_msr,r0c0_cv_isi,r0c0_fano,r0c1_msr")
-    );
+    assert!(header.starts_with(
+        "file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s,r0c0_msr,r0c0_cv_isi"
+    ));
     assert!(header.ends_with("r3c3_fano"));
 
     let json = |method: &str, extra: &[&str]| dir.evaluate_json(&ds, method, extra);

@@ -11,7 +11,7 @@ use crate::classify::{
 };
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method};
-use crate::recording::Meta;
+use crate::recording::{DatasetError, Meta, Selection};
 use crate::values::{Cell, Grid, Speed};
 
 /// Feature rows of many recordings, one per recording.
@@ -69,7 +69,7 @@ impl FeatureTable {
     /// The indices of the rows recorded at one of `speeds`.
     pub fn rows_at(&self, speeds: &[Speed]) -> Vec<usize> {
         (0..self.metas.len())
-            .filter(|&i| speeds.contains(&Speed::of(self.metas[i].speed_mm_s)))
+            .filter(|&i| self.metas[i].speed().is_some_and(|s| speeds.contains(&s)))
             .collect()
     }
 
@@ -94,12 +94,21 @@ pub enum Split {
         /// fold may split; `None` for stratified folds.
         group_by: Option<String>,
     },
-    /// Train on recordings at `train` speeds, test on those at `test` speeds.
+    /// Train on recordings at `train` speeds, test on those at `test` speeds: a
+    /// [`Split::Where`] on `speed_mm_s`.
     ByCondition {
         /// Training speeds.
         train: Vec<Speed>,
         /// Test speeds.
         test: Vec<Speed>,
+    },
+    /// Train on the recordings `train` selects, test on those `test` selects (by speed,
+    /// trial, force or any further manifest column); no recording may be in both.
+    Where {
+        /// The training recordings.
+        train: Selection,
+        /// The test recordings.
+        test: Selection,
     },
 }
 
@@ -276,16 +285,15 @@ fn group_indices(table: &FeatureTable, rows: &[usize], column: &str) -> Result<V
     let mut out = Vec::with_capacity(rows.len());
     for &i in rows {
         let meta = &table.metas[i];
-        let value = match column {
-            "label" => meta.label.clone(),
-            "file" => meta.file.clone(),
-            "speed_mm_s" => meta.speed_mm_s.to_string(),
-            "force_n" => meta.force_n.to_string(),
-            "trial" => meta.trial.to_string(),
-            other => meta.extra.get(other).cloned().ok_or_else(|| {
-                let rule = "--group-by must name a manifest column";
-                ParamError::new("group-by", rule, format!("{other} (not in {})", meta.file))
-            })?,
+        let value = match meta.field(column) {
+            Some(value) => value,
+            // A recording without a value (an empty field) groups with the others like it.
+            None if table.metas.iter().any(|m| m.field(column).is_some()) => String::new(),
+            None => {
+                let rule = "--group-by must name a manifest column with values";
+                let got = format!("{column} (not in {})", meta.file);
+                return Err(ParamError::new("group-by", rule, got).into());
+            }
         };
         let index = names.iter().position(|n| *n == value).unwrap_or_else(|| {
             names.push(value);
@@ -314,13 +322,7 @@ pub fn evaluate<C: Classifier>(
     classifier: &C,
 ) -> Result<Outcome> {
     let groups = column_groups(&table.grid, table.dims(), columns)?;
-    let (train_rows, test_rows) = match split {
-        Split::CrossValidation { speeds: None, .. } => ((0..table.metas.len()).collect(), vec![]),
-        Split::CrossValidation {
-            speeds: Some(s), ..
-        } => (table.rows_at(s), vec![]),
-        Split::ByCondition { train, test } => (table.rows_at(train), table.rows_at(test)),
-    };
+    let (train_rows, test_rows) = split_rows(table, split)?;
     if train_rows.is_empty() {
         return Err(ClassifyError::Empty {
             what: "evaluate: no recordings at the selected speeds",
@@ -354,7 +356,7 @@ pub fn evaluate<C: Classifier>(
                 Split::CrossValidation { cv, .. } => {
                     cross_validate(classifier, &x_train, cols.len(), y_train, &labels, *cv)?
                 }
-                Split::ByCondition { .. } => {
+                Split::ByCondition { .. } | Split::Where { .. } => {
                     let x_test = table.select(&test_rows, cols);
                     let (train, test) = ((&x_train[..], y_train), (&x_test[..], y_test));
                     train_test(classifier, train, test, cols.len(), &labels)?
@@ -368,7 +370,7 @@ pub fn evaluate<C: Classifier>(
         .collect::<Result<_>>()?;
     let evaluated = match split {
         Split::CrossValidation { .. } => &train_rows,
-        Split::ByCondition { .. } => &test_rows,
+        _ => &test_rows,
     };
     let predictions = match &results[..] {
         [one] => Some(OutOfFold::of(&one.evaluation, evaluated)),
@@ -376,7 +378,7 @@ pub fn evaluate<C: Classifier>(
     };
     let truth = match split {
         Split::CrossValidation { .. } => y_train,
-        Split::ByCondition { .. } => y_test,
+        _ => y_test,
     };
     let correct_shares = correct_shares(&results, evaluated, truth);
     Ok(Outcome {
@@ -384,6 +386,44 @@ pub fn evaluate<C: Classifier>(
         correct_shares,
         ..combine(results, labels, columns == Columns::EachTaxel, &table.grid)
     })
+}
+
+/// The rows `split` trains (or cross-validates) on and the rows it tests on.
+///
+/// # Errors
+/// A selection that selects nothing, or a recording in both sets.
+fn split_rows(table: &FeatureTable, split: &Split) -> Result<(Vec<usize>, Vec<usize>)> {
+    Ok(match split {
+        Split::CrossValidation { speeds: None, .. } => ((0..table.metas.len()).collect(), vec![]),
+        Split::CrossValidation {
+            speeds: Some(s), ..
+        } => (table.rows_at(s), vec![]),
+        Split::ByCondition { train, test } => {
+            disjoint(table, &Selection::speeds(train), &Selection::speeds(test))?
+        }
+        Split::Where { train, test } => disjoint(table, train, test)?,
+    })
+}
+
+/// The rows `train` and `test` select.
+///
+/// # Errors
+/// A selection that selects nothing ([`Selection::rows`]), or a recording in both.
+fn disjoint(
+    table: &FeatureTable,
+    train: &Selection,
+    test: &Selection,
+) -> Result<(Vec<usize>, Vec<usize>)> {
+    let (train_rows, test_rows) = (train.rows(&table.metas)?, test.rows(&table.metas)?);
+    if let Some(&i) = test_rows.iter().find(|i| train_rows.contains(i)) {
+        return Err(DatasetError::InBothSets {
+            file: table.metas[i].file.clone(),
+            train: train.to_string(),
+            test: test.to_string(),
+        }
+        .into());
+    }
+    Ok((train_rows, test_rows))
 }
 
 /// Per evaluated recording, the share of all groups' predictions in all repeats that were

@@ -258,17 +258,17 @@ fn meta_from_name(path: &Path, pattern: Option<&NamePattern>) -> Result<Meta> {
         };
         match key.as_str() {
             "label" => meta.label = value.clone(),
-            "speed" => meta.speed_mm_s = number("a number of mm/s")?,
-            "force" => meta.force_n = number("a number")?,
+            "speed" => meta.speed_mm_s = Some(number("a number of mm/s")?),
+            "force" => meta.force_n = Some(number("a number")?),
             "trial" => {
-                meta.trial = value.parse().map_err(|_| {
+                meta.trial = Some(value.parse().map_err(|_| {
                     invalid(
                         path,
                         format!(
                             "field {{trial}} of the file name must be an integer, got `{value}`"
                         ),
                     )
-                })?
+                })?)
             }
             _ => {
                 meta.extra.insert(key, value);
@@ -811,36 +811,35 @@ fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usiz
     Ok((arr, grid))
 }
 
-/// One manifest row per stacked sample: its label, its speed (0 without a speeds file), and
-/// a trial number counting the samples of each label and speed.
+/// One manifest row per stacked sample: its label, its speed (none without a speeds file),
+/// and a trial number counting the samples of each label and speed.
 fn stacked_metas(data: &Path, labels: &Path, speeds: Option<&Path>, n: usize) -> Result<Vec<Meta>> {
     let labels = read_labels(labels)?.into_iter().collect::<Vec<_>>();
     if labels.len() != n {
         let message = format!("{} labels for {n} samples", labels.len());
         return Err(DataError::invalid(data, message).into());
     }
-    let speeds: Vec<f64> = match speeds {
+    let speeds: Vec<Option<f64>> = match speeds {
         Some(path) => {
             let s = read_numbers(path)?;
             if s.len() != n {
                 return Err(invalid(path, format!("{} speeds for {n} samples", s.len())));
             }
-            s.iter().copied().collect()
+            s.iter().copied().map(Some).collect()
         }
-        None => vec![0.0; n],
+        None => vec![None; n],
     };
-    let mut trial_of: BTreeMap<(String, Speed), i64> = BTreeMap::new();
+    let mut trial_of: BTreeMap<(String, Option<Speed>), i64> = BTreeMap::new();
     Ok((0..n)
         .map(|i| {
             let trial = trial_of
-                .entry((labels[i].clone(), Speed::of(speeds[i])))
+                .entry((labels[i].clone(), speeds[i].map(Speed::of)))
                 .or_insert(0);
             let meta = Meta {
                 file: format!("sample_{i:05}.npy"),
                 label: labels[i].clone(),
                 speed_mm_s: speeds[i],
-                force_n: 0.0,
-                trial: *trial,
+                trial: Some(*trial),
                 ..Meta::default()
             };
             *trial += 1;

@@ -5,7 +5,7 @@
 //! as in Gupta, Nakagawa, Lepora and Thakor, "Spatio-temporal encoding improves
 //! neuromorphic tactile texture classification". Data flows down the modules:
 //! [`recording`] → [`signal`] → [`encode`] → [`features`] → [`classify`], joined by
-//! [`pipeline`] and [`analysis`]; [`model`] saves a trained classifier and applies it to
+//! [`pipeline`] and [`analysis`] (with [`diagnostics`] of the taxels); [`model`] saves a trained classifier and applies it to
 //! new recordings.
 //!
 //! The library never prints and never exits: it returns [`Error`]s naming the file, line
@@ -15,6 +15,7 @@
 pub mod analysis;
 pub mod calibrate;
 pub mod classify;
+pub mod diagnostics;
 pub mod encode;
 pub mod error;
 pub mod experiments;

@@ -73,12 +73,13 @@ pub struct Meta {
     pub file: String,
     /// Texture class.
     pub label: String,
-    /// Sliding speed in mm/s (sign = direction where the rig records it).
-    pub speed_mm_s: f64,
-    /// Normal force in N.
-    pub force_n: f64,
-    /// Trial number.
-    pub trial: i64,
+    /// Sliding speed in mm/s (sign = direction where the rig records it); `None` when the
+    /// manifest has no `speed_mm_s` column or leaves the field empty (one condition).
+    pub speed_mm_s: Option<f64>,
+    /// Normal force in N; `None` when the manifest does not give it.
+    pub force_n: Option<f64>,
+    /// Trial number; `None` when the manifest does not give it.
+    pub trial: Option<i64>,
     /// Start of the sliding phase in s from the recording's start, if known.
     pub slide_start_s: Option<f64>,
     /// End of the sliding phase in s, if known.
@@ -88,11 +89,37 @@ pub struct Meta {
 }
 
 impl Meta {
-    /// The sliding speed as a condition.
-    pub fn speed(&self) -> Speed {
-        Speed::of(self.speed_mm_s)
+    /// The sliding speed as a condition; `None` when the manifest gives none.
+    pub fn speed(&self) -> Option<Speed> {
+        self.speed_mm_s.map(Speed::of)
+    }
+
+    /// The value of manifest column `column` as text (numbers written as the shortest
+    /// decimal that reads back to them, as [`write_manifest`] does); `None` when this
+    /// recording has no value there (an absent column or an empty field).
+    pub fn field(&self, column: &str) -> Option<String> {
+        let number = |v: Option<f64>| v.map(|x| x.to_string());
+        match column {
+            "file" => Some(self.file.clone()),
+            "label" => Some(self.label.clone()),
+            "speed_mm_s" => number(self.speed_mm_s),
+            "force_n" => number(self.force_n),
+            "trial" => self.trial.map(|t| t.to_string()),
+            "slide_start_s" => number(self.slide_start_s),
+            "slide_end_s" => number(self.slide_end_s),
+            other => self.extra.get(other).filter(|v| !v.is_empty()).cloned(),
+        }
     }
 }
+
+/// The manifest columns whose values are numbers, compared as numbers.
+pub const NUMERIC_COLUMNS: [&str; 5] = [
+    "speed_mm_s",
+    "force_n",
+    "trial",
+    "slide_start_s",
+    "slide_end_s",
+];
 
 /// One trial's samples, time-major `T x rows x cols`, with its sampling and metadata.
 #[derive(Debug, Clone, PartialEq)]
@@ -466,12 +493,18 @@ pub struct Dataset {
     pub root: PathBuf,
     /// One entry per recording, in manifest order.
     pub entries: Vec<Meta>,
+    /// The manifest's column names, in its order.
+    pub columns: Vec<String>,
     /// The parsed `layout.toml` (all defaults when absent).
     pub layout: LayoutFile,
 }
 
 /// The manifest's required columns.
-pub const MANIFEST_COLUMNS: [&str; 5] = ["file", "label", "speed_mm_s", "force_n", "trial"];
+pub const MANIFEST_COLUMNS: [&str; 2] = ["file", "label"];
+
+/// The manifest's optional condition columns, in the order [`write_manifest`] writes them.
+/// A missing column, or an empty field, means the recordings share one condition.
+pub const CONDITION_COLUMNS: [&str; 3] = ["speed_mm_s", "force_n", "trial"];
 
 impl Dataset {
     /// Opens a dataset folder, reading and checking `manifest.csv` and `layout.toml`.
@@ -494,7 +527,7 @@ impl Dataset {
             LayoutFile::default()
         };
         let manifest_path = root.join("manifest.csv");
-        let entries = read_manifest(&manifest_path)?;
+        let (columns, entries) = read_manifest_columns(&manifest_path)?;
         for (i, m) in entries.iter().enumerate() {
             if !root.join(&m.file).is_file() {
                 return Err(DataError::invalid(
@@ -512,6 +545,7 @@ impl Dataset {
         Ok(Dataset {
             root,
             entries,
+            columns,
             layout,
         })
     }
@@ -580,9 +614,9 @@ impl Dataset {
         out
     }
 
-    /// The distinct speeds, ascending.
+    /// The distinct speeds, ascending; empty when the manifest gives none.
     pub fn speeds(&self) -> Vec<Speed> {
-        Speed::distinct(self.entries.iter().map(Meta::speed))
+        Speed::distinct(self.entries.iter().filter_map(Meta::speed))
     }
 
     /// The indices of the recordings at any of `speeds`, in manifest order.
@@ -601,7 +635,7 @@ impl Dataset {
             .into());
         }
         Ok((0..self.entries.len())
-            .filter(|&i| speeds.contains(&self.entries[i].speed()))
+            .filter(|&i| self.entries[i].speed().is_some_and(|s| speeds.contains(&s)))
             .collect())
     }
 }
@@ -610,7 +644,7 @@ impl Dataset {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DatasetError {
     /// No recording at a speed that was asked for.
-    #[error("no recordings at {speed} mm/s in {} (its speeds: {})", .root.display(), comma_separated(.available))]
+    #[error("no recordings at {speed} mm/s in {} (its speeds: {})", .root.display(), speeds_or_none(.available))]
     NoRecordingsAt {
         /// The speed asked for.
         speed: Speed,
@@ -630,9 +664,153 @@ pub enum DatasetError {
     /// No recording was selected.
     #[error("no recordings selected")]
     Empty,
+    /// A selection names a column in which no recording has a value.
+    #[error("no recording has a value in manifest column `{column}` (columns with values: {})", .columns.join(", "))]
+    NoColumn {
+        /// The column asked for.
+        column: String,
+        /// The columns in which some recording has a value.
+        columns: Vec<String>,
+    },
+    /// A selection asks for a value that no recording has.
+    #[error("no recording has {column} = {value} (values present: {})", .present.join(", "))]
+    NoRecordingsWhere {
+        /// The column.
+        column: String,
+        /// The value asked for.
+        value: String,
+        /// The column's distinct values, in order (numerically for numeric columns).
+        present: Vec<String>,
+    },
+    /// A recording selected both for training and for testing.
+    #[error("{file} is selected both for training ({train}) and for testing ({test}); the two sets must not share a recording")]
+    InBothSets {
+        /// The first recording in both sets.
+        file: String,
+        /// The training selection, as typed.
+        train: String,
+        /// The test selection, as typed.
+        test: String,
+    },
 }
 
-fn comma_separated(speeds: &[Speed]) -> String {
+/// Recordings whose manifest column holds one of some values, written `COLUMN=V1,V2`:
+/// numeric columns ([`NUMERIC_COLUMNS`]) compare as numbers (`5` is `5.0`), every other
+/// column as text. Any column but `label` (selecting classes leaves the test set with
+/// classes never trained on).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Selection {
+    /// The manifest column.
+    pub column: String,
+    /// The values, as written.
+    pub values: Vec<String>,
+}
+
+impl Selection {
+    /// The recordings at `speeds`.
+    pub fn speeds(speeds: &[Speed]) -> Self {
+        Selection {
+            column: "speed_mm_s".into(),
+            values: speeds.iter().map(Speed::to_string).collect(),
+        }
+    }
+
+    fn numeric(&self) -> bool {
+        NUMERIC_COLUMNS.contains(&self.column.as_str())
+    }
+
+    /// Whether `field` (a recording's value in the column) is `value`.
+    fn same(&self, field: &str, value: &str) -> bool {
+        if self.numeric() {
+            matches!((field.parse::<f64>(), value.parse::<f64>()), (Ok(a), Ok(b)) if a == b)
+        } else {
+            field == value
+        }
+    }
+
+    /// The indices of `metas` selected, in order.
+    ///
+    /// # Errors
+    /// [`DatasetError::NoColumn`] when no recording has a value in the column,
+    /// [`DatasetError::NoRecordingsWhere`] for the first value no recording has, naming
+    /// the values present.
+    pub fn rows(&self, metas: &[Meta]) -> Result<Vec<usize>> {
+        let fields: Vec<Option<String>> = metas.iter().map(|m| m.field(&self.column)).collect();
+        let mut present: Vec<&str> = fields.iter().flatten().map(String::as_str).collect();
+        if present.is_empty() {
+            let mut columns: Vec<String> = MANIFEST_COLUMNS.map(String::from).to_vec();
+            let others = NUMERIC_COLUMNS.iter().map(|c| c.to_string());
+            let others = others.chain(metas.iter().flat_map(|m| m.extra.keys().cloned()));
+            for c in others {
+                if !columns.contains(&c) && metas.iter().any(|m| m.field(&c).is_some()) {
+                    columns.push(c);
+                }
+            }
+            let column = self.column.clone();
+            return Err(DatasetError::NoColumn { column, columns }.into());
+        }
+        if let Some(value) = self
+            .values
+            .iter()
+            .find(|v| !present.iter().any(|f| self.same(f, v)))
+        {
+            if self.numeric() {
+                present.sort_by(|a, b| {
+                    a.parse::<f64>()
+                        .unwrap_or(0.0)
+                        .total_cmp(&b.parse().unwrap_or(0.0))
+                });
+            } else {
+                present.sort();
+            }
+            present.dedup();
+            return Err(DatasetError::NoRecordingsWhere {
+                column: self.column.clone(),
+                value: value.clone(),
+                present: present.into_iter().map(String::from).collect(),
+            }
+            .into());
+        }
+        let chosen = |f: &Option<String>| {
+            f.as_deref()
+                .is_some_and(|f| self.values.iter().any(|v| self.same(f, v)))
+        };
+        Ok((0..metas.len()).filter(|&i| chosen(&fields[i])).collect())
+    }
+}
+
+impl fmt::Display for Selection {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}={}", self.column, self.values.join(","))
+    }
+}
+
+impl FromStr for Selection {
+    type Err = ParamError;
+
+    /// Parses `COLUMN=V1,V2,...`; values of numeric columns must be numbers.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        let rule = "a selection is COLUMN=VALUE[,VALUE...] over a manifest column other than label, numbers in numeric columns";
+        let bad = || ParamError::new("where", rule, text);
+        let (column, values) = text.split_once('=').ok_or_else(bad)?;
+        let column = column.trim().to_string();
+        let values: Vec<String> = values.split(',').map(|v| v.trim().to_string()).collect();
+        if column.is_empty() || column == "label" || values.iter().any(String::is_empty) {
+            return Err(bad());
+        }
+        let selection = Selection { column, values };
+        let number = |v: &String| v.parse::<f64>().is_ok_and(f64::is_finite);
+        if selection.numeric() && !selection.values.iter().all(number) {
+            return Err(bad());
+        }
+        Ok(selection)
+    }
+}
+
+fn speeds_or_none(speeds: &[Speed]) -> String {
+    if speeds.is_empty() {
+        return "none, the manifest gives no speed_mm_s".into();
+    }
     let texts: Vec<String> = speeds.iter().map(Speed::to_string).collect();
     texts.join(", ")
 }
@@ -660,6 +838,11 @@ pub fn one_grid<'a>(grids: impl IntoIterator<Item = (&'a str, Grid)>) -> Result<
 /// # Errors
 /// Missing file, missing column, unparsable or non-finite field; each names the line.
 pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
+    read_manifest_columns(path).map(|(_, metas)| metas)
+}
+
+/// Reads and checks a manifest: its column names in order, and its recordings.
+fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Meta>)> {
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_path(path)
@@ -674,13 +857,14 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
     if out.is_empty() {
         return Err(DataError::invalid(path, "the manifest lists no recordings").into());
     }
-    Ok(out)
+    Ok((headers.iter().map(String::from).collect(), out))
 }
 
-/// Where a manifest's columns are: the required ones in [`MANIFEST_COLUMNS`] order, and
-/// the optional sliding interval.
+/// Where a manifest's columns are: the required ones in [`MANIFEST_COLUMNS`] order, the
+/// optional conditions in [`CONDITION_COLUMNS`] order, and the optional sliding interval.
 struct ManifestColumns {
-    required: [usize; 5],
+    required: [usize; 2],
+    conditions: [Option<usize>; 3],
     start: Option<usize>,
     end: Option<usize>,
 }
@@ -688,7 +872,7 @@ struct ManifestColumns {
 impl ManifestColumns {
     fn find(path: &Path, headers: &csv::StringRecord) -> Result<Self> {
         let col = |name: &str| headers.iter().position(|h| h == name);
-        let mut required = [0usize; 5];
+        let mut required = [0usize; 2];
         for (slot, name) in required.iter_mut().zip(MANIFEST_COLUMNS) {
             *slot = col(name).ok_or_else(|| {
                 let needed = MANIFEST_COLUMNS.join(",");
@@ -698,9 +882,18 @@ impl ManifestColumns {
         }
         Ok(ManifestColumns {
             required,
+            conditions: CONDITION_COLUMNS.map(col),
             start: col("slide_start_s"),
             end: col("slide_end_s"),
         })
+    }
+
+    /// Whether column `j` is one neurotex reads into a field of its own.
+    fn known(&self, j: usize) -> bool {
+        self.required.contains(&j)
+            || self.conditions.contains(&Some(j))
+            || Some(j) == self.start
+            || Some(j) == self.end
     }
 
     /// The recording that manifest line `line` describes.
@@ -711,25 +904,20 @@ impl ManifestColumns {
         headers: &csv::StringRecord,
         record: &csv::StringRecord,
     ) -> Result<Meta> {
-        let idx = &self.required;
         let field = |j: usize| record.get(j).unwrap_or("");
         let bad = |message: String| -> crate::Error {
             DataError::invalid(path, format!("line {line}{message}")).into()
         };
-        let num = |j: usize, name: &str| -> Result<f64> {
-            let s = field(j);
+        // An absent column and an empty field both mean "not given".
+        let given = |j: Option<usize>| j.map(field).filter(|s| !s.is_empty());
+        let number = |j: Option<usize>, name: &str| -> Result<Option<f64>> {
+            let Some(s) = given(j) else { return Ok(None) };
             let value = s.parse::<f64>().ok().filter(|v| v.is_finite());
-            value.ok_or_else(|| {
+            value.map(Some).ok_or_else(|| {
                 bad(format!(
                     ", field `{name}`: expected a finite number, got `{s}`"
                 ))
             })
-        };
-        let opt = |j: Option<usize>, name: &str| -> Result<Option<f64>> {
-            match j {
-                Some(j) if !field(j).is_empty() => num(j, name).map(Some),
-                _ => Ok(None),
-            }
         };
         let non_empty = |j: usize, name: &str| -> Result<String> {
             match field(j) {
@@ -737,32 +925,35 @@ impl ManifestColumns {
                 text => Ok(text.to_string()),
             }
         };
+        let idx = &self.required;
         let (file, label) = (non_empty(idx[0], "file")?, non_empty(idx[1], "label")?);
-        let trial_text = field(idx[4]);
-        let trial = trial_text.parse::<i64>().map_err(|_| {
-            bad(format!(
-                ", field `trial`: expected an integer, got `{trial_text}`"
-            ))
-        })?;
-        let slide_start_s = opt(self.start, "slide_start_s")?;
-        let slide_end_s = opt(self.end, "slide_end_s")?;
+        let [speed, force, trial] = self.conditions;
+        let trial = match given(trial) {
+            None => None,
+            Some(text) => Some(text.parse::<i64>().map_err(|_| {
+                bad(format!(
+                    ", field `trial`: expected an integer, got `{text}`"
+                ))
+            })?),
+        };
+        let slide_start_s = number(self.start, "slide_start_s")?;
+        let slide_end_s = number(self.end, "slide_end_s")?;
         if let (Some(a), Some(b)) = (slide_start_s, slide_end_s) {
             if !(a >= 0.0 && b > a) {
                 return Err(bad(format!(": slide interval must satisfy 0 <= slide_start_s < slide_end_s, got [{a}, {b}]")));
             }
         }
-        let known = |j: usize| idx.contains(&j) || Some(j) == self.start || Some(j) == self.end;
         let extra = headers
             .iter()
             .enumerate()
-            .filter(|(j, _)| !known(*j))
+            .filter(|(j, _)| !self.known(*j))
             .map(|(j, h)| (h.to_string(), field(j).to_string()))
             .collect();
         Ok(Meta {
             file,
             label,
-            speed_mm_s: num(idx[2], "speed_mm_s")?,
-            force_n: num(idx[3], "force_n")?,
+            speed_mm_s: number(speed, "speed_mm_s")?,
+            force_n: number(force, "force_n")?,
             trial,
             slide_start_s,
             slide_end_s,
@@ -1009,44 +1200,33 @@ pub(crate) fn read_csv_columns<R: std::io::Read>(
     Ok((samples, times))
 }
 
-/// Writes `manifest.csv` for `metas` into `dir`: the required columns, the sliding interval
-/// when any recording has one, then every extra field any recording carries.
+/// Writes `manifest.csv` for `metas` into `dir`: `file,label`, each condition column
+/// ([`CONDITION_COLUMNS`]) that some recording gives (empty where another does not), the
+/// sliding interval when any recording has one, then every extra field any recording
+/// carries. [`read_manifest`] reads the same recordings back.
 ///
 /// # Errors
 /// The file cannot be written.
 pub fn write_manifest(dir: &Path, metas: &[Meta]) -> Result<()> {
     let path = dir.join("manifest.csv");
-    let with_slide = metas
-        .iter()
-        .any(|m| m.slide_start_s.is_some() || m.slide_end_s.is_some());
-    let mut extra: Vec<&String> = metas.iter().flat_map(|m| m.extra.keys()).collect();
-    extra.sort();
-    extra.dedup();
-    let mut w = csv::Writer::from_path(&path).map_err(|e| csv_error(&path, e))?;
+    let given = |column: &str| metas.iter().any(|m| m.field(column).is_some());
     let mut header: Vec<&str> = MANIFEST_COLUMNS.to_vec();
-    if with_slide {
+    header.extend(CONDITION_COLUMNS.into_iter().filter(|c| given(c)));
+    if given("slide_start_s") || given("slide_end_s") {
         header.extend(["slide_start_s", "slide_end_s"]);
     }
-    header.extend(extra.iter().map(|k| k.as_str()));
+    let mut extra: Vec<&str> = metas
+        .iter()
+        .flat_map(|m| m.extra.keys().map(String::as_str))
+        .collect();
+    extra.sort();
+    extra.dedup();
+    header.extend(extra);
+    let mut w = csv::Writer::from_path(&path).map_err(|e| csv_error(&path, e))?;
     w.write_record(&header).map_err(|e| csv_error(&path, e))?;
-    let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
     for m in metas {
-        let mut row = vec![
-            m.file.clone(),
-            m.label.clone(),
-            m.speed_mm_s.to_string(),
-            m.force_n.to_string(),
-            m.trial.to_string(),
-        ];
-        if with_slide {
-            row.extend([opt(m.slide_start_s), opt(m.slide_end_s)]);
-        }
-        row.extend(
-            extra
-                .iter()
-                .map(|k| m.extra.get(*k).cloned().unwrap_or_default()),
-        );
-        w.write_record(&row).map_err(|e| csv_error(&path, e))?;
+        let row = header.iter().map(|c| m.field(c).unwrap_or_default());
+        w.write_record(row).map_err(|e| csv_error(&path, e))?;
     }
     w.flush().map_err(|e| DataError::io(&path, e))?;
     Ok(())

@@ -69,7 +69,7 @@ fn irregular_stamps_and_gaps_are_kept_then_resampled_to_1_ms() {
     let summary = import_csv(&csv_files(&[src]).unwrap(), &params(), &out, &|| {}).unwrap();
     assert_eq!(summary.written, 2);
     let ds = Dataset::open(&out).unwrap();
-    assert_eq!(ds.entries[0].speed_mm_s, 5.0);
+    assert_eq!(ds.entries[0].speed_mm_s, Some(5.0));
     let rec = ds.load(0).unwrap();
     let times = rec.times_s.as_ref().unwrap();
     assert_eq!(times.len(), stamps.len());

@@ -9,7 +9,8 @@ use neurotex::encode::{FiringType, IzhikevichParams, PRESETS};
 use neurotex::error::{DatasetError, ParamError};
 use neurotex::features::{GlcmParams, VolumeParams};
 use neurotex::recording::{
-    one_grid, read_recording, write_layout, Baseline, ChannelMap, Dataset, LayoutFile, TimeUnit,
+    one_grid, read_manifest, read_recording, write_layout, write_manifest, Baseline, ChannelMap,
+    Dataset, LayoutFile, Meta, Selection, TimeUnit,
 };
 use neurotex::signal::PreprocessParams;
 use neurotex::{Cell, Error, Grid, Speed};
@@ -256,7 +257,7 @@ fn manifest_errors_name_line_and_field() {
     let dir = tempfile::tempdir().unwrap();
     write_npy(dir.path().join("a.npy"), &Array2::<f64>::zeros((300, 4))).unwrap();
     let cases = [
-        ("file,label,speed_mm_s,trial\n", "missing column `force_n`"),
+        ("file,speed_mm_s,trial\n", "missing column `label`"),
         (
             "file,label,speed_mm_s,force_n,trial\na.npy,X,fast,1,0\n",
             "line 2, field `speed_mm_s`",
@@ -448,4 +449,140 @@ fn a_dataset_fingerprint_hashes_the_manifest_and_the_file_sizes() {
         Dataset::open(&root).unwrap().fingerprint().unwrap(),
         expected
     );
+}
+
+#[test]
+fn speed_force_and_trial_are_optional_and_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    for file in ["a.npy", "b.npy"] {
+        write_npy(dir.path().join(file), &Array2::<f64>::zeros((10, 4))).unwrap();
+    }
+    let manifest = dir.path().join("manifest.csv");
+    std::fs::write(&manifest, "file,label\na.npy,A\nb.npy,B\n").unwrap();
+    let ds = Dataset::open(dir.path()).unwrap();
+    assert_eq!(ds.columns, ["file", "label"]);
+    let m = &ds.entries[0];
+    assert_eq!((m.speed_mm_s, m.force_n, m.trial), (None, None, None));
+    assert_eq!(m.speed(), None);
+    assert!(ds.speeds().is_empty());
+    assert!(matches!(
+        ds.indices_at(&[Speed::of(5.0)]),
+        Err(Error::Dataset(DatasetError::NoRecordingsAt { .. }))
+    ));
+    // written back without condition columns, read back the same
+    let out = tempfile::tempdir().unwrap();
+    write_manifest(out.path(), &ds.entries).unwrap();
+    let text = std::fs::read_to_string(out.path().join("manifest.csv")).unwrap();
+    assert_eq!(text, "file,label\na.npy,A\nb.npy,B\n");
+
+    // an empty field is "not given"; a column some recording gives is written for all
+    let text = "file,label,speed_mm_s,force_n,trial,session\na.npy,A,5,,,s1\nb.npy,B,,2,3,\n";
+    std::fs::write(&manifest, text).unwrap();
+    let metas = read_manifest(&manifest).unwrap();
+    assert_eq!(metas[0].speed_mm_s, Some(5.0));
+    assert_eq!(
+        (metas[1].speed_mm_s, metas[1].force_n, metas[1].trial),
+        (None, Some(2.0), Some(3))
+    );
+    assert_eq!(metas[1].field("session"), None);
+    write_manifest(out.path(), &metas).unwrap();
+    let back = read_manifest(&out.path().join("manifest.csv")).unwrap();
+    assert_eq!(back, metas);
+}
+
+/// Recordings `file{i}` with `trial` i and `session` `sessions[i]`.
+fn session_metas(sessions: &[&str]) -> Vec<Meta> {
+    sessions
+        .iter()
+        .enumerate()
+        .map(|(i, session)| Meta {
+            file: format!("file{i}"),
+            label: "A".into(),
+            trial: Some(i as i64),
+            extra: [("session".to_string(), session.to_string())].into(),
+            ..Meta::default()
+        })
+        .collect()
+}
+
+#[test]
+fn selections_compare_numbers_as_numbers_and_name_what_is_missing() {
+    let metas = session_metas(&["s1", "s2", "s1", "s10"]);
+    let select = |text: &str| text.parse::<Selection>().unwrap().rows(&metas);
+    assert_eq!(select("trial=1.0,3").unwrap(), [1, 3]);
+    assert_eq!(select("session=s1").unwrap(), [0, 2]);
+    assert_eq!(
+        Selection::speeds(&[Speed::of(5.0)]).to_string(),
+        "speed_mm_s=5"
+    );
+    match select("session=s3") {
+        Err(Error::Dataset(DatasetError::NoRecordingsWhere {
+            column,
+            value,
+            present,
+        })) => {
+            assert_eq!((column.as_str(), value.as_str()), ("session", "s3"));
+            assert_eq!(present, ["s1", "s10", "s2"]);
+        }
+        other => panic!("{other:?}"),
+    }
+    match select("trial=9") {
+        Err(Error::Dataset(DatasetError::NoRecordingsWhere { present, .. })) => {
+            assert_eq!(present, ["0", "1", "2", "3"]);
+        }
+        other => panic!("{other:?}"),
+    }
+    match select("speed_mm_s=5") {
+        Err(Error::Dataset(DatasetError::NoColumn { column, columns })) => {
+            assert_eq!(column, "speed_mm_s");
+            assert_eq!(columns, ["file", "label", "trial", "session"]);
+        }
+        other => panic!("{other:?}"),
+    }
+    for bad in [
+        "label=A",
+        "trial",
+        "=1",
+        "trial=",
+        "trial=one",
+        "session=a,,b",
+    ] {
+        assert!(bad.parse::<Selection>().is_err(), "{bad}");
+    }
+}
+
+#[test]
+fn a_recording_in_both_the_training_and_the_test_set_is_an_error() {
+    use neurotex::analysis::{evaluate, Columns, FeatureTable, Split};
+    use neurotex::pipeline::Method;
+    let metas = session_metas(&["s1", "s2", "s1", "s2"]);
+    let table = FeatureTable {
+        method: Method::Glcm3d,
+        grid: "1x1".parse().unwrap(),
+        names: vec!["x".into()],
+        values: vec![0.0, 1.0, 2.0, 3.0],
+        metas,
+    };
+    let knn = KnnParams {
+        k: 1,
+        ..Default::default()
+    }
+    .check()
+    .unwrap();
+    let split = |train: &str, test: &str| Split::Where {
+        train: train.parse().unwrap(),
+        test: test.parse().unwrap(),
+    };
+    let both = evaluate(&table, Columns::All, &split("trial=0,1", "trial=1,2"), &knn);
+    match both {
+        Err(Error::Dataset(DatasetError::InBothSets { file, .. })) => assert_eq!(file, "file1"),
+        other => panic!("{other:?}"),
+    }
+    let apart = evaluate(
+        &table,
+        Columns::All,
+        &split("session=s1", "session=s2"),
+        &knn,
+    );
+    assert_eq!(apart.unwrap().n, 2);
 }

@@ -1,5 +1,7 @@
 //! `neurotex evaluate`: KNN on a dataset's features, by cross-validation or by training on
-//! some speeds and testing on others; prints accuracy and confusion matrix.
+//! some conditions (speeds, trials, sessions: any manifest column) and testing on others;
+//! prints accuracy and confusion matrix, and for the single-taxel method which taxels
+//! stay silent or saturate.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -10,11 +12,12 @@ use neurotex::analysis::{
     evaluate, Columns, FeatureTable, OutOfFold, Outcome, Split, TaxelAccuracy,
 };
 use neurotex::classify::{CvParams, Metrics};
+use neurotex::diagnostics::TaxelDiagnostics;
 use neurotex::pipeline::{Method, Pipeline};
-use neurotex::recording::Dataset;
+use neurotex::recording::{Dataset, Selection};
 use neurotex::{Cell, Speed};
 
-use super::feature_table;
+use super::encoded_features;
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
@@ -51,12 +54,14 @@ pub struct EvaluateArgs {
         conflicts_with = "train_speeds"
     )]
     pub speeds: Option<Vec<Speed>>,
-    /// Train on these speeds instead of cross-validating (needs --test-speeds).
+    /// Train on these speeds instead of cross-validating (needs --test-speeds); the same
+    /// as --train-where speed_mm_s=SPEEDS.
     #[arg(
         long = "train-speeds",
         value_delimiter = ',',
         allow_hyphen_values = true,
-        requires = "test_speeds"
+        requires = "test_speeds",
+        conflicts_with = "train_where"
     )]
     pub train_speeds: Option<Vec<Speed>>,
     /// Test on these speeds (needs --train-speeds).
@@ -64,9 +69,30 @@ pub struct EvaluateArgs {
         long = "test-speeds",
         value_delimiter = ',',
         allow_hyphen_values = true,
-        requires = "train_speeds"
+        requires = "train_speeds",
+        conflicts_with = "test_where"
     )]
     pub test_speeds: Option<Vec<Speed>>,
+    /// Train on the recordings whose manifest column COL holds one of the values, instead
+    /// of cross-validating (needs --test-where): COL=V1,V2. Any column but `label`;
+    /// `speed_mm_s`, `force_n` and `trial` compare as numbers, other columns as text.
+    #[arg(
+        long = "train-where",
+        value_name = "COL=V1,V2",
+        allow_hyphen_values = true,
+        requires = "test_where",
+        conflicts_with_all = ["speeds", "group_by"]
+    )]
+    pub train_where: Option<Selection>,
+    /// Test on the recordings whose column COL holds one of the values (needs
+    /// --train-where; no recording may be in both sets).
+    #[arg(
+        long = "test-where",
+        value_name = "COL=V1,V2",
+        allow_hyphen_values = true,
+        requires = "train_where"
+    )]
+    pub test_where: Option<Selection>,
     /// Cross-validation folds never split a group of this manifest column (`trial`,
     /// `force_n`, or any further column such as a session or subject); with fewer groups
     /// than folds, each group is held out in turn.
@@ -77,7 +103,7 @@ pub struct EvaluateArgs {
     pub json: bool,
     /// Write each recording's out-of-fold prediction to this CSV file:
     /// `file,label,predicted,fold,repeat`, one row per recording and CV repeat (folds and
-    /// repeats count from 0; `fold` is `test` with --train-speeds/--test-speeds). Needs one
+    /// repeats count from 0; `fold` is `test` with a train/test split). Needs one
     /// classifier: a GLCM method, or --method taxel with --taxel.
     #[arg(long)]
     pub predictions: Option<PathBuf>,
@@ -86,7 +112,7 @@ pub struct EvaluateArgs {
 }
 
 impl EvaluateArgs {
-    /// Cross-validation, or training and testing on the given speeds.
+    /// Cross-validation, or training and testing on the selected recordings.
     fn split(&self) -> Result<Split> {
         let cv = CvParams {
             folds: self.folds,
@@ -94,12 +120,9 @@ impl EvaluateArgs {
             repeats: self.repeats,
         }
         .check()?;
-        Ok(match (&self.train_speeds, &self.test_speeds) {
-            (Some(train), Some(test)) => Split::ByCondition {
-                train: train.clone(),
-                test: test.clone(),
-            },
-            _ => Split::CrossValidation {
+        Ok(match self.selections() {
+            Some((train, test)) => Split::Where { train, test },
+            None => Split::CrossValidation {
                 speeds: self.speeds.clone(),
                 cv,
                 group_by: self.group_by.clone(),
@@ -107,12 +130,38 @@ impl EvaluateArgs {
         })
     }
 
-    /// The speeds whose recordings the split uses; `None` for all.
-    fn speeds_used(&self) -> Option<Vec<Speed>> {
-        match (&self.train_speeds, &self.test_speeds) {
-            (Some(train), Some(test)) => Some([&train[..], test].concat()),
-            _ => self.speeds.clone(),
+    /// The training and test selections of a train/test split, `--train-speeds` and
+    /// `--test-speeds` as selections on `speed_mm_s`.
+    fn selections(&self) -> Option<(Selection, Selection)> {
+        match (&self.train_where, &self.test_where) {
+            (Some(train), Some(test)) => Some((train.clone(), test.clone())),
+            _ => match (&self.train_speeds, &self.test_speeds) {
+                (Some(train), Some(test)) => {
+                    Some((Selection::speeds(train), Selection::speeds(test)))
+                }
+                _ => None,
+            },
         }
+    }
+
+    /// The dataset's recordings the evaluation uses, in manifest order.
+    fn indices(&self, dataset: &Dataset) -> Result<Vec<usize>> {
+        let entries = &dataset.entries;
+        if let (Some(train), Some(test)) = (&self.train_speeds, &self.test_speeds) {
+            // A speed the dataset lacks is named as --speeds names it, with the speeds it has.
+            dataset.indices_at(&[&train[..], test].concat())?;
+        }
+        Ok(match (self.selections(), &self.speeds) {
+            (Some((train, test)), _) => {
+                let mut rows = train.rows(entries)?;
+                rows.extend(test.rows(entries)?);
+                rows.sort_unstable();
+                rows.dedup();
+                rows
+            }
+            (None, Some(speeds)) => dataset.indices_at(speeds)?,
+            (None, None) => (0..entries.len()).collect(),
+        })
     }
 
     /// The feature columns to classify with.
@@ -136,21 +185,24 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         bail!("--predictions needs one classifier, not one per taxel: add --taxel ROW,COL");
     }
     let dataset = Dataset::open(&args.dataset)?;
-    let speeds = args.speeds_used();
-    let (table, grid) = feature_table(&dataset, &pipeline, speeds.as_deref(), args.method)?;
+    let indices = args.indices(&dataset)?;
+    let features = encoded_features(&dataset, &pipeline, &indices, args.method)?;
+    let (table, grid) = (&features.table, &features.grid);
     if let Some(cell) = args.taxel {
         grid.locate(cell)?;
     }
-    let outcome = evaluate(&table, columns, &split, &knn.check()?)?;
+    let outcome = evaluate(table, columns, &split, &knn.check()?)?;
     if let Some(path) = &args.predictions {
         let predictions = outcome
             .predictions
             .as_deref()
             .context("one classifier's predictions for --predictions")?;
         write_file(path, "out-of-fold predictions", |w| {
-            write_out_of_fold(w, &table, &outcome.labels, predictions)
+            write_out_of_fold(w, table, &outcome.labels, predictions)
         })?;
     }
+    // Silent and saturated taxels matter where taxels are scored one by one.
+    let taxels = (columns == Columns::EachTaxel).then_some(&features.taxels);
     if args.json {
         let mut value = serde_json::to_value(&outcome)?;
         value["method"] = args.method.name().into();
@@ -160,11 +212,53 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         value["metrics"] = serde_json::to_value(Metrics::from_confusion(&outcome.confusion))?;
         let interval = outcome.accuracy_interval(args.seed)?;
         value["accuracy_interval"] = serde_json::to_value(interval)?;
+        if let Some(taxels) = taxels {
+            value["taxels"] = taxels_json(taxels, &outcome)?;
+        }
         println!("{}", serde_json::to_string(&value)?);
     } else {
         print_outcome(&outcome, args.method, &split, grid.cols());
+        if let Some(taxels) = taxels {
+            print_taxels(taxels, &outcome);
+        }
     }
     Ok(())
+}
+
+/// The taxel diagnostics for `evaluate --json`: every taxel's silent and saturated shares,
+/// the silent and saturated ones by name, and the mean accuracy over responsive taxels
+/// (`null` when none responds) beside the mean over all.
+fn taxels_json(taxels: &TaxelDiagnostics, outcome: &Outcome) -> Result<serde_json::Value> {
+    let per = outcome.per_taxel.as_deref().unwrap_or_default();
+    let mut value = serde_json::to_value(taxels)?;
+    value["silent"] = serde_json::to_value(taxels.silent())?;
+    value["saturated"] = serde_json::to_value(taxels.saturated())?;
+    value["mean_all"] = outcome.accuracy.into();
+    value["mean_responsive"] = serde_json::to_value(taxels.responsive_mean(per))?;
+    Ok(value)
+}
+
+/// Prints the silent and saturated taxels and the mean over the responsive ones.
+fn print_taxels(taxels: &TaxelDiagnostics, outcome: &Outcome) {
+    let names = |list: Vec<&str>| match list.is_empty() {
+        true => "none".to_string(),
+        false => list.join(", "),
+    };
+    println!(
+        "taxels silent (no spike) in most recordings: {}; at the encoder's ceiling ({:.0} Hz) in most recordings: {}",
+        names(taxels.silent()),
+        taxels.ceiling_hz,
+        names(taxels.saturated())
+    );
+    let per = outcome.per_taxel.as_deref().unwrap_or_default();
+    let all = 100.0 * outcome.accuracy;
+    match taxels.responsive_mean(per) {
+        Some(mean) => println!(
+            "accuracy {:.1}% (mean over responsive taxels) beside {all:.1}% (mean over all taxels)",
+            100.0 * mean
+        ),
+        None => println!("no taxel responds in most recordings; mean over all taxels {all:.1}%"),
+    }
 }
 
 /// Prints the outcome as text: what was run, the accuracy (per taxel when every taxel was
@@ -174,25 +268,55 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
         Split::CrossValidation {
             cv,
             group_by: Some(column),
-            ..
+            speeds,
         } => format!(
-            "up to {}-fold CV keeping each `{column}` group in one fold, seed {}, {} repeat(s)",
-            cv.folds, cv.seed, cv.repeats
+            "{}, up to {}-fold CV keeping each `{column}` group in one fold, seed {}, {} repeat(s)",
+            recordings_at(speeds.as_deref()),
+            cv.folds,
+            cv.seed,
+            cv.repeats
         ),
-        Split::CrossValidation { cv, .. } => format!(
-            "{}-fold stratified CV, seed {}, {} repeat(s)",
-            cv.folds, cv.seed, cv.repeats
+        Split::CrossValidation { cv, speeds, .. } => format!(
+            "{}, {}-fold stratified CV, seed {}, {} repeat(s)",
+            recordings_at(speeds.as_deref()),
+            cv.folds,
+            cv.seed,
+            cv.repeats
         ),
-        Split::ByCondition { train, test } => {
-            let list = |s: &[Speed]| s.iter().map(|s| s.to_string()).collect::<Vec<_>>();
-            format!(
-                "train on [{}] mm/s, test on [{}] mm/s",
-                list(train).join(", "),
-                list(test).join(", ")
-            )
+        Split::ByCondition { train, test } => format!(
+            "train on {}, test on {}",
+            selected(&Selection::speeds(train)),
+            selected(&Selection::speeds(test))
+        ),
+        Split::Where { train, test } => {
+            format!("train on {}, test on {}", selected(train), selected(test))
         }
     };
     println!("method {}: {} samples, {how}", method.name(), outcome.n);
+    print_accuracy(outcome, cols);
+    print_confusion(outcome);
+}
+
+/// The recordings cross-validation runs over, as text.
+fn recordings_at(speeds: Option<&[Speed]>) -> String {
+    match speeds {
+        None => "all recordings".into(),
+        Some(speeds) => format!("recordings at {}", selected(&Selection::speeds(speeds))),
+    }
+}
+
+/// A selection as text: `[5, 10] mm/s` for speeds, `session in [s1, s2]` otherwise.
+fn selected(selection: &Selection) -> String {
+    let values = selection.values.join(", ");
+    match selection.column.as_str() {
+        "speed_mm_s" => format!("[{values}] mm/s"),
+        column => format!("{column} in [{values}]"),
+    }
+}
+
+/// Prints the accuracy: per taxel with the mean and best when every taxel was evaluated,
+/// with its spread over repeats when there is one.
+fn print_accuracy(outcome: &Outcome, cols: usize) {
     if let (Some(per), Some(best)) = (&outcome.per_taxel, &outcome.best) {
         print_taxel_grid(per, cols);
         println!(
@@ -211,7 +335,6 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
     } else {
         println!("accuracy {:.1}%", 100.0 * outcome.accuracy);
     }
-    print_confusion(outcome);
 }
 
 /// Prints each taxel's accuracy in its place on the grid; `-` for cells without a taxel.

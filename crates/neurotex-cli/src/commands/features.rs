@@ -23,7 +23,8 @@ pub struct FeaturesArgs {
     /// (contrast, correlation, ASM).
     #[arg(long)]
     pub method: Method,
-    /// The CSV file to write: `file,label,speed_mm_s,trial` then the features.
+    /// The CSV file to write: every manifest column in the manifest's order (extra ones
+    /// such as a session or subject included), then the features.
     #[arg(long)]
     pub out: PathBuf,
     #[command(flatten)]
@@ -35,7 +36,10 @@ pub fn run(args: FeaturesArgs) -> Result<()> {
     let pipeline = Pipeline::new(args.stages.pipeline()?)?;
     let dataset = Dataset::open(&args.dataset)?;
     let (table, _) = feature_table(&dataset, &pipeline, None, args.method)?;
-    write_file(&args.out, "the feature table", |w| write_table(w, &table))?;
+    let columns = &dataset.columns;
+    write_file(&args.out, "the feature table", |w| {
+        write_table(w, columns, &table)
+    })?;
     eprintln!(
         "{} recordings x {} features -> {}",
         table.metas.len(),
@@ -45,20 +49,15 @@ pub fn run(args: FeaturesArgs) -> Result<()> {
     Ok(())
 }
 
-/// Writes the table as CSV: `file,label,speed_mm_s,trial`, then one column per feature.
-fn write_table(w: &mut dyn Write, table: &FeatureTable) -> std::io::Result<()> {
+/// Writes the table as CSV: the manifest's `columns` (empty where a recording gives no
+/// value), then one column per feature.
+fn write_table(w: &mut dyn Write, columns: &[String], table: &FeatureTable) -> std::io::Result<()> {
     let mut out = csv::Writer::from_writer(w);
-    let ids = ["file", "label", "speed_mm_s", "trial"].map(String::from);
-    out.write_record(ids.iter().chain(&table.names))?;
+    out.write_record(columns.iter().chain(&table.names))?;
     for (i, m) in table.metas.iter().enumerate() {
-        let ids = [
-            m.file.clone(),
-            m.label.clone(),
-            m.speed_mm_s.to_string(),
-            m.trial.to_string(),
-        ];
+        let ids = columns.iter().map(|c| m.field(c).unwrap_or_default());
         let values = table.row(i).iter().map(f64::to_string);
-        out.write_record(ids.into_iter().chain(values))?;
+        out.write_record(ids.chain(values))?;
     }
     out.flush()
 }

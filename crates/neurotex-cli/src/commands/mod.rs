@@ -13,6 +13,7 @@ pub mod train;
 use anyhow::Result;
 use neurotex::analysis::FeatureTable;
 use neurotex::calibrate::{calibrate_gain, GainCalibration};
+use neurotex::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
 use neurotex::pipeline::{Encoded, Method, Pipeline, PipelineParams};
 use neurotex::recording::{one_grid, Dataset};
 use neurotex::{Grid, Speed};
@@ -32,8 +33,27 @@ fn feature_table(
         Some(speeds) => dataset.indices_at(speeds)?,
         None => (0..dataset.entries.len()).collect(),
     };
+    let features = encoded_features(dataset, pipeline, &indices, method)?;
+    Ok((features.table, features.grid))
+}
+
+/// A feature table, the grid its recordings share, and which taxels respond in them.
+struct Features {
+    table: FeatureTable,
+    grid: Grid,
+    taxels: TaxelDiagnostics,
+}
+
+/// Encodes the dataset's recordings `indices` with a progress bar and extracts `method`'s
+/// features.
+fn encoded_features(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+    method: Method,
+) -> Result<Features> {
     let bar = progress(indices.len(), "encoding");
-    let encoded = pipeline.encode_dataset(dataset, &indices, &|| bar.inc(1));
+    let encoded = pipeline.encode_dataset(dataset, indices, &|| bar.inc(1));
     bar.finish_and_clear();
     let encoded = encoded?;
     report_conditions(&encoded);
@@ -50,7 +70,12 @@ fn feature_table(
     let grid = one_grid(grids)?;
     let extractor = pipeline.extractor(&grid)?;
     let table = FeatureTable::build(&encoded, &extractor, method)?;
-    Ok((table, grid))
+    let taxels = taxel_diagnostics(&encoded, &grid, pipeline.params().encoder)?;
+    Ok(Features {
+        table,
+        grid,
+        taxels,
+    })
 }
 
 /// The pipeline the options name; with `--gain auto`, its gain calibrated on `dataset`'s

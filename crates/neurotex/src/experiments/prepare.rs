@@ -78,16 +78,27 @@ impl Source<'_> {
     }
 
     /// Recording `i`'s speed and label, known before it is loaded.
-    fn condition(&self, i: usize) -> (Speed, String) {
+    ///
+    /// # Errors
+    /// A dataset recording without a speed: the analyses compare speeds.
+    fn condition(&self, i: usize) -> Result<(Speed, String)> {
         match self {
-            Source::Simulated { trials, .. } => (
+            Source::Simulated { trials, .. } => Ok((
                 Speed::of(trials[i].speed_mm_s),
                 trials[i].texture.name().to_string(),
-            ),
-            Source::Dataset(ds) => (
-                Speed::of(ds.entries[i].speed_mm_s),
-                ds.entries[i].label.clone(),
-            ),
+            )),
+            Source::Dataset(ds) => {
+                let meta = &ds.entries[i];
+                let speed = meta.speed().ok_or_else(|| {
+                    let message = format!(
+                        "line {}: `{}` has no speed_mm_s; reproduce compares speeds, so every recording needs one (evaluate and features work without)",
+                        i + 2,
+                        meta.file
+                    );
+                    DataError::invalid(ds.root.join("manifest.csv"), message)
+                })?;
+                Ok((speed, meta.label.clone()))
+            }
         }
     }
 
@@ -215,7 +226,7 @@ impl Prepared {
     pub fn at(&self, speed: Speed) -> impl Iterator<Item = &Encoded> {
         self.encoded
             .iter()
-            .filter(move |e| Speed::of(e.meta.speed_mm_s) == speed)
+            .filter(move |e| e.meta.speed() == Some(speed))
     }
 }
 
@@ -233,7 +244,8 @@ pub fn prepare(
 ) -> Result<Prepared> {
     let start = Instant::now();
     let n = source.len();
-    let conditions: Vec<(Speed, String)> = (0..n).map(|i| source.condition(i)).collect();
+    let conditions: Vec<(Speed, String)> =
+        (0..n).map(|i| source.condition(i)).collect::<Result<_>>()?;
     let slowest = Speed::slowest(conditions.iter().map(|c| c.0)).ok_or(DatasetError::Empty)?;
     let mut labels: Vec<String> = Vec::new();
     for (_, l) in &conditions {

@@ -63,7 +63,7 @@ pub fn sensitivity(c: &Context) -> Result<Option<Sensitivity>, Stop> {
         let g = cv_at(&glcm3d, Columns::All, speed, knn, cv)?.accuracy;
         let t = cv_at(&taxel, Columns::EachTaxel, speed, knn, cv)?.accuracy;
         let pairs = c.prepared.encoded.iter().zip(perturbed);
-        let at_speed = pairs.filter(|(e, _)| crate::Speed::of(e.meta.speed_mm_s) == speed);
+        let at_speed = pairs.filter(|(e, _)| e.meta.speed() == Some(speed));
         let (mut changed, mut recordings) = (0, 0);
         for (e, p) in at_speed {
             recordings += 1;

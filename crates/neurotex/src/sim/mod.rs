@@ -519,9 +519,9 @@ fn trial_recording(
         meta: Meta {
             file: trial_file_name(trial),
             label: trial.texture.name().to_string(),
-            speed_mm_s: trial.speed_mm_s,
-            force_n: p.force_n,
-            trial: i64::from(trial.trial),
+            speed_mm_s: Some(trial.speed_mm_s),
+            force_n: Some(p.force_n),
+            trial: Some(i64::from(trial.trial)),
             slide_start_s: Some(slide_s.0),
             slide_end_s: Some(slide_s.1),
             extra: Default::default(),
