@@ -5,12 +5,13 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
+use neurotex::calibrate::calibrate_gain;
 use neurotex::encode::SpikeTrains;
 use neurotex::pipeline::Pipeline;
 use neurotex::recording::{read_recording, LayoutFile};
 use neurotex::SampleRate;
 
-use super::report_conditions;
+use super::{report_conditions, say_calibration};
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
@@ -48,7 +49,22 @@ pub fn run(args: EncodeArgs) -> Result<()> {
         layout.fs = Some(fs.hz());
     }
     let recording = read_recording(&args.input, &layout)?;
-    let encoded = pipeline.encode(&recording, layout.baseline.unwrap_or_default())?;
+    let baseline = layout.baseline.unwrap_or_default();
+    // `--gain auto` on the one recording being encoded.
+    let pipeline = match args.stages.gain_target() {
+        Some(target) => {
+            let load = |_: usize| Ok(recording.clone());
+            let c = calibrate_gain(&pipeline, &load, &[0], baseline, target)?;
+            say_calibration(&c);
+            {
+                let mut params = pipeline.params().clone();
+                params.encoder.gain = c.gain;
+                Pipeline::new(params)?
+            }
+        }
+        None => pipeline,
+    };
+    let encoded = pipeline.encode(&recording, baseline)?;
     report_conditions(std::slice::from_ref(&encoded));
     let spikes = &encoded.spikes;
     if let Some(events) = &args.events {

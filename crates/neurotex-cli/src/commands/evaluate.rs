@@ -17,7 +17,7 @@ use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::{Dataset, Selection};
 use neurotex::{Cell, Speed};
 
-use super::encoded_features;
+use super::{calibrated_pipeline, encoded_features};
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
@@ -164,6 +164,22 @@ impl EvaluateArgs {
         })
     }
 
+    /// The recordings `--gain auto` calibrates on: the training set of a train/test split;
+    /// under cross-validation every recording evaluated (each is in some training fold, and
+    /// labels are not read; calibrating again inside every fold is not done), said on
+    /// standard error.
+    fn calibration_indices(&self, dataset: &Dataset, all: &[usize]) -> Result<Vec<usize>> {
+        match self.selections() {
+            Some((train, _)) => Ok(train.rows(&dataset.entries)?),
+            None => {
+                if self.stages.gain_target().is_some() {
+                    eprintln!("note: under cross-validation --gain auto calibrates on every recording evaluated (labels unused), test folds included; a train/test split calibrates on the training set only");
+                }
+                Ok(all.to_vec())
+            }
+        }
+    }
+
     /// The feature columns to classify with.
     fn columns(&self) -> Result<Columns> {
         Ok(match (self.method, self.taxel) {
@@ -177,7 +193,6 @@ impl EvaluateArgs {
 
 /// Runs `neurotex evaluate`.
 pub fn run(args: EvaluateArgs) -> Result<()> {
-    let pipeline = Pipeline::new(args.stages.pipeline()?)?;
     let knn = args.stages.knn(args.k)?;
     let split = args.split()?;
     let columns = args.columns()?;
@@ -186,6 +201,12 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     }
     let dataset = Dataset::open(&args.dataset)?;
     let indices = args.indices(&dataset)?;
+    let (params, calibration) = calibrated_pipeline(
+        &args.stages,
+        &dataset,
+        &args.calibration_indices(&dataset, &indices)?,
+    )?;
+    let pipeline = Pipeline::new(params)?;
     let features = encoded_features(&dataset, &pipeline, &indices, args.method)?;
     let (table, grid) = (&features.table, &features.grid);
     if let Some(cell) = args.taxel {
@@ -214,6 +235,9 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         value["accuracy_interval"] = serde_json::to_value(interval)?;
         if let Some(taxels) = taxels {
             value["taxels"] = taxels_json(taxels, &outcome)?;
+        }
+        if let Some(c) = &calibration {
+            value["gain_calibration"] = serde_json::to_value(c)?;
         }
         println!("{}", serde_json::to_string(&value)?);
     } else {

@@ -9,7 +9,7 @@ use neurotex::analysis::FeatureTable;
 use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::Dataset;
 
-use super::feature_table;
+use super::{calibrated_pipeline, feature_table};
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
@@ -33,8 +33,11 @@ pub struct FeaturesArgs {
 
 /// Runs `neurotex features`.
 pub fn run(args: FeaturesArgs) -> Result<()> {
-    let pipeline = Pipeline::new(args.stages.pipeline()?)?;
     let dataset = Dataset::open(&args.dataset)?;
+    // Features are computed for every recording; `--gain auto` calibrates on all of them.
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    let (params, _) = calibrated_pipeline(&args.stages, &dataset, &all)?;
+    let pipeline = Pipeline::new(params)?;
     let (table, _) = feature_table(&dataset, &pipeline, None, args.method)?;
     let columns = &dataset.columns;
     write_file(&args.out, "the feature table", |w| {
