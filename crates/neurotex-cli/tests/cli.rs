@@ -5,6 +5,7 @@
 mod encode;
 mod evaluate;
 mod features;
+mod hostile;
 mod import;
 mod model;
 mod reproduce;
