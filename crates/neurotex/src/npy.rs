@@ -265,7 +265,7 @@ mod tests {
     fn a_well_formed_header_is_read() {
         let h = header_of(&npy_bytes("<U3", "(2,)", &[0; 24])).unwrap();
         assert_eq!((h.kind, h.item_bytes, h.elements), ('U', 12, 2));
-        assert_eq!(h.data_offset, 64);
+        assert_eq!(h.data_offset % 64, 0, "numpy pads the header to 64 bytes");
         let h = header_of(&npy_bytes("<f4", "(2, 3)", &[0; 24])).unwrap();
         assert!(h.is_number());
         // one byte too few or too many
