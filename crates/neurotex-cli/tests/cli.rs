@@ -6,6 +6,7 @@ mod conditions;
 mod encode;
 mod evaluate;
 mod features;
+mod hostile;
 mod import;
 mod model;
 mod reproduce;

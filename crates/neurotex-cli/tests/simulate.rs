@@ -29,6 +29,6 @@ fn simulate_writes_a_dataset_the_pipeline_reads() {
     let err = dir.fails(&["simulate", "--out", s(&y), "--speeds", "0"]);
     assert!(err.contains("positive"), "{err}");
     let err = dir.fails(&["simulate", "--out", s(&y), "--trials", "0"]);
-    assert!(err.contains("--trials must be at least 1"), "{err}");
+    assert!(err.contains("trials must be between 1 and 10000"), "{err}");
     assert!(!x.exists() && !y.exists());
 }

@@ -97,6 +97,19 @@ pub enum DataError {
         /// The bin, ms.
         bin_ms: usize,
     },
+    /// A size beyond one of neurotex's limits (SPEC 8), in data that has no file of its
+    /// own (the recording is named by [`Error::in_recording`]).
+    #[error("{what} is {got}, beyond the limit of {limit}: {hint}")]
+    TooLarge {
+        /// What is too large.
+        what: &'static str,
+        /// Its size.
+        got: u64,
+        /// The limit.
+        limit: u64,
+        /// What to do about it.
+        hint: &'static str,
+    },
     /// A file was read but its content is not what was expected.
     #[error("{path}: {message}")]
     Invalid {

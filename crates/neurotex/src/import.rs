@@ -387,6 +387,7 @@ pub fn import_csv(
         let rule = "without --time-column the sampling rate --fs is needed";
         return Err(ParamError::new("fs", rule, "none").into());
     }
+    reject_duplicate_names(files)?;
     let mut summary = ImportSummary::default();
     let good = parse_all(files, p, on_done, &mut summary.skipped)?;
     let Some(first) = good.first() else {
@@ -420,6 +421,25 @@ pub fn import_csv(
     summary.written = good.len();
     summary.layout = layout;
     Ok(summary)
+}
+
+/// Each input is written under its file name, so two inputs of one name (`a/x.csv` and
+/// `b/x.csv`) would become one file with two manifest rows: refused, naming both.
+fn reject_duplicate_names(files: &[PathBuf]) -> Result<()> {
+    let mut seen: BTreeMap<&std::ffi::OsStr, &Path> = BTreeMap::new();
+    for f in files {
+        let Some(name) = f.file_name() else { continue };
+        if let Some(first) = seen.insert(name, f) {
+            let message = format!(
+                "two inputs have the file name `{}` ({} and {}), which would be one file in the dataset; rename one or import them separately",
+                name.to_string_lossy(),
+                first.display(),
+                f.display()
+            );
+            return Err(invalid(f, message));
+        }
+    }
+    Ok(())
 }
 
 /// Parses every file in parallel; a bad file is an error, or with `skip_bad` is listed in
@@ -470,7 +490,8 @@ fn nominal_fs(good: &[ParsedCsv], p: &CsvImportParams, out: &Path) -> Result<f64
 fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Result<LayoutFile> {
     let n = names.len();
     let (rows, cols) = p.grid.as_ref().map_or((1, n), |g| (g.rows(), g.cols()));
-    if rows * cols < n {
+    let cells = crate::values::check_grid_cells(rows, cols)?;
+    if cells < n {
         let rule = "the grid must have a cell for every channel";
         let got = format!("{rows}x{cols} for {n} channels");
         return Err(ParamError::new("grid", rule, got).into());
@@ -484,7 +505,7 @@ fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Re
         let rule = "the map needs one cell per channel";
         return Err(ParamError::new("channel-map", rule, got).into());
     }
-    let mut used = vec![false; rows * cols];
+    let mut used = vec![false; cells];
     for &[r, c] in &map {
         if r < rows && c < cols {
             used[r * cols + c] = true;
@@ -506,6 +527,7 @@ fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Re
         time_column: timed.then(|| "t_ms".to_string()),
         time_unit: timed.then_some(TimeUnit::Milliseconds),
         channels: Some(names.to_vec()),
+        max_duration_s: None,
     })
 }
 
@@ -607,8 +629,15 @@ fn parse_axes(text: &str) -> Result<Vec<AxisName>, ParamError> {
     Ok(axes)
 }
 
-/// Reads a `.npy` of numbers as f64 (f64, f32, or any integer type).
+/// Reads a `.npy` of numbers as f64 (f64, f32, or any integer type). The header is checked
+/// against the file's size first, so nothing larger than the file is allocated.
 fn read_numbers(path: &Path) -> Result<ArrayD<f64>> {
+    let header = crate::npy::read_header(path)?;
+    let descr = &header.descr;
+    if !header.is_number() {
+        let message = format!("not a .npy array of numbers (float or integer): dtype `{descr}`");
+        return Err(invalid(path, message));
+    }
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     macro_rules! try_as {
         ($($t:ty),*) => {$(
@@ -618,15 +647,15 @@ fn read_numbers(path: &Path) -> Result<ArrayD<f64>> {
         )*};
     }
     try_as!(f64, f32, i64, i32, i16, i8, u64, u32, u16, u8);
-    Err(invalid(
-        path,
-        "not a .npy array of numbers (float or integer)",
-    ))
+    let message = format!("not a readable .npy array of numbers (dtype `{descr}`)");
+    Err(invalid(path, message))
 }
 
 /// Reads labels: integers, or fixed-width strings (`<U` or `|S`), one per sample.
 fn read_labels(path: &Path) -> Result<Vec<String>> {
-    if let Ok(a) = read_numbers(path) {
+    let header = crate::npy::read_header(path)?;
+    if header.is_number() {
+        let a = read_numbers(path)?;
         if a.iter().any(|v| v.fract() != 0.0) {
             return Err(invalid(
                 path,
@@ -635,69 +664,31 @@ fn read_labels(path: &Path) -> Result<Vec<String>> {
         }
         return Ok(a.iter().map(|v| format!("{}", *v as i64)).collect());
     }
-    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
-    let bad = || invalid(path, "not a .npy array of integer or string labels");
-    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
-        return Err(bad());
+    let descr = &header.descr;
+    let little = !descr.starts_with('>');
+    if !(matches!(header.kind, 'U' | 'S') && little) {
+        let message =
+            format!("labels must be integers or strings (`<U` or `|S`), got dtype `{descr}`");
+        return Err(invalid(path, message));
     }
-    let (header_len, start) = if bytes[6] == 1 {
-        (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10)
-    } else {
-        if bytes.len() < 12 {
-            return Err(bad());
-        }
-        (
-            u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
-            12,
-        )
-    };
-    let header = std::str::from_utf8(bytes.get(start..start + header_len).ok_or_else(bad)?)
-        .map_err(|_| bad())?;
-    let descr = header
-        .split("'descr':")
-        .nth(1)
-        .and_then(|s| s.split('\'').nth(1))
-        .ok_or_else(bad)?;
-    let shape = header
-        .split("'shape':")
-        .nth(1)
-        .and_then(|s| s.split(')').next())
-        .ok_or_else(bad)?;
-    let dims: Vec<usize> = shape
-        .trim_start_matches([' ', '('])
-        .split(',')
-        .filter_map(|d| d.trim().parse().ok())
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    // the header check proved the data section is exactly `elements * item_bytes` bytes
+    let data = bytes.get(header.data_offset..).unwrap_or_default();
+    let labels: Vec<String> = data
+        .chunks_exact(header.item_bytes)
+        .take(header.elements)
+        .map(|chunk| match header.kind {
+            'U' => chunk
+                .chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .take_while(|&c| c != 0)
+                .filter_map(char::from_u32)
+                .collect(),
+            _ => String::from_utf8_lossy(chunk)
+                .trim_end_matches('\0')
+                .to_string(),
+        })
         .collect();
-    let n: usize = dims.iter().product();
-    let data = &bytes[start + header_len..];
-    let (kind, width) = (
-        descr.chars().nth(1).ok_or_else(bad)?,
-        descr[2..].parse::<usize>().map_err(|_| bad())?,
-    );
-    let labels: Vec<String> = match (&descr[..1], kind) {
-        ("<" | "|" | "=", 'U') => (0..n)
-            .map(|i| {
-                let chunk = data
-                    .get(i * width * 4..(i + 1) * width * 4)
-                    .ok_or_else(bad)?;
-                Ok(chunk
-                    .chunks_exact(4)
-                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                    .take_while(|&c| c != 0)
-                    .filter_map(char::from_u32)
-                    .collect())
-            })
-            .collect::<Result<_>>()?,
-        ("|", 'S') => (0..n)
-            .map(|i| {
-                let chunk = data.get(i * width..(i + 1) * width).ok_or_else(bad)?;
-                Ok(String::from_utf8_lossy(chunk)
-                    .trim_end_matches('\0')
-                    .to_string())
-            })
-            .collect::<Result<_>>()?,
-        _ => return Err(bad()),
-    };
     if labels.iter().any(|l| l.is_empty()) {
         return Err(invalid(path, "a label is empty"));
     }
@@ -808,6 +799,8 @@ fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usiz
         let message = format!("no samples or no time steps (shape {shape:?})");
         return Err(invalid(data, message));
     }
+    crate::values::check_grid_cells(grid.0, grid.1)
+        .map_err(|e| invalid(data, format!("shape {shape:?}: {e}")))?;
     Ok((arr, grid))
 }
 

@@ -23,6 +23,7 @@ pub mod features;
 pub mod import;
 pub mod io;
 pub mod model;
+mod npy;
 pub mod pipeline;
 pub mod recording;
 pub mod report;

@@ -305,6 +305,15 @@ impl FeatureExtractor {
                         &replanned
                     }
                 };
+                if !plan.counts_fit(volume.bins) {
+                    return Err(DataError::TooLarge {
+                        what: "the GLCM pair count of this recording's volume",
+                        got: plan.counted_pairs(volume.bins),
+                        limit: crate::features::glcm::MAX_COUNTED_PAIRS,
+                        hint: "co-occurrence counts are u32; use a shorter recording, fewer distances or a smaller grid",
+                    }
+                    .into());
+                }
                 let mut q = Vec::new();
                 volume.quantise(self.volume.levels, self.volume.range, &mut q);
                 let l = self.volume.levels;

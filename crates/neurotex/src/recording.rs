@@ -333,7 +333,18 @@ pub struct LayoutFile {
     pub time_unit: Option<TimeUnit>,
     /// CSV recordings: the channel columns, in channel order (default: every other column).
     pub channels: Option<Vec<String>>,
+    /// Longest recording accepted, in s (default [`DEFAULT_MAX_DURATION_S`]); resampling
+    /// allocates one frame per millisecond of it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_duration_s: Option<f64>,
 }
+
+/// The longest recording accepted unless `layout.toml` sets `max_duration_s`: one hour.
+/// Resampling to the encoder's 1 kHz allocates one frame per millisecond of a recording's
+/// time span, so the span, not the file's size, sets the memory: an hour of a 4x4 grid is
+/// 3.6 million frames, 460 MB of f64 samples, about what a laptop can spare per worker.
+/// The paper's slides last seconds; a span of days is a wrong time unit or sampling rate.
+pub const DEFAULT_MAX_DURATION_S: f64 = 3600.0;
 
 impl LayoutFile {
     /// Reads and checks `layout.toml`.
@@ -357,12 +368,22 @@ impl LayoutFile {
                 ));
             }
         }
+        if let Some(max) = self.max_duration_s {
+            if !(max.is_finite() && max > 0.0) {
+                return bad(format!(
+                    "field `max_duration_s` must be a positive number of s, got {max}"
+                ));
+            }
+        }
         if self.rows.is_some() != self.cols.is_some() {
             return bad("fields `rows` and `cols` must be given together".into());
         }
         if let (Some(r), Some(c)) = (self.rows, self.cols) {
             if r == 0 || c == 0 {
                 return bad(format!("grid must be at least 1x1, got {r}x{c}"));
+            }
+            if let Err(e) = crate::values::check_grid_cells(r, c) {
+                return bad(format!("fields `rows` and `cols`: {e}"));
             }
             if let Some(map) = &self.channel_map {
                 let mut seen = vec![false; r * c];
@@ -507,11 +528,24 @@ pub const MANIFEST_COLUMNS: [&str; 2] = ["file", "label"];
 pub const CONDITION_COLUMNS: [&str; 3] = ["speed_mm_s", "force_n", "trial"];
 
 impl Dataset {
-    /// Opens a dataset folder, reading and checking `manifest.csv` and `layout.toml`.
+    /// Opens a dataset folder, reading and checking `manifest.csv` and `layout.toml`; every
+    /// recording must lie inside the folder (see [`Dataset::open_with`]).
     ///
     /// # Errors
-    /// Missing or malformed manifest or layout; a manifest line naming a missing file.
+    /// Missing or malformed manifest or layout; a manifest line naming a missing file or
+    /// one outside the folder.
     pub fn open(root: impl AsRef<Path>) -> Result<Self> {
+        Self::open_with(root, false)
+    }
+
+    /// [`Dataset::open`], with `allow_outside_paths` choosing whether manifest `file`
+    /// entries may leave the dataset folder (`../x.npy`, absolute paths, symbolic links to
+    /// elsewhere). Refused by default: a dataset folder copied or shared should hold its
+    /// recordings, and a manifest from elsewhere should not make neurotex read any file.
+    ///
+    /// # Errors
+    /// As [`Dataset::open`].
+    pub fn open_with(root: impl AsRef<Path>, allow_outside_paths: bool) -> Result<Self> {
         let root = root.as_ref().to_path_buf();
         if !root.is_dir() {
             return Err(DataError::invalid(
@@ -540,6 +574,14 @@ impl Dataset {
                     ),
                 )
                 .into());
+            }
+            if !allow_outside_paths {
+                check_inside(&root, &m.file).map_err(|why| {
+                    DataError::invalid(
+                        &manifest_path,
+                        format!("line {}: file `{}` {why}", i + 2, m.file),
+                    )
+                })?;
             }
         }
         Ok(Dataset {
@@ -638,6 +680,28 @@ impl Dataset {
             .filter(|&i| self.entries[i].speed().is_some_and(|s| speeds.contains(&s)))
             .collect())
     }
+}
+
+/// Whether manifest entry `file` stays inside dataset folder `root`: a relative path
+/// without `..` that, once symbolic links are resolved, still lies under the folder.
+/// Returns why not.
+fn check_inside(root: &Path, file: &str) -> std::result::Result<(), String> {
+    use std::path::Component;
+    let outside = "lies outside the dataset folder; manifest paths must stay inside it";
+    let relative = Path::new(file)
+        .components()
+        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir));
+    if !relative {
+        return Err(format!("{outside} (no absolute paths or `..`)"));
+    }
+    let canonical = |p: &Path| {
+        p.canonicalize()
+            .map_err(|e| format!("cannot be resolved: {e}"))
+    };
+    if !canonical(&root.join(file))?.starts_with(canonical(root)?) {
+        return Err(format!("{outside} (a symbolic link leads out)"));
+    }
+    Ok(())
 }
 
 /// A dataset that cannot serve what was asked of it.
@@ -1012,6 +1076,11 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
     if n_channels == 0 {
         return Err(DataError::invalid(path, "recording has no channels").into());
     }
+    if n_channels > crate::values::MAX_CELLS {
+        let max = crate::values::MAX_CELLS;
+        let message = format!("recording has {n_channels} channels, beyond the limit of {max}");
+        return Err(DataError::invalid(path, message).into());
+    }
     if let Some(pos) = raw.iter().position(|v| !v.is_finite()) {
         return Err(DataError::invalid(
             path,
@@ -1024,8 +1093,9 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
         )
         .into());
     }
-    let lay = layout.layout_for(path, shape)?;
     let t = raw.len() / n_channels;
+    check_duration(path, layout, t, times_s.as_deref())?;
+    let lay = layout.layout_for(path, shape)?;
     let samples = if lay.channel_map.iter().copied().eq(0..lay.cells()) {
         raw
     } else {
@@ -1057,20 +1127,40 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
     })
 }
 
-fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
-    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
-    let array: ArrayD<f64> = match ArrayD::<f64>::read_npy(bytes.as_slice()) {
-        Ok(a) => a,
-        Err(_) => ArrayD::<f32>::read_npy(bytes.as_slice())
-            .map(|a| a.mapv(f64::from))
-            .map_err(|e| {
-                DataError::invalid(
-                    path,
-                    format!("not a readable .npy of float32 or float64 samples: {e}"),
-                )
-            })?,
+/// A recording's time span must stay within the layout's `max_duration_s` (default
+/// [`DEFAULT_MAX_DURATION_S`]): resampling allocates one frame per millisecond of it.
+fn check_duration(
+    path: &Path,
+    layout: &LayoutFile,
+    frames: usize,
+    times: Option<&[f64]>,
+) -> Result<()> {
+    let fs = layout.fs.unwrap_or(1000.0);
+    let span = match times {
+        Some([first, .., last]) => last - first,
+        Some(_) => 0.0,
+        None => frames as f64 / fs,
     };
-    let shape = match *array.shape() {
+    let max = layout.max_duration_s.unwrap_or(DEFAULT_MAX_DURATION_S);
+    if span > max {
+        let what = match times {
+            Some(_) => "time stamps span".to_string(),
+            None => format!("{frames} samples at {fs} Hz last"),
+        };
+        let message = format!(
+            "{what} {span} s, beyond the limit of {max} s per recording (resampling to 1 kHz \
+             allocates a frame per ms; set `max_duration_s` in layout.toml to raise it)"
+        );
+        return Err(DataError::invalid(path, message).into());
+    }
+    Ok(())
+}
+
+fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
+    // The header is checked against the file's size first, so nothing larger than the
+    // file is ever allocated for it.
+    let header = crate::npy::read_header(path)?;
+    let shape = match header.shape[..] {
         [_, r, c] => Shape::Grid(r, c),
         [_, n] => Shape::Channels(n),
         ref other => {
@@ -1081,6 +1171,30 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
             .into())
         }
     };
+    let (rows, cols) = match shape {
+        Shape::Grid(r, c) => (r, c),
+        Shape::Channels(n) => (1, n),
+    };
+    crate::values::check_grid_cells(rows, cols)
+        .map_err(|e| DataError::invalid(path, format!("shape {:?}: {e}", header.shape)))?;
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    let unreadable = |e: ndarray_npy::ReadNpyError| {
+        DataError::invalid(path, format!("not a readable .npy of float samples: {e}"))
+    };
+    let array: ArrayD<f64> = match (header.kind, header.item_bytes) {
+        ('f', 8) => ArrayD::<f64>::read_npy(bytes.as_slice()).map_err(unreadable)?,
+        ('f', 4) => ArrayD::<f32>::read_npy(bytes.as_slice())
+            .map_err(unreadable)?
+            .mapv(f64::from),
+        _ => {
+            let message = format!(
+                "samples must be float32 or float64, got dtype `{}`",
+                header.descr
+            );
+            return Err(DataError::invalid(path, message).into());
+        }
+    };
+    drop(bytes);
     let std = array.as_standard_layout().into_owned();
     Ok((shape, std.into_raw_vec_and_offset().0))
 }

@@ -214,6 +214,13 @@ impl Preprocessor {
         let mut samples = if uniform_1k {
             rec.samples[lo * cells..hi * cells].to_vec()
         } else {
+            let span = times[hi - 1] - times[lo];
+            if resampled_len(span, ENCODER_FS, cells).is_none() {
+                let message = format!(
+                    "a {span} s span resampled to 1 kHz is more samples than memory can hold"
+                );
+                return Err(DataError::invalid(file, message).into());
+            }
             resample_linear(
                 &rec.samples[lo * cells..hi * cells],
                 cells,
@@ -274,11 +281,26 @@ pub fn normalise_global_max(samples: &mut [f64]) -> bool {
     }
 }
 
+/// The number of samples (`frames x cells`) that [`resample_linear`] makes of a `span_s`
+/// second span at `fs`, computed without overflow; `None` when it is not finite or would
+/// need more than `isize::MAX` bytes of f64 (no allocation could hold it).
+pub fn resampled_len(span_s: f64, fs: f64, cells: usize) -> Option<usize> {
+    let steps = (span_s * fs + 1e-9).floor() + 1.0;
+    let limit = (isize::MAX as usize / std::mem::size_of::<f64>()) as f64;
+    if !(steps.is_finite() && steps >= 1.0 && steps <= limit) {
+        return None;
+    }
+    (steps as usize)
+        .checked_mul(cells.max(1))
+        .filter(|&n| n <= isize::MAX as usize / std::mem::size_of::<f64>())
+}
+
 /// Linear interpolation of `frames` (time-major, `cells` per frame, at `times` in s from the
 /// recording's start) onto a grid of `fs` starting at `times[0]`, up to the last time stamp.
 ///
 /// # Panics
-/// If `times` does not have one entry per frame (a caller bug).
+/// If `times` does not have one entry per frame, or the result would not fit in memory
+/// ([`resampled_len`] is `None`): caller bugs, as readers bound a recording's span.
 pub fn resample_linear(frames: &[f64], cells: usize, times: &[f64], fs: f64) -> Vec<f64> {
     assert_eq!(
         frames.len(),
@@ -290,8 +312,9 @@ pub fn resample_linear(frames: &[f64], cells: usize, times: &[f64], fs: f64) -> 
     }
     let t0 = times[0];
     let span = times[times.len() - 1] - t0;
-    let steps = (span * fs + 1e-9).floor() as usize + 1;
-    let mut out = Vec::with_capacity(steps * cells);
+    let total = resampled_len(span, fs, cells).expect("a resampled length that fits in memory");
+    let steps = total / cells.max(1);
+    let mut out = Vec::with_capacity(total);
     let mut k = 0usize;
     for s in 0..steps {
         let t = t0 + s as f64 / fs;
@@ -373,5 +396,23 @@ fn baseline_offsets(rec: &Recording, times: &[f64], baseline: Baseline) -> Resul
             }
             Ok(sum.into_iter().map(|s| s / (b - a) as f64).collect())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resampled_length_is_bounded_not_wrapped() {
+        assert_eq!(resampled_len(0.01, 1000.0, 16), Some(11 * 16));
+        assert_eq!(
+            resampled_len(1e8, 1000.0, 16),
+            Some((1e11 as usize + 1) * 16)
+        );
+        assert_eq!(resampled_len(1e18, 1000.0, 16), None);
+        assert_eq!(resampled_len(1e15, 1000.0, usize::MAX / 2), None);
+        assert_eq!(resampled_len(f64::INFINITY, 1000.0, 1), None);
+        assert_eq!(resampled_len(f64::NAN, 1000.0, 1), None);
     }
 }

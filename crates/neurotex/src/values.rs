@@ -28,7 +28,7 @@ impl Grid {
     /// # Errors
     /// An empty grid or one of more than [`MAX_CELLS`] cells.
     pub fn full(rows: usize, cols: usize) -> Result<Self, ParamError> {
-        Self::masked(rows, cols, vec![true; cells_checked(rows, cols)?])
+        Self::masked(rows, cols, vec![true; check_grid_cells(rows, cols)?])
     }
 
     /// A grid with a mask: `present[row * cols + col]` tells whether that cell holds a taxel.
@@ -37,7 +37,7 @@ impl Grid {
     /// An empty grid, more than [`MAX_CELLS`] cells, a mask of the wrong length, or a mask
     /// without any taxel.
     pub fn masked(rows: usize, cols: usize, present: Vec<bool>) -> Result<Self, ParamError> {
-        let cells = cells_checked(rows, cols)?;
+        let cells = check_grid_cells(rows, cols)?;
         if present.len() != cells {
             return Err(ParamError::new(
                 "mask",
@@ -140,7 +140,11 @@ impl Grid {
     }
 }
 
-fn cells_checked(rows: usize, cols: usize) -> Result<usize, ParamError> {
+/// The number of cells of a `rows x cols` grid, multiplied without overflow.
+///
+/// # Errors
+/// An empty grid, or one of more than [`MAX_CELLS`] cells (an overflowing product included).
+pub fn check_grid_cells(rows: usize, cols: usize) -> Result<usize, ParamError> {
     match rows.checked_mul(cols) {
         Some(cells) if cells > 0 && cells <= MAX_CELLS => Ok(cells),
         _ => Err(ParamError::new(

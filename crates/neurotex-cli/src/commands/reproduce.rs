@@ -99,8 +99,9 @@ impl ReproduceArgs {
     /// Simulated trials per texture and speed.
     fn trials_per(&self) -> Result<u32> {
         let trials_per = self.trials.unwrap_or(if self.quick { 10 } else { 20 });
-        if trials_per == 0 {
-            bail!("--trials must be at least 1");
+        if !(1..=neurotex::sim::MAX_TRIALS).contains(&trials_per) {
+            let max = neurotex::sim::MAX_TRIALS;
+            bail!("--trials must be between 1 and {max}, got {trials_per}");
         }
         Ok(trials_per)
     }

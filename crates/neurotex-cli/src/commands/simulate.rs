@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
-use neurotex::sim::{design, write_dataset, RigParams, Texture, ALL_TEXTURES};
+use neurotex::sim::{check_design, design, write_dataset, RigParams, Texture, ALL_TEXTURES};
 use neurotex::Speed;
 
 use crate::output::progress;
@@ -38,23 +38,14 @@ pub fn texture(name: &str) -> Result<Texture, String> {
 
 /// Runs `neurotex simulate`.
 pub fn run(args: SimulateArgs) -> Result<()> {
-    if args.trials == 0 {
-        bail!("--trials must be at least 1");
-    }
-    if let Some(s) = args.speeds.iter().find(|s| s.mm_s() <= 0.0) {
-        bail!("--speeds must be positive mm/s, got {s}");
-    }
     let textures = args.textures.unwrap_or_else(|| ALL_TEXTURES.to_vec());
     let speeds: Vec<f64> = args.speeds.iter().map(|s| s.mm_s()).collect();
+    let rig = RigParams::default();
+    // checked before the trial list is built: --trials 4000000000 would allocate it
+    check_design(&rig, &textures, &speeds, args.trials)?;
     let trials = design(&textures, &speeds, args.trials);
     let bar = progress(trials.len(), "simulating");
-    let result = write_dataset(
-        &args.out,
-        &RigParams::default(),
-        &trials,
-        args.seed,
-        &|| bar.inc(1),
-    );
+    let result = write_dataset(&args.out, &rig, &trials, args.seed, &|| bar.inc(1));
     bar.finish_and_clear();
     result?;
     eprintln!("{} recordings -> {}", trials.len(), args.out.display());

@@ -9,6 +9,11 @@ use serde::{Deserialize, Serialize};
 use super::{Classifier, ConfusionMatrix, Predict};
 use crate::error::{ClassifyError, ParamError};
 
+/// Largest number of repeats (CV shuffles, E3 draws) accepted; beyond it a run would take
+/// days on the paper's design, so a larger value is a typo (and `usize::MAX` repeats would
+/// ask for a result vector no memory holds).
+pub const MAX_REPEATS: usize = 10_000;
+
 /// Cross-validation parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CvParams {
@@ -31,7 +36,7 @@ impl Default for CvParams {
 }
 
 impl CvParams {
-    /// Checks the rules (at least 2 folds and 1 repeat) and returns the validated form
+    /// Checks the rules (at least 2 folds, 1 to [`MAX_REPEATS`] repeats) and returns the validated form
     /// that cross-validation takes.
     ///
     /// # Errors
@@ -48,6 +53,13 @@ impl CvParams {
             return Err(ParamError::new(
                 "repeats",
                 "repeats must be at least 1",
+                self.repeats,
+            ));
+        }
+        if self.repeats > MAX_REPEATS {
+            return Err(ParamError::new(
+                "repeats",
+                "repeats must be at most 10000",
                 self.repeats,
             ));
         }
@@ -350,6 +362,19 @@ pub fn train_test<C: Classifier>(
 #[cfg(test)]
 mod group_tests {
     use super::*;
+
+    #[test]
+    fn repeats_are_bounded_so_a_huge_count_is_an_error_not_a_panic() {
+        let cv = |repeats| CvParams {
+            repeats,
+            ..CvParams::default()
+        };
+        assert!(cv(MAX_REPEATS).check().is_ok());
+        for repeats in [0, MAX_REPEATS + 1, usize::MAX] {
+            let err = cv(repeats).check().unwrap_err();
+            assert_eq!(err.name, "repeats");
+        }
+    }
 
     #[test]
     fn no_group_is_split_and_few_groups_are_held_out_one_by_one() {

@@ -4,9 +4,7 @@ use crate::classify::{CvParams, Knn, KnnParams, ValidCv};
 use crate::error::ParamError;
 use crate::pipeline::{Pipeline, PipelineParams};
 
-/// Largest number of repeats (CV shuffles, E3 draws) accepted; beyond it a run would take
-/// days on the paper's design, so a larger value is a typo.
-pub const MAX_REPEATS: usize = 10_000;
+pub use crate::classify::cv::MAX_REPEATS;
 
 /// Parameters of a reproduction run; defaults are the paper's values and SPEC's choices.
 #[derive(Debug, Clone, PartialEq)]

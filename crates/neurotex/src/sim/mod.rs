@@ -373,13 +373,7 @@ pub fn simulate_trial_traced(
     seed: u64,
 ) -> Result<(Recording, Vec<(f64, f64)>), ParamError> {
     p.check()?;
-    if !(trial.speed_mm_s.is_finite() && trial.speed_mm_s > 0.0) {
-        return Err(ParamError::new(
-            "speeds",
-            "sliding speeds must be positive mm/s",
-            trial.speed_mm_s,
-        ));
-    }
+    check_speed(p, trial.speed_mm_s)?;
     let mut rng = trial_rng(seed, trial);
     let profiles = build_profiles(p, trial.texture, &mut rng);
     let force = p.force_n * (1.0 + p.force_jitter * rng.sample::<f64, _>(StandardNormal)).max(0.5);
@@ -534,6 +528,69 @@ pub fn trial_file_name(t: &Trial) -> String {
     format!("{}_v{}_t{:02}.npy", t.texture.name(), t.speed_mm_s, t.trial)
 }
 
+/// Most trials per texture and speed a simulation accepts: 500 times the paper's 20, and
+/// about 20 GB of recordings on its design; more is a typo (`design` would allocate the
+/// trial list before anything ran).
+pub const MAX_TRIALS: u32 = 10_000;
+
+/// Longest nominal slide a simulation accepts, s: ten minutes, 33 times the paper's
+/// slowest (90 mm at 5 mm/s, 18 s). Speed jitter may stretch a slide to twice this, which
+/// keeps the recording under the readers' one-hour limit; a 4x4 grid's slide then holds at
+/// most 1.2 million frames (150 MB of f64 per trial in memory).
+pub const MAX_SLIDE_S: f64 = 600.0;
+
+/// Checks a design before it is built: 1 to [`MAX_TRIALS`] trials, positive speeds whose
+/// slide of `p.slide_mm` lasts at most [`MAX_SLIDE_S`], and no texture or speed given twice
+/// (the two would write one file).
+///
+/// # Errors
+/// The rule broken, naming `trials`, `speeds` or `textures`.
+pub fn check_design(
+    p: &RigParams,
+    textures: &[Texture],
+    speeds: &[f64],
+    trials: u32,
+) -> Result<(), ParamError> {
+    if !(1..=MAX_TRIALS).contains(&trials) {
+        return Err(ParamError::new(
+            "trials",
+            "trials must be between 1 and 10000",
+            trials,
+        ));
+    }
+    for (k, &speed) in speeds.iter().enumerate() {
+        check_speed(p, speed)?;
+        if speeds[..k].contains(&speed) {
+            let rule = "each speed may be given once (one file per texture, speed and trial)";
+            return Err(ParamError::new("speeds", rule, format!("{speed} twice")));
+        }
+    }
+    for (k, texture) in textures.iter().enumerate() {
+        if textures[..k].contains(texture) {
+            let rule = "each texture may be given once (one file per texture, speed and trial)";
+            let got = format!("{} twice", texture.name());
+            return Err(ParamError::new("textures", rule, got));
+        }
+    }
+    Ok(())
+}
+
+/// A speed is positive and slides `p.slide_mm` in at most [`MAX_SLIDE_S`].
+fn check_speed(p: &RigParams, speed: f64) -> Result<(), ParamError> {
+    if !(speed.is_finite() && speed > 0.0) {
+        return Err(ParamError::new(
+            "speeds",
+            "sliding speeds must be positive mm/s",
+            speed,
+        ));
+    }
+    if p.slide_mm / speed > MAX_SLIDE_S {
+        let rule = "a slide may last at most 600 s, so a speed must be at least slide_mm / 600 (0.15 mm/s for the rig's 90 mm)";
+        return Err(ParamError::new("speeds", rule, format!("{speed} mm/s")));
+    }
+    Ok(())
+}
+
 /// The trials of a dataset: every texture x speed x trial, in that order (the paper's).
 pub fn design(textures: &[Texture], speeds: &[f64], trials: u32) -> Vec<Trial> {
     let mut out = Vec::new();
@@ -568,6 +625,11 @@ pub fn write_dataset(
     use crate::error::DataError;
     use rayon::prelude::*;
     p.check()?;
+    let mut names = std::collections::BTreeSet::new();
+    if let Some(t) = trials.iter().find(|t| !names.insert(trial_file_name(t))) {
+        let rule = "each texture, speed and trial may be given once (one file each)";
+        return Err(ParamError::new("trials", rule, trial_file_name(t)).into());
+    }
     crate::recording::create_dataset_dir(dir, |tmp| {
         let metas: Vec<Meta> = trials
             .par_iter()

@@ -102,6 +102,9 @@ pub enum Counting {
     OneHot,
 }
 
+/// Largest total of co-occurrence counts a volume may reach: counts are u32.
+pub const MAX_COUNTED_PAIRS: u64 = u32::MAX as u64;
+
 /// All pairs of one cell pair at one time offset: `(V[a, t], V[b, t + dt])` for every `t`
 /// at which both voxels lie inside the volume.
 #[derive(Debug, Clone, Copy)]
@@ -258,8 +261,9 @@ impl GlcmPlan {
     /// [`Counting::Auto`].
     ///
     /// # Panics
-    /// If the volume is not `cells x bins`, `counts` is not `levels^2`, or a voxel's level
-    /// is not below `levels` (caller bugs).
+    /// If the volume is not `cells x bins`, `counts` is not `levels^2`, a voxel's level
+    /// is not below `levels`, or the volume has more pairs than u32 counts hold
+    /// ([`GlcmPlan::counts_fit`] is false): caller bugs.
     pub fn count(&self, quantised: &[u8], bins: usize, counts: &mut [u32]) {
         self.count_with(quantised, bins, counts, Counting::Auto);
     }
@@ -290,6 +294,14 @@ impl GlcmPlan {
         let first = self.runs.partition_point(|r| r.dt <= -(bins as isize));
         let last = self.runs.partition_point(|r| r.dt < bins as isize);
         let runs = &self.runs[first..last];
+        let pairs: usize = runs.iter().map(|r| r.len(bins)).sum();
+        // Every counter of every method (histograms, popcount sums, the one-hot kernel's
+        // flushed u16 rows) holds a partial sum of these pairs, so a total that fits u32
+        // is proof that none of them wraps.
+        assert!(
+            (pairs as u64) << u64::from(self.symmetric) <= MAX_COUNTED_PAIRS,
+            "a volume of {pairs} pairs overflows u32 counts; check GlcmPlan::counts_fit first"
+        );
         let one_hot = onehot::available(l);
         let count_one_hot = |counts: &mut [u32]| {
             onehot::count(quantised, bins, self.cells, &self.by_cell, l, counts);
@@ -302,7 +314,6 @@ impl GlcmPlan {
             }
             Counting::LevelMasks | Counting::Auto => {
                 let mut masks = LevelMasks::new(quantised, bins, l, &self.paired);
-                let pairs: usize = runs.iter().map(|r| r.len(bins)).sum();
                 let masks_cost = masks.cost(runs);
                 let one_hot_cost = if one_hot {
                     onehot::cost(runs, bins, self.cells)
@@ -388,5 +399,45 @@ impl GlcmPlan {
     /// The number of voxel pairs the plan counts in a volume of `bins` time steps.
     pub fn pairs_for(&self, bins: usize) -> usize {
         self.runs.iter().map(|r| r.len(bins)).sum()
+    }
+
+    /// The total of the counts over a volume of `bins` time steps (each pair counted
+    /// twice when symmetric), in u64 so it cannot wrap.
+    pub fn counted_pairs(&self, bins: usize) -> u64 {
+        let pairs: u64 = self.runs.iter().map(|r| r.len(bins) as u64).sum();
+        pairs << u64::from(self.symmetric)
+    }
+
+    /// Whether u32 counts hold a volume of `bins` time steps: its
+    /// [`GlcmPlan::counted_pairs`] is at most [`MAX_COUNTED_PAIRS`]. Counts stay u32 (the
+    /// SIMD kernels add u32 lanes, twice as many per vector as u64); a volume beyond it is
+    /// 4.3 billion pairs, an hour-long recording on a grid of thousands of taxels.
+    pub fn counts_fit(&self, bins: usize) -> bool {
+        self.counted_pairs(bins) <= MAX_COUNTED_PAIRS
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_volume_whose_pairs_overflow_u32_counts_is_detected_before_counting() {
+        let plan = GlcmPlan::new(
+            4,
+            4,
+            &[true; 16],
+            16,
+            &GlcmParams::default(),
+            GlcmKind::ThreeD,
+        )
+        .unwrap();
+        let per_bin = plan.counted_pairs(1_000_001) - plan.counted_pairs(1_000_000);
+        assert!(per_bin > 0);
+        assert!(plan.counts_fit(1000));
+        let limit_bins = (MAX_COUNTED_PAIRS / per_bin) as usize;
+        assert!(!plan.counts_fit(limit_bins + 1000));
+        // computed in u64: no wrap even where usize pair counts would pass u32::MAX
+        assert!(plan.counted_pairs(limit_bins + 1000) > MAX_COUNTED_PAIRS);
     }
 }

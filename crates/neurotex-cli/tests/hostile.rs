@@ -1,0 +1,326 @@
+//! Hostile and extreme input (issue 14, limits): headers that claim more than the file
+//! holds, time spans and grids beyond the documented limits, huge counts, manifest paths
+//! leaving the dataset, and inputs that would overwrite one another. Each must fail with a
+//! message naming the file or option and the limit, exit 1 or 2, and leave no output.
+
+use std::path::Path;
+
+use ndarray::{Array2, Array3};
+use ndarray_npy::write_npy;
+
+use crate::util::{s, Dir};
+
+/// A version 1.0 `.npy` whose header says `descr` and `shape`, followed by `data` bytes
+/// (whatever the header claims).
+fn raw_npy(path: &Path, descr: &str, shape: &str, data: &[u8]) {
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((header.len() as u16).to_le_bytes());
+    bytes.extend(header.as_bytes());
+    bytes.extend(data);
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn npy_headers_claiming_more_than_the_file_holds_are_errors() {
+    let dir = Dir::new();
+    let out = dir.join("spikes.npy");
+    let cases = [
+        // a 192-byte file claiming 128 TB of f64
+        (
+            "huge.npy",
+            "<f8",
+            "(1000000000000, 4, 4)",
+            64,
+            "holds 64 bytes of data",
+        ),
+        (
+            "zero_beside_huge.npy",
+            "<f8",
+            "(0, 1000000000000, 1000000000000)",
+            0,
+            "more elements than any array",
+        ),
+        (
+            "empty_huge_grid.npy",
+            "<f8",
+            "(0, 100000, 100000)",
+            0,
+            "at most 1048576 cells",
+        ),
+        ("non_ascii.npy", "<f\u{e9}8", "(2, 4)", 64, "not ASCII"),
+        (
+            "unknown.npy",
+            "<q16",
+            "(2, 4)",
+            64,
+            "unsupported dtype `<q16`",
+        ),
+        (
+            "ints.npy",
+            "<i8",
+            "(2, 4)",
+            64,
+            "float32 or float64, got dtype `<i8`",
+        ),
+        ("short.npy", "<f8", "(3, 4)", 64, "96 bytes of data"),
+    ];
+    for (name, descr, shape, data, expected) in cases {
+        raw_npy(&dir.join(name), descr, shape, &vec![0u8; data]);
+        let err = dir.fails(&["encode", name, "--out", s(&out)]);
+        assert!(
+            err.contains(name) && err.contains(expected),
+            "{name}: {err}"
+        );
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn stacked_import_refuses_bad_label_and_speed_headers() {
+    let dir = Dir::new();
+    let data = dir.join("data.npy");
+    write_npy(&data, &Array3::<f32>::from_elem((2, 300, 1), 1.0)).unwrap();
+    let out = dir.join("ds");
+    raw_npy(&dir.join("good.npy"), "<i8", "(2,)", &[0; 16]);
+    let cases = [
+        ("labels_accent.npy", "<U\u{e9}3", "(2,)", 24, "not ASCII"),
+        (
+            "labels_huge.npy",
+            "<U3",
+            "(1000000000000,)",
+            24,
+            "bytes of data",
+        ),
+        ("labels_cplx.npy", "<c16", "(2,)", 32, "dtype `<c16`"),
+    ];
+    let stacked = |labels: &str, speeds: &str| {
+        let mut args = vec![
+            "import",
+            "stacked",
+            "--data",
+            s(&data),
+            "--axes",
+            "n,t,channel",
+        ];
+        args.extend(["--fs", "1000", "--out", s(&out), "--labels", labels]);
+        args.extend(["--speeds", speeds]);
+        args.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    for (name, descr, shape, bytes, expected) in cases {
+        raw_npy(&dir.join(name), descr, shape, &vec![0u8; bytes]);
+        for args in [stacked(name, "good.npy"), stacked("good.npy", name)] {
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let err = dir.fails(&args);
+            assert!(
+                err.contains(name) && err.contains(expected),
+                "{args:?}: {err}"
+            );
+            assert!(!out.exists() && !dir.partial_left());
+        }
+    }
+}
+
+#[test]
+fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
+    let dir = Dir::new();
+    let out = dir.join("spikes.npy");
+    std::fs::write(dir.join("far.csv"), "t_s,a\n0,1\n100000000,2\n").unwrap();
+    write_npy(dir.join("x.npy"), &Array2::<f32>::from_elem((10, 2), 1.0)).unwrap();
+    std::fs::write(dir.join("slow.toml"), "fs = 1e-4\n").unwrap();
+    std::fs::write(dir.join("bad.toml"), "max_duration_s = -1\n").unwrap();
+    dir.fails_each(
+        &[
+            (
+                vec!["encode", "far.csv", "--out", s(&out)],
+                "beyond the limit of 3600 s",
+            ),
+            (
+                vec!["encode", "x.npy", "--fs", "1e-9", "--out", s(&out)],
+                "beyond the limit of 3600 s",
+            ),
+            (
+                vec!["encode", "x.npy", "--layout", "slow.toml", "--out", s(&out)],
+                "max_duration_s",
+            ),
+            (
+                vec!["encode", "x.npy", "--layout", "bad.toml", "--out", s(&out)],
+                "`max_duration_s` must be a positive",
+            ),
+        ],
+        &out,
+    );
+    // 4000 s of one taxel: refused by default, read with the limit raised
+    std::fs::write(dir.join("long.csv"), "t_s,a\n0,1\n2000,2\n4000,1\n").unwrap();
+    let err = dir.fails(&["encode", "long.csv", "--out", s(&out)]);
+    assert!(err.contains("long.csv") && err.contains("4000 s"), "{err}");
+    std::fs::write(dir.join("long.toml"), "max_duration_s = 5000\n").unwrap();
+    dir.ok(&[
+        "encode",
+        "long.csv",
+        "--layout",
+        "long.toml",
+        "--out",
+        s(&out),
+    ]);
+    assert!(out.exists());
+}
+
+#[test]
+fn grids_beyond_the_cap_or_overflowing_are_errors() {
+    let dir = Dir::new();
+    let out = dir.join("spikes.npy");
+    write_npy(dir.join("x.npy"), &Array2::<f32>::from_elem((300, 2), 1.0)).unwrap();
+    let huge = "rows = 100000\ncols = 100000\n";
+    let wrap = "rows = 9223372036854775807\ncols = 4\n";
+    let map = "rows = 100000\ncols = 100000\nchannel_map = [[0, 0], [0, 1]]\n";
+    for (name, text) in [("huge.toml", huge), ("wrap.toml", wrap), ("map.toml", map)] {
+        std::fs::write(dir.join(name), text).unwrap();
+        let err = dir.fails(&["encode", "x.npy", "--layout", name, "--out", s(&out)]);
+        assert!(err.contains(name) && err.contains("1048576 cells"), "{err}");
+        assert!(!out.exists());
+    }
+    std::fs::create_dir(dir.join("logs")).unwrap();
+    std::fs::write(dir.join("logs/a.csv"), "t_ms,x\n0,1\n1,2\n").unwrap();
+    let ds = dir.join("ds");
+    for grid in ["100000x100000", "4294967296x4294967296"] {
+        let args = [
+            "import",
+            "csv",
+            "logs",
+            "--out",
+            s(&ds),
+            "--time-column",
+            "t_ms",
+            "--grid",
+            grid,
+        ];
+        let err = dir.fails(&args);
+        assert!(
+            err.contains("--grid") && err.contains("1048576 cells"),
+            "{err}"
+        );
+        assert!(!ds.exists());
+    }
+}
+
+#[test]
+fn count_options_are_bounded() {
+    let dir = Dir::new();
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let huge = "18446744073709551615";
+    for repeats in [huge, "10001"] {
+        let args = [
+            "evaluate",
+            "--dataset",
+            s(&data),
+            "--method",
+            "glcm3d",
+            "--repeats",
+            repeats,
+        ];
+        let err = dir.fails(&args);
+        assert!(
+            err.contains("repeats") && err.contains("at most 10000"),
+            "{err}"
+        );
+    }
+    let out = dir.join("sim");
+    let rep = dir.join("rep");
+    dir.fails_each(
+        &[
+            (
+                vec!["simulate", "--out", s(&out), "--speeds", "0.001"],
+                "at most 600 s",
+            ),
+            (
+                vec!["simulate", "--out", s(&out), "--speeds", "1e-300"],
+                "at most 600 s",
+            ),
+            (
+                vec!["simulate", "--out", s(&out), "--trials", "4000000000"],
+                "between 1 and 10000",
+            ),
+            (
+                vec!["simulate", "--out", s(&out), "--speeds", "5,5"],
+                "5 twice",
+            ),
+            (
+                vec!["simulate", "--out", s(&out), "--textures", "FT1,ft1"],
+                "FT1 twice",
+            ),
+        ],
+        &out,
+    );
+    let args = ["reproduce", "--out", s(&rep), "--trials", "4000000000"];
+    let err = dir.fails(&args);
+    assert!(err.contains("between 1 and 10000"), "{err}");
+    assert!(!rep.exists());
+}
+
+#[test]
+fn manifest_paths_must_stay_inside_the_dataset() {
+    let dir = Dir::new();
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    std::fs::copy(data.join("A_5_0.npy"), dir.join("outside.npy")).unwrap();
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    let absolute = dir.join("outside.npy");
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&absolute, data.join("link.npy")).unwrap();
+    let mut entries = vec!["../outside.npy", s(&absolute)];
+    if cfg!(unix) {
+        entries.push("link.npy");
+    }
+    let model = dir.join("model.json");
+    for entry in entries {
+        let changed = manifest.replacen("A_5_0.npy", entry, 1);
+        std::fs::write(data.join("manifest.csv"), changed).unwrap();
+        let args = ["train", "--dataset", s(&data), "--out", s(&model)];
+        let err = dir.fails(&args);
+        assert!(
+            err.contains("manifest.csv")
+                && err.contains(entry)
+                && err.contains("outside the dataset folder"),
+            "{entry}: {err}"
+        );
+        assert!(!model.exists());
+    }
+    // a link that stays inside is fine
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(data.join("A_5_0.npy"), data.join("inside.npy")).unwrap();
+        let changed = manifest.replacen("A_5_0.npy", "inside.npy", 1);
+        std::fs::write(data.join("manifest.csv"), changed).unwrap();
+        dir.ok(&["train", "--dataset", s(&data), "--out", s(&model)]);
+    }
+}
+
+#[test]
+fn inputs_of_one_name_are_not_merged_into_one_file() {
+    let dir = Dir::new();
+    for folder in ["a", "b"] {
+        std::fs::create_dir(dir.join(folder)).unwrap();
+        std::fs::write(dir.join(folder).join("x.csv"), "t_ms,c\n0,1\n1,2\n").unwrap();
+    }
+    let out = dir.join("ds");
+    let args = [
+        "import",
+        "csv",
+        "a",
+        "b",
+        "--out",
+        s(&out),
+        "--time-column",
+        "t_ms",
+    ];
+    let err = dir.fails(&args);
+    assert!(
+        err.contains("two inputs have the file name `x.csv`"),
+        "{err}"
+    );
+    assert!(!out.exists() && !dir.partial_left());
+}

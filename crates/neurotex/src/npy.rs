@@ -1,0 +1,288 @@
+//! The header of a `.npy` file, read and checked against the file's size before any array
+//! is allocated (SPEC 8: no allocation larger than the input can hold).
+//!
+//! ndarray-npy 0.9 keeps its header parser private (`mod npy` is not public) and allocates
+//! the array the header describes before it finds the data missing, so a 192-byte file
+//! claiming shape `(10**12, 4, 4)` asks for 128 TB. This reads the header just far enough
+//! to know the dtype, the shape and where the data starts, checks that the data the shape
+//! needs is exactly what the file holds, and only then lets ndarray-npy read the file.
+
+use std::io::Read;
+use std::path::Path;
+
+use crate::error::{DataError, Result};
+
+/// Largest header accepted, in bytes. numpy writes a few hundred bytes and itself refuses
+/// headers over 10 000 bytes by default (`max_header_size`); version 1.0 cannot exceed
+/// 65 535. A larger header is not a `.npy` written by numpy.
+const MAX_HEADER_BYTES: usize = 1 << 16;
+
+/// What a `.npy` header says: element type, shape, layout and where the data starts.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct NpyHeader {
+    /// The dtype as written, e.g. `<f8`.
+    pub descr: String,
+    /// Kind letter of the dtype: `f`, `i`, `u`, `b`, `U`, `S`, ...
+    pub kind: char,
+    /// Bytes per element.
+    pub item_bytes: usize,
+    /// The shape.
+    pub shape: Vec<usize>,
+    /// Number of elements (0 when any axis is 0).
+    pub elements: usize,
+    /// Byte offset of the data.
+    pub data_offset: usize,
+}
+
+impl NpyHeader {
+    /// Whether the dtype is an integer or float type of `bytes` bytes.
+    pub fn is_number(&self) -> bool {
+        matches!(
+            (self.kind, self.item_bytes),
+            ('f', 4 | 8) | ('i' | 'u', 1 | 2 | 4 | 8)
+        )
+    }
+}
+
+/// Reads and checks the header of the `.npy` file at `path`: magic, version, an ASCII
+/// dictionary with `descr`, `fortran_order` and `shape`, a simple dtype, and a data section
+/// of exactly `elements * item_bytes` bytes (computed with checked arithmetic).
+///
+/// # Errors
+/// An unreadable file, or one that breaks any of these rules; the message names the file
+/// and what the header claims.
+pub(crate) fn read_header(path: &Path) -> Result<NpyHeader> {
+    let bad = |message: String| -> crate::Error { DataError::invalid(path, message).into() };
+    let mut file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
+    let file_len = file.metadata().map_err(|e| DataError::io(path, e))?.len();
+    let mut prefix = [0u8; 12];
+    let got = read_up_to(&mut file, &mut prefix).map_err(|e| DataError::io(path, e))?;
+    if got < 10 || &prefix[..6] != b"\x93NUMPY" {
+        return Err(bad("not a .npy file (no \\x93NUMPY magic)".into()));
+    }
+    let (header_len, start) = match prefix[6] {
+        1 => (u16::from_le_bytes([prefix[8], prefix[9]]) as usize, 10),
+        2 | 3 if got == 12 => {
+            let len = u32::from_le_bytes([prefix[8], prefix[9], prefix[10], prefix[11]]);
+            (usize::try_from(len).unwrap_or(usize::MAX), 12)
+        }
+        v => return Err(bad(format!("unsupported .npy format version {v}"))),
+    };
+    if header_len > MAX_HEADER_BYTES {
+        return Err(bad(format!(
+            ".npy header of {header_len} bytes is larger than the {MAX_HEADER_BYTES} accepted"
+        )));
+    }
+    let mut header = vec![0u8; header_len];
+    let skip = got.saturating_sub(start);
+    header[..skip.min(header_len)].copy_from_slice(&prefix[start..start + skip.min(header_len)]);
+    if skip < header_len {
+        file.read_exact(&mut header[skip..]).map_err(|_| {
+            bad(format!(
+                "file ends inside its {header_len}-byte .npy header"
+            ))
+        })?;
+    }
+    let text = std::str::from_utf8(&header)
+        .ok()
+        .filter(|t| t.is_ascii())
+        .ok_or_else(|| bad(".npy header is not ASCII text".into()))?;
+    let mut parsed = parse_dict(text).map_err(|m| bad(format!(".npy header: {m}")))?;
+    parsed.data_offset = start + header_len;
+    check_data_size(&parsed, file_len).map_err(bad)?;
+    Ok(parsed)
+}
+
+/// Reads into `buf` until it is full or the file ends; returns the bytes read.
+fn read_up_to(file: &mut std::fs::File, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match file.read(&mut buf[filled..])? {
+            0 => break,
+            n => filled += n,
+        }
+    }
+    Ok(filled)
+}
+
+/// The data the shape needs must be what the file holds, byte for byte.
+fn check_data_size(header: &NpyHeader, file_len: u64) -> std::result::Result<(), String> {
+    let shape = &header.shape;
+    let needed = (header.elements as u64).checked_mul(header.item_bytes as u64);
+    let held = file_len.saturating_sub(header.data_offset as u64);
+    match needed {
+        Some(needed) if needed == held => Ok(()),
+        Some(needed) => Err(format!(
+            "the .npy header claims shape {shape:?} of `{}` ({needed} bytes of data) but the file holds {held} bytes of data",
+            header.descr
+        )),
+        None => Err(format!(
+            "the .npy header claims shape {shape:?} of `{}`, more bytes than any file holds (this one holds {held})",
+            header.descr
+        )),
+    }
+}
+
+/// Parses the header dictionary `{'descr': '<f8', 'fortran_order': False, 'shape': (3, 4), }`.
+fn parse_dict(text: &str) -> std::result::Result<NpyHeader, String> {
+    let descr = value_after(text, "descr")?;
+    let descr = quoted(descr).ok_or_else(|| {
+        "field `descr` must be a simple dtype string such as '<f8' (structured dtypes are not supported)"
+            .to_string()
+    })?;
+    let order = value_after(text, "fortran_order")?;
+    if !(order.starts_with("False") || order.starts_with("True")) {
+        return Err("field `fortran_order` must be True or False".into());
+    }
+    let shape = parse_shape(value_after(text, "shape")?)?;
+    let (kind, item_bytes) = parse_descr(descr)?;
+    // ndarray needs the product of the non-zero axes to fit in isize even when another
+    // axis is 0, so a zero axis beside huge ones is refused rather than passed on.
+    let nonzero = shape
+        .iter()
+        .filter(|&&d| d != 0)
+        .try_fold(1usize, |acc, &d| acc.checked_mul(d))
+        .filter(|&n| n <= isize::MAX as usize)
+        .ok_or_else(|| format!("shape {shape:?} has more elements than any array can hold"))?;
+    let elements = if shape.contains(&0) { 0 } else { nonzero };
+    Ok(NpyHeader {
+        descr: descr.to_string(),
+        kind,
+        item_bytes,
+        shape,
+        elements,
+        data_offset: 0,
+    })
+}
+
+/// The text after `'key':` (or `"key":`), leading blanks removed.
+fn value_after<'a>(text: &'a str, key: &str) -> std::result::Result<&'a str, String> {
+    [format!("'{key}'"), format!("\"{key}\"")]
+        .iter()
+        .find_map(|k| text.find(k.as_str()).map(|at| &text[at + k.len()..]))
+        .and_then(|rest| rest.trim_start().strip_prefix(':'))
+        .map(str::trim_start)
+        .ok_or_else(|| format!("missing field `{key}`"))
+}
+
+/// The content of a quoted string at the start of `text`.
+fn quoted(text: &str) -> Option<&str> {
+    let quote = text.chars().next().filter(|&c| c == '\'' || c == '"')?;
+    let rest = &text[1..];
+    rest.find(quote).map(|end| &rest[..end])
+}
+
+/// `(3, 4)`, `(5,)` or `()` into its dimensions.
+fn parse_shape(text: &str) -> std::result::Result<Vec<usize>, String> {
+    let bad = || "field `shape` must be a tuple of non-negative integers".to_string();
+    let inner = text.strip_prefix('(').ok_or_else(bad)?;
+    let inner = &inner[..inner.find(')').ok_or_else(bad)?];
+    inner
+        .split(',')
+        .map(str::trim)
+        .filter(|d| !d.is_empty())
+        .map(|d| d.parse::<usize>().map_err(|_| bad()))
+        .collect()
+}
+
+/// A simple dtype `<f8`, `|u1`, `<U12`, `|S5`: its kind letter and bytes per element.
+fn parse_descr(descr: &str) -> std::result::Result<(char, usize), String> {
+    let unknown = || format!("unsupported dtype `{descr}`");
+    let mut chars = descr.chars();
+    let (order, kind) = (chars.next(), chars.next());
+    let (Some('<' | '>' | '|' | '='), Some(kind)) = (order, kind) else {
+        return Err(unknown());
+    };
+    let width: usize = chars.as_str().parse().map_err(|_| unknown())?;
+    let item_bytes = match kind {
+        'U' => width.checked_mul(4).ok_or_else(unknown)?,
+        'f' | 'i' | 'u' | 'b' | 'S' | 'c' => width,
+        _ => return Err(unknown()),
+    };
+    if item_bytes == 0 {
+        return Err(unknown());
+    }
+    Ok((kind, item_bytes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A version 1.0 `.npy` with `header` (padded as numpy pads it) and `data` bytes.
+    fn npy_bytes(descr: &str, shape: &str, data: &[u8]) -> Vec<u8> {
+        let mut h = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+        while (10 + h.len() + 1) % 64 != 0 {
+            h.push(' ');
+        }
+        h.push('\n');
+        let mut out = b"\x93NUMPY\x01\x00".to_vec();
+        out.extend((h.len() as u16).to_le_bytes());
+        out.extend(h.as_bytes());
+        out.extend(data);
+        out
+    }
+
+    fn header_of(bytes: &[u8]) -> Result<NpyHeader> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.npy");
+        std::fs::write(&path, bytes).unwrap();
+        read_header(&path)
+    }
+
+    #[test]
+    fn a_shape_larger_than_the_file_is_refused_before_allocating() {
+        let bytes = npy_bytes("<f8", "(1000000000000, 4, 4)", &[0; 64]);
+        let message = header_of(&bytes).unwrap_err().to_string();
+        assert!(message.contains("[1000000000000, 4, 4]"), "{message}");
+        assert!(message.contains("holds 64 bytes"), "{message}");
+    }
+
+    #[test]
+    fn a_zero_axis_beside_huge_ones_is_refused() {
+        let bytes = npy_bytes("<f8", "(0, 1000000000000, 1000000000000)", &[]);
+        let message = header_of(&bytes).unwrap_err().to_string();
+        assert!(
+            message.contains("more elements than any array"),
+            "{message}"
+        );
+        // a zero axis beside reasonable ones is an empty array, which is fine here
+        let ok = header_of(&npy_bytes("<f8", "(0, 4, 4)", &[])).unwrap();
+        assert_eq!((ok.elements, ok.shape), (0, vec![0, 4, 4]));
+    }
+
+    #[test]
+    fn non_ascii_and_unknown_dtypes_are_errors() {
+        for descr in ["<f\u{e9}8", "<q16", "<f", "", "<U0"] {
+            let message = header_of(&npy_bytes(descr, "(2,)", &[0; 16]))
+                .unwrap_err()
+                .to_string();
+            assert!(message.contains("header"), "{descr}: {message}");
+        }
+    }
+
+    #[test]
+    fn a_well_formed_header_is_read() {
+        let h = header_of(&npy_bytes("<U3", "(2,)", &[0; 24])).unwrap();
+        assert_eq!((h.kind, h.item_bytes, h.elements), ('U', 12, 2));
+        assert_eq!(h.data_offset % 64, 0, "numpy pads the header to 64 bytes");
+        let h = header_of(&npy_bytes("<f4", "(2, 3)", &[0; 24])).unwrap();
+        assert!(h.is_number());
+        // one byte too few or too many
+        assert!(header_of(&npy_bytes("<f4", "(2, 3)", &[0; 23])).is_err());
+        assert!(header_of(&npy_bytes("<f4", "(2, 3)", &[0; 25])).is_err());
+    }
+
+    #[test]
+    fn garbage_is_an_error_not_a_panic() {
+        for bytes in [
+            &b""[..],
+            b"\x93NUMPY",
+            b"\x93NUMPY\x01\x00\xff\xff{",
+            b"\x93NUMPY\x02\x00\xff\xff\xff\xff",
+            b"\x93NUMPY\x09\x00\x00\x00",
+        ] {
+            assert!(header_of(bytes).is_err());
+        }
+    }
+}
