@@ -3,6 +3,7 @@
 //! failed run leaves no partial output).
 
 mod commands;
+mod open_args;
 mod output;
 mod stage_args;
 

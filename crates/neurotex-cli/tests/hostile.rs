@@ -288,6 +288,10 @@ fn manifest_paths_must_stay_inside_the_dataset() {
             "{entry}: {err}"
         );
         assert!(!model.exists());
+        assert!(err.contains("--allow-outside-paths"), "{err}");
+        // The user may let them out.
+        dir.ok(&[&args[..], &["--allow-outside-paths"]].concat());
+        std::fs::remove_file(&model).unwrap();
     }
     // a link that stays inside is fine
     #[cfg(unix)]

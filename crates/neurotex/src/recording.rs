@@ -687,7 +687,7 @@ impl Dataset {
 /// Returns why not.
 fn check_inside(root: &Path, file: &str) -> std::result::Result<(), String> {
     use std::path::Component;
-    let outside = "lies outside the dataset folder; manifest paths must stay inside it";
+    let outside = "lies outside the dataset folder; manifest paths must stay inside it (--allow-outside-paths lets them out)";
     let relative = Path::new(file)
         .components()
         .all(|c| matches!(c, Component::Normal(_) | Component::CurDir));

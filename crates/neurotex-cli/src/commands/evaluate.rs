@@ -18,6 +18,7 @@ use neurotex::recording::{Dataset, Selection};
 use neurotex::{Cell, Speed};
 
 use super::{calibrated_pipeline, encoded_features};
+use crate::open_args::OpenArgs;
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
@@ -109,6 +110,8 @@ pub struct EvaluateArgs {
     pub predictions: Option<PathBuf>,
     #[command(flatten)]
     pub stages: StageArgs,
+    #[command(flatten)]
+    pub open: OpenArgs,
 }
 
 impl EvaluateArgs {
@@ -199,7 +202,7 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     if args.predictions.is_some() && columns == Columns::EachTaxel {
         bail!("--predictions needs one classifier, not one per taxel: add --taxel ROW,COL");
     }
-    let dataset = Dataset::open(&args.dataset)?;
+    let dataset = args.open.open(&args.dataset)?;
     let indices = args.indices(&dataset)?;
     let (params, calibration) = calibrated_pipeline(
         &args.stages,

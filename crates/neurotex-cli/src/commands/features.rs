@@ -7,9 +7,9 @@ use anyhow::Result;
 use clap::Args;
 use neurotex::analysis::FeatureTable;
 use neurotex::pipeline::{Method, Pipeline};
-use neurotex::recording::Dataset;
 
 use super::{calibrated_pipeline, feature_table};
+use crate::open_args::OpenArgs;
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
@@ -29,11 +29,13 @@ pub struct FeaturesArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub stages: StageArgs,
+    #[command(flatten)]
+    pub open: OpenArgs,
 }
 
 /// Runs `neurotex features`.
 pub fn run(args: FeaturesArgs) -> Result<()> {
-    let dataset = Dataset::open(&args.dataset)?;
+    let dataset = args.open.open(&args.dataset)?;
     // Features are computed for every recording; `--gain auto` calibrates on all of them.
     let all: Vec<usize> = (0..dataset.entries.len()).collect();
     let (params, _) = calibrated_pipeline(&args.stages, &dataset, &all)?;

@@ -13,6 +13,7 @@ use neurotex::recording::{read_recording, Dataset, LayoutFile};
 use rayon::prelude::*;
 
 use super::report_conditions;
+use crate::open_args::OpenArgs;
 use crate::output::{progress, write_file};
 
 /// Options of `neurotex predict`.
@@ -41,6 +42,8 @@ pub struct PredictArgs {
     /// needs --dataset, and every label there must be a class of the model.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub open: OpenArgs,
 }
 
 /// Runs `neurotex predict`.
@@ -50,7 +53,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
     }
     let model = Model::load(&args.model)?;
     let (encoded, known) = match &args.dataset {
-        Some(dir) => (encode_dataset(&model, dir)?, true),
+        Some(dir) => (encode_dataset(&model, &args.open.open(dir)?)?, true),
         None => (
             encode_files(&model, &args.files, args.layout.as_deref())?,
             false,
@@ -80,22 +83,21 @@ pub fn run(args: PredictArgs) -> Result<()> {
     Ok(())
 }
 
-/// Encodes every recording of the dataset at `dir` with the model's pipeline.
-fn encode_dataset(model: &Model, dir: &Path) -> Result<Vec<Encoded>> {
-    let dataset = Dataset::open(dir)?;
+/// Encodes every recording of `dataset` with the model's pipeline.
+fn encode_dataset(model: &Model, dataset: &Dataset) -> Result<Vec<Encoded>> {
     let layout_baseline = dataset.layout.baseline.unwrap_or_default();
     if layout_baseline != model.baseline() {
         eprintln!(
             "note: the model removes baseline `{}` as in training; {} says `{layout_baseline}`",
             model.baseline(),
-            dir.join("layout.toml").display()
+            dataset.root.join("layout.toml").display()
         );
     }
     let all: Vec<usize> = (0..dataset.entries.len()).collect();
     let bar = progress(all.len(), "encoding");
     let encoded = model
         .pipeline()
-        .encode_dataset(&dataset, &all, &|| bar.inc(1));
+        .encode_dataset(dataset, &all, &|| bar.inc(1));
     bar.finish_and_clear();
     Ok(encoded?)
 }

@@ -12,10 +12,10 @@ use neurotex::experiments::{
     claims, prepare, run_all, run_seeds, Progress, ReproduceParams, Source, ValidReproduceParams,
 };
 use neurotex::pipeline::Pipeline;
-use neurotex::recording::Dataset;
 use neurotex::report::{write_report, ReportContext};
 
 use super::say_calibration;
+use crate::open_args::OpenArgs;
 use crate::output::progress;
 use crate::stage_args::StageArgs;
 
@@ -57,6 +57,8 @@ pub struct ReproduceArgs {
     pub group_by: Option<String>,
     #[command(flatten)]
     pub stages: StageArgs,
+    #[command(flatten)]
+    pub open: OpenArgs,
 }
 
 impl ReproduceArgs {
@@ -120,7 +122,7 @@ impl ReproduceArgs {
 pub fn run(args: ReproduceArgs) -> Result<()> {
     let started = Instant::now();
     let dataset = match &args.dataset {
-        Some(dir) => Some(Dataset::open(dir)?),
+        Some(dir) => Some(args.open.open(dir)?),
         None => None,
     };
     let bar = Mutex::new(progress(0, "starting"));

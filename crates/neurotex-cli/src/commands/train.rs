@@ -8,10 +8,10 @@ use clap::Args;
 use neurotex::analysis::Columns;
 use neurotex::model::{Model, Provenance};
 use neurotex::pipeline::{Method, Pipeline};
-use neurotex::recording::Dataset;
 use neurotex::{Cell, Speed};
 
 use super::{calibrated_pipeline, feature_table};
+use crate::open_args::OpenArgs;
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex train`.
@@ -39,11 +39,13 @@ pub struct TrainArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub stages: StageArgs,
+    #[command(flatten)]
+    pub open: OpenArgs,
 }
 
 /// Runs `neurotex train`.
 pub fn run(args: TrainArgs) -> Result<()> {
-    let dataset = Dataset::open(&args.dataset)?;
+    let dataset = args.open.open(&args.dataset)?;
     let indices = match &args.speeds {
         Some(speeds) => dataset.indices_at(speeds)?,
         None => (0..dataset.entries.len()).collect(),
