@@ -144,6 +144,7 @@ fn reproduce_group_by_keeps_groups_in_folds_and_names_a_missing_column() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 6);
     let out = dir.join("grouped");
+    let predictions = dir.join("predictions.csv");
     let run = dir.run(&[
         "reproduce",
         "--dataset",
@@ -153,6 +154,8 @@ fn reproduce_group_by_keeps_groups_in_folds_and_names_a_missing_column() {
         "trial",
         "--out",
         s(&out),
+        "--predictions",
+        s(&predictions),
     ]);
     assert!(run.status.success(), "{}", run.stderr);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
@@ -160,6 +163,25 @@ fn reproduce_group_by_keeps_groups_in_folds_and_names_a_missing_column() {
         report.contains("keeping each `trial` group in one fold"),
         "parameters line"
     );
+    // Each recording is predicted once per repeat at its speed, and the recordings of one
+    // trial (the group: `{label}_{speed}_{trial}.npy`) share one fold.
+    let text = std::fs::read_to_string(&predictions).unwrap();
+    let mut lines = text.lines();
+    let header = "speed_mm_s,method,file,label,predicted,fold,repeat";
+    assert_eq!(lines.next(), Some(header));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(
+        rows.len(),
+        3 * 2 * 6 * 2,
+        "3 classes x 2 speeds x 6 trials x 2 repeats"
+    );
+    let mut fold_of = std::collections::HashMap::new();
+    for r in &rows {
+        let trial = r[2].trim_end_matches(".npy").rsplit('_').next().unwrap();
+        let key = (r[0], r[6], trial);
+        let fold = *fold_of.entry(key).or_insert(r[5]);
+        assert_eq!(fold, r[5], "{key:?} split over folds");
+    }
     let missing = dir.join("missing");
     dir.fails_each(
         &[(

@@ -9,14 +9,15 @@ use clap::Args;
 use indicatif::ProgressBar;
 use neurotex::calibrate::GainCalibration;
 use neurotex::experiments::{
-    claims, prepare, run_all, run_seeds, Progress, ReproduceParams, Source, ValidReproduceParams,
+    claims, prepare, run_all, run_seeds, HeadlinePrediction, Progress, ReproduceParams, Source,
+    ValidReproduceParams,
 };
 use neurotex::pipeline::Pipeline;
 use neurotex::report::{write_report, ReportContext};
 
 use super::say_calibration;
 use crate::open_args::OpenArgs;
-use crate::output::progress;
+use crate::output::{progress, write_file};
 use crate::stage_args::StageArgs;
 
 /// Most simulated datasets one run accepts (each takes seconds; more is a typo).
@@ -55,6 +56,11 @@ pub struct ReproduceArgs {
     /// groups than folds at a speed, each group is held out in turn.
     #[arg(long = "group-by")]
     pub group_by: Option<String>,
+    /// Write the headline 3D-GLCM evaluations' out-of-fold predictions to this CSV file:
+    /// `speed_mm_s,method,file,label,predicted,fold,repeat`, one row per recording and CV
+    /// repeat at each speed (of the first dataset with --seeds).
+    #[arg(long)]
+    pub predictions: Option<PathBuf>,
     #[command(flatten)]
     pub stages: StageArgs,
     #[command(flatten)]
@@ -162,6 +168,11 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         paper_comparable: dataset.is_none(),
     };
     write_report(&args.out, &results, &ctx)?;
+    if let Some(path) = &args.predictions {
+        write_file(path, "out-of-fold predictions", |w| {
+            write_headline_predictions(w, &results.predictions)
+        })?;
+    }
     for claim in claims(&results) {
         eprintln!("{:<40} {}", claim.verdict.describe(), claim.statement);
     }
@@ -171,6 +182,37 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Writes `speed_mm_s,method,file,label,predicted,fold,repeat`, one row per prediction.
+fn write_headline_predictions(
+    w: &mut dyn std::io::Write,
+    predictions: &[HeadlinePrediction],
+) -> std::io::Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    let header = [
+        "speed_mm_s",
+        "method",
+        "file",
+        "label",
+        "predicted",
+        "fold",
+        "repeat",
+    ];
+    out.write_record(header)?;
+    for p in predictions {
+        let fold = p.fold.map_or("test".to_string(), |f| f.to_string());
+        out.write_record([
+            p.speed.to_string().as_str(),
+            p.method,
+            &p.file,
+            &p.label,
+            &p.predicted,
+            &fold,
+            &p.repeat.to_string(),
+        ])?;
+    }
+    out.flush()
 }
 
 /// The report's data paragraph for a run over simulated datasets: the first dataset's

@@ -122,6 +122,10 @@ pub struct Results {
     /// The code, parameters, data and date of the run (left out of golden comparisons,
     /// whose date and commit change).
     pub provenance: Option<Provenance>,
+    /// The headline 3D-GLCM evaluations' out-of-fold predictions, one per recording and CV
+    /// repeat at each speed (`reproduce --predictions`); not part of `results.json`.
+    #[serde(skip)]
+    pub predictions: Vec<HeadlinePrediction>,
     /// Analyses skipped, with the reason.
     pub skipped: BTreeMap<String, String>,
     /// Wall-clock seconds per analysis.
@@ -151,6 +155,7 @@ impl Results {
             across_seeds: None,
             gain_calibration: None,
             provenance: Some(prepared.provenance.clone()),
+            predictions: Vec::new(),
             skipped: BTreeMap::new(),
             timing_s: BTreeMap::new(),
         }
@@ -159,6 +164,46 @@ impl Results {
     fn skip(&mut self, skip: &Skip) {
         self.skipped.insert(skip.key(), skip.to_string());
     }
+}
+
+/// One out-of-fold prediction of a headline evaluation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeadlinePrediction {
+    /// The speed evaluated at.
+    pub speed: Speed,
+    /// The method (`3D-GLCM`).
+    pub method: &'static str,
+    /// The recording's file, as in the manifest.
+    pub file: String,
+    /// Its true label.
+    pub label: String,
+    /// The predicted label.
+    pub predicted: String,
+    /// The fold it was tested in.
+    pub fold: Option<usize>,
+    /// The CV repeat.
+    pub repeat: usize,
+}
+
+/// The 3D-GLCM headline predictions at every speed, in speed order.
+fn headline_predictions(tables: &Tables) -> Vec<HeadlinePrediction> {
+    let mut out = Vec::new();
+    for (speed, headline) in tables.headline.iter() {
+        let outcome = &headline.glcm3d;
+        for p in outcome.predictions.iter().flatten() {
+            let meta = &tables.glcm3d.metas[p.row];
+            out.push(HeadlinePrediction {
+                speed,
+                method: "3D-GLCM",
+                file: meta.file.clone(),
+                label: meta.label.clone(),
+                predicted: outcome.labels[p.predicted].clone(),
+                fold: p.fold,
+                repeat: p.repeat,
+            });
+        }
+    }
+    out
 }
 
 /// One analysis: its id (the key of its timing and skip) and how its result is stored.
@@ -261,6 +306,7 @@ pub fn run_all(
     progress(Progress::Stage("analyses", ANALYSES.len() + 1));
     let clock = Instant::now();
     let tables = Tables::build(prepared, params)?;
+    results.predictions = headline_predictions(&tables);
     results
         .timing_s
         .insert("tables".into(), clock.elapsed().as_secs_f64());

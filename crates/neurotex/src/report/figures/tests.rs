@@ -259,6 +259,7 @@ pub(crate) fn wide() -> Results {
         e8,
         sensitivity: None,
         across_seeds: None,
+        predictions: Vec::new(),
         gain_calibration: None,
         provenance: None,
         skipped: BTreeMap::new(),
