@@ -94,14 +94,6 @@ pub enum Split {
         /// fold may split; `None` for stratified folds.
         group_by: Option<String>,
     },
-    /// Train on recordings at `train` speeds, test on those at `test` speeds: a
-    /// [`Split::Where`] on `speed_mm_s`.
-    ByCondition {
-        /// Training speeds.
-        train: Vec<Speed>,
-        /// Test speeds.
-        test: Vec<Speed>,
-    },
     /// Train on the recordings `train` selects, test on those `test` selects (by speed,
     /// trial, force or any further manifest column); no recording may be in both.
     Where {
@@ -356,7 +348,7 @@ pub fn evaluate<C: Classifier>(
                 Split::CrossValidation { cv, .. } => {
                     cross_validate(classifier, &x_train, cols.len(), y_train, &labels, *cv)?
                 }
-                Split::ByCondition { .. } | Split::Where { .. } => {
+                Split::Where { .. } => {
                     let x_test = table.select(&test_rows, cols);
                     let (train, test) = ((&x_train[..], y_train), (&x_test[..], y_test));
                     train_test(classifier, train, test, cols.len(), &labels)?
@@ -398,9 +390,6 @@ fn split_rows(table: &FeatureTable, split: &Split) -> Result<(Vec<usize>, Vec<us
         Split::CrossValidation {
             speeds: Some(s), ..
         } => (table.rows_at(s), vec![]),
-        Split::ByCondition { train, test } => {
-            disjoint(table, &Selection::speeds(train), &Selection::speeds(test))?
-        }
         Split::Where { train, test } => disjoint(table, train, test)?,
     })
 }

@@ -310,11 +310,6 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
             cv.seed,
             cv.repeats
         ),
-        Split::ByCondition { train, test } => format!(
-            "train on {}, test on {}",
-            selected(&Selection::speeds(train)),
-            selected(&Selection::speeds(test))
-        ),
         Split::Where { train, test } => {
             format!("train on {}, test on {}", selected(train), selected(test))
         }

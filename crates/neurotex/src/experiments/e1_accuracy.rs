@@ -6,7 +6,6 @@ use serde::{Deserialize, Serialize};
 use super::{compare, Comparison, Context, Stop};
 use crate::classify::Interval;
 use crate::values::BySpeed;
-use crate::values::Cell;
 
 /// E1 at one speed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -65,7 +64,10 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
             let classes = truth.iter().filter(|&&n| n > 0).count();
             let e1 = E1Speed {
                 taxel_mean: h.taxel.accuracy,
-                taxel_mean_responsive: responsive_mean(c, &h.taxel),
+                taxel_mean_responsive: c
+                    .prepared
+                    .taxels
+                    .responsive_mean(h.taxel.per_taxel.as_deref().unwrap_or_default()),
                 taxel_best: best.accuracy,
                 taxel_best_cell: format!("r{}c{}", best.row, best.col),
                 glcm3d: h.glcm3d.accuracy,
@@ -85,26 +87,6 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
             Ok((speed, e1))
         })
         .collect()
-}
-
-/// The mean accuracy over the taxels that respond, from an every-taxel evaluation.
-fn responsive_mean(c: &Context, taxel: &crate::analysis::Outcome) -> Option<f64> {
-    let diagnostics = &c.prepared.taxels;
-    let per = taxel.per_taxel.as_deref().unwrap_or_default();
-    let responsive: Vec<f64> = per
-        .iter()
-        .filter(|t| {
-            diagnostics.responsive(
-                &Cell {
-                    row: t.row,
-                    col: t.col,
-                }
-                .to_string(),
-            )
-        })
-        .map(|t| t.accuracy)
-        .collect();
-    (!responsive.is_empty()).then(|| responsive.iter().sum::<f64>() / responsive.len() as f64)
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{compare, Comparison, Context, Skip, Stop};
 use crate::analysis::{evaluate, Columns, Split};
+use crate::recording::Selection;
 use crate::values::{BySpeed, Speed};
 
 /// E6 at one held-out speed.
@@ -32,9 +33,9 @@ pub fn e6_speed_invariance(c: &Context) -> Result<BySpeed<E6Speed>, Stop> {
     let mut out = BySpeed::new();
     for &test in speeds {
         let train: Vec<Speed> = speeds.iter().copied().filter(|&s| s != test).collect();
-        let split = Split::ByCondition {
-            train: train.clone(),
-            test: vec![test],
+        let split = Split::Where {
+            train: Selection::speeds(&train),
+            test: Selection::speeds(&[test]),
         };
         let knn = c.params.knn();
         let taxel = evaluate(&c.tables.taxel, Columns::EachTaxel, &split, knn)?;
