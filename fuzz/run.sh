@@ -13,14 +13,17 @@ targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
     targets=(npy csv manifest layout dataset import_csv import_stacked)
 fi
+# One build, then the targets' binaries run directly: `cargo fuzz run` would check the build
+# again per target, and neurotex's build script (the git commit) can make that a rebuild.
 cargo +nightly fuzz build
-./target/x86_64-unknown-linux-gnu/release/seeds >/dev/null
+bin=./target/x86_64-unknown-linux-gnu/release
+"$bin/seeds" >/dev/null
 mkdir -p logs
 found=0
 for t in "${targets[@]}"; do
     mkdir -p "corpus/$t" "artifacts/$t"
     before=$(find "artifacts/$t" -type f | wc -l)
-    cargo +nightly fuzz run "$t" "corpus/$t" -- \
+    "$bin/$t" "corpus/$t" \
         -fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1 \
         -rss_limit_mb=4096 -malloc_limit_mb=4096 -timeout=10 \
         -max_total_time="$secs" -artifact_prefix="artifacts/$t/" >"logs/$t.log" 2>&1 || true

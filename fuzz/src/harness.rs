@@ -346,10 +346,7 @@ mask = [\"11\", \"11\"]\nbaseline = { kind = \"min\" }\ntime_column = \"t_ms\"\n
         ("layout", grid_layout.clone()),
         ("layout", b"fs = 250\n".to_vec()),
         ("dataset", join(&[&manifest, b"", &timed, &grid])),
-        (
-            "dataset",
-            join(&[&manifest, &grid_layout, &timed_4, &grid]),
-        ),
+        ("dataset", join(&[&manifest, &grid_layout, &timed_4, &grid])),
     ];
     for selector in 0..5u8 {
         let body = if selector == 3 { &untimed } else { &timed };
@@ -361,9 +358,15 @@ mask = [\"11\", \"11\"]\nbaseline = { kind = \"min\" }\ntime_column = \"t_ms\"\n
     out.push(("import_csv", join(&[b"\x35\n", &untimed])));
     out.push(("import_csv", join(&[b"\x01", &sample_3])));
     let labels = label_bytes(&["FT1", "SB", "CP"]);
-    out.push(("import_stacked", join(&[b"\x04", &npy_bytes(&[3, 5, 2, 2]), &labels])));
+    out.push((
+        "import_stacked",
+        join(&[b"\x04", &npy_bytes(&[3, 5, 2, 2]), &labels]),
+    ));
     let speeds = npy_bytes(&[3]);
     let ints = npy_bytes(&[3]);
-    out.push(("import_stacked", join(&[b"\x0a", &npy_bytes(&[3, 4, 6]), &ints, &speeds])));
+    out.push((
+        "import_stacked",
+        join(&[b"\x0a", &npy_bytes(&[3, 4, 6]), &ints, &speeds]),
+    ));
     out
 }

@@ -62,7 +62,10 @@ fn interrupt_simulate(signal: &str) {
     let out = dir.join("out");
     while !(out.is_dir() && names(&out).iter().any(|n| n.starts_with(".ds.partial-"))) {
         assert!(child.try_wait().unwrap().is_none(), "simulate ended first");
-        assert!(started.elapsed() < Duration::from_secs(60), "no temporary folder");
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "no temporary folder"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     let pid = child.id().to_string();
@@ -101,7 +104,16 @@ fn reproduce_that_cannot_write_leaves_no_partial_output() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[5.0], 5);
     let ds = s(&ds).to_string();
-    let quick = |out: &'static str| ["reproduce", "--dataset", ds.as_str(), "--out", out, "--quick"];
+    let quick = |out: &'static str| {
+        [
+            "reproduce",
+            "--dataset",
+            ds.as_str(),
+            "--out",
+            out,
+            "--quick",
+        ]
+    };
     // the output's folder is a file
     std::fs::write(dir.join("file"), "x").unwrap();
     dir.fails(&quick("file/report"));
@@ -134,7 +146,10 @@ fn reproduce_that_cannot_write_leaves_no_partial_output() {
     // with room, the report lands beside what was there
     dir.ok(&quick("report"));
     let written = names(&dir.join("report"));
-    assert_eq!(written, ["figures", "notes.txt", "report.md", "results.json"]);
+    assert_eq!(
+        written,
+        ["figures", "notes.txt", "report.md", "results.json"]
+    );
     assert!(!names(&dir.join("report/figures")).is_empty());
     assert_eq!(names(dir.path()), ["ds", "file", "report"]);
 }

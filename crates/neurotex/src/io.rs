@@ -234,7 +234,10 @@ pub fn create_parents(path: &Path) -> Result<Option<Temporary>> {
         return Err(DataError::invalid(dir, "is not a folder").into());
     }
     let mut top = dir;
-    while let Some(up) = top.parent().filter(|p| !p.as_os_str().is_empty() && !p.exists()) {
+    while let Some(up) = top
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty() && !p.exists())
+    {
         top = up;
     }
     let tmp = Temporary::new(top.to_path_buf());
@@ -294,7 +297,11 @@ mod tests {
         });
         assert!(failed.is_err());
         assert!(names(dir.path()).is_empty());
-        create_dir_atomic(&out, |tmp| Ok(std::fs::write(tmp.join("f"), "f").unwrap())).unwrap();
+        create_dir_atomic(&out, |tmp| {
+            std::fs::write(tmp.join("f"), "f").unwrap();
+            Ok(())
+        })
+        .unwrap();
         assert_eq!(names(&out), ["f"]);
         assert_eq!(names(&dir.path().join("x/y")), ["out"]);
     }

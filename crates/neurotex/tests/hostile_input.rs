@@ -55,7 +55,10 @@ fn sets_unbounded_size(bytes: &[u8], at: usize) -> bool {
         .windows(6)
         .rposition(|w| w == b"\x93NUMPY")
         .is_some_and(|start| !bytes[start..at].contains(&b'\n'));
-    let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
     let line = &bytes[line_start..at];
     let layout_size = [&b"rows"[..], b"cols", b"channel_map"]
         .iter()
@@ -70,11 +73,19 @@ fn mutants(seed: &[u8]) -> Vec<Mutant> {
     for i in (0..n).step_by((n / 48).max(1)) {
         let mut bytes = seed.to_vec();
         bytes[i] ^= 1 << (i % 8);
-        out.push(Mutant { what: format!("bit {} of byte {i} flipped", i % 8), bytes, pending: false });
+        out.push(Mutant {
+            what: format!("bit {} of byte {i} flipped", i % 8),
+            bytes,
+            pending: false,
+        });
     }
     for len in [0, 1, n / 4, n / 2, 3 * n / 4, n.saturating_sub(1)] {
         let bytes = seed[..len.min(n)].to_vec();
-        out.push(Mutant { what: format!("cut to {len} bytes"), bytes, pending: false });
+        out.push(Mutant {
+            what: format!("cut to {len} bytes"),
+            bytes,
+            pending: false,
+        });
     }
     for (start, end) in digit_runs(seed) {
         for huge in HUGE {
@@ -95,7 +106,11 @@ fn run_all(pending: bool) -> (usize, Vec<String>) {
     let mut ran = 0;
     let mut panics = Vec::new();
     for (target, seed) in harness::seeds() {
-        let seed_itself = Mutant { what: "the seed".into(), bytes: seed.clone(), pending: false };
+        let seed_itself = Mutant {
+            what: "the seed".into(),
+            bytes: seed.clone(),
+            pending: false,
+        };
         for m in std::iter::once(seed_itself).chain(mutants(&seed)) {
             if m.pending != pending {
                 continue;
@@ -114,7 +129,11 @@ fn readers_answer_mutated_files_with_errors_not_panics() {
     let (ran, panics) = run_all(false);
     assert!(ran > 1000, "only {ran} cases");
     eprintln!("{ran} cases, none panicked");
-    assert!(panics.is_empty(), "{} of {ran} cases panicked: {panics:#?}", panics.len());
+    assert!(
+        panics.is_empty(),
+        "{} of {ran} cases panicked: {panics:#?}",
+        panics.len()
+    );
 }
 
 /// Huge sizes in NPY headers and layouts: the readers allocate what the header claims (an
@@ -127,7 +146,11 @@ fn huge_sizes_in_headers_pending_resource_limits() {
         return;
     }
     let (ran, panics) = run_all(true);
-    assert!(panics.is_empty(), "{} of {ran} cases panicked: {panics:#?}", panics.len());
+    assert!(
+        panics.is_empty(),
+        "{} of {ran} cases panicked: {panics:#?}",
+        panics.len()
+    );
 }
 
 #[test]
@@ -135,7 +158,10 @@ fn the_seeds_are_valid_files() {
     use neurotex::recording::{read_manifest, LayoutFile};
     let seeds = harness::seeds();
     for target in harness::TARGETS {
-        assert!(seeds.iter().any(|(t, _)| *t == target), "no seed for {target}");
+        assert!(
+            seeds.iter().any(|(t, _)| *t == target),
+            "no seed for {target}"
+        );
     }
     let case = harness::Case::new();
     for (target, bytes) in &seeds {
