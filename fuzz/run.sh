@@ -24,7 +24,7 @@ for t in "${targets[@]}"; do
     mkdir -p "corpus/$t" "artifacts/$t"
     before=$(find "artifacts/$t" -type f | wc -l)
     "$bin/$t" "corpus/$t" \
-        -fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1 \
+        -dict=neurotex.dict -fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1 \
         -rss_limit_mb=4096 -malloc_limit_mb=4096 -timeout=10 \
         -max_total_time="$secs" -artifact_prefix="artifacts/$t/" >"logs/$t.log" 2>&1 || true
     after=$(find "artifacts/$t" -type f | wc -l)

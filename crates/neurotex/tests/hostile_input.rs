@@ -154,8 +154,7 @@ fn huge_sizes_in_headers_pending_resource_limits() {
 }
 
 #[test]
-fn the_seeds_are_valid_files() {
-    use neurotex::recording::{read_manifest, LayoutFile};
+fn every_seed_is_accepted_all_the_way() {
     let seeds = harness::seeds();
     for target in harness::TARGETS {
         assert!(
@@ -163,20 +162,10 @@ fn the_seeds_are_valid_files() {
             "no seed for {target}"
         );
     }
-    let case = harness::Case::new();
-    for (target, bytes) in &seeds {
-        match *target {
-            "manifest" => {
-                read_manifest(&case.file("manifest.csv", bytes)).unwrap();
-            }
-            "layout" => {
-                LayoutFile::read(&case.file("layout.toml", bytes)).unwrap();
-            }
-            "npy" => {
-                let path = case.file("r.npy", bytes);
-                neurotex::recording::read_recording(&path, &LayoutFile::default()).unwrap();
-            }
-            _ => {}
-        }
+    for (i, (target, bytes)) in seeds.iter().enumerate() {
+        assert!(
+            harness::run(target, bytes),
+            "seed {i} of {target} is refused"
+        );
     }
 }
