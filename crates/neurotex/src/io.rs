@@ -41,13 +41,15 @@ fn remove(path: &Path) {
 #[derive(Debug)]
 pub struct Temporary {
     path: PathBuf,
+    /// Renamed into place or kept: nothing to remove.
+    done: bool,
 }
 
 impl Temporary {
     /// Registers `path` as temporary; the caller then creates it.
     pub fn new(path: PathBuf) -> Self {
         registry().push(path.clone());
-        Temporary { path }
+        Temporary { path, done: false }
     }
 
     /// The hidden temporary name beside `path` (`.name.partial-PID`), registered.
@@ -77,20 +79,21 @@ impl Temporary {
     ///
     /// # Errors
     /// The rename fails (the temporary is then removed).
-    pub fn persist(self, dest: &Path) -> std::io::Result<()> {
+    pub fn persist(mut self, dest: &Path) -> std::io::Result<()> {
         let mut list = registry();
         let result = std::fs::rename(&self.path, dest);
         if result.is_ok() {
             forget(&mut list, &self.path);
-            std::mem::forget(self);
+            self.done = true;
         }
+        drop(list);
         result
     }
 
     /// Keeps the temporary where it is: it is no longer removed.
-    pub fn keep(self) {
+    pub fn keep(mut self) {
         forget(&mut registry(), &self.path);
-        std::mem::forget(self);
+        self.done = true;
     }
 }
 
@@ -102,6 +105,9 @@ fn forget(list: &mut Vec<PathBuf>, path: &Path) {
 
 impl Drop for Temporary {
     fn drop(&mut self) {
+        if self.done {
+            return;
+        }
         let mut list = registry();
         remove(&self.path);
         forget(&mut list, &self.path);
