@@ -16,6 +16,16 @@ pub fn write_file(
     neurotex::io::write_atomic(path, fill).with_context(|| format!("writing {what}"))
 }
 
+/// Writes `what` for `path` through `fill` into a temporary file ([`neurotex::io::stage`]),
+/// to be put in place by [`neurotex::io::Staged::commit`] once every output is written.
+pub fn stage_file(
+    path: &Path,
+    what: &str,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<neurotex::io::Staged> {
+    neurotex::io::stage(path, fill).with_context(|| format!("writing {what}"))
+}
+
 /// A progress bar on standard error, drawn only on a terminal.
 pub fn progress(len: usize, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);

@@ -2,6 +2,7 @@
 //! JSON keys, and bad input (clear message, non-zero exit, no output file). One module per
 //! subcommand; `util` runs the binary and writes the datasets.
 
+mod atomic;
 mod conditions;
 mod encode;
 mod evaluate;

@@ -1346,40 +1346,14 @@ pub fn write_manifest(dir: &Path, metas: &[Meta]) -> Result<()> {
     Ok(())
 }
 
-/// Creates dataset folder `dir` whole or not at all: `fill` writes into a temporary folder
-/// beside it, which is renamed to `dir` only when `fill` succeeds (and removed otherwise).
+/// Creates dataset folder `dir` whole or not at all, with [`crate::io::create_dir_atomic`]:
+/// `fill` writes into a temporary folder beside it, which is renamed to `dir` only when
+/// `fill` succeeds (and removed otherwise, or on SIGINT/SIGTERM in the binary).
 ///
 /// # Errors
 /// `dir` exists and is not empty, or `fill` or the rename fails.
 pub fn create_dataset_dir<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
-    if dir.exists()
-        && std::fs::read_dir(dir)
-            .map(|mut d| d.next().is_some())
-            .unwrap_or(true)
-    {
-        return Err(DataError::invalid(dir, "output folder exists and is not empty").into());
-    }
-    let name = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "dataset".into());
-    let parent = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).map_err(|e| DataError::io(&tmp, e))?;
-    let result = fill(&tmp).and_then(|value| {
-        if dir.exists() {
-            std::fs::remove_dir(dir).map_err(|e| DataError::io(dir, e))?;
-        }
-        std::fs::rename(&tmp, dir).map_err(|e| DataError::io(dir, e))?;
-        Ok(value)
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
-    }
-    result
+    crate::io::create_dir_atomic(dir, fill)
 }
 
 /// Writes `layout.toml` into `dir`.

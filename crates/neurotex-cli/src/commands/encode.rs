@@ -12,7 +12,7 @@ use neurotex::recording::{read_recording, LayoutFile};
 use neurotex::SampleRate;
 
 use super::{report_conditions, say_calibration};
-use crate::output::write_file;
+use crate::output::stage_file;
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex encode`.
@@ -67,16 +67,24 @@ pub fn run(args: EncodeArgs) -> Result<()> {
     let encoded = pipeline.encode(&recording, baseline)?;
     report_conditions(std::slice::from_ref(&encoded));
     let spikes = &encoded.spikes;
-    if let Some(events) = &args.events {
-        write_file(events, "address events", |w| write_events(w, spikes))?;
-    }
     let raster = ndarray::Array3::from_shape_vec(
         (spikes.n_steps, spikes.rows, spikes.cols),
         spikes.to_raster(),
     )?;
-    write_file(&args.out, "spike raster", |w| {
+    // Both files are written before either is put in place: a failure leaves neither.
+    let events = match &args.events {
+        Some(path) => Some(stage_file(path, "address events", |w| {
+            write_events(w, spikes)
+        })?),
+        None => None,
+    };
+    let raster = stage_file(&args.out, "spike raster", |w| {
         ndarray_npy::WriteNpyExt::write_npy(&raster, w).map_err(std::io::Error::other)
     })?;
+    raster.commit()?;
+    if let Some(events) = events {
+        events.commit()?;
+    }
     eprintln!(
         "{} spikes from {} taxels over {} ms -> {}",
         spikes.total_spikes(),

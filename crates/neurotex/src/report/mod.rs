@@ -9,11 +9,11 @@ mod markdown;
 mod paper;
 mod table;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{DataError, Result};
 use crate::experiments::Results;
-use crate::io::write_atomic;
+use crate::io::{create_dir_atomic, Temporary};
 
 pub use markdown::markdown;
 pub use paper::{
@@ -45,23 +45,50 @@ impl ReportContext {
     }
 }
 
-/// Writes `report.md`, `results.json` and `figures/*.svg` into `dir` (created if needed);
-/// each file is written whole or not at all, `report.md` last.
+/// Writes `report.md`, `results.json` and `figures/*.svg` into `dir` (created if needed),
+/// whole or not at all: everything is rendered, then written into a temporary folder beside
+/// `dir`, which becomes `dir` (when `dir` is new or empty) or whose files are renamed into
+/// `dir` one by one, `report.md` last. On any failure the temporary folder is removed.
 ///
 /// # Errors
 /// The folder cannot be created, a file cannot be written or a figure cannot be drawn.
 pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Result<()> {
-    let figures_dir = dir.join("figures");
-    std::fs::create_dir_all(&figures_dir).map_err(|e| DataError::io(&figures_dir, e))?;
+    let mut files = Vec::new();
     for (name, svg) in figures::all(results, ctx.paper()) {
-        let path = figures_dir.join(name);
-        let svg = svg.map_err(|e| DataError::invalid(&path, e.to_string()))?;
-        write_atomic(&path, |w| w.write_all(svg.as_bytes()))?;
+        let path = Path::new("figures").join(name);
+        let svg = svg.map_err(|e| DataError::invalid(dir.join(&path), e.to_string()))?;
+        files.push((path, svg));
     }
     let json = serde_json::to_string_pretty(results)
         .map_err(|e| DataError::invalid(dir.join("results.json"), e.to_string()))?;
-    write_atomic(&dir.join("results.json"), |w| w.write_all(json.as_bytes()))?;
-    let text = markdown(results, ctx);
-    write_atomic(&dir.join("report.md"), |w| w.write_all(text.as_bytes()))?;
+    files.push(("results.json".into(), json));
+    files.push(("report.md".into(), markdown(results, ctx)));
+    let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
+    if !dir.exists() || is_empty(dir) {
+        return create_dir_atomic(dir, |tmp| write_files(tmp, &files));
+    }
+    if !dir.is_dir() {
+        return Err(DataError::invalid(dir, "is not a folder").into());
+    }
+    let tmp = Temporary::beside(dir)?;
+    std::fs::create_dir(tmp.path()).map_err(|e| DataError::io(tmp.path(), e))?;
+    write_files(tmp.path(), &files)?;
+    let figures_dir = dir.join("figures");
+    std::fs::create_dir_all(&figures_dir).map_err(|e| DataError::io(&figures_dir, e))?;
+    for (name, _) in &files {
+        let to = dir.join(name);
+        std::fs::rename(tmp.path().join(name), &to).map_err(|e| DataError::io(&to, e))?;
+    }
+    Ok(())
+}
+
+/// Writes `files` (paths relative to `dir`, and their text) and the `figures` folder.
+fn write_files(dir: &Path, files: &[(PathBuf, String)]) -> Result<()> {
+    let figures_dir = dir.join("figures");
+    std::fs::create_dir(&figures_dir).map_err(|e| DataError::io(&figures_dir, e))?;
+    for (name, text) in files {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
+    }
     Ok(())
 }
