@@ -238,7 +238,11 @@ fn encode_reads_a_raw_log_with_the_import_options() {
     // the same columns by index, headerless: drop the header row
     let text = std::fs::read_to_string(&log).unwrap();
     let headerless = dir.join("raw.csv");
-    std::fs::write(&headerless, text.split_once('\n').unwrap().1.replace(',', "\t")).unwrap();
+    std::fs::write(
+        &headerless,
+        text.split_once('\n').unwrap().1.replace(',', "\t"),
+    )
+    .unwrap();
     let out2 = dir.join("spikes2.npy");
     dir.ok(&[
         "encode",
@@ -289,7 +293,11 @@ fn encode_reads_the_layout_beside_the_recording_unless_given_one() {
     let out = dir.join("spikes.npy");
     let run = dir.run(&["encode", s(&log), "--out", s(&out)]);
     assert!(run.status.success(), "{}", run.stderr);
-    assert!(run.stderr.contains("layout beside the recording"), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("layout beside the recording"),
+        "{}",
+        run.stderr
+    );
     let raster: Array3<u8> = read_npy(&out).unwrap();
     assert_eq!(raster.shape(), &[49 * 28 + 1, 2, 2]);
     // --layout wins over the file beside the recording: here one row of four channels

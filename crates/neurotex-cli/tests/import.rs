@@ -47,8 +47,9 @@ fn fabricslide_imports_every_file_and_classifies_well_above_chance() {
     ));
     assert!(run.status.success(), "{}", run.stderr);
     assert!(
-        run.stderr
-            .contains("966 recordings (0 left out; 0 rows merged and 4 exact duplicates dropped in 4 files)"),
+        run.stderr.contains(
+            "966 recordings (0 left out; 0 rows merged and 4 exact duplicates dropped in 4 files)"
+        ),
         "{}",
         run.stderr
     );
@@ -436,7 +437,16 @@ fn bad_csv_reading_options_are_named() {
         ),
         // a header row read as data names its line and column
         (
-            vec!["import", "csv", "B_1.csv", "--out", o, "--no-header", "--fs", "100"],
+            vec![
+                "import",
+                "csv",
+                "B_1.csv",
+                "--out",
+                o,
+                "--no-header",
+                "--fs",
+                "100",
+            ],
             "line 1, column `column0`: expected a finite number, got `t`",
         ),
         (
@@ -459,7 +469,8 @@ fn a_hundred_field_name_pattern_is_matched_quickly() {
     for name in [&good, &almost] {
         std::fs::write(src.join(name), "t,c\n0,1\n10,2\n").unwrap();
     }
-    let pattern: String = (0..100).map(|k| format!("{{f{k}}}_")).collect::<String>() + "x.{label}.csv";
+    let pattern: String =
+        (0..100).map(|k| format!("{{f{k}}}_")).collect::<String>() + "x.{label}.csv";
     let out = dir.join("ds");
     let start = std::time::Instant::now();
     let run = dir.run(&[
@@ -476,6 +487,10 @@ fn a_hundred_field_name_pattern_is_matched_quickly() {
     ]);
     let took = start.elapsed().as_secs_f64();
     assert!(run.status.success(), "{}", run.stderr);
-    assert!(run.stderr.contains("1 recordings (1 left out"), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("1 recordings (1 left out"),
+        "{}",
+        run.stderr
+    );
     assert!(took < 5.0, "the import took {took} s");
 }

@@ -85,7 +85,11 @@ impl ChannelSelect {
             .filter(|s| !s.is_empty())
             .collect();
         if entries.is_empty() {
-            return Err(ParamError::new("channels", "name at least one column", text));
+            return Err(ParamError::new(
+                "channels",
+                "name at least one column",
+                text,
+            ));
         }
         let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
         let is_index = |e: &&str| match e.split_once('-') {
@@ -583,9 +587,9 @@ impl<'a> RowReader<'a> {
                 self.samples.extend_from_slice(&self.group[..n])
             }
             DuplicateStamps::Last => self.samples.extend_from_slice(&self.group[(k - 1) * n..]),
-            DuplicateStamps::Average => self.samples.extend((0..n).map(|c| {
-                (0..k).map(|r| self.group[r * n + c]).sum::<f64>() / k as f64
-            })),
+            DuplicateStamps::Average => self.samples.extend(
+                (0..n).map(|c| (0..k).map(|r| self.group[r * n + c]).sum::<f64>() / k as f64),
+            ),
         }
         if let (Some(times), Some(t)) = (self.times.as_mut(), self.stamp) {
             times.push(t);

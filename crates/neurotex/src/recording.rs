@@ -1039,7 +1039,11 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
 ///
 /// # Errors
 /// As [`read_recording`].
-pub fn read_recording_as(path: &Path, layout: &LayoutFile, format: &CsvFormat) -> Result<Recording> {
+pub fn read_recording_as(
+    path: &Path,
+    layout: &LayoutFile,
+    format: &CsvFormat,
+) -> Result<Recording> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -1146,7 +1150,9 @@ fn read_csv_samples(
 ) -> Result<(Shape, Vec<f64>, Option<Vec<f64>>)> {
     let log = read_csv_log(path, format)?;
     let scale = log.time_unit.seconds();
-    let times = log.times.map(|t| t.into_iter().map(|x| x * scale).collect());
+    let times = log
+        .times
+        .map(|t| t.into_iter().map(|x| x * scale).collect());
     Ok((Shape::Channels(log.channel_names.len()), log.samples, times))
 }
 

@@ -4,11 +4,11 @@ use std::path::{Path, PathBuf};
 
 use ndarray::{Array, Array1, ArrayD, IxDyn};
 use ndarray_npy::write_npy;
+use neurotex::csvlog::{read_csv_log, Column, CsvFormat, DuplicateStamps};
 use neurotex::import::{
     csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, NamePattern,
     StackedParams,
 };
-use neurotex::csvlog::{read_csv_log, Column, CsvFormat, DuplicateStamps};
 use neurotex::recording::{read_recording, Baseline, Dataset, LayoutFile, TimeUnit};
 use neurotex::signal::{PreprocessParams, Preprocessor};
 use neurotex::Speed;
@@ -352,13 +352,20 @@ fn string_labels_and_speeds_and_bad_stacks() {
 
 #[test]
 fn name_patterns_match_brackets_and_dots_literally() {
-    let p = NamePattern::parse("Data[Texture({label})][Speed({speed})][Force({force})][Trial({trial})].csv")
-        .unwrap();
+    let p = NamePattern::parse(
+        "Data[Texture({label})][Speed({speed})][Force({force})][Trial({trial})].csv",
+    )
+    .unwrap();
     let f = p
         .matches("Data[Texture(003)][Speed(2400)][Force(1.0)][Trial(1)].csv")
         .unwrap();
     assert_eq!(
-        (&f["label"][..], &f["speed"][..], &f["force"][..], &f["trial"][..]),
+        (
+            &f["label"][..],
+            &f["speed"][..],
+            &f["force"][..],
+            &f["trial"][..]
+        ),
         ("003", "2400", "1.0", "1")
     );
     // `.` is a dot, not any character; `(` is a parenthesis, not a group
@@ -374,7 +381,8 @@ fn name_patterns_match_brackets_and_dots_literally() {
 #[test]
 fn a_hundred_fields_match_in_well_under_a_second() {
     // the old backtracking matcher took over a minute on this
-    let pattern: String = (0..100).map(|k| format!("{{f{k}}}_")).collect::<String>() + "{label}.csv";
+    let pattern: String =
+        (0..100).map(|k| format!("{{f{k}}}_")).collect::<String>() + "{label}.csv";
     let name: String = (0..100).map(|k| format!("v{k}_")).collect::<String>() + "x.csv";
     let p = NamePattern::parse(&pattern).unwrap();
     let start = std::time::Instant::now();
@@ -397,7 +405,11 @@ fn log_format(time: Option<Column>, policy: DuplicateStamps) -> CsvFormat {
 #[test]
 fn headerless_semicolon_logs_by_index_ranges() {
     let dir = tempfile::tempdir().unwrap();
-    let p = write(dir.path(), "log.csv", "10;7;1;2;3\n20;7;4;5;6\n30;7;7;8;9\n");
+    let p = write(
+        dir.path(),
+        "log.csv",
+        "10;7;1;2;3\n20;7;4;5;6\n30;7;7;8;9\n",
+    );
     let format = CsvFormat {
         header: false,
         time_column: Some(Column::Index(0)),
@@ -441,8 +453,14 @@ fn repeated_stamps_are_averaged_or_kept_first_or_last_or_refused() {
     assert_eq!(avg.samples, [2.0, 4.0, 5.0, 5.0]);
     assert_eq!(avg.times.as_deref(), Some(&[10.0, 20.0][..]));
     assert_eq!((avg.merged_rows, avg.duplicate_rows), (1, 2));
-    assert_eq!(read(DuplicateStamps::First).unwrap().samples, [1.0, 2.0, 5.0, 5.0]);
-    assert_eq!(read(DuplicateStamps::Last).unwrap().samples, [3.0, 6.0, 5.0, 5.0]);
+    assert_eq!(
+        read(DuplicateStamps::First).unwrap().samples,
+        [1.0, 2.0, 5.0, 5.0]
+    );
+    assert_eq!(
+        read(DuplicateStamps::Last).unwrap().samples,
+        [3.0, 6.0, 5.0, 5.0]
+    );
     let err = read(DuplicateStamps::Error).unwrap_err().to_string();
     assert!(
         err.contains("r.csv") && err.contains("line 3") && err.contains("repeats line 2"),
@@ -471,19 +489,36 @@ fn bad_column_choices_are_named() {
         ..CsvFormat::default()
     };
     let cases = [
-        (headerless(Some(Column::Index(3)), "1"), "time column 3 (0-based) does not exist"),
-        (headerless(None, "1-5"), "channel column 3 (0-based) does not exist"),
+        (
+            headerless(Some(Column::Index(3)), "1"),
+            "time column 3 (0-based) does not exist",
+        ),
+        (
+            headerless(None, "1-5"),
+            "channel column 3 (0-based) does not exist",
+        ),
         (headerless(None, "a,b"), "without a header row"),
         (headerless(None, r"^c\d$"), "not a regular expression"),
-        (headerless(Some(Column::Index(0)), "0-1"), "both the time and a channel"),
-        (headerless(Some(Column::Name("t".into())), "1"), "0-based index, got `t`"),
+        (
+            headerless(Some(Column::Index(0)), "0-1"),
+            "both the time and a channel",
+        ),
+        (
+            headerless(Some(Column::Name("t".into())), "1"),
+            "0-based index, got `t`",
+        ),
     ];
     for (format, expected) in cases {
         let err = read_csv_log(&p, &format).unwrap_err().to_string();
-        assert!(err.contains("h.csv") && err.contains(expected), "{expected}: {err}");
+        assert!(
+            err.contains("h.csv") && err.contains(expected),
+            "{expected}: {err}"
+        );
     }
     assert!("3-1".parse::<neurotex::csvlog::ChannelSelect>().is_err());
-    assert!("0-99999999".parse::<neurotex::csvlog::ChannelSelect>().is_err());
+    assert!("0-99999999"
+        .parse::<neurotex::csvlog::ChannelSelect>()
+        .is_err());
     assert!("pipe".parse::<neurotex::csvlog::Delimiter>().is_err());
     assert!("mean".parse::<DuplicateStamps>().is_err());
 }

@@ -91,7 +91,10 @@ fn input_layout(args: &EncodeArgs) -> Result<LayoutFile> {
     let mut layout = match args.layout.as_ref().or(beside.as_ref()) {
         Some(path) => {
             if args.layout.is_none() {
-                eprintln!("note: reading the layout beside the recording, {}", path.display());
+                eprintln!(
+                    "note: reading the layout beside the recording, {}",
+                    path.display()
+                );
             }
             LayoutFile::read(path)?
         }
