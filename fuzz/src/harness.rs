@@ -10,6 +10,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use neurotex::csvlog::{Column, CsvFormat, DuplicateStamps};
 use neurotex::import::{import_csv, import_stacked, ChannelSelect, CsvImportParams};
 use neurotex::import::{NamePattern, StackedParams};
 use neurotex::recording::{read_manifest, read_recording, Dataset, LayoutFile};
@@ -208,9 +209,8 @@ fn file_name(line: &str, fallback: &str) -> String {
 
 /// The options of a fuzzed CSV import, chosen by the bits of `flags`.
 fn csv_params(flags: u8, pattern: Option<NamePattern>) -> CsvImportParams {
-    CsvImportParams {
-        pattern,
-        time_column: (flags & 1 != 0).then(|| "t_ms".to_string()),
+    let format = CsvFormat {
+        time_column: (flags & 1 != 0).then(|| Column::Name("t_ms".to_string())),
         time_unit: if flags & 2 != 0 {
             TimeUnit::Seconds
         } else {
@@ -221,6 +221,16 @@ fn csv_params(flags: u8, pattern: Option<NamePattern>) -> CsvImportParams {
             1 => ChannelSelect::parse("a,b").expect("a list"),
             _ => ChannelSelect::parse("^[a-z]$").expect("a regex"),
         },
+        duplicate_stamps: if flags & 128 != 0 {
+            DuplicateStamps::Error
+        } else {
+            DuplicateStamps::Average
+        },
+        ..CsvFormat::default()
+    };
+    CsvImportParams {
+        pattern,
+        format,
         grid: (flags & 16 != 0).then(|| "1x2".parse().expect("a grid")),
         channel_map: None,
         fs: (flags & 32 != 0).then_some(100.0),
@@ -231,8 +241,7 @@ fn csv_params(flags: u8, pattern: Option<NamePattern>) -> CsvImportParams {
 
 /// `import csv` on one or two files. The first part of the input is a header: a flags
 /// byte, then lines giving the name pattern and the files' names; the next parts are the
-/// files. Patterns are kept under 48 characters: the matcher backtracks exponentially in
-/// the number of fields (a known issue-14 finding, not one to rediscover on every run).
+/// files. Patterns of any length: the matcher runs in linear time.
 pub fn import_csv_files(data: &[u8]) -> bool {
     let parts = split(data);
     let Some((&flags, header)) = parts[0].split_first() else {
@@ -242,7 +251,7 @@ pub fn import_csv_files(data: &[u8]) -> bool {
     let mut lines = header.lines();
     let pattern = lines
         .next()
-        .filter(|p| !p.is_empty() && p.len() < 48)
+        .filter(|p| !p.is_empty())
         .and_then(|p| NamePattern::parse(p).ok());
     let case = Case::new();
     let mut files = Vec::new();

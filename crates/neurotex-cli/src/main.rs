@@ -3,6 +3,7 @@
 //! failed run leaves no partial output).
 
 mod commands;
+mod csv_args;
 mod open_args;
 mod output;
 mod stage_args;

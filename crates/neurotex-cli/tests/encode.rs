@@ -186,3 +186,139 @@ fn encode_feeds_the_neurons_x_over_its_maximum() {
         "first spike that differs from x / x.max(), as (step, neuron)"
     );
 }
+
+/// A raw logger file at 28 ms (about 35.7 Hz): a header, host stamps in ms, a proximity
+/// column that is not a taxel, then four channels; the last row is written twice.
+fn raw_fabric_log(rows: usize) -> String {
+    let mut text = String::from("timestamp, proximity1, channel1, channel2, channel3, channel4\n");
+    for k in 0..rows {
+        let v = |c: usize| 100 + (k * 7 + c * 13) % 50;
+        text.push_str(&format!(
+            "{},65535,{},{},{},{}\n",
+            4_277_465 + 28 * k,
+            v(0),
+            v(1),
+            v(2),
+            v(3)
+        ));
+    }
+    let last = text.lines().last().unwrap().to_string();
+    text.push_str(&last);
+    text.push('\n');
+    text
+}
+
+#[test]
+fn encode_reads_a_raw_log_with_the_import_options() {
+    let dir = Dir::new();
+    let log = dir.join("Silk_F1_V10mmps_0.csv");
+    std::fs::write(&log, raw_fabric_log(50)).unwrap();
+    let out = dir.join("spikes.npy");
+    let encode = |extra: &[&str]| {
+        let mut args = vec!["encode", s(&log), "--out", s(&out)];
+        args.extend_from_slice(extra);
+        dir.run(&args)
+    };
+    let run = encode(&[
+        "--time-column",
+        "timestamp",
+        "--channels",
+        r"^channel\d+$",
+        "--grid",
+        "2x2",
+        "--baseline",
+        "min",
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    // the time and proximity columns are not taxels, and the 49 intervals of 28 ms
+    // are resampled onto 1 ms steps (not read as 50 samples at 1 kHz)
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape(), &[49 * 28 + 1, 2, 2]);
+    assert!(run.stderr.contains("resampled"), "{}", run.stderr);
+    // the same columns by index, headerless: drop the header row
+    let text = std::fs::read_to_string(&log).unwrap();
+    let headerless = dir.join("raw.csv");
+    std::fs::write(
+        &headerless,
+        text.split_once('\n').unwrap().1.replace(',', "\t"),
+    )
+    .unwrap();
+    let out2 = dir.join("spikes2.npy");
+    dir.ok(&[
+        "encode",
+        s(&headerless),
+        "--out",
+        s(&out2),
+        "--no-header",
+        "--time-column",
+        "0",
+        "--channels",
+        "2-5",
+        "--grid",
+        "2x2",
+        "--baseline",
+        "min",
+    ]);
+    let again: Array3<u8> = read_npy(&out2).unwrap();
+    assert_eq!(again, raster);
+    // with `--duplicate-stamps error` the repeated last row is still only dropped, but
+    // a bad column is named
+    let err = dir.fails(&[
+        "encode",
+        s(&headerless),
+        "--out",
+        s(&out2),
+        "--no-header",
+        "--channels",
+        "2-9",
+    ]);
+    assert!(
+        err.contains("raw.csv") && err.contains("channel column 6 (0-based) does not exist"),
+        "{err}"
+    );
+}
+
+#[test]
+fn encode_reads_the_layout_beside_the_recording_unless_given_one() {
+    let dir = Dir::new();
+    let ds = dir.join("ds");
+    std::fs::create_dir(&ds).unwrap();
+    let log = ds.join("a.csv");
+    std::fs::write(&log, raw_fabric_log(50)).unwrap();
+    std::fs::write(
+        ds.join("layout.toml"),
+        "rows = 2\ncols = 2\ntime_column = \"timestamp\"\nchannels = [\"channel1\", \"channel2\", \"channel3\", \"channel4\"]\n",
+    )
+    .unwrap();
+    let out = dir.join("spikes.npy");
+    let run = dir.run(&["encode", s(&log), "--out", s(&out)]);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("layout beside the recording"),
+        "{}",
+        run.stderr
+    );
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape(), &[49 * 28 + 1, 2, 2]);
+    // --layout wins over the file beside the recording: here one row of four channels
+    let other = dir.join("other.toml");
+    std::fs::write(
+        &other,
+        "time_column = \"timestamp\"\nchannels = [\"channel1\", \"channel2\", \"channel3\", \"channel4\"]\n",
+    )
+    .unwrap();
+    dir.ok(&["encode", s(&log), "--out", s(&out), "--layout", s(&other)]);
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape(), &[49 * 28 + 1, 1, 4]);
+    // and options override single settings of the layout
+    dir.ok(&["encode", s(&log), "--out", s(&out), "--grid", "4x1"]);
+    let raster: Array3<u8> = read_npy(&out).unwrap();
+    assert_eq!(raster.shape(), &[49 * 28 + 1, 4, 1]);
+    // a layout that names a column the file lacks is an error naming the file
+    std::fs::write(ds.join("layout.toml"), "time_column = \"stamp\"\n").unwrap();
+    let err = dir.fails(&["encode", s(&log), "--out", s(&out)]);
+    assert!(
+        err.contains("a.csv") && err.contains("missing time column `stamp`"),
+        "{err}"
+    );
+}

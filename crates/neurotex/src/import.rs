@@ -13,19 +13,33 @@ use ndarray::{ArrayD, Axis, IxDyn};
 use ndarray_npy::ReadNpyExt;
 use rayon::prelude::*;
 
+pub use crate::csvlog::ChannelSelect;
+use crate::csvlog::{read_csv_log, CsvFormat, CsvLog};
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
-    create_dataset_dir, read_csv_columns, write_layout, write_manifest, Baseline, ChannelMap,
-    LayoutFile, Meta, TimeUnit,
+    create_dataset_dir, write_layout, write_manifest, Baseline, ChannelMap, LayoutFile, Meta,
+    TimeUnit,
 };
 use crate::values::{Grid, Speed};
 
 /// A file-name pattern such as `{label}_F{force}_V{speed}mmps_{trial}.csv`: literal text and
 /// `{field}`s. `label`, `speed` (mm/s), `force` (N) and `trial` fill the manifest's columns;
-/// any other field becomes an extra manifest column.
-#[derive(Debug, Clone, PartialEq)]
+/// any other field becomes an extra manifest column. Text outside the fields is matched
+/// literally (brackets, parentheses and dots included), in time linear in the name's
+/// length: the pattern becomes a regular expression of the `regex` crate, which never
+/// backtracks.
+#[derive(Debug, Clone)]
 pub struct NamePattern {
     parts: Vec<Part>,
+    /// The fields in order: capture group `k + 1` holds field `k`.
+    fields: Vec<String>,
+    regex: regex::Regex,
+}
+
+impl PartialEq for NamePattern {
+    fn eq(&self, other: &Self) -> bool {
+        self.parts == other.parts
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -34,51 +48,49 @@ enum Part {
     Field(String),
 }
 
+/// What a field's value looks like: `speed` and `force` are numbers, `trial` an integer,
+/// anything else at least one character, as few as possible.
+fn field_regex(field: &str) -> &'static str {
+    match field {
+        "speed" | "force" => r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)",
+        "trial" => r"([+-]?[0-9]+)",
+        _ => r"(.+?)",
+    }
+}
+
 impl NamePattern {
     /// Parses a pattern.
     ///
     /// # Errors
-    /// Unbalanced braces, an empty field name, or two fields with nothing between them.
+    /// Unbalanced braces, an empty field name, a field named twice, two fields with nothing
+    /// between them, or a pattern too long to compile.
     pub fn parse(pattern: &str) -> Result<Self, ParamError> {
         let bad = |rule| ParamError::new("name-pattern", rule, pattern);
-        let mut parts = Vec::new();
-        let mut rest = pattern;
-        while !rest.is_empty() {
-            match rest.find('{') {
-                Some(0) => {
-                    let end = rest
-                        .find('}')
-                        .ok_or_else(|| bad("every `{` needs a closing `}`"))?;
-                    let name = &rest[1..end];
-                    if name.is_empty() || name.contains('{') {
-                        return Err(bad("fields are written {name}, with a non-empty name"));
+        let parts = split_pattern(pattern)?;
+        let mut fields: Vec<String> = Vec::new();
+        let mut source = String::from(r"(?s)\A");
+        for part in &parts {
+            match part {
+                Part::Literal(text) => source.push_str(&regex::escape(text)),
+                Part::Field(name) => {
+                    if fields.contains(name) {
+                        return Err(bad("each field may appear once"));
                     }
-                    if matches!(parts.last(), Some(Part::Field(_))) {
-                        return Err(bad("two fields need literal text between them"));
-                    }
-                    parts.push(Part::Field(name.to_string()));
-                    rest = &rest[end + 1..];
-                }
-                Some(i) => {
-                    if rest[..i].contains('}') {
-                        return Err(bad("a `}` without its `{`"));
-                    }
-                    parts.push(Part::Literal(rest[..i].to_string()));
-                    rest = &rest[i..];
-                }
-                None => {
-                    if rest.contains('}') {
-                        return Err(bad("a `}` without its `{`"));
-                    }
-                    parts.push(Part::Literal(rest.to_string()));
-                    rest = "";
+                    fields.push(name.clone());
+                    source.push_str(field_regex(name));
                 }
             }
         }
-        if !parts.iter().any(|p| matches!(p, Part::Field(_))) {
+        if fields.is_empty() {
             return Err(bad("the pattern names no {field}"));
         }
-        Ok(NamePattern { parts })
+        source.push_str(r"\z");
+        let regex = regex::Regex::new(&source).map_err(|_| bad("the pattern is too long"))?;
+        Ok(NamePattern {
+            parts,
+            fields,
+            regex,
+        })
     }
 
     /// The fields of `name`, or `None` when it does not match. Fields match as few
@@ -86,40 +98,45 @@ impl NamePattern {
     /// `force` only match numbers and `trial` only integers, so a label may contain the
     /// pattern's separators (`Denim_Flex_F150_...`).
     pub fn matches(&self, name: &str) -> Option<BTreeMap<String, String>> {
-        let mut out = BTreeMap::new();
-        self.match_from(0, name, &mut out).then_some(out)
+        let caps = self.regex.captures(name)?;
+        let fields = self.fields.iter().enumerate();
+        Some(
+            fields
+                .map(|(k, field)| (field.clone(), caps[k + 1].to_string()))
+                .collect(),
+        )
     }
+}
 
-    fn match_from(&self, k: usize, rest: &str, out: &mut BTreeMap<String, String>) -> bool {
-        match self.parts.get(k) {
-            None => rest.is_empty(),
-            Some(Part::Literal(lit)) => rest
-                .strip_prefix(lit.as_str())
-                .is_some_and(|r| self.match_from(k + 1, r, out)),
-            Some(Part::Field(field)) => {
-                for (end, _) in rest
-                    .char_indices()
-                    .skip(1)
-                    .chain(std::iter::once((rest.len(), ' ')))
-                {
-                    if end == 0 {
-                        continue;
-                    }
-                    let value = &rest[..end];
-                    let fits = match field.as_str() {
-                        "speed" | "force" => value.parse::<f64>().is_ok_and(f64::is_finite),
-                        "trial" => value.parse::<i64>().is_ok(),
-                        _ => true,
-                    };
-                    if fits && self.match_from(k + 1, &rest[end..], out) {
-                        out.insert(field.clone(), rest[..end].to_string());
-                        return true;
-                    }
-                }
-                false
+/// A pattern's literal text and `{field}`s, in order.
+fn split_pattern(pattern: &str) -> Result<Vec<Part>, ParamError> {
+    let bad = |rule| ParamError::new("name-pattern", rule, pattern);
+    let mut parts = Vec::new();
+    let mut rest = pattern;
+    while !rest.is_empty() {
+        let literal_end = rest.find('{').unwrap_or(rest.len());
+        if literal_end > 0 {
+            if rest[..literal_end].contains('}') {
+                return Err(bad("a `}` without its `{`"));
             }
+            parts.push(Part::Literal(rest[..literal_end].to_string()));
+            rest = &rest[literal_end..];
+            continue;
         }
+        let end = rest
+            .find('}')
+            .ok_or_else(|| bad("every `{` needs a closing `}`"))?;
+        let name = &rest[1..end];
+        if name.is_empty() || name.contains('{') {
+            return Err(bad("fields are written {name}, with a non-empty name"));
+        }
+        if matches!(parts.last(), Some(Part::Field(_))) {
+            return Err(bad("two fields need literal text between them"));
+        }
+        parts.push(Part::Field(name.to_string()));
+        rest = &rest[end + 1..];
     }
+    Ok(parts)
 }
 
 impl FromStr for NamePattern {
@@ -131,65 +148,14 @@ impl FromStr for NamePattern {
     }
 }
 
-/// How to pick the channel columns of a CSV log.
-#[derive(Debug, Clone)]
-pub enum ChannelSelect {
-    /// Every column but the time column.
-    All,
-    /// These columns, in this order.
-    Names(Vec<String>),
-    /// Columns whose names match, in file order.
-    Regex(regex::Regex),
-}
-
-impl ChannelSelect {
-    /// A comma-separated list of names, or a regular expression when the text holds one of
-    /// `^$*+?[]()|\`.
-    ///
-    /// # Errors
-    /// An invalid regular expression.
-    pub fn parse(text: &str) -> Result<Self, ParamError> {
-        if text.chars().any(|c| "^$*+?[]()|\\".contains(c)) {
-            regex::Regex::new(text)
-                .map(ChannelSelect::Regex)
-                .map_err(|e| {
-                    ParamError::new(
-                        "channels",
-                        "not a valid regular expression",
-                        format!("{text} ({e})"),
-                    )
-                })
-        } else {
-            Ok(ChannelSelect::Names(
-                text.split(',')
-                    .map(|s| s.trim().to_string())
-                    .filter(|s| !s.is_empty())
-                    .collect(),
-            ))
-        }
-    }
-}
-
-impl FromStr for ChannelSelect {
-    type Err = ParamError;
-
-    /// As [`ChannelSelect::parse`].
-    fn from_str(text: &str) -> Result<Self, ParamError> {
-        ChannelSelect::parse(text)
-    }
-}
-
 /// Options of a CSV import.
 #[derive(Debug, Clone)]
 pub struct CsvImportParams {
     /// Metadata from file names; without it the label is the file stem.
     pub pattern: Option<NamePattern>,
-    /// The time column; without it the sampling rate `fs` is used.
-    pub time_column: Option<String>,
-    /// The time column's unit.
-    pub time_unit: TimeUnit,
-    /// The channel columns.
-    pub channels: ChannelSelect,
+    /// How the logs are laid out: header, delimiter, time and channel columns, repeated
+    /// stamps. Without a time column the sampling rate `fs` is used.
+    pub format: CsvFormat,
     /// The grid to place channels on; default one row of all channels.
     pub grid: Option<Grid>,
     /// Each channel's cell; default row-major.
@@ -211,13 +177,24 @@ pub struct ImportSummary {
     pub skipped: Vec<(PathBuf, String)>,
     /// The layout written.
     pub layout: LayoutFile,
+    /// Each imported file in which rows were merged or dropped, in file order.
+    pub merged: Vec<MergedRows>,
+}
+
+/// Rows of one file that did not become frames of their own: they shared a time stamp.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MergedRows {
+    /// The file's name.
+    pub file: String,
+    /// Rows folded into the frame of an earlier row with the same stamp.
+    pub merged_rows: usize,
+    /// Exact duplicate rows dropped.
+    pub duplicate_rows: usize,
 }
 
 struct ParsedCsv {
     meta: Meta,
-    channel_names: Vec<String>,
-    times: Option<Vec<f64>>,
-    samples: Vec<f64>,
+    log: CsvLog,
 }
 
 fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
@@ -283,59 +260,8 @@ fn meta_from_name(path: &Path, pattern: Option<&NamePattern>) -> Result<Meta> {
 
 fn parse_csv(path: &Path, p: &CsvImportParams) -> Result<ParsedCsv> {
     let meta = meta_from_name(path, p.pattern.as_ref())?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| invalid(path, format!("cannot read: {e}")))?;
-    let headers = reader
-        .headers()
-        .map_err(|e| invalid(path, format!("no header row: {e}")))?
-        .clone();
-    let time_col = match &p.time_column {
-        Some(name) => Some(headers.iter().position(|h| h == name).ok_or_else(|| {
-            invalid(
-                path,
-                format!(
-                    "missing time column `{name}` (columns: {})",
-                    headers.iter().collect::<Vec<_>>().join(", ")
-                ),
-            )
-        })?),
-        None => None,
-    };
-    let channel_cols: Vec<usize> = match &p.channels {
-        ChannelSelect::All => (0..headers.len())
-            .filter(|&j| Some(j) != time_col)
-            .collect(),
-        ChannelSelect::Names(names) => names
-            .iter()
-            .map(|n| {
-                headers
-                    .iter()
-                    .position(|h| h == n)
-                    .ok_or_else(|| invalid(path, format!("missing channel column `{n}`")))
-            })
-            .collect::<Result<_>>()?,
-        ChannelSelect::Regex(re) => (0..headers.len())
-            .filter(|&j| Some(j) != time_col && re.is_match(&headers[j]))
-            .collect(),
-    };
-    if channel_cols.is_empty() {
-        return Err(invalid(path, "no channel columns selected"));
-    }
-    let (samples, times) = read_csv_columns(path, &mut reader, &headers, time_col, &channel_cols)?;
-    if samples.is_empty() {
-        return Err(invalid(path, "no data rows"));
-    }
-    Ok(ParsedCsv {
-        meta,
-        channel_names: channel_cols
-            .iter()
-            .map(|&j| headers[j].to_string())
-            .collect(),
-        times,
-        samples,
-    })
+    let log = read_csv_log(path, &p.format)?;
+    Ok(ParsedCsv { meta, log })
 }
 
 /// The `.csv` files among `inputs` (folders are searched one level deep), sorted.
@@ -383,7 +309,7 @@ pub fn import_csv(
     if files.is_empty() {
         return Err(DataError::invalid(out, "no .csv files to import").into());
     }
-    if p.time_column.is_none() && p.fs.is_none() {
+    if p.format.time_column.is_none() && p.fs.is_none() {
         let rule = "without --time-column the sampling rate --fs is needed";
         return Err(ParamError::new("fs", rule, "none").into());
     }
@@ -393,33 +319,42 @@ pub fn import_csv(
     let Some(first) = good.first() else {
         return Err(DataError::invalid(out, "every file was left out").into());
     };
-    let names = first.channel_names.clone();
-    if let Some(other) = good.iter().find(|c| c.channel_names != names) {
+    let names = first.log.channel_names.clone();
+    if let Some(other) = good.iter().find(|c| c.log.channel_names != names) {
         return Err(invalid(
             Path::new(&other.meta.file),
             format!(
                 "its channels {:?} differ from {:?} of {}",
-                other.channel_names, names, first.meta.file
+                other.log.channel_names, names, first.meta.file
             ),
         ));
     }
     let fs = match p.fs {
         Some(fs) => fs,
-        None => nominal_fs(&good, p, out)?,
+        None => nominal_fs(&good, out)?,
     };
-    let layout = csv_layout(p, &names, fs, first.times.is_some())?;
+    let layout = csv_layout(p, &names, fs, first.log.times.is_some())?;
     create_dataset_dir(out, |tmp| {
         write_layout(tmp, &layout)?;
         // validates the layout before anything else is written
         LayoutFile::read(&tmp.join("layout.toml"))?;
         let metas: Vec<Meta> = good
             .par_iter()
-            .map(|c| write_imported(tmp, c, &names, p.time_unit.milliseconds()))
+            .map(|c| write_imported(tmp, c, &names))
             .collect::<Result<_>>()?;
         write_manifest(tmp, &metas)
     })?;
     summary.written = good.len();
     summary.layout = layout;
+    summary.merged = good
+        .iter()
+        .filter(|c| c.log.merged_rows + c.log.duplicate_rows > 0)
+        .map(|c| MergedRows {
+            file: c.meta.file.clone(),
+            merged_rows: c.log.merged_rows,
+            duplicate_rows: c.log.duplicate_rows,
+        })
+        .collect();
     Ok(summary)
 }
 
@@ -470,11 +405,11 @@ fn parse_all(
 }
 
 /// The nominal sampling rate: one over the median interval of all files' time stamps.
-fn nominal_fs(good: &[ParsedCsv], p: &CsvImportParams, out: &Path) -> Result<f64> {
+fn nominal_fs(good: &[ParsedCsv], out: &Path) -> Result<f64> {
     let mut dts: Vec<f64> = good
         .iter()
-        .filter_map(|c| c.times.as_ref())
-        .flat_map(|t| t.windows(2).map(|w| (w[1] - w[0]) * p.time_unit.seconds()))
+        .filter_map(|c| Some((c.log.times.as_ref()?, c.log.time_unit.seconds())))
+        .flat_map(|(t, unit)| t.windows(2).map(move |w| (w[1] - w[0]) * unit))
         .collect();
     if dts.is_empty() {
         let message = "cannot estimate the sampling rate from single-row files; give --fs";
@@ -527,14 +462,16 @@ fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Re
         time_column: timed.then(|| "t_ms".to_string()),
         time_unit: timed.then_some(TimeUnit::Milliseconds),
         channels: Some(names.to_vec()),
-        max_duration_s: None,
+        ..LayoutFile::default()
     })
 }
 
 /// Writes one parsed file into the dataset folder `dir`: `t_ms` relative to its first time
 /// stamp (when it has time stamps), then the channels.
-fn write_imported(dir: &Path, c: &ParsedCsv, names: &[String], ms_per_unit: f64) -> Result<Meta> {
-    let path = dir.join(&c.meta.file);
+fn write_imported(dir: &Path, parsed: &ParsedCsv, names: &[String]) -> Result<Meta> {
+    let path = dir.join(&parsed.meta.file);
+    let c = &parsed.log;
+    let ms_per_unit = c.time_unit.milliseconds();
     let mut text = String::with_capacity(c.samples.len() * 8);
     if c.times.is_some() {
         text.push_str("t_ms,");
@@ -551,7 +488,7 @@ fn write_imported(dir: &Path, c: &ParsedCsv, names: &[String], ms_per_unit: f64)
         text.push('\n');
     }
     std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
-    Ok(c.meta.clone())
+    Ok(parsed.meta.clone())
 }
 
 /// The axes of a stacked array.

@@ -16,6 +16,9 @@ use ndarray::ArrayD;
 use ndarray_npy::ReadNpyExt;
 use serde::{Deserialize, Serialize};
 
+use crate::csvlog::{
+    csv_error, read_csv_log, ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps,
+};
 use crate::error::{DataError, ParamError, Result};
 use crate::values::{Cell, Grid, Speed};
 
@@ -332,11 +335,21 @@ pub struct LayoutFile {
     /// CSV recordings: the time column's unit, `ms` or `s`.
     pub time_unit: Option<TimeUnit>,
     /// CSV recordings: the channel columns, in channel order (default: every other column).
+    /// Without a header row, the time column and the channels are 0-based indices (`"0"`).
     pub channels: Option<Vec<String>>,
     /// Longest recording accepted, in s (default [`DEFAULT_MAX_DURATION_S`]); resampling
     /// allocates one frame per millisecond of it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_duration_s: Option<f64>,
+    /// CSV recordings: whether the first row names the columns (default `true`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub header: Option<bool>,
+    /// CSV recordings: the field delimiter, `,` `;` or `tab` (default: detected).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delimiter: Option<Delimiter>,
+    /// CSV recordings: rows sharing a time stamp (default `average`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duplicate_stamps: Option<DuplicateStamps>,
 }
 
 /// The longest recording accepted unless `layout.toml` sets `max_duration_s`: one hour.
@@ -359,8 +372,55 @@ impl LayoutFile {
         Ok(file)
     }
 
+    /// How this layout's CSV recordings are laid out: `time_column` and `channels` are
+    /// names with a header row and 0-based indices without one; with a header and no
+    /// `time_column`, a column named `t_ms` or `time_ms` (ms), or `t_s` or `time_s` (s), is
+    /// the time column.
+    ///
+    /// # Errors
+    /// Without a header row, a time column or channel that is not an index.
+    pub fn csv_format(&self) -> Result<CsvFormat, ParamError> {
+        let header = self.header.unwrap_or(true);
+        let column = |text: &str| -> Result<Column, ParamError> {
+            let col: Column = text.parse()?;
+            match col {
+                Column::Name(_) if !header => Err(ParamError::new(
+                    "layout.toml",
+                    "without a header row (header = false) columns are 0-based indices",
+                    text,
+                )),
+                col => Ok(col),
+            }
+        };
+        let channels = match &self.channels {
+            None => ChannelSelect::All,
+            Some(names) if header => ChannelSelect::Names(names.clone()),
+            Some(names) => ChannelSelect::Indices(
+                names
+                    .iter()
+                    .map(|n| match column(n)? {
+                        Column::Index(i) => Ok(i),
+                        Column::Name(_) => unreachable!("names are refused above"),
+                    })
+                    .collect::<Result<_, _>>()?,
+            ),
+        };
+        Ok(CsvFormat {
+            header,
+            delimiter: self.delimiter,
+            time_column: self.time_column.as_deref().map(column).transpose()?,
+            time_unit: self.time_unit.unwrap_or_default(),
+            detect_time: header && self.time_column.is_none(),
+            channels,
+            duplicate_stamps: self.duplicate_stamps.unwrap_or_default(),
+        })
+    }
+
     fn check(&self, path: &Path) -> Result<()> {
         let bad = |m: String| -> Result<()> { Err(DataError::invalid(path, m).into()) };
+        if let Err(e) = self.csv_format() {
+            return bad(e.to_string());
+        }
         if let Some(fs) = self.fs {
             if !(fs.is_finite() && fs > 0.0) {
                 return bad(format!(
@@ -1026,30 +1086,28 @@ impl ManifestColumns {
     }
 }
 
-fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
-    match e.kind() {
-        csv::ErrorKind::Io(_) => {
-            let csv::ErrorKind::Io(io) = e.into_kind() else {
-                unreachable!()
-            };
-            DataError::io(path, io).into()
-        }
-        _ => {
-            let line = e
-                .position()
-                .map(|p| format!("line {}: ", p.line()))
-                .unwrap_or_default();
-            DataError::invalid(path, format!("{line}malformed CSV: {e}")).into()
-        }
-    }
-}
-
 /// Reads one recording file (`.npy` or `.csv`) with the dataset's layout settings.
 ///
 /// # Errors
 /// Unreadable file, unsupported dtype or shape, layout mismatch, non-finite samples,
 /// non-increasing time stamps.
 pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
+    let format = layout
+        .csv_format()
+        .map_err(|e| DataError::invalid(path, e.to_string()))?;
+    read_recording_as(path, layout, &format)
+}
+
+/// Reads one recording file (`.npy` or `.csv`) with the layout's grid, map, mask and rate,
+/// a CSV file as `format` says (which overrides the layout's CSV settings).
+///
+/// # Errors
+/// As [`read_recording`].
+pub fn read_recording_as(
+    path: &Path,
+    layout: &LayoutFile,
+    format: &CsvFormat,
+) -> Result<Recording> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -1060,7 +1118,7 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
             let (shape, raw) = read_npy(path)?;
             (shape, raw, None)
         }
-        "csv" => read_csv_samples(path, layout)?,
+        "csv" => read_csv_samples(path, format)?,
         _ => {
             return Err(DataError::invalid(
                 path,
@@ -1199,119 +1257,17 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
     Ok((shape, std.into_raw_vec_and_offset().0))
 }
 
+/// A CSV recording read as `format` says: its channels, samples and time stamps in seconds.
 fn read_csv_samples(
     path: &Path,
-    layout: &LayoutFile,
+    format: &CsvFormat,
 ) -> Result<(Shape, Vec<f64>, Option<Vec<f64>>)> {
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| csv_error(path, e))?;
-    let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
-    let find = |name: &str| headers.iter().position(|h| h == name);
-    let (time_col, unit_scale) = match &layout.time_column {
-        Some(name) => {
-            let j = find(name).ok_or_else(|| {
-                DataError::invalid(
-                    path,
-                    format!("missing time column `{name}` named in layout.toml"),
-                )
-            })?;
-            (Some(j), layout.time_unit.unwrap_or_default().seconds())
-        }
-        None => {
-            if let Some(j) = find("t_ms").or_else(|| find("time_ms")) {
-                (Some(j), 1e-3)
-            } else if let Some(j) = find("t_s").or_else(|| find("time_s")) {
-                (Some(j), 1.0)
-            } else {
-                (None, 1.0)
-            }
-        }
-    };
-    let channel_cols: Vec<usize> = match &layout.channels {
-        Some(names) => names
-            .iter()
-            .map(|n| {
-                find(n).ok_or_else(|| {
-                    crate::Error::from(DataError::invalid(
-                        path,
-                        format!("missing channel column `{n}` named in layout.toml"),
-                    ))
-                })
-            })
-            .collect::<Result<_>>()?,
-        None => (0..headers.len())
-            .filter(|&j| Some(j) != time_col)
-            .collect(),
-    };
-    let n = channel_cols.len();
-    let (samples, times) = read_csv_columns(path, &mut reader, &headers, time_col, &channel_cols)?;
-    let times = times.map(|t| t.into_iter().map(|x| x * unit_scale).collect());
-    Ok((Shape::Channels(n), samples, times))
-}
-
-/// Reads the data rows of an opened CSV file: the `channels` columns of every row, frame
-/// after frame, and the `time` column in the file's own unit, which must increase strictly.
-/// Every cell must be a finite number; errors name the file, line and column. Rows are read
-/// as bytes into one reused record, so no value allocates.
-///
-/// # Errors
-/// A malformed row, a cell that is not a finite number, or a time stamp that does not increase.
-pub(crate) fn read_csv_columns<R: std::io::Read>(
-    path: &Path,
-    reader: &mut csv::Reader<R>,
-    headers: &csv::StringRecord,
-    time: Option<usize>,
-    channels: &[usize],
-) -> Result<(Vec<f64>, Option<Vec<f64>>)> {
-    let mut samples = Vec::new();
-    let mut times = time.map(|_| Vec::new());
-    let mut record = csv::ByteRecord::new();
-    let mut line = 1usize;
-    loop {
-        match reader.read_byte_record(&mut record) {
-            Ok(false) => break,
-            Ok(true) => {}
-            Err(e) => return Err(csv_error(path, e)),
-        }
-        line += 1;
-        let parse = |j: usize| -> Result<f64> {
-            let raw = record.get(j).unwrap_or(b"");
-            std::str::from_utf8(raw)
-                .ok()
-                .and_then(|s| s.trim().parse::<f64>().ok())
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    DataError::invalid(
-                        path,
-                        format!(
-                            "line {line}, column `{}`: expected a finite number, got `{}`",
-                            &headers[j],
-                            String::from_utf8_lossy(raw)
-                        ),
-                    )
-                    .into()
-                })
-        };
-        for &j in channels {
-            samples.push(parse(j)?);
-        }
-        if let (Some(j), Some(times)) = (time, times.as_mut()) {
-            let t = parse(j)?;
-            if let Some(&prev) = times.last() {
-                if t <= prev {
-                    return Err(DataError::invalid(
-                        path,
-                        format!("line {line}: time stamps must increase, got {t} after {prev}"),
-                    )
-                    .into());
-                }
-            }
-            times.push(t);
-        }
-    }
-    Ok((samples, times))
+    let log = read_csv_log(path, format)?;
+    let scale = log.time_unit.seconds();
+    let times = log
+        .times
+        .map(|t| t.into_iter().map(|x| x * scale).collect());
+    Ok((Shape::Channels(log.channel_names.len()), log.samples, times))
 }
 
 /// Writes `manifest.csv` for `metas` into `dir`: `file,label`, each condition column

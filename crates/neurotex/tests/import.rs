@@ -4,20 +4,23 @@ use std::path::{Path, PathBuf};
 
 use ndarray::{Array, Array1, ArrayD, IxDyn};
 use ndarray_npy::write_npy;
+use neurotex::csvlog::{read_csv_log, Column, CsvFormat, DuplicateStamps};
 use neurotex::import::{
     csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, NamePattern,
     StackedParams,
 };
-use neurotex::recording::{Baseline, Dataset, TimeUnit};
+use neurotex::recording::{read_recording, Baseline, Dataset, LayoutFile, TimeUnit};
 use neurotex::signal::{PreprocessParams, Preprocessor};
 use neurotex::Speed;
 
 fn params() -> CsvImportParams {
     CsvImportParams {
         pattern: Some(NamePattern::parse("{label}_V{speed}_{trial}.csv").unwrap()),
-        time_column: Some("stamp".into()),
-        time_unit: TimeUnit::Milliseconds,
-        channels: ChannelSelect::All,
+        format: CsvFormat {
+            time_column: Some(Column::Name("stamp".into())),
+            time_unit: TimeUnit::Milliseconds,
+            ..CsvFormat::default()
+        },
         grid: None,
         channel_map: None,
         fs: None,
@@ -109,7 +112,7 @@ fn channels_by_list_or_regex_and_a_masked_6x10_grid() {
     // a regular expression picks the 52 taxels and leaves the temperature out;
     // 52 channels on a 6x10 grid: the last 8 cells are masked
     let mut p = params();
-    p.channels = ChannelSelect::parse(r"^tax\d+$").unwrap();
+    p.format.channels = ChannelSelect::parse(r"^tax\d+$").unwrap();
     p.grid = Some("6x10".parse().unwrap());
     let out = dir.path().join("grid");
     let summary = import_csv(
@@ -132,7 +135,7 @@ fn channels_by_list_or_regex_and_a_masked_6x10_grid() {
     );
     // a list picks channels in the given order
     let mut p = params();
-    p.channels = ChannelSelect::parse("tax3, tax1").unwrap();
+    p.format.channels = ChannelSelect::parse("tax3, tax1").unwrap();
     let out = dir.path().join("list");
     import_csv(&csv_files(&[src]).unwrap(), &p, &out, &|| {}).unwrap();
     let rec = Dataset::open(&out).unwrap().load(0).unwrap();
@@ -345,4 +348,177 @@ fn string_labels_and_speeds_and_bad_stacks() {
     write_npy(dir.path().join("two.npy"), &Array1::from(vec![1i64, 2])).unwrap();
     assert!(err("n,t,row,col", &dir.path().join("two.npy"), "d").contains("2 labels for 3 samples"));
     assert!(!dir.path().join("d").exists());
+}
+
+#[test]
+fn name_patterns_match_brackets_and_dots_literally() {
+    let p = NamePattern::parse(
+        "Data[Texture({label})][Speed({speed})][Force({force})][Trial({trial})].csv",
+    )
+    .unwrap();
+    let f = p
+        .matches("Data[Texture(003)][Speed(2400)][Force(1.0)][Trial(1)].csv")
+        .unwrap();
+    assert_eq!(
+        (
+            &f["label"][..],
+            &f["speed"][..],
+            &f["force"][..],
+            &f["trial"][..]
+        ),
+        ("003", "2400", "1.0", "1")
+    );
+    // `.` is a dot, not any character; `(` is a parenthesis, not a group
+    assert!(p
+        .matches("Data[Texture(003)][Speed(2400)][Force(1.0)][Trial(1)]xcsv")
+        .is_none());
+    let p = NamePattern::parse("a.b+({label})|x.csv").unwrap();
+    assert_eq!(p.matches("a.b+(q)|x.csv").unwrap()["label"], "q");
+    assert!(p.matches("aXbb+(q)|x.csv").is_none());
+    assert!(NamePattern::parse("{label}_{label}.csv").is_err());
+}
+
+#[test]
+fn a_hundred_fields_match_in_well_under_a_second() {
+    // the old backtracking matcher took over a minute on this
+    let pattern: String =
+        (0..100).map(|k| format!("{{f{k}}}_")).collect::<String>() + "{label}.csv";
+    let name: String = (0..100).map(|k| format!("v{k}_")).collect::<String>() + "x.csv";
+    let p = NamePattern::parse(&pattern).unwrap();
+    let start = std::time::Instant::now();
+    let f = p.matches(&name).unwrap();
+    assert_eq!((&f["f7"][..], &f["label"][..]), ("v7", "x"));
+    // and a name that almost matches, the worst case for backtracking
+    let bad = "a_".repeat(100) + "x.txt";
+    assert!(p.matches(&bad).is_none());
+    assert!(start.elapsed().as_secs_f64() < 0.5, "{:?}", start.elapsed());
+}
+
+fn log_format(time: Option<Column>, policy: DuplicateStamps) -> CsvFormat {
+    CsvFormat {
+        time_column: time,
+        duplicate_stamps: policy,
+        ..CsvFormat::default()
+    }
+}
+
+#[test]
+fn headerless_semicolon_logs_by_index_ranges() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "log.csv",
+        "10;7;1;2;3\n20;7;4;5;6\n30;7;7;8;9\n",
+    );
+    let format = CsvFormat {
+        header: false,
+        time_column: Some(Column::Index(0)),
+        channels: "2-3,4".parse().unwrap(),
+        ..CsvFormat::default()
+    };
+    let log = read_csv_log(&p, &format).unwrap();
+    assert_eq!(log.delimiter.byte(), b';', "detected");
+    assert_eq!(log.channel_names, ["column2", "column3", "column4"]);
+    assert_eq!(log.samples, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    assert_eq!(log.times.as_deref(), Some(&[10.0, 20.0, 30.0][..]));
+    // tab-separated, detected; every column but the time column by default
+    let p = write(dir.path(), "tab.csv", "0\t1\t2\n5\t3\t4\n");
+    let format = CsvFormat {
+        header: false,
+        time_column: Some(Column::Index(0)),
+        ..CsvFormat::default()
+    };
+    let log = read_csv_log(&p, &format).unwrap();
+    assert_eq!((log.delimiter.byte(), log.samples.len()), (b'\t', 4));
+    // the same rules hold in a dataset's layout.toml: indices without a header
+    let layout: LayoutFile =
+        toml::from_str("header = false\ntime_column = \"0\"\nchannels = [\"2\", \"4\"]\n").unwrap();
+    let rec = read_recording(&dir.path().join("log.csv"), &layout).unwrap();
+    assert_eq!(rec.samples, [1.0, 3.0, 4.0, 6.0, 7.0, 9.0]);
+    assert_eq!(rec.times_s.as_deref(), Some(&[0.01, 0.02, 0.03][..]));
+}
+
+#[test]
+fn repeated_stamps_are_averaged_or_kept_first_or_last_or_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // 10 ms: two rows with other values and one exact repeat; 20 ms: one row
+    let p = write(
+        dir.path(),
+        "r.csv",
+        "t,a,b\n10,1,2\n10,3,6\n10,1,2\n20,5,5\n20,5,5\n",
+    );
+    let t = Some(Column::Name("t".into()));
+    let read = |policy| read_csv_log(&p, &log_format(t.clone(), policy));
+    let avg = read(DuplicateStamps::Average).unwrap();
+    assert_eq!(avg.samples, [2.0, 4.0, 5.0, 5.0]);
+    assert_eq!(avg.times.as_deref(), Some(&[10.0, 20.0][..]));
+    assert_eq!((avg.merged_rows, avg.duplicate_rows), (1, 2));
+    assert_eq!(
+        read(DuplicateStamps::First).unwrap().samples,
+        [1.0, 2.0, 5.0, 5.0]
+    );
+    assert_eq!(
+        read(DuplicateStamps::Last).unwrap().samples,
+        [3.0, 6.0, 5.0, 5.0]
+    );
+    let err = read(DuplicateStamps::Error).unwrap_err().to_string();
+    assert!(
+        err.contains("r.csv") && err.contains("line 3") && err.contains("repeats line 2"),
+        "{err}"
+    );
+    // exact repeats alone are dropped even under `error`
+    let q = write(dir.path(), "q.csv", "t,a\n10,1\n20,2\n20,2\n");
+    let log = read_csv_log(&q, &log_format(t.clone(), DuplicateStamps::Error)).unwrap();
+    assert_eq!((log.samples.len(), log.duplicate_rows), (2, 1));
+    // a stamp that goes back is always an error naming the line
+    let back = write(dir.path(), "back.csv", "t,a\n10,1\n20,2\n15,2\n");
+    let err = read_csv_log(&back, &log_format(t, DuplicateStamps::Average))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("back.csv") && err.contains("line 4"), "{err}");
+}
+
+#[test]
+fn bad_column_choices_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "h.csv", "1,2,3\n4,5,6\n");
+    let headerless = |time: Option<Column>, channels: &str| CsvFormat {
+        header: false,
+        time_column: time,
+        channels: channels.parse().unwrap(),
+        ..CsvFormat::default()
+    };
+    let cases = [
+        (
+            headerless(Some(Column::Index(3)), "1"),
+            "time column 3 (0-based) does not exist",
+        ),
+        (
+            headerless(None, "1-5"),
+            "channel column 3 (0-based) does not exist",
+        ),
+        (headerless(None, "a,b"), "without a header row"),
+        (headerless(None, r"^c\d$"), "not a regular expression"),
+        (
+            headerless(Some(Column::Index(0)), "0-1"),
+            "both the time and a channel",
+        ),
+        (
+            headerless(Some(Column::Name("t".into())), "1"),
+            "0-based index, got `t`",
+        ),
+    ];
+    for (format, expected) in cases {
+        let err = read_csv_log(&p, &format).unwrap_err().to_string();
+        assert!(
+            err.contains("h.csv") && err.contains(expected),
+            "{expected}: {err}"
+        );
+    }
+    assert!("3-1".parse::<neurotex::csvlog::ChannelSelect>().is_err());
+    assert!("0-99999999"
+        .parse::<neurotex::csvlog::ChannelSelect>()
+        .is_err());
+    assert!("pipe".parse::<neurotex::csvlog::Delimiter>().is_err());
+    assert!("mean".parse::<DuplicateStamps>().is_err());
 }

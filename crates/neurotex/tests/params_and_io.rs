@@ -214,8 +214,8 @@ fn bad_recordings_are_named_errors() {
         ("nan.csv", "a,b\n1,2\nNaN,3\n", "line 3, column `a`"),
         (
             "time.csv",
-            "t_ms,a\n0,1\n2,1\n2,1\n",
-            "line 4: time stamps must increase",
+            "t_ms,a\n0,1\n2,1\n1,1\n",
+            "line 4: time stamps must not go back",
         ),
         ("text.csv", "a,b\n1,x\n", "got `x`"),
         ("r.txt", "a\n1\n", "expected a .npy or .csv"),

@@ -3,15 +3,16 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use neurotex::calibrate::calibrate_gain;
 use neurotex::encode::SpikeTrains;
 use neurotex::pipeline::Pipeline;
-use neurotex::recording::{read_recording, LayoutFile};
-use neurotex::SampleRate;
+use neurotex::recording::{read_recording_as, LayoutFile};
+use neurotex::{Grid, SampleRate};
 
 use super::{report_conditions, say_calibration};
+use crate::csv_args::CsvArgs;
 use crate::output::stage_file;
 use crate::stage_args::StageArgs;
 
@@ -19,18 +20,28 @@ use crate::stage_args::StageArgs;
 #[derive(Args)]
 pub struct EncodeArgs {
     /// The recording: `.npy` (f32/f64, `(T, rows, cols)` or `(T, channels)`) or `.csv`
-    /// (header row, optional `t_ms`/`t_s` time column, one column per channel).
+    /// (by default a header row, an optional `t_ms`/`t_s` time column, one column per
+    /// channel; the CSV options below read raw logs). Its layout is `--layout FILE` when
+    /// given, else the `layout.toml` beside the recording when there is one (a dataset
+    /// folder's), else the defaults; options given here override the layout's settings.
     pub input: PathBuf,
     /// Where to write the spikes: u8 `.npy` of shape `(T, rows, cols)` at 1 kHz.
     #[arg(long)]
     pub out: PathBuf,
     /// Sampling rate of the input in Hz (default: the layout's, else 1000; ignored when the
-    /// CSV has a time column).
+    /// CSV has a time column: its stamps give the rate).
     #[arg(long, allow_negative_numbers = true)]
     pub fs: Option<SampleRate>,
-    /// A `layout.toml` giving grid, channel map, mask or baseline for the input.
+    /// A `layout.toml` giving grid, channel map, mask, rate, baseline or CSV columns for the
+    /// input (default: the `layout.toml` beside the input, if any).
     #[arg(long)]
     pub layout: Option<PathBuf>,
+    /// Grid `ROWSxCOLS` to place the channels on, row-major (replaces the layout's grid,
+    /// channel map and mask).
+    #[arg(long)]
+    pub grid: Option<Grid>,
+    #[command(flatten)]
+    pub csv: CsvArgs,
     /// Also write the spikes as address events `t_ms,row,col` to this CSV file.
     #[arg(long)]
     pub events: Option<PathBuf>,
@@ -41,14 +52,12 @@ pub struct EncodeArgs {
 /// Runs `neurotex encode`.
 pub fn run(args: EncodeArgs) -> Result<()> {
     let pipeline = Pipeline::new(args.stages.pipeline()?)?;
-    let mut layout = match &args.layout {
-        Some(path) => LayoutFile::read(path)?,
-        None => LayoutFile::default(),
-    };
-    if let Some(fs) = args.fs {
-        layout.fs = Some(fs.hz());
-    }
-    let recording = read_recording(&args.input, &layout)?;
+    let layout = input_layout(&args)?;
+    let format = layout
+        .csv_format()
+        .with_context(|| format!("reading the layout for {}", args.input.display()))?;
+    let format = args.csv.apply(format);
+    let recording = read_recording_as(&args.input, &layout, &format)?;
     let baseline = layout.baseline.unwrap_or_default();
     // `--gain auto` on the one recording being encoded.
     let pipeline = match args.stages.gain_target() {
@@ -56,11 +65,9 @@ pub fn run(args: EncodeArgs) -> Result<()> {
             let load = |_: usize| Ok(recording.clone());
             let c = calibrate_gain(&pipeline, &load, &[0], baseline, target)?;
             say_calibration(&c);
-            {
-                let mut params = pipeline.params().clone();
-                params.encoder.gain = c.gain;
-                Pipeline::new(params)?
-            }
+            let mut params = pipeline.params().clone();
+            params.encoder.gain = c.gain;
+            Pipeline::new(params)?
         }
         None => pipeline,
     };
@@ -93,6 +100,38 @@ pub fn run(args: EncodeArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// The input's layout: `--layout FILE`, else `layout.toml` beside the input, else the
+/// defaults; then `--fs` and `--grid` in place of the layout's.
+fn input_layout(args: &EncodeArgs) -> Result<LayoutFile> {
+    let beside = args
+        .input
+        .parent()
+        .map(|dir| dir.join("layout.toml"))
+        .filter(|p| p.is_file());
+    let mut layout = match args.layout.as_ref().or(beside.as_ref()) {
+        Some(path) => {
+            if args.layout.is_none() {
+                eprintln!(
+                    "note: reading the layout beside the recording, {}",
+                    path.display()
+                );
+            }
+            LayoutFile::read(path)?
+        }
+        None => LayoutFile::default(),
+    };
+    if let Some(fs) = args.fs {
+        layout.fs = Some(fs.hz());
+    }
+    if let Some(grid) = &args.grid {
+        layout.rows = Some(grid.rows());
+        layout.cols = Some(grid.cols());
+        layout.channel_map = None;
+        layout.mask = None;
+    }
+    Ok(layout)
 }
 
 /// Writes `t_ms,row,col`, one spike a line.

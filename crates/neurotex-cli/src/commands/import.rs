@@ -4,20 +4,22 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
+use neurotex::csvlog::CsvFormat;
 use neurotex::import::{
-    csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, NamePattern,
+    csv_files, import_csv, import_stacked, Axes, CsvImportParams, ImportSummary, NamePattern,
     StackedParams,
 };
-use neurotex::recording::{Baseline, ChannelMap, TimeUnit};
+use neurotex::recording::{Baseline, ChannelMap};
 use neurotex::{Grid, SampleRate};
 
+use crate::csv_args::CsvArgs;
 use crate::output::progress;
 
 /// `neurotex import`: bring recordings from other layouts into the dataset format.
 #[derive(Subcommand)]
 pub enum ImportCommand {
-    /// Per-trial CSV logs (a header row, a time column, one column per channel), with
-    /// metadata taken from the file names.
+    /// Per-trial CSV logs (a header row or none, a time column, one column per channel),
+    /// with metadata taken from the file names.
     Csv(ImportCsvArgs),
     /// A stacked array `(N, ...)` with one label (and optionally one speed) per sample.
     Stacked(ImportStackedArgs),
@@ -37,16 +39,8 @@ pub struct ImportCsvArgs {
     /// Without it the label is the file name.
     #[arg(long = "name-pattern")]
     pub name_pattern: Option<NamePattern>,
-    /// The time-stamp column (irregular stamps are kept and resampled onto 1 ms later).
-    #[arg(long = "time-column")]
-    pub time_column: Option<String>,
-    /// Unit of the time column: `ms` or `s`.
-    #[arg(long = "time-unit", default_value = "ms")]
-    pub time_unit: TimeUnit,
-    /// Channel columns: a comma-separated list, or a regular expression such as `^channel\d+$`
-    /// (default: every column but the time column).
-    #[arg(long)]
-    pub channels: Option<ChannelSelect>,
+    #[command(flatten)]
+    pub csv: CsvArgs,
     /// Grid `ROWSxCOLS` to place the channels on, row-major (default one row).
     #[arg(long)]
     pub grid: Option<Grid>,
@@ -103,9 +97,7 @@ pub fn run(command: ImportCommand) -> Result<()> {
 fn csv(args: ImportCsvArgs) -> Result<()> {
     let params = CsvImportParams {
         pattern: args.name_pattern,
-        time_column: args.time_column,
-        time_unit: args.time_unit,
-        channels: args.channels.unwrap_or(ChannelSelect::All),
+        format: args.csv.apply(CsvFormat::default()),
         grid: args.grid,
         channel_map: args.channel_map,
         fs: args.fs.map(SampleRate::hz),
@@ -121,18 +113,32 @@ fn csv(args: ImportCsvArgs) -> Result<()> {
     for (_, why) in &summary.skipped {
         eprintln!("warning: left out {why}");
     }
+    say_summary(&summary, &args.out);
+    Ok(())
+}
+
+/// Says on standard error what each file's repeated stamps became, then what was written.
+fn say_summary(summary: &ImportSummary, out: &std::path::Path) {
+    for m in &summary.merged {
+        eprintln!(
+            "note: {}: {} row(s) sharing a time stamp merged, {} exact duplicate row(s) dropped",
+            m.file, m.merged_rows, m.duplicate_rows
+        );
+    }
+    let merged: usize = summary.merged.iter().map(|m| m.merged_rows).sum();
+    let duplicates: usize = summary.merged.iter().map(|m| m.duplicate_rows).sum();
     let layout = &summary.layout;
     eprintln!(
-        "{} recordings ({} left out) -> {}; {} channels on a {}x{} grid at {:.2} Hz nominal",
+        "{} recordings ({} left out; {merged} rows merged and {duplicates} exact duplicates dropped in {} files) -> {}; {} channels on a {}x{} grid at {:.2} Hz nominal",
         summary.written,
         summary.skipped.len(),
-        args.out.display(),
+        summary.merged.len(),
+        out.display(),
         layout.channels.as_ref().map_or(0, Vec::len),
         layout.rows.unwrap_or(1),
         layout.cols.unwrap_or(1),
         layout.fs.unwrap_or(0.0)
     );
-    Ok(())
 }
 
 fn stacked(args: ImportStackedArgs) -> Result<()> {

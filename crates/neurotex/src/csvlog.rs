@@ -1,0 +1,636 @@
+//! Reading CSV logs as lab loggers write them: with or without a header row, columns by
+//! name or by 0-based index, `,` `;` or tab between fields (detected when not given), and
+//! time stamps that a host may repeat. One [`CsvFormat`] describes a file; `import csv`,
+//! `encode` and the dataset reader all read through [`read_csv_log`], so they cannot drift.
+
+use std::fmt;
+use std::io::Read;
+use std::path::Path;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{DataError, ParamError, Result};
+use crate::recording::TimeUnit;
+
+/// One column of a CSV log: by its header name, or by its 0-based position.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Column {
+    /// The column whose header is this name.
+    Name(String),
+    /// The column at this 0-based position.
+    Index(usize),
+}
+
+impl FromStr for Column {
+    type Err = ParamError;
+
+    /// Digits are a 0-based index, anything else a header name.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        let text = text.trim();
+        if text.is_empty() {
+            return Err(ParamError::new("time-column", "a name or index", "nothing"));
+        }
+        Ok(match text.parse::<usize>() {
+            Ok(i) if text.bytes().all(|b| b.is_ascii_digit()) => Column::Index(i),
+            _ => Column::Name(text.to_string()),
+        })
+    }
+}
+
+impl fmt::Display for Column {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Column::Name(name) => f.write_str(name),
+            Column::Index(i) => write!(f, "{i}"),
+        }
+    }
+}
+
+/// How to pick the channel columns of a CSV log.
+#[derive(Debug, Clone)]
+pub enum ChannelSelect {
+    /// Every column but the time column.
+    All,
+    /// These columns by header name, in this order.
+    Names(Vec<String>),
+    /// These columns by 0-based position, in this order.
+    Indices(Vec<usize>),
+    /// Columns whose header names match, in file order.
+    Regex(regex::Regex),
+}
+
+impl ChannelSelect {
+    /// A regular expression when the text holds one of `^$*+?[]()|\`; else a comma-separated
+    /// list: of 0-based indices and ranges (`0-8`, `2,4-7`, both ends included) when every
+    /// entry is one, of header names otherwise.
+    ///
+    /// # Errors
+    /// An invalid regular expression, or a range whose end is before its start.
+    pub fn parse(text: &str) -> Result<Self, ParamError> {
+        if text.chars().any(|c| "^$*+?[]()|\\".contains(c)) {
+            return regex::Regex::new(text)
+                .map(ChannelSelect::Regex)
+                .map_err(|e| {
+                    ParamError::new(
+                        "channels",
+                        "not a valid regular expression",
+                        format!("{text} ({e})"),
+                    )
+                });
+        }
+        let entries: Vec<&str> = text
+            .split(',')
+            .map(str::trim)
+            .filter(|s| !s.is_empty())
+            .collect();
+        if entries.is_empty() {
+            return Err(ParamError::new(
+                "channels",
+                "name at least one column",
+                text,
+            ));
+        }
+        let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+        let is_index = |e: &&str| match e.split_once('-') {
+            Some((a, b)) => digits(a.trim()) && digits(b.trim()),
+            None => digits(e),
+        };
+        if !entries.iter().all(is_index) {
+            return Ok(ChannelSelect::Names(
+                entries.iter().map(|s| s.to_string()).collect(),
+            ));
+        }
+        let mut indices = Vec::new();
+        for entry in entries {
+            let number = |s: &str| {
+                s.trim().parse::<usize>().map_err(|_| {
+                    ParamError::new("channels", "indices must be small integers", entry)
+                })
+            };
+            let (a, b) = match entry.split_once('-') {
+                Some((a, b)) => (number(a)?, number(b)?),
+                None => (number(entry)?, number(entry)?),
+            };
+            if b < a {
+                let rule = "a range is FIRST-LAST with FIRST <= LAST";
+                return Err(ParamError::new("channels", rule, entry));
+            }
+            if b - a >= MAX_COLUMNS || indices.len() + (b - a) >= MAX_COLUMNS {
+                let rule = "at most 65536 channel columns";
+                return Err(ParamError::new("channels", rule, entry));
+            }
+            indices.extend(a..=b);
+        }
+        Ok(ChannelSelect::Indices(indices))
+    }
+}
+
+/// The most channel columns a selection may name (a bound on what a typo such as `0-99999999`
+/// may allocate).
+const MAX_COLUMNS: usize = 65_536;
+
+impl FromStr for ChannelSelect {
+    type Err = ParamError;
+
+    /// As [`ChannelSelect::parse`].
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        ChannelSelect::parse(text)
+    }
+}
+
+/// The byte between fields: written `,`, `;` or `tab` (also `\t` or a tab itself).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Delimiter(u8);
+
+impl Delimiter {
+    /// The byte.
+    pub fn byte(self) -> u8 {
+        self.0
+    }
+}
+
+impl FromStr for Delimiter {
+    type Err = ParamError;
+
+    /// `,`, `;`, `tab`, `\t` or a tab character.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        match text {
+            "," | "comma" => Ok(Delimiter(b',')),
+            ";" | "semicolon" => Ok(Delimiter(b';')),
+            "tab" | "\\t" | "\t" => Ok(Delimiter(b'\t')),
+            other => Err(ParamError::new(
+                "delimiter",
+                "the delimiter is `,`, `;` or `tab`",
+                other,
+            )),
+        }
+    }
+}
+
+impl fmt::Display for Delimiter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            b'\t' => f.write_str("tab"),
+            b => write!(f, "{}", b as char),
+        }
+    }
+}
+
+impl Serialize for Delimiter {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(&self.to_string())
+    }
+}
+
+impl<'de> Deserialize<'de> for Delimiter {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let text = String::deserialize(d)?;
+        text.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+/// What to do with rows that share one time stamp (a host stamping a buffer it read).
+/// Rows equal in the time stamp and every selected channel are exact duplicates: they are
+/// dropped under every choice, `error` included.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DuplicateStamps {
+    /// One frame, the mean of the rows.
+    #[default]
+    Average,
+    /// One frame, the first row.
+    First,
+    /// One frame, the last row.
+    Last,
+    /// An error naming the line.
+    Error,
+}
+
+impl FromStr for DuplicateStamps {
+    type Err = ParamError;
+
+    /// `average`, `first`, `last` or `error`.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        match text {
+            "average" => Ok(DuplicateStamps::Average),
+            "first" => Ok(DuplicateStamps::First),
+            "last" => Ok(DuplicateStamps::Last),
+            "error" => Ok(DuplicateStamps::Error),
+            other => Err(ParamError::new(
+                "duplicate-stamps",
+                "one of `average`, `first`, `last` or `error`",
+                other,
+            )),
+        }
+    }
+}
+
+impl fmt::Display for DuplicateStamps {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            DuplicateStamps::Average => "average",
+            DuplicateStamps::First => "first",
+            DuplicateStamps::Last => "last",
+            DuplicateStamps::Error => "error",
+        })
+    }
+}
+
+/// How a CSV log is laid out.
+#[derive(Debug, Clone)]
+pub struct CsvFormat {
+    /// Whether the first row names the columns; without it, columns go by 0-based index.
+    pub header: bool,
+    /// The byte between fields; detected from the first lines when `None`.
+    pub delimiter: Option<Delimiter>,
+    /// The time-stamp column; none means the rows are evenly spaced at a known rate.
+    pub time_column: Option<Column>,
+    /// The unit of the time column.
+    pub time_unit: TimeUnit,
+    /// With a header row and no `time_column`: take a column named `t_ms` or `time_ms` (in
+    /// ms), or `t_s` or `time_s` (in s), as the time column when there is one.
+    pub detect_time: bool,
+    /// The channel columns.
+    pub channels: ChannelSelect,
+    /// Rows that share a time stamp.
+    pub duplicate_stamps: DuplicateStamps,
+}
+
+impl Default for CsvFormat {
+    /// A header row, detected delimiter, no time column (none detected), every column,
+    /// `average`.
+    fn default() -> Self {
+        CsvFormat {
+            header: true,
+            delimiter: None,
+            time_column: None,
+            time_unit: TimeUnit::Milliseconds,
+            detect_time: false,
+            channels: ChannelSelect::All,
+            duplicate_stamps: DuplicateStamps::Average,
+        }
+    }
+}
+
+/// A CSV log read: its frames and what was done to its rows.
+#[derive(Debug, Clone)]
+pub struct CsvLog {
+    /// The selected channels' names: header names, or `column{index}` without a header.
+    pub channel_names: Vec<String>,
+    /// Frames, time-major: `frames x channels`.
+    pub samples: Vec<f64>,
+    /// One time stamp per frame in the file's own unit, strictly increasing.
+    pub times: Option<Vec<f64>>,
+    /// The unit of `times`.
+    pub time_unit: TimeUnit,
+    /// Rows folded into another row's frame because they share its time stamp (exact
+    /// duplicates not counted).
+    pub merged_rows: usize,
+    /// Exact duplicate rows dropped.
+    pub duplicate_rows: usize,
+    /// The delimiter used (given or detected).
+    pub delimiter: Delimiter,
+}
+
+fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
+    DataError::invalid(path, message).into()
+}
+
+/// Guesses the delimiter from the first lines: among `,` `;` and tab, the one found the
+/// same non-zero number of times on each of the first ten lines, the most frequent such
+/// one (tab, then `;`, then `,` on a tie: `;` files often carry decimal commas); `,` when
+/// none is.
+fn detect_delimiter(path: &Path) -> Result<Delimiter> {
+    let mut head = Vec::with_capacity(16 * 1024);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(16 * 1024).read_to_end(&mut head))
+        .map_err(|e| DataError::io(path, e))?;
+    let text = String::from_utf8_lossy(&head);
+    let mut lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    if head.len() == 16 * 1024 && lines.len() > 1 {
+        lines.pop(); // probably cut short
+    }
+    lines.truncate(10);
+    let mut best: Option<(usize, u8)> = None;
+    for candidate in [b'\t', b';', b','] {
+        let counts: Vec<usize> = lines
+            .iter()
+            .map(|l| l.bytes().filter(|&b| b == candidate).count())
+            .collect();
+        let Some(&n) = counts.first() else { continue };
+        if n > 0 && counts.iter().all(|&c| c == n) && best.is_none_or(|(m, _)| n > m) {
+            best = Some((n, candidate));
+        }
+    }
+    Ok(Delimiter(best.map_or(b',', |(_, b)| b)))
+}
+
+/// Where the time and channel columns are, and the channels' names.
+struct Columns {
+    names: Vec<String>,
+    time: Option<usize>,
+    unit: TimeUnit,
+    channels: Vec<usize>,
+}
+
+/// Where column `col` is among `names`; `what` says which role it plays in errors.
+fn resolve_column(
+    path: &Path,
+    what: &str,
+    col: &Column,
+    names: &[String],
+    header: bool,
+) -> Result<usize> {
+    match col {
+        Column::Index(i) if *i < names.len() => Ok(*i),
+        Column::Index(i) => Err(invalid(
+            path,
+            format!(
+                "{what} {i} (0-based) does not exist: line 1 has {} columns",
+                names.len()
+            ),
+        )),
+        Column::Name(name) if !header => Err(invalid(
+            path,
+            format!("without a header row the {what} goes by 0-based index, got `{name}`"),
+        )),
+        Column::Name(name) => names.iter().position(|h| h == name).ok_or_else(|| {
+            invalid(
+                path,
+                format!("missing {what} `{name}` (columns: {})", names.join(", ")),
+            )
+        }),
+    }
+}
+
+impl Columns {
+    fn find(path: &Path, format: &CsvFormat, names: Vec<String>) -> Result<Self> {
+        let (time, unit) = match &format.time_column {
+            Some(col) => (
+                Some(resolve_column(
+                    path,
+                    "time column",
+                    col,
+                    &names,
+                    format.header,
+                )?),
+                format.time_unit,
+            ),
+            None if format.detect_time && format.header => detect_time_column(&names),
+            None => (None, format.time_unit),
+        };
+        let channels: Vec<usize> = match &format.channels {
+            ChannelSelect::All => (0..names.len()).filter(|&j| Some(j) != time).collect(),
+            ChannelSelect::Names(list) => list
+                .iter()
+                .map(|n| {
+                    let col = Column::Name(n.clone());
+                    resolve_column(path, "channel column", &col, &names, format.header)
+                })
+                .collect::<Result<_>>()?,
+            ChannelSelect::Indices(list) => list
+                .iter()
+                .map(|&i| {
+                    let col = Column::Index(i);
+                    resolve_column(path, "channel column", &col, &names, format.header)
+                })
+                .collect::<Result<_>>()?,
+            ChannelSelect::Regex(_) if !format.header => {
+                let message = "without a header row --channels takes indices such as 2-17, not a regular expression";
+                return Err(invalid(path, message));
+            }
+            ChannelSelect::Regex(re) => (0..names.len())
+                .filter(|&j| Some(j) != time && re.is_match(&names[j]))
+                .collect(),
+        };
+        if let Some(t) = time.filter(|t| channels.contains(t)) {
+            let message = format!("column `{}` is both the time and a channel", names[t]);
+            return Err(invalid(path, message));
+        }
+        if channels.is_empty() {
+            return Err(invalid(path, "no channel columns selected"));
+        }
+        Ok(Columns {
+            names,
+            time,
+            unit,
+            channels,
+        })
+    }
+}
+
+/// A column named `t_ms` or `time_ms` (in ms), else `t_s` or `time_s` (in s).
+fn detect_time_column(names: &[String]) -> (Option<usize>, TimeUnit) {
+    let find = |wanted: &[&str]| names.iter().position(|h| wanted.contains(&h.as_str()));
+    match (find(&["t_ms", "time_ms"]), find(&["t_s", "time_s"])) {
+        (Some(j), _) => (Some(j), TimeUnit::Milliseconds),
+        (None, Some(j)) => (Some(j), TimeUnit::Seconds),
+        (None, None) => (None, TimeUnit::Milliseconds),
+    }
+}
+
+/// Reads a CSV log as `format` says. Every cell must be a finite number; time stamps must
+/// not decrease, and rows sharing one are handled as [`DuplicateStamps`] says. Errors name
+/// the file, the line and the column.
+///
+/// # Errors
+/// An unreadable or malformed file, a missing column, a cell that is not a finite number,
+/// a time stamp that goes back, a repeated stamp under `error`, or no data rows.
+pub fn read_csv_log(path: &Path, format: &CsvFormat) -> Result<CsvLog> {
+    let delimiter = match format.delimiter {
+        Some(d) => d,
+        None => detect_delimiter(path)?,
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .delimiter(delimiter.byte())
+        .has_headers(format.header)
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| csv_error(path, e))?;
+    let first = reader.headers().map_err(|e| csv_error(path, e))?;
+    let names: Vec<String> = if format.header {
+        first.iter().map(str::to_string).collect()
+    } else {
+        (0..first.len()).map(|j| format!("column{j}")).collect()
+    };
+    if names.is_empty() {
+        return Err(invalid(path, "the file is empty"));
+    }
+    let columns = Columns::find(path, format, names)?;
+    let mut rows = RowReader::new(path, &columns, format.duplicate_stamps);
+    let mut record = csv::ByteRecord::new();
+    loop {
+        match reader.read_byte_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => rows.push(&record)?,
+            Err(e) => return Err(csv_error(path, e)),
+        }
+    }
+    let log = rows.finish(delimiter);
+    if log.samples.is_empty() {
+        return Err(invalid(path, "no data rows"));
+    }
+    Ok(log)
+}
+
+/// Folds rows into frames: the rows of one time stamp are kept (exact duplicates left out)
+/// until the stamp changes, then become one frame.
+struct RowReader<'a> {
+    path: &'a Path,
+    columns: &'a Columns,
+    policy: DuplicateStamps,
+    samples: Vec<f64>,
+    times: Option<Vec<f64>>,
+    /// The distinct rows of the current stamp, `channels` values each, and the line of the
+    /// first.
+    group: Vec<f64>,
+    group_line: u64,
+    stamp: Option<f64>,
+    row: Vec<f64>,
+    merged_rows: usize,
+    duplicate_rows: usize,
+}
+
+impl<'a> RowReader<'a> {
+    fn new(path: &'a Path, columns: &'a Columns, policy: DuplicateStamps) -> Self {
+        RowReader {
+            path,
+            columns,
+            policy,
+            samples: Vec::new(),
+            times: columns.time.map(|_| Vec::new()),
+            group: Vec::new(),
+            group_line: 0,
+            stamp: None,
+            row: Vec::with_capacity(columns.channels.len()),
+            merged_rows: 0,
+            duplicate_rows: 0,
+        }
+    }
+
+    fn parse(&self, record: &csv::ByteRecord, line: u64, j: usize) -> Result<f64> {
+        let raw = record.get(j).unwrap_or(b"");
+        std::str::from_utf8(raw)
+            .ok()
+            .and_then(|s| s.trim().parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                invalid(
+                    self.path,
+                    format!(
+                        "line {line}, column `{}`: expected a finite number, got `{}`",
+                        self.columns.names[j],
+                        String::from_utf8_lossy(raw)
+                    ),
+                )
+            })
+    }
+
+    fn push(&mut self, record: &csv::ByteRecord) -> Result<()> {
+        let line = record.position().map_or(0, |p| p.line());
+        self.row.clear();
+        for k in 0..self.columns.channels.len() {
+            let v = self.parse(record, line, self.columns.channels[k])?;
+            self.row.push(v);
+        }
+        let Some(j) = self.columns.time else {
+            self.samples.extend_from_slice(&self.row);
+            return Ok(());
+        };
+        let t = self.parse(record, line, j)?;
+        match self.stamp {
+            Some(prev) if t < prev => Err(invalid(
+                self.path,
+                format!("line {line}: time stamps must not go back, got {t} after {prev}"),
+            )),
+            Some(prev) if t == prev => self.same_stamp(t, line),
+            _ => {
+                self.flush();
+                self.stamp = Some(t);
+                self.group_line = line;
+                self.group.extend_from_slice(&self.row);
+                Ok(())
+            }
+        }
+    }
+
+    /// Another row at the current stamp: dropped when it repeats one exactly, else kept
+    /// for the frame (or an error under `error`).
+    fn same_stamp(&mut self, t: f64, line: u64) -> Result<()> {
+        let n = self.row.len();
+        if self.group.chunks_exact(n).any(|g| g == self.row.as_slice()) {
+            self.duplicate_rows += 1;
+            return Ok(());
+        }
+        if self.policy == DuplicateStamps::Error {
+            let message = format!(
+                "line {line}: time stamp {t} repeats line {} with other values (--duplicate-stamps average, first or last merges such rows)",
+                self.group_line
+            );
+            return Err(invalid(self.path, message));
+        }
+        self.merged_rows += 1;
+        self.group.extend_from_slice(&self.row);
+        Ok(())
+    }
+
+    /// The current stamp's rows become one frame.
+    fn flush(&mut self) {
+        let n = self.columns.channels.len();
+        let k = self.group.len() / n.max(1);
+        if k == 0 {
+            return;
+        }
+        match self.policy {
+            DuplicateStamps::First | DuplicateStamps::Error => {
+                self.samples.extend_from_slice(&self.group[..n])
+            }
+            DuplicateStamps::Last => self.samples.extend_from_slice(&self.group[(k - 1) * n..]),
+            DuplicateStamps::Average => self.samples.extend(
+                (0..n).map(|c| (0..k).map(|r| self.group[r * n + c]).sum::<f64>() / k as f64),
+            ),
+        }
+        if let (Some(times), Some(t)) = (self.times.as_mut(), self.stamp) {
+            times.push(t);
+        }
+        self.group.clear();
+    }
+
+    fn finish(mut self, delimiter: Delimiter) -> CsvLog {
+        self.flush();
+        CsvLog {
+            channel_names: self
+                .columns
+                .channels
+                .iter()
+                .map(|&j| self.columns.names[j].clone())
+                .collect(),
+            samples: self.samples,
+            times: self.times,
+            time_unit: self.columns.unit,
+            merged_rows: self.merged_rows,
+            duplicate_rows: self.duplicate_rows,
+            delimiter,
+        }
+    }
+}
+
+/// A CSV reading error under the file's name, with its line when the reader knows it.
+pub(crate) fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
+    match e.kind() {
+        csv::ErrorKind::Io(_) => {
+            let csv::ErrorKind::Io(io) = e.into_kind() else {
+                unreachable!()
+            };
+            DataError::io(path, io).into()
+        }
+        _ => {
+            let line = e
+                .position()
+                .map(|p| format!("line {}: ", p.line()))
+                .unwrap_or_default();
+            DataError::invalid(path, format!("{line}malformed CSV: {e}")).into()
+        }
+    }
+}
