@@ -342,7 +342,8 @@ pub fn import_csv(
             .par_iter()
             .map(|c| write_imported(tmp, c, &names))
             .collect::<Result<_>>()?;
-        write_manifest(tmp, &metas)
+        write_manifest(tmp, &metas)?;
+        read_back(tmp)
     })?;
     summary.written = good.len();
     summary.layout = layout;
@@ -684,9 +685,31 @@ pub fn import_stacked(
             ..LayoutFile::default()
         };
         write_layout(tmp, &layout)?;
-        write_manifest(tmp, &metas)
+        write_manifest(tmp, &metas)?;
+        read_back(tmp)
     })?;
     Ok(n)
+}
+
+/// Opens the dataset just written in `dir` and reads every recording back, so an import
+/// never reports success for a dataset neurotex cannot read (a label, speed or grid the
+/// readers refuse); the folder is not yet in place, and is removed on error.
+///
+/// # Errors
+/// The first part that does not read back, with what the reader said.
+fn read_back(dir: &Path) -> Result<()> {
+    let back = |e: crate::Error| -> crate::Error {
+        DataError::invalid(
+            dir,
+            format!("the import would write a dataset neurotex cannot read back: {e}"),
+        )
+        .into()
+    };
+    let dataset = crate::recording::Dataset::open(dir).map_err(back)?;
+    (0..dataset.entries.len())
+        .into_par_iter()
+        .try_for_each(|i| dataset.load(i).map(drop))
+        .map_err(back)
 }
 
 /// The stacked array read and checked, its axes put in the order `n, t, cells...`, and the
@@ -776,4 +799,21 @@ fn stacked_metas(data: &Path, labels: &Path, speeds: Option<&Path>, n: usize) ->
             meta
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn read_back_refuses_a_dataset_the_readers_refuse() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("a.csv"), "t_ms,c\n0,1\n1,2\n").unwrap();
+        std::fs::write(dir.path().join("manifest.csv"), "file,label\na.csv,x\n").unwrap();
+        read_back(dir.path()).unwrap();
+        // A recording whose samples the reader refuses (a NaN).
+        std::fs::write(dir.path().join("a.csv"), "t_ms,c\n0,1\n1,NaN\n").unwrap();
+        let err = read_back(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("cannot read back") && err.contains("a.csv"), "{err}");
+    }
 }

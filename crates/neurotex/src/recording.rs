@@ -552,6 +552,13 @@ impl LayoutFile {
             )
             .into());
         }
+        // A cell no channel reaches carries no signal: masked, never scored as a taxel.
+        let mut present = present;
+        if self.channel_map.is_some() {
+            let mut mapped = vec![false; rows * cols];
+            channel_map.iter().for_each(|&cell| mapped[cell] = true);
+            present.iter_mut().zip(mapped).for_each(|(p, m)| *p &= m);
+        }
         Ok(Layout {
             rows,
             cols,

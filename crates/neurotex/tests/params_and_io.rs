@@ -195,6 +195,20 @@ fn npy_f32_and_f64_in_both_shapes_are_read() {
     };
     let rec = read_recording(&dir.path().join("c.npy"), &layout).unwrap();
     assert_eq!(&rec.samples[6..12], &[15.0, 14.0, 13.0, 12.0, 11.0, 10.0]);
+    assert!(rec.layout.present.iter().all(|&p| p), "every cell mapped");
+    // Four channels on the 2x3 grid: the two cells no channel reaches are masked, not
+    // zero-signal taxels.
+    let four = Array2::<f64>::from_shape_fn((4, 4), |(t, c)| (t * 10 + c) as f64);
+    write_npy(dir.path().join("four.npy"), &four).unwrap();
+    let layout = LayoutFile {
+        channel_map: Some(vec![[0, 0], [0, 1], [1, 0], [1, 2]]),
+        ..layout
+    };
+    let rec = read_recording(&dir.path().join("four.npy"), &layout).unwrap();
+    assert_eq!(
+        rec.layout.present,
+        vec![true, true, false, true, false, true]
+    );
 }
 
 #[test]
