@@ -814,6 +814,9 @@ mod tests {
         // A recording whose samples the reader refuses (a NaN).
         std::fs::write(dir.path().join("a.csv"), "t_ms,c\n0,1\n1,NaN\n").unwrap();
         let err = read_back(dir.path()).unwrap_err().to_string();
-        assert!(err.contains("cannot read back") && err.contains("a.csv"), "{err}");
+        assert!(
+            err.contains("cannot read back") && err.contains("a.csv"),
+            "{err}"
+        );
     }
 }
