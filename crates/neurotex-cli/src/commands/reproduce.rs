@@ -9,10 +9,11 @@ use clap::Args;
 use indicatif::ProgressBar;
 use neurotex::calibrate::GainCalibration;
 use neurotex::experiments::{
-    claims, prepare, run_all, run_seeds, HeadlinePrediction, Progress, ReproduceParams, Source,
-    ValidReproduceParams,
+    claims, prepare, run_all, run_seeds, HeadlinePrediction, Progress, ReproduceParams, Results,
+    Source, ValidReproduceParams,
 };
 use neurotex::pipeline::Pipeline;
+use neurotex::recording::Dataset;
 use neurotex::report::{write_report, ReportContext};
 
 use super::say_calibration;
@@ -133,36 +134,11 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
     };
     let bar = Mutex::new(progress(0, "starting"));
     let on_progress = |p: Progress| show_progress(&bar.lock().expect("progress bar"), p);
-    let (results, described, params) = match &dataset {
-        Some(ds) => {
-            let source = Source::Dataset(ds);
-            let (params, calibration) = args.calibrated(&source)?;
-            let prepared = prepare(&source, &params, &on_progress)?;
-            let mut results = run_all(&prepared, &params, &on_progress)?;
-            results.gain_calibration = calibration;
-            (results, source.describe(), params)
-        }
-        None => {
-            let (trials, seeds) = (args.trials_per()?, args.simulation_seeds()?);
-            let simulate = |seed| Source::paper_design(trials, seed);
-            let (params, calibration) = args.calibrated(&simulate(seeds[0]))?;
-            let mut results = run_seeds(&simulate, &seeds, &params, &on_progress)?;
-            results.gain_calibration = calibration;
-            (results, describe_seeds(&simulate(seeds[0]), &seeds), params)
-        }
-    };
+    let (results, described, params) = analyse(&args, dataset.as_ref(), &on_progress)?;
     bar.lock().expect("progress bar").finish_and_clear();
-    let mut parameters = params.describe();
-    if let Some(c) = &results.gain_calibration {
-        parameters.push(format!(
-            "gain: --gain auto chose G = {} so that the median taxel with signal fires at {} Hz (median {:.1} Hz over {} taxel x recording pairs of {} recordings; labels unused{})",
-            c.gain, c.target_hz, c.median_hz, c.pairs, c.recordings,
-            if results.across_seeds.is_some() { "; calibrated on the first simulated dataset and used for all" } else { "" }
-        ));
-    }
     let ctx = ReportContext {
         dataset: described,
-        parameters,
+        parameters: parameters_described(&params, &results),
         total_seconds: started.elapsed().as_secs_f64(),
         command: command_line(),
         paper_comparable: dataset.is_none(),
@@ -182,6 +158,51 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Every analysis on the dataset folder, or on the simulated datasets; returns the results,
+/// the report's paragraph on the data and the parameters run with.
+fn analyse(
+    args: &ReproduceArgs,
+    dataset: Option<&Dataset>,
+    on_progress: &(dyn Fn(Progress) + Sync),
+) -> Result<(Results, String, ValidReproduceParams)> {
+    Ok(match dataset {
+        Some(ds) => {
+            let source = Source::Dataset(ds);
+            let (params, calibration) = args.calibrated(&source)?;
+            let prepared = prepare(&source, &params, on_progress)?;
+            let mut results = run_all(&prepared, &params, on_progress)?;
+            results.gain_calibration = calibration;
+            (results, source.describe(), params)
+        }
+        None => {
+            let (trials, seeds) = (args.trials_per()?, args.simulation_seeds()?);
+            let simulate = |seed| Source::paper_design(trials, seed);
+            let (params, calibration) = args.calibrated(&simulate(seeds[0]))?;
+            let mut results = run_seeds(&simulate, &seeds, &params, on_progress)?;
+            results.gain_calibration = calibration;
+            (results, describe_seeds(&simulate(seeds[0]), &seeds), params)
+        }
+    })
+}
+
+/// The report's parameter lines: the run's parameters and, under `--gain auto`, the gain
+/// chosen.
+fn parameters_described(params: &ValidReproduceParams, results: &Results) -> Vec<String> {
+    let mut lines = params.describe();
+    if let Some(c) = &results.gain_calibration {
+        let shared = if results.across_seeds.is_some() {
+            "; calibrated on the first simulated dataset and used for all"
+        } else {
+            ""
+        };
+        lines.push(format!(
+            "gain: --gain auto chose G = {} so that the median taxel with signal fires at {} Hz (median {:.1} Hz over {} taxel x recording pairs of {} recordings; labels unused{shared})",
+            c.gain, c.target_hz, c.median_hz, c.pairs, c.recordings
+        ));
+    }
+    lines
 }
 
 /// Writes `speed_mm_s,method,file,label,predicted,fold,repeat`, one row per prediction.
