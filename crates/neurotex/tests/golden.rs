@@ -4,12 +4,13 @@
 //! must regenerate it on purpose (`NEUROTEX_BLESS=1 cargo test -p neurotex --test golden`)
 //! and say why in its commit.
 
+mod support;
+
 use std::sync::OnceLock;
 
 use neurotex::classify::CvParams;
-use neurotex::experiments::{prepare, run_all, ReproduceParams, Results, Source};
+use neurotex::experiments::{prepare, run_all, ReproduceParams, Results};
 use neurotex::report::{markdown, ReportContext};
-use neurotex::sim::{design, RigParams, Texture};
 
 /// The analyses on 4 textures x 10, 20 mm/s x 6 trials of 20 mm slides, seed 7, without
 /// timings and provenance (wall-clock times, dates and commits differ from run to run);
@@ -17,12 +18,6 @@ use neurotex::sim::{design, RigParams, Texture};
 fn small_design_results() -> &'static Results {
     static RESULTS: OnceLock<Results> = OnceLock::new();
     RESULTS.get_or_init(|| {
-        let rig = RigParams {
-            hold_s: 0.5,
-            slide_mm: 20.0,
-            ..RigParams::default()
-        };
-        let textures = [Texture::Ft1, Texture::Sb, Texture::Stf, Texture::Cp];
         let params = ReproduceParams {
             cv: CvParams {
                 folds: 3,
@@ -38,11 +33,7 @@ fn small_design_results() -> &'static Results {
         }
         .check()
         .unwrap();
-        let source = Source::Simulated {
-            rig: Box::new(rig),
-            trials: design(&textures, &[10.0, 20.0], 6),
-            seed: 7,
-        };
+        let source = support::small_design(7);
         let prepared = prepare(&source, &params, &|_| {}).unwrap();
         let mut results = run_all(&prepared, &params, &|_| {}).unwrap();
         results.timing_s.clear();

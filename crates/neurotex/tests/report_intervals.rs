@@ -21,12 +21,13 @@
 //! differently, a shifted percentile, a share counted over the wrong predictions or a
 //! mis-mapped paired interval moves them by 1e-3 or more.
 
+mod support;
+
 use std::collections::BTreeMap;
 
 use neurotex::classify::{BootstrapParams, CvParams};
-use neurotex::experiments::{prepare, run_all, ReproduceParams, Source, Tables};
+use neurotex::experiments::{prepare, run_all, ReproduceParams, Tables};
 use neurotex::report::{markdown, ReportContext};
-use neurotex::sim::{design, RigParams, Texture};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -70,12 +71,6 @@ fn close(what: &str, ours: f64, reference: f64) {
 
 /// A small simulated run: its headline tables, its report, and the bootstrap seed.
 fn small_run() -> (Tables, neurotex::experiments::Results, String, u64) {
-    let rig = RigParams {
-        hold_s: 0.5,
-        slide_mm: 20.0,
-        ..RigParams::default()
-    };
-    let textures = [Texture::Ft1, Texture::Sb, Texture::Stf, Texture::Cp];
     let params = ReproduceParams {
         cv: CvParams {
             folds: 3,
@@ -92,11 +87,7 @@ fn small_run() -> (Tables, neurotex::experiments::Results, String, u64) {
     }
     .check()
     .unwrap();
-    let source = Source::Simulated {
-        rig: Box::new(rig),
-        trials: design(&textures, &[10.0, 20.0], 6),
-        seed: 3,
-    };
+    let source = support::small_design(3);
     let prepared = prepare(&source, &params, &|_| {}).unwrap();
     let tables = Tables::build(&prepared, &params).unwrap();
     let results = run_all(&prepared, &params, &|_| {}).unwrap();

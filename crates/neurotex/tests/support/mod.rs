@@ -1,12 +1,31 @@
-//! What several test files share (`mod support;`): a seeded generator for varied inputs and
-//! proptest strategies for the stages' inputs.
+//! What several test files share (`mod support;`): a seeded generator for varied inputs,
+//! proptest strategies for the stages' inputs, and the small simulated design of the
+//! whole-run tests.
 
 // Each test file is its own crate and uses only part of this module.
 #![allow(dead_code)]
 
 use std::ops::Range;
 
+use neurotex::experiments::Source;
+use neurotex::sim::{design, RigParams, Texture};
 use proptest::prelude::*;
+
+/// The small design the whole-run tests (golden results, report intervals) simulate: 4
+/// textures x 10, 20 mm/s x 6 trials of 20 mm slides after a 0.5 s hold, with `seed`.
+pub fn small_design(seed: u64) -> Source<'static> {
+    let rig = RigParams {
+        hold_s: 0.5,
+        slide_mm: 20.0,
+        ..RigParams::default()
+    };
+    let textures = [Texture::Ft1, Texture::Sb, Texture::Stf, Texture::Cp];
+    Source::Simulated {
+        rig: Box::new(rig),
+        trials: design(&textures, &[10.0, 20.0], 6),
+        seed,
+    }
+}
 
 /// Marsaglia's xorshift64 (shifts 13, 7, 17), seeded: the same seed gives the same numbers
 /// on every machine and thread count. For varied test inputs, not for statistics.

@@ -5,9 +5,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
-    category_labels, error_bar, hline, labels_fit, labels_height, legend, legend_size, mesh,
-    number, percent, render, text, Chart, Drawn, Key, Swatch, BEST, FONT, GLCM2D, GLCM3D, GREY,
-    LABEL, SINGLE, TITLE,
+    accuracy_chart, category_labels, error_bar, hline, labels_fit, labels_height, legend,
+    legend_size, percent, render, text, Chart, Drawn, Key, Swatch, BEST, GLCM2D, GLCM3D, GREY,
+    LABEL, SINGLE,
 };
 use super::{chance, chance_key, chance_per_speed, chance_values, FigureError};
 use crate::experiments::Results;
@@ -122,21 +122,7 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
     let height = TOP + PLOT_H.max(legend_h) + bottom + 8;
     render((width as u32, height as u32), |root| {
         let (area, _) = root.split_horizontally(LEFT + plot_w + 12);
-        let mut chart = ChartBuilder::on(&area)
-            .caption(&g.title, (FONT, TITLE))
-            .margin_top(6)
-            .margin_right(12)
-            .x_label_area_size(bottom)
-            .y_label_area_size(LEFT)
-            .build_cartesian_2d(0.0..n as f64, 0.0..100.0)?;
-        mesh(&mut chart)
-            .disable_x_mesh()
-            .x_labels(0)
-            .y_labels(11)
-            .y_label_formatter(&|v| number(*v))
-            .x_desc(g.x_desc.as_str())
-            .y_desc("accuracy (%)")
-            .draw()?;
+        let mut chart = accuracy_chart(&area, &g.title, n, (LEFT, bottom), &g.x_desc)?;
         bars(&mut chart, &series)?;
         match (&g.chance_per_group, g.chance) {
             (Some(per), _) => {

@@ -518,6 +518,36 @@ pub(crate) fn panel_chart<'a, 'b>(
         .build_cartesian_2d(x, y)
 }
 
+/// A chart of accuracy (0-100 %, a labelled grid line every 10) over `groups` categories
+/// of one x unit each, on `area` with `title`, room for `(left, bottom)` pixels of labels, and
+/// the x description `x_desc` (none when empty); the categories' own labels are drawn apart.
+pub(crate) fn accuracy_chart<'a, 'b>(
+    area: &'a Canvas<'b>,
+    title: &str,
+    groups: usize,
+    (left, bottom): (i32, i32),
+    x_desc: &str,
+) -> Result<Chart<'a, 'b>, DrawingAreaErrorKind<std::io::Error>> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, TITLE))
+        .margin_top(6)
+        .margin_right(12)
+        .x_label_area_size(bottom)
+        .y_label_area_size(left)
+        .build_cartesian_2d(0.0..groups as f64, 0.0..100.0)?;
+    let mut m = mesh(&mut chart);
+    m.disable_x_mesh()
+        .x_labels(0)
+        .y_labels(11)
+        .y_label_formatter(&|v| number(*v))
+        .y_desc("accuracy (%)");
+    if !x_desc.is_empty() {
+        m.x_desc(x_desc);
+    }
+    m.draw()?;
+    Ok(chart)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

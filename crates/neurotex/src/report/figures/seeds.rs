@@ -4,8 +4,8 @@
 use plotters::prelude::*;
 
 use super::plot::{
-    category_labels, error_bar, labels_fit, labels_height, legend, legend_size, mesh, number,
-    render, Chart, Drawn, Key, Swatch, FONT, GLCM3D, GREY, SINGLE, TITLE,
+    accuracy_chart, category_labels, error_bar, labels_fit, labels_height, legend, legend_size,
+    render, Chart, Drawn, Key, Swatch, GLCM3D, GREY, SINGLE,
 };
 use super::{chance_key, FigureError};
 use crate::experiments::{AcrossSeeds, Results, SeedAccuracy};
@@ -107,20 +107,7 @@ pub(crate) fn across_seeds(r: &Results) -> Option<Result<String, FigureError>> {
     let title = format!("E1 and E6 over {} simulated datasets", a.seeds.len());
     Some(render(size, |root| {
         let (area, _) = root.split_horizontally(LEFT + plot_w + 12);
-        let mut chart = ChartBuilder::on(&area)
-            .caption(title.as_str(), (FONT, TITLE))
-            .margin_top(6)
-            .margin_right(12)
-            .x_label_area_size(bottom)
-            .y_label_area_size(LEFT)
-            .build_cartesian_2d(0.0..n as f64, 0.0..100.0)?;
-        mesh(&mut chart)
-            .disable_x_mesh()
-            .x_labels(0)
-            .y_labels(11)
-            .y_label_formatter(&|v| number(*v))
-            .y_desc("accuracy (%)")
-            .draw()?;
+        let mut chart = accuracy_chart(&area, &title, n, (LEFT, bottom), "")?;
         draw_groups(&mut chart, &groups)?;
         let xs: Vec<i32> = (0..n)
             .map(|i| chart.backend_coord(&(i as f64 + 0.5, 0.0)).0)
