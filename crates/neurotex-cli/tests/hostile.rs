@@ -328,3 +328,101 @@ fn inputs_of_one_name_are_not_merged_into_one_file() {
     );
     assert!(!out.exists() && !dir.partial_left());
 }
+
+/// Spike times of each cell from an `encode --events` file of a one-row grid.
+fn events_by_column(path: &Path, cols: usize) -> Vec<Vec<i64>> {
+    let mut trains = vec![Vec::new(); cols];
+    for line in std::fs::read_to_string(path).unwrap().lines().skip(1) {
+        let fields: Vec<i64> = line.split(',').map(|f| f.parse().unwrap()).collect();
+        trains[fields[2] as usize].push(fields[0]);
+    }
+    trains
+}
+
+/// Co-occurrence counts of 1 ms bins (levels 0 and 15: no spike or one) over every offset
+/// the plan of `distances` has on a 1 x 2 grid, counted from spike times in u64: for one cell
+/// pair and time offset, pairs of two spikes by look-up, the other three by subtraction.
+fn binary_counts(trains: &[Vec<i64>], bins: i64, distances: &[i64]) -> [u64; 4] {
+    use neurotex::features::DIRECTIONS_13;
+    let sets: Vec<std::collections::HashSet<i64>> =
+        trains.iter().map(|t| t.iter().copied().collect()).collect();
+    let in_range = |t: &[i64], lo: i64, hi: i64| t.iter().filter(|&&x| lo <= x && x < hi).count();
+    let mut n = [0u64; 4]; // (0,0), (0,1), (1,0), (1,1)
+    for &d in distances {
+        for &(dr, dc, dt) in &DIRECTIONS_13 {
+            let (dr, dc, dt) = (i64::from(dr) * d, i64::from(dc) * d, i64::from(dt) * d);
+            for a in 0..2i64 {
+                let b = a + dc;
+                if dr != 0 || !(0..2).contains(&b) {
+                    continue;
+                }
+                let (lo, hi) = (0.max(-dt), bins.min(bins - dt));
+                let (ta, tb) = (&trains[a as usize], &sets[b as usize]);
+                let both = ta
+                    .iter()
+                    .filter(|&&t| lo <= t && t < hi && tb.contains(&(t + dt)))
+                    .count() as u64;
+                let first = in_range(ta, lo, hi) as u64;
+                let second = in_range(&trains[b as usize], lo + dt, hi + dt) as u64;
+                n[3] += both;
+                n[2] += first - both;
+                n[1] += second - both;
+                n[0] += (hi - lo) as u64 - first - second + both;
+            }
+        }
+    }
+    n
+}
+
+#[test]
+fn glcm_counts_beyond_u32_are_counted_in_u64() {
+    // 2 200 s of a 1 x 2 grid in 1 ms bins with distances 1..1000: 4.4 billion pairs,
+    // more than u32 counts hold.
+    let dir = Dir::new();
+    let data = dir.join("long");
+    std::fs::create_dir_all(&data).unwrap();
+    let steps = 2_200_000;
+    let rec = Array3::from_shape_fn((steps, 1, 2), |(t, _, c)| {
+        let phase = t as f32 / 5000.0 + c as f32;
+        0.6 + 0.4 * phase.sin()
+    });
+    write_npy(data.join("a.npy"), &rec).unwrap();
+    std::fs::write(data.join("manifest.csv"), "file,label\na.npy,x\n").unwrap();
+    let distances: Vec<i64> = (1..=1000).collect();
+    let list = distances
+        .iter()
+        .map(i64::to_string)
+        .collect::<Vec<_>>()
+        .join(",");
+    let stages = ["--whole", "--bin-ms", "1", "--distances", &list];
+    let (events, table) = (dir.join("ev.csv"), dir.join("f.csv"));
+    let npy = data.join("a.npy");
+    let mut encode = vec!["encode", s(&npy), "--out", "sp.npy", "--events", s(&events)];
+    encode.extend(stages);
+    dir.ok(&encode);
+    let mut features = vec!["features", "--dataset", s(&data), "--method", "glcm3d"];
+    features.extend(["--out", s(&table)]);
+    features.extend(stages);
+    dir.ok(&features);
+
+    let n = binary_counts(&events_by_column(&events, 2), steps as i64, &distances);
+    assert!(n.iter().sum::<u64>() > u64::from(u32::MAX), "{n:?}");
+    let mut counts = vec![0u64; 256];
+    (counts[0], counts[15], counts[15 * 16], counts[255]) = (n[0], n[1], n[2], n[3]);
+    let expected = neurotex::features::haralick(&counts, 16).to_array();
+    let csv = std::fs::read_to_string(&table).unwrap();
+    let row: Vec<f64> = csv
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .skip(2)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    for (got, want) in row.iter().zip(expected) {
+        assert!(
+            (got - want).abs() <= 1e-12 * want.abs().max(1.0),
+            "{row:?} vs {expected:?}"
+        );
+    }
+}

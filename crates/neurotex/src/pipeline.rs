@@ -305,20 +305,22 @@ impl FeatureExtractor {
                         &replanned
                     }
                 };
-                if !plan.counts_fit(volume.bins) {
+                if !plan.counts_fit_wide(volume.bins) {
                     return Err(DataError::TooLarge {
-                        what: "the GLCM pair count of this recording's volume",
-                        got: plan.counted_pairs(volume.bins),
-                        limit: crate::features::glcm::MAX_COUNTED_PAIRS,
-                        hint: "co-occurrence counts are u32; use a shorter recording, fewer distances or a smaller grid",
+                        what: "the time bins of this recording's rate volume",
+                        got: volume.bins as u64,
+                        limit: crate::features::glcm::MAX_SLICE_PAIRS,
+                        hint: "use a shorter recording or a wider --bin-ms",
                     }
                     .into());
                 }
                 let mut q = Vec::new();
                 volume.quantise(self.volume.levels, self.volume.range, &mut q);
                 let l = self.volume.levels;
-                let mut counts = vec![0u32; l * l];
-                plan.count(&q, volume.bins, &mut counts);
+                // u64 counts: a long volume with many distances passes u32's 4.3 billion
+                // pairs; below it the u32 kernels count and the result is widened.
+                let mut counts = vec![0u64; l * l];
+                plan.count_wide(&q, volume.bins, &mut counts);
                 Ok(haralick(&counts, l).to_array().to_vec())
             }
         }

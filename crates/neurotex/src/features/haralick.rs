@@ -20,7 +20,7 @@ impl Haralick {
     }
 }
 
-/// Features of the `levels x levels` count matrix `counts`, normalised by its total.
+/// Features of the `levels x levels` count matrix `counts` (u32 or u64), normalised by its total.
 /// An all-zero matrix (no pairs at all) gives contrast 0, correlation 1, ASM 0.
 ///
 /// Every sum is taken over the integer counts exactly (the marginals' means and variances
@@ -29,26 +29,27 @@ impl Haralick {
 ///
 /// # Panics
 /// If `counts` is not square in `levels` (a caller bug).
-pub fn haralick(counts: &[u32], levels: usize) -> Haralick {
+pub fn haralick<C: Copy + Into<u64>>(counts: &[C], levels: usize) -> Haralick {
     assert_eq!(counts.len(), levels * levels);
     let (mut total, mut contrast, mut square, mut cross) = (0u64, 0u128, 0u128, 0u128);
     let mut column = vec![0u64; levels];
     let (mut s_i, mut s_ii) = (0u128, 0u128);
     for (i, row) in counts.chunks_exact(levels).enumerate() {
         let mut row_total = 0u64;
-        let mut row_cross = 0u64;
+        let mut row_cross = 0u128;
         for (j, (&c, col)) in row.iter().zip(column.iter_mut()).enumerate() {
-            let c = u64::from(c);
-            let d = i.abs_diff(j) as u64;
+            let c: u64 = c.into();
+            let d = i.abs_diff(j) as u128;
             row_total += c;
-            row_cross += c * j as u64;
-            contrast += u128::from(c * d * d);
-            square += u128::from(c * c);
-            *col += c;
+            let c = u128::from(c);
+            row_cross += c * j as u128;
+            contrast += c * d * d;
+            square += c * c;
+            *col += c as u64;
         }
         let i = i as u128;
         total += row_total;
-        cross += i * u128::from(row_cross);
+        cross += i * row_cross;
         s_i += i * u128::from(row_total);
         s_ii += i * i * u128::from(row_total);
     }
@@ -68,8 +69,9 @@ pub fn haralick(counts: &[u32], levels: usize) -> Haralick {
         });
     let n = total as f64;
     let big_n = u128::from(total);
-    // N^2 times the covariance and the variances, exact: with u32 counts and at most 256
-    // levels, N < 2^48 and every product below stays under 2^113.
+    // N^2 times the covariance and the variances, exact while N < 2^55 (a total of counts
+    // no volume that fits in memory reaches): with at most 256 levels every product below
+    // stays under 2^128.
     let cov = signed_difference(big_n * cross, s_i * s_j);
     let var_x = signed_difference(big_n * s_ii, s_i * s_i);
     let var_y = signed_difference(big_n * s_jj, s_j * s_j);

@@ -102,8 +102,12 @@ pub enum Counting {
     OneHot,
 }
 
-/// Largest total of co-occurrence counts a volume may reach: counts are u32.
+/// Largest total of co-occurrence counts [`GlcmPlan::count`] takes: its counts are u32.
 pub const MAX_COUNTED_PAIRS: u64 = u32::MAX as u64;
+
+/// Most pairs [`GlcmPlan::count_wide`] counts in one slice of u32 counters (half of
+/// [`MAX_COUNTED_PAIRS`], so a slice may also hold one-sided counts of a symmetric plan).
+pub const MAX_SLICE_PAIRS: u64 = 1 << 31;
 
 /// All pairs of one cell pair at one time offset: `(V[a, t], V[b, t + dt])` for every `t`
 /// at which both voxels lie inside the volume.
@@ -409,11 +413,96 @@ impl GlcmPlan {
     }
 
     /// Whether u32 counts hold a volume of `bins` time steps: its
-    /// [`GlcmPlan::counted_pairs`] is at most [`MAX_COUNTED_PAIRS`]. Counts stay u32 (the
-    /// SIMD kernels add u32 lanes, twice as many per vector as u64); a volume beyond it is
-    /// 4.3 billion pairs, an hour-long recording on a grid of thousands of taxels.
+    /// [`GlcmPlan::counted_pairs`] is at most [`MAX_COUNTED_PAIRS`]. The counting kernels
+    /// add u32 lanes (twice as many per vector as u64); a volume beyond it (4.3 billion
+    /// pairs: an hour-long recording on a grid of thousands of taxels, or many distances)
+    /// is counted by [`GlcmPlan::count_wide`].
     pub fn counts_fit(&self, bins: usize) -> bool {
         self.counted_pairs(bins) <= MAX_COUNTED_PAIRS
+    }
+
+    /// Whether [`GlcmPlan::count_wide`] can count a volume of `bins` time steps: one run
+    /// (a cell pair at one time offset, at most `bins` pairs) must fit the u32 counters of a
+    /// slice, so `bins` may be at most [`MAX_SLICE_PAIRS`], 2^31 time bins, far beyond any
+    /// recording the readers accept.
+    pub fn counts_fit_wide(&self, bins: usize) -> bool {
+        bins as u64 <= MAX_SLICE_PAIRS
+    }
+
+    /// [`GlcmPlan::count`] into u64 counts, for volumes of any size: a volume whose counts
+    /// fit u32 ([`GlcmPlan::counts_fit`]) is counted as usual and widened; a larger one is
+    /// counted in slices of runs of at most [`MAX_SLICE_PAIRS`] pairs each, whose u32 counts
+    /// cannot wrap, added up in u64.
+    ///
+    /// # Panics
+    /// As [`GlcmPlan::count`], except for the size, and if
+    /// [`GlcmPlan::counts_fit_wide`] is false (a caller bug).
+    pub fn count_wide(&self, quantised: &[u8], bins: usize, counts: &mut [u64]) {
+        let l = self.levels;
+        assert_eq!(counts.len(), l * l, "counts must be levels x levels");
+        self.count_sliced(quantised, bins, counts, MAX_SLICE_PAIRS);
+    }
+
+    /// [`GlcmPlan::count_wide`] with slices of at most `slice_pairs` pairs (small in tests).
+    fn count_sliced(&self, quantised: &[u8], bins: usize, counts: &mut [u64], slice_pairs: u64) {
+        let l = self.levels;
+        let mut narrow = vec![0u32; l * l];
+        if self.counted_pairs(bins) <= slice_pairs.min(MAX_COUNTED_PAIRS) {
+            self.count(quantised, bins, &mut narrow);
+            for (wide, &n) in counts.iter_mut().zip(&narrow) {
+                *wide = u64::from(n);
+            }
+            return;
+        }
+        assert!(
+            bins as u64 <= slice_pairs,
+            "a run of {bins} pairs is longer than a slice; check GlcmPlan::counts_fit_wide first"
+        );
+        counts.fill(0);
+        let mut start = 0;
+        while start < self.runs.len() {
+            let mut end = start;
+            let mut pairs = 0u64;
+            while end < self.runs.len() && pairs + self.runs[end].len(bins) as u64 <= slice_pairs {
+                pairs += self.runs[end].len(bins) as u64;
+                end += 1;
+            }
+            // Counted one-sided; the sum is mirrored once, in u64, below.
+            self.sliced(&self.runs[start..end])
+                .count(quantised, bins, &mut narrow);
+            for (wide, &n) in counts.iter_mut().zip(&narrow) {
+                *wide += u64::from(n);
+            }
+            start = end;
+        }
+        if self.symmetric {
+            for i in 0..l {
+                for j in i..l {
+                    let s = counts[i * l + j] + counts[j * l + i];
+                    counts[i * l + j] = s;
+                    counts[j * l + i] = s;
+                }
+            }
+        }
+    }
+
+    /// A one-sided plan of some of this plan's runs (sorted by time offset, as `runs` is).
+    fn sliced(&self, runs: &[Run]) -> GlcmPlan {
+        let mut by_cell = runs.to_vec();
+        by_cell.sort_by_key(|r| (r.a, r.dt));
+        let mut paired = vec![false; self.cells];
+        for r in runs {
+            paired[r.a as usize] = true;
+            paired[r.b as usize] = true;
+        }
+        GlcmPlan {
+            levels: self.levels,
+            cells: self.cells,
+            symmetric: false,
+            runs: runs.to_vec(),
+            by_cell,
+            paired,
+        }
     }
 }
 
@@ -439,5 +528,58 @@ mod tests {
         assert!(!plan.counts_fit(limit_bins + 1000));
         // computed in u64: no wrap even where usize pair counts would pass u32::MAX
         assert!(plan.counted_pairs(limit_bins + 1000) > MAX_COUNTED_PAIRS);
+    }
+
+    /// A small xorshift volume of `cells x bins` levels below `levels`.
+    fn volume(cells: usize, bins: usize, levels: u8, mut seed: u64) -> Vec<u8> {
+        (0..cells * bins)
+            .map(|_| {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                (seed % u64::from(levels)) as u8
+            })
+            .collect()
+    }
+
+    #[test]
+    fn counting_in_slices_of_runs_adds_up_to_the_whole_count() {
+        for symmetric in [false, true] {
+            let params = GlcmParams {
+                distances: vec![1, 2, 3],
+                symmetric,
+            };
+            let present = [true, true, false, true, true, true];
+            let plan = GlcmPlan::new(2, 3, &present, 8, &params, GlcmKind::ThreeD).unwrap();
+            let bins = 40;
+            let q = volume(6, bins, 8, 0x9e37_79b9_7f4a_7c15);
+            let mut whole = vec![0u32; 64];
+            plan.count(&q, bins, &mut whole);
+            let whole: Vec<u64> = whole.into_iter().map(u64::from).collect();
+            // Slices of at most 41..97 pairs: many slices, with runs of 37..40 pairs each.
+            for slice_pairs in [41, 60, 97] {
+                let mut wide = vec![7u64; 64];
+                plan.count_sliced(&q, bins, &mut wide, slice_pairs);
+                assert_eq!(
+                    wide, whole,
+                    "symmetric {symmetric}, slices of {slice_pairs}"
+                );
+            }
+            let mut wide = vec![0u64; 64];
+            plan.count_wide(&q, bins, &mut wide);
+            assert_eq!(wide, whole);
+        }
+    }
+
+    #[test]
+    fn a_run_longer_than_a_slice_is_refused() {
+        let plan =
+            GlcmPlan::new(1, 2, &[true; 2], 4, &GlcmParams::default(), GlcmKind::TwoD).unwrap();
+        assert!(plan.counts_fit_wide(1 << 31));
+        assert!(!plan.counts_fit_wide((1 << 31) + 1));
+        let q = volume(2, 50, 4, 3);
+        let mut wide = vec![0u64; 16];
+        let refused = std::panic::catch_unwind(move || plan.count_sliced(&q, 50, &mut wide, 20));
+        assert!(refused.is_err());
     }
 }
