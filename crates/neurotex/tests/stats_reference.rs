@@ -274,3 +274,41 @@ proptest! {
         prop_assert!((0.0..=1.0).contains(&mcnemar_exact_p(b, c)));
     }
 }
+
+/// `sign_flip_p` against scipy's `permutation_test` (paired, `permutation_type="samples"`),
+/// stored in `tests/data/sign_flip_reference.json` by `tests/reference/make_sign_flip_reference.py`:
+/// every sign pattern enumerated on both sides up to 16 units (equal to 1e-12), and within
+/// five standard errors of sampling (both sides draw 400 000 patterns) beyond.
+#[test]
+fn sign_flip_p_values_match_scipy() {
+    use neurotex::classify::metrics::sign_flip_p;
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/sign_flip_reference.json"
+    ))
+    .unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let differences = |case: &Value| -> Vec<f64> {
+        let values = case["differences"].as_array().unwrap();
+        values.iter().map(|v| v.as_f64().unwrap()).collect()
+    };
+    for case in reference["exact"].as_array().unwrap() {
+        let (d, want) = (differences(case), case["p"].as_f64().unwrap());
+        let got = sign_flip_p(&d, 0, 0).unwrap();
+        assert!((got - want).abs() <= 1e-12, "{d:?}: {got} vs scipy {want}");
+    }
+    for case in reference["sampled"].as_array().unwrap() {
+        let (d, want) = (differences(case), case["p"].as_f64().unwrap());
+        let resamples = case["resamples"].as_u64().unwrap() as usize;
+        let got = sign_flip_p(&d, resamples, 7).unwrap();
+        let se = (2.0 * want * (1.0 - want) / resamples as f64).sqrt();
+        assert!(
+            (got - want).abs() <= 5.0 * se + 1e-6,
+            "n {}: {got} vs scipy {want}",
+            d.len()
+        );
+    }
+    assert!(sign_flip_p(&[], 100, 0).is_err());
+    assert!(sign_flip_p(&[0.5, 1.5], 100, 0).is_err());
+    assert!(sign_flip_p(&[0.5; 20], 0, 0).is_err());
+}
