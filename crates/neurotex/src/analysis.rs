@@ -73,6 +73,17 @@ impl FeatureTable {
             .collect()
     }
 
+    /// The table of rows `rows` alone, in that order.
+    pub fn subset(&self, rows: &[usize]) -> FeatureTable {
+        FeatureTable {
+            method: self.method,
+            grid: self.grid.clone(),
+            names: self.names.clone(),
+            metas: rows.iter().map(|&i| self.metas[i].clone()).collect(),
+            values: rows.iter().flat_map(|&i| self.row(i)).copied().collect(),
+        }
+    }
+
     /// The values of rows `rows` and columns `columns`, row-major.
     pub(crate) fn select(&self, rows: &[usize], columns: &[usize]) -> Vec<f64> {
         rows.iter()
@@ -101,6 +112,14 @@ pub enum Split {
         train: Selection,
         /// The test recordings.
         test: Selection,
+    },
+    /// Train on the table rows `train`, test on the rows `test` (disjoint): for splits
+    /// made outside the manifest's columns, as nested model selection makes them.
+    Rows {
+        /// The training rows.
+        train: Vec<usize>,
+        /// The test rows.
+        test: Vec<usize>,
     },
 }
 
@@ -348,7 +367,7 @@ pub fn evaluate<C: Classifier>(
                 Split::CrossValidation { cv, .. } => {
                     cross_validate(classifier, &x_train, cols.len(), y_train, &labels, *cv)?
                 }
-                Split::Where { .. } => {
+                Split::Where { .. } | Split::Rows { .. } => {
                     let x_test = table.select(&test_rows, cols);
                     let (train, test) = ((&x_train[..], y_train), (&x_test[..], y_test));
                     train_test(classifier, train, test, cols.len(), &labels)?
@@ -391,6 +410,18 @@ fn split_rows(table: &FeatureTable, split: &Split) -> Result<(Vec<usize>, Vec<us
             speeds: Some(s), ..
         } => (table.rows_at(s), vec![]),
         Split::Where { train, test } => disjoint(table, train, test)?,
+        Split::Rows { train, test } => {
+            let n = table.metas.len();
+            if let Some(&i) = train.iter().chain(test).find(|&&i| i >= n) {
+                let message = format!("row {i} of a table of {n} rows");
+                return Err(ClassifyError::BadFeatures(message).into());
+            }
+            if let Some(&i) = test.iter().find(|i| train.contains(i)) {
+                let message = format!("row {i} is in both the training and the test rows");
+                return Err(ClassifyError::BadFeatures(message).into());
+            }
+            (train.clone(), test.clone())
+        }
     })
 }
 

@@ -313,6 +313,9 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
         Split::Where { train, test } => {
             format!("train on {}, test on {}", selected(train), selected(test))
         }
+        Split::Rows { train, test } => {
+            format!("train on {} recordings, test on {}", train.len(), test.len())
+        }
     };
     println!("method {}: {} samples, {how}", method.name(), outcome.n);
     print_accuracy(outcome, cols);
