@@ -15,6 +15,7 @@
 pub mod analysis;
 pub mod calibrate;
 pub mod classify;
+pub mod compare;
 pub mod csvlog;
 pub mod diagnostics;
 pub mod encode;

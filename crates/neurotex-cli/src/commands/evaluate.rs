@@ -314,7 +314,11 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
             format!("train on {}, test on {}", selected(train), selected(test))
         }
         Split::Rows { train, test } => {
-            format!("train on {} recordings, test on {}", train.len(), test.len())
+            format!(
+                "train on {} recordings, test on {}",
+                train.len(),
+                test.len()
+            )
         }
     };
     println!("method {}: {} samples, {how}", method.name(), outcome.n);

@@ -1,0 +1,693 @@
+//! Which encoding, feature method and classifier suit a dataset best (issue 11): every
+//! candidate is evaluated on the same splits of the same recordings, ranked with a 95 %
+//! interval, and compared with the paper's method (3D-GLCM + KNN) by a paired test.
+//!
+//! The splits depend only on the recordings' labels (and groups) and the seed, never on
+//! the features, so every candidate is tested on exactly the same folds and a per-recording
+//! difference between two candidates is a paired one. Intervals are percentile bootstraps
+//! over units (recordings, or groups of `--group-by`) stratified by condition, so that the
+//! interval is of the mean over conditions the accuracy is; the comparison with the paper's
+//! method is the paired sign-flip test of the per-unit differences
+//! ([`sign_flip_p`]).
+//!
+//! Picking the best of many candidates on the same data is itself a choice fitted to that
+//! data: the winner's accuracy is biased upwards (the "winner's curse"; Cawley and Talbot
+//! 2010, JMLR 11). [`CompareParams::nested`] adds the honest estimate of the whole
+//! procedure: for each outer split the candidates are ranked by cross-validation inside
+//! its training recordings only, and the chosen one is scored on its test recordings.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::analysis::{Columns, FeatureTable, Outcome, Split};
+use crate::classify::metrics::sign_flip_p;
+use crate::classify::stats::percentile;
+use crate::classify::{group_folds, stratified_folds, ValidCv};
+use crate::error::{ClassifyError, ParamError, Result};
+use crate::recording::{Meta, Selection};
+
+/// Evaluates a candidate's table (or a subset of it) under a split.
+pub type EvaluateFn = dyn Fn(&FeatureTable, Columns, &Split) -> Result<Outcome> + Send + Sync;
+
+/// One encoding x feature method x classifier, with its features computed.
+#[derive(Clone)]
+pub struct Candidate {
+    /// The encoding's name (`sa`, `fa`, `sa+fa`).
+    pub encoding: String,
+    /// The feature method's name.
+    pub method: String,
+    /// The classifier's name.
+    pub classifier: String,
+    /// The features of every compared recording, rows in the same order for every candidate.
+    pub table: Arc<FeatureTable>,
+    /// The columns classified (every taxel in turn for the paper's single-taxel method).
+    pub columns: Columns,
+    /// The classifier applied to a table under a split.
+    pub evaluate: Arc<EvaluateFn>,
+    /// Seconds spent making the table (encoding shared among the methods of one encoding
+    /// is split evenly among them).
+    pub prepare_s: f64,
+}
+
+impl Candidate {
+    /// `encoding / method / classifier`.
+    pub fn name(&self) -> String {
+        format!("{} / {} / {}", self.encoding, self.method, self.classifier)
+    }
+
+    /// Whether this is the paper's method: the SA encoding, 3D-GLCM and KNN.
+    pub fn is_paper(&self) -> bool {
+        (
+            self.encoding.as_str(),
+            self.method.as_str(),
+            self.classifier.as_str(),
+        ) == ("sa", "glcm3d", "knn")
+    }
+}
+
+/// How recordings are split.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Protocol {
+    /// Cross-validation over all recordings pooled.
+    Pooled,
+    /// Cross-validation within each value of a manifest column (each speed, say); the
+    /// accuracy is the mean over values.
+    Per(String),
+    /// Each value of a manifest column held out in turn: trained on the other values,
+    /// tested on it; the accuracy is the mean over held-out values.
+    HoldOut(String),
+    /// Trained on one selection, tested on another.
+    Where {
+        /// The training recordings.
+        train: Selection,
+        /// The test recordings.
+        test: Selection,
+    },
+}
+
+impl std::fmt::Display for Protocol {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Protocol::Pooled => write!(f, "cross-validation over all recordings pooled"),
+            Protocol::Per(c) => write!(f, "cross-validation within each `{c}`, mean over them"),
+            Protocol::HoldOut(c) => write!(f, "each `{c}` held out in turn, mean over them"),
+            Protocol::Where { train, test } => write!(
+                f,
+                "train on `{}` in [{}], test on `{}` in [{}]",
+                train.column,
+                train.values.join(", "),
+                test.column,
+                test.values.join(", ")
+            ),
+        }
+    }
+}
+
+/// How to compare.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareParams {
+    /// The splits.
+    pub protocol: Protocol,
+    /// Folds, seed and repeats of every cross-validation.
+    pub cv: ValidCv,
+    /// A manifest column whose groups no fold splits, and the unit of intervals and tests.
+    pub group_by: Option<String>,
+    /// Resamples of the bootstrap and the sign-flip test.
+    pub resamples: usize,
+    /// Also estimate the accuracy of choosing the best candidate inside each training set.
+    pub nested: bool,
+}
+
+/// A candidate's accuracy at one condition.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConditionAccuracy {
+    /// The condition's value (a speed, a session).
+    pub condition: String,
+    /// Accuracy, 0..1.
+    pub accuracy: f64,
+}
+
+/// One candidate's result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Ranked {
+    /// Encoding name.
+    pub encoding: String,
+    /// Feature method name.
+    pub method: String,
+    /// Classifier name.
+    pub classifier: String,
+    /// Accuracy, 0..1: the mean over conditions of the protocol.
+    pub accuracy: f64,
+    /// 95 % percentile-bootstrap interval of the accuracy over units.
+    pub ci: [f64; 2],
+    /// Two-sided p-value of the paired sign-flip test against the paper's method (`None`
+    /// for the paper's method itself, or when it is not among the candidates).
+    pub p_vs_paper: Option<f64>,
+    /// Mean per-unit difference from the paper's method.
+    pub difference_vs_paper: Option<f64>,
+    /// Accuracy per condition (empty for pooled cross-validation).
+    pub per_condition: Vec<ConditionAccuracy>,
+    /// Seconds to make the features and evaluate.
+    pub seconds: f64,
+    /// Whether this is the paper's method.
+    pub paper: bool,
+}
+
+/// Choosing the best candidate inside each training set, scored on the test set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Nested {
+    /// Accuracy of the selection procedure, 0..1 (mean over conditions).
+    pub accuracy: f64,
+    /// Its 95 % interval.
+    pub ci: [f64; 2],
+    /// How often each candidate was chosen, most often first: `(name, times)`.
+    pub chosen: Vec<(String, usize)>,
+    /// Outer splits.
+    pub outer_splits: usize,
+}
+
+/// The comparison of every candidate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Comparison {
+    /// The protocol, as text.
+    pub protocol: String,
+    /// What intervals and tests resample: `recordings` or `groups of COLUMN`.
+    pub units: String,
+    /// Units compared.
+    pub n_units: usize,
+    /// Recordings compared.
+    pub n_recordings: usize,
+    /// Classes.
+    pub classes: usize,
+    /// Chance accuracy, 1 / classes.
+    pub chance: f64,
+    /// Share of the largest class among the evaluated recordings.
+    pub majority: f64,
+    /// Every candidate, best first.
+    pub results: Vec<Ranked>,
+    /// The best candidate (the first of `results`).
+    pub best: Ranked,
+    /// The selection procedure's own estimate, when asked for.
+    pub nested: Option<Nested>,
+    /// What the ranking does not say.
+    pub caveat: String,
+}
+
+/// The caveat every comparison carries.
+pub const CAVEAT: &str = "the best of several candidates chosen on the same recordings \
+    scores higher than it will on new recordings of the same kind; the nested estimate \
+    (selection inside each training set) is the one to quote for the chosen procedure";
+
+/// One candidate's scores under the protocol.
+struct Scored {
+    accuracy: f64,
+    per_condition: Vec<ConditionAccuracy>,
+    /// Per evaluated table row, its share of right predictions.
+    shares: Vec<(usize, f64)>,
+    seconds: f64,
+}
+
+/// Evaluates every candidate under `params` and ranks them.
+///
+/// # Errors
+/// No candidates, tables of different recordings, or an evaluation that fails (a class
+/// smaller than the folds, a protocol column the manifest lacks).
+pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Comparison> {
+    let first = candidates.first().ok_or(ClassifyError::Empty {
+        what: "compare: no candidates",
+    })?;
+    let metas = &first.table.metas;
+    if let Some(c) = candidates.iter().find(|c| c.table.metas != *metas) {
+        let message = format!("{} has other recordings than {}", c.name(), first.name());
+        return Err(ClassifyError::BadFeatures(message).into());
+    }
+    let scored: Vec<Scored> = candidates
+        .iter()
+        .map(|c| score(c, params))
+        .collect::<Result<_>>()?;
+    let units = Units::new(metas, &scored[0].shares, params)?;
+    let paper = candidates.iter().position(Candidate::is_paper);
+    let mut results: Vec<Ranked> = candidates
+        .iter()
+        .zip(&scored)
+        .map(|(c, s)| units.rank(c, s, paper.map(|p| &scored[p]), params))
+        .collect::<Result<_>>()?;
+    results.sort_by(|a, b| b.accuracy.total_cmp(&a.accuracy));
+    let nested = if params.nested {
+        Some(nested(candidates, params, &units)?)
+    } else {
+        None
+    };
+    let (classes, majority) = class_shares(metas, &scored[0].shares);
+    Ok(Comparison {
+        protocol: params.protocol.to_string(),
+        units: match &params.group_by {
+            Some(column) => format!("groups of {column}"),
+            None => "recordings".into(),
+        },
+        n_units: units.n_units(),
+        n_recordings: scored[0].shares.len(),
+        classes,
+        chance: 1.0 / classes.max(1) as f64,
+        majority,
+        best: results[0].clone(),
+        results,
+        nested,
+        caveat: CAVEAT.into(),
+    })
+}
+
+/// The number of classes among the evaluated rows and the largest class's share.
+fn class_shares(metas: &[Meta], shares: &[(usize, f64)]) -> (usize, f64) {
+    let mut counts: Vec<(String, usize)> = Vec::new();
+    for &(row, _) in shares {
+        let label = &metas[row].label;
+        match counts.iter_mut().find(|(l, _)| l == label) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((label.clone(), 1)),
+        }
+    }
+    let largest = counts.iter().map(|(_, n)| *n).max().unwrap_or(0);
+    (counts.len(), largest as f64 / shares.len().max(1) as f64)
+}
+
+/// The distinct values of `column` over `metas`, numerically ordered when all are numbers.
+///
+/// # Errors
+/// A column no recording has a value in.
+fn conditions(metas: &[Meta], column: &str) -> Result<Vec<String>> {
+    let mut values: Vec<String> = Vec::new();
+    for m in metas {
+        if let Some(v) = m.field(column) {
+            if !values.contains(&v) {
+                values.push(v);
+            }
+        }
+    }
+    if values.len() < 2 {
+        let rule = "the protocol's column must have at least two values";
+        let got = format!("{column}: {} value(s)", values.len());
+        return Err(ParamError::new("per / hold-out", rule, got).into());
+    }
+    if values.iter().all(|v| v.parse::<f64>().is_ok()) {
+        values.sort_by(|a, b| {
+            let (a, b): (f64, f64) = (a.parse().unwrap_or(0.0), b.parse().unwrap_or(0.0));
+            a.total_cmp(&b)
+        });
+    }
+    Ok(values)
+}
+
+/// The rows of `metas` whose `column` is `value`.
+fn rows_with(metas: &[Meta], column: &str, value: &str) -> Vec<usize> {
+    (0..metas.len())
+        .filter(|&i| metas[i].field(column).as_deref() == Some(value))
+        .collect()
+}
+
+/// Cross-validation of a whole table with the comparison's folds and groups.
+fn cv_split(params: &CompareParams) -> Split {
+    Split::CrossValidation {
+        speeds: None,
+        cv: params.cv,
+        group_by: params.group_by.clone(),
+    }
+}
+
+/// Evaluates one candidate under the protocol, timing it.
+fn score(c: &Candidate, params: &CompareParams) -> Result<Scored> {
+    let start = Instant::now();
+    let table = &c.table;
+    let mut per_condition = Vec::new();
+    let mut shares = Vec::new();
+    let accuracy = match &params.protocol {
+        Protocol::Pooled => {
+            let outcome = (c.evaluate)(table, c.columns, &cv_split(params))?;
+            shares = outcome.correct_shares;
+            outcome.accuracy
+        }
+        Protocol::Per(column) => {
+            for value in conditions(&table.metas, column)? {
+                let rows = rows_with(&table.metas, column, &value);
+                let sub = table.subset(&rows);
+                let outcome = (c.evaluate)(&sub, c.columns, &cv_split(params))
+                    .map_err(|e| in_condition(e, column, &value))?;
+                shares.extend(outcome.correct_shares.iter().map(|&(r, s)| (rows[r], s)));
+                per_condition.push(ConditionAccuracy {
+                    condition: value,
+                    accuracy: outcome.accuracy,
+                });
+            }
+            mean(per_condition.iter().map(|p| p.accuracy))
+        }
+        Protocol::HoldOut(column) => {
+            let values = conditions(&table.metas, column)?;
+            for value in &values {
+                let split = hold_out(column, &values, value);
+                let outcome = (c.evaluate)(table, c.columns, &split)?;
+                shares.extend(outcome.correct_shares);
+                per_condition.push(ConditionAccuracy {
+                    condition: value.clone(),
+                    accuracy: outcome.accuracy,
+                });
+            }
+            mean(per_condition.iter().map(|p| p.accuracy))
+        }
+        Protocol::Where { train, test } => {
+            let split = Split::Where {
+                train: train.clone(),
+                test: test.clone(),
+            };
+            let outcome = (c.evaluate)(table, c.columns, &split)?;
+            shares = outcome.correct_shares;
+            outcome.accuracy
+        }
+    };
+    shares.sort_by_key(|&(row, _)| row);
+    Ok(Scored {
+        accuracy,
+        per_condition,
+        shares,
+        seconds: c.prepare_s + start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Trains on every value of `column` but `value`, tests on `value`.
+fn hold_out(column: &str, values: &[String], value: &str) -> Split {
+    let others = values.iter().filter(|v| *v != value).cloned().collect();
+    let select = |values| Selection {
+        column: column.to_string(),
+        values,
+    };
+    Split::Where {
+        train: select(others),
+        test: select(vec![value.to_string()]),
+    }
+}
+
+/// An error of one condition's evaluation, saying which condition.
+fn in_condition(e: crate::Error, column: &str, value: &str) -> crate::Error {
+    let rule = "every condition must be evaluable on its own";
+    ParamError::new("per", rule, format!("{column} = {value}: {e}")).into()
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (total, n) = values.fold((0.0, 0usize), |(t, n), v| (t + v, n + 1));
+    total / n.max(1) as f64
+}
+
+/// The units intervals and tests resample: per evaluated row, its unit; units grouped by
+/// condition (one condition unless the protocol has several).
+struct Units {
+    /// Each evaluated row's unit index, in the order of the scored shares.
+    unit_of: Vec<usize>,
+    /// Each condition's units.
+    by_condition: Vec<Vec<usize>>,
+    n_units: usize,
+    resamples: usize,
+    seed: u64,
+}
+
+impl Units {
+    fn new(metas: &[Meta], shares: &[(usize, f64)], params: &CompareParams) -> Result<Units> {
+        let condition_column = match &params.protocol {
+            Protocol::Per(c) | Protocol::HoldOut(c) => Some(c.as_str()),
+            _ => None,
+        };
+        let key = |row: usize| {
+            let meta = &metas[row];
+            let condition = condition_column
+                .and_then(|c| meta.field(c))
+                .unwrap_or_default();
+            let unit = match &params.group_by {
+                Some(column) => meta.field(column).unwrap_or_default(),
+                None => meta.file.clone(),
+            };
+            (condition, unit)
+        };
+        let mut keys: Vec<(String, String)> = Vec::new();
+        let mut unit_of = Vec::with_capacity(shares.len());
+        for &(row, _) in shares {
+            let k = key(row);
+            let index = keys.iter().position(|x| *x == k).unwrap_or_else(|| {
+                keys.push(k);
+                keys.len() - 1
+            });
+            unit_of.push(index);
+        }
+        let mut names: Vec<&String> = Vec::new();
+        let mut by_condition: Vec<Vec<usize>> = Vec::new();
+        for (u, (condition, _)) in keys.iter().enumerate() {
+            match names.iter().position(|n| *n == condition) {
+                Some(i) => by_condition[i].push(u),
+                None => {
+                    names.push(condition);
+                    by_condition.push(vec![u]);
+                }
+            }
+        }
+        Ok(Units {
+            unit_of,
+            by_condition,
+            n_units: keys.len(),
+            resamples: params.resamples,
+            seed: params.cv.seed,
+        })
+    }
+
+    fn n_units(&self) -> usize {
+        self.n_units
+    }
+
+    /// Per unit, the sum of its rows' shares and its row count.
+    fn totals(&self, shares: &[(usize, f64)]) -> Vec<(f64, usize)> {
+        let mut totals = vec![(0.0, 0usize); self.n_units];
+        for (&(_, s), &u) in shares.iter().zip(&self.unit_of) {
+            totals[u].0 += s;
+            totals[u].1 += 1;
+        }
+        totals
+    }
+
+    /// The 95 % interval of the mean over conditions of the row-weighted mean share, by a
+    /// percentile bootstrap resampling units within each condition.
+    fn interval(&self, shares: &[(usize, f64)]) -> [f64; 2] {
+        let totals = self.totals(shares);
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        let mut means: Vec<f64> = (0..self.resamples.max(1))
+            .map(|_| {
+                mean(self.by_condition.iter().map(|units| {
+                    let (mut s, mut n) = (0.0, 0usize);
+                    for _ in 0..units.len() {
+                        let u = units[rng.gen_range(0..units.len() as u64) as usize];
+                        s += totals[u].0;
+                        n += totals[u].1;
+                    }
+                    s / n.max(1) as f64
+                }))
+            })
+            .collect();
+        means.sort_by(f64::total_cmp);
+        [percentile(&means, 0.025), percentile(&means, 0.975)]
+    }
+
+    /// Per unit, the mean share of `a` minus that of `b`.
+    fn differences(&self, a: &[(usize, f64)], b: &[(usize, f64)]) -> Vec<f64> {
+        let (ta, tb) = (self.totals(a), self.totals(b));
+        ta.iter()
+            .zip(&tb)
+            .map(|(x, y)| (x.0 - y.0) / x.1.max(1) as f64)
+            .collect()
+    }
+
+    fn rank(
+        &self,
+        c: &Candidate,
+        s: &Scored,
+        paper: Option<&Scored>,
+        params: &CompareParams,
+    ) -> Result<Ranked> {
+        let against = match paper {
+            Some(p) if !c.is_paper() => {
+                if p.shares
+                    .iter()
+                    .map(|x| x.0)
+                    .ne(s.shares.iter().map(|x| x.0))
+                {
+                    let (first, second) = (c.name(), "the paper's method".to_string());
+                    return Err(ClassifyError::Unpaired { first, second }.into());
+                }
+                let d = self.differences(&s.shares, &p.shares);
+                let p_value = sign_flip_p(&d, params.resamples, params.cv.seed)?;
+                Some((p_value, mean(d.iter().copied())))
+            }
+            _ => None,
+        };
+        Ok(Ranked {
+            encoding: c.encoding.clone(),
+            method: c.method.clone(),
+            classifier: c.classifier.clone(),
+            accuracy: s.accuracy,
+            ci: self.interval(&s.shares),
+            p_vs_paper: against.map(|a| a.0),
+            difference_vs_paper: against.map(|a| a.1),
+            per_condition: s.per_condition.clone(),
+            seconds: s.seconds,
+            paper: c.is_paper(),
+        })
+    }
+}
+
+/// The outer splits of nested selection: `(condition, training rows, test rows)`, from the
+/// first repeat's folds (or the held-out conditions).
+fn outer_splits(
+    metas: &[Meta],
+    params: &CompareParams,
+) -> Result<Vec<(String, Vec<usize>, Vec<usize>)>> {
+    let folds_of = |rows: Vec<usize>, condition: String| -> Result<Vec<_>> {
+        let fold_of = fold_assignment(metas, &rows, params)?;
+        let n_folds = fold_of.iter().max().map_or(0, |&f| f + 1);
+        Ok((0..n_folds)
+            .map(|f| {
+                let pick = |test: bool| -> Vec<usize> {
+                    let rows = rows.iter().zip(&fold_of);
+                    rows.filter(|(_, &g)| (g == f) == test)
+                        .map(|(&r, _)| r)
+                        .collect()
+                };
+                (condition.clone(), pick(false), pick(true))
+            })
+            .collect())
+    };
+    match &params.protocol {
+        Protocol::Pooled => folds_of((0..metas.len()).collect(), String::new()),
+        Protocol::Per(column) => {
+            let mut out = Vec::new();
+            for value in conditions(metas, column)? {
+                out.extend(folds_of(rows_with(metas, column, &value), value)?);
+            }
+            Ok(out)
+        }
+        Protocol::HoldOut(column) => Ok(conditions(metas, column)?
+            .into_iter()
+            .map(|value| {
+                let test = rows_with(metas, column, &value);
+                let train = (0..metas.len()).filter(|i| !test.contains(i)).collect();
+                (value, train, test)
+            })
+            .collect()),
+        Protocol::Where { train, test } => {
+            Ok(vec![(String::new(), train.rows(metas)?, test.rows(metas)?)])
+        }
+    }
+}
+
+/// The first repeat's fold of each of `rows`: stratified by label, or by groups.
+fn fold_assignment(metas: &[Meta], rows: &[usize], params: &CompareParams) -> Result<Vec<usize>> {
+    let index = |values: Vec<String>| -> (Vec<usize>, Vec<String>) {
+        let mut names: Vec<String> = Vec::new();
+        let out = values
+            .into_iter()
+            .map(|v| {
+                names.iter().position(|n| *n == v).unwrap_or_else(|| {
+                    names.push(v);
+                    names.len() - 1
+                })
+            })
+            .collect();
+        (out, names)
+    };
+    match &params.group_by {
+        Some(column) => {
+            let values = rows
+                .iter()
+                .map(|&r| metas[r].field(column).unwrap_or_default());
+            let (groups, _) = index(values.collect());
+            Ok(group_folds(&groups, params.cv.folds, params.cv.seed).0)
+        }
+        None => {
+            let labels: Vec<String> = rows.iter().map(|&r| metas[r].label.clone()).collect();
+            let (y, names) = index(labels);
+            let (folds, seed) = (params.cv.folds, params.cv.seed);
+            Ok(stratified_folds(&y, names.len(), folds, seed, &names)?)
+        }
+    }
+}
+
+/// Nested selection: inside each outer split's training rows every candidate is
+/// cross-validated (one repeat), the best is trained on all of them and tested on the
+/// split's test rows.
+fn nested(candidates: &[Candidate], params: &CompareParams, units: &Units) -> Result<Nested> {
+    let metas = &candidates[0].table.metas;
+    let splits = outer_splits(metas, params)?;
+    let inner = CompareParams {
+        cv: crate::classify::CvParams {
+            repeats: 1,
+            ..*params.cv
+        }
+        .check()?,
+        ..params.clone()
+    };
+    let outcomes: Vec<(String, usize, Vec<(usize, f64)>, f64)> = splits
+        .par_iter()
+        .map(|(condition, train, test)| {
+            let mut best = (f64::NEG_INFINITY, 0);
+            for (k, c) in candidates.iter().enumerate() {
+                let sub = c.table.subset(train);
+                let accuracy = (c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy;
+                if accuracy > best.0 {
+                    best = (accuracy, k);
+                }
+            }
+            let c = &candidates[best.1];
+            let split = Split::Rows {
+                train: train.clone(),
+                test: test.clone(),
+            };
+            let outcome = (c.evaluate)(&c.table, c.columns, &split)?;
+            Ok((
+                condition.clone(),
+                best.1,
+                outcome.correct_shares,
+                outcome.accuracy,
+            ))
+        })
+        .collect::<Result<_>>()?;
+    let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.2.clone()).collect();
+    shares.sort_by_key(|&(row, _)| row);
+    let mut chosen: Vec<(String, usize)> = Vec::new();
+    for o in &outcomes {
+        let name = candidates[o.1].name();
+        match chosen.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, times)) => *times += 1,
+            None => chosen.push((name, 1)),
+        }
+    }
+    chosen.sort_by(|a, b| b.1.cmp(&a.1));
+    // Mean over conditions of each condition's share of right test predictions.
+    let mut per: Vec<(String, f64, usize)> = Vec::new();
+    for o in &outcomes {
+        let right: f64 = o.2.iter().map(|x| x.1).sum();
+        match per.iter_mut().find(|(c, _, _)| *c == o.0) {
+            Some((_, r, n)) => (*r, *n) = (*r + right, *n + o.2.len()),
+            None => per.push((o.0.clone(), right, o.2.len())),
+        }
+    }
+    // The outer test sets cover the rows every candidate was scored on, once each, so the
+    // units are the same.
+    if shares.len() != units.unit_of.len() {
+        let (first, second) = ("nested selection".to_string(), "the candidates".to_string());
+        return Err(ClassifyError::Unpaired { first, second }.into());
+    }
+    Ok(Nested {
+        accuracy: mean(per.iter().map(|(_, r, n)| r / (*n).max(1) as f64)),
+        ci: units.interval(&shares),
+        chosen,
+        outer_splits: splits.len(),
+    })
+}
