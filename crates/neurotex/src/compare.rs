@@ -148,7 +148,7 @@ pub struct Ranked {
     /// Two-sided p-value of the paired sign-flip test against the paper's method (`None`
     /// for the paper's method itself, or when it is not among the candidates).
     pub p_vs_paper: Option<f64>,
-    /// Mean per-unit difference from the paper's method.
+    /// Accuracy minus the paper's method's (both means over conditions).
     pub difference_vs_paper: Option<f64>,
     /// Accuracy per condition (empty for pooled cross-validation).
     pub per_condition: Vec<ConditionAccuracy>,
@@ -524,7 +524,7 @@ impl Units {
                 }
                 let d = self.differences(&s.shares, &p.shares);
                 let p_value = sign_flip_p(&d, params.resamples, params.cv.seed)?;
-                Some((p_value, mean(d.iter().copied())))
+                Some((p_value, s.accuracy - p.accuracy))
             }
             _ => None,
         };
@@ -690,4 +690,137 @@ fn nested(candidates: &[Candidate], params: &CompareParams, units: &Units) -> Re
         chosen,
         outer_splits: splits.len(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::classify::{CvParams, KnnParams};
+    use crate::pipeline::Method;
+    use crate::values::Grid;
+
+    /// 3 classes x 2 speeds x 12 trials; `separable` features put each class far apart,
+    /// otherwise the features are noise that knows nothing of the class.
+    fn table(separable: bool) -> FeatureTable {
+        let mut metas = Vec::new();
+        let mut values = Vec::new();
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut noise = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % 1000) as f64 / 1000.0
+        };
+        for class in 0..3 {
+            for speed in [5.0, 10.0] {
+                for trial in 0..12 {
+                    metas.push(Meta {
+                        file: format!("c{class}_{speed}_{trial}.npy"),
+                        label: format!("c{class}"),
+                        speed_mm_s: Some(speed),
+                        force_n: None,
+                        trial: Some(trial),
+                        slide_start_s: None,
+                        slide_end_s: None,
+                        extra: Default::default(),
+                    });
+                    let centre = if separable { 10.0 * class as f64 } else { 0.0 };
+                    values.extend([centre + noise(), centre + noise(), centre + noise()]);
+                }
+            }
+        }
+        FeatureTable {
+            method: Method::Glcm3d,
+            grid: Grid::full(2, 2).unwrap(),
+            names: vec!["a".into(), "b".into(), "c".into()],
+            metas,
+            values,
+        }
+    }
+
+    fn candidate(method: &str, separable: bool) -> Candidate {
+        let knn = KnnParams::default().check().unwrap();
+        Candidate {
+            encoding: "sa".into(),
+            method: method.into(),
+            classifier: "knn".into(),
+            table: Arc::new(table(separable)),
+            columns: Columns::All,
+            evaluate: Arc::new(move |t, c, s| crate::analysis::evaluate(t, c, s, &knn)),
+            prepare_s: 0.0,
+        }
+    }
+
+    fn params(protocol: Protocol, nested: bool) -> CompareParams {
+        CompareParams {
+            protocol,
+            cv: CvParams {
+                folds: 4,
+                seed: 3,
+                repeats: 2,
+            }
+            .check()
+            .unwrap(),
+            group_by: None,
+            resamples: 500,
+            nested,
+        }
+    }
+
+    #[test]
+    fn a_separable_candidate_beats_the_paper_method_on_noise_significantly() {
+        // The paper's method sees noise here; "good" sees the classes.
+        let candidates = [candidate("glcm3d", false), candidate("good", true)];
+        for protocol in [
+            Protocol::Pooled,
+            Protocol::Per("speed_mm_s".into()),
+            Protocol::HoldOut("speed_mm_s".into()),
+        ] {
+            let c = compare(&candidates, &params(protocol.clone(), true)).unwrap();
+            assert_eq!(c.best.method, "good", "{protocol}");
+            assert_eq!(c.best.accuracy, 1.0);
+            assert_eq!((c.classes, c.n_recordings, c.n_units), (3, 72, 72));
+            assert!((c.chance - 1.0 / 3.0).abs() < 1e-15);
+            let (best, paper) = (&c.results[0], &c.results[1]);
+            assert!(paper.paper && paper.p_vs_paper.is_none());
+            assert!(best.p_vs_paper.unwrap() < 0.01, "{protocol}: {best:?}");
+            let gap = best.difference_vs_paper.unwrap();
+            assert!((gap - (best.accuracy - paper.accuracy)).abs() < 1e-12);
+            // noise classifies near chance, its interval holding chance and its estimate
+            assert!(paper.ci[0] <= paper.accuracy && paper.accuracy <= paper.ci[1]);
+            assert!(paper.ci[0] < 0.5 && paper.accuracy < 0.6, "{paper:?}");
+            let nested = c.nested.as_ref().unwrap();
+            assert_eq!(nested.chosen[0].0, "sa / good / knn");
+            assert_eq!(nested.accuracy, 1.0);
+            let conditions = if protocol == Protocol::Pooled { 0 } else { 2 };
+            assert_eq!(best.per_condition.len(), conditions);
+        }
+    }
+
+    #[test]
+    fn per_condition_accuracies_average_to_the_accuracy_and_splits_are_shared() {
+        let candidates = [candidate("glcm3d", true), candidate("glcm3d-again", true)];
+        let c = compare(
+            &candidates,
+            &params(Protocol::Per("speed_mm_s".into()), false),
+        )
+        .unwrap();
+        let r = &c.results[1];
+        let mean = (r.per_condition[0].accuracy + r.per_condition[1].accuracy) / 2.0;
+        assert_eq!(r.accuracy, mean);
+        assert_eq!(r.per_condition[0].condition, "5");
+        // the same features on the same splits: no difference at all, p = 1
+        let other = c.results.iter().find(|r| !r.paper).unwrap();
+        assert_eq!(other.difference_vs_paper, Some(0.0));
+        assert_eq!(other.p_vs_paper, Some(1.0));
+        assert!(c.nested.is_none());
+    }
+
+    #[test]
+    fn a_protocol_column_without_two_values_is_an_error() {
+        let candidates = [candidate("glcm3d", true)];
+        let err = compare(&candidates, &params(Protocol::Per("session".into()), false));
+        assert!(err.unwrap_err().to_string().contains("session"));
+        assert!(compare(&[], &params(Protocol::Pooled, false)).is_err());
+    }
 }

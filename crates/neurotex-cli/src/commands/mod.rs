@@ -1,6 +1,7 @@
 //! The subcommands, one module each: every one parses its options into the library's typed
 //! values and parameters, runs the library, and writes or prints the result.
 
+pub mod compare;
 pub mod encode;
 pub mod evaluate;
 pub mod features;
@@ -52,6 +53,24 @@ fn encoded_features(
     indices: &[usize],
     method: Method,
 ) -> Result<Features> {
+    let (encoded, grid) = encode_all(dataset, pipeline, indices)?;
+    let extractor = pipeline.extractor(&grid)?;
+    let table = FeatureTable::build(&encoded, &extractor, method)?;
+    let taxels = taxel_diagnostics(&encoded, &grid, pipeline.params().encoder)?;
+    Ok(Features {
+        table,
+        grid,
+        taxels,
+    })
+}
+
+/// Encodes the dataset's recordings `indices` with a progress bar, saying what the
+/// conditioning noticed; also returns the grid the recordings share.
+fn encode_all(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+) -> Result<(Vec<Encoded>, Grid)> {
     let bar = progress(indices.len(), "encoding");
     let encoded = pipeline.encode_dataset(dataset, indices, &|| bar.inc(1));
     bar.finish_and_clear();
@@ -68,14 +87,7 @@ fn encoded_features(
         })
         .collect::<Result<Vec<_>>>()?;
     let grid = one_grid(grids)?;
-    let extractor = pipeline.extractor(&grid)?;
-    let table = FeatureTable::build(&encoded, &extractor, method)?;
-    let taxels = taxel_diagnostics(&encoded, &grid, pipeline.params().encoder)?;
-    Ok(Features {
-        table,
-        grid,
-        taxels,
-    })
+    Ok((encoded, grid))
 }
 
 /// The pipeline the options name; with `--gain auto`, its gain calibrated on `dataset`'s

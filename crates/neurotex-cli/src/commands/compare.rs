@@ -1,0 +1,380 @@
+//! `neurotex compare`: every encoding x feature method x classifier on the same splits of a
+//! dataset, ranked with 95 % intervals and a paired test against the paper's method
+//! (SA encoding, 3D-GLCM, KNN); to find what suits a sensor best.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use neurotex::analysis::{evaluate, Columns, FeatureTable};
+use neurotex::classify::CvParams;
+use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
+use neurotex::pipeline::{Method, Pipeline};
+use neurotex::recording::{Dataset, Selection};
+use neurotex::Speed;
+
+use super::{calibrated_pipeline, encode_all};
+use crate::open_args::OpenArgs;
+use crate::output::write_file;
+use crate::stage_args::StageArgs;
+
+/// Most candidates one run compares (encodings x methods x classifiers).
+const MAX_CANDIDATES: usize = 200;
+
+/// Options of `neurotex compare`.
+#[derive(Args)]
+pub struct CompareArgs {
+    /// The dataset folder.
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// Only recordings at these speeds (mm/s, comma-separated); default all.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub speeds: Option<Vec<Speed>>,
+    /// Cross-validate within each value of this manifest column (each speed:
+    /// `speed_mm_s`) and rank by the mean over values. Default: all recordings pooled.
+    #[arg(long, conflicts_with_all = ["hold_out", "train_where"])]
+    pub per: Option<String>,
+    /// Hold out each value of this manifest column in turn (train on the others), and rank
+    /// by the mean over held-out values: `speed_mm_s` asks which method generalises to an
+    /// unseen speed.
+    #[arg(long = "hold-out", conflicts_with = "train_where")]
+    pub hold_out: Option<String>,
+    /// Train on the recordings whose column holds one of the values (needs --test-where).
+    #[arg(
+        long = "train-where",
+        value_name = "COL=V1,V2",
+        requires = "test_where"
+    )]
+    pub train_where: Option<Selection>,
+    /// Test on the recordings whose column holds one of the values.
+    #[arg(
+        long = "test-where",
+        value_name = "COL=V1,V2",
+        requires = "train_where"
+    )]
+    pub test_where: Option<Selection>,
+    /// Folds never split a group of this manifest column; intervals and tests resample
+    /// its groups.
+    #[arg(long = "group-by")]
+    pub group_by: Option<String>,
+    /// Encodings to compare, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "sa")]
+    pub encodings: Vec<String>,
+    /// Feature methods to compare, comma-separated. `taxel` is the paper's single-taxel
+    /// method (each taxel alone, mean over taxels; KNN only).
+    #[arg(long, value_delimiter = ',', default_value = "taxel,glcm2d,glcm3d")]
+    pub methods: Vec<String>,
+    /// Classifiers to compare, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "knn")]
+    pub classifiers: Vec<String>,
+    /// Neighbours in KNN.
+    #[arg(long, default_value_t = 5)]
+    pub k: usize,
+    /// Cross-validation folds.
+    #[arg(long, default_value_t = 5)]
+    pub folds: usize,
+    /// Cross-validation repeats (every candidate gets the same folds in each).
+    #[arg(long, default_value_t = 2)]
+    pub repeats: usize,
+    /// Seed of the folds, the bootstrap and the sign-flip test.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Also estimate the accuracy of choosing the best candidate inside each training set
+    /// (nested selection): the number to quote for "the best method".
+    #[arg(long)]
+    pub nested: bool,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write compare.json, compare.md and the figures into this folder.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub stages: StageArgs,
+    #[command(flatten)]
+    pub open: OpenArgs,
+}
+
+impl CompareArgs {
+    fn protocol(&self) -> Protocol {
+        match (
+            &self.per,
+            &self.hold_out,
+            &self.train_where,
+            &self.test_where,
+        ) {
+            (Some(column), ..) => Protocol::Per(column.clone()),
+            (_, Some(column), ..) => Protocol::HoldOut(column.clone()),
+            (_, _, Some(train), Some(test)) => Protocol::Where {
+                train: train.clone(),
+                test: test.clone(),
+            },
+            _ => Protocol::Pooled,
+        }
+    }
+
+    fn params(&self) -> Result<CompareParams> {
+        let cv = CvParams {
+            folds: self.folds,
+            seed: self.seed,
+            repeats: self.repeats,
+        }
+        .check()?;
+        Ok(CompareParams {
+            protocol: self.protocol(),
+            cv,
+            group_by: self.group_by.clone(),
+            resamples: 2000,
+            nested: self.nested,
+        })
+    }
+
+    /// The recordings compared: those at `--speeds`, or both sides of a train/test split.
+    fn indices(&self, dataset: &Dataset) -> Result<Vec<usize>> {
+        let entries = &dataset.entries;
+        let mut rows = match &self.speeds {
+            Some(speeds) => dataset.indices_at(speeds)?,
+            None => (0..entries.len()).collect(),
+        };
+        if let (Some(train), Some(test)) = (&self.train_where, &self.test_where) {
+            let (train, test) = (train.rows(entries)?, test.rows(entries)?);
+            rows.retain(|i| train.contains(i) || test.contains(i));
+        }
+        if rows.is_empty() {
+            bail!("no recordings to compare");
+        }
+        Ok(rows)
+    }
+
+    /// Every (method, classifier) pair to run, checked, with the columns each classifies.
+    fn pairs(&self) -> Result<Vec<(Method, Columns, String)>> {
+        let mut out = Vec::new();
+        for name in &self.methods {
+            let method: Method = name.parse()?;
+            for classifier in &self.classifiers {
+                if !["knn"].contains(&classifier.as_str()) {
+                    bail!("unknown classifier `{classifier}`: knn");
+                }
+                if method == Method::Taxel && classifier != "knn" {
+                    continue; // the paper's per-taxel method is a KNN method
+                }
+                let columns = if method == Method::Taxel {
+                    Columns::EachTaxel
+                } else {
+                    Columns::All
+                };
+                out.push((method, columns, classifier.clone()));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Runs `neurotex compare`.
+pub fn run(args: CompareArgs) -> Result<()> {
+    let params = args.params()?;
+    let dataset = args.open.open(&args.dataset)?;
+    let indices = args.indices(&dataset)?;
+    let pairs = args.pairs()?;
+    let n = pairs.len() * args.encodings.len();
+    if n == 0 || n > MAX_CANDIDATES {
+        bail!("{n} candidates to compare; between 1 and {MAX_CANDIDATES} are allowed");
+    }
+    let mut candidates = Vec::new();
+    for encoding in &args.encodings {
+        if encoding != "sa" {
+            bail!("unknown encoding `{encoding}`: sa");
+        }
+        candidates.extend(candidates_of(&args, &dataset, &indices, encoding, &pairs)?);
+    }
+    eprintln!(
+        "comparing {} candidates on {} recordings: {}",
+        candidates.len(),
+        indices.len(),
+        params.protocol
+    );
+    let comparison = compare(&candidates, &params)?;
+    if let Some(dir) = &args.out {
+        write_outputs(dir, &comparison)?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&comparison)?);
+    } else {
+        print_comparison(&comparison);
+    }
+    Ok(())
+}
+
+/// The candidates of one encoding: the recordings encoded once, each method's table made
+/// once, each classifier run on it.
+fn candidates_of(
+    args: &CompareArgs,
+    dataset: &Dataset,
+    indices: &[usize],
+    encoding: &str,
+    pairs: &[(Method, Columns, String)],
+) -> Result<Vec<Candidate>> {
+    let start = Instant::now();
+    let (params, _) = calibrated_pipeline(&args.stages, dataset, indices)?;
+    let pipeline = Pipeline::new(params)?;
+    let mut methods: Vec<Method> = pairs.iter().map(|p| p.0).collect();
+    methods.dedup();
+    let (encoded, grid) = encode_all(dataset, &pipeline, indices)?;
+    let extractor = pipeline.extractor(&grid)?;
+    let encode_s = start.elapsed().as_secs_f64() / methods.len() as f64;
+    let tables: Vec<(Method, Arc<FeatureTable>, f64)> = methods
+        .iter()
+        .map(|&method| {
+            let start = Instant::now();
+            let table = FeatureTable::build(&encoded, &extractor, method)?;
+            Ok((
+                method,
+                Arc::new(table),
+                encode_s + start.elapsed().as_secs_f64(),
+            ))
+        })
+        .collect::<Result<_>>()?;
+    let knn = args.stages.knn(args.k)?.check()?;
+    pairs
+        .iter()
+        .map(|(method, columns, classifier)| {
+            let (_, table, prepare_s) = tables
+                .iter()
+                .find(|t| t.0 == *method)
+                .context("every method has a table")?;
+            let knn = knn.clone();
+            Ok(Candidate {
+                encoding: encoding.to_string(),
+                method: method.name().to_string(),
+                classifier: classifier.clone(),
+                table: Arc::clone(table),
+                columns: *columns,
+                evaluate: Arc::new(move |t, c, s| evaluate(t, c, s, &knn)),
+                prepare_s: *prepare_s,
+            })
+        })
+        .collect()
+}
+
+/// compare.json and compare.md in `dir`.
+fn write_outputs(dir: &std::path::Path, c: &Comparison) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    write_file(&dir.join("compare.json"), "compare.json", |w| {
+        serde_json::to_writer_pretty(&mut *w, c).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })?;
+    write_file(&dir.join("compare.md"), "compare.md", |w| {
+        w.write_all(markdown(c).as_bytes())
+    })?;
+    eprintln!("wrote {}", dir.display());
+    Ok(())
+}
+
+/// `87.5% [85.1, 89.8]`.
+fn with_interval(accuracy: f64, ci: [f64; 2]) -> String {
+    format!(
+        "{:.1}% [{:.1}, {:.1}]",
+        100.0 * accuracy,
+        100.0 * ci[0],
+        100.0 * ci[1]
+    )
+}
+
+/// The ranking as a Markdown document.
+fn markdown(c: &Comparison) -> String {
+    let mut out = format!(
+        "# Comparison\n\n{} recordings ({} units: {}), {} classes; {}.\n\
+         Chance {:.1}%, majority class {:.1}%.\n\n\
+         | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) | seconds |\n\
+         |---:|---|---|---|---|---|---:|\n",
+        c.n_recordings,
+        c.n_units,
+        c.units,
+        c.classes,
+        c.protocol,
+        100.0 * c.chance,
+        100.0 * c.majority
+    );
+    for (i, r) in c.results.iter().enumerate() {
+        out.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {:.2} |\n",
+            i + 1,
+            r.encoding,
+            r.method,
+            r.classifier,
+            with_interval(r.accuracy, r.ci),
+            versus_paper(r),
+            r.seconds
+        ));
+    }
+    if let Some(n) = &c.nested {
+        out.push_str(&format!("\nNested selection: {}\n", nested_text(n)));
+    }
+    out.push_str(&format!("\nCaveat: {}.\n", c.caveat));
+    out
+}
+
+/// `+12.3 points (p 0.0004)`, `paper's method`, or `-`.
+fn versus_paper(r: &neurotex::compare::Ranked) -> String {
+    match (r.paper, r.difference_vs_paper, r.p_vs_paper) {
+        (true, ..) => "paper's method".into(),
+        (false, Some(d), Some(p)) => format!("{:+.1} points (p {})", 100.0 * d, p_text(p)),
+        _ => "-".into(),
+    }
+}
+
+fn p_text(p: f64) -> String {
+    if p < 0.001 {
+        "< 0.001".into()
+    } else {
+        format!("{p:.3}")
+    }
+}
+
+fn nested_text(n: &neurotex::compare::Nested) -> String {
+    let chosen: Vec<String> = n
+        .chosen
+        .iter()
+        .map(|(name, times)| format!("{name} ({times} of {})", n.outer_splits))
+        .collect();
+    format!(
+        "{} over {} outer splits; chosen: {}",
+        with_interval(n.accuracy, n.ci),
+        n.outer_splits,
+        chosen.join(", ")
+    )
+}
+
+/// The ranking as text.
+fn print_comparison(c: &Comparison) {
+    println!(
+        "{} recordings, {} classes ({}); chance {:.1}%, majority {:.1}%",
+        c.n_recordings,
+        c.classes,
+        c.protocol,
+        100.0 * c.chance,
+        100.0 * c.majority
+    );
+    let width = c
+        .results
+        .iter()
+        .map(|r| r.encoding.len() + r.method.len() + r.classifier.len() + 6)
+        .max()
+        .unwrap_or(0);
+    for (i, r) in c.results.iter().enumerate() {
+        let name = format!("{} / {} / {}", r.encoding, r.method, r.classifier);
+        println!(
+            "{:>3}. {name:<width$}  {:<24} {:<28} {:>7.2} s",
+            i + 1,
+            with_interval(r.accuracy, r.ci),
+            versus_paper(r),
+            r.seconds
+        );
+    }
+    if let Some(n) = &c.nested {
+        println!("nested selection: {}", nested_text(n));
+    }
+    println!("caveat: {}", c.caveat);
+}
