@@ -1,0 +1,117 @@
+//! `neurotex compare` through the binary: the JSON the issue asks for, the same splits as
+//! `evaluate`, the files of `--out`, and bad options.
+
+use serde_json::Value;
+
+use crate::util::{s, Dir};
+
+#[test]
+fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 10);
+    let out = dir.join("cmp");
+    let text = dir.ok(&[
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--per",
+        "speed_mm_s",
+        "--repeats",
+        "2",
+        "--json",
+        "--out",
+        s(&out),
+    ]);
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let results = v["results"].as_array().unwrap();
+    assert_eq!(results.len(), 3);
+    for r in results {
+        for key in [
+            "encoding",
+            "method",
+            "classifier",
+            "accuracy",
+            "ci",
+            "p_vs_paper",
+        ] {
+            assert!(r.get(key).is_some(), "{key} missing in {r}");
+        }
+        let (acc, ci) = (r["accuracy"].as_f64().unwrap(), r["ci"].as_array().unwrap());
+        assert!(ci[0].as_f64().unwrap() <= acc && acc <= ci[1].as_f64().unwrap());
+    }
+    assert_eq!(v["best"], results[0]);
+    let accuracies: Vec<f64> = results
+        .iter()
+        .map(|r| r["accuracy"].as_f64().unwrap())
+        .collect();
+    assert!(
+        accuracies.windows(2).all(|w| w[0] >= w[1]),
+        "{accuracies:?}"
+    );
+    // The paper's method at each speed is exactly what `evaluate` gives with the same folds.
+    let paper = results.iter().find(|r| r["paper"] == true).unwrap();
+    assert_eq!(paper["p_vs_paper"], Value::Null);
+    for (i, speed) in ["5", "10"].iter().enumerate() {
+        let e = dir.evaluate_json(&ds, "glcm3d", &["--speeds", speed, "--repeats", "2"]);
+        let at = &paper["per_condition"][i];
+        assert_eq!(at["condition"], *speed);
+        assert_eq!(at["accuracy"], e["accuracy"], "speed {speed}");
+    }
+    let taxel = results.iter().find(|r| r["method"] == "taxel").unwrap();
+    let e = dir.evaluate_json(&ds, "taxel", &["--speeds", "5", "--repeats", "2"]);
+    assert_eq!(taxel["per_condition"][0]["accuracy"], e["accuracy"]);
+    for file in ["compare.json", "compare.md"] {
+        assert!(out.join(file).exists(), "{file}");
+    }
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    assert!(
+        md.contains("paper's method") && md.contains("Caveat"),
+        "{md}"
+    );
+}
+
+#[test]
+fn nested_selection_over_held_out_speeds_names_its_choices() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0, 10.0, 15.0], 6);
+    let text = dir.ok(&[
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--hold-out",
+        "speed_mm_s",
+        "--methods",
+        "glcm2d,glcm3d",
+        "--nested",
+    ]);
+    assert!(text.contains("held out in turn"), "{text}");
+    assert!(
+        text.contains("nested selection:") && text.contains("of 3)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("paper's method") && text.contains("caveat"),
+        "{text}"
+    );
+}
+
+#[test]
+fn bad_compare_options_are_clear_errors() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 6);
+    let out = dir.join("never");
+    let base = ["compare", "--dataset", s(&ds), "--out", s(&out)];
+    let with = |extra: &[&'static str]| -> Vec<&str> {
+        base.iter().copied().chain(extra.iter().copied()).collect()
+    };
+    dir.fails_each(
+        &[
+            (with(&["--methods", "glcm9d"]), "glcm9d"),
+            (with(&["--classifiers", "svm"]), "svm"),
+            (with(&["--encodings", "xy"]), "xy"),
+            (with(&["--per", "session"]), "session"),
+            (with(&["--per", "speed_mm_s"]), "at least two values"),
+        ],
+        &out,
+    );
+}
