@@ -231,35 +231,33 @@ impl Traces {
         }
     }
 
-    /// Fills the traces of `tr` (forward causal pass, then the strictly later spikes
-    /// backwards, both by repeated multiplication with `e^{-1/τ}`).
-    fn fill(&mut self, tr: &SpikeTrains, taxels: &[usize], step_decay: f64) {
+    /// Fills the traces of `tr` from `decay[d] = e^{-d/τ}` (flushed to 0 where it would be
+    /// subnormal): between two spikes every step is one independent multiplication of the
+    /// level at the last spike (causal part) or of the sum over the next and later spikes
+    /// (the strictly later part), so the loops vectorise.
+    fn fill(&mut self, tr: &SpikeTrains, taxels: &[usize], decay: &[f64]) {
         for (trace, &cell) in self.values.chunks_exact_mut(self.steps).zip(taxels) {
             let spikes = tr.train(cell);
-            let (mut level, mut next) = (0.0f64, 0);
-            for (x, g) in trace.iter_mut().enumerate() {
-                level *= step_decay;
-                // flush what is left of a long silence before it turns subnormal (slow)
-                if level < 1e-300 {
-                    level = 0.0;
+            let first = spikes.first().map_or(self.steps, |&t| t as usize);
+            trace[..first].fill(0.0);
+            let mut level = 0.0;
+            for (k, &t) in spikes.iter().enumerate() {
+                let t = t as usize;
+                level = 1.0 + level * decay[t - spikes[k.saturating_sub(1)] as usize];
+                let end = spikes.get(k + 1).map_or(self.steps, |&u| u as usize);
+                for (g, &q) in trace[t..end].iter_mut().zip(decay) {
+                    *g = level * q;
                 }
-                if next < spikes.len() && spikes[next] as usize == x {
-                    level += 1.0;
-                    next += 1;
-                }
-                *g = level;
             }
-            let mut later = 0.0f64;
-            let mut next = spikes.len();
-            for (x, g) in trace.iter_mut().enumerate().rev() {
-                *g += later;
-                if next > 0 && spikes[next - 1] as usize == x {
-                    later += 1.0;
-                    next -= 1;
-                }
-                later *= step_decay;
-                if later < 1e-300 {
-                    later = 0.0;
+            // the part of later spikes: at x in [t_{k-1}, t_k), R_k e^{-(t_k - x)/τ}
+            let mut later = 0.0;
+            for (k, &t) in spikes.iter().enumerate().rev() {
+                let t = t as usize;
+                let next = spikes.get(k + 1).map_or(t, |&u| u as usize);
+                later = 1.0 + later * decay[next - t];
+                let start = if k == 0 { 0 } else { spikes[k - 1] as usize };
+                for (g, &q) in trace[start..t].iter_mut().rev().zip(&decay[1..]) {
+                    *g += later * q;
                 }
             }
         }
@@ -316,6 +314,15 @@ impl VanRossum {
             .sum()
     }
 
+    /// `e^{-d/τ}` for `d` in `0..=steps`, flushed to 0 below 1e-300 (subnormal arithmetic
+    /// is slow and the value no longer counts).
+    fn decay_table(&self, steps: usize) -> Vec<f64> {
+        (0..=steps)
+            .map(|d| (-(d as f64) / self.tau_ms).exp())
+            .map(|q| if q < 1e-300 { 0.0 } else { q })
+            .collect()
+    }
+
     /// Whether the trace table of recordings `steps` long fits [`MAX_TRACE_VALUES`].
     fn traces_fit(steps: usize, taxels: usize) -> bool {
         steps.saturating_mul(taxels) <= MAX_TRACE_VALUES
@@ -365,13 +372,13 @@ impl VanRossum {
         values: &mut [f64],
     ) {
         let n = recordings.len();
-        let step_decay = (-1.0 / self.tau_ms).exp();
+        let decay = self.decay_table(steps);
         let rows: Vec<(f64, Vec<f64>)> = (0..n)
             .into_par_iter()
             .map_init(
                 || Traces::new(steps, taxels.len()),
                 |traces, i| {
-                    traces.fill(&recordings[i], taxels, step_decay);
+                    traces.fill(&recordings[i], taxels, &decay);
                     let own = traces.cross_sum(&recordings[i], taxels);
                     let cross = recordings[i + 1..]
                         .iter()
@@ -420,13 +427,13 @@ impl VanRossum {
                 .collect();
             return Ok(rows.concat());
         }
-        let step_decay = (-1.0 / self.tau_ms).exp();
+        let decay = self.decay_table(steps);
         let own = |set: &[SpikeTrains]| -> Vec<f64> {
             set.par_iter()
                 .map_init(
                     || Traces::new(steps, taxels.len()),
                     |traces, r| {
-                        traces.fill(r, &taxels, step_decay);
+                        traces.fill(r, &taxels, &decay);
                         traces.cross_sum(r, &taxels)
                     },
                 )
@@ -438,7 +445,7 @@ impl VanRossum {
             .map_init(
                 || Traces::new(steps, taxels.len()),
                 |traces, q| {
-                    traces.fill(q, &taxels, step_decay);
+                    traces.fill(q, &taxels, &decay);
                     let own_q = traces.cross_sum(q, &taxels);
                     let refs = references.iter().zip(&own_ref);
                     refs.map(|(r, &own_r)| from_sums(own_q, own_r, traces.cross_sum(r, &taxels)))
