@@ -8,6 +8,7 @@ pub mod confusion;
 pub mod cv;
 pub mod knn;
 pub mod metrics;
+pub mod spike_distance;
 pub mod stats;
 
 pub use confusion::ConfusionMatrix;
@@ -20,6 +21,10 @@ pub use metrics::{
     bootstrap_accuracy, bootstrap_mean_share, mcnemar_exact, mcnemar_exact_p,
     t_interval_over_repeats, wilson_interval, BootstrapParams, ClassMetrics, Interval,
     IntervalMethod, Metrics, PairedTest, PairedVerdict, Side, ValidBootstrap,
+};
+pub use spike_distance::{
+    van_rossum, van_rossum_squared, DistanceMatrix, SpikeDistanceKnn, SpikeDistanceKnnModel,
+    VanRossum, VanRossumParams,
 };
 pub use stats::StatsError;
 
