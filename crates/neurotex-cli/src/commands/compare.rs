@@ -10,15 +10,20 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use neurotex::analysis::{evaluate, Columns, FeatureTable};
 use neurotex::classify::CvParams;
+use neurotex::classify::{SpikeDistanceKnn, VanRossumParams};
 use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
-use neurotex::pipeline::{Method, Pipeline};
+use neurotex::encode::SpikeTrains;
+use neurotex::pipeline::{Encoded, Method, Pipeline};
 use neurotex::recording::{Dataset, Selection};
-use neurotex::Speed;
+use neurotex::{Grid, Speed};
 
 use super::{calibrated_pipeline, encode_all};
 use crate::open_args::OpenArgs;
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
+
+/// The spike-timing method's name.
+const VAN_ROSSUM: &str = "van-rossum";
 
 /// Most candidates one run compares (encodings x methods x classifiers).
 const MAX_CANDIDATES: usize = 200;
@@ -63,12 +68,17 @@ pub struct CompareArgs {
     #[arg(long, value_delimiter = ',', default_value = "sa")]
     pub encodings: Vec<String>,
     /// Feature methods to compare, comma-separated. `taxel` is the paper's single-taxel
-    /// method (each taxel alone, mean over taxels; KNN only).
+    /// method (each taxel alone, mean over taxels; KNN only); `van-rossum` classifies by
+    /// spike-train distances (KNN only).
     #[arg(long, value_delimiter = ',', default_value = "taxel,glcm2d,glcm3d")]
     pub methods: Vec<String>,
     /// Classifiers to compare, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "knn")]
     pub classifiers: Vec<String>,
+    /// Time constant of the van Rossum kernel in ms (method `van-rossum`). Default: the
+    /// rate volume's 200 ms bin, the time resolution the paper's rate code keeps.
+    #[arg(long = "tau-ms", default_value_t = 200.0)]
+    pub tau_ms: f64,
     /// Neighbours in KNN.
     #[arg(long, default_value_t = 5)]
     pub k: usize,
@@ -151,8 +161,10 @@ impl CompareArgs {
     /// Every (method, classifier) pair to run, checked, with the columns each classifies.
     fn pairs(&self) -> Result<Vec<(Method, Columns, String)>> {
         let mut out = Vec::new();
-        for name in &self.methods {
-            let method: Method = name.parse()?;
+        for name in self.methods.iter().filter(|m| *m != VAN_ROSSUM) {
+            let method: Method = name.parse().map_err(|e| {
+                anyhow::anyhow!("{e}; or {VAN_ROSSUM} (KNN over spike-train distances)")
+            })?;
             for classifier in &self.classifiers {
                 if !["knn"].contains(&classifier.as_str()) {
                     bail!("unknown classifier `{classifier}`: knn");
@@ -178,7 +190,8 @@ pub fn run(args: CompareArgs) -> Result<()> {
     let dataset = args.open.open(&args.dataset)?;
     let indices = args.indices(&dataset)?;
     let pairs = args.pairs()?;
-    let n = pairs.len() * args.encodings.len();
+    let timing = usize::from(args.methods.iter().any(|m| m == VAN_ROSSUM));
+    let n = (pairs.len() + timing) * args.encodings.len();
     if n == 0 || n > MAX_CANDIDATES {
         bail!("{n} candidates to compare; between 1 and {MAX_CANDIDATES} are allowed");
     }
@@ -221,6 +234,9 @@ fn candidates_of(
     let pipeline = Pipeline::new(params)?;
     let mut methods: Vec<Method> = pairs.iter().map(|p| p.0).collect();
     methods.dedup();
+    if methods.is_empty() {
+        methods.push(Method::Glcm3d); // only van Rossum: the grid still comes from a table
+    }
     let (encoded, grid) = encode_all(dataset, &pipeline, indices)?;
     let extractor = pipeline.extractor(&grid)?;
     let encode_s = start.elapsed().as_secs_f64() / methods.len() as f64;
@@ -237,7 +253,7 @@ fn candidates_of(
         })
         .collect::<Result<_>>()?;
     let knn = args.stages.knn(args.k)?.check()?;
-    pairs
+    let mut candidates: Vec<Candidate> = pairs
         .iter()
         .map(|(method, columns, classifier)| {
             let (_, table, prepare_s) = tables
@@ -255,7 +271,49 @@ fn candidates_of(
                 prepare_s: *prepare_s,
             })
         })
-        .collect()
+        .collect::<Result<_>>()?;
+    if args.methods.iter().any(|m| m == VAN_ROSSUM) {
+        candidates.push(van_rossum_candidate(
+            args, encoding, &encoded, &grid, encode_s,
+        )?);
+    }
+    Ok(candidates)
+}
+
+/// The spike-timing candidate: KNN over van Rossum distances between the recordings'
+/// spike trains (of the first population), the matrix computed once. Its table holds each
+/// recording's row index into the matrix, the "feature" the classifier looks up.
+fn van_rossum_candidate(
+    args: &CompareArgs,
+    encoding: &str,
+    encoded: &[Encoded],
+    grid: &Grid,
+    encode_s: f64,
+) -> Result<Candidate> {
+    let start = Instant::now();
+    let trains: Vec<SpikeTrains> = encoded.iter().map(|e| e.spikes.clone()).collect();
+    let metric = VanRossumParams {
+        tau_ms: args.tau_ms,
+    }
+    .check()?;
+    let knn = SpikeDistanceKnn::new(Arc::new(metric.matrix(&trains)?), args.k)?;
+    let table = FeatureTable {
+        // Not a feature method: the field is not read for a table of row indices.
+        method: Method::Glcm3d,
+        grid: grid.clone(),
+        names: vec!["row".into()],
+        metas: encoded.iter().map(|e| e.meta.clone()).collect(),
+        values: knn.samples(),
+    };
+    Ok(Candidate {
+        encoding: encoding.to_string(),
+        method: VAN_ROSSUM.into(),
+        classifier: "knn".into(),
+        table: Arc::new(table),
+        columns: Columns::All,
+        evaluate: Arc::new(move |t, c, s| evaluate(t, c, s, &knn)),
+        prepare_s: encode_s + start.elapsed().as_secs_f64(),
+    })
 }
 
 /// compare.json and compare.md in `dir`.
