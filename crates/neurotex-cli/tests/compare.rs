@@ -81,10 +81,11 @@ fn nested_selection_over_held_out_speeds_names_its_choices() {
         "--hold-out",
         "speed_mm_s",
         "--methods",
-        "glcm2d,glcm3d",
+        "glcm2d,glcm3d,van-rossum",
         "--nested",
     ]);
     assert!(text.contains("held out in turn"), "{text}");
+    assert!(text.contains("sa / van-rossum / knn"), "{text}");
     assert!(
         text.contains("nested selection:") && text.contains("of 3)"),
         "{text}"
