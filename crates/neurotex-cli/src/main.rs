@@ -2,6 +2,7 @@
 //! library, shows progress and writes files (always to a temporary name, then renamed, so a
 //! failed run leaves no partial output).
 
+mod classifier_args;
 mod commands;
 mod csv_args;
 mod open_args;
