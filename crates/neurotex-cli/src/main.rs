@@ -29,9 +29,10 @@ enum Command {
     Encode(encode::EncodeArgs),
     /// Extract one feature row per recording of a dataset into a CSV file.
     Features(features::FeaturesArgs),
-    /// Classify a dataset's recordings with KNN and print accuracy and confusion matrix.
+    /// Classify a dataset's recordings (KNN, random forest or logistic regression) and print
+    /// accuracy and confusion matrix.
     Evaluate(evaluate::EvaluateArgs),
-    /// Train a KNN on a dataset and save it as a model file (pipeline, features, grid,
+    /// Train a classifier on a dataset and save it as a model file (pipeline, features, grid,
     /// classifier, training data's fingerprint) for `neurotex predict`.
     Train(train::TrainArgs),
     /// Predict the texture of new recordings (a dataset or files) with a saved model,

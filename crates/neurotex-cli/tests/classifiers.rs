@@ -65,7 +65,11 @@ fn a_linear_model_is_trained_saved_and_applied() {
         s(&model),
     ]);
     assert!(run.status.success(), "{}", run.stderr);
-    assert!(run.stderr.contains("logistic regression (C = 1)"), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("logistic regression (C = 1)"),
+        "{}",
+        run.stderr
+    );
     let file: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(
         file["classifier"],
@@ -112,11 +116,26 @@ fn options_of_another_classifier_are_refused() {
         args
     };
     let cases = [
-        (train(&["--classifier", "svm"]), "classifier must be knn, forest or linear"),
-        (train(&["--trees", "10"]), "apply only to --classifier forest"),
-        (train(&["--classifier", "forest", "--c", "2"]), "applies only to --classifier linear"),
-        (train(&["--classifier", "forest", "--trees", "0"]), "trees must be at least 1"),
-        (train(&["--classifier", "linear", "--c", "0"]), "C must be positive"),
+        (
+            train(&["--classifier", "svm"]),
+            "classifier must be knn, forest or linear",
+        ),
+        (
+            train(&["--trees", "10"]),
+            "apply only to --classifier forest",
+        ),
+        (
+            train(&["--classifier", "forest", "--c", "2"]),
+            "applies only to --classifier linear",
+        ),
+        (
+            train(&["--classifier", "forest", "--trees", "0"]),
+            "trees must be at least 1",
+        ),
+        (
+            train(&["--classifier", "linear", "--c", "0"]),
+            "C must be positive",
+        ),
     ];
     dir.fails_each(&cases, &out);
 }

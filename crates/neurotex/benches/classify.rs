@@ -55,7 +55,11 @@ fn overlapping(n: usize, dims: usize, classes: usize) -> (Vec<f64>, Vec<usize>) 
         .flat_map(|&c| {
             (0..dims)
                 .map(|j| {
-                    let offset = if j < dims / 4 { ((c + j) % classes) as f64 * 0.3 } else { 0.0 };
+                    let offset = if j < dims / 4 {
+                        ((c + j) % classes) as f64 * 0.3
+                    } else {
+                        0.0
+                    };
                     offset + next()
                 })
                 .collect::<Vec<_>>()

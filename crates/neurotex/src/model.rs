@@ -688,7 +688,9 @@ mod tests {
             let loaded = Model::load(&path).unwrap();
             assert_eq!(loaded.classifier(), choice);
             assert_eq!(loaded.predict_rows(&queries).unwrap(), before);
-            let rows: Vec<f64> = (0..18).flat_map(|i| model.file.training.rows[i].clone()).collect();
+            let rows: Vec<f64> = (0..18)
+                .flat_map(|i| model.file.training.rows[i].clone())
+                .collect();
             let right = model
                 .predict_rows(&rows)
                 .unwrap()
@@ -699,7 +701,11 @@ mod tests {
             assert_eq!(right, 18, "{choice}: separable training rows");
             for p in &before {
                 assert!((p.shares.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-                let top = model.labels().iter().position(|l| *l == p.predicted).unwrap();
+                let top = model
+                    .labels()
+                    .iter()
+                    .position(|l| *l == p.predicted)
+                    .unwrap();
                 assert!(p.shares.iter().all(|&s| s <= p.shares[top]));
             }
         }

@@ -210,11 +210,14 @@ fn knn_shares_are_its_votes_over_k() {
     let (x, y) = separable(8, 3, 3, 5);
     let (queries, _) = separable(4, 3, 3, 6);
     let queries: Vec<f64> = queries.iter().map(|v| v * 0.7).collect();
-    let model = KnnParams { k: 5, standardize: true }
-        .check()
-        .unwrap()
-        .fit(&x, 3, &y)
-        .unwrap();
+    let model = KnnParams {
+        k: 5,
+        standardize: true,
+    }
+    .check()
+    .unwrap()
+    .fit(&x, 3, &y)
+    .unwrap();
     let votes = model.predict_with_votes(&queries);
     let shares = model.predict_with_shares(&queries);
     for ((class, v), (predicted, s)) in votes.iter().zip(&shares) {
@@ -292,7 +295,9 @@ impl SlowData<'_> {
                 Slow::Leaf(counts.iter().map(|&c| c as f64 / n).collect())
             }
             Some((_, f, t)) => {
-                let (left, right) = samples.iter().partition(|&&s| self.x[s * self.dims + f] <= t);
+                let (left, right) = samples
+                    .iter()
+                    .partition(|&&s| self.x[s * self.dims + f] <= t);
                 Slow::Split(
                     f,
                     t,

@@ -409,7 +409,13 @@ impl Tree {
                     threshold,
                     left,
                     right,
-                } => node = if row[feature] <= threshold { left } else { right },
+                } => {
+                    node = if row[feature] <= threshold {
+                        left
+                    } else {
+                        right
+                    }
+                }
                 Node::Leaf(offset) => return &self.shares[offset..offset + n_classes],
             }
         }
@@ -509,7 +515,13 @@ mod tests {
         let d = ForestParams::default();
         let name = |p: ForestParams| p.check().unwrap_err().name;
         assert_eq!(name(ForestParams { trees: 0, ..d }), "trees");
-        assert_eq!(name(ForestParams { max_depth: Some(0), ..d }), "max_depth");
+        assert_eq!(
+            name(ForestParams {
+                max_depth: Some(0),
+                ..d
+            }),
+            "max_depth"
+        );
         assert_eq!(
             name(ForestParams {
                 min_samples_leaf: 0,
@@ -538,7 +550,9 @@ mod tests {
         let model = params.check().unwrap().fit(&x, 1, &y).unwrap();
         let tree = &model.trees[0];
         assert_eq!(tree.nodes.len(), 3);
-        assert!(matches!(tree.nodes[0], Node::Split { feature: 0, threshold, .. } if threshold == 6.0));
+        assert!(
+            matches!(tree.nodes[0], Node::Split { feature: 0, threshold, .. } if threshold == 6.0)
+        );
         assert_eq!(model.predict(&[5.9, 6.0, 6.1]), vec![0, 0, 1]);
     }
 }

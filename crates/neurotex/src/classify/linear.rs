@@ -463,7 +463,11 @@ mod tests {
             up[j] += h;
             down[j] -= h;
             let numeric = (problem.value_grad(&up).0 - problem.value_grad(&down).0) / (2.0 * h);
-            assert!((numeric - grad[j]).abs() < 1e-8, "{j}: {numeric} vs {}", grad[j]);
+            assert!(
+                (numeric - grad[j]).abs() < 1e-8,
+                "{j}: {numeric} vs {}",
+                grad[j]
+            );
         }
     }
 
@@ -475,7 +479,10 @@ mod tests {
             .unwrap()
             .fit(&x, 1, &[2, 2, 2, 2])
             .unwrap();
-        assert_eq!(model.predict_with_shares(&[5.0]), vec![(2, vec![0.0, 0.0, 1.0])]);
+        assert_eq!(
+            model.predict_with_shares(&[5.0]),
+            vec![(2, vec![0.0, 0.0, 1.0])]
+        );
         let model = LinearParams::default()
             .check()
             .unwrap()
