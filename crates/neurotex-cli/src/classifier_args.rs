@@ -8,8 +8,10 @@ use neurotex::classify::{ClassifierChoice, ForestParams, KnnParams, LinearParams
 /// Options choosing the classifier.
 #[derive(Args, Debug, Clone)]
 pub struct ClassifierArgs {
-    /// Classifier: `knn` (the paper's), `forest` (random forest of CART trees) or `linear`
-    /// (multinomial logistic regression, L2 penalty, features z-scored).
+    /// Classifier: `knn` (the paper's), `forest` (random forest of CART trees, √d features
+    /// tried per split) or `linear` (multinomial logistic regression, L2 penalty). The
+    /// regression always z-scores features with training statistics and the forest needs no
+    /// scaling: --no-standardize applies to KNN only.
     #[arg(long, default_value = "knn")]
     pub classifier: ClassifierChoice,
     /// With `--classifier forest`: trees in the forest [default: 200].
