@@ -2,6 +2,7 @@
 //! library, shows progress and writes files (always to a temporary name, then renamed, so a
 //! failed run leaves no partial output).
 
+mod classifier_args;
 mod commands;
 mod csv_args;
 mod open_args;
@@ -28,12 +29,13 @@ enum Command {
     Encode(encode::EncodeArgs),
     /// Extract one feature row per recording of a dataset into a CSV file.
     Features(features::FeaturesArgs),
-    /// Classify a dataset's recordings with KNN and print accuracy and confusion matrix.
+    /// Classify a dataset's recordings (KNN, random forest or logistic regression) and print
+    /// accuracy and confusion matrix.
     Evaluate(evaluate::EvaluateArgs),
     /// Compare encodings, feature methods and classifiers on the same splits of a dataset:
     /// a ranking with 95 % intervals and a paired test against the paper's method.
     Compare(compare::CompareArgs),
-    /// Train a KNN on a dataset and save it as a model file (pipeline, features, grid,
+    /// Train a classifier on a dataset and save it as a model file (pipeline, features, grid,
     /// classifier, training data's fingerprint) for `neurotex predict`.
     Train(train::TrainArgs),
     /// Predict the texture of new recordings (a dataset or files) with a saved model,

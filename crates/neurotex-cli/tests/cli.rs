@@ -3,6 +3,7 @@
 //! subcommand; `util` runs the binary and writes the datasets.
 
 mod atomic;
+mod classifiers;
 mod compare;
 mod conditions;
 mod encode;

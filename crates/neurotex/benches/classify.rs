@@ -1,8 +1,12 @@
 //! KNN (k = 5) with 5-fold stratified cross-validation on 160 samples x 3 features
-//! (8 classes x 20 trials, one speed of the paper's dataset).
+//! (8 classes x 20 trials, one speed of the paper's dataset); fitting a random forest
+//! (200 trees, √d features per split) and a logistic regression (C = 1) on 1000 samples x
+//! 100 features of 8 classes.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use neurotex::classify::{cross_validate, CvParams, KnnParams};
+use neurotex::classify::{
+    cross_validate, Classifier, CvParams, ForestParams, KnnParams, LinearParams,
+};
 
 fn bench(c: &mut Criterion) {
     let mut state = 0x2545f4914f6cdd1du64;
@@ -35,5 +39,50 @@ fn bench(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench);
+/// `n` samples x `dims` features of `classes` classes: every feature uniform noise plus a
+/// class offset on the first quarter of the features, so the classes overlap.
+fn overlapping(n: usize, dims: usize, classes: usize) -> (Vec<f64>, Vec<usize>) {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % 1_000_000) as f64 / 1_000_000.0
+    };
+    let y: Vec<usize> = (0..n).map(|i| i % classes).collect();
+    let x = y
+        .iter()
+        .flat_map(|&c| {
+            (0..dims)
+                .map(|j| {
+                    let offset = if j < dims / 4 {
+                        ((c + j) % classes) as f64 * 0.3
+                    } else {
+                        0.0
+                    };
+                    offset + next()
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    (x, y)
+}
+
+fn bench_fit(c: &mut Criterion) {
+    let (n, dims) = (1000, 100);
+    let (x, y) = overlapping(n, dims, 8);
+    let forest = ForestParams::default().check().unwrap();
+    let mut group = c.benchmark_group("classify");
+    group.sample_size(10);
+    group.bench_function(format!("forest_fit/200trees/{n}x{dims}"), |b| {
+        b.iter(|| forest.fit(&x, dims, &y).unwrap())
+    });
+    let linear = LinearParams::default().check().unwrap();
+    group.bench_function(format!("linear_fit/{n}x{dims}"), |b| {
+        b.iter(|| linear.fit(&x, dims, &y).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_fit);
 criterion_main!(benches);

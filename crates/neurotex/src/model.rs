@@ -3,13 +3,17 @@
 //! pipeline, the feature method and columns, the taxel grid, the classifier's parameters
 //! and training set, the class labels, and the training data's fingerprint.
 //!
-//! The fitted KNN is kept in the file as its training feature rows and their labels, and
-//! re-fitted on load, rather than as [`KnnModel`]'s internal state (z-scored columns stored
-//! feature-major, scaling factors, a visiting stride). Fitting is deterministic, so the
-//! re-fitted model predicts exactly what the saved one did; the raw rows mean the same to
-//! any reader (Python fits scikit-learn's KNN on them), stay valid when the fast layout
-//! changes, and pass through every check of [`Classifier::fit`] when a file is loaded,
-//! where stored internals could hold a stride or a scale that no fit would produce.
+//! The fitted classifier (KNN, random forest or logistic regression, a [`ClassifierChoice`]
+//! tagged by `kind`) is kept in the file as its parameters and its training feature rows
+//! and labels, and re-fitted on load, rather than as the fitted model's internal state
+//! (KNN's z-scored columns and visiting stride, the forest's trees, the regression's
+//! weights). Fitting is deterministic (the forest's seed is among its parameters, and its
+//! result does not depend on the number of threads), so the re-fitted model predicts
+//! exactly what the saved one did; the raw rows mean the same to any reader (Python fits
+//! scikit-learn's classifiers on them), stay valid when the fast layout changes, and pass
+//! through every check of [`Classifier::fit`] when a file is loaded, where stored internals
+//! could hold a stride or a scale that no fit would produce. Files written before the
+//! forest and the regression existed (`"kind": "knn"`) read unchanged.
 
 use std::path::{Path, PathBuf};
 
@@ -18,7 +22,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::{column_groups, Columns, FeatureTable};
-use crate::classify::{Classifier, ConfusionMatrix, KnnModel, KnnParams};
+use crate::classify::{ChosenModel, Classifier, ClassifierChoice, ConfusionMatrix, Predict};
 use crate::error::{ClassifyError, DataError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method, Pipeline, PipelineParams};
 use crate::recording::{Baseline, Dataset, Recording};
@@ -92,14 +96,6 @@ pub struct FeatureSpec {
     pub columns: Vec<String>,
 }
 
-/// The classifier and its parameters, tagged by `kind` in the file.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "lowercase")]
-enum ClassifierSpec {
-    /// k-nearest neighbours.
-    Knn(KnnParams),
-}
-
 /// Where a model's training data came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
@@ -149,7 +145,7 @@ struct ModelFile {
     pipeline: PipelineParams,
     features: FeatureSpec,
     grid: Grid,
-    classifier: ClassifierSpec,
+    classifier: ClassifierChoice,
     labels: Vec<String>,
     training: TrainingSet,
 }
@@ -167,8 +163,9 @@ struct Header {
 pub struct Prediction {
     /// The predicted class.
     pub predicted: String,
-    /// Each class's share of the votes among the `k` neighbours, in the order of
-    /// [`Model::labels`]; the shares sum to 1.
+    /// Each class's share, in the order of [`Model::labels`], summing to 1: its votes
+    /// among KNN's `k` neighbours, its mean leaf share over the forest's trees, or the
+    /// logistic regression's probability (see [`Predict::predict_with_shares`]).
     pub shares: Vec<f64>,
 }
 
@@ -193,7 +190,7 @@ pub struct Model {
     pipeline: Pipeline,
     extractor: FeatureExtractor,
     columns: Vec<usize>,
-    knn: KnnModel,
+    classifier: ChosenModel,
 }
 
 impl PartialEq for Model {
@@ -204,7 +201,7 @@ impl PartialEq for Model {
 }
 
 impl Model {
-    /// Trains a KNN on `columns` of `table` (the features of the training recordings,
+    /// Trains `classifier` on `columns` of `table` (the features of the training recordings,
     /// conditioned and encoded with `params`).
     ///
     /// # Errors
@@ -215,7 +212,7 @@ impl Model {
         params: &PipelineParams,
         table: &FeatureTable,
         columns: Columns,
-        knn: KnnParams,
+        classifier: ClassifierChoice,
         provenance: Provenance,
     ) -> Result<Model> {
         let taxel = match columns {
@@ -250,7 +247,7 @@ impl Model {
                 columns: selected.iter().map(|&j| table.names[j].clone()).collect(),
             },
             grid: table.grid.clone(),
-            classifier: ClassifierSpec::Knn(knn),
+            classifier,
             labels,
             training: TrainingSet {
                 dataset: provenance,
@@ -299,13 +296,13 @@ impl Model {
                 spec.method.name()
             )));
         }
-        let knn = fit(&file, columns.len())?;
+        let classifier = fit(&file, columns.len())?;
         Ok(Model {
             file,
             pipeline,
             extractor,
             columns,
-            knn,
+            classifier,
         })
     }
 
@@ -428,16 +425,15 @@ impl Model {
             ))
             .into());
         }
-        let k = self.knn_params().k as f64;
         let n_classes = self.file.labels.len();
         Ok(self
-            .knn
-            .predict_with_votes(x)
+            .classifier
+            .predict_with_shares(x)
             .into_iter()
-            .map(|(class, votes)| Prediction {
+            .map(|(class, shares)| Prediction {
                 predicted: self.file.labels[class].clone(),
                 shares: (0..n_classes)
-                    .map(|c| votes.get(c).copied().unwrap_or(0) as f64 / k)
+                    .map(|c| shares.get(c).copied().unwrap_or(0.0))
                     .collect(),
             })
             .collect())
@@ -514,10 +510,9 @@ impl Model {
             .unwrap_or(self.file.training.dataset.baseline)
     }
 
-    /// The classifier's parameters.
-    pub fn knn_params(&self) -> KnnParams {
-        let ClassifierSpec::Knn(params) = self.file.classifier;
-        params
+    /// The classifier and its parameters.
+    pub fn classifier(&self) -> ClassifierChoice {
+        self.file.classifier
     }
 
     /// Where the training data came from.
@@ -541,7 +536,7 @@ impl Model {
 /// # Errors
 /// Rows of another length, labels that are not classes of the model, or a training set
 /// the classifier cannot fit.
-fn fit(file: &ModelFile, dims: usize) -> Result<KnnModel> {
+fn fit(file: &ModelFile, dims: usize) -> Result<ChosenModel> {
     let training = &file.training;
     let inconsistent = |what: String| -> crate::Error { ModelError::Inconsistent(what).into() };
     if training.labels.len() != training.rows.len() {
@@ -571,13 +566,14 @@ fn fit(file: &ModelFile, dims: usize) -> Result<KnnModel> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    let ClassifierSpec::Knn(params) = file.classifier;
-    Ok(params.check()?.fit(&training.rows.concat(), dims, &y)?)
+    let classifier = file.classifier.check()?;
+    Ok(classifier.fit(&training.rows.concat(), dims, &y)?)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::classify::{ForestParams, KnnParams, LinearParams};
     use crate::encode::SpikeTrains;
     use crate::recording::Meta;
 
@@ -627,12 +623,16 @@ mod tests {
     }
 
     fn trained(method: Method, columns: Columns) -> Model {
-        let params = PipelineParams::default();
-        let knn = KnnParams {
+        let knn = ClassifierChoice::Knn(KnnParams {
             k: 3,
             standardize: true,
-        };
-        Model::train(&params, &table(method), columns, knn, provenance()).unwrap()
+        });
+        trained_with(method, columns, knn)
+    }
+
+    fn trained_with(method: Method, columns: Columns, classifier: ClassifierChoice) -> Model {
+        let params = PipelineParams::default();
+        Model::train(&params, &table(method), columns, classifier, provenance()).unwrap()
     }
 
     #[test]
@@ -653,6 +653,52 @@ mod tests {
             assert_eq!(loaded, model);
             assert_eq!(loaded.predict_rows(&queries).unwrap(), before);
             assert_eq!(loaded.baseline(), Baseline::Min, "the training layout's");
+            for p in &before {
+                assert!((p.shares.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                let top = model
+                    .labels()
+                    .iter()
+                    .position(|l| *l == p.predicted)
+                    .unwrap();
+                assert!(p.shares.iter().all(|&s| s <= p.shares[top]));
+            }
+        }
+    }
+
+    #[test]
+    fn forest_and_linear_models_save_load_and_predict_the_same() {
+        let dir = tempfile::tempdir().unwrap();
+        let forest = ForestParams {
+            trees: 25,
+            seed: 3,
+            ..ForestParams::default()
+        };
+        for choice in [
+            ClassifierChoice::Forest(forest),
+            ClassifierChoice::Linear(LinearParams::default()),
+        ] {
+            let model = trained_with(Method::Glcm3d, Columns::All, choice);
+            let dims = model.features().columns.len();
+            let queries = values(5, 30 * dims);
+            let before = model.predict_rows(&queries).unwrap();
+            let path = dir.path().join("model.json");
+            model.save(&path).unwrap();
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(text.contains(&format!("\"kind\": \"{}\"", choice.name())));
+            let loaded = Model::load(&path).unwrap();
+            assert_eq!(loaded.classifier(), choice);
+            assert_eq!(loaded.predict_rows(&queries).unwrap(), before);
+            let rows: Vec<f64> = (0..18)
+                .flat_map(|i| model.file.training.rows[i].clone())
+                .collect();
+            let right = model
+                .predict_rows(&rows)
+                .unwrap()
+                .iter()
+                .zip(&model.file.training.labels)
+                .filter(|(p, l)| p.predicted == **l)
+                .count();
+            assert_eq!(right, 18, "{choice}: separable training rows");
             for p in &before {
                 assert!((p.shares.iter().sum::<f64>() - 1.0).abs() < 1e-12);
                 let top = model
@@ -701,7 +747,7 @@ mod tests {
             &params,
             &table(Method::Taxel),
             Columns::EachTaxel,
-            KnnParams::default(),
+            ClassifierChoice::default(),
             provenance(),
         )
         .unwrap_err();
@@ -713,10 +759,10 @@ mod tests {
             &params,
             &table(Method::Glcm3d),
             Columns::All,
-            KnnParams {
+            ClassifierChoice::Knn(KnnParams {
                 k: 19,
                 standardize: true,
-            },
+            }),
             provenance(),
         )
         .unwrap_err();

@@ -10,7 +10,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use neurotex::analysis::{evaluate, Columns, FeatureTable};
 use neurotex::classify::CvParams;
-use neurotex::classify::{SpikeDistanceKnn, VanRossumParams};
+use neurotex::classify::{ClassifierChoice, ForestParams, SpikeDistanceKnn, VanRossumParams};
 use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
 use neurotex::encode::SpikeTrains;
 use neurotex::pipeline::{Encoded, Method, Pipeline};
@@ -159,17 +159,22 @@ impl CompareArgs {
     }
 
     /// Every (method, classifier) pair to run, checked, with the columns each classifies.
-    fn pairs(&self) -> Result<Vec<(Method, Columns, String)>> {
+    fn pairs(&self) -> Result<Vec<(Method, Columns, ClassifierChoice)>> {
         let mut out = Vec::new();
         for name in self.methods.iter().filter(|m| *m != VAN_ROSSUM) {
             let method: Method = name.parse().map_err(|e| {
                 anyhow::anyhow!("{e}; or {VAN_ROSSUM} (KNN over spike-train distances)")
             })?;
-            for classifier in &self.classifiers {
-                if !["knn"].contains(&classifier.as_str()) {
-                    bail!("unknown classifier `{classifier}`: knn");
-                }
-                if method == Method::Taxel && classifier != "knn" {
+            for name in &self.classifiers {
+                let classifier = match name.parse::<ClassifierChoice>()? {
+                    ClassifierChoice::Knn(_) => ClassifierChoice::Knn(self.stages.knn(self.k)?),
+                    ClassifierChoice::Forest(p) => ClassifierChoice::Forest(ForestParams {
+                        seed: self.seed,
+                        ..p
+                    }),
+                    linear => linear,
+                };
+                if method == Method::Taxel && classifier.name() != "knn" {
                     continue; // the paper's per-taxel method is a KNN method
                 }
                 let columns = if method == Method::Taxel {
@@ -177,7 +182,7 @@ impl CompareArgs {
                 } else {
                     Columns::All
                 };
-                out.push((method, columns, classifier.clone()));
+                out.push((method, columns, classifier));
             }
         }
         Ok(out)
@@ -227,7 +232,7 @@ fn candidates_of(
     dataset: &Dataset,
     indices: &[usize],
     encoding: &str,
-    pairs: &[(Method, Columns, String)],
+    pairs: &[(Method, Columns, ClassifierChoice)],
 ) -> Result<Vec<Candidate>> {
     let start = Instant::now();
     let (params, _) = calibrated_pipeline(&args.stages, dataset, indices)?;
@@ -252,7 +257,6 @@ fn candidates_of(
             ))
         })
         .collect::<Result<_>>()?;
-    let knn = args.stages.knn(args.k)?.check()?;
     let mut candidates: Vec<Candidate> = pairs
         .iter()
         .map(|(method, columns, classifier)| {
@@ -260,14 +264,14 @@ fn candidates_of(
                 .iter()
                 .find(|t| t.0 == *method)
                 .context("every method has a table")?;
-            let knn = knn.clone();
+            let chosen = classifier.check()?;
             Ok(Candidate {
                 encoding: encoding.to_string(),
                 method: method.name().to_string(),
-                classifier: classifier.clone(),
+                classifier: classifier.name().to_string(),
                 table: Arc::clone(table),
                 columns: *columns,
-                evaluate: Arc::new(move |t, c, s| evaluate(t, c, s, &knn)),
+                evaluate: Arc::new(move |t, c, s| evaluate(t, c, s, &chosen)),
                 prepare_s: *prepare_s,
             })
         })

@@ -18,6 +18,7 @@ use neurotex::recording::{Dataset, Selection};
 use neurotex::{Cell, Speed};
 
 use super::{calibrated_pipeline, encoded_features};
+use crate::classifier_args::ClassifierArgs;
 use crate::open_args::OpenArgs;
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
@@ -111,6 +112,8 @@ pub struct EvaluateArgs {
     #[command(flatten)]
     pub stages: StageArgs,
     #[command(flatten)]
+    pub classifier: ClassifierArgs,
+    #[command(flatten)]
     pub open: OpenArgs,
 }
 
@@ -196,7 +199,7 @@ impl EvaluateArgs {
 
 /// Runs `neurotex evaluate`.
 pub fn run(args: EvaluateArgs) -> Result<()> {
-    let knn = args.stages.knn(args.k)?;
+    let classifier = args.classifier.choice(args.stages.knn(args.k)?)?;
     let split = args.split()?;
     let columns = args.columns()?;
     if args.predictions.is_some() && columns == Columns::EachTaxel {
@@ -215,7 +218,7 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     if let Some(cell) = args.taxel {
         grid.locate(cell)?;
     }
-    let outcome = evaluate(table, columns, &split, &knn.check()?)?;
+    let outcome = evaluate(table, columns, &split, &classifier.check()?)?;
     if let Some(path) = &args.predictions {
         let predictions = outcome
             .predictions

@@ -34,8 +34,8 @@ pub struct PredictArgs {
     #[arg(long)]
     pub layout: Option<PathBuf>,
     /// The CSV file to write: `file,label,predicted`, then `share_<class>` for each class
-    /// of the model (its share of the votes among the k neighbours); `label` is empty
-    /// when unknown.
+    /// of the model (KNN: its share of the votes among the k neighbours; forest: its mean
+    /// leaf share over the trees; linear: its probability); `label` is empty when unknown.
     #[arg(long)]
     pub out: PathBuf,
     /// Also print `{"accuracy", "n", "labels", "confusion"}` (rows = true label) as JSON;

@@ -1,4 +1,4 @@
-//! `neurotex train`: a KNN trained on a dataset's features, saved as a model file that
+//! `neurotex train`: a classifier (KNN, random forest or logistic regression) trained on a dataset's features, saved as a model file that
 //! `neurotex predict` applies to new recordings.
 
 use std::path::PathBuf;
@@ -11,6 +11,7 @@ use neurotex::pipeline::{Method, Pipeline};
 use neurotex::{Cell, Speed};
 
 use super::{calibrated_pipeline, feature_table};
+use crate::classifier_args::ClassifierArgs;
 use crate::open_args::OpenArgs;
 use crate::stage_args::StageArgs;
 
@@ -40,6 +41,8 @@ pub struct TrainArgs {
     #[command(flatten)]
     pub stages: StageArgs,
     #[command(flatten)]
+    pub classifier: ClassifierArgs,
+    #[command(flatten)]
     pub open: OpenArgs,
 }
 
@@ -52,7 +55,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
     };
     let (params, calibration) = calibrated_pipeline(&args.stages, &dataset, &indices)?;
     let pipeline = Pipeline::new(params.clone())?;
-    let knn = args.stages.knn(args.k)?;
+    let classifier = args.classifier.choice(args.stages.knn(args.k)?)?;
     let columns = match (args.method, args.taxel) {
         (Method::Taxel, Some(cell)) => Columns::Taxel(cell),
         (_, Some(_)) => bail!("--taxel applies only to --method taxel"),
@@ -66,11 +69,10 @@ pub fn run(args: TrainArgs) -> Result<()> {
         gain_calibration: calibration,
         ..Provenance::of(&dataset, args.speeds.clone())?
     };
-    let model = Model::train(&params, &table, columns, knn, provenance)?;
+    let model = Model::train(&params, &table, columns, classifier, provenance)?;
     model.save(&args.out)?;
     eprintln!(
-        "KNN (k = {}) on {} recordings of {} classes, {} {} features on the {} grid -> {}",
-        knn.k,
+        "{classifier} on {} recordings of {} classes, {} {} features on the {} grid -> {}",
         model.n_training(),
         model.labels().len(),
         model.features().columns.len(),

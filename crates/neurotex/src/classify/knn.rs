@@ -249,6 +249,20 @@ impl Predict for KnnModel {
         self.dims
     }
 
+    fn n_classes(&self) -> usize {
+        self.n_classes
+    }
+
+    /// The votes of each class among the `k` neighbours, divided by `k`.
+    fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
+        let k = self.k as f64;
+        let mut out = Vec::with_capacity(x.len() / self.dims.max(1));
+        self.classify(x, |predicted, votes| {
+            out.push((predicted, votes.iter().map(|&v| v as f64 / k).collect()))
+        });
+        out
+    }
+
     fn predict(&self, x: &[f64]) -> Vec<usize> {
         let mut out = Vec::with_capacity(x.len() / self.dims.max(1));
         self.classify(x, |predicted, _| out.push(predicted));

@@ -1,22 +1,29 @@
 //! Classification (SPEC 3.12-3.13): a [`Classifier`] trait (fit, then predict), k-nearest
-//! neighbours with training-fold z-scoring, stratified shuffled k-fold cross-validation and
+//! neighbours with training-fold z-scoring, a random forest ([`forest`]) and multinomial
+//! logistic regression ([`linear`]) beside it, one [`ClassifierChoice`] over the three, stratified shuffled k-fold cross-validation and
 //! train/test evaluation over any classifier, and the [`ConfusionMatrix`] they fill; then
 //! what the results mean (SPEC 9): [`Metrics`] with chance levels, 95 % intervals for an
 //! accuracy, and McNemar's paired test of two methods ([`metrics`], on [`stats`]).
 
+pub mod choice;
 pub mod confusion;
 pub mod cv;
+pub mod forest;
 pub mod knn;
+pub mod linear;
 pub mod metrics;
 pub mod spike_distance;
 pub mod stats;
 
+pub use choice::{ChosenClassifier, ChosenModel, ClassifierChoice};
 pub use confusion::ConfusionMatrix;
 pub use cv::{
     cross_validate, cross_validate_grouped, group_folds, stratified_folds, train_test, CvParams,
     Evaluation, RepeatPredictions, ValidCv,
 };
+pub use forest::{Forest, ForestModel, ForestParams};
 pub use knn::{Knn, KnnModel, KnnParams};
+pub use linear::{Linear, LinearModel, LinearParams};
 pub use metrics::{
     bootstrap_accuracy, bootstrap_mean_share, mcnemar_exact, mcnemar_exact_p,
     t_interval_over_repeats, wilson_interval, BootstrapParams, ClassMetrics, Interval,
@@ -53,4 +60,60 @@ pub trait Predict {
     /// # Panics
     /// If `x` is not whole rows of the training dimension (a caller bug).
     fn predict(&self, x: &[f64]) -> Vec<usize>;
+
+    /// The classes the shares of [`Predict::predict_with_shares`] cover: the largest class
+    /// index seen in training, plus one.
+    fn n_classes(&self) -> usize;
+
+    /// The predicted class of each row of `x` with every class's share, indexed by class
+    /// ([`Predict::n_classes`] of them, summing to 1): KNN's votes among the `k`
+    /// neighbours, the forest's mean of its trees' leaf class distributions, the linear
+    /// model's softmax probabilities. The predicted class is the one [`Predict::predict`]
+    /// gives; it has the largest share.
+    ///
+    /// # Panics
+    /// If `x` is not whole rows of the training dimension (a caller bug).
+    fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)>;
+}
+
+/// Checks a training set: not empty, whole rows of `dims` features, all finite, fewer
+/// than 2^32 samples (the forest packs sample indices into 32 bits).
+///
+/// # Errors
+/// The first rule broken.
+fn check_training(x: &[f64], dims: usize, y: &[usize]) -> Result<(), ClassifyError> {
+    let n = y.len();
+    if n == 0 || dims == 0 {
+        return Err(ClassifyError::Empty { what: "train on" });
+    }
+    if x.len() != n * dims {
+        return Err(ClassifyError::BadFeatures(format!(
+            "{} feature values for {n} samples of {dims} features",
+            x.len()
+        )));
+    }
+    if u32::try_from(n).is_err() {
+        return Err(ClassifyError::BadFeatures(format!(
+            "{n} training samples, more than the 2^32 - 1 supported"
+        )));
+    }
+    if let Some(pos) = x.iter().position(|v| !v.is_finite()) {
+        return Err(ClassifyError::BadFeatures(format!(
+            "feature {} of training sample {} is not finite",
+            pos % dims,
+            pos / dims
+        )));
+    }
+    Ok(())
+}
+
+/// The first class with the largest share (ties go to the lower class index).
+fn first_max(shares: &[f64]) -> usize {
+    let mut best = 0;
+    for (c, &s) in shares.iter().enumerate() {
+        if s > shares[best] {
+            best = c;
+        }
+    }
+    best
 }

@@ -635,6 +635,27 @@ fn vote(
         .unwrap_or(0)
 }
 
+impl SpikeDistanceKnnModel {
+    /// Calls `on_row` with each query's predicted class and the votes of every class.
+    ///
+    /// # Panics
+    /// If a sample is not a row index of the matrix (see [`Predict::predict`]).
+    fn classify(&self, x: &[f64], mut on_row: impl FnMut(usize, &[usize])) {
+        let queries = row_indices(x, self.matrix.n(), "query").unwrap_or_else(|e| panic!("{e}"));
+        let mut votes = vec![0usize; self.n_classes];
+        let mut best = Vec::with_capacity(self.k);
+        let mut row = vec![0.0; self.train.len()];
+        for q in queries {
+            let all = self.matrix.row(q);
+            for (d, &t) in row.iter_mut().zip(&self.train) {
+                *d = all[t];
+            }
+            let predicted = vote(self.k, &row, &self.labels, &mut best, &mut votes);
+            on_row(predicted, &votes);
+        }
+    }
+}
+
 impl Predict for SpikeDistanceKnnModel {
     fn dims(&self) -> usize {
         1
@@ -644,20 +665,23 @@ impl Predict for SpikeDistanceKnnModel {
     /// If a sample is not a row index of the matrix (a caller bug: the table must come
     /// from [`SpikeDistanceKnn::samples`] or its rows).
     fn predict(&self, x: &[f64]) -> Vec<usize> {
-        let queries = row_indices(x, self.matrix.n(), "query").unwrap_or_else(|e| panic!("{e}"));
-        let mut votes = vec![0usize; self.n_classes];
-        let mut best = Vec::with_capacity(self.k);
-        let mut row = vec![0.0; self.train.len()];
-        queries
-            .into_iter()
-            .map(|q| {
-                let all = self.matrix.row(q);
-                for (d, &t) in row.iter_mut().zip(&self.train) {
-                    *d = all[t];
-                }
-                vote(self.k, &row, &self.labels, &mut best, &mut votes)
-            })
-            .collect()
+        let mut out = Vec::with_capacity(x.len());
+        self.classify(x, |predicted, _| out.push(predicted));
+        out
+    }
+
+    fn n_classes(&self) -> usize {
+        self.n_classes
+    }
+
+    /// The votes of each class among the `k` nearest recordings, divided by `k`.
+    fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
+        let k = self.k as f64;
+        let mut out = Vec::with_capacity(x.len());
+        self.classify(x, |predicted, votes| {
+            out.push((predicted, votes.iter().map(|&v| v as f64 / k).collect()));
+        });
+        out
     }
 }
 

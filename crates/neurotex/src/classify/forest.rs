@@ -1,0 +1,558 @@
+//! Random forest (Breiman 2001): CART trees grown on bootstrap samples, each split chosen
+//! by Gini impurity among a random subset of features (⌊√d⌋ by default), the class
+//! shares the mean of the trees' leaf class distributions (scikit-learn's
+//! `predict_proba`), the prediction the class with the largest mean share.
+//!
+//! Written here rather than taken from a crate: smartcore's and linfa-ensemble's forests
+//! fit their trees one after another (no rayon), linfa-ensemble samples features once per
+//! tree rather than per split and defaults to a thread-local generator, and neither
+//! promises a result independent of how the work is scheduled. Here tree `t` draws
+//! everything it needs (its bootstrap sample, the features tried at each node) from its own
+//! ChaCha8 stream, `seed` with stream number `t`, and the trees are fitted in parallel and
+//! averaged in tree order, so a forest is the same bit for bit on any number of threads.
+//!
+//! Splits are searched by sorting: every feature is rank-transformed once per fit (equal
+//! values share a rank), and a node sorts its samples by rank for each feature it tries, as
+//! 64-bit keys (rank, sample). A split's quality is the Gini proxy
+//! `Σ_c L_c² / |L| + Σ_c R_c² / |R|` (class counts weighted by bootstrap multiplicity),
+//! compared exactly as a fraction of integers, so equal splits are equal and the choice
+//! among them is fixed: the lowest feature index, then the lowest threshold. A threshold
+//! lies midway between two neighbouring distinct values; a sample goes left when its value
+//! is at most the threshold. A node is split while it is impure, above the depth limit and
+//! large enough for two leaves of `min_samples_leaf` samples (counted without
+//! multiplicity), even by a split that does not lower the impurity (as scikit-learn does).
+//! Features constant within a node do not count towards the ones tried; when the drawn
+//! features are all constant, further ones are drawn.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::{check_training, first_max, Classifier, Predict};
+use crate::error::{ClassifyError, ParamError};
+
+/// Random forest parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForestParams {
+    /// Trees in the forest (200).
+    pub trees: usize,
+    /// Deepest level of a tree (the root is depth 0); `None` grows trees until their leaves
+    /// are pure or too small to split.
+    pub max_depth: Option<usize>,
+    /// Fewest training samples in a leaf (1).
+    pub min_samples_leaf: usize,
+    /// Features tried at each split; `None` for ⌊√d⌋ (at least 1); more than `d` tries all.
+    pub max_features: Option<usize>,
+    /// Grow each tree on a bootstrap sample (`true`) or on the whole training set.
+    pub bootstrap: bool,
+    /// Seed of the trees' random streams.
+    pub seed: u64,
+}
+
+impl Default for ForestParams {
+    fn default() -> Self {
+        ForestParams {
+            trees: 200,
+            max_depth: None,
+            min_samples_leaf: 1,
+            max_features: None,
+            bootstrap: true,
+            seed: 0,
+        }
+    }
+}
+
+impl ForestParams {
+    /// Checks the rules (at least one tree, depth, leaf size and features tried at least 1)
+    /// and returns the unfitted classifier.
+    ///
+    /// # Errors
+    /// The rule broken.
+    pub fn check(self) -> Result<Forest, ParamError> {
+        if self.trees == 0 {
+            return Err(ParamError::new("trees", "trees must be at least 1", 0));
+        }
+        if self.max_depth == Some(0) {
+            return Err(ParamError::new(
+                "max_depth",
+                "max depth must be at least 1",
+                0,
+            ));
+        }
+        if self.min_samples_leaf == 0 {
+            return Err(ParamError::new(
+                "min_samples_leaf",
+                "a leaf must hold at least 1 sample",
+                0,
+            ));
+        }
+        if self.max_features == Some(0) {
+            return Err(ParamError::new(
+                "max_features",
+                "at least 1 feature must be tried per split",
+                0,
+            ));
+        }
+        Ok(Forest { params: self })
+    }
+}
+
+/// The unfitted forest, with parameters that passed [`ForestParams::check`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Forest {
+    params: ForestParams,
+}
+
+impl Forest {
+    /// The parameters.
+    pub fn params(&self) -> ForestParams {
+        self.params
+    }
+}
+
+/// One node of a tree.
+#[derive(Debug, Clone, PartialEq)]
+enum Node {
+    /// Samples with `feature <= threshold` go to `left`, the others to `right`.
+    Split {
+        feature: usize,
+        threshold: f64,
+        left: usize,
+        right: usize,
+    },
+    /// A leaf; its class distribution starts at this offset of the tree's `shares`.
+    Leaf(usize),
+}
+
+/// One fitted tree: nodes (the root first) and its leaves' class distributions.
+#[derive(Debug, Clone, PartialEq)]
+struct Tree {
+    nodes: Vec<Node>,
+    shares: Vec<f64>,
+}
+
+/// A fitted forest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForestModel {
+    dims: usize,
+    n_classes: usize,
+    trees: Vec<Tree>,
+}
+
+/// The training set as every tree reads it.
+struct Prepared<'a> {
+    x: &'a [f64],
+    dims: usize,
+    y: &'a [usize],
+    n_classes: usize,
+    /// Dense rank of each sample's value among all training values of a feature,
+    /// feature-major (`dims x n`).
+    ranks: Vec<u32>,
+}
+
+impl<'a> Prepared<'a> {
+    fn new(x: &'a [f64], dims: usize, y: &'a [usize]) -> Self {
+        let n = y.len();
+        let mut ranks = vec![0u32; n * dims];
+        let mut order: Vec<usize> = (0..n).collect();
+        for (f, feature_ranks) in ranks.chunks_exact_mut(n).enumerate() {
+            order.sort_unstable_by(|&a, &b| x[a * dims + f].total_cmp(&x[b * dims + f]));
+            let mut rank = 0u32;
+            for (i, &s) in order.iter().enumerate() {
+                if i > 0 && x[s * dims + f] != x[order[i - 1] * dims + f] {
+                    rank += 1;
+                }
+                feature_ranks[s] = rank;
+            }
+        }
+        Prepared {
+            x,
+            dims,
+            y,
+            n_classes: y.iter().max().map_or(0, |&m| m + 1),
+            ranks,
+        }
+    }
+}
+
+/// The parameters a tree is grown with, resolved for the training set.
+#[derive(Debug, Clone, Copy)]
+struct Growth {
+    max_depth: usize,
+    min_leaf: usize,
+    max_features: usize,
+    bootstrap: bool,
+}
+
+/// The best split found so far in a node: its Gini proxy as the fraction `num / den`.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    num: u128,
+    den: u128,
+    feature: usize,
+    /// Samples going left.
+    n_left: usize,
+}
+
+impl Candidate {
+    /// Whether this split is better than `other`: a larger proxy, or an equal one on a
+    /// lower feature.
+    fn beats(&self, other: &Option<Candidate>) -> bool {
+        match other {
+            None => true,
+            Some(o) => {
+                let (a, b) = (self.num * o.den, o.num * self.den);
+                a > b || (a == b && self.feature < o.feature)
+            }
+        }
+    }
+}
+
+/// Grows one tree: the state of its random stream, its in-bag samples and scratch space.
+struct Grower<'a> {
+    data: &'a Prepared<'a>,
+    growth: Growth,
+    rng: ChaCha8Rng,
+    /// Bootstrap multiplicity of each training sample.
+    weight: Vec<u64>,
+    /// The in-bag samples; each node owns a contiguous range.
+    samples: Vec<u32>,
+    keys: Vec<u64>,
+    features: Vec<usize>,
+    counts: Vec<u64>,
+    left: Vec<u64>,
+}
+
+impl<'a> Grower<'a> {
+    fn new(data: &'a Prepared<'a>, growth: Growth, seed: u64, tree: usize) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(tree as u64);
+        let n = data.y.len();
+        let mut weight = vec![u64::from(!growth.bootstrap); n];
+        if growth.bootstrap {
+            for _ in 0..n {
+                weight[rng.gen_range(0..n as u64) as usize] += 1;
+            }
+        }
+        let samples = (0..n as u32).filter(|&s| weight[s as usize] > 0).collect();
+        Grower {
+            data,
+            growth,
+            rng,
+            weight,
+            samples,
+            keys: Vec::new(),
+            features: Vec::new(),
+            counts: vec![0; data.n_classes],
+            left: vec![0; data.n_classes],
+        }
+    }
+
+    /// Grows the tree depth first from the root.
+    fn grow(mut self) -> Tree {
+        let mut tree = Tree {
+            nodes: vec![Node::Leaf(0)],
+            shares: Vec::new(),
+        };
+        let mut stack = vec![(0usize, 0usize, self.samples.len(), 0usize)];
+        while let Some((node, start, end, depth)) = stack.pop() {
+            self.count(start, end);
+            let split = if self.splittable(end - start, depth) {
+                self.best_split(start, end)
+            } else {
+                None
+            };
+            match split {
+                Some(best) => {
+                    let threshold = self.partition(start, end, &best);
+                    let (left, right) = (tree.nodes.len(), tree.nodes.len() + 1);
+                    tree.nodes.extend([Node::Leaf(0), Node::Leaf(0)]);
+                    tree.nodes[node] = Node::Split {
+                        feature: best.feature,
+                        threshold,
+                        left,
+                        right,
+                    };
+                    let middle = start + best.n_left;
+                    stack.push((right, middle, end, depth + 1));
+                    stack.push((left, start, middle, depth + 1));
+                }
+                None => {
+                    tree.nodes[node] = Node::Leaf(tree.shares.len());
+                    let total: u64 = self.counts.iter().sum();
+                    let shares = self.counts.iter().map(|&c| c as f64 / total as f64);
+                    tree.shares.extend(shares);
+                }
+            }
+        }
+        tree
+    }
+
+    /// Fills `counts` with the node's class counts (weighted by multiplicity).
+    fn count(&mut self, start: usize, end: usize) {
+        self.counts.fill(0);
+        for &s in &self.samples[start..end] {
+            self.counts[self.data.y[s as usize]] += self.weight[s as usize];
+        }
+    }
+
+    /// Whether a node of `n` samples at `depth` (with `counts` filled) may be split.
+    fn splittable(&self, n: usize, depth: usize) -> bool {
+        let classes = self.counts.iter().filter(|&&c| c > 0).count();
+        classes > 1 && depth < self.growth.max_depth && n >= 2 * self.growth.min_leaf
+    }
+
+    /// Sorts the node's samples by their rank on `feature` into `keys`.
+    fn sort_keys(&mut self, start: usize, end: usize, feature: usize) {
+        let n = self.data.y.len();
+        let ranks = &self.data.ranks[feature * n..(feature + 1) * n];
+        self.keys.clear();
+        self.keys.extend(
+            self.samples[start..end]
+                .iter()
+                .map(|&s| (u64::from(ranks[s as usize]) << 32) | u64::from(s)),
+        );
+        self.keys.sort_unstable();
+    }
+
+    /// The best split of the node among randomly drawn features, or `None` when every
+    /// feature is constant in it or no split leaves `min_samples_leaf` on both sides.
+    fn best_split(&mut self, start: usize, end: usize) -> Option<Candidate> {
+        let dims = self.data.dims;
+        self.features.clear();
+        self.features.extend(0..dims);
+        let mut best = None;
+        let mut tried = 0;
+        for i in 0..dims {
+            if tried == self.growth.max_features {
+                break;
+            }
+            let j = self.rng.gen_range(i as u64..dims as u64) as usize;
+            self.features.swap(i, j);
+            let feature = self.features[i];
+            self.sort_keys(start, end, feature);
+            let (first, last) = (self.keys[0] >> 32, self.keys[self.keys.len() - 1] >> 32);
+            if first == last {
+                continue;
+            }
+            tried += 1;
+            self.scan(feature, &mut best);
+        }
+        best
+    }
+
+    /// Walks the sorted `keys` of `feature`, moving samples left one at a time, and keeps
+    /// in `best` every split position that beats it.
+    fn scan(&mut self, feature: usize, best: &mut Option<Candidate>) {
+        let min_leaf = self.growth.min_leaf;
+        let m = self.keys.len();
+        self.left.fill(0);
+        let total: u64 = self.counts.iter().sum();
+        let mut sq_left = 0u64;
+        let mut sq_right: u64 = self.counts.iter().map(|&c| c * c).sum();
+        let mut w_left = 0u64;
+        for p in 0..m - min_leaf {
+            let s = (self.keys[p] & 0xffff_ffff) as usize;
+            let (c, w) = (self.data.y[s], self.weight[s]);
+            let right_c = self.counts[c] - self.left[c];
+            sq_left += (2 * self.left[c] + w) * w;
+            sq_right -= (2 * right_c - w) * w;
+            self.left[c] += w;
+            w_left += w;
+            if p + 1 < min_leaf || self.keys[p] >> 32 == self.keys[p + 1] >> 32 {
+                continue;
+            }
+            let w_right = total - w_left;
+            let candidate = Candidate {
+                num: u128::from(sq_left) * u128::from(w_right)
+                    + u128::from(sq_right) * u128::from(w_left),
+                den: u128::from(w_left) * u128::from(w_right),
+                feature,
+                n_left: p + 1,
+            };
+            if candidate.beats(best) {
+                *best = Some(candidate);
+            }
+        }
+    }
+
+    /// Orders the node's samples by `best`'s feature, so that its left child's come first,
+    /// and returns the threshold: midway between the last left and the first right value,
+    /// or the left value where the midpoint rounds to the right one.
+    fn partition(&mut self, start: usize, end: usize, best: &Candidate) -> f64 {
+        self.sort_keys(start, end, best.feature);
+        for (slot, &key) in self.samples[start..end].iter_mut().zip(&self.keys) {
+            *slot = (key & 0xffff_ffff) as u32;
+        }
+        let value = |s: u32| self.data.x[s as usize * self.data.dims + best.feature];
+        let below = value(self.samples[start + best.n_left - 1]);
+        let above = value(self.samples[start + best.n_left]);
+        let middle = below / 2.0 + above / 2.0;
+        if middle >= above || !middle.is_finite() {
+            below
+        } else {
+            middle
+        }
+    }
+}
+
+impl Tree {
+    /// The class distribution of the leaf `row` falls in.
+    fn leaf(&self, row: &[f64], n_classes: usize) -> &[f64] {
+        let mut node = 0;
+        loop {
+            match self.nodes[node] {
+                Node::Split {
+                    feature,
+                    threshold,
+                    left,
+                    right,
+                } => {
+                    node = if row[feature] <= threshold {
+                        left
+                    } else {
+                        right
+                    }
+                }
+                Node::Leaf(offset) => return &self.shares[offset..offset + n_classes],
+            }
+        }
+    }
+}
+
+impl Classifier for Forest {
+    type Model = ForestModel;
+
+    /// Grows the trees in parallel, each from its own random stream.
+    ///
+    /// # Errors
+    /// Empty or ragged input, non-finite features.
+    fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<ForestModel, ClassifyError> {
+        check_training(x, dims, y)?;
+        let p = self.params;
+        let growth = Growth {
+            max_depth: p.max_depth.unwrap_or(usize::MAX),
+            min_leaf: p.min_samples_leaf,
+            max_features: p
+                .max_features
+                .unwrap_or(((dims as f64).sqrt().floor() as usize).max(1))
+                .min(dims),
+            bootstrap: p.bootstrap,
+        };
+        let data = Prepared::new(x, dims, y);
+        let trees = (0..p.trees)
+            .into_par_iter()
+            .map(|t| Grower::new(&data, growth, p.seed, t).grow())
+            .collect();
+        Ok(ForestModel {
+            dims,
+            n_classes: data.n_classes,
+            trees,
+        })
+    }
+}
+
+impl ForestModel {
+    /// The trees.
+    pub fn n_trees(&self) -> usize {
+        self.trees.len()
+    }
+
+    /// Every class's mean leaf share over the trees, for one row.
+    fn shares(&self, row: &[f64]) -> Vec<f64> {
+        let mut sum = vec![0.0; self.n_classes];
+        for tree in &self.trees {
+            for (s, &v) in sum.iter_mut().zip(tree.leaf(row, self.n_classes)) {
+                *s += v;
+            }
+        }
+        let n = self.trees.len() as f64;
+        sum.iter_mut().for_each(|s| *s /= n);
+        sum
+    }
+}
+
+impl Predict for ForestModel {
+    fn dims(&self) -> usize {
+        self.dims
+    }
+
+    fn n_classes(&self) -> usize {
+        self.n_classes
+    }
+
+    fn predict(&self, x: &[f64]) -> Vec<usize> {
+        self.predict_with_shares(x)
+            .into_iter()
+            .map(|(c, _)| c)
+            .collect()
+    }
+
+    /// Rows are predicted in parallel; each row's shares are summed in tree order.
+    fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
+        assert_eq!(
+            x.len() % self.dims,
+            0,
+            "samples must have the training dimension"
+        );
+        x.par_chunks_exact(self.dims)
+            .map(|row| {
+                let shares = self.shares(row);
+                (first_max(&shares), shares)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_rule_is_checked() {
+        let d = ForestParams::default();
+        let name = |p: ForestParams| p.check().unwrap_err().name;
+        assert_eq!(name(ForestParams { trees: 0, ..d }), "trees");
+        assert_eq!(
+            name(ForestParams {
+                max_depth: Some(0),
+                ..d
+            }),
+            "max_depth"
+        );
+        assert_eq!(
+            name(ForestParams {
+                min_samples_leaf: 0,
+                ..d
+            }),
+            "min_samples_leaf"
+        );
+        assert_eq!(
+            name(ForestParams {
+                max_features: Some(0),
+                ..d
+            }),
+            "max_features"
+        );
+    }
+
+    #[test]
+    fn a_stump_splits_between_the_classes() {
+        let x = [0.0, 1.0, 2.0, 10.0, 11.0];
+        let y = [0, 0, 0, 1, 1];
+        let params = ForestParams {
+            trees: 1,
+            bootstrap: false,
+            ..ForestParams::default()
+        };
+        let model = params.check().unwrap().fit(&x, 1, &y).unwrap();
+        let tree = &model.trees[0];
+        assert_eq!(tree.nodes.len(), 3);
+        assert!(
+            matches!(tree.nodes[0], Node::Split { feature: 0, threshold, .. } if threshold == 6.0)
+        );
+        assert_eq!(model.predict(&[5.9, 6.0, 6.1]), vec![0, 0, 1]);
+    }
+}

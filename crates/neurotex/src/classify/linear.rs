@@ -1,0 +1,496 @@
+//! Multinomial logistic regression with an L2 penalty, scikit-learn's
+//! `LogisticRegression(C, solver="lbfgs")` on z-scored features.
+//!
+//! Features are z-scored with the training set's mean and population standard deviation (a
+//! feature constant in training is only centred, as in KNN). The weights `W` (one row per
+//! class) and intercepts `b` minimise
+//! `(1/n) Σ_i -log softmax(W z_i + b)[y_i] + ‖W‖² / (2 C n)`,
+//! which is scikit-learn's objective (`C Σ_i loss_i + ‖W‖²/2`, intercepts unpenalised)
+//! divided by `C n`. The problem is smooth and convex; it is solved by L-BFGS (ten
+//! correction pairs, backtracking Armijo line search) from zero until the largest absolute
+//! gradient component is at most `tol`, or `max_iter` iterations. Starting from zero keeps
+//! the intercepts summing to zero (every gradient does), which fixes the one direction the
+//! penalty leaves free. Classes absent from the training set get probability 0 and take no
+//! part in the fit (their intercept would run to minus infinity).
+//!
+//! Written here rather than taken from linfa-logistic (argmin's L-BFGS): that crate
+//! penalises with its own `alpha` and does not scale features, so matching scikit-learn's
+//! `C` would need a translation layer around it, and it brings argmin and a second ndarray
+//! major version into the build for about a hundred lines of optimiser. Everything here is
+//! sequential and deterministic.
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use super::{check_training, first_max, Classifier, Predict};
+use crate::error::{ClassifyError, ParamError};
+
+/// Logistic regression parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinearParams {
+    /// Inverse penalty strength, scikit-learn's `C` (1.0): smaller penalises more.
+    pub c: f64,
+    /// Most L-BFGS iterations (1000).
+    pub max_iter: usize,
+    /// Stop when no gradient component of the objective exceeds this (1e-8).
+    pub tol: f64,
+}
+
+impl Default for LinearParams {
+    fn default() -> Self {
+        LinearParams {
+            c: 1.0,
+            max_iter: 1000,
+            tol: 1e-8,
+        }
+    }
+}
+
+impl LinearParams {
+    /// Checks the rules (`c` and `tol` positive and finite, at least one iteration) and
+    /// returns the unfitted classifier.
+    ///
+    /// # Errors
+    /// The rule broken.
+    pub fn check(self) -> Result<Linear, ParamError> {
+        if !(self.c > 0.0 && self.c.is_finite()) {
+            return Err(ParamError::new(
+                "c",
+                "C must be positive and finite",
+                self.c,
+            ));
+        }
+        if self.max_iter == 0 {
+            return Err(ParamError::new(
+                "max_iter",
+                "at least 1 iteration is needed",
+                0,
+            ));
+        }
+        if !(self.tol > 0.0 && self.tol.is_finite()) {
+            return Err(ParamError::new(
+                "tol",
+                "the tolerance must be positive and finite",
+                self.tol,
+            ));
+        }
+        Ok(Linear { params: self })
+    }
+}
+
+/// The unfitted classifier, with parameters that passed [`LinearParams::check`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Linear {
+    params: LinearParams,
+}
+
+impl Linear {
+    /// The parameters.
+    pub fn params(&self) -> LinearParams {
+        self.params
+    }
+}
+
+/// A fitted logistic regression.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearModel {
+    dims: usize,
+    n_classes: usize,
+    /// The classes seen in training, ascending; the rows of `weights`.
+    classes: Vec<usize>,
+    mean: Vec<f64>,
+    inv_std: Vec<f64>,
+    /// `classes.len() x dims`, row-major, on z-scored features.
+    weights: Vec<f64>,
+    intercepts: Vec<f64>,
+    iterations: usize,
+    converged: bool,
+}
+
+impl LinearModel {
+    /// The classes seen in training, ascending: the rows of [`LinearModel::weights`].
+    pub fn classes(&self) -> &[usize] {
+        &self.classes
+    }
+
+    /// The weights on z-scored features, one row of [`Predict::dims`] per class of
+    /// [`LinearModel::classes`] (scikit-learn's `coef_` fitted on standardised features).
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// The intercepts, one per class of [`LinearModel::classes`]; they sum to zero.
+    pub fn intercepts(&self) -> &[f64] {
+        &self.intercepts
+    }
+
+    /// L-BFGS iterations made.
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+
+    /// Whether the gradient fell to the tolerance within `max_iter` iterations (else the
+    /// model holds the last iterate).
+    pub fn converged(&self) -> bool {
+        self.converged
+    }
+
+    /// Every class's probability for one row (0 for classes absent in training).
+    fn shares(&self, row: &[f64]) -> Vec<f64> {
+        let z: Vec<f64> = row
+            .iter()
+            .zip(self.mean.iter().zip(&self.inv_std))
+            .map(|(&v, (&m, &s))| (v - m) * s)
+            .collect();
+        let logits: Vec<f64> = self
+            .weights
+            .chunks_exact(self.dims)
+            .zip(&self.intercepts)
+            .map(|(w, &b)| b + dot(w, &z))
+            .collect();
+        let mut shares = vec![0.0; self.n_classes];
+        for (&c, p) in self.classes.iter().zip(softmax(&logits)) {
+            shares[c] = p;
+        }
+        shares
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Softmax of `logits`, shifted by their maximum.
+fn softmax(logits: &[f64]) -> Vec<f64> {
+    let top = logits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let exp: Vec<f64> = logits.iter().map(|&l| (l - top).exp()).collect();
+    let sum: f64 = exp.iter().sum();
+    exp.iter().map(|e| e / sum).collect()
+}
+
+/// The fitting problem: z-scored rows, compact class indices, the penalty factor.
+struct Problem {
+    z: Vec<f64>,
+    dims: usize,
+    y: Vec<usize>,
+    k: usize,
+    /// `1 / (C n)`.
+    penalty: f64,
+}
+
+impl Problem {
+    /// The objective and its gradient at `theta` (`k x dims` weights, then `k` intercepts).
+    fn value_grad(&self, theta: &[f64]) -> (f64, Vec<f64>) {
+        let (d, k) = (self.dims, self.k);
+        let (w, b) = theta.split_at(k * d);
+        let mut grad = vec![0.0; theta.len()];
+        let mut loss = 0.0;
+        let mut logits = vec![0.0; k];
+        for (row, &y) in self.z.chunks_exact(d).zip(&self.y) {
+            for ((l, wc), &bc) in logits.iter_mut().zip(w.chunks_exact(d)).zip(b) {
+                *l = bc + dot(wc, row);
+            }
+            let top = logits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let sum: f64 = logits.iter().map(|&l| (l - top).exp()).sum();
+            let log_norm = top + sum.ln();
+            loss += log_norm - logits[y];
+            let (gw, gb) = grad.split_at_mut(k * d);
+            for (c, (g, &l)) in gw.chunks_exact_mut(d).zip(&logits).enumerate() {
+                let r = (l - log_norm).exp() - f64::from(u8::from(c == y));
+                for (gj, &zj) in g.iter_mut().zip(row) {
+                    *gj += r * zj;
+                }
+                gb[c] += r;
+            }
+        }
+        let n = self.y.len() as f64;
+        grad.iter_mut().for_each(|g| *g /= n);
+        for (g, &wj) in grad.iter_mut().zip(w) {
+            *g += self.penalty * wj;
+        }
+        (loss / n + 0.5 * self.penalty * dot(w, w), grad)
+    }
+}
+
+/// The end of an L-BFGS run.
+struct Solution {
+    theta: Vec<f64>,
+    iterations: usize,
+    converged: bool,
+}
+
+/// L-BFGS's search direction `-H g` by the two-loop recursion over the stored pairs
+/// `(s, y, 1/(s·y))`, the initial Hessian scaled by the newest pair.
+fn direction(grad: &[f64], pairs: &VecDeque<(Vec<f64>, Vec<f64>, f64)>) -> Vec<f64> {
+    let mut q = grad.to_vec();
+    let mut alpha = Vec::with_capacity(pairs.len());
+    for (s, y, rho) in pairs.iter().rev() {
+        let a = rho * dot(s, &q);
+        q.iter_mut().zip(y).for_each(|(qi, yi)| *qi -= a * yi);
+        alpha.push(a);
+    }
+    if let Some((s, y, _)) = pairs.back() {
+        let gamma = dot(s, y) / dot(y, y);
+        q.iter_mut().for_each(|qi| *qi *= gamma);
+    }
+    for ((s, y, rho), a) in pairs.iter().zip(alpha.iter().rev()) {
+        let b = rho * dot(y, &q);
+        q.iter_mut().zip(s).for_each(|(qi, si)| *qi += (a - b) * si);
+    }
+    q.iter_mut().for_each(|qi| *qi = -*qi);
+    q
+}
+
+/// Minimises the problem's objective from zero by L-BFGS.
+fn lbfgs(problem: &Problem, params: LinearParams) -> Solution {
+    const MEMORY: usize = 10;
+    let len = problem.k * (problem.dims + 1);
+    let mut theta = vec![0.0; len];
+    let (mut value, mut grad) = problem.value_grad(&theta);
+    let mut pairs: VecDeque<(Vec<f64>, Vec<f64>, f64)> = VecDeque::new();
+    let largest = |g: &[f64]| g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for iteration in 0..params.max_iter {
+        if largest(&grad) <= params.tol {
+            return Solution {
+                theta,
+                iterations: iteration,
+                converged: true,
+            };
+        }
+        let mut dir = direction(&grad, &pairs);
+        let mut slope = dot(&grad, &dir);
+        if slope >= 0.0 {
+            pairs.clear();
+            dir = grad.iter().map(|g| -g).collect();
+            slope = dot(&grad, &dir);
+        }
+        // The first step is scaled to unit length; later ones start at 1 (L-BFGS's
+        // scaled direction). A rounding-level slack lets the last steps through once the
+        // objective no longer changes in its last digits.
+        let mut step = if pairs.is_empty() {
+            1.0 / dot(&dir, &dir).sqrt().max(1.0)
+        } else {
+            1.0
+        };
+        let slack = 8.0 * f64::EPSILON * value.abs();
+        let accepted = loop {
+            let trial: Vec<f64> = theta.iter().zip(&dir).map(|(t, d)| t + step * d).collect();
+            let (v, g) = problem.value_grad(&trial);
+            if v <= value + 1e-4 * step * slope + slack {
+                break Some((trial, v, g));
+            }
+            step *= 0.5;
+            if step < 1e-20 {
+                break None;
+            }
+        };
+        let Some((next, next_value, next_grad)) = accepted else {
+            return Solution {
+                theta,
+                iterations: iteration,
+                converged: false,
+            };
+        };
+        let s: Vec<f64> = next.iter().zip(&theta).map(|(a, b)| a - b).collect();
+        let y: Vec<f64> = next_grad.iter().zip(&grad).map(|(a, b)| a - b).collect();
+        let sy = dot(&s, &y);
+        if sy > 1e-12 * dot(&y, &y).sqrt() * dot(&s, &s).sqrt() && sy > 0.0 {
+            if pairs.len() == MEMORY {
+                pairs.pop_front();
+            }
+            pairs.push_back((s, y, 1.0 / sy));
+        }
+        (theta, value, grad) = (next, next_value, next_grad);
+    }
+    let converged = largest(&grad) <= params.tol;
+    Solution {
+        theta,
+        iterations: params.max_iter,
+        converged,
+    }
+}
+
+/// Each feature's training mean and inverse population standard deviation (1 for a
+/// constant feature).
+fn scaling(x: &[f64], dims: usize) -> (Vec<f64>, Vec<f64>) {
+    let n = (x.len() / dims) as f64;
+    let mut mean = vec![0.0; dims];
+    for row in x.chunks_exact(dims) {
+        mean.iter_mut().zip(row).for_each(|(m, v)| *m += v);
+    }
+    mean.iter_mut().for_each(|m| *m /= n);
+    let mut var = vec![0.0; dims];
+    for row in x.chunks_exact(dims) {
+        for ((s, &v), &m) in var.iter_mut().zip(row).zip(&mean) {
+            *s += (v - m) * (v - m);
+        }
+    }
+    let inv_std = var
+        .iter()
+        .map(|&s| {
+            let sd = (s / n).sqrt();
+            if sd > 0.0 {
+                1.0 / sd
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    (mean, inv_std)
+}
+
+impl Classifier for Linear {
+    type Model = LinearModel;
+
+    /// Z-scores the features and solves for the weights.
+    ///
+    /// # Errors
+    /// Empty or ragged input, non-finite features.
+    fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<LinearModel, ClassifyError> {
+        check_training(x, dims, y)?;
+        let n_classes = y.iter().max().map_or(0, |&m| m + 1);
+        let mut classes = y.to_vec();
+        classes.sort_unstable();
+        classes.dedup();
+        let (mean, inv_std) = scaling(x, dims);
+        let z: Vec<f64> = x
+            .chunks_exact(dims)
+            .flat_map(|row| {
+                row.iter()
+                    .zip(mean.iter().zip(&inv_std))
+                    .map(|(&v, (&m, &s))| (v - m) * s)
+            })
+            .collect();
+        let k = classes.len();
+        let compact = y
+            .iter()
+            .map(|c| classes.binary_search(c).unwrap_or(0))
+            .collect();
+        let problem = Problem {
+            z,
+            dims,
+            y: compact,
+            k,
+            penalty: 1.0 / (self.params.c * y.len() as f64),
+        };
+        let solution = if k > 1 {
+            lbfgs(&problem, self.params)
+        } else {
+            Solution {
+                theta: vec![0.0; dims + 1],
+                iterations: 0,
+                converged: true,
+            }
+        };
+        let mut weights = solution.theta;
+        let intercepts = weights.split_off(k * dims);
+        Ok(LinearModel {
+            dims,
+            n_classes,
+            classes,
+            mean,
+            inv_std,
+            weights,
+            intercepts,
+            iterations: solution.iterations,
+            converged: solution.converged,
+        })
+    }
+}
+
+impl Predict for LinearModel {
+    fn dims(&self) -> usize {
+        self.dims
+    }
+
+    fn n_classes(&self) -> usize {
+        self.n_classes
+    }
+
+    fn predict(&self, x: &[f64]) -> Vec<usize> {
+        self.predict_with_shares(x)
+            .into_iter()
+            .map(|(c, _)| c)
+            .collect()
+    }
+
+    fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
+        assert_eq!(
+            x.len() % self.dims,
+            0,
+            "samples must have the training dimension"
+        );
+        x.chunks_exact(self.dims)
+            .map(|row| {
+                let shares = self.shares(row);
+                (first_max(&shares), shares)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_rule_is_checked() {
+        let d = LinearParams::default();
+        let name = |p: LinearParams| p.check().unwrap_err().name;
+        assert_eq!(name(LinearParams { c: 0.0, ..d }), "c");
+        assert_eq!(name(LinearParams { c: f64::NAN, ..d }), "c");
+        assert_eq!(name(LinearParams { max_iter: 0, ..d }), "max_iter");
+        assert_eq!(name(LinearParams { tol: -1.0, ..d }), "tol");
+    }
+
+    #[test]
+    fn the_gradient_is_the_objectives() {
+        let x = [0.3, -1.0, 2.0, 0.5, -0.7, 0.1, 1.5, 1.5, -2.0, 0.0];
+        let problem = Problem {
+            z: x.to_vec(),
+            dims: 2,
+            y: vec![0, 2, 1, 2, 0],
+            k: 3,
+            penalty: 0.3,
+        };
+        let theta: Vec<f64> = (0..9).map(|i| 0.1 * i as f64 - 0.35).collect();
+        let (_, grad) = problem.value_grad(&theta);
+        for j in 0..theta.len() {
+            let h = 1e-6;
+            let (mut up, mut down) = (theta.clone(), theta.clone());
+            up[j] += h;
+            down[j] -= h;
+            let numeric = (problem.value_grad(&up).0 - problem.value_grad(&down).0) / (2.0 * h);
+            assert!(
+                (numeric - grad[j]).abs() < 1e-8,
+                "{j}: {numeric} vs {}",
+                grad[j]
+            );
+        }
+    }
+
+    #[test]
+    fn one_class_and_absent_classes_are_handled() {
+        let x = [0.0, 1.0, 2.0, 3.0];
+        let model = LinearParams::default()
+            .check()
+            .unwrap()
+            .fit(&x, 1, &[2, 2, 2, 2])
+            .unwrap();
+        assert_eq!(
+            model.predict_with_shares(&[5.0]),
+            vec![(2, vec![0.0, 0.0, 1.0])]
+        );
+        let model = LinearParams::default()
+            .check()
+            .unwrap()
+            .fit(&x, 1, &[0, 0, 2, 2])
+            .unwrap();
+        assert!(model.converged());
+        let shares = model.predict_with_shares(&[3.0]);
+        assert_eq!(shares[0].0, 2);
+        assert_eq!(shares[0].1[1], 0.0);
+    }
+}
