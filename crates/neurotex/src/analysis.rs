@@ -43,7 +43,7 @@ impl FeatureTable {
             .par_iter()
             .map(|e| {
                 extractor
-                    .row(&e.spikes, method)
+                    .row(e, method)
                     .map_err(|err| err.in_recording(&e.meta.file))
             })
             .collect::<Result<_>>()?;
@@ -213,7 +213,7 @@ impl OutOfFold {
 pub enum Columns {
     /// All of them (GLCM methods).
     All,
-    /// The three of one taxel.
+    /// The three of one taxel (six with two populations).
     Taxel(Cell),
     /// Each taxel in turn, reporting the mean and the best.
     EachTaxel,
@@ -234,7 +234,16 @@ pub(crate) fn column_groups(
     columns: Columns,
 ) -> Result<Vec<(Option<usize>, Vec<usize>)>> {
     let taxels: Vec<usize> = grid.taxels().collect();
-    let of_taxel = |k: usize| (Some(taxels[k]), (3 * k..3 * k + 3).collect());
+    // Per-taxel methods hold 3 columns per taxel per population (SA block, then FA block
+    // for sa+fa): a taxel's group is its columns in every population.
+    let block = 3 * taxels.len();
+    let populations = if block == 0 { 1 } else { (dims / block).max(1) };
+    let of_taxel = |k: usize| {
+        let columns = (0..populations)
+            .flat_map(|p| p * block + 3 * k..p * block + 3 * k + 3)
+            .collect();
+        (Some(taxels[k]), columns)
+    };
     Ok(match columns {
         Columns::All => vec![(None, (0..dims).collect())],
         Columns::Taxel(cell) => {

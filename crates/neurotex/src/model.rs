@@ -398,7 +398,7 @@ impl Model {
             .map(|e| {
                 let row = self
                     .extractor
-                    .row(&e.spikes, method)
+                    .row(e, method)
                     .map_err(|err| err.in_recording(&e.meta.file))?;
                 Ok(self.columns.iter().map(|&j| row[j]).collect())
             })
