@@ -46,7 +46,7 @@ pub struct StageArgs {
     #[arg(long, default_value = "sa")]
     pub encoding: Encoding,
     /// Gain of the FA neurons from rate of change (normalised units per ms) to current;
-    /// the default 200 gives a full-scale 100 ms triangle wave the SA channel's mean drive.
+    /// the default 8000 gives FA neurons about the SA neurons' rate on a typical simulated slide.
     #[arg(long = "fa-gain", default_value_t = FaParams::default().gain)]
     pub fa_gain: f64,
     /// Haralick features of the GLCM methods: `paper` (contrast, correlation, ASM) or

@@ -492,3 +492,21 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
         correct_shares: Vec::new(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_taxels_group_holds_its_columns_in_every_population() {
+        let grid = Grid::full(2, 2).unwrap();
+        let each = column_groups(&grid, 12, Columns::EachTaxel).unwrap();
+        assert_eq!(each[1], (Some(1), vec![3, 4, 5]));
+        // sa+fa: 12 SA columns, then 12 FA columns.
+        let each = column_groups(&grid, 24, Columns::EachTaxel).unwrap();
+        assert_eq!(each.len(), 4);
+        assert_eq!(each[1], (Some(1), vec![3, 4, 5, 15, 16, 17]));
+        let one = column_groups(&grid, 24, Columns::Taxel(Cell { row: 1, col: 1 })).unwrap();
+        assert_eq!(one, vec![(Some(3), vec![9, 10, 11, 21, 22, 23])]);
+    }
+}
