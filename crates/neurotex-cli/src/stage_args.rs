@@ -54,7 +54,11 @@ pub struct StageArgs {
     #[arg(long, default_value = "paper")]
     pub haralick: HaralickSet,
     /// Rate-volume bin widths in ms of `--method glcm3d-multi`, comma-separated.
-    #[arg(long = "bin-widths", value_delimiter = ',', default_value = "50,100,200,400")]
+    #[arg(
+        long = "bin-widths",
+        value_delimiter = ',',
+        default_value = "50,100,200,400"
+    )]
     pub bin_widths: Vec<usize>,
     /// Fano window of `--method all-taxels-mm`, in mm of travel.
     #[arg(long = "window-mm", default_value_t = FeatureParams::default().window_mm)]

@@ -6,6 +6,7 @@ mod atomic;
 mod conditions;
 mod encode;
 mod evaluate;
+mod extensions;
 mod features;
 mod hostile;
 mod import;

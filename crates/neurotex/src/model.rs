@@ -791,6 +791,7 @@ mod tests {
                 cols,
                 &vec![true; rows * cols],
             ),
+            fa: None,
             resampled: false,
             flat: false,
         };

@@ -359,7 +359,16 @@ impl Pipeline {
         cond: &Conditioned,
     ) -> Result<(SpikeTrains, Option<SpikeTrains>)> {
         let l = &rec.layout;
-        let fa = || encode_fa(&cond.samples, l.rows, l.cols, &l.present, self.params.encoder, self.params.fa);
+        let fa = || {
+            encode_fa(
+                &cond.samples,
+                l.rows,
+                l.cols,
+                &l.present,
+                self.params.encoder,
+                self.params.fa,
+            )
+        };
         Ok(match self.params.encoding {
             Encoding::Sa => (self.encode_conditioned(rec, cond, None)?, None),
             Encoding::Fa => (fa()?, None),
@@ -510,11 +519,17 @@ impl FeatureExtractor {
         if populations.len() < wanted {
             return Err(DataError::invalid(
                 &encoded.meta.file,
-                format!("the {} encoding needs two populations; the recording was encoded with one", self.encoding.name()),
+                format!(
+                    "the {} encoding needs two populations; the recording was encoded with one",
+                    self.encoding.name()
+                ),
             )
             .into());
         }
-        let speed = encoded.meta.speed_mm_s.filter(|s| s.is_finite() && *s != 0.0);
+        let speed = encoded
+            .meta
+            .speed_mm_s
+            .filter(|s| s.is_finite() && *s != 0.0);
         if method == Method::AllTaxelsMm && speed.is_none() {
             return Err(DataError::invalid(&encoded.meta.file, NO_SPEED).into());
         }
@@ -552,7 +567,9 @@ impl FeatureExtractor {
                     .ok_or_else(|| ParamError::new("speed", NO_SPEED, "none"))?;
                 let window = self.features.window_mm;
                 Ok(taxel_cells(&spikes.present)
-                    .flat_map(|cell| distance_stats(spikes.train(cell), n, speed, window).to_array())
+                    .flat_map(|cell| {
+                        distance_stats(spikes.train(cell), n, speed, window).to_array()
+                    })
                     .collect())
             }
             Method::Glcm2d => self.glcm_features(spikes, GlcmKind::TwoD, bin),
@@ -569,7 +586,12 @@ impl FeatureExtractor {
 
     /// The Haralick features of the mean GLCM of the rate volume with bins of `bin_ms`
     /// (3D) or of the time-collapsed image (2D).
-    fn glcm_features(&self, spikes: &SpikeTrains, kind: GlcmKind, bin_ms: usize) -> Result<Vec<f64>> {
+    fn glcm_features(
+        &self,
+        spikes: &SpikeTrains,
+        kind: GlcmKind,
+        bin_ms: usize,
+    ) -> Result<Vec<f64>> {
         let volume = match kind {
             GlcmKind::ThreeD => CountVolume::from_spikes(spikes, bin_ms),
             GlcmKind::TwoD => CountVolume::collapsed(spikes),

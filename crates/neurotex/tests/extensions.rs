@@ -113,7 +113,10 @@ fn sa_fa_rows_are_each_populations_row_with_prefixed_names() {
         let fa = one.row(&fa_only, method).unwrap();
         assert_eq!(row, [sa, fa].concat(), "{}", method.name());
     }
-    assert_eq!(one.names(Method::AllTaxels)[..3], ["r0c0_msr", "r0c0_cv_isi", "r0c0_fano"]);
+    assert_eq!(
+        one.names(Method::AllTaxels)[..3],
+        ["r0c0_msr", "r0c0_cv_isi", "r0c0_fano"]
+    );
     assert_eq!(one.names(Method::AllTaxels), one.names(Method::Taxel));
     let missing = both.row(&encoded(Some(10.0), false), Method::Glcm3d);
     assert!(missing.unwrap_err().to_string().contains("two populations"));
@@ -157,13 +160,19 @@ fn distance_statistics_are_time_statistics_rescaled_by_speed() {
     assert_eq!(per_mm.cv_isi, spike_stats(&train, 400, 100).cv_isi);
     // Through the extractor: at 10 mm/s a 2 mm window is the default 200 ms bin.
     let e = extractor(PipelineParams::default());
-    let time = e.row(&encoded(Some(10.0), false), Method::AllTaxels).unwrap();
-    let distance = e.row(&encoded(Some(10.0), false), Method::AllTaxelsMm).unwrap();
+    let time = e
+        .row(&encoded(Some(10.0), false), Method::AllTaxels)
+        .unwrap();
+    let distance = e
+        .row(&encoded(Some(10.0), false), Method::AllTaxelsMm)
+        .unwrap();
     for (k, (t, d)) in time.iter().zip(&distance).enumerate() {
         let expected = if k % 3 == 0 { t / 10.0 } else { *t };
         assert_eq!(*d, expected, "column {k}");
     }
-    let err = e.row(&encoded(None, false), Method::AllTaxelsMm).unwrap_err();
+    let err = e
+        .row(&encoded(None, false), Method::AllTaxelsMm)
+        .unwrap_err();
     assert!(err.to_string().contains("speed"), "{err}");
 }
 

@@ -111,7 +111,12 @@ pub fn haralick_full(counts: &[f64], levels: usize) -> [f64; 13] {
     };
     let (sum_average, sum_variance) = moments(&m.sum);
     let (_, difference_variance) = moments(&m.diff);
-    let contrast: f64 = m.diff.iter().enumerate().map(|(k, &v)| (k * k) as f64 * v).sum();
+    let contrast: f64 = m
+        .diff
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| (k * k) as f64 * v)
+        .sum();
     let hxy = entropy(&p);
     let (hx, hy) = (entropy(&m.p_x), entropy(&m.p_y));
     let imc1 = (hxy - hxy1) / if hx.max(hy) == 0.0 { 1.0 } else { hx.max(hy) };

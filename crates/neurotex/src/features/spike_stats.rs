@@ -81,7 +81,12 @@ pub fn distance_window_ms(window_mm: f64, speed_mm_s: f64) -> usize {
 /// # Panics
 /// If `n_steps` is 0, or `speed_mm_s` or `window_mm` is not positive and finite (a caller
 /// bug; the pipeline checks both).
-pub fn distance_stats(train: &[u32], n_steps: usize, speed_mm_s: f64, window_mm: f64) -> SpikeStats {
+pub fn distance_stats(
+    train: &[u32],
+    n_steps: usize,
+    speed_mm_s: f64,
+    window_mm: f64,
+) -> SpikeStats {
     let speed = speed_mm_s.abs();
     assert!(speed.is_finite() && speed > 0.0 && window_mm.is_finite() && window_mm > 0.0);
     let per_time = spike_stats(train, n_steps, distance_window_ms(window_mm, speed));
