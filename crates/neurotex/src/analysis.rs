@@ -237,7 +237,7 @@ pub(crate) fn column_groups(
     // Per-taxel methods hold 3 columns per taxel per population (SA block, then FA block
     // for sa+fa): a taxel's group is its columns in every population.
     let block = 3 * taxels.len();
-    let populations = if block == 0 { 1 } else { (dims / block).max(1) };
+    let populations = dims.checked_div(block).unwrap_or(1).max(1);
     let of_taxel = |k: usize| {
         let columns = (0..populations)
             .flat_map(|p| p * block + 3 * k..p * block + 3 * k + 3)
