@@ -4,8 +4,8 @@ use anyhow::Result;
 use clap::Args;
 use neurotex::calibrate::GainChoice;
 use neurotex::classify::KnnParams;
-use neurotex::encode::{FiringType, IzhikevichParams};
-use neurotex::pipeline::PipelineParams;
+use neurotex::encode::{FaParams, FiringType, IzhikevichParams};
+use neurotex::pipeline::{Encoding, FeatureParams, HaralickSet, PipelineParams};
 use neurotex::recording::Baseline;
 
 /// Stage parameters; defaults are the paper's values (or SPEC's choice where it gives none).
@@ -40,6 +40,29 @@ pub struct StageArgs {
     /// Count co-occurrences in both directions.
     #[arg(long)]
     pub symmetric: bool,
+    /// Mechanoreceptor populations: `sa` (slowly adapting, driven by the signal; the
+    /// paper's), `fa` (fast adapting, driven by its rectified rate of change) or `sa+fa`
+    /// (both, each with its own features, names prefixed `sa_` and `fa_`).
+    #[arg(long, default_value = "sa")]
+    pub encoding: Encoding,
+    /// Gain of the FA neurons from rate of change (normalised units per ms) to current;
+    /// the default 8000 gives FA neurons about the SA neurons' rate on a typical simulated slide.
+    #[arg(long = "fa-gain", default_value_t = FaParams::default().gain)]
+    pub fa_gain: f64,
+    /// Haralick features of the GLCM methods: `paper` (contrast, correlation, ASM) or
+    /// `full` (the 13 of Haralick 1973, as mahotas defines them).
+    #[arg(long, default_value = "paper")]
+    pub haralick: HaralickSet,
+    /// Rate-volume bin widths in ms of `--method glcm3d-multi`, comma-separated.
+    #[arg(
+        long = "bin-widths",
+        value_delimiter = ',',
+        default_value = "50,100,200,400"
+    )]
+    pub bin_widths: Vec<usize>,
+    /// Fano window of `--method all-taxels-mm`, in mm of travel.
+    #[arg(long = "window-mm", default_value_t = FeatureParams::default().window_mm)]
+    pub window_mm: f64,
     /// Do not z-score features with training-fold statistics before KNN.
     #[arg(long = "no-standardize")]
     pub no_standardize: bool,
@@ -63,6 +86,13 @@ impl StageArgs {
         p.volume.bin_ms = self.bin_ms;
         p.glcm.distances = self.distances.clone();
         p.glcm.symmetric = self.symmetric;
+        p.encoding = self.encoding;
+        p.fa.gain = self.fa_gain;
+        p.features = FeatureParams {
+            haralick: self.haralick,
+            bin_widths_ms: self.bin_widths.clone(),
+            window_mm: self.window_mm,
+        };
         p.check()?;
         Ok(p)
     }

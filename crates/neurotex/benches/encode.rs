@@ -1,8 +1,9 @@
-//! Izhikevich encoding throughput: one recording on one core, and the paper-scale work
+//! Izhikevich encoding throughput: one recording on one core (SA, and FA-I from the
+//! rectified rate of change), and the paper-scale work
 //! (480 trials x 16 taxels, slides of 18, 9 and 6 s: 84.5 M neuron-steps) across all cores.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use neurotex::encode::{encode, Encoder, IzhikevichParams};
+use neurotex::encode::{encode, encode_fa, Encoder, FaParams, IzhikevichParams};
 use rayon::prelude::*;
 
 fn signal(steps: usize, cells: usize) -> Vec<f64> {
@@ -30,6 +31,13 @@ fn bench(c: &mut Criterion) {
     group.bench_function(BenchmarkId::new("to_trains_1core", "16x18000"), |b| {
         b.iter(|| {
             encode(&one, 4, 4, &[true; 16], params)
+                .unwrap()
+                .total_spikes()
+        })
+    });
+    group.bench_function(BenchmarkId::new("fa_to_trains_1core", "16x18000"), |b| {
+        b.iter(|| {
+            encode_fa(&one, 4, 4, &[true; 16], params, FaParams::default())
                 .unwrap()
                 .total_spikes()
         })

@@ -65,7 +65,11 @@ fn bench(c: &mut Criterion) {
             })
         });
         group.bench_function(BenchmarkId::new("from_spike_trains", &size), |b| {
-            b.iter(|| extractor.row(&spikes, Method::Glcm3d).unwrap())
+            b.iter(|| {
+                extractor
+                    .population_row(&spikes, None, Method::Glcm3d)
+                    .unwrap()
+            })
         });
         let mut q = Vec::new();
         quantise(&volume, 16, None, &mut q);

@@ -43,7 +43,7 @@ impl FeatureTable {
             .par_iter()
             .map(|e| {
                 extractor
-                    .row(&e.spikes, method)
+                    .row(e, method)
                     .map_err(|err| err.in_recording(&e.meta.file))
             })
             .collect::<Result<_>>()?;
@@ -232,7 +232,7 @@ impl OutOfFold {
 pub enum Columns {
     /// All of them (GLCM methods).
     All,
-    /// The three of one taxel.
+    /// The three of one taxel (six with two populations).
     Taxel(Cell),
     /// Each taxel in turn, reporting the mean and the best.
     EachTaxel,
@@ -253,7 +253,16 @@ pub(crate) fn column_groups(
     columns: Columns,
 ) -> Result<Vec<(Option<usize>, Vec<usize>)>> {
     let taxels: Vec<usize> = grid.taxels().collect();
-    let of_taxel = |k: usize| (Some(taxels[k]), (3 * k..3 * k + 3).collect());
+    // Per-taxel methods hold 3 columns per taxel per population (SA block, then FA block
+    // for sa+fa): a taxel's group is its columns in every population.
+    let block = 3 * taxels.len();
+    let populations = dims.checked_div(block).unwrap_or(1).max(1);
+    let of_taxel = |k: usize| {
+        let columns = (0..populations)
+            .flat_map(|p| p * block + 3 * k..p * block + 3 * k + 3)
+            .collect();
+        (Some(taxels[k]), columns)
+    };
     Ok(match columns {
         Columns::All => vec![(None, (0..dims).collect())],
         Columns::Taxel(cell) => {
@@ -512,5 +521,23 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
         best,
         predictions: None,
         correct_shares: Vec::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_taxels_group_holds_its_columns_in_every_population() {
+        let grid = Grid::full(2, 2).unwrap();
+        let each = column_groups(&grid, 12, Columns::EachTaxel).unwrap();
+        assert_eq!(each[1], (Some(1), vec![3, 4, 5]));
+        // sa+fa: 12 SA columns, then 12 FA columns.
+        let each = column_groups(&grid, 24, Columns::EachTaxel).unwrap();
+        assert_eq!(each.len(), 4);
+        assert_eq!(each[1], (Some(1), vec![3, 4, 5, 15, 16, 17]));
+        let one = column_groups(&grid, 24, Columns::Taxel(Cell { row: 1, col: 1 })).unwrap();
+        assert_eq!(one, vec![(Some(3), vec![9, 10, 11, 21, 22, 23])]);
     }
 }

@@ -395,7 +395,7 @@ impl Model {
             .map(|e| {
                 let row = self
                     .extractor
-                    .row(&e.spikes, method)
+                    .row(e, method)
                     .map_err(|err| err.in_recording(&e.meta.file))?;
                 Ok(self.columns.iter().map(|&j| row[j]).collect())
             })
@@ -837,6 +837,7 @@ mod tests {
                 cols,
                 &vec![true; rows * cols],
             ),
+            fa: None,
             resampled: false,
             flat: false,
         };

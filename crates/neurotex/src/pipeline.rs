@@ -5,64 +5,232 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::encode::{encode, IzhikevichParams, SpikeTrains};
+use crate::encode::{encode, encode_fa, FaParams, IzhikevichParams, SpikeTrains};
 use crate::error::{DataError, ParamError, Result};
 use crate::features::glcm::GlcmKind;
-use crate::features::{haralick, spike_stats, CountVolume, GlcmParams, GlcmPlan, VolumeParams};
+use crate::features::{
+    distance_stats, haralick, haralick_full, spike_stats, CountVolume, GlcmParams, GlcmPlan,
+    VolumeParams, FULL_NAMES,
+};
 use crate::recording::{Baseline, Dataset, Meta, Recording};
 use crate::signal::{Conditioned, PreprocessParams, Preprocessor};
 use crate::values::Grid;
 
-/// The feature sets the paper compares.
+/// The feature sets: the paper's three and the extensions of issue #11.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
 pub enum Method {
-    /// MSR, CV_ISI and Fano factor of each taxel (approach 1).
+    /// MSR, CV_ISI and Fano factor of each taxel (approach 1), each taxel classified alone.
+    #[serde(rename = "taxel")]
     Taxel,
     /// Contrast, correlation, ASM of the time-collapsed image's GLCM (the paper's control).
+    #[serde(rename = "glcm2d")]
     Glcm2d,
     /// Contrast, correlation, ASM of the rate volume's mean 3D GLCM (approach 2).
+    #[serde(rename = "glcm3d")]
     Glcm3d,
+    /// Every taxel's MSR, CV_ISI and Fano factor in one vector, classified as one (the
+    /// multi-taxel baseline the paper lacks); the columns of [`Method::Taxel`].
+    #[serde(rename = "all-taxels")]
+    AllTaxels,
+    /// [`Method::AllTaxels`] in units of travelled distance (spikes per mm, Fano windows
+    /// of fixed travel; [`crate::features::distance_stats`]), needing each recording's
+    /// speed: a representation meant to be invariant to the sliding speed.
+    #[serde(rename = "all-taxels-mm")]
+    AllTaxelsMm,
+    /// The 3D-GLCM features at each of [`FeatureParams::bin_widths_ms`], concatenated.
+    #[serde(rename = "glcm3d-multi")]
+    Glcm3dMulti,
 }
 
 impl Method {
+    /// Every method, in the order of the enum.
+    pub const ALL: [Method; 6] = [
+        Method::Taxel,
+        Method::Glcm2d,
+        Method::Glcm3d,
+        Method::AllTaxels,
+        Method::AllTaxelsMm,
+        Method::Glcm3dMulti,
+    ];
+
     /// The command-line name.
     pub fn name(self) -> &'static str {
         match self {
             Method::Taxel => "taxel",
             Method::Glcm2d => "glcm2d",
             Method::Glcm3d => "glcm3d",
+            Method::AllTaxels => "all-taxels",
+            Method::AllTaxelsMm => "all-taxels-mm",
+            Method::Glcm3dMulti => "glcm3d-multi",
         }
+    }
+
+    /// Whether the columns are three statistics per taxel, taxel by taxel.
+    pub fn per_taxel(self) -> bool {
+        matches!(
+            self,
+            Method::Taxel | Method::AllTaxels | Method::AllTaxelsMm
+        )
     }
 }
 
 impl std::str::FromStr for Method {
     type Err = ParamError;
     fn from_str(s: &str) -> Result<Self, ParamError> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                ParamError::new(
+                    "method",
+                    "method must be taxel, glcm2d, glcm3d, all-taxels, all-taxels-mm or glcm3d-multi",
+                    s,
+                )
+            })
+    }
+}
+
+/// Which mechanoreceptor populations encode the signal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum Encoding {
+    /// Slowly adapting (SA-I) neurons driven by the signal, the paper's.
+    #[default]
+    #[serde(rename = "sa")]
+    Sa,
+    /// Fast-adapting (FA-I) neurons driven by its rectified rate of change
+    /// ([`crate::encode::FaParams`]).
+    #[serde(rename = "fa")]
+    Fa,
+    /// Both populations, each with its own features (SA columns, then FA columns).
+    #[serde(rename = "sa+fa")]
+    SaFa,
+}
+
+impl Encoding {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Encoding::Sa => "sa",
+            Encoding::Fa => "fa",
+            Encoding::SaFa => "sa+fa",
+        }
+    }
+
+    /// The column-name prefix of each population, in the order of
+    /// [`Encoded::populations`]: empty for a single population.
+    pub fn prefixes(self) -> &'static [&'static str] {
+        match self {
+            Encoding::Sa | Encoding::Fa => &[""],
+            Encoding::SaFa => &["sa_", "fa_"],
+        }
+    }
+}
+
+impl std::str::FromStr for Encoding {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        [Encoding::Sa, Encoding::Fa, Encoding::SaFa]
+            .into_iter()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| ParamError::new("encoding", "encoding must be sa, fa or sa+fa", s))
+    }
+}
+
+/// Which Haralick features the GLCM methods compute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HaralickSet {
+    /// Contrast, correlation and ASM (the paper's eqs. 5-8).
+    #[default]
+    Paper,
+    /// The 13 features of [`crate::features::haralick_full`].
+    Full,
+}
+
+impl std::str::FromStr for HaralickSet {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
         match s {
-            "taxel" => Ok(Method::Taxel),
-            "glcm2d" => Ok(Method::Glcm2d),
-            "glcm3d" => Ok(Method::Glcm3d),
+            "paper" => Ok(HaralickSet::Paper),
+            "full" => Ok(HaralickSet::Full),
             _ => Err(ParamError::new(
-                "method",
-                "method must be taxel, glcm2d or glcm3d",
+                "haralick",
+                "haralick must be paper or full",
                 s,
             )),
         }
     }
 }
 
-/// All stage parameters, each with the paper's value (or SPEC's choice) as default.
+/// Parameters of the feature methods beyond the paper's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FeatureParams {
+    /// The Haralick features of the GLCM methods.
+    pub haralick: HaralickSet,
+    /// The rate-volume bin widths of [`Method::Glcm3dMulti`], in ms.
+    pub bin_widths_ms: Vec<usize>,
+    /// The Fano window of [`Method::AllTaxelsMm`] in mm of travel (2 mm: the paper's
+    /// 200 ms window at 10 mm/s).
+    pub window_mm: f64,
+}
+
+impl Default for FeatureParams {
+    fn default() -> Self {
+        FeatureParams {
+            haralick: HaralickSet::Paper,
+            bin_widths_ms: vec![50, 100, 200, 400],
+            window_mm: 2.0,
+        }
+    }
+}
+
+impl FeatureParams {
+    /// Checks the rules: at least one bin width, each at least 1 ms; a positive window.
+    ///
+    /// # Errors
+    /// The rule broken.
+    pub fn check(&self) -> Result<(), ParamError> {
+        if self.bin_widths_ms.is_empty() || self.bin_widths_ms.contains(&0) {
+            return Err(ParamError::new(
+                "bin-widths",
+                "bin widths must be at least one width, each at least 1 ms",
+                format!("{:?}", self.bin_widths_ms),
+            ));
+        }
+        if !(self.window_mm.is_finite() && self.window_mm > 0.0) {
+            return Err(ParamError::new(
+                "window-mm",
+                "the travelled-distance window must be a positive number of mm",
+                self.window_mm,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// All stage parameters, each with the paper's value (or SPEC's choice) as default. The
+/// fields after `glcm` default when absent, so model files written before them load with
+/// the paper's SA encoding.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct PipelineParams {
     /// Conditioning.
     pub preprocess: PreprocessParams,
-    /// Neuron model and gain.
+    /// Neuron model and gain (of the SA population; the FA population uses its firing type).
     pub encoder: IzhikevichParams,
     /// Rate volume bins (also the Fano window) and quantisation.
     pub volume: VolumeParams,
     /// Co-occurrence offsets.
     pub glcm: GlcmParams,
+    /// The populations that encode.
+    #[serde(default)]
+    pub encoding: Encoding,
+    /// The FA population's gain.
+    #[serde(default)]
+    pub fa: FaParams,
+    /// Multi-scale widths, Haralick set and travelled-distance window.
+    #[serde(default)]
+    pub features: FeatureParams,
 }
 
 impl PipelineParams {
@@ -74,7 +242,9 @@ impl PipelineParams {
         self.preprocess.check()?;
         self.encoder.check()?;
         self.volume.check()?;
-        self.glcm.check()
+        self.glcm.check()?;
+        self.fa.check()?;
+        self.features.check()
     }
 }
 
@@ -83,12 +253,32 @@ impl PipelineParams {
 pub struct Encoded {
     /// The recording's manifest fields.
     pub meta: Meta,
-    /// Spike trains over the selected phase.
+    /// The first population's spike trains over the selected phase: SA for the `sa` and
+    /// `sa+fa` encodings, FA for `fa`.
     pub spikes: SpikeTrains,
+    /// The FA population of an `sa+fa` encoding; `None` for a single population.
+    pub fa: Option<SpikeTrains>,
     /// The input was resampled to 1 kHz.
     pub resampled: bool,
     /// The recording had no positive signal and was left at zero.
     pub flat: bool,
+}
+
+impl Encoded {
+    /// The populations in feature order: `spikes`, then `fa` when present.
+    pub fn populations(&self) -> impl Iterator<Item = &SpikeTrains> {
+        std::iter::once(&self.spikes).chain(self.fa.as_ref())
+    }
+
+    /// The same recording with every population transformed by `f` (truncation,
+    /// permutation).
+    pub fn map_spikes(&self, f: impl Fn(&SpikeTrains) -> SpikeTrains) -> Encoded {
+        Encoded {
+            spikes: f(&self.spikes),
+            fa: self.fa.as_ref().map(&f),
+            ..self.clone()
+        }
+    }
 }
 
 /// The planned pipeline.
@@ -138,8 +328,8 @@ impl Pipeline {
         Ok(cond)
     }
 
-    /// Encodes a conditioned recording with the pipeline's neurons, or with `gain` instead
-    /// of the pipeline's gain.
+    /// Encodes a conditioned recording with the pipeline's SA neurons, or with `gain`
+    /// instead of the pipeline's gain.
     ///
     /// # Errors
     /// A gain that breaks the encoder's rules.
@@ -157,16 +347,46 @@ impl Pipeline {
         Ok(encode(&cond.samples, l.rows, l.cols, &l.present, params)?)
     }
 
+    /// Encodes a conditioned recording with the populations of the pipeline's encoding:
+    /// `(first population, FA population of sa+fa)`, as [`Encoded::spikes`] and
+    /// [`Encoded::fa`].
+    ///
+    /// # Errors
+    /// A broken encoder rule.
+    pub fn encode_populations(
+        &self,
+        rec: &Recording,
+        cond: &Conditioned,
+    ) -> Result<(SpikeTrains, Option<SpikeTrains>)> {
+        let l = &rec.layout;
+        let fa = || {
+            encode_fa(
+                &cond.samples,
+                l.rows,
+                l.cols,
+                &l.present,
+                self.params.encoder,
+                self.params.fa,
+            )
+        };
+        Ok(match self.params.encoding {
+            Encoding::Sa => (self.encode_conditioned(rec, cond, None)?, None),
+            Encoding::Fa => (fa()?, None),
+            Encoding::SaFa => (self.encode_conditioned(rec, cond, None)?, Some(fa()?)),
+        })
+    }
+
     /// Conditions and encodes one recording.
     ///
     /// # Errors
     /// An empty sliding phase or a selected phase shorter than one bin.
     pub fn encode(&self, rec: &Recording, dataset_baseline: Baseline) -> Result<Encoded> {
         let cond = self.condition(rec, dataset_baseline)?;
-        let spikes = self.encode_conditioned(rec, &cond, None)?;
+        let (spikes, fa) = self.encode_populations(rec, &cond)?;
         Ok(Encoded {
             meta: rec.meta.clone(),
             spikes,
+            fa,
             resampled: cond.resampled,
             flat: cond.flat,
         })
@@ -210,6 +430,8 @@ impl Pipeline {
 pub struct FeatureExtractor {
     volume: VolumeParams,
     glcm: GlcmParams,
+    encoding: Encoding,
+    features: FeatureParams,
     grid: Grid,
     plan3d: GlcmPlan,
     plan2d: GlcmPlan,
@@ -222,11 +444,14 @@ impl FeatureExtractor {
     /// A broken parameter rule.
     pub fn new(params: &PipelineParams, grid: &Grid) -> Result<Self, ParamError> {
         params.volume.check()?;
+        params.features.check()?;
         let levels = params.volume.levels;
         let (rows, cols, present) = (grid.rows(), grid.cols(), grid.present());
         Ok(FeatureExtractor {
             volume: params.volume.clone(),
             glcm: params.glcm.clone(),
+            encoding: params.encoding,
+            features: params.features.clone(),
             grid: grid.clone(),
             plan3d: GlcmPlan::new(rows, cols, present, levels, &params.glcm, GlcmKind::ThreeD)?,
             plan2d: GlcmPlan::new(rows, cols, present, levels, &params.glcm, GlcmKind::TwoD)?,
@@ -238,93 +463,195 @@ impl FeatureExtractor {
         &self.grid
     }
 
-    /// Column names of `method`'s features for this grid.
+    /// The encoding whose populations the rows hold.
+    pub fn encoding(&self) -> Encoding {
+        self.encoding
+    }
+
+    /// Column names of `method`'s features for this grid: one population's names, each
+    /// population's prefixed with `sa_` / `fa_` for the `sa+fa` encoding.
     pub fn names(&self, method: Method) -> Vec<String> {
-        match method {
-            Method::Taxel => self
-                .grid
+        let one = self.population_names(method);
+        self.encoding
+            .prefixes()
+            .iter()
+            .flat_map(|prefix| one.iter().map(move |n| format!("{prefix}{n}")))
+            .collect()
+    }
+
+    /// One population's column names.
+    fn population_names(&self, method: Method) -> Vec<String> {
+        let haralick: Vec<&str> = match self.features.haralick {
+            HaralickSet::Paper => vec!["contrast", "correlation", "asm"],
+            HaralickSet::Full => FULL_NAMES.to_vec(),
+        };
+        let per_taxel = |stats: [&str; 3]| -> Vec<String> {
+            self.grid
                 .taxels()
                 .flat_map(|cell| {
                     let cell = self.grid.cell(cell);
-                    ["msr", "cv_isi", "fano"].map(|f| format!("{cell}_{f}"))
+                    stats.map(|f| format!("{cell}_{f}"))
                 })
+                .collect()
+        };
+        match method {
+            Method::Taxel | Method::AllTaxels => per_taxel(["msr", "cv_isi", "fano"]),
+            Method::AllTaxelsMm => per_taxel(["spikes_per_mm", "cv_isi", "fano_mm"]),
+            Method::Glcm2d | Method::Glcm3d => haralick.iter().map(|h| h.to_string()).collect(),
+            Method::Glcm3dMulti => self
+                .features
+                .bin_widths_ms
+                .iter()
+                .flat_map(|w| haralick.iter().map(move |h| format!("{w}ms_{h}")))
                 .collect(),
-            Method::Glcm2d | Method::Glcm3d => ["contrast", "correlation", "asm"]
-                .map(String::from)
-                .to_vec(),
         }
     }
 
-    /// The feature row of one recording's spike trains.
+    /// The feature row of one encoded recording: each population's features in the order
+    /// of [`Encoded::populations`], as many populations as the extractor's encoding has.
     ///
     /// # Errors
-    /// The trains are shorter than one bin.
-    pub fn row(&self, spikes: &SpikeTrains, method: Method) -> Result<Vec<f64>> {
-        let bin = self.volume.bin_ms;
-        let too_short = || -> crate::Error {
-            DataError::TooShort {
-                n_ms: spikes.n_steps,
-                bin_ms: bin,
-            }
-            .into()
-        };
-        if spikes.n_steps < bin {
-            return Err(too_short());
+    /// The trains are shorter than one bin; a population the encoding needs is missing;
+    /// [`Method::AllTaxelsMm`] on a recording without a nonzero speed.
+    pub fn row(&self, encoded: &Encoded, method: Method) -> Result<Vec<f64>> {
+        let wanted = self.encoding.prefixes().len();
+        let populations: Vec<&SpikeTrains> = encoded.populations().take(wanted).collect();
+        if populations.len() < wanted {
+            return Err(DataError::invalid(
+                &encoded.meta.file,
+                format!(
+                    "the {} encoding needs two populations; the recording was encoded with one",
+                    self.encoding.name()
+                ),
+            )
+            .into());
         }
+        let speed = encoded
+            .meta
+            .speed_mm_s
+            .filter(|s| s.is_finite() && *s != 0.0);
+        if method == Method::AllTaxelsMm && speed.is_none() {
+            return Err(DataError::invalid(&encoded.meta.file, NO_SPEED).into());
+        }
+        let mut row = Vec::new();
+        for spikes in populations {
+            row.extend(self.population_row(spikes, speed, method)?);
+        }
+        Ok(row)
+    }
+
+    /// One population's features; `speed_mm_s` is the recording's, for
+    /// [`Method::AllTaxelsMm`].
+    ///
+    /// # Errors
+    /// The trains are shorter than one bin, or [`Method::AllTaxelsMm`] without a nonzero
+    /// speed.
+    pub fn population_row(
+        &self,
+        spikes: &SpikeTrains,
+        speed_mm_s: Option<f64>,
+        method: Method,
+    ) -> Result<Vec<f64>> {
+        let bin = self.volume.bin_ms;
+        if spikes.n_steps < bin {
+            return Err(too_short(spikes, bin));
+        }
+        let n = spikes.n_steps;
         match method {
-            Method::Taxel => Ok(taxel_cells(&spikes.present)
-                .flat_map(|cell| spike_stats(spikes.train(cell), spikes.n_steps, bin).to_array())
+            Method::Taxel | Method::AllTaxels => Ok(taxel_cells(&spikes.present)
+                .flat_map(|cell| spike_stats(spikes.train(cell), n, bin).to_array())
                 .collect()),
-            Method::Glcm2d | Method::Glcm3d => {
-                let volume = if method == Method::Glcm3d {
-                    CountVolume::from_spikes(spikes, bin)
-                } else {
-                    CountVolume::collapsed(spikes)
+            Method::AllTaxelsMm => {
+                let speed = speed_mm_s
+                    .filter(|s| s.is_finite() && *s != 0.0)
+                    .ok_or_else(|| ParamError::new("speed", NO_SPEED, "none"))?;
+                let window = self.features.window_mm;
+                Ok(taxel_cells(&spikes.present)
+                    .flat_map(|cell| {
+                        distance_stats(spikes.train(cell), n, speed, window).to_array()
+                    })
+                    .collect())
+            }
+            Method::Glcm2d => self.glcm_features(spikes, GlcmKind::TwoD, bin),
+            Method::Glcm3d => self.glcm_features(spikes, GlcmKind::ThreeD, bin),
+            Method::Glcm3dMulti => {
+                let mut row = Vec::new();
+                for &width in &self.features.bin_widths_ms {
+                    row.extend(self.glcm_features(spikes, GlcmKind::ThreeD, width)?);
                 }
-                .ok_or_else(too_short)?;
-                let same_grid = (spikes.rows, spikes.cols) == (self.grid.rows(), self.grid.cols())
-                    && spikes.present == self.grid.present();
-                let kind = if method == Method::Glcm3d {
-                    GlcmKind::ThreeD
-                } else {
-                    GlcmKind::TwoD
-                };
-                let replanned;
-                let plan = match (same_grid, kind) {
-                    (true, GlcmKind::ThreeD) => &self.plan3d,
-                    (true, GlcmKind::TwoD) => &self.plan2d,
-                    (false, _) => {
-                        replanned = GlcmPlan::new(
-                            spikes.rows,
-                            spikes.cols,
-                            &spikes.present,
-                            self.volume.levels,
-                            &self.glcm,
-                            kind,
-                        )?;
-                        &replanned
-                    }
-                };
-                if !plan.counts_fit_wide(volume.bins) {
-                    return Err(DataError::TooLarge {
-                        what: "the time bins of this recording's rate volume",
-                        got: volume.bins as u64,
-                        limit: crate::features::glcm::MAX_SLICE_PAIRS,
-                        hint: "use a shorter recording or a wider --bin-ms",
-                    }
-                    .into());
-                }
-                let mut q = Vec::new();
-                volume.quantise(self.volume.levels, self.volume.range, &mut q);
-                let l = self.volume.levels;
-                // u64 counts: a long volume with many distances passes u32's 4.3 billion
-                // pairs; below it the u32 kernels count and the result is widened.
-                let mut counts = vec![0u64; l * l];
-                plan.count_wide(&q, volume.bins, &mut counts);
-                Ok(haralick(&counts, l).to_array().to_vec())
+                Ok(row)
             }
         }
     }
+
+    /// The Haralick features of the mean GLCM of the rate volume with bins of `bin_ms`
+    /// (3D) or of the time-collapsed image (2D).
+    fn glcm_features(
+        &self,
+        spikes: &SpikeTrains,
+        kind: GlcmKind,
+        bin_ms: usize,
+    ) -> Result<Vec<f64>> {
+        let volume = match kind {
+            GlcmKind::ThreeD => CountVolume::from_spikes(spikes, bin_ms),
+            GlcmKind::TwoD => CountVolume::collapsed(spikes),
+        }
+        .ok_or_else(|| too_short(spikes, bin_ms))?;
+        let same_grid = (spikes.rows, spikes.cols) == (self.grid.rows(), self.grid.cols())
+            && spikes.present == self.grid.present();
+        let replanned;
+        let plan = match (same_grid, kind) {
+            (true, GlcmKind::ThreeD) => &self.plan3d,
+            (true, GlcmKind::TwoD) => &self.plan2d,
+            (false, _) => {
+                replanned = GlcmPlan::new(
+                    spikes.rows,
+                    spikes.cols,
+                    &spikes.present,
+                    self.volume.levels,
+                    &self.glcm,
+                    kind,
+                )?;
+                &replanned
+            }
+        };
+        if !plan.counts_fit_wide(volume.bins) {
+            return Err(DataError::TooLarge {
+                what: "the time bins of this recording's rate volume",
+                got: volume.bins as u64,
+                limit: crate::features::glcm::MAX_SLICE_PAIRS,
+                hint: "use a shorter recording or a wider --bin-ms",
+            }
+            .into());
+        }
+        let mut q = Vec::new();
+        volume.quantise(self.volume.levels, self.volume.range, &mut q);
+        let l = self.volume.levels;
+        // u64 counts: a long volume with many distances passes u32's 4.3 billion pairs;
+        // below it the u32 kernels count and the result is widened.
+        let mut counts = vec![0u64; l * l];
+        plan.count_wide(&q, volume.bins, &mut counts);
+        Ok(match self.features.haralick {
+            HaralickSet::Paper => haralick(&counts, l).to_array().to_vec(),
+            HaralickSet::Full => {
+                let weights: Vec<f64> = counts.iter().map(|&c| c as f64).collect();
+                haralick_full(&weights, l).to_vec()
+            }
+        })
+    }
+}
+
+/// Why [`Method::AllTaxelsMm`] refuses a recording without a speed.
+const NO_SPEED: &str =
+    "the all-taxels-mm method needs the recording's sliding speed (manifest column speed_mm_s, nonzero)";
+
+/// The error of trains shorter than one bin of `bin_ms`.
+fn too_short(spikes: &SpikeTrains, bin_ms: usize) -> crate::Error {
+    DataError::TooShort {
+        n_ms: spikes.n_steps,
+        bin_ms,
+    }
+    .into()
 }
 
 /// Row-major indices of the cells holding a taxel.

@@ -29,7 +29,9 @@ pub struct EvaluateArgs {
     /// The dataset folder.
     #[arg(long)]
     pub dataset: PathBuf,
-    /// Feature set: `taxel`, `glcm2d` or `glcm3d`.
+    /// Feature set: `taxel` (each taxel alone, the mean reported), `glcm2d`, `glcm3d`,
+    /// `all-taxels` (every taxel's statistics in one vector), `all-taxels-mm` (the same per
+    /// mm of travel) or `glcm3d-multi` (3D-GLCM at each of `--bin-widths`).
     #[arg(long)]
     pub method: Method,
     /// With `--method taxel`: the taxel to use, as `ROW,COL`. Without it every taxel is

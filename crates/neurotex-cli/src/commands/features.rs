@@ -19,8 +19,9 @@ pub struct FeaturesArgs {
     /// The dataset folder (with `manifest.csv`, optional `layout.toml`).
     #[arg(long)]
     pub dataset: PathBuf,
-    /// Feature set: `taxel` (MSR, CV_ISI, Fano of every taxel), `glcm2d` or `glcm3d`
-    /// (contrast, correlation, ASM).
+    /// Feature set: `taxel` or `all-taxels` (MSR, CV_ISI, Fano of every taxel),
+    /// `all-taxels-mm` (spikes per mm, CV_ISI, Fano over fixed travel), `glcm2d`, `glcm3d`
+    /// or `glcm3d-multi` (Haralick features, at each of `--bin-widths` for the last).
     #[arg(long)]
     pub method: Method,
     /// The CSV file to write: every manifest column in the manifest's order (extra ones

@@ -24,7 +24,8 @@ pub struct TrainArgs {
     /// Train only on recordings at these speeds (mm/s, comma-separated); default all.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub speeds: Option<Vec<Speed>>,
-    /// Feature set: `taxel`, `glcm2d` or `glcm3d` (the paper's spatio-temporal approach).
+    /// Feature set: `taxel`, `glcm2d`, `glcm3d` (the paper's spatio-temporal approach),
+    /// `all-taxels`, `all-taxels-mm` or `glcm3d-multi`.
     #[arg(long, default_value = "glcm3d")]
     pub method: Method,
     /// With `--method taxel`: classify with this one taxel's statistics, as `ROW,COL`.

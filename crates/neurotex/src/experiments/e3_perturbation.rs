@@ -122,10 +122,7 @@ fn perturbed(
             let seed = c.params.seed ^ ((n as u64) << 40) ^ ((rep as u64) << 20) ^ i as u64;
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let perm = perturbation(taxels, e.spikes.cells(), n, &mut rng);
-            Encoded {
-                spikes: e.spikes.permuted(&perm),
-                ..(*e).clone()
-            }
+            e.map_spikes(|s| s.permuted(&perm))
         })
         .collect();
     let features = table(&perturbed, Method::Glcm3d, c.params)?;

@@ -99,11 +99,9 @@ fn outcome_on_part(c: &Context, speed: Speed, fraction: f64) -> Result<Option<Ou
     let at_speed: Vec<&Encoded> = c.prepared.at(speed).collect();
     let truncated: Vec<Encoded> = at_speed
         .par_iter()
-        .map(|e| Encoded {
-            spikes: e
-                .spikes
-                .truncated(((e.spikes.n_steps as f64) * fraction).floor() as usize),
-            ..(*e).clone()
+        .map(|e| {
+            let n_steps = ((e.spikes.n_steps as f64) * fraction).floor() as usize;
+            e.map_spikes(|s| s.truncated(n_steps))
         })
         .collect();
     let bin = c.params.pipeline.volume.bin_ms;

@@ -315,7 +315,7 @@ fn encode_one(
     let pipeline = params.pipeline();
     let rec = source.load(i)?;
     let mut cond = pipeline.condition(&rec, source.baseline())?;
-    let spikes = pipeline.encode_conditioned(&rec, &cond, None)?;
+    let (spikes, fa) = pipeline.encode_populations(&rec, &cond)?;
     let sweep = if sweep {
         Some(gain_sweep(&rec, &cond, params)?)
     } else {
@@ -324,15 +324,17 @@ fn encode_one(
     let encoded = Encoded {
         meta: rec.meta.clone(),
         spikes,
+        fa,
         resampled: cond.resampled,
         flat: cond.flat,
     };
     let perturbed = match params.sensitivity {
         Some(eps) => {
             cond.samples.iter_mut().for_each(|x| *x *= 1.0 + eps);
-            let spikes = pipeline.encode_conditioned(&rec, &cond, None)?;
+            let (spikes, fa) = pipeline.encode_populations(&rec, &cond)?;
             Some(Encoded {
                 spikes,
+                fa,
                 ..encoded.clone()
             })
         }

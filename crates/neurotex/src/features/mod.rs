@@ -3,10 +3,12 @@
 
 pub mod glcm;
 pub mod haralick;
+pub mod haralick_full;
 pub mod spike_stats;
 pub mod volume;
 
 pub use glcm::{Counting, GlcmParams, GlcmPlan, DIRECTIONS_13};
 pub use haralick::{haralick, Haralick};
-pub use spike_stats::{spike_stats, SpikeStats};
+pub use haralick_full::{haralick_full, FULL_NAMES};
+pub use spike_stats::{distance_stats, spike_stats, SpikeStats};
 pub use volume::{quantise, CountVolume, RateVolume, VolumeParams};

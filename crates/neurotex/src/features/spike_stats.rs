@@ -63,3 +63,35 @@ pub fn spike_stats(train: &[u32], n_steps: usize, window_ms: usize) -> SpikeStat
     };
     SpikeStats { msr, cv_isi, fano }
 }
+
+/// The Fano window in 1 ms steps that covers `window_mm` of travel at `speed_mm_s`
+/// (rounded to the nearest step, at least one).
+pub fn distance_window_ms(window_mm: f64, speed_mm_s: f64) -> usize {
+    ((window_mm / speed_mm_s.abs() * 1e3).round() as usize).max(1)
+}
+
+/// Statistics of one train in units of travelled distance, for a slide at `speed_mm_s`
+/// (its sign, the direction, is ignored): the rate in spikes per mm instead of per s,
+/// CV_ISI unchanged (a ratio of times, the same in distance), and the Fano factor of
+/// counts in windows of `window_mm` of travel ([`distance_window_ms`]). A texture of
+/// spatial period P read at any speed gives the same spikes per mm and the same counts
+/// per window when the neurons follow the signal; they do not exactly (the neuron has
+/// its own time constants), so the invariance is approximate.
+///
+/// # Panics
+/// If `n_steps` is 0, or `speed_mm_s` or `window_mm` is not positive and finite (a caller
+/// bug; the pipeline checks both).
+pub fn distance_stats(
+    train: &[u32],
+    n_steps: usize,
+    speed_mm_s: f64,
+    window_mm: f64,
+) -> SpikeStats {
+    let speed = speed_mm_s.abs();
+    assert!(speed.is_finite() && speed > 0.0 && window_mm.is_finite() && window_mm > 0.0);
+    let per_time = spike_stats(train, n_steps, distance_window_ms(window_mm, speed));
+    SpikeStats {
+        msr: per_time.msr / speed,
+        ..per_time
+    }
+}
