@@ -4,7 +4,7 @@
 //! The report judges nothing: whether the paper's claims hold comes from
 //! [`crate::experiments::claims`]; this module only writes tables, captions and figures.
 
-mod figures;
+pub mod figures;
 mod markdown;
 mod paper;
 mod table;

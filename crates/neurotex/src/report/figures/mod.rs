@@ -3,6 +3,7 @@
 //! written beside its drawing so that the two change together.
 
 mod accuracy;
+pub mod compare;
 mod confusion;
 mod gain;
 mod neighbours;

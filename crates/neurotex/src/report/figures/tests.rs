@@ -377,6 +377,30 @@ pub(crate) fn assert_no_overprint(name: &str, svg: &str) {
     }
 }
 
+/// Checks that every level text of `svg` lies wholly on its canvas, by plotters' estimate
+/// of its width: no name or key is clipped at an edge.
+pub(crate) fn assert_inside(name: &str, svg: &str) {
+    let (width, height) = canvas_size(svg);
+    for part in svg.split("<text").skip(1) {
+        let (Some(close), Some(end)) = (part.find('>'), part.find("</text>")) else {
+            continue;
+        };
+        let content = part[close + 1..end]
+            .trim()
+            .replace("&apos;", "'")
+            .replace("&quot;", "\"")
+            .replace("&lt;", "<")
+            .replace("&gt;", ">")
+            .replace("&amp;", "&");
+        if let Some((x0, y0, x1, y1)) = text_box(&part[..close], &content) {
+            assert!(
+                x0 >= 0.0 && y0 >= 0.0 && x1 <= width && y1 <= height,
+                "{name}: \"{content}\" spans ({x0}, {y0})-({x1}, {y1}) off the {width}x{height} canvas"
+            );
+        }
+    }
+}
+
 fn check_all(r: &Results, paper: Option<&Paper>) -> Vec<&'static str> {
     let figures = all(r, paper);
     for (name, svg) in &figures {

@@ -1,0 +1,204 @@
+//! The comparison's figures on hand-built comparisons of 2, 10 and 40 candidates, with and
+//! without nested selection and conditions.
+
+use super::*;
+use crate::compare::{ConditionAccuracy, Nested, Protocol};
+use crate::report::figures::tests::{assert_inside, assert_no_overprint, assert_well_formed};
+
+const ENCODINGS: [&str; 3] = ["sa", "fa", "sa+fa"];
+const METHODS: [&str; 5] = [
+    "glcm3d",
+    "glcm2d",
+    "spike_stats",
+    "volume",
+    "haralick_all_offsets_and_directions",
+];
+const CLASSIFIERS: [&str; 3] = ["knn", "logistic_regression", "nearest_centroid"];
+
+/// `n` candidates, the paper's method among them (third unless `n` < 3), ranked; with
+/// `conditions` speeds per candidate (none: pooled) and nested selection when `nested`.
+fn comparison(n: usize, nested: bool, conditions: usize) -> Comparison {
+    let speeds: Vec<String> = (0..conditions)
+        .map(|i| format!("{}", 10 * (i as i32 + 1) * if i % 2 == 0 { 1 } else { -1 }))
+        .collect();
+    let paper_at = 2.min(n - 1);
+    let results: Vec<Ranked> = (0..n)
+        .map(|k| {
+            let accuracy = 0.92 - 0.6 * k as f64 / n as f64;
+            let paper = k == paper_at;
+            let (encoding, method, classifier) = if paper {
+                ("sa", "glcm3d", "knn")
+            } else {
+                // from k + 1, so that no other candidate is named as the paper's
+                let i = k + 1;
+                (
+                    ENCODINGS[i % 3],
+                    METHODS[(i / 3) % 5],
+                    CLASSIFIERS[(i / 15) % 3],
+                )
+            };
+            let versus = (!paper).then(|| (accuracy - 0.8, [0.0004, 0.03, 0.4][k % 3]));
+            Ranked {
+                encoding: encoding.into(),
+                method: method.into(),
+                classifier: classifier.into(),
+                accuracy,
+                ci: [(accuracy - 0.06).max(0.0), (accuracy + 0.05).min(1.0)],
+                p_vs_paper: versus.map(|v| v.1),
+                difference_vs_paper: versus.map(|v| v.0),
+                per_condition: speeds
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| ConditionAccuracy {
+                        condition: s.clone(),
+                        accuracy: (accuracy + 0.1 * ((i + k) % 3) as f64 - 0.1).clamp(0.0, 1.0),
+                    })
+                    .collect(),
+                seconds: 1.0,
+                paper,
+            }
+        })
+        .collect();
+    let protocol = if conditions > 0 {
+        Protocol::Per("speed".into())
+    } else {
+        Protocol::Pooled
+    };
+    Comparison {
+        protocol: protocol.to_string(),
+        units: "recordings".into(),
+        n_units: 280,
+        n_recordings: 280,
+        classes: 7,
+        chance: 1.0 / 7.0,
+        majority: 0.2,
+        best: results[0].clone(),
+        results,
+        nested: nested.then(|| Nested {
+            accuracy: 0.81,
+            ci: [0.76, 0.86],
+            chosen: vec![
+                ("sa / glcm3d / knn".into(), 4),
+                ("fa / glcm2d / knn".into(), 1),
+            ],
+            outer_splits: 5,
+        }),
+        caveat: crate::compare::CAVEAT.into(),
+    }
+}
+
+/// The SVG's text with the entities plotters writes turned back into characters.
+fn plain(svg: &str) -> String {
+    svg.replace("&apos;", "'")
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+}
+
+fn check(name: &str, svg: &str) {
+    assert_well_formed(name, svg);
+    assert_no_overprint(name, svg);
+    assert_inside(name, svg);
+    if let Some(dump) = std::env::var_os("NEUROTEX_DUMP_FIGURES") {
+        let path = std::path::Path::new(&dump).join(format!("{name}.svg"));
+        std::fs::write(path, svg).unwrap();
+    }
+}
+
+#[test]
+fn ranking_names_every_candidate_on_the_canvas() {
+    for n in [2, 10, 40] {
+        for nested in [false, true] {
+            let c = comparison(n, nested, 0);
+            let svg = ranking(&c).unwrap();
+            check(&format!("compare_ranking_{n}_{nested}"), &svg);
+            let svg = plain(&svg);
+            for r in &c.results {
+                assert!(svg.contains(&name(r)), "{n}: {} missing", name(r));
+            }
+            assert!(svg.contains("sa / glcm3d / knn (paper)"));
+            assert!(svg.contains("chance, 1 / 7 classes (14.3 %)"));
+            assert!(svg.contains("majority class (20 %)"));
+            assert_eq!(svg.contains("nested selection"), nested, "{n}");
+            // one dot per row, one per point key of the legend
+            let rows = n + usize::from(nested);
+            let keys = 2 + usize::from(nested);
+            assert_eq!(svg.matches("<circle").count(), rows + keys, "{n} {nested}");
+        }
+    }
+}
+
+#[test]
+fn ranking_stars_only_significant_differences_from_the_paper() {
+    let svg = plain(&ranking(&comparison(10, false, 0)).unwrap());
+    // p cycles through 0.0004, 0.03 and 0.4 over the nine candidates that are not the paper's
+    assert!(svg.contains("p < 0.001 *") && svg.contains("p = 0.030 *"));
+    assert!(svg.contains("p = 0.400") && !svg.contains("p = 0.400 *"));
+    assert!(svg.contains("reference"));
+}
+
+#[test]
+fn ranking_without_the_paper_drops_its_column_and_balanced_classes_share_one_line() {
+    let mut c = comparison(10, true, 0);
+    c.results.retain(|r| !r.paper);
+    for r in &mut c.results {
+        (r.p_vs_paper, r.difference_vs_paper) = (None, None);
+    }
+    c.majority = c.chance;
+    let svg = ranking(&c).unwrap();
+    check("compare_ranking_no_paper", &svg);
+    let svg = plain(&svg);
+    assert!(!svg.contains(VERSUS_HEAD) && !svg.contains("(paper)"));
+    assert!(svg.contains("chance, 1 / 7 classes = majority class (14.3 %)"));
+    assert_eq!(
+        svg.matches("majority class").count(),
+        1,
+        "one line, one key"
+    );
+}
+
+#[test]
+fn per_condition_only_with_conditions_and_for_1_to_20() {
+    assert!(per_condition(&comparison(10, true, 0)).is_none());
+    for conditions in [1, 2, 12, 20] {
+        for n in [2, 40] {
+            let c = comparison(n, false, conditions);
+            let svg = per_condition(&c).unwrap().unwrap();
+            check(&format!("compare_per_condition_{n}_{conditions}"), &svg);
+            let svg = plain(&svg);
+            assert!(svg.contains(&format!("best: {}", name(&c.best))));
+            assert!(svg.contains("the paper's method: sa / glcm3d / knn"));
+            assert!(svg.contains("chance, 1 / 7 classes"));
+            assert!(svg.contains("speed, cross-validated within each"));
+            assert!(svg.contains("accuracy per speed"));
+            // a marker per condition and line, one per legend key with a marker
+            assert_eq!(svg.matches("<circle").count(), 2 * conditions + 2);
+        }
+    }
+}
+
+#[test]
+fn per_condition_names_the_held_out_column_and_a_paper_best() {
+    let mut c = comparison(2, false, 3);
+    c.protocol = Protocol::HoldOut("session".into()).to_string();
+    c.results.swap(0, 1);
+    c.best = c.results[0].clone();
+    assert!(c.best.paper);
+    let svg = per_condition(&c).unwrap().unwrap();
+    check("compare_per_condition_paper_best", &svg);
+    let svg = plain(&svg);
+    assert!(svg.contains("held-out session, trained on the others"));
+    assert!(svg.contains("best, the paper's method: sa / glcm3d / knn"));
+    assert_eq!(svg.matches("<circle").count(), 3 + 1);
+}
+
+#[test]
+fn captions_say_what_is_drawn() {
+    let c = comparison(10, true, 4);
+    let caption = ranking_caption(&c);
+    assert!(
+        caption.contains("81.0 %") && caption.contains("5 training sets"),
+        "{caption}"
+    );
+    assert!(!ranking_caption(&comparison(10, false, 0)).contains("nested"));
+    assert!(per_condition_caption(&c).contains("dashed vermillion"));
+}
