@@ -24,7 +24,9 @@ fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
     ]);
     let v: Value = serde_json::from_str(&text).unwrap();
     let results = v["results"].as_array().unwrap();
-    assert_eq!(results.len(), 3);
+    // 2 encodings x (the paper's taxel method with KNN, 4 feature methods x 3 classifiers,
+    // van Rossum with KNN)
+    assert_eq!(results.len(), 28);
     for r in results {
         for key in [
             "encoding",
@@ -57,7 +59,29 @@ fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
         assert_eq!(at["condition"], *speed);
         assert_eq!(at["accuracy"], e["accuracy"], "speed {speed}");
     }
-    let taxel = results.iter().find(|r| r["method"] == "taxel").unwrap();
+    let of = |encoding: &str, method: &str, classifier: &str| {
+        let found = results.iter().find(|r| {
+            (r["encoding"] == encoding) && r["method"] == method && r["classifier"] == classifier
+        });
+        found.unwrap().clone()
+    };
+    let forest = of("sa+fa", "all-taxels", "forest");
+    let e = dir.evaluate_json(
+        &ds,
+        "all-taxels",
+        &[
+            "--speeds",
+            "10",
+            "--repeats",
+            "2",
+            "--encoding",
+            "sa+fa",
+            "--classifier",
+            "forest",
+        ],
+    );
+    assert_eq!(forest["per_condition"][1]["accuracy"], e["accuracy"]);
+    let taxel = of("sa", "taxel", "knn");
     let e = dir.evaluate_json(&ds, "taxel", &["--speeds", "5", "--repeats", "2"]);
     assert_eq!(taxel["per_condition"][0]["accuracy"], e["accuracy"]);
     for file in ["compare.json", "compare.md"] {

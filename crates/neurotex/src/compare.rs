@@ -543,12 +543,28 @@ impl Units {
     }
 }
 
-/// The outer splits of nested selection: `(condition, training rows, test rows)`, from the
-/// first repeat's folds (or the held-out conditions).
-fn outer_splits(
-    metas: &[Meta],
-    params: &CompareParams,
-) -> Result<Vec<(String, Vec<usize>, Vec<usize>)>> {
+/// One outer split of nested selection.
+struct OuterSplit {
+    /// The condition it belongs to (empty for pooled cross-validation).
+    condition: String,
+    /// Training rows.
+    train: Vec<usize>,
+    /// Test rows.
+    test: Vec<usize>,
+}
+
+/// What one outer split chose and how its test rows fared.
+struct OuterResult {
+    condition: String,
+    /// The chosen candidate.
+    chosen: usize,
+    /// Per test row, its share of right predictions.
+    shares: Vec<(usize, f64)>,
+}
+
+/// The outer splits of nested selection, from the first repeat's folds (or the held-out
+/// conditions).
+fn outer_splits(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
     let folds_of = |rows: Vec<usize>, condition: String| -> Result<Vec<_>> {
         let fold_of = fold_assignment(metas, &rows, params)?;
         let n_folds = fold_of.iter().max().map_or(0, |&f| f + 1);
@@ -560,7 +576,11 @@ fn outer_splits(
                         .map(|(&r, _)| r)
                         .collect()
                 };
-                (condition.clone(), pick(false), pick(true))
+                OuterSplit {
+                    condition: condition.clone(),
+                    train: pick(false),
+                    test: pick(true),
+                }
             })
             .collect())
     };
@@ -578,12 +598,18 @@ fn outer_splits(
             .map(|value| {
                 let test = rows_with(metas, column, &value);
                 let train = (0..metas.len()).filter(|i| !test.contains(i)).collect();
-                (value, train, test)
+                OuterSplit {
+                    condition: value,
+                    train,
+                    test,
+                }
             })
             .collect()),
-        Protocol::Where { train, test } => {
-            Ok(vec![(String::new(), train.rows(metas)?, test.rows(metas)?)])
-        }
+        Protocol::Where { train, test } => Ok(vec![OuterSplit {
+            condition: String::new(),
+            train: train.rows(metas)?,
+            test: test.rows(metas)?,
+        }]),
     }
 }
 
@@ -633,49 +659,48 @@ fn nested(candidates: &[Candidate], params: &CompareParams, units: &Units) -> Re
         .check()?,
         ..params.clone()
     };
-    let outcomes: Vec<(String, usize, Vec<(usize, f64)>, f64)> = splits
+    let outcomes: Vec<OuterResult> = splits
         .par_iter()
-        .map(|(condition, train, test)| {
+        .map(|split| {
             let mut best = (f64::NEG_INFINITY, 0);
             for (k, c) in candidates.iter().enumerate() {
-                let sub = c.table.subset(train);
+                let sub = c.table.subset(&split.train);
                 let accuracy = (c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy;
                 if accuracy > best.0 {
                     best = (accuracy, k);
                 }
             }
             let c = &candidates[best.1];
-            let split = Split::Rows {
-                train: train.clone(),
-                test: test.clone(),
+            let rows = Split::Rows {
+                train: split.train.clone(),
+                test: split.test.clone(),
             };
-            let outcome = (c.evaluate)(&c.table, c.columns, &split)?;
-            Ok((
-                condition.clone(),
-                best.1,
-                outcome.correct_shares,
-                outcome.accuracy,
-            ))
+            let outcome = (c.evaluate)(&c.table, c.columns, &rows)?;
+            Ok(OuterResult {
+                condition: split.condition.clone(),
+                chosen: best.1,
+                shares: outcome.correct_shares,
+            })
         })
         .collect::<Result<_>>()?;
-    let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.2.clone()).collect();
+    let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();
     shares.sort_by_key(|&(row, _)| row);
     let mut chosen: Vec<(String, usize)> = Vec::new();
     for o in &outcomes {
-        let name = candidates[o.1].name();
+        let name = candidates[o.chosen].name();
         match chosen.iter_mut().find(|(n, _)| *n == name) {
             Some((_, times)) => *times += 1,
             None => chosen.push((name, 1)),
         }
     }
-    chosen.sort_by(|a, b| b.1.cmp(&a.1));
+    chosen.sort_by_key(|c| std::cmp::Reverse(c.1));
     // Mean over conditions of each condition's share of right test predictions.
     let mut per: Vec<(String, f64, usize)> = Vec::new();
     for o in &outcomes {
-        let right: f64 = o.2.iter().map(|x| x.1).sum();
-        match per.iter_mut().find(|(c, _, _)| *c == o.0) {
-            Some((_, r, n)) => (*r, *n) = (*r + right, *n + o.2.len()),
-            None => per.push((o.0.clone(), right, o.2.len())),
+        let right: f64 = o.shares.iter().map(|x| x.1).sum();
+        match per.iter_mut().find(|(c, _, _)| *c == o.condition) {
+            Some((_, r, n)) => (*r, *n) = (*r + right, *n + o.shares.len()),
+            None => per.push((o.condition.clone(), right, o.shares.len())),
         }
     }
     // The outer test sets cover the rows every candidate was scored on, once each, so the

@@ -13,8 +13,9 @@ use neurotex::classify::CvParams;
 use neurotex::classify::{ClassifierChoice, ForestParams, SpikeDistanceKnn, VanRossumParams};
 use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
 use neurotex::encode::SpikeTrains;
-use neurotex::pipeline::{Encoded, Method, Pipeline};
+use neurotex::pipeline::{Encoded, Encoding, Method, Pipeline};
 use neurotex::recording::{Dataset, Selection};
+use neurotex::report::figures::compare as figures;
 use neurotex::{Grid, Speed};
 
 use super::{calibrated_pipeline, encode_all};
@@ -64,16 +65,23 @@ pub struct CompareArgs {
     /// its groups.
     #[arg(long = "group-by")]
     pub group_by: Option<String>,
-    /// Encodings to compare, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "sa")]
-    pub encodings: Vec<String>,
+    /// Encodings to compare, comma-separated: `sa` (the paper's slowly adapting neurons),
+    /// `fa` (fast adapting, driven by the rectified rate of change), `sa+fa` (both).
+    /// Overrides --encoding.
+    #[arg(long, value_delimiter = ',', default_value = "sa,sa+fa")]
+    pub encodings: Vec<Encoding>,
     /// Feature methods to compare, comma-separated. `taxel` is the paper's single-taxel
     /// method (each taxel alone, mean over taxels; KNN only); `van-rossum` classifies by
     /// spike-train distances (KNN only).
-    #[arg(long, value_delimiter = ',', default_value = "taxel,glcm2d,glcm3d")]
+    /// `all-taxels-mm` (statistics per mm travelled) needs the manifest's speeds.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "taxel,all-taxels,glcm2d,glcm3d,glcm3d-multi,van-rossum"
+    )]
     pub methods: Vec<String>,
-    /// Classifiers to compare, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "knn")]
+    /// Classifiers to compare, comma-separated: knn, forest, linear.
+    #[arg(long, value_delimiter = ',', default_value = "knn,forest,linear")]
     pub classifiers: Vec<String>,
     /// Time constant of the van Rossum kernel in ms (method `van-rossum`). Default: the
     /// rate volume's 200 ms bin, the time resolution the paper's rate code keeps.
@@ -201,10 +209,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
         bail!("{n} candidates to compare; between 1 and {MAX_CANDIDATES} are allowed");
     }
     let mut candidates = Vec::new();
-    for encoding in &args.encodings {
-        if encoding != "sa" {
-            bail!("unknown encoding `{encoding}`: sa");
-        }
+    for &encoding in &args.encodings {
         candidates.extend(candidates_of(&args, &dataset, &indices, encoding, &pairs)?);
     }
     eprintln!(
@@ -231,11 +236,13 @@ fn candidates_of(
     args: &CompareArgs,
     dataset: &Dataset,
     indices: &[usize],
-    encoding: &str,
+    encoding: Encoding,
     pairs: &[(Method, Columns, ClassifierChoice)],
 ) -> Result<Vec<Candidate>> {
     let start = Instant::now();
-    let (params, _) = calibrated_pipeline(&args.stages, dataset, indices)?;
+    let (mut params, _) = calibrated_pipeline(&args.stages, dataset, indices)?;
+    params.encoding = encoding;
+    let encoding = encoding.name();
     let pipeline = Pipeline::new(params)?;
     let mut methods: Vec<Method> = pairs.iter().map(|p| p.0).collect();
     methods.dedup();
@@ -330,6 +337,16 @@ fn write_outputs(dir: &std::path::Path, c: &Comparison) -> Result<()> {
     write_file(&dir.join("compare.md"), "compare.md", |w| {
         w.write_all(markdown(c).as_bytes())
     })?;
+    let ranking = figures::ranking(c).map_err(|e| anyhow::anyhow!("{e}"))?;
+    write_file(&dir.join("ranking.svg"), "ranking.svg", |w| {
+        w.write_all(ranking.as_bytes())
+    })?;
+    if let Some(svg) = figures::per_condition(c) {
+        let svg = svg.map_err(|e| anyhow::anyhow!("{e}"))?;
+        write_file(&dir.join("per_condition.svg"), "per_condition.svg", |w| {
+            w.write_all(svg.as_bytes())
+        })?;
+    }
     eprintln!("wrote {}", dir.display());
     Ok(())
 }

@@ -152,7 +152,7 @@ fn notes(c: &Comparison) -> Vec<String> {
     let mut notes = Vec::new();
     if c.results.iter().any(|r| r.p_vs_paper.is_some()) {
         notes.push(format!(
-            "vs paper: mean difference per unit in points; p of the paired sign-flip test over {}; * p < {SIGNIFICANT}",
+            "vs paper: difference in accuracy, in points; p of the paired sign-flip test over {}; * p < {SIGNIFICANT}",
             c.units
         ));
     }
