@@ -3,28 +3,22 @@
 //! (SA encoding, 3D-GLCM, KNN); to find what suits a sensor best.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use neurotex::analysis::{evaluate, Columns, FeatureTable};
-use neurotex::classify::CvParams;
-use neurotex::classify::{ClassifierChoice, ForestParams, SpikeDistanceKnn, VanRossumParams};
+use neurotex::classify::{ClassifierChoice, CvParams, ForestParams};
+use neurotex::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
-use neurotex::encode::SpikeTrains;
-use neurotex::pipeline::{Encoded, Encoding, Method, Pipeline};
+use neurotex::pipeline::{Encoding, Pipeline};
 use neurotex::recording::{Dataset, Selection};
 use neurotex::report::figures::compare as figures;
-use neurotex::{Grid, Speed};
+use neurotex::Speed;
 
 use super::{calibrated_pipeline, encode_all};
 use crate::open_args::OpenArgs;
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
-
-/// The spike-timing method's name.
-const VAN_ROSSUM: &str = "van-rossum";
 
 /// Most candidates one run compares (encodings x methods x classifiers).
 const MAX_CANDIDATES: usize = 200;
@@ -166,34 +160,33 @@ impl CompareArgs {
         Ok(rows)
     }
 
-    /// Every (method, classifier) pair to run, checked, with the columns each classifies.
-    fn pairs(&self) -> Result<Vec<(Method, Columns, ClassifierChoice)>> {
-        let mut out = Vec::new();
-        for name in self.methods.iter().filter(|m| *m != VAN_ROSSUM) {
-            let method: Method = name.parse().map_err(|e| {
-                anyhow::anyhow!("{e}; or {VAN_ROSSUM} (KNN over spike-train distances)")
-            })?;
-            for name in &self.classifiers {
-                let classifier = match name.parse::<ClassifierChoice>()? {
+    /// The candidates to compare, checked.
+    fn set(&self) -> Result<CandidateSet> {
+        let methods = self
+            .methods
+            .iter()
+            .map(|m| m.parse::<MethodChoice>())
+            .collect::<Result<Vec<_>, _>>()?;
+        let classifiers = self
+            .classifiers
+            .iter()
+            .map(|name| {
+                Ok(match name.parse::<ClassifierChoice>()? {
                     ClassifierChoice::Knn(_) => ClassifierChoice::Knn(self.stages.knn(self.k)?),
                     ClassifierChoice::Forest(p) => ClassifierChoice::Forest(ForestParams {
                         seed: self.seed,
                         ..p
                     }),
                     linear => linear,
-                };
-                if method == Method::Taxel && classifier.name() != "knn" {
-                    continue; // the paper's per-taxel method is a KNN method
-                }
-                let columns = if method == Method::Taxel {
-                    Columns::EachTaxel
-                } else {
-                    Columns::All
-                };
-                out.push((method, columns, classifier));
-            }
-        }
-        Ok(out)
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(CandidateSet {
+            encodings: self.encodings.clone(),
+            methods,
+            classifiers,
+            tau_ms: self.tau_ms,
+        })
     }
 }
 
@@ -202,16 +195,12 @@ pub fn run(args: CompareArgs) -> Result<()> {
     let params = args.params()?;
     let dataset = args.open.open(&args.dataset)?;
     let indices = args.indices(&dataset)?;
-    let pairs = args.pairs()?;
-    let timing = usize::from(args.methods.iter().any(|m| m == VAN_ROSSUM));
-    let n = (pairs.len() + timing) * args.encodings.len();
+    let set = args.set()?;
+    let n = set.len();
     if n == 0 || n > MAX_CANDIDATES {
         bail!("{n} candidates to compare; between 1 and {MAX_CANDIDATES} are allowed");
     }
-    let mut candidates = Vec::new();
-    for &encoding in &args.encodings {
-        candidates.extend(candidates_of(&args, &dataset, &indices, encoding, &pairs)?);
-    }
+    let candidates = make_candidates(&args, &dataset, &indices, &set)?;
     eprintln!(
         "comparing {} candidates on {} recordings: {}",
         candidates.len(),
@@ -230,101 +219,25 @@ pub fn run(args: CompareArgs) -> Result<()> {
     Ok(())
 }
 
-/// The candidates of one encoding: the recordings encoded once, each method's table made
-/// once, each classifier run on it.
-fn candidates_of(
+/// Encodes the recordings once (both populations when an encoding needs the fast-adapting
+/// one) and makes every candidate of `set` from them.
+fn make_candidates(
     args: &CompareArgs,
     dataset: &Dataset,
     indices: &[usize],
-    encoding: Encoding,
-    pairs: &[(Method, Columns, ClassifierChoice)],
+    set: &CandidateSet,
 ) -> Result<Vec<Candidate>> {
     let start = Instant::now();
     let (mut params, _) = calibrated_pipeline(&args.stages, dataset, indices)?;
-    params.encoding = encoding;
-    let encoding = encoding.name();
-    let pipeline = Pipeline::new(params)?;
-    let mut methods: Vec<Method> = pairs.iter().map(|p| p.0).collect();
-    methods.dedup();
-    if methods.is_empty() {
-        methods.push(Method::Glcm3d); // only van Rossum: the grid still comes from a table
-    }
-    let (encoded, grid) = encode_all(dataset, &pipeline, indices)?;
-    let extractor = pipeline.extractor(&grid)?;
-    let encode_s = start.elapsed().as_secs_f64() / methods.len() as f64;
-    let tables: Vec<(Method, Arc<FeatureTable>, f64)> = methods
-        .iter()
-        .map(|&method| {
-            let start = Instant::now();
-            let table = FeatureTable::build(&encoded, &extractor, method)?;
-            Ok((
-                method,
-                Arc::new(table),
-                encode_s + start.elapsed().as_secs_f64(),
-            ))
-        })
-        .collect::<Result<_>>()?;
-    let mut candidates: Vec<Candidate> = pairs
-        .iter()
-        .map(|(method, columns, classifier)| {
-            let (_, table, prepare_s) = tables
-                .iter()
-                .find(|t| t.0 == *method)
-                .context("every method has a table")?;
-            let chosen = classifier.check()?;
-            Ok(Candidate {
-                encoding: encoding.to_string(),
-                method: method.name().to_string(),
-                classifier: classifier.name().to_string(),
-                table: Arc::clone(table),
-                columns: *columns,
-                evaluate: Arc::new(move |t, c, s| evaluate(t, c, s, &chosen)),
-                prepare_s: *prepare_s,
-            })
-        })
-        .collect::<Result<_>>()?;
-    if args.methods.iter().any(|m| m == VAN_ROSSUM) {
-        candidates.push(van_rossum_candidate(
-            args, encoding, &encoded, &grid, encode_s,
-        )?);
-    }
-    Ok(candidates)
-}
-
-/// The spike-timing candidate: KNN over van Rossum distances between the recordings'
-/// spike trains (of the first population), the matrix computed once. Its table holds each
-/// recording's row index into the matrix, the "feature" the classifier looks up.
-fn van_rossum_candidate(
-    args: &CompareArgs,
-    encoding: &str,
-    encoded: &[Encoded],
-    grid: &Grid,
-    encode_s: f64,
-) -> Result<Candidate> {
-    let start = Instant::now();
-    let trains: Vec<SpikeTrains> = encoded.iter().map(|e| e.spikes.clone()).collect();
-    let metric = VanRossumParams {
-        tau_ms: args.tau_ms,
-    }
-    .check()?;
-    let knn = SpikeDistanceKnn::new(Arc::new(metric.matrix(&trains)?), args.k)?;
-    let table = FeatureTable {
-        // Not a feature method: the field is not read for a table of row indices.
-        method: Method::Glcm3d,
-        grid: grid.clone(),
-        names: vec!["row".into()],
-        metas: encoded.iter().map(|e| e.meta.clone()).collect(),
-        values: knn.samples(),
+    params.encoding = if set.needs_fa() {
+        Encoding::SaFa
+    } else {
+        Encoding::Sa
     };
-    Ok(Candidate {
-        encoding: encoding.to_string(),
-        method: VAN_ROSSUM.into(),
-        classifier: "knn".into(),
-        table: Arc::new(table),
-        columns: Columns::All,
-        evaluate: Arc::new(move |t, c, s| evaluate(t, c, s, &knn)),
-        prepare_s: encode_s + start.elapsed().as_secs_f64(),
-    })
+    let pipeline = Pipeline::new(params.clone())?;
+    let (encoded, grid) = encode_all(dataset, &pipeline, indices)?;
+    let encode_s = start.elapsed().as_secs_f64();
+    Ok(candidates(&encoded, &grid, &params, set, encode_s)?)
 }
 
 /// compare.json and compare.md in `dir`.

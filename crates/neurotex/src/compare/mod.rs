@@ -16,6 +16,8 @@
 //! procedure: for each outer split the candidates are ranked by cross-validation inside
 //! its training recordings only, and the chosen one is scored on its test recordings.
 
+pub mod candidates;
+
 use std::sync::Arc;
 use std::time::Instant;
 

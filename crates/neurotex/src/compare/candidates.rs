@@ -1,0 +1,244 @@
+//! The candidates of a comparison made from encoded recordings: for each encoding, each
+//! feature method's table is built once and shared by every classifier; the spike-timing
+//! method's distance matrix is computed once per encoding.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::Candidate;
+use crate::analysis::{evaluate, Columns, FeatureTable};
+use crate::classify::{ClassifierChoice, KnnParams, SpikeDistanceKnn, VanRossumParams};
+use crate::encode::SpikeTrains;
+use crate::error::{ParamError, Result};
+use crate::pipeline::{Encoded, Encoding, FeatureExtractor, Method, PipelineParams};
+use crate::values::Grid;
+
+/// The spike-timing method's name.
+pub const VAN_ROSSUM: &str = "van-rossum";
+
+/// A feature method, or the spike-timing method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MethodChoice {
+    /// Feature rows of a [`Method`].
+    Features(Method),
+    /// KNN over van Rossum distances between the recordings' spike trains.
+    VanRossum,
+}
+
+impl MethodChoice {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodChoice::Features(m) => m.name(),
+            MethodChoice::VanRossum => VAN_ROSSUM,
+        }
+    }
+}
+
+impl std::str::FromStr for MethodChoice {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        if s == VAN_ROSSUM {
+            return Ok(MethodChoice::VanRossum);
+        }
+        s.parse().map(MethodChoice::Features).map_err(|_| {
+            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi or van-rossum";
+            ParamError::new("methods", rule, s)
+        })
+    }
+}
+
+/// What to compare: every encoding x method x classifier, except that the paper's
+/// single-taxel method (each taxel alone, mean over taxels) and the spike-timing method
+/// are KNN methods and run with KNN only.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CandidateSet {
+    /// Encodings.
+    pub encodings: Vec<Encoding>,
+    /// Methods.
+    pub methods: Vec<MethodChoice>,
+    /// Classifiers.
+    pub classifiers: Vec<ClassifierChoice>,
+    /// Time constant of the van Rossum kernel, ms.
+    pub tau_ms: f64,
+}
+
+impl CandidateSet {
+    /// The (method, classifier) pairs of one encoding.
+    fn pairs(&self) -> Vec<(MethodChoice, ClassifierChoice)> {
+        let knn = self
+            .classifiers
+            .iter()
+            .find(|c| matches!(c, ClassifierChoice::Knn(_)))
+            .copied()
+            .unwrap_or(ClassifierChoice::Knn(KnnParams::default()));
+        let mut out = Vec::new();
+        for &method in &self.methods {
+            let knn_only = matches!(
+                method,
+                MethodChoice::VanRossum | MethodChoice::Features(Method::Taxel)
+            );
+            if knn_only {
+                out.push((method, knn));
+            } else {
+                out.extend(self.classifiers.iter().map(|&c| (method, c)));
+            }
+        }
+        out
+    }
+
+    /// How many candidates the set makes.
+    pub fn len(&self) -> usize {
+        self.encodings.len() * self.pairs().len()
+    }
+
+    /// Whether the set makes no candidate.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Whether some encoding needs the fast-adapting population.
+    pub fn needs_fa(&self) -> bool {
+        self.encodings.iter().any(|e| *e != Encoding::Sa)
+    }
+}
+
+/// The candidates of `set` from recordings encoded with both populations where the set
+/// needs them (`encoded[i].fa` present for `fa` and `sa+fa`), all on `grid`.
+/// `encode_s` (the encoding's wall time) is shared evenly among each encoding's methods in
+/// [`Candidate::prepare_s`].
+///
+/// # Errors
+/// A broken parameter, recordings without the population an encoding needs, or a feature
+/// method the recordings cannot support (a speed missing for `all-taxels-mm`).
+pub fn candidates(
+    encoded: &[Encoded],
+    grid: &Grid,
+    params: &PipelineParams,
+    set: &CandidateSet,
+    encode_s: f64,
+) -> Result<Vec<Candidate>> {
+    let pairs = set.pairs();
+    let mut out = Vec::new();
+    for &encoding in &set.encodings {
+        let view = population_view(encoded, encoding);
+        let params = PipelineParams {
+            encoding,
+            ..params.clone()
+        };
+        let extractor = FeatureExtractor::new(&params, grid)?;
+        let mut methods: Vec<MethodChoice> = pairs.iter().map(|p| p.0).collect();
+        methods.dedup();
+        let share = encode_s / (set.encodings.len() * methods.len()).max(1) as f64;
+        for method in methods {
+            let start = Instant::now();
+            let table = Arc::new(match method {
+                MethodChoice::Features(m) => FeatureTable::build(&view, &extractor, m)?,
+                MethodChoice::VanRossum => index_table(&view, grid),
+            });
+            let knn_distances = match method {
+                MethodChoice::VanRossum => Some(distance_matrix(&view, encoding, set.tau_ms)?),
+                MethodChoice::Features(_) => None,
+            };
+            let prepare_s = share + start.elapsed().as_secs_f64();
+            for &(_, classifier) in pairs.iter().filter(|p| p.0 == method) {
+                out.push(Candidate {
+                    encoding: encoding.name().to_string(),
+                    method: method.name().to_string(),
+                    classifier: classifier.name().to_string(),
+                    table: Arc::clone(&table),
+                    columns: match method {
+                        MethodChoice::Features(Method::Taxel) => Columns::EachTaxel,
+                        _ => Columns::All,
+                    },
+                    evaluate: evaluator(classifier, knn_distances.clone())?,
+                    prepare_s,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The classifier as a [`Candidate::evaluate`]; with a distance matrix, KNN over it.
+fn evaluator(
+    classifier: ClassifierChoice,
+    distances: Option<Arc<crate::classify::DistanceMatrix>>,
+) -> Result<Arc<super::EvaluateFn>> {
+    Ok(match (distances, classifier) {
+        (Some(matrix), ClassifierChoice::Knn(p)) => {
+            let knn = SpikeDistanceKnn::new(matrix, p.k)?;
+            Arc::new(move |t, c, s| evaluate(t, c, s, &knn))
+        }
+        (Some(_), other) => {
+            let rule = "the van-rossum method classifies with KNN only";
+            return Err(ParamError::new("classifiers", rule, other.name()).into());
+        }
+        (None, classifier) => {
+            let chosen = classifier.check()?;
+            Arc::new(move |t, c, s| evaluate(t, c, s, &chosen))
+        }
+    })
+}
+
+/// The recordings as `encoding` sees them: for `fa` alone, the fast-adapting population
+/// as the first (and only) one.
+fn population_view(encoded: &[Encoded], encoding: Encoding) -> Vec<Encoded> {
+    encoded
+        .iter()
+        .map(|e| match (encoding, &e.fa) {
+            (Encoding::Fa, Some(fa)) => Encoded {
+                spikes: fa.clone(),
+                fa: None,
+                ..e.clone()
+            },
+            _ => e.clone(),
+        })
+        .collect()
+}
+
+/// The table of the spike-timing method: each recording's row index into the distance
+/// matrix, the "feature" [`SpikeDistanceKnn`] looks up.
+fn index_table(encoded: &[Encoded], grid: &Grid) -> FeatureTable {
+    FeatureTable {
+        // Not a feature method: the field is not read for a table of row indices.
+        method: Method::Glcm3d,
+        grid: grid.clone(),
+        names: vec!["row".into()],
+        metas: encoded.iter().map(|e| e.meta.clone()).collect(),
+        values: (0..encoded.len()).map(|i| i as f64).collect(),
+    }
+}
+
+/// The van Rossum distances between every two recordings, over the encoding's populations
+/// (with `sa+fa` the squared distances of the two add, as those of the taxels do).
+fn distance_matrix(
+    encoded: &[Encoded],
+    encoding: Encoding,
+    tau_ms: f64,
+) -> Result<Arc<crate::classify::DistanceMatrix>> {
+    let metric = VanRossumParams { tau_ms }.check()?;
+    let trains = |pick: fn(&Encoded) -> Option<&SpikeTrains>| -> Vec<SpikeTrains> {
+        encoded.iter().filter_map(|e| pick(e).cloned()).collect()
+    };
+    let sa = metric.matrix(&trains(|e| Some(&e.spikes)))?;
+    let fa = trains(|e| e.fa.as_ref());
+    if encoding != Encoding::SaFa {
+        return Ok(Arc::new(sa));
+    }
+    if fa.len() != encoded.len() {
+        let rule = "the sa+fa encoding needs both populations of every recording";
+        return Err(ParamError::new("encodings", rule, "one population").into());
+    }
+    let fa = metric.matrix(&fa)?;
+    let n = sa.n();
+    let values = sa
+        .values()
+        .iter()
+        .zip(fa.values())
+        .map(|(a, b)| (a * a + b * b).sqrt())
+        .collect();
+    Ok(Arc::new(crate::classify::DistanceMatrix::from_values(
+        n, values,
+    )?))
+}
