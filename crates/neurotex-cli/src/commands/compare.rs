@@ -8,7 +8,10 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use neurotex::classify::{ClassifierChoice, CvParams, ForestParams};
-use neurotex::compare::candidates::{candidates, CandidateSet, MethodChoice};
+use neurotex::compare::candidates::{
+    candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
+    STANDARD_METHODS, STANDARD_TAU_MS,
+};
 use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
 use neurotex::pipeline::{Encoding, Pipeline};
 use neurotex::recording::{Dataset, Selection};
@@ -62,24 +65,20 @@ pub struct CompareArgs {
     /// Encodings to compare, comma-separated: `sa` (the paper's slowly adapting neurons),
     /// `fa` (fast adapting, driven by the rectified rate of change), `sa+fa` (both).
     /// Overrides --encoding.
-    #[arg(long, value_delimiter = ',', default_value = "sa,sa+fa")]
+    #[arg(long, value_delimiter = ',', default_value = STANDARD_ENCODINGS)]
     pub encodings: Vec<Encoding>,
     /// Feature methods to compare, comma-separated. `taxel` is the paper's single-taxel
     /// method (each taxel alone, mean over taxels; KNN only); `van-rossum` classifies by
     /// spike-train distances (KNN only).
     /// `all-taxels-mm` (statistics per mm travelled) needs the manifest's speeds.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "taxel,all-taxels,glcm2d,glcm3d,glcm3d-multi,van-rossum"
-    )]
+    #[arg(long, value_delimiter = ',', default_value = STANDARD_METHODS)]
     pub methods: Vec<String>,
     /// Classifiers to compare, comma-separated: knn, forest, linear.
-    #[arg(long, value_delimiter = ',', default_value = "knn,forest,linear")]
+    #[arg(long, value_delimiter = ',', default_value = STANDARD_CLASSIFIERS)]
     pub classifiers: Vec<String>,
     /// Time constant of the van Rossum kernel in ms (method `van-rossum`). Default: the
     /// rate volume's 200 ms bin, the time resolution the paper's rate code keeps.
-    #[arg(long = "tau-ms", default_value_t = 200.0)]
+    #[arg(long = "tau-ms", default_value_t = STANDARD_TAU_MS)]
     pub tau_ms: f64,
     /// Neighbours in KNN.
     #[arg(long, default_value_t = 5)]

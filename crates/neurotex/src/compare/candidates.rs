@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use super::Candidate;
 use crate::analysis::{evaluate, Columns, FeatureTable};
-use crate::classify::{ClassifierChoice, KnnParams, SpikeDistanceKnn, VanRossumParams};
+use crate::classify::{
+    ClassifierChoice, ForestParams, KnnParams, SpikeDistanceKnn, VanRossumParams,
+};
 use crate::encode::SpikeTrains;
 use crate::error::{ParamError, Result};
 use crate::pipeline::{Encoded, Encoding, FeatureExtractor, Method, PipelineParams};
@@ -63,7 +65,47 @@ pub struct CandidateSet {
     pub tau_ms: f64,
 }
 
+/// The encodings `neurotex compare` and E9 compare by default.
+pub const STANDARD_ENCODINGS: &str = "sa,sa+fa";
+/// The methods compared by default (`all-taxels-mm` needs every recording's speed, so it is
+/// asked for by name).
+pub const STANDARD_METHODS: &str = "taxel,all-taxels,glcm2d,glcm3d,glcm3d-multi,van-rossum";
+/// The classifiers compared by default.
+pub const STANDARD_CLASSIFIERS: &str = "knn,forest,linear";
+/// The van Rossum time constant by default: the rate volume's 200 ms bin, the time
+/// resolution the paper's rate code keeps (chosen a priori, not on any data).
+pub const STANDARD_TAU_MS: f64 = 200.0;
+
 impl CandidateSet {
+    /// The standard set ([`STANDARD_ENCODINGS`] x [`STANDARD_METHODS`] x
+    /// [`STANDARD_CLASSIFIERS`]) with KNN's parameters `knn` and the forest seeded by `seed`.
+    pub fn standard(knn: KnnParams, seed: u64) -> CandidateSet {
+        let parse = |list: &str| -> Vec<String> { list.split(',').map(String::from).collect() };
+        let encodings = parse(STANDARD_ENCODINGS)
+            .iter()
+            .filter_map(|e| e.parse().ok())
+            .collect();
+        let methods = parse(STANDARD_METHODS)
+            .iter()
+            .filter_map(|m| m.parse().ok())
+            .collect();
+        let classifiers = parse(STANDARD_CLASSIFIERS)
+            .iter()
+            .filter_map(|c| c.parse::<ClassifierChoice>().ok())
+            .map(|c| match c {
+                ClassifierChoice::Knn(_) => ClassifierChoice::Knn(knn),
+                ClassifierChoice::Forest(p) => ClassifierChoice::Forest(ForestParams { seed, ..p }),
+                other => other,
+            })
+            .collect();
+        CandidateSet {
+            encodings,
+            methods,
+            classifiers,
+            tau_ms: STANDARD_TAU_MS,
+        }
+    }
+
     /// The (method, classifier) pairs of one encoding.
     fn pairs(&self) -> Vec<(MethodChoice, ClassifierChoice)> {
         let knn = self

@@ -18,6 +18,7 @@ mod e5_time;
 mod e6_speed_invariance;
 mod e7_gain;
 mod e8_neighbours;
+mod e9_compare;
 mod params;
 mod prepare;
 mod provenance;
@@ -45,6 +46,7 @@ pub use e5_time::{e5_time_to_recognition, E5Speed};
 pub use e6_speed_invariance::{e6_speed_invariance, E6Speed};
 pub use e7_gain::{e7_gain_sweep, E7};
 pub use e8_neighbours::{e8_neighbours, E8Speed};
+pub use e9_compare::{e9_compare, E9};
 pub use params::{ReproduceParams, ValidReproduceParams, MAX_REPEATS};
 pub use prepare::{prepare, IsiSweep, Prepared, Source};
 pub use provenance::Provenance;
@@ -110,6 +112,9 @@ pub struct Results {
     pub e7: Option<E7>,
     /// E8 by speed.
     pub e8: BySpeed<E8Speed>,
+    /// E9: the best of `neurotex compare`'s standard candidates beside the paper's method.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub e9: Option<E9>,
     /// The headline accuracies on an input changed by a rounding-level amount.
     pub sensitivity: Option<Sensitivity>,
     /// How `--gain auto` chose the gain (on the first dataset's recordings, labels unused);
@@ -151,6 +156,7 @@ impl Results {
             e6: BySpeed::new(),
             e7: None,
             e8: BySpeed::new(),
+            e9: None,
             sensitivity: None,
             across_seeds: None,
             gain_calibration: None,
@@ -216,7 +222,7 @@ pub struct Analysis {
 
 /// The analyses in the order they run (E0 last: it shows examples, and the paper's own
 /// order puts the accuracies first).
-pub const ANALYSES: [Analysis; 10] = [
+pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e1",
         run: |c, r| {
@@ -272,6 +278,15 @@ pub const ANALYSES: [Analysis; 10] = [
             let (e8, skipped) = e8_neighbours(c)?;
             skipped.iter().for_each(|s| r.skip(s));
             r.e8 = e8;
+            Ok(())
+        },
+    },
+    Analysis {
+        id: "e9",
+        run: |c, r| {
+            if c.params.e9 {
+                r.e9 = Some(e9_compare(c)?);
+            }
             Ok(())
         },
     },

@@ -8,8 +8,9 @@ use serde::{Deserialize, Serialize};
 
 use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidReproduceParams};
 use crate::calibrate::{calibrate_gain, GainCalibration};
+use crate::encode::encode_fa;
 use crate::error::{DataError, DatasetError, Result};
-use crate::pipeline::{Encoded, Pipeline};
+use crate::pipeline::{Encoded, Encoding, Pipeline};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
 use crate::sim::{design, simulate_trial, RigParams, Trial, ALL_TEXTURES};
@@ -315,7 +316,13 @@ fn encode_one(
     let pipeline = params.pipeline();
     let rec = source.load(i)?;
     let mut cond = pipeline.condition(&rec, source.baseline())?;
-    let (spikes, fa) = pipeline.encode_populations(&rec, &cond)?;
+    let (spikes, mut fa) = pipeline.encode_populations(&rec, &cond)?;
+    if params.e9 && fa.is_none() && pipeline.params().encoding == Encoding::Sa {
+        // E9 compares the sa+fa encoding too; the other analyses read the SA population.
+        let (l, p) = (&rec.layout, pipeline.params());
+        let trains = encode_fa(&cond.samples, l.rows, l.cols, &l.present, p.encoder, p.fa)?;
+        fa = Some(trains);
+    }
     let sweep = if sweep {
         Some(gain_sweep(&rec, &cond, params)?)
     } else {

@@ -11,6 +11,9 @@ pub enum Skip {
     /// E6 trains on other speeds.
     #[error("the dataset has only one speed; E6 needs at least two")]
     OneSpeed,
+    /// E9 compares within and across speeds.
+    #[error("the dataset has only one speed; E9 compares within and across speeds")]
+    OneSpeedE9,
     /// E8: this `k` cannot be evaluated at this speed.
     #[error("{reason}")]
     Neighbours {
@@ -29,6 +32,7 @@ impl Skip {
         match self {
             Skip::TooFewTaxels => "e3".into(),
             Skip::OneSpeed => "e6".into(),
+            Skip::OneSpeedE9 => "e9".into(),
             Skip::Neighbours { k, speed, .. } => format!("e8 k={k} at {speed} mm/s"),
         }
     }

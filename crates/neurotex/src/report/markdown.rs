@@ -51,6 +51,7 @@ pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
         e6(r, paper),
         e7(r),
         e8(r),
+        e9(r),
         e0(r),
         sensitivity(r),
         skipped(r),
@@ -515,6 +516,91 @@ fn e8(r: &Results) -> String {
         "E8: one line chart per speed of accuracy against k",
         &figures::e8_caption(r),
     )
+}
+
+fn e9(r: &Results) -> String {
+    let Some(e9) = &r.e9 else {
+        return String::new();
+    };
+    let (within, held) = (&e9.per_speed, &e9.held_out);
+    let name =
+        |x: &crate::compare::Ranked| format!("{} / {} / {}", x.encoding, x.method, x.classifier);
+    let mut out = format!(
+        "## E9 (beyond the paper): the best of `neurotex compare`'s candidates\n\n\
+         {} candidates (encodings, feature methods, classifiers: see `neurotex compare --help`) on the same folds: \
+         accuracy (%) of the paper's method (SA, 3D-GLCM, KNN) and of the best candidate, cross-validated within each speed \
+         and with each speed held out (trained on the others, E6's question). Intervals: 95 % bootstrap over {}. \
+         **Caveat**: {}.\n\n",
+        within.results.len(),
+        within.units,
+        within.caveat
+    );
+    let paper = |c: &crate::compare::Comparison| c.results.iter().find(|x| x.paper).cloned();
+    let mut t = Table::new([
+        "speed (mm/s)".to_string(),
+        "paper, within speed".into(),
+        format!("best within speed: {}", name(&within.best)),
+        "paper, speed held out".into(),
+        format!("best held out: {}", name(&held.best)),
+    ]);
+    let at = |x: &Option<crate::compare::Ranked>, i: usize| {
+        x.as_ref()
+            .and_then(|x| x.per_condition.get(i))
+            .map_or("-".into(), |p| pct(p.accuracy))
+    };
+    let (wp, hp) = (paper(within), paper(held));
+    let (wb, hb) = (Some(within.best.clone()), Some(held.best.clone()));
+    for (i, c) in within.best.per_condition.iter().enumerate() {
+        t.row([
+            c.condition.clone(),
+            at(&wp, i),
+            at(&wb, i),
+            at(&hp, i),
+            at(&hb, i),
+        ]);
+    }
+    let mean = |x: &Option<crate::compare::Ranked>| {
+        x.as_ref().map_or("-".into(), |x| {
+            format!("{} [{}, {}]", pct(x.accuracy), pct(x.ci[0]), pct(x.ci[1]))
+        })
+    };
+    t.row([
+        "mean [95 % CI]".to_string(),
+        mean(&wp),
+        mean(&wb),
+        mean(&hp),
+        mean(&hb),
+    ]);
+    out += &t.render();
+    if let Some(n) = &held.nested {
+        let chosen: Vec<String> = n
+            .chosen
+            .iter()
+            .map(|(c, k)| format!("{c} ({k} of {})", n.outer_splits))
+            .collect();
+        out += &format!(
+            "\nWith each speed held out and the candidate chosen inside each training set (nested selection): {} [{}, {}] % (chose {}).\n",
+            pct(n.accuracy), pct(n.ci[0]), pct(n.ci[1]), chosen.join(", ")
+        );
+    }
+    out += "\n";
+    out + &figure(
+        file::E9_PER_SPEED,
+        "E9: every candidate's accuracy within each speed, ranked",
+        &figures::compare::ranking_caption(within),
+    ) + &figure(
+        file::E9_HELD_OUT,
+        "E9: every candidate's accuracy with each speed held out, ranked, with nested selection",
+        &figures::compare::ranking_caption(held),
+    ) + &if figures::compare::per_condition(held).is_some() {
+        figure(
+            file::E9_SPEEDS,
+            "E9: the best candidate and the paper's method at each held-out speed",
+            &figures::compare::per_condition_caption(held),
+        )
+    } else {
+        String::new()
+    }
 }
 
 fn e0(r: &Results) -> String {

@@ -354,7 +354,7 @@ pub fn ranking_caption(c: &Comparison) -> String {
         None => String::new(),
     };
     format!(
-        "Every candidate (encoding / feature method / classifier) under {}, best at the top: the dot is the accuracy, the whisker its 95 % percentile-bootstrap interval over {} {}, stratified by condition. The paper's method (sa / glcm3d / knn) is in vermillion; the right-hand columns give the accuracy and the mean difference from the paper's method with the p-value of a paired sign-flip test (* p < 0.05, not corrected for the number of candidates). Grey dashed: chance, one over {} classes; purple dashed: the largest class's share (drawn only when it differs from chance).{nested}",
+        "Every candidate (encoding / feature method / classifier) under {}, best at the top: the dot is the accuracy, the whisker its 95 % percentile-bootstrap interval over {} {}, stratified by condition. The paper's method (sa / glcm3d / knn) is in vermillion; the right-hand columns give the accuracy and its difference from the paper's method, in points, with the p-value of a paired sign-flip test over units (* p < 0.05, not corrected for the number of candidates). Grey dashed: chance, one over {} classes; purple dashed: the largest class's share (drawn only when it differs from chance).{nested}",
         c.protocol, c.n_units, c.units, c.classes
     )
 }

@@ -65,6 +65,12 @@ pub(crate) mod file {
     pub(crate) const E8: &str = "e8_k.svg";
     /// E1 and E6 over several simulated datasets.
     pub(crate) const SEEDS: &str = "across_seeds.svg";
+    /// E9: candidates ranked within each speed.
+    pub(crate) const E9_PER_SPEED: &str = "e9_per_speed.svg";
+    /// E9: candidates ranked with each speed held out.
+    pub(crate) const E9_HELD_OUT: &str = "e9_held_out.svg";
+    /// E9: the best candidate and the paper's method at each held-out speed.
+    pub(crate) const E9_SPEEDS: &str = "e9_speeds.svg";
 }
 
 /// Chance level (%) with every class of the dataset present.
@@ -176,6 +182,13 @@ pub(crate) fn all(
         out.push((file::E7_ISI, gain::e7_isi(e7)));
     }
     out.push((file::E8, neighbours::e8(r)));
+    if let Some(e9) = &r.e9 {
+        out.push((file::E9_PER_SPEED, compare::ranking(&e9.per_speed)));
+        out.push((file::E9_HELD_OUT, compare::ranking(&e9.held_out)));
+        if let Some(svg) = compare::per_condition(&e9.held_out) {
+            out.push((file::E9_SPEEDS, svg));
+        }
+    }
     if let Some(e0) = &r.e0 {
         out.push((file::E0, psth::e0(e0)));
     }

@@ -257,6 +257,7 @@ pub(crate) fn wide() -> Results {
             median_isi_ms: vec![vec![None; n]; gains.len()],
         }),
         e8,
+        e9: None,
         sensitivity: None,
         across_seeds: None,
         predictions: Vec::new(),

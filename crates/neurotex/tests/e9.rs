@@ -1,0 +1,69 @@
+//! E9 on a small simulated design: its paper's-method column is E1's and E6's 3D-GLCM on the
+//! same folds (a second path to the same numbers), every standard candidate is ranked, and
+//! the report shows the section and its figures.
+
+mod support;
+
+use neurotex::classify::CvParams;
+use neurotex::experiments::{prepare, run_all, ReproduceParams};
+use neurotex::report::{markdown, ReportContext};
+
+#[test]
+fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
+    let params = ReproduceParams {
+        cv: CvParams {
+            folds: 3,
+            seed: 0,
+            repeats: 2,
+        },
+        e9_repeats: 2,
+        e3_counts: vec![4],
+        e5_fractions: vec![1.0],
+        e7_gains: vec![8.0],
+        e8_ks: vec![5],
+        sensitivity: None,
+        ..ReproduceParams::default()
+    }
+    .check()
+    .unwrap();
+    let prepared = prepare(&support::small_design(7), &params, &|_| {}).unwrap();
+    assert!(
+        prepared.encoded.iter().all(|e| e.fa.is_some()),
+        "E9 needs FA"
+    );
+    let r = run_all(&prepared, &params, &|_| {}).unwrap();
+    let e9 = r.e9.as_ref().expect("E9 ran");
+    for c in [&e9.per_speed, &e9.held_out] {
+        assert_eq!(c.results.len(), 28);
+        assert_eq!(c.n_recordings, prepared.encoded.len());
+        let accuracies: Vec<f64> = c.results.iter().map(|x| x.accuracy).collect();
+        assert!(accuracies.windows(2).all(|w| w[0] >= w[1]));
+        assert_eq!(c.best, c.results[0]);
+    }
+    let paper = |c: &neurotex::compare::Comparison| c.results.iter().find(|x| x.paper).cloned();
+    let (within, held) = (paper(&e9.per_speed).unwrap(), paper(&e9.held_out).unwrap());
+    for (i, (speed, e1)) in r.e1.iter().enumerate() {
+        let at = &within.per_condition[i];
+        assert_eq!(at.condition, speed.to_string());
+        assert_eq!(at.accuracy, e1.glcm3d, "within {speed} mm/s");
+    }
+    for (i, (speed, e6)) in r.e6.iter().enumerate() {
+        let at = &held.per_condition[i];
+        assert_eq!(at.condition, speed.to_string());
+        assert_eq!(at.accuracy, e6.glcm3d, "held out {speed} mm/s");
+    }
+    assert!(e9.held_out.nested.is_some() && e9.per_speed.nested.is_none());
+
+    let context = ReportContext {
+        dataset: "a small simulated design".into(),
+        parameters: Vec::new(),
+        total_seconds: 1.0,
+        command: "cargo test --test e9".into(),
+        paper_comparable: false,
+    };
+    let text = markdown(&r, &context);
+    assert!(text.contains("## E9 (beyond the paper)"), "{text}");
+    for figure in ["e9_per_speed.svg", "e9_held_out.svg", "e9_speeds.svg"] {
+        assert!(text.contains(figure), "{figure}");
+    }
+}
