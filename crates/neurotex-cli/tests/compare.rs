@@ -118,6 +118,19 @@ fn nested_selection_over_held_out_speeds_names_its_choices() {
         text.contains("paper's method") && text.contains("caveat"),
         "{text}"
     );
+    // Within each speed, an outer training set holds 4 or 5 recordings of a class: the
+    // inner cross-validation uses fewer folds rather than failing.
+    let text = dir.ok(&[
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--per",
+        "speed_mm_s",
+        "--methods",
+        "glcm3d,all-taxels",
+        "--nested",
+    ]);
+    assert!(text.contains("over 15 outer splits"), "{text}");
 }
 
 #[test]

@@ -647,23 +647,40 @@ fn fold_assignment(metas: &[Meta], rows: &[usize], params: &CompareParams) -> Re
     }
 }
 
+/// The size of the smallest class among `rows`.
+fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for &r in rows {
+        let label = metas[r].label.as_str();
+        match counts.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((label, 1)),
+        }
+    }
+    counts.iter().map(|c| c.1).min().unwrap_or(0)
+}
+
 /// Nested selection: inside each outer split's training rows every candidate is
 /// cross-validated (one repeat), the best is trained on all of them and tested on the
 /// split's test rows.
 fn nested(candidates: &[Candidate], params: &CompareParams, units: &Units) -> Result<Nested> {
     let metas = &candidates[0].table.metas;
     let splits = outer_splits(metas, params)?;
-    let inner = CompareParams {
-        cv: crate::classify::CvParams {
-            repeats: 1,
-            ..*params.cv
-        }
-        .check()?,
-        ..params.clone()
-    };
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
         .map(|split| {
+            // One repeat; fewer folds when a class of the training set is smaller than
+            // the folds (an outer training set is a part of one condition's recordings).
+            let smallest = smallest_class(metas, &split.train);
+            let inner = CompareParams {
+                cv: crate::classify::CvParams {
+                    repeats: 1,
+                    folds: params.cv.folds.min(smallest).max(2),
+                    ..*params.cv
+                }
+                .check()?,
+                ..params.clone()
+            };
             let mut best = (f64::NEG_INFINITY, 0);
             for (k, c) in candidates.iter().enumerate() {
                 let sub = c.table.subset(&split.train);
