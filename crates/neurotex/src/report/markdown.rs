@@ -523,8 +523,6 @@ fn e9(r: &Results) -> String {
         return String::new();
     };
     let (within, held) = (&e9.per_speed, &e9.held_out);
-    let name =
-        |x: &crate::compare::Ranked| format!("{} / {} / {}", x.encoding, x.method, x.classifier);
     let mut out = format!(
         "## E9 (beyond the paper): the best of `neurotex compare`'s candidates\n\n\
          {} candidates (encodings, feature methods, classifiers: see `neurotex compare --help`) on the same folds: \
@@ -535,43 +533,7 @@ fn e9(r: &Results) -> String {
         within.units,
         within.caveat
     );
-    let paper = |c: &crate::compare::Comparison| c.results.iter().find(|x| x.paper).cloned();
-    let mut t = Table::new([
-        "speed (mm/s)".to_string(),
-        "paper, within speed".into(),
-        format!("best within speed: {}", name(&within.best)),
-        "paper, speed held out".into(),
-        format!("best held out: {}", name(&held.best)),
-    ]);
-    let at = |x: &Option<crate::compare::Ranked>, i: usize| {
-        x.as_ref()
-            .and_then(|x| x.per_condition.get(i))
-            .map_or("-".into(), |p| pct(p.accuracy))
-    };
-    let (wp, hp) = (paper(within), paper(held));
-    let (wb, hb) = (Some(within.best.clone()), Some(held.best.clone()));
-    for (i, c) in within.best.per_condition.iter().enumerate() {
-        t.row([
-            c.condition.clone(),
-            at(&wp, i),
-            at(&wb, i),
-            at(&hp, i),
-            at(&hb, i),
-        ]);
-    }
-    let mean = |x: &Option<crate::compare::Ranked>| {
-        x.as_ref().map_or("-".into(), |x| {
-            format!("{} [{}, {}]", pct(x.accuracy), pct(x.ci[0]), pct(x.ci[1]))
-        })
-    };
-    t.row([
-        "mean [95 % CI]".to_string(),
-        mean(&wp),
-        mean(&wb),
-        mean(&hp),
-        mean(&hb),
-    ]);
-    out += &t.render();
+    out += &e9_table(within, held);
     if let Some(n) = &held.nested {
         let chosen: Vec<String> = n
             .chosen
@@ -601,6 +563,42 @@ fn e9(r: &Results) -> String {
     } else {
         String::new()
     }
+}
+
+/// E9's table: per speed, the paper's method and the best candidate within the speed and
+/// with it held out; the means with their intervals last.
+fn e9_table(within: &crate::compare::Comparison, held: &crate::compare::Comparison) -> String {
+    use crate::compare::Ranked;
+    let name = |x: &Ranked| format!("{} / {} / {}", x.encoding, x.method, x.classifier);
+    let paper = |c: &crate::compare::Comparison| c.results.iter().find(|x| x.paper).cloned();
+    let mut t = Table::new([
+        "speed (mm/s)".to_string(),
+        "paper, within speed".into(),
+        format!("best within speed: {}", name(&within.best)),
+        "paper, speed held out".into(),
+        format!("best held out: {}", name(&held.best)),
+    ]);
+    let columns = [
+        paper(within),
+        Some(within.best.clone()),
+        paper(held),
+        Some(held.best.clone()),
+    ];
+    for (i, c) in within.best.per_condition.iter().enumerate() {
+        let at = |x: &Option<Ranked>| {
+            x.as_ref()
+                .and_then(|x| x.per_condition.get(i))
+                .map_or("-".into(), |p| pct(p.accuracy))
+        };
+        t.row(std::iter::once(c.condition.clone()).chain(columns.iter().map(at)));
+    }
+    let mean = |x: &Option<Ranked>| {
+        x.as_ref().map_or("-".into(), |x| {
+            format!("{} [{}, {}]", pct(x.accuracy), pct(x.ci[0]), pct(x.ci[1]))
+        })
+    };
+    t.row(std::iter::once("mean [95 % CI]".to_string()).chain(columns.iter().map(mean)));
+    t.render()
 }
 
 fn e0(r: &Results) -> String {
