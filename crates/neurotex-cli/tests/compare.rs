@@ -88,6 +88,10 @@ fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
         ],
     );
     assert_eq!(forest["per_condition"][1]["accuracy"], e["accuracy"]);
+    let timing = of("sa", "van-rossum", "knn");
+    let e = dir.evaluate_json(&ds, "van-rossum", &["--speeds", "5", "--repeats", "2"]);
+    assert_eq!(timing["per_condition"][0]["accuracy"], e["accuracy"]);
+    assert_eq!(e["method"], "van-rossum");
     let taxel = of("sa", "taxel", "knn");
     let e = dir.evaluate_json(&ds, "taxel", &["--speeds", "5", "--repeats", "2"]);
     assert_eq!(taxel["per_condition"][0]["accuracy"], e["accuracy"]);

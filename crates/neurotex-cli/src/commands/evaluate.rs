@@ -17,11 +17,15 @@ use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::{Dataset, Selection};
 use neurotex::{Cell, Speed};
 
-use super::{calibrated_pipeline, encoded_features};
+use super::{calibrated_pipeline, encode_all, encoded_features};
 use crate::classifier_args::ClassifierArgs;
 use crate::open_args::OpenArgs;
 use crate::output::write_file;
 use crate::stage_args::StageArgs;
+use neurotex::classify::ClassifierChoice;
+use neurotex::compare::candidates::{
+    candidates, CandidateSet, MethodChoice, STANDARD_TAU_MS, VAN_ROSSUM,
+};
 
 /// Options of `neurotex evaluate`.
 #[derive(Args)]
@@ -31,9 +35,14 @@ pub struct EvaluateArgs {
     pub dataset: PathBuf,
     /// Feature set: `taxel` (each taxel alone, the mean reported), `glcm2d`, `glcm3d`,
     /// `all-taxels` (every taxel's statistics in one vector), `all-taxels-mm` (the same per
-    /// mm of travel) or `glcm3d-multi` (3D-GLCM at each of `--bin-widths`).
+    /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`) or `van-rossum`
+    /// (KNN over van Rossum distances between the recordings' spike trains).
     #[arg(long)]
-    pub method: Method,
+    pub method: MethodChoice,
+    /// With `--method van-rossum`: the kernel's time constant in ms (default: the rate
+    /// volume's 200 ms bin).
+    #[arg(long = "tau-ms", default_value_t = STANDARD_TAU_MS)]
+    pub tau_ms: f64,
     /// With `--method taxel`: the taxel to use, as `ROW,COL`. Without it every taxel is
     /// evaluated and the mean over taxels is reported, with the best beside it.
     #[arg(long)]
@@ -191,8 +200,8 @@ impl EvaluateArgs {
     /// The feature columns to classify with.
     fn columns(&self) -> Result<Columns> {
         Ok(match (self.method, self.taxel) {
-            (Method::Taxel, Some(cell)) => Columns::Taxel(cell),
-            (Method::Taxel, None) => Columns::EachTaxel,
+            (MethodChoice::Features(Method::Taxel), Some(cell)) => Columns::Taxel(cell),
+            (MethodChoice::Features(Method::Taxel), None) => Columns::EachTaxel,
             (_, Some(_)) => bail!("--taxel applies only to --method taxel"),
             (_, None) => Columns::All,
         })
@@ -215,7 +224,10 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         &args.calibration_indices(&dataset, &indices)?,
     )?;
     let pipeline = Pipeline::new(params)?;
-    let features = encoded_features(&dataset, &pipeline, &indices, args.method)?;
+    let MethodChoice::Features(method) = args.method else {
+        return evaluate_spike_timing(&args, &dataset, &indices, &pipeline, &split);
+    };
+    let features = encoded_features(&dataset, &pipeline, &indices, method)?;
     let (table, grid) = (&features.table, &features.grid);
     if let Some(cell) = args.taxel {
         grid.locate(cell)?;
@@ -234,7 +246,7 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     let taxels = (columns == Columns::EachTaxel).then_some(&features.taxels);
     if args.json {
         let mut value = serde_json::to_value(&outcome)?;
-        value["method"] = args.method.name().into();
+        value["method"] = method.name().into();
         // Balanced accuracy, per-class recall and precision and both chance levels from the
         // confusion matrix; the interval resamples recordings, keeping each one's
         // predictions over repeats (and taxels) together.
@@ -249,10 +261,48 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         }
         println!("{}", serde_json::to_string(&value)?);
     } else {
-        print_outcome(&outcome, args.method, &split, grid.cols());
+        print_outcome(&outcome, method.name(), &split, grid.cols());
         if let Some(taxels) = taxels {
             print_taxels(taxels, &outcome);
         }
+    }
+    Ok(())
+}
+
+/// `evaluate --method van-rossum`: KNN over the van Rossum distances between the
+/// recordings' spike trains (of the encoding's populations), the matrix computed once.
+fn evaluate_spike_timing(
+    args: &EvaluateArgs,
+    dataset: &Dataset,
+    indices: &[usize],
+    pipeline: &Pipeline,
+    split: &Split,
+) -> Result<()> {
+    let ClassifierChoice::Knn(knn) = args.classifier.choice(args.stages.knn(args.k)?)? else {
+        bail!("--method van-rossum classifies with KNN only (--classifier knn)");
+    };
+    if args.taxel.is_some() || args.predictions.is_some() {
+        bail!("--taxel and --predictions do not apply to --method van-rossum");
+    }
+    let (encoded, grid) = encode_all(dataset, pipeline, indices)?;
+    let set = CandidateSet {
+        encodings: vec![pipeline.params().encoding],
+        methods: vec![MethodChoice::VanRossum],
+        classifiers: vec![ClassifierChoice::Knn(knn)],
+        tau_ms: args.tau_ms,
+    };
+    let candidate = candidates(&encoded, &grid, pipeline.params(), &set, 0.0)?.remove(0);
+    let outcome = (candidate.evaluate)(&candidate.table, Columns::All, split)?;
+    if args.json {
+        let mut value = serde_json::to_value(&outcome)?;
+        value["method"] = VAN_ROSSUM.into();
+        value["tau_ms"] = args.tau_ms.into();
+        value["metrics"] = serde_json::to_value(Metrics::from_confusion(&outcome.confusion))?;
+        let interval = outcome.accuracy_interval(args.seed)?;
+        value["accuracy_interval"] = serde_json::to_value(interval)?;
+        println!("{}", serde_json::to_string(&value)?);
+    } else {
+        print_outcome(&outcome, VAN_ROSSUM, split, grid.cols());
     }
     Ok(())
 }
@@ -295,7 +345,7 @@ fn print_taxels(taxels: &TaxelDiagnostics, outcome: &Outcome) {
 
 /// Prints the outcome as text: what was run, the accuracy (per taxel when every taxel was
 /// evaluated) and the confusion matrix.
-fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) {
+fn print_outcome(outcome: &Outcome, method: &str, split: &Split, cols: usize) {
     let how = match split {
         Split::CrossValidation {
             cv,
@@ -326,7 +376,7 @@ fn print_outcome(outcome: &Outcome, method: Method, split: &Split, cols: usize) 
             )
         }
     };
-    println!("method {}: {} samples, {how}", method.name(), outcome.n);
+    println!("method {method}: {} samples, {how}", outcome.n);
     print_accuracy(outcome, cols);
     print_confusion(outcome);
 }
