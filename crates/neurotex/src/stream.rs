@@ -344,6 +344,17 @@ impl StreamClassifier {
         self.bad_frames += 1;
     }
 
+    /// Spike times held for the current window, over all populations and cells (what
+    /// grows with the window, not with the stream).
+    pub fn retained_spikes(&self) -> usize {
+        self.episode.as_ref().map_or(0, |e| {
+            e.spikes
+                .iter()
+                .flat_map(|cells| cells.iter().map(VecDeque::len))
+                .sum()
+        })
+    }
+
     /// Whether an episode is under way.
     pub fn in_episode(&self) -> bool {
         self.episode.is_some()
@@ -526,7 +537,7 @@ impl StreamClassifier {
             loop {
                 let episode = self.episode.as_mut().expect("an episode is under way");
                 let ts = 0.0 + episode.next as f64 / ENCODER_FS;
-                if !(ts < t) {
+                if ts >= t {
                     break;
                 }
                 episode.next += 1;

@@ -21,7 +21,7 @@ use serde_json::{json, Map, Value};
 pub struct DecisionArgs {
     /// The window classified at each bin boundary, s (whole bins); default: the median
     /// length of the model's training recordings (10 s when the model does not say).
-    #[arg(long = "window-s")]
+    #[arg(long = "window-s", allow_negative_numbers = true)]
     pub window_s: Option<f64>,
     /// The vote share a bin's label needs to count towards the decision (KNN: 0.8 is four
     /// of five neighbours).
