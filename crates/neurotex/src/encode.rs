@@ -385,6 +385,39 @@ impl SpikeTrains {
         }
     }
 
+    /// Builds trains from their compact form: `offsets[c]..offsets[c + 1]` indexes cell
+    /// `c`'s spike times in `times` (what a stream assembles for its window without a list
+    /// per cell).
+    ///
+    /// # Panics
+    /// If there is not one offset per cell plus one, offsets decrease or pass the end of
+    /// `times`, or a train is unsorted or reaches `n_steps` (caller bugs).
+    pub fn from_parts(
+        rows: usize,
+        cols: usize,
+        present: &[bool],
+        n_steps: usize,
+        offsets: Vec<u32>,
+        times: Vec<u32>,
+    ) -> Self {
+        assert_eq!(offsets.len(), rows * cols + 1);
+        assert!(offsets.windows(2).all(|w| w[0] <= w[1]));
+        assert_eq!(offsets[rows * cols] as usize, times.len());
+        let trains = SpikeTrains {
+            rows,
+            cols,
+            present: present.to_vec(),
+            n_steps,
+            offsets,
+            times,
+        };
+        for c in 0..trains.cells() {
+            let t = trains.train(c);
+            assert!(t.windows(2).all(|w| w[0] < w[1]) && t.iter().all(|&x| (x as usize) < n_steps));
+        }
+        trains
+    }
+
     /// The grid the trains were encoded on.
     pub fn grid(&self) -> crate::values::Grid {
         crate::values::Grid::from_parts(self.rows, self.cols, &self.present)

@@ -15,6 +15,7 @@
 use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
+use serde_json::{json, Map, Value};
 
 use crate::causal::{window_steps, BinDecision, Decider, DecisionRule, EpisodeEnd, EpisodeSummary};
 use crate::encode::{Encoder, SpikeTrains};
@@ -396,7 +397,12 @@ impl StreamClassifier {
         {
             self.end_episode(EpisodeEnd::Gap)?;
         }
-        let level = self.contact_level();
+        // Only onset episodes look at the contact level: a whole-stream episode skips the
+        // pass over the cells.
+        let level = match self.params.episodes {
+            EpisodeRule::Onset { .. } => self.contact_level(),
+            EpisodeRule::Whole => 0.0,
+        };
         if self.episode.is_none() {
             if let EpisodeRule::Onset { level: onset, .. } = self.params.episodes {
                 if level < onset {
@@ -586,28 +592,44 @@ impl StreamClassifier {
 
     /// Conditions one 1 kHz step (`step_in`, raw values per cell), runs the neurons,
     /// keeps their spikes, and classifies at a bin boundary.
+    ///
+    /// One pass over the cells removes the resting value, filters and scales, with the
+    /// operations of the offline pipeline in its order. Masked cells are filtered too:
+    /// their input is 0 and a filter started at 0 stays at exactly 0, as offline, where
+    /// they are left out; including them keeps the loop free of gathers.
     fn step(&mut self) -> Result<(), StreamError> {
         let episode = self.episode.as_mut().expect("an episode is under way");
         let c = &self.conditioning;
-        for (cell, x) in self.conditioned.iter_mut().enumerate() {
-            *x = match self.present[cell] {
-                true => self.step_in[cell] - c.offsets[cell],
-                false => 0.0,
-            };
-        }
-        if let Some(filter) = &self.filter {
-            let first = episode.steps == 0;
-            for &cell in &self.channel_cells {
-                let x = self.conditioned[cell];
-                let z = &mut episode.filter_state[cell];
-                if first {
-                    *z = filter.steady_state(x);
+        let first = episode.steps == 0;
+        match &self.filter {
+            Some(f) => {
+                for ((((x, &raw), &offset), &present), z) in self
+                    .conditioned
+                    .iter_mut()
+                    .zip(&self.step_in)
+                    .zip(&c.offsets)
+                    .zip(&self.present)
+                    .zip(episode.filter_state.iter_mut())
+                {
+                    let v = if present { raw - offset } else { 0.0 };
+                    if first {
+                        *z = f.steady_state(v);
+                    }
+                    *x = f.step(v, z) / c.scale;
                 }
-                self.conditioned[cell] = filter.step(x, z);
             }
-        }
-        for x in self.conditioned.iter_mut() {
-            *x /= c.scale;
+            None => {
+                for (((x, &raw), &offset), &present) in self
+                    .conditioned
+                    .iter_mut()
+                    .zip(&self.step_in)
+                    .zip(&c.offsets)
+                    .zip(&self.present)
+                {
+                    let v = if present { raw - offset } else { 0.0 };
+                    *x = v / c.scale;
+                }
+            }
         }
         let t = episode.steps as u32;
         for (population, (neurons, is_fa)) in episode.neurons.iter_mut().enumerate() {
@@ -631,9 +653,16 @@ impl StreamClassifier {
             };
             neurons.run(input, &mut self.raster);
             let trains = &mut episode.spikes[population];
-            for &cell in &self.channel_cells {
-                if self.raster[cell] != 0 {
-                    trains[cell].push_back(t);
+            // Spikes are sparse: test eight cells at a time as one word.
+            for (w, word) in self.raster.chunks(8).enumerate() {
+                if word.iter().all(|&b| b == 0) {
+                    continue;
+                }
+                for (k, &b) in word.iter().enumerate() {
+                    let cell = w * 8 + k;
+                    if b != 0 && self.present[cell] {
+                        trains[cell].push_back(t);
+                    }
                 }
             }
         }
@@ -687,17 +716,27 @@ impl StreamClassifier {
             .spikes
             .iter()
             .map(|cells| {
-                let lists: Vec<Vec<u32>> = cells
-                    .iter()
-                    .map(|train| {
-                        train
-                            .iter()
-                            .filter(|&&t| (t as usize) >= start && (t as usize) < end)
-                            .map(|&t| t - start as u32)
-                            .collect()
-                    })
-                    .collect();
-                SpikeTrains::from_lists(&lists, self.rows, self.cols, &self.present, end - start)
+                let mut offsets = Vec::with_capacity(cells.len() + 1);
+                let mut times = Vec::new();
+                offsets.push(0);
+                for train in cells {
+                    // Sorted: the window is a contiguous run of each train.
+                    let (a, b) = train.as_slices();
+                    for part in [a, b] {
+                        let lo = part.partition_point(|&t| (t as usize) < start);
+                        let hi = part.partition_point(|&t| (t as usize) < end);
+                        times.extend(part[lo..hi].iter().map(|&t| t - start as u32));
+                    }
+                    offsets.push(times.len() as u32);
+                }
+                SpikeTrains::from_parts(
+                    self.rows,
+                    self.cols,
+                    &self.present,
+                    end - start,
+                    offsets,
+                    times,
+                )
             })
             .collect();
         let mut populations = trains.into_iter();
@@ -747,4 +786,46 @@ fn interpolate(a: &[f64], b: &[f64], w: f64, out: &mut [f64]) {
     for ((o, &x), &y) in out.iter_mut().zip(a).zip(b) {
         *o = x + (y - x) * w;
     }
+}
+
+/// A bin boundary's line: `{"t_s", "label", "scores", "decided", "decision"}`, with the
+/// recording's `file` first when given (`predict --causal`).
+pub fn bin_json(labels: &[String], bin: &BinDecision, file: Option<&str>) -> Value {
+    let mut line = Map::new();
+    if let Some(file) = file {
+        line.insert("file".into(), file.into());
+    }
+    line.insert("t_s".into(), bin.t_s.into());
+    line.insert("label".into(), labels[bin.class].clone().into());
+    let scores: Map<String, Value> = labels
+        .iter()
+        .zip(&bin.shares)
+        .map(|(l, &s)| (l.clone(), s.into()))
+        .collect();
+    line.insert("scores".into(), scores.into());
+    line.insert("decided".into(), bin.decided.into());
+    line.insert(
+        "decision".into(),
+        bin.decision.map(|c| labels[c].clone()).into(),
+    );
+    line.into()
+}
+
+/// An episode's end: `{"end": true, "label", "decided_at_s", "decision", "duration_s",
+/// "bins", "ended_by"}`; `label` is the whole episode's classification (its last window
+/// when longer), null when it is shorter than one bin.
+pub fn end_json(labels: &[String], summary: &EpisodeSummary, file: Option<&str>) -> Value {
+    let mut line = json!({
+        "end": true,
+        "label": summary.class.map(|c| labels[c].clone()),
+        "decided_at_s": summary.decided_at_s,
+        "decision": summary.decision.map(|c| labels[c].clone()),
+        "duration_s": summary.duration_s,
+        "bins": summary.bins,
+        "ended_by": summary.ended_by,
+    });
+    if let Some(file) = file {
+        line["file"] = file.into();
+    }
+    line
 }

@@ -11,10 +11,11 @@ use neurotex::causal::episode_decisions;
 use neurotex::model::{Model, Prediction};
 use neurotex::pipeline::Encoded;
 use neurotex::recording::{read_recording, Dataset, LayoutFile};
+use neurotex::stream::{bin_json, end_json};
 use rayon::prelude::*;
 
 use super::report_conditions;
-use super::stream::{bin_json, end_json, DecisionArgs};
+use super::stream::DecisionArgs;
 use crate::open_args::OpenArgs;
 use crate::output::{progress, write_file};
 

@@ -8,12 +8,13 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use neurotex::causal::{BinDecision, DecisionRule, EpisodeSummary};
+use neurotex::causal::DecisionRule;
 use neurotex::csvlog::{ChannelSelect, Column, Columns, CsvFormat, Delimiter};
 use neurotex::model::Model;
 use neurotex::recording::TimeUnit;
-use neurotex::stream::{EpisodeRule, Event, StreamClassifier, StreamError, StreamParams};
-use serde_json::{json, Map, Value};
+use neurotex::stream::{
+    bin_json, end_json, EpisodeRule, Event, StreamClassifier, StreamError, StreamParams,
+};
 
 /// How the per-bin classifications of an episode become a decision, and over which window:
 /// the options `stream` and `predict --causal` share.
@@ -449,46 +450,4 @@ impl<W: Write> Output<W> {
         self.out.flush()?;
         Ok(())
     }
-}
-
-/// A bin boundary's line: `{"t_s", "label", "scores", "decided", "decision"}`, with the
-/// recording's `file` first when given (`predict --causal`).
-pub fn bin_json(labels: &[String], bin: &BinDecision, file: Option<&str>) -> Value {
-    let mut line = Map::new();
-    if let Some(file) = file {
-        line.insert("file".into(), file.into());
-    }
-    line.insert("t_s".into(), bin.t_s.into());
-    line.insert("label".into(), labels[bin.class].clone().into());
-    let scores: Map<String, Value> = labels
-        .iter()
-        .zip(&bin.shares)
-        .map(|(l, &s)| (l.clone(), s.into()))
-        .collect();
-    line.insert("scores".into(), scores.into());
-    line.insert("decided".into(), bin.decided.into());
-    line.insert(
-        "decision".into(),
-        bin.decision.map(|c| labels[c].clone()).into(),
-    );
-    line.into()
-}
-
-/// An episode's end: `{"end": true, "label", "decided_at_s", "decision", "duration_s",
-/// "bins", "ended_by"}`; `label` is the whole episode's classification (its last window
-/// when longer), null when it is shorter than one bin.
-pub fn end_json(labels: &[String], summary: &EpisodeSummary, file: Option<&str>) -> Value {
-    let mut line = json!({
-        "end": true,
-        "label": summary.class.map(|c| labels[c].clone()),
-        "decided_at_s": summary.decided_at_s,
-        "decision": summary.decision.map(|c| labels[c].clone()),
-        "duration_s": summary.duration_s,
-        "bins": summary.bins,
-        "ended_by": summary.ended_by,
-    });
-    if let Some(file) = file {
-        line["file"] = file.into();
-    }
-    line
 }
