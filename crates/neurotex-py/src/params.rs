@@ -118,7 +118,7 @@ pub fn method(name: &str) -> PyResult<Method> {
 }
 
 /// A classifier by name with its knobs: `k`, `standardize` (KNN); `trees`, `max_depth`,
-/// `min_samples_leaf`, `max_features`, `bootstrap`, `seed` (forest); `c`, `max_iter`, `tol`
+/// `min_samples_leaf`, `max_features`, `bootstrap`, `seed` or `forest_seed` (forest); `c`, `max_iter`, `tol`
 /// (linear). Checked.
 pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<ClassifierChoice> {
     let choice = match kind {
@@ -137,7 +137,10 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
                 min_samples_leaf: get(options, "min_samples_leaf")?.unwrap_or(d.min_samples_leaf),
                 max_features: get(options, "max_features")?.or(d.max_features),
                 bootstrap: get(options, "bootstrap")?.unwrap_or(d.bootstrap),
-                seed: get(options, "seed")?.unwrap_or(d.seed),
+                seed: match get(options, "forest_seed")? {
+                    Some(seed) => seed,
+                    None => get(options, "seed")?.unwrap_or(d.seed),
+                },
             })
         }
         "linear" => {

@@ -364,7 +364,7 @@ def cross_validate(
     ``neurotex evaluate`` scores a feature table: the same accuracy for the same rows,
     labels and seed. ``classifier``: ``knn`` (``k``, ``standardize``), ``forest``
     (``trees``, ``max_depth``, ``min_samples_leaf``, ``max_features``, ``bootstrap``,
-    ``seed``) or ``linear`` (``c``, ``max_iter``, ``tol``). Returns a dict with
+    ``forest_seed``: ``seed`` is the folds', as the CLI's ``--seed``) or ``linear`` (``c``, ``max_iter``, ``tol``). Returns a dict with
     ``accuracy``, ``accuracy_std``, ``per_repeat``, ``confusion`` and ``labels``."""
     X = np.asarray(X, dtype=np.float64)
     if X.ndim != 2:
