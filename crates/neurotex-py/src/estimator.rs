@@ -53,6 +53,15 @@ impl FittedClassifier {
         Ok(FittedClassifier { model })
     }
 
+    /// L-BFGS iterations of a logistic regression; `None` for the other classifiers.
+    #[getter]
+    fn n_iter(&self) -> Option<usize> {
+        match &self.model {
+            ChosenModel::Linear(m) => Some(m.iterations()),
+            _ => None,
+        }
+    }
+
     /// Predicted class indices and every class's share, `(n,)` and `(n, classes)`.
     fn predict<'py>(
         &self,

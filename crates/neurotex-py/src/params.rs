@@ -121,6 +121,32 @@ pub fn method(name: &str) -> PyResult<Method> {
 /// `min_samples_leaf`, `max_features`, `bootstrap`, `seed` or `forest_seed` (forest); `c`, `max_iter`, `tol`
 /// (linear). Checked.
 pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<ClassifierChoice> {
+    let known: &[&str] = match kind {
+        "knn" => &["k", "standardize"],
+        "forest" => &[
+            "trees",
+            "max_depth",
+            "min_samples_leaf",
+            "max_features",
+            "bootstrap",
+            "seed",
+            "forest_seed",
+        ],
+        "linear" => &["c", "max_iter", "tol"],
+        _ => &[],
+    };
+    for key in options.keys() {
+        let key: String = key.extract()?;
+        if !known.contains(&key.as_str()) {
+            return Err(raise(
+                Kind::Parameter,
+                format!(
+                    "unknown option `{key}` for classifier {kind}; its options are {}",
+                    known.join(", ")
+                ),
+            ));
+        }
+    }
     let choice = match kind {
         "knn" => {
             let d = KnnParams::default();

@@ -103,7 +103,7 @@ def _stage_options(**kw: Any) -> Dict[str, Any]:
         if v is None:
             continue
         if isinstance(v, (tuple, np.ndarray)):
-            v = [int(d) for d in v]
+            v = list(v)
         out[k] = v
     return out
 
@@ -210,9 +210,8 @@ def encode(
     samples (NaN, wrong shape, shorter than one 200 ms bin)."""
     rec = Recording(x=x, fs=fs, slide=slide, times=times, mask=mask, name="x")
     arrays, infos = _prepare([rec], fs, None)
-    opts = _stage_options(gain=float(gain), cutoff=float(cutoff), preset=preset,
-                          baseline=baseline, encoding=encoding, fa_gain=float(fa_gain),
-                          whole=whole)
+    opts = _stage_options(gain=gain, cutoff=cutoff, preset=preset, baseline=baseline,
+                          encoding=encoding, fa_gain=fa_gain, whole=whole)
     first, fa = _native.encode(arrays[0], infos[0], opts)
     return (first, fa) if fa is not None else first
 
@@ -258,10 +257,10 @@ def features(
             f"got {method}"
         )
     opts = _stage_options(
-        gain=float(gain), preset=preset, cutoff=float(cutoff), baseline=baseline,
-        whole=whole, levels=int(levels), bin_ms=int(bin_ms), distances=tuple(distances),
-        symmetric=symmetric, encoding=encoding, fa_gain=float(fa_gain), haralick=haralick,
-        bin_widths=tuple(bin_widths), window_mm=float(window_mm),
+        gain=gain, preset=preset, cutoff=cutoff, baseline=baseline, whole=whole,
+        levels=levels, bin_ms=bin_ms, distances=tuple(distances), symmetric=symmetric,
+        encoding=encoding, fa_gain=fa_gain, haralick=haralick,
+        bin_widths=tuple(bin_widths), window_mm=window_mm,
     )
     if isinstance(recordings, (str, os.PathLike)):
         values, names, _ = _native.features_dataset(os.fspath(recordings), method, opts)

@@ -85,12 +85,11 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         from . import _stage_options
 
         opts = _stage_options(
-            gain=float(self.gain), preset=self.preset, cutoff=float(self.cutoff),
-            baseline=self.baseline, whole=self.whole, levels=int(self.levels),
-            bin_ms=int(self.bin_ms), distances=tuple(self.distances),
-            symmetric=self.symmetric, encoding=self.encoding, fa_gain=float(self.fa_gain),
-            haralick=self.haralick, bin_widths=tuple(self.bin_widths),
-            window_mm=float(self.window_mm),
+            gain=self.gain, preset=self.preset, cutoff=self.cutoff, baseline=self.baseline,
+            whole=self.whole, levels=self.levels, bin_ms=self.bin_ms,
+            distances=tuple(self.distances), symmetric=self.symmetric,
+            encoding=self.encoding, fa_gain=self.fa_gain, haralick=self.haralick,
+            bin_widths=tuple(self.bin_widths), window_mm=self.window_mm,
         )
         _native.check_options(self.method, opts)
         self.n_recordings_seen_ = len(X)
@@ -141,12 +140,27 @@ class _LibraryClassifier(ClassifierMixin, BaseEstimator):
             first.setdefault(label, len(first))
         self._order = np.array(list(first), dtype=self.classes_.dtype)
         index = np.array([first[label] for label in y], dtype=np.int64)
-        self._fitted = _native.FittedClassifier.fit(
-            self._kind, self._options(), np.ascontiguousarray(X), [int(i) for i in index]
-        )
+        self._training = (np.ascontiguousarray(X), [int(i) for i in index])
+        self._fitted = self._fit_native()
         # columns of the library's shares -> columns in classes_ order
         self._to_sorted = np.searchsorted(self.classes_, self._order)
         return self
+
+    def _fit_native(self) -> Any:
+        X, index = self._training
+        return _native.FittedClassifier.fit(self._kind, self._options(), X, index)
+
+    def __getstate__(self) -> Dict[str, Any]:
+        # The native model is not picklable; the training set is kept instead and the
+        # (deterministic, seeded) fit repeated on unpickling, giving the same model.
+        state = self.__dict__.copy()
+        state.pop("_fitted", None)
+        return state
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        if "_training" in state:
+            self._fitted = self._fit_native()
 
     def predict(self, X: Any) -> np.ndarray:
         """The predicted label of each row."""
@@ -210,3 +224,9 @@ class LogisticRegression(_LibraryClassifier):
         self.c = c
         self.max_iter = max_iter
         self.tol = tol
+
+    def fit(self, X: Any, y: Any) -> "LogisticRegression":
+        """Fits on ``X`` and ``y``; ``n_iter_`` holds the L-BFGS iterations."""
+        super().fit(X, y)
+        self.n_iter_ = np.array([self._fitted.n_iter])
+        return self
