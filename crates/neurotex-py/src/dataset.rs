@@ -45,14 +45,28 @@ fn manifest_row<'py>(
 /// Reads every recording of a dataset folder (in parallel, without the GIL) as the library
 /// does: a dict with `arrays` (float64 `(T, rows, cols)`), `infos` (what `features` needs
 /// beside the samples), `rows` (manifest rows as text), `columns`, `fs`, `baseline`, `mask`.
+/// `indices` selects manifest rows (0-based, data rows only); `None` reads all.
 #[pyfunction]
-fn load_dataset<'py>(py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (dir, indices=None))]
+fn load_dataset<'py>(
+    py: Python<'py>,
+    dir: PathBuf,
+    indices: Option<Vec<usize>>,
+) -> PyResult<Bound<'py, PyDict>> {
     let dataset = open(&dir)?;
+    let n = dataset.entries.len();
+    let indices = indices.unwrap_or_else(|| (0..n).collect());
+    if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
+        return Err(raise(
+            Kind::Parameter,
+            format!("row {bad} is beyond the manifest's {n} recordings"),
+        ));
+    }
     let recordings: Vec<Recording> = py.detach(|| {
         guarded(|| {
-            (0..dataset.entries.len())
-                .into_par_iter()
-                .map(|i| dataset.load(i))
+            indices
+                .par_iter()
+                .map(|&i| dataset.load(i))
                 .collect::<neurotex::Result<Vec<_>>>()
         })
     })?;

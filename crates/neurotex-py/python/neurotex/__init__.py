@@ -372,14 +372,15 @@ def cross_validate(
                                   int(folds), int(seed), int(repeats))
 
 
-def load_dataset(path: Union[str, os.PathLike]) -> Dataset:
+def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = None) -> Dataset:
     """Reads a dataset folder (``manifest.csv``, recordings, optional ``layout.toml``) as
     the library reads it: every recording as float64 ``(T, rows, cols)`` on its grid,
-    with its label, speed, sliding phase and the layout's rate and mask.
+    with its label, speed, sliding phase and the layout's rate and mask. ``rows`` reads
+    only those manifest rows (0-based), e.g. one shard of a large dataset.
 
     Raises :class:`NotFoundError` for a missing folder and :class:`DataError` for a bad
     manifest or recording."""
-    d = _native.load_dataset(os.fspath(path))
+    d = _native.load_dataset(os.fspath(path), None if rows is None else [int(i) for i in rows])
     mask = None
     recs = []
     for a, info in zip(d["arrays"], d["infos"]):
