@@ -40,7 +40,7 @@ def main() -> None:
     counts = neurotex.glcm3d(volume)              # (16, 16) co-occurrence counts
     print(f"{rec.label}: {int(spikes.sum())} spikes over {spikes.shape[0]} ms; "
           f"taxel (0,0) fires at {stats[0, 0, 0]:.1f} Hz; "
-          f"rate volume {volume.shape}; Haralick {dict(zip(neurotex.HARALICK_NAMES, neurotex.haralick(counts).round(4)))}")
+          f"rate volume {volume.shape}; Haralick {{k: round(float(v), 4) for k, v in zip(neurotex.HARALICK_NAMES, neurotex.haralick(counts))}}")
 
     # 3. The paper's comparison at 5 mm/s, with scikit-learn's cross-validation.
     at5 = [r for r in ds.recordings if r.speed == 5.0]

@@ -19,7 +19,7 @@ GOOD = np.random.default_rng(1).random((1000, 4, 4))
     (np.zeros((10, 2, 2, 2)), errors.DataError, "expected shape"),
     (np.zeros(1000), errors.DataError, "expected shape"),
     (np.array([["a"]]), errors.DataError, "real numbers"),
-    (np.zeros((0, 4, 4)), errors.DataError, ""),
+    (np.zeros((0, 4, 4)), errors.DataError, "recording holds no samples"),
 ])
 def test_bad_samples(x, exc, match):
     with pytest.raises(exc, match=match) as info:
