@@ -12,7 +12,9 @@ mod stage_args;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use commands::{compare, encode, evaluate, features, import, predict, reproduce, simulate, train};
+use commands::{
+    compare, encode, evaluate, features, import, predict, reproduce, simulate, stream, train,
+};
 
 /// Neuromorphic tactile texture classification: taxel recordings → Izhikevich spikes →
 /// single-taxel statistics or 2D/3D GLCM features → KNN.
@@ -46,6 +48,9 @@ enum Command {
     /// Run every analysis of the paper (E0-E8) and write a report with figures; without
     /// --dataset, on the built-in simulated rig.
     Reproduce(reproduce::ReproduceArgs),
+    /// Classify a live taxel stream (standard input, a file, TCP or UDP) frame by frame with
+    /// a model trained with --causal: one JSON line per 200 ms bin, one per episode's end.
+    Stream(stream::StreamArgs),
     /// Import CSV logs or stacked arrays into a dataset folder.
     #[command(subcommand)]
     Import(import::ImportCommand),
@@ -80,6 +85,7 @@ fn main() -> ExitCode {
         Command::Predict(args) => predict::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Reproduce(args) => reproduce::run(args),
+        Command::Stream(args) => stream::run(args),
         Command::Import(command) => import::run(command),
     };
     match result {

@@ -63,6 +63,12 @@ pub struct StageArgs {
     /// Fano window of `--method all-taxels-mm`, in mm of travel.
     #[arg(long = "window-mm", default_value_t = FeatureParams::default().window_mm)]
     pub window_mm: f64,
+    /// Condition causally, as a live stream can (`neurotex stream`): a forward-only
+    /// low-pass, and each taxel's resting value and one normalisation scale fixed on the
+    /// training recordings (labels unused) instead of the zero-phase filter and each
+    /// recording's own baseline and maximum, which need the whole recording.
+    #[arg(long)]
+    pub causal: bool,
     /// Do not z-score features with training-fold statistics before KNN.
     #[arg(long = "no-standardize")]
     pub no_standardize: bool,

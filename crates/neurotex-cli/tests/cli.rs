@@ -15,6 +15,7 @@ mod import;
 mod model;
 mod reproduce;
 mod simulate;
+mod stream;
 mod util;
 
 use util::Dir;
@@ -32,6 +33,7 @@ fn help_explains_the_commands() {
         "import",
         "train",
         "predict",
+        "stream",
     ] {
         assert!(text.contains(cmd), "{text}");
     }

@@ -194,6 +194,9 @@ fn train_model<'py>(
                 baseline: dataset_baseline,
                 speeds: None,
                 gain_calibration: None,
+                // Python trains offline models; a causal model (the CLI's `--causal`) is
+                // not offered here yet.
+                median_duration_ms: None,
             };
             LibModel::train(&params, &table, columns, choice, provenance)
         })

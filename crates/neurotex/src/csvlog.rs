@@ -326,12 +326,17 @@ fn detect_delimiter(path: &Path) -> Result<Delimiter> {
     Ok(Delimiter(best.map_or(b',', |(_, b)| b)))
 }
 
-/// Where the time and channel columns are, and the channels' names.
-struct Columns {
-    names: Vec<String>,
-    time: Option<usize>,
-    unit: TimeUnit,
-    channels: Vec<usize>,
+/// Where the time and channel columns of a log are, and the columns' names.
+#[derive(Debug, Clone)]
+pub struct Columns {
+    /// Every column's name: header names, or `column{index}` without a header.
+    pub names: Vec<String>,
+    /// The time column's index, if any.
+    pub time: Option<usize>,
+    /// The time column's unit.
+    pub unit: TimeUnit,
+    /// The channel columns' indices, in channel order.
+    pub channels: Vec<usize>,
 }
 
 /// Where column `col` is among `names`; `what` says which role it plays in errors.
@@ -365,7 +370,13 @@ fn resolve_column(
 }
 
 impl Columns {
-    fn find(path: &Path, format: &CsvFormat, names: Vec<String>) -> Result<Self> {
+    /// Finds `format`'s time and channel columns among `names` (the header's, or
+    /// `column{index}` without one); `path` names the source in errors.
+    ///
+    /// # Errors
+    /// A missing column, a name without a header row, the time column among the channels,
+    /// or no channel selected.
+    pub fn find(path: &Path, format: &CsvFormat, names: Vec<String>) -> Result<Self> {
         let (time, unit) = match &format.time_column {
             Some(col) => (
                 Some(resolve_column(

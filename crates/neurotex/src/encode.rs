@@ -425,6 +425,27 @@ impl SpikeTrains {
         )
     }
 
+    /// The steps `[start, end)` only, as trains of their own (step `start` becomes step 0):
+    /// the window a causal classifier looks at.
+    ///
+    /// # Panics
+    /// If `start > end` or `end > n_steps` (a caller bug).
+    pub fn window(&self, start: usize, end: usize) -> SpikeTrains {
+        assert!(
+            start <= end && end <= self.n_steps,
+            "a window inside the trains"
+        );
+        let lists: Vec<Vec<u32>> = (0..self.cells())
+            .map(|c| {
+                let train = self.train(c);
+                let lo = train.partition_point(|&t| (t as usize) < start);
+                let hi = train.partition_point(|&t| (t as usize) < end);
+                train[lo..hi].iter().map(|&t| t - start as u32).collect()
+            })
+            .collect();
+        SpikeTrains::from_lists(&lists, self.rows, self.cols, &self.present, end - start)
+    }
+
     /// The trains with cells moved: cell `i`'s train goes to cell `perm[i]`.
     ///
     /// # Panics

@@ -14,6 +14,7 @@
 
 pub mod analysis;
 pub mod calibrate;
+pub mod causal;
 pub mod classify;
 pub mod compare;
 pub mod csvlog;
@@ -31,6 +32,7 @@ pub mod recording;
 pub mod report;
 pub mod signal;
 pub mod sim;
+pub mod stream;
 pub mod values;
 
 pub use error::{Error, Result};

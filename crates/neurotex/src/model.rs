@@ -110,6 +110,10 @@ pub struct Provenance {
     /// gain given as a number.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gain_calibration: Option<GainCalibration>,
+    /// For a causal model: the median length of the training recordings' selected phases,
+    /// ms (a stream's default window).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub median_duration_ms: Option<usize>,
 }
 
 impl Provenance {
@@ -123,6 +127,7 @@ impl Provenance {
             baseline: dataset.layout.baseline.unwrap_or_default(),
             speeds,
             gain_calibration: None,
+            median_duration_ms: None,
         })
     }
 }
@@ -377,30 +382,51 @@ impl Model {
     /// model's; a recording shorter than one bin.
     pub fn predict(&self, encoded: &[Encoded]) -> Result<Vec<Prediction>> {
         for e in encoded {
-            let s = &e.spikes;
-            let found = Grid::masked(s.rows, s.cols, s.present.clone())
-                .map_err(|err| crate::Error::from(err).in_recording(&e.meta.file))?;
-            if found != self.file.grid {
-                return Err(ModelError::OtherGrid {
-                    file: e.meta.file.clone(),
-                    expected: self.file.grid.clone(),
-                    found,
-                }
-                .into());
-            }
+            self.check_grid(e)?;
         }
-        let method = self.file.features.method;
         let rows: Vec<Vec<f64>> = encoded
             .par_iter()
-            .map(|e| {
-                let row = self
-                    .extractor
-                    .row(e, method)
-                    .map_err(|err| err.in_recording(&e.meta.file))?;
-                Ok(self.columns.iter().map(|&j| row[j]).collect())
-            })
+            .map(|e| self.feature_row(e))
             .collect::<Result<_>>()?;
         self.predict_rows(&rows.concat())
+    }
+
+    /// Predicts the class of one encoded recording on the calling thread (a causal
+    /// classifier's window at a bin boundary, where a thread pool would only add latency).
+    ///
+    /// # Errors
+    /// As [`Model::predict`].
+    pub fn predict_one(&self, encoded: &Encoded) -> Result<Prediction> {
+        self.check_grid(encoded)?;
+        let row = self.feature_row(encoded)?;
+        Ok(self.predict_rows(&row)?.remove(0))
+    }
+
+    /// [`ModelError::OtherGrid`] unless `e` has the model's grid.
+    fn check_grid(&self, e: &Encoded) -> Result<()> {
+        let s = &e.spikes;
+        if (s.rows, s.cols) == (self.file.grid.rows(), self.file.grid.cols())
+            && s.present == self.file.grid.present()
+        {
+            return Ok(());
+        }
+        let found = Grid::masked(s.rows, s.cols, s.present.clone())
+            .map_err(|err| crate::Error::from(err).in_recording(&e.meta.file))?;
+        Err(ModelError::OtherGrid {
+            file: e.meta.file.clone(),
+            expected: self.file.grid.clone(),
+            found,
+        }
+        .into())
+    }
+
+    /// The model's feature columns of one encoded recording.
+    fn feature_row(&self, e: &Encoded) -> Result<Vec<f64>> {
+        let row = self
+            .extractor
+            .row(e, self.file.features.method)
+            .map_err(|err| err.in_recording(&e.meta.file))?;
+        Ok(self.columns.iter().map(|&j| row[j]).collect())
     }
 
     /// Predicts the class of each feature row of `x` (row-major, the model's columns,
@@ -477,6 +503,25 @@ impl Model {
     /// The class labels, in the order of [`Prediction::shares`].
     pub fn labels(&self) -> &[String] {
         &self.file.labels
+    }
+
+    /// The index in [`Model::labels`] of a label the model predicted.
+    ///
+    /// # Panics
+    /// If `label` is not one of the model's classes (a caller bug: predictions only name
+    /// the model's classes).
+    pub fn class_index(&self, label: &str) -> usize {
+        self.file
+            .labels
+            .iter()
+            .position(|l| l == label)
+            .expect("a predicted label is one of the model's classes")
+    }
+
+    /// The causal conditioning the model was trained with; `None` for the paper's
+    /// offline pipeline (zero-phase filter, each recording's own baseline and maximum).
+    pub fn causal(&self) -> Option<&crate::signal::CausalConditioning> {
+        self.file.pipeline.preprocess.causal.as_ref()
     }
 
     /// The feature method, the taxel and the column names.
@@ -619,6 +664,7 @@ mod tests {
             baseline: Baseline::Min,
             speeds: Some(vec![Speed::of(5.0)]),
             gain_calibration: None,
+            median_duration_ms: None,
         }
     }
 

@@ -19,6 +19,11 @@ pub struct PreprocessParams {
     pub slide_only: bool,
     /// Baseline removal; `None` takes the dataset's `layout.toml` choice.
     pub baseline: Option<Baseline>,
+    /// Causal conditioning (for streaming): a causal filter and a resting value and scale
+    /// fixed at training, instead of the zero-phase filter and each recording's own
+    /// baseline and maximum. `None` (the paper's offline pipeline) when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub causal: Option<CausalConditioning>,
 }
 
 impl Default for PreprocessParams {
@@ -27,7 +32,48 @@ impl Default for PreprocessParams {
             cutoff_hz: 50.0,
             slide_only: true,
             baseline: None,
+            causal: None,
         }
+    }
+}
+
+/// What causal conditioning fixes at training so that a sample can be conditioned the
+/// moment it arrives (SPEC 10): the offline pipeline's zero-phase filter needs the future,
+/// its `min` baseline and its division by the recording's maximum need the whole
+/// recording. Here the low-pass runs forward only (the same Butterworth biquad, started in
+/// its steady state for the first sample, as `scipy.signal.lfilter` with
+/// `lfilter_zi * x[0]`), each cell's resting value is subtracted as fixed `offsets`, and
+/// every sample is divided by one fixed `scale`
+/// ([`crate::causal::calibrate_conditioning`] sets both from the training recordings).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CausalConditioning {
+    /// Each cell's resting value, row-major over the grid (0 for a masked cell).
+    pub offsets: Vec<f64>,
+    /// The divisor taking the filtered, offset-free signal to about `[0, 1]`.
+    pub scale: f64,
+}
+
+impl CausalConditioning {
+    /// Checks the rules: finite offsets, a finite positive scale.
+    ///
+    /// # Errors
+    /// The rule broken.
+    pub fn check(&self) -> Result<(), ParamError> {
+        if !(self.scale.is_finite() && self.scale > 0.0) {
+            return Err(ParamError::new(
+                "causal.scale",
+                "the causal normalisation scale must be a finite positive number",
+                self.scale,
+            ));
+        }
+        if let Some(bad) = self.offsets.iter().find(|o| !o.is_finite()) {
+            return Err(ParamError::new(
+                "causal.offsets",
+                "every causal resting value must be a finite number",
+                bad,
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -45,7 +91,10 @@ impl PreprocessParams {
                 c,
             ));
         }
-        Ok(())
+        match &self.causal {
+            Some(causal) => causal.check(),
+            None => Ok(()),
+        }
     }
 }
 
@@ -97,14 +146,37 @@ impl Butterworth2 {
 
     /// Runs the filter over `x` in place (direct form II transposed) from state `z`.
     fn run(&self, x: &mut [f64], mut z: [f64; 2]) {
+        for s in x.iter_mut() {
+            *s = self.step(*s, &mut z);
+        }
+    }
+
+    /// One sample through the filter (direct form II transposed), updating state `z`: the
+    /// one place both the offline and the streaming filters compute a sample, so they agree
+    /// bit for bit.
+    #[inline]
+    pub fn step(&self, xn: f64, z: &mut [f64; 2]) -> f64 {
         let [b0, b1, b2] = self.b;
         let [_, a1, a2] = self.a;
-        for s in x.iter_mut() {
-            let xn = *s;
-            let y = b0 * xn + z[0];
-            z[0] = b1 * xn - a1 * y + z[1];
-            z[1] = b2 * xn - a2 * y;
-            *s = y;
+        let y = b0 * xn + z[0];
+        z[0] = b1 * xn - a1 * y + z[1];
+        z[1] = b2 * xn - a2 * y;
+        y
+    }
+
+    /// The state of a filter that has seen `x0` for ever (its steady state), so that a
+    /// signal starting at `x0` starts without a transient (`scipy.signal.lfilter_zi * x0`).
+    pub fn steady_state(&self, x0: f64) -> [f64; 2] {
+        let zi = self.zi();
+        [zi[0] * x0, zi[1] * x0]
+    }
+
+    /// Causal forward filtering of `x` in place from the steady state of its first sample,
+    /// as `scipy.signal.lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])`: what a stream can
+    /// compute sample by sample.
+    pub fn lfilter(&self, x: &mut [f64]) {
+        if let Some(&x0) = x.first() {
+            self.run(x, self.steady_state(x0));
         }
     }
 
@@ -184,6 +256,11 @@ impl Preprocessor {
         &self.params
     }
 
+    /// The designed low-pass; `None` when the filter is off.
+    pub fn filter(&self) -> Option<&Butterworth2> {
+        self.filter.as_ref()
+    }
+
     /// Conditions one recording; `dataset_baseline` is the dataset's layout choice, used
     /// when the parameters do not override it.
     ///
@@ -196,15 +273,15 @@ impl Preprocessor {
         if n == 0 {
             return Err(DataError::invalid(file, "recording holds no samples").into());
         }
-        let times: Vec<f64> = match &rec.times_s {
-            Some(t) => t.iter().map(|&x| x - t[0]).collect(),
-            None => (0..n).map(|i| i as f64 / rec.fs).collect(),
+        let times = relative_times(rec);
+        let offsets = match &self.params.causal {
+            Some(causal) => fixed_offsets(rec, causal)?,
+            None => baseline_offsets(
+                rec,
+                &times,
+                self.params.baseline.unwrap_or(dataset_baseline),
+            )?,
         };
-        let offsets = baseline_offsets(
-            rec,
-            &times,
-            self.params.baseline.unwrap_or(dataset_baseline),
-        )?;
         let (lo, hi) = if self.params.slide_only {
             slide_range(rec, &times)?
         } else {
@@ -248,13 +325,19 @@ impl Preprocessor {
                 for (dst, frame) in channel.iter_mut().zip(samples.chunks_exact(cells)) {
                     *dst = frame[cell];
                 }
-                filter.filtfilt(&mut channel, &mut scratch);
+                match self.params.causal {
+                    Some(_) => filter.lfilter(&mut channel),
+                    None => filter.filtfilt(&mut channel, &mut scratch),
+                }
                 for (src, frame) in channel.iter().zip(samples.chunks_exact_mut(cells)) {
                     frame[cell] = *src;
                 }
             }
         }
-        let flat = normalise_global_max(&mut samples);
+        let flat = match &self.params.causal {
+            Some(causal) => normalise_fixed(&mut samples, causal.scale),
+            None => normalise_global_max(&mut samples),
+        };
         Ok(Conditioned {
             samples,
             cells,
@@ -279,6 +362,44 @@ pub fn normalise_global_max(samples: &mut [f64]) -> bool {
         samples.iter_mut().for_each(|s| *s = 0.0);
         true
     }
+}
+
+/// Each sample's time in s from the recording's first: its time stamps less the first, or
+/// `i / fs` (the stream computes its frames' times the same way, so both resample alike).
+pub fn relative_times(rec: &Recording) -> Vec<f64> {
+    match &rec.times_s {
+        Some(t) => t.iter().map(|&x| x - t[0]).collect(),
+        None => (0..rec.len()).map(|i| i as f64 / rec.fs).collect(),
+    }
+}
+
+/// Divides every sample by the fixed causal `scale` (a true division, as
+/// [`normalise_global_max`], so the stream's per-sample division gives the same bits).
+/// Returns whether no sample is positive (the recording gives the neurons no drive).
+pub fn normalise_fixed(samples: &mut [f64], scale: f64) -> bool {
+    let mut any_positive = false;
+    for s in samples.iter_mut() {
+        *s /= scale;
+        any_positive |= *s > 0.0;
+    }
+    !any_positive
+}
+
+/// The causal resting values for `rec`'s grid, with the grid's size checked (a model
+/// applied to another grid is refused before this; a hand-edited file could still differ).
+fn fixed_offsets(rec: &Recording, causal: &CausalConditioning) -> Result<Vec<f64>> {
+    let cells = rec.layout.cells();
+    if causal.offsets.len() != cells {
+        return Err(DataError::invalid(
+            &rec.meta.file,
+            format!(
+                "the causal resting values are for {} cells, the recording has {cells}",
+                causal.offsets.len()
+            ),
+        )
+        .into());
+    }
+    Ok(causal.offsets.clone())
 }
 
 /// The number of samples (`frames x cells`) that [`resample_linear`] makes of a `span_s`
@@ -365,7 +486,12 @@ fn slide_range(rec: &Recording, times: &[f64]) -> Result<(usize, usize)> {
     Ok((lo, hi))
 }
 
-fn baseline_offsets(rec: &Recording, times: &[f64], baseline: Baseline) -> Result<Vec<f64>> {
+/// Each cell's resting value under `baseline` (zeros for [`Baseline::None`]), over the whole
+/// recording (`times` in s from its first sample).
+///
+/// # Errors
+/// A mean baseline whose interval holds no samples.
+pub fn baseline_offsets(rec: &Recording, times: &[f64], baseline: Baseline) -> Result<Vec<f64>> {
     let cells = rec.layout.cells();
     match baseline {
         Baseline::None => Ok(vec![0.0; cells]),

@@ -227,7 +227,7 @@ fn make_candidates(
     set: &CandidateSet,
 ) -> Result<Vec<Candidate>> {
     let start = Instant::now();
-    let (mut params, _) = calibrated_pipeline(&args.stages, dataset, indices)?;
+    let mut params = calibrated_pipeline(&args.stages, dataset, indices)?.params;
     params.encoding = if set.needs_fa() {
         Encoding::SaFa
     } else {

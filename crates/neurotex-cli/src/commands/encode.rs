@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use neurotex::calibrate::calibrate_gain;
 use neurotex::encode::SpikeTrains;
@@ -51,6 +51,9 @@ pub struct EncodeArgs {
 
 /// Runs `neurotex encode`.
 pub fn run(args: EncodeArgs) -> Result<()> {
+    if args.stages.causal {
+        bail!("--causal fixes resting values and a scale on training recordings: use it with train, evaluate, features or compare (then predict or stream with the model)");
+    }
     let pipeline = Pipeline::new(args.stages.pipeline()?)?;
     let layout = input_layout(&args)?;
     let format = layout

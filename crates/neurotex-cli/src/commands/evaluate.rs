@@ -218,12 +218,14 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     }
     let dataset = args.open.open(&args.dataset)?;
     let indices = args.indices(&dataset)?;
-    let (params, calibration) = calibrated_pipeline(
+    let calibrated = calibrated_pipeline(
         &args.stages,
         &dataset,
         &args.calibration_indices(&dataset, &indices)?,
     )?;
-    let pipeline = Pipeline::new(params)?;
+    let calibration = calibrated.gain;
+    let causal = calibrated.causal;
+    let pipeline = Pipeline::new(calibrated.params)?;
     let MethodChoice::Features(method) = args.method else {
         return evaluate_spike_timing(&args, &dataset, &indices, &pipeline, &split);
     };
@@ -255,6 +257,9 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         value["accuracy_interval"] = serde_json::to_value(interval)?;
         if let Some(taxels) = taxels {
             value["taxels"] = taxels_json(taxels, &outcome)?;
+        }
+        if let Some(c) = &causal {
+            value["causal_conditioning"] = serde_json::to_value(c)?;
         }
         if let Some(c) = &calibration {
             value["gain_calibration"] = serde_json::to_value(c)?;

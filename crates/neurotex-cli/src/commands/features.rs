@@ -39,7 +39,7 @@ pub fn run(args: FeaturesArgs) -> Result<()> {
     let dataset = args.open.open(&args.dataset)?;
     // Features are computed for every recording; `--gain auto` calibrates on all of them.
     let all: Vec<usize> = (0..dataset.entries.len()).collect();
-    let (params, _) = calibrated_pipeline(&args.stages, &dataset, &all)?;
+    let params = calibrated_pipeline(&args.stages, &dataset, &all)?.params;
     let pipeline = Pipeline::new(params)?;
     let (table, _) = feature_table(&dataset, &pipeline, None, args.method)?;
     let columns = &dataset.columns;

@@ -7,12 +7,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use neurotex::causal::episode_decisions;
 use neurotex::model::{Model, Prediction};
 use neurotex::pipeline::Encoded;
 use neurotex::recording::{read_recording, Dataset, LayoutFile};
 use rayon::prelude::*;
 
 use super::report_conditions;
+use super::stream::{bin_json, end_json, DecisionArgs};
 use crate::open_args::OpenArgs;
 use crate::output::{progress, write_file};
 
@@ -42,12 +44,23 @@ pub struct PredictArgs {
     /// needs --dataset, and every label there must be a class of the model.
     #[arg(long)]
     pub json: bool,
+    /// Decide as `neurotex stream` would, bin by bin (needs a model trained with
+    /// --causal): --out gets JSON lines, one per bin boundary of each recording's selected
+    /// phase and one for its end, each with the recording's `file`; the same lines
+    /// `neurotex stream --episode whole` prints for that recording's frames.
+    #[arg(long)]
+    pub causal: bool,
+    #[command(flatten)]
+    pub decision: DecisionArgs,
     #[command(flatten)]
     pub open: OpenArgs,
 }
 
 /// Runs `neurotex predict`.
 pub fn run(args: PredictArgs) -> Result<()> {
+    if args.causal && args.json {
+        bail!("--causal writes per-bin decisions; score whole recordings without it (a causal model's whole-recording predictions are its episodes' end labels)");
+    }
     if args.json && args.dataset.is_none() {
         bail!("--json scores the predictions against known labels: it needs --dataset");
     }
@@ -60,6 +73,9 @@ pub fn run(args: PredictArgs) -> Result<()> {
         ),
     };
     report_conditions(&encoded);
+    if args.causal {
+        return predict_causal(&args, &model, &encoded);
+    }
     let predictions = model.predict(&encoded)?;
     let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
     // Scored before anything is written, so that a label the model cannot score leaves no
@@ -78,6 +94,40 @@ pub fn run(args: PredictArgs) -> Result<()> {
         "{} recordings predicted with {} -> {}",
         predictions.len(),
         args.model.display(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Writes every recording's per-bin decisions and end, as `neurotex stream` prints them.
+fn predict_causal(args: &PredictArgs, model: &Model, encoded: &[Encoded]) -> Result<()> {
+    if model.causal().is_none() {
+        bail!("{}: --causal needs a model trained with --causal (this one conditions each recording with the zero-phase filter and its own maximum, which need the whole recording)", args.model.display());
+    }
+    let window_ms = args.decision.window_ms(model)?;
+    let rule = args.decision.rule()?;
+    let episodes = encoded
+        .par_iter()
+        .map(|e| episode_decisions(model, e, window_ms, rule))
+        .collect::<neurotex::Result<Vec<_>>>()?;
+    let labels = model.labels();
+    write_file(&args.out, "causal decisions", |w| {
+        for (e, episode) in encoded.iter().zip(&episodes) {
+            let file = Some(e.meta.file.as_str());
+            for bin in &episode.bins {
+                writeln!(w, "{}", bin_json(labels, bin, file))?;
+            }
+            writeln!(w, "{}", end_json(labels, &episode.summary, file))?;
+        }
+        Ok(())
+    })?;
+    let decided = episodes
+        .iter()
+        .filter(|e| e.summary.decision.is_some())
+        .count();
+    eprintln!(
+        "{} recordings, {decided} decided before their end -> {}",
+        episodes.len(),
         args.out.display()
     );
     Ok(())

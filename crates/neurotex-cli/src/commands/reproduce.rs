@@ -77,6 +77,9 @@ impl ReproduceArgs {
         } else {
             ReproduceParams::default()
         };
+        if self.stages.causal {
+            bail!("reproduce runs the causal pipeline itself (its causal E5 beside the paper's offline E5); --causal is for train, evaluate, features and compare");
+        }
         params.pipeline = self.stages.pipeline()?;
         params.knn = self.stages.knn(self.k)?;
         params.seed = self.seed;

@@ -54,7 +54,8 @@ pub fn run(args: TrainArgs) -> Result<()> {
         Some(speeds) => dataset.indices_at(speeds)?,
         None => (0..dataset.entries.len()).collect(),
     };
-    let (params, calibration) = calibrated_pipeline(&args.stages, &dataset, &indices)?;
+    let calibrated = calibrated_pipeline(&args.stages, &dataset, &indices)?;
+    let params = calibrated.params;
     let pipeline = Pipeline::new(params.clone())?;
     let classifier = args.classifier.choice(args.stages.knn(args.k)?)?;
     let columns = match (args.method, args.taxel) {
@@ -67,7 +68,8 @@ pub fn run(args: TrainArgs) -> Result<()> {
         grid.locate(cell)?;
     }
     let provenance = Provenance {
-        gain_calibration: calibration,
+        gain_calibration: calibrated.gain,
+        median_duration_ms: calibrated.causal.map(|c| c.median_duration_ms),
         ..Provenance::of(&dataset, args.speeds.clone())?
     };
     let model = Model::train(&params, &table, columns, classifier, provenance)?;

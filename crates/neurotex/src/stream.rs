@@ -1,0 +1,750 @@
+//! A live taxel stream classified frame by frame with a causal model (SPEC 10): online
+//! resampling to 1 kHz, the causal filter, the fixed resting values and scale, Izhikevich
+//! state across frames, and at every bin boundary the model's classification of the
+//! current window with the decision rule of [`crate::causal`].
+//!
+//! Every stage keeps its state between frames and computes each 1 ms step with the same
+//! arithmetic as the offline causal pipeline ([`crate::signal::Preprocessor`] with
+//! [`crate::signal::CausalConditioning`], [`crate::encode::Encoder`],
+//! [`crate::causal::episode_decisions`]), so a recording streamed as one episode gives
+//! exactly the decisions of the offline twin.
+//!
+//! Memory is bounded by the window, not the stream: per taxel the filter, neuron and
+//! resampler state (a few f64) and the spike times of the current window (as u32).
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use crate::causal::{window_steps, BinDecision, Decider, DecisionRule, EpisodeEnd, EpisodeSummary};
+use crate::encode::{Encoder, SpikeTrains};
+use crate::error::{ParamError, Result};
+use crate::model::{Model, Prediction};
+use crate::pipeline::{Encoded, Encoding};
+use crate::recording::Meta;
+use crate::signal::{Butterworth2, CausalConditioning, Preprocessor, ENCODER_FS};
+
+/// The default largest gap between two frames' time stamps within one episode, s: a
+/// longer silence ends the episode (resampling across it would invent samples).
+pub const DEFAULT_MAX_GAP_S: f64 = 1.0;
+
+/// The default window when the model does not record its training recordings' length,
+/// ms.
+pub const DEFAULT_WINDOW_MS: usize = 10_000;
+
+/// How a stream is cut into episodes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum EpisodeRule {
+    /// One episode from the first frame until a reset or the end of the input.
+    Whole,
+    /// An episode starts at the first frame whose largest conditioned taxel value
+    /// (resting value removed, divided by the scale; unfiltered) reaches `level`, and ends
+    /// once that value has stayed below `level / 2` for `rest_ms`.
+    Onset {
+        /// The contact level, in units of the model's scale.
+        level: f64,
+        /// How long the signal stays at rest before the episode ends, ms.
+        rest_ms: usize,
+    },
+}
+
+impl std::str::FromStr for EpisodeRule {
+    type Err = ParamError;
+
+    /// `whole`, `onset` (level 0.1, rest 500 ms), `onset:LEVEL` or `onset:LEVEL:REST_MS`.
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        let bad = || {
+            ParamError::new(
+                "episode",
+                "episodes are `whole`, `onset`, `onset:LEVEL` or `onset:LEVEL:REST_MS` (LEVEL > 0, REST_MS >= 1)",
+                s,
+            )
+        };
+        let mut parts = s.trim().split(':');
+        match parts.next() {
+            Some("whole") if parts.next().is_none() => Ok(EpisodeRule::Whole),
+            Some("onset") => {
+                let level = match parts.next() {
+                    Some(l) => l.parse::<f64>().map_err(|_| bad())?,
+                    None => 0.1,
+                };
+                let rest_ms = match parts.next() {
+                    Some(r) => r.parse::<usize>().map_err(|_| bad())?,
+                    None => 500,
+                };
+                let ok = level.is_finite() && level > 0.0 && (1..=3_600_000).contains(&rest_ms);
+                if !ok || parts.next().is_some() {
+                    return Err(bad());
+                }
+                Ok(EpisodeRule::Onset { level, rest_ms })
+            }
+            _ => Err(bad()),
+        }
+    }
+}
+
+/// How a stream is classified.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamParams {
+    /// The window classified at each bin boundary, ms (whole bins).
+    pub window_ms: usize,
+    /// When the per-bin classifications become a decision.
+    pub rule: DecisionRule,
+    /// How the stream is cut into episodes.
+    pub episodes: EpisodeRule,
+    /// The frames' rate when they carry no time stamps, Hz.
+    pub fs: f64,
+    /// The largest gap between time stamps within an episode, s.
+    pub max_gap_s: f64,
+    /// The sliding speed, for models whose features need it (`all-taxels-mm`).
+    pub speed_mm_s: Option<f64>,
+}
+
+impl StreamParams {
+    /// The defaults for `model`: its training recordings' median length as the window
+    /// ([`DEFAULT_WINDOW_MS`] when unknown), the default rule, whole episodes, 1 kHz.
+    pub fn for_model(model: &Model) -> Self {
+        StreamParams {
+            window_ms: model
+                .provenance()
+                .median_duration_ms
+                .unwrap_or(DEFAULT_WINDOW_MS),
+            rule: DecisionRule::default(),
+            episodes: EpisodeRule::Whole,
+            fs: ENCODER_FS,
+            max_gap_s: DEFAULT_MAX_GAP_S,
+            speed_mm_s: None,
+        }
+    }
+
+    fn check(&self) -> Result<(), ParamError> {
+        self.rule.check()?;
+        if !(1..=3_600_000).contains(&self.window_ms) {
+            let rule = "the window must be between 1 ms and one hour";
+            return Err(ParamError::new("window", rule, self.window_ms));
+        }
+        if !(self.fs.is_finite() && self.fs >= 1.0 && self.fs <= 1e6) {
+            let rule = "the frame rate must be between 1 Hz and 1 MHz";
+            return Err(ParamError::new("fs", rule, self.fs));
+        }
+        if !(self.max_gap_s.is_finite() && self.max_gap_s > 0.0 && self.max_gap_s <= 3600.0) {
+            let rule = "the largest gap must be in (0, 3600] s";
+            return Err(ParamError::new("max-gap", rule, self.max_gap_s));
+        }
+        Ok(())
+    }
+}
+
+/// What a stream reports.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    /// A bin boundary's classification.
+    Bin(BinDecision),
+    /// The end of an episode.
+    End(EpisodeSummary),
+}
+
+/// A frame that was skipped, and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BadFrame {
+    /// Not one value per channel.
+    #[error("expected {expected} values, got {got}")]
+    FieldCount {
+        /// The model's channels.
+        expected: usize,
+        /// The frame's values.
+        got: usize,
+    },
+    /// A value or time stamp that is not a finite number.
+    #[error("value {index} is not a finite number")]
+    NotFinite {
+        /// Which value (the time stamp is value 0 when given).
+        index: usize,
+    },
+    /// A time stamp not after the previous frame's.
+    #[error("time stamp {t} s is not after the previous frame's {previous} s")]
+    Stamp {
+        /// The frame's stamp.
+        t: f64,
+        /// The previous frame's.
+        previous: f64,
+    },
+}
+
+/// Why a frame was not taken.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamError {
+    /// A bad frame, counted and skipped: the stream goes on.
+    #[error("bad frame: {0}")]
+    Bad(#[from] BadFrame),
+    /// The model could not classify a window (only a model that cannot run on this
+    /// stream, such as one whose features need a speed that was not given).
+    #[error(transparent)]
+    Classify(#[from] crate::Error),
+}
+
+/// The longest episode, in 1 ms steps: spike times are kept as u32 (49 days); an episode
+/// this long ends and the next starts, one hour (the largest gap) short of the limit.
+const MAX_EPISODE_STEPS: usize = u32::MAX as usize - 3_600_000;
+
+/// One episode's state.
+#[derive(Debug, Clone)]
+struct EpisodeState {
+    /// The first frame's time stamp, or its frame number without stamps.
+    origin: f64,
+    /// Frames of the episode seen by the resampler.
+    frames: usize,
+    /// The resampler's last two frames' times, s from the origin (the values are
+    /// [`StreamClassifier::before`] and [`StreamClassifier::last`]).
+    before_t: f64,
+    last_t: f64,
+    /// The next 1 kHz step the resampler emits.
+    next: usize,
+    /// Steps conditioned so far.
+    steps: usize,
+    filter_state: Vec<[f64; 2]>,
+    /// Whether [`StreamClassifier::previous`] holds the previous step (for the FA drive).
+    has_previous: bool,
+    /// The populations' neurons, in the order of [`Encoded::populations`], each marked
+    /// whether it is FA (driven by the rectified rate of change).
+    neurons: Vec<(Encoder, bool)>,
+    /// Spike times of the current window, per population, per cell.
+    spikes: Vec<Vec<VecDeque<u32>>>,
+    decider: Decider,
+    bins: usize,
+    /// Since when (s from the origin) the signal has been at rest, for onset episodes.
+    rest_since: Option<f64>,
+}
+
+/// A causal model classifying a live stream frame by frame.
+#[derive(Debug)]
+pub struct StreamClassifier {
+    model: Model,
+    params: StreamParams,
+    conditioning: CausalConditioning,
+    filter: Option<Butterworth2>,
+    rows: usize,
+    cols: usize,
+    present: Vec<bool>,
+    /// The cell of each value of a frame.
+    channel_cells: Vec<usize>,
+    bin: usize,
+    window: usize,
+    /// Frames at 1 kHz without stamps go straight to the encoder (as offline).
+    uniform_1k: bool,
+    episode: Option<EpisodeState>,
+    /// The previous frame's time stamp.
+    previous_stamp: Option<f64>,
+    frames: u64,
+    bad_frames: u64,
+    events: Vec<Event>,
+    // Per-frame buffers, `rows * cols` each, reused so that a frame between bin boundaries
+    // allocates nothing.
+    cell_frame: Vec<f64>,
+    before: Vec<f64>,
+    last: Vec<f64>,
+    step_in: Vec<f64>,
+    conditioned: Vec<f64>,
+    previous: Vec<f64>,
+    drive: Vec<f64>,
+    raster: Vec<u8>,
+}
+
+impl StreamClassifier {
+    /// A stream classifier for a causal `model`; frames hold one value per taxel of the
+    /// model's grid, in row-major order of the cells holding a taxel.
+    ///
+    /// # Errors
+    /// A model trained without `--causal` (its filter needs the future), a model whose
+    /// features need a speed when none is given, or broken parameters.
+    pub fn new(model: Model, params: StreamParams) -> Result<Self> {
+        params.check()?;
+        let Some(conditioning) = model.causal().cloned() else {
+            let rule = "streaming needs a model trained with --causal (this one uses the zero-phase filter and each recording's own maximum, which need the whole recording)";
+            return Err(ParamError::new("model", rule, "an offline model").into());
+        };
+        if model.features().method == crate::pipeline::Method::AllTaxelsMm
+            && !params.speed_mm_s.is_some_and(|v| v.is_finite() && v != 0.0)
+        {
+            let rule = "the model's all-taxels-mm features need the sliding speed (--speed)";
+            return Err(ParamError::new("speed", rule, "none").into());
+        }
+        let grid = model.grid().clone();
+        let (rows, cols) = (grid.rows(), grid.cols());
+        let cells = rows * cols;
+        let present = grid.present().to_vec();
+        if conditioning.offsets.len() != cells {
+            let rule = "the model's causal resting values must match its grid";
+            return Err(ParamError::new("model", rule, conditioning.offsets.len()).into());
+        }
+        let channel_cells = (0..cells).filter(|&c| present[c]).collect();
+        let filter = Preprocessor::new(&model.params().preprocess)?
+            .filter()
+            .copied();
+        let bin = model.params().volume.bin_ms;
+        let window = window_steps(params.window_ms, bin);
+        let buffer = vec![0.0; cells];
+        Ok(StreamClassifier {
+            conditioning,
+            filter,
+            rows,
+            cols,
+            present,
+            channel_cells,
+            bin,
+            window,
+            uniform_1k: (params.fs - ENCODER_FS).abs() < 1e-9,
+            episode: None,
+            previous_stamp: None,
+            frames: 0,
+            bad_frames: 0,
+            events: Vec::new(),
+            cell_frame: buffer.clone(),
+            before: buffer.clone(),
+            last: buffer.clone(),
+            step_in: buffer.clone(),
+            conditioned: buffer.clone(),
+            previous: buffer.clone(),
+            drive: buffer,
+            raster: vec![0; cells],
+            model,
+            params,
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &StreamParams {
+        &self.params
+    }
+
+    /// Values a frame holds: one per taxel.
+    pub fn channels(&self) -> usize {
+        self.channel_cells.len()
+    }
+
+    /// Frames taken (bad ones not counted).
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// Frames skipped as bad.
+    pub fn bad_frames(&self) -> u64 {
+        self.bad_frames
+    }
+
+    /// Counts a frame the caller could not even parse (a text line that is not numbers, a
+    /// truncated binary frame) among the bad frames.
+    pub fn skip_bad_frame(&mut self) {
+        self.bad_frames += 1;
+    }
+
+    /// Spike times held for the current window, over all populations and cells (what
+    /// grows with the window, not with the stream).
+    pub fn retained_spikes(&self) -> usize {
+        self.episode.as_ref().map_or(0, |e| {
+            e.spikes
+                .iter()
+                .flat_map(|cells| cells.iter().map(VecDeque::len))
+                .sum()
+        })
+    }
+
+    /// Whether an episode is under way.
+    pub fn in_episode(&self) -> bool {
+        self.episode.is_some()
+    }
+
+    /// Takes one frame: its time stamp in s (`None` for frames at the stream's fixed rate;
+    /// a stream stamps every frame or none) and one value per taxel. Returns what the
+    /// frame completed: a classification at each bin boundary it reached, and the end of
+    /// an episode it closed.
+    ///
+    /// # Errors
+    /// [`StreamError::Bad`] for a bad frame (wrong value count, a value that is not finite,
+    /// a time stamp not after the previous one): it is counted and skipped, and the stream
+    /// goes on. [`StreamError::Classify`] when the model cannot classify a window.
+    pub fn push(&mut self, time_s: Option<f64>, values: &[f64]) -> Result<&[Event], StreamError> {
+        self.events.clear();
+        if let Err(bad) = self.check_frame(time_s, values) {
+            self.bad_frames += 1;
+            return Err(bad.into());
+        }
+        let index = self.frames as f64;
+        self.frames += 1;
+        for (&v, &cell) in values.iter().zip(&self.channel_cells) {
+            self.cell_frame[cell] = v;
+        }
+        if let Some(t) = time_s {
+            let gap = self
+                .previous_stamp
+                .is_some_and(|p| t - p > self.params.max_gap_s);
+            self.previous_stamp = Some(t);
+            if gap && self.episode.is_some() {
+                self.end_episode(EpisodeEnd::Gap)?;
+            }
+        }
+        if self
+            .episode
+            .as_ref()
+            .is_some_and(|e| e.steps >= MAX_EPISODE_STEPS)
+        {
+            self.end_episode(EpisodeEnd::Gap)?;
+        }
+        let level = self.contact_level();
+        if self.episode.is_none() {
+            if let EpisodeRule::Onset { level: onset, .. } = self.params.episodes {
+                if level < onset {
+                    return Ok(&self.events);
+                }
+            }
+            self.episode = Some(self.new_episode(time_s.unwrap_or(index)));
+        }
+        let origin = self
+            .episode
+            .as_ref()
+            .expect("an episode is under way")
+            .origin;
+        // As offline: stamps less the first, or frame numbers over the rate.
+        let relative = match time_s {
+            Some(t) => t - origin,
+            None => (index - origin) / self.params.fs,
+        };
+        if time_s.is_none() && self.uniform_1k {
+            self.step_in.copy_from_slice(&self.cell_frame);
+            self.step()?;
+        } else {
+            self.resample(relative)?;
+        }
+        if let EpisodeRule::Onset {
+            level: onset,
+            rest_ms,
+        } = self.params.episodes
+        {
+            let episode = self.episode.as_mut().expect("an episode is under way");
+            if level < onset / 2.0 {
+                let since = *episode.rest_since.get_or_insert(relative);
+                if relative - since >= rest_ms as f64 / 1000.0 {
+                    self.end_episode(EpisodeEnd::Rest)?;
+                }
+            } else {
+                episode.rest_since = None;
+            }
+        }
+        Ok(&self.events)
+    }
+
+    /// Ends the current episode (a reset frame or control line); the next frame starts a
+    /// new one (at once, or at contact for onset episodes).
+    ///
+    /// # Errors
+    /// The model cannot classify the episode's last window.
+    pub fn reset(&mut self) -> Result<&[Event], StreamError> {
+        self.events.clear();
+        if self.episode.is_some() {
+            self.end_episode(EpisodeEnd::Reset)?;
+        }
+        Ok(&self.events)
+    }
+
+    /// Ends the stream: the last steps of the current episode and its summary.
+    ///
+    /// # Errors
+    /// The model cannot classify the episode's last window.
+    pub fn finish(&mut self) -> Result<&[Event], StreamError> {
+        self.events.clear();
+        if self.episode.is_some() {
+            self.end_episode(EpisodeEnd::EndOfInput)?;
+        }
+        Ok(&self.events)
+    }
+
+    fn check_frame(&self, time_s: Option<f64>, values: &[f64]) -> Result<(), BadFrame> {
+        let expected = self.channel_cells.len();
+        if values.len() != expected {
+            return Err(BadFrame::FieldCount {
+                expected,
+                got: values.len(),
+            });
+        }
+        let first_value = usize::from(time_s.is_some());
+        if let Some(t) = time_s {
+            if !t.is_finite() {
+                return Err(BadFrame::NotFinite { index: 0 });
+            }
+            if let Some(previous) = self.previous_stamp.filter(|&p| t <= p) {
+                return Err(BadFrame::Stamp { t, previous });
+            }
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(BadFrame::NotFinite {
+                index: i + first_value,
+            });
+        }
+        Ok(())
+    }
+
+    /// The largest taxel value of the current frame, resting value removed, in units of
+    /// the scale (unfiltered): what onset episodes compare to their level.
+    fn contact_level(&self) -> f64 {
+        let c = &self.conditioning;
+        self.channel_cells
+            .iter()
+            .map(|&cell| (self.cell_frame[cell] - c.offsets[cell]) / c.scale)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    fn new_episode(&self, origin: f64) -> EpisodeState {
+        let cells = self.rows * self.cols;
+        let p = self.model.params();
+        let neuron = |gain: f64| {
+            Encoder::new(p.encoder.with_gain(gain), cells).expect("the model's checked parameters")
+        };
+        let neurons = match p.encoding {
+            Encoding::Sa => vec![(neuron(p.encoder.gain), false)],
+            Encoding::Fa => vec![(neuron(p.fa.gain), true)],
+            Encoding::SaFa => vec![(neuron(p.encoder.gain), false), (neuron(p.fa.gain), true)],
+        };
+        EpisodeState {
+            origin,
+            frames: 0,
+            before_t: 0.0,
+            last_t: 0.0,
+            next: 0,
+            steps: 0,
+            filter_state: vec![[0.0; 2]; cells],
+            has_previous: false,
+            spikes: vec![vec![VecDeque::new(); cells]; neurons.len()],
+            neurons,
+            decider: Decider::new(self.params.rule),
+            bins: 0,
+            rest_since: None,
+        }
+    }
+
+    /// Takes the current frame, at `t` s from the episode's start, into the resampler
+    /// and conditions each 1 kHz step before `t`: those steps lie between the last frame
+    /// and this one, as [`crate::signal::resample_linear`] brackets them.
+    fn resample(&mut self, t: f64) -> Result<(), StreamError> {
+        let episode = self.episode.as_mut().expect("an episode is under way");
+        if episode.frames > 0 {
+            let ta = episode.last_t;
+            loop {
+                let episode = self.episode.as_mut().expect("an episode is under way");
+                let ts = 0.0 + episode.next as f64 / ENCODER_FS;
+                if ts >= t {
+                    break;
+                }
+                episode.next += 1;
+                let w = ((ts - ta) / (t - ta)).clamp(0.0, 1.0);
+                interpolate(&self.last, &self.cell_frame, w, &mut self.step_in);
+                self.step()?;
+            }
+        }
+        let episode = self.episode.as_mut().expect("an episode is under way");
+        std::mem::swap(&mut self.before, &mut self.last);
+        self.last.copy_from_slice(&self.cell_frame);
+        episode.before_t = episode.last_t;
+        episode.last_t = t;
+        episode.frames += 1;
+        Ok(())
+    }
+
+    /// The episode's last steps, up to its last frame's time, as offline: bracketed by
+    /// the last two frames (clamped beyond the last), or the only frame.
+    fn flush(&mut self) -> Result<(), StreamError> {
+        let episode = self.episode.as_mut().expect("an episode is under way");
+        let (ta, tb) = (episode.before_t, episode.last_t);
+        let total = match episode.frames {
+            0 => return Ok(()),
+            1 => 1,
+            _ => crate::signal::resampled_len(tb, ENCODER_FS, 1)
+                .expect("a span bounded by the longest episode"),
+        };
+        loop {
+            let episode = self.episode.as_mut().expect("an episode is under way");
+            if episode.next >= total {
+                return Ok(());
+            }
+            let ts = 0.0 + episode.next as f64 / ENCODER_FS;
+            episode.next += 1;
+            match episode.frames {
+                1 => self.step_in.copy_from_slice(&self.last),
+                _ => {
+                    let w = ((ts - ta) / (tb - ta)).clamp(0.0, 1.0);
+                    interpolate(&self.before, &self.last, w, &mut self.step_in);
+                }
+            }
+            self.step()?;
+        }
+    }
+
+    /// Conditions one 1 kHz step (`step_in`, raw values per cell), runs the neurons,
+    /// keeps their spikes, and classifies at a bin boundary.
+    fn step(&mut self) -> Result<(), StreamError> {
+        let episode = self.episode.as_mut().expect("an episode is under way");
+        let c = &self.conditioning;
+        for (cell, x) in self.conditioned.iter_mut().enumerate() {
+            *x = match self.present[cell] {
+                true => self.step_in[cell] - c.offsets[cell],
+                false => 0.0,
+            };
+        }
+        if let Some(filter) = &self.filter {
+            let first = episode.steps == 0;
+            for &cell in &self.channel_cells {
+                let x = self.conditioned[cell];
+                let z = &mut episode.filter_state[cell];
+                if first {
+                    *z = filter.steady_state(x);
+                }
+                self.conditioned[cell] = filter.step(x, z);
+            }
+        }
+        for x in self.conditioned.iter_mut() {
+            *x /= c.scale;
+        }
+        let t = episode.steps as u32;
+        for (population, (neurons, is_fa)) in episode.neurons.iter_mut().enumerate() {
+            let input = match is_fa {
+                false => &self.conditioned,
+                true => {
+                    for ((d, &x), &p) in self
+                        .drive
+                        .iter_mut()
+                        .zip(&self.conditioned)
+                        .zip(&self.previous)
+                    {
+                        *d = if episode.has_previous {
+                            (x - p).abs()
+                        } else {
+                            0.0
+                        };
+                    }
+                    &self.drive
+                }
+            };
+            neurons.run(input, &mut self.raster);
+            let trains = &mut episode.spikes[population];
+            for &cell in &self.channel_cells {
+                if self.raster[cell] != 0 {
+                    trains[cell].push_back(t);
+                }
+            }
+        }
+        if episode.neurons.iter().any(|n| n.1) {
+            self.previous.copy_from_slice(&self.conditioned);
+            episode.has_previous = true;
+        }
+        episode.steps += 1;
+        if episode.steps % self.bin == 0 {
+            self.boundary()?;
+        }
+        Ok(())
+    }
+
+    /// Classifies the window ending at the current step, a bin boundary.
+    fn boundary(&mut self) -> Result<(), StreamError> {
+        let episode = self.episode.as_mut().expect("an episode is under way");
+        let end = episode.steps;
+        let start = end.saturating_sub(self.window);
+        // Later windows start later, and the episode's summary no earlier than this one.
+        for trains in &mut episode.spikes {
+            for train in trains.iter_mut() {
+                while train.front().is_some_and(|&t| (t as usize) < start) {
+                    train.pop_front();
+                }
+            }
+        }
+        let prediction = self.classify(start, end)?;
+        let class = self.model.class_index(&prediction.predicted);
+        let t_s = end as f64 / 1000.0;
+        let episode = self.episode.as_mut().expect("an episode is under way");
+        let decided = episode
+            .decider
+            .observe(t_s, class, prediction.shares[class]);
+        episode.bins += 1;
+        let decision = episode.decider.decision().map(|d| d.0);
+        self.events.push(Event::Bin(BinDecision {
+            t_s,
+            class,
+            shares: prediction.shares,
+            decided,
+            decision,
+        }));
+        Ok(())
+    }
+
+    /// The model's prediction for the steps `[start, end)` of the episode.
+    fn classify(&self, start: usize, end: usize) -> Result<Prediction, StreamError> {
+        let episode = self.episode.as_ref().expect("an episode is under way");
+        let trains: Vec<SpikeTrains> = episode
+            .spikes
+            .iter()
+            .map(|cells| {
+                let lists: Vec<Vec<u32>> = cells
+                    .iter()
+                    .map(|train| {
+                        train
+                            .iter()
+                            .filter(|&&t| (t as usize) >= start && (t as usize) < end)
+                            .map(|&t| t - start as u32)
+                            .collect()
+                    })
+                    .collect();
+                SpikeTrains::from_lists(&lists, self.rows, self.cols, &self.present, end - start)
+            })
+            .collect();
+        let mut populations = trains.into_iter();
+        let encoded = Encoded {
+            meta: Meta {
+                file: "stream".into(),
+                speed_mm_s: self.params.speed_mm_s,
+                ..Meta::default()
+            },
+            spikes: populations.next().expect("one population at least"),
+            fa: populations.next(),
+            resampled: false,
+            flat: false,
+        };
+        Ok(self.model.predict_one(&encoded)?)
+    }
+
+    /// Conditions the episode's last steps, then summarises it: the classification of its
+    /// last window (all of it when shorter) and the decision.
+    fn end_episode(&mut self, ended_by: EpisodeEnd) -> Result<(), StreamError> {
+        self.flush()?;
+        let episode = self.episode.as_ref().expect("an episode is under way");
+        let n = episode.steps;
+        let whole = n.min(self.window);
+        let last = match whole >= self.bin {
+            true => Some(self.classify(n - whole, n)?),
+            false => None,
+        };
+        let episode = self.episode.take().expect("an episode is under way");
+        let decision = episode.decider.decision();
+        self.events.push(Event::End(EpisodeSummary {
+            duration_s: n as f64 / 1000.0,
+            class: last.as_ref().map(|p| self.model.class_index(&p.predicted)),
+            shares: last.map(|p| p.shares),
+            decision: decision.map(|d| d.0),
+            decided_at_s: decision.map(|d| d.1),
+            bins: episode.bins,
+            ended_by,
+        }));
+        Ok(())
+    }
+}
+
+/// `out = a + (b - a) * w`, cell by cell: the arithmetic of
+/// [`crate::signal::resample_linear`].
+fn interpolate(a: &[f64], b: &[f64], w: f64, out: &mut [f64]) {
+    for ((o, &x), &y) in out.iter_mut().zip(a).zip(b) {
+        *o = x + (y - x) * w;
+    }
+}

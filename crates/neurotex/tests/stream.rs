@@ -1,0 +1,382 @@
+//! The stream classifier against its offline twin: a recording fed frame by frame (at
+//! 1 kHz, at another fixed rate, or with irregular time stamps) gives exactly the
+//! decisions `causal::episode_decisions` computes from the whole recording; bad frames are
+//! skipped without changing them; memory stays within the window; onset episodes.
+
+mod support;
+
+use neurotex::analysis::{Columns, FeatureTable};
+use neurotex::causal::{
+    calibrate_conditioning, episode_decisions, DecisionRule, Episode, EpisodeEnd,
+};
+use neurotex::classify::{ClassifierChoice, ForestParams, KnnParams};
+use neurotex::model::{Model, Provenance};
+use neurotex::pipeline::{Encoding, Method, Pipeline, PipelineParams};
+use neurotex::recording::{Baseline, Phase, Recording};
+use neurotex::sim::{design, simulate_trial, RigParams, Texture};
+use neurotex::stream::{BadFrame, EpisodeRule, Event, StreamClassifier, StreamError, StreamParams};
+use support::XorShift;
+
+/// Short simulated slides (2 s) of three textures at 20 mm/s.
+fn recordings() -> Vec<Recording> {
+    let rig = RigParams {
+        hold_s: 0.3,
+        slide_mm: 40.0,
+        ..RigParams::default()
+    };
+    let trials = design(&[Texture::Ft1, Texture::Sb, Texture::Stf], &[20.0], 5);
+    trials
+        .iter()
+        .map(|t| simulate_trial(&rig, t, 11).unwrap())
+        .collect()
+}
+
+/// A causal model trained on `train` (conditioning fixed on them, labels unused).
+fn causal_model(
+    train: &[Recording],
+    encoding: Encoding,
+    method: Method,
+    classifier: ClassifierChoice,
+) -> Model {
+    let mut params = PipelineParams {
+        encoding,
+        ..PipelineParams::default()
+    };
+    let load = |i: usize| Ok(train[i].clone());
+    let indices: Vec<usize> = (0..train.len()).collect();
+    let calibration = calibrate_conditioning(&params, &load, &indices, Baseline::Min).unwrap();
+    params.preprocess.causal = Some(calibration.conditioning);
+    let pipeline = Pipeline::new(params.clone()).unwrap();
+    let encoded: Vec<_> = train
+        .iter()
+        .map(|r| pipeline.encode(r, Baseline::Min).unwrap())
+        .collect();
+    let extractor = pipeline.extractor(&train[0].layout_grid()).unwrap();
+    let table = FeatureTable::build(&encoded, &extractor, method).unwrap();
+    let provenance = Provenance {
+        fingerprint: "test".into(),
+        baseline: Baseline::Min,
+        speeds: None,
+        gain_calibration: None,
+        median_duration_ms: Some(calibration.median_duration_ms),
+    };
+    Model::train(&params, &table, Columns::All, classifier, provenance).unwrap()
+}
+
+trait LayoutGrid {
+    fn layout_grid(&self) -> neurotex::Grid;
+}
+
+impl LayoutGrid for Recording {
+    fn layout_grid(&self) -> neurotex::Grid {
+        let l = &self.layout;
+        neurotex::Grid::masked(l.rows, l.cols, l.present.clone()).unwrap()
+    }
+}
+
+/// The sliding phase of a simulated recording as a recording of its own (what a sensor
+/// streams during the slide).
+fn slide_only(rec: &Recording) -> Recording {
+    let phases = rec.phases.as_ref().unwrap();
+    let lo = phases.iter().position(|&p| p == Phase::Slide).unwrap();
+    let hi = phases.iter().rposition(|&p| p == Phase::Slide).unwrap() + 1;
+    let cells = rec.layout.cells();
+    let mut meta = rec.meta.clone();
+    (meta.slide_start_s, meta.slide_end_s) = (None, None);
+    Recording {
+        samples: rec.samples[lo * cells..hi * cells].to_vec(),
+        phases: None,
+        meta,
+        ..rec.clone()
+    }
+}
+
+/// Every event a stream reports for `frames` (`(stamp, values)`), then its end.
+fn stream_events(stream: &mut StreamClassifier, frames: &[(Option<f64>, Vec<f64>)]) -> Vec<Event> {
+    let mut events = Vec::new();
+    for (t, values) in frames {
+        match stream.push(*t, values) {
+            Ok(e) => events.extend_from_slice(e),
+            Err(StreamError::Bad(_)) => {}
+            Err(e) => panic!("{e}"),
+        }
+    }
+    events.extend_from_slice(stream.finish().unwrap());
+    events
+}
+
+/// The offline twin's decisions as the stream's events.
+fn offline_events(episode: Episode) -> Vec<Event> {
+    let mut events: Vec<Event> = episode.bins.into_iter().map(Event::Bin).collect();
+    events.push(Event::End(episode.summary));
+    events
+}
+
+/// A recording's frames: one value per taxel, with its stamp when it has stamps.
+fn frames_of(rec: &Recording) -> Vec<(Option<f64>, Vec<f64>)> {
+    let cells = rec.layout.cells();
+    rec.samples
+        .chunks_exact(cells)
+        .enumerate()
+        .map(|(i, frame)| {
+            let values = (0..cells)
+                .filter(|&c| rec.layout.present[c])
+                .map(|c| frame[c])
+                .collect();
+            (rec.times_s.as_ref().map(|t| t[i]), values)
+        })
+        .collect()
+}
+
+/// `rec` taken at irregular instants about `mean_ms` apart (stamped), as a slow sensor
+/// logs it: each kept frame is a sample of the 1 kHz recording.
+fn irregular(rec: &Recording, mean_ms: u64, seed: u64) -> Recording {
+    let cells = rec.layout.cells();
+    let mut rng = XorShift::new(seed);
+    let (mut keep, mut i) = (Vec::new(), 0usize);
+    while i < rec.len() {
+        keep.push(i);
+        i += 1 + (rng.below(2 * mean_ms) as usize);
+    }
+    Recording {
+        samples: keep
+            .iter()
+            .flat_map(|&i| rec.samples[i * cells..(i + 1) * cells].to_vec())
+            .collect(),
+        // Stamps in s from an arbitrary origin, as a host clock gives them.
+        times_s: Some(keep.iter().map(|&i| 1234.5 + i as f64 / 1000.0).collect()),
+        fs: 1000.0 / mean_ms as f64,
+        ..rec.clone()
+    }
+}
+
+fn params(model: &Model) -> StreamParams {
+    StreamParams::for_model(model)
+}
+
+#[test]
+fn a_stream_at_1_khz_decides_as_the_offline_twin() {
+    let recs = recordings();
+    let model = causal_model(
+        &recs,
+        Encoding::Sa,
+        Method::Glcm3d,
+        ClassifierChoice::Knn(KnnParams::default()),
+    );
+    let p = params(&model);
+    for rec in recs.iter().step_by(4) {
+        let offline = model.encode(rec).unwrap();
+        let expected = episode_decisions(&model, &offline, p.window_ms, p.rule).unwrap();
+        assert!(expected.bins.len() >= 5, "a slide of several bins");
+        let mut stream = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+        let got = stream_events(&mut stream, &frames_of(&slide_only(rec)));
+        assert_eq!(got, offline_events(expected), "{}", rec.meta.file);
+    }
+}
+
+#[test]
+fn irregular_stamps_and_other_rates_resample_as_offline() {
+    let recs = recordings();
+    let model = causal_model(
+        &recs,
+        Encoding::SaFa,
+        Method::AllTaxels,
+        ClassifierChoice::Forest(ForestParams {
+            trees: 20,
+            ..ForestParams::default()
+        }),
+    );
+    let mut p = params(&model);
+    // A window shorter than the slide, so that it slides.
+    p.window_ms = 1000;
+    for (k, rec) in recs.iter().step_by(5).enumerate() {
+        // Stamped frames about 28 ms apart (FabricSlide's 35.7 Hz), irregular.
+        let slow = irregular(&slide_only(rec), 28, k as u64 + 1);
+        let expected =
+            episode_decisions(&model, &model.encode(&slow).unwrap(), p.window_ms, p.rule).unwrap();
+        let mut stream = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+        let got = stream_events(&mut stream, &frames_of(&slow));
+        assert_eq!(got, offline_events(expected), "stamped, {}", rec.meta.file);
+
+        // The same frames without stamps at a fixed 250 Hz.
+        let mut fixed = slow.clone();
+        fixed.times_s = None;
+        fixed.fs = 250.0;
+        let expected =
+            episode_decisions(&model, &model.encode(&fixed).unwrap(), p.window_ms, p.rule).unwrap();
+        let mut stream = StreamClassifier::new(
+            model.clone(),
+            StreamParams {
+                fs: 250.0,
+                ..p.clone()
+            },
+        )
+        .unwrap();
+        let got = stream_events(&mut stream, &frames_of(&fixed));
+        assert_eq!(got, offline_events(expected), "250 Hz, {}", rec.meta.file);
+    }
+}
+
+#[test]
+fn bad_frames_are_counted_skipped_and_change_nothing() {
+    let recs = recordings();
+    let model = causal_model(
+        &recs,
+        Encoding::Sa,
+        Method::Glcm3d,
+        ClassifierChoice::Knn(KnnParams::default()),
+    );
+    let p = params(&model);
+    let slow = irregular(&slide_only(&recs[2]), 10, 7);
+    let clean = frames_of(&slow);
+    let mut stream = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+    let expected = stream_events(&mut stream, &clean);
+
+    let mut hostile = Vec::new();
+    let mut kinds = Vec::new();
+    for (i, (t, values)) in clean.iter().enumerate() {
+        hostile.push((*t, values.clone()));
+        if i % 50 == 7 {
+            let mut nan = values.clone();
+            nan[3] = f64::NAN;
+            hostile.push((t.map(|t| t + 1e-4), nan));
+            hostile.push((*t, values.clone())); // a repeated stamp
+            hostile.push((t.map(|t| t + 1e-4), values[..5].to_vec())); // too few values
+            hostile.push((Some(f64::INFINITY), values.clone()));
+        }
+    }
+    let mut stream = StreamClassifier::new(model, p).unwrap();
+    let mut got = Vec::new();
+    for (t, values) in &hostile {
+        match stream.push(*t, values) {
+            Ok(e) => got.extend_from_slice(e),
+            Err(StreamError::Bad(bad)) => kinds.push(bad),
+            Err(e) => panic!("{e}"),
+        }
+    }
+    got.extend_from_slice(stream.finish().unwrap());
+    assert_eq!(got, expected);
+    let bad = hostile.len() - clean.len();
+    assert_eq!(stream.bad_frames() as usize, bad);
+    assert_eq!(kinds.len(), bad);
+    assert!(kinds
+        .iter()
+        .any(|k| matches!(k, BadFrame::NotFinite { index: 4 })));
+    assert!(kinds.iter().any(|k| matches!(k, BadFrame::Stamp { .. })));
+    assert!(kinds.iter().any(|k| matches!(
+        k,
+        BadFrame::FieldCount {
+            expected: 16,
+            got: 5
+        }
+    )));
+}
+
+#[test]
+fn a_long_stream_keeps_only_its_window() {
+    let recs = recordings();
+    let model = causal_model(
+        &recs,
+        Encoding::Sa,
+        Method::AllTaxels,
+        ClassifierChoice::Knn(KnnParams::default()),
+    );
+    let mut p = params(&model);
+    p.window_ms = 600;
+    let frames = frames_of(&slide_only(&recs[0]));
+    let mut stream = StreamClassifier::new(model, p).unwrap();
+    let mut most = 0;
+    // The slide over and over: 20 times its length in one episode.
+    for _ in 0..20 {
+        for (_, values) in &frames {
+            stream.push(None, values).unwrap();
+            most = most.max(stream.retained_spikes());
+        }
+    }
+    // At most the window plus one bin of spikes is held: 16 neurons below 1 kHz.
+    assert!(most > 0);
+    assert!(most <= 16 * 800, "{most} spike times held");
+}
+
+#[test]
+fn onset_episodes_start_at_contact_and_end_at_rest() {
+    let recs = recordings();
+    let model = causal_model(
+        &recs,
+        Encoding::Sa,
+        Method::Glcm3d,
+        ClassifierChoice::Knn(KnnParams::default()),
+    );
+    let c = model.causal().unwrap().clone();
+    let rest: Vec<f64> = (0..16).map(|cell| c.offsets[cell]).collect();
+    let slide = frames_of(&slide_only(&recs[1]));
+    let mut p = params(&model);
+    p.episodes = EpisodeRule::Onset {
+        level: 0.1,
+        rest_ms: 300,
+    };
+    let mut stream = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+    let mut frames: Vec<(Option<f64>, Vec<f64>)> = Vec::new();
+    for _ in 0..2 {
+        frames.extend(std::iter::repeat_n((None, rest.clone()), 1000));
+        frames.extend(slide.iter().cloned());
+    }
+    frames.extend(std::iter::repeat_n((None, rest.clone()), 1000));
+    let events = stream_events(&mut stream, &frames);
+    let ends: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            Event::End(s) => Some(s),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(ends.len(), 2, "two contacts, two episodes");
+    for end in &ends {
+        assert_eq!(end.ended_by, EpisodeEnd::Rest);
+        // The episode holds the slide from its onset and the rest that ended it.
+        let slide_s = slide.len() as f64 / 1000.0;
+        assert!(
+            end.duration_s > 0.3 && end.duration_s <= slide_s + 0.31,
+            "{}",
+            end.duration_s
+        );
+    }
+    assert_eq!(ends[0], ends[1], "the same contact twice, the same episode");
+    assert!(!stream.in_episode());
+}
+
+#[test]
+fn an_offline_model_cannot_stream() {
+    let recs = recordings();
+    let params = PipelineParams::default();
+    let pipeline = Pipeline::new(params.clone()).unwrap();
+    let encoded: Vec<_> = recs
+        .iter()
+        .map(|r| pipeline.encode(r, Baseline::None).unwrap())
+        .collect();
+    let extractor = pipeline.extractor(&recs[0].layout_grid()).unwrap();
+    let table = FeatureTable::build(&encoded, &extractor, Method::Glcm3d).unwrap();
+    let provenance = Provenance {
+        fingerprint: "test".into(),
+        baseline: Baseline::None,
+        speeds: None,
+        gain_calibration: None,
+        median_duration_ms: None,
+    };
+    let model = Model::train(
+        &params,
+        &table,
+        Columns::All,
+        ClassifierChoice::default(),
+        provenance,
+    )
+    .unwrap();
+    let err = StreamClassifier::new(model.clone(), StreamParams::for_model(&model)).unwrap_err();
+    assert!(err.to_string().contains("--causal"), "{err}");
+    let mut p = StreamParams::for_model(&model);
+    p.rule = DecisionRule {
+        share: 0.0,
+        bins: 3,
+    };
+    assert!(StreamClassifier::new(model, p).is_err());
+}
