@@ -1,0 +1,568 @@
+"""neurotex for Python: neuromorphic tactile texture features on numpy arrays.
+
+The same library as the ``neurotex`` command line, with the same results bit for bit:
+taxel-array recordings ``(T, rows, cols)`` (or ``(T, channels)``) become spikes of
+Izhikevich neurons (:func:`encode`), spike statistics (:func:`spike_stats`), rate volumes
+(:func:`rate_volume`), co-occurrence matrices (:func:`glcm3d`, :func:`glcm2d`) and Haralick
+features (:func:`haralick`); :func:`features` does all of it for many recordings at once,
+in parallel, without the GIL. :mod:`neurotex.sklearn` wraps it for scikit-learn.
+
+Defaults are the paper's (Gupta, Nakagawa, Lepora, Thakor): gain 8, RS neurons, 50 Hz
+zero-phase low-pass, 200 ms bins, 16 gray levels, distances 1, 2, 4, 8.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import tempfile
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _native
+from .errors import (
+    ClassifyError,
+    DataError,
+    Error,
+    InternalError,
+    ModelError,
+    NotFoundError,
+    ParameterError,
+    ReadWriteError,
+)
+
+__version__ = _native.library_version()
+
+HARALICK_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(False))
+"""Names of the paper's Haralick features, in the order :func:`haralick` returns them."""
+HARALICK_FULL_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(True))
+"""Names of the 13 features of ``haralick(..., full=True)``."""
+
+METHODS = ("taxel", "glcm2d", "glcm3d", "all-taxels", "all-taxels-mm", "glcm3d-multi")
+"""Feature methods of :func:`features`, as the CLI's ``--method``."""
+
+
+@dataclass
+class Recording:
+    """One trial: samples ``x`` of shape ``(T, rows, cols)`` or ``(T, channels)``
+    (float32 or float64, any memory order) with what the pipeline needs beside them.
+
+    ``slide`` is the sliding phase ``(start_s, end_s)`` (the rest is ignored unless
+    ``whole=True``); ``times`` are per-sample time stamps in seconds for irregular
+    sampling (then resampled to 1 kHz); ``mask`` marks the grid cells holding a taxel
+    (``(rows, cols)`` bool); ``speed`` in mm/s is needed by ``all-taxels-mm``."""
+
+    x: np.ndarray
+    fs: float = 1000.0
+    label: str = ""
+    speed: Optional[float] = None
+    slide: Optional[Tuple[float, float]] = None
+    times: Optional[np.ndarray] = None
+    mask: Optional[np.ndarray] = None
+    name: Optional[str] = None
+
+
+@dataclass
+class Dataset:
+    """A dataset folder in memory (:func:`load_dataset`): its recordings (with their
+    sliding phases, rates and masks), labels and manifest rows."""
+
+    recordings: List[Recording]
+    rows: List[Dict[str, str]]
+    columns: List[str]
+    fs: float
+    baseline: str
+    mask: Optional[np.ndarray] = None
+    path: Optional[str] = None
+
+    @property
+    def arrays(self) -> List[np.ndarray]:
+        """The samples of every recording, float64 ``(T, rows, cols)``."""
+        return [r.x for r in self.recordings]
+
+    @property
+    def labels(self) -> np.ndarray:
+        """Every recording's texture label."""
+        return np.array([r.label for r in self.recordings], dtype=object)
+
+    @property
+    def speeds(self) -> np.ndarray:
+        """Every recording's sliding speed in mm/s (NaN where unknown)."""
+        return np.array([np.nan if r.speed is None else r.speed for r in self.recordings])
+
+    def __len__(self) -> int:
+        return len(self.recordings)
+
+
+def _stage_options(**kw: Any) -> Dict[str, Any]:
+    """The pipeline options the library checks; tuples become lists."""
+    out = {}
+    for k, v in kw.items():
+        if v is None:
+            continue
+        if isinstance(v, (tuple, np.ndarray)):
+            v = list(v)
+        out[k] = v
+    return out
+
+
+def _samples(x: Any, what: str) -> np.ndarray:
+    """``x`` as a float32 or float64 array, without copying those two."""
+    a = np.asarray(x)
+    if a.dtype in (np.float32, np.float64):
+        return a
+    if a.dtype.kind in "iu":
+        return a.astype(np.float64)
+    raise DataError(f"{what}: samples must be real numbers, got dtype {a.dtype}")
+
+
+def _mask_list(mask: Any, what: str) -> Optional[List[bool]]:
+    if mask is None:
+        return None
+    m = np.asarray(mask)
+    if m.dtype != bool:
+        raise DataError(f"{what}: the mask must be a boolean array (rows, cols)")
+    return [bool(v) for v in m.ravel()]
+
+
+def _recording_list(recordings: Any) -> List[Any]:
+    if isinstance(recordings, Dataset):
+        return list(recordings.recordings)
+    if isinstance(recordings, (Recording, np.ndarray)) and not (
+        isinstance(recordings, np.ndarray) and recordings.ndim == 4
+    ):
+        if isinstance(recordings, np.ndarray):
+            raise DataError(
+                f"recordings: expected a list of arrays or a 4-D array (n, T, rows, cols), "
+                f"got an array of shape {recordings.shape} (use encode for one recording)"
+            )
+        return [recordings]
+    if isinstance(recordings, np.ndarray):
+        return list(recordings)  # views, no copy
+    return list(recordings)
+
+
+def _prepare(
+    recordings: Sequence[Any],
+    fs: float,
+    mask: Any,
+    speeds: Any = None,
+) -> Tuple[List[np.ndarray], List[tuple]]:
+    """Arrays and the library's per-recording descriptions."""
+    arrays, infos = [], []
+    if speeds is not None and len(speeds) != len(recordings):
+        raise ParameterError(
+            f"speeds has {len(speeds)} values for {len(recordings)} recordings"
+        )
+    for i, r in enumerate(recordings):
+        if isinstance(r, Recording):
+            name = r.name or f"recording {i}"
+            a = _samples(r.x, name)
+            slide = r.slide or (None, None)
+            times = None if r.times is None else [float(t) for t in np.asarray(r.times)]
+            m = r.mask if r.mask is not None else mask
+            speed = r.speed if speeds is None else speeds[i]
+            infos.append(
+                (name, float(r.fs), _mask_list(m, name), str(r.label),
+                 None if speed is None else float(speed), slide[0], slide[1], times)
+            )
+        else:
+            name = f"recording {i}"
+            a = _samples(r, name)
+            speed = None if speeds is None else speeds[i]
+            infos.append(
+                (name, float(fs), _mask_list(mask, name), "",
+                 None if speed is None else float(speed), None, None, None)
+            )
+        arrays.append(a)
+    return arrays, infos
+
+
+def encode(
+    x: Any,
+    fs: float = 1000.0,
+    gain: float = 8.0,
+    cutoff: float = 50.0,
+    *,
+    preset: str = "RS",
+    baseline: Optional[str] = None,
+    encoding: str = "sa",
+    fa_gain: float = 8000.0,
+    whole: bool = False,
+    slide: Optional[Tuple[float, float]] = None,
+    times: Any = None,
+    mask: Any = None,
+) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+    """Encodes one recording into spikes, as ``neurotex encode`` does.
+
+    ``x``: samples ``(T, rows, cols)`` or ``(T, channels)``, float32 or float64, any
+    memory order (read in place, without copying into a new numpy array). The signal is
+    resampled to 1 kHz when ``fs`` differs, low-pass filtered (``cutoff`` Hz, zero-phase
+    2nd-order Butterworth; 0 = off), divided by its maximum, multiplied by ``gain`` and
+    fed to Izhikevich neurons of firing type ``preset``.
+
+    Returns a uint8 raster ``(T_ms, rows, cols)`` at 1 kHz (1 = spike); for
+    ``encoding="sa+fa"`` the pair ``(sa, fa)``.
+
+    Raises :class:`ParameterError` for a broken option and :class:`DataError` for bad
+    samples (NaN, wrong shape, shorter than one 200 ms bin)."""
+    rec = Recording(x=x, fs=fs, slide=slide, times=times, mask=mask, name="x")
+    arrays, infos = _prepare([rec], fs, None)
+    opts = _stage_options(gain=gain, cutoff=cutoff, preset=preset, baseline=baseline,
+                          encoding=encoding, fa_gain=fa_gain, whole=whole)
+    first, fa = _native.encode(arrays[0], infos[0], opts)
+    return (first, fa) if fa is not None else first
+
+
+def features(
+    recordings: Any,
+    method: str = "glcm3d",
+    encoding: str = "sa",
+    *,
+    fs: float = 1000.0,
+    mask: Any = None,
+    speeds: Any = None,
+    gain: float = 8.0,
+    preset: str = "RS",
+    cutoff: float = 50.0,
+    baseline: Optional[str] = None,
+    whole: bool = False,
+    levels: int = 16,
+    bin_ms: int = 200,
+    distances: Sequence[int] = (1, 2, 4, 8),
+    symmetric: bool = False,
+    fa_gain: float = 8000.0,
+    haralick: str = "paper",
+    bin_widths: Sequence[int] = (50, 100, 200, 400),
+    window_mm: float = 2.0,
+) -> Tuple[np.ndarray, List[str]]:
+    """One feature row per recording, as ``neurotex features`` computes it.
+
+    ``recordings``: a list of arrays ``(T, rows, cols)``, a 4-D array
+    ``(n, T, rows, cols)``, a list of :class:`Recording`, a :class:`Dataset`, or the path
+    of a dataset folder (read by the library, as the CLI reads it). Recordings are
+    encoded and featured in parallel on all cores, without the GIL.
+
+    ``method``: ``taxel``/``all-taxels`` (MSR, CV_ISI, Fano of every taxel),
+    ``all-taxels-mm`` (per mm of travel; needs ``speeds``), ``glcm2d``, ``glcm3d`` (the
+    paper's contrast, correlation, ASM), ``glcm3d-multi``. ``encoding``: ``sa``, ``fa``
+    or ``sa+fa``.
+
+    Returns ``(X, names)``: float64 ``(n, k)`` and the ``k`` column names."""
+    if method not in METHODS:
+        raise ParameterError(
+            f"invalid parameter `method`: method must be one of {', '.join(METHODS)}, "
+            f"got {method}"
+        )
+    opts = _stage_options(
+        gain=gain, preset=preset, cutoff=cutoff, baseline=baseline, whole=whole,
+        levels=levels, bin_ms=bin_ms, distances=tuple(distances), symmetric=symmetric,
+        encoding=encoding, fa_gain=fa_gain, haralick=haralick,
+        bin_widths=tuple(bin_widths), window_mm=window_mm,
+    )
+    if isinstance(recordings, (str, os.PathLike)):
+        values, names, _ = _native.features_dataset(os.fspath(recordings), method, opts)
+        return values, names
+    dataset_baseline = recordings.baseline if isinstance(recordings, Dataset) else None
+    items = _recording_list(recordings)
+    if not items:
+        raise DataError("no recordings to compute features of")
+    arrays, infos = _prepare(items, fs, mask, speeds)
+    return _native.features(arrays, infos, method, opts, dataset_baseline)
+
+
+def _raster(spikes: Any) -> np.ndarray:
+    a = np.asarray(spikes)
+    if a.dtype == bool:
+        a = a.astype(np.uint8)
+    if a.dtype != np.uint8:
+        if a.dtype.kind in "iu" and a.size and (a.min() < 0 or a.max() > 1):
+            raise DataError("spikes: a raster holds 0 or 1")
+        if a.dtype.kind not in "iu":
+            raise DataError(f"spikes must be a uint8 raster (T, rows, cols), got dtype {a.dtype}")
+        a = a.astype(np.uint8)
+    return a
+
+
+def spike_stats(spikes: Any, bin_ms: int = 200) -> np.ndarray:
+    """MSR (Hz), CV_ISI and Fano factor (``bin_ms`` windows) of every cell of a spike
+    raster ``(T, rows, cols)`` (as :func:`encode` returns): float64 ``(rows, cols, 3)``."""
+    return _native.spike_stats(_raster(spikes), int(bin_ms))
+
+
+def rate_volume(spikes: Any, bin_ms: Optional[int] = 200) -> np.ndarray:
+    """Mean rates (Hz) in ``bin_ms`` bins of a spike raster ``(T, rows, cols)``:
+    float64 ``(rows, cols, bins)``; a last partial bin is dropped. ``bin_ms=None`` gives
+    one bin over the whole raster (the 2D-GLCM's image)."""
+    return _native.rate_volume(_raster(spikes), None if bin_ms is None else int(bin_ms))
+
+
+def _volume(v: Any) -> np.ndarray:
+    a = np.asarray(v)
+    if a.dtype.kind not in "fiu":
+        raise DataError(f"volume must hold real numbers, got dtype {a.dtype}")
+    return a.astype(np.float64, copy=False)
+
+
+def glcm3d(
+    volume: Any,
+    levels: int = 16,
+    distances: Sequence[int] = (1, 2, 4, 8),
+    symmetric: bool = False,
+    range: Optional[Tuple[float, float]] = None,
+    mask: Any = None,
+) -> np.ndarray:
+    """The mean 3D co-occurrence matrix of a rate volume ``(rows, cols, bins)``, as
+    summed counts: uint64 ``(levels, levels)``. The volume is quantised to ``levels``
+    gray levels over its own range (or ``range``), and pairs are counted for the 13
+    directions of the paper times each distance (coordinates row, col, time)."""
+    return _native.glcm(_volume(volume), True, int(levels), [int(d) for d in distances],
+                        bool(symmetric), range, _mask_list(mask, "mask"))
+
+
+def glcm2d(
+    image: Any,
+    levels: int = 16,
+    distances: Sequence[int] = (1, 2, 4, 8),
+    symmetric: bool = False,
+    range: Optional[Tuple[float, float]] = None,
+    mask: Any = None,
+) -> np.ndarray:
+    """The summed 2D co-occurrence counts of an image ``(rows, cols)`` (such as
+    ``rate_volume(spikes, None)[..., 0]``) over the first four directions times each
+    distance: uint64 ``(levels, levels)``."""
+    return _native.glcm(_volume(image), False, int(levels), [int(d) for d in distances],
+                        bool(symmetric), range, _mask_list(mask, "mask"))
+
+
+def haralick(counts: Any, full: bool = False) -> np.ndarray:
+    """Haralick features of a co-occurrence count matrix ``(L, L)`` (non-negative
+    integers, as :func:`glcm3d` returns): contrast, correlation, ASM (the paper's), or the
+    13 of :data:`HARALICK_FULL_NAMES` with ``full=True``. float64."""
+    a = np.asarray(counts)
+    if a.dtype.kind not in "iu":
+        raise DataError(f"counts must be non-negative integers, got dtype {a.dtype}")
+    if a.size and a.min() < 0:
+        raise DataError("counts must be non-negative integers")
+    return _native.haralick_features(a.astype(np.uint64, copy=False), bool(full))
+
+
+def cross_validate(
+    X: Any,
+    y: Sequence[Any],
+    classifier: str = "knn",
+    *,
+    folds: int = 5,
+    seed: int = 0,
+    repeats: int = 1,
+    **classifier_options: Any,
+) -> Dict[str, Any]:
+    """Stratified, shuffled ``folds``-fold cross-validation with the library's folds, as
+    ``neurotex evaluate`` scores a feature table: the same accuracy for the same rows,
+    labels and seed. ``classifier``: ``knn`` (``k``, ``standardize``), ``forest``
+    (``trees``, ``max_depth``, ``min_samples_leaf``, ``max_features``, ``bootstrap``,
+    ``forest_seed``: ``seed`` is the folds', as the CLI's ``--seed``) or ``linear`` (``c``, ``max_iter``, ``tol``). Returns a dict with
+    ``accuracy``, ``accuracy_std``, ``per_repeat``, ``confusion`` and ``labels``."""
+    X = np.asarray(X, dtype=np.float64)
+    if X.ndim != 2:
+        raise DataError(f"X must be (n_samples, n_features), got shape {X.shape}")
+    return _native.cross_validate(X, [str(v) for v in y], classifier, classifier_options,
+                                  int(folds), int(seed), int(repeats))
+
+
+def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = None) -> Dataset:
+    """Reads a dataset folder (``manifest.csv``, recordings, optional ``layout.toml``) as
+    the library reads it: every recording as float64 ``(T, rows, cols)`` on its grid,
+    with its label, speed, sliding phase and the layout's rate and mask. ``rows`` reads
+    only those manifest rows (0-based), e.g. one shard of a large dataset.
+
+    Raises :class:`NotFoundError` for a missing folder and :class:`DataError` for a bad
+    manifest or recording."""
+    d = _native.load_dataset(os.fspath(path), None if rows is None else [int(i) for i in rows])
+    mask = None
+    recs = []
+    for a, info in zip(d["arrays"], d["infos"]):
+        name, fs, present, label, speed, start, end, times = info
+        m = None
+        if present is not None and not all(present):
+            m = np.array(present, dtype=bool).reshape(a.shape[1], a.shape[2])
+            mask = m
+        recs.append(Recording(
+            x=a, fs=fs, label=label, speed=speed,
+            slide=None if start is None and end is None else (start, end),
+            times=None if times is None else np.array(times), mask=m, name=name))
+    return Dataset(recordings=recs, rows=list(d["rows"]), columns=list(d["columns"]),
+                   fs=d["fs"], baseline=d["baseline"], mask=mask, path=os.fspath(path))
+
+
+def save_dataset(
+    path: Union[str, os.PathLike],
+    recordings: Any,
+    labels: Sequence[Any],
+    *,
+    fs: float = 1000.0,
+    speeds: Any = None,
+    trials: Any = None,
+    forces: Any = None,
+    names: Optional[Sequence[str]] = None,
+    extra: Optional[Sequence[Dict[str, Any]]] = None,
+    mask: Any = None,
+) -> None:
+    """Writes recordings as a dataset folder the CLI reads: one ``.npy`` each (as given,
+    float32 or float64), ``manifest.csv`` (file, label, speed, force, trial, ``extra``
+    columns) and ``layout.toml`` (``fs``, mask). Written whole or not at all; the folder
+    must not exist or be empty."""
+    items = _recording_list(recordings)
+    n = len(items)
+    if len(labels) != n:
+        raise ParameterError(f"{len(labels)} labels for {n} recordings")
+    if names is None:
+        names = [f"rec_{i:05d}.npy" for i in range(n)]
+    items = [r if isinstance(r, Recording) else Recording(x=r, fs=fs) for r in items]
+    for r, nm, lab in zip(items, names, labels):
+        r.name, r.label = nm, str(lab)
+    arrays, infos = _prepare(items, fs, mask, speeds)
+    trials = [None if t is None else int(t) for t in (trials if trials is not None else [None] * n)]
+    forces = [None if f is None else float(f) for f in (forces if forces is not None else [None] * n)]
+    extra = [{str(k): str(v) for k, v in e.items()} for e in (extra or [{}] * n)]
+    _native.save_dataset(os.fspath(path), arrays, infos, trials, forces, extra, float(fs))
+
+
+def simulate(
+    out: Optional[Union[str, os.PathLike]] = None,
+    *,
+    seed: int = 0,
+    trials: int = 20,
+    speeds: Sequence[float] = (5.0, 10.0, 15.0),
+    textures: Optional[Sequence[str]] = None,
+) -> Dataset:
+    """Simulates the paper's rig (8 textures x ``speeds`` x ``trials``, deterministic for
+    ``seed``) as ``neurotex simulate`` does, writes it to ``out`` (a temporary folder when
+    ``None``) and returns it loaded: the same bits as the CLI's files."""
+    if out is None:
+        with tempfile.TemporaryDirectory() as tmp:
+            target = os.path.join(tmp, "sim")
+            _native.simulate(target, int(seed), int(trials), [float(s) for s in speeds],
+                             None if textures is None else list(textures))
+            ds = load_dataset(target)
+            ds.path = None
+            return ds
+    _native.simulate(os.fspath(out), int(seed), int(trials), [float(s) for s in speeds],
+                     None if textures is None else list(textures))
+    return load_dataset(out)
+
+
+def _fingerprint(arrays: Sequence[np.ndarray], labels: Sequence[str]) -> str:
+    h = hashlib.sha256()
+    for a, l in zip(arrays, labels):
+        h.update(str(a.shape).encode())
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+        h.update(l.encode())
+    return "python-arrays-sha256:" + h.hexdigest()
+
+
+class Model:
+    """A trained classifier with its pipeline: the model file of ``neurotex train``
+    (read with :meth:`load`, written with :meth:`save`, which the CLI reads back)."""
+
+    def __init__(self, native: Any) -> None:
+        self._native = native
+
+    @classmethod
+    def load(cls, path: Union[str, os.PathLike]) -> "Model":
+        """Reads a model file. Raises :class:`NotFoundError` or :class:`ModelError`."""
+        return cls(_native.NativeModel.load(os.fspath(path)))
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the model file (whole or not at all)."""
+        self._native.save(os.fspath(path))
+
+    @classmethod
+    def train(
+        cls,
+        recordings: Any,
+        labels: Optional[Sequence[Any]] = None,
+        method: str = "glcm3d",
+        classifier: str = "knn",
+        *,
+        fs: float = 1000.0,
+        mask: Any = None,
+        speeds: Any = None,
+        taxel: Optional[str] = None,
+        classifier_options: Optional[Dict[str, Any]] = None,
+        **stage_options: Any,
+    ) -> "Model":
+        """Trains ``classifier`` (``knn``, ``forest``, ``linear``; knobs in
+        ``classifier_options``, e.g. ``{"k": 5}``) on ``method``'s features of the
+        recordings, as ``neurotex train`` does. ``labels`` default to the recordings' own
+        (a :class:`Dataset`'s). ``stage_options`` are :func:`features`' (gain, cutoff,
+        levels, ...)."""
+        baseline = recordings.baseline if isinstance(recordings, Dataset) else None
+        items = _recording_list(recordings)
+        if labels is not None:
+            if len(labels) != len(items):
+                raise ParameterError(f"{len(labels)} labels for {len(items)} recordings")
+            items = [r if isinstance(r, Recording) else Recording(x=r, fs=fs) for r in items]
+            items = [Recording(**{**r.__dict__, "label": str(l)}) for r, l in zip(items, labels)]
+        arrays, infos = _prepare(items, fs, mask, speeds)
+        opts = _stage_options(**{k: (tuple(v) if isinstance(v, (list, tuple)) else v)
+                                 for k, v in stage_options.items()})
+        fp = _fingerprint(arrays, [i[3] for i in infos])
+        native = _native.train_model(arrays, infos, method, opts, classifier,
+                                     dict(classifier_options or {}), fp, baseline, taxel)
+        return cls(native)
+
+    def predict(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
+        """The predicted label of each recording (encoded with the model's own pipeline)."""
+        return self._predict(recordings, fs, mask)[0]
+
+    def predict_proba(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
+        """Each class's share (columns in :attr:`classes_` order): KNN's votes, the
+        forest's mean leaf shares, the logistic regression's probabilities."""
+        return self._predict(recordings, fs, mask)[1]
+
+    def _predict(self, recordings: Any, fs: float, mask: Any) -> Tuple[np.ndarray, np.ndarray]:
+        items = _recording_list(recordings)
+        arrays, infos = _prepare(items, fs, mask)
+        labels, shares = self._native.predict(arrays, infos)
+        return np.array(labels, dtype=object), shares
+
+    @property
+    def classes_(self) -> List[str]:
+        """The classes, in the order of :meth:`predict_proba`'s columns."""
+        return list(self._native.labels)
+
+    @property
+    def method(self) -> str:
+        """The feature method."""
+        return self._native.method
+
+    @property
+    def columns(self) -> List[str]:
+        """The feature columns the classifier uses."""
+        return list(self._native.columns)
+
+    @property
+    def gain(self) -> float:
+        """The encoder's gain."""
+        return self._native.gain
+
+    @property
+    def fingerprint(self) -> str:
+        """The training data's fingerprint."""
+        return self._native.fingerprint
+
+    def __repr__(self) -> str:
+        return (f"Model({self._native.classifier}, method={self.method!r}, "
+                f"classes={len(self.classes_)}, trained on {self._native.n_training})")
+
+
+__all__ = [
+    "encode", "features", "spike_stats", "rate_volume", "glcm3d", "glcm2d", "haralick",
+    "cross_validate", "load_dataset", "save_dataset", "simulate", "Model", "Recording",
+    "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",
+    "ParameterError", "DataError", "NotFoundError", "ReadWriteError", "ModelError",
+    "ClassifyError", "InternalError",
+]

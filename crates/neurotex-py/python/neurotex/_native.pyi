@@ -1,0 +1,119 @@
+"""Type stubs of the compiled half of neurotex. Use the functions of :mod:`neurotex`,
+which give these their keyword signatures; the descriptions below are the tuples they
+pass."""
+
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+# (name, fs, mask (row-major, rows*cols) or None, label, speed_mm_s, slide_start_s,
+#  slide_end_s, time stamps in s or None)
+Info = Tuple[
+    str,
+    float,
+    Optional[List[bool]],
+    str,
+    Optional[float],
+    Optional[float],
+    Optional[float],
+    Optional[List[float]],
+]
+Samples = npt.NDArray[np.floating[Any]]
+
+def library_version() -> str: ...
+def check_options(method: str, options: Dict[str, Any]) -> None: ...
+def haralick_names(full: bool) -> List[str]: ...
+def encode(
+    x: Samples, info: Info, options: Dict[str, Any], baseline: Optional[str] = None
+) -> Tuple[npt.NDArray[np.uint8], Optional[npt.NDArray[np.uint8]]]: ...
+def features(
+    recordings: Sequence[Samples],
+    infos: Sequence[Info],
+    method: str,
+    options: Dict[str, Any],
+    baseline: Optional[str] = None,
+) -> Tuple[npt.NDArray[np.float64], List[str]]: ...
+def spike_stats(spikes: npt.NDArray[np.uint8], bin_ms: int = 200) -> npt.NDArray[np.float64]: ...
+def rate_volume(
+    spikes: npt.NDArray[np.uint8], bin_ms: Optional[int] = 200
+) -> npt.NDArray[np.float64]: ...
+def glcm(
+    volume: npt.NDArray[np.float64],
+    three_d: bool,
+    levels: int,
+    distances: List[int],
+    symmetric: bool,
+    range: Optional[Tuple[float, float]] = None,
+    mask: Optional[List[bool]] = None,
+) -> npt.NDArray[np.uint64]: ...
+def haralick_features(counts: npt.NDArray[np.uint64], full: bool = False) -> npt.NDArray[np.float64]: ...
+def cross_validate(
+    x: npt.NDArray[np.float64],
+    y: List[str],
+    kind: str,
+    options: Dict[str, Any],
+    folds: int = 5,
+    seed: int = 0,
+    repeats: int = 1,
+) -> Dict[str, Any]: ...
+def load_dataset(dir: str, indices: Optional[List[int]] = None) -> Dict[str, Any]: ...
+def features_dataset(
+    dir: str, method: str, options: Dict[str, Any]
+) -> Tuple[npt.NDArray[np.float64], List[str], List[Dict[str, str]]]: ...
+def save_dataset(
+    dir: str,
+    recordings: Sequence[Samples],
+    infos: Sequence[Info],
+    trials: List[Optional[int]],
+    forces: List[Optional[float]],
+    extra: List[Dict[str, str]],
+    fs: float,
+) -> None: ...
+def simulate(
+    out: str, seed: int, trials: int, speeds: List[float], textures: Optional[List[str]] = None
+) -> None: ...
+def train_model(
+    recordings: Sequence[Samples],
+    infos: Sequence[Info],
+    method: str,
+    options: Dict[str, Any],
+    classifier: str,
+    classifier_options: Dict[str, Any],
+    fingerprint: str,
+    baseline: Optional[str] = None,
+    taxel: Optional[str] = None,
+) -> NativeModel: ...
+
+class NativeModel:
+    @staticmethod
+    def load(path: str) -> NativeModel: ...
+    def save(self, path: str) -> None: ...
+    def predict(
+        self, recordings: Sequence[Samples], infos: Sequence[Info]
+    ) -> Tuple[List[str], npt.NDArray[np.float64]]: ...
+    @property
+    def labels(self) -> List[str]: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def columns(self) -> List[str]: ...
+    @property
+    def classifier(self) -> str: ...
+    @property
+    def n_training(self) -> int: ...
+    @property
+    def gain(self) -> float: ...
+    @property
+    def fingerprint(self) -> str: ...
+
+class FittedClassifier:
+    @staticmethod
+    def fit(
+        kind: str, options: Dict[str, Any], x: npt.NDArray[np.float64], y: List[int]
+    ) -> FittedClassifier: ...
+    @property
+    def n_iter(self) -> Optional[int]: ...
+    def predict(
+        self, x: npt.NDArray[np.float64]
+    ) -> Tuple[List[int], npt.NDArray[np.float64]]: ...

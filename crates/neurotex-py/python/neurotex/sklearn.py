@@ -1,0 +1,232 @@
+"""scikit-learn estimators over neurotex: a transformer from recordings to features
+(:class:`SpikeFeatures`) and the library's classifiers (:class:`KNNClassifier`,
+:class:`RandomForestClassifier`, :class:`LogisticRegression`). They follow scikit-learn's
+conventions (``get_params``/``set_params``, ``clone``, ``Pipeline``, ``GridSearchCV``)::
+
+    from sklearn.pipeline import make_pipeline
+    from sklearn.model_selection import cross_val_score
+    from neurotex.sklearn import SpikeFeatures, KNNClassifier
+
+    pipe = make_pipeline(SpikeFeatures(method="glcm3d"), KNNClassifier(k=5))
+    cross_val_score(pipe, dataset.recordings, dataset.labels, cv=5)
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict, List, Optional, Sequence
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+from . import _native, features as _features
+
+__all__ = ["SpikeFeatures", "KNNClassifier", "RandomForestClassifier", "LogisticRegression"]
+
+
+class SpikeFeatures(TransformerMixin, BaseEstimator):
+    """Recordings to spike features, as :func:`neurotex.features` computes them.
+
+    ``X`` is a list of arrays ``(T, rows, cols)``, a 4-D array ``(n, T, rows, cols)`` or
+    a list of :class:`neurotex.Recording` (``Dataset.recordings``, which keep each
+    recording's sliding phase). The transformer learns nothing: every parameter is the
+    pipeline's (the paper's defaults), so ``fit`` only checks them.
+
+    Parameters are those of :func:`neurotex.features`: ``method``, ``encoding``, ``gain``,
+    ``preset``, ``cutoff``, ``baseline``, ``whole``, ``levels``, ``bin_ms``,
+    ``distances``, ``symmetric``, ``fa_gain``, ``haralick``, ``bin_widths``,
+    ``window_mm``, and ``fs`` for bare arrays."""
+
+    def __init__(
+        self,
+        method: str = "glcm3d",
+        encoding: str = "sa",
+        gain: float = 8.0,
+        preset: str = "RS",
+        cutoff: float = 50.0,
+        baseline: Optional[str] = None,
+        whole: bool = False,
+        levels: int = 16,
+        bin_ms: int = 200,
+        distances: Sequence[int] = (1, 2, 4, 8),
+        symmetric: bool = False,
+        fa_gain: float = 8000.0,
+        haralick: str = "paper",
+        bin_widths: Sequence[int] = (50, 100, 200, 400),
+        window_mm: float = 2.0,
+        fs: float = 1000.0,
+    ) -> None:
+        self.method = method
+        self.encoding = encoding
+        self.gain = gain
+        self.preset = preset
+        self.cutoff = cutoff
+        self.baseline = baseline
+        self.whole = whole
+        self.levels = levels
+        self.bin_ms = bin_ms
+        self.distances = distances
+        self.symmetric = symmetric
+        self.fa_gain = fa_gain
+        self.haralick = haralick
+        self.bin_widths = bin_widths
+        self.window_mm = window_mm
+        self.fs = fs
+
+    def _kwargs(self) -> Dict[str, Any]:
+        p = self.get_params()
+        p.pop("method")
+        p.pop("encoding")
+        return p
+
+    def fit(self, X: Any, y: Any = None) -> "SpikeFeatures":
+        """Checks the parameters (raising :class:`neurotex.ParameterError`); learns
+        nothing from ``X``."""
+        from . import _stage_options
+
+        opts = _stage_options(
+            gain=self.gain, preset=self.preset, cutoff=self.cutoff, baseline=self.baseline,
+            whole=self.whole, levels=self.levels, bin_ms=self.bin_ms,
+            distances=tuple(self.distances), symmetric=self.symmetric,
+            encoding=self.encoding, fa_gain=self.fa_gain, haralick=self.haralick,
+            bin_widths=tuple(self.bin_widths), window_mm=self.window_mm,
+        )
+        _native.check_options(self.method, opts)
+        self.n_recordings_seen_ = len(X)
+        self.feature_names_out_: Optional[List[str]] = None
+        return self
+
+    def transform(self, X: Any) -> np.ndarray:
+        """The feature matrix ``(n, k)``, float64."""
+        check_is_fitted(self, "n_recordings_seen_")
+        values, names = _features(X, self.method, self.encoding, **self._kwargs())
+        self.feature_names_out_ = names
+        return values
+
+    def get_feature_names_out(self, input_features: Any = None) -> np.ndarray:
+        """The column names of the last :meth:`transform` (they depend on the grid)."""
+        check_is_fitted(self, "n_recordings_seen_")
+        if self.feature_names_out_ is None:
+            raise ValueError("the feature names are known after the first transform")
+        return np.asarray(self.feature_names_out_, dtype=object)
+
+    def __sklearn_tags__(self):  # noqa: D105
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        tags.requires_fit = True
+        return tags
+
+
+class _LibraryClassifier(ClassifierMixin, BaseEstimator):
+    """A classifier of the library fitted on a feature matrix."""
+
+    _kind = ""
+
+    def _options(self) -> Dict[str, Any]:
+        return {k: v for k, v in self.get_params().items() if v is not None}
+
+    def fit(self, X: Any, y: Any) -> "_LibraryClassifier":
+        """Fits on ``X`` (n_samples, n_features) and labels ``y``."""
+        X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=False)
+        from sklearn.utils.multiclass import check_classification_targets
+
+        check_classification_targets(y)
+        self.classes_ = np.unique(y)
+        # Classes are indexed in order of first appearance, as the CLI indexes them, so
+        # that ties resolve as they do there.
+        first = {}
+        for label in y:
+            first.setdefault(label, len(first))
+        self._order = np.array(list(first), dtype=self.classes_.dtype)
+        index = np.array([first[label] for label in y], dtype=np.int64)
+        self._training = (np.ascontiguousarray(X), [int(i) for i in index])
+        self._fitted = self._fit_native()
+        # columns of the library's shares -> columns in classes_ order
+        self._to_sorted = np.searchsorted(self.classes_, self._order)
+        return self
+
+    def _fit_native(self) -> Any:
+        X, index = self._training
+        return _native.FittedClassifier.fit(self._kind, self._options(), X, index)
+
+    def __getstate__(self) -> Dict[str, Any]:
+        # The native model is not picklable; the training set is kept instead and the
+        # (deterministic, seeded) fit repeated on unpickling, giving the same model.
+        state = self.__dict__.copy()
+        state.pop("_fitted", None)
+        return state
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        if "_training" in state:
+            self._fitted = self._fit_native()
+
+    def predict(self, X: Any) -> np.ndarray:
+        """The predicted label of each row."""
+        check_is_fitted(self, "_fitted")
+        X = validate_data(self, X, dtype=np.float64, reset=False)
+        predicted, _ = self._fitted.predict(np.ascontiguousarray(X))
+        return self._order[np.asarray(predicted, dtype=np.int64)]
+
+    def predict_proba(self, X: Any) -> np.ndarray:
+        """Each class's share, columns in ``classes_`` order."""
+        check_is_fitted(self, "_fitted")
+        X = validate_data(self, X, dtype=np.float64, reset=False)
+        _, shares = self._fitted.predict(np.ascontiguousarray(X))
+        out = np.zeros((shares.shape[0], len(self.classes_)))
+        n = min(shares.shape[1], len(self._order))
+        out[:, self._to_sorted[:n]] = shares[:, :n]
+        return out
+
+
+class KNNClassifier(_LibraryClassifier):
+    """k nearest neighbours (Euclidean, majority vote; a tie goes to the tied class with
+    the nearest member), features z-scored with training statistics unless
+    ``standardize=False``: the paper's classifier, as ``neurotex evaluate`` runs it."""
+
+    _kind = "knn"
+
+    def __init__(self, k: int = 5, standardize: bool = True) -> None:
+        self.k = k
+        self.standardize = standardize
+
+
+class RandomForestClassifier(_LibraryClassifier):
+    """The library's random forest (``--classifier forest``), seeded."""
+
+    _kind = "forest"
+
+    def __init__(
+        self,
+        trees: int = 200,
+        max_depth: Optional[int] = None,
+        min_samples_leaf: int = 1,
+        max_features: Optional[int] = None,
+        bootstrap: bool = True,
+        seed: int = 0,
+    ) -> None:
+        self.trees = trees
+        self.max_depth = max_depth
+        self.min_samples_leaf = min_samples_leaf
+        self.max_features = max_features
+        self.bootstrap = bootstrap
+        self.seed = seed
+
+
+class LogisticRegression(_LibraryClassifier):
+    """The library's multinomial logistic regression (``--classifier linear``), L2
+    penalty with scikit-learn's ``C``, fitted by L-BFGS."""
+
+    _kind = "linear"
+
+    def __init__(self, c: float = 1.0, max_iter: int = 1000, tol: float = 1e-8) -> None:
+        self.c = c
+        self.max_iter = max_iter
+        self.tol = tol
+
+    def fit(self, X: Any, y: Any) -> "LogisticRegression":
+        """Fits on ``X`` and ``y``; ``n_iter_`` holds the L-BFGS iterations."""
+        super().fit(X, y)
+        self.n_iter_ = np.array([self._fitted.n_iter])
+        return self

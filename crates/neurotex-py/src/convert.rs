@@ -1,0 +1,211 @@
+//! numpy arrays in: views of the caller's memory (any strides, float32 or float64), read
+//! without the GIL into the library's recordings and rasters.
+
+use ndarray::ArrayViewD;
+use neurotex::recording::{Layout, Meta, Recording, DEFAULT_MAX_DURATION_S};
+use numpy::PyReadonlyArrayDyn;
+use pyo3::prelude::*;
+
+use crate::errors::{raise, Kind};
+
+/// A borrowed numpy array of samples, float32 or float64, as the caller laid it out.
+pub enum Samples<'py> {
+    /// float32 samples (widened exactly to f64, as the CLI reads a float32 `.npy`).
+    F32(PyReadonlyArrayDyn<'py, f32>),
+    /// float64 samples.
+    F64(PyReadonlyArrayDyn<'py, f64>),
+}
+
+/// A view of the samples that may cross into code running without the GIL.
+pub enum SamplesView<'a> {
+    /// float32 samples.
+    F32(ArrayViewD<'a, f32>),
+    /// float64 samples.
+    F64(ArrayViewD<'a, f64>),
+}
+
+impl<'py> Samples<'py> {
+    /// Borrows `array`, which must be a float32 or float64 numpy array (the Python layer
+    /// converts other numeric types first).
+    pub fn borrow(array: &Bound<'py, PyAny>, what: &str) -> PyResult<Self> {
+        if let Ok(a) = array.extract::<PyReadonlyArrayDyn<'py, f64>>() {
+            return Ok(Samples::F64(a));
+        }
+        if let Ok(a) = array.extract::<PyReadonlyArrayDyn<'py, f32>>() {
+            return Ok(Samples::F32(a));
+        }
+        Err(raise(
+            Kind::Data,
+            format!("{what}: samples must be a float32 or float64 numpy array"),
+        ))
+    }
+
+    /// The view.
+    pub fn view(&self) -> SamplesView<'_> {
+        match self {
+            Samples::F32(a) => SamplesView::F32(a.as_array()),
+            Samples::F64(a) => SamplesView::F64(a.as_array()),
+        }
+    }
+}
+
+/// What a recording carries beside its samples.
+#[derive(Debug, Clone, Default)]
+pub struct RecordingInfo {
+    /// Name used in error messages (`recording 3`, or the dataset file).
+    pub name: String,
+    /// Sampling rate in Hz.
+    pub fs: f64,
+    /// Grid cells holding a taxel (row-major); `None`: every cell.
+    pub present: Option<Vec<bool>>,
+    /// Time stamps in s of an irregularly sampled recording (strictly increasing, one per
+    /// sample); `None`: regular sampling at `fs`.
+    pub times_s: Option<Vec<f64>>,
+    /// Manifest fields: label, speed, slide interval.
+    pub meta: Meta,
+}
+
+impl SamplesView<'_> {
+    /// The samples in C order as f64, with the recording's grid: `(T, rows, cols)` or
+    /// `(T, channels)` (a `1 x channels` grid, as the CLI reads a `(T, channels)` file
+    /// without a layout). Checks what the CLI's reader checks: shape, finite samples,
+    /// duration within the per-recording limit.
+    ///
+    /// # Errors
+    /// A `DataError` naming the recording and what is wrong.
+    pub fn recording(&self, info: &RecordingInfo) -> Result<Recording, String> {
+        let shape = match self {
+            SamplesView::F32(a) => a.shape(),
+            SamplesView::F64(a) => a.shape(),
+        };
+        let name = &info.name;
+        let (t, rows, cols) = match *shape {
+            [t, r, c] => (t, r, c),
+            [t, n] => (t, 1, n),
+            ref other => {
+                return Err(format!(
+                    "{name}: expected shape (T, rows, cols) or (T, channels), got {other:?}"
+                ))
+            }
+        };
+        neurotex::values::check_grid_cells(rows, cols)
+            .map_err(|e| format!("{name}: shape {shape:?}: {e}"))?;
+        if !(info.fs.is_finite() && info.fs > 0.0) {
+            return Err(format!(
+                "{name}: fs must be a positive sampling rate in Hz, got {}",
+                info.fs
+            ));
+        }
+        let span = match &info.times_s {
+            Some(times) => {
+                if times.len() != t {
+                    return Err(format!(
+                        "{name}: {} time stamps for {t} samples",
+                        times.len()
+                    ));
+                }
+                if let Some(i) = times
+                    .windows(2)
+                    .position(|w| !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]))
+                {
+                    return Err(format!(
+                        "{name}: time stamps must be finite and strictly increasing; stamp {} \
+                         is {} after {}",
+                        i + 1,
+                        times[i + 1],
+                        times[i]
+                    ));
+                }
+                match times[..] {
+                    [first, .., last] => last - first,
+                    _ => 0.0,
+                }
+            }
+            None => t as f64 / info.fs,
+        };
+        if span > DEFAULT_MAX_DURATION_S {
+            return Err(format!(
+                "{name}: {t} samples at {} Hz last {span} s, beyond the limit of \
+                 {DEFAULT_MAX_DURATION_S} s per recording",
+                info.fs
+            ));
+        }
+        // Logical (C) order whatever the strides: a C-contiguous array is one copy.
+        let samples: Vec<f64> = match self {
+            SamplesView::F64(a) => match a.as_slice() {
+                Some(s) => s.to_vec(),
+                None => a.iter().copied().collect(),
+            },
+            SamplesView::F32(a) => match a.as_slice() {
+                Some(s) => s.iter().map(|&v| f64::from(v)).collect(),
+                None => a.iter().map(|&v| f64::from(v)).collect(),
+            },
+        };
+        let n_cells = rows * cols;
+        if let Some(pos) = samples.iter().position(|v| !v.is_finite()) {
+            return Err(format!(
+                "{name}: sample {} of channel {} is {} (every sample must be a finite number)",
+                pos / n_cells,
+                pos % n_cells,
+                samples[pos]
+            ));
+        }
+        let mut layout = Layout::grid(rows, cols);
+        if let Some(present) = &info.present {
+            if present.len() != n_cells {
+                return Err(format!(
+                    "{name}: the mask has {} cells but the recording's grid is {rows}x{cols}",
+                    present.len()
+                ));
+            }
+            layout.present = present.clone();
+        }
+        Ok(Recording {
+            fs: info.fs,
+            layout,
+            samples,
+            times_s: info.times_s.clone(),
+            phases: None,
+            meta: Meta {
+                file: info.meta.file.clone(),
+                ..info.meta.clone()
+            },
+        })
+    }
+}
+
+/// A borrowed spike raster: uint8 `(T, rows, cols)`.
+pub fn raster_of(raster: &PyReadonlyArrayDyn<'_, u8>) -> PyResult<(Vec<u8>, usize, usize)> {
+    let a = raster.as_array();
+    let (rows, cols) = match *a.shape() {
+        [_, r, c] => (r, c),
+        ref other => {
+            return Err(raise(
+                Kind::Data,
+                format!(
+                    "spikes must be a uint8 array of shape (T, rows, cols), got shape {other:?}"
+                ),
+            ))
+        }
+    };
+    if rows * cols == 0 {
+        return Err(raise(Kind::Data, "spikes: the grid has no cells"));
+    }
+    let data: Vec<u8> = match a.as_slice() {
+        Some(s) => s.to_vec(),
+        None => a.iter().copied().collect(),
+    };
+    if let Some(pos) = data.iter().position(|&v| v > 1) {
+        let cells = rows * cols;
+        return Err(raise(
+            Kind::Data,
+            format!(
+                "spikes: value {} at step {} of cell {} (a raster holds 0 or 1)",
+                data[pos],
+                pos / cells,
+                pos % cells
+            ),
+        ));
+    }
+    Ok((data, rows, cols))
+}

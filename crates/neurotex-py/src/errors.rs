@@ -1,0 +1,119 @@
+//! The library's errors as Python exceptions of `neurotex.errors`, and panics caught before
+//! they reach Python.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use neurotex::error::{DataError, ParamError};
+use pyo3::prelude::*;
+
+/// The exception classes of `neurotex.errors`, by name.
+#[derive(Debug, Clone, Copy)]
+pub enum Kind {
+    /// A parameter broke its rule (also a `ValueError`).
+    Parameter,
+    /// Bad input data (also a `ValueError`).
+    Data,
+    /// A file or folder that does not exist (also a `FileNotFoundError`).
+    NotFound,
+    /// Another input/output failure (also an `OSError`).
+    Io,
+    /// A model file that cannot be used (also a `ValueError`).
+    Model,
+    /// Training or prediction data a classifier cannot use (also a `ValueError`).
+    Classify,
+    /// A bug: a panic inside neurotex, caught at the boundary.
+    Internal,
+}
+
+impl Kind {
+    fn class_name(self) -> &'static str {
+        match self {
+            Kind::Parameter => "ParameterError",
+            Kind::Data => "DataError",
+            Kind::NotFound => "NotFoundError",
+            Kind::Io => "ReadWriteError",
+            Kind::Model => "ModelError",
+            Kind::Classify => "ClassifyError",
+            Kind::Internal => "InternalError",
+        }
+    }
+}
+
+/// A Python exception of class `kind` with `message`.
+pub fn raise(kind: Kind, message: impl Into<String>) -> PyErr {
+    let message = message.into();
+    Python::attach(|py| {
+        let class = py
+            .import("neurotex.errors")
+            .and_then(|m| m.getattr(kind.class_name()));
+        match class.and_then(|c| c.call1((message.clone(),))) {
+            Ok(value) => PyErr::from_value(value),
+            // Only when the package's Python half is missing (the module imported alone).
+            Err(_) => pyo3::exceptions::PyRuntimeError::new_err(message),
+        }
+    })
+}
+
+/// The exception class a library error belongs to.
+fn kind_of(error: &neurotex::Error) -> Kind {
+    use neurotex::Error as E;
+    match error {
+        E::Param(_) => Kind::Parameter,
+        E::Data(DataError::Io { source, .. }) => io_kind(source),
+        E::Data(_) | E::Dataset(_) => Kind::Data,
+        E::Classify(_) | E::Stats(_) => Kind::Classify,
+        E::Model(_) => Kind::Model,
+        E::InRecording { source, .. } => kind_of(source),
+        // The library's error enum may grow; a new stage's errors are bad input until
+        // this layer learns better.
+        #[allow(unreachable_patterns)]
+        _ => Kind::Data,
+    }
+}
+
+/// `NotFound` for a missing file, the general input/output class otherwise.
+fn io_kind(error: &std::io::Error) -> Kind {
+    match error.kind() {
+        std::io::ErrorKind::NotFound => Kind::NotFound,
+        _ => Kind::Io,
+    }
+}
+
+/// A library error as the Python exception of its kind, with the library's message.
+pub fn to_py(error: neurotex::Error) -> PyErr {
+    raise(kind_of(&error), error.to_string())
+}
+
+/// A parameter error as a `neurotex.ParameterError`.
+pub fn param(error: ParamError) -> PyErr {
+    raise(Kind::Parameter, error.to_string())
+}
+
+/// Runs `f`, turning a panic into a `neurotex.InternalError` (no panic crosses into
+/// Python) and a library error into its exception.
+pub fn guarded<T>(f: impl FnOnce() -> neurotex::Result<T>) -> PyResult<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(value)) => Ok(value),
+        Ok(Err(error)) => Err(to_py(error)),
+        Err(panic) => Err(raise(Kind::Internal, panic_message(panic))),
+    }
+}
+
+/// Runs `f`, which returns Python errors already, turning a panic into a
+/// `neurotex.InternalError`.
+pub fn guarded_py<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(result) => result,
+        Err(panic) => Err(raise(Kind::Internal, panic_message(panic))),
+    }
+}
+
+/// The text of a caught panic.
+fn panic_message(panic: Box<dyn std::any::Any + Send>) -> String {
+    let text = panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_string());
+    format!("internal error in neurotex (please report it): {text}")
+}

@@ -1,0 +1,126 @@
+"""Bad input raises the right exception with the library's message; nothing panics."""
+
+import json
+
+import numpy as np
+import pytest
+
+import neurotex
+from neurotex import errors
+
+GOOD = np.random.default_rng(1).random((1000, 4, 4))
+
+
+@pytest.mark.parametrize("x,exc,match", [
+    (np.full((1000, 4, 4), np.nan), errors.DataError, "sample 0 of channel 0 is NaN"),
+    (np.where(np.arange(16000).reshape(1000, 4, 4) == 7000, np.inf, GOOD), errors.DataError,
+     "sample 437 of channel 8 is inf"),
+    (np.zeros((100, 4, 4)), errors.DataError, "shorter than one 200 ms bin"),
+    (np.zeros((10, 2, 2, 2)), errors.DataError, "expected shape"),
+    (np.zeros(1000), errors.DataError, "expected shape"),
+    (np.array([["a"]]), errors.DataError, "real numbers"),
+    (np.zeros((0, 4, 4)), errors.DataError, "recording holds no samples"),
+])
+def test_bad_samples(x, exc, match):
+    with pytest.raises(exc, match=match) as info:
+        neurotex.encode(x)
+    assert isinstance(info.value, ValueError) and isinstance(info.value, neurotex.Error)
+
+
+@pytest.mark.parametrize("kwargs,name", [
+    ({"gain": -1.0}, "gain"),
+    ({"levels": 1}, "levels"),
+    ({"levels": 300}, "levels"),
+    ({"bin_ms": 0}, "bin-ms"),
+    ({"distances": ()}, "distances"),
+    ({"distances": (0,)}, "distances"),
+    ({"cutoff": -5.0}, "cutoff"),
+    ({"encoding": "xa"}, "encoding"),
+    ({"preset": "ZZ"}, "preset|firing"),
+    ({"haralick": "most"}, "haralick"),
+    ({"baseline": "max"}, "baseline"),
+    ({"window_mm": 0.0}, "window"),
+    ({"bin_widths": ()}, "bin-widths"),
+    ({"gain": "high"}, "gain"),
+    ({"levels": 2.5}, "levels"),
+    ({"distances": (1, -2)}, "distances"),
+])
+def test_bad_options(kwargs, name):
+    with pytest.raises(errors.ParameterError, match=name):
+        neurotex.features([GOOD], "glcm3d", **kwargs)
+
+
+def test_bad_method_and_fs():
+    with pytest.raises(errors.ParameterError, match="method"):
+        neurotex.features([GOOD], "glcm4d")
+    with pytest.raises(errors.DataError, match="fs must be a positive"):
+        neurotex.features([GOOD], fs=0.0)
+    with pytest.raises(errors.DataError, match="speed"):
+        neurotex.features([GOOD], "all-taxels-mm")
+
+
+def test_mixed_grids_are_refused():
+    with pytest.raises(errors.DataError, match="grid"):
+        neurotex.features([GOOD, np.random.default_rng(2).random((1000, 2, 8))])
+
+
+def test_rasters_and_volumes():
+    with pytest.raises(errors.DataError, match="0 or 1"):
+        neurotex.spike_stats(np.full((300, 2, 2), 3, dtype=np.uint8))
+    with pytest.raises(errors.DataError, match="shorter"):
+        neurotex.spike_stats(np.zeros((100, 2, 2), dtype=np.uint8))
+    with pytest.raises(errors.DataError, match="shape"):
+        neurotex.rate_volume(np.zeros((300, 4), dtype=np.uint8))
+    with pytest.raises(errors.DataError, match="finite"):
+        neurotex.glcm3d(np.full((2, 2, 3), np.nan))
+    with pytest.raises(errors.ParameterError, match="range"):
+        neurotex.glcm3d(np.ones((2, 2, 3)), range=(5.0, 1.0))
+    with pytest.raises(errors.DataError, match="square"):
+        neurotex.haralick(np.ones((3, 4), dtype=np.uint64))
+    with pytest.raises(errors.DataError, match="non-negative"):
+        neurotex.haralick(-np.ones((3, 3), dtype=np.int64))
+
+
+def test_files(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no such dataset folder") as info:
+        neurotex.load_dataset(tmp_path / "nowhere")
+    assert isinstance(info.value, neurotex.NotFoundError)
+    with pytest.raises(FileNotFoundError):
+        neurotex.Model.load(tmp_path / "missing.json")
+    (tmp_path / "other.json").write_text(json.dumps({"format": "something-else"}))
+    with pytest.raises(errors.ModelError, match="not a neurotex model|format"):
+        neurotex.Model.load(tmp_path / "other.json")
+    (tmp_path / "cut.json").write_text('{"format": "neurotex-model", "version": 1, "pipe')
+    with pytest.raises(errors.ModelError):
+        neurotex.Model.load(tmp_path / "cut.json")
+    (tmp_path / "ds").mkdir()
+    (tmp_path / "ds" / "manifest.csv").write_text("file,label\nmissing.npy,a\n")
+    with pytest.raises(errors.DataError, match="line 2: file `missing.npy` does not exist"):
+        neurotex.load_dataset(tmp_path / "ds")
+    with pytest.raises(errors.DataError, match="not empty|exists"):
+        neurotex.save_dataset(tmp_path / "ds", [GOOD], ["a"])
+
+
+def test_classifiers():
+    X = np.random.default_rng(0).random((6, 3))
+    y = ["a", "a", "a", "b", "b", "b"]
+    with pytest.raises(errors.ClassifyError, match="k = 9 neighbours"):
+        neurotex.cross_validate(X, y, "knn", k=9, folds=2)
+    with pytest.raises(errors.ClassifyError, match="class `b` has 2 samples, fewer than the 5"):
+        neurotex.cross_validate(np.random.default_rng(0).random((12, 3)), ["a"] * 10 + ["b"] * 2)
+    with pytest.raises(errors.ParameterError, match="classifier"):
+        neurotex.cross_validate(X, y, "svm")
+    with pytest.raises(errors.ParameterError, match="trees"):
+        neurotex.cross_validate(X, y, "forest", trees=0, folds=2)
+    with pytest.raises(errors.ParameterError, match="unknown"):
+        neurotex.cross_validate(X, y, "knn", neighbours=3, folds=2)
+
+
+def test_model_train_errors(tmp_path):
+    recs = [GOOD, GOOD * 0.5]
+    with pytest.raises(errors.ClassifyError, match="k = 5"):
+        neurotex.Model.train(recs, ["a", "b"])
+    with pytest.raises(errors.ParameterError, match="taxel"):
+        neurotex.Model.train(recs, ["a", "b"], method="glcm3d", taxel="0,0")
+    with pytest.raises(errors.ParameterError, match="labels"):
+        neurotex.Model.train(recs, ["a"])
