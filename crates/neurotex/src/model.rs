@@ -664,6 +664,7 @@ mod tests {
             baseline: Baseline::Min,
             speeds: Some(vec![Speed::of(5.0)]),
             gain_calibration: None,
+            median_duration_ms: None,
         }
     }
 
