@@ -247,6 +247,9 @@ pub struct CausalPrepared {
     pub seconds: f64,
 }
 
+/// One speed's causal conditioning and the pipeline applying it, or why it could not be fixed.
+type CausalPipeline = std::result::Result<(ConditioningCalibration, Pipeline), String>;
+
 /// With E5c, the causal conditioning of each speed, fixed on all of its recordings (labels
 /// unused: each is in some training fold of the cross-validation), and the pipeline that
 /// applies it; a speed where it cannot be fixed gets the reason instead.
@@ -254,14 +257,7 @@ fn causal_pipelines(
     source: &Source,
     params: &ValidReproduceParams,
     conditions: &[(Speed, String)],
-) -> Result<
-    Option<
-        Vec<(
-            Speed,
-            std::result::Result<(ConditioningCalibration, Pipeline), String>,
-        )>,
-    >,
-> {
+) -> Result<Option<Vec<(Speed, CausalPipeline)>>> {
     if !params.e5_causal {
         return Ok(None);
     }
