@@ -271,7 +271,14 @@ pub fn calibrate_conditioning(
         return Err(ParamError::new("causal", rule, "none").into());
     }
     let baseline = params.preprocess.baseline.unwrap_or(dataset_baseline);
-    let per_recording: Vec<Vec<f64>> = indices
+    // Without a baseline every recording's resting values are zeros, so one recording
+    // gives the grid's size and the others need not be loaded twice (a recording of
+    // another grid is still refused, by the conditioning below).
+    let first_only = match baseline {
+        Baseline::None => &indices[..1],
+        _ => indices,
+    };
+    let per_recording: Vec<Vec<f64>> = first_only
         .par_iter()
         .map(|&i| {
             let rec = load(i)?;

@@ -14,6 +14,7 @@ mod e1_accuracy;
 mod e2_confusion;
 mod e3_perturbation;
 mod e4_temporal;
+mod e5_causal;
 mod e5_time;
 mod e6_speed_invariance;
 mod e7_gain;
@@ -42,13 +43,14 @@ pub use e1_accuracy::{e1_accuracy, E1Speed};
 pub use e2_confusion::{e2_confusion, E2};
 pub use e3_perturbation::{e3_perturbation, E3};
 pub use e4_temporal::{e4_temporal, E4Speed};
+pub use e5_causal::{e5_causal, E5CausalSpeed, E5cFraction, TimeToDecision};
 pub use e5_time::{e5_time_to_recognition, E5Speed};
 pub use e6_speed_invariance::{e6_speed_invariance, E6Speed};
 pub use e7_gain::{e7_gain_sweep, E7};
 pub use e8_neighbours::{e8_neighbours, E8Speed};
 pub use e9_compare::{e9_compare, E9};
 pub use params::{ReproduceParams, ValidReproduceParams, MAX_REPEATS};
-pub use prepare::{prepare, IsiSweep, Prepared, Source};
+pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, Source};
 pub use provenance::Provenance;
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
 pub use sensitivity::{sensitivity, Sensitivity, SensitivitySpeed};
@@ -106,6 +108,10 @@ pub struct Results {
     pub e4: BySpeed<E4Speed>,
     /// E5 by speed.
     pub e5: BySpeed<E5Speed>,
+    /// E5c (beyond the paper) by speed: the causal pipeline's accuracy against time into
+    /// the slide, its time to decision and its cost against E1's zero-phase 3D-GLCM.
+    #[serde(default, skip_serializing_if = "BySpeed::is_empty")]
+    pub e5c: BySpeed<E5CausalSpeed>,
     /// E6 by held-out speed.
     pub e6: BySpeed<E6Speed>,
     /// E7.
@@ -153,6 +159,7 @@ impl Results {
             e3: None,
             e4: BySpeed::new(),
             e5: BySpeed::new(),
+            e5c: BySpeed::new(),
             e6: BySpeed::new(),
             e7: None,
             e8: BySpeed::new(),
@@ -222,7 +229,7 @@ pub struct Analysis {
 
 /// The analyses in the order they run (E0 last: it shows examples, and the paper's own
 /// order puts the accuracies first).
-pub const ANALYSES: [Analysis; 11] = [
+pub const ANALYSES: [Analysis; 12] = [
     Analysis {
         id: "e1",
         run: |c, r| {
@@ -255,6 +262,15 @@ pub const ANALYSES: [Analysis; 11] = [
         id: "e5",
         run: |c, r| {
             r.e5 = e5_time_to_recognition(c)?;
+            Ok(())
+        },
+    },
+    Analysis {
+        id: "e5c",
+        run: |c, r| {
+            let (e5c, skipped) = e5_causal(c, &r.e5)?;
+            skipped.iter().for_each(|s| r.skip(s));
+            r.e5c = e5c;
             Ok(())
         },
     },
@@ -318,6 +334,11 @@ pub fn run_all(
 ) -> Result<Results> {
     let mut results = Results::empty(prepared);
     results.timing_s.insert("prepare".into(), prepared.seconds);
+    if let Some(causal) = &prepared.causal {
+        // Part of `prepare`: the causal conditioning fixed on every recording, loaded again.
+        let key = "prepare: e5c calibration";
+        results.timing_s.insert(key.into(), causal.seconds);
+    }
     progress(Progress::Stage("analyses", ANALYSES.len() + 1));
     let clock = Instant::now();
     let tables = Tables::build(prepared, params)?;

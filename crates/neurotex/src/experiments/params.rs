@@ -43,6 +43,9 @@ pub struct ReproduceParams {
     pub e9: bool,
     /// E9: cross-validation repeats (each candidate gets the same folds).
     pub e9_repeats: usize,
+    /// E5c (beyond the paper): the causal pipeline's accuracy against time into the slide
+    /// and its time to decision, beside the offline E5; `false` skips it.
+    pub e5_causal: bool,
 }
 
 impl Default for ReproduceParams {
@@ -69,6 +72,7 @@ impl Default for ReproduceParams {
             // One repeat: the intervals come from the bootstrap over recordings, and the
             // search over 28 candidates is the longest analysis of the run.
             e9_repeats: 1,
+            e5_causal: true,
         }
     }
 }
@@ -129,6 +133,13 @@ impl ReproduceParams {
             ),
         ]
         .into_iter()
+        .chain(self.e5_causal.then(|| {
+            let rule = crate::causal::DecisionRule::default();
+            format!(
+                "E5c: causal conditioning (forward-only low-pass; resting values and scale fixed per speed on all of that speed's recordings, labels unused), a classification at every bin over the slide so far, E1's folds; decided at a share of {} of the vote in {} consecutive bins",
+                rule.share, rule.bins
+            )
+        }))
         .chain(self.e9.then(|| {
             format!(
                 "E9: the standard candidates of `neurotex compare`, {}-fold CV with {} repeat(s) within each speed, and each speed held out with nested selection",
@@ -247,12 +258,13 @@ impl ValidReproduceParams {
         .unwrap_or(self.cv)
     }
 
-    /// The same parameters without the numerical sensitivity check and E9 (the further
+    /// The same parameters without the numerical sensitivity check, E5c and E9 (the further
     /// datasets of a run over several simulator seeds: the check speaks of one dataset's
-    /// numerics, and E9's search is reported for the first dataset).
+    /// numerics, and E5c and E9 are reported for the first dataset).
     pub fn without_sensitivity(&self) -> Self {
         let mut quiet = self.clone();
         quiet.params.sensitivity = None;
+        quiet.params.e5_causal = false;
         quiet.params.e9 = false;
         quiet
     }

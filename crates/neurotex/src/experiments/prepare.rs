@@ -8,13 +8,14 @@ use serde::{Deserialize, Serialize};
 
 use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidReproduceParams};
 use crate::calibrate::{calibrate_gain, GainCalibration};
+use crate::causal::{calibrate_conditioning, ConditioningCalibration};
 use crate::encode::encode_fa;
 use crate::error::{DataError, DatasetError, Result};
 use crate::pipeline::{Encoded, Encoding, Pipeline};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
 use crate::sim::{design, simulate_trial, RigParams, Trial, ALL_TEXTURES};
-use crate::values::{Grid, Speed};
+use crate::values::{BySpeed, Grid, Speed};
 
 /// Where the recordings come from.
 pub enum Source<'a> {
@@ -215,6 +216,8 @@ pub struct Prepared {
     pub taxels: TaxelDiagnostics,
     /// The code, parameters, data and date of the run.
     pub provenance: Provenance,
+    /// With E5c: the causal pipeline of each speed and every recording's spikes through it.
+    pub causal: Option<CausalPrepared>,
     /// With a sensitivity check: every recording's spikes from its input changed by the
     /// relative amount asked, in the order of `encoded`.
     pub perturbed: Option<Vec<Encoded>>,
@@ -229,6 +232,55 @@ impl Prepared {
             .iter()
             .filter(move |e| e.meta.speed() == Some(speed))
     }
+}
+
+/// E5c's recordings: the causal pipeline fixed at each speed and every recording's spikes
+/// through its speed's pipeline.
+pub struct CausalPrepared {
+    /// Per speed, the resting values and scale fixed on all of that speed's recordings
+    /// (labels unused), or why they could not be.
+    pub calibration: BySpeed<std::result::Result<ConditioningCalibration, String>>,
+    /// Every recording's SA spikes through the causal pipeline of its speed, in the order of
+    /// [`Prepared::encoded`]; `None` at a speed whose calibration failed.
+    pub encoded: Vec<Option<Encoded>>,
+    /// Seconds the calibration pass took (the causal encoding is part of the main pass).
+    pub seconds: f64,
+}
+
+/// One speed's causal conditioning and the pipeline applying it, or why it could not be fixed.
+type CausalPipeline = std::result::Result<(ConditioningCalibration, Pipeline), String>;
+
+/// With E5c, the causal conditioning of each speed, fixed on all of its recordings (labels
+/// unused: each is in some training fold of the cross-validation), and the pipeline that
+/// applies it; a speed where it cannot be fixed gets the reason instead.
+fn causal_pipelines(
+    source: &Source,
+    params: &ValidReproduceParams,
+    conditions: &[(Speed, String)],
+) -> Result<Option<Vec<(Speed, CausalPipeline)>>> {
+    if !params.e5_causal {
+        return Ok(None);
+    }
+    let mut sa = params.pipeline().params().clone();
+    // E5c compares the paper's SA encoding with its causal twin.
+    sa.encoding = Encoding::Sa;
+    let load = |i: usize| source.load(i);
+    let mut out = Vec::new();
+    for speed in Speed::distinct(conditions.iter().map(|c| c.0)) {
+        let indices: Vec<usize> = (0..conditions.len())
+            .filter(|&i| conditions[i].0 == speed)
+            .collect();
+        let fixed = match calibrate_conditioning(&sa, &load, &indices, source.baseline()) {
+            Ok(c) => {
+                let mut p = sa.clone();
+                p.preprocess.causal = Some(c.conditioning.clone());
+                Ok((c, Pipeline::new(p)?))
+            }
+            Err(e) => Err(e.to_string()),
+        };
+        out.push((speed, fixed));
+    }
+    Ok(Some(out))
 }
 
 /// One pass over the recordings: condition, encode at the pipeline's gain, and for the
@@ -254,11 +306,22 @@ pub fn prepare(
             labels.push(l.clone());
         }
     }
+    let clock = Instant::now();
+    let causal = causal_pipelines(source, params, &conditions)?;
+    let causal_seconds = clock.elapsed().as_secs_f64();
+    let causal_at = |speed: Speed| {
+        causal.as_ref().and_then(|all| {
+            all.iter()
+                .find(|(s, _)| *s == speed)
+                .and_then(|(_, p)| p.as_ref().ok().map(|(_, p)| p))
+        })
+    };
     progress(Progress::Stage("recordings", n));
     let results: Vec<EncodedOne> = (0..n)
         .into_par_iter()
         .map(|i| {
-            let out = encode_one(source, i, conditions[i].0 == slowest, params);
+            let (speed, sweep) = (conditions[i].0, conditions[i].0 == slowest);
+            let out = encode_one(source, i, sweep, causal_at(speed), params);
             progress(Progress::Tick);
             out
         })
@@ -266,7 +329,9 @@ pub fn prepare(
     let mut isi = IsiSweep::empty(params, labels.clone());
     let mut encoded = Vec::with_capacity(n);
     let mut perturbed = params.sensitivity.map(|_| Vec::with_capacity(n));
+    let mut causal_encoded = Vec::with_capacity(n);
     for one in results {
+        causal_encoded.push(one.causal);
         if let Some(points) = one.sweep {
             isi.add(&one.encoded.meta.label, points);
         }
@@ -281,7 +346,16 @@ pub fn prepare(
         return Err(DataError::invalid(&e.meta.file, message).into());
     }
     let taxels = taxel_diagnostics(&encoded, &grid, params)?;
+    let causal = causal.map(|all| CausalPrepared {
+        calibration: all
+            .into_iter()
+            .map(|(s, p)| (s, p.map(|(c, _)| c)))
+            .collect(),
+        encoded: causal_encoded,
+        seconds: causal_seconds,
+    });
     Ok(Prepared {
+        causal,
         provenance: Provenance::of(source, params)?,
         speeds: Speed::distinct(conditions.iter().map(|c| c.0)),
         taxels,
@@ -302,19 +376,26 @@ struct EncodedOne {
     sweep: Option<Vec<GainPoint>>,
     /// The spikes of the perturbed input, with a sensitivity check.
     perturbed: Option<Encoded>,
+    /// The spikes through the causal pipeline of the recording's speed, with E5c.
+    causal: Option<Encoded>,
 }
 
 /// Loads, conditions and encodes recording `i`; with `sweep`, also encodes it at every E7
 /// gain and returns its ISI histograms; with a sensitivity check, also encodes its input
-/// changed by that relative amount.
+/// changed by that relative amount; with a `causal` pipeline, also encodes it through that.
 fn encode_one(
     source: &Source,
     i: usize,
     sweep: bool,
+    causal: Option<&Pipeline>,
     params: &ValidReproduceParams,
 ) -> Result<EncodedOne> {
     let pipeline = params.pipeline();
     let rec = source.load(i)?;
+    let causal = match causal {
+        Some(p) => Some(p.encode(&rec, source.baseline())?),
+        None => None,
+    };
     let mut cond = pipeline.condition(&rec, source.baseline())?;
     let (spikes, mut fa) = pipeline.encode_populations(&rec, &cond)?;
     if params.e9 && fa.is_none() && pipeline.params().encoding == Encoding::Sa {
@@ -351,6 +432,7 @@ fn encode_one(
         encoded,
         sweep,
         perturbed,
+        causal,
     })
 }
 

@@ -14,6 +14,14 @@ pub enum Skip {
     /// E9 compares within and across speeds.
     #[error("the dataset has only one speed; E9 compares within and across speeds")]
     OneSpeedE9,
+    /// E5c: the causal conditioning cannot be fixed on this speed's recordings.
+    #[error("{reason}")]
+    Causal {
+        /// Speed.
+        speed: Speed,
+        /// The calibration's reason.
+        reason: String,
+    },
     /// E8: this `k` cannot be evaluated at this speed.
     #[error("{reason}")]
     Neighbours {
@@ -33,6 +41,7 @@ impl Skip {
             Skip::TooFewTaxels => "e3".into(),
             Skip::OneSpeed => "e6".into(),
             Skip::OneSpeedE9 => "e9".into(),
+            Skip::Causal { speed, .. } => format!("e5c at {speed} mm/s"),
             Skip::Neighbours { k, speed, .. } => format!("e8 k={k} at {speed} mm/s"),
         }
     }

@@ -25,7 +25,7 @@ pub(crate) use gain::{e7_isi_caption, e7_rate_caption};
 pub(crate) use neighbours::e8_caption;
 pub(crate) use perturbation::e3_caption;
 pub(crate) use psth::e0_caption;
-pub(crate) use recognition::e5_caption;
+pub(crate) use recognition::{e5_caption, e5c_accuracy_caption, e5c_decision_caption};
 pub(crate) use seeds::across_seeds_caption;
 
 /// A figure could not be drawn.
@@ -55,6 +55,10 @@ pub(crate) mod file {
     pub(crate) const E4: &str = "e4_temporal.svg";
     /// E5.
     pub(crate) const E5: &str = "e5_time_to_recognition.svg";
+    /// E5c, accuracy against time into the slide.
+    pub(crate) const E5C_ACCURACY: &str = "e5c_accuracy_over_time.svg";
+    /// E5c, time to decision.
+    pub(crate) const E5C_DECISION: &str = "e5c_time_to_decision.svg";
     /// E6.
     pub(crate) const E6: &str = "e6_speed_invariance.svg";
     /// E7, firing rates.
@@ -174,6 +178,10 @@ pub(crate) fn all(
     }
     out.push((file::E4, accuracy::e4(r, paper)));
     out.push((file::E5, recognition::e5(r, paper)));
+    if !r.e5c.is_empty() {
+        out.push((file::E5C_ACCURACY, recognition::e5c_accuracy(r)));
+        out.push((file::E5C_DECISION, recognition::e5c_decision(r)));
+    }
     if !r.e6.is_empty() {
         out.push((file::E6, accuracy::e6(r, paper)));
     }

@@ -7,7 +7,7 @@ use super::plot::{
     GLCM3D, GREY, SINGLE,
 };
 use super::{panel_chance_note, panel_chances, FigureError};
-use crate::experiments::Results;
+use crate::experiments::{E5CausalSpeed, Results};
 use crate::report::paper::Paper;
 
 /// E5: 3D-GLCM on the first part of the slide against the single taxel on all of it, one
@@ -106,5 +106,150 @@ pub(crate) fn e5_caption(r: &Results, paper: Option<&Paper>) -> String {
             ""
         },
         first.join(", ")
+    )
+}
+
+/// The time axis of an E5c panel: up to the longest slide, at least one bin.
+fn time_range(e: &E5CausalSpeed) -> std::ops::Range<f64> {
+    let end = e.times_s.last().copied().unwrap_or(0.2);
+    0.0..end.max(0.2)
+}
+
+/// E5c: causal 3D-GLCM accuracy against time into the slide beside the offline E5, one
+/// panel per speed.
+pub(crate) fn e5c_accuracy(r: &Results) -> Result<String, FigureError> {
+    let speeds: Vec<_> = r.e5c.iter().collect();
+    let mut keys = vec![
+        Key::new(
+            "causal, the slide so far (whole-slide classifier)",
+            Swatch::Line(GLCM3D),
+        ),
+        Key::new(
+            "offline E5, first part of every slide",
+            Swatch::Points(SINGLE),
+        ),
+        Key::new(
+            "zero-phase 3D-GLCM, whole slide (E1)",
+            Swatch::Dashed(BLACK),
+        ),
+    ];
+    let chances = panel_chances(
+        r,
+        &speeds.iter().map(|(s, _)| *s).collect::<Vec<_>>(),
+        &mut keys,
+    );
+    let layout = Multiples {
+        n: speeds.len(),
+        panel: (250, 200),
+        title: "E5c: accuracy against time into the slide",
+        x_desc: "time into the slide (s)",
+        y_desc: "accuracy (%)",
+        keys: &keys,
+    };
+    multiples(&layout, |i, area| {
+        let (speed, e) = speeds[i];
+        let mut chart = panel_chart(area, &format!("{speed} mm/s"), time_range(e), 0.0..100.0)?;
+        mesh(&mut chart)
+            .x_labels(6)
+            .y_labels(6)
+            .x_label_formatter(&|v| number(*v))
+            .y_label_formatter(&|v| number(*v))
+            .draw()?;
+        if let Some(c) = chances[i] {
+            hline(&mut chart, c, GREY, 6)?;
+        }
+        hline(&mut chart, 100.0 * e.offline, BLACK, 6)?;
+        let causal: Vec<(f64, f64)> = e
+            .times_s
+            .iter()
+            .zip(&e.accuracy)
+            .map(|(&t, &a)| (t, 100.0 * a))
+            .collect();
+        chart.draw_series(LineSeries::new(causal, GLCM3D.stroke_width(2)))?;
+        let offline: Vec<(f64, f64)> = e
+            .fractions
+            .iter()
+            .filter_map(|f| f.offline.map(|a| (f.time_s, 100.0 * a)))
+            .collect();
+        line_with_markers(&mut chart, &offline, SINGLE, false)?;
+        Ok(())
+    })
+}
+
+/// E5c accuracy figure's caption.
+pub(crate) fn e5c_accuracy_caption(r: &Results) -> String {
+    format!(
+        "Online time to recognition, one panel per speed (each on its own time axis, up to the longest slide): the causal 3D-GLCM's accuracy at every 200 ms bin boundary from the slide so far, classified by a KNN trained on whole causal slides in the folds of E1 and pooled over its repeats (vermillion; a slide that has ended keeps its last classification); the offline E5 (blue points: trained and tested on the first part of every slide, zero-phase, plotted at that share of the median slide); E1's zero-phase 3D-GLCM on whole slides (black dashed); {}.",
+        panel_chance_note(r, &r.e5c.iter().map(|(s, _)| s).collect::<Vec<_>>())
+    )
+}
+
+/// E5c: the share of slides decided by each time, one panel per speed.
+pub(crate) fn e5c_decision(r: &Results) -> Result<String, FigureError> {
+    let speeds: Vec<_> = r.e5c.iter().collect();
+    let keys = vec![
+        Key::new("decided by then", Swatch::Line(GLCM3D)),
+        Key::new("still sliding", Swatch::Dashed(GREY)),
+        Key::new("median time to decision", Swatch::Dashed(BLACK)),
+    ];
+    let layout = Multiples {
+        n: speeds.len(),
+        panel: (250, 200),
+        title: "E5c: time to decision",
+        x_desc: "time into the slide (s)",
+        y_desc: "share of slides (%)",
+        keys: &keys,
+    };
+    multiples(&layout, |i, area| {
+        let (speed, e) = speeds[i];
+        let mut chart = panel_chart(area, &format!("{speed} mm/s"), time_range(e), 0.0..100.0)?;
+        mesh(&mut chart)
+            .x_labels(6)
+            .y_labels(6)
+            .x_label_formatter(&|v| number(*v))
+            .y_label_formatter(&|v| number(*v))
+            .draw()?;
+        // Steps: the share decided holds from one bin boundary to the next.
+        let mut decided = vec![(0.0, 0.0)];
+        for (&t, &d) in e.times_s.iter().zip(&e.decision.decided_by) {
+            let last = decided.last().map_or(0.0, |p: &(f64, f64)| p.1);
+            decided.push((t, last));
+            decided.push((t, 100.0 * d));
+        }
+        chart.draw_series(LineSeries::new(decided, GLCM3D.stroke_width(2)))?;
+        let sliding: Vec<(f64, f64)> = std::iter::once((0.0, 100.0))
+            .chain(
+                e.times_s
+                    .iter()
+                    .zip(&e.sliding)
+                    .map(|(&t, &s)| (t, 100.0 * s)),
+            )
+            .collect();
+        chart.draw_series(DashedLineSeries::new(sliding, 6, 4, GREY.stroke_width(2)))?;
+        if let Some(q) = e.decision.quartiles_s {
+            vline(&mut chart, q[1], BLACK, 6)?;
+        }
+        Ok(())
+    })
+}
+
+/// E5c decision figure's caption.
+pub(crate) fn e5c_decision_caption(r: &Results) -> String {
+    let rule = r
+        .e5c
+        .values()
+        .next()
+        .map(|e| e.decision.rule)
+        .unwrap_or_default();
+    let never: Vec<String> = r
+        .e5c
+        .iter()
+        .map(|(s, e)| format!("{s} mm/s {:.1} %", 100.0 * e.decision.never_share))
+        .collect();
+    format!(
+        "Time to decision, one panel per speed: the share of test slides (over E1's repeats) decided by each time into the slide (vermillion steps), a decision being the first time one class holds at least {} of the vote in {} consecutive bins; grey dashed: the share of slides still sliding; black dashed: the median time to decision of the slides decided. Never decided before the slide ended: {}.",
+        rule.share,
+        rule.bins,
+        never.join(", ")
     )
 }

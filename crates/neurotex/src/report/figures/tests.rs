@@ -108,6 +108,48 @@ pub(crate) fn wide() -> Results {
             )
         })
         .collect();
+    let e5c = speeds
+        .iter()
+        .enumerate()
+        .map(|(i, &s)| {
+            let bins = 5 + 3 * i;
+            let times_s: Vec<f64> = (1..=bins).map(|b| 0.2 * b as f64).collect();
+            let rise = |b: usize| (b as f64 / bins as f64).min(1.0);
+            (
+                s,
+                crate::experiments::E5CausalSpeed {
+                    calibration: crate::causal::ConditioningCalibration {
+                        conditioning: crate::signal::CausalConditioning {
+                            offsets: vec![0.0; 16],
+                            scale: 1234.5,
+                        },
+                        recordings: 69,
+                        median_duration_ms: 200 * bins,
+                    },
+                    n: 69,
+                    chance: if s.mm_s() > 0.0 { 0.2 } else { 1.0 / 7.0 },
+                    median_slide_s: 0.2 * bins as f64,
+                    accuracy: (1..=bins).map(|b| acc[i] * (0.3 + 0.6 * rise(b))).collect(),
+                    sliding: (1..=bins).map(|b| 1.0 - 0.5 * rise(b).powi(8)).collect(),
+                    fractions: e5_fraction_rows(&fractions, 0.2 * bins as f64, acc[i]),
+                    whole: acc[i] * 0.9,
+                    whole_interval: interval(acc[i] * 0.9),
+                    offline: acc[i],
+                    offline_vs_causal: comparison(acc[i] * 0.1),
+                    decision: crate::experiments::TimeToDecision {
+                        rule: crate::causal::DecisionRule::default(),
+                        episodes: 69,
+                        decided: 50,
+                        never_share: 19.0 / 69.0,
+                        accuracy: Some(0.8),
+                        quartiles_s: Some([0.6, 0.2 * (bins / 2).max(3) as f64, 0.2 * bins as f64]),
+                        decided_by: (1..=bins).map(|b| 50.0 / 69.0 * rise(b)).collect(),
+                    },
+                    times_s,
+                },
+            )
+        })
+        .collect();
     let e6 = speeds
         .iter()
         .enumerate()
@@ -242,6 +284,7 @@ pub(crate) fn wide() -> Results {
         }),
         e4,
         e5,
+        e5c,
         e6,
         e7: Some(E7 {
             speed: Speed::of(10.0),
@@ -415,8 +458,8 @@ fn check_all(r: &Results, paper: Option<&Paper>) -> Vec<&'static str> {
 #[test]
 fn every_figure_is_well_formed_on_both_designs() {
     let names = check_all(&small(), Some(&PAPER));
-    assert_eq!(names.len(), 10, "{names:?}");
-    assert_eq!(check_all(&wide(), None).len(), 10);
+    assert_eq!(names.len(), 12, "{names:?}");
+    assert_eq!(check_all(&wide(), None).len(), 12);
 }
 
 #[test]
@@ -605,6 +648,23 @@ fn thirty_classes_still_lay_out() {
         assert_well_formed(name, &svg);
         assert_no_overprint(name, &svg);
     }
+}
+
+/// E5c's rows at E5's shares of a slide of `slide_s`.
+fn e5_fraction_rows(
+    fractions: &[f64],
+    slide_s: f64,
+    a: f64,
+) -> Vec<crate::experiments::E5cFraction> {
+    fractions
+        .iter()
+        .map(|&p| crate::experiments::E5cFraction {
+            fraction: p,
+            time_s: p * slide_s,
+            causal: Some(a * (0.3 + 0.6 * p)),
+            offline: Some(a * (0.4 + 0.6 * p)),
+        })
+        .collect()
 }
 
 /// A hand-made 95 % interval of ±5 points around `a`.
