@@ -243,18 +243,16 @@ impl Profiles {
     /// linearly between profile samples.
     fn heights(&self, s_mm: f64, out: &mut [f64]) {
         let last = (self.columns[0].len() - 2) as f64;
-        for (row, (offset, out)) in self
+        for (offset, out) in self
             .row_offset_mm
             .iter()
             .zip(out.chunks_exact_mut(self.cols))
-            .enumerate()
         {
             // One position per row: the taxels of a row share it (every column's profile
             // has the same sampling), so it is computed once, not once per taxel.
             let x = ((s_mm + offset - self.start_mm) * self.per_mm).clamp(0.0, last);
             let k = x as usize;
             let w = x - k as f64;
-            debug_assert!(row < self.row_offset_mm.len());
             for (h, o) in self.columns.iter().zip(out.iter_mut()) {
                 *o = h[k] + (h[k + 1] - h[k]) * w;
             }
@@ -427,6 +425,8 @@ fn simulate(
         Vec::with_capacity(cells),
     );
     let sensor = Sensor {
+        k,
+        saturation: p.saturation_n_per_mm2,
         alpha,
         noise: p.noise,
         full_scale,
@@ -447,10 +447,7 @@ fn simulate(
             } else {
                 f64::INFINITY
             };
-            for ((t, &hi), &gain) in target.iter_mut().zip(&h).zip(&gains) {
-                let pressure = k * (hi - z).max(0.0);
-                *t = gain * pressure / (pressure + p.saturation_n_per_mm2);
-            }
+            sensor.targets(&h, z, &gains, &mut target);
             solved = Some((f.to_bits(), s.to_bits()));
         }
         if let Some(forces) = forces.as_deref_mut() {
@@ -516,6 +513,10 @@ impl Normals {
 
 /// The piezoresistive read-out of a trial: response lag, noise and ADC.
 struct Sensor {
+    /// Contact stiffness per unit area, N/mm³ (pad and texture in series).
+    k: f64,
+    /// Pressure of half the maximum response, N/mm².
+    saturation: f64,
     /// Weight of the new target in the first-order lag per step.
     alpha: f64,
     /// Noise: standard deviation `noise * sqrt(y)`.
@@ -525,6 +526,34 @@ struct Sensor {
 }
 
 impl Sensor {
+    /// Each taxel's saturated response to its pressure, at heights `h` under a pad at
+    /// `z`, scaled by its gain: the target its output lags towards.
+    fn targets(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, the only feature the function enables.
+                return unsafe { self.targets_avx2(h, z, gains, target) };
+            }
+        }
+        self.targets_lanes(h, z, gains, target);
+    }
+
+    /// [`Sensor::targets_lanes`] compiled for AVX2, exact as [`Sensor::read_avx2`] is.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn targets_avx2(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
+        self.targets_lanes(h, z, gains, target);
+    }
+
+    #[inline(always)]
+    fn targets_lanes(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
+        for ((t, &hi), &gain) in target.iter_mut().zip(h).zip(gains) {
+            let pressure = self.k * (hi - z).max(0.0);
+            *t = gain * pressure / (pressure + self.saturation);
+        }
+    }
+
     /// One step of every taxel: the lag of the response `y` towards `target`, the noise
     /// (one of `draws` per loaded taxel, in taxel order) and the ADC counts into `frame`.
     /// Returns the number of draws used.
@@ -556,11 +585,7 @@ impl Sensor {
 
     #[inline(always)]
     fn read_lanes(&self, target: &[f64], y: &mut [f64], draws: &[f64], frame: &mut [f64]) -> usize {
-        let Sensor {
-            alpha,
-            noise,
-            full_scale,
-        } = *self;
+        let (alpha, noise, full_scale) = (self.alpha, self.noise, self.full_scale);
         // Rounds half up: the value is non-negative, so adding 0.5 and truncating is
         // round-to-nearest without a call into libm.
         let adc = |v: f64| ((v.clamp(0.0, 1.0) * full_scale + 0.5) as u32) as f64;
