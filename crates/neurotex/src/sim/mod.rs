@@ -438,7 +438,7 @@ fn simulate(
         let (phase, f, s) = schedule.at(step);
         phases.push(phase);
         // Before contact, in the hold and after lift-off the pad neither moves nor changes
-        // its force (6 s of the protocol's 24 at 5 mm/s): the previous step's contact
+        // its force (5.4 s of the protocol's 24 at 5 mm/s): the previous step's contact
         // solution is still exact, so it is solved only when force or position change.
         if solved != Some((f.to_bits(), s.to_bits())) {
             profiles.heights(s, &mut h);
