@@ -376,3 +376,29 @@ impl Surface {
         0.5 * self.fibres.height(x, y)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cached, four-lane fibre mat gives `Texture::height`'s bits on a path crossing
+    /// many cells, back and forth (so the cache is both reused and replaced).
+    #[test]
+    fn surface_heights_equal_texture_heights_bit_for_bit() {
+        for seed in [0, 7, 0xDEAD_BEEF] {
+            let mut surface = Surface::new(Texture::Sb, seed);
+            for k in 0..3000 {
+                let along = (k % 1000) as f64 * 0.07 - 20.0;
+                let (x, y) = (
+                    123.4 + along * 0.99,
+                    -56.7 + along * 0.05 + (k / 1000) as f64,
+                );
+                assert_eq!(
+                    surface.height(x, y).to_bits(),
+                    Texture::Sb.height(x, y, seed).to_bits(),
+                    "seed {seed}, point {k}"
+                );
+            }
+        }
+    }
+}
