@@ -230,3 +230,102 @@ fn every_texture_has_relief_and_the_rig_rejects_unphysical_parameters() {
     .is_err());
     assert!(simulate_trial(&RigParams::default(), &trial(Texture::Cp, 0.0, 0), 0).is_err());
 }
+
+/// FNV-1a over the bits of every sample, phase and traced force: a change of any bit of the
+/// simulator's output changes the digest.
+fn digest(rec: &neurotex::recording::Recording, forces: &[(f64, f64)]) -> u64 {
+    let mut h: u64 = 0xCBF2_9CE4_8422_2325;
+    let mut eat = |word: u64| {
+        for byte in word.to_le_bytes() {
+            h = (h ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01B3);
+        }
+    };
+    rec.samples.iter().for_each(|v| eat(v.to_bits()));
+    let phases = rec.phases.as_ref().unwrap();
+    phases.iter().for_each(|&ph| eat(ph as u64));
+    for &(commanded, actual) in forces {
+        eat(commanded.to_bits());
+        eat(actual.to_bits());
+    }
+    h
+}
+
+/// The full paper protocol for every texture at 5, 10 and 15 mm/s, bit for bit as stored:
+/// digests of the simulator's output taken before the simulator was made faster (issue 15),
+/// so a rewrite that moves any sample, phase or force by one bit fails here. A change to
+/// the physics must update them on purpose and say why.
+#[test]
+fn full_protocol_bits_match_the_stored_digests() {
+    const STORED: [(&str, [u64; 3]); 8] = [
+        (
+            "FT1",
+            [0xfe3a39cd05a120f6, 0xe4cf46b889a1c845, 0x386dbe5285e75d9],
+        ),
+        (
+            "FT2",
+            [0x7b5fbd99d845d691, 0xc931b622b1e38b21, 0x88a55b4620073acc],
+        ),
+        (
+            "FT3",
+            [0x91efc97c30740524, 0x68e91b437ac3eb3f, 0x2342e6c33c2ea6ef],
+        ),
+        (
+            "RT",
+            [0x238ada52df3490b, 0x8421bb7591fb3d6c, 0x51259b14e0af5197],
+        ),
+        (
+            "TRug",
+            [0x2fb53723856da878, 0xa4f086a7877137, 0x9b865078c8e29780],
+        ),
+        (
+            "SB",
+            [0x6b2c38a590b5bb0, 0x9e9046dcacb2d80c, 0x3bfc5451746f7f39],
+        ),
+        (
+            "CP",
+            [0xece4ad518f19f86a, 0x32939c2a497ff165, 0x34cece2995786b6a],
+        ),
+        (
+            "STF",
+            [0x368975dc09103ab3, 0xf1cdf1019eff3893, 0xd8572602465621d7],
+        ),
+    ];
+    let p = RigParams::default();
+    let mut got = Vec::new();
+    for (name, _) in STORED {
+        let texture = Texture::from_name(name).unwrap();
+        let row: Vec<u64> = [5.0, 10.0, 15.0]
+            .iter()
+            .enumerate()
+            .map(|(k, &speed)| {
+                let (rec, forces) =
+                    simulate_trial_traced(&p, &trial(texture, speed, 3 + k as u32), 11).unwrap();
+                assert_eq!(
+                    simulate_trial(&p, &trial(texture, speed, 3 + k as u32), 11)
+                        .unwrap()
+                        .samples,
+                    rec.samples
+                );
+                digest(&rec, &forces)
+            })
+            .collect();
+        got.push((name, row));
+    }
+    let printed: Vec<String> = got
+        .iter()
+        .map(|(name, row)| {
+            format!(
+                "(\"{name}\", [{:#x}, {:#x}, {:#x}]),",
+                row[0], row[1], row[2]
+            )
+        })
+        .collect();
+    for ((name, stored), (_, row)) in STORED.iter().zip(&got) {
+        assert_eq!(
+            &stored[..],
+            &row[..],
+            "{name} moved; now:\n{}",
+            printed.join("\n")
+        );
+    }
+}

@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::ParamError;
 use crate::recording::{Layout, Meta, Phase, Recording};
-use texture::hash3;
+use texture::{hash3, Surface};
 pub use texture::{Texture, ALL_TEXTURES};
 
 /// Physical parameters of the sensor, the protocol and the trial-to-trial variation.
@@ -239,14 +239,24 @@ struct Profiles {
 }
 
 impl Profiles {
-    fn at(&self, taxel: usize, s_mm: f64) -> f64 {
-        let (r, c) = (taxel / self.cols, taxel % self.cols);
-        let h = &self.columns[c];
-        let x = ((s_mm + self.row_offset_mm[r] - self.start_mm) * self.per_mm)
-            .clamp(0.0, (h.len() - 2) as f64);
-        let k = x as usize;
-        let w = x - k as f64;
-        h[k] + (h[k + 1] - h[k]) * w
+    /// The height under every taxel (row-major) after sliding `s_mm`, interpolated
+    /// linearly between profile samples.
+    fn heights(&self, s_mm: f64, out: &mut [f64]) {
+        let last = (self.columns[0].len() - 2) as f64;
+        for (offset, out) in self
+            .row_offset_mm
+            .iter()
+            .zip(out.chunks_exact_mut(self.cols))
+        {
+            // One position per row: the taxels of a row share it (every column's profile
+            // has the same sampling), so it is computed once, not once per taxel.
+            let x = ((s_mm + offset - self.start_mm) * self.per_mm).clamp(0.0, last);
+            let k = x as usize;
+            let w = x - k as f64;
+            for (h, o) in self.columns.iter().zip(out.iter_mut()) {
+                *o = h[k] + (h[k + 1] - h[k]) * w;
+            }
+        }
     }
 }
 
@@ -304,17 +314,19 @@ fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Prof
         (p.taxel_mm / 3.0, 0.25),
     ];
     let mut raw = vec![0.0; raw_len];
+    // One surface per line, so each keeps what its neighbouring points share.
+    let mut surfaces = lines.map(|_| Surface::new(texture, texture_seed));
     let columns = (0..p.cols)
         .map(|c| {
             let across0 = (c as f64 - (p.cols - 1) as f64 / 2.0) * pitch + lateral;
             raw.fill(0.0);
             for (k, h) in raw.iter_mut().enumerate() {
                 let along = start_mm + (k as f64 - reach as f64) * step;
-                for &(offset, weight) in &lines {
+                for (&(offset, weight), surface) in lines.iter().zip(&mut surfaces) {
                     let across = across0 + offset;
                     let x = origin.0 + along * u.0 + across * n.0;
                     let y = origin.1 + along * u.1 + across * n.1;
-                    *h += weight * texture.height(x, y, texture_seed);
+                    *h += weight * surface.height(x, y);
                 }
             }
             (0..samples)
@@ -359,7 +371,7 @@ fn solve_contact(h: &[f64], depth_sum: f64, sorted: &mut Vec<f64>) -> f64 {
 /// # Errors
 /// Unphysical parameters or a non-positive speed.
 pub fn simulate_trial(p: &RigParams, trial: &Trial, seed: u64) -> Result<Recording, ParamError> {
-    simulate_trial_traced(p, trial, seed).map(|(rec, _)| rec)
+    simulate(p, trial, seed, None)
 }
 
 /// [`simulate_trial`] that also returns the contact force (N) of every step, recomputed
@@ -372,6 +384,18 @@ pub fn simulate_trial_traced(
     trial: &Trial,
     seed: u64,
 ) -> Result<(Recording, Vec<(f64, f64)>), ParamError> {
+    let mut forces = Vec::new();
+    let rec = simulate(p, trial, seed, Some(&mut forces))?;
+    Ok((rec, forces))
+}
+
+/// The simulation; with `forces`, also the commanded and the contact force of every step.
+fn simulate(
+    p: &RigParams,
+    trial: &Trial,
+    seed: u64,
+    mut forces: Option<&mut Vec<(f64, f64)>>,
+) -> Result<Recording, ParamError> {
     p.check()?;
     check_speed(p, trial.speed_mm_s)?;
     let mut rng = trial_rng(seed, trial);
@@ -388,49 +412,206 @@ pub fn simulate_trial_traced(
     let area = p.active_mm * p.active_mm / cells as f64;
     let alpha = 1.0 - (-1.0 / p.lag_ms).exp();
     let full_scale = ((1u64 << p.adc_bits) - 1) as f64;
-    let mut samples = Vec::with_capacity(total * cells);
+    let mut samples = vec![0.0; total * cells];
     let mut phases = Vec::with_capacity(total);
-    let mut forces = Vec::with_capacity(total);
-    let (mut h, mut y, mut sorted) = (
+    let mut normals = Normals::new(rng);
+    if let Some(forces) = forces.as_deref_mut() {
+        forces.reserve(total);
+    }
+    let (mut h, mut target, mut y, mut sorted) = (
+        vec![0.0; cells],
         vec![0.0; cells],
         vec![0.0; cells],
         Vec::with_capacity(cells),
     );
+    let sensor = Sensor {
+        k,
+        saturation: p.saturation_n_per_mm2,
+        alpha,
+        noise: p.noise,
+        full_scale,
+    };
+    let mut z = f64::INFINITY;
+    // The force and the distance slid of the step whose contact `h`, `z` and `target` hold.
+    let mut solved: Option<(u64, u64)> = None;
     for step in 0..total {
         let (phase, f, s) = schedule.at(step);
         phases.push(phase);
-        for (i, hi) in h.iter_mut().enumerate() {
-            *hi = profiles.at(i, s);
-        }
-        let z = if f > 0.0 {
-            solve_contact(&h, f / (k * area), &mut sorted)
-        } else {
-            f64::INFINITY
-        };
-        forces.push((
-            f,
-            h.iter()
-                .map(|&hi| k * area * (hi - z).max(0.0))
-                .sum::<f64>(),
-        ));
-        for i in 0..cells {
-            let pressure = k * (h[i] - z).max(0.0);
-            let target = gains[i] * pressure / (pressure + p.saturation_n_per_mm2);
-            y[i] += (target - y[i]) * alpha;
-            let noisy = if y[i] > 0.0 {
-                y[i] + p.noise * y[i].sqrt() * rng.sample::<f64, _>(StandardNormal)
+        // Before contact, in the hold and after lift-off the pad neither moves nor changes
+        // its force (5.4 s of the protocol's 24 at 5 mm/s): the previous step's contact
+        // solution is still exact, so it is solved only when force or position change.
+        if solved != Some((f.to_bits(), s.to_bits())) {
+            profiles.heights(s, &mut h);
+            z = if f > 0.0 {
+                solve_contact(&h, f / (k * area), &mut sorted)
             } else {
-                0.0
+                f64::INFINITY
             };
-            // Rounds half up: the value is non-negative, so adding 0.5 and truncating is
-            // round-to-nearest without a call into libm.
-            samples.push(((noisy.clamp(0.0, 1.0) * full_scale + 0.5) as u32) as f64);
+            sensor.targets(&h, z, &gains, &mut target);
+            solved = Some((f.to_bits(), s.to_bits()));
         }
+        if let Some(forces) = forces.as_deref_mut() {
+            let contact = h
+                .iter()
+                .map(|&hi| k * area * (hi - z).max(0.0))
+                .sum::<f64>();
+            forces.push((f, contact));
+        }
+        let frame = &mut samples[step * cells..(step + 1) * cells];
+        let used = sensor.read(&target, &mut y, normals.ready(cells), frame);
+        normals.used(used);
     }
     let slide_start = schedule.slide_start() as f64 / 1000.0;
     let slide_s = (slide_start, slide_start + schedule.slide as f64 / 1000.0);
-    let rec = trial_recording(p, trial, samples, phases, slide_s);
-    Ok((rec, forces))
+    Ok(trial_recording(p, trial, samples, phases, slide_s))
+}
+
+/// The trial generator's standard normal draws, drawn ahead in blocks.
+///
+/// After the trial's own draws (texture, patch, force, speed) the generator only feeds the
+/// sensor noise, one draw per loaded taxel in step and taxel order, so drawing ahead hands
+/// every taxel the number it drew one at a time. Drawing in a tight loop lets the processor
+/// overlap the draws; one call per taxel in the step loop stalled each step's arithmetic
+/// on the generator (the draws left over at the end are never used).
+struct Normals {
+    rng: ChaCha8Rng,
+    drawn: Vec<f64>,
+    next: usize,
+}
+
+impl Normals {
+    /// Draws per refill.
+    const BLOCK: usize = 4096;
+
+    fn new(rng: ChaCha8Rng) -> Self {
+        Normals {
+            rng,
+            drawn: Vec::new(),
+            next: 0,
+        }
+    }
+
+    /// The next draws, at least `n` of them.
+    fn ready(&mut self, n: usize) -> &[f64] {
+        if self.drawn.len() - self.next < n {
+            self.drawn.drain(..self.next);
+            self.next = 0;
+            let kept = self.drawn.len();
+            self.drawn.resize(Self::BLOCK.max(n), 0.0);
+            for draw in &mut self.drawn[kept..] {
+                *draw = self.rng.sample(StandardNormal);
+            }
+        }
+        &self.drawn[self.next..]
+    }
+
+    /// Marks the first `n` draws of [`Normals::ready`] as taken.
+    fn used(&mut self, n: usize) {
+        self.next += n;
+    }
+}
+
+/// The piezoresistive read-out of a trial: response lag, noise and ADC.
+struct Sensor {
+    /// Contact stiffness per unit area, N/mm³ (pad and texture in series).
+    k: f64,
+    /// Pressure of half the maximum response, N/mm².
+    saturation: f64,
+    /// Weight of the new target in the first-order lag per step.
+    alpha: f64,
+    /// Noise: standard deviation `noise * sqrt(y)`.
+    noise: f64,
+    /// The ADC's largest count.
+    full_scale: f64,
+}
+
+impl Sensor {
+    /// Each taxel's saturated response to its pressure, at heights `h` under a pad at
+    /// `z`, scaled by its gain: the target its output lags towards.
+    fn targets(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, the only feature the function enables.
+                return unsafe { self.targets_avx2(h, z, gains, target) };
+            }
+        }
+        self.targets_lanes(h, z, gains, target);
+    }
+
+    /// [`Sensor::targets_lanes`] compiled for AVX2, exact as [`Sensor::read_avx2`] is.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn targets_avx2(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
+        self.targets_lanes(h, z, gains, target);
+    }
+
+    #[inline(always)]
+    fn targets_lanes(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
+        for ((t, &hi), &gain) in target.iter_mut().zip(h).zip(gains) {
+            let pressure = self.k * (hi - z).max(0.0);
+            *t = gain * pressure / (pressure + self.saturation);
+        }
+    }
+
+    /// One step of every taxel: the lag of the response `y` towards `target`, the noise
+    /// (one of `draws` per loaded taxel, in taxel order) and the ADC counts into `frame`.
+    /// Returns the number of draws used.
+    fn read(&self, target: &[f64], y: &mut [f64], draws: &[f64], frame: &mut [f64]) -> usize {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, the only feature the function enables.
+                return unsafe { self.read_avx2(target, y, draws, frame) };
+            }
+        }
+        self.read_lanes(target, y, draws, frame)
+    }
+
+    /// [`Sensor::read_lanes`] compiled for AVX2 (four taxels per instruction). FMA is not
+    /// enabled and Rust never fuses a multiply and an add on its own; division, square
+    /// root and conversions are exact in every width: the bits do not depend on it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn read_avx2(
+        &self,
+        target: &[f64],
+        y: &mut [f64],
+        draws: &[f64],
+        frame: &mut [f64],
+    ) -> usize {
+        self.read_lanes(target, y, draws, frame)
+    }
+
+    #[inline(always)]
+    fn read_lanes(&self, target: &[f64], y: &mut [f64], draws: &[f64], frame: &mut [f64]) -> usize {
+        let (alpha, noise, full_scale) = (self.alpha, self.noise, self.full_scale);
+        // Rounds half up: the value is non-negative, so adding 0.5 and truncating is
+        // round-to-nearest without a call into libm.
+        let adc = |v: f64| ((v.clamp(0.0, 1.0) * full_scale + 0.5) as u32) as f64;
+        for (&t, y) in target.iter().zip(y.iter_mut()) {
+            *y += (t - *y) * alpha;
+        }
+        let n = y.len();
+        if draws.len() >= n && y.iter().all(|&yi| yi > 0.0) {
+            // Every taxel loaded (the usual case in contact): taxel i takes draw i, and
+            // all of them are computed side by side.
+            for ((&yi, &draw), sample) in y.iter().zip(&draws[..n]).zip(frame.iter_mut()) {
+                *sample = adc(yi + noise * yi.sqrt() * draw);
+            }
+            return n;
+        }
+        let mut used = 0;
+        for (&yi, sample) in y.iter().zip(frame.iter_mut()) {
+            *sample = if yi > 0.0 {
+                used += 1;
+                adc(yi + noise * yi.sqrt() * draws[used - 1])
+            } else {
+                adc(0.0)
+            };
+        }
+        used
+    }
 }
 
 /// The protocol's phases in 1 ms steps: free, contact (force ramps up), hold, slide,
