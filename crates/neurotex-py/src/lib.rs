@@ -12,6 +12,7 @@ mod errors;
 mod estimator;
 mod model;
 mod params;
+mod stream;
 
 use ndarray::{Array2, Array3};
 use neurotex::encode::SpikeTrains;
@@ -472,5 +473,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     dataset::register(m)?;
     model::register(m)?;
     estimator::register(m)?;
+    stream::register(m)?;
     Ok(())
 }

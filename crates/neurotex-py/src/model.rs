@@ -18,7 +18,7 @@ use crate::{info_of, params, Failure, InfoTuple};
 /// A trained classifier with its pipeline, as `neurotex train` writes it.
 #[pyclass(module = "neurotex._native", frozen)]
 pub struct NativeModel {
-    inner: LibModel,
+    pub(crate) inner: LibModel,
 }
 
 /// Encodes recordings with the model's own pipeline, in parallel without the GIL.

@@ -14,6 +14,7 @@ zero-phase low-pass, 200 ms bins, 16 gray levels, distances 1, 2, 4, 8.
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -559,9 +560,52 @@ class Model:
                 f"classes={len(self.classes_)}, trained on {self._native.n_training})")
 
 
+
+class StreamClassifier:
+    """A causal model (``neurotex train --causal``) classifying a live stream frame by
+    frame, as ``neurotex stream`` does: ``push`` one frame (one value per taxel, in
+    row-major order of the model's taxels) and get ``None``, or the list of what it
+    completed: a dict per bin boundary (``t_s``, ``label``, ``scores``, ``decided``,
+    ``decision``) and one per episode's end (``end``, ``label``, ``decided_at_s``, ...).
+    A bad frame (wrong length, NaN, a stamp not after the last) raises :class:`DataError`
+    and is skipped; the stream goes on."""
+
+    def __init__(self, model: Union["Model", str, os.PathLike], *, window_s: Optional[float] = None,
+                 decide: float = 0.8, decide_bins: int = 3, episode: str = "whole",
+                 fs: float = 1000.0, max_gap_s: float = 1.0,
+                 speed: Optional[float] = None) -> None:
+        if not isinstance(model, Model):
+            model = Model.load(model)
+        self.model = model
+        self._native = _native.NativeStream(model._native, window_s, decide, decide_bins,
+                                            episode, fs, max_gap_s, speed)
+
+    @staticmethod
+    def _events(lines: List[str]) -> Optional[List[Dict[str, Any]]]:
+        return [json.loads(line) for line in lines] or None
+
+    def push(self, frame: Any, t: Optional[float] = None) -> Optional[List[Dict[str, Any]]]:
+        """Takes one frame, with its time stamp in s (or none, at ``fs``)."""
+        values = np.asarray(frame, dtype=np.float64).ravel().tolist()
+        return self._events(self._native.push(values, t))
+
+    def reset(self) -> Optional[List[Dict[str, Any]]]:
+        """Ends the current episode (its summary)."""
+        return self._events(self._native.reset())
+
+    def finish(self) -> Optional[List[Dict[str, Any]]]:
+        """Ends the stream (the last bins and the summary)."""
+        return self._events(self._native.finish())
+
+    @property
+    def bad_frames(self) -> int:
+        """Frames skipped as bad."""
+        return self._native.bad_frames
+
 __all__ = [
     "encode", "features", "spike_stats", "rate_volume", "glcm3d", "glcm2d", "haralick",
     "cross_validate", "load_dataset", "save_dataset", "simulate", "Model", "Recording",
+    "StreamClassifier",
     "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",
     "ParameterError", "DataError", "NotFoundError", "ReadWriteError", "ModelError",
     "ClassifyError", "InternalError",

@@ -1,0 +1,117 @@
+//! The stream classifier as an object fed frame by frame: a causal model's decisions at
+//! every bin, as `neurotex stream` prints them.
+
+use neurotex::causal::DecisionRule;
+use neurotex::stream::{bin_json, end_json, Event, StreamClassifier, StreamError, StreamParams};
+use pyo3::prelude::*;
+
+use crate::errors::{guarded, param, raise, to_py, Kind};
+use crate::model::NativeModel;
+
+/// A causal model classifying a live stream.
+#[pyclass(module = "neurotex._native")]
+pub struct NativeStream {
+    inner: StreamClassifier,
+}
+
+/// The events as JSON lines, the lines `neurotex stream` prints (without `bad_frames`).
+fn lines(stream: &StreamClassifier, events: &[Event]) -> Vec<String> {
+    let labels = stream.model().labels();
+    events
+        .iter()
+        .map(|e| match e {
+            Event::Bin(b) => bin_json(labels, b, None).to_string(),
+            Event::End(s) => end_json(labels, s, None).to_string(),
+        })
+        .collect()
+}
+
+fn stream_error(e: StreamError) -> PyErr {
+    match e {
+        StreamError::Bad(bad) => raise(Kind::Data, format!("bad frame skipped: {bad}")),
+        StreamError::Classify(e) => to_py(e),
+    }
+}
+
+#[pymethods]
+impl NativeStream {
+    /// A stream classifier for `model` (trained with `--causal`).
+    #[new]
+    #[pyo3(signature = (model, window_s=None, decide=0.8, decide_bins=3, episode="whole", fs=1000.0, max_gap_s=1.0, speed=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        model: &NativeModel,
+        window_s: Option<f64>,
+        decide: f64,
+        decide_bins: usize,
+        episode: &str,
+        fs: f64,
+        max_gap_s: f64,
+        speed: Option<f64>,
+    ) -> PyResult<Self> {
+        let model = model.inner.clone();
+        let mut params = StreamParams::for_model(&model);
+        if let Some(s) = window_s {
+            if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
+                return Err(raise(
+                    Kind::Parameter,
+                    format!("window_s must be in (0, 3600] s, got {s}"),
+                ));
+            }
+            params.window_ms = (s * 1000.0).round() as usize;
+        }
+        params.rule = DecisionRule {
+            share: decide,
+            bins: decide_bins,
+        };
+        params.episodes = episode.parse().map_err(param)?;
+        params.fs = fs;
+        params.max_gap_s = max_gap_s;
+        params.speed_mm_s = speed;
+        let inner = guarded(|| StreamClassifier::new(model, params))?;
+        Ok(NativeStream { inner })
+    }
+
+    /// Takes one frame (one value per taxel) with its time stamp in s, or none at the
+    /// stream's rate; returns the JSON lines it completed.
+    #[pyo3(signature = (values, t=None))]
+    fn push(&mut self, values: Vec<f64>, t: Option<f64>) -> PyResult<Vec<String>> {
+        let events = self.inner.push(t, &values).map_err(stream_error)?.to_vec();
+        Ok(lines(&self.inner, &events))
+    }
+
+    /// Ends the current episode; its summary line.
+    fn reset(&mut self) -> PyResult<Vec<String>> {
+        let events = self.inner.reset().map_err(stream_error)?.to_vec();
+        Ok(lines(&self.inner, &events))
+    }
+
+    /// Ends the stream; the last lines.
+    fn finish(&mut self) -> PyResult<Vec<String>> {
+        let events = self.inner.finish().map_err(stream_error)?.to_vec();
+        Ok(lines(&self.inner, &events))
+    }
+
+    /// Values a frame holds.
+    #[getter]
+    fn channels(&self) -> usize {
+        self.inner.channels()
+    }
+
+    /// Frames taken.
+    #[getter]
+    fn frames(&self) -> u64 {
+        self.inner.frames()
+    }
+
+    /// Frames skipped as bad.
+    #[getter]
+    fn bad_frames(&self) -> u64 {
+        self.inner.bad_frames()
+    }
+}
+
+/// Registers the stream class.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<NativeStream>()
+}
