@@ -63,6 +63,12 @@ fn causal_model(
     Model::train(&params, &table, Columns::All, classifier, provenance).unwrap()
 }
 
+/// The paper's method (SA, 3D-GLCM, KNN) as a causal model trained on `train`.
+fn paper_model(train: &[Recording]) -> Model {
+    let knn = ClassifierChoice::Knn(KnnParams::default());
+    causal_model(train, Encoding::Sa, Method::Glcm3d, knn)
+}
+
 trait LayoutGrid {
     fn layout_grid(&self) -> neurotex::Grid;
 }
@@ -157,12 +163,7 @@ fn params(model: &Model) -> StreamParams {
 #[test]
 fn a_stream_at_1_khz_decides_as_the_offline_twin() {
     let recs = recordings();
-    let model = causal_model(
-        &recs,
-        Encoding::Sa,
-        Method::Glcm3d,
-        ClassifierChoice::Knn(KnnParams::default()),
-    );
+    let model = paper_model(&recs);
     let p = params(&model);
     for rec in recs.iter().step_by(4) {
         let offline = model.encode(rec).unwrap();
@@ -220,12 +221,7 @@ fn irregular_stamps_and_other_rates_resample_as_offline() {
 #[test]
 fn bad_frames_are_counted_skipped_and_change_nothing() {
     let recs = recordings();
-    let model = causal_model(
-        &recs,
-        Encoding::Sa,
-        Method::Glcm3d,
-        ClassifierChoice::Knn(KnnParams::default()),
-    );
+    let model = paper_model(&recs);
     let p = params(&model);
     let slow = irregular(&slide_only(&recs[2]), 10, 7);
     let clean = frames_of(&slow);
@@ -301,12 +297,7 @@ fn a_long_stream_keeps_only_its_window() {
 #[test]
 fn onset_episodes_start_at_contact_and_end_at_rest() {
     let recs = recordings();
-    let model = causal_model(
-        &recs,
-        Encoding::Sa,
-        Method::Glcm3d,
-        ClassifierChoice::Knn(KnnParams::default()),
-    );
+    let model = paper_model(&recs);
     let c = model.causal().unwrap().clone();
     let rest: Vec<f64> = (0..16).map(|cell| c.offsets[cell]).collect();
     let slide = frames_of(&slide_only(&recs[1]));

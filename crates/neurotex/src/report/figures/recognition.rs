@@ -3,8 +3,8 @@
 use plotters::prelude::*;
 
 use super::plot::{
-    hline, line_with_markers, mesh, multiples, number, panel_chart, vline, Key, Multiples, Swatch,
-    GLCM3D, GREY, SINGLE,
+    hline, line_with_markers, mesh, multiples, number, panel_chart, vline, Canvas, Chart, Key,
+    Multiples, Swatch, GLCM3D, GREY, SINGLE,
 };
 use super::{panel_chance_note, panel_chances, FigureError};
 use crate::experiments::{E5CausalSpeed, Results};
@@ -148,13 +148,7 @@ pub(crate) fn e5c_accuracy(r: &Results) -> Result<String, FigureError> {
     };
     multiples(&layout, |i, area| {
         let (speed, e) = speeds[i];
-        let mut chart = panel_chart(area, &format!("{speed} mm/s"), time_range(e), 0.0..100.0)?;
-        mesh(&mut chart)
-            .x_labels(6)
-            .y_labels(6)
-            .x_label_formatter(&|v| number(*v))
-            .y_label_formatter(&|v| number(*v))
-            .draw()?;
+        let mut chart = e5c_panel(area, speed, e)?;
         if let Some(c) = chances[i] {
             hline(&mut chart, c, GREY, 6)?;
         }
@@ -174,6 +168,22 @@ pub(crate) fn e5c_accuracy(r: &Results) -> Result<String, FigureError> {
         line_with_markers(&mut chart, &offline, SINGLE, false)?;
         Ok(())
     })
+}
+
+/// One E5c panel: the speed's time axis (s) against 0-100 %, its mesh drawn.
+fn e5c_panel<'a, 'b>(
+    area: &'a Canvas<'b>,
+    speed: crate::values::Speed,
+    e: &E5CausalSpeed,
+) -> Result<Chart<'a, 'b>, DrawingAreaErrorKind<std::io::Error>> {
+    let mut chart = panel_chart(area, &format!("{speed} mm/s"), time_range(e), 0.0..100.0)?;
+    mesh(&mut chart)
+        .x_labels(6)
+        .y_labels(6)
+        .x_label_formatter(&|v| number(*v))
+        .y_label_formatter(&|v| number(*v))
+        .draw()?;
+    Ok(chart)
 }
 
 /// E5c accuracy figure's caption.
@@ -202,13 +212,7 @@ pub(crate) fn e5c_decision(r: &Results) -> Result<String, FigureError> {
     };
     multiples(&layout, |i, area| {
         let (speed, e) = speeds[i];
-        let mut chart = panel_chart(area, &format!("{speed} mm/s"), time_range(e), 0.0..100.0)?;
-        mesh(&mut chart)
-            .x_labels(6)
-            .y_labels(6)
-            .x_label_formatter(&|v| number(*v))
-            .y_label_formatter(&|v| number(*v))
-            .draw()?;
+        let mut chart = e5c_panel(area, speed, e)?;
         // Steps: the share decided holds from one bin boundary to the next.
         let mut decided = vec![(0.0, 0.0)];
         for (&t, &d) in e.times_s.iter().zip(&e.decision.decided_by) {
