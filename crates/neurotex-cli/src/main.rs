@@ -5,6 +5,7 @@
 mod classifier_args;
 mod commands;
 mod csv_args;
+mod interrupt;
 mod open_args;
 mod output;
 mod stage_args;
@@ -56,26 +57,9 @@ enum Command {
     Import(import::ImportCommand),
 }
 
-/// The exit code after SIGINT, SIGTERM or SIGHUP (the shell's 128 + SIGINT).
-const INTERRUPTED: i32 = 130;
-
-/// On SIGINT, SIGTERM or SIGHUP, removes the run's temporary files and folders (the
-/// library registers each one; finished outputs are never among them) and exits with 130.
-fn remove_temporaries_on_signal() {
-    let installed = ctrlc::set_handler(|| {
-        // Held until exit: no temporary is created or renamed into place after the clean-up.
-        let _registry = neurotex::io::remove_temporaries();
-        eprintln!("interrupted: temporary files removed");
-        std::process::exit(INTERRUPTED);
-    });
-    if let Err(e) = installed {
-        eprintln!("warning: an interrupted run may leave temporary files ({e})");
-    }
-}
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    remove_temporaries_on_signal();
+    interrupt::install();
     let result = match cli.command {
         Command::Encode(args) => encode::run(args),
         Command::Features(args) => features::run(args),

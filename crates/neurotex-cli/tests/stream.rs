@@ -304,6 +304,59 @@ fn reset_lines_and_frames_end_episodes() {
     assert_eq!(lines(&out).iter().filter(|l| l["end"] == true).count(), 2);
 }
 
+/// Sends SIGINT to a child process.
+fn interrupt(child: &Child) {
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(status.success());
+}
+
+#[test]
+fn an_interrupt_ends_the_stream_with_its_summary() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[0]);
+    let text = csv_text(&frames);
+    let (head, rest) = text.split_at(text.len() / 2);
+    let next_line = rest.split_inclusive('\n').nth(1).unwrap();
+
+    // A frame arrives after the interrupt: the stream ends there, with the summary.
+    let mut child = spawn(&dir, &["--model", s(&model)]);
+    let mut stdin = child.stdin.take().unwrap();
+    stdin.write_all(head.as_bytes()).unwrap();
+    stdin.flush().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    interrupt(&child);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    stdin.write_all(next_line.as_bytes()).unwrap();
+    stdin.flush().unwrap();
+    let (out, err) = finish(child);
+    let all = lines(&out);
+    let end = all.last().unwrap();
+    assert_eq!(end["end"], true, "{out}");
+    assert_eq!(end["ended_by"], "stopped");
+    assert!(all.len() > 2, "bins before the end: {out}");
+    assert!(err.contains("interrupted"), "{err}");
+    drop(stdin);
+
+    // No frame after the interrupt: the run ends within the grace time, exit 130.
+    let mut child = spawn(&dir, &["--model", s(&model)]);
+    let mut stdin = child.stdin.take().unwrap();
+    stdin.write_all(head.as_bytes()).unwrap();
+    stdin.flush().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let start = std::time::Instant::now();
+    interrupt(&child);
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130));
+    assert!(start.elapsed().as_secs_f64() < 10.0);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("without its summary"), "{err}");
+    drop(stdin);
+}
+
 #[test]
 fn offline_models_and_bad_options_are_refused() {
     let dir = Dir::new();

@@ -4,6 +4,8 @@
 //! cargo run --release -p neurotex --example stream_latency            # both parts
 //! cargo run --release -p neurotex --example stream_latency -- latency
 //! cargo run --release -p neurotex --example stream_latency -- capacity
+//! cargo run --release -p neurotex --example stream_latency -- capacity 316   # one grid
+//! cargo run --release -p neurotex --example stream_latency -- memory         # 10 minutes
 //! ```
 //!
 //! Latency: a causal 3D-GLCM + KNN model trained on simulated slides (4x4 taxels); the slide
@@ -16,6 +18,9 @@
 //! whose training rows are made up (the work per frame and per bin does not depend on
 //! them), fed 4 s of a moving sinusoidal texture at 1 kHz; the real-time factor is stream
 //! time over processing time, so a factor above 1 means the skin is processed in real time.
+//!
+//! Memory (Linux): a 100x100 skin streamed for 10 minutes as one episode with a 10 s
+//! window; the process's resident memory (`VmRSS`, and its peak `VmHWM`) after each minute.
 
 use std::time::Instant;
 
@@ -37,6 +42,9 @@ fn main() {
     }
     if part.is_empty() || part == "capacity" {
         capacity();
+    }
+    if part == "memory" {
+        memory();
     }
 }
 
@@ -182,7 +190,12 @@ fn large_model(side: usize) -> Model {
 
 fn capacity() {
     println!("capacity, one thread, 3D-GLCM + KNN, frames at 1 kHz without stamps:");
-    for side in [100usize, 200, 316] {
+    // `capacity SIDE` measures one grid only.
+    let sides = match std::env::args().nth(2) {
+        Some(side) => vec![side.parse::<usize>().expect("a grid side")],
+        None => vec![100, 200, 316],
+    };
+    for side in sides {
         for window_s in [2.0, 10.0] {
             let model = large_model(side);
             let mut params = StreamParams::for_model(&model);
@@ -222,5 +235,51 @@ fn capacity() {
                 stream.retained_spikes()
             );
         }
+    }
+}
+
+/// A `/proc/self/status` field in MiB (Linux).
+fn status_mib(field: &str) -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find(|l| l.starts_with(field))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|kb| kb.parse::<f64>().ok())
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+fn memory() {
+    let side = 100;
+    let cells = side * side;
+    let model = large_model(side);
+    let mut params = StreamParams::for_model(&model);
+    params.window_ms = 10_000;
+    let mut stream = StreamClassifier::new(model, params).unwrap();
+    // 97 frames (a prime) cycle, so the pattern does not repeat bin for bin.
+    let pattern: Vec<Vec<f64>> = (0..97)
+        .map(|t| {
+            (0..cells)
+                .map(|c| {
+                    let x = (c % side) as f64 + 0.01 * t as f64;
+                    0.5 + 0.5 * (std::f64::consts::TAU * x / 1.3).sin()
+                })
+                .collect()
+        })
+        .collect();
+    println!(
+        "memory, {side}x{side} taxels, window 10 s, one episode of 10 minutes at 1 kHz; before: RSS {:.1} MiB",
+        status_mib("VmRSS:")
+    );
+    for minute in 1..=10 {
+        for i in 0..60_000 {
+            stream.push(None, &pattern[i % pattern.len()]).unwrap();
+        }
+        println!(
+            "  after {minute:2} min: RSS {:.1} MiB, peak {:.1} MiB, {} spike times held",
+            status_mib("VmRSS:"),
+            status_mib("VmHWM:"),
+            stream.retained_spikes()
+        );
     }
 }

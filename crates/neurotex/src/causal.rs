@@ -148,6 +148,8 @@ pub enum EpisodeEnd {
     Rest,
     /// The time stamps jumped further than the largest gap allowed.
     Gap,
+    /// The stream was stopped before its input ended (an interrupt).
+    Stopped,
 }
 
 /// The end of an episode.

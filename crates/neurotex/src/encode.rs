@@ -226,6 +226,29 @@ impl Encoder {
         run_blocks(self.params, &mut self.v, &mut self.u, input, raster);
         self.steps += (input.len() / n) as u64;
     }
+
+    /// Runs one step of the neurons `first..first + input.len()` only (one value each) and
+    /// writes their spikes into `raster`: for callers that take a frame through all their
+    /// stages a cache-sized part at a time. [`Encoder::steps`] counts [`Encoder::run`]'s
+    /// frames only.
+    ///
+    /// # Panics
+    /// If the part does not lie inside the bank or `raster` is not `input`'s size (a
+    /// caller bug).
+    pub fn run_part(&mut self, first: usize, input: &[f64], raster: &mut [u8]) {
+        let cells = first..first + input.len();
+        assert_eq!(input.len(), raster.len(), "raster must match input");
+        let (v, u) = (&mut self.v[cells.clone()], &mut self.u[cells]);
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, the only feature the function enables.
+                unsafe { run_avx2(self.params, v, u, input, raster) };
+                return;
+            }
+        }
+        run_blocks(self.params, v, u, input, raster);
+    }
 }
 
 /// Neurons per block whose state stays in registers across time steps: enough independent

@@ -402,6 +402,21 @@ impl Model {
         Ok(self.predict_rows(&row)?.remove(0))
     }
 
+    /// Predicts the class of one row of the extractor's features (all of them, as
+    /// [`FeatureExtractor::row`] gives them; the model takes its columns).
+    ///
+    /// # Errors
+    /// As [`Model::predict_rows`].
+    pub(crate) fn predict_extracted(&self, row: &[f64]) -> Result<Prediction> {
+        let row: Vec<f64> = self.columns.iter().map(|&j| row[j]).collect();
+        Ok(self.predict_rows(&row)?.remove(0))
+    }
+
+    /// The feature extractor.
+    pub(crate) fn extractor(&self) -> &FeatureExtractor {
+        &self.extractor
+    }
+
     /// [`ModelError::OtherGrid`] unless `e` has the model's grid.
     fn check_grid(&self, e: &Encoded) -> Result<()> {
         let s = &e.spikes;

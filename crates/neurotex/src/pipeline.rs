@@ -631,13 +631,30 @@ impl FeatureExtractor {
         // below it the u32 kernels count and the result is widened.
         let mut counts = vec![0u64; l * l];
         plan.count_wide(&q, volume.bins, &mut counts);
-        Ok(match self.features.haralick {
-            HaralickSet::Paper => haralick(&counts, l).to_array().to_vec(),
+        Ok(self.haralick_row(&counts))
+    }
+
+    /// The Haralick features of the extractor's set from a GLCM's summed counts
+    /// (`levels x levels`).
+    pub(crate) fn haralick_row(&self, counts: &[u64]) -> Vec<f64> {
+        let l = self.volume.levels;
+        match self.features.haralick {
+            HaralickSet::Paper => haralick(counts, l).to_array().to_vec(),
             HaralickSet::Full => {
                 let weights: Vec<f64> = counts.iter().map(|&c| c as f64).collect();
                 haralick_full(&weights, l).to_vec()
             }
-        })
+        }
+    }
+
+    /// The quantisation and binning parameters.
+    pub(crate) fn volume_params(&self) -> &VolumeParams {
+        &self.volume
+    }
+
+    /// The co-occurrence parameters.
+    pub(crate) fn glcm_params(&self) -> &GlcmParams {
+        &self.glcm
     }
 }
 

@@ -176,6 +176,32 @@ fn a_stream_at_1_khz_decides_as_the_offline_twin() {
 }
 
 #[test]
+fn a_sliding_3d_glcm_window_decides_as_the_offline_twin() {
+    // The stream keeps a 3D-GLCM model's co-occurrence counts bin by bin as the window
+    // slides; offline, each window's volume is counted afresh.
+    let recs = recordings();
+    let model = causal_model(
+        &recs,
+        Encoding::SaFa,
+        Method::Glcm3d,
+        ClassifierChoice::Knn(KnnParams::default()),
+    );
+    let mut p = params(&model);
+    p.window_ms = 600;
+    for rec in recs.iter().step_by(3) {
+        let offline = model.encode(rec).unwrap();
+        let expected = episode_decisions(&model, &offline, p.window_ms, p.rule).unwrap();
+        assert!(
+            expected.bins.len() >= 6,
+            "a window that slides several bins"
+        );
+        let mut stream = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+        let got = stream_events(&mut stream, &frames_of(&slide_only(rec)));
+        assert_eq!(got, offline_events(expected), "{}", rec.meta.file);
+    }
+}
+
+#[test]
 fn irregular_stamps_and_other_rates_resample_as_offline() {
     let recs = recordings();
     let model = causal_model(

@@ -74,7 +74,8 @@ pub struct StreamArgs {
     /// Where frames come from: `-` (standard input), a file, `tcp://HOST:PORT` (listens
     /// there and takes one connection: the sensor's driver connects and sends frames
     /// until it closes) or `udp://HOST:PORT` (binds there; each datagram holds whole lines
-    /// or frames; an empty datagram ends the input).
+    /// or frames; an empty datagram ends the input). SIGINT (Ctrl-C), SIGTERM or SIGHUP
+    /// ends the stream at its next frame with the episode's summary.
     #[arg(long, default_value = "-")]
     pub input: String,
     /// The frame format.
@@ -142,11 +143,19 @@ pub fn run(args: StreamArgs) -> Result<()> {
     let input = open_input(&args.input)?;
     let mut out = Output::new(std::io::stdout().lock());
     let pace = args.realtime.then(Pace::new);
+    crate::interrupt::end_input_on_signal();
     match args.format {
         FrameFormat::Csv => read_csv(&args, input, &mut stream, &mut out, pace)?,
         FrameFormat::F32le => read_f32le(&args, input, &mut stream, &mut out, pace)?,
     }
-    let events = stream.finish().map_err(fatal)?.to_vec();
+    let events = match crate::interrupt::stop_requested() {
+        true => {
+            eprintln!("interrupted: the stream stopped at its next frame");
+            stream.stop()
+        }
+        false => stream.finish(),
+    };
+    let events = events.map_err(fatal)?.to_vec();
     out.events(&stream, &events)?;
     eprintln!(
         "{} frames, {} bad frame(s) skipped, {} episode(s)",
@@ -283,6 +292,9 @@ fn read_csv(
     let mut fields: Vec<f64> = Vec::new();
     let mut values: Vec<f64> = Vec::new();
     for (number, line) in input.lines().enumerate() {
+        if crate::interrupt::stop_requested() {
+            break;
+        }
         let line_no = number + 1;
         let line = line.with_context(|| format!("reading line {line_no} of {}", args.input))?;
         let text = line.trim();
@@ -375,7 +387,7 @@ fn read_f32le(
     let mut number = 0u64;
     loop {
         let got = read_full(&mut input, &mut frame)?;
-        if got == 0 {
+        if got == 0 || crate::interrupt::stop_requested() {
             return Ok(());
         }
         number += 1;

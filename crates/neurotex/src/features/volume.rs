@@ -175,7 +175,7 @@ impl CountVolume {
     /// One count's rate in Hz, computed one way for [`CountVolume::rates`] and
     /// [`CountVolume::quantise`] so that their levels agree bit for bit.
     fn rate(&self, count: u32) -> f64 {
-        f64::from(count) * (1000.0 / self.bin_ms as f64)
+        rate_of(count, self.bin_ms)
     }
 
     /// The levels [`quantise`] gives for [`CountVolume::rates`], bit for bit.
@@ -186,8 +186,7 @@ impl CountVolume {
         if min > max {
             return; // no present cell
         }
-        let (lo, hi) = range.unwrap_or((self.rate(min), self.rate(max)));
-        let level = |c: u32| level_of(self.rate(c), lo, hi, levels);
+        let level = count_levels(self.bin_ms, levels, range, (min, max));
         let rows = present_levels(out, &self.counts, self.bins, &self.present);
         if max - min < 256 {
             // The usual case: a table indexed by a byte needs no bounds checks.
@@ -209,6 +208,25 @@ impl CountVolume {
             }
         }
     }
+}
+
+/// The rate in Hz of `count` spikes in a bin of `bin_ms`.
+fn rate_of(count: u32, bin_ms: usize) -> f64 {
+    f64::from(count) * (1000.0 / bin_ms as f64)
+}
+
+/// The level of each count of a count volume with bins of `bin_ms` whose present voxels
+/// span the counts `min..=max`: the levels of [`CountVolume::quantise`] (the range is
+/// `range`, or the rates of `min` and `max`), for volumes kept other ways (a stream's
+/// sliding window).
+pub(crate) fn count_levels(
+    bin_ms: usize,
+    levels: usize,
+    range: Option<(f64, f64)>,
+    (min, max): (u32, u32),
+) -> impl Fn(u32) -> u8 {
+    let (lo, hi) = range.unwrap_or((rate_of(min, bin_ms), rate_of(max, bin_ms)));
+    move |c: u32| level_of(rate_of(c, bin_ms), lo, hi, levels)
 }
 
 /// The smallest and largest count of `rows`, `(u32::MAX, 0)` for none.

@@ -139,6 +139,40 @@ impl Run {
     }
 }
 
+/// Counts each pair in both orders: `counts + counts^T` (`l x l`), the diagonal doubled
+/// as both orders of a pair of equal levels.
+pub(crate) fn symmetrise<T: Copy + std::ops::Add<Output = T>>(counts: &mut [T], l: usize) {
+    for i in 0..l {
+        for j in i..l {
+            let s = counts[i * l + j] + counts[j * l + i];
+            counts[i * l + j] = s;
+            counts[j * l + i] = s;
+        }
+    }
+}
+
+/// The `(dr, dc, dt)` offsets of `kind`: the paper's directions times each distance, in
+/// the order of `params.distances`.
+pub fn planned_offsets(params: &GlcmParams, kind: GlcmKind) -> Vec<(isize, isize, isize)> {
+    let dirs: &[(i32, i32, i32)] = match kind {
+        GlcmKind::ThreeD => &DIRECTIONS_13,
+        GlcmKind::TwoD => &DIRECTIONS_13[..4],
+    };
+    params
+        .distances
+        .iter()
+        .flat_map(|&d| {
+            dirs.iter().map(move |&(dr, dc, dt)| {
+                (
+                    dr as isize * d as isize,
+                    dc as isize * d as isize,
+                    dt as isize * d as isize,
+                )
+            })
+        })
+        .collect()
+}
+
 /// Offset tables for one grid, mask and parameter set, built once and applied to many volumes.
 #[derive(Debug, Clone)]
 pub struct GlcmPlan {
@@ -171,23 +205,7 @@ impl GlcmPlan {
         kind: GlcmKind,
     ) -> Result<Self, ParamError> {
         params.check()?;
-        let dirs: &[(i32, i32, i32)] = match kind {
-            GlcmKind::ThreeD => &DIRECTIONS_13,
-            GlcmKind::TwoD => &DIRECTIONS_13[..4],
-        };
-        let offsets: Vec<(isize, isize, isize)> = params
-            .distances
-            .iter()
-            .flat_map(|&d| {
-                dirs.iter().map(move |&(dr, dc, dt)| {
-                    (
-                        dr as isize * d as isize,
-                        dc as isize * d as isize,
-                        dt as isize * d as isize,
-                    )
-                })
-            })
-            .collect();
+        let offsets = planned_offsets(params, kind);
         Self::from_offsets(rows, cols, present, levels, &offsets, params.symmetric)
     }
 
@@ -335,13 +353,7 @@ impl GlcmPlan {
             }
         }
         if self.symmetric {
-            for i in 0..l {
-                for j in i..l {
-                    let s = counts[i * l + j] + counts[j * l + i];
-                    counts[i * l + j] = s;
-                    counts[j * l + i] = s;
-                }
-            }
+            symmetrise(counts, l);
         }
     }
 
@@ -476,13 +488,7 @@ impl GlcmPlan {
             start = end;
         }
         if self.symmetric {
-            for i in 0..l {
-                for j in i..l {
-                    let s = counts[i * l + j] + counts[j * l + i];
-                    counts[i * l + j] = s;
-                    counts[j * l + i] = s;
-                }
-            }
+            symmetrise(counts, l);
         }
     }
 

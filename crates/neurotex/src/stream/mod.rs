@@ -12,7 +12,8 @@
 //! Memory is bounded by the window, not the stream: per taxel the filter, neuron and
 //! resampler state (a few f64) and the spike times of the current window (as u32).
 
-use std::collections::VecDeque;
+mod spike_log;
+mod window_glcm;
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
@@ -24,6 +25,8 @@ use crate::model::{Model, Prediction};
 use crate::pipeline::{Encoded, Encoding};
 use crate::recording::Meta;
 use crate::signal::{Butterworth2, CausalConditioning, Preprocessor, ENCODER_FS};
+use spike_log::SpikeLog;
+use window_glcm::WindowGlcm;
 
 /// The default largest gap between two frames' time stamps within one episode, s: a
 /// longer silence ends the episode (resampling across it would invent samples).
@@ -204,14 +207,18 @@ struct EpisodeState {
     next: usize,
     /// Steps conditioned so far.
     steps: usize,
-    filter_state: Vec<[f64; 2]>,
+    /// The causal filter's two state values per cell.
+    filter_state: [Vec<f64>; 2],
     /// Whether [`StreamClassifier::previous`] holds the previous step (for the FA drive).
     has_previous: bool,
     /// The populations' neurons, in the order of [`Encoded::populations`], each marked
     /// whether it is FA (driven by the rectified rate of change).
     neurons: Vec<(Encoder, bool)>,
-    /// Spike times of the current window, per population, per cell.
-    spikes: Vec<Vec<VecDeque<u32>>>,
+    /// The spikes of the current window, per population.
+    spikes: Vec<SpikeLog>,
+    /// Per population, the window's co-occurrence counts kept bin by bin, for 3D-GLCM
+    /// models (empty for others, which count the window's spike times afresh).
+    glcm: Vec<WindowGlcm>,
     decider: Decider,
     bins: usize,
     /// Since when (s from the origin) the signal has been at rest, for onset episodes.
@@ -234,6 +241,8 @@ pub struct StreamClassifier {
     window: usize,
     /// Frames at 1 kHz without stamps go straight to the encoder (as offline).
     uniform_1k: bool,
+    /// An empty window of a 3D-GLCM model's co-occurrence counts, each episode's start.
+    empty_glcm: Option<WindowGlcm>,
     episode: Option<EpisodeState>,
     /// The previous frame's time stamp.
     previous_stamp: Option<f64>,
@@ -285,6 +294,17 @@ impl StreamClassifier {
             .copied();
         let bin = model.params().volume.bin_ms;
         let window = window_steps(params.window_ms, bin);
+        let empty_glcm = match model.features().method {
+            crate::pipeline::Method::Glcm3d => WindowGlcm::new(
+                rows,
+                cols,
+                &present,
+                bin,
+                model.extractor().glcm_params(),
+                window / bin,
+            ),
+            _ => None,
+        };
         let buffer = vec![0.0; cells];
         Ok(StreamClassifier {
             conditioning,
@@ -296,6 +316,7 @@ impl StreamClassifier {
             bin,
             window,
             uniform_1k: (params.fs - ENCODER_FS).abs() < 1e-9,
+            empty_glcm,
             episode: None,
             previous_stamp: None,
             frames: 0,
@@ -348,12 +369,9 @@ impl StreamClassifier {
     /// Spike times held for the current window, over all populations and cells (what
     /// grows with the window, not with the stream).
     pub fn retained_spikes(&self) -> usize {
-        self.episode.as_ref().map_or(0, |e| {
-            e.spikes
-                .iter()
-                .flat_map(|cells| cells.iter().map(VecDeque::len))
-                .sum()
-        })
+        self.episode
+            .as_ref()
+            .map_or(0, |e| e.spikes.iter().map(SpikeLog::len).sum())
     }
 
     /// Whether an episode is under way.
@@ -378,8 +396,12 @@ impl StreamClassifier {
         }
         let index = self.frames as f64;
         self.frames += 1;
-        for (&v, &cell) in values.iter().zip(&self.channel_cells) {
-            self.cell_frame[cell] = v;
+        if values.len() == self.cell_frame.len() {
+            self.cell_frame.copy_from_slice(values); // every cell holds a taxel
+        } else {
+            for (&v, &cell) in values.iter().zip(&self.channel_cells) {
+                self.cell_frame[cell] = v;
+            }
         }
         if let Some(t) = time_s {
             let gap = self
@@ -422,7 +444,9 @@ impl StreamClassifier {
             None => (index - origin) / self.params.fs,
         };
         if time_s.is_none() && self.uniform_1k {
-            self.step_in.copy_from_slice(&self.cell_frame);
+            // The frame is the step's input; the buffers trade places, not values (both
+            // hold 0 in masked cells, and the next frame overwrites every taxel).
+            std::mem::swap(&mut self.step_in, &mut self.cell_frame);
             self.step()?;
         } else {
             self.resample(relative)?;
@@ -451,11 +475,7 @@ impl StreamClassifier {
     /// # Errors
     /// The model cannot classify the episode's last window.
     pub fn reset(&mut self) -> Result<&[Event], StreamError> {
-        self.events.clear();
-        if self.episode.is_some() {
-            self.end_episode(EpisodeEnd::Reset)?;
-        }
-        Ok(&self.events)
+        self.end_with(EpisodeEnd::Reset)
     }
 
     /// Ends the stream: the last steps of the current episode and its summary.
@@ -463,9 +483,23 @@ impl StreamClassifier {
     /// # Errors
     /// The model cannot classify the episode's last window.
     pub fn finish(&mut self) -> Result<&[Event], StreamError> {
+        self.end_with(EpisodeEnd::EndOfInput)
+    }
+
+    /// Stops the stream before its input ended (an interrupt): as [`StreamClassifier::finish`],
+    /// the episode's summary saying it was stopped.
+    ///
+    /// # Errors
+    /// The model cannot classify the episode's last window.
+    pub fn stop(&mut self) -> Result<&[Event], StreamError> {
+        self.end_with(EpisodeEnd::Stopped)
+    }
+
+    /// Ends the current episode, if any, for `why`; its summary is the one event.
+    fn end_with(&mut self, why: EpisodeEnd) -> Result<&[Event], StreamError> {
         self.events.clear();
         if self.episode.is_some() {
-            self.end_episode(EpisodeEnd::EndOfInput)?;
+            self.end_episode(why)?;
         }
         Ok(&self.events)
     }
@@ -487,7 +521,9 @@ impl StreamClassifier {
                 return Err(BadFrame::Stamp { t, previous });
             }
         }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        // One pass without early exit (it vectorises); the position only for a bad frame.
+        if values.iter().fold(false, |bad, v| bad | !v.is_finite()) {
+            let i = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
             return Err(BadFrame::NotFinite {
                 index: i + first_value,
             });
@@ -523,9 +559,13 @@ impl StreamClassifier {
             last_t: 0.0,
             next: 0,
             steps: 0,
-            filter_state: vec![[0.0; 2]; cells],
+            filter_state: [vec![0.0; cells], vec![0.0; cells]],
             has_previous: false,
-            spikes: vec![vec![VecDeque::new(); cells]; neurons.len()],
+            spikes: vec![SpikeLog::default(); neurons.len()],
+            glcm: match &self.empty_glcm {
+                Some(empty) => vec![empty.clone(); neurons.len()],
+                None => Vec::new(),
+            },
             neurons,
             decider: Decider::new(self.params.rule),
             bins: 0,
@@ -593,85 +633,69 @@ impl StreamClassifier {
     /// Conditions one 1 kHz step (`step_in`, raw values per cell), runs the neurons,
     /// keeps their spikes, and classifies at a bin boundary.
     ///
-    /// One pass over the cells removes the resting value, filters and scales, with the
+    /// The cells go through every stage [`PART`] at a time, so that a large skin's step
+    /// reads and writes each cell's state once while the part's values stay in the
+    /// cache. Conditioning removes the resting value, filters and scales, with the
     /// operations of the offline pipeline in its order. Masked cells are filtered too:
     /// their input is 0 and a filter started at 0 stays at exactly 0, as offline, where
     /// they are left out; including them keeps the loop free of gathers.
     fn step(&mut self) -> Result<(), StreamError> {
         let episode = self.episode.as_mut().expect("an episode is under way");
-        let c = &self.conditioning;
         let first = episode.steps == 0;
-        match &self.filter {
-            Some(f) => {
-                for ((((x, &raw), &offset), &present), z) in self
-                    .conditioned
-                    .iter_mut()
-                    .zip(&self.step_in)
-                    .zip(&c.offsets)
-                    .zip(&self.present)
-                    .zip(episode.filter_state.iter_mut())
-                {
-                    let v = if present { raw - offset } else { 0.0 };
-                    if first {
-                        *z = f.steady_state(v);
-                    }
-                    *x = f.step(v, z) / c.scale;
-                }
-            }
-            None => {
-                for (((x, &raw), &offset), &present) in self
-                    .conditioned
-                    .iter_mut()
-                    .zip(&self.step_in)
-                    .zip(&c.offsets)
-                    .zip(&self.present)
-                {
-                    let v = if present { raw - offset } else { 0.0 };
-                    *x = v / c.scale;
-                }
-            }
+        let cells = self.rows * self.cols;
+        let has_fa = episode.neurons.iter().any(|n| n.1);
+        let [z0, z1] = &mut episode.filter_state;
+        for log in &mut episode.spikes {
+            log.begin_step();
         }
-        let t = episode.steps as u32;
-        for (population, (neurons, is_fa)) in episode.neurons.iter_mut().enumerate() {
-            let input = match is_fa {
-                false => &self.conditioned,
-                true => {
-                    for ((d, &x), &p) in self
-                        .drive
-                        .iter_mut()
-                        .zip(&self.conditioned)
-                        .zip(&self.previous)
-                    {
-                        *d = if episode.has_previous {
-                            (x - p).abs()
-                        } else {
-                            0.0
-                        };
-                    }
-                    &self.drive
-                }
+        for start in (0..cells).step_by(PART) {
+            let part = start..(start + PART).min(cells);
+            let cells = Conditioning {
+                raw: &self.step_in[part.clone()],
+                offsets: &self.conditioning.offsets[part.clone()],
+                present: &self.present[part.clone()],
+                state: [&mut z0[part.clone()], &mut z1[part.clone()]],
+                out: &mut self.conditioned[part.clone()],
             };
-            neurons.run(input, &mut self.raster);
-            let trains = &mut episode.spikes[population];
-            // Spikes are sparse: test eight cells at a time as one word.
-            for (w, word) in self.raster.chunks(8).enumerate() {
-                if word.iter().all(|&b| b == 0) {
-                    continue;
-                }
-                for (k, &b) in word.iter().enumerate() {
-                    let cell = w * 8 + k;
-                    if b != 0 && self.present[cell] {
-                        trains[cell].push_back(t);
+            cells.run(self.filter.as_ref(), self.conditioning.scale, first);
+            let raster = &mut self.raster[part.clone()];
+            for (population, (neurons, is_fa)) in episode.neurons.iter_mut().enumerate() {
+                let input = match is_fa {
+                    false => &self.conditioned[part.clone()],
+                    true => {
+                        let drive = &mut self.drive[part.clone()];
+                        let x = &self.conditioned[part.clone()];
+                        let p = &self.previous[part.clone()];
+                        for ((d, &x), &p) in drive.iter_mut().zip(x).zip(p) {
+                            *d = if episode.has_previous {
+                                (x - p).abs()
+                            } else {
+                                0.0
+                            };
+                        }
+                        &*drive
                     }
+                };
+                neurons.run_part(part.start, input, raster);
+                if let Some(window) = episode.glcm.get_mut(population) {
+                    window.add_spikes(part.start, raster);
                 }
+                episode.spikes[population].add_part(
+                    part.start,
+                    raster,
+                    &self.present[part.clone()],
+                );
             }
         }
-        if episode.neurons.iter().any(|n| n.1) {
-            self.previous.copy_from_slice(&self.conditioned);
+        if has_fa {
+            std::mem::swap(&mut self.previous, &mut self.conditioned);
             episode.has_previous = true;
         }
         episode.steps += 1;
         if episode.steps % self.bin == 0 {
+            for window in &mut episode.glcm {
+                window.close_bin();
+            }
             self.boundary()?;
         }
         Ok(())
@@ -683,14 +707,13 @@ impl StreamClassifier {
         let end = episode.steps;
         let start = end.saturating_sub(self.window);
         // Later windows start later, and the episode's summary no earlier than this one.
-        for trains in &mut episode.spikes {
-            for train in trains.iter_mut() {
-                while train.front().is_some_and(|&t| (t as usize) < start) {
-                    train.pop_front();
-                }
-            }
+        for log in &mut episode.spikes {
+            log.drop_before(start);
         }
-        let prediction = self.classify(start, end)?;
+        let prediction = match episode.glcm.is_empty() {
+            true => self.classify(start, end)?,
+            false => self.classify_window()?,
+        };
         let class = self.model.class_index(&prediction.predicted);
         let t_s = end as f64 / 1000.0;
         let episode = self.episode.as_mut().expect("an episode is under way");
@@ -715,29 +738,7 @@ impl StreamClassifier {
         let trains: Vec<SpikeTrains> = episode
             .spikes
             .iter()
-            .map(|cells| {
-                let mut offsets = Vec::with_capacity(cells.len() + 1);
-                let mut times = Vec::new();
-                offsets.push(0);
-                for train in cells {
-                    // Sorted: the window is a contiguous run of each train.
-                    let (a, b) = train.as_slices();
-                    for part in [a, b] {
-                        let lo = part.partition_point(|&t| (t as usize) < start);
-                        let hi = part.partition_point(|&t| (t as usize) < end);
-                        times.extend(part[lo..hi].iter().map(|&t| t - start as u32));
-                    }
-                    offsets.push(times.len() as u32);
-                }
-                SpikeTrains::from_parts(
-                    self.rows,
-                    self.cols,
-                    &self.present,
-                    end - start,
-                    offsets,
-                    times,
-                )
-            })
+            .map(|log| log.trains(start, end, (self.rows, self.cols), &self.present))
             .collect();
         let mut populations = trains.into_iter();
         let encoded = Encoded {
@@ -752,6 +753,23 @@ impl StreamClassifier {
             flat: false,
         };
         Ok(self.model.predict_one(&encoded)?)
+    }
+
+    /// The model's prediction for the current window from its co-occurrence counts kept
+    /// bin by bin (3D-GLCM models): the same features as [`StreamClassifier::classify`]
+    /// gives at a bin boundary, without counting the window afresh.
+    fn classify_window(&self) -> Result<Prediction, StreamError> {
+        let episode = self.episode.as_ref().expect("an episode is under way");
+        let extractor = self.model.extractor();
+        let volume = extractor.volume_params();
+        let symmetric = extractor.glcm_params().symmetric;
+        let mut row = Vec::new();
+        let mut counts = Vec::new();
+        for window in &episode.glcm {
+            window.counts(volume.levels, volume.range, symmetric, &mut counts);
+            row.extend(extractor.haralick_row(&counts));
+        }
+        Ok(self.model.predict_extracted(&row)?)
     }
 
     /// Conditions the episode's last steps, then summarises it: the classification of its
@@ -777,6 +795,75 @@ impl StreamClassifier {
             ended_by,
         }));
         Ok(())
+    }
+}
+
+/// Cells taken through all the stages of a step at a time: their values and state (some
+/// 60 bytes per cell) stay in the first-level cache.
+const PART: usize = 512;
+
+/// One step of some cells to condition: their raw values, resting values, whether they
+/// hold a taxel, the filter's state, and where the conditioned values go.
+struct Conditioning<'a> {
+    raw: &'a [f64],
+    offsets: &'a [f64],
+    present: &'a [bool],
+    state: [&'a mut [f64]; 2],
+    out: &'a mut [f64],
+}
+
+impl Conditioning<'_> {
+    /// Removes the resting value (0 for masked cells), filters (the filter started in its
+    /// steady state at the episode's first step) when there is a filter, and divides by
+    /// the scale: the offline causal pipeline's operations in its order.
+    fn run(self, filter: Option<&Butterworth2>, scale: f64, first: bool) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            /// The same loops with AVX2's four-lane division; no FMA, so the results are
+            /// the portable path's bit for bit.
+            #[target_feature(enable = "avx2")]
+            unsafe fn run_avx2(
+                cells: Conditioning<'_>,
+                filter: Option<&Butterworth2>,
+                scale: f64,
+                first: bool,
+            ) {
+                cells.run_portable(filter, scale, first);
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2, checked just above.
+                return unsafe { run_avx2(self, filter, scale, first) };
+            }
+        }
+        self.run_portable(filter, scale, first);
+    }
+
+    #[inline(always)]
+    fn run_portable(self, filter: Option<&Butterworth2>, scale: f64, first: bool) {
+        let n = self.out.len();
+        let (raw, offsets, present) = (&self.raw[..n], &self.offsets[..n], &self.present[..n]);
+        let [z0, z1] = self.state;
+        let (z0, z1, out) = (&mut z0[..n], &mut z1[..n], self.out);
+        let input = |i: usize| if present[i] { raw[i] - offsets[i] } else { 0.0 };
+        match filter {
+            Some(f) => {
+                if first {
+                    for i in 0..n {
+                        [z0[i], z1[i]] = f.steady_state(input(i));
+                    }
+                }
+                for i in 0..n {
+                    let mut z = [z0[i], z1[i]];
+                    out[i] = f.step(input(i), &mut z) / scale;
+                    [z0[i], z1[i]] = z;
+                }
+            }
+            None => {
+                for (i, x) in out.iter_mut().enumerate() {
+                    *x = input(i) / scale;
+                }
+            }
+        }
     }
 }
 

@@ -1,0 +1,53 @@
+//! What SIGINT, SIGTERM and SIGHUP do: a run stops at once and removes its temporary files;
+//! a stream that asked for it ends at its next frame with the episode's summary.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// The exit code after a signal (the shell's 128 + SIGINT).
+const INTERRUPTED: i32 = 130;
+
+/// How long a stream that handles the signal has to reach its next frame; an input that
+/// stays silent longer ends the run as any other.
+const GRACE: Duration = Duration::from_secs(2);
+
+/// Set once a command takes the signal as the end of its input.
+static GRACEFUL: AtomicBool = AtomicBool::new(false);
+
+/// Set by the signal for such a command.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Installs the handler: with [`end_input_on_signal`] called, the signal asks the command to
+/// stop ([`stop_requested`]) and the process exits after [`GRACE`] if it has not; otherwise
+/// the run's temporary files and folders are removed (the library registers each one;
+/// finished outputs are never among them) and the process exits with 130.
+pub fn install() {
+    let installed = ctrlc::set_handler(|| {
+        if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
+            // The command ends by itself at its next frame; the process exits then.
+            std::thread::sleep(GRACE);
+            eprintln!(
+                "interrupted: no frame arrived within {} s, so the episode ended without its summary",
+                GRACE.as_secs()
+            );
+        }
+        // Held until exit: no temporary is created or renamed into place after the clean-up.
+        let _registry = neurotex::io::remove_temporaries();
+        eprintln!("interrupted: temporary files removed");
+        std::process::exit(INTERRUPTED);
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: an interrupted run may leave temporary files ({e})");
+    }
+}
+
+/// Makes the signal the end of the input: the command checks [`stop_requested`] after each
+/// frame and ends cleanly.
+pub fn end_input_on_signal() {
+    GRACEFUL.store(true, Ordering::SeqCst);
+}
+
+/// Whether a signal asked the command to stop.
+pub fn stop_requested() -> bool {
+    STOP.load(Ordering::Relaxed)
+}
