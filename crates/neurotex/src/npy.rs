@@ -32,6 +32,8 @@ pub(crate) struct NpyHeader {
     pub elements: usize,
     /// Byte offset of the data.
     pub data_offset: usize,
+    /// Whether the data is in column-major (Fortran) order.
+    pub fortran_order: bool,
 }
 
 impl NpyHeader {
@@ -93,6 +95,50 @@ pub(crate) fn read_header(path: &Path) -> Result<NpyHeader> {
     Ok(parsed)
 }
 
+/// The samples of a `.npy` of little-endian floats (`<f8` or `<f4`) in C order, whose
+/// header [`read_header`] checked: the data read in one call into a byte buffer kept for the
+/// thread's next file, and converted to f64 in one pass. `None` for any other dtype or order
+/// (ndarray-npy reads those).
+///
+/// # Errors
+/// The file cannot be read (or changed size since its header was read).
+pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<Vec<f64>>> {
+    use std::io::{Seek, SeekFrom};
+    thread_local! {
+        /// The last file's bytes: one allocation per thread, not one per recording.
+        static BYTES: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+    let item = match header.descr.as_str() {
+        "<f8" => 8,
+        "<f4" => 4,
+        _ => return Ok(None),
+    };
+    if header.fortran_order {
+        return Ok(None);
+    }
+    let io = |e| DataError::io(path, e);
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    file.seek(SeekFrom::Start(header.data_offset as u64))
+        .map_err(io)?;
+    BYTES.with_borrow_mut(|bytes| {
+        // Only growth is zeroed: the read overwrites every byte kept.
+        let size = header.elements * item;
+        bytes.truncate(size);
+        bytes.resize(size, 0);
+        file.read_exact(bytes).map_err(io)?;
+        Ok(Some(match item {
+            8 => bytes
+                .chunks_exact(8)
+                .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
+                .collect(),
+            _ => bytes
+                .chunks_exact(4)
+                .map(|b| f64::from(f32::from_le_bytes(b.try_into().expect("4 bytes"))))
+                .collect(),
+        }))
+    })
+}
+
 /// Reads into `buf` until it is full or the file ends; returns the bytes read.
 fn read_up_to(file: &mut std::fs::File, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut filled = 0;
@@ -134,6 +180,7 @@ fn parse_dict(text: &str) -> std::result::Result<NpyHeader, String> {
     if !(order.starts_with("False") || order.starts_with("True")) {
         return Err("field `fortran_order` must be True or False".into());
     }
+    let fortran_order = order.starts_with("True");
     let shape = parse_shape(value_after(text, "shape")?)?;
     let (kind, item_bytes) = parse_descr(descr)?;
     // ndarray needs the product of the non-zero axes to fit in isize even when another
@@ -152,6 +199,7 @@ fn parse_dict(text: &str) -> std::result::Result<NpyHeader, String> {
         shape,
         elements,
         data_offset: 0,
+        fortran_order,
     })
 }
 

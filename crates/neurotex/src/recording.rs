@@ -1146,7 +1146,12 @@ pub fn read_recording_as(
         let message = format!("recording has {n_channels} channels, beyond the limit of {max}");
         return Err(DataError::invalid(path, message).into());
     }
-    if let Some(pos) = raw.iter().position(|v| !v.is_finite()) {
+    // One pass without early exit (it vectorises); the position only for a bad file.
+    let any_bad = raw.iter().fold(false, |bad, v| bad | !v.is_finite());
+    if let Some(pos) = any_bad
+        .then(|| raw.iter().position(|v| !v.is_finite()))
+        .flatten()
+    {
         return Err(DataError::invalid(
             path,
             format!(
@@ -1242,6 +1247,9 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
     };
     crate::values::check_grid_cells(rows, cols)
         .map_err(|e| DataError::invalid(path, format!("shape {:?}: {e}", header.shape)))?;
+    if let Some(samples) = crate::npy::read_le_floats(path, &header)? {
+        return Ok((shape, samples));
+    }
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     let unreadable = |e: ndarray_npy::ReadNpyError| {
         DataError::invalid(path, format!("not a readable .npy of float samples: {e}"))

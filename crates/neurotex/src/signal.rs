@@ -288,8 +288,24 @@ impl Preprocessor {
             (0, n)
         };
         let uniform_1k = rec.times_s.is_none() && (rec.fs - ENCODER_FS).abs() < 1e-9;
+        let present = &rec.layout.present;
         let mut samples = if uniform_1k {
-            rec.samples[lo * cells..hi * cells].to_vec()
+            // The copy of the selected phase, each sample less its cell's resting value.
+            let mut out = Vec::with_capacity((hi - lo) * cells);
+            for frame in rec.samples[lo * cells..hi * cells].chunks_exact(cells) {
+                out.extend(
+                    frame.iter().zip(&offsets).zip(present).map(
+                        |((&s, &o), &p)| {
+                            if p {
+                                s - o
+                            } else {
+                                0.0
+                            }
+                        },
+                    ),
+                );
+            }
+            out
         } else {
             let span = times[hi - 1] - times[lo];
             if resampled_len(span, ENCODER_FS, cells).is_none() {
@@ -312,9 +328,11 @@ impl Preprocessor {
             )
             .into());
         }
-        for frame in samples.chunks_exact_mut(cells) {
-            for ((s, &o), &p) in frame.iter_mut().zip(&offsets).zip(&rec.layout.present) {
-                *s = if p { *s - o } else { 0.0 };
+        if !uniform_1k {
+            for frame in samples.chunks_exact_mut(cells) {
+                for ((s, &o), &p) in frame.iter_mut().zip(&offsets).zip(present) {
+                    *s = if p { *s - o } else { 0.0 };
+                }
             }
         }
         if let Some(filter) = &self.filter {
@@ -351,17 +369,56 @@ impl Preprocessor {
 /// relative activation between taxels survives. Returns `true`, and sets everything to 0,
 /// when that maximum is <= 0 (a recording with no positive signal is never divided).
 pub fn normalise_global_max(samples: &mut [f64]) -> bool {
-    let max = samples.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let max = largest(samples);
     if max > 0.0 {
         // A true division, not a multiplication by `1 / max`: that rounds twice and can
         // differ in the last bit, which the encoder's threshold can turn into a spike more
         // or less; dividing gives numpy's `x / x.max()` bit for bit.
-        samples.iter_mut().for_each(|s| *s /= max);
+        divide_all(samples, max);
         false
     } else {
         samples.iter_mut().for_each(|s| *s = 0.0);
         true
     }
+}
+
+/// The largest of `samples` (finite numbers; -inf for none): eight running maxima, which
+/// vectorise where one fold through `f64::max` is a chain of dependent comparisons. The
+/// largest of a set does not depend on the order it is sought in (a maximum of 0 may come
+/// out as -0, which compares equal).
+fn largest(samples: &[f64]) -> f64 {
+    let mut lanes = [f64::NEG_INFINITY; 8];
+    let chunks = samples.chunks_exact(8);
+    for &x in chunks.remainder() {
+        lanes[0] = if x > lanes[0] { x } else { lanes[0] };
+    }
+    for chunk in chunks {
+        for (m, &x) in lanes.iter_mut().zip(chunk) {
+            *m = if x > *m { x } else { *m };
+        }
+    }
+    lanes.into_iter().fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Divides every sample by `by` (correctly rounded in any vector width, so the same bits
+/// as one division at a time); AVX2's four lanes where the processor has them.
+fn divide_all(samples: &mut [f64], by: f64) {
+    #[inline(always)]
+    fn divide(samples: &mut [f64], by: f64) {
+        samples.iter_mut().for_each(|s| *s /= by);
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2")]
+        unsafe fn divide_avx2(samples: &mut [f64], by: f64) {
+            divide(samples, by);
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { divide_avx2(samples, by) };
+        }
+    }
+    divide(samples, by);
 }
 
 /// Each sample's time in s from the recording's first: its time stamps less the first, or
