@@ -439,8 +439,7 @@ def calibrate_gain(
     Raises :class:`ParameterError` when no recording has any signal to calibrate on."""
     if "gain" in stage_options:
         raise ParameterError("calibrate_gain chooses the gain; give target_hz instead")
-    opts = _stage_options(**{k: (tuple(v) if isinstance(v, (list, tuple)) else v)
-                             for k, v in stage_options.items()})
+    opts = _stage_options(**stage_options)
     try:
         target = float(target_hz)
     except (TypeError, ValueError):
@@ -695,8 +694,7 @@ class Model:
             items = [r if isinstance(r, Recording) else Recording(x=r, fs=fs) for r in items]
             items = [Recording(**{**r.__dict__, "label": str(l)}) for r, l in zip(items, labels)]
         arrays, infos = _prepare(items, fs, mask, speeds)
-        opts = _stage_options(**{k: (tuple(v) if isinstance(v, (list, tuple)) else v)
-                                 for k, v in stage_options.items()})
+        opts = _stage_options(**stage_options)
         fp = _fingerprint(arrays, [i[3] for i in infos])
         opts["causal"] = bool(causal)
         native = _native.train_model(arrays, infos, method, opts, classifier,
@@ -838,8 +836,7 @@ def reproduce(
     Raises :class:`ParameterError` for a broken option, :class:`NotFoundError` for a
     missing dataset folder, :class:`DataError` for recordings the analyses cannot use."""
     out = os.fspath(out_dir)
-    opts = _stage_options(**{key: (tuple(v) if isinstance(v, (list, tuple)) else v)
-                             for key, v in stage_options.items()})
+    opts = _stage_options(**stage_options)
     given = {"dataset": None if dataset is None else os.fspath(dataset), "quick": quick,
              "seed": seed, "trials": trials, "seeds": seeds, "k": k,
              "standardize": standardize, "group_by": group_by}
