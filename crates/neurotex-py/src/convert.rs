@@ -2,9 +2,12 @@
 //! without the GIL into the library's recordings and rasters.
 
 use ndarray::ArrayViewD;
+use neurotex::error::DataError;
+use neurotex::pipeline::Encoded;
 use neurotex::recording::{Layout, Meta, Recording, DEFAULT_MAX_DURATION_S};
 use numpy::PyReadonlyArrayDyn;
 use pyo3::prelude::*;
+use rayon::prelude::*;
 
 use crate::errors::{raise, Kind};
 
@@ -73,48 +76,46 @@ impl SamplesView<'_> {
     ///
     /// # Errors
     /// A `DataError` naming the recording and what is wrong.
-    pub fn recording(&self, info: &RecordingInfo) -> Result<Recording, String> {
+    pub fn recording(&self, info: &RecordingInfo) -> neurotex::Result<Recording> {
         let shape = match self {
             SamplesView::F32(a) => a.shape(),
             SamplesView::F64(a) => a.shape(),
         };
         let name = &info.name;
+        let bad = |message: String| -> neurotex::Error { DataError::invalid(name, message).into() };
         let (t, rows, cols) = match *shape {
             [t, r, c] => (t, r, c),
             [t, n] => (t, 1, n),
             ref other => {
-                return Err(format!(
-                    "{name}: expected shape (T, rows, cols) or (T, channels), got {other:?}"
-                ))
+                return Err(bad(format!(
+                    "expected shape (T, rows, cols) or (T, channels), got {other:?}"
+                )))
             }
         };
         neurotex::values::check_grid_cells(rows, cols)
-            .map_err(|e| format!("{name}: shape {shape:?}: {e}"))?;
+            .map_err(|e| bad(format!("shape {shape:?}: {e}")))?;
         if !(info.fs.is_finite() && info.fs > 0.0) {
-            return Err(format!(
-                "{name}: fs must be a positive sampling rate in Hz, got {}",
+            return Err(bad(format!(
+                "fs must be a positive sampling rate in Hz, got {}",
                 info.fs
-            ));
+            )));
         }
         let span = match &info.times_s {
             Some(times) => {
                 if times.len() != t {
-                    return Err(format!(
-                        "{name}: {} time stamps for {t} samples",
-                        times.len()
-                    ));
+                    return Err(bad(format!("{} time stamps for {t} samples", times.len())));
                 }
                 if let Some(i) = times
                     .windows(2)
                     .position(|w| !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]))
                 {
-                    return Err(format!(
-                        "{name}: time stamps must be finite and strictly increasing; stamp {} \
+                    return Err(bad(format!(
+                        "time stamps must be finite and strictly increasing; stamp {} \
                          is {} after {}",
                         i + 1,
                         times[i + 1],
                         times[i]
-                    ));
+                    )));
                 }
                 match times[..] {
                     [first, .., last] => last - first,
@@ -124,11 +125,11 @@ impl SamplesView<'_> {
             None => t as f64 / info.fs,
         };
         if span > DEFAULT_MAX_DURATION_S {
-            return Err(format!(
-                "{name}: {t} samples at {} Hz last {span} s, beyond the limit of \
+            return Err(bad(format!(
+                "{t} samples at {} Hz last {span} s, beyond the limit of \
                  {DEFAULT_MAX_DURATION_S} s per recording",
                 info.fs
-            ));
+            )));
         }
         // Logical (C) order whatever the strides: a C-contiguous array is one copy.
         let samples: Vec<f64> = match self {
@@ -143,20 +144,20 @@ impl SamplesView<'_> {
         };
         let n_cells = rows * cols;
         if let Some(pos) = samples.iter().position(|v| !v.is_finite()) {
-            return Err(format!(
-                "{name}: sample {} of channel {} is {} (every sample must be a finite number)",
+            return Err(bad(format!(
+                "sample {} of channel {} is {} (every sample must be a finite number)",
                 pos / n_cells,
                 pos % n_cells,
                 samples[pos]
-            ));
+            )));
         }
         let mut layout = Layout::grid(rows, cols);
         if let Some(present) = &info.present {
             if present.len() != n_cells {
-                return Err(format!(
-                    "{name}: the mask has {} cells but the recording's grid is {rows}x{cols}",
+                return Err(bad(format!(
+                    "the mask has {} cells but the recording's grid is {rows}x{cols}",
                     present.len()
-                ));
+                )));
             }
             layout.present = present.clone();
         }
@@ -171,6 +172,135 @@ impl SamplesView<'_> {
                 ..info.meta.clone()
             },
         })
+    }
+}
+
+/// One recording's description as the Python layer passes it beside the samples:
+/// `(name, fs, mask or None, label, speed_mm_s, slide_start_s, slide_end_s, time stamps in s
+/// or None)`.
+pub type InfoTuple = (
+    String,
+    f64,
+    Option<Vec<bool>>,
+    String,
+    Option<f64>,
+    Option<f64>,
+    Option<f64>,
+    Option<Vec<f64>>,
+);
+
+/// The recording description of an [`InfoTuple`].
+pub fn info_of(t: InfoTuple) -> RecordingInfo {
+    let (name, fs, present, label, speed, start, end, times_s) = t;
+    RecordingInfo {
+        name: name.clone(),
+        fs,
+        present,
+        times_s,
+        meta: Meta {
+            file: name,
+            label,
+            speed_mm_s: speed,
+            slide_start_s: start,
+            slide_end_s: end,
+            ..Default::default()
+        },
+    }
+}
+
+/// Recordings passed from Python: the borrowed samples of each, with its description.
+pub struct Batch<'py> {
+    samples: Vec<Samples<'py>>,
+    infos: Vec<RecordingInfo>,
+}
+
+impl<'py> Batch<'py> {
+    /// Borrows every recording (float32 or float64 arrays) with its description.
+    ///
+    /// # Errors
+    /// A `ParameterError` when the counts differ, a `DataError` for an array of another
+    /// type.
+    pub fn new(recordings: &[Bound<'py, PyAny>], infos: Vec<InfoTuple>) -> PyResult<Self> {
+        if recordings.len() != infos.len() {
+            return Err(raise(
+                Kind::Parameter,
+                "one description per recording is needed",
+            ));
+        }
+        let samples = recordings
+            .iter()
+            .enumerate()
+            .map(|(i, r)| Samples::borrow(r, &format!("recording {i}")))
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok(Batch {
+            samples,
+            infos: infos.into_iter().map(info_of).collect(),
+        })
+    }
+
+    /// Views of the samples for work without the GIL.
+    pub fn view(&self) -> BatchView<'_> {
+        BatchView {
+            samples: self.samples.iter().map(Samples::view).collect(),
+            infos: &self.infos,
+        }
+    }
+}
+
+/// A [`Batch`] as it crosses into code running without the GIL.
+pub struct BatchView<'a> {
+    samples: Vec<SamplesView<'a>>,
+    infos: &'a [RecordingInfo],
+}
+
+impl BatchView<'_> {
+    /// The number of recordings.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// The descriptions, in order.
+    pub fn infos(&self) -> &[RecordingInfo] {
+        self.infos
+    }
+
+    /// Recording `i` as the library reads a file (what `load` is to a dataset folder).
+    ///
+    /// # Errors
+    /// What [`SamplesView::recording`] checks.
+    pub fn load(&self, i: usize) -> neurotex::Result<Recording> {
+        self.samples[i].recording(&self.infos[i])
+    }
+
+    /// Writes recording `i`'s samples as given (float32 or float64, C order) to an `.npy`
+    /// file.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn write_npy(&self, i: usize, path: &std::path::Path) -> neurotex::Result<()> {
+        let written = match &self.samples[i] {
+            SamplesView::F32(a) => ndarray_npy::write_npy(path, &a.as_standard_layout()),
+            SamplesView::F64(a) => ndarray_npy::write_npy(path, &a.as_standard_layout()),
+        };
+        written.map_err(|e| DataError::invalid(path, e.to_string()).into())
+    }
+
+    /// Every recording read and encoded by `encode`, in parallel on the library's pool, in
+    /// order.
+    ///
+    /// # Errors
+    /// The first failing recording's error, naming it.
+    pub fn encode(
+        &self,
+        encode: impl Fn(&Recording) -> neurotex::Result<Encoded> + Sync,
+    ) -> neurotex::Result<Vec<Encoded>> {
+        (0..self.len())
+            .into_par_iter()
+            .map(|i| {
+                let rec = self.load(i)?;
+                encode(&rec).map_err(|e| e.in_recording(&self.infos[i].name))
+            })
+            .collect()
     }
 }
 

@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 
 use ndarray::Array3;
-use neurotex::pipeline::Pipeline;
 use neurotex::recording::{
     create_dataset_dir, write_layout, write_manifest, Dataset, LayoutFile, Meta, Recording,
 };
@@ -14,12 +13,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 
-use crate::convert::Samples;
+use crate::calibrate::{calibrated, Report};
+use crate::convert::{Batch, InfoTuple};
 use crate::errors::{guarded, param, raise, Kind};
-use crate::{info_of, params, table_of, Failure, InfoTuple};
+use crate::{params, table_of};
 
 /// Opens a dataset folder, a missing folder raising `NotFoundError`.
-fn open(dir: &Path) -> PyResult<Dataset> {
+pub(crate) fn open(dir: &Path) -> PyResult<Dataset> {
     if !dir.exists() {
         return Err(raise(
             Kind::NotFound,
@@ -112,12 +112,19 @@ fn load_dataset<'py>(
     Ok(out)
 }
 
-/// A feature table, its column names and its recordings' manifest rows.
-type TableWithRows<'py> = (Bound<'py, PyArray2<f64>>, Vec<String>, Bound<'py, PyList>);
+/// A feature table, its column names, its recordings' manifest rows and what was
+/// calibrated.
+type TableWithRows<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Vec<String>,
+    Bound<'py, PyList>,
+    Report,
+);
 
 /// The feature table of a dataset folder, computed as `neurotex features --dataset` does
-/// (the recordings read, encoded and featured in parallel without the GIL): `(values,
-/// names, manifest rows)`.
+/// (the recordings read, encoded and featured in parallel without the GIL; under
+/// `gain="auto"` or `causal=True` the pipeline calibrated on all of them first): `(values,
+/// names, manifest rows, what was calibrated)`.
 #[pyfunction]
 fn features_dataset<'py>(
     py: Python<'py>,
@@ -126,22 +133,24 @@ fn features_dataset<'py>(
     options: &Bound<'py, PyDict>,
 ) -> PyResult<TableWithRows<'py>> {
     let method = params::method(method)?;
-    let pipeline = Pipeline::new(params::pipeline(options)?).map_err(param)?;
+    let stages = params::stages(options)?;
     let dataset = open(&dir)?;
-    let (values, names, metas) = py.detach(|| {
+    let (values, names, metas, c) = py.detach(|| {
         guarded(|| {
             let all: Vec<usize> = (0..dataset.entries.len()).collect();
-            let encoded = pipeline.encode_dataset(&dataset, &all, &|| ())?;
-            let (values, names) = table_of(&encoded, &pipeline, method)?;
+            let baseline = dataset.layout.baseline.unwrap_or_default();
+            let c = calibrated(&stages, &|i| dataset.load(i), &all, baseline)?;
+            let encoded = c.pipeline.encode_dataset(&dataset, &all, &|| ())?;
+            let (values, names) = table_of(&encoded, &c.pipeline, method)?;
             let metas: Vec<Meta> = encoded.into_iter().map(|e| e.meta).collect();
-            Ok((values, names, metas))
+            Ok((values, names, metas, c))
         })
     })?;
     let rows = PyList::empty(py);
     for m in &metas {
         rows.append(manifest_row(py, &dataset.columns, m)?)?;
     }
-    Ok((values.into_pyarray(py), names, rows))
+    Ok((values.into_pyarray(py), names, rows, c.report()?))
 }
 
 /// Writes arrays as a dataset folder (whole or not at all): one `.npy` per recording named
@@ -161,23 +170,20 @@ fn save_dataset(
     fs: f64,
 ) -> PyResult<()> {
     let n = recordings.len();
-    if [infos.len(), trials.len(), forces.len(), extra.len()] != [n; 4] {
+    if [trials.len(), forces.len(), extra.len()] != [n; 3] {
         return Err(raise(
             Kind::Parameter,
             "one description per recording is needed",
         ));
     }
-    let samples = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| Samples::borrow(r, &format!("recording {i}")))
-        .collect::<PyResult<Vec<_>>>()?;
-    let infos: Vec<_> = infos.into_iter().map(info_of).collect();
+    let batch = Batch::new(&recordings, infos)?;
+    let view = batch.view();
+    let infos = view.infos();
     // Check every recording as `features` would before anything is written.
     let mut metas = Vec::with_capacity(n);
     let mut grid: Option<(usize, usize, Vec<bool>)> = None;
-    for (i, (s, info)) in samples.iter().zip(&infos).enumerate() {
-        let rec = s.view().recording(info).map_err(|m| raise(Kind::Data, m))?;
+    for (i, info) in infos.iter().enumerate() {
+        let rec = guarded(|| view.load(i))?;
         let l = &rec.layout;
         let this = (l.rows, l.cols, l.present.clone());
         match &grid {
@@ -223,30 +229,17 @@ fn save_dataset(
                 .collect(),
         );
     }
-    let views: Vec<_> = samples.iter().map(Samples::view).collect();
-    let result: Result<(), Failure> = py.detach(|| {
-        crate::guarded_failure(|| {
+    py.detach(|| {
+        guarded(|| {
             create_dataset_dir(&dir, |tmp| {
-                for (view, info) in views.iter().zip(&infos) {
-                    let path = tmp.join(&info.name);
-                    let written = match view {
-                        crate::convert::SamplesView::F32(a) => {
-                            ndarray_npy::write_npy(&path, &a.as_standard_layout().into_owned())
-                        }
-                        crate::convert::SamplesView::F64(a) => {
-                            ndarray_npy::write_npy(&path, &a.as_standard_layout().into_owned())
-                        }
-                    };
-                    written
-                        .map_err(|e| neurotex::error::DataError::invalid(&path, e.to_string()))?;
+                for (i, info) in infos.iter().enumerate() {
+                    view.write_npy(i, &tmp.join(&info.name))?;
                 }
                 write_manifest(tmp, &metas)?;
                 write_layout(tmp, &layout)
             })
-            .map_err(Failure::Library)
         })
-    });
-    Ok(result?)
+    })
 }
 
 /// Simulates the paper's rig into a dataset folder, as `neurotex simulate` does.

@@ -27,6 +27,18 @@ fn rows_of(x: &PyReadonlyArray2<'_, f64>) -> (Vec<f64>, usize, usize) {
     (data, n, d)
 }
 
+/// The rows of `x` in C order, with one label per row.
+fn labelled_rows<T>(x: &PyReadonlyArray2<'_, f64>, y: &[T]) -> PyResult<(Vec<f64>, usize)> {
+    let (data, n, d) = rows_of(x);
+    if y.len() != n {
+        return Err(raise(
+            Kind::Data,
+            format!("x has {n} samples but y has {} labels", y.len()),
+        ));
+    }
+    Ok((data, d))
+}
+
 #[pymethods]
 impl FittedClassifier {
     /// Fits classifier `kind` (knn, forest, linear) with `options` on `x` (n, d) and class
@@ -39,16 +51,8 @@ impl FittedClassifier {
         x: PyReadonlyArray2<'_, f64>,
         y: Vec<usize>,
     ) -> PyResult<Self> {
-        let chosen = params::classifier(kind, options)?
-            .check()
-            .map_err(crate::errors::param)?;
-        let (data, n, d) = rows_of(&x);
-        if y.len() != n {
-            return Err(raise(
-                Kind::Data,
-                format!("x has {n} samples but y has {} labels", y.len()),
-            ));
-        }
+        let chosen = params::chosen_classifier(kind, options)?;
+        let (data, d) = labelled_rows(&x, &y)?;
         let model = py.detach(|| guarded(|| Ok(chosen.fit(&data, d, &y)?)))?;
         Ok(FittedClassifier { model })
     }
@@ -116,9 +120,7 @@ fn cross_validate<'py>(
     seed: u64,
     repeats: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let chosen = params::classifier(kind, options)?
-        .check()
-        .map_err(crate::errors::param)?;
+    let chosen = params::chosen_classifier(kind, options)?;
     let cv = CvParams {
         folds,
         seed,
@@ -126,13 +128,7 @@ fn cross_validate<'py>(
     }
     .check()
     .map_err(crate::errors::param)?;
-    let (data, n, d) = rows_of(&x);
-    if y.len() != n {
-        return Err(raise(
-            Kind::Data,
-            format!("x has {n} samples but y has {} labels", y.len()),
-        ));
-    }
+    let (data, d) = labelled_rows(&x, &y)?;
     let mut labels: Vec<String> = Vec::new();
     let indices: Vec<usize> = y
         .iter()

@@ -6,12 +6,14 @@
 //! (`python/neurotex`) gives the functions their keyword signatures and docstrings.
 #![deny(missing_docs)]
 
+mod calibrate;
 mod convert;
 mod dataset;
 mod errors;
 mod estimator;
 mod model;
 mod params;
+mod reproduce;
 mod stream;
 
 use ndarray::{Array2, Array3};
@@ -23,129 +25,23 @@ use neurotex::features::{
     VolumeParams,
 };
 use neurotex::pipeline::{Encoded, Pipeline};
-use neurotex::recording::{one_grid, Baseline};
+use neurotex::recording::one_grid;
 use neurotex::Grid;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rayon::prelude::*;
 
-use convert::{raster_of, RecordingInfo, Samples, SamplesView};
+use calibrate::{calibrated, Report};
+use convert::{raster_of, Batch, InfoTuple};
 use errors::{guarded, guarded_py, param, raise, Kind};
-
-/// A failure inside work done without the GIL: bad input found by this layer, or a
-/// library error. Turned into an exception once the GIL is back.
-pub(crate) enum Failure {
-    /// Bad input found here (a `DataError`).
-    Input(String),
-    /// A library error.
-    Library(neurotex::Error),
-}
-
-impl From<neurotex::Error> for Failure {
-    fn from(e: neurotex::Error) -> Self {
-        Failure::Library(e)
-    }
-}
-
-impl From<Failure> for PyErr {
-    fn from(f: Failure) -> PyErr {
-        match f {
-            Failure::Input(message) => raise(Kind::Data, message),
-            Failure::Library(e) => errors::to_py(e),
-        }
-    }
-}
-
-/// One recording to encode: its samples and what it carries beside them, as the Python
-/// layer passes them: `(name, fs, mask or None, label, speed_mm_s, slide_start_s,
-/// slide_end_s, time stamps in s or None)`.
-pub(crate) type InfoTuple = (
-    String,
-    f64,
-    Option<Vec<bool>>,
-    String,
-    Option<f64>,
-    Option<f64>,
-    Option<f64>,
-    Option<Vec<f64>>,
-);
-
-/// The recording description of an [`InfoTuple`].
-pub(crate) fn info_of(t: InfoTuple) -> RecordingInfo {
-    let (name, fs, present, label, speed, start, end, times_s) = t;
-    RecordingInfo {
-        name: name.clone(),
-        fs,
-        present,
-        times_s,
-        meta: neurotex::recording::Meta {
-            file: name,
-            label,
-            speed_mm_s: speed,
-            slide_start_s: start,
-            slide_end_s: end,
-            ..Default::default()
-        },
-    }
-}
-
-/// The baseline of the recordings' dataset (its layout's), used when the options give none.
-pub(crate) fn dataset_baseline(name: Option<&str>) -> PyResult<Baseline> {
-    match name {
-        Some(s) => s.parse().map_err(param),
-        None => Ok(Baseline::default()),
-    }
-}
-
-/// Encodes every recording in parallel without the GIL, in order.
-fn encode_all(
-    py: Python<'_>,
-    samples: &[Samples<'_>],
-    infos: Vec<RecordingInfo>,
-    pipeline: &Pipeline,
-    baseline: Baseline,
-) -> PyResult<Vec<Encoded>> {
-    let views: Vec<SamplesView<'_>> = samples.iter().map(Samples::view).collect();
-    let result: Result<Vec<Encoded>, Failure> = py.detach(|| {
-        guarded_failure(|| {
-            views
-                .par_iter()
-                .zip(infos.par_iter())
-                .map(|(view, info)| {
-                    let rec = view.recording(info).map_err(Failure::Input)?;
-                    pipeline
-                        .encode(&rec, baseline)
-                        .map_err(|e| Failure::Library(e.in_recording(&info.name)))
-                })
-                .collect()
-        })
-    });
-    Ok(result?)
-}
-
-/// Runs `f`, turning a panic into a library-shaped failure (no panic crosses into Python).
-pub(crate) fn guarded_failure<T>(f: impl FnOnce() -> Result<T, Failure>) -> Result<T, Failure> {
-    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
-        Ok(r) => r,
-        Err(p) => {
-            let text = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Err(Failure::Input(format!(
-                "internal error in neurotex (please report it): {text}"
-            )))
-        }
-    }
-}
 
 /// A raster and, for `sa+fa`, the FA population's.
 type Rasters<'py> = (Bound<'py, PyArray3<u8>>, Option<Bound<'py, PyArray3<u8>>>);
 
-/// Encodes one recording: `(first population's raster, FA raster of sa+fa or None)`, each
-/// uint8 `(T, rows, cols)` at 1 kHz.
+/// Encodes one recording: `((first population's raster, FA raster of sa+fa or None), gain
+/// calibration as JSON or None)`, each raster uint8 `(T, rows, cols)` at 1 kHz. Under
+/// `gain="auto"` the gain is calibrated on this recording, as `neurotex encode --gain auto`
+/// does.
 #[pyfunction]
 #[pyo3(signature = (x, info, options, baseline=None))]
 fn encode<'py>(
@@ -154,11 +50,24 @@ fn encode<'py>(
     info: InfoTuple,
     options: &Bound<'py, PyDict>,
     baseline: Option<&str>,
-) -> PyResult<Rasters<'py>> {
-    let pipeline = Pipeline::new(params::pipeline(options)?).map_err(param)?;
-    let baseline = dataset_baseline(baseline)?;
-    let samples = [Samples::borrow(&x, "x")?];
-    let mut encoded = encode_all(py, &samples, vec![info_of(info)], &pipeline, baseline)?;
+) -> PyResult<(Rasters<'py>, Option<String>)> {
+    let stages = params::stages(options)?;
+    if stages.causal {
+        return Err(raise(
+            Kind::Parameter,
+            "causal fixes resting values and a scale on training recordings: use it with features or Model.train (then predict or stream with the model)",
+        ));
+    }
+    let baseline = params::baseline(baseline)?;
+    let batch = Batch::new(&[x], vec![info])?;
+    let view = batch.view();
+    let (mut encoded, c) = py.detach(|| {
+        guarded(|| {
+            let c = calibrated(&stages, &|i| view.load(i), &[0], baseline)?;
+            Ok((view.encode(|rec| c.pipeline.encode(rec, baseline))?, c))
+        })
+    })?;
+    let (gain, _) = c.report()?;
     let e = encoded.remove(0);
     let raster = |s: &SpikeTrains| {
         Array3::from_shape_vec((s.n_steps, s.rows, s.cols), s.to_raster())
@@ -167,10 +76,15 @@ fn encode<'py>(
     };
     let first = raster(&e.spikes);
     let fa = e.fa.as_ref().map(raster);
-    Ok((first, fa))
+    Ok(((first, fa), gain))
 }
 
-/// The feature table of many recordings: `(values (n, k) float64, column names)`.
+/// A feature table, its column names and what was calibrated.
+type TableWithCalibration<'py> = (Bound<'py, PyArray2<f64>>, Vec<String>, Report);
+
+/// The feature table of many recordings: `(values (n, k) float64, column names, what
+/// was calibrated)`. Under `gain="auto"` or `causal=True` the pipeline is calibrated on
+/// all of them first, as `neurotex features` calibrates on its whole dataset.
 #[pyfunction]
 #[pyo3(signature = (recordings, infos, method, options, baseline=None))]
 fn features<'py>(
@@ -180,36 +94,32 @@ fn features<'py>(
     method: &str,
     options: &Bound<'py, PyDict>,
     baseline: Option<&str>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Vec<String>)> {
-    if recordings.len() != infos.len() {
-        return Err(raise(
-            Kind::Parameter,
-            "one description per recording is needed",
-        ));
-    }
+) -> PyResult<TableWithCalibration<'py>> {
     if recordings.is_empty() {
         return Err(raise(Kind::Data, "no recordings to compute features of"));
     }
     let method = params::method(method)?;
-    let pipeline = Pipeline::new(params::pipeline(options)?).map_err(param)?;
-    let baseline = dataset_baseline(baseline)?;
-    let samples = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| Samples::borrow(r, &format!("recording {i}")))
-        .collect::<PyResult<Vec<_>>>()?;
-    let infos: Vec<RecordingInfo> = infos.into_iter().map(info_of).collect();
-    let encoded = encode_all(py, &samples, infos, &pipeline, baseline)?;
-    let (values, names) = py.detach(|| guarded(|| table_of(&encoded, &pipeline, method)))?;
-    Ok((values.into_pyarray(py), names))
+    let stages = params::stages(options)?;
+    let baseline = params::baseline(baseline)?;
+    let batch = Batch::new(&recordings, infos)?;
+    let view = batch.view();
+    let all: Vec<usize> = (0..view.len()).collect();
+    let (values, names, c) = py.detach(|| {
+        guarded(|| {
+            let c = calibrated(&stages, &|i| view.load(i), &all, baseline)?;
+            let encoded = view.encode(|rec| c.pipeline.encode(rec, baseline))?;
+            let (values, names) = table_of(&encoded, &c.pipeline, method)?;
+            Ok((values, names, c))
+        })
+    })?;
+    Ok((values.into_pyarray(py), names, c.report()?))
 }
 
-/// The feature table of encoded recordings, as the CLI's `features` command builds it.
-pub(crate) fn table_of(
-    encoded: &[Encoded],
-    pipeline: &Pipeline,
-    method: neurotex::pipeline::Method,
-) -> neurotex::Result<(Array2<f64>, Vec<String>)> {
+/// The grid every encoded recording shares.
+///
+/// # Errors
+/// Recordings on different grids, named.
+pub(crate) fn grid_of(encoded: &[Encoded]) -> neurotex::Result<Grid> {
     let grids = encoded
         .iter()
         .map(|e| {
@@ -220,8 +130,16 @@ pub(crate) fn table_of(
             ))
         })
         .collect::<neurotex::Result<Vec<_>>>()?;
-    let grid = one_grid(grids)?;
-    let extractor = pipeline.extractor(&grid)?;
+    one_grid(grids)
+}
+
+/// The feature table of encoded recordings, as the CLI's `features` command builds it.
+pub(crate) fn table_of(
+    encoded: &[Encoded],
+    pipeline: &Pipeline,
+    method: neurotex::pipeline::Method,
+) -> neurotex::Result<(Array2<f64>, Vec<String>)> {
+    let extractor = pipeline.extractor(&grid_of(encoded)?)?;
     let table = neurotex::analysis::FeatureTable::build(encoded, &extractor, method)?;
     let n = table.metas.len();
     let k = table.dims();
@@ -448,7 +366,7 @@ fn haralick_names(full: bool) -> Vec<String> {
 #[pyfunction]
 fn check_options(method: &str, options: &Bound<'_, PyDict>) -> PyResult<()> {
     params::method(method)?;
-    params::pipeline(options)?;
+    params::stages(options)?;
     Ok(())
 }
 
@@ -470,7 +388,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(haralick_names, m)?)?;
     m.add_function(wrap_pyfunction!(library_version, m)?)?;
     m.add_function(wrap_pyfunction!(check_options, m)?)?;
+    calibrate::register(m)?;
     dataset::register(m)?;
+    reproduce::register(m)?;
     model::register(m)?;
     estimator::register(m)?;
     stream::register(m)?;

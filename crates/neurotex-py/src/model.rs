@@ -4,58 +4,21 @@ use std::path::PathBuf;
 
 use neurotex::analysis::{Columns, FeatureTable};
 use neurotex::model::{Model as LibModel, Provenance};
-use neurotex::pipeline::{Encoded, Pipeline};
+use neurotex::pipeline::Method;
 use neurotex::Cell;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rayon::prelude::*;
 
-use crate::convert::{Samples, SamplesView};
+use crate::calibrate::{calibrated, json};
+use crate::convert::{Batch, InfoTuple};
 use crate::errors::{guarded, param, raise, Kind};
-use crate::{info_of, params, Failure, InfoTuple};
+use crate::{grid_of, params};
 
 /// A trained classifier with its pipeline, as `neurotex train` writes it.
 #[pyclass(module = "neurotex._native", frozen)]
 pub struct NativeModel {
     pub(crate) inner: LibModel,
-}
-
-/// Encodes recordings with the model's own pipeline, in parallel without the GIL.
-fn encode_with(
-    py: Python<'_>,
-    model: &LibModel,
-    recordings: &[Bound<'_, PyAny>],
-    infos: Vec<InfoTuple>,
-) -> PyResult<Vec<Encoded>> {
-    if recordings.len() != infos.len() {
-        return Err(raise(
-            Kind::Parameter,
-            "one description per recording is needed",
-        ));
-    }
-    let samples = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| Samples::borrow(r, &format!("recording {i}")))
-        .collect::<PyResult<Vec<_>>>()?;
-    let views: Vec<SamplesView<'_>> = samples.iter().map(Samples::view).collect();
-    let infos: Vec<_> = infos.into_iter().map(info_of).collect();
-    let result: Result<Vec<Encoded>, Failure> = py.detach(|| {
-        crate::guarded_failure(|| {
-            views
-                .par_iter()
-                .zip(infos.par_iter())
-                .map(|(view, info)| {
-                    let rec = view.recording(info).map_err(Failure::Input)?;
-                    model
-                        .encode(&rec)
-                        .map_err(|e| Failure::Library(e.in_recording(&info.name)))
-                })
-                .collect()
-        })
-    });
-    Ok(result?)
 }
 
 #[pymethods]
@@ -79,8 +42,14 @@ impl NativeModel {
         recordings: Vec<Bound<'py, PyAny>>,
         infos: Vec<InfoTuple>,
     ) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
-        let encoded = encode_with(py, &self.inner, &recordings, infos)?;
-        let predictions = py.detach(|| guarded(|| self.inner.predict(&encoded)))?;
+        let batch = Batch::new(&recordings, infos)?;
+        let view = batch.view();
+        let predictions = py.detach(|| {
+            guarded(|| {
+                let encoded = view.encode(|rec| self.inner.encode(rec))?;
+                self.inner.predict(&encoded)
+            })
+        })?;
         let classes = self.inner.labels().len();
         let shares: Vec<f64> = predictions.iter().flat_map(|p| p.shares.clone()).collect();
         let shares = ndarray::Array2::from_shape_vec((predictions.len(), classes), shares)
@@ -130,11 +99,32 @@ impl NativeModel {
     fn fingerprint(&self) -> String {
         self.inner.provenance().fingerprint.clone()
     }
+
+    /// How `gain="auto"` (`--gain auto`) chose the gain, as JSON; `None` for a gain given
+    /// as a number.
+    #[getter]
+    fn gain_calibration(&self) -> PyResult<Option<String>> {
+        json(&self.inner.provenance().gain_calibration)
+    }
+
+    /// The causal conditioning (`offsets`, `scale`) as JSON; `None` for an offline model.
+    #[getter]
+    fn causal(&self) -> PyResult<Option<String>> {
+        json(&self.inner.causal())
+    }
+
+    /// A causal model's median training phase in ms (a stream's default window).
+    #[getter]
+    fn median_duration_ms(&self) -> Option<usize> {
+        self.inner.provenance().median_duration_ms
+    }
 }
 
 /// Trains a model on recordings (arrays with their labels) as `neurotex train` does on a
-/// dataset folder. `fingerprint` identifies the training data in the file; `taxel` is
-/// `"row,col"` for the taxel method.
+/// dataset folder: under `gain="auto"` or `causal=True` (the CLI's `--causal`) the pipeline
+/// is calibrated on these recordings first and the calibration stored in the model.
+/// `fingerprint` identifies the training data in the file; `taxel` is `"row,col"` for the
+/// taxel method.
 #[pyfunction]
 #[pyo3(signature = (recordings, infos, method, options, classifier, classifier_options, fingerprint, baseline=None, taxel=None))]
 #[allow(clippy::too_many_arguments)]
@@ -151,14 +141,11 @@ fn train_model<'py>(
     taxel: Option<&str>,
 ) -> PyResult<NativeModel> {
     let method = params::method(method)?;
-    let params = params::pipeline(options)?;
+    let stages = params::stages(options)?;
     let choice = params::classifier(classifier, classifier_options)?;
-    let pipeline = Pipeline::new(params.clone()).map_err(param)?;
-    let dataset_baseline = crate::dataset_baseline(baseline)?;
+    let dataset_baseline = params::baseline(baseline)?;
     let columns = match (method, taxel) {
-        (neurotex::pipeline::Method::Taxel, Some(t)) => {
-            Columns::Taxel(t.parse::<Cell>().map_err(param)?)
-        }
+        (Method::Taxel, Some(t)) => Columns::Taxel(t.parse::<Cell>().map_err(param)?),
         (_, Some(_)) => {
             return Err(raise(
                 Kind::Parameter,
@@ -167,24 +154,15 @@ fn train_model<'py>(
         }
         (_, None) => Columns::All,
     };
-    let samples = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| Samples::borrow(r, &format!("recording {i}")))
-        .collect::<PyResult<Vec<_>>>()?;
-    let infos: Vec<_> = infos.into_iter().map(info_of).collect();
-    let encoded = crate::encode_all(py, &samples, infos, &pipeline, dataset_baseline)?;
+    let batch = Batch::new(&recordings, infos)?;
+    let view = batch.view();
+    let all: Vec<usize> = (0..view.len()).collect();
     let inner = py.detach(|| {
         guarded(|| {
-            let grid = neurotex::recording::one_grid(encoded.iter().map(|e| {
-                let s = &e.spikes;
-                (
-                    e.meta.file.as_str(),
-                    neurotex::Grid::masked(s.rows, s.cols, s.present.clone())
-                        .expect("the encoder's grid is valid"),
-                )
-            }))?;
-            let extractor = pipeline.extractor(&grid)?;
+            let c = calibrated(&stages, &|i| view.load(i), &all, dataset_baseline)?;
+            let encoded = view.encode(|rec| c.pipeline.encode(rec, dataset_baseline))?;
+            let grid = grid_of(&encoded)?;
+            let extractor = c.pipeline.extractor(&grid)?;
             let table = FeatureTable::build(&encoded, &extractor, method)?;
             if let Columns::Taxel(cell) = columns {
                 grid.locate(cell)?;
@@ -193,12 +171,10 @@ fn train_model<'py>(
                 fingerprint,
                 baseline: dataset_baseline,
                 speeds: None,
-                gain_calibration: None,
-                // Python trains offline models; a causal model (the CLI's `--causal`) is
-                // not offered here yet.
-                median_duration_ms: None,
+                gain_calibration: c.gain,
+                median_duration_ms: c.causal.map(|c| c.median_duration_ms),
             };
-            LibModel::train(&params, &table, columns, choice, provenance)
+            LibModel::train(c.pipeline.params(), &table, columns, choice, provenance)
         })
     })?;
     Ok(NativeModel { inner })

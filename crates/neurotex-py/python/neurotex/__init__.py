@@ -6,6 +6,8 @@ Izhikevich neurons (:func:`encode`), spike statistics (:func:`spike_stats`), rat
 (:func:`rate_volume`), co-occurrence matrices (:func:`glcm3d`, :func:`glcm2d`) and Haralick
 features (:func:`haralick`); :func:`features` does all of it for many recordings at once,
 in parallel, without the GIL. :mod:`neurotex.sklearn` wraps it for scikit-learn.
+:func:`reproduce` runs the paper's analyses and writes their report; :class:`Model` trains,
+saves and applies classifiers (causal ones too, for :class:`StreamClassifier`).
 
 Defaults are the paper's (Gupta, Nakagawa, Lepora, Thakor): gain 8, RS neurons, 50 Hz
 zero-phase low-pass, 200 ms bins, 16 gray levels, distances 1, 2, 4, 8.
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -40,6 +43,8 @@ HARALICK_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(False))
 """Names of the paper's Haralick features, in the order :func:`haralick` returns them."""
 HARALICK_FULL_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(True))
 """Names of the 13 features of ``haralick(..., full=True)``."""
+
+_log = logging.getLogger("neurotex")
 
 METHODS = ("taxel", "glcm2d", "glcm3d", "all-taxels", "all-taxels-mm", "glcm3d-multi")
 """Feature methods of :func:`features`, as the CLI's ``--method``."""
@@ -95,6 +100,117 @@ class Dataset:
 
     def __len__(self) -> int:
         return len(self.recordings)
+
+
+@dataclass(frozen=True)
+class GainCalibration:
+    """How ``gain="auto"`` chose the encoder's gain (the CLI's ``--gain auto``): the
+    smallest gain of 3 significant digits at which the median firing rate, over every
+    (taxel, recording) pair of the calibration recordings with any signal, reaches
+    ``target_hz`` (labels are never read; at most 32 recordings, evenly spread, are used).
+
+    ``gain``: the chosen gain; ``median_hz``: the median rate it gives; ``recordings``,
+    ``pairs``: what the median ran over; ``clamped``: the target was out of reach and the
+    gain is the end of the searched range (0.01 to 10000)."""
+
+    gain: float
+    target_hz: float
+    median_hz: float
+    recordings: int
+    pairs: int
+    clamped: bool
+
+    @classmethod
+    def _from_json(cls, text: Optional[str]) -> Optional["GainCalibration"]:
+        if text is None:
+            return None
+        d = json.loads(text)
+        return cls(gain=d["gain"], target_hz=d["target_hz"], median_hz=d["median_hz"],
+                   recordings=d["recordings"], pairs=d["pairs"], clamped=d["clamped"])
+
+    def __str__(self) -> str:
+        reached = (" (target out of reach: the end of the searched range)"
+                   if self.clamped else "")
+        return (f"gain auto: G = {self.gain} gives a median of {self.median_hz:.1f} Hz "
+                f"(target {self.target_hz} Hz) over {self.pairs} taxel x recording pairs "
+                f"with signal in {self.recordings} recording(s){reached}")
+
+
+@dataclass(frozen=True)
+class CausalConditioning:
+    """What ``causal=True`` (the CLI's ``--causal``) fixed on the training recordings,
+    labels unused, so that each sample can be conditioned the moment it arrives (a
+    forward-only low-pass instead of the zero-phase one): ``offsets``, each grid cell's
+    resting value (row-major, float64; zeros without a baseline), and ``scale``, the
+    divisor that replaces each recording's own maximum. ``recordings`` and
+    ``median_duration_ms`` (the median selected phase, a stream's default window) say what
+    it was fixed on, where known."""
+
+    offsets: np.ndarray
+    scale: float
+    recordings: Optional[int] = None
+    median_duration_ms: Optional[int] = None
+
+    @classmethod
+    def _from_json(cls, text: Optional[str]) -> Optional["CausalConditioning"]:
+        if text is None:
+            return None
+        d = json.loads(text)
+        # a calibration nests the conditioning; a model file holds the conditioning alone
+        c = d.get("conditioning", d)
+        return cls(offsets=np.array(c["offsets"], dtype=np.float64), scale=c["scale"],
+                   recordings=d.get("recordings"),
+                   median_duration_ms=d.get("median_duration_ms"))
+
+    def __str__(self) -> str:
+        on = "" if self.recordings is None else f" on {self.recordings} recording(s)"
+        phase = ("" if self.median_duration_ms is None
+                 else f" (median selected phase {self.median_duration_ms} ms)")
+        return (f"causal: forward-only filter; resting values and scale {self.scale:.6f} "
+                f"fixed{on}{phase}")
+
+
+def _calibrations(report: Tuple[Optional[str], Optional[str]]
+                  ) -> Tuple[Optional[GainCalibration], Optional[CausalConditioning]]:
+    """The library's calibration report as objects, said on the ``neurotex`` logger (at
+    INFO, as the CLI says it on standard error)."""
+    gain = GainCalibration._from_json(report[0])
+    causal = CausalConditioning._from_json(report[1])
+    for c in (causal, gain):
+        if c is not None:
+            _log.info("%s", c)
+    return gain, causal
+
+
+class FeatureTable(tuple):
+    """What :func:`features` returns: the pair ``(X, names)``, unpacked as one
+    (``X, names = features(...)``), with what was calibrated beside it:
+    :attr:`gain_calibration` under ``gain="auto"``, :attr:`causal` under ``causal=True``
+    (``None`` otherwise)."""
+
+    gain_calibration: Optional[GainCalibration]
+    causal: Optional[CausalConditioning]
+
+    def __new__(cls, X: np.ndarray, names: List[str],
+                gain_calibration: Optional[GainCalibration] = None,
+                causal: Optional[CausalConditioning] = None) -> "FeatureTable":
+        self = super().__new__(cls, (X, names))
+        self.gain_calibration = gain_calibration
+        self.causal = causal
+        return self
+
+    def __reduce__(self) -> Any:
+        return (FeatureTable, (self[0], self[1], self.gain_calibration, self.causal))
+
+    @property
+    def X(self) -> np.ndarray:
+        """The features, float64 ``(n, k)``."""
+        return self[0]
+
+    @property
+    def names(self) -> List[str]:
+        """The ``k`` column names."""
+        return self[1]
 
 
 def _stage_options(**kw: Any) -> Dict[str, Any]:
@@ -184,7 +300,7 @@ def _prepare(
 def encode(
     x: Any,
     fs: float = 1000.0,
-    gain: float = 8.0,
+    gain: Union[float, str] = 8.0,
     cutoff: float = 50.0,
     *,
     preset: str = "RS",
@@ -202,7 +318,10 @@ def encode(
     memory order (read in place, without copying into a new numpy array). The signal is
     resampled to 1 kHz when ``fs`` differs, low-pass filtered (``cutoff`` Hz, zero-phase
     2nd-order Butterworth; 0 = off), divided by its maximum, multiplied by ``gain`` and
-    fed to Izhikevich neurons of firing type ``preset``.
+    fed to Izhikevich neurons of firing type ``preset``. ``gain="auto"`` (or
+    ``"auto:HZ"``) calibrates the gain on this recording as ``neurotex encode --gain auto``
+    does (see :class:`GainCalibration`; the choice is logged on the ``neurotex`` logger,
+    and :func:`calibrate_gain` returns it).
 
     Returns a uint8 raster ``(T_ms, rows, cols)`` at 1 kHz (1 = spike); for
     ``encoding="sa+fa"`` the pair ``(sa, fa)``.
@@ -213,7 +332,8 @@ def encode(
     arrays, infos = _prepare([rec], fs, None)
     opts = _stage_options(gain=gain, cutoff=cutoff, preset=preset, baseline=baseline,
                           encoding=encoding, fa_gain=fa_gain, whole=whole)
-    first, fa = _native.encode(arrays[0], infos[0], opts)
+    (first, fa), gain_report = _native.encode(arrays[0], infos[0], opts)
+    _calibrations((gain_report, None))
     return (first, fa) if fa is not None else first
 
 
@@ -225,7 +345,8 @@ def features(
     fs: float = 1000.0,
     mask: Any = None,
     speeds: Any = None,
-    gain: float = 8.0,
+    gain: Union[float, str] = 8.0,
+    causal: bool = False,
     preset: str = "RS",
     cutoff: float = 50.0,
     baseline: Optional[str] = None,
@@ -238,7 +359,7 @@ def features(
     haralick: str = "paper",
     bin_widths: Sequence[int] = (50, 100, 200, 400),
     window_mm: float = 2.0,
-) -> Tuple[np.ndarray, List[str]]:
+) -> FeatureTable:
     """One feature row per recording, as ``neurotex features`` computes it.
 
     ``recordings``: a list of arrays ``(T, rows, cols)``, a 4-D array
@@ -251,27 +372,84 @@ def features(
     paper's contrast, correlation, ASM), ``glcm3d-multi``. ``encoding``: ``sa``, ``fa``
     or ``sa+fa``.
 
-    Returns ``(X, names)``: float64 ``(n, k)`` and the ``k`` column names."""
+    ``gain="auto"`` (or ``"auto:HZ"``, a target median rate other than 20 Hz) calibrates
+    the gain on these recordings, labels unused, as ``neurotex features --gain auto`` does
+    on its dataset; ``causal=True`` conditions causally, as a live stream can, with each
+    taxel's resting value and one scale fixed on these recordings (``--causal``). Both are
+    calibrated on every recording given: for a train/test split calibrate on the training
+    recordings (:func:`calibrate_gain`, :class:`Model`, or
+    :class:`neurotex.sklearn.SpikeFeatures`, which calibrates in ``fit``).
+
+    Returns ``(X, names)``, float64 ``(n, k)`` and the ``k`` column names, as a
+    :class:`FeatureTable` that also holds what was calibrated."""
     if method not in METHODS:
         raise ParameterError(
             f"invalid parameter `method`: method must be one of {', '.join(METHODS)}, "
             f"got {method}"
         )
     opts = _stage_options(
-        gain=gain, preset=preset, cutoff=cutoff, baseline=baseline, whole=whole,
-        levels=levels, bin_ms=bin_ms, distances=tuple(distances), symmetric=symmetric,
-        encoding=encoding, fa_gain=fa_gain, haralick=haralick,
+        gain=gain, causal=causal, preset=preset, cutoff=cutoff, baseline=baseline,
+        whole=whole, levels=levels, bin_ms=bin_ms, distances=tuple(distances),
+        symmetric=symmetric, encoding=encoding, fa_gain=fa_gain, haralick=haralick,
         bin_widths=tuple(bin_widths), window_mm=window_mm,
     )
     if isinstance(recordings, (str, os.PathLike)):
-        values, names, _ = _native.features_dataset(os.fspath(recordings), method, opts)
-        return values, names
+        values, names, _, report = _native.features_dataset(os.fspath(recordings), method, opts)
+    else:
+        dataset_baseline = recordings.baseline if isinstance(recordings, Dataset) else None
+        items = _recording_list(recordings)
+        if not items:
+            raise DataError("no recordings to compute features of")
+        arrays, infos = _prepare(items, fs, mask, speeds)
+        values, names, report = _native.features(arrays, infos, method, opts, dataset_baseline)
+    return FeatureTable(values, names, *_calibrations(report))
+
+
+def _calibrate(recordings: Any, opts: Dict[str, Any], fs: float, mask: Any
+               ) -> Tuple[Optional[GainCalibration], Optional[CausalConditioning]]:
+    """What the stage options calibrate on these recordings (a folder path read by the
+    library), as :func:`features` would calibrate it."""
+    if isinstance(recordings, (str, os.PathLike)):
+        return _calibrations(_native.calibrate_dataset(os.fspath(recordings), opts))
     dataset_baseline = recordings.baseline if isinstance(recordings, Dataset) else None
     items = _recording_list(recordings)
-    if not items:
-        raise DataError("no recordings to compute features of")
-    arrays, infos = _prepare(items, fs, mask, speeds)
-    return _native.features(arrays, infos, method, opts, dataset_baseline)
+    arrays, infos = _prepare(items, fs, mask)
+    return _calibrations(_native.calibrate(arrays, infos, opts, dataset_baseline))
+
+
+def calibrate_gain(
+    recordings: Any,
+    target_hz: float = 20.0,
+    *,
+    fs: float = 1000.0,
+    mask: Any = None,
+    causal: bool = False,
+    **stage_options: Any,
+) -> GainCalibration:
+    """The gain ``gain="auto"`` chooses on these recordings (``gain="auto:HZ"`` for
+    ``target_hz``): the CLI's ``--gain auto`` on the same recordings gives the same gain.
+    Labels are never read. ``recordings`` takes what :func:`features` takes; with
+    ``causal=True`` the gain is calibrated on the causally conditioned signal, as
+    ``neurotex train --causal --gain auto`` does. ``stage_options`` are :func:`features`'
+    (``preset``, ``cutoff``, ``baseline``, ``whole``, ...).
+
+    Pass the result's ``gain`` to the features of further recordings (a test set) so
+    that they are encoded as the calibration recordings were.
+
+    Raises :class:`ParameterError` when no recording has any signal to calibrate on."""
+    if "gain" in stage_options:
+        raise ParameterError("calibrate_gain chooses the gain; give target_hz instead")
+    opts = _stage_options(**stage_options)
+    try:
+        target = float(target_hz)
+    except (TypeError, ValueError):
+        raise ParameterError(f"invalid parameter `target_hz`: expected a number, got {target_hz!r}")
+    opts["gain"] = f"auto:{target!r}"
+    opts["causal"] = bool(causal)
+    gain, _ = _calibrate(recordings, opts, fs, mask)
+    if gain is None:
+        raise InternalError("internal error in neurotex (please report it): no gain calibration")
+    return gain
 
 
 def _raster(spikes: Any) -> np.ndarray:
@@ -493,13 +671,21 @@ class Model:
         speeds: Any = None,
         taxel: Optional[str] = None,
         classifier_options: Optional[Dict[str, Any]] = None,
+        causal: bool = False,
         **stage_options: Any,
     ) -> "Model":
         """Trains ``classifier`` (``knn``, ``forest``, ``linear``; knobs in
         ``classifier_options``, e.g. ``{"k": 5}``) on ``method``'s features of the
         recordings, as ``neurotex train`` does. ``labels`` default to the recordings' own
         (a :class:`Dataset`'s). ``stage_options`` are :func:`features`' (gain, cutoff,
-        levels, ...)."""
+        levels, ...).
+
+        ``causal=True`` trains a causal model (``neurotex train --causal``): a forward-only
+        low-pass, and each taxel's resting value and one normalisation scale fixed on
+        these recordings (labels unused) and stored in the model, so that
+        :class:`StreamClassifier` can classify a live stream with it. ``gain="auto"``
+        calibrates the gain on these recordings (after the causal conditioning, when
+        both); the model keeps the calibration (:attr:`gain_calibration`)."""
         baseline = recordings.baseline if isinstance(recordings, Dataset) else None
         items = _recording_list(recordings)
         if labels is not None:
@@ -508,12 +694,16 @@ class Model:
             items = [r if isinstance(r, Recording) else Recording(x=r, fs=fs) for r in items]
             items = [Recording(**{**r.__dict__, "label": str(l)}) for r, l in zip(items, labels)]
         arrays, infos = _prepare(items, fs, mask, speeds)
-        opts = _stage_options(**{k: (tuple(v) if isinstance(v, (list, tuple)) else v)
-                                 for k, v in stage_options.items()})
+        opts = _stage_options(**stage_options)
         fp = _fingerprint(arrays, [i[3] for i in infos])
+        opts["causal"] = bool(causal)
         native = _native.train_model(arrays, infos, method, opts, classifier,
                                      dict(classifier_options or {}), fp, baseline, taxel)
-        return cls(native)
+        model = cls(native)
+        for c in (model.causal, model.gain_calibration):
+            if c is not None:
+                _log.info("%s", c)
+        return model
 
     def predict(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
         """The predicted label of each recording (encoded with the model's own pipeline)."""
@@ -555,10 +745,125 @@ class Model:
         """The training data's fingerprint."""
         return self._native.fingerprint
 
+    @property
+    def gain_calibration(self) -> Optional[GainCalibration]:
+        """How ``gain="auto"`` chose :attr:`gain` on the training recordings; ``None`` for
+        a gain given as a number."""
+        return GainCalibration._from_json(self._native.gain_calibration)
+
+    @property
+    def causal(self) -> Optional[CausalConditioning]:
+        """The causal conditioning of a model trained with ``causal=True`` (or
+        ``neurotex train --causal``): what :class:`StreamClassifier` needs; ``None`` for
+        the paper's offline pipeline."""
+        c = CausalConditioning._from_json(self._native.causal)
+        if c is None:
+            return None
+        return CausalConditioning(c.offsets, c.scale, None, self._native.median_duration_ms)
+
     def __repr__(self) -> str:
         return (f"Model({self._native.classifier}, method={self.method!r}, "
                 f"classes={len(self.classes_)}, trained on {self._native.n_training})")
 
+
+
+@dataclass
+class Reproduction:
+    """What :func:`reproduce` ran and wrote.
+
+    ``report``: the path of ``report.md`` (``results.json`` and ``figures/*.svg`` beside
+    it); ``results``: ``results.json`` as a dict (every analysis: ``e1`` .. ``e9``,
+    ``sensitivity``, ``taxels``, ``provenance``, ...); ``claims``: the paper's claims
+    judged on these results, each a dict with ``statement``, ``verdict`` (``holds``,
+    ``not_shown``, ``contradicted``, ``point_agrees``, ``point_disagrees``), ``holds``
+    and ``detail``; ``headline``: E1 by speed in mm/s, each a dict of accuracies
+    (``glcm3d``, ``taxel_mean``, ``taxel_best``, ``chance``, ``majority``, ``n``);
+    ``gain_calibration``: what ``gain="auto"`` chose; ``predictions``: the headline
+    3D-GLCM evaluations' out-of-fold predictions (the CLI's ``--predictions`` rows, as
+    dicts); ``seconds``: the run's wall-clock time."""
+
+    report: str
+    results: Dict[str, Any]
+    claims: List[Dict[str, Any]]
+    headline: Dict[float, Dict[str, Any]]
+    gain_calibration: Optional[GainCalibration]
+    predictions: List[Dict[str, Any]]
+    seconds: float
+
+    @property
+    def out_dir(self) -> str:
+        """The folder holding the report, ``results.json`` and ``figures/``."""
+        return os.path.dirname(self.report)
+
+
+_HOLDS = ("holds", "point_agrees")
+_HEADLINE = ("glcm3d", "taxel_mean", "taxel_best", "chance", "majority", "n")
+
+
+def reproduce(
+    out_dir: Union[str, os.PathLike],
+    *,
+    dataset: Optional[Union[str, os.PathLike]] = None,
+    quick: bool = False,
+    seed: int = 0,
+    trials: Optional[int] = None,
+    seeds: Optional[int] = None,
+    k: int = 5,
+    standardize: bool = True,
+    group_by: Optional[str] = None,
+    **stage_options: Any,
+) -> Reproduction:
+    """Runs the paper's analyses (E0-E9: accuracy per speed, confusion, spatial
+    perturbation, temporal information, time to recognition offline and causal, speed
+    invariance, gain sweep, neighbours, the standard candidates) as ``neurotex reproduce``
+    does with the same options, writes ``report.md``, ``results.json`` and
+    ``figures/*.svg`` into ``out_dir`` (whole or not at all; an existing folder's files are
+    replaced) and returns a :class:`Reproduction`.
+
+    Without ``dataset`` the built-in simulator generates the paper's design in memory
+    (8 textures x 5, 10, 15 mm/s x ``trials`` trials, default 20, or 10 with ``quick``),
+    ``seeds`` independent datasets from simulation seeds ``seed``, ``seed + 1``, ...
+    (default 5, or 1 with ``quick``); ``dataset`` names a dataset folder instead, whose
+    manifest must give each recording's speed. ``quick``: fewer CV repeats, perturbation
+    counts, fractions and gains (the CI run). ``seed`` also seeds the CV shuffles and the
+    perturbations. ``k``, ``standardize``: the KNN. ``group_by``: keep each group of this
+    manifest column in one fold. ``stage_options`` are :func:`features`' (``gain``, also
+    ``"auto"``, ``preset``, ``cutoff``, ``levels``, ...).
+
+    The run takes minutes (the full paper-scale run with 5 seeds much longer) with the GIL
+    released; it cannot be interrupted from Python before it ends.
+
+    Raises :class:`ParameterError` for a broken option, :class:`NotFoundError` for a
+    missing dataset folder, :class:`DataError` for recordings the analyses cannot use."""
+    out = os.fspath(out_dir)
+    opts = _stage_options(**stage_options)
+    given = {"dataset": None if dataset is None else os.fspath(dataset), "quick": quick,
+             "seed": seed, "trials": trials, "seeds": seeds, "k": k,
+             "standardize": standardize, "group_by": group_by}
+    defaults = {"quick": False, "seed": 0, "k": 5, "standardize": True}
+    shown = [repr(out)] + [f"{key}={v!r}" for key, v in given.items()
+                           if v is not None and defaults.get(key) != v]
+    shown += [f"{key}={v!r}" for key, v in stage_options.items()]
+    command = f"neurotex.reproduce({', '.join(shown)})  # Python {__version__}"
+    results_json, claims_json, predictions, seconds = _native.reproduce(
+        out, opts, given["dataset"], bool(quick), int(seed),
+        None if trials is None else int(trials), None if seeds is None else int(seeds),
+        int(k), bool(standardize), group_by, command)
+    results = json.loads(results_json)
+    claims = [dict(c, holds=c["verdict"] in _HOLDS) for c in json.loads(claims_json)]
+    headline = {float(speed): {key: e[key] for key in _HEADLINE}
+                for speed, e in results.get("e1", {}).items()}
+    gain = results.get("gain_calibration")
+    fields = ("speed_mm_s", "method", "file", "label", "predicted", "fold", "repeat")
+    return Reproduction(
+        report=os.path.join(out, "report.md"),
+        results=results,
+        claims=claims,
+        headline=headline,
+        gain_calibration=None if gain is None else GainCalibration._from_json(json.dumps(gain)),
+        predictions=[dict(zip(fields, row)) for row in predictions],
+        seconds=seconds,
+    )
 
 
 class StreamClassifier:
@@ -605,7 +910,8 @@ class StreamClassifier:
 __all__ = [
     "encode", "features", "spike_stats", "rate_volume", "glcm3d", "glcm2d", "haralick",
     "cross_validate", "load_dataset", "save_dataset", "simulate", "Model", "Recording",
-    "StreamClassifier",
+    "StreamClassifier", "reproduce", "Reproduction", "calibrate_gain", "GainCalibration",
+    "CausalConditioning", "FeatureTable",
     "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",
     "ParameterError", "DataError", "NotFoundError", "ReadWriteError", "ModelError",
     "ClassifyError", "InternalError",

@@ -20,20 +20,46 @@ Info = Tuple[
     Optional[List[float]],
 ]
 Samples = npt.NDArray[np.floating[Any]]
+# What was calibrated, as the library's JSON: (gain calibration, causal conditioning), each
+# None when not asked for.
+Report = Tuple[Optional[str], Optional[str]]
+# One headline out-of-fold prediction: (speed_mm_s, method, file, label, predicted, fold or
+# None, repeat).
+PredictionRow = Tuple[float, str, str, str, str, Optional[int], int]
 
 def library_version() -> str: ...
 def check_options(method: str, options: Dict[str, Any]) -> None: ...
 def haralick_names(full: bool) -> List[str]: ...
 def encode(
     x: Samples, info: Info, options: Dict[str, Any], baseline: Optional[str] = None
-) -> Tuple[npt.NDArray[np.uint8], Optional[npt.NDArray[np.uint8]]]: ...
+) -> Tuple[Tuple[npt.NDArray[np.uint8], Optional[npt.NDArray[np.uint8]]], Optional[str]]: ...
 def features(
     recordings: Sequence[Samples],
     infos: Sequence[Info],
     method: str,
     options: Dict[str, Any],
     baseline: Optional[str] = None,
-) -> Tuple[npt.NDArray[np.float64], List[str]]: ...
+) -> Tuple[npt.NDArray[np.float64], List[str], Report]: ...
+def calibrate(
+    recordings: Sequence[Samples],
+    infos: Sequence[Info],
+    options: Dict[str, Any],
+    baseline: Optional[str] = None,
+) -> Report: ...
+def calibrate_dataset(dir: str, options: Dict[str, Any]) -> Report: ...
+def reproduce(
+    out: str,
+    options: Dict[str, Any],
+    dataset: Optional[str] = None,
+    quick: bool = False,
+    seed: int = 0,
+    trials: Optional[int] = None,
+    seeds: Optional[int] = None,
+    k: int = 5,
+    standardize: bool = True,
+    group_by: Optional[str] = None,
+    command: str = "",
+) -> Tuple[str, str, List[PredictionRow], float]: ...
 def spike_stats(spikes: npt.NDArray[np.uint8], bin_ms: int = 200) -> npt.NDArray[np.float64]: ...
 def rate_volume(
     spikes: npt.NDArray[np.uint8], bin_ms: Optional[int] = 200
@@ -60,7 +86,7 @@ def cross_validate(
 def load_dataset(dir: str, indices: Optional[List[int]] = None) -> Dict[str, Any]: ...
 def features_dataset(
     dir: str, method: str, options: Dict[str, Any]
-) -> Tuple[npt.NDArray[np.float64], List[str], List[Dict[str, str]]]: ...
+) -> Tuple[npt.NDArray[np.float64], List[str], List[Dict[str, str]], Report]: ...
 def save_dataset(
     dir: str,
     recordings: Sequence[Samples],
@@ -120,6 +146,12 @@ class NativeModel:
     def gain(self) -> float: ...
     @property
     def fingerprint(self) -> str: ...
+    @property
+    def gain_calibration(self) -> Optional[str]: ...
+    @property
+    def causal(self) -> Optional[str]: ...
+    @property
+    def median_duration_ms(self) -> Optional[int]: ...
 
 class FittedClassifier:
     @staticmethod

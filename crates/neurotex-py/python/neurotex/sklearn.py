@@ -13,7 +13,7 @@ conventions (``get_params``/``set_params``, ``clone``, ``Pipeline``, ``GridSearc
 
 from __future__ import annotations
 
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin
@@ -29,8 +29,12 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
 
     ``X`` is a list of arrays ``(T, rows, cols)``, a 4-D array ``(n, T, rows, cols)`` or
     a list of :class:`neurotex.Recording` (``Dataset.recordings``, which keep each
-    recording's sliding phase). The transformer learns nothing: every parameter is the
-    pipeline's (the paper's defaults), so ``fit`` only checks them.
+    recording's sliding phase). With a gain given as a number the transformer learns
+    nothing (every parameter is the pipeline's, the paper's defaults), so ``fit`` only
+    checks the parameters. With ``gain="auto"`` (or ``"auto:HZ"``) ``fit`` calibrates the
+    gain on the training recordings, labels unused, as ``neurotex train --gain auto``
+    does, and ``transform`` encodes every later recording with that gain: ``gain_`` holds
+    it and ``gain_calibration_`` how it was chosen (``None`` for a number).
 
     Parameters are those of :func:`neurotex.features`: ``method``, ``encoding``, ``gain``,
     ``preset``, ``cutoff``, ``baseline``, ``whole``, ``levels``, ``bin_ms``,
@@ -41,7 +45,7 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         self,
         method: str = "glcm3d",
         encoding: str = "sa",
-        gain: float = 8.0,
+        gain: Union[float, str] = 8.0,
         preset: str = "RS",
         cutoff: float = 50.0,
         baseline: Optional[str] = None,
@@ -80,9 +84,9 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         return p
 
     def fit(self, X: Any, y: Any = None) -> "SpikeFeatures":
-        """Checks the parameters (raising :class:`neurotex.ParameterError`); learns
-        nothing from ``X``."""
-        from . import _stage_options
+        """Checks the parameters (raising :class:`neurotex.ParameterError`) and, under
+        ``gain="auto"``, calibrates the gain on ``X``; learns nothing else."""
+        from . import _calibrate, _stage_options
 
         opts = _stage_options(
             gain=self.gain, preset=self.preset, cutoff=self.cutoff, baseline=self.baseline,
@@ -92,6 +96,14 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
             bin_widths=tuple(self.bin_widths), window_mm=self.window_mm,
         )
         _native.check_options(self.method, opts)
+        if isinstance(self.gain, str):
+            calibration, _ = _calibrate(X, opts, self.fs, None)
+            self.gain_calibration_ = calibration
+            # a number written as text ("8") calibrates nothing
+            self.gain_ = float(self.gain) if calibration is None else calibration.gain
+        else:
+            self.gain_calibration_ = None
+            self.gain_ = self.gain
         self.n_recordings_seen_ = len(X)
         self.feature_names_out_: Optional[List[str]] = None
         return self
@@ -99,7 +111,9 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
     def transform(self, X: Any) -> np.ndarray:
         """The feature matrix ``(n, k)``, float64."""
         check_is_fitted(self, "n_recordings_seen_")
-        values, names = _features(X, self.method, self.encoding, **self._kwargs())
+        kwargs = self._kwargs()
+        kwargs["gain"] = self.gain_
+        values, names = _features(X, self.method, self.encoding, **kwargs)
         self.feature_names_out_ = names
         return values
 

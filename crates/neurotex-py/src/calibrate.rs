@@ -1,0 +1,130 @@
+//! `gain="auto"` and `causal=True`: the pipeline calibrated on the training recordings
+//! (labels never read) before anything is encoded, in the order the CLI calibrates it.
+
+use std::path::PathBuf;
+
+use neurotex::calibrate::{calibrate_gain, GainCalibration};
+use neurotex::causal::{calibrate_conditioning, ConditioningCalibration};
+use neurotex::pipeline::Pipeline;
+use neurotex::recording::{Baseline, Recording};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use serde::Serialize;
+
+use crate::convert::{Batch, InfoTuple};
+use crate::dataset::open;
+use crate::errors::{guarded, raise, Kind};
+use crate::params::{self, Stages};
+
+/// Reads the training recordings by index.
+pub type Load<'a> = dyn Fn(usize) -> neurotex::Result<Recording> + Sync + 'a;
+
+/// The pipeline of the stage options, calibrated.
+pub struct Calibrated {
+    /// The planned pipeline, with the calibrated gain and causal conditioning in place.
+    pub pipeline: Pipeline,
+    /// What `gain="auto"` chose.
+    pub gain: Option<GainCalibration>,
+    /// What `causal=True` fixed.
+    pub causal: Option<ConditioningCalibration>,
+}
+
+/// What was calibrated, for Python: the JSON of the gain calibration and of the causal
+/// conditioning (the library's serialised forms, as a model file holds them), each `None`
+/// when not asked for.
+pub type Report = (Option<String>, Option<String>);
+
+impl Calibrated {
+    /// What was calibrated, as JSON for the Python layer.
+    pub fn report(&self) -> PyResult<Report> {
+        Ok((json(&self.gain)?, json(&self.causal)?))
+    }
+}
+
+/// `value` as JSON, `None` for `None`.
+pub fn json<T: Serialize>(value: &Option<T>) -> PyResult<Option<String>> {
+    value
+        .as_ref()
+        .map(|v| serde_json::to_string(v).map_err(|e| raise(Kind::Internal, e.to_string())))
+        .transpose()
+}
+
+/// The pipeline the stage options name; with `causal`, each taxel's resting value and
+/// one scale fixed on the recordings `indices` (read by `load`); with `gain="auto"`, the
+/// gain calibrated on them too, on the causally conditioned signal when both are asked
+/// for. The CLI's commands calibrate the same way (`calibrated_pipeline`), so the same
+/// recordings give the same pipeline.
+///
+/// # Errors
+/// No recording, one that cannot be read or conditioned, no signal to calibrate on.
+pub fn calibrated(
+    stages: &Stages,
+    load: &Load<'_>,
+    indices: &[usize],
+    baseline: Baseline,
+) -> neurotex::Result<Calibrated> {
+    let mut params = stages.params.clone();
+    let causal = match stages.causal {
+        true => {
+            let c = calibrate_conditioning(&params, load, indices, baseline)?;
+            params.preprocess.causal = Some(c.conditioning.clone());
+            Some(c)
+        }
+        false => None,
+    };
+    let gain = match stages.gain_target() {
+        Some(target_hz) => {
+            let pipeline = Pipeline::new(params.clone())?;
+            let c = calibrate_gain(&pipeline, load, indices, baseline, target_hz)?;
+            params.encoder.gain = c.gain;
+            Some(c)
+        }
+        None => None,
+    };
+    Ok(Calibrated {
+        pipeline: Pipeline::new(params)?,
+        gain,
+        causal,
+    })
+}
+
+/// Calibrates the stage options on recordings (arrays): what `features` would choose.
+#[pyfunction]
+#[pyo3(signature = (recordings, infos, options, baseline=None))]
+fn calibrate<'py>(
+    py: Python<'py>,
+    recordings: Vec<Bound<'py, PyAny>>,
+    infos: Vec<InfoTuple>,
+    options: &Bound<'py, PyDict>,
+    baseline: Option<&str>,
+) -> PyResult<Report> {
+    let stages = params::stages(options)?;
+    let baseline = params::baseline(baseline)?;
+    let batch = Batch::new(&recordings, infos)?;
+    let view = batch.view();
+    let all: Vec<usize> = (0..view.len()).collect();
+    let c = py.detach(|| guarded(|| calibrated(&stages, &|i| view.load(i), &all, baseline)))?;
+    c.report()
+}
+
+/// Calibrates the stage options on every recording of a dataset folder, as `neurotex
+/// features --dataset` does.
+#[pyfunction]
+fn calibrate_dataset(
+    py: Python<'_>,
+    dir: PathBuf,
+    options: &Bound<'_, PyDict>,
+) -> PyResult<Report> {
+    let stages = params::stages(options)?;
+    let dataset = open(&dir)?;
+    let baseline = dataset.layout.baseline.unwrap_or_default();
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    let c = py.detach(|| guarded(|| calibrated(&stages, &|i| dataset.load(i), &all, baseline)))?;
+    c.report()
+}
+
+/// Registers the calibration functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate_dataset, m)?)
+}

@@ -1,0 +1,239 @@
+//! `neurotex reproduce` from Python: every analysis of the paper (E0-E9) on the built-in
+//! simulator or on a dataset folder, the report written as the CLI writes it, and the
+//! results handed back.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use neurotex::calibrate::GainCalibration;
+use neurotex::classify::KnnParams;
+use neurotex::experiments::{
+    claims, prepare, run_all, run_seeds, HeadlinePrediction, Progress, ReproduceParams, Results,
+    Source, ValidReproduceParams,
+};
+use neurotex::pipeline::Pipeline;
+use neurotex::report::{write_report, ReportContext};
+use neurotex::sim::MAX_TRIALS;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::dataset::open;
+use crate::errors::{guarded, param, raise, Kind};
+use crate::params::{self, Stages};
+
+/// Most simulated datasets one run accepts (the CLI's `--seeds` limit).
+const MAX_SEEDS: u64 = 1000;
+
+/// One headline out-of-fold prediction: `(speed_mm_s, method, file, label, predicted,
+/// fold or None for a held-out test set, repeat)`, the CLI's `--predictions` row.
+type PredictionRow = (f64, String, String, String, String, Option<usize>, usize);
+
+/// What a run hands back: `results.json`'s text, the claims as JSON, the headline
+/// predictions and the run's wall-clock seconds.
+type Outcome = (String, String, Vec<PredictionRow>, f64);
+
+/// Which data a run analyses.
+enum Data {
+    /// A dataset folder.
+    Folder(Box<neurotex::recording::Dataset>),
+    /// `trials` per texture and speed of the paper's design, one simulated dataset per seed.
+    Simulated { trials: u32, seeds: Vec<u64> },
+}
+
+/// Runs every analysis as `neurotex reproduce` does with the same options, writes
+/// `report.md`, `results.json` and `figures/` into `out` (whole or not at all) and returns
+/// the results. The GIL is released for the whole run.
+#[pyfunction]
+#[pyo3(signature = (out, options, dataset=None, quick=false, seed=0, trials=None, seeds=None, k=5, standardize=true, group_by=None, command=String::new()))]
+#[allow(clippy::too_many_arguments)]
+fn reproduce(
+    py: Python<'_>,
+    out: PathBuf,
+    options: &Bound<'_, PyDict>,
+    dataset: Option<PathBuf>,
+    quick: bool,
+    seed: u64,
+    trials: Option<u32>,
+    seeds: Option<u64>,
+    k: usize,
+    standardize: bool,
+    group_by: Option<String>,
+    command: String,
+) -> PyResult<Outcome> {
+    let stages = params::stages(options)?;
+    if stages.causal {
+        return Err(raise(
+            Kind::Parameter,
+            "reproduce runs the causal pipeline itself (its causal E5 beside the paper's offline E5); causal=True is for features and Model.train",
+        ));
+    }
+    let mut params = if quick {
+        ReproduceParams::quick()
+    } else {
+        ReproduceParams::default()
+    };
+    params.pipeline = stages.params.clone();
+    params.knn = KnnParams { k, standardize };
+    params.knn.check().map_err(param)?;
+    params.seed = seed;
+    params.cv.seed = seed;
+    params.group_by = group_by;
+    let data = match dataset {
+        Some(dir) => {
+            if trials.is_some() || seeds.is_some() {
+                return Err(raise(
+                    Kind::Parameter,
+                    "trials and seeds apply to the built-in simulator; a dataset folder is one draw of its own size",
+                ));
+            }
+            Data::Folder(Box::new(open(&dir)?))
+        }
+        None => {
+            let trials = trials.unwrap_or(if quick { 10 } else { 20 });
+            if !(1..=MAX_TRIALS).contains(&trials) {
+                return Err(raise(
+                    Kind::Parameter,
+                    format!("trials must be between 1 and {MAX_TRIALS}, got {trials}"),
+                ));
+            }
+            let n = seeds.unwrap_or(if quick { 1 } else { 5 });
+            if !(1..=MAX_SEEDS).contains(&n) {
+                return Err(raise(
+                    Kind::Parameter,
+                    format!("seeds must be between 1 and {MAX_SEEDS}, got {n}"),
+                ));
+            }
+            let seeds = (0..n)
+                .map(|i| seed.checked_add(i))
+                .collect::<Option<Vec<u64>>>()
+                .ok_or_else(|| raise(Kind::Parameter, "seed plus seeds overflows a 64-bit seed"))?;
+            Data::Simulated { trials, seeds }
+        }
+    };
+    py.detach(|| guarded(|| run(&out, &data, &stages, params, &command)))
+}
+
+/// The run itself, without the GIL.
+fn run(
+    out: &std::path::Path,
+    data: &Data,
+    stages: &Stages,
+    params: ReproduceParams,
+    command: &str,
+) -> neurotex::Result<Outcome> {
+    let started = Instant::now();
+    let quiet = |_: Progress| ();
+    let (results, described, params) = match data {
+        Data::Folder(ds) => {
+            let source = Source::Dataset(ds);
+            let (params, calibration) = calibrated(params, stages, &source)?;
+            let prepared = prepare(&source, &params, &quiet)?;
+            let mut results = run_all(&prepared, &params, &quiet)?;
+            results.gain_calibration = calibration;
+            (results, source.describe(), params)
+        }
+        Data::Simulated { trials, seeds } => {
+            let simulate = |seed| Source::paper_design(*trials, seed);
+            let (params, calibration) = calibrated(params, stages, &simulate(seeds[0]))?;
+            let mut results = run_seeds(&simulate, seeds, &params, &quiet)?;
+            results.gain_calibration = calibration;
+            (results, describe_seeds(&simulate(seeds[0]), seeds), params)
+        }
+    };
+    let ctx = ReportContext {
+        dataset: described,
+        parameters: parameters_described(&params, &results),
+        total_seconds: started.elapsed().as_secs_f64(),
+        command: command.to_string(),
+        paper_comparable: matches!(data, Data::Simulated { .. }),
+    };
+    write_report(out, &results, &ctx)?;
+    let json = |what: &str, text: serde_json::Result<String>| {
+        text.map_err(|e| neurotex::error::DataError::invalid(out.join(what), e.to_string()))
+    };
+    let results_json = json("results.json", serde_json::to_string(&results))?;
+    let claims_json = json("claims", serde_json::to_string(&claims(&results)))?;
+    let predictions = results.predictions.iter().map(prediction_row).collect();
+    Ok((
+        results_json,
+        claims_json,
+        predictions,
+        started.elapsed().as_secs_f64(),
+    ))
+}
+
+/// The checked parameters, with the gain calibrated on `first` (the dataset, or the first
+/// simulated one) under `gain="auto"`, as the CLI calibrates it.
+fn calibrated(
+    mut params: ReproduceParams,
+    stages: &Stages,
+    first: &Source,
+) -> neurotex::Result<(ValidReproduceParams, Option<GainCalibration>)> {
+    let calibration = match stages.gain_target() {
+        Some(target) => {
+            let pipeline = Pipeline::new(params.pipeline.clone())?;
+            let c = first.calibrate_gain(&pipeline, target)?;
+            params.pipeline.encoder.gain = c.gain;
+            Some(c)
+        }
+        None => None,
+    };
+    Ok((params.check()?, calibration))
+}
+
+fn prediction_row(p: &HeadlinePrediction) -> PredictionRow {
+    (
+        p.speed.mm_s(),
+        p.method.to_string(),
+        p.file.clone(),
+        p.label.clone(),
+        p.predicted.clone(),
+        p.fold,
+        p.repeat,
+    )
+}
+
+// The report's two paragraphs below are worded as the CLI words them
+// (crates/neurotex-cli/src/commands/reproduce.rs), so that a report written from Python
+// reads as one written by `neurotex reproduce`.
+
+/// The report's parameter lines: the run's parameters and, under `gain="auto"`, the gain
+/// chosen.
+fn parameters_described(params: &ValidReproduceParams, results: &Results) -> Vec<String> {
+    let mut lines = params.describe();
+    if let Some(c) = &results.gain_calibration {
+        let shared = if results.across_seeds.is_some() {
+            "; calibrated on the first simulated dataset and used for all"
+        } else {
+            ""
+        };
+        lines.push(format!(
+            "gain: --gain auto chose G = {} so that the median taxel with signal fires at {} Hz (median {:.1} Hz over {} taxel x recording pairs of {} recordings; labels unused{shared})",
+            c.gain, c.target_hz, c.median_hz, c.pairs, c.recordings
+        ));
+    }
+    lines
+}
+
+/// The report's data paragraph for a run over simulated datasets: the first dataset's
+/// description and, with several, which further seeds were run.
+fn describe_seeds(first: &Source, seeds: &[u64]) -> String {
+    let mut text = first.describe();
+    if let [_, rest @ ..] = seeds {
+        if !rest.is_empty() {
+            let list: Vec<String> = rest.iter().map(u64::to_string).collect();
+            text.push_str(&format!(
+                " {} further independent datasets of the same design (seeds {}) were simulated and analysed the same way; the sections below show the first, and \"Across simulated datasets\" gives every headline accuracy over all {}.",
+                rest.len(),
+                list.join(", "),
+                seeds.len()
+            ));
+        }
+    }
+    text
+}
+
+/// Registers `reproduce`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(reproduce, m)?)
+}
