@@ -650,14 +650,14 @@ impl StreamClassifier {
         }
         for start in (0..cells).step_by(PART) {
             let part = start..(start + PART).min(cells);
-            let cells = Conditioning {
+            let conditioning = Conditioning {
                 raw: &self.step_in[part.clone()],
                 offsets: &self.conditioning.offsets[part.clone()],
                 present: &self.present[part.clone()],
                 state: [&mut z0[part.clone()], &mut z1[part.clone()]],
                 out: &mut self.conditioned[part.clone()],
             };
-            cells.run(self.filter.as_ref(), self.conditioning.scale, first);
+            conditioning.run(self.filter.as_ref(), self.conditioning.scale, first);
             let raster = &mut self.raster[part.clone()];
             for (population, (neurons, is_fa)) in episode.neurons.iter_mut().enumerate() {
                 let input = match is_fa {
