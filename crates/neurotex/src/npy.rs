@@ -95,6 +95,10 @@ pub(crate) fn read_header(path: &Path) -> Result<NpyHeader> {
     Ok(parsed)
 }
 
+/// The largest read buffer a thread keeps between files (64 MiB): beyond it the
+/// allocation's cost is small beside the file's, and memory goes back at once.
+const KEPT_BYTES: usize = 64 << 20;
+
 /// The samples of a `.npy` of little-endian floats (`<f8` or `<f4`) in C order, whose
 /// header [`read_header`] checked: the data read in one call into a byte buffer kept for the
 /// thread's next file, and converted to f64 in one pass. `None` for any other dtype or order
@@ -126,7 +130,7 @@ pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<V
         bytes.truncate(size);
         bytes.resize(size, 0);
         file.read_exact(bytes).map_err(io)?;
-        Ok(Some(match item {
+        let samples = match item {
             8 => bytes
                 .chunks_exact(8)
                 .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
@@ -135,7 +139,12 @@ pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<V
                 .chunks_exact(4)
                 .map(|b| f64::from(f32::from_le_bytes(b.try_into().expect("4 bytes"))))
                 .collect(),
-        }))
+        };
+        // A very large file's buffer is not kept for the thread's next, smaller ones.
+        if bytes.capacity() > KEPT_BYTES {
+            *bytes = Vec::new();
+        }
+        Ok(Some(samples))
     })
 }
 

@@ -437,6 +437,10 @@ impl Preprocessor {
                     }
                     SCRATCH.with_borrow_mut(|scratch| {
                         filter.filtfilt_frames(&mut samples, cells, scratch);
+                        // A very long recording's copy (over 64 MiB) is not kept.
+                        if scratch.capacity() > 1 << 23 {
+                            *scratch = Vec::new();
+                        }
                     });
                 }
             }
