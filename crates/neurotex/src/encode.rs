@@ -214,16 +214,7 @@ impl Encoder {
         let n = self.v.len();
         assert!(n > 0 && input.len() % n == 0, "input must be whole frames");
         assert_eq!(input.len(), raster.len(), "raster must match input");
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2, the only feature the function enables.
-                unsafe { run_avx2(self.params, &mut self.v, &mut self.u, input, raster) };
-                self.steps += (input.len() / n) as u64;
-                return;
-            }
-        }
-        run_blocks(self.params, &mut self.v, &mut self.u, input, raster);
+        run_fastest(self.params, &mut self.v, &mut self.u, input, raster);
         self.steps += (input.len() / n) as u64;
     }
 
@@ -239,16 +230,27 @@ impl Encoder {
         let cells = first..first + input.len();
         assert_eq!(input.len(), raster.len(), "raster must match input");
         let (v, u) = (&mut self.v[cells.clone()], &mut self.u[cells]);
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2, the only feature the function enables.
-                unsafe { run_avx2(self.params, v, u, input, raster) };
-                return;
-            }
-        }
-        run_blocks(self.params, v, u, input, raster);
+        run_fastest(self.params, v, u, input, raster);
     }
+}
+
+/// [`run_blocks`] with AVX2 where the processor has it.
+fn run_fastest(
+    p: IzhikevichParams,
+    v: &mut [f64],
+    u: &mut [f64],
+    input: &[f64],
+    raster: &mut [u8],
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, the only feature the function enables.
+            unsafe { run_avx2(p, v, u, input, raster) };
+            return;
+        }
+    }
+    run_blocks(p, v, u, input, raster);
 }
 
 /// Neurons per block whose state stays in registers across time steps: enough independent
