@@ -284,7 +284,9 @@ pub const ANALYSES: [Analysis; 12] = [
     Analysis {
         id: "e7",
         run: |c, r| {
-            r.e7 = Some(e7_gain_sweep(c)?);
+            if c.params.e7 {
+                r.e7 = Some(e7_gain_sweep(c)?);
+            }
             Ok(())
         },
     },

@@ -202,7 +202,7 @@ fn histogram_bins(params: &ValidReproduceParams) -> usize {
 pub struct Prepared {
     /// Every recording's spikes at the pipeline's gain (the sliding phase).
     pub encoded: Vec<Encoded>,
-    /// The gain sweep at the slowest speed.
+    /// The gain sweep at the slowest speed (no counts without E7).
     pub isi: IsiSweep,
     /// The taxel grid, the same for every recording.
     pub grid: Grid,
@@ -320,7 +320,7 @@ pub fn prepare(
     let results: Vec<EncodedOne> = (0..n)
         .into_par_iter()
         .map(|i| {
-            let (speed, sweep) = (conditions[i].0, conditions[i].0 == slowest);
+            let (speed, sweep) = (conditions[i].0, params.e7 && conditions[i].0 == slowest);
             let out = encode_one(source, i, sweep, causal_at(speed), params);
             progress(Progress::Tick);
             out

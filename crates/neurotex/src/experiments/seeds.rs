@@ -19,7 +19,8 @@ use crate::error::Result;
 /// Runs every analysis on one simulated dataset per seed (`simulate(seed)` gives the
 /// design), one dataset in memory at a time, and returns the first dataset's results with
 /// [`AcrossSeeds`] over all of them attached (none with a single seed). The further datasets
-/// skip the numerical sensitivity check, which speaks of the first one's numerics.
+/// skip what only the first one's report shows: the numerical sensitivity check, E5c, E7
+/// and E9 ([`ValidReproduceParams::for_further_datasets`]).
 ///
 /// # Errors
 /// No seed, or an analysis that cannot run on one of the datasets.
@@ -50,7 +51,7 @@ pub fn run_seeds(
     if rest.is_empty() {
         return Ok(main);
     }
-    let quiet = params.without_sensitivity();
+    let quiet = params.for_further_datasets();
     let mut others = Vec::with_capacity(rest.len());
     for (i, &seed) in rest.iter().enumerate() {
         others.push(run(i + 1, seed, &quiet)?);
