@@ -13,7 +13,8 @@
 //!
 //! Splits are searched by sorting: every feature is rank-transformed once per fit (equal
 //! values share a rank), and a node sorts its samples by rank for each feature it tries, as
-//! 64-bit keys (rank, sample). A split's quality is the Gini proxy
+//! 64-bit keys (rank, sample): a stable counting sort over the node's samples, which are
+//! kept in ascending order, or a comparison sort for small nodes. A split's quality is the Gini proxy
 //! `Σ_c L_c² / |L| + Σ_c R_c² / |R|` (class counts weighted by bootstrap multiplicity),
 //! compared exactly as a fraction of integers, so equal splits are equal and the choice
 //! among them is fixed: the lowest feature index, then the lowest threshold. A threshold
@@ -150,12 +151,15 @@ struct Prepared<'a> {
     /// Dense rank of each sample's value among all training values of a feature,
     /// feature-major (`dims x n`).
     ranks: Vec<u32>,
+    /// Each feature's number of distinct values (its largest rank + 1).
+    distinct: Vec<u32>,
 }
 
 impl<'a> Prepared<'a> {
     fn new(x: &'a [f64], dims: usize, y: &'a [usize]) -> Self {
         let n = y.len();
         let mut ranks = vec![0u32; n * dims];
+        let mut distinct = vec![0u32; dims];
         let mut order: Vec<usize> = (0..n).collect();
         for (f, feature_ranks) in ranks.chunks_exact_mut(n).enumerate() {
             order.sort_unstable_by(|&a, &b| x[a * dims + f].total_cmp(&x[b * dims + f]));
@@ -166,6 +170,7 @@ impl<'a> Prepared<'a> {
                 }
                 feature_ranks[s] = rank;
             }
+            distinct[f] = rank + 1;
         }
         Prepared {
             x,
@@ -173,6 +178,7 @@ impl<'a> Prepared<'a> {
             y,
             n_classes: y.iter().max().map_or(0, |&m| m + 1),
             ranks,
+            distinct,
         }
     }
 }
@@ -194,6 +200,9 @@ struct Candidate {
     feature: usize,
     /// Samples going left.
     n_left: usize,
+    /// The feature's largest rank among them: a sample goes left when its rank is at most
+    /// this.
+    rank: u32,
 }
 
 impl Candidate {
@@ -220,6 +229,10 @@ struct Grower<'a> {
     /// The in-bag samples; each node owns a contiguous range.
     samples: Vec<u32>,
     keys: Vec<u64>,
+    /// The counting sort's first slot of each rank.
+    rank_starts: Vec<u32>,
+    /// The samples going right while a node is partitioned.
+    right: Vec<u32>,
     features: Vec<usize>,
     counts: Vec<u64>,
     left: Vec<u64>,
@@ -244,6 +257,8 @@ impl<'a> Grower<'a> {
             weight,
             samples,
             keys: Vec::new(),
+            rank_starts: Vec::new(),
+            right: Vec::new(),
             features: Vec::new(),
             counts: vec![0; data.n_classes],
             left: vec![0; data.n_classes],
@@ -304,17 +319,38 @@ impl<'a> Grower<'a> {
         classes > 1 && depth < self.growth.max_depth && n >= 2 * self.growth.min_leaf
     }
 
-    /// Sorts the node's samples by their rank on `feature` into `keys`.
+    /// Sorts the node's samples by their rank on `feature` into `keys`, as 64-bit keys
+    /// (rank, sample). A node's samples are kept in ascending order (the root's are, and
+    /// [`Grower::partition`] keeps the order), so a stable counting sort by rank gives the
+    /// keys in order; small nodes, where clearing a count per rank would cost more than
+    /// the sort, are sorted by comparison. The keys are distinct, so both give one order.
     fn sort_keys(&mut self, start: usize, end: usize, feature: usize) {
         let n = self.data.y.len();
         let ranks = &self.data.ranks[feature * n..(feature + 1) * n];
+        let samples = &self.samples[start..end];
+        let key = |s: u32| (u64::from(ranks[s as usize]) << 32) | u64::from(s);
         self.keys.clear();
-        self.keys.extend(
-            self.samples[start..end]
-                .iter()
-                .map(|&s| (u64::from(ranks[s as usize]) << 32) | u64::from(s)),
-        );
-        self.keys.sort_unstable();
+        let distinct = self.data.distinct[feature] as usize;
+        if samples.len() * 12 < distinct || samples.len() < 32 {
+            self.keys.extend(samples.iter().map(|&s| key(s)));
+            self.keys.sort_unstable();
+            return;
+        }
+        let starts = &mut self.rank_starts;
+        starts.clear();
+        starts.resize(distinct + 1, 0);
+        for &s in samples {
+            starts[ranks[s as usize] as usize + 1] += 1;
+        }
+        for r in 1..=distinct {
+            starts[r] += starts[r - 1];
+        }
+        self.keys.resize(samples.len(), 0);
+        for &s in samples {
+            let slot = &mut starts[ranks[s as usize] as usize];
+            self.keys[*slot as usize] = key(s);
+            *slot += 1;
+        }
     }
 
     /// The best split of the node among randomly drawn features, or `None` when every
@@ -371,6 +407,7 @@ impl<'a> Grower<'a> {
                 den: u128::from(w_left) * u128::from(w_right),
                 feature,
                 n_left: p + 1,
+                rank: (self.keys[p] >> 32) as u32,
             };
             if candidate.beats(best) {
                 *best = Some(candidate);
@@ -378,17 +415,45 @@ impl<'a> Grower<'a> {
         }
     }
 
-    /// Orders the node's samples by `best`'s feature, so that its left child's come first,
-    /// and returns the threshold: midway between the last left and the first right value,
-    /// or the left value where the midpoint rounds to the right one.
+    /// Moves the node's samples that go left (rank on `best`'s feature at most its rank)
+    /// before the others, each side keeping its ascending order, and returns the threshold:
+    /// midway between the largest left and the smallest right value, or the left value
+    /// where the midpoint rounds to the right one.
     fn partition(&mut self, start: usize, end: usize, best: &Candidate) -> f64 {
-        self.sort_keys(start, end, best.feature);
-        for (slot, &key) in self.samples[start..end].iter_mut().zip(&self.keys) {
-            *slot = (key & 0xffff_ffff) as u32;
+        let n = self.data.y.len();
+        let ranks = &self.data.ranks[best.feature * n..(best.feature + 1) * n];
+        let node = &mut self.samples[start..end];
+        self.right.clear();
+        let mut left = 0;
+        let mut above: Option<u32> = None;
+        for i in 0..node.len() {
+            let s = node[i];
+            let r = ranks[s as usize];
+            if r <= best.rank {
+                node[left] = s;
+                left += 1;
+            } else {
+                self.right.push(s);
+                if above.is_none_or(|a| r < ranks[a as usize]) {
+                    above = Some(s);
+                }
+            }
         }
+        node[left..].copy_from_slice(&self.right);
+        debug_assert_eq!(
+            left, best.n_left,
+            "a split's left side is its ranks up to its own"
+        );
+        // Equal values share a rank: any left sample of the split's rank holds the largest
+        // left value.
+        let below = node[..left]
+            .iter()
+            .copied()
+            .find(|&s| ranks[s as usize] == best.rank)
+            .expect("the split's rank is on its left side");
+        let above = above.expect("a split has a right side");
         let value = |s: u32| self.data.x[s as usize * self.data.dims + best.feature];
-        let below = value(self.samples[start + best.n_left - 1]);
-        let above = value(self.samples[start + best.n_left]);
+        let (below, above) = (value(below), value(above));
         let middle = below / 2.0 + above / 2.0;
         if middle >= above || !middle.is_finite() {
             below
@@ -537,6 +602,92 @@ mod tests {
             "max_features"
         );
     }
+
+    /// FNV-1a over every node (feature, threshold's bits, children) and every leaf share's
+    /// bits of every tree.
+    fn digest(model: &ForestModel) -> u64 {
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        let mut eat = |v: u64| {
+            for b in v.to_le_bytes() {
+                h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+            }
+        };
+        for tree in &model.trees {
+            for node in &tree.nodes {
+                match *node {
+                    Node::Split {
+                        feature,
+                        threshold,
+                        left,
+                        right,
+                    } => {
+                        [
+                            feature as u64,
+                            threshold.to_bits(),
+                            left as u64,
+                            right as u64,
+                        ]
+                        .into_iter()
+                        .for_each(&mut eat);
+                    }
+                    Node::Leaf(offset) => eat(u64::MAX - offset as u64),
+                }
+            }
+            tree.shares.iter().for_each(|s| eat(s.to_bits()));
+        }
+        h
+    }
+
+    /// Forests on data with many ties and without, small and larger, with and without
+    /// bootstrap, depth and leaf limits: the digests of the trees grown before the split
+    /// search stopped sorting each node's samples (sort_unstable of (rank, sample) keys),
+    /// so that any change to the trees is seen.
+    #[test]
+    fn forests_are_the_ones_grown_before() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut digests = Vec::new();
+        for (n, dims, classes, levels) in [(40, 3, 3, 5u64), (200, 12, 8, 1000), (480, 96, 8, 40)] {
+            let x: Vec<f64> = (0..n * dims)
+                .map(|_| (next() % levels) as f64 * 0.37 - 2.0)
+                .collect();
+            let y: Vec<usize> = (0..n)
+                .map(|i| (i + (next() % 2) as usize) % classes)
+                .collect();
+            for (bootstrap, max_depth, min_samples_leaf) in
+                [(true, None, 1), (false, Some(4), 1), (true, None, 3)]
+            {
+                let params = ForestParams {
+                    trees: 12,
+                    bootstrap,
+                    max_depth,
+                    min_samples_leaf,
+                    seed: 7,
+                    ..ForestParams::default()
+                };
+                digests.push(digest(&params.check().unwrap().fit(&x, dims, &y).unwrap()));
+            }
+        }
+        assert_eq!(digests, EXPECTED);
+    }
+
+    /// Taken with the sorting split search (commit cebc8de).
+    const EXPECTED: [u64; 9] = [
+        0xd9bf95ed6f2181a9,
+        0x75d139cf1b81539e,
+        0x35f13b98acf758e3,
+        0xbbdbe603709b9d2b,
+        0x688db7f982fa4af1,
+        0xfe3595d94cc1d3b5,
+        0x147c710072d89bc1,
+        0xae7a98d51b3beada,
+        0xfadec57147b6908a,
+    ];
 
     #[test]
     fn a_stump_splits_between_the_classes() {
