@@ -4,14 +4,32 @@ criterion benches (run both in one session: these machines are noisy).
     python -m venv /tmp/peers && /tmp/peers/bin/pip install numpy scikit-learn \
         six pykwalify pywavelets simpleitk setuptools wheel versioneer
     # pyradiomics 3.0.1 from its sdist, as SPEC section 7 describes
-    /tmp/peers/bin/python crates/neurotex/benches/peers/peers.py
+    /tmp/peers/bin/python crates/neurotex/benches/peers/peers.py [--data DIR] [--cli PATH]
 
-Prints one line per stage with the median time and the work size.
+Prints one line per stage with the median time and the work size. With `--data` (a folder
+written by `neurotex simulate --out DIR`, the paper's 480 recordings by default; scipy
+needed) it also times the whole path from files to 3D-GLCM features: the `neurotex
+features` process against the numpy/scipy pipeline of `numpy_pipeline.py` reading the same
+files, run alternately so that the machine's other load falls on both.
 """
+import argparse
+import pathlib
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
 
 import numpy as np
+
+HERE = pathlib.Path(__file__).resolve().parent
+REPO = HERE.parents[3]
+ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+ap.add_argument("--data", help="a `neurotex simulate` folder for the whole-path case")
+ap.add_argument("--cli", default=str(REPO / "target" / "release" / "neurotex"))
+ap.add_argument("--repeats", type=int, default=5, help="whole path: neurotex runs")
+ap.add_argument("--peer-repeats", type=int, default=3, help="whole path: numpy runs")
+args = ap.parse_args()
 
 
 def median_time(fn, repeats):
@@ -64,15 +82,45 @@ except ImportError as e:
     print(f"pyradiomics not installed: {e}")
 
 # KNN (k = 5) with 5-fold stratified CV on 160 x 3, standardised (scikit-learn)
-from sklearn.model_selection import StratifiedKFold, cross_val_score
-from sklearn.neighbors import KNeighborsClassifier
-from sklearn.pipeline import make_pipeline
-from sklearn.preprocessing import StandardScaler
+try:
+    from sklearn.model_selection import StratifiedKFold, cross_val_score
+    from sklearn.neighbors import KNeighborsClassifier
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
 
-rng = np.random.default_rng(2)
-y = np.repeat(np.arange(8), 20)
-X = rng.normal(size=(160, 3)) + y[:, None] * 0.3
-clf = make_pipeline(StandardScaler(), KNeighborsClassifier(n_neighbors=5))
-cv = StratifiedKFold(5, shuffle=True, random_state=0)
-t = median_time(lambda: cross_val_score(clf, X, y, cv=cv), 20)
-print(f"scikit-learn knn 5-fold cv 160x3: {t * 1e3:.2f} ms (median of 20)")
+    rng = np.random.default_rng(2)
+    y = np.repeat(np.arange(8), 20)
+    X = rng.normal(size=(160, 3)) + y[:, None] * 0.3
+    clf = make_pipeline(StandardScaler(), KNeighborsClassifier(n_neighbors=5))
+    cv = StratifiedKFold(5, shuffle=True, random_state=0)
+    t = median_time(lambda: cross_val_score(clf, X, y, cv=cv), 20)
+    print(f"scikit-learn knn 5-fold cv 160x3: {t * 1e3:.2f} ms (median of 20)")
+except ImportError as e:
+    print(f"scikit-learn not installed: {e}")
+
+# The whole path: files to 3D-GLCM features of every recording of a dataset folder.
+if args.data:
+    sys.path.insert(0, str(HERE))
+    from numpy_pipeline import numpy_features, read_dataset
+
+    data = pathlib.Path(args.data)
+    arrays, slides = read_dataset(data)
+    steps = sum(round((e - s) * 1000) for s, e in slides) * arrays[0][0].size
+    out_csv = pathlib.Path(tempfile.mkdtemp()) / "features.csv"
+    command = [args.cli, "features", "--dataset", str(data), "--method", "glcm3d",
+               "--out", str(out_csv)]
+    del arrays  # the peer reads the files in its timed runs, as neurotex does
+    ours, theirs = [], []
+    for i in range(max(args.repeats, args.peer_repeats)):
+        if i < args.repeats:
+            t0 = time.perf_counter()
+            subprocess.run(command, check=True, capture_output=True)
+            ours.append(time.perf_counter() - t0)
+        if i < args.peer_repeats:
+            t0 = time.perf_counter()
+            numpy_features(*read_dataset(data))
+            theirs.append(time.perf_counter() - t0)
+    a, b = statistics.median(ours), statistics.median(theirs)
+    print(f"whole path, {len(slides)} recordings ({steps / 1e6:.1f} M neuron-steps), files to "
+          f"3D-GLCM features: neurotex features {a:.3f} s (median of {len(ours)}), "
+          f"numpy/scipy {b:.3f} s (median of {len(theirs)}): {b / a:.1f}x")
