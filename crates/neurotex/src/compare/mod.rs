@@ -154,7 +154,8 @@ pub struct Ranked {
     pub difference_vs_paper: Option<f64>,
     /// Accuracy per condition (empty for pooled cross-validation).
     pub per_condition: Vec<ConditionAccuracy>,
-    /// Seconds to make the features and evaluate.
+    /// Seconds to make the features and evaluate (wall clock; candidates are evaluated side
+    /// by side, so each one's time includes its share of the others' load).
     pub seconds: f64,
     /// Whether this is the paper's method.
     pub paper: bool,
@@ -228,8 +229,11 @@ pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Compa
         let message = format!("{} has other recordings than {}", c.name(), first.name());
         return Err(ClassifyError::BadFeatures(message).into());
     }
+    // Candidates are scored side by side (each is deterministic, so the order of work
+    // changes nothing but its clock): one candidate's folds are too few and too unequal
+    // to keep every core busy.
     let scored: Vec<Scored> = candidates
-        .iter()
+        .par_iter()
         .map(|c| score(c, params))
         .collect::<Result<_>>()?;
     let units = Units::new(metas, &scored[0].shares, params)?;
@@ -681,10 +685,16 @@ fn nested(candidates: &[Candidate], params: &CompareParams, units: &Units) -> Re
                 .check()?,
                 ..params.clone()
             };
+            let accuracies: Vec<f64> = candidates
+                .par_iter()
+                .map(|c| {
+                    let sub = c.table.subset(&split.train);
+                    Ok((c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy)
+                })
+                .collect::<Result<_>>()?;
+            // The first candidate of the highest accuracy.
             let mut best = (f64::NEG_INFINITY, 0);
-            for (k, c) in candidates.iter().enumerate() {
-                let sub = c.table.subset(&split.train);
-                let accuracy = (c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy;
+            for (k, &accuracy) in accuracies.iter().enumerate() {
                 if accuracy > best.0 {
                     best = (accuracy, k);
                 }

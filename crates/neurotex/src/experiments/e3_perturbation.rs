@@ -63,7 +63,9 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
     let rows = c.tables.glcm3d.rows_at(&[speed]);
     let (mut mean, mut std, mut unperturbed_vs_moved) = (Vec::new(), Vec::new(), Vec::new());
     for &n in &counts {
+        // The draws side by side: each is seeded by (n, draw, recording).
         let outcomes = (0..c.params.e3_repeats)
+            .into_par_iter()
             .map(|rep| perturbed(c, &slow, &taxels, n, rep))
             .collect::<Result<Vec<Outcome>>>()?;
         let accs: Vec<f64> = outcomes.iter().map(|o| o.accuracy).collect();

@@ -1,5 +1,6 @@
 //! E8: robustness of E1 to the number of neighbours k (paper section IV-A).
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::tables::cv_at;
@@ -35,13 +36,24 @@ pub fn e8_neighbours(c: &Context) -> Result<(BySpeed<E8Speed>, Vec<Skip>), Stop>
             glcm3d: Vec::new(),
             glcm3d_vs_taxel: Vec::new(),
         };
-        for &k in &c.params.e8_ks {
-            let knn = c.params.knn_with_k(k);
-            let cv = c.params.folds();
-            match (
-                cv_at(&c.tables.taxel, Columns::EachTaxel, speed, &knn, cv),
-                cv_at(&c.tables.glcm3d, Columns::All, speed, &knn, cv),
-            ) {
+        // Every k's two evaluations side by side (each is deterministic), then taken in
+        // the order of k.
+        let runs: Vec<_> = c
+            .params
+            .e8_ks
+            .par_iter()
+            .map(|&k| {
+                let knn = c.params.knn_with_k(k);
+                let cv = c.params.folds();
+                let (t, g) = rayon::join(
+                    || cv_at(&c.tables.taxel, Columns::EachTaxel, speed, &knn, cv),
+                    || cv_at(&c.tables.glcm3d, Columns::All, speed, &knn, cv),
+                );
+                (k, t, g)
+            })
+            .collect();
+        for (k, t, g) in runs {
+            match (t, g) {
                 (Ok(t), Ok(g)) => {
                     let paired = compare(("3D-GLCM", &g), ("single taxel", &t), c.params)?;
                     e8.k.push(k);
