@@ -336,46 +336,123 @@ mod avx2 {
         }
     }
 
-    /// [`super::Kernels::gradient`]: sixteen (then four, then one) features of a class's
-    /// gradient held in registers while the group's rows are added in order.
+    /// [`super::Kernels::gradient`]: sixteen (then four, then one) features of two classes'
+    /// gradients held in registers while the group's rows are added in order; the two
+    /// classes share each load of a row's features.
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn gradient(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
         let d = gw.len() / k;
         let rows = residuals.len() / k;
-        for (c, g) in gw.chunks_exact_mut(d).enumerate() {
-            let mut j = 0;
-            while j + 4 * LANES <= d {
-                let mut acc = [_mm256_setzero_pd(); 4];
+        let mut pairs = gw.chunks_exact_mut(2 * d);
+        let mut c = 0;
+        for pair in pairs.by_ref() {
+            let (ga, gb) = pair.split_at_mut(d);
+            gradient_two(z, residuals, k, c, rows, ga, gb);
+            c += 2;
+        }
+        if let [_, ..] = pairs.into_remainder() {
+            gradient_one(z, residuals, k, c, rows, &mut gw[c * d..]);
+        }
+    }
+
+    /// Classes `c` and `c + 1`'s gradients, `ga` and `gb`.
+    #[target_feature(enable = "avx2")]
+    unsafe fn gradient_two(
+        z: &[f64],
+        residuals: &[f64],
+        k: usize,
+        c: usize,
+        rows: usize,
+        ga: &mut [f64],
+        gb: &mut [f64],
+    ) {
+        let d = ga.len();
+        let mut j = 0;
+        while j + 4 * LANES <= d {
+            let mut a = [_mm256_setzero_pd(); 4];
+            let mut b = [_mm256_setzero_pd(); 4];
+            for q in 0..4 {
+                a[q] = _mm256_loadu_pd(ga[j + q * LANES..][..LANES].as_ptr());
+                b[q] = _mm256_loadu_pd(gb[j + q * LANES..][..LANES].as_ptr());
+            }
+            for r in 0..rows {
+                let res = &residuals[r * k + c..r * k + c + 2];
+                let (ra, rb) = (_mm256_set1_pd(res[0]), _mm256_set1_pd(res[1]));
+                let row = &z[r * d + j..r * d + j + 4 * LANES];
+                for q in 0..4 {
+                    let x = _mm256_loadu_pd(row[q * LANES..][..LANES].as_ptr());
+                    a[q] = _mm256_add_pd(a[q], _mm256_mul_pd(ra, x));
+                    b[q] = _mm256_add_pd(b[q], _mm256_mul_pd(rb, x));
+                }
+            }
+            for q in 0..4 {
+                _mm256_storeu_pd(ga[j + q * LANES..][..LANES].as_mut_ptr(), a[q]);
+                _mm256_storeu_pd(gb[j + q * LANES..][..LANES].as_mut_ptr(), b[q]);
+            }
+            j += 4 * LANES;
+        }
+        tail(z, residuals, k, c, rows, j, ga);
+        tail(z, residuals, k, c + 1, rows, j, gb);
+    }
+
+    /// Class `c`'s gradient `g` alone (the last of an odd number of classes).
+    #[target_feature(enable = "avx2")]
+    unsafe fn gradient_one(
+        z: &[f64],
+        residuals: &[f64],
+        k: usize,
+        c: usize,
+        rows: usize,
+        g: &mut [f64],
+    ) {
+        let d = g.len();
+        let mut j = 0;
+        while j + 4 * LANES <= d {
+            let mut acc = [_mm256_setzero_pd(); 4];
+            for (q, a) in acc.iter_mut().enumerate() {
+                *a = _mm256_loadu_pd(g[j + q * LANES..][..LANES].as_ptr());
+            }
+            for r in 0..rows {
+                let res = _mm256_set1_pd(residuals[r * k + c]);
+                let row = &z[r * d + j..r * d + j + 4 * LANES];
                 for (q, a) in acc.iter_mut().enumerate() {
-                    *a = _mm256_loadu_pd(g[j + q * LANES..][..LANES].as_ptr());
+                    let x = _mm256_loadu_pd(row[q * LANES..][..LANES].as_ptr());
+                    *a = _mm256_add_pd(*a, _mm256_mul_pd(res, x));
                 }
-                for r in 0..rows {
-                    let res = _mm256_set1_pd(residuals[r * k + c]);
-                    let row = &z[r * d + j..r * d + j + 4 * LANES];
-                    for (q, a) in acc.iter_mut().enumerate() {
-                        let x = _mm256_loadu_pd(row[q * LANES..][..LANES].as_ptr());
-                        *a = _mm256_add_pd(*a, _mm256_mul_pd(res, x));
-                    }
-                }
-                for (q, a) in acc.iter().enumerate() {
-                    _mm256_storeu_pd(g[j + q * LANES..][..LANES].as_mut_ptr(), *a);
-                }
-                j += 4 * LANES;
             }
-            while j + LANES <= d {
-                let mut acc = _mm256_loadu_pd(g[j..j + LANES].as_ptr());
-                for r in 0..rows {
-                    let res = _mm256_set1_pd(residuals[r * k + c]);
-                    let x = _mm256_loadu_pd(z[r * d + j..r * d + j + LANES].as_ptr());
-                    acc = _mm256_add_pd(acc, _mm256_mul_pd(res, x));
-                }
-                _mm256_storeu_pd(g[j..j + LANES].as_mut_ptr(), acc);
-                j += LANES;
+            for (q, a) in acc.iter().enumerate() {
+                _mm256_storeu_pd(g[j + q * LANES..][..LANES].as_mut_ptr(), *a);
             }
-            for (jj, gj) in g.iter_mut().enumerate().skip(j) {
-                for r in 0..rows {
-                    *gj += residuals[r * k + c] * z[r * d + jj];
-                }
+            j += 4 * LANES;
+        }
+        tail(z, residuals, k, c, rows, j, g);
+    }
+
+    /// Features `j..` of class `c`'s gradient `g`: four, then one at a time.
+    #[target_feature(enable = "avx2")]
+    unsafe fn tail(
+        z: &[f64],
+        residuals: &[f64],
+        k: usize,
+        c: usize,
+        rows: usize,
+        mut j: usize,
+        g: &mut [f64],
+    ) {
+        let d = g.len();
+        while j + LANES <= d {
+            let mut acc = _mm256_loadu_pd(g[j..j + LANES].as_ptr());
+            for r in 0..rows {
+                let res = _mm256_set1_pd(residuals[r * k + c]);
+                let x = _mm256_loadu_pd(z[r * d + j..r * d + j + LANES].as_ptr());
+                acc = _mm256_add_pd(acc, _mm256_mul_pd(res, x));
+            }
+            _mm256_storeu_pd(g[j..j + LANES].as_mut_ptr(), acc);
+            j += LANES;
+        }
+        for (jj, gj) in g.iter_mut().enumerate().skip(j) {
+            for r in 0..rows {
+                *gj += residuals[r * k + c] * z[r * d + jj];
             }
         }
     }
