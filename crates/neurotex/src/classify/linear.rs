@@ -184,7 +184,8 @@ impl Problem {
     /// The objective and its gradient at `theta` (`k x dims` weights, then `k` intercepts).
     ///
     /// Rows go a group of [`ROWS`] at a time: the group's logits are summed for four
-    /// classes side by side and its gradient terms four or sixteen features side by side,
+    /// classes side by side and its gradient terms sixteen features of two classes side by
+    /// side,
     /// but every sum is formed in the order of the textbook loop (one row, then each
     /// class's dot product over the features, then its gradient terms): each logit is
     /// `b + Σ_j w_j z_j` summed over `j` from -0 upward as `Iterator::sum` does, and each
@@ -338,7 +339,8 @@ mod avx2 {
 
     /// [`super::Kernels::gradient`]: sixteen (then four, then one) features of two classes'
     /// gradients held in registers while the group's rows are added in order; the two
-    /// classes share each load of a row's features.
+    /// classes share each load of a row's features. The last of an odd number of classes
+    /// goes four features at a time.
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn gradient(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
         let d = gw.len() / k;
@@ -350,8 +352,10 @@ mod avx2 {
             gradient_two(z, residuals, k, c, rows, ga, gb);
             c += 2;
         }
-        if let [_, ..] = pairs.into_remainder() {
-            gradient_one(z, residuals, k, c, rows, &mut gw[c * d..]);
+        // The last of an odd number of classes: four features, then one, at a time.
+        let last = pairs.into_remainder();
+        if !last.is_empty() {
+            tail(z, residuals, k, c, rows, 0, last);
         }
     }
 
@@ -393,39 +397,6 @@ mod avx2 {
         }
         tail(z, residuals, k, c, rows, j, ga);
         tail(z, residuals, k, c + 1, rows, j, gb);
-    }
-
-    /// Class `c`'s gradient `g` alone (the last of an odd number of classes).
-    #[target_feature(enable = "avx2")]
-    unsafe fn gradient_one(
-        z: &[f64],
-        residuals: &[f64],
-        k: usize,
-        c: usize,
-        rows: usize,
-        g: &mut [f64],
-    ) {
-        let d = g.len();
-        let mut j = 0;
-        while j + 4 * LANES <= d {
-            let mut acc = [_mm256_setzero_pd(); 4];
-            for (q, a) in acc.iter_mut().enumerate() {
-                *a = _mm256_loadu_pd(g[j + q * LANES..][..LANES].as_ptr());
-            }
-            for r in 0..rows {
-                let res = _mm256_set1_pd(residuals[r * k + c]);
-                let row = &z[r * d + j..r * d + j + 4 * LANES];
-                for (q, a) in acc.iter_mut().enumerate() {
-                    let x = _mm256_loadu_pd(row[q * LANES..][..LANES].as_ptr());
-                    *a = _mm256_add_pd(*a, _mm256_mul_pd(res, x));
-                }
-            }
-            for (q, a) in acc.iter().enumerate() {
-                _mm256_storeu_pd(g[j + q * LANES..][..LANES].as_mut_ptr(), *a);
-            }
-            j += 4 * LANES;
-        }
-        tail(z, residuals, k, c, rows, j, g);
     }
 
     /// Features `j..` of class `c`'s gradient `g`: four, then one at a time.
