@@ -64,12 +64,15 @@ fn chosen_gain_is_the_smallest_3_digit_gain_reaching_the_target() {
             c.median_hz
         );
         assert!(at >= target, "{target} Hz: median {at} at G = {}", c.gain);
-        // One unit lower in the third significant digit falls short of the target.
-        let unit = 10f64.powi(c.gain.log10().floor() as i32 - 2);
-        let below = median_rate(&pipeline, &recs, c.gain - unit);
+        // One unit lower in the third significant digit falls short of the target. The
+        // lower gain is formed as digits / scale, the double the calibration evaluates:
+        // `gain - unit` can land one rounding step away, and spike counts change with that.
+        let scale = 10f64.powi(2 - c.gain.log10().floor() as i32);
+        let lower = ((c.gain * scale).round() - 1.0) / scale;
+        let below = median_rate(&pipeline, &recs, lower);
         assert!(
             below < target,
-            "{target} Hz: G = {} - {unit} still gives {below}",
+            "{target} Hz: G = {lower}, one unit below {}, still gives {below}",
             c.gain
         );
     }

@@ -18,6 +18,7 @@ pub mod texture;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
+use rand_xoshiro::Xoshiro256PlusPlus;
 use serde::{Deserialize, Serialize};
 
 use crate::error::ParamError;
@@ -232,8 +233,9 @@ struct Profiles {
     start_mm: f64,
     per_mm: f64,
     cols: usize,
-    /// Per column, heights from `start_mm` in steps of `1 / per_mm`.
-    columns: Vec<Vec<f64>>,
+    /// Profile sample `k` of column `c` at `k * cols + c`: heights from `start_mm` in steps
+    /// of `1 / per_mm`, the columns of one sample side by side.
+    heights: Vec<f64>,
     /// Per row, its offset along the sliding direction, mm.
     row_offset_mm: Vec<f64>,
 }
@@ -242,19 +244,17 @@ impl Profiles {
     /// The height under every taxel (row-major) after sliding `s_mm`, interpolated
     /// linearly between profile samples.
     fn heights(&self, s_mm: f64, out: &mut [f64]) {
-        let last = (self.columns[0].len() - 2) as f64;
-        for (offset, out) in self
-            .row_offset_mm
-            .iter()
-            .zip(out.chunks_exact_mut(self.cols))
-        {
+        let cols = self.cols;
+        let last = (self.heights.len() / cols - 2) as f64;
+        for (offset, out) in self.row_offset_mm.iter().zip(out.chunks_exact_mut(cols)) {
             // One position per row: the taxels of a row share it (every column's profile
             // has the same sampling), so it is computed once, not once per taxel.
             let x = ((s_mm + offset - self.start_mm) * self.per_mm).clamp(0.0, last);
             let k = x as usize;
             let w = x - k as f64;
-            for (h, o) in self.columns.iter().zip(out.iter_mut()) {
-                *o = h[k] + (h[k + 1] - h[k]) * w;
+            let (here, next) = self.heights[k * cols..(k + 2) * cols].split_at(cols);
+            for ((o, &a), &b) in out.iter_mut().zip(here).zip(next) {
+                *o = a + (b - a) * w;
             }
         }
     }
@@ -316,7 +316,7 @@ fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Prof
     let mut raw = vec![0.0; raw_len];
     // One surface per line, so each keeps what its neighbouring points share.
     let mut surfaces = lines.map(|_| Surface::new(texture, texture_seed));
-    let columns = (0..p.cols)
+    let columns: Vec<Vec<f64>> = (0..p.cols)
         .map(|c| {
             let across0 = (c as f64 - (p.cols - 1) as f64 / 2.0) * pitch + lateral;
             raw.fill(0.0);
@@ -334,11 +334,14 @@ fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Prof
                 .collect()
         })
         .collect();
+    let heights = (0..samples)
+        .flat_map(|k| columns.iter().map(move |column| column[k]))
+        .collect();
     Profiles {
         start_mm,
         per_mm: 1.0 / step,
         cols: p.cols,
-        columns,
+        heights,
         row_offset_mm,
     }
 }
@@ -347,8 +350,18 @@ fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Prof
 /// of the Winkler contact (exact; taxels below `z` carry no load).
 fn solve_contact(h: &[f64], depth_sum: f64, sorted: &mut Vec<f64>) -> f64 {
     // Usually every taxel touches: then z is the plain mean solution, no sorting needed.
-    let all = (h.iter().sum::<f64>() - depth_sum) / h.len() as f64;
-    if h.iter().all(|&hi| hi >= all) {
+    // (Four running sums and a check without early exit: this runs every millisecond of
+    // the slide, and a single chain of additions was most of its time.)
+    let mut sums = [0.0; 4];
+    let mut quads = h.chunks_exact(4);
+    for quad in &mut quads {
+        for (s, &hi) in sums.iter_mut().zip(quad) {
+            *s += hi;
+        }
+    }
+    let total = (sums[0] + sums[1]) + (sums[2] + sums[3]) + quads.remainder().iter().sum::<f64>();
+    let all = (total - depth_sum) * (1.0 / h.len() as f64);
+    if h.iter().fold(true, |touch, &hi| touch & (hi >= all)) {
         return all;
     }
     sorted.clear();
@@ -414,7 +427,10 @@ fn simulate(
     let full_scale = ((1u64 << p.adc_bits) - 1) as f64;
     let mut samples = vec![0.0; total * cells];
     let mut phases = Vec::with_capacity(total);
-    let mut normals = Normals::new(rng);
+    // The sensor noise has its own generator, seeded from the trial's: ChaCha8 and the
+    // ziggurat took half of a trial's time for one normal draw per taxel and millisecond;
+    // xoshiro256++ draws them three times faster with the same ziggurat.
+    let mut noise_rng = Xoshiro256PlusPlus::seed_from_u64(rng.gen());
     if let Some(forces) = forces.as_deref_mut() {
         forces.reserve(total);
     }
@@ -432,82 +448,57 @@ fn simulate(
         full_scale,
     };
     let mut z = f64::INFINITY;
-    // The force and the distance slid of the step whose contact `h`, `z` and `target` hold.
+    // The force and the distance slid of the step whose contact `h` and `z` hold.
     let mut solved: Option<(u64, u64)> = None;
-    for step in 0..total {
-        let (phase, f, s) = schedule.at(step);
-        phases.push(phase);
-        // Before contact, in the hold and after lift-off the pad neither moves nor changes
-        // its force (5.4 s of the protocol's 24 at 5 mm/s): the previous step's contact
-        // solution is still exact, so it is solved only when force or position change.
-        if solved != Some((f.to_bits(), s.to_bits())) {
-            profiles.heights(s, &mut h);
-            z = if f > 0.0 {
-                solve_contact(&h, f / (k * area), &mut sorted)
-            } else {
-                f64::INFINITY
-            };
-            sensor.targets(&h, z, &gains, &mut target);
-            solved = Some((f.to_bits(), s.to_bits()));
+    // Steps go in blocks: each step's targets first, then the block's noise in one tight
+    // loop (the processor overlaps the draws), then the read-out of the whole block.
+    let block = Sensor::BLOCK_STEPS * cells;
+    let (mut targets, mut draws) = (vec![0.0; block], vec![0.0; block]);
+    for (b, frames) in samples.chunks_mut(block).enumerate() {
+        let steps = frames.len() / cells;
+        for (i, row) in targets[..frames.len()].chunks_exact_mut(cells).enumerate() {
+            let step = b * Sensor::BLOCK_STEPS + i;
+            let (phase, f, s) = schedule.at(step);
+            phases.push(phase);
+            // Before contact, in the hold and after lift-off the pad neither moves nor
+            // changes its force (5.4 s of the protocol's 24 at 5 mm/s): the previous
+            // step's contact solution is still exact, so it is solved only when force or
+            // position change.
+            if solved != Some((f.to_bits(), s.to_bits())) {
+                profiles.heights(s, &mut h);
+                z = if f > 0.0 {
+                    solve_contact(&h, f / (k * area), &mut sorted)
+                } else {
+                    f64::INFINITY
+                };
+                sensor.targets(&h, z, &gains, &mut target);
+                solved = Some((f.to_bits(), s.to_bits()));
+            }
+            row.copy_from_slice(&target);
+            if let Some(forces) = forces.as_deref_mut() {
+                let contact = h
+                    .iter()
+                    .map(|&hi| k * area * (hi - z).max(0.0))
+                    .sum::<f64>();
+                forces.push((f, contact));
+            }
         }
-        if let Some(forces) = forces.as_deref_mut() {
-            let contact = h
-                .iter()
-                .map(|&hi| k * area * (hi - z).max(0.0))
-                .sum::<f64>();
-            forces.push((f, contact));
-        }
-        let frame = &mut samples[step * cells..(step + 1) * cells];
-        let used = sensor.read(&target, &mut y, normals.ready(cells), frame);
-        normals.used(used);
+        let draws = &mut draws[..steps * cells];
+        standard_normals(&mut noise_rng, draws);
+        sensor.read(&targets[..frames.len()], &mut y, draws, frames);
     }
     let slide_start = schedule.slide_start() as f64 / 1000.0;
     let slide_s = (slide_start, slide_start + schedule.slide as f64 / 1000.0);
     Ok(trial_recording(p, trial, samples, phases, slide_s))
 }
 
-/// The trial generator's standard normal draws, drawn ahead in blocks.
-///
-/// After the trial's own draws (texture, patch, force, speed) the generator only feeds the
-/// sensor noise, one draw per loaded taxel in step and taxel order, so drawing ahead hands
-/// every taxel the number it drew one at a time. Drawing in a tight loop lets the processor
-/// overlap the draws; one call per taxel in the step loop stalled each step's arithmetic
-/// on the generator (the draws left over at the end are never used).
-struct Normals {
-    rng: ChaCha8Rng,
-    drawn: Vec<f64>,
-    next: usize,
-}
-
-impl Normals {
-    /// Draws per refill.
-    const BLOCK: usize = 4096;
-
-    fn new(rng: ChaCha8Rng) -> Self {
-        Normals {
-            rng,
-            drawn: Vec::new(),
-            next: 0,
-        }
-    }
-
-    /// The next draws, at least `n` of them.
-    fn ready(&mut self, n: usize) -> &[f64] {
-        if self.drawn.len() - self.next < n {
-            self.drawn.drain(..self.next);
-            self.next = 0;
-            let kept = self.drawn.len();
-            self.drawn.resize(Self::BLOCK.max(n), 0.0);
-            for draw in &mut self.drawn[kept..] {
-                *draw = self.rng.sample(StandardNormal);
-            }
-        }
-        &self.drawn[self.next..]
-    }
-
-    /// Marks the first `n` draws of [`Normals::ready`] as taken.
-    fn used(&mut self, n: usize) {
-        self.next += n;
+/// Fills `out` with standard normal draws. A function of its own, so that the draw is
+/// compiled into this one tight loop (inlined, the processor overlaps the draws) whatever
+/// the inliner decides for the large step loop around it.
+#[inline(never)]
+fn standard_normals(rng: &mut Xoshiro256PlusPlus, out: &mut [f64]) {
+    for draw in out {
+        *draw = rng.sample(StandardNormal);
     }
 }
 
@@ -554,18 +545,22 @@ impl Sensor {
         }
     }
 
-    /// One step of every taxel: the lag of the response `y` towards `target`, the noise
-    /// (one of `draws` per loaded taxel, in taxel order) and the ADC counts into `frame`.
-    /// Returns the number of draws used.
-    fn read(&self, target: &[f64], y: &mut [f64], draws: &[f64], frame: &mut [f64]) -> usize {
+    /// Steps read out together: the block's targets and noise draws stay in the cache.
+    const BLOCK_STEPS: usize = 256;
+
+    /// Consecutive steps of every taxel (`targets`, `draws` and `frames` hold one row of
+    /// `y.len()` taxels per step): the lag of the response `y` towards the step's target,
+    /// the noise (the step's draw of each taxel, scaled by `sqrt(y)`, so an unloaded taxel
+    /// reads 0) and the ADC counts into `frames`.
+    fn read(&self, targets: &[f64], y: &mut [f64], draws: &[f64], frames: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
         {
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: the CPU supports AVX2, the only feature the function enables.
-                return unsafe { self.read_avx2(target, y, draws, frame) };
+                return unsafe { self.read_avx2(targets, y, draws, frames) };
             }
         }
-        self.read_lanes(target, y, draws, frame)
+        self.read_lanes(targets, y, draws, frames)
     }
 
     /// [`Sensor::read_lanes`] compiled for AVX2 (four taxels per instruction). FMA is not
@@ -573,44 +568,27 @@ impl Sensor {
     /// root and conversions are exact in every width: the bits do not depend on it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn read_avx2(
-        &self,
-        target: &[f64],
-        y: &mut [f64],
-        draws: &[f64],
-        frame: &mut [f64],
-    ) -> usize {
-        self.read_lanes(target, y, draws, frame)
+    unsafe fn read_avx2(&self, targets: &[f64], y: &mut [f64], draws: &[f64], frames: &mut [f64]) {
+        self.read_lanes(targets, y, draws, frames)
     }
 
     #[inline(always)]
-    fn read_lanes(&self, target: &[f64], y: &mut [f64], draws: &[f64], frame: &mut [f64]) -> usize {
+    fn read_lanes(&self, targets: &[f64], y: &mut [f64], draws: &[f64], frames: &mut [f64]) {
         let (alpha, noise, full_scale) = (self.alpha, self.noise, self.full_scale);
-        // Rounds half up: the value is non-negative, so adding 0.5 and truncating is
-        // round-to-nearest without a call into libm.
-        let adc = |v: f64| ((v.clamp(0.0, 1.0) * full_scale + 0.5) as u32) as f64;
-        for (&t, y) in target.iter().zip(y.iter_mut()) {
-            *y += (t - *y) * alpha;
-        }
         let n = y.len();
-        if draws.len() >= n && y.iter().all(|&yi| yi > 0.0) {
-            // Every taxel loaded (the usual case in contact): taxel i takes draw i, and
-            // all of them are computed side by side.
-            for ((&yi, &draw), sample) in y.iter().zip(&draws[..n]).zip(frame.iter_mut()) {
-                *sample = adc(yi + noise * yi.sqrt() * draw);
+        for ((target, draw), frame) in targets
+            .chunks_exact(n)
+            .zip(draws.chunks_exact(n))
+            .zip(frames.chunks_exact_mut(n))
+        {
+            for (((&t, y), &d), sample) in target.iter().zip(y.iter_mut()).zip(draw).zip(frame) {
+                *y += (t - *y) * alpha;
+                // Rounds half up (a floor, not a conversion to integers: that has no
+                // vector instruction for unsigned integers before AVX-512).
+                let v = *y + noise * y.sqrt() * d;
+                *sample = (v.clamp(0.0, 1.0) * full_scale + 0.5).floor();
             }
-            return n;
         }
-        let mut used = 0;
-        for (&yi, sample) in y.iter().zip(frame.iter_mut()) {
-            *sample = if yi > 0.0 {
-                used += 1;
-                adc(yi + noise * yi.sqrt() * draws[used - 1])
-            } else {
-                adc(0.0)
-            };
-        }
-        used
     }
 }
 
