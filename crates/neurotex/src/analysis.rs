@@ -47,13 +47,24 @@ impl FeatureTable {
                     .map_err(|err| err.in_recording(&e.meta.file))
             })
             .collect::<Result<_>>()?;
-        Ok(FeatureTable {
+        let metas = encoded.iter().map(|e| e.meta.clone()).collect();
+        Ok(Self::from_rows(extractor, method, metas, &rows))
+    }
+
+    /// The table of `rows`, `method`'s features by `extractor` of the recordings `metas`.
+    pub(crate) fn from_rows(
+        extractor: &FeatureExtractor,
+        method: Method,
+        metas: Vec<Meta>,
+        rows: &[Vec<f64>],
+    ) -> Self {
+        FeatureTable {
             method,
             grid: extractor.grid().clone(),
             names: extractor.names(method),
-            metas: encoded.iter().map(|e| e.meta.clone()).collect(),
+            metas,
             values: rows.concat(),
-        })
+        }
     }
 
     /// Features per row.

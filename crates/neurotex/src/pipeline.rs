@@ -425,6 +425,13 @@ impl Pipeline {
     }
 }
 
+/// One population's 3D-GLCM gray levels, `cell * bins + bin`, as the extractor quantises
+/// its rate volume (kept by E3, which counts them again with taxels moved).
+pub(crate) struct Quantised {
+    levels: Vec<u8>,
+    bins: usize,
+}
+
 /// Turns spike trains into feature rows, with the GLCM offsets planned once for a grid.
 #[derive(Debug, Clone)]
 pub struct FeatureExtractor {
@@ -514,18 +521,7 @@ impl FeatureExtractor {
     /// The trains are shorter than one bin; a population the encoding needs is missing;
     /// [`Method::AllTaxelsMm`] on a recording without a nonzero speed.
     pub fn row(&self, encoded: &Encoded, method: Method) -> Result<Vec<f64>> {
-        let wanted = self.encoding.prefixes().len();
-        let populations: Vec<&SpikeTrains> = encoded.populations().take(wanted).collect();
-        if populations.len() < wanted {
-            return Err(DataError::invalid(
-                &encoded.meta.file,
-                format!(
-                    "the {} encoding needs two populations; the recording was encoded with one",
-                    self.encoding.name()
-                ),
-            )
-            .into());
-        }
+        let populations = self.populations(encoded)?;
         let speed = encoded
             .meta
             .speed_mm_s
@@ -538,6 +534,105 @@ impl FeatureExtractor {
             row.extend(self.population_row(spikes, speed, method)?);
         }
         Ok(row)
+    }
+
+    /// The populations of `encoded` the extractor's encoding reads.
+    ///
+    /// # Errors
+    /// A population the encoding needs is missing.
+    fn populations<'a>(&self, encoded: &'a Encoded) -> Result<Vec<&'a SpikeTrains>> {
+        let wanted = self.encoding.prefixes().len();
+        let populations: Vec<&SpikeTrains> = encoded.populations().take(wanted).collect();
+        if populations.len() < wanted {
+            return Err(DataError::invalid(
+                &encoded.meta.file,
+                format!(
+                    "the {} encoding needs two populations; the recording was encoded with one",
+                    self.encoding.name()
+                ),
+            )
+            .into());
+        }
+        Ok(populations)
+    }
+
+    /// Each population's 3D-GLCM gray levels of `encoded` (see [`Quantised`]), for
+    /// [`FeatureExtractor::glcm3d_moved`].
+    ///
+    /// # Errors
+    /// As [`FeatureExtractor::row`] with [`Method::Glcm3d`].
+    pub(crate) fn quantised_3d(&self, encoded: &Encoded) -> Result<Vec<Quantised>> {
+        self.populations(encoded)?
+            .into_iter()
+            .map(|spikes| {
+                let bin = self.volume.bin_ms;
+                let volume =
+                    CountVolume::from_spikes(spikes, bin).ok_or_else(|| too_short(spikes, bin))?;
+                self.check_bins(&self.plan3d, volume.bins)?;
+                let mut levels = Vec::new();
+                volume.quantise(self.volume.levels, self.volume.range, &mut levels);
+                let same_grid = (spikes.rows, spikes.cols) == (self.grid.rows(), self.grid.cols())
+                    && spikes.present == self.grid.present();
+                if !same_grid {
+                    let message = "its taxel grid differs from the extractor's";
+                    return Err(DataError::invalid(&encoded.meta.file, message).into());
+                }
+                Ok(Quantised {
+                    levels,
+                    bins: volume.bins,
+                })
+            })
+            .collect()
+    }
+
+    /// The [`Method::Glcm3d`] row of a recording whose taxels were moved: cell `from`'s
+    /// gray levels go to cell `perm[from]`. The same as the row of the recording's spike
+    /// trains moved by [`SpikeTrains::permuted`] (binning and quantising do not depend on
+    /// where a cell is), without copying and binning the trains again.
+    ///
+    /// # Errors
+    /// A permutation that is not one of the grid's cells, or that moves a taxel onto a
+    /// cell without one.
+    pub(crate) fn glcm3d_moved(&self, quantised: &[Quantised], perm: &[usize]) -> Result<Vec<f64>> {
+        let present = self.grid.present();
+        let keeps_taxels = perm.len() == present.len()
+            && perm
+                .iter()
+                .enumerate()
+                .all(|(from, &to)| to < present.len() && present[from] == present[to]);
+        if !keeps_taxels {
+            let rule = "a permutation of the grid's cells that keeps taxels on taxel cells";
+            return Err(ParamError::new("perm", rule, format!("{perm:?}")).into());
+        }
+        let l = self.volume.levels;
+        let mut row = Vec::new();
+        let mut moved = Vec::new();
+        for q in quantised {
+            moved.clear();
+            moved.resize(q.levels.len(), 0);
+            for (from, &to) in perm.iter().enumerate() {
+                moved[to * q.bins..(to + 1) * q.bins]
+                    .copy_from_slice(&q.levels[from * q.bins..(from + 1) * q.bins]);
+            }
+            let mut counts = vec![0u64; l * l];
+            self.plan3d.count_wide(&moved, q.bins, &mut counts);
+            row.extend(self.haralick_row(&counts));
+        }
+        Ok(row)
+    }
+
+    /// The error for a volume of more time bins than the plan's counts hold.
+    fn check_bins(&self, plan: &GlcmPlan, bins: usize) -> Result<()> {
+        if plan.counts_fit_wide(bins) {
+            return Ok(());
+        }
+        Err(DataError::TooLarge {
+            what: "the time bins of this recording's rate volume",
+            got: bins as u64,
+            limit: crate::features::glcm::MAX_SLICE_PAIRS,
+            hint: "use a shorter recording or a wider --bin-ms",
+        }
+        .into())
     }
 
     /// One population's features; `speed_mm_s` is the recording's, for
@@ -615,15 +710,7 @@ impl FeatureExtractor {
                 &replanned
             }
         };
-        if !plan.counts_fit_wide(volume.bins) {
-            return Err(DataError::TooLarge {
-                what: "the time bins of this recording's rate volume",
-                got: volume.bins as u64,
-                limit: crate::features::glcm::MAX_SLICE_PAIRS,
-                hint: "use a shorter recording or a wider --bin-ms",
-            }
-            .into());
-        }
+        self.check_bins(plan, volume.bins)?;
         let mut q = Vec::new();
         volume.quantise(self.volume.levels, self.volume.range, &mut q);
         let l = self.volume.levels;
@@ -678,4 +765,72 @@ pub fn taxel_cells(present: &[bool]) -> impl Iterator<Item = usize> + '_ {
         .enumerate()
         .filter(|(_, &p)| p)
         .map(|(i, _)| i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::seq::SliceRandom;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Random sorted spike trains on a 3x3 grid whose centre cell holds no taxel.
+    fn trains(rng: &mut ChaCha8Rng, present: &[bool], n_steps: usize) -> SpikeTrains {
+        let lists: Vec<Vec<u32>> = present
+            .iter()
+            .map(|&p| {
+                let rate = if p { rng.gen_range(0.0..0.08) } else { 0.0 };
+                (0..n_steps as u32).filter(|_| rng.gen_bool(rate)).collect()
+            })
+            .collect();
+        SpikeTrains::from_lists(&lists, 3, 3, present, n_steps)
+    }
+
+    /// E3's shortcut, the gray levels moved between cells, gives the row of the spike
+    /// trains moved by `SpikeTrains::permuted` bit for bit, for one and two populations; a
+    /// permutation that puts a taxel on the empty cell is refused.
+    #[test]
+    fn moved_gray_levels_give_the_row_of_the_moved_trains() {
+        let present = [true, true, true, true, false, true, true, true, true];
+        let taxels: Vec<usize> = (0..9).filter(|&c| present[c]).collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for encoding in [Encoding::Sa, Encoding::SaFa] {
+            let mut params = PipelineParams {
+                encoding,
+                ..PipelineParams::default()
+            };
+            params.volume.bin_ms = 50;
+            let n_steps = 2_000;
+            let sa = trains(&mut rng, &present, n_steps);
+            let extractor = FeatureExtractor::new(&params, &sa.grid()).unwrap();
+            let fa = (encoding == Encoding::SaFa).then(|| trains(&mut rng, &present, n_steps));
+            let encoded = Encoded {
+                meta: Meta::default(),
+                spikes: sa,
+                fa,
+                resampled: false,
+                flat: false,
+            };
+            let levels = extractor.quantised_3d(&encoded).unwrap();
+            for _ in 0..20 {
+                let mut shuffled = taxels.clone();
+                shuffled.shuffle(&mut rng);
+                let mut perm: Vec<usize> = (0..9).collect();
+                for (&from, &to) in taxels.iter().zip(&shuffled) {
+                    perm[from] = to;
+                }
+                let moved = encoded.map_spikes(|s| s.permuted(&perm));
+                let want = extractor.row(&moved, Method::Glcm3d).unwrap();
+                let got = extractor.glcm3d_moved(&levels, &perm).unwrap();
+                assert_eq!(
+                    got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    want.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    "{encoding:?} {perm:?}"
+                );
+            }
+            let mut onto_empty: Vec<usize> = (0..9).collect();
+            onto_empty.swap(0, 4);
+            assert!(extractor.glcm3d_moved(&levels, &onto_empty).is_err());
+        }
+    }
 }

@@ -8,11 +8,10 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::tables::table;
 use super::{compare_shares, Comparison, Context, Skip, Stop};
-use crate::analysis::{evaluate, Columns, Outcome, Split};
+use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split};
 use crate::error::Result;
-use crate::pipeline::{Encoded, Method};
+use crate::pipeline::{Encoded, FeatureExtractor, Method, Quantised};
 use crate::values::Speed;
 
 /// E3: spatial perturbation at the slowest speed.
@@ -61,12 +60,28 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
     // The perturbed tables hold only this speed's recordings; E1's rows name them in the
     // table of all recordings, in the same order.
     let rows = c.tables.glcm3d.rows_at(&[speed]);
+    // Each recording's gray levels once: a draw only moves them between cells.
+    let extractor = c
+        .params
+        .pipeline()
+        .extractor(&slow[0].spikes.grid())
+        .map_err(crate::Error::from)?;
+    let levels = slow
+        .par_iter()
+        .map(|e| extractor.quantised_3d(e))
+        .collect::<Result<Vec<_>>>()?;
+    let moving = Moving {
+        slow: &slow,
+        levels: &levels,
+        extractor: &extractor,
+        taxels: &taxels,
+    };
     let (mut mean, mut std, mut unperturbed_vs_moved) = (Vec::new(), Vec::new(), Vec::new());
     for &n in &counts {
         // The draws side by side: each is seeded by (n, draw, recording).
         let outcomes = (0..c.params.e3_repeats)
             .into_par_iter()
-            .map(|rep| perturbed(c, &slow, &taxels, n, rep))
+            .map(|rep| perturbed(c, &moving, n, rep))
             .collect::<Result<Vec<Outcome>>>()?;
         let accs: Vec<f64> = outcomes.iter().map(|o| o.accuracy).collect();
         let m = accs.iter().sum::<f64>() / accs.len() as f64;
@@ -110,24 +125,33 @@ fn pooled_shares(outcomes: &[Outcome], rows: &[usize]) -> Vec<(usize, f64)> {
 
 /// 3D-GLCM evaluated (one CV shuffle) after draw `rep` of moving `n` taxels in every
 /// recording; each recording gets its own seeded draw.
-fn perturbed(
-    c: &Context,
-    slow: &[&Encoded],
-    taxels: &[usize],
-    n: usize,
-    rep: usize,
-) -> Result<Outcome> {
-    let perturbed: Vec<Encoded> = slow
+/// The slowest speed's recordings with what a draw needs to move their taxels.
+struct Moving<'a> {
+    slow: &'a [&'a Encoded],
+    /// Each recording's gray levels, per population.
+    levels: &'a [Vec<Quantised>],
+    extractor: &'a FeatureExtractor,
+    taxels: &'a [usize],
+}
+
+/// Draw `rep` of `n` taxels moved in every recording, evaluated. The features are those
+/// of the recordings' spike trains with the taxels moved
+/// ([`crate::encode::SpikeTrains::permuted`]), counted from the gray levels moved.
+fn perturbed(c: &Context, m: &Moving, n: usize, rep: usize) -> Result<Outcome> {
+    let rows = m
+        .slow
         .par_iter()
+        .zip(m.levels)
         .enumerate()
-        .map(|(i, e)| {
+        .map(|(i, (e, levels))| {
             let seed = c.params.seed ^ ((n as u64) << 40) ^ ((rep as u64) << 20) ^ i as u64;
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let perm = perturbation(taxels, e.spikes.cells(), n, &mut rng);
-            e.map_spikes(|s| s.permuted(&perm))
+            let perm = perturbation(m.taxels, e.spikes.cells(), n, &mut rng);
+            m.extractor.glcm3d_moved(levels, &perm)
         })
-        .collect();
-    let features = table(&perturbed, Method::Glcm3d, c.params)?;
+        .collect::<Result<Vec<_>>>()?;
+    let metas = m.slow.iter().map(|e| e.meta.clone()).collect();
+    let features = FeatureTable::from_rows(m.extractor, Method::Glcm3d, metas, &rows);
     let split = Split::CrossValidation {
         speeds: None,
         cv: c.params.cv_once(),
