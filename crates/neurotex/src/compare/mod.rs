@@ -238,8 +238,10 @@ pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Compa
         .collect::<Result<_>>()?;
     let units = Units::new(metas, &scored[0].shares, params)?;
     let paper = candidates.iter().position(Candidate::is_paper);
+    // Each candidate's interval and paired test resample from their own seeded stream,
+    // thousands of draws per unit: ranked side by side too.
     let mut results: Vec<Ranked> = candidates
-        .iter()
+        .par_iter()
         .zip(&scored)
         .map(|(c, s)| units.rank(c, s, paper.map(|p| &scored[p]), params))
         .collect::<Result<_>>()?;

@@ -17,15 +17,18 @@ use crate::classify::{t_interval_over_repeats, Interval};
 use crate::error::Result;
 
 /// Runs every analysis on one simulated dataset per seed (`simulate(seed)` gives the
-/// design), one dataset in memory at a time, and returns the first dataset's results with
-/// [`AcrossSeeds`] over all of them attached (none with a single seed). The further datasets
-/// skip what only the first one's report shows: the numerical sensitivity check, E5c, E7
-/// and E9 ([`ValidReproduceParams::for_further_datasets`]).
+/// design) and returns the first dataset's results with [`AcrossSeeds`] over all of them
+/// attached (none with a single seed). The further datasets skip what only the first one's
+/// report shows: the numerical sensitivity check, E5c, E7 and E9
+/// ([`ValidReproduceParams::for_further_datasets`]). They run one after another beside the
+/// first, so at most two datasets are in memory; the results do not depend on it (every
+/// analysis is deterministic), but the first dataset's clock (`timing_s`) is then shared
+/// with them.
 ///
 /// # Errors
 /// No seed, or an analysis that cannot run on one of the datasets.
 pub fn run_seeds(
-    simulate: &dyn Fn(u64) -> Source<'static>,
+    simulate: &(dyn Fn(u64) -> Source<'static> + Sync),
     seeds: &[u64],
     params: &ValidReproduceParams,
     progress: &(dyn Fn(Progress) + Sync),
@@ -33,29 +36,50 @@ pub fn run_seeds(
     let Some((&first, rest)) = seeds.split_first() else {
         return Err(crate::error::ParamError::new("--seeds", "at least 1", 0).into());
     };
-    let total = seeds.len();
-    let run = |i: usize, seed: u64, params: &ValidReproduceParams| -> Result<Results> {
-        let tagged = |p: Progress| match p {
-            Progress::Stage(name, n) if total > 1 => {
-                progress(Progress::Stage(
-                    &format!("dataset {}/{total}: {name}", i + 1),
-                    n,
-                ));
-            }
-            other => progress(other),
-        };
-        let prepared = prepare(&simulate(seed), params, &tagged)?;
-        run_all(&prepared, params, &tagged)
+    let run = |seed: u64, params: &ValidReproduceParams, progress: &(dyn Fn(Progress) + Sync)| {
+        let prepared = prepare(&simulate(seed), params, progress)?;
+        run_all(&prepared, params, progress)
     };
-    let mut main = run(0, first, params)?;
     if rest.is_empty() {
-        return Ok(main);
+        return run(first, params, progress);
     }
+    let total = seeds.len();
+    let tagged = |p: Progress| match p {
+        Progress::Stage(name, n) => {
+            progress(Progress::Stage(&format!("dataset 1/{total}: {name}"), n));
+        }
+        other => progress(other),
+    };
+    // The further datasets run one after another beside the first, whose analyses leave a
+    // core idle at times (E9's ranking, conditions fewer than the cores): at most two
+    // datasets are in memory. They report no stages of their own while the first runs;
+    // once it is done, one stage counts them (those already done at once).
     let quiet = params.for_further_datasets();
-    let mut others = Vec::with_capacity(rest.len());
-    for (i, &seed) in rest.iter().enumerate() {
-        others.push(run(i + 1, seed, &quiet)?);
-    }
+    let further = std::sync::Mutex::new((false, 0usize));
+    let stage = format!("datasets 2-{total}");
+    let (main, others) = rayon::join(
+        || {
+            let main = run(first, params, &tagged);
+            let mut state = further.lock().expect("progress of the further datasets");
+            state.0 = true;
+            progress(Progress::Stage(&stage, rest.len()));
+            (0..state.1).for_each(|_| progress(Progress::Tick));
+            main
+        },
+        || {
+            let mut others = Vec::with_capacity(rest.len());
+            for &seed in rest {
+                others.push(run(seed, &quiet, &|_| ())?);
+                let mut state = further.lock().expect("progress of the further datasets");
+                state.1 += 1;
+                if state.0 {
+                    progress(Progress::Tick);
+                }
+            }
+            Ok::<_, crate::Error>(others)
+        },
+    );
+    let (mut main, others) = (main?, others?);
     let runs: Vec<(u64, &Results)> = std::iter::once((first, &main))
         .chain(rest.iter().copied().zip(&others))
         .collect();
