@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Skip, Stop};
+use super::{Prepared, Skip, Stop, ValidReproduceParams};
 use crate::classify::CvParams;
 use crate::compare::candidates::{candidates, CandidateSet};
 use crate::compare::{compare, CompareParams, Comparison, Protocol};
@@ -26,8 +26,7 @@ pub struct E9 {
 ///
 /// # Errors
 /// Skipped with one speed; fails when a candidate cannot be evaluated.
-pub fn e9_compare(c: &Context) -> Result<E9, Stop> {
-    let (prepared, params) = (c.prepared, c.params);
+pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<E9, Stop> {
     if prepared.speeds.len() < 2 {
         return Err(Stop::Skipped(Skip::OneSpeedE9));
     }
