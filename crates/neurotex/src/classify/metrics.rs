@@ -6,10 +6,9 @@
 //! Everything here is a pure function of counts or per-recording results; the
 //! distributions they rest on are in [`super::stats`].
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::draws::{Signs, UniformIndices};
 use super::stats::{binomial_half_cdf, percentile, student_t_quantile, StatsError, Z_95};
 use super::ConfusionMatrix;
 use crate::error::ParamError;
@@ -281,12 +280,12 @@ pub fn bootstrap_mean_share(
     }
     check_accuracies(shares)?;
     let n = shares.len();
-    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    let mut draws = UniformIndices::new(params.seed);
+    let mut picked = Vec::with_capacity(n + 1);
     let mut means: Vec<f64> = (0..params.resamples)
         .map(|_| {
-            let total: f64 = (0..n)
-                .map(|_| shares[rng.gen_range(0..n as u64) as usize])
-                .sum();
+            draws.fill(n, n, &mut picked);
+            let total: f64 = picked.iter().map(|&i| shares[i]).sum();
             total / n as f64
         })
         .collect();
@@ -429,13 +428,10 @@ pub fn sign_flip_p(differences: &[f64], resamples: usize, seed: u64) -> Result<f
             what: "sign-flip resamples",
         });
     }
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut signs = Signs::new(seed);
     let hits = (0..resamples)
         .filter(|_| {
-            let total: f64 = differences
-                .iter()
-                .map(|&d| if rng.gen::<bool>() { -d } else { d })
-                .sum();
+            let total: f64 = differences.iter().map(|&d| signs.flip(d)).sum();
             extreme(total)
         })
         .count();

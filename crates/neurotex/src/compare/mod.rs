@@ -21,12 +21,11 @@ pub mod candidates;
 use std::sync::Arc;
 use std::time::Instant;
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::{Columns, FeatureTable, Outcome, Split};
+use crate::classify::draws::UniformIndices;
 use crate::classify::metrics::sign_flip_p;
 use crate::classify::stats::percentile;
 use crate::classify::{group_folds, stratified_folds, ValidCv};
@@ -486,13 +485,15 @@ impl Units {
     /// percentile bootstrap resampling units within each condition.
     fn interval(&self, shares: &[(usize, f64)]) -> [f64; 2] {
         let totals = self.totals(shares);
-        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        let mut draws = UniformIndices::new(self.seed);
+        let mut picked = Vec::new();
         let mut means: Vec<f64> = (0..self.resamples.max(1))
             .map(|_| {
                 mean(self.by_condition.iter().map(|units| {
+                    draws.fill(units.len(), units.len(), &mut picked);
                     let (mut s, mut n) = (0.0, 0usize);
-                    for _ in 0..units.len() {
-                        let u = units[rng.gen_range(0..units.len() as u64) as usize];
+                    for &i in &picked {
+                        let u = units[i];
                         s += totals[u].0;
                         n += totals[u].1;
                     }
