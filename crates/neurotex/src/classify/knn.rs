@@ -69,6 +69,29 @@ fn closer(a: (f64, usize), b: (f64, usize)) -> bool {
     a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
 }
 
+/// Training samples visited in the scattered order before the rest are read in blocks.
+const SEEDS: usize = 16;
+/// Distances compared at a time while the rest are read.
+const LANES: usize = 4;
+
+/// Puts `key` into `best` (at most `k` keys, nearest first) if it belongs among them.
+#[inline(always)]
+fn insert(best: &mut Vec<(f64, usize)>, k: usize, key: (f64, usize)) {
+    if best.len() == k && !closer(key, best[k - 1]) {
+        return;
+    }
+    if best.len() < k {
+        best.push(key);
+    } else {
+        best[k - 1] = key;
+    }
+    let mut pos = best.len() - 1;
+    while pos > 0 && closer(best[pos], best[pos - 1]) {
+        best.swap(pos, pos - 1);
+        pos -= 1;
+    }
+}
+
 /// A step near `n / golden ratio` coprime to `n` (1 for tiny sets): `j -> j + step mod n`
 /// visits every index once, well scattered (a Weyl sequence).
 fn scatter_stride(n: usize) -> usize {
@@ -224,30 +247,37 @@ impl KnnModel {
                 }
             }
             // The k smallest under the total order (distance, training index): ties in
-            // distance go to the earlier training sample. Training samples are visited
-            // in a fixed scattered order (a stride coprime to n) so that a training set
-            // sorted by class, as manifests often are, does not make every sample an
-            // insertion; the result does not depend on the visiting order.
+            // distance go to the earlier training sample. The result does not depend on
+            // the order the samples are visited in; the order only decides how much work
+            // it takes. A first few, visited in a fixed scattered order (a stride coprime
+            // to n, so that a training set sorted by class, as manifests often are, does
+            // not make each a new nearest), give the k-th distance to beat; the rest are
+            // then read in index order four at a time, and a block with no distance at
+            // most that is passed over whole (one vector comparison), most of them once
+            // the k-th distance has settled. The seeds' distances are set to NaN, which
+            // no comparison passes, so they are not taken twice.
             best.clear();
             let mut j = 0usize;
-            for _ in 0..n {
-                let key = (dist[j], j);
+            for _ in 0..n.min(self.k.max(SEEDS)) {
+                insert(&mut best, self.k, (dist[j], j));
+                dist[j] = f64::NAN;
                 j += self.stride;
                 if j >= n {
                     j -= n;
                 }
-                if best.len() == self.k && !closer(key, best[self.k - 1]) {
-                    continue;
-                }
-                if best.len() < self.k {
-                    best.push(key);
-                } else {
-                    best[self.k - 1] = key;
-                }
-                let mut pos = best.len() - 1;
-                while pos > 0 && closer(best[pos], best[pos - 1]) {
-                    best.swap(pos, pos - 1);
-                    pos -= 1;
+            }
+            if best.len() == self.k {
+                let mut bar = best[self.k - 1].0;
+                for (b, block) in dist.chunks(LANES).enumerate() {
+                    if !block.iter().fold(false, |any, &d| any | (d <= bar)) {
+                        continue;
+                    }
+                    for (o, &d) in block.iter().enumerate() {
+                        if d <= bar {
+                            insert(&mut best, self.k, (d, b * LANES + o));
+                            bar = best[self.k - 1].0;
+                        }
+                    }
                 }
             }
             votes.fill(0);
