@@ -56,10 +56,16 @@ pub fn run_seeds(
     // once it is done, one stage counts them (those already done at once).
     let quiet = params.for_further_datasets();
     let further = std::sync::Mutex::new((false, 0usize));
-    let stage = format!("datasets 2-{total}");
+    // A failure on the first dataset ends the run: the further ones not yet begun are not.
+    let failed = std::sync::atomic::AtomicBool::new(false);
+    let stage = match total {
+        2 => "dataset 2/2".to_string(),
+        _ => format!("datasets 2-{total}"),
+    };
     let (main, others) = rayon::join(
         || {
             let main = run(first, params, &tagged);
+            failed.store(main.is_err(), std::sync::atomic::Ordering::Relaxed);
             let mut state = further.lock().expect("progress of the further datasets");
             state.0 = true;
             progress(Progress::Stage(&stage, rest.len()));
@@ -69,6 +75,9 @@ pub fn run_seeds(
         || {
             let mut others = Vec::with_capacity(rest.len());
             for &seed in rest {
+                if failed.load(std::sync::atomic::Ordering::Relaxed) {
+                    break;
+                }
                 others.push(run(seed, &quiet, &|_| ())?);
                 let mut state = further.lock().expect("progress of the further datasets");
                 state.1 += 1;
