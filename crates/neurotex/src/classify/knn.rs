@@ -76,7 +76,7 @@ const LANES: usize = 4;
 
 /// Puts `key` into `best` (at most `k` keys, nearest first) if it belongs among them.
 #[inline(always)]
-fn insert(best: &mut Vec<(f64, usize)>, k: usize, key: (f64, usize)) {
+pub(super) fn insert(best: &mut Vec<(f64, usize)>, k: usize, key: (f64, usize)) {
     if best.len() == k && !closer(key, best[k - 1]) {
         return;
     }
@@ -90,6 +90,20 @@ fn insert(best: &mut Vec<(f64, usize)>, k: usize, key: (f64, usize)) {
         best.swap(pos, pos - 1);
         pos -= 1;
     }
+}
+
+/// The majority class among the neighbours `best` (nearest first), with each class's votes
+/// in `votes`; among classes with equal votes, the one with the nearest member.
+pub(super) fn majority(best: &[(f64, usize)], labels: &[usize], votes: &mut [usize]) -> usize {
+    votes.fill(0);
+    for &(_, i) in best {
+        votes[labels[i]] += 1;
+    }
+    let top = votes.iter().copied().max().unwrap_or(0);
+    best.iter()
+        .map(|&(_, i)| labels[i])
+        .find(|&c| votes[c] == top)
+        .unwrap_or(0)
 }
 
 /// A step near `n / golden ratio` coprime to `n` (1 for tiny sets): `j -> j + step mod n`
@@ -280,17 +294,7 @@ impl KnnModel {
                     }
                 }
             }
-            votes.fill(0);
-            for &(_, i) in &best {
-                votes[self.labels[i]] += 1;
-            }
-            let top = *votes.iter().max().unwrap_or(&0);
-            // Nearest-first order: the first neighbour of a top-voted class wins.
-            let predicted = best
-                .iter()
-                .map(|&(_, i)| self.labels[i])
-                .find(|&c| votes[c] == top)
-                .unwrap_or(0);
+            let predicted = majority(&best, &self.labels, &mut votes);
             on_row(predicted, &votes);
         }
     }

@@ -37,6 +37,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use super::knn::{insert, majority};
 use super::{Classifier, Predict};
 use crate::encode::SpikeTrains;
 use crate::error::{ClassifyError, ParamError};
@@ -594,11 +595,6 @@ impl SpikeDistanceKnnModel {
     }
 }
 
-/// Whether `a` comes before `b` in the order (distance, training position).
-fn closer(a: (f64, usize), b: (f64, usize)) -> bool {
-    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
-}
-
 /// The majority class among the `k` training samples nearest under the order (distance,
 /// training position); among classes with equal votes, the one with the nearest member.
 fn vote(
@@ -610,29 +606,9 @@ fn vote(
 ) -> usize {
     best.clear();
     for key in distances.iter().copied().zip(0..) {
-        if best.len() == k && !closer(key, best[k - 1]) {
-            continue;
-        }
-        if best.len() < k {
-            best.push(key);
-        } else {
-            best[k - 1] = key;
-        }
-        let mut pos = best.len() - 1;
-        while pos > 0 && closer(best[pos], best[pos - 1]) {
-            best.swap(pos, pos - 1);
-            pos -= 1;
-        }
+        insert(best, k, key);
     }
-    votes.fill(0);
-    for &(_, i) in best.iter() {
-        votes[labels[i]] += 1;
-    }
-    let top = votes.iter().copied().max().unwrap_or(0);
-    best.iter()
-        .map(|&(_, i)| labels[i])
-        .find(|&c| votes[c] == top)
-        .unwrap_or(0)
+    majority(best, labels, votes)
 }
 
 impl SpikeDistanceKnnModel {
