@@ -565,18 +565,16 @@ impl FeatureExtractor {
         self.populations(encoded)?
             .into_iter()
             .map(|spikes| {
+                if !self.on_grid(spikes) {
+                    let message = "its taxel grid differs from the extractor's";
+                    return Err(DataError::invalid(&encoded.meta.file, message).into());
+                }
                 let bin = self.volume.bin_ms;
                 let volume =
                     CountVolume::from_spikes(spikes, bin).ok_or_else(|| too_short(spikes, bin))?;
                 self.check_bins(&self.plan3d, volume.bins)?;
                 let mut levels = Vec::new();
                 volume.quantise(self.volume.levels, self.volume.range, &mut levels);
-                let same_grid = (spikes.rows, spikes.cols) == (self.grid.rows(), self.grid.cols())
-                    && spikes.present == self.grid.present();
-                if !same_grid {
-                    let message = "its taxel grid differs from the extractor's";
-                    return Err(DataError::invalid(&encoded.meta.file, message).into());
-                }
                 Ok(Quantised {
                     levels,
                     bins: volume.bins,
@@ -619,6 +617,12 @@ impl FeatureExtractor {
             row.extend(self.haralick_row(&counts));
         }
         Ok(row)
+    }
+
+    /// Whether `spikes` are on the grid the extractor's GLCM offsets were planned for.
+    fn on_grid(&self, spikes: &SpikeTrains) -> bool {
+        (spikes.rows, spikes.cols) == (self.grid.rows(), self.grid.cols())
+            && spikes.present == self.grid.present()
     }
 
     /// The error for a volume of more time bins than the plan's counts hold.
@@ -692,10 +696,8 @@ impl FeatureExtractor {
             GlcmKind::TwoD => CountVolume::collapsed(spikes),
         }
         .ok_or_else(|| too_short(spikes, bin_ms))?;
-        let same_grid = (spikes.rows, spikes.cols) == (self.grid.rows(), self.grid.cols())
-            && spikes.present == self.grid.present();
         let replanned;
-        let plan = match (same_grid, kind) {
+        let plan = match (self.on_grid(spikes), kind) {
             (true, GlcmKind::ThreeD) => &self.plan3d,
             (true, GlcmKind::TwoD) => &self.plan2d,
             (false, _) => {

@@ -123,8 +123,6 @@ fn pooled_shares(outcomes: &[Outcome], rows: &[usize]) -> Vec<(usize, f64)> {
         .collect()
 }
 
-/// 3D-GLCM evaluated (one CV shuffle) after draw `rep` of moving `n` taxels in every
-/// recording; each recording gets its own seeded draw.
 /// The slowest speed's recordings with what a draw needs to move their taxels.
 struct Moving<'a> {
     slow: &'a [&'a Encoded],
@@ -134,9 +132,10 @@ struct Moving<'a> {
     taxels: &'a [usize],
 }
 
-/// Draw `rep` of `n` taxels moved in every recording, evaluated. The features are those
-/// of the recordings' spike trains with the taxels moved
-/// ([`crate::encode::SpikeTrains::permuted`]), counted from the gray levels moved.
+/// 3D-GLCM evaluated (one CV shuffle) after draw `rep` of moving `n` taxels in every
+/// recording; each recording gets its own seeded draw. The features are those of the
+/// recordings' spike trains with the taxels moved ([`crate::encode::SpikeTrains::permuted`]),
+/// counted from the gray levels moved.
 fn perturbed(c: &Context, m: &Moving, n: usize, rep: usize) -> Result<Outcome> {
     let rows = m
         .slow
