@@ -1,9 +1,9 @@
-//! Izhikevich encoding throughput: one recording on one core (SA, and FA-I from the
-//! rectified rate of change), and the paper-scale work
+//! Izhikevich encoding throughput: one recording on one core (SA, FA-I from the rectified
+//! rate of change, and both as two banks side by side), and the paper-scale work
 //! (480 trials x 16 taxels, slides of 18, 9 and 6 s: 84.5 M neuron-steps) across all cores.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use neurotex::encode::{encode, encode_fa, Encoder, FaParams, IzhikevichParams};
+use neurotex::encode::{encode, encode_fa, encode_sa_fa, Encoder, FaParams, IzhikevichParams};
 use rayon::prelude::*;
 
 fn signal(steps: usize, cells: usize) -> Vec<f64> {
@@ -40,6 +40,15 @@ fn bench(c: &mut Criterion) {
             encode_fa(&one, 4, 4, &[true; 16], params, FaParams::default())
                 .unwrap()
                 .total_spikes()
+        })
+    });
+    // SA and FA as two banks side by side (what `sa+fa` and `reproduce` encode), against
+    // to_trains_1core + fa_to_trains_1core.
+    group.bench_function(BenchmarkId::new("sa_fa_to_trains_1core", "16x18000"), |b| {
+        b.iter(|| {
+            let (sa, fa) =
+                encode_sa_fa(&one, 4, 4, &[true; 16], params, FaParams::default()).unwrap();
+            sa.total_spikes() + fa.total_spikes()
         })
     });
     // Paper scale: 160 recordings at each of three slide lengths (90 mm at 5, 10, 15 mm/s).

@@ -87,7 +87,7 @@ fn bench(c: &mut Criterion) {
                 while timed < iters {
                     let pushed = stream.frames() as usize + 1;
                     let frame = &frames[pushed % 200];
-                    if pushed % 200 == 0 {
+                    if pushed.is_multiple_of(200) {
                         assert_eq!(stream.push(None, frame).unwrap().len(), 1);
                         continue;
                     }

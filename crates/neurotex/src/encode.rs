@@ -175,6 +175,9 @@ impl IzhikevichParams {
 #[derive(Debug, Clone)]
 pub struct Encoder {
     params: IzhikevichParams,
+    /// Each neuron's input gain: the parameters' gain unless built by
+    /// [`Encoder::with_gains`].
+    gains: Vec<f64>,
     v: Vec<f64>,
     u: Vec<f64>,
     steps: u64,
@@ -186,9 +189,22 @@ impl Encoder {
     /// # Errors
     /// A broken parameter rule.
     pub fn new(params: IzhikevichParams, n: usize) -> Result<Self, ParamError> {
+        Encoder::with_gains(params, vec![params.gain; n])
+    }
+
+    /// One neuron at rest per gain, with that input gain and `params`' other parameters.
+    ///
+    /// # Errors
+    /// A broken parameter rule, for `params` or with one of the gains.
+    fn with_gains(params: IzhikevichParams, gains: Vec<f64>) -> Result<Self, ParamError> {
         params.check()?;
+        for &g in &gains {
+            params.with_gain(g).check()?;
+        }
+        let n = gains.len();
         Ok(Encoder {
             params,
+            gains,
             v: vec![params.c; n],
             u: vec![params.b * params.c; n],
             steps: 0,
@@ -212,9 +228,19 @@ impl Encoder {
     /// If `input` is not whole frames or `raster` is not its size (a caller bug).
     pub fn run(&mut self, input: &[f64], raster: &mut [u8]) {
         let n = self.v.len();
-        assert!(n > 0 && input.len() % n == 0, "input must be whole frames");
+        assert!(
+            n > 0 && input.len().is_multiple_of(n),
+            "input must be whole frames"
+        );
         assert_eq!(input.len(), raster.len(), "raster must match input");
-        run_fastest(self.params, &mut self.v, &mut self.u, input, raster);
+        let bank = Bank {
+            gains: &self.gains,
+            v: &mut self.v,
+            u: &mut self.u,
+            input,
+            raster,
+        };
+        run_fastest(&self.params, bank);
         self.steps += (input.len() / n) as u64;
     }
 
@@ -229,85 +255,209 @@ impl Encoder {
     pub fn run_part(&mut self, first: usize, input: &[f64], raster: &mut [u8]) {
         let cells = first..first + input.len();
         assert_eq!(input.len(), raster.len(), "raster must match input");
-        let (v, u) = (&mut self.v[cells.clone()], &mut self.u[cells]);
-        run_fastest(self.params, v, u, input, raster);
+        let bank = Bank {
+            gains: &self.gains[cells.clone()],
+            v: &mut self.v[cells.clone()],
+            u: &mut self.u[cells],
+            input,
+            raster,
+        };
+        run_fastest(&self.params, bank);
     }
 }
 
-/// [`run_blocks`] with AVX2 where the processor has it.
-fn run_fastest(
-    p: IzhikevichParams,
-    v: &mut [f64],
-    u: &mut [f64],
-    input: &[f64],
-    raster: &mut [u8],
-) {
+/// The part of a bank one kernel call runs: each neuron's gain and state, and the
+/// time-major input and raster (one value per neuron per frame).
+struct Bank<'a> {
+    gains: &'a [f64],
+    v: &'a mut [f64],
+    u: &'a mut [f64],
+    input: &'a [f64],
+    raster: &'a mut [u8],
+}
+
+/// Runs the bank with AVX-512 or AVX2 where the processor has them.
+fn run_fastest(p: &IzhikevichParams, bank: Bank<'_>) {
     #[cfg(target_arch = "x86_64")]
     {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports AVX-512F, the only feature the function enables.
+            unsafe { run_avx512(p, bank) };
+            return;
+        }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, the only feature the function enables.
-            unsafe { run_avx2(p, v, u, input, raster) };
+            unsafe { run_avx2(p, bank) };
             return;
         }
     }
-    run_blocks(p, v, u, input, raster);
+    run_portable(p, bank);
 }
 
-/// Neurons per block whose state stays in registers across time steps: enough independent
-/// dependency chains to hide the latency of the update (about 20 dependent operations).
+/// Neurons per block whose state stays in registers across time steps. One step is a
+/// chain of about 20 dependent operations, so a block is bound by their latency, and the
+/// more independent chains (lanes) in flight the better, as long as the registers hold
+/// them: 16 neurons with AVX2 (four registers of four f64 each for `v`, four for `u`,
+/// out of 16), 32 with AVX-512 (four of eight each, out of 32), where a block of 32 runs in
+/// little more time than one of 16. A bank of 16 taxels gains from the wider block only
+/// when two populations run as one bank ([`encode_banks`]).
 const BLOCK: usize = 16;
 
-/// [`run_blocks`] compiled with AVX2 (4 f64 lanes). FMA is not enabled, and Rust never
-/// fuses a multiply and an add on its own, so results are bit-identical to the portable path.
+/// Blocks of [`BLOCK`], then the rest, compiled with AVX2 (4 f64 lanes). FMA is not
+/// enabled, and Rust never fuses a multiply and an add on its own, so results are
+/// bit-identical to the portable path.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn run_avx2(
-    p: IzhikevichParams,
-    v: &mut [f64],
-    u: &mut [f64],
-    input: &[f64],
-    raster: &mut [u8],
-) {
-    run_blocks(p, v, u, input, raster);
+unsafe fn run_avx2(p: &IzhikevichParams, mut bank: Bank<'_>) {
+    let done = run_blocks::<BLOCK>(p, &mut bank, 0);
+    run_rest(p, &mut bank, done);
 }
 
-/// Runs the neurons a block of [`BLOCK`] at a time (time inner), then any remainder.
+/// Blocks of 32, 16 and 8 neurons (four, two and one register of eight f64 lanes per
+/// state variable, see [`BLOCK`]), then the rest, with AVX-512F; bit-identical to the
+/// portable path as [`run_avx2`] is.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn run_avx512(p: &IzhikevichParams, mut bank: Bank<'_>) {
+    let done = avx512::run_blocks::<4>(p, &mut bank, 0);
+    let done = avx512::run_blocks::<2>(p, &mut bank, done);
+    let done = avx512::run_blocks::<1>(p, &mut bank, done);
+    run_rest(p, &mut bank, done);
+}
+
+/// The AVX-512 blocks, written with intrinsics: the compiler's own vectorisation of
+/// [`step`] kept part of a 32-neuron block's state in memory between steps, which
+/// lengthened every step's chain of dependent operations.
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use super::{Bank, IzhikevichParams, V_PEAK};
+
+    /// f64 lanes per register.
+    const LANES: usize = 8;
+
+    /// Runs the whole blocks of `R` registers (`8 R` neurons) from neuron `first` on and
+    /// returns the first neuron not run: [`super::step`]'s operations in its order, on
+    /// eight neurons per instruction.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn run_blocks<const R: usize>(
+        p: &IzhikevichParams,
+        bank: &mut Bank<'_>,
+        first: usize,
+    ) -> usize {
+        let n = bank.v.len();
+        let width = R * LANES;
+        let end = first + (n - first) / width * width;
+        let [a, b, c, d] = [p.a, p.b, p.c, p.d].map(|k| _mm512_set1_pd(k));
+        let [peak, half, quad, five, rest] =
+            [V_PEAK, 0.5, 0.04, 5.0, 140.0].map(|k| _mm512_set1_pd(k));
+        // `v += 0.5 * (0.04 * (v * v) + 5.0 * v + 140.0 - u + i)`, left to right.
+        let half_step = |v: __m512d, u: __m512d, i: __m512d| {
+            let square = _mm512_mul_pd(quad, _mm512_mul_pd(v, v));
+            let sum = _mm512_add_pd(square, _mm512_mul_pd(five, v));
+            let sum = _mm512_add_pd(_mm512_sub_pd(_mm512_add_pd(sum, rest), u), i);
+            _mm512_add_pd(v, _mm512_mul_pd(half, sum))
+        };
+        for start in (first..end).step_by(width) {
+            let load = |from: &[f64], r: usize| {
+                _mm512_loadu_pd(from[start + r * LANES..][..LANES].as_ptr())
+            };
+            let mut v: [__m512d; R] = std::array::from_fn(|r| load(bank.v, r));
+            let mut u: [__m512d; R] = std::array::from_fn(|r| load(bank.u, r));
+            let g: [__m512d; R] = std::array::from_fn(|r| load(bank.gains, r));
+            let frames = bank.input.chunks_exact(n);
+            for (frame, out) in frames.zip(bank.raster.chunks_exact_mut(n)) {
+                for r in 0..R {
+                    let at = start + r * LANES;
+                    let fired = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(v[r], peak);
+                    let spikes = _mm512_cvtepi64_epi8(_mm512_maskz_set1_epi64(fired, 1));
+                    _mm_storel_epi64(out[at..at + LANES].as_mut_ptr().cast(), spikes);
+                    let vv = _mm512_mask_blend_pd(fired, v[r], c);
+                    let uu = _mm512_mask_add_pd(u[r], fired, u[r], d);
+                    let i = _mm512_mul_pd(g[r], _mm512_loadu_pd(frame[at..at + LANES].as_ptr()));
+                    let vv = half_step(half_step(vv, uu, i), uu, i);
+                    let recovery = _mm512_sub_pd(_mm512_mul_pd(b, vv), uu);
+                    u[r] = _mm512_add_pd(uu, _mm512_mul_pd(a, recovery));
+                    v[r] = vv;
+                }
+            }
+            for r in 0..R {
+                let at = start + r * LANES;
+                _mm512_storeu_pd(bank.v[at..at + LANES].as_mut_ptr(), v[r]);
+                _mm512_storeu_pd(bank.u[at..at + LANES].as_mut_ptr(), u[r]);
+            }
+        }
+        end
+    }
+}
+
+/// Blocks of [`BLOCK`], then the rest, for any processor.
+fn run_portable(p: &IzhikevichParams, mut bank: Bank<'_>) {
+    let done = run_blocks::<BLOCK>(p, &mut bank, 0);
+    run_rest(p, &mut bank, done);
+}
+
+/// Runs the whole blocks of `B` neurons from neuron `first` on (time inner, a block's state
+/// in registers) and returns the first neuron not run.
 #[inline(always)]
-fn run_blocks(p: IzhikevichParams, v: &mut [f64], u: &mut [f64], input: &[f64], raster: &mut [u8]) {
-    let n = v.len();
-    let full = n / BLOCK * BLOCK;
-    for start in (0..full).step_by(BLOCK) {
-        let mut vb = [0.0; BLOCK];
-        let mut ub = [0.0; BLOCK];
-        vb.copy_from_slice(&v[start..start + BLOCK]);
-        ub.copy_from_slice(&u[start..start + BLOCK]);
-        for (frame, out) in input.chunks_exact(n).zip(raster.chunks_exact_mut(n)) {
-            let x: &[f64; BLOCK] = frame[start..start + BLOCK].try_into().expect("block");
-            let o: &mut [u8; BLOCK] = (&mut out[start..start + BLOCK]).try_into().expect("block");
-            step(&p, &mut vb, &mut ub, x, o);
+fn run_blocks<const B: usize>(p: &IzhikevichParams, bank: &mut Bank<'_>, first: usize) -> usize {
+    let n = bank.v.len();
+    let end = first + (n - first) / B * B;
+    for start in (first..end).step_by(B) {
+        let block = start..start + B;
+        let mut vb = [0.0; B];
+        let mut ub = [0.0; B];
+        let mut gb = [0.0; B];
+        vb.copy_from_slice(&bank.v[block.clone()]);
+        ub.copy_from_slice(&bank.u[block.clone()]);
+        gb.copy_from_slice(&bank.gains[block.clone()]);
+        let frames = bank.input.chunks_exact(n);
+        for (frame, out) in frames.zip(bank.raster.chunks_exact_mut(n)) {
+            let x: &[f64; B] = frame[block.clone()].try_into().expect("a block");
+            let o: &mut [u8; B] = (&mut out[block.clone()]).try_into().expect("a block");
+            step(p, &gb, &mut vb, &mut ub, x, o);
         }
-        v[start..start + BLOCK].copy_from_slice(&vb);
-        u[start..start + BLOCK].copy_from_slice(&ub);
+        bank.v[block.clone()].copy_from_slice(&vb);
+        bank.u[block].copy_from_slice(&ub);
     }
-    if full < n {
-        for (frame, out) in input.chunks_exact(n).zip(raster.chunks_exact_mut(n)) {
-            step(
-                &p,
-                &mut v[full..],
-                &mut u[full..],
-                &frame[full..],
-                &mut out[full..],
-            );
-        }
+    end
+}
+
+/// Runs the neurons from `first` on, frame by frame.
+#[inline(always)]
+fn run_rest(p: &IzhikevichParams, bank: &mut Bank<'_>, first: usize) {
+    let n = bank.v.len();
+    if first == n {
+        return;
+    }
+    let frames = bank.input.chunks_exact(n);
+    for (frame, out) in frames.zip(bank.raster.chunks_exact_mut(n)) {
+        step(
+            p,
+            &bank.gains[first..],
+            &mut bank.v[first..],
+            &mut bank.u[first..],
+            &frame[first..],
+            &mut out[first..],
+        );
     }
 }
 
-/// One 1 ms step of the reference scheme for a group of neurons. Branch-free per neuron so
+/// One 1 ms step of the reference scheme for a group of neurons, each with its gain. Branch-free per neuron so
 /// it vectorises; the order of every floating-point operation is that of the reference.
 #[inline(always)]
-fn step(p: &IzhikevichParams, v: &mut [f64], u: &mut [f64], x: &[f64], out: &mut [u8]) {
-    let IzhikevichParams { a, b, c, d, gain } = *p;
-    for (((vi, ui), &x), o) in v.iter_mut().zip(u.iter_mut()).zip(x).zip(out.iter_mut()) {
+fn step(
+    p: &IzhikevichParams,
+    gains: &[f64],
+    v: &mut [f64],
+    u: &mut [f64],
+    x: &[f64],
+    out: &mut [u8],
+) {
+    let IzhikevichParams { a, b, c, d, .. } = *p;
+    let lanes = v.iter_mut().zip(u.iter_mut()).zip(gains.iter().zip(x));
+    for (((vi, ui), (&gain, &x)), o) in lanes.zip(out.iter_mut()) {
         let fired = *vi >= V_PEAK;
         *o = fired as u8;
         let mut vv = if fired { c } else { *vi };
@@ -344,7 +494,7 @@ impl SpikeTrains {
     pub fn from_raster(raster: &[u8], rows: usize, cols: usize, present: &[bool]) -> Self {
         let cells = rows * cols;
         assert_eq!(present.len(), cells);
-        assert!(cells > 0 && raster.len() % cells == 0);
+        assert!(cells > 0 && raster.len().is_multiple_of(cells));
         let n_steps = raster.len() / cells;
         let mut counts = vec![0u32; cells + 1];
         for frame in raster.chunks_exact(cells) {
@@ -560,29 +710,79 @@ pub fn encode(
     present: &[bool],
     params: IzhikevichParams,
 ) -> Result<SpikeTrains, ParamError> {
+    let mut trains = encode_banks(&[samples], &[params.gain], rows, cols, present, params)?;
+    Ok(trains.pop().expect("one bank"))
+}
+
+/// Encodes several conditioned `n_steps x cells` signals of one grid and length, signal
+/// `k` by neurons of input gain `gains[k]` and `params`' other parameters, into one set of
+/// spike trains each: the same trains as [`encode`] of each signal alone.
+///
+/// The signals run as one bank of neurons, their frames side by side: where the processor
+/// has AVX-512, two banks of 16 taxels run in little more time than one (see [`BLOCK`]).
+/// The callers pair the encodings one recording needs (SA and FA, the gains of a sweep).
+///
+/// # Errors
+/// A broken parameter rule, for `params` or with one of the gains.
+///
+/// # Panics
+/// If the signals and gains differ in number, or the signals in length (a caller bug).
+pub fn encode_banks(
+    signals: &[&[f64]],
+    gains: &[f64],
+    rows: usize,
+    cols: usize,
+    present: &[bool],
+    params: IzhikevichParams,
+) -> Result<Vec<SpikeTrains>, ParamError> {
     const BLOCK_STEPS: usize = 1024;
-    let cells = rows * cols;
-    let mut encoder = Encoder::new(params, cells)?;
-    let mut raster = vec![0u8; BLOCK_STEPS * cells];
-    let mut lists: Vec<Vec<u32>> = vec![Vec::new(); cells];
-    for (k, block) in samples.chunks(BLOCK_STEPS * cells).enumerate() {
-        let raster = &mut raster[..block.len()];
-        encoder.run(block, raster);
+    assert_eq!(signals.len(), gains.len(), "one gain per signal");
+    let len = signals.first().map_or(0, |s| s.len());
+    assert!(
+        signals.iter().all(|s| s.len() == len),
+        "signals of one length"
+    );
+    let (cells, banks) = (rows * cols, signals.len());
+    let width = cells * banks;
+    let bank_gains = gains.iter().flat_map(|&g| std::iter::repeat_n(g, cells));
+    let mut encoder = Encoder::with_gains(params, bank_gains.collect())?;
+    let mut raster = vec![0u8; BLOCK_STEPS * width];
+    // The banks' frames side by side, for more than one bank.
+    let mut frames = vec![0.0; if banks > 1 { BLOCK_STEPS * width } else { 0 }];
+    let mut lists: Vec<Vec<u32>> = vec![Vec::new(); width];
+    for k in 0..len.div_ceil((BLOCK_STEPS * cells).max(1)) {
+        let part = k * BLOCK_STEPS * cells..((k + 1) * BLOCK_STEPS * cells).min(len);
+        let steps = part.len() / cells.max(1);
+        let input = if banks == 1 {
+            &signals[0][part]
+        } else {
+            let frames = &mut frames[..steps * width];
+            for (b, signal) in signals.iter().enumerate() {
+                let rows = signal[part.clone()].chunks_exact(cells);
+                for (row, frame) in rows.zip(frames.chunks_exact_mut(width)) {
+                    copy_short(row, &mut frame[b * cells..(b + 1) * cells]);
+                }
+            }
+            &*frames
+        };
+        let raster = &mut raster[..input.len()];
+        encoder.run(input, raster);
         let t0 = k * BLOCK_STEPS;
-        // Spikes are sparse: test eight entries at a time as one word.
         let mut collect = |i: usize| {
-            let cell = i % cells;
-            if present[cell] {
-                lists[cell].push((t0 + i / cells) as u32);
+            let neuron = i % width;
+            if present[neuron % cells] {
+                lists[neuron].push((t0 + i / width) as u32);
             }
         };
+        // Spikes are sparse: eight entries (each 0 or 1) are read as one word, and only
+        // its set bytes visited, in order.
         let words = raster.chunks_exact(8);
         let tail = words.remainder();
         for (w, word) in words.enumerate() {
-            if u64::from_ne_bytes(word.try_into().expect("8 bytes")) != 0 {
-                (0..8)
-                    .filter(|&j| word[j] != 0)
-                    .for_each(|j| collect(w * 8 + j));
+            let mut bits = u64::from_le_bytes(word.try_into().expect("8 bytes"));
+            while bits != 0 {
+                collect(w * 8 + bits.trailing_zeros() as usize / 8);
+                bits &= bits - 1;
             }
         }
         let base = raster.len() - tail.len();
@@ -590,13 +790,25 @@ pub fn encode(
             .filter(|&j| tail[j] != 0)
             .for_each(|j| collect(base + j));
     }
-    Ok(SpikeTrains::from_lists(
-        &lists,
-        rows,
-        cols,
-        present,
-        samples.len() / cells.max(1),
-    ))
+    let n_steps = len / cells.max(1);
+    Ok(lists
+        .chunks(cells.max(1))
+        .map(|lists| SpikeTrains::from_lists(lists, rows, cols, present, n_steps))
+        .collect())
+}
+
+/// Copies a frame's few values eight at a time: `copy_from_slice` calls `memcpy` for
+/// each, whose call costs more than the copy.
+#[inline(always)]
+fn copy_short(from: &[f64], to: &mut [f64]) {
+    let mut to_eights = to.chunks_exact_mut(8);
+    let mut from_eights = from.chunks_exact(8);
+    for (t, f) in to_eights.by_ref().zip(from_eights.by_ref()) {
+        let f: [f64; 8] = f.try_into().expect("eight values");
+        t.copy_from_slice(&f);
+    }
+    let rest = to_eights.into_remainder().iter_mut();
+    rest.zip(from_eights.remainder()).for_each(|(t, &f)| *t = f);
 }
 
 /// Fast-adapting (FA-I) encoding parameters.
@@ -655,7 +867,10 @@ impl FaParams {
 /// # Panics
 /// If `samples` is not whole frames (a caller bug).
 pub fn rectified_rate(samples: &[f64], cells: usize) -> Vec<f64> {
-    assert!(cells > 0 && samples.len() % cells == 0, "whole frames");
+    assert!(
+        cells > 0 && samples.len().is_multiple_of(cells),
+        "whole frames"
+    );
     let mut out = vec![0.0; samples.len()];
     for ((now, before), o) in samples[cells..]
         .chunks_exact(cells)
@@ -685,4 +900,28 @@ pub fn encode_fa(
     fa.check()?;
     let drive = rectified_rate(samples, (rows * cols).max(1));
     encode(&drive, rows, cols, present, neuron.with_gain(fa.gain))
+}
+
+/// The SA trains of a conditioned signal ([`encode`] with `neuron`) and its FA-I trains
+/// ([`encode_fa`]), encoded side by side as two banks ([`encode_banks`]).
+///
+/// # Errors
+/// A broken parameter rule.
+pub fn encode_sa_fa(
+    samples: &[f64],
+    rows: usize,
+    cols: usize,
+    present: &[bool],
+    neuron: IzhikevichParams,
+    fa: FaParams,
+) -> Result<(SpikeTrains, SpikeTrains), ParamError> {
+    neuron.check()?;
+    fa.check()?;
+    let drive = rectified_rate(samples, (rows * cols).max(1));
+    let signals = [samples, drive.as_slice()];
+    let gains = [neuron.gain, fa.gain];
+    let [sa, fa]: [SpikeTrains; 2] = encode_banks(&signals, &gains, rows, cols, present, neuron)?
+        .try_into()
+        .expect("two banks");
+    Ok((sa, fa))
 }

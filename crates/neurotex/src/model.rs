@@ -451,7 +451,7 @@ impl Model {
     /// Rows of another length, or a feature that is not finite.
     pub fn predict_rows(&self, x: &[f64]) -> Result<Vec<Prediction>> {
         let dims = self.columns.len();
-        if x.len() % dims != 0 {
+        if !x.len().is_multiple_of(dims) {
             return Err(ClassifyError::BadFeatures(format!(
                 "{} feature values are not whole rows of the model's {dims} features",
                 x.len()

@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::encode::{encode, encode_fa, FaParams, IzhikevichParams, SpikeTrains};
+use crate::encode::{encode, encode_fa, encode_sa_fa, FaParams, IzhikevichParams, SpikeTrains};
 use crate::error::{DataError, ParamError, Result};
 use crate::features::glcm::GlcmKind;
 use crate::features::{
@@ -372,8 +372,32 @@ impl Pipeline {
         Ok(match self.params.encoding {
             Encoding::Sa => (self.encode_conditioned(rec, cond, None)?, None),
             Encoding::Fa => (fa()?, None),
-            Encoding::SaFa => (self.encode_conditioned(rec, cond, None)?, Some(fa()?)),
+            Encoding::SaFa => {
+                let (sa, fa) = self.encode_sa_fa(rec, cond)?;
+                (sa, Some(fa))
+            }
         })
+    }
+
+    /// Encodes a conditioned recording with the pipeline's SA neurons and its FA
+    /// population side by side ([`encode_sa_fa`]), whatever the pipeline's encoding.
+    ///
+    /// # Errors
+    /// A broken encoder rule.
+    pub fn encode_sa_fa(
+        &self,
+        rec: &Recording,
+        cond: &Conditioned,
+    ) -> Result<(SpikeTrains, SpikeTrains)> {
+        let (l, p) = (&rec.layout, &self.params);
+        Ok(encode_sa_fa(
+            &cond.samples,
+            l.rows,
+            l.cols,
+            &l.present,
+            p.encoder,
+            p.fa,
+        )?)
     }
 
     /// Conditions and encodes one recording.

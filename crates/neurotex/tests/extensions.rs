@@ -65,7 +65,7 @@ fn trains(seed: u32) -> SpikeTrains {
     let lists: Vec<Vec<u32>> = (0..4)
         .map(|c| {
             (0..1000)
-                .filter(|t| (t * (c + 3) + seed * 7) % (37 + 5 * c) == 0)
+                .filter(|t| (t * (c + 3) + seed * 7).is_multiple_of(37 + 5 * c))
                 .collect()
         })
         .collect();

@@ -284,7 +284,7 @@ fn string_labels_and_speeds_and_bad_stacks() {
     // numpy.save("labels.npy", numpy.array(["silk", "wool", "silk"])) writes '<U4'
     let mut npy = b"\x93NUMPY\x01\x00".to_vec();
     let mut header = "{'descr': '<U4', 'fortran_order': False, 'shape': (3,), }".to_string();
-    while (10 + header.len() + 1) % 64 != 0 {
+    while !(10 + header.len() + 1).is_multiple_of(64) {
         header.push(' ');
     }
     header.push('\n');

@@ -2,7 +2,7 @@
 //! on random inputs (proptest).
 
 use neurotex::classify::{Classifier, KnnParams, Predict};
-use neurotex::encode::{Encoder, IzhikevichParams, SpikeTrains};
+use neurotex::encode::{encode, encode_banks, Encoder, IzhikevichParams, SpikeTrains};
 use neurotex::features::glcm::GlcmKind;
 use neurotex::features::{
     haralick, quantise, spike_stats, CountVolume, Counting, GlcmParams, GlcmPlan, RateVolume,
@@ -242,7 +242,8 @@ proptest! {
 
     #[test]
     fn encoder_matches_step_by_step_and_chunks_do_not_matter(
-        n in 1usize..20,
+        // blocks of 32, 16 and 8 neurons and a rest (AVX-512), of 16 and a rest (AVX2)
+        n in 1usize..80,
         steps in 1usize..600,
         seed in any::<u64>(),
         gain in 1.0f64..25.0,
@@ -263,6 +264,32 @@ proptest! {
         let slow = slow_encoder(&input, n, p);
         for (k, expected) in slow.iter().enumerate() {
             prop_assert_eq!(trains.train(k), expected.as_slice());
+        }
+    }
+
+    #[test]
+    fn banks_side_by_side_give_each_signals_own_trains(
+        rows in 1usize..5,
+        cols in 1usize..9,
+        banks in 1usize..5,
+        // past one 1024-step block, and a part block
+        steps in 1usize..1500,
+        seed in any::<u64>(),
+    ) {
+        let mut rng = XorShift::new(seed);
+        let cells = rows * cols;
+        let present: Vec<bool> = (0..cells).map(|c| c == 0 || rng.below(4) > 0).collect();
+        let signals: Vec<Vec<f64>> = (0..banks)
+            .map(|_| (0..cells * steps).map(|_| rng.fraction(10_000)).collect())
+            .collect();
+        let gains: Vec<f64> = (0..banks).map(|_| 1.0 + rng.fraction(10_000) * 30.0).collect();
+        let p = IzhikevichParams::default();
+        let views: Vec<&[f64]> = signals.iter().map(|s| s.as_slice()).collect();
+        let together = encode_banks(&views, &gains, rows, cols, &present, p).unwrap();
+        prop_assert_eq!(together.len(), banks);
+        for ((signal, &gain), trains) in signals.iter().zip(&gains).zip(&together) {
+            let alone = encode(signal, rows, cols, &present, p.with_gain(gain)).unwrap();
+            prop_assert_eq!(trains, &alone);
         }
     }
 

@@ -110,7 +110,7 @@ pub fn student_t_quantile(p: f64, dof: usize) -> Result<f64, StatsError> {
 fn t_two_sided_mass(theta: f64, dof: usize) -> f64 {
     let (sin, cos) = theta.sin_cos();
     let cos2 = cos * cos;
-    if dof % 2 == 0 {
+    if dof.is_multiple_of(2) {
         // 1 + 1/2 cos²θ + (1·3)/(2·4) cos⁴θ + ... up to cos^(dof-2)θ
         let (mut term, mut sum) = (1.0, 1.0);
         for j in 1..dof / 2 {

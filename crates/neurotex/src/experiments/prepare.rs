@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidReproduceParams};
 use crate::calibrate::{calibrate_gain, GainCalibration};
 use crate::causal::{calibrate_conditioning, ConditioningCalibration};
-use crate::encode::encode_fa;
+use crate::encode::encode_banks;
 use crate::error::{DataError, DatasetError, Result};
 use crate::pipeline::{Encoded, Encoding, Pipeline};
 use crate::recording::{Baseline, Dataset, Recording};
@@ -397,13 +397,13 @@ fn encode_one(
         None => None,
     };
     let mut cond = pipeline.condition(&rec, source.baseline())?;
-    let (spikes, mut fa) = pipeline.encode_populations(&rec, &cond)?;
-    if params.e9 && fa.is_none() && pipeline.params().encoding == Encoding::Sa {
+    let (spikes, fa) = if params.e9 && pipeline.params().encoding == Encoding::Sa {
         // E9 compares the sa+fa encoding too; the other analyses read the SA population.
-        let (l, p) = (&rec.layout, pipeline.params());
-        let trains = encode_fa(&cond.samples, l.rows, l.cols, &l.present, p.encoder, p.fa)?;
-        fa = Some(trains);
-    }
+        let (sa, fa) = pipeline.encode_sa_fa(&rec, &cond)?;
+        (sa, Some(fa))
+    } else {
+        pipeline.encode_populations(&rec, &cond)?
+    };
     let sweep = if sweep {
         Some(gain_sweep(&rec, &cond, params)?)
     } else {
@@ -442,11 +442,13 @@ fn gain_sweep(
     params: &ValidReproduceParams,
 ) -> Result<Vec<GainPoint>> {
     let bins = histogram_bins(params);
-    params
-        .e7_gains
+    let (l, encoder) = (&rec.layout, params.pipeline().params().encoder);
+    // Every gain's neurons see the same signal; they run side by side.
+    let signals = vec![cond.samples.as_slice(); params.e7_gains.len()];
+    let gains = &params.e7_gains;
+    encode_banks(&signals, gains, l.rows, l.cols, &l.present, encoder)?
         .iter()
-        .map(|&g| {
-            let trains = params.pipeline().encode_conditioned(rec, cond, Some(g))?;
+        .map(|trains| {
             let mut histogram = vec![0u64; bins];
             for cell in 0..trains.cells() {
                 for w in trains.train(cell).windows(2) {

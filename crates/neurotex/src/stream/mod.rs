@@ -692,7 +692,7 @@ impl StreamClassifier {
             episode.has_previous = true;
         }
         episode.steps += 1;
-        if episode.steps % self.bin == 0 {
+        if episode.steps.is_multiple_of(self.bin) {
             for window in &mut episode.glcm {
                 window.close_bin();
             }
