@@ -209,27 +209,33 @@ impl Butterworth2 {
     /// per frame), bit for bit: the channels' filters run side by side, frame after frame,
     /// so the steps are independent (they vectorise) where one channel's steps each wait on
     /// the one before, and no channel is gathered out of the frames and back.
-    pub fn filtfilt_frames(&self, x: &mut [f64], cells: usize, scratch: &mut Vec<f64>) {
+    ///
+    /// The padded signal is never built: the filter runs over the left pad, the samples in
+    /// place and the right pad in turn (and back), its state carried from one to the next,
+    /// the same steps in the same order as over one padded copy.
+    pub fn filtfilt_frames(&self, x: &mut [f64], cells: usize) {
         let n = x.len() / cells.max(1);
         if n < 2 {
             return;
         }
         let pad = 9.min(n - 1);
         let frame = |i: usize| &x[i * cells..(i + 1) * cells];
-        scratch.clear();
-        scratch.reserve((n + 2 * pad) * cells);
+        let mut left = Vec::with_capacity(pad * cells);
         for i in (1..=pad).rev() {
-            scratch.extend(frame(0).iter().zip(frame(i)).map(|(&f, &v)| 2.0 * f - v));
+            left.extend(frame(0).iter().zip(frame(i)).map(|(&f, &v)| 2.0 * f - v));
         }
-        scratch.extend_from_slice(x);
+        let mut right = Vec::with_capacity(pad * cells);
         for i in 1..=pad {
             let (last, back) = (frame(n - 1), frame(n - 1 - i));
-            scratch.extend(last.iter().zip(back).map(|(&l, &v)| 2.0 * l - v));
+            right.extend(last.iter().zip(back).map(|(&l, &v)| 2.0 * l - v));
         }
         let mut state = [vec![0.0; cells], vec![0.0; cells]];
-        self.run_frames(scratch, cells, &mut state, false);
-        self.run_frames(scratch, cells, &mut state, true);
-        x.copy_from_slice(&scratch[pad * cells..(pad + n) * cells]);
+        self.run_frames(&mut left, cells, &mut state, false, true);
+        self.run_frames(x, cells, &mut state, false, false);
+        self.run_frames(&mut right, cells, &mut state, false, false);
+        self.run_frames(&mut right, cells, &mut state, true, true);
+        self.run_frames(x, cells, &mut state, true, false);
+        self.run_frames(&mut left, cells, &mut state, true, false);
     }
 
     /// [`Butterworth2::lfilter`] of every channel of frame-major samples, bit for bit, the
@@ -237,15 +243,30 @@ impl Butterworth2 {
     pub fn lfilter_frames(&self, x: &mut [f64], cells: usize) {
         if x.len() >= cells && cells > 0 {
             let mut state = [vec![0.0; cells], vec![0.0; cells]];
-            self.run_frames(x, cells, &mut state, false);
+            self.run_frames(x, cells, &mut state, false, true);
         }
     }
 
     /// Runs every channel's filter over the frames of `x` in place, forward or (`backward`)
-    /// from the last frame, each channel started in its steady state for its first value.
-    fn run_frames(&self, x: &mut [f64], cells: usize, state: &mut [Vec<f64>; 2], backward: bool) {
+    /// from the last frame, from the state in `state` or (`start`) each channel started in
+    /// its steady state for its first value.
+    fn run_frames(
+        &self,
+        x: &mut [f64],
+        cells: usize,
+        state: &mut [Vec<f64>; 2],
+        backward: bool,
+        start: bool,
+    ) {
         #[inline(always)]
-        fn run(f: &Butterworth2, x: &mut [f64], cells: usize, z: &mut [Vec<f64>; 2], back: bool) {
+        fn run(
+            f: &Butterworth2,
+            x: &mut [f64],
+            cells: usize,
+            z: &mut [Vec<f64>; 2],
+            back: bool,
+            start: bool,
+        ) {
             let [z0, z1] = z;
             let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
             let mut step = |frame: &mut [f64], first: bool| {
@@ -264,12 +285,12 @@ impl Butterworth2 {
             match back {
                 false => {
                     for (i, frame) in x.chunks_exact_mut(cells).enumerate() {
-                        step(frame, i == 0);
+                        step(frame, start && i == 0);
                     }
                 }
                 true => {
                     for (i, frame) in x.chunks_exact_mut(cells).rev().enumerate() {
-                        step(frame, i == 0);
+                        step(frame, start && i == 0);
                     }
                 }
             }
@@ -284,15 +305,16 @@ impl Butterworth2 {
                 cells: usize,
                 z: &mut [Vec<f64>; 2],
                 back: bool,
+                start: bool,
             ) {
-                run(f, x, cells, z, back);
+                run(f, x, cells, z, back, start);
             }
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: the CPU supports AVX2, checked just above.
-                return unsafe { run_avx2(self, x, cells, state, backward) };
+                return unsafe { run_avx2(self, x, cells, state, backward, start) };
             }
         }
-        run(self, x, cells, state, backward);
+        run(self, x, cells, state, backward, start);
     }
 }
 
@@ -428,21 +450,7 @@ impl Preprocessor {
         if let Some(filter) = &self.filter {
             match self.params.causal {
                 Some(_) => filter.lfilter_frames(&mut samples, cells),
-                None => {
-                    thread_local! {
-                        /// The padded copy filtfilt runs over, kept for the thread's next
-                        /// recording: a fresh one each time costs its pages' faults.
-                        static SCRATCH: std::cell::RefCell<Vec<f64>> =
-                            const { std::cell::RefCell::new(Vec::new()) };
-                    }
-                    SCRATCH.with_borrow_mut(|scratch| {
-                        filter.filtfilt_frames(&mut samples, cells, scratch);
-                        // A very long recording's copy (over 64 MiB) is not kept.
-                        if scratch.capacity() > 1 << 23 {
-                            *scratch = Vec::new();
-                        }
-                    });
-                }
+                None => filter.filtfilt_frames(&mut samples, cells),
             }
             // Masked cells hold 0 and stay exactly 0, as when only taxels were filtered.
             if present.iter().any(|&p| !p) {
@@ -717,7 +725,7 @@ mod tests {
             let channel =
                 |c: usize| -> Vec<f64> { x.iter().skip(c).step_by(cells).copied().collect() };
             let mut both = x.clone();
-            f.filtfilt_frames(&mut both, cells, &mut Vec::new());
+            f.filtfilt_frames(&mut both, cells);
             let mut forward = x.clone();
             f.lfilter_frames(&mut forward, cells);
             for c in 0..cells {
