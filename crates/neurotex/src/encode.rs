@@ -444,8 +444,9 @@ fn run_rest(p: &IzhikevichParams, bank: &mut Bank<'_>, first: usize) {
     }
 }
 
-/// One 1 ms step of the reference scheme for a group of neurons, each with its gain. Branch-free per neuron so
-/// it vectorises; the order of every floating-point operation is that of the reference.
+/// One 1 ms step of the reference scheme for a group of neurons, each with its gain.
+/// Branch-free per neuron so it vectorises; the order of every floating-point operation is
+/// that of the reference.
 #[inline(always)]
 fn step(
     p: &IzhikevichParams,
@@ -750,9 +751,15 @@ pub fn encode_banks(
     // The banks' frames side by side, for more than one bank.
     let mut frames = vec![0.0; if banks > 1 { BLOCK_STEPS * width } else { 0 }];
     let mut lists: Vec<Vec<u32>> = vec![Vec::new(); width];
-    for k in 0..len.div_ceil((BLOCK_STEPS * cells).max(1)) {
+    // A grid without cells has no frames and no trains to fill.
+    let blocks = if cells == 0 {
+        0
+    } else {
+        len.div_ceil(BLOCK_STEPS * cells)
+    };
+    for k in 0..blocks {
         let part = k * BLOCK_STEPS * cells..((k + 1) * BLOCK_STEPS * cells).min(len);
-        let steps = part.len() / cells.max(1);
+        let steps = part.len() / cells;
         let input = if banks == 1 {
             &signals[0][part]
         } else {
@@ -790,10 +797,12 @@ pub fn encode_banks(
             .filter(|&j| tail[j] != 0)
             .for_each(|j| collect(base + j));
     }
-    let n_steps = len / cells.max(1);
-    Ok(lists
-        .chunks(cells.max(1))
-        .map(|lists| SpikeTrains::from_lists(lists, rows, cols, present, n_steps))
+    let n_steps = len.checked_div(cells).unwrap_or(0);
+    Ok((0..banks)
+        .map(|b| {
+            let lists = &lists[b * cells..(b + 1) * cells];
+            SpikeTrains::from_lists(lists, rows, cols, present, n_steps)
+        })
         .collect())
 }
 
