@@ -328,22 +328,13 @@ impl Pipeline {
         Ok(cond)
     }
 
-    /// Encodes a conditioned recording with the pipeline's SA neurons, or with `gain`
-    /// instead of the pipeline's gain.
+    /// Encodes a conditioned recording with the pipeline's SA neurons.
     ///
     /// # Errors
-    /// A gain that breaks the encoder's rules.
-    pub fn encode_conditioned(
-        &self,
-        rec: &Recording,
-        cond: &Conditioned,
-        gain: Option<f64>,
-    ) -> Result<SpikeTrains> {
+    /// A broken encoder rule.
+    pub fn encode_conditioned(&self, rec: &Recording, cond: &Conditioned) -> Result<SpikeTrains> {
         let l = &rec.layout;
-        let params = match gain {
-            Some(g) => self.params.encoder.with_gain(g),
-            None => self.params.encoder,
-        };
+        let params = self.params.encoder;
         Ok(encode(&cond.samples, l.rows, l.cols, &l.present, params)?)
     }
 
@@ -370,7 +361,7 @@ impl Pipeline {
             )
         };
         Ok(match self.params.encoding {
-            Encoding::Sa => (self.encode_conditioned(rec, cond, None)?, None),
+            Encoding::Sa => (self.encode_conditioned(rec, cond)?, None),
             Encoding::Fa => (fa()?, None),
             Encoding::SaFa => {
                 let (sa, fa) = self.encode_sa_fa(rec, cond)?;

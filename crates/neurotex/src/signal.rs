@@ -318,6 +318,73 @@ impl Butterworth2 {
     }
 }
 
+/// Whether the recording is sampled uniformly at the encoder's 1 kHz (no resampling).
+fn uniform_1k(rec: &Recording) -> bool {
+    rec.times_s.is_none() && (rec.fs - ENCODER_FS).abs() < 1e-9
+}
+
+/// The selected phase (`frames`) of a recording at 1 kHz, each sample less its cell's
+/// resting value (`offsets`) and masked cells 0: a copy where the recording is already
+/// uniform at 1 kHz, else resampled linearly first.
+///
+/// # Errors
+/// A span whose resampling would not fit in memory, or a phase shorter than one step.
+fn selected_phase(
+    rec: &Recording,
+    times: &[f64],
+    offsets: &[f64],
+    frames: std::ops::Range<usize>,
+) -> Result<Vec<f64>> {
+    let (cells, file) = (rec.layout.cells(), &rec.meta.file);
+    let present = &rec.layout.present;
+    let (lo, hi) = (frames.start, frames.end);
+    let uniform_1k = uniform_1k(rec);
+    let mut samples = if uniform_1k {
+        // The copy of the selected phase, each sample less its cell's resting value.
+        let mut out = Vec::with_capacity((hi - lo) * cells);
+        for frame in rec.samples[lo * cells..hi * cells].chunks_exact(cells) {
+            out.extend(frame.iter().zip(offsets).zip(present).map(
+                |((&s, &o), &p)| {
+                    if p {
+                        s - o
+                    } else {
+                        0.0
+                    }
+                },
+            ));
+        }
+        out
+    } else {
+        let span = times[hi - 1] - times[lo];
+        if resampled_len(span, ENCODER_FS, cells).is_none() {
+            let message =
+                format!("a {span} s span resampled to 1 kHz is more samples than memory can hold");
+            return Err(DataError::invalid(file, message).into());
+        }
+        resample_linear(
+            &rec.samples[lo * cells..hi * cells],
+            cells,
+            &times[lo..hi],
+            ENCODER_FS,
+        )
+    };
+    if samples.is_empty() {
+        return Err(DataError::invalid(
+            file,
+            "the selected phase is shorter than one 1 ms encoder step",
+        )
+        .into());
+    }
+    if !uniform_1k {
+        for frame in samples.chunks_exact_mut(cells) {
+            for ((s, &o), &p) in frame.iter_mut().zip(offsets).zip(present) {
+                *s = if p { *s - o } else { 0.0 };
+            }
+        }
+    }
+    Ok(samples)
+}
+
 /// A recording conditioned for the encoder: `n_steps x cells` samples at 1 kHz, in `[.., 1]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Conditioned {
@@ -373,6 +440,28 @@ impl Preprocessor {
         self.filter.as_ref()
     }
 
+    /// Low-passes the frames with the conditioning's filter (causal or zero-phase); masked
+    /// cells hold 0 and stay exactly 0, as when only taxels were filtered.
+    fn filter_frames(
+        &self,
+        filter: &Butterworth2,
+        samples: &mut [f64],
+        cells: usize,
+        present: &[bool],
+    ) {
+        match self.params.causal {
+            Some(_) => filter.lfilter_frames(samples, cells),
+            None => filter.filtfilt_frames(samples, cells),
+        }
+        if present.iter().any(|&p| !p) {
+            for frame in samples.chunks_exact_mut(cells) {
+                for (s, _) in frame.iter_mut().zip(present).filter(|(_, &p)| !p) {
+                    *s = 0.0;
+                }
+            }
+        }
+    }
+
     /// Conditions one recording; `dataset_baseline` is the dataset's layout choice, used
     /// when the parameters do not override it.
     ///
@@ -399,67 +488,9 @@ impl Preprocessor {
         } else {
             (0, n)
         };
-        let uniform_1k = rec.times_s.is_none() && (rec.fs - ENCODER_FS).abs() < 1e-9;
-        let present = &rec.layout.present;
-        let mut samples = if uniform_1k {
-            // The copy of the selected phase, each sample less its cell's resting value.
-            let mut out = Vec::with_capacity((hi - lo) * cells);
-            for frame in rec.samples[lo * cells..hi * cells].chunks_exact(cells) {
-                out.extend(
-                    frame.iter().zip(&offsets).zip(present).map(
-                        |((&s, &o), &p)| {
-                            if p {
-                                s - o
-                            } else {
-                                0.0
-                            }
-                        },
-                    ),
-                );
-            }
-            out
-        } else {
-            let span = times[hi - 1] - times[lo];
-            if resampled_len(span, ENCODER_FS, cells).is_none() {
-                let message = format!(
-                    "a {span} s span resampled to 1 kHz is more samples than memory can hold"
-                );
-                return Err(DataError::invalid(file, message).into());
-            }
-            resample_linear(
-                &rec.samples[lo * cells..hi * cells],
-                cells,
-                &times[lo..hi],
-                ENCODER_FS,
-            )
-        };
-        if samples.is_empty() {
-            return Err(DataError::invalid(
-                file,
-                "the selected phase is shorter than one 1 ms encoder step",
-            )
-            .into());
-        }
-        if !uniform_1k {
-            for frame in samples.chunks_exact_mut(cells) {
-                for ((s, &o), &p) in frame.iter_mut().zip(&offsets).zip(present) {
-                    *s = if p { *s - o } else { 0.0 };
-                }
-            }
-        }
+        let mut samples = selected_phase(rec, &times, &offsets, lo..hi)?;
         if let Some(filter) = &self.filter {
-            match self.params.causal {
-                Some(_) => filter.lfilter_frames(&mut samples, cells),
-                None => filter.filtfilt_frames(&mut samples, cells),
-            }
-            // Masked cells hold 0 and stay exactly 0, as when only taxels were filtered.
-            if present.iter().any(|&p| !p) {
-                for frame in samples.chunks_exact_mut(cells) {
-                    for (s, _) in frame.iter_mut().zip(present).filter(|(_, &p)| !p) {
-                        *s = 0.0;
-                    }
-                }
-            }
+            self.filter_frames(filter, &mut samples, cells, &rec.layout.present);
         }
         let flat = match &self.params.causal {
             Some(causal) => normalise_fixed(&mut samples, causal.scale),
@@ -468,7 +499,7 @@ impl Preprocessor {
         Ok(Conditioned {
             samples,
             cells,
-            resampled: !uniform_1k,
+            resampled: !uniform_1k(rec),
             flat,
         })
     }
