@@ -751,6 +751,7 @@ pub fn encode_banks(
     // The banks' frames side by side, for more than one bank.
     let mut frames = vec![0.0; if banks > 1 { BLOCK_STEPS * width } else { 0 }];
     let mut lists: Vec<Vec<u32>> = vec![Vec::new(); width];
+    let neuron_present: Vec<bool> = (0..width).map(|neuron| present[neuron % cells]).collect();
     // A grid without cells has no frames and no trains to fill.
     let blocks = if cells == 0 {
         0
@@ -774,28 +775,30 @@ pub fn encode_banks(
         };
         let raster = &mut raster[..input.len()];
         encoder.run(input, raster);
-        let t0 = k * BLOCK_STEPS;
-        let mut collect = |i: usize| {
-            let neuron = i % width;
-            if present[neuron % cells] {
-                lists[neuron].push((t0 + i / width) as u32);
+        // Spikes are sparse: a step's entries (each 0 or 1) are read eight at a time as
+        // one word, and only its set bytes visited, in order. Step and neuron come from
+        // the loop, not from dividing a spike's place in the raster.
+        for (s, row) in raster.chunks_exact(width).enumerate() {
+            let t = (k * BLOCK_STEPS + s) as u32;
+            let words = row.chunks_exact(8);
+            let tail = words.remainder();
+            for (w, word) in words.enumerate() {
+                let mut bits = u64::from_le_bytes(word.try_into().expect("8 bytes"));
+                while bits != 0 {
+                    let neuron = w * 8 + bits.trailing_zeros() as usize / 8;
+                    if neuron_present[neuron] {
+                        lists[neuron].push(t);
+                    }
+                    bits &= bits - 1;
+                }
             }
-        };
-        // Spikes are sparse: eight entries (each 0 or 1) are read as one word, and only
-        // its set bytes visited, in order.
-        let words = raster.chunks_exact(8);
-        let tail = words.remainder();
-        for (w, word) in words.enumerate() {
-            let mut bits = u64::from_le_bytes(word.try_into().expect("8 bytes"));
-            while bits != 0 {
-                collect(w * 8 + bits.trailing_zeros() as usize / 8);
-                bits &= bits - 1;
+            let base = width - tail.len();
+            for (neuron, _) in (base..).zip(tail).filter(|&(_, &spike)| spike != 0) {
+                if neuron_present[neuron] {
+                    lists[neuron].push(t);
+                }
             }
         }
-        let base = raster.len() - tail.len();
-        (0..tail.len())
-            .filter(|&j| tail[j] != 0)
-            .for_each(|j| collect(base + j));
     }
     let n_steps = len.checked_div(cells).unwrap_or(0);
     Ok((0..banks)

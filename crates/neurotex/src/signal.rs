@@ -268,31 +268,77 @@ impl Butterworth2 {
             start: bool,
         ) {
             let [z0, z1] = z;
-            let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
-            let mut step = |frame: &mut [f64], first: bool| {
-                let frame = &mut frame[..cells];
-                if first {
-                    for ((&v, a), b) in frame.iter().zip(z0.iter_mut()).zip(z1.iter_mut()) {
-                        [*a, *b] = f.steady_state(v);
+            match cells {
+                4 => run_width::<4>(f, x, [z0, z1], back, start),
+                8 => run_width::<8>(f, x, [z0, z1], back, start),
+                16 => run_width::<16>(f, x, [z0, z1], back, start),
+                _ => {
+                    let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
+                    let frames = x.chunks_exact_mut(cells);
+                    match back {
+                        false => {
+                            for (i, frame) in frames.enumerate() {
+                                step_frame(f, frame, z0, z1, start && i == 0);
+                            }
+                        }
+                        true => {
+                            for (i, frame) in frames.rev().enumerate() {
+                                step_frame(f, frame, z0, z1, start && i == 0);
+                            }
+                        }
                     }
                 }
-                for ((v, a), b) in frame.iter_mut().zip(z0.iter_mut()).zip(z1.iter_mut()) {
-                    let mut z = [*a, *b];
-                    *v = f.step(*v, &mut z);
-                    [*a, *b] = z;
-                }
-            };
+            }
+        }
+        /// [`run`] for frames of exactly `W` cells: the state is held in arrays the
+        /// compiler keeps in registers from frame to frame, where with `cells` known only
+        /// at run time it is stored and loaded back every frame, on the chain each frame
+        /// waits for.
+        #[inline(always)]
+        fn run_width<const W: usize>(
+            f: &Butterworth2,
+            x: &mut [f64],
+            [z0, z1]: [&mut Vec<f64>; 2],
+            back: bool,
+            start: bool,
+        ) {
+            let mut a: [f64; W] = z0[..W].try_into().expect("W states");
+            let mut b: [f64; W] = z1[..W].try_into().expect("W states");
+            let frames = x.as_chunks_mut::<W>().0.iter_mut();
             match back {
                 false => {
-                    for (i, frame) in x.chunks_exact_mut(cells).enumerate() {
-                        step(frame, start && i == 0);
+                    for (i, frame) in frames.enumerate() {
+                        step_frame(f, frame, &mut a, &mut b, start && i == 0);
                     }
                 }
                 true => {
-                    for (i, frame) in x.chunks_exact_mut(cells).rev().enumerate() {
-                        step(frame, start && i == 0);
+                    for (i, frame) in frames.rev().enumerate() {
+                        step_frame(f, frame, &mut a, &mut b, start && i == 0);
                     }
                 }
+            }
+            z0[..W].copy_from_slice(&a);
+            z1[..W].copy_from_slice(&b);
+        }
+        /// One frame through each channel's filter, its state in `z0` and `z1`; `first`
+        /// starts each channel in its steady state for its value.
+        #[inline(always)]
+        fn step_frame(
+            f: &Butterworth2,
+            frame: &mut [f64],
+            z0: &mut [f64],
+            z1: &mut [f64],
+            first: bool,
+        ) {
+            if first {
+                for ((&v, a), b) in frame.iter().zip(z0.iter_mut()).zip(z1.iter_mut()) {
+                    [*a, *b] = f.steady_state(v);
+                }
+            }
+            for ((v, a), b) in frame.iter_mut().zip(z0.iter_mut()).zip(z1.iter_mut()) {
+                let mut z = [*a, *b];
+                *v = f.step(*v, &mut z);
+                [*a, *b] = z;
             }
         }
         #[cfg(target_arch = "x86_64")]
@@ -308,6 +354,22 @@ impl Butterworth2 {
                 start: bool,
             ) {
                 run(f, x, cells, z, back, start);
+            }
+            /// The same loops with AVX-512's 32 registers (no FMA: the same bits).
+            #[target_feature(enable = "avx512f")]
+            unsafe fn run_avx512(
+                f: &Butterworth2,
+                x: &mut [f64],
+                cells: usize,
+                z: &mut [Vec<f64>; 2],
+                back: bool,
+                start: bool,
+            ) {
+                run(f, x, cells, z, back, start);
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the CPU supports AVX-512F, checked just above.
+                return unsafe { run_avx512(self, x, cells, state, backward, start) };
             }
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: the CPU supports AVX2, checked just above.
@@ -751,7 +813,17 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 1.0
         };
-        for (n, cells) in [(1, 3), (2, 1), (5, 16), (10, 7), (11, 16), (300, 9)] {
+        for (n, cells) in [
+            (1, 3),
+            (2, 1),
+            (5, 16),
+            (10, 7),
+            (11, 16),
+            (300, 9),
+            (40, 4),
+            (40, 8),
+            (300, 16),
+        ] {
             let x: Vec<f64> = (0..n * cells).map(|_| next()).collect();
             let channel =
                 |c: usize| -> Vec<f64> { x.iter().skip(c).step_by(cells).copied().collect() };
