@@ -258,89 +258,6 @@ impl Butterworth2 {
         backward: bool,
         start: bool,
     ) {
-        #[inline(always)]
-        fn run(
-            f: &Butterworth2,
-            x: &mut [f64],
-            cells: usize,
-            z: &mut [Vec<f64>; 2],
-            back: bool,
-            start: bool,
-        ) {
-            let [z0, z1] = z;
-            match cells {
-                4 => run_width::<4>(f, x, [z0, z1], back, start),
-                8 => run_width::<8>(f, x, [z0, z1], back, start),
-                16 => run_width::<16>(f, x, [z0, z1], back, start),
-                _ => {
-                    let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
-                    let frames = x.chunks_exact_mut(cells);
-                    match back {
-                        false => {
-                            for (i, frame) in frames.enumerate() {
-                                step_frame(f, frame, z0, z1, start && i == 0);
-                            }
-                        }
-                        true => {
-                            for (i, frame) in frames.rev().enumerate() {
-                                step_frame(f, frame, z0, z1, start && i == 0);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        /// [`run`] for frames of exactly `W` cells: the state is held in arrays the
-        /// compiler keeps in registers from frame to frame, where with `cells` known only
-        /// at run time it is stored and loaded back every frame, on the chain each frame
-        /// waits for.
-        #[inline(always)]
-        fn run_width<const W: usize>(
-            f: &Butterworth2,
-            x: &mut [f64],
-            [z0, z1]: [&mut Vec<f64>; 2],
-            back: bool,
-            start: bool,
-        ) {
-            let mut a: [f64; W] = z0[..W].try_into().expect("W states");
-            let mut b: [f64; W] = z1[..W].try_into().expect("W states");
-            let frames = x.as_chunks_mut::<W>().0.iter_mut();
-            match back {
-                false => {
-                    for (i, frame) in frames.enumerate() {
-                        step_frame(f, frame, &mut a, &mut b, start && i == 0);
-                    }
-                }
-                true => {
-                    for (i, frame) in frames.rev().enumerate() {
-                        step_frame(f, frame, &mut a, &mut b, start && i == 0);
-                    }
-                }
-            }
-            z0[..W].copy_from_slice(&a);
-            z1[..W].copy_from_slice(&b);
-        }
-        /// One frame through each channel's filter, its state in `z0` and `z1`; `first`
-        /// starts each channel in its steady state for its value.
-        #[inline(always)]
-        fn step_frame(
-            f: &Butterworth2,
-            frame: &mut [f64],
-            z0: &mut [f64],
-            z1: &mut [f64],
-            first: bool,
-        ) {
-            if first {
-                for ((&v, a), b) in frame.iter().zip(z0.iter_mut()).zip(z1.iter_mut()) {
-                    [*a, *b] = f.steady_state(v);
-                }
-            }
-            for ((v, a), b) in frame.iter_mut().zip(z0.iter_mut()).zip(z1.iter_mut()) {
-                let mut z = [*a, *b];
-                *v = f.step(*v, &mut z);
-                [*a, *b] = z;
-            }
-        }
         #[cfg(target_arch = "x86_64")]
         {
             /// The same loops with AVX2's four lanes (no FMA: the same bits).
@@ -353,7 +270,7 @@ impl Butterworth2 {
                 back: bool,
                 start: bool,
             ) {
-                run(f, x, cells, z, back, start);
+                run_channels(f, x, cells, z, back, start);
             }
             /// The same loops with AVX-512's 32 registers (no FMA: the same bits).
             #[target_feature(enable = "avx512f")]
@@ -365,7 +282,7 @@ impl Butterworth2 {
                 back: bool,
                 start: bool,
             ) {
-                run(f, x, cells, z, back, start);
+                run_channels(f, x, cells, z, back, start);
             }
             if std::arch::is_x86_feature_detected!("avx512f") {
                 // SAFETY: the CPU supports AVX-512F, checked just above.
@@ -376,7 +293,90 @@ impl Butterworth2 {
                 return unsafe { run_avx2(self, x, cells, state, backward, start) };
             }
         }
-        run(self, x, cells, state, backward, start);
+        run_channels(self, x, cells, state, backward, start);
+    }
+}
+
+/// [`Butterworth2::run_frames`]' loops: every channel's filter over the frames of `x` in
+/// place, forward or (`back`) from the last frame, from the state in `z` or (`start`) each
+/// channel started in its steady state for its first value.
+#[inline(always)]
+fn run_channels(
+    f: &Butterworth2,
+    x: &mut [f64],
+    cells: usize,
+    z: &mut [Vec<f64>; 2],
+    back: bool,
+    start: bool,
+) {
+    let [z0, z1] = z;
+    match cells {
+        4 => run_width::<4>(f, x, [z0, z1], back, start),
+        8 => run_width::<8>(f, x, [z0, z1], back, start),
+        16 => run_width::<16>(f, x, [z0, z1], back, start),
+        _ => {
+            let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
+            let frames = x.chunks_exact_mut(cells);
+            match back {
+                false => {
+                    for (i, frame) in frames.enumerate() {
+                        step_frame(f, frame, z0, z1, start && i == 0);
+                    }
+                }
+                true => {
+                    for (i, frame) in frames.rev().enumerate() {
+                        step_frame(f, frame, z0, z1, start && i == 0);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`run_channels`] for frames of exactly `W` cells: the state is held in arrays the
+/// compiler keeps in registers from frame to frame, where with `cells` known only
+/// at run time it is stored and loaded back every frame, on the chain each frame
+/// waits for.
+#[inline(always)]
+fn run_width<const W: usize>(
+    f: &Butterworth2,
+    x: &mut [f64],
+    [z0, z1]: [&mut Vec<f64>; 2],
+    back: bool,
+    start: bool,
+) {
+    let mut a: [f64; W] = z0[..W].try_into().expect("W states");
+    let mut b: [f64; W] = z1[..W].try_into().expect("W states");
+    let frames = x.as_chunks_mut::<W>().0.iter_mut();
+    match back {
+        false => {
+            for (i, frame) in frames.enumerate() {
+                step_frame(f, frame, &mut a, &mut b, start && i == 0);
+            }
+        }
+        true => {
+            for (i, frame) in frames.rev().enumerate() {
+                step_frame(f, frame, &mut a, &mut b, start && i == 0);
+            }
+        }
+    }
+    z0[..W].copy_from_slice(&a);
+    z1[..W].copy_from_slice(&b);
+}
+
+/// One frame through each channel's filter, its state in `z0` and `z1`; `first`
+/// starts each channel in its steady state for its value.
+#[inline(always)]
+fn step_frame(f: &Butterworth2, frame: &mut [f64], z0: &mut [f64], z1: &mut [f64], first: bool) {
+    if first {
+        for ((&v, a), b) in frame.iter().zip(z0.iter_mut()).zip(z1.iter_mut()) {
+            [*a, *b] = f.steady_state(v);
+        }
+    }
+    for ((v, a), b) in frame.iter_mut().zip(z0.iter_mut()).zip(z1.iter_mut()) {
+        let mut z = [*a, *b];
+        *v = f.step(*v, &mut z);
+        [*a, *b] = z;
     }
 }
 
