@@ -1,6 +1,6 @@
 //! The candidates of a comparison made from encoded recordings: for each encoding, each
 //! feature method's table is built once and shared by every classifier; the spike-timing
-//! method's distance matrix is computed once per encoding.
+//! method's distance matrix is computed once per population and shared by the encodings.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -8,7 +8,8 @@ use std::time::Instant;
 use super::Candidate;
 use crate::analysis::{evaluate, Columns, FeatureTable};
 use crate::classify::{
-    ClassifierChoice, ForestParams, KnnParams, SpikeDistanceKnn, VanRossumParams,
+    ClassifierChoice, DistanceMatrix, ForestParams, KnnParams, SpikeDistanceKnn, VanRossum,
+    VanRossumParams,
 };
 use crate::encode::SpikeTrains;
 use crate::error::{ParamError, Result};
@@ -162,6 +163,7 @@ pub fn candidates(
 ) -> Result<Vec<Candidate>> {
     let pairs = set.pairs();
     let mut out = Vec::new();
+    let mut van_rossum = PopulationMatrices::new(set.tau_ms)?;
     for &encoding in &set.encodings {
         let view = population_view(encoded, encoding);
         let params = PipelineParams {
@@ -179,7 +181,7 @@ pub fn candidates(
                 MethodChoice::VanRossum => index_table(&view, grid),
             });
             let knn_distances = match method {
-                MethodChoice::VanRossum => Some(distance_matrix(&view, encoding, set.tau_ms)?),
+                MethodChoice::VanRossum => Some(van_rossum.matrix(&view, encoding)?),
                 MethodChoice::Features(_) => None,
             };
             let prepare_s = share + start.elapsed().as_secs_f64();
@@ -252,35 +254,63 @@ fn index_table(encoded: &[Encoded], grid: &Grid) -> FeatureTable {
     }
 }
 
-/// The van Rossum distances between every two recordings, over the encoding's populations
-/// (with `sa+fa` the squared distances of the two add, as those of the taxels do).
-fn distance_matrix(
-    encoded: &[Encoded],
-    encoding: Encoding,
-    tau_ms: f64,
-) -> Result<Arc<crate::classify::DistanceMatrix>> {
-    let metric = VanRossumParams { tau_ms }.check()?;
-    let trains = |pick: fn(&Encoded) -> Option<&SpikeTrains>| -> Vec<SpikeTrains> {
-        encoded.iter().filter_map(|e| pick(e).cloned()).collect()
-    };
-    let sa = metric.matrix(&trains(|e| Some(&e.spikes)))?;
-    let fa = trains(|e| e.fa.as_ref());
-    if encoding != Encoding::SaFa {
-        return Ok(Arc::new(sa));
+/// The van Rossum distances between every two recordings of each population, computed
+/// once and shared by the encodings that use it: `sa` and `sa+fa` read the same SA matrix.
+struct PopulationMatrices {
+    metric: VanRossum,
+    /// The first population's matrix (the SA neurons, or the FA neurons of `fa` alone).
+    first: Option<Arc<DistanceMatrix>>,
+    /// The FA population's matrix, as `sa+fa` adds it.
+    fa: Option<Arc<DistanceMatrix>>,
+}
+
+impl PopulationMatrices {
+    fn new(tau_ms: f64) -> Result<Self> {
+        Ok(PopulationMatrices {
+            metric: VanRossumParams { tau_ms }.check()?,
+            first: None,
+            fa: None,
+        })
     }
-    if fa.len() != encoded.len() {
-        let rule = "the sa+fa encoding needs both populations of every recording";
-        return Err(ParamError::new("encodings", rule, "one population").into());
+
+    /// The distances over `encoding`'s populations of `view` (the recordings as
+    /// [`population_view`] gives them): with `sa+fa` the squared distances of the two
+    /// populations add, as those of the taxels do.
+    fn matrix(&mut self, view: &[Encoded], encoding: Encoding) -> Result<Arc<DistanceMatrix>> {
+        let trains = |pick: fn(&Encoded) -> Option<&SpikeTrains>| -> Vec<SpikeTrains> {
+            view.iter().filter_map(|e| pick(e).cloned()).collect()
+        };
+        if encoding == Encoding::Fa {
+            // The view's first population is then the FA one: a matrix of its own.
+            return Ok(Arc::new(self.metric.matrix(&trains(|e| Some(&e.spikes)))?));
+        }
+        let sa = match &self.first {
+            Some(m) => Arc::clone(m),
+            None => {
+                let m = Arc::new(self.metric.matrix(&trains(|e| Some(&e.spikes)))?);
+                self.first.insert(m).clone()
+            }
+        };
+        if encoding != Encoding::SaFa {
+            return Ok(sa);
+        }
+        let fa = match &self.fa {
+            Some(m) => Arc::clone(m),
+            None => {
+                let fa = trains(|e| e.fa.as_ref());
+                if fa.len() != view.len() {
+                    let rule = "the sa+fa encoding needs both populations of every recording";
+                    return Err(ParamError::new("encodings", rule, "one population").into());
+                }
+                self.fa.insert(Arc::new(self.metric.matrix(&fa)?)).clone()
+            }
+        };
+        let values = sa
+            .values()
+            .iter()
+            .zip(fa.values())
+            .map(|(a, b)| (a * a + b * b).sqrt())
+            .collect();
+        Ok(Arc::new(DistanceMatrix::from_values(sa.n(), values)?))
     }
-    let fa = metric.matrix(&fa)?;
-    let n = sa.n();
-    let values = sa
-        .values()
-        .iter()
-        .zip(fa.values())
-        .map(|(a, b)| (a * a + b * b).sqrt())
-        .collect();
-    Ok(Arc::new(crate::classify::DistanceMatrix::from_values(
-        n, values,
-    )?))
 }
