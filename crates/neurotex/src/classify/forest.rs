@@ -379,16 +379,44 @@ impl<'a> Grower<'a> {
         best
     }
 
-    /// Walks the sorted `keys` of `feature`, moving samples left one at a time, and keeps
-    /// in `best` every split position that beats it.
+    /// Walks the sorted `keys` of `feature`, moving samples left one at a time, and puts
+    /// the feature's best split position in `best` where it beats it.
+    ///
+    /// The feature's own best is the first position of its largest proxy (a later equal
+    /// one does not beat a split on the same feature), which beats `best` exactly when
+    /// some position would have beaten it one at a time. Its proxies are compared in
+    /// 64-bit integers when the node's weight keeps every product below 2^64 (a proxy's
+    /// numerator is below `total³` and its denominator below `total²`), else in 128 bits:
+    /// exact either way, so the choice is the same.
     fn scan(&mut self, feature: usize, best: &mut Option<Candidate>) {
+        let total: u64 = self.counts.iter().sum();
+        let found = if total < 1 << 12 {
+            self.scan_in::<u64>(feature, total)
+        } else {
+            self.scan_in::<u128>(feature, total)
+        };
+        if let Some(candidate) = found {
+            if candidate.beats(best) {
+                *best = Some(candidate);
+            }
+        }
+    }
+
+    /// [`Grower::scan`]'s walk, the proxies compared in `T`; the feature's best position.
+    #[inline(always)]
+    fn scan_in<T>(&mut self, feature: usize, total: u64) -> Option<Candidate>
+    where
+        T: Copy + Ord + From<u64> + std::ops::Mul<Output = T> + std::ops::Add<Output = T>,
+    {
         let min_leaf = self.growth.min_leaf;
         let m = self.keys.len();
         self.left.fill(0);
-        let total: u64 = self.counts.iter().sum();
         let mut sq_left = 0u64;
         let mut sq_right: u64 = self.counts.iter().map(|&c| c * c).sum();
         let mut w_left = 0u64;
+        // The best proxy so far: its numerator and denominator in `T`, and the position
+        // with its sums (`sq_left`, `sq_right`, `w_left`).
+        let mut top: Option<(T, T, usize, [u64; 3])> = None;
         for p in 0..m - min_leaf {
             let s = (self.keys[p] & 0xffff_ffff) as usize;
             let (c, w) = (self.data.y[s], self.weight[s]);
@@ -401,18 +429,22 @@ impl<'a> Grower<'a> {
                 continue;
             }
             let w_right = total - w_left;
-            let candidate = Candidate {
-                num: u128::from(sq_left) * u128::from(w_right)
-                    + u128::from(sq_right) * u128::from(w_left),
-                den: u128::from(w_left) * u128::from(w_right),
-                feature,
-                n_left: p + 1,
-                rank: (self.keys[p] >> 32) as u32,
-            };
-            if candidate.beats(best) {
-                *best = Some(candidate);
+            let num = T::from(sq_left) * T::from(w_right) + T::from(sq_right) * T::from(w_left);
+            let den = T::from(w_left) * T::from(w_right);
+            if top.is_none_or(|(n, d, _, _)| num * d > n * den) {
+                top = Some((num, den, p, [sq_left, sq_right, w_left]));
             }
         }
+        let (_, _, p, [sq_left, sq_right, w_left]) = top?;
+        let w_right = total - w_left;
+        Some(Candidate {
+            num: u128::from(sq_left) * u128::from(w_right)
+                + u128::from(sq_right) * u128::from(w_left),
+            den: u128::from(w_left) * u128::from(w_right),
+            feature,
+            n_left: p + 1,
+            rank: (self.keys[p] >> 32) as u32,
+        })
     }
 
     /// Moves the node's samples that go left (rank on `best`'s feature at most its rank)
