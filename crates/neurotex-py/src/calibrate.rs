@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use neurotex::calibrate::{calibrate_gain, GainCalibration};
-use neurotex::causal::{calibrate_conditioning, ConditioningCalibration};
+use neurotex::calibrate::{calibrate_pipeline, GainCalibration};
+use neurotex::causal::ConditioningCalibration;
 use neurotex::pipeline::Pipeline;
 use neurotex::recording::{Baseline, Recording};
 use pyo3::prelude::*;
@@ -49,11 +49,9 @@ pub fn json<T: Serialize>(value: &Option<T>) -> PyResult<Option<String>> {
         .transpose()
 }
 
-/// The pipeline the stage options name; with `causal`, each taxel's resting value and
-/// one scale fixed on the recordings `indices` (read by `load`); with `gain="auto"`, the
-/// gain calibrated on them too, on the causally conditioned signal when both are asked
-/// for. The CLI's commands calibrate the same way (`calibrated_pipeline`), so the same
-/// recordings give the same pipeline.
+/// The pipeline the stage options name, calibrated on the recordings `indices` (read by
+/// `load`) as the library's [`calibrate_pipeline`] does: what the CLI's commands calibrate
+/// too, so the same recordings give the same pipeline.
 ///
 /// # Errors
 /// No recording, one that cannot be read or conditioned, no signal to calibrate on.
@@ -63,28 +61,12 @@ pub fn calibrated(
     indices: &[usize],
     baseline: Baseline,
 ) -> neurotex::Result<Calibrated> {
-    let mut params = stages.params.clone();
-    let causal = match stages.causal {
-        true => {
-            let c = calibrate_conditioning(&params, load, indices, baseline)?;
-            params.preprocess.causal = Some(c.conditioning.clone());
-            Some(c)
-        }
-        false => None,
-    };
-    let gain = match stages.gain_target() {
-        Some(target_hz) => {
-            let pipeline = Pipeline::new(params.clone())?;
-            let c = calibrate_gain(&pipeline, load, indices, baseline, target_hz)?;
-            params.encoder.gain = c.gain;
-            Some(c)
-        }
-        None => None,
-    };
+    let params = stages.params.clone();
+    let c = calibrate_pipeline(params, stages.causal, stages.gain, load, indices, baseline)?;
     Ok(Calibrated {
-        pipeline: Pipeline::new(params)?,
-        gain,
-        causal,
+        pipeline: Pipeline::new(c.params)?,
+        gain: c.gain,
+        causal: c.causal,
     })
 }
 

@@ -26,9 +26,10 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::causal::{calibrate_conditioning, ConditioningCalibration};
 use crate::encode::encode;
 use crate::error::{ParamError, Result};
-use crate::pipeline::Pipeline;
+use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recording::{Baseline, Recording};
 use crate::signal::Conditioned;
 
@@ -111,6 +112,57 @@ struct Sample {
     present: Vec<bool>,
     /// Present cells whose input is not zero throughout.
     driven: Vec<usize>,
+}
+
+/// A pipeline's parameters calibrated on training recordings, with what was calibrated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibratedParams {
+    /// The parameters, with the causal conditioning and the gain filled in.
+    pub params: PipelineParams,
+    /// What [`GainChoice::Auto`] chose.
+    pub gain: Option<GainCalibration>,
+    /// What the causal conditioning fixed.
+    pub causal: Option<ConditioningCalibration>,
+}
+
+/// `params` calibrated on the recordings `indices` (read by `load`; labels never read):
+/// with `causal`, each taxel's resting value and one scale fixed on them
+/// ([`calibrate_conditioning`]); with [`GainChoice::Auto`], the gain calibrated on them
+/// too, on the causally conditioned signal when both are asked for. The command line and
+/// the Python package both calibrate here, so the same recordings give the same pipeline.
+///
+/// # Errors
+/// No recording, one that cannot be read or conditioned, or no signal to calibrate on.
+pub fn calibrate_pipeline(
+    mut params: PipelineParams,
+    causal: bool,
+    gain: GainChoice,
+    load: &(dyn Fn(usize) -> Result<Recording> + Sync),
+    indices: &[usize],
+    baseline: Baseline,
+) -> Result<CalibratedParams> {
+    let causal = match causal {
+        true => {
+            let c = calibrate_conditioning(&params, load, indices, baseline)?;
+            params.preprocess.causal = Some(c.conditioning.clone());
+            Some(c)
+        }
+        false => None,
+    };
+    let gain = match gain {
+        GainChoice::Auto { target_hz } => {
+            let pipeline = Pipeline::new(params.clone())?;
+            let c = calibrate_gain(&pipeline, load, indices, baseline, target_hz)?;
+            params.encoder.gain = c.gain;
+            Some(c)
+        }
+        GainChoice::Fixed(_) => None,
+    };
+    Ok(CalibratedParams {
+        params,
+        gain,
+        causal,
+    })
 }
 
 /// Chooses the gain on the recordings `indices` (loaded by `load`, conditioned by

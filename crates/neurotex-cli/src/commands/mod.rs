@@ -14,10 +14,9 @@ pub mod train;
 
 use anyhow::Result;
 use neurotex::analysis::FeatureTable;
-use neurotex::calibrate::{calibrate_gain, GainCalibration};
-use neurotex::causal::{calibrate_conditioning, ConditioningCalibration};
+use neurotex::calibrate::{calibrate_pipeline, CalibratedParams, GainCalibration};
 use neurotex::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
-use neurotex::pipeline::{Encoded, Method, Pipeline, PipelineParams};
+use neurotex::pipeline::{Encoded, Method, Pipeline};
 use neurotex::recording::{one_grid, Dataset};
 use neurotex::{Grid, Speed};
 
@@ -92,54 +91,30 @@ fn encode_all(
     Ok((encoded, grid))
 }
 
-/// The pipeline the options name, calibrated on the training recordings.
-struct Calibrated {
-    /// The parameters, with the causal conditioning and the gain filled in.
-    params: PipelineParams,
-    /// What `--gain auto` chose.
-    gain: Option<GainCalibration>,
-    /// What `--causal` fixed.
-    causal: Option<ConditioningCalibration>,
-}
-
 /// The pipeline the options name; with `--causal`, its resting values and scale fixed on
 /// `dataset`'s recordings `indices` (the training recordings: never a test one); with
-/// `--gain auto`, its gain calibrated on them too. Each choice is said on standard error.
+/// `--gain auto`, its gain calibrated on them too ([`calibrate_pipeline`]). Each choice is
+/// said on standard error.
 fn calibrated_pipeline(
     stages: &StageArgs,
     dataset: &Dataset,
     indices: &[usize],
-) -> Result<Calibrated> {
-    let mut params = stages.pipeline()?;
+) -> Result<CalibratedParams> {
     let baseline = dataset.layout.baseline.unwrap_or_default();
     let load = |i: usize| dataset.load(i);
-    let causal = match stages.causal {
-        true => {
-            let c = calibrate_conditioning(&params, &load, indices, baseline)?;
-            eprintln!(
-                "--causal: forward-only filter; resting values and scale {:.6} fixed on {} training recording(s) (median selected phase {} ms)",
-                c.conditioning.scale, c.recordings, c.median_duration_ms
-            );
-            params.preprocess.causal = Some(c.conditioning.clone());
-            Some(c)
-        }
-        false => None,
-    };
-    let gain = match stages.gain_target() {
-        Some(target_hz) => {
-            let pipeline = Pipeline::new(params.clone())?;
-            let calibration = calibrate_gain(&pipeline, &load, indices, baseline, target_hz)?;
-            say_calibration(&calibration);
-            params.encoder.gain = calibration.gain;
-            Some(calibration)
-        }
-        None => None,
-    };
-    Ok(Calibrated {
-        params,
-        gain,
-        causal,
-    })
+    let (causal, gain) = (stages.causal, stages.gain);
+    let calibrated =
+        calibrate_pipeline(stages.pipeline()?, causal, gain, &load, indices, baseline)?;
+    if let Some(c) = &calibrated.causal {
+        eprintln!(
+            "--causal: forward-only filter; resting values and scale {:.6} fixed on {} training recording(s) (median selected phase {} ms)",
+            c.conditioning.scale, c.recordings, c.median_duration_ms
+        );
+    }
+    if let Some(c) = &calibrated.gain {
+        say_calibration(c);
+    }
+    Ok(calibrated)
 }
 
 /// Says on standard error which gain `--gain auto` chose.
