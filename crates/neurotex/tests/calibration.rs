@@ -1,8 +1,9 @@
 //! `--gain auto`: the chosen gain checked against a plain recomputation of its rule (the
 //! median firing rate over every driven taxel x recording pair, by sorting) at the chosen
-//! gain and at the next smaller 3-digit gain.
+//! gain and at the next smaller 3-digit gain; with causal conditioning, on the causally
+//! conditioned signal.
 
-use neurotex::calibrate::calibrate_gain;
+use neurotex::calibrate::{calibrate_gain, calibrate_pipeline, GainChoice};
 use neurotex::encode::encode;
 use neurotex::error::Result;
 use neurotex::pipeline::{Pipeline, PipelineParams};
@@ -99,4 +100,44 @@ fn training_recordings_only_and_flat_data_refused() {
     let load_flat = |_: usize| -> Result<Recording> { Ok(flat.clone()) };
     let err = calibrate_gain(&pipeline, &load_flat, &[0], Baseline::None, 20.0).unwrap_err();
     assert!(err.to_string().contains("signal"), "{err}");
+}
+
+#[test]
+fn causal_conditioning_is_fixed_first_and_the_gain_calibrated_on_it() {
+    let recs = recordings();
+    let train = [0usize, 1, 3, 5];
+    let load = |i: usize| -> Result<Recording> {
+        assert!(
+            train.contains(&i),
+            "read recording {i} outside the training set"
+        );
+        Ok(recs[i].clone())
+    };
+    let gain = GainChoice::Auto { target_hz: 20.0 };
+    let params = PipelineParams::default();
+    let c = calibrate_pipeline(params, true, gain, &load, &train, Baseline::None).unwrap();
+    let causal = c.causal.as_ref().expect("causal conditioning fixed");
+    assert_eq!(
+        c.params.preprocess.causal.as_ref(),
+        Some(&causal.conditioning)
+    );
+    let g = c.gain.as_ref().expect("gain calibrated");
+    assert_eq!(c.params.encoder.gain, g.gain);
+    // The gain's rule holds on the causally conditioned training recordings.
+    let pipeline = Pipeline::new(c.params.clone()).unwrap();
+    let used: Vec<Recording> = train.iter().map(|&i| recs[i].clone()).collect();
+    let at = median_rate(&pipeline, &used, g.gain);
+    assert!((at - g.median_hz).abs() < 1e-9, "{at} vs {}", g.median_hz);
+    let scale = 10f64.powi(2 - g.gain.log10().floor() as i32);
+    let lower = ((g.gain * scale).round() - 1.0) / scale;
+    assert!(
+        median_rate(&pipeline, &used, lower) < 20.0,
+        "G = {lower} reaches 20 Hz too"
+    );
+    // Without either, the parameters come back as they went in.
+    let fixed = GainChoice::Fixed(8.0);
+    let plain = PipelineParams::default();
+    let none = calibrate_pipeline(plain.clone(), false, fixed, &load, &train, Baseline::None);
+    let none = none.unwrap();
+    assert_eq!((none.params, none.gain, none.causal), (plain, None, None));
 }
