@@ -32,6 +32,7 @@ pub mod recording;
 pub mod report;
 pub mod signal;
 pub mod sim;
+mod simd;
 pub mod stream;
 pub mod values;
 

@@ -8,9 +8,11 @@
 //! needs is exactly what the file holds, and only then lets ndarray-npy read the file.
 
 use std::io::Read;
+use std::mem::MaybeUninit;
 use std::path::Path;
 
 use crate::error::{DataError, Result};
+use crate::simd::avx2_or_plain;
 
 /// Largest header accepted, in bytes. numpy writes a few hundred bytes and itself refuses
 /// headers over 10 000 bytes by default (`max_header_size`); version 1.0 cannot exceed
@@ -130,22 +132,49 @@ pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<V
         bytes.truncate(size);
         bytes.resize(size, 0);
         file.read_exact(bytes).map_err(io)?;
-        let samples = match item {
-            8 => bytes
-                .chunks_exact(8)
-                .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
-                .collect(),
-            _ => bytes
-                .chunks_exact(4)
-                .map(|b| f64::from(f32::from_le_bytes(b.try_into().expect("4 bytes"))))
-                .collect(),
-        };
+        let n = header.elements;
+        let mut samples = Vec::with_capacity(n);
+        let out = &mut samples.spare_capacity_mut()[..n];
+        match item {
+            8 => f64_from_le(bytes, out),
+            _ => f64_from_f32_le(bytes, out),
+        }
+        // SAFETY: both conversions wrote all `n` values (`bytes` holds `n` items).
+        unsafe { samples.set_len(n) };
         // A very large file's buffer is not kept for the thread's next, smaller ones.
         if bytes.capacity() > KEPT_BYTES {
             *bytes = Vec::new();
         }
         Ok(Some(samples))
     })
+}
+
+avx2_or_plain! {
+    /// Little-endian float64 `bytes` into `out`, one sample per 8 bytes.
+    ///
+    /// # Panics
+    /// `bytes` holds fewer than `out.len()` samples.
+    fn f64_from_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) {
+        let items = bytes.as_chunks::<8>().0;
+        assert!(items.len() >= out.len(), "a sample for every output value");
+        for (o, b) in out.iter_mut().zip(items) {
+            o.write(f64::from_le_bytes(*b));
+        }
+    }
+}
+
+avx2_or_plain! {
+    /// Little-endian float32 `bytes` into `out` as float64 (exact), one per 4 bytes.
+    ///
+    /// # Panics
+    /// `bytes` holds fewer than `out.len()` samples.
+    fn f64_from_f32_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) {
+        let items = bytes.as_chunks::<4>().0;
+        assert!(items.len() >= out.len(), "a sample for every output value");
+        for (o, b) in out.iter_mut().zip(items) {
+            o.write(f64::from(f32::from_le_bytes(*b)));
+        }
+    }
 }
 
 /// Reads into `buf` until it is full or the file ends; returns the bytes read.

@@ -20,6 +20,7 @@ use crate::csvlog::{
     csv_error, read_csv_log, ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps,
 };
 use crate::error::{DataError, ParamError, Result};
+use crate::simd::avx2_or_plain;
 use crate::values::{Cell, Grid, Speed};
 
 /// The phase of the protocol a sample belongs to (paper section II-D).
@@ -1146,9 +1147,7 @@ pub fn read_recording_as(
         let message = format!("recording has {n_channels} channels, beyond the limit of {max}");
         return Err(DataError::invalid(path, message).into());
     }
-    // One pass without early exit (it vectorises); the position only for a bad file.
-    let any_bad = raw.iter().fold(false, |bad, v| bad | !v.is_finite());
-    if let Some(pos) = any_bad
+    if let Some(pos) = (!all_finite(&raw))
         .then(|| raw.iter().position(|v| !v.is_finite()))
         .flatten()
     {
@@ -1270,6 +1269,18 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
     drop(bytes);
     let std = array.as_standard_layout().into_owned();
     Ok((shape, std.into_raw_vec_and_offset().0))
+}
+
+avx2_or_plain! {
+    /// Whether every sample is a finite number: one pass without early exit, which
+    /// vectorises (the position of a bad one is sought only for the error).
+    fn all_finite(samples: &[f64]) -> bool {
+        let mut bad = false;
+        for v in samples {
+            bad |= !v.is_finite();
+        }
+        !bad
+    }
 }
 
 /// A CSV recording read as `format` says: its channels, samples and time stamps in seconds.

@@ -2,10 +2,13 @@
 //! baseline removal, resampling to the encoder's 1 kHz, zero-phase Butterworth low-pass
 //! and global-max normalisation.
 
+use std::mem::MaybeUninit;
+
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{Baseline, Phase, Recording};
+use crate::simd::avx2_or_plain;
 
 /// The encoder's sampling rate: one Izhikevich step per millisecond (paper section II-E).
 pub const ENCODER_FS: f64 = 1000.0;
@@ -402,20 +405,7 @@ fn selected_phase(
     let (lo, hi) = (frames.start, frames.end);
     let uniform_1k = uniform_1k(rec);
     let mut samples = if uniform_1k {
-        // The copy of the selected phase, each sample less its cell's resting value.
-        let mut out = Vec::with_capacity((hi - lo) * cells);
-        for frame in rec.samples[lo * cells..hi * cells].chunks_exact(cells) {
-            out.extend(frame.iter().zip(offsets).zip(present).map(
-                |((&s, &o), &p)| {
-                    if p {
-                        s - o
-                    } else {
-                        0.0
-                    }
-                },
-            ));
-        }
-        out
+        less_offsets(&rec.samples[lo * cells..hi * cells], offsets, present)
     } else {
         let span = times[hi - 1] - times[lo];
         if resampled_len(span, ENCODER_FS, cells).is_none() {
@@ -445,6 +435,48 @@ fn selected_phase(
         }
     }
     Ok(samples)
+}
+
+/// A copy of frame-major `samples`, each less its cell's resting value (`offsets`) and
+/// the cells not `present` 0.
+fn less_offsets(samples: &[f64], offsets: &[f64], present: &[bool]) -> Vec<f64> {
+    // The mask keeps a present cell's bits and clears an absent one's to +0: a choice
+    // without a branch, so the copy vectorises.
+    let keep: Vec<u64> = present
+        .iter()
+        .map(|&p| if p { u64::MAX } else { 0 })
+        .collect();
+    let n = match offsets.len() {
+        0 => return Vec::new(),
+        cells => samples.len() / cells * cells,
+    };
+    let mut out = Vec::with_capacity(n);
+    copy_less_offsets(samples, offsets, &keep, &mut out.spare_capacity_mut()[..n]);
+    // SAFETY: the pass wrote every one of the `n` values (whole frames of `samples`).
+    unsafe { out.set_len(n) };
+    out
+}
+
+avx2_or_plain! {
+    /// [`less_offsets`]' pass: each frame of `samples` less `offsets`, masked by `keep`,
+    /// into `out`.
+    ///
+    /// # Panics
+    /// `out` is not whole frames of `samples`, or `keep` not one mask per cell.
+    fn copy_less_offsets(
+        samples: &[f64],
+        offsets: &[f64],
+        keep: &[u64],
+        out: &mut [MaybeUninit<f64>],
+    ) {
+        let cells = offsets.len();
+        assert!(keep.len() == cells && out.len().is_multiple_of(cells) && out.len() <= samples.len());
+        for (frame, into) in samples.chunks_exact(cells).zip(out.chunks_exact_mut(cells)) {
+            for (((o, &s), &r), &k) in into.iter_mut().zip(frame).zip(offsets).zip(keep) {
+                o.write(f64::from_bits((s - r).to_bits() & k));
+            }
+        }
+    }
 }
 
 /// A recording conditioned for the encoder: `n_steps x cells` samples at 1 kHz, in `[.., 1]`.
@@ -584,43 +616,38 @@ pub fn normalise_global_max(samples: &mut [f64]) -> bool {
     }
 }
 
-/// The largest of `samples` (finite numbers; -inf for none): eight running maxima, which
-/// vectorise where one fold through `f64::max` is a chain of dependent comparisons. The
-/// largest of a set does not depend on the order it is sought in (a maximum of 0 may come
-/// out as -0, which compares equal).
-fn largest(samples: &[f64]) -> f64 {
-    let mut lanes = [f64::NEG_INFINITY; 8];
-    let chunks = samples.chunks_exact(8);
-    for &x in chunks.remainder() {
-        lanes[0] = if x > lanes[0] { x } else { lanes[0] };
-    }
-    for chunk in chunks {
-        for (m, &x) in lanes.iter_mut().zip(chunk) {
-            *m = if x > *m { x } else { *m };
+avx2_or_plain! {
+    /// The largest of `samples` (finite numbers; -inf for none): eight running maxima,
+    /// which vectorise where one fold through `f64::max` is a chain of dependent
+    /// comparisons. The largest of a set does not depend on the order it is sought in (a
+    /// maximum of 0 may come out as -0, which compares equal).
+    fn largest(samples: &[f64]) -> f64 {
+        let mut lanes = [f64::NEG_INFINITY; 8];
+        let chunks = samples.chunks_exact(8);
+        for &x in chunks.remainder() {
+            lanes[0] = if x > lanes[0] { x } else { lanes[0] };
         }
+        for chunk in chunks {
+            for (m, &x) in lanes.iter_mut().zip(chunk) {
+                *m = if x > *m { x } else { *m };
+            }
+        }
+        let mut top = f64::NEG_INFINITY;
+        for m in lanes {
+            top = top.max(m);
+        }
+        top
     }
-    lanes.into_iter().fold(f64::NEG_INFINITY, f64::max)
 }
 
-/// Divides every sample by `by` (correctly rounded in any vector width, so the same bits
-/// as one division at a time); AVX2's four lanes where the processor has them.
-fn divide_all(samples: &mut [f64], by: f64) {
-    #[inline(always)]
-    fn divide(samples: &mut [f64], by: f64) {
-        samples.iter_mut().for_each(|s| *s /= by);
-    }
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx2")]
-        unsafe fn divide_avx2(samples: &mut [f64], by: f64) {
-            divide(samples, by);
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2, checked just above.
-            return unsafe { divide_avx2(samples, by) };
+avx2_or_plain! {
+    /// Divides every sample by `by` (correctly rounded in any vector width, so the same
+    /// bits as one division at a time).
+    fn divide_all(samples: &mut [f64], by: f64) {
+        for s in samples {
+            *s /= by;
         }
     }
-    divide(samples, by);
 }
 
 /// Each sample's time in s from the recording's first: its time stamps less the first, or
@@ -799,6 +826,49 @@ mod tests {
         assert_eq!(resampled_len(1e15, 1000.0, usize::MAX / 2), None);
         assert_eq!(resampled_len(f64::INFINITY, 1000.0, 1), None);
         assert_eq!(resampled_len(f64::NAN, 1000.0, 1), None);
+    }
+
+    /// The masked copy less offsets, the maximum and the division equal their one-value-
+    /// at-a-time definitions bit for bit (whichever instruction set runs them), a frame
+    /// remainder of the maximum's eight lanes included.
+    #[test]
+    fn whole_array_passes_are_their_scalar_definitions() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0
+        };
+        for (n, cells) in [(1, 1), (3, 5), (13, 16), (7, 3)] {
+            let x: Vec<f64> = (0..n * cells).map(|_| next()).collect();
+            let mut offsets: Vec<f64> = (0..cells).map(|_| next()).collect();
+            // A sample equal to its offset (difference +0) and a negative difference.
+            offsets[0] = x[0];
+            let present: Vec<bool> = (0..cells).map(|c| c % 3 != 1).collect();
+            let got = less_offsets(&x, &offsets, &present);
+            let want: Vec<f64> = x
+                .iter()
+                .enumerate()
+                .map(|(i, &s)| match present[i % cells] {
+                    true => s - offsets[i % cells],
+                    false => 0.0,
+                })
+                .collect();
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "copy, {n} frames of {cells}");
+            let top = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            assert_eq!(largest(&x), top, "maximum, {n} frames of {cells}");
+            let mut divided = x.clone();
+            divide_all(&mut divided, 0.37);
+            let want: Vec<f64> = x.iter().map(|v| v / 0.37).collect();
+            assert_eq!(
+                bits(&divided),
+                bits(&want),
+                "division, {n} frames of {cells}"
+            );
+        }
+        assert!(less_offsets(&[1.0], &[], &[]).is_empty());
     }
 
     /// The channels filtered side by side equal each channel filtered alone, bit for bit
