@@ -828,18 +828,22 @@ mod tests {
         assert_eq!(resampled_len(f64::NAN, 1000.0, 1), None);
     }
 
+    /// Numbers spread over `[lo, hi)` from a xorshift generator seeded with `state`.
+    fn uniform(mut state: u64, lo: f64, hi: f64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * (hi - lo) + lo
+        }
+    }
+
     /// The masked copy less offsets, the maximum and the division equal their one-value-
     /// at-a-time definitions bit for bit (whichever instruction set runs them), a frame
     /// remainder of the maximum's eight lanes included.
     #[test]
     fn whole_array_passes_are_their_scalar_definitions() {
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0
-        };
+        let mut next = uniform(0x9E37_79B9_7F4A_7C15, -3.0, 3.0);
         for (n, cells) in [(1, 1), (3, 5), (13, 16), (7, 3)] {
             let x: Vec<f64> = (0..n * cells).map(|_| next()).collect();
             let mut offsets: Vec<f64> = (0..cells).map(|_| next()).collect();
@@ -876,13 +880,7 @@ mod tests {
     #[test]
     fn frames_filter_as_each_channel_alone() {
         let f = Butterworth2::lowpass(ENCODER_FS, 50.0).unwrap();
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 1.0
-        };
+        let mut next = uniform(0x2545_F491_4F6C_DD1D, -1.0, 3.0);
         for (n, cells) in [
             (1, 3),
             (2, 1),
