@@ -15,9 +15,9 @@ use serde::{Deserialize, Serialize};
 
 use super::tables::cv_at;
 use super::{compare_shares, Comparison, Context, E5Speed, Skip, Stop};
-use crate::analysis::{Columns, FeatureTable, Outcome};
+use crate::analysis::{Columns, FeatureTable, OutOfFold, Outcome};
 use crate::causal::{ConditioningCalibration, Decider, DecisionRule};
-use crate::classify::{Classifier, Interval, Predict};
+use crate::classify::{Classifier, Interval, Knn, KnnModel, Predict};
 use crate::error::Result;
 use crate::pipeline::{Encoded, FeatureExtractor, Method};
 use crate::values::{BySpeed, Speed};
@@ -159,11 +159,7 @@ pub fn e5_causal(
 /// The causal evaluation at `speed`: whole slides by E1's cross-validation, then every
 /// test recording's growing window classified at each bin by its fold's classifier.
 pub(crate) fn speed_run(c: &Context, speed: Speed, rule: DecisionRule) -> Result<SpeedRun> {
-    let causal = c.prepared.causal.as_ref().map(|p| &p.encoded);
-    let (rows, encoded): (Vec<usize>, Vec<&Encoded>) = (0..c.prepared.encoded.len())
-        .filter(|&i| c.prepared.encoded[i].meta.speed() == Some(speed))
-        .filter_map(|i| causal.and_then(|all| all[i].as_ref()).map(|e| (i, e)))
-        .unzip();
+    let (rows, encoded) = speed_recordings(c, speed);
     let extractor = extractor(c, &encoded)?;
     let owned: Vec<Encoded> = encoded.iter().map(|&e| e.clone()).collect();
     let table = FeatureTable::build(&owned, &extractor, Method::Glcm3d)?;
@@ -175,8 +171,45 @@ pub(crate) fn speed_run(c: &Context, speed: Speed, rule: DecisionRule) -> Result
         c.params.folds(),
     )?;
     let bin = c.params.pipeline.volume.bin_ms;
-    // Each recording's features at every bin boundary of its slide so far.
-    let windows: Vec<Vec<f64>> = owned
+    let windows = growing_windows(&owned, &extractor, bin)?;
+    let labels = outcome.labels.clone();
+    let truth = classes(&table, &labels);
+    let episodes = Episodes {
+        knn: c.params.knn(),
+        table: &table,
+        truth: &truth,
+        windows: &windows,
+        bin,
+        rule,
+    };
+    let traces = episodes.every_repeat(outcome.predictions.as_deref().unwrap_or_default())?;
+    Ok(SpeedRun {
+        labels,
+        rows,
+        outcome,
+        steps: owned.iter().map(|e| e.spikes.n_steps).collect(),
+        traces,
+    })
+}
+
+/// The rows (in [`super::Prepared::encoded`]) and causal encodings of the recordings at
+/// `speed` that have a causal encoding.
+fn speed_recordings<'a>(c: &Context<'a>, speed: Speed) -> (Vec<usize>, Vec<&'a Encoded>) {
+    let causal = c.prepared.causal.as_ref().map(|p| &p.encoded);
+    (0..c.prepared.encoded.len())
+        .filter(|&i| c.prepared.encoded[i].meta.speed() == Some(speed))
+        .filter_map(|i| causal.and_then(|all| all[i].as_ref()).map(|e| (i, e)))
+        .unzip()
+}
+
+/// Each recording's 3D-GLCM features at every bin boundary of its slide so far, one row
+/// per boundary, end to end.
+fn growing_windows(
+    encoded: &[Encoded],
+    extractor: &FeatureExtractor,
+    bin: usize,
+) -> Result<Vec<Vec<f64>>> {
+    encoded
         .par_iter()
         .map(|e| {
             let ends = (1..=e.spikes.n_steps / bin).map(|b| b * bin);
@@ -185,62 +218,101 @@ pub(crate) fn speed_run(c: &Context, speed: Speed, rule: DecisionRule) -> Result
                 .collect::<Result<Vec<_>>>()?;
             Ok(rows.concat())
         })
-        .collect::<Result<_>>()?;
-    let dims = table.dims();
-    let labels = outcome.labels.clone();
-    let truth: Vec<usize> = table
+        .collect()
+}
+
+/// Each row's class in `table`, as an index into `labels`.
+fn classes(table: &FeatureTable, labels: &[String]) -> Vec<usize> {
+    table
         .metas
         .iter()
         .map(|m| labels.iter().position(|l| *l == m.label).unwrap_or(0))
-        .collect();
-    let predictions = outcome.predictions.as_deref().unwrap_or_default();
-    let repeats = predictions.iter().map(|p| p.repeat + 1).max().unwrap_or(0);
-    let traces: Vec<Vec<Trace>> = (0..repeats)
-        .into_par_iter()
-        .map(|repeat| -> Result<Vec<Trace>> {
-            let mut fold_of = vec![None; owned.len()];
-            for p in predictions.iter().filter(|p| p.repeat == repeat) {
-                fold_of[p.row] = p.fold;
-            }
-            let folds = fold_of.iter().flatten().max().map_or(0, |f| f + 1);
-            let mut traces = Vec::new();
-            for fold in 0..folds {
-                let train: Vec<usize> = (0..owned.len())
-                    .filter(|&i| fold_of[i] != Some(fold))
-                    .collect();
-                let x: Vec<f64> = train.iter().flat_map(|&i| table.row(i)).copied().collect();
-                let y: Vec<usize> = train.iter().map(|&i| truth[i]).collect();
-                let model = c.params.knn().fit(&x, dims, &y)?;
-                for i in (0..owned.len()).filter(|&i| fold_of[i] == Some(fold)) {
-                    let bins: Vec<(usize, f64)> = model
-                        .predict_with_shares(&windows[i])
-                        .into_iter()
-                        .map(|(class, shares)| (class, shares[class]))
-                        .collect();
-                    let mut decider = Decider::new(rule);
-                    for (b, &(class, share)) in bins.iter().enumerate() {
-                        decider.observe(((b + 1) * bin) as f64 / 1000.0, class, share);
-                    }
-                    traces.push(Trace {
-                        recording: i,
-                        repeat,
-                        truth: truth[i],
-                        whole: model.predict(table.row(i))[0],
-                        decision: decider.decision(),
-                        bins,
-                    });
-                }
-            }
-            Ok(traces)
-        })
-        .collect::<Result<_>>()?;
-    Ok(SpeedRun {
-        labels,
-        rows,
-        outcome,
-        steps: owned.iter().map(|e| e.spikes.n_steps).collect(),
-        traces: traces.concat(),
-    })
+        .collect()
+}
+
+/// What the folds' classifiers need to trace their test recordings: the whole-slide table,
+/// each recording's class and growing-window features, the bin and the decision rule.
+struct Episodes<'a> {
+    /// The classifier trained in each fold.
+    knn: &'a Knn,
+    /// The whole-slide features, one row per recording.
+    table: &'a FeatureTable,
+    /// Each recording's class.
+    truth: &'a [usize],
+    /// Each recording's features at every bin boundary ([`growing_windows`]).
+    windows: &'a [Vec<f64>],
+    /// The bin, ms.
+    bin: usize,
+    /// The decision rule.
+    rule: DecisionRule,
+}
+
+impl Episodes<'_> {
+    /// Every test recording's trace in each CV repeat of `predictions`, repeat by repeat.
+    fn every_repeat(&self, predictions: &[OutOfFold]) -> Result<Vec<Trace>> {
+        let repeats = predictions.iter().map(|p| p.repeat + 1).max().unwrap_or(0);
+        let traces: Vec<Vec<Trace>> = (0..repeats)
+            .into_par_iter()
+            .map(|repeat| self.repeat(predictions, repeat))
+            .collect::<Result<_>>()?;
+        Ok(traces.concat())
+    }
+
+    /// The test recordings' traces in one CV repeat, fold by fold.
+    fn repeat(&self, predictions: &[OutOfFold], repeat: usize) -> Result<Vec<Trace>> {
+        let mut fold_of = vec![None; self.windows.len()];
+        for p in predictions.iter().filter(|p| p.repeat == repeat) {
+            fold_of[p.row] = p.fold;
+        }
+        let folds = fold_of.iter().flatten().max().map_or(0, |f| f + 1);
+        let mut traces = Vec::new();
+        for fold in 0..folds {
+            traces.extend(self.fold(&fold_of, fold, repeat)?);
+        }
+        Ok(traces)
+    }
+
+    /// Trains on the recordings outside `fold` and traces the recordings in it.
+    fn fold(&self, fold_of: &[Option<usize>], fold: usize, repeat: usize) -> Result<Vec<Trace>> {
+        let recordings = 0..fold_of.len();
+        let train: Vec<usize> = recordings
+            .clone()
+            .filter(|&i| fold_of[i] != Some(fold))
+            .collect();
+        let x: Vec<f64> = train
+            .iter()
+            .flat_map(|&i| self.table.row(i))
+            .copied()
+            .collect();
+        let y: Vec<usize> = train.iter().map(|&i| self.truth[i]).collect();
+        let model = self.knn.fit(&x, self.table.dims(), &y)?;
+        Ok(recordings
+            .filter(|&i| fold_of[i] == Some(fold))
+            .map(|i| self.trace(&model, i, repeat))
+            .collect())
+    }
+
+    /// One test recording's class at every bin boundary, its whole-slide class and its
+    /// decision, by its fold's `model`.
+    fn trace(&self, model: &KnnModel, recording: usize, repeat: usize) -> Trace {
+        let bins: Vec<(usize, f64)> = model
+            .predict_with_shares(&self.windows[recording])
+            .into_iter()
+            .map(|(class, shares)| (class, shares[class]))
+            .collect();
+        let mut decider = Decider::new(self.rule);
+        for (b, &(class, share)) in bins.iter().enumerate() {
+            decider.observe(((b + 1) * self.bin) as f64 / 1000.0, class, share);
+        }
+        Trace {
+            recording,
+            repeat,
+            truth: self.truth[recording],
+            whole: model.predict(self.table.row(recording))[0],
+            decision: decider.decision(),
+            bins,
+        }
+    }
 }
 
 /// The 3D-GLCM extractor of the causal recordings (SA, the pipeline's volume and GLCM).
@@ -264,106 +336,153 @@ fn summarise(
     rule: DecisionRule,
 ) -> Result<E5CausalSpeed> {
     let bin = c.params.pipeline.volume.bin_ms;
-    let n = run.steps.len();
     let most_bins = run.steps.iter().map(|s| s / bin).max().unwrap_or(0);
     let times_s: Vec<f64> = (1..=most_bins).map(|b| (b * bin) as f64 / 1000.0).collect();
-    let episodes = run.traces.len().max(1) as f64;
-    // A slide that has ended keeps its whole-slide classification.
-    let class_at = |t: &Trace, b: usize| t.bins.get(b - 1).map_or(t.whole, |x| x.0);
-    let accuracy: Vec<f64> = (1..=most_bins)
-        .map(|b| {
-            let right = run.traces.iter().filter(|t| class_at(t, b) == t.truth);
-            right.count() as f64 / episodes
-        })
-        .collect();
-    let sliding: Vec<f64> = (1..=most_bins)
-        .map(|b| run.steps.iter().filter(|&&s| s / bin >= b).count() as f64 / n.max(1) as f64)
-        .collect();
-    let mut durations: Vec<usize> = run.steps.clone();
-    durations.sort_unstable();
-    let median_steps = match n {
-        0 => 0.0,
-        _ if n % 2 == 1 => durations[n / 2] as f64,
-        _ => 0.5 * (durations[n / 2 - 1] + durations[n / 2]) as f64,
-    };
-    let fractions = e5.map_or(Vec::new(), |e5| {
-        e5.fractions
-            .iter()
-            .zip(&e5.glcm3d)
-            .map(|(&p, &offline)| {
-                // The bins the offline E5 keeps of each slide: floor(p n) steps, whole bins.
-                let at = |steps: usize| ((steps as f64) * p).floor() as usize / bin;
-                let causal = match run.steps.iter().any(|&s| at(s) == 0) {
-                    true => None,
-                    false => {
-                        let right = run
-                            .traces
-                            .iter()
-                            .filter(|t| class_at(t, at(run.steps[t.recording])) == t.truth);
-                        Some(right.count() as f64 / episodes)
-                    }
-                };
-                E5cFraction {
-                    fraction: p,
-                    time_s: p * median_steps / 1000.0,
-                    causal,
-                    offline,
-                }
-            })
-            .collect()
-    });
-    let decided: Vec<&Trace> = run.traces.iter().filter(|t| t.decision.is_some()).collect();
-    let mut when: Vec<f64> = decided
-        .iter()
-        .filter_map(|t| t.decision.map(|d| d.1))
-        .collect();
-    when.sort_by(f64::total_cmp);
-    let quantile = |q: f64| when[((when.len() - 1) as f64 * q).round() as usize];
-    let decision = TimeToDecision {
-        rule,
-        episodes: run.traces.len(),
-        decided: decided.len(),
-        never_share: 1.0 - decided.len() as f64 / episodes,
-        accuracy: (!decided.is_empty()).then(|| {
-            let right = decided
-                .iter()
-                .filter(|t| t.decision.map(|d| d.0) == Some(t.truth));
-            right.count() as f64 / decided.len() as f64
-        }),
-        quartiles_s: (!when.is_empty()).then(|| [quantile(0.25), quantile(0.5), quantile(0.75)]),
-        decided_by: times_s
-            .iter()
-            .map(|&t| when.partition_point(|&w| w <= t + 1e-9) as f64 / episodes)
-            .collect(),
-    };
+    let median_steps = run.median_steps();
+    let fractions = e5.map_or(Vec::new(), |e5| run.fractions(e5, bin, median_steps));
+    let decision = run.time_to_decision(rule, &times_s);
     let offline = &c.tables.at(speed).glcm3d;
-    // The speed's recordings as the tables' rows, so that the pairs are the same recordings.
-    let causal_shares: Vec<(usize, f64)> = run
-        .outcome
-        .correct_shares
-        .iter()
-        .map(|&(i, s)| (run.rows[i], s))
-        .collect();
     let classes = run.labels.len().max(1);
     Ok(E5CausalSpeed {
         calibration,
-        n,
+        n: run.steps.len(),
         chance: 1.0 / classes as f64,
         median_slide_s: median_steps / 1000.0,
         times_s,
-        accuracy,
-        sliding,
+        accuracy: run.accuracy(most_bins),
+        sliding: run.sliding(most_bins, bin),
         fractions,
         whole: run.outcome.accuracy,
         whole_interval: run.outcome.accuracy_interval(c.params.seed)?,
         offline: offline.accuracy,
         offline_vs_causal: compare_shares(
             ("zero-phase 3D-GLCM", &offline.correct_shares),
-            ("causal 3D-GLCM", &causal_shares),
+            ("causal 3D-GLCM", &run.causal_shares()),
             c.params,
         )?,
         decision,
     })
+}
+
+impl Trace {
+    /// The class at bin boundary `b` (from 1); a slide that has ended keeps its whole-slide
+    /// classification.
+    fn class_at(&self, b: usize) -> usize {
+        self.bins.get(b - 1).map_or(self.whole, |x| x.0)
+    }
+}
+
+impl SpeedRun {
+    /// The episodes (recordings x repeats), at least one: the shares' denominator.
+    fn episodes(&self) -> f64 {
+        self.traces.len().max(1) as f64
+    }
+
+    /// The share of episodes classified right at each bin boundary up to `most_bins`.
+    fn accuracy(&self, most_bins: usize) -> Vec<f64> {
+        (1..=most_bins)
+            .map(|b| {
+                let right = self.traces.iter().filter(|t| t.class_at(b) == t.truth);
+                right.count() as f64 / self.episodes()
+            })
+            .collect()
+    }
+
+    /// The share of recordings still sliding at each bin boundary up to `most_bins`.
+    fn sliding(&self, most_bins: usize, bin: usize) -> Vec<f64> {
+        let n = self.steps.len();
+        (1..=most_bins)
+            .map(|b| self.steps.iter().filter(|&&s| s / bin >= b).count() as f64 / n.max(1) as f64)
+            .collect()
+    }
+
+    /// The median slide, steps (0 without recordings).
+    fn median_steps(&self) -> f64 {
+        let n = self.steps.len();
+        let mut durations: Vec<usize> = self.steps.clone();
+        durations.sort_unstable();
+        match n {
+            0 => 0.0,
+            _ if n % 2 == 1 => durations[n / 2] as f64,
+            _ => 0.5 * (durations[n / 2 - 1] + durations[n / 2]) as f64,
+        }
+    }
+
+    /// Causal beside offline at each of `e5`'s shares of the slide.
+    fn fractions(&self, e5: &E5Speed, bin: usize, median_steps: f64) -> Vec<E5cFraction> {
+        e5.fractions
+            .iter()
+            .zip(&e5.glcm3d)
+            .map(|(&p, &offline)| E5cFraction {
+                fraction: p,
+                time_s: p * median_steps / 1000.0,
+                causal: self.accuracy_at_share(p, bin),
+                offline,
+            })
+            .collect()
+    }
+
+    /// The share of episodes classified right at the last bin boundary within share `p` of
+    /// their slide; `None` when some share is shorter than one bin.
+    fn accuracy_at_share(&self, p: f64, bin: usize) -> Option<f64> {
+        // The bins the offline E5 keeps of each slide: floor(p n) steps, whole bins.
+        let at = |steps: usize| ((steps as f64) * p).floor() as usize / bin;
+        match self.steps.iter().any(|&s| at(s) == 0) {
+            true => None,
+            false => {
+                let right = self
+                    .traces
+                    .iter()
+                    .filter(|t| t.class_at(at(self.steps[t.recording])) == t.truth);
+                Some(right.count() as f64 / self.episodes())
+            }
+        }
+    }
+
+    /// The time to decision under `rule`, with the share of episodes decided by each of
+    /// `times_s`.
+    fn time_to_decision(&self, rule: DecisionRule, times_s: &[f64]) -> TimeToDecision {
+        let episodes = self.episodes();
+        let decided: Vec<&Trace> = self
+            .traces
+            .iter()
+            .filter(|t| t.decision.is_some())
+            .collect();
+        let mut when: Vec<f64> = decided
+            .iter()
+            .filter_map(|t| t.decision.map(|d| d.1))
+            .collect();
+        when.sort_by(f64::total_cmp);
+        let quantile = |q: f64| when[((when.len() - 1) as f64 * q).round() as usize];
+        TimeToDecision {
+            rule,
+            episodes: self.traces.len(),
+            decided: decided.len(),
+            never_share: 1.0 - decided.len() as f64 / episodes,
+            accuracy: (!decided.is_empty()).then(|| {
+                let right = decided
+                    .iter()
+                    .filter(|t| t.decision.map(|d| d.0) == Some(t.truth));
+                right.count() as f64 / decided.len() as f64
+            }),
+            quartiles_s: (!when.is_empty())
+                .then(|| [quantile(0.25), quantile(0.5), quantile(0.75)]),
+            decided_by: times_s
+                .iter()
+                .map(|&t| when.partition_point(|&w| w <= t + 1e-9) as f64 / episodes)
+                .collect(),
+        }
+    }
+
+    /// Each recording's share of right whole-slide predictions, keyed by its row in the
+    /// tables, so that the pairs with the zero-phase evaluation are the same recordings.
+    fn causal_shares(&self) -> Vec<(usize, f64)> {
+        self.outcome
+            .correct_shares
+            .iter()
+            .map(|&(i, s)| (self.rows[i], s))
+            .collect()
+    }
 }
 
 #[cfg(test)]
