@@ -417,18 +417,37 @@ fn e5(r: &Results, paper: Option<&Paper>) -> String {
 
 /// E5c: the causal pipeline over time, its time to decision and its cost.
 fn e5c(r: &Results) -> String {
-    use crate::classify::PairedVerdict;
     let Some(first) = r.e5c.values().next() else {
         return String::new();
     };
-    let rule = first.decision.rule;
-    let mut out = format!(
+    let mut out = e5c_intro(first.decision.rule);
+    out += &e5c_whole_slides(r);
+    out += &e5c_shares(r);
+    out += "\n";
+    out + &figure(
+        file::E5C_ACCURACY,
+        "E5c: one line chart per speed of causal and offline 3D-GLCM accuracy against time into the slide",
+        &figures::e5c_accuracy_caption(r),
+    ) + &figure(
+        file::E5C_DECISION,
+        "E5c: one step chart per speed of the share of slides decided against time into the slide",
+        &figures::e5c_decision_caption(r),
+    )
+}
+
+/// E5c's heading and what it measures, with the decision rule's numbers.
+fn e5c_intro(rule: crate::causal::DecisionRule) -> String {
+    format!(
         "## E5c (beyond the paper): online time to recognition\n\n\
          The paper's 3D-GLCM + KNN as a live classifier runs it (`neurotex stream`): causal conditioning (a forward-only low-pass; each taxel's resting value and one normalisation scale fixed per speed on **all of that speed's recordings, labels unused**, rather than inside each training fold: each recording is in some training fold, and fixing them per fold would encode every recording once per fold), trained on whole slides in the folds and repeats of E1, and classifying each test recording at every 200 ms bin boundary from the slide so far. \
          A decision is the first time one class holds at least {} of the vote in {} consecutive bins. \
          The cost of causal processing is E1's zero-phase 3D-GLCM minus the causal one on whole slides, per recording on the same folds (95 % bootstrap interval over recordings; a positive difference is accuracy lost).\n\n",
         rule.share, rule.bins
-    );
+    )
+}
+
+/// E5c's table of whole slides and decisions, one row per speed.
+fn e5c_whole_slides(r: &Results) -> String {
     let mut t = Table::new(vec![
         "speed (mm/s)",
         "recordings (chance %)",
@@ -442,42 +461,53 @@ fn e5c(r: &Results) -> String {
         "decisions right (%)",
     ]);
     for (s, e) in r.e5c.iter() {
-        let c = &e.offline_vs_causal;
-        let verdict = match c.verdict {
-            PairedVerdict::Supported => "causal lower",
-            PairedVerdict::Contradicted => "causal higher",
-            PairedVerdict::NotShown => "no difference shown",
-        };
-        let d = &e.decision;
-        t.row(vec![
-            s.to_string(),
-            format!("{} ({})", e.n, pct(e.chance)),
-            format!(
-                "{:.4} ({} recordings)",
-                e.calibration.conditioning.scale, e.calibration.recordings
-            ),
-            pct(e.offline),
-            format!("{} {}", pct(e.whole), bracket(&e.whole_interval)),
-            format!(
-                "{:+.1} [{:+.1}, {:+.1}], {verdict}",
-                100.0 * c.difference,
-                100.0 * c.lower,
-                100.0 * c.upper
-            ),
-            d.quartiles_s.map_or("-".into(), |q| {
-                format!("{:.1} [{:.1}, {:.1}]", q[1], q[0], q[2])
-            }),
-            format!("{:.1}", e.median_slide_s),
-            format!(
-                "{:.1} ({} of {})",
-                100.0 * d.never_share,
-                d.episodes - d.decided,
-                d.episodes
-            ),
-            d.accuracy.map_or("-".into(), pct),
-        ]);
+        t.row(e5c_whole_slide_row(s, e));
     }
-    out += &t.render();
+    t.render()
+}
+
+/// One speed's row of [`e5c_whole_slides`].
+fn e5c_whole_slide_row(s: Speed, e: &crate::experiments::E5CausalSpeed) -> Vec<String> {
+    use crate::classify::PairedVerdict;
+    let c = &e.offline_vs_causal;
+    let verdict = match c.verdict {
+        PairedVerdict::Supported => "causal lower",
+        PairedVerdict::Contradicted => "causal higher",
+        PairedVerdict::NotShown => "no difference shown",
+    };
+    let d = &e.decision;
+    vec![
+        s.to_string(),
+        format!("{} ({})", e.n, pct(e.chance)),
+        format!(
+            "{:.4} ({} recordings)",
+            e.calibration.conditioning.scale, e.calibration.recordings
+        ),
+        pct(e.offline),
+        format!("{} {}", pct(e.whole), bracket(&e.whole_interval)),
+        format!(
+            "{:+.1} [{:+.1}, {:+.1}], {verdict}",
+            100.0 * c.difference,
+            100.0 * c.lower,
+            100.0 * c.upper
+        ),
+        d.quartiles_s.map_or("-".into(), |q| {
+            format!("{:.1} [{:.1}, {:.1}]", q[1], q[0], q[2])
+        }),
+        format!("{:.1}", e.median_slide_s),
+        format!(
+            "{:.1} ({} of {})",
+            100.0 * d.never_share,
+            d.episodes - d.decided,
+            d.episodes
+        ),
+        d.accuracy.map_or("-".into(), pct),
+    ]
+}
+
+/// E5c's causal against offline accuracy at E5's shares of the slide, with its
+/// explanation; empty when no speed has shares.
+fn e5c_shares(r: &Results) -> String {
     let mut fractions: Vec<f64> = r
         .e5c
         .values()
@@ -485,37 +515,31 @@ fn e5c(r: &Results) -> String {
         .collect();
     fractions.sort_by(f64::total_cmp);
     fractions.dedup();
-    if !fractions.is_empty() {
-        out += "\nCausal against offline at E5's shares of the slide, accuracy (%) as causal / offline: causal classifies each test recording at the last bin boundary within that share of its slide with the whole-slide classifier; the offline E5 trains and tests on that share of every slide, zero-phase (\"short\": some share is shorter than one bin).\n\n";
-        let mut header = vec!["speed (mm/s)".to_string()];
-        header.extend(fractions.iter().map(|p| format!("{:.0} %", 100.0 * p)));
-        let mut t = Table::new(header);
-        for (s, e) in r.e5c.iter() {
-            let mut row = vec![s.to_string()];
-            row.extend(fractions.iter().map(
-                |&p| match e.fractions.iter().find(|f| f.fraction == p) {
+    if fractions.is_empty() {
+        return String::new();
+    }
+    let mut out = "\nCausal against offline at E5's shares of the slide, accuracy (%) as causal / offline: causal classifies each test recording at the last bin boundary within that share of its slide with the whole-slide classifier; the offline E5 trains and tests on that share of every slide, zero-phase (\"short\": some share is shorter than one bin).\n\n".to_string();
+    let mut header = vec!["speed (mm/s)".to_string()];
+    header.extend(fractions.iter().map(|p| format!("{:.0} %", 100.0 * p)));
+    let mut t = Table::new(header);
+    for (s, e) in r.e5c.iter() {
+        let mut row = vec![s.to_string()];
+        row.extend(
+            fractions
+                .iter()
+                .map(|&p| match e.fractions.iter().find(|f| f.fraction == p) {
                     Some(f) => format!(
                         "{} / {}",
                         f.causal.map_or("short".into(), pct),
                         f.offline.map_or("short".into(), pct)
                     ),
                     None => "-".into(),
-                },
-            ));
-            t.row(row);
-        }
-        out += &t.render();
+                }),
+        );
+        t.row(row);
     }
-    out += "\n";
-    out + &figure(
-        file::E5C_ACCURACY,
-        "E5c: one line chart per speed of causal and offline 3D-GLCM accuracy against time into the slide",
-        &figures::e5c_accuracy_caption(r),
-    ) + &figure(
-        file::E5C_DECISION,
-        "E5c: one step chart per speed of the share of slides decided against time into the slide",
-        &figures::e5c_decision_caption(r),
-    )
+    out += &t.render();
+    out
 }
 
 /// The training speeds of an E6 row: "all others" when that is what they are.
