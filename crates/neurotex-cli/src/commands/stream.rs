@@ -278,16 +278,7 @@ fn read_csv(
     out: &mut Output<impl Write>,
     mut pace: Option<Pace>,
 ) -> Result<()> {
-    let format = CsvFormat {
-        header: !args.no_header,
-        delimiter: args.delimiter,
-        time_column: args.time_column.clone(),
-        time_unit: args.time_unit.unwrap_or_default(),
-        detect_time: !args.no_header && args.time_column.is_none(),
-        channels: args.channels.clone().unwrap_or(ChannelSelect::All),
-        ..CsvFormat::default()
-    };
-    let source = PathBuf::from(&args.input);
+    let format = csv_format(args);
     let mut plan: Option<(u8, Columns)> = None;
     let mut fields: Vec<f64> = Vec::new();
     let mut values: Vec<f64> = Vec::new();
@@ -309,46 +300,16 @@ fn read_csv(
         let (delimiter, columns) = match &plan {
             Some(p) => p,
             None => {
-                let delimiter = format.delimiter.map_or_else(|| detect(text), |d| d.byte());
-                let split: Vec<&str> = text.split(delimiter as char).map(str::trim).collect();
-                let names: Vec<String> = match format.header {
-                    true => split.iter().map(|s| s.to_string()).collect(),
-                    false => (0..split.len()).map(|j| format!("column{j}")).collect(),
-                };
-                let columns = Columns::find(&source, &format, names)?;
-                if columns.channels.len() != stream.channels() {
-                    bail!(
-                        "{}: {} channel columns selected, the model has {} taxels",
-                        args.input,
-                        columns.channels.len(),
-                        stream.channels()
-                    );
-                }
-                plan = Some((delimiter, columns));
+                plan = Some(plan_columns(args, &format, text, stream)?);
                 if format.header {
                     continue;
                 }
                 plan.as_ref().expect("just set")
             }
         };
-        fields.clear();
-        let mut parsed = true;
-        for field in text.split(*delimiter as char) {
-            match field.trim().parse::<f64>() {
-                Ok(v) => fields.push(v),
-                Err(_) => {
-                    parsed = false;
-                    break;
-                }
-            }
-        }
         let place = || format!("line {line_no}");
-        if !parsed || fields.len() != columns.names.len() {
+        if let Err(why) = parse_fields(text, *delimiter, columns.names.len(), &mut fields) {
             stream.skip_bad_frame();
-            let why = match parsed {
-                false => "a field is not a number".to_string(),
-                true => format!("{} fields, expected {}", fields.len(), columns.names.len()),
-            };
             eprintln!("warning: {}: bad frame skipped: {why}", place());
             continue;
         }
@@ -359,6 +320,68 @@ fn read_csv(
             p.wait(time_s.unwrap_or(stream.frames() as f64 / args.fs));
         }
         push(stream, out, time_s, &values, &place)?;
+    }
+    Ok(())
+}
+
+/// The CSV format the options describe (time column found by name when there is a header
+/// and no --time-column).
+fn csv_format(args: &StreamArgs) -> CsvFormat {
+    CsvFormat {
+        header: !args.no_header,
+        delimiter: args.delimiter,
+        time_column: args.time_column.clone(),
+        time_unit: args.time_unit.unwrap_or_default(),
+        detect_time: !args.no_header && args.time_column.is_none(),
+        channels: args.channels.clone().unwrap_or(ChannelSelect::All),
+        ..CsvFormat::default()
+    }
+}
+
+/// The delimiter and the columns from the first line (the header, or the first frame),
+/// checked against the model's taxels.
+fn plan_columns(
+    args: &StreamArgs,
+    format: &CsvFormat,
+    text: &str,
+    stream: &StreamClassifier,
+) -> Result<(u8, Columns)> {
+    let source = PathBuf::from(&args.input);
+    let delimiter = format.delimiter.map_or_else(|| detect(text), |d| d.byte());
+    let split: Vec<&str> = text.split(delimiter as char).map(str::trim).collect();
+    let names: Vec<String> = match format.header {
+        true => split.iter().map(|s| s.to_string()).collect(),
+        false => (0..split.len()).map(|j| format!("column{j}")).collect(),
+    };
+    let columns = Columns::find(&source, format, names)?;
+    if columns.channels.len() != stream.channels() {
+        bail!(
+            "{}: {} channel columns selected, the model has {} taxels",
+            args.input,
+            columns.channels.len(),
+            stream.channels()
+        );
+    }
+    Ok((delimiter, columns))
+}
+
+/// Parses a frame's line into `fields`, `expected` numbers split at `delimiter`, or says
+/// why it is a bad frame.
+fn parse_fields(
+    text: &str,
+    delimiter: u8,
+    expected: usize,
+    fields: &mut Vec<f64>,
+) -> std::result::Result<(), String> {
+    fields.clear();
+    for field in text.split(delimiter as char) {
+        match field.trim().parse::<f64>() {
+            Ok(v) => fields.push(v),
+            Err(_) => return Err("a field is not a number".to_string()),
+        }
+    }
+    if fields.len() != expected {
+        return Err(format!("{} fields, expected {expected}", fields.len()));
     }
     Ok(())
 }
