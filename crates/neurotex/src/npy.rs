@@ -12,7 +12,7 @@ use std::mem::MaybeUninit;
 use std::path::Path;
 
 use crate::error::{DataError, Result};
-use crate::simd::avx2_or_plain;
+use crate::simd::widest_or_plain;
 
 /// Largest header accepted, in bytes. numpy writes a few hundred bytes and itself refuses
 /// headers over 10 000 bytes by default (`max_header_size`); version 1.0 cannot exceed
@@ -149,7 +149,8 @@ pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<V
     })
 }
 
-avx2_or_plain! {
+widest_or_plain! {
+    ["avx2"]
     /// Little-endian float64 `bytes` into `out`, one sample per 8 bytes.
     ///
     /// # Panics
@@ -163,7 +164,8 @@ avx2_or_plain! {
     }
 }
 
-avx2_or_plain! {
+widest_or_plain! {
+    ["avx2"]
     /// Little-endian float32 `bytes` into `out` as float64 (exact), one per 4 bytes.
     ///
     /// # Panics

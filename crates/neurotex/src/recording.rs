@@ -20,7 +20,7 @@ use crate::csvlog::{
     csv_error, read_csv_log, ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps,
 };
 use crate::error::{DataError, ParamError, Result};
-use crate::simd::avx2_or_plain;
+use crate::simd::widest_or_plain;
 use crate::values::{Cell, Grid, Speed};
 
 /// The phase of the protocol a sample belongs to (paper section II-D).
@@ -1271,7 +1271,8 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
     Ok((shape, std.into_raw_vec_and_offset().0))
 }
 
-avx2_or_plain! {
+widest_or_plain! {
+    ["avx2"]
     /// Whether every sample is a finite number: one pass without early exit, which
     /// vectorises (the position of a bad one is sought only for the error).
     fn all_finite(samples: &[f64]) -> bool {

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{Baseline, Phase, Recording};
-use crate::simd::avx2_or_plain;
+use crate::simd::widest_or_plain;
 
 /// The encoder's sampling rate: one Izhikevich step per millisecond (paper section II-E).
 pub const ENCODER_FS: f64 = 1000.0;
@@ -261,42 +261,23 @@ impl Butterworth2 {
         backward: bool,
         start: bool,
     ) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            /// The same loops with AVX2's four lanes (no FMA: the same bits).
-            #[target_feature(enable = "avx2")]
-            unsafe fn run_avx2(
-                f: &Butterworth2,
-                x: &mut [f64],
-                cells: usize,
-                z: &mut [Vec<f64>; 2],
-                back: bool,
-                start: bool,
-            ) {
-                run_channels(f, x, cells, z, back, start);
-            }
-            /// The same loops with AVX-512's 32 registers (no FMA: the same bits).
-            #[target_feature(enable = "avx512f")]
-            unsafe fn run_avx512(
-                f: &Butterworth2,
-                x: &mut [f64],
-                cells: usize,
-                z: &mut [Vec<f64>; 2],
-                back: bool,
-                start: bool,
-            ) {
-                run_channels(f, x, cells, z, back, start);
-            }
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                // SAFETY: the CPU supports AVX-512F, checked just above.
-                return unsafe { run_avx512(self, x, cells, state, backward, start) };
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2, checked just above.
-                return unsafe { run_avx2(self, x, cells, state, backward, start) };
-            }
-        }
-        run_channels(self, x, cells, state, backward, start);
+        run_channels_widest(self, x, cells, state, backward, start);
+    }
+}
+
+widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// [`run_channels`] with AVX-512's 32 registers, else AVX2's four lanes, where the
+    /// processor has them (no multiply and add is fused: the same bits).
+    fn run_channels_widest(
+        f: &Butterworth2,
+        x: &mut [f64],
+        cells: usize,
+        z: &mut [Vec<f64>; 2],
+        back: bool,
+        start: bool,
+    ) {
+        run_channels(f, x, cells, z, back, start);
     }
 }
 
@@ -457,7 +438,8 @@ fn less_offsets(samples: &[f64], offsets: &[f64], present: &[bool]) -> Vec<f64> 
     out
 }
 
-avx2_or_plain! {
+widest_or_plain! {
+    ["avx2"]
     /// [`less_offsets`]' pass: each frame of `samples` less `offsets`, masked by `keep`,
     /// into `out`.
     ///
@@ -616,7 +598,8 @@ pub fn normalise_global_max(samples: &mut [f64]) -> bool {
     }
 }
 
-avx2_or_plain! {
+widest_or_plain! {
+    ["avx2"]
     /// The largest of `samples` (finite numbers; -inf for none): eight running maxima,
     /// which vectorise where one fold through `f64::max` is a chain of dependent
     /// comparisons. The largest of a set does not depend on the order it is sought in (a
@@ -640,7 +623,8 @@ avx2_or_plain! {
     }
 }
 
-avx2_or_plain! {
+widest_or_plain! {
+    ["avx2"]
     /// Divides every sample by `by` (correctly rounded in any vector width, so the same
     /// bits as one division at a time).
     fn divide_all(samples: &mut [f64], by: f64) {

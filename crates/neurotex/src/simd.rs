@@ -1,18 +1,28 @@
-//! Whole-array passes compiled twice: as plain code, and with AVX2 enabled for processors
-//! that have it (chosen at run time), so one binary runs on any x86-64 and still uses the
-//! wider vectors where they exist.
+//! Whole-array passes compiled several times: as plain code, and with wider vector
+//! instructions (AVX2, AVX-512) for processors that have them, the widest chosen at run
+//! time, so one binary runs on any x86-64 and still uses the wider vectors where they exist.
 //!
 //! Only passes whose result does not depend on the vector width go through here: copies,
 //! conversions, comparisons, and arithmetic that is exact or correctly rounded one element
-//! at a time (no FMA is enabled, and Rust never fuses a multiply and an add on its own).
-//! Their bodies are plain `for` loops over slices: iterator adaptors that take closures
-//! (`fold`, `for_each`) were seen compiled out of line, without the feature.
+//! at a time (Rust never fuses a multiply and an add on its own, so an FMA unit that a
+//! feature brings along changes nothing). Their bodies are plain `for` loops over slices:
+//! iterator adaptors that take closures (`fold`, `for_each`) were seen compiled out of
+//! line, without the feature.
 
-/// Defines a function whose body is compiled once as plain code and once with AVX2, the
-/// AVX2 copy called where the processor has it. The body must give the same result either
-/// way (see the module documentation).
-macro_rules! avx2_or_plain {
+/// Defines a function whose body is compiled once as plain code and once per listed target
+/// feature, the first listed feature the processor has chosen at run time (list the widest
+/// first). The body must give the same result either way (see the module documentation).
+///
+/// ```ignore
+/// widest_or_plain! {
+///     ["avx512f", "avx2"]
+///     /// Doc comment.
+///     fn name(a: &[f64], b: &mut [f64]) { for .. }
+/// }
+/// ```
+macro_rules! widest_or_plain {
     (
+        [$($feature:tt),+ $(,)?]
         $(#[$meta:meta])*
         $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block
     ) => {
@@ -20,20 +30,27 @@ macro_rules! avx2_or_plain {
         $vis fn $name($($arg: $ty),*) $(-> $ret)? {
             #[inline(always)]
             fn body($($arg: $ty),*) $(-> $ret)? $body
-            #[cfg(target_arch = "x86_64")]
-            {
-                #[target_feature(enable = "avx2")]
-                unsafe fn avx2($($arg: $ty),*) $(-> $ret)? {
-                    body($($arg),*)
-                }
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU supports AVX2, the only feature `avx2` enables.
-                    return unsafe { avx2($($arg),*) };
-                }
-            }
+            $crate::simd::widest_or_plain!(@try [$($feature),+] ($($arg: $ty),*) $(-> $ret)?);
             body($($arg),*)
         }
     };
+    // One feature's copy of `body`, returned from the caller when the processor has it;
+    // then the next feature's.
+    (@try [$feature:tt $(, $rest:tt)*] ($($arg:ident: $ty:ty),*) $(-> $ret:ty)?) => {
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = $feature)]
+            unsafe fn wide($($arg: $ty),*) $(-> $ret)? {
+                body($($arg),*)
+            }
+            if std::arch::is_x86_feature_detected!($feature) {
+                // SAFETY: the CPU supports the feature, the only one `wide` enables.
+                return unsafe { wide($($arg),*) };
+            }
+        }
+        $crate::simd::widest_or_plain!(@try [$($rest),*] ($($arg: $ty),*) $(-> $ret)?);
+    };
+    (@try [] ($($arg:ident: $ty:ty),*) $(-> $ret:ty)?) => {};
 }
 
-pub(crate) use avx2_or_plain;
+pub(crate) use widest_or_plain;
