@@ -233,12 +233,12 @@ impl Butterworth2 {
             right.extend(last.iter().zip(back).map(|(&l, &v)| 2.0 * l - v));
         }
         let mut state = [vec![0.0; cells], vec![0.0; cells]];
-        self.run_frames(&mut left, cells, &mut state, false, true);
-        self.run_frames(x, cells, &mut state, false, false);
-        self.run_frames(&mut right, cells, &mut state, false, false);
-        self.run_frames(&mut right, cells, &mut state, true, true);
-        self.run_frames(x, cells, &mut state, true, false);
-        self.run_frames(&mut left, cells, &mut state, true, false);
+        run_frames(self, &mut left, cells, &mut state, false, true);
+        run_frames(self, x, cells, &mut state, false, false);
+        run_frames(self, &mut right, cells, &mut state, false, false);
+        run_frames(self, &mut right, cells, &mut state, true, true);
+        run_frames(self, x, cells, &mut state, true, false);
+        run_frames(self, &mut left, cells, &mut state, true, false);
     }
 
     /// [`Butterworth2::lfilter`] of every channel of frame-major samples, bit for bit, the
@@ -246,30 +246,19 @@ impl Butterworth2 {
     pub fn lfilter_frames(&self, x: &mut [f64], cells: usize) {
         if x.len() >= cells && cells > 0 {
             let mut state = [vec![0.0; cells], vec![0.0; cells]];
-            self.run_frames(x, cells, &mut state, false, true);
+            run_frames(self, x, cells, &mut state, false, true);
         }
-    }
-
-    /// Runs every channel's filter over the frames of `x` in place, forward or (`backward`)
-    /// from the last frame, from the state in `state` or (`start`) each channel started in
-    /// its steady state for its first value.
-    fn run_frames(
-        &self,
-        x: &mut [f64],
-        cells: usize,
-        state: &mut [Vec<f64>; 2],
-        backward: bool,
-        start: bool,
-    ) {
-        run_channels_widest(self, x, cells, state, backward, start);
     }
 }
 
 widest_or_plain! {
     ["avx512f", "avx2"]
-    /// [`run_channels`] with AVX-512's 32 registers, else AVX2's four lanes, where the
-    /// processor has them (no multiply and add is fused: the same bits).
-    fn run_channels_widest(
+    /// Runs every channel's filter over the frames of `x` in place, forward or (`back`)
+    /// from the last frame, from the state in `z` or (`start`) each channel started in its
+    /// steady state for its first value; compiled with AVX-512's 32 registers, else AVX2's
+    /// four lanes, where the processor has them (no multiply and add is fused: the same
+    /// bits).
+    fn run_frames(
         f: &Butterworth2,
         x: &mut [f64],
         cells: usize,
@@ -277,39 +266,24 @@ widest_or_plain! {
         back: bool,
         start: bool,
     ) {
-        run_channels(f, x, cells, z, back, start);
-    }
-}
-
-/// [`Butterworth2::run_frames`]' loops: every channel's filter over the frames of `x` in
-/// place, forward or (`back`) from the last frame, from the state in `z` or (`start`) each
-/// channel started in its steady state for its first value.
-#[inline(always)]
-fn run_channels(
-    f: &Butterworth2,
-    x: &mut [f64],
-    cells: usize,
-    z: &mut [Vec<f64>; 2],
-    back: bool,
-    start: bool,
-) {
-    let [z0, z1] = z;
-    match cells {
-        4 => run_width::<4>(f, x, [z0, z1], back, start),
-        8 => run_width::<8>(f, x, [z0, z1], back, start),
-        16 => run_width::<16>(f, x, [z0, z1], back, start),
-        _ => {
-            let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
-            let frames = x.chunks_exact_mut(cells);
-            match back {
-                false => {
-                    for (i, frame) in frames.enumerate() {
-                        step_frame(f, frame, z0, z1, start && i == 0);
+        let [z0, z1] = z;
+        match cells {
+            4 => run_width::<4>(f, x, [z0, z1], back, start),
+            8 => run_width::<8>(f, x, [z0, z1], back, start),
+            16 => run_width::<16>(f, x, [z0, z1], back, start),
+            _ => {
+                let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
+                let frames = x.chunks_exact_mut(cells);
+                match back {
+                    false => {
+                        for (i, frame) in frames.enumerate() {
+                            step_frame(f, frame, z0, z1, start && i == 0);
+                        }
                     }
-                }
-                true => {
-                    for (i, frame) in frames.rev().enumerate() {
-                        step_frame(f, frame, z0, z1, start && i == 0);
+                    true => {
+                        for (i, frame) in frames.rev().enumerate() {
+                            step_frame(f, frame, z0, z1, start && i == 0);
+                        }
                     }
                 }
             }
@@ -317,7 +291,7 @@ fn run_channels(
     }
 }
 
-/// [`run_channels`] for frames of exactly `W` cells: the state is held in arrays the
+/// [`run_frames`] for frames of exactly `W` cells: the state is held in arrays the
 /// compiler keeps in registers from frame to frame, where with `cells` known only
 /// at run time it is stored and loaded back every frame, on the chain each frame
 /// waits for.
