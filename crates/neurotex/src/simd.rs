@@ -13,7 +13,7 @@
 /// feature, the first listed feature the processor has chosen at run time (list the widest
 /// first). The body must give the same result either way (see the module documentation).
 ///
-/// ```ignore
+/// ```text
 /// widest_or_plain! {
 ///     ["avx512f", "avx2"]
 ///     /// Doc comment.
