@@ -6,8 +6,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::classify::{
-    bootstrap_mean_share, cross_validate, cross_validate_grouped, train_test, BootstrapParams,
-    Classifier, ConfusionMatrix, Interval, ValidCv,
+    bootstrap_mean_share, cross_validate_sweep, train_test_sweep, BootstrapParams, Classifier,
+    ConfusionMatrix, Evaluation, Interval, Sweep, ValidCv,
 };
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method};
@@ -352,6 +352,27 @@ pub fn evaluate<C: Classifier>(
     split: &Split,
     classifier: &C,
 ) -> Result<Outcome> {
+    let mut each = evaluate_sweep(table, columns, split, classifier)?;
+    each.pop().ok_or_else(|| {
+        ClassifyError::Empty {
+            what: "evaluate: no classifier setting",
+        }
+        .into()
+    })
+}
+
+/// [`evaluate`] of every setting of `sweep` (one outcome each, in its order), each fold
+/// fitted once for all of them: E8's k from one neighbour search
+/// ([`KnnSweep`](crate::classify::KnnSweep)).
+///
+/// # Errors
+/// As [`evaluate`].
+pub fn evaluate_sweep<C: Sweep>(
+    table: &FeatureTable,
+    columns: Columns,
+    split: &Split,
+    sweep: &C,
+) -> Result<Vec<Outcome>> {
     let groups = column_groups(&table.grid, table.dims(), columns)?;
     let (train_rows, test_rows) = split_rows(table, split)?;
     if train_rows.is_empty() {
@@ -370,32 +391,22 @@ pub fn evaluate<C: Classifier>(
         } => Some(group_indices(table, &train_rows, column)?),
         _ => None,
     };
-    let results: Vec<GroupResult> = groups
+    // Per column group, each setting's evaluation.
+    let results: Vec<Vec<Evaluation>> = groups
         .par_iter()
-        .map(|(cell, cols)| -> Result<GroupResult> {
+        .map(|(_, cols)| -> Result<Vec<Evaluation>> {
             let x_train = table.select(&train_rows, cols);
-            let evaluation = match split {
-                Split::CrossValidation {
-                    cv,
-                    group_by: Some(_),
-                    ..
-                } => {
-                    let groups = row_groups.as_deref().unwrap_or_default();
-                    let d = cols.len();
-                    cross_validate_grouped(classifier, &x_train, d, y_train, &labels, *cv, groups)?
-                }
+            let d = cols.len();
+            Ok(match split {
                 Split::CrossValidation { cv, .. } => {
-                    cross_validate(classifier, &x_train, cols.len(), y_train, &labels, *cv)?
+                    let groups = row_groups.as_deref();
+                    cross_validate_sweep(sweep, (&x_train, d), y_train, &labels, *cv, groups)?
                 }
                 Split::Where { .. } | Split::Rows { .. } => {
                     let x_test = table.select(&test_rows, cols);
                     let (train, test) = ((&x_train[..], y_train), (&x_test[..], y_test));
-                    train_test(classifier, train, test, cols.len(), &labels)?
+                    train_test_sweep(sweep, train, test, d, &labels)?
                 }
-            };
-            Ok(GroupResult {
-                cell: *cell,
-                evaluation,
             })
         })
         .collect::<Result<_>>()?;
@@ -403,20 +414,41 @@ pub fn evaluate<C: Classifier>(
         Split::CrossValidation { .. } => &train_rows,
         _ => &test_rows,
     };
-    let predictions = match &results[..] {
-        [one] => Some(OutOfFold::of(&one.evaluation, evaluated)),
-        _ => None,
-    };
     let truth = match split {
         Split::CrossValidation { .. } => y_train,
         _ => y_test,
     };
-    let correct_shares = correct_shares(&results, evaluated, truth);
-    Ok(Outcome {
-        predictions,
-        correct_shares,
-        ..combine(results, labels, columns == Columns::EachTaxel, &table.grid)
-    })
+    let settings = results.first().map_or(0, Vec::len);
+    let mut by_group: Vec<_> = results.into_iter().map(Vec::into_iter).collect();
+    let outcomes = (0..settings).map(|_| {
+        let results: Vec<GroupResult> = groups
+            .iter()
+            .zip(by_group.iter_mut())
+            .filter_map(|((cell, _), each)| {
+                let evaluation = each.next()?;
+                Some(GroupResult {
+                    cell: *cell,
+                    evaluation,
+                })
+            })
+            .collect();
+        let predictions = match &results[..] {
+            [one] => Some(OutOfFold::of(&one.evaluation, evaluated)),
+            _ => None,
+        };
+        let correct_shares = correct_shares(&results, evaluated, truth);
+        Outcome {
+            predictions,
+            correct_shares,
+            ..combine(
+                results,
+                labels.clone(),
+                columns == Columns::EachTaxel,
+                &table.grid,
+            )
+        }
+    });
+    Ok(outcomes.collect())
 }
 
 /// The rows `split` trains (or cross-validates) on and the rows it tests on.

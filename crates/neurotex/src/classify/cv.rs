@@ -6,7 +6,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{Classifier, ConfusionMatrix, Predict};
+use super::{Classifier, ConfusionMatrix, Sweep, SweepModel};
 use crate::error::{ClassifyError, ParamError};
 
 /// Largest number of repeats (CV shuffles, E3 draws) accepted; beyond it a run would take
@@ -181,7 +181,21 @@ pub fn predict_out_of_fold<C: Classifier>(
     fold_of: &[usize],
     folds: usize,
 ) -> Result<Vec<usize>, ClassifyError> {
-    let mut predicted = vec![0usize; y.len()];
+    let mut each = out_of_fold_sweep(classifier, (x, dims), y, fold_of, folds)?;
+    // No fold tested anything (fold numbers past `folds`): every prediction stays 0.
+    Ok(each.pop().unwrap_or_else(|| vec![0; y.len()]))
+}
+
+/// Out-of-fold predictions of every setting of `sweep` under a given fold assignment, one
+/// fit per fold.
+fn out_of_fold_sweep<C: Sweep>(
+    sweep: &C,
+    (x, dims): (&[f64], usize),
+    y: &[usize],
+    fold_of: &[usize],
+    folds: usize,
+) -> Result<Vec<Vec<usize>>, ClassifyError> {
+    let mut predicted: Vec<Vec<usize>> = Vec::new();
     let (mut xtr, mut ytr, mut xte, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for fold in 0..folds {
         xtr.clear();
@@ -201,9 +215,14 @@ pub fn predict_out_of_fold<C: Classifier>(
         if idx.is_empty() {
             continue;
         }
-        let model = classifier.fit(&xtr, dims, &ytr)?;
-        for (&i, p) in idx.iter().zip(model.predict(&xte)) {
-            predicted[i] = p;
+        let model = sweep.fit_sweep(&xtr, dims, &ytr)?;
+        for (s, setting) in model.predict_sweep(&xte).into_iter().enumerate() {
+            if s == predicted.len() {
+                predicted.push(vec![0usize; y.len()]);
+            }
+            for (&i, p) in idx.iter().zip(setting) {
+                predicted[s][i] = p;
+            }
         }
     }
     Ok(predicted)
@@ -223,7 +242,14 @@ pub fn cross_validate<C: Classifier>(
     class_names: &[String],
     cv: ValidCv,
 ) -> Result<Evaluation, ClassifyError> {
-    cross_validate_with(classifier, (x, dims), y, class_names, cv, None)
+    single(cross_validate_sweep(
+        classifier,
+        (x, dims),
+        y,
+        class_names,
+        cv,
+        None,
+    ))
 }
 
 /// Cross-validation whose folds never split a group: `groups[i]` is sample `i`'s group
@@ -243,11 +269,22 @@ pub fn cross_validate_grouped<C: Classifier>(
     cv: ValidCv,
     groups: &[usize],
 ) -> Result<Evaluation, ClassifyError> {
-    if groups.len() != y.len() {
-        let message = format!("{} groups for {} samples", groups.len(), y.len());
-        return Err(ClassifyError::BadFeatures(message));
-    }
-    cross_validate_with(classifier, (x, dims), y, class_names, cv, Some(groups))
+    single(cross_validate_sweep(
+        classifier,
+        (x, dims),
+        y,
+        class_names,
+        cv,
+        Some(groups),
+    ))
+}
+
+/// The one evaluation of a classifier's sweep.
+fn single(each: Result<Vec<Evaluation>, ClassifyError>) -> Result<Evaluation, ClassifyError> {
+    let mut each = each?;
+    each.pop().ok_or(ClassifyError::Empty {
+        what: "evaluate: no classifier setting",
+    })
 }
 
 /// Assigns each sample a fold so that no group is split (see [`cross_validate_grouped`]);
@@ -273,23 +310,30 @@ pub fn group_folds(groups: &[usize], folds: usize, seed: u64) -> (Vec<usize>, us
     (groups.iter().map(|&g| fold_of_group[g]).collect(), folds)
 }
 
-fn cross_validate_with<C: Classifier>(
-    classifier: &C,
+/// [`cross_validate`] of every setting of `sweep` (one evaluation each, in its order),
+/// grouped by `groups` as [`cross_validate_grouped`] when given; each fold is fitted once.
+///
+/// # Errors
+/// As [`cross_validate_grouped`].
+pub fn cross_validate_sweep<C: Sweep>(
+    sweep: &C,
     (x, dims): (&[f64], usize),
     y: &[usize],
     class_names: &[String],
     cv: ValidCv,
     groups: Option<&[usize]>,
-) -> Result<Evaluation, ClassifyError> {
+) -> Result<Vec<Evaluation>, ClassifyError> {
+    if let Some(groups) = groups.filter(|g| g.len() != y.len()) {
+        let message = format!("{} groups for {} samples", groups.len(), y.len());
+        return Err(ClassifyError::BadFeatures(message));
+    }
     if y.is_empty() {
         return Err(ClassifyError::Empty {
             what: "cross-validate",
         });
     }
     let n_classes = class_names.len().max(y.iter().max().map_or(0, |&m| m + 1));
-    let mut per_repeat = Vec::with_capacity(cv.repeats);
-    let mut predictions = Vec::with_capacity(cv.repeats);
-    let mut confusion = ConfusionMatrix::zeros(n_classes);
+    let mut settings: Vec<Repeats> = Vec::new();
     for r in 0..cv.repeats {
         let seed = cv.seed.wrapping_add(r as u64);
         let (fold_of, folds) = match groups {
@@ -299,21 +343,47 @@ fn cross_validate_with<C: Classifier>(
                 cv.folds,
             ),
         };
-        let predicted = predict_out_of_fold(classifier, x, dims, y, &fold_of, folds)?;
-        let matrix = ConfusionMatrix::from_predictions(y, &predicted, n_classes);
-        per_repeat.push(matrix.accuracy());
-        confusion.add(&matrix);
-        predictions.push(RepeatPredictions {
-            fold_of: Some(fold_of),
-            predicted,
-        });
+        let each = out_of_fold_sweep(sweep, (x, dims), y, &fold_of, folds)?;
+        for (s, predicted) in each.into_iter().enumerate() {
+            if s == settings.len() {
+                settings.push(Repeats::new(n_classes, cv.repeats));
+            }
+            settings[s].add(y, predicted, Some(fold_of.clone()));
+        }
     }
-    Ok(Evaluation::of_repeats(
-        per_repeat,
-        confusion,
-        y.len(),
-        predictions,
-    ))
+    Ok(settings.into_iter().map(|r| r.finish(y.len())).collect())
+}
+
+/// One setting's repeats as they are made: accuracy, summed confusion, predictions.
+struct Repeats {
+    per_repeat: Vec<f64>,
+    confusion: ConfusionMatrix,
+    predictions: Vec<RepeatPredictions>,
+}
+
+impl Repeats {
+    fn new(n_classes: usize, repeats: usize) -> Self {
+        Repeats {
+            per_repeat: Vec::with_capacity(repeats),
+            confusion: ConfusionMatrix::zeros(n_classes),
+            predictions: Vec::with_capacity(repeats),
+        }
+    }
+
+    /// One repeat's predictions of the samples whose classes are `y`.
+    fn add(&mut self, y: &[usize], predicted: Vec<usize>, fold_of: Option<Vec<usize>>) {
+        let n_classes = self.confusion.n_classes();
+        let matrix = ConfusionMatrix::from_predictions(y, &predicted, n_classes);
+        self.per_repeat.push(matrix.accuracy());
+        self.confusion.add(&matrix);
+        self.predictions
+            .push(RepeatPredictions { fold_of, predicted });
+    }
+
+    /// The evaluation of `n` samples per repeat.
+    fn finish(self, n: usize) -> Evaluation {
+        Evaluation::of_repeats(self.per_repeat, self.confusion, n, self.predictions)
+    }
 }
 
 /// Trains on one set and tests on another (for example train on two speeds, test on the third).
@@ -328,6 +398,21 @@ pub fn train_test<C: Classifier>(
     dims: usize,
     class_names: &[String],
 ) -> Result<Evaluation, ClassifyError> {
+    single(train_test_sweep(classifier, train, test, dims, class_names))
+}
+
+/// [`train_test`] of every setting of `sweep` (one evaluation each, in its order), fitted
+/// once.
+///
+/// # Errors
+/// As [`train_test`].
+pub fn train_test_sweep<C: Sweep>(
+    sweep: &C,
+    train: (&[f64], &[usize]),
+    test: (&[f64], &[usize]),
+    dims: usize,
+    class_names: &[String],
+) -> Result<Vec<Evaluation>, ClassifyError> {
     let ((x_train, y_train), (x_test, y_test)) = (train, test);
     if y_test.is_empty() {
         return Err(ClassifyError::Empty { what: "test" });
@@ -337,26 +422,24 @@ pub fn train_test<C: Classifier>(
             label: class_names.get(c).cloned().unwrap_or_else(|| c.to_string()),
         });
     }
-    let model = classifier.fit(x_train, dims, y_train)?;
+    let model = sweep.fit_sweep(x_train, dims, y_train)?;
     if x_test.len() != y_test.len() * dims || x_test.iter().any(|v| !v.is_finite()) {
         return Err(ClassifyError::BadFeatures(
             "test features are ragged or not finite".into(),
         ));
     }
-    let predicted = model.predict(x_test);
     let n_classes = class_names
         .len()
         .max(1 + *y_train.iter().chain(y_test).max().unwrap_or(&0));
-    let confusion = ConfusionMatrix::from_predictions(y_test, &predicted, n_classes);
-    Ok(Evaluation::of_repeats(
-        vec![confusion.accuracy()],
-        confusion,
-        y_test.len(),
-        vec![RepeatPredictions {
-            fold_of: None,
-            predicted,
-        }],
-    ))
+    Ok(model
+        .predict_sweep(x_test)
+        .into_iter()
+        .map(|predicted| {
+            let mut one = Repeats::new(n_classes, 1);
+            one.add(y_test, predicted, None);
+            one.finish(y_test.len())
+        })
+        .collect())
 }
 
 #[cfg(test)]

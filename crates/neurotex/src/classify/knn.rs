@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Classifier, Predict};
+use super::{Classifier, Predict, Sweep, SweepModel};
 use crate::error::{ClassifyError, ParamError};
 
 /// KNN parameters.
@@ -220,7 +220,17 @@ impl KnnModel {
 
     /// Finds each row's `k` nearest training samples and calls `on_row` with the predicted
     /// class and the votes per class.
-    fn classify(&self, x: &[f64], on_row: impl FnMut(usize, &[usize])) {
+    fn classify(&self, x: &[f64], mut on_row: impl FnMut(usize, &[usize])) {
+        let mut votes = vec![0usize; self.n_classes];
+        self.neighbours(x, |best| {
+            let predicted = majority(best, &self.labels, &mut votes);
+            on_row(predicted, &votes);
+        });
+    }
+
+    /// Calls `on_row` with each row's `k` nearest training samples, nearest first under
+    /// the order (distance, training index).
+    fn neighbours(&self, x: &[f64], on_row: impl FnMut(&[(f64, usize)])) {
         assert_eq!(
             x.len() % self.dims,
             0,
@@ -230,28 +240,27 @@ impl KnnModel {
         {
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: the CPU supports AVX2, the only feature the function enables.
-                return unsafe { self.classify_avx2(x, on_row) };
+                return unsafe { self.neighbours_avx2(x, on_row) };
             }
         }
-        self.classify_rows(x, on_row);
+        self.neighbours_of_rows(x, on_row);
     }
 
-    /// [`KnnModel::classify_rows`] compiled for AVX2: the distances of four training
+    /// [`KnnModel::neighbours_of_rows`] compiled for AVX2: the distances of four training
     /// samples per instruction. FMA is not enabled and Rust never fuses a multiply and an
     /// add on its own, and each distance is still summed over the features in order: the
     /// bits do not depend on it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn classify_avx2(&self, x: &[f64], on_row: impl FnMut(usize, &[usize])) {
-        self.classify_rows(x, on_row);
+    unsafe fn neighbours_avx2(&self, x: &[f64], on_row: impl FnMut(&[(f64, usize)])) {
+        self.neighbours_of_rows(x, on_row);
     }
 
     #[inline(always)]
-    fn classify_rows(&self, x: &[f64], mut on_row: impl FnMut(usize, &[usize])) {
+    fn neighbours_of_rows(&self, x: &[f64], mut on_row: impl FnMut(&[(f64, usize)])) {
         let n = self.labels.len();
         let mut dist = vec![0.0f64; n];
         let mut best: Vec<(f64, usize)> = Vec::with_capacity(self.k);
-        let mut votes = vec![0usize; self.n_classes];
         for row in x.chunks_exact(self.dims) {
             dist.fill(0.0);
             for (j, column) in self.columns.chunks_exact(n).enumerate() {
@@ -294,9 +303,86 @@ impl KnnModel {
                     }
                 }
             }
-            let predicted = majority(&best, &self.labels, &mut votes);
-            on_row(predicted, &votes);
+            on_row(&best);
         }
+    }
+}
+
+/// KNN at several k from one neighbour search per sample: the `k` nearest under the order
+/// (distance, training index) are the first `k` of the largest k's nearest, and the vote
+/// and its tie-break read only those, so each k's prediction is exactly that of [`Knn`]
+/// with that k (`tests::a_sweep_predicts_as_each_k_alone`). E8 cross-validates five k this
+/// way for the price of about one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KnnSweep {
+    /// The classifier with the largest k.
+    widest: Knn,
+    ks: Vec<usize>,
+}
+
+impl KnnSweep {
+    /// `knn`'s standardisation at each of `ks` (in that order).
+    ///
+    /// # Errors
+    /// No k, or a k of 0.
+    pub fn new(knn: &Knn, ks: &[usize]) -> Result<Self, ParamError> {
+        let Some(&largest) = ks.iter().max() else {
+            return Err(ParamError::new("k", "a sweep needs at least one k", "none"));
+        };
+        if ks.contains(&0) {
+            return Err(ParamError::new("k", "k must be at least 1", 0));
+        }
+        let widest = KnnParams {
+            k: largest,
+            ..knn.params()
+        }
+        .check()?;
+        Ok(KnnSweep {
+            widest,
+            ks: ks.to_vec(),
+        })
+    }
+}
+
+/// A fitted [`KnnSweep`]: the model of the largest k and every k.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KnnSweepModel {
+    model: KnnModel,
+    ks: Vec<usize>,
+}
+
+impl Sweep for KnnSweep {
+    type Model = KnnSweepModel;
+
+    /// Stores the z-scored training set.
+    ///
+    /// # Errors
+    /// The largest k larger than the training set, empty or ragged input, non-finite
+    /// features.
+    fn fit_sweep(
+        &self,
+        x: &[f64],
+        dims: usize,
+        y: &[usize],
+    ) -> Result<KnnSweepModel, ClassifyError> {
+        Ok(KnnSweepModel {
+            model: self.widest.fit(x, dims, y)?,
+            ks: self.ks.clone(),
+        })
+    }
+}
+
+impl SweepModel for KnnSweepModel {
+    fn predict_sweep(&self, x: &[f64]) -> Vec<Vec<usize>> {
+        let rows = x.len() / self.model.dims.max(1);
+        let mut out: Vec<Vec<usize>> = self.ks.iter().map(|_| Vec::with_capacity(rows)).collect();
+        let mut votes = vec![0usize; self.model.n_classes];
+        self.model.neighbours(x, |best| {
+            for (&k, predicted) in self.ks.iter().zip(out.iter_mut()) {
+                predicted.push(majority(&best[..k], &self.model.labels, &mut votes));
+            }
+        });
+        out
     }
 }
 
@@ -323,5 +409,97 @@ impl Predict for KnnModel {
         let mut out = Vec::with_capacity(x.len() / self.dims.max(1));
         self.classify(x, |predicted, _| out.push(predicted));
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::*;
+    use crate::classify::{
+        cross_validate, cross_validate_grouped, cross_validate_sweep, train_test, train_test_sweep,
+        CvParams,
+    };
+
+    /// `n` samples of `dims` small integer features (many equal distances, so the
+    /// tie-breaks are exercised) in `classes` classes, and each sample's group of 4.
+    fn data(
+        seed: u64,
+        n: usize,
+        dims: usize,
+        classes: usize,
+    ) -> (Vec<f64>, Vec<usize>, Vec<usize>) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x = (0..n * dims)
+            .map(|_| f64::from(rng.gen_range(0..3u8)))
+            .collect();
+        let y = (0..n).map(|i| i % classes).collect();
+        (x, y, (0..n).map(|i| i / 4).collect())
+    }
+
+    fn knn(k: usize, standardize: bool) -> Knn {
+        KnnParams { k, standardize }.check().unwrap()
+    }
+
+    #[test]
+    fn a_sweep_predicts_as_each_k_alone() {
+        let ks = [7, 1, 3, 3, 9, 2];
+        for (seed, dims, standardize) in [(1, 2, true), (2, 3, false), (3, 5, true)] {
+            let (x, y, _) = data(seed, 60, dims, 4);
+            let (train, test) = x.split_at(40 * dims);
+            let sweep = KnnSweep::new(&knn(5, standardize), &ks).unwrap();
+            let each = sweep
+                .fit_sweep(train, dims, &y[..40])
+                .unwrap()
+                .predict_sweep(test);
+            assert_eq!(each.len(), ks.len());
+            for (&k, predicted) in ks.iter().zip(&each) {
+                let alone = knn(k, standardize).fit(train, dims, &y[..40]).unwrap();
+                assert_eq!(*predicted, alone.predict(test), "k={k}, seed {seed}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_swept_evaluation_is_each_ks_evaluation() {
+        let (x, y, groups) = data(4, 48, 3, 3);
+        let names: Vec<String> = ["a", "b", "c"].map(String::from).to_vec();
+        let ks = [1, 4, 9];
+        let sweep = KnnSweep::new(&knn(5, true), &ks).unwrap();
+        let cv = CvParams {
+            folds: 4,
+            seed: 11,
+            repeats: 3,
+        }
+        .check()
+        .unwrap();
+        let swept = cross_validate_sweep(&sweep, (&x, 3), &y, &names, cv, None).unwrap();
+        let grouped = cross_validate_sweep(&sweep, (&x, 3), &y, &names, cv, Some(&groups));
+        let (train, test) = ((&x[..90], &y[..30]), (&x[90..], &y[30..]));
+        let split = train_test_sweep(&sweep, train, test, 3, &names).unwrap();
+        for (i, &k) in ks.iter().enumerate() {
+            let alone = knn(k, true);
+            assert_eq!(
+                swept[i],
+                cross_validate(&alone, &x, 3, &y, &names, cv).unwrap()
+            );
+            let by_group = cross_validate_grouped(&alone, &x, 3, &y, &names, cv, &groups);
+            assert_eq!(grouped.as_ref().unwrap()[i], by_group.unwrap());
+            assert_eq!(
+                split[i],
+                train_test(&alone, train, test, 3, &names).unwrap()
+            );
+        }
+        // A k above a fold's training set fails the sweep as it fails that k alone.
+        let too_many = KnnSweep::new(&knn(5, true), &[1, 40]).unwrap();
+        let err = cross_validate_sweep(&too_many, (&x, 3), &y, &names, cv, None).unwrap_err();
+        assert!(
+            matches!(err, ClassifyError::KTooLarge { k: 40, .. }),
+            "{err}"
+        );
+        assert!(KnnSweep::new(&knn(5, true), &[]).is_err());
+        assert!(KnnSweep::new(&knn(5, true), &[2, 0]).is_err());
     }
 }

@@ -19,11 +19,11 @@ pub mod stats;
 pub use choice::{ChosenClassifier, ChosenModel, ClassifierChoice};
 pub use confusion::ConfusionMatrix;
 pub use cv::{
-    cross_validate, cross_validate_grouped, group_folds, stratified_folds, train_test, CvParams,
-    Evaluation, RepeatPredictions, ValidCv,
+    cross_validate, cross_validate_grouped, cross_validate_sweep, group_folds, stratified_folds,
+    train_test, train_test_sweep, CvParams, Evaluation, RepeatPredictions, ValidCv,
 };
 pub use forest::{Forest, ForestModel, ForestParams};
-pub use knn::{Knn, KnnModel, KnnParams};
+pub use knn::{Knn, KnnModel, KnnParams, KnnSweep, KnnSweepModel};
 pub use linear::{Linear, LinearModel, LinearParams};
 pub use metrics::{
     bootstrap_accuracy, bootstrap_mean_share, mcnemar_exact, mcnemar_exact_p,
@@ -49,6 +49,45 @@ pub trait Classifier: Sync {
     /// # Errors
     /// Training data this classifier cannot use (empty, ragged, non-finite, too small).
     fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<Self::Model, ClassifyError>;
+}
+
+/// A classifier that, fitted once, predicts under several settings at once, the way one
+/// neighbour search gives KNN's vote for every k ([`knn::KnnSweep`]). Each setting's
+/// predictions are those of the classifier fitted with that setting alone, so
+/// cross-validating a sweep is cross-validating each setting, with one fit per fold.
+/// Every [`Classifier`] is a sweep of one setting.
+pub trait Sweep: Sync {
+    /// The fitted model.
+    type Model: SweepModel;
+
+    /// Fits on `x` (row-major, `dims` features per sample) with class indices `y`.
+    ///
+    /// # Errors
+    /// Training data one of the settings cannot use.
+    fn fit_sweep(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<Self::Model, ClassifyError>;
+}
+
+/// A fitted [`Sweep`].
+pub trait SweepModel {
+    /// Each setting's predicted class of each row of `x` (row-major), setting by setting.
+    ///
+    /// # Panics
+    /// If `x` is not whole rows of the training dimension (a caller bug).
+    fn predict_sweep(&self, x: &[f64]) -> Vec<Vec<usize>>;
+}
+
+impl<C: Classifier> Sweep for C {
+    type Model = C::Model;
+
+    fn fit_sweep(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<C::Model, ClassifyError> {
+        self.fit(x, dims, y)
+    }
+}
+
+impl<M: Predict> SweepModel for M {
+    fn predict_sweep(&self, x: &[f64]) -> Vec<Vec<usize>> {
+        vec![self.predict(x)]
+    }
 }
 
 /// A fitted classifier (linfa's `Predict`).

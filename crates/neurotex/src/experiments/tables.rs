@@ -2,8 +2,8 @@
 //! paper's two approaches at each speed) that several analyses compare against.
 
 use super::{Prepared, ValidReproduceParams};
-use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split};
-use crate::classify::{Knn, ValidCv};
+use crate::analysis::{evaluate, evaluate_sweep, Columns, FeatureTable, Outcome, Split};
+use crate::classify::{Knn, Sweep, ValidCv};
 use crate::error::Result;
 use crate::pipeline::{Encoded, Method};
 use crate::values::{BySpeed, Speed};
@@ -96,12 +96,30 @@ pub fn cv_at(
     columns: Columns,
     speed: Speed,
     knn: &Knn,
-    (cv, group_by): (ValidCv, Option<&str>),
+    folds: (ValidCv, Option<&str>),
 ) -> Result<Outcome> {
-    let split = Split::CrossValidation {
+    evaluate(table, columns, &cv_split(speed, folds), knn)
+}
+
+/// [`cv_at`] of every setting of `sweep`, one outcome each.
+///
+/// # Errors
+/// As [`cv_at`].
+pub fn cv_sweep_at<C: Sweep>(
+    table: &FeatureTable,
+    columns: Columns,
+    speed: Speed,
+    sweep: &C,
+    folds: (ValidCv, Option<&str>),
+) -> Result<Vec<Outcome>> {
+    evaluate_sweep(table, columns, &cv_split(speed, folds), sweep)
+}
+
+/// Cross-validation over the recordings at `speed`.
+fn cv_split(speed: Speed, (cv, group_by): (ValidCv, Option<&str>)) -> Split {
+    Split::CrossValidation {
         speeds: Some(vec![speed]),
         cv,
         group_by: group_by.map(str::to_string),
-    };
-    evaluate(table, columns, &split, knn)
+    }
 }
