@@ -14,6 +14,8 @@
 //! `tests::the_draws_are_rands_one_at_a_time` holds them to `gen_range` and `gen` over
 //! ranges with and without rejections, across block boundaries and repeated calls.
 
+use std::sync::{Arc, Mutex};
+
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -69,6 +71,78 @@ impl UniformIndices {
     }
 }
 
+/// Most indices one [`for_each_resample`] keeps for later calls (32 MiB of them), and
+/// most kept at once: a larger draw is made again each time.
+const KEPT: usize = 1 << 22;
+
+/// The draws kept: `(seed, bounds, rounds)` and the indices.
+type Kept = Vec<((u64, Vec<usize>, usize), Arc<Vec<usize>>)>;
+
+/// Calls `each` with `rounds` rounds of indices from the stream of
+/// `ChaCha8Rng::seed_from_u64(seed)`: each round is `bounds[0]` indices below `bounds[0]`,
+/// then `bounds[1]` below `bounds[1]`, and so on, concatenated, as
+/// [`UniformIndices::fill`] draws them in turn.
+///
+/// A bootstrap interval draws nothing but these, and every interval of a run resamples
+/// the same recordings (or units per condition) with the run's seed: the draws are the
+/// same each time. So they are made once per process and kept (up to [`KEPT`] indices in
+/// all; the oldest go first), and an interval then costs its sums alone. The values are
+/// those drawn in turn either way (`tests::kept_draws_are_the_streams`).
+pub(crate) fn for_each_resample(
+    seed: u64,
+    bounds: &[usize],
+    rounds: usize,
+    mut each: impl FnMut(&[usize]),
+) {
+    let per_round: usize = bounds.iter().sum();
+    let Some(total) = per_round.checked_mul(rounds).filter(|&t| t <= KEPT) else {
+        // Too many to keep: drawn round by round.
+        let mut draws = UniformIndices::new(seed);
+        let (mut round, mut part) = (Vec::with_capacity(per_round), Vec::new());
+        for _ in 0..rounds {
+            round.clear();
+            for &bound in bounds {
+                draws.fill(bound, bound, &mut part);
+                round.extend_from_slice(&part);
+            }
+            each(&round);
+        }
+        return;
+    };
+    static DRAWS: Mutex<Kept> = Mutex::new(Vec::new());
+    let key = (seed, bounds.to_vec(), rounds);
+    let found = {
+        let kept = DRAWS.lock().unwrap_or_else(|e| e.into_inner());
+        kept.iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, d)| Arc::clone(d))
+    };
+    let all = found.unwrap_or_else(|| {
+        let mut draws = UniformIndices::new(seed);
+        let (mut all, mut part) = (Vec::with_capacity(total), Vec::new());
+        for _ in 0..rounds {
+            for &bound in bounds {
+                draws.fill(bound, bound, &mut part);
+                all.extend_from_slice(&part);
+            }
+        }
+        let all = Arc::new(all);
+        let mut kept = DRAWS.lock().unwrap_or_else(|e| e.into_inner());
+        if !kept.iter().any(|(k, _)| *k == key) {
+            kept.push((key, Arc::clone(&all)));
+            while kept.iter().map(|(_, d)| d.len()).sum::<usize>() > KEPT {
+                kept.remove(0);
+            }
+        }
+        all
+    });
+    // `per_round` is 0 only with no bounds or empty ones: rounds of nothing.
+    match per_round {
+        0 => (0..rounds).for_each(|_| each(&[])),
+        _ => all.chunks_exact(per_round).for_each(each),
+    }
+}
+
 /// Fair coin flips, as `gen::<bool>()` draws them in turn (the top bit of a 32-bit word).
 pub(crate) struct Signs {
     rng: ChaCha8Rng,
@@ -102,6 +176,33 @@ impl Signs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn kept_draws_are_the_streams() {
+        // Kept (small), kept and found again, and too many to keep (drawn round by round).
+        for (seed, bounds, rounds) in [
+            (3u64, vec![160, 7], 50),
+            (3, vec![160, 7], 50),
+            (5, vec![1000, 3000], 1500),
+            (9, vec![], 4),
+        ] {
+            let mut one = ChaCha8Rng::seed_from_u64(seed);
+            let mut calls = 0;
+            for_each_resample(seed, &bounds, rounds, |round| {
+                let expected: Vec<usize> = bounds
+                    .iter()
+                    .flat_map(|&b| {
+                        (0..b)
+                            .map(|_| one.gen_range(0..b as u64) as usize)
+                            .collect::<Vec<_>>()
+                    })
+                    .collect();
+                assert_eq!(round, expected, "seed {seed}, round {calls}");
+                calls += 1;
+            });
+            assert_eq!(calls, rounds);
+        }
+    }
 
     #[test]
     fn the_draws_are_rands_one_at_a_time() {

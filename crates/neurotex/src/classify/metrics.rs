@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::draws::{Signs, UniformIndices};
+use super::draws::{for_each_resample, Signs};
 use super::stats::{binomial_half_cdf, percentile, student_t_quantile, StatsError, Z_95};
 use super::ConfusionMatrix;
 use crate::error::ParamError;
@@ -280,15 +280,11 @@ pub fn bootstrap_mean_share(
     }
     check_accuracies(shares)?;
     let n = shares.len();
-    let mut draws = UniformIndices::new(params.seed);
-    let mut picked = Vec::with_capacity(n + 1);
-    let mut means: Vec<f64> = (0..params.resamples)
-        .map(|_| {
-            draws.fill(n, n, &mut picked);
-            let total: f64 = picked.iter().map(|&i| shares[i]).sum();
-            total / n as f64
-        })
-        .collect();
+    let mut means: Vec<f64> = Vec::with_capacity(params.resamples);
+    for_each_resample(params.seed, &[n], params.resamples, |picked| {
+        let total: f64 = picked.iter().map(|&i| shares[i]).sum();
+        means.push(total / n as f64);
+    });
     means.sort_by(f64::total_cmp);
     let tail = (1.0 - LEVEL) / 2.0;
     Ok(Interval {

@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::{Columns, FeatureTable, Outcome, Split};
-use crate::classify::draws::UniformIndices;
+use crate::classify::draws::for_each_resample;
 use crate::classify::metrics::sign_flip_p;
 use crate::classify::stats::percentile;
 use crate::classify::{group_folds, stratified_folds, ValidCv};
@@ -485,22 +485,22 @@ impl Units {
     /// percentile bootstrap resampling units within each condition.
     fn interval(&self, shares: &[(usize, f64)]) -> [f64; 2] {
         let totals = self.totals(shares);
-        let mut draws = UniformIndices::new(self.seed);
-        let mut picked = Vec::new();
-        let mut means: Vec<f64> = (0..self.resamples.max(1))
-            .map(|_| {
-                mean(self.by_condition.iter().map(|units| {
-                    draws.fill(units.len(), units.len(), &mut picked);
-                    let (mut s, mut n) = (0.0, 0usize);
-                    for &i in &picked {
-                        let u = units[i];
-                        s += totals[u].0;
-                        n += totals[u].1;
-                    }
-                    s / n.max(1) as f64
-                }))
-            })
-            .collect();
+        let sizes: Vec<usize> = self.by_condition.iter().map(Vec::len).collect();
+        let rounds = self.resamples.max(1);
+        let mut means: Vec<f64> = Vec::with_capacity(rounds);
+        for_each_resample(self.seed, &sizes, rounds, |mut picked| {
+            means.push(mean(self.by_condition.iter().map(|units| {
+                let here;
+                (here, picked) = picked.split_at(units.len());
+                let (mut s, mut n) = (0.0, 0usize);
+                for &i in here {
+                    let u = units[i];
+                    s += totals[u].0;
+                    n += totals[u].1;
+                }
+                s / n.max(1) as f64
+            })));
+        });
         means.sort_by(f64::total_cmp);
         [percentile(&means, 0.025), percentile(&means, 0.975)]
     }
