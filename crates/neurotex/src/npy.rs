@@ -101,14 +101,21 @@ pub(crate) fn read_header(path: &Path) -> Result<NpyHeader> {
 /// allocation's cost is small beside the file's, and memory goes back at once.
 const KEPT_BYTES: usize = 64 << 20;
 
+/// A `.npy`'s samples as f64, and whether every one is a finite number.
+pub(crate) struct Floats {
+    pub(crate) samples: Vec<f64>,
+    pub(crate) finite: bool,
+}
+
 /// The samples of a `.npy` of little-endian floats (`<f8` or `<f4`) in C order, whose
 /// header [`read_header`] checked: the data read in one call into a byte buffer kept for the
-/// thread's next file, and converted to f64 in one pass. `None` for any other dtype or order
-/// (ndarray-npy reads those).
+/// thread's next file, and converted to f64 in one pass that also finds whether every
+/// sample is finite (the recording's check, without a pass of its own). `None` for any
+/// other dtype or order (ndarray-npy reads those).
 ///
 /// # Errors
 /// The file cannot be read (or changed size since its header was read).
-pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<Vec<f64>>> {
+pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<Floats>> {
     use std::io::{Seek, SeekFrom};
     thread_local! {
         /// The last file's bytes: one allocation per thread, not one per recording.
@@ -135,47 +142,57 @@ pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<V
         let n = header.elements;
         let mut samples = Vec::with_capacity(n);
         let out = &mut samples.spare_capacity_mut()[..n];
-        match item {
+        let finite = match item {
             8 => f64_from_le(bytes, out),
             _ => f64_from_f32_le(bytes, out),
-        }
+        };
         // SAFETY: both conversions wrote all `n` values (`bytes` holds `n` items).
         unsafe { samples.set_len(n) };
         // A very large file's buffer is not kept for the thread's next, smaller ones.
         if bytes.capacity() > KEPT_BYTES {
             *bytes = Vec::new();
         }
-        Ok(Some(samples))
+        Ok(Some(Floats { samples, finite }))
     })
 }
 
 widest_or_plain! {
     ["avx2"]
-    /// Little-endian float64 `bytes` into `out`, one sample per 8 bytes.
+    /// Little-endian float64 `bytes` into `out`, one sample per 8 bytes; whether every
+    /// sample is finite.
     ///
     /// # Panics
     /// `bytes` holds fewer than `out.len()` samples.
-    fn f64_from_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) {
+    fn f64_from_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) -> bool {
         let items = bytes.as_chunks::<8>().0;
         assert!(items.len() >= out.len(), "a sample for every output value");
+        let mut bad = false;
         for (o, b) in out.iter_mut().zip(items) {
-            o.write(f64::from_le_bytes(*b));
+            let v = f64::from_le_bytes(*b);
+            bad |= !v.is_finite();
+            o.write(v);
         }
+        !bad
     }
 }
 
 widest_or_plain! {
     ["avx2"]
-    /// Little-endian float32 `bytes` into `out` as float64 (exact), one per 4 bytes.
+    /// Little-endian float32 `bytes` into `out` as float64 (exact), one per 4 bytes;
+    /// whether every sample is finite.
     ///
     /// # Panics
     /// `bytes` holds fewer than `out.len()` samples.
-    fn f64_from_f32_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) {
+    fn f64_from_f32_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) -> bool {
         let items = bytes.as_chunks::<4>().0;
         assert!(items.len() >= out.len(), "a sample for every output value");
+        let mut bad = false;
         for (o, b) in out.iter_mut().zip(items) {
-            o.write(f64::from(f32::from_le_bytes(*b)));
+            let v = f64::from(f32::from_le_bytes(*b));
+            bad |= !v.is_finite();
+            o.write(v);
         }
+        !bad
     }
 }
 

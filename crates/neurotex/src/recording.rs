@@ -1121,12 +1121,16 @@ pub fn read_recording_as(
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    let (shape, raw, times_s) = match ext.as_str() {
+    let (shape, raw, times_s, finite) = match ext.as_str() {
         "npy" => {
-            let (shape, raw) = read_npy(path)?;
-            (shape, raw, None)
+            let (shape, raw, finite) = read_npy(path)?;
+            (shape, raw, None, finite)
         }
-        "csv" => read_csv_samples(path, format)?,
+        "csv" => {
+            let (shape, raw, times_s) = read_csv_samples(path, format)?;
+            let finite = all_finite(&raw);
+            (shape, raw, times_s, finite)
+        }
         _ => {
             return Err(DataError::invalid(
                 path,
@@ -1147,7 +1151,7 @@ pub fn read_recording_as(
         let message = format!("recording has {n_channels} channels, beyond the limit of {max}");
         return Err(DataError::invalid(path, message).into());
     }
-    if let Some(pos) = (!all_finite(&raw))
+    if let Some(pos) = (!finite)
         .then(|| raw.iter().position(|v| !v.is_finite()))
         .flatten()
     {
@@ -1225,7 +1229,8 @@ fn check_duration(
     Ok(())
 }
 
-fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
+/// A `.npy` recording's shape, its samples as f64 and whether every one is finite.
+fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>, bool)> {
     // The header is checked against the file's size first, so nothing larger than the
     // file is ever allocated for it.
     let header = crate::npy::read_header(path)?;
@@ -1246,8 +1251,8 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
     };
     crate::values::check_grid_cells(rows, cols)
         .map_err(|e| DataError::invalid(path, format!("shape {:?}: {e}", header.shape)))?;
-    if let Some(samples) = crate::npy::read_le_floats(path, &header)? {
-        return Ok((shape, samples));
+    if let Some(floats) = crate::npy::read_le_floats(path, &header)? {
+        return Ok((shape, floats.samples, floats.finite));
     }
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     let unreadable = |e: ndarray_npy::ReadNpyError| {
@@ -1267,8 +1272,13 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>)> {
         }
     };
     drop(bytes);
-    let std = array.as_standard_layout().into_owned();
-    Ok((shape, std.into_raw_vec_and_offset().0))
+    let samples = array
+        .as_standard_layout()
+        .into_owned()
+        .into_raw_vec_and_offset()
+        .0;
+    let finite = all_finite(&samples);
+    Ok((shape, samples, finite))
 }
 
 widest_or_plain! {

@@ -212,6 +212,35 @@ fn npy_f32_and_f64_in_both_shapes_are_read() {
 }
 
 #[test]
+fn a_non_finite_npy_sample_is_named_in_float32_and_float64() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("r.npy");
+    let read = || read_recording(&path, &LayoutFile::default()).map_err(|e| e.to_string());
+    // 37 frames of 3 channels: bad values in the vectorised body and in the tail.
+    for (frame, channel) in [(0, 0), (20, 1), (36, 2)] {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut x = Array2::<f64>::from_shape_fn((37, 3), |(t, c)| (t + c) as f64);
+            x[[frame, channel]] = bad;
+            write_npy(&path, &x).unwrap();
+            let f64_error = read().unwrap_err();
+            write_npy(&path, &x.mapv(|v| v as f32)).unwrap();
+            let f32_error = read().unwrap_err();
+            let expected = format!("sample {frame} of channel {channel} is {bad}");
+            for error in [f64_error, f32_error] {
+                assert!(error.contains(&expected), "{expected}: {error}");
+            }
+        }
+    }
+    // The largest finite values are read.
+    let x = Array2::<f32>::from_shape_fn(
+        (37, 3),
+        |(t, _)| if t % 2 == 0 { f32::MAX } else { f32::MIN },
+    );
+    write_npy(&path, &x).unwrap();
+    assert_eq!(read().unwrap().samples[3], f64::from(f32::MIN));
+}
+
+#[test]
 fn csv_with_time_column_keeps_irregular_stamps() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("r.csv");
