@@ -160,19 +160,8 @@ widest_or_plain! {
     ["avx2"]
     /// Little-endian float64 `bytes` into `out`, one sample per 8 bytes; whether every
     /// sample is finite.
-    ///
-    /// # Panics
-    /// `bytes` holds fewer than `out.len()` samples.
     fn f64_from_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) -> bool {
-        let items = bytes.as_chunks::<8>().0;
-        assert!(items.len() >= out.len(), "a sample for every output value");
-        let mut bad = false;
-        for (o, b) in out.iter_mut().zip(items) {
-            let v = f64::from_le_bytes(*b);
-            bad |= !v.is_finite();
-            o.write(v);
-        }
-        !bad
+        decode_finite(bytes, out, f64::from_le_bytes)
     }
 }
 
@@ -180,20 +169,32 @@ widest_or_plain! {
     ["avx2"]
     /// Little-endian float32 `bytes` into `out` as float64 (exact), one per 4 bytes;
     /// whether every sample is finite.
-    ///
-    /// # Panics
-    /// `bytes` holds fewer than `out.len()` samples.
     fn f64_from_f32_le(bytes: &[u8], out: &mut [MaybeUninit<f64>]) -> bool {
-        let items = bytes.as_chunks::<4>().0;
-        assert!(items.len() >= out.len(), "a sample for every output value");
-        let mut bad = false;
-        for (o, b) in out.iter_mut().zip(items) {
-            let v = f64::from(f32::from_le_bytes(*b));
-            bad |= !v.is_finite();
-            o.write(v);
-        }
-        !bad
+        decode_finite(bytes, out, |b| f64::from(f32::from_le_bytes(b)))
     }
+}
+
+/// The conversions' one loop: each `N`-byte item of `bytes` through `decode` into `out`,
+/// and whether every value is finite. Inlined into each compiled copy of its caller, so
+/// the loop takes the caller's vector width.
+///
+/// # Panics
+/// `bytes` holds fewer than `out.len()` items.
+#[inline(always)]
+fn decode_finite<const N: usize>(
+    bytes: &[u8],
+    out: &mut [MaybeUninit<f64>],
+    decode: impl Fn([u8; N]) -> f64,
+) -> bool {
+    let items = bytes.as_chunks::<N>().0;
+    assert!(items.len() >= out.len(), "a sample for every output value");
+    let mut bad = false;
+    for (o, b) in out.iter_mut().zip(items) {
+        let v = decode(*b);
+        bad |= !v.is_finite();
+        o.write(v);
+    }
+    !bad
 }
 
 /// Reads into `buf` until it is full or the file ends; returns the bytes read.

@@ -1116,29 +1116,66 @@ pub fn read_recording_as(
     layout: &LayoutFile,
     format: &CsvFormat,
 ) -> Result<Recording> {
+    let (shape, raw, times_s, finite) = read_samples(path, format)?;
+    let n_channels = checked_channels(path, shape, &raw, finite)?;
+    let t = raw.len() / n_channels;
+    check_duration(path, layout, t, times_s.as_deref())?;
+    let lay = layout.layout_for(path, shape)?;
+    let samples = onto_cells(raw, n_channels, &lay);
+    Ok(Recording {
+        fs: layout.fs.unwrap_or(1000.0),
+        layout: lay,
+        samples,
+        times_s,
+        phases: None,
+        meta: Meta {
+            file: path
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            ..Meta::default()
+        },
+    })
+}
+
+/// A `.npy` or `.csv` recording's shape, samples (frame-major), time stamps in seconds
+/// (CSV only) and whether every sample is finite.
+///
+/// # Errors
+/// Another extension, or a file its reader refuses.
+fn read_samples(path: &Path, format: &CsvFormat) -> Result<RawSamples> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    let (shape, raw, times_s, finite) = match ext.as_str() {
+    match ext.as_str() {
         "npy" => {
             let (shape, raw, finite) = read_npy(path)?;
-            (shape, raw, None, finite)
+            Ok((shape, raw, None, finite))
         }
         "csv" => {
             let (shape, raw, times_s) = read_csv_samples(path, format)?;
             let finite = all_finite(&raw);
-            (shape, raw, times_s, finite)
+            Ok((shape, raw, times_s, finite))
         }
-        _ => {
-            return Err(DataError::invalid(
-                path,
-                "unsupported recording format: expected a .npy or .csv file",
-            )
-            .into())
-        }
-    };
+        _ => Err(DataError::invalid(
+            path,
+            "unsupported recording format: expected a .npy or .csv file",
+        )
+        .into()),
+    }
+}
+
+/// A file's shape, samples, time stamps in seconds and whether every sample is finite.
+type RawSamples = (Shape, Vec<f64>, Option<Vec<f64>>, bool);
+
+/// The number of channels of `shape`, checked: at least one, at most the cell limit, and
+/// every sample finite (`finite`; the first bad one is named from `raw`).
+///
+/// # Errors
+/// The rule broken.
+fn checked_channels(path: &Path, shape: Shape, raw: &[f64], finite: bool) -> Result<usize> {
     let n_channels = match shape {
         Shape::Grid(r, c) => r * c,
         Shape::Channels(n) => n,
@@ -1166,38 +1203,26 @@ pub fn read_recording_as(
         )
         .into());
     }
-    let t = raw.len() / n_channels;
-    check_duration(path, layout, t, times_s.as_deref())?;
-    let lay = layout.layout_for(path, shape)?;
-    let samples = if lay.channel_map.iter().copied().eq(0..lay.cells()) {
-        raw
-    } else {
-        let cells = lay.cells();
-        let mut out = vec![0.0; t * cells];
-        for (frame_in, frame_out) in raw
-            .chunks_exact(n_channels)
-            .zip(out.chunks_exact_mut(cells))
-        {
-            for (&v, &cell) in frame_in.iter().zip(&lay.channel_map) {
-                frame_out[cell] = v;
-            }
+    Ok(n_channels)
+}
+
+/// The frames of `raw` (`n_channels` values each) placed on the layout's cells by its
+/// channel map; unmapped cells 0. `raw` itself when the map is the identity.
+fn onto_cells(raw: Vec<f64>, n_channels: usize, lay: &Layout) -> Vec<f64> {
+    if lay.channel_map.iter().copied().eq(0..lay.cells()) {
+        return raw;
+    }
+    let cells = lay.cells();
+    let mut out = vec![0.0; raw.len() / n_channels * cells];
+    for (frame_in, frame_out) in raw
+        .chunks_exact(n_channels)
+        .zip(out.chunks_exact_mut(cells))
+    {
+        for (&v, &cell) in frame_in.iter().zip(&lay.channel_map) {
+            frame_out[cell] = v;
         }
-        out
-    };
-    Ok(Recording {
-        fs: layout.fs.unwrap_or(1000.0),
-        layout: lay,
-        samples,
-        times_s,
-        phases: None,
-        meta: Meta {
-            file: path
-                .file_name()
-                .map(|f| f.to_string_lossy().into_owned())
-                .unwrap_or_default(),
-            ..Meta::default()
-        },
-    })
+    }
+    out
 }
 
 /// A recording's time span must stay within the layout's `max_duration_s` (default
