@@ -241,6 +241,43 @@ impl Butterworth2 {
         run_frames(self, &mut left, cells, &mut state, true, false);
     }
 
+    /// [`Butterworth2::filtfilt_frames`] of the frames of `from` less each cell's resting
+    /// value (as [`less_offsets`] copies them), into a new buffer, and the largest filtered
+    /// value: the forward pass reads `from` and makes the copy, and the backward pass finds
+    /// the maximum, where a copy and a maximum would each be a pass over the samples of
+    /// their own. The same bits as the three steps one after another.
+    fn filtfilt_frames_less(&self, from: &[f64], less: &LessOffsets) -> (Vec<f64>, f64) {
+        let cells = less.offsets.len();
+        let n = from.len().checked_div(cells).unwrap_or(0);
+        if n < 2 {
+            let samples = less.copy(from);
+            let top = largest(&samples);
+            return (samples, top);
+        }
+        let pad = 9.min(n - 1);
+        let frame = |i: usize| less.frame(&from[i * cells..(i + 1) * cells]);
+        let mut left = Vec::with_capacity(pad * cells);
+        for i in (1..=pad).rev() {
+            left.extend(frame(0).zip(frame(i)).map(|(f, v)| 2.0 * f - v));
+        }
+        let mut right = Vec::with_capacity(pad * cells);
+        for i in 1..=pad {
+            right.extend(frame(n - 1).zip(frame(n - 1 - i)).map(|(l, v)| 2.0 * l - v));
+        }
+        let mut state = [vec![0.0; cells], vec![0.0; cells]];
+        run_frames(self, &mut left, cells, &mut state, false, true);
+        let mut x = Vec::with_capacity(n * cells);
+        let out = &mut x.spare_capacity_mut()[..n * cells];
+        run_frames_less(self, &from[..n * cells], less, out, &mut state, false);
+        // SAFETY: the pass wrote every one of the `n` frames.
+        unsafe { x.set_len(n * cells) };
+        run_frames(self, &mut right, cells, &mut state, false, false);
+        run_frames(self, &mut right, cells, &mut state, true, true);
+        let top = run_frames(self, &mut x, cells, &mut state, true, false);
+        run_frames(self, &mut left, cells, &mut state, true, false);
+        (x, top)
+    }
+
     /// [`Butterworth2::lfilter`] of every channel of frame-major samples, bit for bit, the
     /// channels side by side as in [`Butterworth2::filtfilt_frames`].
     pub fn lfilter_frames(&self, x: &mut [f64], cells: usize) {
@@ -248,6 +285,22 @@ impl Butterworth2 {
             let mut state = [vec![0.0; cells], vec![0.0; cells]];
             run_frames(self, x, cells, &mut state, false, true);
         }
+    }
+
+    /// [`Butterworth2::lfilter_frames`] of the frames of `from` less each cell's resting
+    /// value, into a new buffer: the filter's one pass makes the copy.
+    fn lfilter_frames_less(&self, from: &[f64], less: &LessOffsets) -> Vec<f64> {
+        let cells = less.offsets.len();
+        let len = from.len().checked_div(cells).unwrap_or(0) * cells;
+        let mut x = Vec::with_capacity(len);
+        if len > 0 {
+            let mut state = [vec![0.0; cells], vec![0.0; cells]];
+            let out = &mut x.spare_capacity_mut()[..len];
+            run_frames_less(self, &from[..len], less, out, &mut state, true);
+            // SAFETY: the pass wrote every frame.
+            unsafe { x.set_len(len) };
+        }
+        x
     }
 }
 
@@ -257,7 +310,8 @@ widest_or_plain! {
     /// from the last frame, from the state in `z` or (`start`) each channel started in its
     /// steady state for its first value; compiled with AVX-512's 32 registers, else AVX2's
     /// four lanes, where the processor has them (no multiply and add is fused: the same
-    /// bits).
+    /// bits). Returns the largest value written (-inf for none), found off the filter's
+    /// chain of dependent steps, where a pass of its own would read every sample again.
     fn run_frames(
         f: &Butterworth2,
         x: &mut [f64],
@@ -265,7 +319,7 @@ widest_or_plain! {
         z: &mut [Vec<f64>; 2],
         back: bool,
         start: bool,
-    ) {
+    ) -> f64 {
         let [z0, z1] = z;
         match cells {
             4 => run_width::<4>(f, x, [z0, z1], back, start),
@@ -273,17 +327,57 @@ widest_or_plain! {
             16 => run_width::<16>(f, x, [z0, z1], back, start),
             _ => {
                 let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
+                let mut top = f64::NEG_INFINITY;
                 let frames = x.chunks_exact_mut(cells);
                 match back {
                     false => {
                         for (i, frame) in frames.enumerate() {
                             step_frame(f, frame, z0, z1, start && i == 0);
+                            top = frame.iter().fold(top, |m, &v| if v > m { v } else { m });
                         }
                     }
                     true => {
                         for (i, frame) in frames.rev().enumerate() {
                             step_frame(f, frame, z0, z1, start && i == 0);
+                            top = frame.iter().fold(top, |m, &v| if v > m { v } else { m });
                         }
+                    }
+                }
+                top
+            }
+        }
+    }
+}
+
+widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// [`run_frames`] forward over the frames of `from` less each cell's resting value
+    /// (masked), written to `out`: the copy of the selected phase made by the filter's
+    /// first pass over it.
+    fn run_frames_less(
+        f: &Butterworth2,
+        from: &[f64],
+        less: &LessOffsets,
+        out: &mut [MaybeUninit<f64>],
+        z: &mut [Vec<f64>; 2],
+        start: bool,
+    ) {
+        let [z0, z1] = z;
+        match less.offsets.len() {
+            4 => run_width_less::<4>(f, from, less, out, [z0, z1], start),
+            8 => run_width_less::<8>(f, from, less, out, [z0, z1], start),
+            16 => run_width_less::<16>(f, from, less, out, [z0, z1], start),
+            cells => {
+                let (z0, z1) = (&mut z0[..cells], &mut z1[..cells]);
+                let mut frame = vec![0.0; cells];
+                let pairs = from.chunks_exact(cells).zip(out.chunks_exact_mut(cells));
+                for (i, (src, dst)) in pairs.enumerate() {
+                    for (v, s) in frame.iter_mut().zip(less.frame(src)) {
+                        *v = s;
+                    }
+                    step_frame(f, &mut frame, z0, z1, start && i == 0);
+                    for (d, &v) in dst.iter_mut().zip(&frame) {
+                        d.write(v);
                     }
                 }
             }
@@ -302,24 +396,67 @@ fn run_width<const W: usize>(
     [z0, z1]: [&mut Vec<f64>; 2],
     back: bool,
     start: bool,
-) {
+) -> f64 {
     let mut a: [f64; W] = z0[..W].try_into().expect("W states");
     let mut b: [f64; W] = z1[..W].try_into().expect("W states");
+    let mut top = [f64::NEG_INFINITY; W];
     let frames = x.as_chunks_mut::<W>().0.iter_mut();
     match back {
         false => {
             for (i, frame) in frames.enumerate() {
                 step_frame(f, frame, &mut a, &mut b, start && i == 0);
+                keep_largest(&mut top, frame);
             }
         }
         true => {
             for (i, frame) in frames.rev().enumerate() {
                 step_frame(f, frame, &mut a, &mut b, start && i == 0);
+                keep_largest(&mut top, frame);
             }
         }
     }
     z0[..W].copy_from_slice(&a);
     z1[..W].copy_from_slice(&b);
+    top.into_iter().fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// [`run_frames_less`] for frames of exactly `W` cells, the state in registers as in
+/// [`run_width`].
+#[inline(always)]
+fn run_width_less<const W: usize>(
+    f: &Butterworth2,
+    from: &[f64],
+    less: &LessOffsets,
+    out: &mut [MaybeUninit<f64>],
+    [z0, z1]: [&mut Vec<f64>; 2],
+    start: bool,
+) {
+    let mut a: [f64; W] = z0[..W].try_into().expect("W states");
+    let mut b: [f64; W] = z1[..W].try_into().expect("W states");
+    let offsets: [f64; W] = less.offsets[..W].try_into().expect("W offsets");
+    let keep: [u64; W] = less.keep[..W].try_into().expect("W masks");
+    let pairs = from
+        .as_chunks::<W>()
+        .0
+        .iter()
+        .zip(out.as_chunks_mut::<W>().0);
+    for (i, (src, dst)) in pairs.enumerate() {
+        let mut frame: [f64; W] = std::array::from_fn(|c| masked_less(src[c], offsets[c], keep[c]));
+        step_frame(f, &mut frame, &mut a, &mut b, start && i == 0);
+        for (d, v) in dst.iter_mut().zip(frame) {
+            d.write(v);
+        }
+    }
+    z0[..W].copy_from_slice(&a);
+    z1[..W].copy_from_slice(&b);
+}
+
+/// Each of `top`'s running maxima raised to its value of `frame` where that is larger.
+#[inline(always)]
+fn keep_largest(top: &mut [f64], frame: &[f64]) {
+    for (m, &v) in top.iter_mut().zip(frame) {
+        *m = if v > *m { v } else { *m };
+    }
 }
 
 /// One frame through each channel's filter, its state in `z0` and `z1`; `first`
@@ -351,7 +488,7 @@ fn uniform_1k(rec: &Recording) -> bool {
 /// A span whose resampling would not fit in memory, or a phase shorter than one step.
 fn selected_phase(
     rec: &Recording,
-    times: &[f64],
+    times: Times,
     offsets: &[f64],
     frames: std::ops::Range<usize>,
 ) -> Result<Vec<f64>> {
@@ -362,7 +499,7 @@ fn selected_phase(
     let mut samples = if uniform_1k {
         less_offsets(&rec.samples[lo * cells..hi * cells], offsets, present)
     } else {
-        let span = times[hi - 1] - times[lo];
+        let span = times.at(hi - 1) - times.at(lo);
         if resampled_len(span, ENCODER_FS, cells).is_none() {
             let message =
                 format!("a {span} s span resampled to 1 kHz is more samples than memory can hold");
@@ -371,16 +508,12 @@ fn selected_phase(
         resample_linear(
             &rec.samples[lo * cells..hi * cells],
             cells,
-            &times[lo..hi],
+            &times.span(lo..hi),
             ENCODER_FS,
         )
     };
     if samples.is_empty() {
-        return Err(DataError::invalid(
-            file,
-            "the selected phase is shorter than one 1 ms encoder step",
-        )
-        .into());
+        return Err(phase_too_short(rec));
     }
     if !uniform_1k {
         for frame in samples.chunks_exact_mut(cells) {
@@ -392,24 +525,61 @@ fn selected_phase(
     Ok(samples)
 }
 
+/// The error of a selected phase without a whole 1 ms step.
+fn phase_too_short(rec: &Recording) -> crate::Error {
+    let message = "the selected phase is shorter than one 1 ms encoder step";
+    DataError::invalid(&rec.meta.file, message).into()
+}
+
 /// A copy of frame-major `samples`, each less its cell's resting value (`offsets`) and
 /// the cells not `present` 0.
 fn less_offsets(samples: &[f64], offsets: &[f64], present: &[bool]) -> Vec<f64> {
-    // The mask keeps a present cell's bits and clears an absent one's to +0: a choice
-    // without a branch, so the copy vectorises.
-    let keep: Vec<u64> = present
-        .iter()
-        .map(|&p| if p { u64::MAX } else { 0 })
-        .collect();
-    let n = match offsets.len() {
-        0 => return Vec::new(),
-        cells => samples.len() / cells * cells,
-    };
-    let mut out = Vec::with_capacity(n);
-    copy_less_offsets(samples, offsets, &keep, &mut out.spare_capacity_mut()[..n]);
-    // SAFETY: the pass wrote every one of the `n` values (whole frames of `samples`).
-    unsafe { out.set_len(n) };
-    out
+    LessOffsets::new(offsets, present).copy(samples)
+}
+
+/// How the selected phase is taken out of a recording: each cell's resting value
+/// subtracted, and the cells not present cleared to +0.
+struct LessOffsets<'a> {
+    offsets: &'a [f64],
+    /// Per cell, a mask that keeps a present cell's bits and clears an absent one's: a
+    /// choice without a branch, so the passes vectorise.
+    keep: Vec<u64>,
+}
+
+impl<'a> LessOffsets<'a> {
+    fn new(offsets: &'a [f64], present: &[bool]) -> Self {
+        let keep = present
+            .iter()
+            .map(|&p| if p { u64::MAX } else { 0 })
+            .collect();
+        LessOffsets { offsets, keep }
+    }
+
+    /// One frame's values.
+    fn frame<'s>(&'s self, frame: &'s [f64]) -> impl Iterator<Item = f64> + 's {
+        let cells = frame.iter().zip(self.offsets).zip(&self.keep);
+        cells.map(|((&s, &r), &k)| masked_less(s, r, k))
+    }
+
+    /// A copy of the whole frames of `samples`.
+    fn copy(&self, samples: &[f64]) -> Vec<f64> {
+        let n = match self.offsets.len() {
+            0 => return Vec::new(),
+            cells => samples.len() / cells * cells,
+        };
+        let mut out = Vec::with_capacity(n);
+        let into = &mut out.spare_capacity_mut()[..n];
+        copy_less_offsets(samples, self.offsets, &self.keep, into);
+        // SAFETY: the pass wrote every one of the `n` values (whole frames of `samples`).
+        unsafe { out.set_len(n) };
+        out
+    }
+}
+
+/// A sample less its cell's resting value `r`, its bits kept or cleared by `keep`.
+#[inline(always)]
+fn masked_less(s: f64, r: f64, keep: u64) -> f64 {
+    f64::from_bits((s - r).to_bits() & keep)
 }
 
 widest_or_plain! {
@@ -429,7 +599,7 @@ widest_or_plain! {
         assert!(keep.len() == cells && out.len().is_multiple_of(cells) && out.len() <= samples.len());
         for (frame, into) in samples.chunks_exact(cells).zip(out.chunks_exact_mut(cells)) {
             for (((o, &s), &r), &k) in into.iter_mut().zip(frame).zip(offsets).zip(keep) {
-                o.write(f64::from_bits((s - r).to_bits() & k));
+                o.write(masked_less(s, r, k));
             }
         }
     }
@@ -490,19 +660,48 @@ impl Preprocessor {
         self.filter.as_ref()
     }
 
-    /// Low-passes the frames with the conditioning's filter (causal or zero-phase); masked
-    /// cells hold 0 and stay exactly 0, as when only taxels were filtered.
-    fn filter_frames(
+    /// The selected phase (`frames`) of `rec` less its resting values (`offsets`), low-passed
+    /// with the conditioning's filter (causal or zero-phase) where it has one, and its
+    /// largest value where the filter's passes found it on their way. A recording already
+    /// uniform at 1 kHz is copied by the filter's first pass, not copied and then filtered.
+    /// Masked cells hold 0 and stay exactly 0, as when only taxels were filtered.
+    ///
+    /// # Errors
+    /// As [`selected_phase`].
+    fn filtered_phase(
         &self,
-        filter: &Butterworth2,
-        samples: &mut [f64],
-        cells: usize,
-        present: &[bool],
-    ) {
-        match self.params.causal {
-            Some(_) => filter.lfilter_frames(samples, cells),
-            None => filter.filtfilt_frames(samples, cells),
-        }
+        rec: &Recording,
+        times: Times,
+        offsets: &[f64],
+        frames: std::ops::Range<usize>,
+    ) -> Result<(Vec<f64>, Option<f64>)> {
+        let (cells, present) = (rec.layout.cells(), &rec.layout.present);
+        let Some(filter) = &self.filter else {
+            return Ok((selected_phase(rec, times, offsets, frames)?, None));
+        };
+        let (mut samples, top) = if uniform_1k(rec) {
+            if cells == 0 || frames.is_empty() {
+                return Err(phase_too_short(rec));
+            }
+            let from = &rec.samples[frames.start * cells..frames.end * cells];
+            let less = LessOffsets::new(offsets, present);
+            match self.params.causal {
+                Some(_) => (filter.lfilter_frames_less(from, &less), None),
+                None => {
+                    let (samples, top) = filter.filtfilt_frames_less(from, &less);
+                    (samples, Some(top))
+                }
+            }
+        } else {
+            let mut samples = selected_phase(rec, times, offsets, frames)?;
+            match self.params.causal {
+                Some(_) => filter.lfilter_frames(&mut samples, cells),
+                None => filter.filtfilt_frames(&mut samples, cells),
+            }
+            (samples, None)
+        };
+        // A masked cell's filtered zeros are +0 or -0 (the sign of a coefficient), so the
+        // largest value found before they are set to +0 is the largest after.
         if present.iter().any(|&p| !p) {
             for frame in samples.chunks_exact_mut(cells) {
                 for (s, _) in frame.iter_mut().zip(present).filter(|(_, &p)| !p) {
@@ -510,6 +709,7 @@ impl Preprocessor {
                 }
             }
         }
+        Ok((samples, top))
     }
 
     /// Conditions one recording; `dataset_baseline` is the dataset's layout choice, used
@@ -524,27 +724,27 @@ impl Preprocessor {
         if n == 0 {
             return Err(DataError::invalid(file, "recording holds no samples").into());
         }
-        let times = relative_times(rec);
+        let stamps = rec.times_s.as_ref().map(|_| relative_times(rec));
+        let times = Times::of(rec, stamps.as_deref());
         let offsets = match &self.params.causal {
             Some(causal) => fixed_offsets(rec, causal)?,
-            None => baseline_offsets(
-                rec,
-                &times,
-                self.params.baseline.unwrap_or(dataset_baseline),
-            )?,
+            None => {
+                let baseline = self.params.baseline.unwrap_or(dataset_baseline);
+                offsets_at(rec, times, baseline)?
+            }
         };
         let (lo, hi) = if self.params.slide_only {
-            slide_range(rec, &times)?
+            slide_range(rec, times)?
         } else {
             (0, n)
         };
-        let mut samples = selected_phase(rec, &times, &offsets, lo..hi)?;
-        if let Some(filter) = &self.filter {
-            self.filter_frames(filter, &mut samples, cells, &rec.layout.present);
-        }
+        let (mut samples, top) = self.filtered_phase(rec, times, &offsets, lo..hi)?;
         let flat = match &self.params.causal {
             Some(causal) => normalise_fixed(&mut samples, causal.scale),
-            None => normalise_global_max(&mut samples),
+            None => {
+                let max = top.unwrap_or_else(|| largest(&samples));
+                normalise_by_max(&mut samples, max)
+            }
         };
         Ok(Conditioned {
             samples,
@@ -559,7 +759,11 @@ impl Preprocessor {
 /// relative activation between taxels survives. Returns `true`, and sets everything to 0,
 /// when that maximum is <= 0 (a recording with no positive signal is never divided).
 pub fn normalise_global_max(samples: &mut [f64]) -> bool {
-    let max = largest(samples);
+    normalise_by_max(samples, largest(samples))
+}
+
+/// [`normalise_global_max`] with the samples' maximum `max` already found.
+fn normalise_by_max(samples: &mut [f64], max: f64) -> bool {
     if max > 0.0 {
         // A true division, not a multiplication by `1 / max`: that rounds twice and can
         // differ in the last bit, which the encoder's threshold can turn into a spike more
@@ -614,6 +818,68 @@ pub fn relative_times(rec: &Recording) -> Vec<f64> {
     match &rec.times_s {
         Some(t) => t.iter().map(|&x| x - t[0]).collect(),
         None => (0..rec.len()).map(|i| i as f64 / rec.fs).collect(),
+    }
+}
+
+/// A recording's [`relative_times`], without a list for one sampled uniformly: its time
+/// `i / fs` is computed where it is read (the same number as the list's).
+#[derive(Debug, Clone, Copy)]
+enum Times<'a> {
+    /// Time stamps less the first.
+    Stamps(&'a [f64]),
+    /// `n` samples at `fs`.
+    Uniform { fs: f64, n: usize },
+}
+
+impl<'a> Times<'a> {
+    /// The times of `rec`, whose [`relative_times`] are `stamps` where it has time stamps.
+    fn of(rec: &Recording, stamps: Option<&'a [f64]>) -> Self {
+        match stamps {
+            Some(t) => Times::Stamps(t),
+            None => Times::Uniform {
+                fs: rec.fs,
+                n: rec.len(),
+            },
+        }
+    }
+
+    fn len(self) -> usize {
+        match self {
+            Times::Stamps(t) => t.len(),
+            Times::Uniform { n, .. } => n,
+        }
+    }
+
+    /// Sample `i`'s time.
+    fn at(self, i: usize) -> f64 {
+        match self {
+            Times::Stamps(t) => t[i],
+            Times::Uniform { fs, .. } => i as f64 / fs,
+        }
+    }
+
+    /// The number of samples before the first whose time is not `before` (times ascend, so
+    /// `before` holds for a prefix): `slice::partition_point` over the times.
+    fn partition_point(self, before: impl Fn(f64) -> bool) -> usize {
+        match self {
+            Times::Stamps(t) => t.partition_point(|&x| before(x)),
+            Times::Uniform { n, .. } => {
+                let (mut lo, mut hi) = (0, n);
+                while lo < hi {
+                    let mid = lo + (hi - lo) / 2;
+                    match before(self.at(mid)) {
+                        true => lo = mid + 1,
+                        false => hi = mid,
+                    }
+                }
+                lo
+            }
+        }
+    }
+
+    /// The times of samples `range`, as a list.
+    fn span(self, range: std::ops::Range<usize>) -> Vec<f64> {
+        range.map(|i| self.at(i)).collect()
     }
 }
 
@@ -703,7 +969,7 @@ pub fn resample_linear(frames: &[f64], cells: usize, times: &[f64], fs: f64) -> 
 
 /// The sample range `[lo, hi)` of the sliding phase: labelled phases first, then the
 /// manifest's `slide_start_s`/`slide_end_s`, else the whole recording.
-fn slide_range(rec: &Recording, times: &[f64]) -> Result<(usize, usize)> {
+fn slide_range(rec: &Recording, times: Times) -> Result<(usize, usize)> {
     let n = times.len();
     if let Some(phases) = &rec.phases {
         let lo = phases.iter().position(|&p| p == Phase::Slide);
@@ -715,8 +981,8 @@ fn slide_range(rec: &Recording, times: &[f64]) -> Result<(usize, usize)> {
     }
     let start = rec.meta.slide_start_s.unwrap_or(0.0);
     let end = rec.meta.slide_end_s.unwrap_or(f64::INFINITY);
-    let lo = times.partition_point(|&t| t < start - 1e-9);
-    let hi = times.partition_point(|&t| t < end - 1e-9);
+    let lo = times.partition_point(|t| t < start - 1e-9);
+    let hi = times.partition_point(|t| t < end - 1e-9);
     if hi <= lo || lo >= n {
         return Err(DataError::invalid(
             &rec.meta.file,
@@ -736,6 +1002,11 @@ fn slide_range(rec: &Recording, times: &[f64]) -> Result<(usize, usize)> {
 /// # Errors
 /// A mean baseline whose interval holds no samples.
 pub fn baseline_offsets(rec: &Recording, times: &[f64], baseline: Baseline) -> Result<Vec<f64>> {
+    offsets_at(rec, Times::Stamps(times), baseline)
+}
+
+/// [`baseline_offsets`] with the recording's [`Times`].
+fn offsets_at(rec: &Recording, times: Times, baseline: Baseline) -> Result<Vec<f64>> {
     let cells = rec.layout.cells();
     match baseline {
         Baseline::None => Ok(vec![0.0; cells]),
@@ -749,8 +1020,8 @@ pub fn baseline_offsets(rec: &Recording, times: &[f64], baseline: Baseline) -> R
             Ok(lo)
         }
         Baseline::Mean { start_s, end_s } => {
-            let a = times.partition_point(|&t| t < start_s);
-            let b = times.partition_point(|&t| t < end_s);
+            let a = times.partition_point(|t| t < start_s);
+            let b = times.partition_point(|t| t < end_s);
             if b <= a {
                 return Err(DataError::invalid(
                     &rec.meta.file,
@@ -831,6 +1102,80 @@ mod tests {
             );
         }
         assert!(less_offsets(&[1.0], &[], &[]).is_empty());
+    }
+
+    /// The filters that copy the selected phase out of a recording on their first pass
+    /// (and find the maximum on their last) give the bits of the copy, the filter and the
+    /// maximum one after another: every width the passes specialise (4, 8, 16) and others,
+    /// masked cells, and signals too short to filter.
+    #[test]
+    fn fused_passes_are_the_passes_one_after_another() {
+        let f = Butterworth2::lowpass(ENCODER_FS, 50.0).unwrap();
+        let mut next = uniform(0x5851_F42D_4C95_7F2D, -1.0, 3.0);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for (n, cells) in [
+            (1, 16),
+            (2, 4),
+            (5, 16),
+            (12, 8),
+            (300, 16),
+            (300, 7),
+            (40, 1),
+        ] {
+            // A partial frame at the end, which no pass reads.
+            let x: Vec<f64> = (0..n * cells + cells / 2).map(|_| next()).collect();
+            let offsets: Vec<f64> = (0..cells).map(|_| next()).collect();
+            let present: Vec<bool> = (0..cells).map(|c| c % 5 != 2).collect();
+            let less = LessOffsets::new(&offsets, &present);
+            let mut want = less_offsets(&x, &offsets, &present);
+            f.filtfilt_frames(&mut want, cells);
+            let (got, top) = f.filtfilt_frames_less(&x, &less);
+            assert_eq!(bits(&got), bits(&want), "filtfilt, {n} frames of {cells}");
+            assert_eq!(top, largest(&want), "maximum, {n} frames of {cells}");
+            let mut want = less_offsets(&x, &offsets, &present);
+            f.lfilter_frames(&mut want, cells);
+            let got = f.lfilter_frames_less(&x, &less);
+            assert_eq!(bits(&got), bits(&want), "lfilter, {n} frames of {cells}");
+        }
+    }
+
+    /// The times of a uniformly sampled recording, computed where they are read, are the
+    /// list's: each time, and the sample a search for any time finds.
+    #[test]
+    fn uniform_times_are_the_listed_times() {
+        let layout = crate::recording::Layout::grid(1, 1);
+        for (n, fs) in [
+            (0, 1000.0),
+            (1, 1000.0),
+            (7, 3.0),
+            (1000, 1000.0),
+            (999, 333.3),
+        ] {
+            let rec = Recording {
+                fs,
+                layout: layout.clone(),
+                samples: vec![0.0; n],
+                times_s: None,
+                phases: None,
+                meta: Default::default(),
+            };
+            let listed = relative_times(&rec);
+            let times = Times::of(&rec, None);
+            assert_eq!(times.len(), n);
+            assert_eq!(bits_of(&times.span(0..n)), bits_of(&listed));
+            for t in [-1.0, 0.0, 1e-9, 0.5, 0.999, 1.0, 2.0 / 3.0, 2.5, 1e9] {
+                let want = listed.partition_point(|&x| x < t - 1e-9);
+                assert_eq!(
+                    times.partition_point(|x| x < t - 1e-9),
+                    want,
+                    "{n} at {fs} Hz, {t}"
+                );
+            }
+        }
+    }
+
+    fn bits_of(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
     }
 
     /// The channels filtered side by side equal each channel filtered alone, bit for bit
