@@ -497,9 +497,13 @@ fn simulate(
 /// the inliner decides for the large step loop around it.
 #[inline(never)]
 fn standard_normals(rng: &mut Xoshiro256PlusPlus, out: &mut [f64]) {
+    // The generator's state in a local: through the reference it was stored back to
+    // memory after every draw.
+    let mut local = rng.clone();
     for draw in out {
-        *draw = rng.sample(StandardNormal);
+        *draw = local.sample(StandardNormal);
     }
+    *rng = local;
 }
 
 /// The piezoresistive read-out of a trial: response lag, noise and ADC.
