@@ -7,8 +7,9 @@
 //! `(1/n) Σ_i -log softmax(W z_i + b)[y_i] + ‖W‖² / (2 C n)`,
 //! which is scikit-learn's objective (`C Σ_i loss_i + ‖W‖²/2`, intercepts unpenalised)
 //! divided by `C n`. The problem is smooth and convex; it is solved by L-BFGS (forty
-//! correction pairs, the initial Hessian of [`Preconditioner`], backtracking Armijo line
-//! search) from zero until the largest absolute
+//! correction pairs and the initial Hessian of [`Preconditioner`] up to 256 features, ten
+//! pairs and a scaled identity beyond; backtracking Armijo line search) from zero until
+//! the largest absolute
 //! gradient component is at most `tol`, or `max_iter` iterations. Starting from zero keeps
 //! the intercepts summing to zero (every gradient does), which fixes the one direction the
 //! penalty leaves free. Classes absent from the training set get probability 0 and take no
@@ -457,11 +458,12 @@ struct Solution {
 }
 
 /// L-BFGS's search direction `-H g` by the two-loop recursion over the stored pairs
-/// `(s, y, 1/(s·y))`, the initial Hessian the preconditioner's, scaled by the newest pair.
+/// `(s, y, 1/(s·y))`, the initial Hessian the preconditioner's (else the identity), scaled
+/// by the newest pair.
 fn direction(
     grad: &[f64],
     pairs: &VecDeque<(Vec<f64>, Vec<f64>, f64)>,
-    pre: &Preconditioner,
+    pre: Option<&Preconditioner>,
 ) -> Vec<f64> {
     let mut q = grad.to_vec();
     let mut alpha = Vec::with_capacity(pairs.len());
@@ -470,10 +472,15 @@ fn direction(
         q.iter_mut().zip(y).for_each(|(qi, yi)| *qi -= a * yi);
         alpha.push(a);
     }
-    pre.solve(&mut q);
+    let solve = |v: &mut [f64]| {
+        if let Some(pre) = pre {
+            pre.solve(v);
+        }
+    };
+    solve(&mut q);
     if let Some((s, y, _)) = pairs.back() {
         let mut my = y.clone();
-        pre.solve(&mut my);
+        solve(&mut my);
         let gamma = dot8(s, y) / dot8(y, &my);
         q.iter_mut().for_each(|qi| *qi *= gamma);
     }
@@ -490,10 +497,12 @@ fn direction(
 /// penalty): the objective's Hessian with the coupling between classes left out and every
 /// row's softmax curvature taken as `a`.
 ///
-/// Collinear features (a GLCM's statistics at four distances, 48 or 96 columns) give the
-/// plain problem directions of curvature thousands of times the penalty's, and L-BFGS
+/// Collinear features (every taxel's statistics side by side, 48 or 96 columns in E9) give
+/// the plain problem directions of curvature thousands of times the penalty's, and L-BFGS
 /// from a scaled identity crawled along them (500-800 iterations on E9's fits). This
-/// matrix takes them out. It changes the path, not the minimum: the fit stops at the same
+/// matrix takes them out. It costs `dims²` numbers and `dims³` operations per fit, so
+/// problems of more than [`PRECONDITIONED_DIMS`] features go without it (and with the ten
+/// correction pairs of plain L-BFGS, whose memory grows with the features too). It changes the path, not the minimum: the fit stops at the same
 /// gradient tolerance. `a = A_SHARE / k`: at uniform probabilities a row's curvature is
 /// `1/k`, but at the minimum of a training set the classes separate well, most rows are
 /// fitted with probabilities near 0 or 1 and their curvature is far smaller. `A_SHARE`
@@ -509,9 +518,17 @@ struct Preconditioner {
 /// The share of the uniform curvature `1/k` the preconditioner assumes for every row.
 const A_SHARE: f64 = 0.01;
 
+/// The most features a fit is preconditioned for: the inverse is then at most 512 KiB and
+/// a few milliseconds to form.
+const PRECONDITIONED_DIMS: usize = 256;
+
 impl Preconditioner {
-    fn new(problem: &Problem) -> Self {
+    /// The preconditioner of `problem`, or `None` beyond [`PRECONDITIONED_DIMS`] features.
+    fn new(problem: &Problem) -> Option<Self> {
         let d = problem.dims;
+        if d > PRECONDITIONED_DIMS {
+            return None;
+        }
         let n = problem.y.len() as f64;
         let curvature = A_SHARE / problem.k as f64;
         let mut m = vec![0.0; d * d];
@@ -527,11 +544,11 @@ impl Preconditioner {
             }
             m[i * d + i] += problem.penalty;
         }
-        Preconditioner {
+        Some(Preconditioner {
             dims: d,
             curvature,
             inverse: inverse(m, d),
-        }
+        })
     }
 
     /// `v` (`k` rows of weights, then `k` intercepts) times the matrix's inverse.
@@ -583,12 +600,16 @@ fn inverse(mut m: Vec<f64>, d: usize) -> Vec<f64> {
 
 /// Minimises the problem's objective from zero by L-BFGS.
 fn lbfgs(problem: &Problem, params: LinearParams) -> Solution {
-    const MEMORY: usize = 40;
+    lbfgs_from(problem, params, Preconditioner::new(problem))
+}
+
+/// [`lbfgs`] with the given preconditioner, or none.
+fn lbfgs_from(problem: &Problem, params: LinearParams, pre: Option<Preconditioner>) -> Solution {
     let len = problem.k * (problem.dims + 1);
     let mut theta = vec![0.0; len];
     let (mut value, mut grad) = problem.value_grad(&theta);
     let mut pairs: VecDeque<(Vec<f64>, Vec<f64>, f64)> = VecDeque::new();
-    let pre = Preconditioner::new(problem);
+    let memory = if pre.is_some() { 40 } else { 10 };
     let largest = |g: &[f64]| g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for iteration in 0..params.max_iter {
         if largest(&grad) <= params.tol {
@@ -598,11 +619,11 @@ fn lbfgs(problem: &Problem, params: LinearParams) -> Solution {
                 converged: true,
             };
         }
-        let mut dir = direction(&grad, &pairs, &pre);
+        let mut dir = direction(&grad, &pairs, pre.as_ref());
         let mut slope = dot8(&grad, &dir);
         if slope >= 0.0 {
             pairs.clear();
-            dir = direction(&grad, &pairs, &pre);
+            dir = direction(&grad, &pairs, pre.as_ref());
             slope = dot8(&grad, &dir);
         }
         // The first step is scaled to unit length; later ones start at 1 (L-BFGS's
@@ -636,7 +657,7 @@ fn lbfgs(problem: &Problem, params: LinearParams) -> Solution {
         let y: Vec<f64> = next_grad.iter().zip(&grad).map(|(a, b)| a - b).collect();
         let sy = dot8(&s, &y);
         if sy > 1e-12 * dot8(&y, &y).sqrt() * dot8(&s, &s).sqrt() && sy > 0.0 {
-            if pairs.len() == MEMORY {
+            if pairs.len() == memory {
                 pairs.pop_front();
             }
             pairs.push_back((s, y, 1.0 / sy));
@@ -942,12 +963,9 @@ mod tests {
     }
 
     /// Collinear columns (each of 8 underlying features seen 12 times with small
-    /// differences, as a GLCM's statistics at several distances) over 8 classes. To the
-    /// default tolerance, L-BFGS from a scaled identity needed 138 iterations with ten
-    /// pairs (the solver before the preconditioner) and 104 with forty; the preconditioned
-    /// one needs 52.
-    #[test]
-    fn collinear_features_converge_in_few_iterations() {
+    /// differences, as every taxel's statistics side by side) over 8 classes: `dims`
+    /// z-scored columns and their labels.
+    fn collinear_problem() -> (Vec<f64>, usize, Vec<usize>) {
         let (n, base, copies, k) = (128, 8, 12, 8);
         let mut state = 11;
         let mut x = Vec::new();
@@ -964,12 +982,89 @@ mod tests {
             }
             y.push(class);
         }
+        (x, base * copies, y)
+    }
+
+    /// To the default tolerance, L-BFGS from a scaled identity needed 138 iterations on
+    /// [`collinear_problem`] with ten pairs (the solver before the preconditioner) and 104
+    /// with forty; the preconditioned one needs 52.
+    #[test]
+    fn collinear_features_converge_in_few_iterations() {
+        let (x, dims, y) = collinear_problem();
         let model = LinearParams::default()
             .check()
             .unwrap()
-            .fit(&x, base * copies, &y)
+            .fit(&x, dims, &y)
             .unwrap();
         assert!(model.converged());
         assert!(model.iterations() < 80, "{} iterations", model.iterations());
+    }
+
+    /// The preconditioner changes the path, not the minimum: with and without it the
+    /// weights agree to the tolerance's reach (gradient 1e-10 over the penalty's curvature).
+    #[test]
+    fn the_preconditioned_minimum_is_the_plain_one() {
+        let (x, dims, y) = collinear_problem();
+        let params = LinearParams {
+            tol: 1e-10,
+            ..LinearParams::default()
+        };
+        let (mean, inv_std) = scaling(&x, dims);
+        let z: Vec<f64> = x
+            .chunks_exact(dims)
+            .flat_map(|row| {
+                row.iter()
+                    .zip(mean.iter().zip(&inv_std))
+                    .map(|(&v, (&m, &s))| (v - m) * s)
+            })
+            .collect();
+        let problem = Problem {
+            penalty: 1.0 / (params.c * y.len() as f64),
+            z,
+            dims,
+            y,
+            k: 8,
+        };
+        let pre = Preconditioner::new(&problem);
+        assert!(pre.is_some());
+        let with = lbfgs_from(&problem, params, pre);
+        let without = lbfgs_from(&problem, params, None);
+        assert!(with.converged && without.converged);
+        assert!(with.iterations < without.iterations);
+        for (a, b) in with.theta.iter().zip(&without.theta) {
+            assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+        }
+    }
+
+    /// Beyond [`PRECONDITIONED_DIMS`] features the fit goes without the preconditioner
+    /// (its inverse would grow with the square of the features) and still converges.
+    #[test]
+    fn wide_problems_go_without_the_preconditioner() {
+        let (n, dims) = (40, PRECONDITIONED_DIMS + 44);
+        let mut state = 5;
+        let y: Vec<usize> = (0..n).map(|i| i % 3).collect();
+        let x: Vec<f64> = y
+            .iter()
+            .flat_map(|&c| {
+                let mut row: Vec<f64> = (0..dims).map(|_| uniform(&mut state)).collect();
+                row[c] += 2.0;
+                row
+            })
+            .collect();
+        let problem = Problem {
+            z: x.clone(),
+            dims,
+            y: y.clone(),
+            k: 3,
+            penalty: 1.0 / n as f64,
+        };
+        assert!(Preconditioner::new(&problem).is_none());
+        let model = LinearParams::default()
+            .check()
+            .unwrap()
+            .fit(&x, dims, &y)
+            .unwrap();
+        assert!(model.converged());
+        assert_eq!(model.predict(&x), y);
     }
 }
