@@ -701,6 +701,17 @@ fn scaling(x: &[f64], dims: usize) -> (Vec<f64>, Vec<f64>) {
     (mean, inv_std)
 }
 
+/// The rows of `x` z-scored with each feature's mean and inverse standard deviation.
+fn z_scored(x: &[f64], dims: usize, mean: &[f64], inv_std: &[f64]) -> Vec<f64> {
+    x.chunks_exact(dims)
+        .flat_map(|row| {
+            row.iter()
+                .zip(mean.iter().zip(inv_std))
+                .map(|(&v, (&m, &s))| (v - m) * s)
+        })
+        .collect()
+}
+
 impl Classifier for Linear {
     type Model = LinearModel;
 
@@ -715,14 +726,7 @@ impl Classifier for Linear {
         classes.sort_unstable();
         classes.dedup();
         let (mean, inv_std) = scaling(x, dims);
-        let z: Vec<f64> = x
-            .chunks_exact(dims)
-            .flat_map(|row| {
-                row.iter()
-                    .zip(mean.iter().zip(&inv_std))
-                    .map(|(&v, (&m, &s))| (v - m) * s)
-            })
-            .collect();
+        let z = z_scored(x, dims, &mean, &inv_std);
         let k = classes.len();
         let compact = y
             .iter()
@@ -1010,14 +1014,7 @@ mod tests {
             ..LinearParams::default()
         };
         let (mean, inv_std) = scaling(&x, dims);
-        let z: Vec<f64> = x
-            .chunks_exact(dims)
-            .flat_map(|row| {
-                row.iter()
-                    .zip(mean.iter().zip(&inv_std))
-                    .map(|(&v, (&m, &s))| (v - m) * s)
-            })
-            .collect();
+        let z = z_scored(&x, dims, &mean, &inv_std);
         let problem = Problem {
             penalty: 1.0 / (params.c * y.len() as f64),
             z,
