@@ -915,24 +915,25 @@ mod tests {
     #[test]
     fn one_class_and_absent_classes_are_handled() {
         let x = [0.0, 1.0, 2.0, 3.0];
-        let model = LinearParams::default()
-            .check()
-            .unwrap()
-            .fit(&x, 1, &[2, 2, 2, 2])
-            .unwrap();
+        let model = fit_default(&x, 1, &[2, 2, 2, 2]);
         assert_eq!(
             model.predict_with_shares(&[5.0]),
             vec![(2, vec![0.0, 0.0, 1.0])]
         );
-        let model = LinearParams::default()
-            .check()
-            .unwrap()
-            .fit(&x, 1, &[0, 0, 2, 2])
-            .unwrap();
+        let model = fit_default(&x, 1, &[0, 0, 2, 2]);
         assert!(model.converged());
         let shares = model.predict_with_shares(&[3.0]);
         assert_eq!(shares[0].0, 2);
         assert_eq!(shares[0].1[1], 0.0);
+    }
+
+    /// A logistic regression with the default parameters fitted on `x`.
+    fn fit_default(x: &[f64], dims: usize, y: &[usize]) -> LinearModel {
+        LinearParams::default()
+            .check()
+            .unwrap()
+            .fit(x, dims, y)
+            .unwrap()
     }
 
     /// A small deterministic generator for the tests' data (uniform in [-1, 1)).
@@ -995,11 +996,7 @@ mod tests {
     #[test]
     fn collinear_features_converge_in_few_iterations() {
         let (x, dims, y) = collinear_problem();
-        let model = LinearParams::default()
-            .check()
-            .unwrap()
-            .fit(&x, dims, &y)
-            .unwrap();
+        let model = fit_default(&x, dims, &y);
         assert!(model.converged());
         assert!(model.iterations() < 80, "{} iterations", model.iterations());
     }
@@ -1056,11 +1053,7 @@ mod tests {
             penalty: 1.0 / n as f64,
         };
         assert!(Preconditioner::new(&problem).is_none());
-        let model = LinearParams::default()
-            .check()
-            .unwrap()
-            .fit(&x, dims, &y)
-            .unwrap();
+        let model = fit_default(&x, dims, &y);
         assert!(model.converged());
         assert_eq!(model.predict(&x), y);
     }
