@@ -22,6 +22,7 @@ static STOP: AtomicBool = AtomicBool::new(false);
 /// the run's temporary files and folders are removed (the library registers each one;
 /// finished outputs are never among them) and the process exits with 130.
 pub fn install() {
+    ignore_file_size_signal();
     let installed = ctrlc::set_handler(|| {
         if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
             // The command ends by itself at its next frame; the process exits then.
@@ -51,3 +52,18 @@ pub fn end_input_on_signal() {
 pub fn stop_requested() -> bool {
     STOP.load(Ordering::Relaxed)
 }
+
+/// Makes a write beyond the file-size limit (`ulimit -f`) fail with `EFBIG`, which the run
+/// reports as a write error (naming the output) and cleans up after, instead of the kernel's
+/// SIGXFSZ killing the process with a half-written temporary left behind.
+#[cfg(unix)]
+fn ignore_file_size_signal() {
+    // SAFETY: setting a standard signal's disposition to SIG_IGN installs no handler code;
+    // it is done once, at start, before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+}
+
+#[cfg(not(unix))]
+fn ignore_file_size_signal() {}

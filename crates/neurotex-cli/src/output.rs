@@ -26,6 +26,13 @@ pub fn stage_file(
     neurotex::io::stage(path, fill).with_context(|| format!("writing {what}"))
 }
 
+/// Checks, before any work, that output file `path` can be written and is none of `inputs`
+/// ([`neurotex::io::check_output`]): neurotex never renames over a device, a link or a
+/// file with other hard links, nor writes over what it reads.
+pub fn check_output<P: AsRef<Path>>(path: &Path, inputs: &[P]) -> Result<()> {
+    neurotex::io::check_output(path, inputs).context("checking the output")
+}
+
 /// A progress bar on standard error, drawn only on a terminal.
 pub fn progress(len: usize, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);

@@ -85,10 +85,11 @@ fn sigint_and_sigterm_during_simulate_leave_nothing_behind() {
     interrupt_simulate("-TERM");
 }
 
-/// Runs `neurotex ARGS` under `ulimit -f BLOCKS` with SIGXFSZ ignored, so that writing
-/// past the limit fails as on a full disk.
+/// Runs `neurotex ARGS` under `ulimit -f BLOCKS`, so that writing past the limit fails as
+/// on a full disk. The shell leaves SIGXFSZ at its default (killing the process): the
+/// binary must ignore it itself to turn the limit into an error it reports.
 fn run_with_file_limit(dir: &Dir, blocks: u32, args: &[&str]) -> std::process::Output {
-    let script = format!("trap '' XFSZ; ulimit -f {blocks}; exec \"$0\" \"$@\"");
+    let script = format!("trap - XFSZ; ulimit -f {blocks}; exec \"$0\" \"$@\"");
     Command::new("sh")
         .arg("-c")
         .arg(script)
@@ -129,32 +130,181 @@ fn reproduce_that_cannot_write_leaves_no_partial_output() {
     set_mode(&ro, 0o755);
     let _ = std::fs::remove_file(ro.join("probe"));
     std::fs::remove_dir(&ro).unwrap();
-    // a full disk (a file size limit), into a new folder and into an earlier report
+    // a full disk (a file size limit) into a new folder: an error naming the report's
+    // file, not the hidden temporary, and nothing left
     let run = run_with_file_limit(&dir, 4, &quick("report"));
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("cannot write report/"), "{stderr}");
     assert!(stderr.contains("File too large"), "{stderr}");
+    assert!(!stderr.contains("partial"), "{stderr}");
     assert_eq!(names(dir.path()), ["ds", "file"]);
+    // a folder holding something a report does not write is refused before any work
     std::fs::create_dir(dir.join("report")).unwrap();
     std::fs::write(dir.join("report/notes.txt"), "mine").unwrap();
-    let run = run_with_file_limit(&dir, 4, &quick("report"));
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert_eq!(run.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("File too large"), "{stderr}");
-    assert_eq!(names(dir.path()), ["ds", "file", "report"]);
+    let err = dir.fails(&quick("report"));
+    assert!(err.contains("holds notes.txt"), "{err}");
     assert_eq!(names(&dir.join("report")), ["notes.txt"]);
-    // with room, the report lands beside what was there
+    std::fs::remove_file(dir.join("report/notes.txt")).unwrap();
+    // an earlier report is replaced whole: a figure only it had goes, and a run that
+    // cannot write leaves it as it was
     dir.ok(&quick("report"));
-    let written = names(&dir.join("report"));
+    std::fs::write(dir.join("report/figures/e9_earlier.svg"), "<svg/>").unwrap();
+    let earlier = names(&dir.join("report/figures"));
+    let run = run_with_file_limit(&dir, 4, &quick("report"));
+    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(names(&dir.join("report/figures")), earlier);
+    assert_eq!(names(dir.path()), ["ds", "file", "report"]);
+    dir.ok(&quick("report"));
+    let figures = names(&dir.join("report/figures"));
+    assert!(!figures.is_empty() && !figures.contains(&"e9_earlier.svg".to_string()));
     assert_eq!(
-        written,
-        ["figures", "notes.txt", "report.md", "results.json"]
+        names(&dir.join("report")),
+        ["figures", "report.md", "results.json"]
     );
-    assert!(!names(&dir.join("report/figures")).is_empty());
     assert_eq!(names(dir.path()), ["ds", "file", "report"]);
 }
 
 fn set_mode(path: &Path, mode: u32) {
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(path, std::fs::Permissions::from_mode(mode)).unwrap();
+}
+
+/// The file type of `path` itself (a link is not followed).
+fn kind(path: &Path) -> std::fs::FileType {
+    std::fs::symlink_metadata(path).unwrap().file_type()
+}
+
+#[test]
+fn outputs_never_replace_a_device_a_link_or_an_input() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 5);
+    let features = |out: &str| -> Vec<String> {
+        [
+            "features",
+            "--dataset",
+            s(&ds),
+            "--method",
+            "glcm3d",
+            "--out",
+            out,
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let run_ok = |args: Vec<String>| dir.ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let run_fails =
+        |args: Vec<String>| dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    // a device is written through, not renamed over (as root, a rename would succeed and
+    // turn /dev/null into a file for every process)
+    run_ok(features("/dev/null"));
+    assert!(kind(Path::new("/dev/null")).is_char_device());
+    // a symbolic link keeps linking: its target gets the new content
+    std::fs::write(dir.join("target.csv"), "old").unwrap();
+    std::os::unix::fs::symlink("target.csv", dir.join("link.csv")).unwrap();
+    run_ok(features("link.csv"));
+    assert!(kind(&dir.join("link.csv")).is_symlink());
+    let written = std::fs::read_to_string(dir.join("target.csv")).unwrap();
+    assert!(written.starts_with("file,label"), "{written}");
+    // a dangling link, a file with another hard link and a folder are refused, untouched
+    std::os::unix::fs::symlink("missing.csv", dir.join("dangling.csv")).unwrap();
+    let err = run_fails(features("dangling.csv"));
+    assert!(err.contains("missing.csv, which does not exist"), "{err}");
+    assert!(!dir.join("missing.csv").exists());
+    std::fs::hard_link(dir.join("target.csv"), dir.join("second.csv")).unwrap();
+    let err = run_fails(features("second.csv"));
+    assert!(err.contains("2 hard links"), "{err}");
+    assert!(kind(&dir.join("second.csv")).is_file());
+    std::fs::create_dir(dir.join("folder")).unwrap();
+    let err = run_fails(features("folder"));
+    assert!(err.contains("is a folder"), "{err}");
+    // an output that is one of the inputs, by its name or through a link
+    let manifest = std::fs::read(ds.join("manifest.csv")).unwrap();
+    let err = run_fails(features(s(&ds.join("manifest.csv"))));
+    assert!(err.contains("is also an input"), "{err}");
+    std::os::unix::fs::symlink(ds.join("manifest.csv"), dir.join("m.csv")).unwrap();
+    let err = run_fails(features("m.csv"));
+    assert!(err.contains("same file as input"), "{err}");
+    assert_eq!(std::fs::read(ds.join("manifest.csv")).unwrap(), manifest);
+    let recording = ds.join("A_5_0.npy");
+    let before = std::fs::read(&recording).unwrap();
+    let err = dir.fails(&["encode", s(&recording), "--out", s(&recording)]);
+    assert!(err.contains("is also an input"), "{err}");
+    let err = dir.fails(&[
+        "encode",
+        s(&recording),
+        "--out",
+        "x.npy",
+        "--events",
+        "x.npy",
+    ]);
+    assert!(err.contains("name the same file"), "{err}");
+    assert_eq!(std::fs::read(&recording).unwrap(), before);
+    dir.ok(&["train", "--dataset", s(&ds), "--out", "model.json"]);
+    let model = std::fs::read(dir.join("model.json")).unwrap();
+    let err = dir.fails(&[
+        "predict",
+        "--model",
+        "model.json",
+        "--dataset",
+        s(&ds),
+        "--out",
+        "model.json",
+    ]);
+    assert!(err.contains("is also an input"), "{err}");
+    let err = dir.fails(&["train", "--dataset", s(&ds), "--out", s(&recording)]);
+    assert!(err.contains("is also an input"), "{err}");
+    assert_eq!(std::fs::read(dir.join("model.json")).unwrap(), model);
+    assert_eq!(std::fs::read(&recording).unwrap(), before);
+    assert!(!dir.partial_left());
+}
+
+#[test]
+fn a_full_disk_is_an_error_even_where_sigxfsz_would_kill() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 3);
+    let run = run_with_file_limit(
+        &dir,
+        1,
+        &[
+            "features",
+            "--dataset",
+            s(&ds),
+            "--method",
+            "all-taxels",
+            "--out",
+            "f.csv",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("cannot write f.csv: File too large"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.matches("File too large").count(), 1, "{stderr}");
+    assert_eq!(names(dir.path()), ["ds"]);
+}
+
+#[test]
+fn temporaries_of_a_killed_run_are_removed_by_the_next() {
+    let dir = Dir::new();
+    // what `kill -9` during `simulate --out out/ds` leaves: a temporary folder whose
+    // process is gone (no process has a PID this large)
+    let stale = dir.join("out/.ds.partial-4194999");
+    std::fs::create_dir_all(stale.join("inner")).unwrap();
+    std::fs::write(stale.join("inner/x.npy"), "x").unwrap();
+    // and one of a process that still runs (this test's): left alone
+    let live = dir.join(&format!("out/.ds.partial-{}", std::process::id()));
+    std::fs::create_dir(&live).unwrap();
+    dir.ok(&["simulate", "--out", "out/ds", "--trials", "1"]);
+    let left = names(&dir.join("out"));
+    assert_eq!(
+        left,
+        [
+            format!(".ds.partial-{}", std::process::id()),
+            "ds".to_string()
+        ]
+    );
 }

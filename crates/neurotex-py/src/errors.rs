@@ -59,7 +59,7 @@ fn kind_of(error: &neurotex::Error) -> Kind {
     use neurotex::Error as E;
     match error {
         E::Param(_) => Kind::Parameter,
-        E::Data(DataError::Io { source, .. }) => io_kind(source),
+        E::Data(DataError::Io { reason, .. } | DataError::Write { reason, .. }) => io_kind(reason),
         E::Data(_) | E::Dataset(_) => Kind::Data,
         E::Classify(_) | E::Stats(_) => Kind::Classify,
         E::Model(_) => Kind::Model,

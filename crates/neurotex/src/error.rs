@@ -42,7 +42,9 @@ impl Error {
     /// already name a file are returned as they are.
     pub fn in_recording(self, file: &str) -> Error {
         match self {
-            Error::Data(DataError::Io { .. } | DataError::Invalid { .. })
+            Error::Data(
+                DataError::Io { .. } | DataError::Write { .. } | DataError::Invalid { .. },
+            )
             | Error::InRecording { .. } => self,
             other => Error::InRecording {
                 file: file.to_string(),
@@ -82,12 +84,21 @@ impl ParamError {
 #[derive(Debug, thiserror::Error)]
 pub enum DataError {
     /// A file could not be opened or read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}: {reason}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// The operating system's reason.
-        source: std::io::Error,
+        /// The operating system's reason (in the message, so not also a `source()`, which
+        /// would print it twice in an error chain).
+        reason: std::io::Error,
+    },
+    /// A file or folder could not be created or written.
+    #[error("cannot write {path}: {reason}")]
+    Write {
+        /// The output, as the user named it (never the hidden temporary).
+        path: PathBuf,
+        /// The operating system's reason (in the message, not a `source()`).
+        reason: std::io::Error,
     },
     /// Spike trains (or a part of them) shorter than one rate-volume bin.
     #[error("{n_ms} ms of spikes is shorter than one {bin_ms} ms bin")]
@@ -129,11 +140,19 @@ impl DataError {
         }
     }
 
+    /// A [`DataError::Write`] for output `path`.
+    pub fn write(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        DataError::Write {
+            path: path.into(),
+            reason: source,
+        }
+    }
+
     /// An [`DataError::Io`] for `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         DataError::Io {
             path: path.into(),
-            source,
+            reason: source,
         }
     }
 }
@@ -158,6 +177,16 @@ pub enum ClassifyError {
         count: usize,
         /// Folds asked for.
         folds: usize,
+    },
+    /// Every sample has one class: any classifier scores 100 %, which says nothing.
+    #[error(
+        "every recording to {what} is of class `{label}`: telling classes apart needs at least two"
+    )]
+    OneClass {
+        /// The one class.
+        label: String,
+        /// What was to be done (`cross-validate`, `train`).
+        what: &'static str,
     },
     /// The test set holds a label the training set never saw.
     #[error("test label `{label}` does not occur in the training set")]

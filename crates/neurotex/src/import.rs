@@ -463,6 +463,8 @@ fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Re
         time_column: timed.then(|| "t_ms".to_string()),
         time_unit: timed.then_some(TimeUnit::Milliseconds),
         channels: Some(names.to_vec()),
+        max_gap_s: (timed && p.format.max_gap_s != crate::csvlog::DEFAULT_MAX_GAP_S)
+            .then_some(p.format.max_gap_s),
         ..LayoutFile::default()
     })
 }
@@ -488,7 +490,7 @@ fn write_imported(dir: &Path, parsed: &ParsedCsv, names: &[String]) -> Result<Me
         text.push_str(&values.join(","));
         text.push('\n');
     }
-    std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
+    std::fs::write(&path, text).map_err(|e| DataError::write(&path, e))?;
     Ok(parsed.meta.clone())
 }
 

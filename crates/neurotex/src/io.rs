@@ -5,6 +5,14 @@
 //! Each temporary file or folder is listed in a process-wide registry from before it is
 //! created until it is renamed into place or removed, so that a signal handler in the
 //! binary can remove whatever is still temporary ([`remove_temporaries`]) before it exits.
+//!
+//! neurotex often runs as root (in containers), where a rename replaces anything: a device
+//! node, a link, another program's file. So a rename only ever replaces a regular file
+//! with no other hard link ([`destination`]): a symbolic link is followed and its target
+//! replaced (the link stays), a character device or a pipe (`/dev/null`, `/dev/stdout`, a
+//! FIFO) is written through, and anything else (a folder, a block device, a socket, a file
+//! with several hard links, a dangling link) is refused before any work is done. An output
+//! that is one of a command's inputs is refused too ([`check_output`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -60,11 +68,9 @@ impl Temporary {
         let name = path
             .file_name()
             .ok_or_else(|| DataError::invalid(path, "not a file or folder name"))?;
-        let tmp = parent(path).join(format!(
-            ".{}.partial-{}",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
+        let prefix = format!(".{}.partial-", name.to_string_lossy());
+        remove_stale(parent(path), &prefix);
+        let tmp = parent(path).join(format!("{prefix}{}", std::process::id()));
         Ok(Temporary::new(tmp))
     }
 
@@ -136,20 +142,24 @@ fn parent(path: &Path) -> &Path {
 /// A file written and flushed to disk under a temporary name, not yet in place.
 #[derive(Debug)]
 pub struct Staged {
-    tmp: Temporary,
+    /// `None` when the content was written through (a device or a pipe).
+    tmp: Option<Temporary>,
     path: PathBuf,
 }
 
 impl Staged {
-    /// Renames the file into place.
+    /// Renames the file into place (nothing to do for a device or a pipe, written already).
     ///
     /// # Errors
     /// The rename fails; the temporary is removed and `path` left as it was.
     pub fn commit(self) -> Result<()> {
         let path = self.path;
-        self.tmp
-            .persist(&path)
-            .map_err(|e| DataError::io(&path, e).into())
+        match self.tmp {
+            Some(tmp) => tmp
+                .persist(&path)
+                .map_err(|e| DataError::write(&path, e).into()),
+            None => Ok(()),
+        }
     }
 }
 
@@ -164,14 +174,24 @@ pub fn stage(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<Staged> {
-    let dir = parent(path);
+    let target = match destination(path)? {
+        Destination::Replace(target) => target,
+        Destination::WriteThrough(target) => {
+            write_through(&target, fill).map_err(|e| DataError::write(path, e))?;
+            return Ok(Staged {
+                tmp: None,
+                path: target,
+            });
+        }
+    };
+    let dir = parent(&target);
     if !dir.is_dir() {
         let message = format!("folder {} does not exist", dir.display());
         return Err(DataError::invalid(path, message).into());
     }
-    let tmp = Temporary::beside(path)?;
+    let tmp = Temporary::beside(&target)?;
     let written = (|| -> std::io::Result<()> {
-        let file = std::fs::File::create(tmp.path())?;
+        let file = std::fs::File::create_new(tmp.path())?;
         let mut w = std::io::BufWriter::new(file);
         fill(&mut w)?;
         w.flush()?;
@@ -179,10 +199,179 @@ pub fn stage(
     })();
     match written {
         Ok(()) => Ok(Staged {
-            tmp,
-            path: path.to_path_buf(),
+            tmp: Some(tmp),
+            path: target,
         }),
-        Err(e) => Err(DataError::io(path, e).into()),
+        Err(e) => Err(DataError::write(path, e).into()),
+    }
+}
+
+/// Writes `fill` straight into an existing character device or pipe, which has no content
+/// to lose and cannot be renamed over.
+fn write_through(
+    target: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let file = std::fs::OpenOptions::new().write(true).open(target)?;
+    let mut w = std::io::BufWriter::new(file);
+    fill(&mut w)?;
+    w.flush()
+}
+
+/// Where an output path's content goes (see the module's notes).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Destination {
+    /// A new file, or a regular file with no other hard link, at this path (a symbolic
+    /// link's target): written beside it under a temporary name and renamed over it.
+    Replace(PathBuf),
+    /// A character device or a pipe: written through, never renamed over.
+    WriteThrough(PathBuf),
+}
+
+/// Where the content for output file `path` goes, following symbolic links.
+///
+/// # Errors
+/// `path` is (or links to) a folder, a block device, a socket or a regular file with
+/// other hard links; or a link whose target does not exist.
+pub fn destination(path: &Path) -> Result<Destination> {
+    let meta = match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Destination::Replace(path.to_path_buf()))
+        }
+        Err(e) => return Err(DataError::write(path, e).into()),
+        Ok(meta) => meta,
+    };
+    if meta.file_type().is_symlink() {
+        let target = std::fs::canonicalize(path).map_err(|_| {
+            let to = std::fs::read_link(path).unwrap_or_default();
+            DataError::invalid(
+                path,
+                format!(
+                    "is a symbolic link to {}, which does not exist; write to the target's \
+                     path or remove the link",
+                    to.display()
+                ),
+            )
+        })?;
+        return match destination(&target)? {
+            // `canonicalize` leaves no link in `target`, so this does not recurse again.
+            Destination::Replace(t) if t == target => Ok(Destination::Replace(target)),
+            other => Ok(other),
+        };
+    }
+    let refuse = |what: String| -> Result<Destination> {
+        Err(DataError::invalid(
+            path,
+            format!("{what}; neurotex replaces only regular files"),
+        )
+        .into())
+    };
+    let kind = meta.file_type();
+    if kind.is_file() {
+        let links = hard_links(&meta);
+        if links > 1 {
+            let message = format!(
+                "has {links} hard links, and writing a new file would split them (the other \
+                 names would keep the old content); remove it first or choose another name"
+            );
+            return Err(DataError::invalid(path, message).into());
+        }
+        return Ok(Destination::Replace(path.to_path_buf()));
+    }
+    if kind.is_dir() {
+        return refuse("is a folder, not a file".to_string());
+    }
+    if is_char_device_or_pipe(&kind) {
+        return Ok(Destination::WriteThrough(path.to_path_buf()));
+    }
+    refuse("is a block device or socket, not a file".to_string())
+}
+
+#[cfg(unix)]
+fn hard_links(meta: &std::fs::Metadata) -> u64 {
+    use std::os::unix::fs::MetadataExt;
+    meta.nlink()
+}
+
+#[cfg(not(unix))]
+fn hard_links(_: &std::fs::Metadata) -> u64 {
+    1
+}
+
+#[cfg(unix)]
+fn is_char_device_or_pipe(kind: &std::fs::FileType) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    kind.is_char_device() || kind.is_fifo()
+}
+
+#[cfg(not(unix))]
+fn is_char_device_or_pipe(_: &std::fs::FileType) -> bool {
+    false
+}
+
+/// Checks, before any work, that output file `output` can be written ([`destination`])
+/// and is none of `inputs` (compared as files, through links and hard links: the same
+/// device and inode).
+///
+/// # Errors
+/// As [`destination`]; or `output` is one of `inputs`.
+pub fn check_output<P: AsRef<Path>>(output: &Path, inputs: &[P]) -> Result<()> {
+    destination(output)?;
+    if let Some(input) = inputs.iter().find(|i| same_file(output, i.as_ref())) {
+        let message = if input.as_ref() == output {
+            "is also an input of this command; write the output elsewhere".to_string()
+        } else {
+            format!(
+                "is the same file as input {}; write the output elsewhere",
+                input.as_ref().display()
+            )
+        };
+        return Err(DataError::invalid(output, message).into());
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` both exist and are one file.
+#[cfg(unix)]
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Whether `a` and `b` both exist and are one file.
+#[cfg(not(unix))]
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Removes the temporaries `{prefix}PID` in `dir` that a process killed without a chance to
+/// clean up (`kill -9`, a power cut) left behind: those whose process no longer runs.
+/// Where that cannot be told (no `/proc`), nothing is removed.
+fn remove_stale(dir: &Path, prefix: &str) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(prefix))
+            .and_then(|pid| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            remove(&entry.path());
+        }
     }
 }
 
@@ -214,15 +403,135 @@ pub fn create_dir_atomic<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -
     }
     let created = create_parents(dir)?;
     let tmp = Temporary::beside(dir)?;
-    std::fs::create_dir(tmp.path()).map_err(|e| DataError::io(tmp.path(), e))?;
-    let value = fill(tmp.path())?;
+    std::fs::create_dir(tmp.path()).map_err(|e| DataError::write(dir, e))?;
+    let value = fill(tmp.path()).map_err(|e| named_in(e, tmp.path(), dir))?;
     if dir.exists() {
-        std::fs::remove_dir(dir).map_err(|e| DataError::io(dir, e))?;
+        std::fs::remove_dir(dir).map_err(|e| DataError::write(dir, e))?;
     }
-    tmp.persist(dir).map_err(|e| DataError::io(dir, e))?;
+    tmp.persist(dir).map_err(|e| DataError::write(dir, e))?;
     if let Some(created) = created {
         created.keep();
     }
+    Ok(value)
+}
+
+/// `error` with a path inside the temporary folder `tmp` named as it will be inside `dir`:
+/// the user never sees the hidden temporary's name.
+fn named_in(error: crate::Error, tmp: &Path, dir: &Path) -> crate::Error {
+    let rename = |path: PathBuf| match path.strip_prefix(tmp) {
+        Ok(rest) => dir.join(rest),
+        Err(_) => path,
+    };
+    match error {
+        crate::Error::Data(DataError::Write { path, reason }) => DataError::Write {
+            path: rename(path),
+            reason,
+        }
+        .into(),
+        crate::Error::Data(DataError::Io { path, reason }) => DataError::Io {
+            path: rename(path),
+            reason,
+        }
+        .into(),
+        crate::Error::Data(DataError::Invalid { path, message }) => DataError::Invalid {
+            path: rename(path),
+            message,
+        }
+        .into(),
+        other => other,
+    }
+}
+
+/// Checks, before any work, that output folder `dir` can be written by
+/// [`replace_dir`]: it is new, empty, or holds only what `is_own` recognises (paths
+/// relative to `dir`) as an earlier output of the same kind.
+///
+/// # Errors
+/// `dir` is not a folder, or holds something `is_own` does not recognise (named).
+pub fn check_output_dir(dir: &Path, is_own: &dyn Fn(&Path) -> bool) -> Result<()> {
+    let meta = match std::fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(DataError::write(dir, e).into()),
+        Ok(meta) => meta,
+    };
+    if !meta.is_dir() {
+        let what = if meta.file_type().is_symlink() {
+            "is a symbolic link, not a folder; give the folder's own path"
+        } else {
+            "exists and is not a folder"
+        };
+        return Err(DataError::invalid(dir, what).into());
+    }
+    if let Some(foreign) = first_foreign(dir, Path::new(""), is_own)? {
+        let message = format!(
+            "holds {}, which is not part of an earlier output of this command; neurotex \
+             replaces a folder only when it holds nothing else: choose a new or empty folder",
+            foreign.display()
+        );
+        return Err(DataError::invalid(dir, message).into());
+    }
+    Ok(())
+}
+
+/// The first entry under `dir/rel` (depth first) that `is_own` does not recognise.
+fn first_foreign(
+    dir: &Path,
+    rel: &Path,
+    is_own: &dyn Fn(&Path) -> bool,
+) -> Result<Option<PathBuf>> {
+    let here = dir.join(rel);
+    let entries = std::fs::read_dir(&here).map_err(|e| DataError::io(&here, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| DataError::io(&here, e))?;
+        let path = rel.join(entry.file_name());
+        if !is_own(&path) {
+            return Ok(Some(path));
+        }
+        let kind = entry
+            .file_type()
+            .map_err(|e| DataError::io(entry.path(), e))?;
+        if kind.is_dir() {
+            if let Some(foreign) = first_foreign(dir, &path, is_own)? {
+                return Ok(Some(foreign));
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// Writes output folder `dir` whole: `fill` writes into a temporary folder beside it,
+/// which then takes `dir`'s place. An earlier output there (checked by
+/// [`check_output_dir`] with `is_own`) is moved aside first and removed afterwards, so
+/// `dir` never mixes two runs' files; between the two renames `dir` is briefly absent.
+/// Two runs writing the same folder at once each leave a whole output, the later one.
+///
+/// # Errors
+/// As [`check_output_dir`]; or a folder cannot be created, or `fill` or a rename fails
+/// (the earlier output is then put back).
+pub fn replace_dir<T>(
+    dir: &Path,
+    is_own: &dyn Fn(&Path) -> bool,
+    fill: impl FnOnce(&Path) -> Result<T>,
+) -> Result<T> {
+    check_output_dir(dir, is_own)?;
+    let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
+    if !dir.exists() || is_empty(dir) {
+        return create_dir_atomic(dir, fill);
+    }
+    let tmp = Temporary::beside(dir)?;
+    std::fs::create_dir(tmp.path()).map_err(|e| DataError::write(dir, e))?;
+    let value = fill(tmp.path()).map_err(|e| named_in(e, tmp.path(), dir))?;
+    let name = dir.file_name().unwrap_or_default().to_string_lossy();
+    let prefix = format!(".{name}.old-");
+    remove_stale(parent(dir), &prefix);
+    let old = Temporary::new(parent(dir).join(format!("{prefix}{}", std::process::id())));
+    std::fs::rename(dir, old.path()).map_err(|e| DataError::write(dir, e))?;
+    if let Err(e) = tmp.persist(dir) {
+        // Put the earlier output back; `old` is then gone and its removal does nothing.
+        let _ = std::fs::rename(old.path(), dir);
+        return Err(DataError::write(dir, e).into());
+    }
+    drop(old);
     Ok(value)
 }
 
@@ -247,7 +556,7 @@ pub fn create_parents(path: &Path) -> Result<Option<Temporary>> {
         top = up;
     }
     let tmp = Temporary::new(top.to_path_buf());
-    std::fs::create_dir_all(dir).map_err(|e| DataError::io(dir, e))?;
+    std::fs::create_dir_all(dir).map_err(|e| DataError::write(dir, e))?;
     Ok(Some(tmp))
 }
 
@@ -291,6 +600,100 @@ mod tests {
         let staged = stage(&dir.path().join("a"), |w| w.write_all(b"a")).unwrap();
         staged.commit().unwrap();
         assert_eq!(names(dir.path()), ["a"]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn only_a_regular_file_with_one_link_is_renamed_over() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("f.csv");
+        assert_eq!(
+            destination(&file).unwrap(),
+            Destination::Replace(file.clone())
+        );
+        std::fs::write(&file, "old").unwrap();
+        assert_eq!(
+            destination(&file).unwrap(),
+            Destination::Replace(file.clone())
+        );
+        // a link is followed: its target is replaced, the link stays a link
+        let link = dir.path().join("link.csv");
+        std::os::unix::fs::symlink(&file, &link).unwrap();
+        let target = std::fs::canonicalize(&file).unwrap();
+        assert_eq!(destination(&link).unwrap(), Destination::Replace(target));
+        write_atomic(&link, |w| w.write_all(b"new")).unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "new");
+        // a device is written through
+        let null = Path::new("/dev/null");
+        assert_eq!(
+            destination(null).unwrap(),
+            Destination::WriteThrough(null.into())
+        );
+        write_atomic(null, |w| w.write_all(b"gone")).unwrap();
+        // refused: a second hard link, a folder, a dangling link
+        let second = dir.path().join("second.csv");
+        std::fs::hard_link(&file, &second).unwrap();
+        assert!(destination(&second).is_err());
+        assert!(destination(&file).is_err());
+        assert!(destination(dir.path()).is_err());
+        let dangling = dir.path().join("dangling.csv");
+        std::os::unix::fs::symlink(dir.path().join("missing"), &dangling).unwrap();
+        assert!(destination(&dangling).is_err());
+        assert!(write_atomic(&second, |w| w.write_all(b"x")).is_err());
+        assert_eq!(std::fs::read_to_string(&second).unwrap(), "new");
+    }
+
+    #[test]
+    fn an_output_that_is_an_input_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("in.npy");
+        std::fs::write(&input, "x").unwrap();
+        let other = dir.path().join("out.npy");
+        assert!(check_output(&other, &[&input]).is_ok());
+        assert!(check_output(&input, &[&input]).is_err());
+        let roundabout = dir.path().join(".").join("in.npy");
+        assert!(check_output(&roundabout, &[&input]).is_err());
+    }
+
+    #[test]
+    fn a_folder_is_replaced_whole_and_only_when_it_holds_an_earlier_output() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let own = |p: &Path| p.to_str().is_some_and(|n| n.ends_with(".txt"));
+        replace_dir(&out, &own, |tmp| {
+            std::fs::write(tmp.join("a.txt"), "1").unwrap();
+            std::fs::write(tmp.join("b.txt"), "1").unwrap();
+            Ok(())
+        })
+        .unwrap();
+        replace_dir(&out, &own, |tmp| {
+            std::fs::write(tmp.join("a.txt"), "2").unwrap();
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(names(&out), ["a.txt"]);
+        assert_eq!(names(dir.path()), ["out"]);
+        // a failure leaves the earlier output as it was
+        let failed: Result<()> = replace_dir(&out, &own, |tmp| {
+            Err(DataError::write(tmp.join("a.txt"), std::io::Error::other("disk full")).into())
+        });
+        let message = failed.unwrap_err().to_string();
+        assert!(
+            message.contains(&format!("{}", out.join("a.txt").display())),
+            "{message}"
+        );
+        assert!(!message.contains("partial"), "{message}");
+        assert_eq!(std::fs::read_to_string(out.join("a.txt")).unwrap(), "2");
+        assert_eq!(names(dir.path()), ["out"]);
+        // something else in the folder: refused, untouched
+        std::fs::write(out.join("data.npy"), "mine").unwrap();
+        let refused = replace_dir(&out, &own, |_| Ok(()));
+        assert!(refused.unwrap_err().to_string().contains("holds data.npy"));
+        assert_eq!(names(&out), ["a.txt", "data.npy"]);
     }
 
     #[test]

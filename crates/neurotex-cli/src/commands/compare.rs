@@ -20,7 +20,6 @@ use neurotex::Speed;
 
 use super::{calibrated_pipeline, encode_all};
 use crate::open_args::OpenArgs;
-use crate::output::write_file;
 use crate::stage_args::StageArgs;
 
 /// Most candidates one run compares (encodings x methods x classifiers).
@@ -193,6 +192,10 @@ impl CompareArgs {
 pub fn run(args: CompareArgs) -> Result<()> {
     let params = args.params()?;
     let dataset = args.open.open(&args.dataset)?;
+    if let Some(dir) = &args.out {
+        neurotex::io::check_output_dir(dir, &is_compare_file)
+            .context("checking the output folder")?;
+    }
     let indices = args.indices(&dataset)?;
     let set = args.set()?;
     let n = set.len();
@@ -239,28 +242,41 @@ fn make_candidates(
     Ok(candidates(&encoded, &grid, &params, set, encode_s)?)
 }
 
-/// compare.json and compare.md in `dir`.
+/// compare.json, compare.md and the figures, written as one folder `dir` that replaces an
+/// earlier comparison there as a whole ([`neurotex::io::replace_dir`]).
 fn write_outputs(dir: &std::path::Path, c: &Comparison) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    write_file(&dir.join("compare.json"), "compare.json", |w| {
-        serde_json::to_writer_pretty(&mut *w, c).map_err(std::io::Error::other)?;
-        writeln!(w)
-    })?;
-    write_file(&dir.join("compare.md"), "compare.md", |w| {
-        w.write_all(markdown(c).as_bytes())
-    })?;
-    let ranking = figures::ranking(c).map_err(|e| anyhow::anyhow!("{e}"))?;
-    write_file(&dir.join("ranking.svg"), "ranking.svg", |w| {
-        w.write_all(ranking.as_bytes())
-    })?;
+    let mut files = vec![
+        ("compare.json", serde_json::to_string_pretty(c)? + "\n"),
+        ("compare.md", markdown(c)),
+        (
+            "ranking.svg",
+            figures::ranking(c).map_err(|e| anyhow::anyhow!("{e}"))?,
+        ),
+    ];
     if let Some(svg) = figures::per_condition(c) {
-        let svg = svg.map_err(|e| anyhow::anyhow!("{e}"))?;
-        write_file(&dir.join("per_condition.svg"), "per_condition.svg", |w| {
-            w.write_all(svg.as_bytes())
-        })?;
+        files.push((
+            "per_condition.svg",
+            svg.map_err(|e| anyhow::anyhow!("{e}"))?,
+        ));
     }
+    neurotex::io::replace_dir(dir, &is_compare_file, |tmp| {
+        for (name, text) in &files {
+            let path = tmp.join(name);
+            std::fs::write(&path, text).map_err(|e| neurotex::error::DataError::write(&path, e))?;
+        }
+        Ok(())
+    })
+    .context("writing the comparison")?;
     eprintln!("wrote {}", dir.display());
     Ok(())
+}
+
+/// Whether `path` (relative to the output folder) is a file `compare --out` writes.
+fn is_compare_file(path: &std::path::Path) -> bool {
+    matches!(
+        path.to_str(),
+        Some("compare.json" | "compare.md" | "ranking.svg" | "per_condition.svg")
+    )
 }
 
 /// `87.5% [85.1, 89.8]`.

@@ -13,7 +13,7 @@ use neurotex::{Grid, SampleRate};
 
 use super::{report_conditions, say_calibration};
 use crate::csv_args::CsvArgs;
-use crate::output::stage_file;
+use crate::output::{check_output, stage_file};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex encode`.
@@ -55,6 +55,18 @@ pub fn run(args: EncodeArgs) -> Result<()> {
         bail!("--causal fixes resting values and a scale on training recordings: use it with train, evaluate, features or compare (then predict or stream with the model)");
     }
     let pipeline = Pipeline::new(args.stages.pipeline()?)?;
+    let mut inputs = vec![args.input.clone()];
+    inputs.extend(layout_path(&args));
+    check_output(&args.out, &inputs)?;
+    if let Some(events) = &args.events {
+        if events == &args.out || neurotex::io::same_file(events, &args.out) {
+            bail!(
+                "--events and --out name the same file, {}",
+                args.out.display()
+            );
+        }
+        check_output(events, &inputs)?;
+    }
     let layout = input_layout(&args)?;
     let format = layout
         .csv_format()
@@ -105,15 +117,20 @@ pub fn run(args: EncodeArgs) -> Result<()> {
     Ok(())
 }
 
-/// The input's layout: `--layout FILE`, else `layout.toml` beside the input, else the
-/// defaults; then `--fs` and `--grid` in place of the layout's.
-fn input_layout(args: &EncodeArgs) -> Result<LayoutFile> {
+/// The layout file read for the input: `--layout FILE`, else `layout.toml` beside it.
+fn layout_path(args: &EncodeArgs) -> Option<PathBuf> {
     let beside = args
         .input
         .parent()
         .map(|dir| dir.join("layout.toml"))
         .filter(|p| p.is_file());
-    let mut layout = match args.layout.as_ref().or(beside.as_ref()) {
+    args.layout.clone().or(beside)
+}
+
+/// The input's layout: `--layout FILE`, else `layout.toml` beside the input, else the
+/// defaults; then `--fs` and `--grid` in place of the layout's.
+fn input_layout(args: &EncodeArgs) -> Result<LayoutFile> {
+    let mut layout = match layout_path(args).as_ref() {
         Some(path) => {
             if args.layout.is_none() {
                 eprintln!(

@@ -20,7 +20,7 @@ use neurotex::{Cell, Speed};
 use super::{calibrated_pipeline, encode_all, encoded_features};
 use crate::classifier_args::ClassifierArgs;
 use crate::open_args::OpenArgs;
-use crate::output::write_file;
+use crate::output::{check_output, write_file};
 use crate::stage_args::StageArgs;
 use neurotex::classify::ClassifierChoice;
 use neurotex::compare::candidates::{
@@ -217,6 +217,9 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         bail!("--predictions needs one classifier, not one per taxel: add --taxel ROW,COL");
     }
     let dataset = args.open.open(&args.dataset)?;
+    if let Some(path) = &args.predictions {
+        check_output(path, &dataset.files())?;
+    }
     let indices = args.indices(&dataset)?;
     let calibrated = calibrated_pipeline(
         &args.stages,

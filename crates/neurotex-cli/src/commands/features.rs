@@ -10,7 +10,7 @@ use neurotex::pipeline::{Method, Pipeline};
 
 use super::{calibrated_pipeline, feature_table};
 use crate::open_args::OpenArgs;
-use crate::output::write_file;
+use crate::output::{check_output, write_file};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex features`.
@@ -37,6 +37,7 @@ pub struct FeaturesArgs {
 /// Runs `neurotex features`.
 pub fn run(args: FeaturesArgs) -> Result<()> {
     let dataset = args.open.open(&args.dataset)?;
+    check_output(&args.out, &dataset.files())?;
     // Features are computed for every recording; `--gain auto` calibrates on all of them.
     let all: Vec<usize> = (0..dataset.entries.len()).collect();
     let params = calibrated_pipeline(&args.stages, &dataset, &all)?.params;

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use super::report_conditions;
 use super::stream::DecisionArgs;
 use crate::open_args::OpenArgs;
-use crate::output::{progress, write_file};
+use crate::output::{check_output, progress, write_file};
 
 /// Options of `neurotex predict`.
 #[derive(Args)]
@@ -65,9 +65,20 @@ pub fn run(args: PredictArgs) -> Result<()> {
     if args.json && args.dataset.is_none() {
         bail!("--json scores the predictions against known labels: it needs --dataset");
     }
+    let dataset = args
+        .dataset
+        .as_ref()
+        .map(|d| args.open.open(d))
+        .transpose()?;
+    let mut inputs = vec![args.model.clone()];
+    match &dataset {
+        Some(dataset) => inputs.extend(dataset.files()),
+        None => inputs.extend(args.files.iter().chain(&args.layout).cloned()),
+    }
+    check_output(&args.out, &inputs)?;
     let model = Model::load(&args.model)?;
-    let (encoded, known) = match &args.dataset {
-        Some(dir) => (encode_dataset(&model, &args.open.open(dir)?)?, true),
+    let (encoded, known) = match &dataset {
+        Some(dataset) => (encode_dataset(&model, dataset)?, true),
         None => (
             encode_files(&model, &args.files, args.layout.as_deref())?,
             false,

@@ -18,7 +18,7 @@ use neurotex::report::{write_report, ReportContext};
 
 use super::say_calibration;
 use crate::open_args::OpenArgs;
-use crate::output::{progress, write_file};
+use crate::output::{check_output, progress, write_file};
 use crate::stage_args::StageArgs;
 
 /// Most simulated datasets one run accepts (each takes seconds; more is a typo).
@@ -135,6 +135,11 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         Some(dir) => Some(args.open.open(dir)?),
         None => None,
     };
+    neurotex::report::check_report_dir(&args.out).context("checking the report folder")?;
+    if let Some(path) = &args.predictions {
+        let inputs = dataset.as_ref().map(Dataset::files).unwrap_or_default();
+        check_output(path, &inputs)?;
+    }
     let bar = Mutex::new(progress(0, "starting"));
     let on_progress = |p: Progress| show_progress(&bar.lock().expect("progress bar"), p);
     let (results, described, params) = analyse(&args, dataset.as_ref(), &on_progress)?;

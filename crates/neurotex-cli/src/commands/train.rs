@@ -13,6 +13,7 @@ use neurotex::{Cell, Speed};
 use super::{calibrated_pipeline, feature_table};
 use crate::classifier_args::ClassifierArgs;
 use crate::open_args::OpenArgs;
+use crate::output::check_output;
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex train`.
@@ -50,6 +51,7 @@ pub struct TrainArgs {
 /// Runs `neurotex train`.
 pub fn run(args: TrainArgs) -> Result<()> {
     let dataset = args.open.open(&args.dataset)?;
+    check_output(&args.out, &dataset.files())?;
     let indices = match &args.speeds {
         Some(speeds) => dataset.indices_at(speeds)?,
         None => (0..dataset.entries.len()).collect(),

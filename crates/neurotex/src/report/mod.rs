@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{DataError, Result};
 use crate::experiments::Results;
-use crate::io::{create_dir_atomic, Temporary};
+use crate::io::{check_output_dir, replace_dir};
 
 pub use markdown::markdown;
 pub use paper::{
@@ -45,14 +45,17 @@ impl ReportContext {
     }
 }
 
-/// Writes `report.md`, `results.json` and `figures/*.svg` into `dir` (created if needed),
-/// whole or not at all: everything is rendered, then written into a temporary folder beside
-/// `dir`, which becomes `dir` (when `dir` is new or empty) or whose files are renamed into
-/// `dir` one by one, `report.md` last. On any failure the temporary folder is removed.
+/// Writes `report.md`, `results.json` and `figures/*.svg` into `dir` whole or not at all
+/// ([`replace_dir`]): everything is rendered, then written into a temporary folder beside
+/// `dir`, which takes `dir`'s place. An earlier report in `dir` is replaced as a whole (no
+/// figure of an earlier run stays beside the new report); a folder holding anything else is
+/// refused ([`check_report_dir`]). On any failure the temporary folder is removed and `dir`
+/// is left as it was.
 ///
 /// # Errors
 /// The folder cannot be created, a file cannot be written or a figure cannot be drawn.
 pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Result<()> {
+    check_report_dir(dir)?;
     let mut files = Vec::new();
     for (name, svg) in figures::all(results, ctx.paper()) {
         let path = Path::new("figures").join(name);
@@ -63,32 +66,35 @@ pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Resul
         .map_err(|e| DataError::invalid(dir.join("results.json"), e.to_string()))?;
     files.push(("results.json".into(), json));
     files.push(("report.md".into(), markdown(results, ctx)));
-    let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
-    if !dir.exists() || is_empty(dir) {
-        return create_dir_atomic(dir, |tmp| write_files(tmp, &files));
+    replace_dir(dir, &is_report_file, |tmp| write_files(tmp, &files))
+}
+
+/// Checks, before any work, that `dir` is new, empty or an earlier report (`report.md`,
+/// `results.json`, `figures/` with SVG and PNG files): a report replaces nothing else.
+///
+/// # Errors
+/// `dir` is not a folder, or holds a file a report does not write (named).
+pub fn check_report_dir(dir: &Path) -> Result<()> {
+    check_output_dir(dir, &is_report_file)
+}
+
+/// Whether `path` (relative to the report folder) is a name a report writes.
+fn is_report_file(path: &Path) -> bool {
+    let names: Vec<_> = path.iter().filter_map(|c| c.to_str()).collect();
+    match names.as_slice() {
+        ["report.md" | "results.json" | "figures"] => true,
+        ["figures", name] => name.ends_with(".svg") || name.ends_with(".png"),
+        _ => false,
     }
-    if !dir.is_dir() {
-        return Err(DataError::invalid(dir, "is not a folder").into());
-    }
-    let tmp = Temporary::beside(dir)?;
-    std::fs::create_dir(tmp.path()).map_err(|e| DataError::io(tmp.path(), e))?;
-    write_files(tmp.path(), &files)?;
-    let figures_dir = dir.join("figures");
-    std::fs::create_dir_all(&figures_dir).map_err(|e| DataError::io(&figures_dir, e))?;
-    for (name, _) in &files {
-        let to = dir.join(name);
-        std::fs::rename(tmp.path().join(name), &to).map_err(|e| DataError::io(&to, e))?;
-    }
-    Ok(())
 }
 
 /// Writes `files` (paths relative to `dir`, and their text) and the `figures` folder.
 fn write_files(dir: &Path, files: &[(PathBuf, String)]) -> Result<()> {
     let figures_dir = dir.join("figures");
-    std::fs::create_dir(&figures_dir).map_err(|e| DataError::io(&figures_dir, e))?;
+    std::fs::create_dir(&figures_dir).map_err(|e| DataError::write(&figures_dir, e))?;
     for (name, text) in files {
         let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
+        std::fs::write(&path, text).map_err(|e| DataError::write(&path, e))?;
     }
     Ok(())
 }
