@@ -19,7 +19,9 @@ pub struct CsvArgs {
     /// resampled onto 1 ms later).
     #[arg(long = "time-column")]
     pub time_column: Option<Column>,
-    /// Unit of the time column: `ms` or `s` (default `ms`).
+    /// Unit of the time column: `ms`, `s` or `us` (default: from a suffix of the column's
+    /// name such as `_ms`, `_s`, `_us` or `(s)`, else `ms`; stamps implying a rate above
+    /// 20 kHz or below 0.1 Hz are then refused, asking for this option).
     #[arg(long = "time-unit")]
     pub time_unit: Option<TimeUnit>,
     /// Channel columns: a comma-separated list of names, of 0-based indices and ranges such
@@ -31,6 +33,11 @@ pub struct CsvArgs {
     /// `error`. Exact duplicate rows are dropped under each; the counts are reported.
     #[arg(long = "duplicate-stamps")]
     pub duplicate_stamps: Option<DuplicateStamps>,
+    /// The longest gap between two time stamps, in s, that resampling may fill by
+    /// interpolation (default 1, as `stream`'s --max-gap-s): a longer pause in a log is an
+    /// error naming where, not a straight line through it.
+    #[arg(long = "max-gap-s")]
+    pub max_gap_s: Option<f64>,
 }
 
 impl CsvArgs {
@@ -49,12 +56,16 @@ impl CsvArgs {
         }
         if let Some(unit) = self.time_unit {
             base.time_unit = unit;
+            base.unit_given = true;
         }
         if let Some(channels) = &self.channels {
             base.channels = channels.clone();
         }
         if let Some(policy) = self.duplicate_stamps {
             base.duplicate_stamps = policy;
+        }
+        if let Some(gap) = self.max_gap_s {
+            base.max_gap_s = gap;
         }
         base
     }

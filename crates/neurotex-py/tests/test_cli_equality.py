@@ -27,7 +27,8 @@ def test_encode_equals_cli_in_every_dtype_and_order(sim_dir, cli, tmp_path):
     assert x.dtype == np.float32
     assert expected.sum() > 100, "the test recording must spike"
     for variant in (x, x.astype(np.float64), np.asfortranarray(x),
-                    np.asfortranarray(x.astype(np.float64)), x[:, ::-1, :][:, ::-1, :]):
+                    np.asfortranarray(x.astype(np.float64)), x[:, ::-1, :][:, ::-1, :],
+                    x.astype(">f4"), x.astype(">f8")):
         got = neurotex.encode(variant)
         assert got.dtype == np.uint8
         assert got.shape == expected.shape

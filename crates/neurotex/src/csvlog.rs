@@ -248,6 +248,10 @@ pub struct CsvFormat {
     pub time_column: Option<Column>,
     /// The unit of the time column.
     pub time_unit: TimeUnit,
+    /// Whether `time_unit` was given (an option, `layout.toml`): when not, a unit named in
+    /// the time column's name (`t_s`, `stamp_us`, `time (ms)`) is taken instead, and with
+    /// none there, stamps implying an implausible rate are refused ([`PLAUSIBLE_HZ`]).
+    pub unit_given: bool,
     /// With a header row and no `time_column`: take a column named `t_ms` or `time_ms` (in
     /// ms), or `t_s` or `time_s` (in s), as the time column when there is one.
     pub detect_time: bool,
@@ -255,7 +259,15 @@ pub struct CsvFormat {
     pub channels: ChannelSelect,
     /// Rows that share a time stamp.
     pub duplicate_stamps: DuplicateStamps,
+    /// The longest gap between two time stamps, in s, that resampling may fill by
+    /// interpolation (default [`DEFAULT_MAX_GAP_S`]); a longer one is an error.
+    pub max_gap_s: f64,
 }
+
+/// The longest gap between time stamps read by default, in s: the live stream's default
+/// too. A logger that stopped for minutes would otherwise have the pause filled with a
+/// straight line, and recordings with different data could give identical features.
+pub const DEFAULT_MAX_GAP_S: f64 = 1.0;
 
 impl Default for CsvFormat {
     /// A header row, detected delimiter, no time column (none detected), every column,
@@ -266,9 +278,11 @@ impl Default for CsvFormat {
             delimiter: None,
             time_column: None,
             time_unit: TimeUnit::Milliseconds,
+            unit_given: false,
             detect_time: false,
             channels: ChannelSelect::All,
             duplicate_stamps: DuplicateStamps::Average,
+            max_gap_s: DEFAULT_MAX_GAP_S,
         }
     }
 }
@@ -335,6 +349,8 @@ pub struct Columns {
     pub time: Option<usize>,
     /// The time column's unit.
     pub unit: TimeUnit,
+    /// Whether the unit was given or named in the time column's name, rather than assumed.
+    pub unit_known: bool,
     /// The channel columns' indices, in channel order.
     pub channels: Vec<usize>,
 }
@@ -363,7 +379,11 @@ fn resolve_column(
         Column::Name(name) => names.iter().position(|h| h == name).ok_or_else(|| {
             invalid(
                 path,
-                format!("missing {what} `{name}` (columns: {})", names.join(", ")),
+                format!(
+                    "missing {what} `{}` (columns: {})",
+                    excerpt(name),
+                    excerpt(&names.join(", "))
+                ),
             )
         }),
     }
@@ -391,8 +411,21 @@ impl Columns {
             None if format.detect_time && format.header => detect_time_column(&names),
             None => (None, format.time_unit),
         };
+        let named = time
+            .filter(|_| format.header)
+            .and_then(|t| unit_in_name(&names[t]));
+        let (unit, unit_known) = match named {
+            Some(named) if !format.unit_given => (named, true),
+            _ => (unit, format.unit_given || named.is_some()),
+        };
+        // A header ending in a delimiter (`a,b,`), as some loggers write every line, has
+        // an empty last name: not a channel.
+        let trailing = format.header && names.last().is_some_and(String::is_empty);
+        let last = names.len() - 1;
         let channels: Vec<usize> = match &format.channels {
-            ChannelSelect::All => (0..names.len()).filter(|&j| Some(j) != time).collect(),
+            ChannelSelect::All => (0..names.len())
+                .filter(|&j| Some(j) != time && !(trailing && j == last))
+                .collect(),
             ChannelSelect::Names(list) => list
                 .iter()
                 .map(|n| {
@@ -422,13 +455,166 @@ impl Columns {
         if channels.is_empty() {
             return Err(invalid(path, "no channel columns selected"));
         }
+        if format.header {
+            unique_names(path, &names, time.iter().chain(&channels))?;
+        }
         Ok(Columns {
             names,
             time,
             unit,
+            unit_known,
             channels,
         })
     }
+}
+
+/// The columns used must have distinct names: a layout, a model and the import's map
+/// find channels by name, and a repeated name would send them all to its first column.
+fn unique_names<'a>(
+    path: &Path,
+    names: &[String],
+    used: impl Iterator<Item = &'a usize>,
+) -> Result<()> {
+    let mut first: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    for &j in used {
+        if let Some(&i) = first.get(names[j].as_str()) {
+            let (i, j) = (i.min(j), i.max(j));
+            let message = format!(
+                "columns {} and {} of line 1 are both named `{}`: each column read needs a \
+                 name of its own (rename them, or read the file without its header row and \
+                 select channels by index)",
+                i + 1,
+                j + 1,
+                excerpt(&names[j])
+            );
+            return Err(invalid(path, message));
+        }
+        first.insert(&names[j], j);
+    }
+    Ok(())
+}
+
+/// `text`, cut to its first 60 characters (with `...`) so that an error never echoes a
+/// huge field whole.
+pub(crate) fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
+    const MAX: usize = 60;
+    match text.char_indices().nth(MAX) {
+        None => text.into(),
+        Some((end, _)) => format!("{}...", &text[..end]).into(),
+    }
+}
+
+/// The unit a time column's name ends in: `_ms`, `_s`, `_us` (or `-`, a space, `(ms)`,
+/// `[s]`), in any case.
+fn unit_in_name(name: &str) -> Option<TimeUnit> {
+    let name = name.trim().to_lowercase();
+    let name = name.trim_end_matches([')', ']']);
+    [
+        ("ms", TimeUnit::Milliseconds),
+        ("us", TimeUnit::Microseconds),
+        ("µs", TimeUnit::Microseconds),
+        ("s", TimeUnit::Seconds),
+    ]
+    .into_iter()
+    .find(|(suffix, _)| {
+        name.strip_suffix(suffix)
+            .is_some_and(|rest| rest.ends_with(['_', '-', ' ', '(', '[']))
+    })
+    .map(|(_, unit)| unit)
+}
+
+/// Sampling rates a tactile log plausibly has, in Hz: stamps whose median step implies a
+/// rate outside are most likely in another unit than assumed (seconds read as ms give
+/// 1000 times the rate), so without a unit given or named they are refused.
+pub const PLAUSIBLE_HZ: (f64, f64) = (0.1, 20_000.0);
+
+/// Refuses stamps whose unit was only assumed when their median step implies a rate
+/// outside [`PLAUSIBLE_HZ`].
+fn check_plausible_rate(path: &Path, columns: &Columns, times: &[f64]) -> Result<()> {
+    let (Some(t), false) = (columns.time, columns.unit_known) else {
+        return Ok(());
+    };
+    let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    if steps.is_empty() {
+        return Ok(());
+    }
+    let mid = steps.len() / 2;
+    let (_, &mut median, _) = steps.select_nth_unstable_by(mid, f64::total_cmp);
+    let hz = 1.0 / (median * columns.unit.seconds());
+    if (PLAUSIBLE_HZ.0..=PLAUSIBLE_HZ.1).contains(&hz) {
+        return Ok(());
+    }
+    let median = format!("{median:.6}");
+    let median = median.trim_end_matches('0').trim_end_matches('.');
+    let message = format!(
+        "time column `{}` steps by a median {median} {unit}, which is {hz:.1} Hz if its \
+         stamps are in {unit}; a tactile log at that rate is unlikely, so the unit is \
+         probably another: say it with --time-unit ms, s or us (`time_unit` in layout.toml), \
+         or end the column's name in `_ms`, `_s` or `_us`",
+        excerpt(&columns.names[t]),
+        unit = columns.unit,
+    );
+    Err(invalid(path, message))
+}
+
+/// Refuses a gap between consecutive time stamps longer than `max_gap_s`.
+fn check_gaps(path: &Path, log: &CsvLog, max_gap_s: f64) -> Result<()> {
+    let Some(times) = &log.times else {
+        return Ok(());
+    };
+    let scale = log.time_unit.seconds();
+    let Some(i) = times
+        .windows(2)
+        .position(|w| (w[1] - w[0]) * scale > max_gap_s)
+    else {
+        return Ok(());
+    };
+    let message = format!(
+        "time stamps jump by {} s between frames {} and {} (stamps {} and {} {}), beyond the \
+         {max_gap_s} s that resampling may fill by interpolation: split the recording there, \
+         or raise the limit (--max-gap-s, `max_gap_s` in layout.toml)",
+        (times[i + 1] - times[i]) * scale,
+        i + 1,
+        i + 2,
+        times[i],
+        times[i + 1],
+        log.time_unit,
+    );
+    Err(invalid(path, message))
+}
+
+/// Refuses a log read without a time column whose first channel is named like a time
+/// column (`t`, `time...`, `...stamp...`) and rises on every row: it is its stamps, and
+/// read as one more taxel it would put a ramp on a cell and leave the rate unknown.
+fn check_no_stamps_among_channels(
+    path: &Path,
+    format: &CsvFormat,
+    columns: &Columns,
+    log: &CsvLog,
+) -> Result<()> {
+    let n = columns.channels.len();
+    if columns.time.is_some() || !format.header || n < 2 || log.samples.len() < 3 * n {
+        return Ok(());
+    }
+    let name = &columns.names[columns.channels[0]];
+    let lower = name.trim().to_lowercase();
+    let timelike = lower == "t"
+        || lower.starts_with("time")
+        || lower.contains("stamp")
+        || unit_in_name(&lower).is_some_and(|_| lower.starts_with("t"));
+    let first = log.samples.iter().step_by(n);
+    let rising = first.clone().zip(first.skip(1)).all(|(a, b)| b > a);
+    if !(timelike && rising) {
+        return Ok(());
+    }
+    let message = format!(
+        "column `{}` is named like time stamps and rises on every row, but no time column \
+         was chosen, so it would be read as a taxel: pass --time-column {} (and --time-unit \
+         if it is not in ms), or choose the taxel columns with --channels",
+        excerpt(name),
+        excerpt(name),
+    );
+    Err(invalid(path, message))
 }
 
 /// A column named `t_ms` or `time_ms` (in ms), else `t_s` or `time_s` (in s).
@@ -449,6 +635,10 @@ fn detect_time_column(names: &[String]) -> (Option<usize>, TimeUnit) {
 /// An unreadable or malformed file, a missing column, a cell that is not a finite number,
 /// a time stamp that goes back, a repeated stamp under `error`, or no data rows.
 pub fn read_csv_log(path: &Path, format: &CsvFormat) -> Result<CsvLog> {
+    if !(format.max_gap_s.is_finite() && format.max_gap_s > 0.0) {
+        let rule = "the largest gap between stamps must be a positive number of s";
+        return Err(ParamError::new("max-gap-s", rule, format.max_gap_s).into());
+    }
     let delimiter = match format.delimiter {
         Some(d) => d,
         None => detect_delimiter(path)?,
@@ -482,6 +672,11 @@ pub fn read_csv_log(path: &Path, format: &CsvFormat) -> Result<CsvLog> {
     if log.samples.is_empty() {
         return Err(invalid(path, "no data rows"));
     }
+    if let Some(times) = &log.times {
+        check_plausible_rate(path, &columns, times)?;
+        check_gaps(path, &log, format.max_gap_s)?;
+    }
+    check_no_stamps_among_channels(path, format, &columns, &log)?;
     Ok(log)
 }
 
@@ -531,8 +726,8 @@ impl<'a> RowReader<'a> {
                     self.path,
                     format!(
                         "line {line}, column `{}`: expected a finite number, got `{}`",
-                        self.columns.names[j],
-                        String::from_utf8_lossy(raw)
+                        excerpt(&self.columns.names[j]),
+                        excerpt(&String::from_utf8_lossy(raw))
                     ),
                 )
             })

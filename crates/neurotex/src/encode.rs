@@ -134,7 +134,11 @@ impl IzhikevichParams {
         self
     }
 
-    /// Checks the rules: finite values, `a > 0`, reset below the 30 mV peak, gain > 0.
+    /// Checks the rules: `a` in (0, 1], `b` in [-1, 1], `c` in [-100, 30) mV, `d` in
+    /// [-100, 100], gain in (0, 10000]. Izhikevich's firing types (2003, 2004) lie well
+    /// inside (a 0.02-0.1, b -0.1-0.26, c -65 to -50, d -2 to 8); far outside, the 1 ms
+    /// Euler step overflows to NaN, which never crosses the peak: the neuron would fall
+    /// silent without an error.
     ///
     /// # Errors
     /// The rule broken.
@@ -146,25 +150,32 @@ impl IzhikevichParams {
                 self.gain,
             ));
         }
-        if !(self.a.is_finite() && self.a > 0.0) {
+        if !(self.a > 0.0 && self.a <= 1.0) {
             return Err(ParamError::new(
                 "a",
-                "recovery scale a must be positive",
+                "recovery scale a must be in (0, 1]",
                 self.a,
             ));
         }
-        if !self.b.is_finite() || !self.d.is_finite() {
+        if !(-1.0..=1.0).contains(&self.b) {
             return Err(ParamError::new(
-                "b, d",
-                "b and d must be finite",
-                format!("{}, {}", self.b, self.d),
+                "b",
+                "recovery sensitivity b must be in [-1, 1]",
+                self.b,
             ));
         }
-        if !(self.c.is_finite() && self.c < V_PEAK) {
+        if !(self.c >= -100.0 && self.c < V_PEAK) {
             return Err(ParamError::new(
                 "c",
-                "reset potential c must be below the 30 mV peak",
+                "reset potential c must be in [-100, 30) mV, below the 30 mV peak",
                 self.c,
+            ));
+        }
+        if !(-100.0..=100.0).contains(&self.d) {
+            return Err(ParamError::new(
+                "d",
+                "recovery jump d must be in [-100, 100]",
+                self.d,
             ));
         }
         Ok(())

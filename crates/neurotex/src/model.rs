@@ -612,6 +612,18 @@ fn fit(file: &ModelFile, dims: usize) -> Result<ChosenModel> {
             training.rows[i].len()
         )));
     }
+    // The features neurotex computes are rates, statistics and Haralick values, all far
+    // below this; a larger value in a model file is damage, and would overflow the
+    // z-scoring's squares to infinity and the distances to NaN.
+    const MAX_FEATURE: f64 = 1e15;
+    for (i, row) in training.rows.iter().enumerate() {
+        if let Some(j) = row.iter().position(|v| !(v.abs() <= MAX_FEATURE)) {
+            return Err(inconsistent(format!(
+                "training row {i}, feature {j} is {}, beyond the ±1e15 any feature can reach",
+                row[j]
+            )));
+        }
+    }
     for (i, label) in file.labels.iter().enumerate() {
         if file.labels[..i].contains(label) {
             return Err(inconsistent(format!("class `{label}` is listed twice")));
@@ -873,6 +885,11 @@ mod tests {
             &text.replacen("\"rows\": 2,", "\"rows\": 3,", 1),
             &text.replacen("\"asm\"", "\"energy\"", 1),
             &text.replacen("\"k\": 3", "\"k\": 0", 1),
+            // absurd neuron constants: the Euler step would overflow to NaN, silently
+            // silencing every neuron
+            &text.replacen("\"a\": 0.02", "\"a\": 1e300", 1),
+            &text.replacen("\"b\": 0.2", "\"b\": -1e300", 1),
+            &text.replacen("\"d\": 8.0", "\"d\": 1e300", 1),
         ] {
             let err = load_text(damaged);
             assert!(
@@ -882,6 +899,33 @@ mod tests {
         }
         let missing = Model::load(Path::new("/nonexistent/model.json")).unwrap_err();
         assert!(matches!(missing, crate::Error::Data(DataError::Io { .. })));
+    }
+
+    #[test]
+    fn model_files_asking_for_absurd_work_or_values_are_damaged_not_aborts() {
+        let model = trained(Method::Glcm3d, Columns::All);
+        let value = serde_json::to_value(&model.file).unwrap();
+        // a billion trees: refused by the forest's limit before anything is allocated
+        let mut forest = value.clone();
+        let trees = ForestParams {
+            trees: 1_000_000_000,
+            ..ForestParams::default()
+        };
+        forest["classifier"] = serde_json::to_value(ClassifierChoice::Forest(trees)).unwrap();
+        let err = load_text(&forest.to_string());
+        assert!(
+            matches!(err, crate::Error::Model(ModelError::Damaged { .. })),
+            "{err}"
+        );
+        assert!(err.to_string().contains("at most 10000"), "{err}");
+        // a training value that would overflow the z-scoring
+        let mut rows = value;
+        rows["training"]["rows"][0][1] = serde_json::json!(1e300);
+        let err = load_text(&rows.to_string());
+        assert!(
+            err.to_string().contains("training row 0, feature 1"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -208,7 +208,8 @@ impl fmt::Display for Baseline {
     }
 }
 
-/// The unit of a CSV recording's time column; written `ms` or `s` (in `layout.toml` too).
+/// The unit of a CSV recording's time column; written `ms`, `s` or `us` (in
+/// `layout.toml` too).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum TimeUnit {
     /// Milliseconds, `ms`.
@@ -218,6 +219,9 @@ pub enum TimeUnit {
     /// Seconds, `s`.
     #[serde(rename = "s")]
     Seconds,
+    /// Microseconds, `us`.
+    #[serde(rename = "us")]
+    Microseconds,
 }
 
 impl TimeUnit {
@@ -226,6 +230,7 @@ impl TimeUnit {
         match self {
             TimeUnit::Milliseconds => 1e-3,
             TimeUnit::Seconds => 1.0,
+            TimeUnit::Microseconds => 1e-6,
         }
     }
 
@@ -234,6 +239,7 @@ impl TimeUnit {
         match self {
             TimeUnit::Milliseconds => 1.0,
             TimeUnit::Seconds => 1e3,
+            TimeUnit::Microseconds => 1e-3,
         }
     }
 }
@@ -243,6 +249,7 @@ impl fmt::Display for TimeUnit {
         f.write_str(match self {
             TimeUnit::Milliseconds => "ms",
             TimeUnit::Seconds => "s",
+            TimeUnit::Microseconds => "us",
         })
     }
 }
@@ -250,14 +257,15 @@ impl fmt::Display for TimeUnit {
 impl FromStr for TimeUnit {
     type Err = ParamError;
 
-    /// Parses `ms` or `s`.
+    /// Parses `ms`, `s` or `us` (`µs` too).
     fn from_str(text: &str) -> Result<Self, ParamError> {
         match text.trim() {
             "ms" => Ok(TimeUnit::Milliseconds),
             "s" => Ok(TimeUnit::Seconds),
+            "us" | "µs" => Ok(TimeUnit::Microseconds),
             _ => Err(ParamError::new(
                 "time-unit",
-                "a time unit is `ms` or `s`",
+                "a time unit is `ms`, `s` or `us`",
                 text,
             )),
         }
@@ -338,6 +346,10 @@ pub struct LayoutFile {
     /// CSV recordings: the channel columns, in channel order (default: every other column).
     /// Without a header row, the time column and the channels are 0-based indices (`"0"`).
     pub channels: Option<Vec<String>>,
+    /// CSV recordings: the longest gap between time stamps resampling may fill, in s
+    /// (default [`crate::csvlog::DEFAULT_MAX_GAP_S`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_gap_s: Option<f64>,
     /// Longest recording accepted, in s (default [`DEFAULT_MAX_DURATION_S`]); resampling
     /// allocates one frame per millisecond of it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -411,9 +423,11 @@ impl LayoutFile {
             delimiter: self.delimiter,
             time_column: self.time_column.as_deref().map(column).transpose()?,
             time_unit: self.time_unit.unwrap_or_default(),
+            unit_given: self.time_unit.is_some(),
             detect_time: header && self.time_column.is_none(),
             channels,
             duplicate_stamps: self.duplicate_stamps.unwrap_or_default(),
+            max_gap_s: self.max_gap_s.unwrap_or(crate::csvlog::DEFAULT_MAX_GAP_S),
         })
     }
 
@@ -426,6 +440,13 @@ impl LayoutFile {
             if !(fs.is_finite() && fs > 0.0) {
                 return bad(format!(
                     "field `fs` must be a positive number of Hz, got {fs}"
+                ));
+            }
+        }
+        if let Some(gap) = self.max_gap_s {
+            if !(gap.is_finite() && gap > 0.0) {
+                return bad(format!(
+                    "field `max_gap_s` must be a positive number of s, got {gap}"
                 ));
             }
         }
@@ -658,6 +679,17 @@ impl Dataset {
             columns,
             layout,
         })
+    }
+
+    /// Every file the dataset reads: `manifest.csv`, `layout.toml` when there is one, and
+    /// each recording the manifest lists (so a command can refuse to write over its input).
+    pub fn files(&self) -> Vec<PathBuf> {
+        let mut files = vec![
+            self.root.join("manifest.csv"),
+            self.root.join("layout.toml"),
+        ];
+        files.extend(self.entries.iter().map(|m| self.root.join(&m.file)));
+        files
     }
 
     /// The sampling rate of the dataset's recordings (default 1000 Hz, the paper's).
@@ -989,6 +1021,25 @@ fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Meta>)> {
     if out.is_empty() {
         return Err(DataError::invalid(path, "the manifest lists no recordings").into());
     }
+    // A recording listed twice would count twice, and could sit in a training and a test
+    // fold at once. Names are compared by their path components (`./a.npy` is `a.npy`).
+    let mut seen: std::collections::HashMap<PathBuf, usize> = std::collections::HashMap::new();
+    for (i, meta) in out.iter().enumerate() {
+        let key: PathBuf = Path::new(&meta.file)
+            .components()
+            .filter(|c| c != &std::path::Component::CurDir)
+            .collect();
+        if let Some(first) = seen.insert(key, i) {
+            let message = format!(
+                "line {}: file `{}` is listed again (first on line {}); each recording may be \
+                 listed once",
+                i + 2,
+                meta.file,
+                first + 2
+            );
+            return Err(DataError::invalid(path, message).into());
+        }
+    }
     Ok((headers.iter().map(String::from).collect(), out))
 }
 
@@ -1119,8 +1170,8 @@ pub fn read_recording_as(
     let (shape, raw, times_s, finite) = read_samples(path, format)?;
     let n_channels = checked_channels(path, shape, &raw, finite)?;
     let t = raw.len() / n_channels;
-    check_duration(path, layout, t, times_s.as_deref())?;
     let lay = layout.layout_for(path, shape)?;
+    check_duration(path, layout, t, times_s.as_deref(), lay.cells(), raw.len())?;
     let samples = onto_cells(raw, n_channels, &lay);
     Ok(Recording {
         fs: layout.fs.unwrap_or(1000.0),
@@ -1225,13 +1276,25 @@ fn onto_cells(raw: Vec<f64>, n_channels: usize, lay: &Layout) -> Vec<f64> {
     out
 }
 
+/// Samples per second of `max_duration_s` that one recording may hold once placed on its
+/// grid and resampled to 1 kHz: the paper's 16 taxels. With the default hour that is 57.6
+/// million values, 460 MB as f64; a larger grid may span proportionally less.
+const VALUES_PER_LIMIT_S: f64 = 16_000.0;
+
 /// A recording's time span must stay within the layout's `max_duration_s` (default
-/// [`DEFAULT_MAX_DURATION_S`]): resampling allocates one frame per millisecond of it.
+/// [`DEFAULT_MAX_DURATION_S`]), and so must what it becomes in memory: resampling allocates
+/// one frame of `cells` values per millisecond of the span, and placing the channels on the
+/// grid one per sample, so neither may exceed `max_duration_s` x [`VALUES_PER_LIMIT_S`]
+/// values (a few channels on a huge grid, or a wide file whose stamps span an hour, would
+/// otherwise ask for far more memory than the file holds). `raw_values` (already in memory)
+/// is always allowed.
 fn check_duration(
     path: &Path,
     layout: &LayoutFile,
     frames: usize,
     times: Option<&[f64]>,
+    cells: usize,
+    raw_values: usize,
 ) -> Result<()> {
     let fs = layout.fs.unwrap_or(1000.0);
     let span = match times {
@@ -1240,14 +1303,29 @@ fn check_duration(
         None => frames as f64 / fs,
     };
     let max = layout.max_duration_s.unwrap_or(DEFAULT_MAX_DURATION_S);
+    let what = || match times {
+        Some(_) => "time stamps span".to_string(),
+        None => format!("{frames} samples at {fs} Hz last"),
+    };
+    let raise = "set `max_duration_s` in layout.toml to raise it";
     if span > max {
-        let what = match times {
-            Some(_) => "time stamps span".to_string(),
-            None => format!("{frames} samples at {fs} Hz last"),
-        };
         let message = format!(
-            "{what} {span} s, beyond the limit of {max} s per recording (resampling to 1 kHz \
-             allocates a frame per ms; set `max_duration_s` in layout.toml to raise it)"
+            "{} {span} s, beyond the limit of {max} s per recording (resampling to 1 kHz \
+             allocates a frame per ms; {raise})",
+            what()
+        );
+        return Err(DataError::invalid(path, message).into());
+    }
+    let max_values = max * VALUES_PER_LIMIT_S;
+    let resampled = span * 1000.0 * cells as f64;
+    let placed = frames as f64 * cells as f64;
+    if resampled > max_values || (placed > max_values && placed > raw_values as f64) {
+        let message = format!(
+            "{} {span} s on {cells} grid cells: {:.3e} values once placed on the grid and \
+             resampled to 1 kHz, beyond the limit of {max_values:.3e} ({max} s of a 16-taxel \
+             grid; a wrong grid, rate or time unit is the usual cause, else {raise})",
+            what(),
+            resampled.max(placed),
         );
         return Err(DataError::invalid(path, message).into());
     }
@@ -1360,7 +1438,7 @@ pub fn write_manifest(dir: &Path, metas: &[Meta]) -> Result<()> {
         let row = header.iter().map(|c| m.field(c).unwrap_or_default());
         w.write_record(row).map_err(|e| csv_error(&path, e))?;
     }
-    w.flush().map_err(|e| DataError::io(&path, e))?;
+    w.flush().map_err(|e| DataError::write(&path, e))?;
     Ok(())
 }
 
@@ -1381,6 +1459,6 @@ pub fn create_dataset_dir<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) 
 pub fn write_layout(dir: &Path, layout: &LayoutFile) -> Result<()> {
     let path = dir.join("layout.toml");
     let text = toml::to_string(layout).map_err(|e| DataError::invalid(&path, e.to_string()))?;
-    std::fs::write(&path, text).map_err(|e| DataError::io(&path, e))?;
+    std::fs::write(&path, text).map_err(|e| DataError::write(&path, e))?;
     Ok(())
 }

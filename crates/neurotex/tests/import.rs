@@ -522,3 +522,152 @@ fn bad_column_choices_are_named() {
     assert!("pipe".parse::<neurotex::csvlog::Delimiter>().is_err());
     assert!("mean".parse::<DuplicateStamps>().is_err());
 }
+
+#[test]
+fn repeated_names_are_refused_and_a_trailing_delimiter_is_no_column() {
+    let dir = tempfile::tempdir().unwrap();
+    // every reader would resolve `channel1` to the first column: 16 taxels, one signal
+    let header = vec!["channel1"; 16].join(",");
+    let row: Vec<String> = (0..16).map(|j| j.to_string()).collect();
+    let p = write(
+        dir.path(),
+        "same.csv",
+        &format!("{header}\n{}\n", row.join(",")),
+    );
+    let err = read_csv_log(&p, &CsvFormat::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("columns 1 and 2 of line 1 are both named `channel1`"),
+        "{err}"
+    );
+    // a logger that ends every line with the delimiter
+    let p = write(dir.path(), "trail.csv", "t_ms,a,b,\n0,1,2,\n1,3,4,\n");
+    let detect = CsvFormat {
+        detect_time: true,
+        ..CsvFormat::default()
+    };
+    let log = read_csv_log(&p, &detect).unwrap();
+    assert_eq!(log.channel_names, ["a", "b"]);
+    assert_eq!(log.samples, [1.0, 2.0, 3.0, 4.0]);
+    // a huge cell is quoted in part, not whole
+    let cell = "x".repeat(1 << 20);
+    let p = write(dir.path(), "big.csv", &format!("a,b\n1,{cell}\n"));
+    let err = read_csv_log(&p, &CsvFormat::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("expected a finite number, got `xxx"), "{err}");
+    assert!(err.len() < 400, "{} bytes", err.len());
+}
+
+#[test]
+fn the_time_unit_comes_from_the_column_name_and_an_implausible_rate_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let by_name = |name: &str| CsvFormat {
+        time_column: Some(Column::Name(name.into())),
+        ..CsvFormat::default()
+    };
+    // seconds at 35.7 Hz, in a column whose name says so
+    let rows: String = (0..20)
+        .map(|i| format!("{},{}\n", f64::from(i) * 0.028, i))
+        .collect();
+    for (name, unit) in [
+        ("t_s", TimeUnit::Seconds),
+        ("time (s)", TimeUnit::Seconds),
+        ("Stamp_S", TimeUnit::Seconds),
+    ] {
+        let p = write(dir.path(), "s.csv", &format!("{name},a\n{rows}"));
+        let log = read_csv_log(&p, &by_name(name)).unwrap();
+        assert_eq!(log.time_unit, unit, "{name}");
+    }
+    let p = write(dir.path(), "us.csv", "stamp_us,a\n0,1\n1000,2\n2000,3\n");
+    let log = read_csv_log(&p, &by_name("stamp_us")).unwrap();
+    assert_eq!(log.time_unit, TimeUnit::Microseconds);
+    // the same seconds under a name that says nothing: read as ms they would be 35714 Hz
+    let p = write(dir.path(), "stamp.csv", &format!("timestamp,a\n{rows}"));
+    let err = read_csv_log(&p, &by_name("timestamp"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("stamp.csv") && err.contains("`timestamp`") && err.contains("--time-unit"),
+        "{err}"
+    );
+    // said explicitly, either unit is taken as given
+    let given = |unit| CsvFormat {
+        time_unit: unit,
+        unit_given: true,
+        ..by_name("timestamp")
+    };
+    assert_eq!(
+        read_csv_log(&p, &given(TimeUnit::Seconds))
+            .unwrap()
+            .time_unit,
+        TimeUnit::Seconds
+    );
+    assert!(read_csv_log(&p, &given(TimeUnit::Milliseconds)).is_ok());
+    // milliseconds at a plausible rate need nothing
+    let p = write(dir.path(), "ms.csv", "timestamp,a\n0,1\n28,2\n57,3\n");
+    assert_eq!(
+        read_csv_log(&p, &by_name("timestamp")).unwrap().time_unit,
+        TimeUnit::Milliseconds
+    );
+    assert_eq!("us".parse::<TimeUnit>().unwrap(), TimeUnit::Microseconds);
+}
+
+#[test]
+fn stamps_read_as_a_taxel_are_refused_with_the_option_to_name() {
+    let dir = tempfile::tempdir().unwrap();
+    // FabricSlide's layout: a `timestamp` column first, in ms
+    let p = write(
+        dir.path(),
+        "f.csv",
+        "timestamp, channel1, channel2\n89819,116,197\n89848,119,195\n89877,117,190\n",
+    );
+    let err = read_csv_log(&p, &CsvFormat::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("--time-column timestamp"), "{err}");
+    // chosen as time, or left out of the channels, it reads
+    let format = CsvFormat {
+        time_column: Some(Column::Name("timestamp".into())),
+        ..CsvFormat::default()
+    };
+    assert_eq!(
+        read_csv_log(&p, &format).unwrap().channel_names,
+        ["channel1", "channel2"]
+    );
+    // a rising taxel of another name is a taxel
+    let p = write(dir.path(), "g.csv", "a,b\n1,5\n2,5\n3,5\n");
+    assert!(read_csv_log(&p, &CsvFormat::default()).is_ok());
+}
+
+#[test]
+fn a_long_gap_in_the_stamps_is_an_error_not_a_straight_line() {
+    let dir = tempfile::tempdir().unwrap();
+    // 300 rows at 28 ms, then one fifty minutes later
+    let mut text = String::from("t_ms,a\n");
+    for i in 0..300 {
+        text.push_str(&format!("{},{}\n", i * 28, i % 7));
+    }
+    text.push_str(&format!("{},3\n", 299 * 28 + 50 * 60 * 1000));
+    let p = write(dir.path(), "gap.csv", &text);
+    let format = CsvFormat {
+        detect_time: true,
+        ..CsvFormat::default()
+    };
+    let err = read_csv_log(&p, &format).unwrap_err().to_string();
+    assert!(
+        err.contains("jump by 3000 s between frames 300 and 301") && err.contains("max_gap_s"),
+        "{err}"
+    );
+    let raised = CsvFormat {
+        max_gap_s: 3600.0,
+        ..format.clone()
+    };
+    assert_eq!(read_csv_log(&p, &raised).unwrap().samples.len(), 301);
+    let zero = CsvFormat {
+        max_gap_s: 0.0,
+        ..format
+    };
+    assert!(read_csv_log(&p, &zero).is_err());
+}

@@ -317,6 +317,10 @@ fn manifest_errors_name_line_and_field() {
             "file,label,speed_mm_s,force_n,trial\n",
             "lists no recordings",
         ),
+        (
+            "file,label\na.npy,X\n./a.npy,Y\n",
+            "line 3: file `./a.npy` is listed again (first on line 2)",
+        ),
     ];
     for (manifest, expected) in cases {
         std::fs::write(dir.path().join("manifest.csv"), manifest).unwrap();
@@ -598,7 +602,11 @@ fn selections_compare_numbers_as_numbers_and_name_what_is_missing() {
 fn a_recording_in_both_the_training_and_the_test_set_is_an_error() {
     use neurotex::analysis::{evaluate, Columns, FeatureTable, Split};
     use neurotex::pipeline::Method;
-    let metas = session_metas(&["s1", "s2", "s1", "s2"]);
+    let mut metas = session_metas(&["s1", "s2", "s1", "s2"]);
+    // two classes in each session (one class would be refused as a trivial 100 %)
+    for m in &mut metas[2..] {
+        m.label = "B".into();
+    }
     let table = FeatureTable {
         method: Method::Glcm3d,
         grid: "1x1".parse().unwrap(),

@@ -228,9 +228,13 @@ def _stage_options(**kw: Any) -> Dict[str, Any]:
 def _samples(x: Any, what: str) -> np.ndarray:
     """``x`` as a float32 or float64 array, without copying those two."""
     a = np.asarray(x)
-    if a.dtype in (np.float32, np.float64):
+    if a.dtype.kind == "f" and a.dtype.itemsize in (4, 8):
+        if not a.dtype.isnative:
+            # Big-endian samples (a `.npy` written on such a machine, which the CLI reads
+            # too): the same values in this machine's byte order.
+            a = a.astype(a.dtype.newbyteorder("="))
         return a
-    if a.dtype.kind in "iu":
+    if a.dtype.kind in "iuf":
         return a.astype(np.float64)
     raise DataError(f"{what}: samples must be real numbers, got dtype {a.dtype}")
 

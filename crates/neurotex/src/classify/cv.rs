@@ -129,6 +129,24 @@ impl Evaluation {
     }
 }
 
+/// [`ClassifyError::OneClass`] when every one of `y` (not empty) is of one class.
+fn two_classes(
+    y: &[usize],
+    class_names: &[String],
+    what: &'static str,
+) -> Result<(), ClassifyError> {
+    match y.split_first() {
+        Some((&first, rest)) if rest.iter().all(|&c| c == first) => Err(ClassifyError::OneClass {
+            label: class_names
+                .get(first)
+                .cloned()
+                .unwrap_or_else(|| first.to_string()),
+            what,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Assigns each sample a fold so every class is spread evenly: the samples of each class are
 /// shuffled with a ChaCha8 generator seeded by `seed`, then dealt to the folds in turn,
 /// continuing from the fold where the previous class stopped (so fold sizes differ by at most 1).
@@ -332,6 +350,7 @@ pub fn cross_validate_sweep<C: Sweep>(
             what: "cross-validate",
         });
     }
+    two_classes(y, class_names, "cross-validate")?;
     let n_classes = class_names.len().max(y.iter().max().map_or(0, |&m| m + 1));
     let mut settings: Vec<Repeats> = Vec::new();
     for r in 0..cv.repeats {
@@ -417,6 +436,7 @@ pub fn train_test_sweep<C: Sweep>(
     if y_test.is_empty() {
         return Err(ClassifyError::Empty { what: "test" });
     }
+    two_classes(y_train, class_names, "train on")?;
     if let Some(&c) = y_test.iter().find(|c| !y_train.contains(c)) {
         return Err(ClassifyError::UnknownTestLabel {
             label: class_names.get(c).cloned().unwrap_or_else(|| c.to_string()),
@@ -457,6 +477,29 @@ mod group_tests {
             let err = cv(repeats).check().unwrap_err();
             assert_eq!(err.name, "repeats");
         }
+    }
+
+    #[test]
+    fn one_class_is_an_error_not_a_perfect_score() {
+        let knn = super::super::KnnParams {
+            k: 1,
+            standardize: false,
+        }
+        .check()
+        .unwrap();
+        let x: Vec<f64> = (0..10).map(f64::from).collect();
+        let y = vec![0usize; 10];
+        let names = vec!["only".to_string()];
+        let cv = CvParams::default().check().unwrap();
+        let err = cross_validate(&knn, &x, 1, &y, &names, cv).unwrap_err();
+        assert!(
+            matches!(&err, ClassifyError::OneClass { label, .. } if label == "only"),
+            "{err}"
+        );
+        let err = cross_validate_grouped(&knn, &x, 1, &y, &names, cv, &[0; 10]).unwrap_err();
+        assert!(matches!(err, ClassifyError::OneClass { .. }), "{err}");
+        let err = train_test(&knn, (&x[..5], &y[..5]), (&x[5..], &y[5..]), 1, &names);
+        assert!(matches!(err, Err(ClassifyError::OneClass { .. })));
     }
 
     #[test]

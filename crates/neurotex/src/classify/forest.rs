@@ -75,6 +75,13 @@ impl ForestParams {
         if self.trees == 0 {
             return Err(ParamError::new("trees", "trees must be at least 1", 0));
         }
+        if self.trees > MAX_TREES {
+            return Err(ParamError::new(
+                "trees",
+                "trees must be at most 10000",
+                self.trees,
+            ));
+        }
         if self.max_depth == Some(0) {
             return Err(ParamError::new(
                 "max_depth",
@@ -99,6 +106,11 @@ impl ForestParams {
         Ok(Forest { params: self })
     }
 }
+
+/// The most trees a forest may have: far beyond where more trees stop helping (hundreds),
+/// and small enough that a model file or option asking for more (a typo, a corrupted file)
+/// is an error rather than an attempt to allocate that many.
+pub const MAX_TREES: usize = 10_000;
 
 /// The unfitted forest, with parameters that passed [`ForestParams::check`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

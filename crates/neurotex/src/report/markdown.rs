@@ -94,7 +94,7 @@ fn data(r: &Results, ctx: &ReportContext) -> String {
         "{} recordings, {} classes ({}), speeds {} mm/s.",
         r.recordings,
         r.labels.len(),
-        r.labels.join(", "),
+        super::table::escape_html(&r.labels.join(", ")),
         list(&r.speeds)
     );
     if r.resampled > 0 {

@@ -10,9 +10,17 @@ pub struct Table {
     rows: Vec<Vec<String>>,
 }
 
-/// A cell's text with the characters that would break a markdown table escaped.
+/// A cell's text with the characters that would break a markdown table escaped, and
+/// HTML's (labels and file names come from the user's data: `<b>` must show as text).
 fn cell(text: &str) -> String {
-    text.replace('|', "\\|").replace('\n', " ")
+    escape_html(text).replace('|', "\\|").replace('\n', " ")
+}
+
+/// `text` with `&`, `<` and `>` escaped, so that a renderer shows it as written.
+pub(crate) fn escape_html(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 impl Table {
@@ -74,6 +82,12 @@ mod tests {
         assert_eq!(
             t.render(),
             "| a | b |\n|---|---|\n| 1 |  |\n| x\\|y | 2 |\n"
+        );
+        let mut t = Table::new(["label"]);
+        t.row(["<img src=x onerror=alert(1)> & co"]);
+        assert_eq!(
+            t.render(),
+            "| label |\n|---|\n| &lt;img src=x onerror=alert(1)&gt; &amp; co |\n"
         );
     }
 }
