@@ -588,3 +588,32 @@ fn a_stamp_jump_costs_one_frame_and_huge_stamps_are_refused() {
     assert!(err.contains("exact range"), "{err}");
     assert!(!err.contains("not after"), "{err}");
 }
+
+#[test]
+fn a_realtime_replay_survives_stamps_that_are_not_numbers_or_far_ahead() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[0]);
+    let clean = stamped_lines(&frames[..400]);
+    let (good, _) = stream_stdin(
+        &dir,
+        &["--model", s(&model)],
+        (clean.join("\n") + "\n").as_bytes(),
+    );
+    // After the first frame: a stamp that is not a number, then one an hour ahead.
+    let mut text = clean.clone();
+    let values = clean[1].split_once(',').unwrap().1;
+    text.insert(2, format!("NaN,{values}"));
+    text.insert(3, format!("3600000,{values}"));
+    let start = std::time::Instant::now();
+    let (out, err) = stream_stdin(
+        &dir,
+        &["--model", s(&model), "--realtime"],
+        (text.join("\n") + "\n").as_bytes(),
+    );
+    // The replay waits for the frame an hour ahead at most --max-gap-s (1 s), then for the
+    // 400 ms of frames.
+    assert!(start.elapsed().as_secs_f64() < 30.0);
+    assert_eq!(streamed(&out), streamed(&good), "{err}");
+    assert_eq!(lines(&out).last().unwrap()["bad_frames"], 2, "{err}");
+}

@@ -144,7 +144,7 @@ pub fn run(args: StreamArgs) -> Result<()> {
     let mut stream = StreamClassifier::new(model, params)?;
     let input = open_input(&args.input)?;
     let mut out = Output::new(std::io::stdout().lock());
-    let pace = args.realtime.then(Pace::new);
+    let pace = args.realtime.then(|| Pace::new(stream.params().max_gap_s));
     crate::interrupt::end_input_on_signal();
     match args.format {
         FrameFormat::Csv => read_csv(&args, input, &mut stream, &mut out, pace)?,
@@ -225,22 +225,34 @@ impl Read for Datagrams {
 struct Pace {
     start: Instant,
     first: Option<f64>,
+    /// The longest wait for one frame: a frame further ahead is bad (or starts an episode
+    /// after a gap), and a stamp far ahead must not hold the replay for days.
+    longest: Duration,
 }
 
 impl Pace {
-    fn new() -> Self {
+    /// A replay whose longest wait is `max_gap_s`, checked by the stream (finite, in
+    /// (0, 10] s).
+    fn new(max_gap_s: f64) -> Self {
         Pace {
             start: Instant::now(),
             first: None,
+            longest: Duration::from_secs_f64(max_gap_s.clamp(0.0, 3600.0)),
         }
     }
 
-    /// Waits until `t_s` (the frame's time) has come, counted from the first frame's.
+    /// Waits until `t_s` (the frame's time) has come, counted from the first frame's, or
+    /// for the largest gap at most.
     fn wait(&mut self, t_s: f64) {
+        // A stamp that is not a finite number is a bad frame later; `from_secs_f64` would
+        // panic on it.
+        if !t_s.is_finite() {
+            return;
+        }
         let first = *self.first.get_or_insert(t_s);
         let due = Duration::from_secs_f64((t_s - first).clamp(0.0, 1e6));
         if let Some(left) = due.checked_sub(self.start.elapsed()) {
-            std::thread::sleep(left);
+            std::thread::sleep(left.min(self.longest));
         }
     }
 }
