@@ -51,6 +51,17 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
     /// Classify a live taxel stream (standard input, a file, TCP or UDP) frame by frame with
     /// a model trained with --causal: one JSON line per 200 ms bin, one per episode's end.
+    ///
+    /// Bad frames are said on standard error with their line or frame number, counted
+    /// (`bad_frames` in the end line) and skipped; the stream goes on. They are: a CSV line
+    /// longer than 64 bytes a taxel (at least 1 MiB; it is read to its end in bounded
+    /// memory) or not UTF-8, a wrong field count, a value that is not a finite number, a
+    /// stamp beyond 2^33 s (272 years) from zero, where f64 stamps stop resolving 1 us, and
+    /// a stamp that does not follow the previous frame's: not after it, or more than
+    /// --max-gap-s after it. When the next frame follows such a stamp instead of the previous
+    /// one, the clock has jumped (a pause, a restarted sensor): the episode ends
+    /// ("ended_by":"gap") and a new one starts at that next frame. So one wrong stamp (a bit
+    /// flip far ahead) costs its own frame, and a jump that stays costs one frame.
     Stream(stream::StreamArgs),
     /// Import CSV logs or stacked arrays into a dataset folder.
     #[command(subcommand)]

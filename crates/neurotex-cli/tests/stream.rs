@@ -131,8 +131,14 @@ fn streamed(text: &str) -> Vec<Value> {
 /// `neurotex stream ARGS` with `input` on standard input; its standard output and error.
 fn stream_stdin(dir: &Dir, args: &[&str], input: &[u8]) -> (String, String) {
     let mut child = spawn(dir, args);
-    child.stdin.take().unwrap().write_all(input).unwrap();
-    finish(child)
+    let mut stdin = child.stdin.take().unwrap();
+    // Written from a thread: a child that warns a lot fills its standard error while the
+    // input is still being written, and would wait on us as we wait on it.
+    let input = input.to_vec();
+    let writer = std::thread::spawn(move || stdin.write_all(&input));
+    let out = finish(child);
+    writer.join().unwrap().unwrap();
+    out
 }
 
 fn spawn(dir: &Dir, args: &[&str]) -> Child {
@@ -384,6 +390,7 @@ fn offline_models_and_bad_options_are_refused() {
         (vec!["--window-s", "-1"], "--window-s"),
         (vec!["--episode", "onset:x"], "episodes are"),
         (vec!["--fs", "0"], "frame rate"),
+        (vec!["--max-gap-s", "3600"], "largest gap"),
         (vec!["--input", "missing.csv"], "missing.csv"),
         (vec!["--input", "tcp://not-an-address"], "tcp://"),
     ] {
@@ -469,4 +476,144 @@ fn fabricslide_stream_equals_predict_causal() {
         ]);
         assert_eq!(streamed(&text), expected, "{file}");
     }
+}
+
+/// A slide's frames as CSV lines stamped in ms (`t_ms` first), with the header line.
+fn stamped_lines(frames: &[Vec<f32>]) -> Vec<String> {
+    let names: Vec<String> = (0..16).map(|i| format!("c{i}")).collect();
+    let mut all = vec![format!("t_ms,{}", names.join(","))];
+    for (i, f) in frames.iter().enumerate() {
+        let values: Vec<String> = f.iter().map(|v| v.to_string()).collect();
+        all.push(format!("{i},{}", values.join(",")));
+    }
+    all
+}
+
+#[test]
+fn invalid_utf8_is_a_bad_frame_and_the_stream_goes_on() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[0]);
+    let clean = csv_text(&frames);
+    let mut hostile: Vec<u8> = Vec::new();
+    for (i, line) in clean.split_inclusive('\n').enumerate() {
+        hostile.extend_from_slice(line.as_bytes());
+        if i == 700 {
+            hostile.extend_from_slice(b"0.5,\xff\xfe,0.5\n");
+        }
+    }
+    let args = ["--model", s(&model)];
+    let (good, _) = stream_stdin(&dir, &args, clean.as_bytes());
+    let (out, err) = stream_stdin(&dir, &args, &hostile);
+    assert_eq!(streamed(&out), streamed(&good));
+    assert_eq!(lines(&out).last().unwrap()["bad_frames"], 1, "{err}");
+    assert!(err.contains("line 702: bad frame skipped"), "{err}");
+    assert!(err.contains("not UTF-8"), "{err}");
+}
+
+#[test]
+fn an_overlong_line_is_a_bad_frame_read_in_bounded_memory() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[1]);
+    let clean = csv_text(&frames);
+    let (good, _) = stream_stdin(&dir, &["--model", s(&model)], clean.as_bytes());
+    // The binary under a 1 GiB address-space limit, sent a 2 GiB line between two frames:
+    // buffered whole, it would not fit.
+    let script = r#"ulimit -v 1048576 && exec "$0" stream "$@""#;
+    let mut child = Command::new("bash")
+        .args([
+            "-c",
+            script,
+            env!("CARGO_BIN_EXE_neurotex"),
+            "--model",
+            s(&model),
+        ])
+        .current_dir(dir.path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        let (head, tail) = clean.split_at(clean.find("\n").unwrap() + 1);
+        stdin.write_all(head.as_bytes())?;
+        let chunk = "1,".repeat(1 << 19); // 1 MiB
+        for _ in 0..2048 {
+            stdin.write_all(chunk.as_bytes())?;
+        }
+        stdin.write_all(b"1\n")?;
+        stdin.write_all(tail.as_bytes())
+    });
+    let out = child.wait_with_output().unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(out.status.success(), "{stderr}");
+    writer.join().unwrap().unwrap();
+    assert_eq!(streamed(&stdout), streamed(&good));
+    assert_eq!(lines(&stdout).last().unwrap()["bad_frames"], 1);
+    assert!(stderr.contains("line 2: bad frame skipped"), "{stderr}");
+    assert!(stderr.contains("longer than"), "{stderr}");
+}
+
+#[test]
+fn a_stamp_jump_costs_one_frame_and_huge_stamps_are_refused() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[5]);
+    let clean = stamped_lines(&frames);
+    let args = ["--model", s(&model)];
+    let (good, _) = stream_stdin(&dir, &args, (clean.join("\n") + "\n").as_bytes());
+    // One stamp with a flipped exponent bit, some 2^40 ms ahead; later frames continue
+    // the clock before it.
+    let mut hostile = clean.clone();
+    let jumped = clean[1001].replacen("1000,", "1099511628776,", 1);
+    hostile.insert(1002, jumped);
+    let (out, err) = stream_stdin(&dir, &args, (hostile.join("\n") + "\n").as_bytes());
+    assert_eq!(streamed(&out), streamed(&good), "{err}");
+    assert_eq!(lines(&out).last().unwrap()["bad_frames"], 1, "{err}");
+    assert!(err.contains("line 1003: bad frame skipped"), "{err}");
+
+    // Stamps past 2^53 ms cannot be told apart: refused as such, not as equal stamps.
+    let mut huge = clean.clone();
+    let values = clean[1].split_once(',').unwrap().1;
+    huge.insert(1, format!("9007199254740993,{values}"));
+    huge.insert(2, format!("9007199254740994,{values}"));
+    let (out, err) = stream_stdin(&dir, &args, (huge.join("\n") + "\n").as_bytes());
+    assert_eq!(streamed(&out), streamed(&good), "{err}");
+    assert_eq!(err.matches("bad frame skipped").count(), 2, "{err}");
+    assert!(err.contains("exact range"), "{err}");
+    assert!(!err.contains("not after"), "{err}");
+}
+
+#[test]
+fn a_realtime_replay_survives_stamps_that_are_not_numbers_or_far_ahead() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[0]);
+    let clean = stamped_lines(&frames[..400]);
+    let (good, _) = stream_stdin(
+        &dir,
+        &["--model", s(&model)],
+        (clean.join("\n") + "\n").as_bytes(),
+    );
+    // After the first frame: a stamp that is not a number, then one an hour ahead.
+    let mut text = clean.clone();
+    let values = clean[1].split_once(',').unwrap().1;
+    text.insert(2, format!("NaN,{values}"));
+    text.insert(3, format!("3600000,{values}"));
+    let start = std::time::Instant::now();
+    let (out, err) = stream_stdin(
+        &dir,
+        &["--model", s(&model), "--realtime"],
+        (text.join("\n") + "\n").as_bytes(),
+    );
+    // The replay waits for the frame an hour ahead at most --max-gap-s (1 s), then for the
+    // 400 ms of frames.
+    assert!(start.elapsed().as_secs_f64() < 30.0);
+    assert_eq!(streamed(&out), streamed(&good), "{err}");
+    assert_eq!(lines(&out).last().unwrap()["bad_frames"], 2, "{err}");
 }

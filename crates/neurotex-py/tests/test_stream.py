@@ -71,3 +71,38 @@ def test_offline_models_and_bad_options_are_refused(sim_dir, tmp_path):
         neurotex.StreamClassifier(offline)
     with pytest.raises(ParameterError):
         neurotex.StreamClassifier(offline, episode="sometimes")
+
+
+def test_a_stamp_far_ahead_costs_its_own_frame(sim_dir, causal_model):
+    """The library's stamp rule, as the CLI applies it: one stamp far ahead (a bit flip) is
+    a bad frame and the frames after it go on; a clock that jumps and stays starts a new
+    episode one frame later."""
+    row = [r for r in manifest(sim_dir) if r["speed_mm_s"] == "10"][1]
+    frames = slide_frames(sim_dir, row)[:3000]
+    stamps = 100.0 + np.arange(len(frames)) / 1000.0
+
+    def run(stamped):
+        stream = neurotex.StreamClassifier(causal_model)
+        got, bad = [], []
+        for t, f in stamped:
+            try:
+                got.extend(stream.push(f, t=t) or [])
+            except DataError as e:
+                bad.append(str(e))
+        got.extend(stream.finish() or [])
+        return got, bad
+
+    clean = list(zip(stamps, frames))
+    expected, _ = run(clean)
+    flipped = clean[:1000] + [(stamps[999] * 2.0**20, frames[999])] + clean[1000:]
+    got, bad = run(flipped)
+    assert got == expected
+    assert len(bad) == 1 and "more than the largest gap" in bad[0]
+
+    back = clean + [(t - 50.0, f) for t, f in clean]
+    got, bad = run(back)
+    ends = [e for e in got if e.get("end")]
+    assert [e["ended_by"] for e in ends] == ["gap", "end_of_input"]
+    assert len(bad) == 1 and "not after the previous" in bad[0]
+    with pytest.raises(ParameterError, match="largest gap"):
+        neurotex.StreamClassifier(causal_model, max_gap_s=3600.0)

@@ -146,7 +146,8 @@ pub enum EpisodeEnd {
     Reset,
     /// The signal stayed at rest (onset episodes).
     Rest,
-    /// The time stamps jumped further than the largest gap allowed.
+    /// The time stamps jumped, ahead by more than the largest gap allowed or back, and the
+    /// next frame followed the jump (or the episode reached its longest length, 49 days).
     Gap,
     /// The stream was stopped before its input ended (an interrupt).
     Stopped,

@@ -397,3 +397,120 @@ fn an_offline_model_cannot_stream() {
     };
     assert!(StreamClassifier::new(model, p).is_err());
 }
+
+/// The stream's bad frames as well as its events.
+fn stream_with_bad(
+    stream: &mut StreamClassifier,
+    frames: &[(Option<f64>, Vec<f64>)],
+) -> (Vec<Event>, Vec<BadFrame>) {
+    let (mut events, mut bad) = (Vec::new(), Vec::new());
+    for (t, values) in frames {
+        match stream.push(*t, values) {
+            Ok(e) => events.extend_from_slice(e),
+            Err(StreamError::Bad(b)) => bad.push(b),
+            Err(e) => panic!("{e}"),
+        }
+    }
+    events.extend_from_slice(stream.finish().unwrap());
+    (events, bad)
+}
+
+#[test]
+fn a_stamp_far_in_the_future_costs_its_own_frame_only() {
+    let recs = recordings();
+    let model = paper_model(&recs);
+    let p = params(&model);
+    let clean = frames_of(&irregular(&slide_only(&recs[2]), 10, 7));
+    let expected = stream_events(
+        &mut StreamClassifier::new(model.clone(), p.clone()).unwrap(),
+        &clean,
+    );
+    // A bit flip in the exponent of one stamp: some 10^6 s ahead.
+    let mut hostile = clean.clone();
+    let (t, values) = clean[40].clone();
+    hostile.insert(41, (t.map(|t| t * 1024.0), values));
+    let mut stream = StreamClassifier::new(model, p).unwrap();
+    let (got, bad) = stream_with_bad(&mut stream, &hostile);
+    assert_eq!(got, expected);
+    assert_eq!(stream.bad_frames(), 1);
+    assert!(matches!(bad[..], [BadFrame::Jump { .. }]), "{bad:?}");
+}
+
+#[test]
+fn a_clock_that_jumps_and_stays_starts_a_new_episode() {
+    let recs = recordings();
+    let model = paper_model(&recs);
+    let p = params(&model);
+    let frames = frames_of(&irregular(&slide_only(&recs[4]), 10, 3));
+    // Back (a sensor whose clock restarts) and forward (a pause longer than the largest gap).
+    for shift in [-1000.0, 100.0] {
+        let moved: Vec<_> = frames
+            .iter()
+            .map(|(t, v)| (t.map(|t| t + shift), v.clone()))
+            .collect();
+        let mut both = frames.clone();
+        both.extend(moved.iter().cloned());
+        let mut stream = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+        let (got, bad) = stream_with_bad(&mut stream, &both);
+        // The first frame on the new clock is skipped: it alone cannot tell a wrong stamp
+        // from a jump; the second, following it, starts the new episode.
+        assert_eq!(bad.len(), 1, "shift {shift}: {bad:?}");
+        let mut first = stream_events(
+            &mut StreamClassifier::new(model.clone(), p.clone()).unwrap(),
+            &frames,
+        );
+        let Some(Event::End(end)) = first.last_mut() else {
+            panic!("an end")
+        };
+        end.ended_by = EpisodeEnd::Gap;
+        let second = stream_events(
+            &mut StreamClassifier::new(model.clone(), p.clone()).unwrap(),
+            &moved[1..],
+        );
+        assert_eq!(got, [first, second].concat(), "shift {shift}");
+    }
+}
+
+#[test]
+fn stamps_beyond_the_exact_range_are_bad_frames() {
+    let recs = recordings();
+    let model = paper_model(&recs);
+    let mut stream = StreamClassifier::new(model.clone(), params(&model)).unwrap();
+    let values = frames_of(&recs[0])[0].1.clone();
+    // 2^53 + 1 and 2^53 + 2 ms: as f64 they are one number, and a step of 2 ms.
+    for ms in [9_007_199_254_740_993.0_f64, 9_007_199_254_740_994.0] {
+        match stream.push(Some(ms / 1000.0), &values) {
+            Err(StreamError::Bad(BadFrame::StampRange { .. })) => {}
+            other => panic!("{other:?}"),
+        }
+    }
+    // An ordinary host clock in s stays in range.
+    assert!(stream.push(Some(1.7e9), &values).is_ok());
+    assert!(stream.push(Some(1.7e9 + 0.001), &values).is_ok());
+    assert_eq!(stream.bad_frames(), 2);
+}
+
+#[test]
+fn the_largest_gap_and_so_the_work_per_frame_are_bounded() {
+    let recs = recordings();
+    let model = paper_model(&recs);
+    let mut p = params(&model);
+    p.max_gap_s = 3600.0;
+    let err = StreamClassifier::new(model.clone(), p.clone()).unwrap_err();
+    assert!(
+        matches!(err, neurotex::Error::Param(ref e) if e.name == "max-gap"),
+        "{err}"
+    );
+    p.max_gap_s = neurotex::stream::MAX_GAP_S;
+    let mut stream = StreamClassifier::new(model.clone(), p).unwrap();
+    let values = frames_of(&recs[0])[0].1.clone();
+    stream.push(Some(0.0), &values).unwrap();
+    // A frame at the largest gap completes at most that gap's bins.
+    let events = stream
+        .push(Some(neurotex::stream::MAX_GAP_S), &values)
+        .unwrap();
+    assert_eq!(
+        events.len(),
+        (neurotex::stream::MAX_GAP_S * 1000.0) as usize / 200
+    );
+}

@@ -114,8 +114,10 @@ pub struct StreamArgs {
     /// until it stays below half that for REST_MS, default 500).
     #[arg(long, default_value = "whole")]
     pub episode: EpisodeRule,
-    /// The largest gap between two frames' stamps within an episode, s; a longer silence
-    /// ends the episode.
+    /// The largest gap between two frames' stamps within an episode, s, at most 10: a frame
+    /// completes the 1 ms steps since the previous one, so this bounds what one frame costs.
+    /// A frame further ahead is a bad frame; if the next frame follows it, the episode ends
+    /// and a new one starts there.
     #[arg(long = "max-gap-s", default_value_t = neurotex::stream::DEFAULT_MAX_GAP_S)]
     pub max_gap_s: f64,
     /// The sliding speed in mm/s, for a model with all-taxels-mm features.
@@ -142,7 +144,7 @@ pub fn run(args: StreamArgs) -> Result<()> {
     let mut stream = StreamClassifier::new(model, params)?;
     let input = open_input(&args.input)?;
     let mut out = Output::new(std::io::stdout().lock());
-    let pace = args.realtime.then(Pace::new);
+    let pace = args.realtime.then(|| Pace::new(stream.params().max_gap_s));
     crate::interrupt::end_input_on_signal();
     match args.format {
         FrameFormat::Csv => read_csv(&args, input, &mut stream, &mut out, pace)?,
@@ -223,22 +225,34 @@ impl Read for Datagrams {
 struct Pace {
     start: Instant,
     first: Option<f64>,
+    /// The longest wait for one frame: a frame further ahead is bad (or starts an episode
+    /// after a gap), and a stamp far ahead must not hold the replay for days.
+    longest: Duration,
 }
 
 impl Pace {
-    fn new() -> Self {
+    /// A replay whose longest wait is `max_gap_s`, checked by the stream (finite, in
+    /// (0, 10] s).
+    fn new(max_gap_s: f64) -> Self {
         Pace {
             start: Instant::now(),
             first: None,
+            longest: Duration::from_secs_f64(max_gap_s.clamp(0.0, 3600.0)),
         }
     }
 
-    /// Waits until `t_s` (the frame's time) has come, counted from the first frame's.
+    /// Waits until `t_s` (the frame's time) has come, counted from the first frame's, or
+    /// for the largest gap at most.
     fn wait(&mut self, t_s: f64) {
+        // A stamp that is not a finite number is a bad frame later; `from_secs_f64` would
+        // panic on it.
+        if !t_s.is_finite() {
+            return;
+        }
         let first = *self.first.get_or_insert(t_s);
         let due = Duration::from_secs_f64((t_s - first).clamp(0.0, 1e6));
         if let Some(left) = due.checked_sub(self.start.elapsed()) {
-            std::thread::sleep(left);
+            std::thread::sleep(left.min(self.longest));
         }
     }
 }
@@ -270,10 +284,63 @@ fn push(
     }
 }
 
+/// The longest CSV line taken, bytes, for `channels` taxels: 64 bytes a taxel (the longest
+/// f64 text, `-2.2250738585072014e-308`, has 24 characters; the rest leaves room for
+/// spaces, a time column and a few unselected ones), and at least 1 MiB for headers.
+fn line_limit(channels: usize) -> usize {
+    channels.saturating_mul(64).max(1 << 20)
+}
+
+/// Reads the next line of `input` into `line` (without its newline), keeping at most
+/// `limit` bytes of it: a longer line is read to its end and the rest dropped, so a peer
+/// cannot make the stream buffer more. Returns the line's whole length in bytes, `None`
+/// at the end of the input or once a signal asked the stream to stop (a line that never
+/// ends does not hold the stream past the signal).
+fn read_line(
+    input: &mut dyn BufRead,
+    line: &mut Vec<u8>,
+    limit: usize,
+) -> std::io::Result<Option<usize>> {
+    line.clear();
+    let mut length: Option<usize> = None;
+    loop {
+        if crate::interrupt::stop_requested() {
+            return Ok(None);
+        }
+        let available = match input.fill_buf() {
+            Ok(bytes) => bytes,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if available.is_empty() {
+            return Ok(length);
+        }
+        let newline = available.iter().position(|&b| b == b'\n');
+        let part = &available[..newline.unwrap_or(available.len())];
+        let room = limit.saturating_sub(line.len());
+        line.extend_from_slice(&part[..part.len().min(room)]);
+        let length = length.get_or_insert(0);
+        *length = length.saturating_add(part.len());
+        let used = newline.map_or(available.len(), |i| i + 1);
+        input.consume(used);
+        if newline.is_some() {
+            return Ok(Some(*length));
+        }
+    }
+}
+
+/// Counts a frame that could not be parsed and says so on standard error.
+fn skip(stream: &mut StreamClassifier, place: &str, why: impl std::fmt::Display) {
+    stream.skip_bad_frame();
+    eprintln!("warning: {place}: bad frame skipped: {why}");
+}
+
 /// The CSV frames of `input`: a header line (unless --no-header), then one frame per line.
+/// A line longer than [`line_limit`] or not UTF-8 is a bad frame (the header or first line
+/// is needed, so there it is an error).
 fn read_csv(
     args: &StreamArgs,
-    input: Box<dyn BufRead>,
+    mut input: Box<dyn BufRead>,
     stream: &mut StreamClassifier,
     out: &mut Output<impl Write>,
     mut pace: Option<Pace>,
@@ -282,13 +349,35 @@ fn read_csv(
     let mut plan: Option<(u8, Columns)> = None;
     let mut fields: Vec<f64> = Vec::new();
     let mut values: Vec<f64> = Vec::new();
-    for (number, line) in input.lines().enumerate() {
-        if crate::interrupt::stop_requested() {
-            break;
-        }
-        let line_no = number + 1;
-        let line = line.with_context(|| format!("reading line {line_no} of {}", args.input))?;
-        let text = line.trim();
+    let limit = line_limit(stream.channels());
+    let mut line: Vec<u8> = Vec::new();
+    let mut line_no = 0usize;
+    loop {
+        let read = read_line(&mut *input, &mut line, limit);
+        let read =
+            read.with_context(|| format!("reading line {} of {}", line_no + 1, args.input))?;
+        let Some(length) = read else { break };
+        line_no += 1;
+        let place = || format!("line {line_no}");
+        let text = match (length > limit, std::str::from_utf8(&line)) {
+            (true, _) => Err(format!(
+                "the line is longer than a frame of {} values may be ({length} bytes, at most {limit})",
+                stream.channels()
+            )),
+            (false, Err(e)) => Err(format!(
+                "the line is not UTF-8 text (its byte {} is not valid UTF-8)",
+                e.valid_up_to() + 1
+            )),
+            (false, Ok(text)) => Ok(text.trim()),
+        };
+        let text = match (text, &plan) {
+            (Ok(text), _) => text,
+            (Err(why), None) => bail!("{}: {}: {why}", args.input, place()),
+            (Err(why), Some(_)) => {
+                skip(stream, &place(), why);
+                continue;
+            }
+        };
         if text.is_empty() || text.starts_with('#') {
             continue;
         }
@@ -307,10 +396,8 @@ fn read_csv(
                 plan.as_ref().expect("just set")
             }
         };
-        let place = || format!("line {line_no}");
         if let Err(why) = parse_fields(text, *delimiter, columns.names.len(), &mut fields) {
-            stream.skip_bad_frame();
-            eprintln!("warning: {}: bad frame skipped: {why}", place());
+            skip(stream, &place(), why);
             continue;
         }
         let time_s = columns.time.map(|j| fields[j] * columns.unit.seconds());

@@ -876,8 +876,11 @@ class StreamClassifier:
     row-major order of the model's taxels) and get ``None``, or the list of what it
     completed: a dict per bin boundary (``t_s``, ``label``, ``scores``, ``decided``,
     ``decision``) and one per episode's end (``end``, ``label``, ``decided_at_s``, ...).
-    A bad frame (wrong length, NaN, a stamp not after the last) raises :class:`DataError`
-    and is skipped; the stream goes on."""
+    A bad frame (wrong length, NaN, a stamp beyond 2^33 s, a stamp not after the last or
+    more than ``max_gap_s`` after it) raises :class:`DataError` and is skipped; the stream
+    goes on. When the next frame follows such a stamp instead of the last good one, the
+    clock has jumped: the episode ends (``"ended_by": "gap"``) and a new one starts at that
+    frame, as in ``neurotex stream``. ``max_gap_s`` is at most 10 s."""
 
     def __init__(self, model: Union["Model", str, os.PathLike], *, window_s: Optional[float] = None,
                  decide: float = 0.8, decide_bins: int = 3, episode: str = "whole",

@@ -32,6 +32,16 @@ use window_glcm::WindowGlcm;
 /// longer silence ends the episode (resampling across it would invent samples).
 pub const DEFAULT_MAX_GAP_S: f64 = 1.0;
 
+/// The largest `max_gap_s` allowed, s. A frame completes the 1 kHz steps (and their bins)
+/// since the previous frame, so the largest gap bounds what one frame can cost: 10 000
+/// steps and 50 classifications.
+pub const MAX_GAP_S: f64 = 10.0;
+
+/// The largest time stamp either side of zero, s (2^33 s, about 272 years): up to there an
+/// f64 stamp resolves 1 µs or better; beyond, stamps 1 ms apart can round to one number
+/// (at 2^53 ms to the same one), and the 1 kHz resampling would place steps wrongly.
+pub const MAX_STAMP_S: f64 = 8_589_934_592.0;
+
 /// The default window when the model does not record its training recordings' length,
 /// ms.
 pub const DEFAULT_WINDOW_MS: usize = 10_000;
@@ -132,8 +142,9 @@ impl StreamParams {
             let rule = "the frame rate must be between 1 Hz and 1 MHz";
             return Err(ParamError::new("fs", rule, self.fs));
         }
-        if !(self.max_gap_s.is_finite() && self.max_gap_s > 0.0 && self.max_gap_s <= 3600.0) {
-            let rule = "the largest gap must be in (0, 3600] s";
+        if !(self.max_gap_s.is_finite() && self.max_gap_s > 0.0 && self.max_gap_s <= MAX_GAP_S) {
+            let rule =
+                "the largest gap must be in (0, 10] s (it bounds the steps one frame completes)";
             return Err(ParamError::new("max-gap", rule, self.max_gap_s));
         }
         Ok(())
@@ -174,6 +185,25 @@ pub enum BadFrame {
         /// The previous frame's.
         previous: f64,
     },
+    /// A time stamp further after the previous frame's than the largest gap.
+    #[error(
+        "time stamp {t} s is {} s after the previous frame's {previous} s, more than the largest gap ({max_gap_s} s)",
+        .t - .previous
+    )]
+    Jump {
+        /// The frame's stamp.
+        t: f64,
+        /// The previous frame's.
+        previous: f64,
+        /// The largest gap.
+        max_gap_s: f64,
+    },
+    /// A time stamp beyond [`MAX_STAMP_S`].
+    #[error("time stamp {t} s exceeds the exact range of stamps (within 2^33 s, about 272 years, of zero; beyond, stamps 1 ms apart can be one number)")]
+    StampRange {
+        /// The frame's stamp.
+        t: f64,
+    },
 }
 
 /// Why a frame was not taken.
@@ -189,7 +219,8 @@ pub enum StreamError {
 }
 
 /// The longest episode, in 1 ms steps: spike times are kept as u32 (49 days); an episode
-/// this long ends and the next starts, one hour (the largest gap) short of the limit.
+/// this long ends and the next starts, one hour short of the limit (far more than the
+/// steps one frame completes, [`MAX_GAP_S`]).
 const MAX_EPISODE_STEPS: usize = u32::MAX as usize - 3_600_000;
 
 /// One episode's state.
@@ -246,6 +277,10 @@ pub struct StreamClassifier {
     episode: Option<EpisodeState>,
     /// The previous frame's time stamp.
     previous_stamp: Option<f64>,
+    /// The stamp of the last frame refused for not following the previous one, until the
+    /// next frame that reaches the stamp check: when that frame follows it instead, the
+    /// clock has jumped (see [`StreamClassifier::push`]).
+    stray_stamp: Option<f64>,
     frames: u64,
     bad_frames: u64,
     events: Vec<Event>,
@@ -319,6 +354,7 @@ impl StreamClassifier {
             empty_glcm,
             episode: None,
             previous_stamp: None,
+            stray_stamp: None,
             frames: 0,
             bad_frames: 0,
             events: Vec::new(),
@@ -384,16 +420,34 @@ impl StreamClassifier {
     /// frame completed: a classification at each bin boundary it reached, and the end of
     /// an episode it closed.
     ///
+    /// A stamped frame follows the previous one when its stamp is after the previous
+    /// frame's by at most `max_gap_s`. A frame that does not is a bad frame
+    /// ([`BadFrame::Stamp`] or [`BadFrame::Jump`]); if the next frame (with a valid stamp and
+    /// values) follows that bad frame instead of the previous one, the clock has jumped (a
+    /// pause, a restarted sensor): the episode ends (`ended_by: gap`) and a new one starts
+    /// at that next frame. So one wrong stamp (a bit flip far ahead, a repeated or early
+    /// stamp) costs its own frame only, and a clock that jumps and stays costs one frame.
+    ///
     /// # Errors
     /// [`StreamError::Bad`] for a bad frame (wrong value count, a value that is not finite,
-    /// a time stamp not after the previous one): it is counted and skipped, and the stream
-    /// goes on. [`StreamError::Classify`] when the model cannot classify a window.
+    /// a time stamp beyond [`MAX_STAMP_S`] or not following the previous one): it is
+    /// counted and skipped, and the stream goes on. [`StreamError::Classify`] when the
+    /// model cannot classify a window.
     pub fn push(&mut self, time_s: Option<f64>, values: &[f64]) -> Result<&[Event], StreamError> {
         self.events.clear();
-        if let Err(bad) = self.check_frame(time_s, values) {
-            self.bad_frames += 1;
-            return Err(bad.into());
-        }
+        let checked = self.check_frame(time_s, values);
+        let jumped = match (checked, time_s) {
+            (Err(bad), _) => Err(bad),
+            (Ok(()), Some(t)) => self.follow(t),
+            (Ok(()), None) => Ok(false),
+        };
+        let jumped = match jumped {
+            Ok(jumped) => jumped,
+            Err(bad) => {
+                self.bad_frames += 1;
+                return Err(bad.into());
+            }
+        };
         let index = self.frames as f64;
         self.frames += 1;
         if values.len() == self.cell_frame.len() {
@@ -403,14 +457,8 @@ impl StreamClassifier {
                 self.cell_frame[cell] = v;
             }
         }
-        if let Some(t) = time_s {
-            let gap = self
-                .previous_stamp
-                .is_some_and(|p| t - p > self.params.max_gap_s);
-            self.previous_stamp = Some(t);
-            if gap && self.episode.is_some() {
-                self.end_episode(EpisodeEnd::Gap)?;
-            }
+        if jumped && self.episode.is_some() {
+            self.end_episode(EpisodeEnd::Gap)?;
         }
         if self
             .episode
@@ -517,8 +565,8 @@ impl StreamClassifier {
             if !t.is_finite() {
                 return Err(BadFrame::NotFinite { index: 0 });
             }
-            if let Some(previous) = self.previous_stamp.filter(|&p| t <= p) {
-                return Err(BadFrame::Stamp { t, previous });
+            if t.abs() > MAX_STAMP_S {
+                return Err(BadFrame::StampRange { t });
             }
         }
         // One pass without early exit (it vectorises); the position only for a bad frame.
@@ -529,6 +577,34 @@ impl StreamClassifier {
             });
         }
         Ok(())
+    }
+
+    /// Whether a frame stamped `t` (otherwise good) moves the stream's clock: `Ok(false)`
+    /// when it follows the previous frame, `Ok(true)` when it follows the last frame refused
+    /// instead (the clock jumped there), the bad frame otherwise. Only frames that reach
+    /// this check touch the clock, so a frame refused for its values cannot confirm a jump.
+    fn follow(&mut self, t: f64) -> Result<bool, BadFrame> {
+        let max_gap_s = self.params.max_gap_s;
+        let follows = |p: f64| t > p && t - p <= max_gap_s;
+        let stray = self.stray_stamp.take();
+        let Some(previous) = self.previous_stamp else {
+            self.previous_stamp = Some(t);
+            return Ok(false);
+        };
+        // When it follows both (a repeated stamp was refused), the clock has not moved.
+        if follows(previous) || stray.is_some_and(follows) {
+            self.previous_stamp = Some(t);
+            return Ok(!follows(previous));
+        }
+        self.stray_stamp = Some(t);
+        Err(match t <= previous {
+            true => BadFrame::Stamp { t, previous },
+            false => BadFrame::Jump {
+                t,
+                previous,
+                max_gap_s,
+            },
+        })
     }
 
     /// The largest taxel value of the current frame, resting value removed, in units of
