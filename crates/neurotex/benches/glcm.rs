@@ -8,7 +8,9 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use neurotex::encode::SpikeTrains;
 use neurotex::features::glcm::GlcmKind;
-use neurotex::features::{haralick, quantise, Counting, GlcmParams, GlcmPlan, RateVolume};
+use neurotex::features::{
+    haralick, quantise, CountVolume, Counting, GlcmParams, GlcmPlan, RateVolume,
+};
 use neurotex::pipeline::{FeatureExtractor, Method, Pipeline, PipelineParams};
 use neurotex::recording::Baseline;
 use neurotex::sim::texture::Texture;
@@ -71,6 +73,22 @@ fn bench(c: &mut Criterion) {
                     .unwrap()
             })
         });
+        group.bench_function(BenchmarkId::new("from_spike_trains_2d", &size), |b| {
+            b.iter(|| {
+                extractor
+                    .population_row(&spikes, None, Method::Glcm2d)
+                    .unwrap()
+            })
+        });
+        // The levels of the counts alone, over the volume's own range and a fixed one.
+        let counted = CountVolume::from_spikes(&spikes, 200).unwrap();
+        for (range_name, range) in [("own_range", None), ("fixed_range", Some((5.0, 95.0)))] {
+            let id = BenchmarkId::new(format!("quantise_counts_{range_name}"), &size);
+            group.bench_function(id, |b| {
+                let mut q = Vec::new();
+                b.iter(|| counted.quantise(16, range, &mut q))
+            });
+        }
         let mut q = Vec::new();
         quantise(&volume, 16, None, &mut q);
         for counting in [Counting::Histogram, Counting::LevelMasks, Counting::OneHot] {

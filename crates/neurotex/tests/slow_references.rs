@@ -362,24 +362,162 @@ proptest! {
         }
         let mut q = Vec::new();
         quantise(&vol, levels, None, &mut q);
-        // The count volume quantises to the same levels, with or without a fixed range.
+        // The count volume holds the same rates; its levels are the formula's in fractions
+        // of the counts. The f64 rates' levels agree except on a boundary, where rounding
+        // may have put the rate just below it.
         let counted = CountVolume::from_spikes(&trains, bin).unwrap();
         prop_assert_eq!(&counted.rates(), &vol);
         let mut from_counts = Vec::new();
         counted.quantise(levels, None, &mut from_counts);
-        prop_assert_eq!(&from_counts, &q);
+        let (min, max) = (counted.counts.iter().min().unwrap(), counted.counts.iter().max().unwrap());
+        let (lo, hi) = (rate_frac(*min, bin), rate_frac(*max, bin));
+        for ((&c, &exact), &float) in counted.counts.iter().zip(&from_counts).zip(&q) {
+            let v = level_value(rate_frac(c, bin), lo, hi, levels);
+            prop_assert_eq!(exact, level_by_definition(rate_frac(c, bin), lo, hi, levels));
+            let on_boundary = v.is_some_and(|v| v.1 == 1 && v.0 >= 1 && v.0 < levels as i128);
+            prop_assert!(float == exact || (on_boundary && float + 1 == exact), "count {c}: {float} vs {exact}");
+        }
         let range = Some((5.0, 5.0 + 37.5 * levels as f64));
-        let mut fixed = Vec::new();
-        quantise(&vol, levels, range, &mut fixed);
         counted.quantise(levels, range, &mut from_counts);
-        prop_assert_eq!(&from_counts, &fixed);
-        let lo = vol.data.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = vol.data.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        for (&x, &level) in vol.data.iter().zip(&q) {
-            let expected = if hi > lo { (((x - lo) / (hi - lo) * levels as f64).floor() as usize).min(levels - 1) } else { 0 };
-            prop_assert_eq!(level as usize, expected);
+        let (lo, hi) = (Frac::new(5, 1), Frac::new(10 + 75 * levels as i128, 2));
+        for (&c, &exact) in counted.counts.iter().zip(&from_counts) {
+            prop_assert_eq!(exact, level_by_definition(rate_frac(c, bin), lo, hi, levels));
         }
     }
+
+    /// Count volumes from spike trains, 3D (bins of `bin` ms) and 2D (one bin spanning the
+    /// train), against SPEC 3.9's formula in fractions, over counts on level boundaries
+    /// (the span of the counts a multiple of L) and anywhere.
+    #[test]
+    fn count_volume_levels_are_the_formula_in_fractions(
+        bin in prop_oneof![Just(201usize), Just(300), Just(7 * 31), 110usize..400],
+        bins in 1usize..6,
+        levels in 2usize..=32,
+        min in 0u32..10,
+        step in 1u32..=3,
+        on_boundaries in any::<bool>(),
+        picks in proptest::collection::vec(any::<u32>(), 30),
+        masked in proptest::option::of(0usize..6),
+        fixed in proptest::option::of((-80i32..400, 1i32..8000)),
+    ) {
+        let present: Vec<bool> = (0..6).map(|cell| Some(cell) != masked).collect();
+        let span = if on_boundaries { step * levels as u32 } else { picks[0] % (bin as u32 - min) };
+        let counts: Vec<u32> = picks.iter().take(6 * bins).map(|&p| min + p % (span + 1)).collect();
+        // Trains with those counts per cell and bin, bins of `bin` ms.
+        let lists: Vec<Vec<u32>> = counts
+            .chunks_exact(bins)
+            .map(|cell| {
+                cell.iter()
+                    .enumerate()
+                    .flat_map(|(b, &c)| (0..c).map(move |j| (b * bin) as u32 + j))
+                    .collect()
+            })
+            .collect();
+        let trains = SpikeTrains::from_lists(&lists, 2, 3, &present, bins * bin);
+        let three_d = CountVolume::from_spikes(&trains, bin).unwrap();
+        prop_assert_eq!(&three_d.counts, &counts);
+        let two_d = CountVolume::collapsed(&trains).unwrap();
+        let range = fixed.map(|(lo8, width8)| (f64::from(lo8) / 8.0, f64::from(lo8 + width8) / 8.0));
+        for volume in [&three_d, &two_d] {
+            let mut q = Vec::new();
+            volume.quantise(levels, range, &mut q);
+            let held: Vec<u32> = volume.counts.chunks_exact(volume.bins).zip(&present).filter(|(_, &p)| p).flat_map(|(c, _)| c.iter().copied()).collect();
+            let (lo, hi) = match fixed {
+                Some((lo8, width8)) => (Frac::new(lo8.into(), 8), Frac::new((lo8 + width8).into(), 8)),
+                None => (
+                    rate_frac(*held.iter().min().unwrap(), volume.bin_ms),
+                    rate_frac(*held.iter().max().unwrap(), volume.bin_ms),
+                ),
+            };
+            for (cell, (levels_of_cell, counts_of_cell)) in q.chunks_exact(volume.bins).zip(volume.counts.chunks_exact(volume.bins)).enumerate() {
+                for (&level, &c) in levels_of_cell.iter().zip(counts_of_cell) {
+                    let expected = if present[cell] { level_by_definition(rate_frac(c, volume.bin_ms), lo, hi, levels) } else { 0 };
+                    prop_assert_eq!(level, expected, "cell {} count {} ({} bins)", cell, c, volume.bins);
+                }
+            }
+        }
+    }
+
+    /// Rates given as f64 (eighths of a Hz, exact in binary) quantise to the formula's
+    /// levels in fractions, rates on boundaries included, over their own range and a fixed one.
+    #[test]
+    fn float_rate_levels_are_the_formula_in_fractions(
+        levels in 2usize..=64,
+        lo8 in -400i64..400,
+        step8 in 1i64..40,
+        picks in proptest::collection::vec((any::<u32>(), 0i64..3), 1..40),
+        fixed in any::<bool>(),
+    ) {
+        // Eighths lo8 + k * step8 lie on boundary k of lo8..lo8 + L * step8.
+        let top8 = lo8 + step8 * levels as i64;
+        let mut eighths: Vec<i64> = picks
+            .iter()
+            .map(|&(p, jitter)| lo8 + step8 * i64::from(p % (levels as u32 + 1)) + if p % 4 == 0 { jitter - 1 } else { 0 })
+            .collect();
+        eighths.extend([lo8, top8]);
+        let data: Vec<f64> = eighths.iter().map(|&e| e as f64 / 8.0).collect();
+        let volume = RateVolume { rows: 1, cols: 1, bins: data.len(), present: vec![true], data };
+        let (range, lo, hi) = if fixed {
+            (Some((lo8 as f64 / 8.0, top8 as f64 / 8.0)), Frac::new(lo8.into(), 8), Frac::new(top8.into(), 8))
+        } else {
+            let (min, max) = (*eighths.iter().min().unwrap(), *eighths.iter().max().unwrap());
+            (None, Frac::new(min.into(), 8), Frac::new(max.into(), 8))
+        };
+        let mut q = Vec::new();
+        quantise(&volume, levels, range, &mut q);
+        for (&e, &level) in eighths.iter().zip(&q) {
+            prop_assert_eq!(level, level_by_definition(Frac::new(e.into(), 8), lo, hi, levels), "{}/8 Hz", e);
+        }
+    }
+}
+
+/// A fraction `num / den` with `den > 0`, kept in lowest terms: the slow exact arithmetic
+/// of SPEC 3.9's levels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Frac(i128, i128);
+
+impl Frac {
+    fn new(num: i128, den: i128) -> Frac {
+        let g = gcd(num.unsigned_abs(), den.unsigned_abs()).max(1) as i128;
+        let sign = if den < 0 { -1 } else { 1 };
+        Frac(sign * num / g, sign * den / g)
+    }
+    fn sub(self, o: Frac) -> Frac {
+        Frac::new(self.0 * o.1 - o.0 * self.1, self.1 * o.1)
+    }
+    fn div(self, o: Frac) -> Frac {
+        Frac::new(self.0 * o.1, self.1 * o.0)
+    }
+    fn times(self, n: i128) -> Frac {
+        Frac::new(self.0 * n, self.1)
+    }
+}
+
+fn gcd(a: u128, b: u128) -> u128 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// The rate of `count` spikes in `bin_ms`, in Hz.
+fn rate_frac(count: u32, bin_ms: usize) -> Frac {
+    Frac::new(i128::from(count) * 1000, bin_ms as i128)
+}
+
+/// `(x - lo) / (hi - lo) * L`, `None` for `hi <= lo`.
+fn level_value(x: Frac, lo: Frac, hi: Frac, levels: usize) -> Option<Frac> {
+    let span = hi.sub(lo);
+    (span.0 > 0).then(|| x.sub(lo).div(span).times(levels as i128))
+}
+
+/// SPEC 3.9: `min(L-1, floor((x - lo) / (hi - lo) * L))`, clamped at 0; 0 for a constant
+/// volume (`hi <= lo`).
+fn level_by_definition(x: Frac, lo: Frac, hi: Frac, levels: usize) -> u8 {
+    level_value(x, lo, hi, levels).map_or(0, |v| {
+        v.0.div_euclid(v.1).clamp(0, levels as i128 - 1) as u8
+    })
 }
 
 /// Uniform random levels below `levels`.
