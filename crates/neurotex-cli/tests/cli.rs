@@ -46,7 +46,7 @@ fn help_explains_the_commands() {
     assert!(
         text.contains("ROWSxCOLS")
             && text.contains("row,col;row,col")
-            && text.contains("`ms` or `s`"),
+            && text.contains("`ms`, `s` or `us`"),
         "{text}"
     );
 }

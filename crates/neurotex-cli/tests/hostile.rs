@@ -131,13 +131,31 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
     let out = dir.join("spikes.npy");
     std::fs::write(dir.join("far.csv"), "t_s,a\n0,1\n100000000,2\n").unwrap();
     write_npy(dir.join("x.npy"), &Array2::<f32>::from_elem((10, 2), 1.0)).unwrap();
+    write_npy(dir.join("wide.npy"), &Array2::<f32>::from_elem((3, 4096), 1.0)).unwrap();
+    let names: Vec<String> = (0..4096).map(|j| format!("c{j}")).collect();
+    let row = |t: u32| format!("{t},{}\n", vec!["1"; 4096].join(","));
+    let wide = format!("t_s,{}\n{}{}", names.join(","), row(0), row(3500));
+    std::fs::write(dir.join("wide.csv"), wide).unwrap();
     std::fs::write(dir.join("slow.toml"), "fs = 1e-4\n").unwrap();
     std::fs::write(dir.join("bad.toml"), "max_duration_s = -1\n").unwrap();
     dir.fails_each(
         &[
             (
                 vec!["encode", "far.csv", "--out", s(&out)],
+                "jump by 100000000 s between frames 1 and 2",
+            ),
+            (
+                vec!["encode", "far.csv", "--max-gap-s", "1e9", "--out", s(&out)],
                 "beyond the limit of 3600 s",
+            ),
+            // 4096 channels, 3 rows, 3000 s: little in the file, 98 GB at 1 kHz
+            (
+                vec!["encode", "wide.npy", "--fs", "0.001", "--out", s(&out)],
+                "grid cells",
+            ),
+            (
+                vec!["encode", "wide.csv", "--max-gap-s", "3600", "--out", s(&out)],
+                "grid cells",
             ),
             (
                 vec!["encode", "x.npy", "--fs", "1e-9", "--out", s(&out)],
@@ -156,9 +174,13 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
     );
     // 4000 s of one taxel: refused by default, read with the limit raised
     std::fs::write(dir.join("long.csv"), "t_s,a\n0,1\n2000,2\n4000,1\n").unwrap();
-    let err = dir.fails(&["encode", "long.csv", "--out", s(&out)]);
+    let err = dir.fails(&["encode", "long.csv", "--max-gap-s", "3000", "--out", s(&out)]);
     assert!(err.contains("long.csv") && err.contains("4000 s"), "{err}");
-    std::fs::write(dir.join("long.toml"), "max_duration_s = 5000\n").unwrap();
+    std::fs::write(
+        dir.join("long.toml"),
+        "max_duration_s = 5000\nmax_gap_s = 3000\n",
+    )
+    .unwrap();
     dir.ok(&[
         "encode",
         "long.csv",

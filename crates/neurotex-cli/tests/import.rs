@@ -196,7 +196,7 @@ fn import_bad_input_is_named_through_the_binary() {
             timed(&["--grid", "2x2", "--channel-map", "0,0;0"]),
             "row,col entries separated by `;`",
         ),
-        (timed(&["--time-unit", "min"]), "`ms` or `s`"),
+        (timed(&["--time-unit", "min"]), "`ms`, `s` or `us`"),
         (timed(&["--baseline", "mean"]), "`none` or `min`"),
         (
             timed(&["--channels", "^(bad"]),
