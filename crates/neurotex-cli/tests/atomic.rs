@@ -146,21 +146,35 @@ fn reproduce_that_cannot_write_leaves_no_partial_output() {
     assert!(err.contains("holds notes.txt"), "{err}");
     assert_eq!(names(&dir.join("report")), ["notes.txt"]);
     std::fs::remove_file(dir.join("report/notes.txt")).unwrap();
-    // an earlier report is replaced whole: a figure only it had goes, and a run that
-    // cannot write leaves it as it was
+    // an earlier report is replaced whole, and a run that cannot write leaves it as it was
     dir.ok(&quick("report"));
-    std::fs::write(dir.join("report/figures/e9_earlier.svg"), "<svg/>").unwrap();
     let earlier = names(&dir.join("report/figures"));
+    let record = std::fs::read(dir.join("report/.neurotex-output")).unwrap();
     let run = run_with_file_limit(&dir, 4, &quick("report"));
     assert_eq!(run.status.code(), Some(1));
     assert_eq!(names(&dir.join("report/figures")), earlier);
+    assert_eq!(
+        std::fs::read(dir.join("report/.neurotex-output")).unwrap(),
+        record
+    );
     assert_eq!(names(dir.path()), ["ds", "file", "report"]);
     dir.ok(&quick("report"));
-    let figures = names(&dir.join("report/figures"));
-    assert!(!figures.is_empty() && !figures.contains(&"e9_earlier.svg".to_string()));
+    // a file of the user's among the figures, or a report edited since, is not replaced
+    for (path, why) in [
+        ("report/figures/my_plot.svg", "did not write"),
+        ("report/report.md", "changed since"),
+    ] {
+        std::fs::write(dir.join(path), "mine").unwrap();
+        let err = dir.fails(&quick("report"));
+        assert!(err.contains(why), "{err}");
+        assert_eq!(std::fs::read_to_string(dir.join(path)).unwrap(), "mine");
+        std::fs::remove_file(dir.join(path)).unwrap();
+    }
+    // a file of the earlier report removed since is no obstacle
+    dir.ok(&quick("report"));
     assert_eq!(
         names(&dir.join("report")),
-        ["figures", "report.md", "results.json"]
+        [".neurotex-output", "figures", "report.md", "results.json"]
     );
     assert_eq!(names(dir.path()), ["ds", "file", "report"]);
 }

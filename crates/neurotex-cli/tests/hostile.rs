@@ -131,7 +131,11 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
     let out = dir.join("spikes.npy");
     std::fs::write(dir.join("far.csv"), "t_s,a\n0,1\n100000000,2\n").unwrap();
     write_npy(dir.join("x.npy"), &Array2::<f32>::from_elem((10, 2), 1.0)).unwrap();
-    write_npy(dir.join("wide.npy"), &Array2::<f32>::from_elem((3, 4096), 1.0)).unwrap();
+    write_npy(
+        dir.join("wide.npy"),
+        &Array2::<f32>::from_elem((3, 4096), 1.0),
+    )
+    .unwrap();
     let names: Vec<String> = (0..4096).map(|j| format!("c{j}")).collect();
     let row = |t: u32| format!("{t},{}\n", vec!["1"; 4096].join(","));
     let wide = format!("t_s,{}\n{}{}", names.join(","), row(0), row(3500));
@@ -154,7 +158,14 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
                 "grid cells",
             ),
             (
-                vec!["encode", "wide.csv", "--max-gap-s", "3600", "--out", s(&out)],
+                vec![
+                    "encode",
+                    "wide.csv",
+                    "--max-gap-s",
+                    "3600",
+                    "--out",
+                    s(&out),
+                ],
                 "grid cells",
             ),
             (
@@ -174,7 +185,14 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
     );
     // 4000 s of one taxel: refused by default, read with the limit raised
     std::fs::write(dir.join("long.csv"), "t_s,a\n0,1\n2000,2\n4000,1\n").unwrap();
-    let err = dir.fails(&["encode", "long.csv", "--max-gap-s", "3000", "--out", s(&out)]);
+    let err = dir.fails(&[
+        "encode",
+        "long.csv",
+        "--max-gap-s",
+        "3000",
+        "--out",
+        s(&out),
+    ]);
     assert!(err.contains("long.csv") && err.contains("4000 s"), "{err}");
     std::fs::write(
         dir.join("long.toml"),

@@ -442,13 +442,19 @@ fn named_in(error: crate::Error, tmp: &Path, dir: &Path) -> crate::Error {
     }
 }
 
-/// Checks, before any work, that output folder `dir` can be written by
-/// [`replace_dir`]: it is new, empty, or holds only what `is_own` recognises (paths
-/// relative to `dir`) as an earlier output of the same kind.
+/// The file in an output folder that lists what neurotex wrote there: one line per file,
+/// its SHA-256 in hex, two spaces and its path relative to the folder (`sha256sum`'s form,
+/// so `sha256sum -c .neurotex-output` checks it by hand).
+pub const OUTPUT_RECORD: &str = ".neurotex-output";
+
+/// Checks, before any work, that output folder `dir` can be written by [`replace_dir`]:
+/// it is new, empty, or an earlier output that nobody changed since: every file in it is
+/// listed in its [`OUTPUT_RECORD`] with the content neurotex wrote.
 ///
 /// # Errors
-/// `dir` is not a folder, or holds something `is_own` does not recognise (named).
-pub fn check_output_dir(dir: &Path, is_own: &dyn Fn(&Path) -> bool) -> Result<()> {
+/// `dir` is not a folder; or it holds a file neurotex did not write there, or one changed
+/// since (named).
+pub fn check_output_dir(dir: &Path) -> Result<()> {
     let meta = match std::fs::symlink_metadata(dir) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
         Err(e) => return Err(DataError::write(dir, e).into()),
@@ -462,65 +468,112 @@ pub fn check_output_dir(dir: &Path, is_own: &dyn Fn(&Path) -> bool) -> Result<()
         };
         return Err(DataError::invalid(dir, what).into());
     }
-    if let Some(foreign) = first_foreign(dir, Path::new(""), is_own)? {
-        let message = format!(
-            "holds {}, which is not part of an earlier output of this command; neurotex \
-             replaces a folder only when it holds nothing else: choose a new or empty folder",
-            foreign.display()
-        );
-        return Err(DataError::invalid(dir, message).into());
+    let mut files = Vec::new();
+    list_files(dir, Path::new(""), &mut files)?;
+    if files.is_empty() {
+        return Ok(());
+    }
+    let record = std::fs::read_to_string(dir.join(OUTPUT_RECORD)).unwrap_or_default();
+    let written: std::collections::HashMap<&str, &str> = record
+        .lines()
+        .filter_map(|line| line.split_once("  "))
+        .map(|(hash, path)| (path, hash))
+        .collect();
+    for (path, hash) in &files {
+        let refuse = |why: &str| -> Result<()> {
+            let message = format!(
+                "holds {}, {why}; neurotex replaces a folder only when it holds nothing but \
+                 its own earlier output, unchanged: choose a new or empty folder, or move \
+                 the file away",
+                path.display()
+            );
+            Err(DataError::invalid(dir, message).into())
+        };
+        if path == Path::new(OUTPUT_RECORD) {
+            continue;
+        }
+        match path.to_str().and_then(|p| written.get(p)) {
+            None => return refuse("which neurotex did not write there"),
+            Some(&h) if h != hash => return refuse("which changed since neurotex wrote it"),
+            Some(_) => {}
+        }
     }
     Ok(())
 }
 
-/// The first entry under `dir/rel` (depth first) that `is_own` does not recognise.
-fn first_foreign(
-    dir: &Path,
-    rel: &Path,
-    is_own: &dyn Fn(&Path) -> bool,
-) -> Result<Option<PathBuf>> {
+/// Every file under `dir/rel` (depth first, links not followed) with its SHA-256 in hex,
+/// as paths relative to `dir`.
+fn list_files(dir: &Path, rel: &Path, out: &mut Vec<(PathBuf, String)>) -> Result<()> {
     let here = dir.join(rel);
     let entries = std::fs::read_dir(&here).map_err(|e| DataError::io(&here, e))?;
     for entry in entries {
         let entry = entry.map_err(|e| DataError::io(&here, e))?;
         let path = rel.join(entry.file_name());
-        if !is_own(&path) {
-            return Ok(Some(path));
-        }
         let kind = entry
             .file_type()
             .map_err(|e| DataError::io(entry.path(), e))?;
         if kind.is_dir() {
-            if let Some(foreign) = first_foreign(dir, &path, is_own)? {
-                return Ok(Some(foreign));
-            }
+            list_files(dir, &path, out)?;
+        } else if kind.is_file() {
+            out.push((path, sha256_file(&entry.path())?));
+        } else {
+            // a link or a device was never written by neurotex: listed with no hash
+            out.push((path, String::new()));
         }
     }
-    Ok(None)
+    Ok(())
 }
 
-/// Writes output folder `dir` whole: `fill` writes into a temporary folder beside it,
-/// which then takes `dir`'s place. An earlier output there (checked by
-/// [`check_output_dir`] with `is_own`) is moved aside first and removed afterwards, so
-/// `dir` never mixes two runs' files; between the two renames `dir` is briefly absent.
-/// Two runs writing the same folder at once each leave a whole output, the later one.
+/// The SHA-256 of a file's content, in hex.
+fn sha256_file(path: &Path) -> Result<String> {
+    use sha2::{Digest, Sha256};
+    let mut file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
+    let mut hasher = Sha256::new();
+    std::io::copy(&mut file, &mut hasher).map_err(|e| DataError::io(path, e))?;
+    Ok(hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect())
+}
+
+/// Writes [`OUTPUT_RECORD`] into the finished temporary folder `tmp`.
+fn write_record(tmp: &Path, dir: &Path) -> Result<()> {
+    let mut files = Vec::new();
+    list_files(tmp, Path::new(""), &mut files)?;
+    files.sort();
+    let text: String = files
+        .iter()
+        .map(|(path, hash)| format!("{hash}  {}\n", path.display()))
+        .collect();
+    let path = tmp.join(OUTPUT_RECORD);
+    std::fs::write(&path, text).map_err(|e| DataError::write(dir.join(OUTPUT_RECORD), e).into())
+}
+
+/// Writes output folder `dir` whole: `fill` writes into a temporary folder beside it, an
+/// [`OUTPUT_RECORD`] of what it wrote is added, and the folder takes `dir`'s place. An
+/// earlier output there (checked by [`check_output_dir`]: nothing added or changed since)
+/// is moved aside first and removed afterwards, so `dir` never mixes two runs' files;
+/// between the two renames `dir` is briefly absent. Two runs writing the same folder at
+/// once each leave a whole output, the later one.
 ///
 /// # Errors
 /// As [`check_output_dir`]; or a folder cannot be created, or `fill` or a rename fails
 /// (the earlier output is then put back).
-pub fn replace_dir<T>(
-    dir: &Path,
-    is_own: &dyn Fn(&Path) -> bool,
-    fill: impl FnOnce(&Path) -> Result<T>,
-) -> Result<T> {
-    check_output_dir(dir, is_own)?;
+pub fn replace_dir<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
+    check_output_dir(dir)?;
     let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
     if !dir.exists() || is_empty(dir) {
-        return create_dir_atomic(dir, fill);
+        return create_dir_atomic(dir, |tmp| {
+            let value = fill(tmp)?;
+            write_record(tmp, dir)?;
+            Ok(value)
+        });
     }
     let tmp = Temporary::beside(dir)?;
     std::fs::create_dir(tmp.path()).map_err(|e| DataError::write(dir, e))?;
     let value = fill(tmp.path()).map_err(|e| named_in(e, tmp.path(), dir))?;
+    write_record(tmp.path(), dir)?;
     let name = dir.file_name().unwrap_or_default().to_string_lossy();
     let prefix = format!(".{name}.old-");
     remove_stale(parent(dir), &prefix);
@@ -660,25 +713,31 @@ mod tests {
     }
 
     #[test]
-    fn a_folder_is_replaced_whole_and_only_when_it_holds_an_earlier_output() {
+    fn a_folder_is_replaced_whole_and_only_when_it_holds_an_unchanged_earlier_output() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("out");
-        let own = |p: &Path| p.to_str().is_some_and(|n| n.ends_with(".txt"));
-        replace_dir(&out, &own, |tmp| {
-            std::fs::write(tmp.join("a.txt"), "1").unwrap();
-            std::fs::write(tmp.join("b.txt"), "1").unwrap();
-            Ok(())
-        })
-        .unwrap();
-        replace_dir(&out, &own, |tmp| {
-            std::fs::write(tmp.join("a.txt"), "2").unwrap();
-            Ok(())
-        })
-        .unwrap();
-        assert_eq!(names(&out), ["a.txt"]);
+        let write = |files: &'static [&'static str]| {
+            replace_dir(&out, |tmp| {
+                std::fs::create_dir(tmp.join("sub")).unwrap();
+                for name in files {
+                    std::fs::write(tmp.join(name), "1").unwrap();
+                }
+                Ok(())
+            })
+        };
+        write(&["a.txt", "sub/b.svg"]).unwrap();
+        let record = std::fs::read_to_string(out.join(OUTPUT_RECORD)).unwrap();
+        assert!(
+            record.contains("  a.txt\n") && record.contains("  sub/b.svg\n"),
+            "{record}"
+        );
+        // what the earlier output had and the new one has not goes
+        write(&["a.txt"]).unwrap();
+        assert_eq!(names(&out), [OUTPUT_RECORD, "a.txt", "sub"]);
+        assert!(names(&out.join("sub")).is_empty());
         assert_eq!(names(dir.path()), ["out"]);
-        // a failure leaves the earlier output as it was
-        let failed: Result<()> = replace_dir(&out, &own, |tmp| {
+        // a failure leaves the earlier output as it was, and names no temporary
+        let failed: Result<()> = replace_dir(&out, |tmp| {
             Err(DataError::write(tmp.join("a.txt"), std::io::Error::other("disk full")).into())
         });
         let message = failed.unwrap_err().to_string();
@@ -687,13 +746,21 @@ mod tests {
             "{message}"
         );
         assert!(!message.contains("partial"), "{message}");
-        assert_eq!(std::fs::read_to_string(out.join("a.txt")).unwrap(), "2");
         assert_eq!(names(dir.path()), ["out"]);
-        // something else in the folder: refused, untouched
-        std::fs::write(out.join("data.npy"), "mine").unwrap();
-        let refused = replace_dir(&out, &own, |_| Ok(()));
-        assert!(refused.unwrap_err().to_string().contains("holds data.npy"));
-        assert_eq!(names(&out), ["a.txt", "data.npy"]);
+        // a file of the user's, even under a name neurotex writes, or an edited file of the
+        // earlier output: refused, untouched
+        for (path, why) in [("sub/b.svg", "did not write"), ("a.txt", "changed since")] {
+            std::fs::write(out.join(path), "mine").unwrap();
+            let refused = replace_dir(&out, |_| Ok(())).unwrap_err().to_string();
+            assert!(refused.contains(path) && refused.contains(why), "{refused}");
+            assert_eq!(std::fs::read_to_string(out.join(path)).unwrap(), "mine");
+            std::fs::remove_file(out.join(path)).unwrap();
+        }
+        // a folder without a record, holding anything: refused
+        let other = dir.path().join("other");
+        std::fs::create_dir(&other).unwrap();
+        std::fs::write(other.join("report.md"), "my notes").unwrap();
+        assert!(check_output_dir(&other).is_err());
     }
 
     #[test]

@@ -193,8 +193,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
     let params = args.params()?;
     let dataset = args.open.open(&args.dataset)?;
     if let Some(dir) = &args.out {
-        neurotex::io::check_output_dir(dir, &is_compare_file)
-            .context("checking the output folder")?;
+        neurotex::io::check_output_dir(dir).context("checking the output folder")?;
     }
     let indices = args.indices(&dataset)?;
     let set = args.set()?;
@@ -259,7 +258,7 @@ fn write_outputs(dir: &std::path::Path, c: &Comparison) -> Result<()> {
             svg.map_err(|e| anyhow::anyhow!("{e}"))?,
         ));
     }
-    neurotex::io::replace_dir(dir, &is_compare_file, |tmp| {
+    neurotex::io::replace_dir(dir, |tmp| {
         for (name, text) in &files {
             let path = tmp.join(name);
             std::fs::write(&path, text).map_err(|e| neurotex::error::DataError::write(&path, e))?;
@@ -269,14 +268,6 @@ fn write_outputs(dir: &std::path::Path, c: &Comparison) -> Result<()> {
     .context("writing the comparison")?;
     eprintln!("wrote {}", dir.display());
     Ok(())
-}
-
-/// Whether `path` (relative to the output folder) is a file `compare --out` writes.
-fn is_compare_file(path: &std::path::Path) -> bool {
-    matches!(
-        path.to_str(),
-        Some("compare.json" | "compare.md" | "ranking.svg" | "per_condition.svg")
-    )
 }
 
 /// `87.5% [85.1, 89.8]`.

@@ -48,8 +48,8 @@ impl ReportContext {
 /// Writes `report.md`, `results.json` and `figures/*.svg` into `dir` whole or not at all
 /// ([`replace_dir`]): everything is rendered, then written into a temporary folder beside
 /// `dir`, which takes `dir`'s place. An earlier report in `dir` is replaced as a whole (no
-/// figure of an earlier run stays beside the new report); a folder holding anything else is
-/// refused ([`check_report_dir`]). On any failure the temporary folder is removed and `dir`
+/// figure of an earlier run stays beside the new report); a folder holding anything else,
+/// or an earlier report edited since, is refused ([`check_report_dir`]). On any failure the temporary folder is removed and `dir`
 /// is left as it was.
 ///
 /// # Errors
@@ -66,26 +66,17 @@ pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Resul
         .map_err(|e| DataError::invalid(dir.join("results.json"), e.to_string()))?;
     files.push(("results.json".into(), json));
     files.push(("report.md".into(), markdown(results, ctx)));
-    replace_dir(dir, &is_report_file, |tmp| write_files(tmp, &files))
+    replace_dir(dir, |tmp| write_files(tmp, &files))
 }
 
-/// Checks, before any work, that `dir` is new, empty or an earlier report (`report.md`,
-/// `results.json`, `figures/` with SVG and PNG files): a report replaces nothing else.
+/// Checks, before any work, that `dir` is new, empty or an earlier report left as it was
+/// written ([`check_output_dir`]): a report replaces nothing else.
 ///
 /// # Errors
-/// `dir` is not a folder, or holds a file a report does not write (named).
+/// `dir` is not a folder, or holds a file the earlier report did not write, or one changed
+/// since (named).
 pub fn check_report_dir(dir: &Path) -> Result<()> {
-    check_output_dir(dir, &is_report_file)
-}
-
-/// Whether `path` (relative to the report folder) is a name a report writes.
-fn is_report_file(path: &Path) -> bool {
-    let names: Vec<_> = path.iter().filter_map(|c| c.to_str()).collect();
-    match names.as_slice() {
-        ["report.md" | "results.json" | "figures"] => true,
-        ["figures", name] => name.ends_with(".svg") || name.ends_with(".png"),
-        _ => false,
-    }
+    check_output_dir(dir)
 }
 
 /// Writes `files` (paths relative to `dir`, and their text) and the `figures` folder.
