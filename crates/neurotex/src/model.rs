@@ -617,7 +617,7 @@ fn fit(file: &ModelFile, dims: usize) -> Result<ChosenModel> {
     // z-scoring's squares to infinity and the distances to NaN.
     const MAX_FEATURE: f64 = 1e15;
     for (i, row) in training.rows.iter().enumerate() {
-        if let Some(j) = row.iter().position(|v| !(v.abs() <= MAX_FEATURE)) {
+        if let Some(j) = row.iter().position(|v| v.is_nan() || v.abs() > MAX_FEATURE) {
             return Err(inconsistent(format!(
                 "training row {i}, feature {j} is {}, beyond the ±1e15 any feature can reach",
                 row[j]
