@@ -481,8 +481,8 @@ fn unique_names<'a>(
             let (i, j) = (i.min(j), i.max(j));
             let message = format!(
                 "columns {} and {} of line 1 are both named `{}`: each column read needs a \
-                 name of its own (rename them, or read the file without its header row and \
-                 select channels by index)",
+                 name of its own (layouts, models and imported datasets find channels by \
+                 name), so rename them in the header row",
                 i + 1,
                 j + 1,
                 excerpt(&names[j])
