@@ -1,4 +1,4 @@
-//! Outputs whole or not at all (SPEC 8, issue 14): a failed or interrupted run leaves no
+//! Outputs whole or not at all (SPEC 8): a failed or interrupted run leaves no
 //! output file or folder and no temporary one.
 
 use std::path::Path;

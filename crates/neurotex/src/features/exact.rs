@@ -129,15 +129,19 @@ mod tests {
         fast
     }
 
-    #[test]
-    fn the_sign_of_a_difference_of_two_doubles_is_their_order() {
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
+    /// A xorshift64 stream from `seed`: bit patterns of every kind for the doubles.
+    fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             state
-        };
+        }
+    }
+
+    #[test]
+    fn the_sign_of_a_difference_of_two_doubles_is_their_order() {
+        let mut next = xorshift(0x9E37_79B9_7F4A_7C15);
         let edges = [
             0.0,
             -0.0,
@@ -174,13 +178,7 @@ mod tests {
 
     #[test]
     fn sums_in_one_i128_agree_with_the_limbs() {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = xorshift(0x2545_F491_4F6C_DD1D);
         for _ in 0..20_000 {
             let terms: Vec<(i128, i32)> = (0..3)
                 .map(|_| {
@@ -193,7 +191,7 @@ mod tests {
                 })
                 .collect();
             // A cancelling pair now and then, for sums of exactly 0.
-            let terms = if next() % 4 == 0 {
+            let terms = if next().is_multiple_of(4) {
                 vec![terms[0], (-terms[0].0, terms[0].1), terms[2]]
             } else {
                 terms

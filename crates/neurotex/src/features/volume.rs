@@ -349,17 +349,10 @@ fn first_reaching(guess: u64, end: u64, reaches: impl Fn(u64) -> bool) -> u64 {
             step = step.saturating_mul(2);
         }
     }
-    if let Some(mut no) = below {
-        while yes - no > 1 {
-            let mid = no + (yes - no) / 2;
-            if reaches(mid) {
-                yes = mid;
-            } else {
-                no = mid;
-            }
-        }
+    match below {
+        Some(no) => bisect(no, yes, reaches).1,
+        None => yes,
     }
-    yes
 }
 
 /// The smallest and largest count of `rows`, `(u32::MAX, 0)` for none.
@@ -497,16 +490,7 @@ impl ExactRateLevels {
         }
         let reaches = |k: u64| self.reaches(x, k);
         // Boundaries reached are a prefix of 1..L: bisect for its length.
-        let (mut reached, mut not) = (0u64, self.levels);
-        while not - reached > 1 {
-            let mid = reached + (not - reached) / 2;
-            if reaches(mid) {
-                reached = mid;
-            } else {
-                not = mid;
-            }
-        }
-        Some(reached as u8)
+        Some(bisect(0, self.levels, |k| !reaches(k)).0 as u8)
     }
 }
 
@@ -597,6 +581,20 @@ fn present_levels<'a, T>(
         .zip(present)
         .filter(|(_, &p)| p)
         .map(|(rows, _)| rows)
+}
+
+/// Narrows `(low, high)`, where `high_side(high)` holds and `high_side(low)` does not (nor
+/// is asked), to two neighbours with the same property, `high_side` being monotone between.
+fn bisect(mut low: u64, mut high: u64, high_side: impl Fn(u64) -> bool) -> (u64, u64) {
+    while high - low > 1 {
+        let mid = low + (high - low) / 2;
+        if high_side(mid) {
+            high = mid;
+        } else {
+            low = mid;
+        }
+    }
+    (low, high)
 }
 
 #[cfg(test)]
