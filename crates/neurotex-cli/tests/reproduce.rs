@@ -12,11 +12,12 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
     let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 6);
     let out = dir.join("report");
     // a quick run on a dataset; returns its results.json
-    let reproduce = |ds: &Path, out: &Path| -> Value {
-        dir.ok(&["reproduce", "--dataset", s(ds), "--out", s(out), "--quick"]);
+    let reproduce = |ds: &Path, out: &Path, more: &[&str]| -> Value {
+        let args = ["reproduce", "--dataset", s(ds), "--out", s(out), "--quick"];
+        dir.ok(&[&args[..], more].concat());
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap()
     };
-    let json = reproduce(&ds, &out);
+    let json = reproduce(&ds, &out, &[]);
     for speed in ["5", "10"] {
         for key in ["taxel_mean", "taxel_best", "glcm3d"] {
             let v = json["e1"][speed][key].as_f64().unwrap();
@@ -43,6 +44,16 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("## E1") && report.contains("| 5 |") && report.contains("paper"));
+    // E1 and E4 over the default eight encodings, with the section that explains them
+    let encodings = &json["encoder_sensitivity"];
+    assert_eq!(encodings["encodings"], 8);
+    assert_eq!(json["e1"]["5"]["encodings"], 8);
+    let over = encodings["speeds"]["5"]["glcm3d"]["per_encoding"]
+        .as_array()
+        .unwrap();
+    assert_eq!(over.len(), 8);
+    assert!(report.contains("## The encoder's sensitivity"));
+    assert!(!report.contains("IzhikevichParams"), "no Rust debug output");
     for fig in [
         "e0_psth_volume",
         "e1_accuracy",
@@ -59,7 +70,9 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
     }
     // one speed only: E6 is skipped with a reason, not an error
     let one = dir.dataset("one", &["A", "B"], &[5.0], 5);
-    let json = reproduce(&one, &dir.join("r1"));
+    let json = reproduce(&one, &dir.join("r1"), &["--encoder-draws", "1"]);
+    assert!(json.get("encoder_sensitivity").is_none());
+    assert_eq!(json["e1"]["5"]["encodings"], 1);
     assert!(json["skipped"]["e6"]
         .as_str()
         .unwrap()
@@ -109,6 +122,14 @@ fn reproduce_rejects_seeds_it_cannot_run() {
             (
                 vec!["reproduce", "--out", s(&out), "--seeds", "0"],
                 "--seeds",
+            ),
+            (
+                vec!["reproduce", "--out", s(&out), "--encoder-draws", "0"],
+                "--encoder-draws",
+            ),
+            (
+                vec!["reproduce", "--out", s(&out), "--encoder-draws", "101"],
+                "--encoder-draws",
             ),
             (
                 vec![

@@ -44,7 +44,7 @@ enum Data {
 /// `report.md`, `results.json` and `figures/` into `out` (whole or not at all) and returns
 /// the results. The GIL is released for the whole run.
 #[pyfunction]
-#[pyo3(signature = (out, options, dataset=None, quick=false, seed=0, trials=None, seeds=None, k=5, standardize=true, group_by=None, command=String::new()))]
+#[pyo3(signature = (out, options, dataset=None, quick=false, seed=0, trials=None, seeds=None, k=5, standardize=true, group_by=None, encoder_draws=None, command=String::new()))]
 #[allow(clippy::too_many_arguments)]
 fn reproduce(
     py: Python<'_>,
@@ -58,6 +58,7 @@ fn reproduce(
     k: usize,
     standardize: bool,
     group_by: Option<String>,
+    encoder_draws: Option<usize>,
     command: String,
 ) -> PyResult<Outcome> {
     let stages = params::stages(options)?;
@@ -78,6 +79,9 @@ fn reproduce(
     params.seed = seed;
     params.cv.seed = seed;
     params.group_by = group_by;
+    if let Some(draws) = encoder_draws {
+        params.encoder_draws = draws;
+    }
     let data = match dataset {
         Some(dir) => {
             if trials.is_some() || seeds.is_some() {

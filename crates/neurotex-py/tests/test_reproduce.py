@@ -53,12 +53,15 @@ def same_report(ours, theirs):
 
 def test_quick_run_on_a_folder_equals_the_cli(sim_dir, tmp_path):
     cli = run_cli("reproduce", "--quick", "--dataset", sim_dir, "--seed", "2", "--k", "3",
-                  "--out", tmp_path / "cli", "--predictions", tmp_path / "p.csv")
-    run = neurotex.reproduce(tmp_path / "py", dataset=sim_dir, quick=True, seed=2, k=3)
+                  "--encoder-draws", "3", "--out", tmp_path / "cli",
+                  "--predictions", tmp_path / "p.csv")
+    run = neurotex.reproduce(tmp_path / "py", dataset=sim_dir, quick=True, seed=2, k=3,
+                             encoder_draws=3)
     same_report(tmp_path / "py", tmp_path / "cli")
     assert run.report == str(tmp_path / "py" / "report.md")
     assert run.results == json.loads((tmp_path / "py" / "results.json").read_text())
     assert run.results["recordings"] == 30 and run.gain_calibration is None
+    assert run.results["encoder_sensitivity"]["encodings"] == 3
     # the claims the CLI prints, in its order and with its verdicts
     printed = [l for l in cli.stderr.splitlines() if not l.startswith("report in ")]
     assert printed == [f"{cli_verdict(c):<40} {c['statement']}" for c in run.claims]
@@ -116,6 +119,8 @@ def test_bad_options(sim_dir, tmp_path):
         neurotex.reproduce(tmp_path / "a", seeds=1001)
     with pytest.raises(ParameterError, match="k"):
         neurotex.reproduce(tmp_path / "a", dataset=sim_dir, k=0)
+    with pytest.raises(ParameterError, match="encoder draws must be between 1 and 100"):
+        neurotex.reproduce(tmp_path / "a", dataset=sim_dir, encoder_draws=0)
     with pytest.raises(ParameterError, match="levels"):
         neurotex.reproduce(tmp_path / "a", dataset=sim_dir, levels=1)
     with pytest.raises(ParameterError, match="unknown option `speed`"):

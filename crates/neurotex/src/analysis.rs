@@ -6,8 +6,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::classify::{
-    bootstrap_mean_share, cross_validate_sweep, train_test_sweep, BootstrapParams, Classifier,
-    ConfusionMatrix, Evaluation, Interval, Sweep, ValidCv,
+    bootstrap_mean_share, bootstrap_over_encodings, cross_validate_sweep, train_test_sweep,
+    BootstrapParams, Classifier, ConfusionMatrix, Evaluation, Interval, Sweep, ValidCv,
 };
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method};
@@ -202,6 +202,21 @@ pub(crate) fn seeded_bootstrap(shares: &[f64], seed: u64) -> Result<Interval> {
     }
     .check()?;
     Ok(bootstrap_mean_share(shares, &params)?)
+}
+
+/// [`seeded_bootstrap`] over recordings and encodings: `shares[e]` holds every recording's
+/// share under encoding `e` ([`bootstrap_over_encodings`]); one encoding gives
+/// [`seeded_bootstrap`]'s interval.
+///
+/// # Errors
+/// No encodings or shares, encodings of different lengths, or a share outside 0..1.
+pub(crate) fn seeded_bootstrap_over_encodings(shares: &[Vec<f64>], seed: u64) -> Result<Interval> {
+    let params = BootstrapParams {
+        seed,
+        ..BootstrapParams::default()
+    }
+    .check()?;
+    Ok(bootstrap_over_encodings(shares, &params)?)
 }
 
 /// One recording's out-of-fold prediction in one evaluation repeat.

@@ -21,7 +21,7 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
         e5_fractions: vec![1.0],
         e7_gains: vec![8.0],
         e8_ks: vec![5],
-        sensitivity: None,
+        encoder_draws: 1,
         ..ReproduceParams::default()
     }
     .check()

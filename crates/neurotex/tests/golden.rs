@@ -29,6 +29,7 @@ fn small_design_results() -> &'static Results {
             e5_fractions: vec![0.5, 1.0],
             e7_gains: vec![5.0, 8.0],
             e8_ks: vec![1, 5],
+            encoder_draws: 3,
             // E9's results carry wall-clock times; it has tests of its own.
             e9: false,
             ..ReproduceParams::default()

@@ -1,13 +1,15 @@
 //! The intervals the report prints, recomputed independently from the analyses'
-//! per-recording results: E1's accuracy intervals (`Outcome::accuracy_interval`) and its
-//! paired comparison of 3D-GLCM with the single taxel (`experiments::compare`).
+//! per-recording results: E1's accuracy intervals over recordings and encodings
+//! (`classify::bootstrap_over_encodings`) and its paired comparison of 3D-GLCM with the
+//! single taxel (`experiments::compare_encodings`).
 //!
 //! The statistics layer itself is checked against scipy, statsmodels and numpy in
 //! `stats_reference.rs`; this file checks the path from predictions to the numbers in
 //! report.md. A seeded bootstrap has no outside value to compare with (scipy's bootstrap
 //! draws other resamples), so the reference here redraws the same resamples (the same
-//! ChaCha8 generator and seed, one uniform index in 0..n per draw, as `bootstrap_mean_share`
-//! documents) and does everything else its own slow, evident way:
+//! ChaCha8 generator and seed, one uniform index in 0..encodings and then one in 0..n per
+//! recording, as `bootstrap_over_encodings` documents) and does everything else its own
+//! slow, evident way:
 //! - each recording's share of right predictions from the out-of-fold predictions and the
 //!   table's labels (3D-GLCM);
 //! - the resampled means by plain loops, sorted, and read at the 2.5th and 97.5th percentiles
@@ -45,16 +47,22 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
     }
 }
 
-/// The 95 % percentile-bootstrap interval of the mean of `values`, drawn with the library's
-/// generator and seed but computed step by step.
-fn reference_bootstrap(values: &[f64], seed: u64, resamples: usize) -> (f64, f64) {
-    let n = values.len();
+/// The 95 % percentile-bootstrap interval of the mean of `values[e]` over recordings and
+/// encodings `e`, drawn with the library's generator and seed but computed step by step:
+/// each resample picks an encoding (when there are several), then the recordings.
+fn reference_bootstrap(values: &[Vec<f64>], seed: u64, resamples: usize) -> (f64, f64) {
+    let n = values[0].len();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut means = Vec::with_capacity(resamples);
     for _ in 0..resamples {
+        let e = if values.len() > 1 {
+            rng.gen_range(0..values.len() as u64) as usize
+        } else {
+            0
+        };
         let mut sum = 0.0;
         for _ in 0..n {
-            sum += values[rng.gen_range(0..n as u64) as usize];
+            sum += values[e][rng.gen_range(0..n as u64) as usize];
         }
         means.push(sum / n as f64);
     }
@@ -82,6 +90,7 @@ fn small_run() -> (Tables, neurotex::experiments::Results, String, u64) {
         e5_fractions: vec![1.0],
         e7_gains: vec![8.0],
         e8_ks: vec![5],
+        encoder_draws: 3,
         seed: 11,
         ..ReproduceParams::default()
     }
@@ -108,33 +117,41 @@ fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bo
     let resamples = BootstrapParams::default().resamples;
     let pct = |v: f64| format!("{:.1}", 100.0 * v);
 
-    for (speed, h) in tables.headline.iter() {
+    for speed in results.speeds.clone() {
         let e1 = results.e1.get(speed).expect("E1 at every speed");
-        // each recording's share of right 3D-GLCM predictions, from the predictions
-        let mut right: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
-        for p in h
-            .glcm3d
-            .predictions
-            .as_ref()
-            .expect("3D-GLCM keeps its predictions")
-        {
-            let truth = &tables.glcm3d.metas[p.row].label;
-            let entry = right.entry(p.row).or_default();
-            entry.0 += usize::from(h.glcm3d.labels[p.predicted] == *truth);
-            entry.1 += 1;
+        let encodings = tables.encodings_at(speed);
+        assert_eq!(encodings.len(), 3);
+        // each recording's share of right 3D-GLCM predictions under each encoding, from the
+        // predictions
+        let mut glcm3d: Vec<Vec<f64>> = Vec::new();
+        for h in &encodings {
+            let mut right: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
+            for p in h
+                .glcm3d
+                .predictions
+                .as_ref()
+                .expect("3D-GLCM keeps its predictions")
+            {
+                let truth = &tables.glcm3d.metas[p.row].label;
+                let entry = right.entry(p.row).or_default();
+                entry.0 += usize::from(h.glcm3d.labels[p.predicted] == *truth);
+                entry.1 += 1;
+            }
+            assert_eq!(right.len(), h.glcm3d.correct_shares.len());
+            for ((row, share), (&ref_row, &(k, n))) in h.glcm3d.correct_shares.iter().zip(&right) {
+                assert_eq!(*row, ref_row);
+                close("3D-GLCM share", *share, k as f64 / n as f64);
+            }
+            glcm3d.push(right.values().map(|&(k, n)| k as f64 / n as f64).collect());
         }
-        let glcm3d: Vec<f64> = right.values().map(|&(k, n)| k as f64 / n as f64).collect();
-        assert_eq!(right.len(), h.glcm3d.correct_shares.len());
-        for ((row, share), (&ref_row, &reference)) in h.glcm3d.correct_shares.iter().zip(&right) {
-            assert_eq!(*row, ref_row);
-            close(
-                "3D-GLCM share",
-                *share,
-                reference.0 as f64 / reference.1 as f64,
-            );
-        }
-        let taxel: Vec<f64> = h.taxel.correct_shares.iter().map(|s| s.1).collect();
-        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        let taxel: Vec<Vec<f64>> = encodings
+            .iter()
+            .map(|h| h.taxel.correct_shares.iter().map(|s| s.1).collect())
+            .collect();
+        let mean = |v: &[Vec<f64>]| {
+            let all: Vec<f64> = v.iter().flatten().copied().collect();
+            all.iter().sum::<f64>() / all.len() as f64
+        };
         close("3D-GLCM accuracy", e1.glcm3d, mean(&glcm3d));
         close("single taxel accuracy", e1.taxel_mean, mean(&taxel));
 
@@ -156,7 +173,11 @@ fn the_printed_accuracy_intervals_and_paired_differences_match_a_step_by_step_bo
             "{speed} mm/s: {printed} not in the report"
         );
 
-        let differences: Vec<f64> = glcm3d.iter().zip(&taxel).map(|(g, t)| g - t).collect();
+        let differences: Vec<Vec<f64>> = glcm3d
+            .iter()
+            .zip(&taxel)
+            .map(|(g, t)| g.iter().zip(t).map(|(g, t)| g - t).collect())
+            .collect();
         let (lo, hi) = reference_bootstrap(&differences, seed, resamples);
         let paired = &e1.glcm3d_vs_taxel;
         close("paired difference", paired.difference, mean(&differences));

@@ -57,6 +57,14 @@ pub struct ReproduceArgs {
     /// groups than folds at a speed, each group is held out in turn.
     #[arg(long = "group-by")]
     pub group_by: Option<String>,
+    /// Encodings of every recording behind E1's and E4's accuracies: as run, and N - 1 more
+    /// with independent rounding-level perturbations of the input (each sample times
+    /// 1 + u x 1e-12). Spiking neurons near threshold turn such changes into moved spikes;
+    /// the accuracies are means over the encodings and their intervals resample encodings
+    /// as well as recordings. 1 evaluates the input as run only.
+    #[arg(long = "encoder-draws", value_name = "N", default_value_t = neurotex::experiments::DEFAULT_ENCODER_DRAWS as u64,
+          value_parser = clap::value_parser!(u64).range(1..=neurotex::experiments::MAX_ENCODER_DRAWS as u64))]
+    pub encoder_draws: u64,
     /// Write the headline 3D-GLCM evaluations' out-of-fold predictions to this CSV file:
     /// `speed_mm_s,method,file,label,predicted,fold,repeat`, one row per recording and CV
     /// repeat at each speed (of the first dataset with --seeds).
@@ -85,6 +93,7 @@ impl ReproduceArgs {
         params.seed = self.seed;
         params.cv.seed = self.seed;
         params.group_by = self.group_by.clone();
+        params.encoder_draws = usize::try_from(self.encoder_draws)?;
         Ok(params)
     }
 

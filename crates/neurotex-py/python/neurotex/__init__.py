@@ -777,7 +777,7 @@ class Reproduction:
 
     ``report``: the path of ``report.md`` (``results.json`` and ``figures/*.svg`` beside
     it); ``results``: ``results.json`` as a dict (every analysis: ``e1`` .. ``e9``,
-    ``sensitivity``, ``taxels``, ``provenance``, ...); ``claims``: the paper's claims
+    ``encoder_sensitivity``, ``taxels``, ``provenance``, ...); ``claims``: the paper's claims
     judged on these results, each a dict with ``statement``, ``verdict`` (``holds``,
     ``not_shown``, ``contradicted``, ``point_agrees``, ``point_disagrees``), ``holds``
     and ``detail``; ``headline``: E1 by speed in mm/s, each a dict of accuracies
@@ -815,6 +815,7 @@ def reproduce(
     k: int = 5,
     standardize: bool = True,
     group_by: Optional[str] = None,
+    encoder_draws: Optional[int] = None,
     **stage_options: Any,
 ) -> Reproduction:
     """Runs the paper's analyses (E0-E9: accuracy per speed, confusion, spatial
@@ -831,7 +832,10 @@ def reproduce(
     manifest must give each recording's speed. ``quick``: fewer CV repeats, perturbation
     counts, fractions and gains (the CI run). ``seed`` also seeds the CV shuffles and the
     perturbations. ``k``, ``standardize``: the KNN. ``group_by``: keep each group of this
-    manifest column in one fold. ``stage_options`` are :func:`features`' (``gain``, also
+    manifest column in one fold. ``encoder_draws``: encodings of every recording behind
+    E1's and E4's accuracies (as run, then with independent rounding-level input
+    perturbations; their intervals resample encodings as well as recordings; default 5,
+    1 for the input as run only). ``stage_options`` are :func:`features`' (``gain``, also
     ``"auto"``, ``preset``, ``cutoff``, ``levels``, ...).
 
     The run takes minutes (the full paper-scale run with 5 seeds much longer) with the GIL
@@ -843,7 +847,8 @@ def reproduce(
     opts = _stage_options(**stage_options)
     given = {"dataset": None if dataset is None else os.fspath(dataset), "quick": quick,
              "seed": seed, "trials": trials, "seeds": seeds, "k": k,
-             "standardize": standardize, "group_by": group_by}
+             "standardize": standardize, "group_by": group_by,
+             "encoder_draws": encoder_draws}
     defaults = {"quick": False, "seed": 0, "k": 5, "standardize": True}
     shown = [repr(out)] + [f"{key}={v!r}" for key, v in given.items()
                            if v is not None and defaults.get(key) != v]
@@ -852,7 +857,8 @@ def reproduce(
     results_json, claims_json, predictions, seconds = _native.reproduce(
         out, opts, given["dataset"], bool(quick), int(seed),
         None if trials is None else int(trials), None if seeds is None else int(seeds),
-        int(k), bool(standardize), group_by, command)
+        int(k), bool(standardize), group_by,
+        None if encoder_draws is None else int(encoder_draws), command)
     results = json.loads(results_json)
     claims = [dict(c, holds=c["verdict"] in _HOLDS) for c in json.loads(claims_json)]
     headline = {float(speed): {key: e[key] for key in _HEADLINE}

@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::draws::{for_each_resample, Signs};
+use super::draws::{for_each_resample, Signs, UniformIndices};
 use super::stats::{binomial_half_cdf, percentile, student_t_quantile, StatsError, Z_95};
 use super::ConfusionMatrix;
 use crate::error::ParamError;
@@ -123,6 +123,18 @@ pub enum IntervalMethod {
     PercentileBootstrap {
         /// Recordings resampled.
         n: usize,
+        /// Bootstrap resamples.
+        resamples: usize,
+        /// The resampling generator's seed.
+        seed: u64,
+    },
+    /// Percentile bootstrap over recordings and encodings
+    /// ([`bootstrap_over_encodings`]).
+    EncodingBootstrap {
+        /// Recordings resampled.
+        n: usize,
+        /// Encodings of each recording, one drawn per resample.
+        encodings: usize,
         /// Bootstrap resamples.
         resamples: usize,
         /// The resampling generator's seed.
@@ -294,6 +306,65 @@ pub fn bootstrap_mean_share(
         level: LEVEL,
         method: IntervalMethod::PercentileBootstrap {
             n,
+            resamples: params.resamples,
+            seed: params.seed,
+        },
+    })
+}
+
+/// [`bootstrap_mean_share`] for recordings encoded several times into spikes (the same
+/// input with independent rounding-level perturbations): `shares[e][i]` is the share of
+/// recording `i`'s predictions that were right under encoding `e`. The estimate is the mean
+/// over encodings and recordings. Each resample draws one encoding (uniformly) and then as
+/// many recordings as there are, with replacement, so the interval holds both the
+/// variability of the recordings and that of the encoder, whose spikes move by whole
+/// threshold crossings under changes far below any sensor's resolution: it is where one
+/// run's accuracy may land, not only where the mean over encodings lies.
+///
+/// With one encoding this is [`bootstrap_mean_share`] exactly (same draws, same interval).
+///
+/// # Errors
+/// No encodings or recordings, encodings of different lengths, or a share outside [0, 1].
+pub fn bootstrap_over_encodings(
+    shares: &[Vec<f64>],
+    params: &ValidBootstrap,
+) -> Result<Interval, StatsError> {
+    let Some(first) = shares.first() else {
+        return Err(StatsError::Empty { what: "encodings" });
+    };
+    if shares.len() == 1 {
+        return bootstrap_mean_share(first, params);
+    }
+    let n = first.len();
+    if n == 0 {
+        return Err(StatsError::Empty { what: "recordings" });
+    }
+    if let Some(other) = shares.iter().find(|s| s.len() != n) {
+        let (first, second) = (n, other.len());
+        return Err(StatsError::LengthMismatch { first, second });
+    }
+    shares.iter().try_for_each(|s| check_accuracies(s))?;
+    let mut draws = UniformIndices::new(params.seed);
+    let (mut encoding, mut picked) = (Vec::new(), Vec::new());
+    let mut means: Vec<f64> = Vec::with_capacity(params.resamples);
+    for _ in 0..params.resamples {
+        draws.fill(shares.len(), 1, &mut encoding);
+        draws.fill(n, n, &mut picked);
+        let chosen = &shares[encoding[0]];
+        let total: f64 = picked.iter().map(|&i| chosen[i]).sum();
+        means.push(total / n as f64);
+    }
+    means.sort_by(f64::total_cmp);
+    let tail = (1.0 - LEVEL) / 2.0;
+    let all: f64 = shares.iter().flatten().sum();
+    Ok(Interval {
+        estimate: all / (n * shares.len()) as f64,
+        lower: percentile(&means, tail),
+        upper: percentile(&means, 1.0 - tail),
+        level: LEVEL,
+        method: IntervalMethod::EncodingBootstrap {
+            n,
+            encodings: shares.len(),
             resamples: params.resamples,
             seed: params.seed,
         },
@@ -627,6 +698,47 @@ mod tests {
         assert_eq!(interval.estimate, 0.8);
         assert!((interval.lower - 0.72).abs() <= 0.011, "{interval:?}");
         assert!((interval.upper - 0.88).abs() <= 0.011, "{interval:?}");
+    }
+
+    #[test]
+    fn one_encoding_is_the_recordings_bootstrap_and_several_widen_it_to_their_mixture() {
+        let params = BootstrapParams::default().check().unwrap();
+        let share = |k: usize| {
+            (0..100)
+                .map(|i| f64::from(u8::from(i < k)))
+                .collect::<Vec<_>>()
+        };
+        let alone = bootstrap_mean_share(&share(80), &params).unwrap();
+        assert_eq!(
+            bootstrap_over_encodings(&[share(80)], &params).unwrap(),
+            alone
+        );
+        // Encodings giving 80 and 60 of 100: each resample is Binomial(100, 0.8) / 100 or
+        // Binomial(100, 0.6) / 100 with equal odds, and that mixture's 2.5 % and 97.5 %
+        // quantiles are 0.52 and 0.86 (the binomial sums in exact arithmetic); 2000
+        // resamples land within a count or two of them.
+        let both = bootstrap_over_encodings(&[share(80), share(60)], &params).unwrap();
+        assert_eq!(both.estimate, 0.7);
+        assert!((both.lower - 0.52).abs() <= 0.021, "{both:?}");
+        assert!((both.upper - 0.86).abs() <= 0.021, "{both:?}");
+        assert!(both.upper - both.lower > 2.0 * (alone.upper - alone.lower));
+        assert!(matches!(
+            both.method,
+            IntervalMethod::EncodingBootstrap {
+                n: 100,
+                encodings: 2,
+                ..
+            }
+        ));
+        assert!(bootstrap_over_encodings(&[], &params).is_err());
+        assert_eq!(
+            bootstrap_over_encodings(&[share(80), vec![1.0; 3]], &params),
+            Err(StatsError::LengthMismatch {
+                first: 100,
+                second: 3
+            })
+        );
+        assert!(bootstrap_over_encodings(&[share(80), vec![2.0; 100]], &params).is_err());
     }
 
     #[test]

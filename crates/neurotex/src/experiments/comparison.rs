@@ -11,7 +11,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::ValidReproduceParams;
-use crate::analysis::{seeded_bootstrap, Outcome};
+use crate::analysis::{seeded_bootstrap_over_encodings, Outcome};
 use crate::classify::PairedVerdict;
 use crate::error::{ClassifyError, Result};
 
@@ -44,9 +44,28 @@ pub fn compare(
     second: (&str, &Outcome),
     params: &ValidReproduceParams,
 ) -> Result<Comparison> {
-    compare_shares(
-        (first.0, &first.1.correct_shares),
-        (second.0, &second.1.correct_shares),
+    compare_encodings((first.0, &[first.1]), (second.0, &[second.1]), params)
+}
+
+/// `first` against `second` over several encodings of the same recordings: `first.1[e]`
+/// and `second.1[e]` were evaluated on encoding `e`. The difference is the mean over
+/// encodings and recordings, and its interval resamples both (one encoding per resample,
+/// the same for the two methods, [`crate::classify::bootstrap_over_encodings`]); with one
+/// encoding this is [`compare`].
+///
+/// # Errors
+/// No encodings, different numbers of them, or outcomes on different recordings.
+pub fn compare_encodings(
+    first: (&str, &[&Outcome]),
+    second: (&str, &[&Outcome]),
+    params: &ValidReproduceParams,
+) -> Result<Comparison> {
+    let shares = |o: &[&Outcome]| -> Vec<Vec<(usize, f64)>> {
+        o.iter().map(|o| o.correct_shares.clone()).collect()
+    };
+    paired(
+        (first.0, &shares(first.1)),
+        (second.0, &shares(second.1)),
         params,
     )
 }
@@ -62,19 +81,45 @@ pub fn compare_shares(
     second: (&str, &[(usize, f64)]),
     params: &ValidReproduceParams,
 ) -> Result<Comparison> {
-    let (a, b) = (first.1, second.1);
-    if a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.0 != y.0) {
+    paired(
+        (first.0, &[first.1.to_vec()]),
+        (second.0, &[second.1.to_vec()]),
+        params,
+    )
+}
+
+/// The paired comparison of per-recording shares under each encoding.
+fn paired(
+    first: (&str, &[Vec<(usize, f64)>]),
+    second: (&str, &[Vec<(usize, f64)>]),
+    params: &ValidReproduceParams,
+) -> Result<Comparison> {
+    let unpaired = || -> crate::Error {
         let (first, second) = (first.0.to_string(), second.0.to_string());
-        return Err(ClassifyError::Unpaired { first, second }.into());
+        ClassifyError::Unpaired { first, second }.into()
+    };
+    let (a, b) = (first.1, second.1);
+    if a.len() != b.len() || a.is_empty() {
+        return Err(unpaired());
+    }
+    let rows = |x: &[(usize, f64)]| x.iter().map(|r| r.0).collect::<Vec<_>>();
+    let recordings = rows(&a[0]);
+    if a.iter().chain(b).any(|x| rows(x) != recordings) {
+        return Err(unpaired());
     }
     // The difference lies in [-1, 1]; the bootstrap takes shares in [0, 1], so it resamples
     // (d + 1) / 2 and the interval is mapped back, which is exact for a mean.
-    let shifted: Vec<f64> = a
+    let shifted: Vec<Vec<f64>> = a
         .iter()
         .zip(b)
-        .map(|(x, y)| (x.1 - y.1 + 1.0) / 2.0)
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (x.1 - y.1 + 1.0) / 2.0)
+                .collect()
+        })
         .collect();
-    let interval = seeded_bootstrap(&shifted, params.seed)?;
+    let interval = seeded_bootstrap_over_encodings(&shifted, params.seed)?;
     let back = |v: f64| 2.0 * v - 1.0;
     let (lower, upper) = (back(interval.lower), back(interval.upper));
     let verdict = if lower > 0.0 {
@@ -91,7 +136,7 @@ pub fn compare_shares(
         lower,
         upper,
         verdict,
-        recordings: a.len(),
+        recordings: recordings.len(),
     })
 }
 
@@ -134,6 +179,18 @@ mod tests {
         let interval = mixed.accuracy_interval(params.seed).unwrap();
         assert_eq!(interval.estimate, 0.5);
         assert!(interval.lower < 0.5 && interval.upper > 0.5);
+        // One encoding where the first wins on every recording, one where they tie: the
+        // difference is half, but half the resamples see none, so it is not shown.
+        let as_run = compare(("a", &better), ("b", &worse), params).unwrap();
+        let tie = outcome(&[1.0; 40]);
+        let over =
+            compare_encodings(("a", &[&better, &tie]), ("b", &[&worse, &tie]), params).unwrap();
+        assert_eq!(as_run.verdict, PairedVerdict::Supported);
+        assert_eq!((over.difference, over.lower), (0.5, 0.0));
+        assert_eq!(over.verdict, PairedVerdict::NotShown);
+        let single = compare_encodings(("a", &[&better]), ("b", &[&worse]), params).unwrap();
+        assert_eq!(single, as_run);
+        assert!(compare_encodings(("a", &[&better, &tie]), ("b", &[&worse]), params).is_err());
         let unpaired = compare(("a", &better), ("short", &outcome(&[1.0; 3])), params);
         assert!(matches!(
             unpaired,

@@ -3,14 +3,15 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{compare, Comparison, Context, Stop};
+use super::encodings::{Methods, OverEncodings};
+use super::{compare_encodings, Comparison, Context, Stop};
 use crate::classify::Interval;
 use crate::values::BySpeed;
 
 /// E1 at one speed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E1Speed {
-    /// Single taxel, mean over taxels.
+    /// Single taxel, mean over taxels (and over encodings).
     pub taxel_mean: f64,
     /// Single taxel, mean over the responsive taxels (neither silent nor at the ceiling in
     /// most recordings); `None` when no taxel responds.
@@ -19,10 +20,13 @@ pub struct E1Speed {
     pub taxel_best: f64,
     /// Which taxel was best, `r{row}c{col}`.
     pub taxel_best_cell: String,
-    /// 3D-GLCM.
+    /// 3D-GLCM (mean over encodings).
     pub glcm3d: f64,
-    /// 3D-GLCM standard deviation over CV repeats.
+    /// 3D-GLCM standard deviation over CV repeats (the encoding as run).
     pub glcm3d_std: f64,
+    /// Encodings of each recording the accuracies and intervals are over (1: as run).
+    #[serde(default = "one")]
+    pub encodings: usize,
     /// Samples.
     pub n: usize,
     /// Classes recorded at this speed.
@@ -31,15 +35,22 @@ pub struct E1Speed {
     pub chance: f64,
     /// Chance by always answering the most frequent class at this speed.
     pub majority: f64,
-    /// 95 % interval of the 3D-GLCM accuracy (bootstrap over recordings).
+    /// 95 % interval of the 3D-GLCM accuracy (bootstrap over recordings and encodings).
     pub glcm3d_interval: Interval,
-    /// 95 % interval of the single taxel's mean over taxels (bootstrap over recordings).
+    /// 95 % interval of the single taxel's mean over taxels (bootstrap over recordings and
+    /// encodings).
     pub taxel_mean_interval: Interval,
-    /// 3D-GLCM against the single taxel (mean over taxels) on the same recordings.
+    /// 3D-GLCM against the single taxel (mean over taxels) on the same recordings and
+    /// encodings.
     pub glcm3d_vs_taxel: Comparison,
 }
 
-/// E1 at every speed, from the headline evaluations.
+fn one() -> usize {
+    1
+}
+
+/// E1 at every speed, from the headline evaluations of every encoding (the responsive
+/// and the best taxel from the encoding as run).
 ///
 /// # Errors
 /// None of its own: the evaluations ran when the tables were built.
@@ -48,6 +59,10 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
         .headline
         .iter()
         .map(|(speed, h)| -> Result<_, Stop> {
+            let encodings = c.tables.encodings_at(speed);
+            let m = Methods::of(&encodings);
+            let glcm3d = OverEncodings::of(&m.glcm3d, c.params.seed)?;
+            let taxel = OverEncodings::of(&m.taxel, c.params.seed)?;
             let best = h.taxel.best.unwrap_or(crate::analysis::TaxelAccuracy {
                 row: 0,
                 col: 0,
@@ -63,24 +78,25 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
             let total = truth.iter().sum::<usize>().max(1) as f64;
             let classes = truth.iter().filter(|&&n| n > 0).count();
             let e1 = E1Speed {
-                taxel_mean: h.taxel.accuracy,
+                taxel_mean: taxel.mean(),
                 taxel_mean_responsive: c
                     .prepared
                     .taxels
                     .responsive_mean(h.taxel.per_taxel.as_deref().unwrap_or_default()),
                 taxel_best: best.accuracy,
                 taxel_best_cell: format!("r{}c{}", best.row, best.col),
-                glcm3d: h.glcm3d.accuracy,
+                glcm3d: glcm3d.mean(),
                 glcm3d_std: h.glcm3d.accuracy_std,
+                encodings: encodings.len(),
                 n: h.glcm3d.n,
                 classes,
                 chance: 1.0 / classes.max(1) as f64,
                 majority: truth.iter().copied().max().unwrap_or(0) as f64 / total,
-                glcm3d_interval: h.glcm3d.accuracy_interval(c.params.seed)?,
-                taxel_mean_interval: h.taxel.accuracy_interval(c.params.seed)?,
-                glcm3d_vs_taxel: compare(
-                    ("3D-GLCM", &h.glcm3d),
-                    ("single taxel", &h.taxel),
+                glcm3d_interval: glcm3d.combined,
+                taxel_mean_interval: taxel.combined,
+                glcm3d_vs_taxel: compare_encodings(
+                    ("3D-GLCM", &m.glcm3d),
+                    ("single taxel", &m.taxel),
                     c.params,
                 )?,
             };

@@ -3,12 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::tables::cv_at;
-use super::{compare, Comparison, Context, Stop};
-use crate::analysis::Columns;
+use super::encodings::{Methods, OverEncodings};
+use super::{compare_encodings, Comparison, Context, Stop};
+use crate::classify::Interval;
 use crate::values::BySpeed;
 
-/// E4 at one speed.
+/// E4 at one speed; accuracies are means over encodings, as E1's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E4Speed {
     /// Single taxel mean.
@@ -17,36 +17,36 @@ pub struct E4Speed {
     pub glcm2d: f64,
     /// 3D-GLCM.
     pub glcm3d: f64,
+    /// 95 % interval of 2D-GLCM (bootstrap over recordings and encodings; the other two
+    /// are E1's).
+    pub glcm2d_interval: Interval,
     /// The single taxel (mean over taxels) against 2D-GLCM, on the same recordings.
     pub taxel_vs_glcm2d: Comparison,
     /// 3D-GLCM against 2D-GLCM, on the same recordings.
     pub glcm3d_vs_glcm2d: Comparison,
 }
 
-/// E4 at every speed.
+/// E4 at every speed, over every encoding.
 ///
 /// # Errors
-/// A classification that cannot run.
+/// Evaluations of different recordings.
 pub fn e4_temporal(c: &Context) -> Result<BySpeed<E4Speed>, Stop> {
     let mut out = BySpeed::new();
-    for (speed, h) in c.tables.headline.iter() {
-        let g2 = cv_at(
-            &c.tables.glcm2d,
-            Columns::All,
-            speed,
-            c.params.knn(),
-            c.params.folds(),
-        )?;
-        out.insert(
-            speed,
-            E4Speed {
-                taxel_mean: h.taxel.accuracy,
-                glcm2d: g2.accuracy,
-                glcm3d: h.glcm3d.accuracy,
-                taxel_vs_glcm2d: compare(("single taxel", &h.taxel), ("2D-GLCM", &g2), c.params)?,
-                glcm3d_vs_glcm2d: compare(("3D-GLCM", &h.glcm3d), ("2D-GLCM", &g2), c.params)?,
-            },
-        );
+    for &speed in &c.prepared.speeds {
+        let m = Methods::of(&c.tables.encodings_at(speed));
+        let over = |o| OverEncodings::of(o, c.params.seed);
+        let (taxel, g2, g3) = (over(&m.taxel)?, over(&m.glcm2d)?, over(&m.glcm3d)?);
+        let versus_2d =
+            |name, first| compare_encodings((name, first), ("2D-GLCM", &m.glcm2d), c.params);
+        let e4 = E4Speed {
+            taxel_mean: taxel.mean(),
+            glcm2d: g2.mean(),
+            glcm3d: g3.mean(),
+            glcm2d_interval: g2.combined,
+            taxel_vs_glcm2d: versus_2d("single taxel", &m.taxel)?,
+            glcm3d_vs_glcm2d: versus_2d("3D-GLCM", &m.glcm3d)?,
+        };
+        out.insert(speed, e4);
     }
     Ok(out)
 }
@@ -57,13 +57,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn takes_taxel_and_3d_from_the_headline() {
+    fn means_over_the_encodings_of_the_headline() {
         let run = small_run();
         let c = run.context();
         let e4 = e4_temporal(&c).unwrap();
         for (speed, e) in e4.iter() {
-            assert_eq!(e.glcm3d, c.tables.at(speed).glcm3d.accuracy);
+            let e1 = &c.tables.encodings_at(speed);
+            let mean = e1.iter().map(|h| h.glcm3d.accuracy).sum::<f64>() / e1.len() as f64;
+            assert!((e.glcm3d - mean).abs() < 1e-12);
             assert!((0.0..=1.0).contains(&e.glcm2d));
+            let i = &e.glcm2d_interval;
+            assert!(i.lower <= e.glcm2d && e.glcm2d <= i.upper);
         }
     }
 }

@@ -20,11 +20,11 @@ mod e6_speed_invariance;
 mod e7_gain;
 mod e8_neighbours;
 mod e9_compare;
+mod encodings;
 mod params;
 mod prepare;
 mod provenance;
 mod seeds;
-mod sensitivity;
 mod skip;
 mod tables;
 #[cfg(test)]
@@ -36,7 +36,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 pub use claims::{claims, Claim, Verdict};
-pub use comparison::{compare, compare_shares, Comparison};
+pub use comparison::{compare, compare_encodings, compare_shares, Comparison};
 pub use diagnostics::{taxel_diagnostics, TaxelDiagnostics, TaxelResponse, SATURATION_SHARE};
 pub use e0_psth::{e0_psth, E0Example, E0};
 pub use e1_accuracy::{e1_accuracy, E1Speed};
@@ -49,11 +49,13 @@ pub use e6_speed_invariance::{e6_speed_invariance, E6Speed};
 pub use e7_gain::{e7_gain_sweep, E7};
 pub use e8_neighbours::{e8_neighbours, E8Speed};
 pub use e9_compare::{e9_compare, E9};
-pub use params::{ReproduceParams, ValidReproduceParams, MAX_REPEATS};
+pub use encodings::{encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, OverEncodings};
+pub use params::{
+    ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS, MAX_REPEATS,
+};
 pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, Source};
 pub use provenance::Provenance;
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
-pub use sensitivity::{sensitivity, Sensitivity, SensitivitySpeed};
 pub use skip::{Skip, Stop};
 pub use tables::{Headline, Tables};
 
@@ -121,8 +123,10 @@ pub struct Results {
     /// E9: the best of `neurotex compare`'s standard candidates beside the paper's method.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub e9: Option<E9>,
-    /// The headline accuracies on an input changed by a rounding-level amount.
-    pub sensitivity: Option<Sensitivity>,
+    /// The headline accuracies of every encoding, with and without the encoder's
+    /// variability in their intervals; `None` with one encoding.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub encoder_sensitivity: Option<EncoderSensitivity>,
     /// How `--gain auto` chose the gain (on the first dataset's recordings, labels unused);
     /// `None` for a gain given as a number.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -164,7 +168,7 @@ impl Results {
             e7: None,
             e8: BySpeed::new(),
             e9: None,
-            sensitivity: None,
+            encoder_sensitivity: None,
             across_seeds: None,
             gain_calibration: None,
             provenance: Some(prepared.provenance.clone()),
@@ -301,9 +305,9 @@ pub const ANALYSES: [Analysis; 11] = [
         },
     },
     Analysis {
-        id: "sensitivity",
+        id: "encoder sensitivity",
         run: |c, r| {
-            r.sensitivity = sensitivity(c)?;
+            r.encoder_sensitivity = encoder_sensitivity(c)?;
             Ok(())
         },
     },
@@ -325,7 +329,7 @@ pub const ANALYSES: [Analysis; 11] = [
 /// cores, one resampling stream per interval): it runs beside them from the start. The
 /// results are the same as one after another; E9's time in `timing_s` is its own wall
 /// clock, shared with the others. When both fail, the error is the one that came first in
-/// the order E1, ..., E8, E9, the sensitivity check, E0.
+/// the order E1, ..., E8, E9, the encoder's sensitivity, E0.
 ///
 /// # Errors
 /// A classification that cannot run (a class smaller than the fold count, for example).

@@ -3,6 +3,8 @@
 
 use std::time::Instant;
 
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -218,9 +220,12 @@ pub struct Prepared {
     pub provenance: Provenance,
     /// With E5c: the causal pipeline of each speed and every recording's spikes through it.
     pub causal: Option<CausalPrepared>,
-    /// With a sensitivity check: every recording's spikes from its input changed by the
-    /// relative amount asked, in the order of `encoded`.
-    pub perturbed: Option<Vec<Encoded>>,
+    /// The further encodings of the encoder's sensitivity ([`ReproduceParams::encoder_draws`]
+    /// less the one as run): each is every recording's spikes from its input perturbed
+    /// independently, in the order of `encoded`.
+    ///
+    /// [`ReproduceParams::encoder_draws`]: super::ReproduceParams::encoder_draws
+    pub perturbed: Vec<Vec<Encoded>>,
     /// Seconds the pass took.
     pub seconds: f64,
 }
@@ -328,14 +333,16 @@ pub fn prepare(
         .collect::<Result<_>>()?;
     let mut isi = IsiSweep::empty(params, labels.clone());
     let mut encoded = Vec::with_capacity(n);
-    let mut perturbed = params.sensitivity.map(|_| Vec::with_capacity(n));
+    let mut perturbed: Vec<Vec<Encoded>> = (1..params.encoder_draws)
+        .map(|_| Vec::with_capacity(n))
+        .collect();
     let mut causal_encoded = Vec::with_capacity(n);
     for one in results {
         causal_encoded.push(one.causal);
         if let Some(points) = one.sweep {
             isi.add(&one.encoded.meta.label, points);
         }
-        if let (Some(all), Some(p)) = (perturbed.as_mut(), one.perturbed) {
+        for (all, p) in perturbed.iter_mut().zip(one.perturbed) {
             all.push(p);
         }
         encoded.push(one.encoded);
@@ -374,15 +381,15 @@ struct EncodedOne {
     encoded: Encoded,
     /// The E7 sweep's histograms, at the slowest speed.
     sweep: Option<Vec<GainPoint>>,
-    /// The spikes of the perturbed input, with a sensitivity check.
-    perturbed: Option<Encoded>,
+    /// The spikes of each perturbed encoding of the input.
+    perturbed: Vec<Encoded>,
     /// The spikes through the causal pipeline of the recording's speed, with E5c.
     causal: Option<Encoded>,
 }
 
 /// Loads, conditions and encodes recording `i`; with `sweep`, also encodes it at every E7
-/// gain and returns its ISI histograms; with a sensitivity check, also encodes its input
-/// changed by that relative amount; with a `causal` pipeline, also encodes it through that.
+/// gain and returns its ISI histograms; encodes its input perturbed once for each further
+/// encoding; with a `causal` pipeline, also encodes it through that.
 fn encode_one(
     source: &Source,
     i: usize,
@@ -396,7 +403,7 @@ fn encode_one(
         Some(p) => Some(p.encode(&rec, source.baseline())?),
         None => None,
     };
-    let mut cond = pipeline.condition(&rec, source.baseline())?;
+    let cond = pipeline.condition(&rec, source.baseline())?;
     let (spikes, fa) = if params.e9 && pipeline.params().encoding == Encoding::Sa {
         // E9 compares the sa+fa encoding too; the other analyses read the SA population.
         let (sa, fa) = pipeline.encode_sa_fa(&rec, &cond)?;
@@ -416,24 +423,47 @@ fn encode_one(
         resampled: cond.resampled,
         flat: cond.flat,
     };
-    let perturbed = match params.sensitivity {
-        Some(eps) => {
-            cond.samples.iter_mut().for_each(|x| *x *= 1.0 + eps);
+    let perturbed = (1..params.encoder_draws)
+        .map(|encoding| {
+            let samples = perturbed_input(&cond.samples, params, encoding, i);
+            let cond = Conditioned { samples, ..cond };
             let (spikes, fa) = pipeline.encode_populations(&rec, &cond)?;
-            Some(Encoded {
+            Ok(Encoded {
                 spikes,
                 fa,
                 ..encoded.clone()
             })
-        }
-        None => None,
-    };
+        })
+        .collect::<Result<_>>()?;
     Ok(EncodedOne {
         encoded,
         sweep,
         perturbed,
         causal,
     })
+}
+
+/// `samples`, each times `1 + u * params.perturbation` with `u` uniform in [-1, 1) from a
+/// ChaCha8 stream of its own for the run's seed, the encoding and the recording: the
+/// perturbations are independent across samples, encodings and recordings, and the same
+/// on every run and thread count.
+fn perturbed_input(
+    samples: &[f64],
+    params: &ValidReproduceParams,
+    encoding: usize,
+    recording: usize,
+) -> Vec<f64> {
+    let mut key = [0u8; 32];
+    key[..8].copy_from_slice(&params.seed.to_le_bytes());
+    key[8..16].copy_from_slice(&(encoding as u64).to_le_bytes());
+    key[16..24].copy_from_slice(&(recording as u64).to_le_bytes());
+    key[24..].copy_from_slice(b"encoding");
+    let mut rng = ChaCha8Rng::from_seed(key);
+    let eps = params.perturbation;
+    samples
+        .iter()
+        .map(|&x| x * (1.0 + eps * rng.gen_range(-1.0..1.0)))
+        .collect()
 }
 
 fn gain_sweep(
@@ -464,4 +494,32 @@ fn gain_sweep(
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::ReproduceParams;
+
+    #[test]
+    fn perturbations_are_tiny_seeded_and_independent_per_encoding_and_recording() {
+        let params = ReproduceParams::default().check().unwrap();
+        let input: Vec<f64> = (0..1000)
+            .map(|i| 0.5 + (i as f64 * 0.01).sin() / 3.0)
+            .collect();
+        let a = perturbed_input(&input, &params, 1, 0);
+        assert_eq!(a, perturbed_input(&input, &params, 1, 0));
+        let moved = a.iter().zip(&input).filter(|(p, x)| p != x).count();
+        assert!(moved > 900, "only {moved} of 1000 samples moved");
+        for (p, x) in a.iter().zip(&input) {
+            assert!(((p - x) / x).abs() <= params.perturbation * (1.0 + 1e-3));
+        }
+        assert_ne!(a, perturbed_input(&input, &params, 2, 0));
+        assert_ne!(a, perturbed_input(&input, &params, 1, 1));
+        let reseeded = ReproduceParams {
+            seed: 1,
+            ..ReproduceParams::default()
+        };
+        assert_ne!(a, perturbed_input(&input, &reseeded.check().unwrap(), 1, 0));
+    }
 }

@@ -1,5 +1,6 @@
 //! The feature tables every analysis reads, built once, and the headline evaluations (the
-//! paper's two approaches at each speed) that several analyses compare against.
+//! paper's two approaches and 2D-GLCM at each speed, on every encoding) that several
+//! analyses compare against.
 
 use super::{Prepared, ValidReproduceParams};
 use crate::analysis::{evaluate, evaluate_sweep, Columns, FeatureTable, Outcome, Split};
@@ -8,13 +9,16 @@ use crate::error::Result;
 use crate::pipeline::{Encoded, Method};
 use crate::values::{BySpeed, Speed};
 
-/// The paper's two approaches evaluated by cross-validation at one speed.
+/// The paper's two approaches, and 2D-GLCM (E4), evaluated by cross-validation at one
+/// speed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Headline {
     /// Single taxel, every taxel in turn (mean, per taxel, best).
     pub taxel: Outcome,
     /// 3D-GLCM.
     pub glcm3d: Outcome,
+    /// 2D-GLCM.
+    pub glcm2d: Outcome,
 }
 
 /// Feature tables over all recordings, and the headline evaluations per speed.
@@ -28,10 +32,14 @@ pub struct Tables {
     pub glcm2d: FeatureTable,
     /// Both approaches by cross-validation at each speed.
     pub headline: BySpeed<Headline>,
+    /// The headline evaluations of each further encoding ([`Prepared::perturbed`]), on the
+    /// same folds.
+    pub perturbed: Vec<BySpeed<Headline>>,
 }
 
 impl Tables {
-    /// Builds the three tables and the headline evaluations.
+    /// Builds the three tables and the headline evaluations, of the recordings as run and
+    /// of each further encoding.
     ///
     /// # Errors
     /// A recording too short for one bin, or a classification that cannot run.
@@ -40,18 +48,15 @@ impl Tables {
         let taxel = table(encoded, Method::Taxel, params)?;
         let glcm3d = table(encoded, Method::Glcm3d, params)?;
         let glcm2d = table(encoded, Method::Glcm2d, params)?;
-        let headline = prepared
-            .speeds
+        let headline = evaluate_headline(&[&taxel, &glcm3d, &glcm2d], &prepared.speeds, params)?;
+        let perturbed = prepared
+            .perturbed
             .iter()
-            .map(|&s| {
-                let knn = params.knn();
-                Ok((
-                    s,
-                    Headline {
-                        taxel: cv_at(&taxel, Columns::EachTaxel, s, knn, params.folds())?,
-                        glcm3d: cv_at(&glcm3d, Columns::All, s, knn, params.folds())?,
-                    },
-                ))
+            .map(|encoded| {
+                let tables = [Method::Taxel, Method::Glcm3d, Method::Glcm2d]
+                    .map(|m| table(encoded, m, params));
+                let [t, g3, g2] = tables;
+                evaluate_headline(&[&t?, &g3?, &g2?], &prepared.speeds, params)
             })
             .collect::<Result<_>>()?;
         Ok(Tables {
@@ -59,7 +64,15 @@ impl Tables {
             glcm3d,
             glcm2d,
             headline,
+            perturbed,
         })
+    }
+
+    /// The headline evaluations at `speed` of every encoding: as run, then each further one.
+    pub fn encodings_at(&self, speed: Speed) -> Vec<&Headline> {
+        std::iter::once(self.at(speed))
+            .chain(self.perturbed.iter().filter_map(|p| p.get(speed)))
+            .collect()
     }
 
     /// The headline evaluations at `speed`, a speed of the prepared data.
@@ -71,6 +84,26 @@ impl Tables {
             .get(speed)
             .expect("headline evaluations exist at every prepared speed")
     }
+}
+
+/// The headline evaluations of the tables `[taxel, glcm3d, glcm2d]` at each speed.
+fn evaluate_headline(
+    [taxel, glcm3d, glcm2d]: &[&FeatureTable; 3],
+    speeds: &[Speed],
+    params: &ValidReproduceParams,
+) -> Result<BySpeed<Headline>> {
+    let (knn, folds) = (params.knn(), params.folds());
+    speeds
+        .iter()
+        .map(|&s| {
+            let h = Headline {
+                taxel: cv_at(taxel, Columns::EachTaxel, s, knn, folds)?,
+                glcm3d: cv_at(glcm3d, Columns::All, s, knn, folds)?,
+                glcm2d: cv_at(glcm2d, Columns::All, s, knn, folds)?,
+            };
+            Ok((s, h))
+        })
+        .collect()
 }
 
 /// `method`'s features of `encoded` (recordings of one grid).

@@ -49,6 +49,7 @@ pub fn small_run() -> &'static SmallRun {
             e5_fractions: vec![0.5, 1.0],
             e7_gains: vec![5.0, 8.0],
             e8_ks: vec![1, 5],
+            encoder_draws: 3,
             ..ReproduceParams::default()
         }
         .check()

@@ -43,6 +43,7 @@ pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
         data(r, ctx),
         summary(r),
         across_seeds(r),
+        encoder_sensitivity(r),
         e1(r, paper),
         e2(r),
         e3(r),
@@ -54,7 +55,6 @@ pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
         e8(r),
         e9(r),
         e0(r),
-        sensitivity(r),
         skipped(r),
         parameters(r, ctx),
         timing(r),
@@ -143,9 +143,10 @@ fn taxel_diagnostics(r: &Results) -> String {
 }
 
 fn summary(r: &Results) -> String {
-    let mut out = "## Summary: where we agree with the paper\n\n\
-        A claim *holds* only when a paired comparison on the same recordings (95 % bootstrap interval of the per-recording difference, resampling recordings) puts it on the paper's side at every speed; it is *not shown* when an interval holds 0, and *contradicted* when one lies on the other side. Claims without such a comparison are judged on point estimates and say so. Intervals are in brackets.\n\n"
-        .to_string();
+    let mut out = format!("## Summary: where we agree with the paper\n\n\
+        A claim *holds* only when a paired comparison on the same recordings (95 % bootstrap interval of the per-recording difference, resampling recordings) puts it on the paper's side at every speed; it is *not shown* when an interval holds 0, and *contradicted* when one lies on the other side. Claims without such a comparison are judged on point estimates and say so. Intervals are in brackets.{}\n\n",
+        encodings_note(r)
+    );
     for c in claims(r) {
         let verdict = format!("{}:", c.verdict.describe());
         let detail = if c.detail.is_empty() {
@@ -166,8 +167,12 @@ fn across_seeds(r: &Results) -> String {
     let n = a.seeds.len();
     let mut out = format!(
         "## Across simulated datasets\n\n\
-         The analyses ran on {n} independent simulated datasets of the same design (simulation seeds {}); the sections below show the first. Each headline accuracy is given here as its mean over the {n} datasets with a 95 % Student-t interval over them (the spread a new dataset of this design would see; narrower than the range when datasets agree), the first dataset's value and the range. Each claim is judged on every dataset separately.\n\n",
-        list(&a.seeds)
+         The analyses ran on {n} independent simulated datasets of the same design (simulation seeds {}); the sections below show the first. Each headline accuracy is given here as its mean over the {n} datasets with a 95 % Student-t interval over them (the spread a new dataset of this design would see; narrower than the range when datasets agree), the first dataset's value and the range. Each claim is judged on every dataset separately.{}\n\n",
+        list(&a.seeds),
+        r.encoder_sensitivity.as_ref().map_or(String::new(), |s| format!(
+            " The first dataset's E1 and E4 values are means over its {} encodings; each further dataset is one encoding of new recordings, so the spread over datasets holds the encoder's variability too.",
+            s.encodings
+        ))
     );
     let mut t = Table::new([
         "analysis",
@@ -223,10 +228,21 @@ fn verdict_counts(verdicts: &[crate::experiments::Verdict]) -> String {
     parts.join(", ")
 }
 
+/// What E1's and E4's numbers are over, when the run has several encodings.
+fn encodings_note(r: &Results) -> String {
+    r.encoder_sensitivity.as_ref().map_or(String::new(), |s| {
+        format!(
+            " E1 and E4 are means over {} encodings of every recording, and their intervals resample the encodings too (see The encoder's sensitivity); the other analyses, and E1's responsive and best taxels, use the encoding as run.",
+            s.encodings
+        )
+    })
+}
+
 fn e1(r: &Results, paper: Option<&Paper>) -> String {
-    let mut out = "## E1: accuracy per speed, single taxel vs 3D-GLCM\n\n\
-        Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline, the mean over the responsive taxels (neither silent nor at the encoder's ceiling in most recordings; see Data) and the best taxel beside it (chosen after the fact, so optimistic). Chance is one over the classes recorded at that speed. Stratified cross-validation, mean over repeats (folds and repeats under Parameters); the 95 % intervals come from a percentile bootstrap over recordings (2000 resamples), each recording's predictions over repeats (and taxels) kept together.\n\n"
-        .to_string();
+    let mut out = format!("## E1: accuracy per speed, single taxel vs 3D-GLCM\n\n\
+        Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline, the mean over the responsive taxels (neither silent nor at the encoder's ceiling in most recordings; see Data) and the best taxel beside it (chosen after the fact, so optimistic). Chance is one over the classes recorded at that speed. Stratified cross-validation, mean over repeats (folds and repeats under Parameters); the 95 % intervals come from a percentile bootstrap over recordings (2000 resamples), each recording's predictions over repeats (and taxels) kept together.{}\n\n",
+        encodings_note(r)
+    );
     let mut header = vec![
         "speed (mm/s)",
         "classes (chance %)",
@@ -262,7 +278,7 @@ fn e1(r: &Results, paper: Option<&Paper>) -> String {
     out += &figure(
         file::E1,
         "E1: bar chart of accuracy per speed, single taxel and 3D-GLCM",
-        &figures::e1_caption(paper),
+        &figures::e1_caption(r, paper),
     );
     out
 }
@@ -322,20 +338,25 @@ fn e4(r: &Results, paper: Option<&Paper>) -> String {
     let mut out = "## E4: temporal information removed (2D-GLCM)\n\n".to_string();
     let mut header = vec![
         "speed (mm/s)",
-        "single taxel (%)",
-        "2D-GLCM (%)",
-        "3D-GLCM (%)",
+        "single taxel (%) [95 % interval]",
+        "2D-GLCM (%) [95 % interval]",
+        "3D-GLCM (%) [95 % interval]",
     ];
     if paper.is_some() {
         header.extend(["paper: single", "paper: 2D", "paper: 3D"]);
     }
     let mut t = Table::new(header);
     for (s, e) in r.e4.iter() {
+        // The single taxel and 3D-GLCM are E1's, with E1's intervals.
+        let e1 = r.e1.get(s);
+        let with = |v: f64, i: Option<&crate::classify::Interval>| {
+            i.map_or(pct(v), |i| format!("{} {}", pct(v), bracket(i)))
+        };
         let mut row = vec![
             s.to_string(),
-            pct(e.taxel_mean),
-            pct(e.glcm2d),
-            pct(e.glcm3d),
+            with(e.taxel_mean, e1.map(|e| &e.taxel_mean_interval)),
+            with(e.glcm2d, Some(&e.glcm2d_interval)),
+            with(e.glcm3d, e1.map(|e| &e.glcm3d_interval)),
         ];
         if let Some(p) = paper {
             let e1 = p.e1_at(s);
@@ -741,32 +762,44 @@ fn e0(r: &Results) -> String {
         )
 }
 
-fn sensitivity(r: &Results) -> String {
-    let Some(s) = &r.sensitivity else {
+fn encoder_sensitivity(r: &Results) -> String {
+    let Some(s) = &r.encoder_sensitivity else {
         return String::new();
     };
     let out = format!(
-        "## Numerical sensitivity\n\nThe headline evaluations repeated on the spikes of every encoder input multiplied by 1 + {:e}, a change far below any sensor's resolution. Spike trains are a discontinuous function of their input, so accuracies move by far more than the change: the largest move here is {} points, and a difference between two accuracies smaller than that is within numerical noise.\n\n",
-        s.relative_change,
-        pct(s.largest_move)
+        "## The encoder's sensitivity\n\n\
+         Spiking neurons turn a signal into threshold crossings: a neuron near its threshold fires a step earlier or later, or once more or less, when its input moves by far less than any sensor resolves, and those spikes move features and sometimes predictions. So E1 and E4 classify every recording under {n} encodings: as run, and {more} more with each input sample multiplied by 1 + u x {eps:e} (u uniform in [-1, 1), independent). Their accuracies are means over the encodings, their intervals resample encodings as well as recordings, and their claims are judged on those. One encoding's accuracy differs from another's by up to {spread} points here; the other analyses use the encoding as run, so a difference between them smaller than that is within the encoder's noise.\n\n",
+        n = s.encodings,
+        more = s.encodings - 1,
+        eps = s.perturbation,
+        spread = pct(s.largest_spread)
     );
     let mut t = Table::new(vec![
         "speed (mm/s)",
-        "3D-GLCM (%)",
-        "3D-GLCM, perturbed (%)",
-        "single taxel, mean (%)",
-        "single taxel, perturbed (%)",
+        "method",
+        "as run (%) [95 % interval, recordings only]",
+        "range over encodings (%)",
+        "mean over encodings (%) [95 % interval, recordings and encodings]",
         "recordings whose spikes changed",
     ]);
     for (speed, e) in s.speeds.iter() {
-        t.row(vec![
-            speed.to_string(),
-            pct(e.glcm3d),
-            pct(e.glcm3d_perturbed),
-            pct(e.taxel_mean),
-            pct(e.taxel_mean_perturbed),
-            format!("{} of {}", e.recordings_changed, e.recordings),
-        ]);
+        let methods = [
+            ("3D-GLCM", &e.glcm3d),
+            ("single taxel, mean", &e.taxel_mean),
+            ("2D-GLCM", &e.glcm2d),
+        ];
+        for (name, a) in methods {
+            let (lo, hi) = a.range();
+            let i = &a.recordings_only;
+            t.row(vec![
+                speed.to_string(),
+                name.to_string(),
+                format!("{} {}", pct(i.estimate), bracket(i)),
+                format!("{}-{}", pct(lo), pct(hi)),
+                format!("{} {}", pct(a.mean()), bracket(&a.combined)),
+                format!("{} of {}", e.recordings_changed, e.recordings),
+            ]);
+        }
     }
     out + &t.render() + "\n"
 }

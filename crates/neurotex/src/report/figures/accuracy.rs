@@ -20,8 +20,8 @@ struct Bars {
     colour: RGBColor,
     hollow: bool,
     values: Vec<Option<f64>>,
-    /// Standard deviations (%) per group, empty when the series has no spread.
-    errors: Vec<f64>,
+    /// 95 % intervals (%, lower and upper) per group, empty when the series has none.
+    errors: Vec<(f64, f64)>,
 }
 
 impl Bars {
@@ -33,6 +33,19 @@ impl Bars {
             values,
             errors: Vec::new(),
         }
+    }
+
+    /// The series with error bars at `intervals`, one per group.
+    fn with_intervals<'a>(
+        mut self,
+        intervals: impl IntoIterator<Item = &'a crate::classify::Interval>,
+    ) -> Self {
+        self.key.swatch = Swatch::BarError(self.colour);
+        self.errors = intervals
+            .into_iter()
+            .map(|i| (100.0 * i.lower, 100.0 * i.upper))
+            .collect();
+        self
     }
 
     fn paper(label: &str, colour: RGBColor, values: Vec<Option<f64>>) -> Self {
@@ -68,7 +81,7 @@ fn speed_desc(speeds: &[Speed], what: &str) -> String {
 }
 
 /// Draws each series' bars side by side within each group's unit of x, with error bars
-/// where the series has a spread.
+/// where the series has intervals.
 fn bars(chart: &mut Chart, series: &[&Bars]) -> Drawn {
     let width = 0.8 / series.len().max(1) as f64;
     for (k, s) in series.iter().enumerate() {
@@ -84,9 +97,9 @@ fn bars(chart: &mut Chart, series: &[&Bars]) -> Drawn {
             } else {
                 chart.draw_series([Rectangle::new([(x0, 0.0), (x1, v)], s.colour.filled())])?;
             }
-            if let Some(&e) = s.errors.get(i).filter(|e| **e > 0.0) {
+            if let Some(&(lo, hi)) = s.errors.get(i).filter(|(lo, hi)| hi > lo) {
                 let x = (x0 + x1) / 2.0;
-                error_bar(chart, x, (v - e).max(0.0), (v + e).min(100.0), width * 0.25)?;
+                error_bar(chart, x, lo, hi, width * 0.25)?;
             }
         }
     }
@@ -143,7 +156,7 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
         category_labels(root, &g.groups, &xs, axis_y, level)?;
         legend(root, (LEFT + plot_w + 28, TOP + 4), &keys)?;
         if g.series.iter().any(|s| !s.errors.is_empty()) {
-            let note = "error bars: ± 1 std over CV repeats";
+            let note = "error bars: 95 % intervals";
             let y = TOP + legend_h + 14;
             root.draw(&Text::new(
                 note,
@@ -159,7 +172,8 @@ fn pct(v: f64) -> Option<f64> {
     Some(100.0 * v)
 }
 
-/// E1: single taxel (mean over taxels and the best taxel) and 3D-GLCM ± std, per speed.
+/// E1: single taxel (mean over taxels and the best taxel) and 3D-GLCM with the table's 95 %
+/// intervals, per speed.
 pub(crate) fn e1(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
     let speeds: Vec<Speed> = r.e1.iter().map(|(s, _)| s).collect();
     let at = |f: &dyn Fn(&crate::experiments::E1Speed) -> Option<f64>| -> Vec<Option<f64>> {
@@ -171,15 +185,16 @@ pub(crate) fn e1(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
             .map(|&s| paper.and_then(|p| p.e1_at(s)).map(f))
             .collect()
     };
-    let mut glcm3d = Bars::ours("ours: 3D-GLCM", GLCM3D, at(&|e| pct(e.glcm3d)));
-    glcm3d.key.swatch = Swatch::BarError(GLCM3D);
-    glcm3d.errors = r.e1.values().map(|e| 100.0 * e.glcm3d_std).collect();
+    let glcm3d = Bars::ours("ours: 3D-GLCM", GLCM3D, at(&|e| pct(e.glcm3d)))
+        .with_intervals(r.e1.values().map(|e| &e.glcm3d_interval));
+    let taxel = Bars::ours(
+        "ours: single taxel, mean over taxels",
+        SINGLE,
+        at(&|e| pct(e.taxel_mean)),
+    )
+    .with_intervals(r.e1.values().map(|e| &e.taxel_mean_interval));
     let series = vec![
-        Bars::ours(
-            "ours: single taxel, mean over taxels",
-            SINGLE,
-            at(&|e| pct(e.taxel_mean)),
-        ),
+        taxel,
         Bars::paper("paper: single taxel", SINGLE, paper_at(&|p| p.taxel)),
         Bars::ours(
             "ours: best taxel (chosen after the fact)",
@@ -215,20 +230,26 @@ pub(crate) fn e4(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         .iter()
         .map(|&s| paper.and_then(|p| p.e4_2d_at(s)))
         .collect();
+    // E4's single taxel and 3D-GLCM are E1's, with E1's intervals.
+    let e1 = |s: &Speed| r.e1.get(*s);
+    let taxel = speeds.iter().filter_map(e1).map(|e| &e.taxel_mean_interval);
+    let glcm3d = speeds.iter().filter_map(e1).map(|e| &e.glcm3d_interval);
     let series = vec![
         Bars::ours(
             "ours: single taxel, mean over taxels",
             SINGLE,
             ours(&|e| e.taxel_mean),
-        ),
+        )
+        .with_intervals(taxel),
         Bars::paper("paper: single taxel", SINGLE, paper_e1(&|p| p.taxel)),
         Bars::ours(
             "ours: 2D-GLCM (time collapsed)",
             GLCM2D,
             ours(&|e| e.glcm2d),
-        ),
+        )
+        .with_intervals(r.e4.values().map(|e| &e.glcm2d_interval)),
         Bars::paper("paper: 2D-GLCM", GLCM2D, paper_2d),
-        Bars::ours("ours: 3D-GLCM", GLCM3D, ours(&|e| e.glcm3d)),
+        Bars::ours("ours: 3D-GLCM", GLCM3D, ours(&|e| e.glcm3d)).with_intervals(glcm3d),
         Bars::paper("paper: 3D-GLCM", GLCM3D, paper_e1(&|p| p.glcm3d)),
     ];
     draw(&Grouped {
@@ -299,17 +320,27 @@ fn paper_note(paper: Option<&Paper>) -> &'static str {
 }
 
 /// E1's caption.
-pub(crate) fn e1_caption(paper: Option<&Paper>) -> String {
+pub(crate) fn e1_caption(r: &Results, paper: Option<&Paper>) -> String {
     format!(
-        "Accuracy per speed (cross-validated, mean over repeats): the single taxel as the mean over all taxels (dark blue) and the best taxel, chosen after the fact (light blue), against 3D-GLCM (vermillion, error bar ± 1 std over CV repeats).{} The dashed grey segment over each speed is chance there, one over the classes recorded at that speed.",
+        "Accuracy per speed (cross-validated, mean over repeats{}): the single taxel as the mean over all taxels (dark blue) and the best taxel, chosen after the fact (light blue), against 3D-GLCM (vermillion); error bars are the table's 95 % intervals.{} The dashed grey segment over each speed is chance there, one over the classes recorded at that speed.",
+        over_encodings(r),
         paper_note(paper),
     )
+}
+
+/// `" and over N encodings"` when E1's accuracies are means over several encodings.
+fn over_encodings(r: &Results) -> String {
+    match r.e1.values().next().map_or(1, |e| e.encodings) {
+        1 => String::new(),
+        n => format!(" and over {n} encodings"),
+    }
 }
 
 /// E4's caption.
 pub(crate) fn e4_caption(r: &Results, paper: Option<&Paper>) -> String {
     format!(
-        "Accuracy per speed without the time axis: 2D-GLCM on the time-collapsed rate image (green) beside the single taxel (mean over taxels, blue) and 3D-GLCM (vermillion).{} {}",
+        "Accuracy per speed without the time axis{}: 2D-GLCM on the time-collapsed rate image (green) beside the single taxel (mean over taxels, blue) and 3D-GLCM (vermillion); error bars are the table's 95 % intervals.{} {}",
+        over_encodings(r),
         paper_note(paper),
         chance_note(r, &r.e4.iter().map(|(s, _)| s).collect::<Vec<_>>(), "speed")
     )
