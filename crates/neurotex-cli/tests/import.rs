@@ -111,14 +111,16 @@ fn import_csv_writes_the_layout_it_was_given() {
     let layout = std::fs::read_to_string(out.join("layout.toml")).unwrap();
     assert!(
         layout.contains("channel_map = [[1, 1], [1, 0], [0, 1], [0, 0]]")
-            && layout.contains("time_unit = \"ms\"")
+            && layout.contains("time_column = \"t_s\"")
+            && layout.contains("time_unit = \"s\"")
             && !layout.contains("baseline"),
         "{layout}"
     );
-    // the time stamps are rewritten in ms from the first
+    // the time stamps are rewritten from the first, in their own unit (so the copy reads
+    // as the log does, to the bit)
     let first = std::fs::read_to_string(out.join("Silk_F1_V5mmps_0.csv")).unwrap();
     assert!(
-        first.starts_with("t_ms,c1,c2,c3,c4\n0,1,2,3,4\n28,"),
+        first.starts_with("t_s,c1,c2,c3,c4\n0,1,2,3,4\n0.028,"),
         "{first}"
     );
 }

@@ -617,3 +617,26 @@ fn a_realtime_replay_survives_stamps_that_are_not_numbers_or_far_ahead() {
     assert_eq!(streamed(&out), streamed(&good), "{err}");
     assert_eq!(lines(&out).last().unwrap()["bad_frames"], 2, "{err}");
 }
+
+#[test]
+fn frames_stamped_on_the_1_ms_grid_stream_as_the_same_frames_unstamped() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[1]);
+    let plain = dir.join("plain.csv");
+    std::fs::write(&plain, csv_text(&frames)).unwrap();
+    let expected = streamed(&dir.ok(&["stream", "--model", s(&model), "--input", s(&plain)]));
+    assert!(expected.len() > 40);
+    // ms since an epoch, as a host clock logs them, and ms from 0
+    for origin in [1_700_000_000_000u64, 0] {
+        let mut lines = stamped_lines(&frames);
+        for (i, line) in lines.iter_mut().skip(1).enumerate() {
+            let values = line.split_once(',').unwrap().1.to_string();
+            *line = format!("{},{values}", origin + i as u64);
+        }
+        let stamped = dir.join("stamped.csv");
+        std::fs::write(&stamped, lines.join("\n") + "\n").unwrap();
+        let text = dir.ok(&["stream", "--model", s(&model), "--input", s(&stamped)]);
+        assert_eq!(streamed(&text), expected, "stamped from {origin} ms");
+    }
+}

@@ -336,6 +336,24 @@ fn haralick_features<'py>(
         }
     };
     let data: Vec<u64> = a.iter().copied().collect();
+    // The features are ratios of sums of the counts, exact while the total stays below
+    // 2^55; an empty matrix has no pairs and so no features (not a plausible [0, 1, 0]).
+    let total = data.iter().try_fold(0u64, |t, &c| t.checked_add(c));
+    match total {
+        Some(0) => {
+            return Err(raise(
+                Kind::Data,
+                "counts holds no pairs (every count is 0): a co-occurrence matrix without pairs has no features",
+            ))
+        }
+        Some(t) if t < 1 << 55 => {}
+        _ => {
+            return Err(raise(
+                Kind::Data,
+                "counts total 2^55 or more, beyond the exact sums of the features: scale the matrix down",
+            ))
+        }
+    }
     let values = guarded_py(|| {
         Ok(if full {
             let weights: Vec<f64> = data.iter().map(|&c| c as f64).collect();

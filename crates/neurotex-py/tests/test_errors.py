@@ -79,6 +79,13 @@ def test_rasters_and_volumes():
         neurotex.haralick(np.ones((3, 4), dtype=np.uint64))
     with pytest.raises(errors.DataError, match="non-negative"):
         neurotex.haralick(-np.ones((3, 3), dtype=np.int64))
+    # no pairs, or counts whose total leaves the exact sums: errors, not [0, 1, 0]
+    with pytest.raises(errors.DataError, match="no pairs"):
+        neurotex.haralick(np.zeros((4, 4), dtype=np.uint64))
+    for huge in (np.full((2, 2), 2**63, dtype=np.uint64), np.full((2, 2), 2**54, dtype=np.uint64)):
+        with pytest.raises(errors.DataError, match="2\\^55"):
+            neurotex.haralick(huge)
+    assert neurotex.haralick(np.full((2, 2), 2**52, dtype=np.uint64)).shape == (3,)
 
 
 def test_files(tmp_path):

@@ -333,7 +333,8 @@ pub fn import_csv(
         Some(fs) => fs,
         None => nominal_fs(&good, out)?,
     };
-    let layout = csv_layout(p, &names, fs, first.log.times.is_some())?;
+    let unit = first.log.times.is_some().then_some(first.log.time_unit);
+    let layout = csv_layout(p, &names, fs, unit)?;
     create_dataset_dir(out, |tmp| {
         write_layout(tmp, &layout)?;
         // validates the layout before anything else is written
@@ -422,8 +423,14 @@ fn nominal_fs(good: &[ParsedCsv], out: &Path) -> Result<f64> {
 }
 
 /// The layout of the imported dataset: channels fill the grid row-major unless mapped, and
-/// cells no channel reaches are masked.
-fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Result<LayoutFile> {
+/// cells no channel reaches are masked; `unit` is the logs' time unit when they have stamps.
+fn csv_layout(
+    p: &CsvImportParams,
+    names: &[String],
+    fs: f64,
+    unit: Option<TimeUnit>,
+) -> Result<LayoutFile> {
+    let timed = unit.is_some();
     let n = names.len();
     let (rows, cols) = p.grid.as_ref().map_or((1, n), |g| (g.rows(), g.cols()));
     let cells = crate::values::check_grid_cells(rows, cols)?;
@@ -460,8 +467,8 @@ fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Re
         channel_map: (p.channel_map.is_some() || !full).then_some(map),
         mask: (!full).then(|| (0..rows).map(mask_row).collect()),
         baseline: p.baseline,
-        time_column: timed.then(|| "t_ms".to_string()),
-        time_unit: timed.then_some(TimeUnit::Milliseconds),
+        time_column: unit.map(time_column),
+        time_unit: unit,
         channels: Some(names.to_vec()),
         max_gap_s: (timed && p.format.max_gap_s != crate::csvlog::DEFAULT_MAX_GAP_S)
             .then_some(p.format.max_gap_s),
@@ -469,22 +476,29 @@ fn csv_layout(p: &CsvImportParams, names: &[String], fs: f64, timed: bool) -> Re
     })
 }
 
-/// Writes one parsed file into the dataset folder `dir`: `t_ms` relative to its first time
-/// stamp (when it has time stamps), then the channels.
+/// The imported files' time column: `t_ms`, `t_s` or `t_us` after the logs' unit.
+fn time_column(unit: TimeUnit) -> String {
+    format!("t_{unit}")
+}
+
+/// Writes one parsed file into the dataset folder `dir`: its time stamps less the first in
+/// their own unit (when it has time stamps; [`time_column`]), then the channels. The stamps
+/// are subtracted in their unit and written in the shortest form that reads back to the
+/// same double, so the imported copy gives the times the raw log gives, to the bit.
 fn write_imported(dir: &Path, parsed: &ParsedCsv, names: &[String]) -> Result<Meta> {
     let path = dir.join(&parsed.meta.file);
     let c = &parsed.log;
-    let ms_per_unit = c.time_unit.milliseconds();
     let mut text = String::with_capacity(c.samples.len() * 8);
     if c.times.is_some() {
-        text.push_str("t_ms,");
+        text.push_str(&time_column(c.time_unit));
+        text.push(',');
     }
     text.push_str(&names.join(","));
     text.push('\n');
     let t0 = c.times.as_ref().map_or(0.0, |t| t[0]);
     for (k, frame) in c.samples.chunks_exact(names.len()).enumerate() {
         if let Some(t) = &c.times {
-            text.push_str(&format!("{},", (t[k] - t0) * ms_per_unit));
+            text.push_str(&format!("{},", t[k] - t0));
         }
         let values: Vec<String> = frame.iter().map(|v| v.to_string()).collect();
         text.push_str(&values.join(","));

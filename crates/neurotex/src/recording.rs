@@ -134,7 +134,8 @@ pub struct Recording {
     pub layout: Layout,
     /// Samples, `T * rows * cols`, cell index fastest. Masked cells hold 0.
     pub samples: Vec<f64>,
-    /// Per-sample time stamps in s for irregularly sampled recordings (strictly increasing).
+    /// Per-sample time stamps in s from the first (so the first is 0; strictly increasing),
+    /// for recordings read with time stamps.
     pub times_s: Option<Vec<f64>>,
     /// Per-sample protocol phase, where the source labels phases.
     pub phases: Option<Vec<Phase>>,
@@ -232,6 +233,24 @@ impl TimeUnit {
             TimeUnit::Seconds => 1.0,
             TimeUnit::Microseconds => 1e-6,
         }
+    }
+
+    /// Units per second (1, 1000 or 1e6), an exact integer.
+    pub fn per_second(self) -> f64 {
+        match self {
+            TimeUnit::Milliseconds => 1e3,
+            TimeUnit::Seconds => 1.0,
+            TimeUnit::Microseconds => 1e6,
+        }
+    }
+
+    /// A time in this unit in seconds, by one correctly rounded division by
+    /// [`Self::per_second`]: the nearest double to the exact value, so an integer stamp in
+    /// ms or us lands on the same double as the encoder's 1 kHz grid point `k / 1000` at
+    /// that time (a product with `1e-3`, itself rounded, can miss it by a unit in the last
+    /// place and give an interpolation weight of 1e-13 instead of 0).
+    pub fn to_seconds(self, t: f64) -> f64 {
+        t / self.per_second()
     }
 
     /// Milliseconds per unit.
@@ -1397,16 +1416,24 @@ widest_or_plain! {
     }
 }
 
-/// A CSV recording read as `format` says: its channels, samples and time stamps in seconds.
+/// A CSV recording read as `format` says: its channels, samples and time stamps in seconds
+/// from the first.
+///
+/// The first stamp is subtracted in the stamps' own unit, where integer stamps (ms or us
+/// since an epoch, up to 2^53) subtract exactly, and only then converted to seconds
+/// ([`TimeUnit::to_seconds`]): a raw log stamped from an epoch and its imported copy
+/// stamped from 0 give the same times to the bit, and a stamp on the encoder's grid gives
+/// its sample exactly.
 fn read_csv_samples(
     path: &Path,
     format: &CsvFormat,
 ) -> Result<(Shape, Vec<f64>, Option<Vec<f64>>)> {
     let log = read_csv_log(path, format)?;
-    let scale = log.time_unit.seconds();
-    let times = log
-        .times
-        .map(|t| t.into_iter().map(|x| x * scale).collect());
+    let unit = log.time_unit;
+    let times = log.times.map(|t| {
+        let first = t.first().copied().unwrap_or(0.0);
+        t.into_iter().map(|x| unit.to_seconds(x - first)).collect()
+    });
     Ok((Shape::Channels(log.channel_names.len()), log.samples, times))
 }
 

@@ -9,7 +9,10 @@ use neurotex::import::{
     csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, NamePattern,
     StackedParams,
 };
-use neurotex::recording::{read_recording, Baseline, Dataset, LayoutFile, TimeUnit};
+use neurotex::pipeline::{Pipeline, PipelineParams};
+use neurotex::recording::{
+    read_recording, read_recording_as, Baseline, Dataset, LayoutFile, TimeUnit,
+};
 use neurotex::signal::{PreprocessParams, Preprocessor};
 use neurotex::Speed;
 
@@ -435,7 +438,8 @@ fn headerless_semicolon_logs_by_index_ranges() {
         toml::from_str("header = false\ntime_column = \"0\"\nchannels = [\"2\", \"4\"]\n").unwrap();
     let rec = read_recording(&dir.path().join("log.csv"), &layout).unwrap();
     assert_eq!(rec.samples, [1.0, 3.0, 4.0, 6.0, 7.0, 9.0]);
-    assert_eq!(rec.times_s.as_deref(), Some(&[0.01, 0.02, 0.03][..]));
+    // seconds from the first stamp
+    assert_eq!(rec.times_s.as_deref(), Some(&[0.0, 0.01, 0.02][..]));
 }
 
 #[test]
@@ -670,4 +674,81 @@ fn a_long_gap_in_the_stamps_is_an_error_not_a_straight_line() {
         ..format
     };
     assert!(read_csv_log(&p, &zero).is_err());
+}
+
+/// A 1 kHz log of 4 channels over 3 s, as CSV text with a `t_ms` column stamping row `i`
+/// with `stamp(i)` (or no time column), values a few sines that cross the encoder's
+/// threshold often.
+fn log_1khz(stamp: Option<&dyn Fn(u64) -> String>) -> String {
+    let mut text = String::from(if stamp.is_some() { "t_ms," } else { "" });
+    text.push_str("c0,c1,c2,c3\n");
+    for i in 0..3000u64 {
+        if let Some(stamp) = stamp {
+            text.push_str(&format!("{},", stamp(i)));
+        }
+        let values: Vec<String> = (0..4)
+            .map(|c| {
+                let x = i as f64 * 0.0131 * (c + 1) as f64;
+                format!("{}", 0.55 + 0.45 * x.sin() + 0.05 * (7.3 * x).sin())
+            })
+            .collect();
+        text.push_str(&values.join(","));
+        text.push('\n');
+    }
+    text
+}
+
+#[test]
+fn stamps_on_the_1_ms_grid_give_the_spikes_of_the_unstamped_log_wherever_they_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let epoch = |i: u64| format!("{}", 1_700_000_000_000u64 + i);
+    let zero = |i: u64| format!("{i}");
+    let seconds = |i: u64| format!("{}", i as f64 / 1000.0);
+    let files = [
+        ("plain.csv", log_1khz(None), None),
+        (
+            "epoch.csv",
+            log_1khz(Some(&epoch)),
+            Some(TimeUnit::Milliseconds),
+        ),
+        (
+            "zero.csv",
+            log_1khz(Some(&zero)),
+            Some(TimeUnit::Milliseconds),
+        ),
+        (
+            "seconds.csv",
+            log_1khz(Some(&seconds)),
+            Some(TimeUnit::Seconds),
+        ),
+    ];
+    let layout = LayoutFile {
+        fs: Some(1000.0),
+        rows: Some(2),
+        cols: Some(2),
+        ..LayoutFile::default()
+    };
+    let pipeline = Pipeline::new(PipelineParams::default()).unwrap();
+    let spikes: Vec<_> = files
+        .iter()
+        .map(|(name, text, unit)| {
+            let path = write(dir.path(), name, text);
+            let format = CsvFormat {
+                time_column: unit.map(|_| Column::Name("t_ms".into())),
+                time_unit: unit.unwrap_or_default(),
+                unit_given: true,
+                ..CsvFormat::default()
+            };
+            let rec = read_recording_as(&path, &layout, &format).unwrap();
+            let encoded = pipeline.encode(&rec, Baseline::None).unwrap();
+            assert!(encoded.spikes.total_spikes() > 100, "{name}");
+            encoded.spikes
+        })
+        .collect();
+    for (k, (name, ..)) in files.iter().enumerate().skip(1) {
+        assert!(
+            spikes[k] == spikes[0],
+            "{name}: spikes differ from the unstamped log's"
+        );
+    }
 }

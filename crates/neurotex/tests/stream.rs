@@ -12,7 +12,7 @@ use neurotex::causal::{
 use neurotex::classify::{ClassifierChoice, ForestParams, KnnParams};
 use neurotex::model::{Model, Provenance};
 use neurotex::pipeline::{Encoding, Method, Pipeline, PipelineParams};
-use neurotex::recording::{Baseline, Phase, Recording};
+use neurotex::recording::{Baseline, Phase, Recording, TimeUnit};
 use neurotex::sim::{design, simulate_trial, RigParams, Texture};
 use neurotex::stream::{BadFrame, EpisodeRule, Event, StreamClassifier, StreamError, StreamParams};
 use support::XorShift;
@@ -513,4 +513,34 @@ fn the_largest_gap_and_so_the_work_per_frame_are_bounded() {
         events.len(),
         (neurotex::stream::MAX_GAP_S * 1000.0) as usize / 200
     );
+}
+
+#[test]
+fn frames_stamped_on_the_1_ms_grid_give_the_spikes_of_unstamped_frames_at_1_khz() {
+    let recs = recordings();
+    let model = paper_model(&recs);
+    let p = params(&model);
+    for rec in recs.iter().step_by(4) {
+        let frames = frames_of(&slide_only(rec));
+        let mut plain = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+        let expected = stream_events(&mut plain, &frames);
+        // Stamped in ms, from an epoch (a host clock) and from 0.
+        for origin in [1_700_000_000_000.0, 0.0] {
+            let mut stamped = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+            let mut events = Vec::new();
+            for (i, (_, values)) in frames.iter().enumerate() {
+                let t = origin + i as f64;
+                let e = stamped
+                    .push_in(Some(t), TimeUnit::Milliseconds, values)
+                    .unwrap();
+                events.extend_from_slice(e);
+            }
+            events.extend_from_slice(stamped.finish().unwrap());
+            assert_eq!(
+                events, expected,
+                "stamped from {origin} ms, {}",
+                rec.meta.file
+            );
+        }
+    }
 }

@@ -262,16 +262,17 @@ fn fatal(e: StreamError) -> anyhow::Error {
     anyhow::Error::new(e)
 }
 
-/// Pushes one frame and prints what it completed; a bad frame is said on standard error,
+/// Pushes one frame (its stamp in `unit`) and prints what it completed; a bad frame is said on standard error,
 /// with where it was, and skipped.
 fn push(
     stream: &mut StreamClassifier,
     out: &mut Output<impl Write>,
-    time_s: Option<f64>,
+    stamp: Option<f64>,
+    unit: TimeUnit,
     values: &[f64],
     place: &dyn Fn() -> String,
 ) -> Result<()> {
-    match stream.push(time_s, values) {
+    match stream.push_in(stamp, unit, values) {
         Ok(events) => {
             let events = events.to_vec();
             out.events(stream, &events)
@@ -400,13 +401,14 @@ fn read_csv(
             skip(stream, &place(), why);
             continue;
         }
-        let time_s = columns.time.map(|j| fields[j] * columns.unit.seconds());
+        let stamp = columns.time.map(|j| fields[j]);
         values.clear();
         values.extend(columns.channels.iter().map(|&j| fields[j]));
         if let Some(p) = pace.as_mut() {
+            let time_s = stamp.map(|t| columns.unit.to_seconds(t));
             p.wait(time_s.unwrap_or(stream.frames() as f64 / args.fs));
         }
-        push(stream, out, time_s, &values, &place)?;
+        push(stream, out, stamp, columns.unit, &values, &place)?;
     }
     Ok(())
 }
@@ -510,10 +512,10 @@ fn read_f32le(
             stream.skip_bad_frame();
             return Ok(());
         }
-        let unit = args.time_unit.unwrap_or(TimeUnit::Seconds).seconds();
-        let time_s = args
+        let unit = args.time_unit.unwrap_or(TimeUnit::Seconds);
+        let stamped = args
             .stamped
-            .then(|| f64::from_le_bytes(frame[..8].try_into().expect("8 bytes")) * unit);
+            .then(|| f64::from_le_bytes(frame[..8].try_into().expect("8 bytes")));
         for (v, bytes) in values.iter_mut().zip(frame[stamp..].chunks_exact(4)) {
             *v = f64::from(f32::from_le_bytes(bytes.try_into().expect("4 bytes")));
         }
@@ -523,9 +525,10 @@ fn read_f32le(
             continue;
         }
         if let Some(p) = pace.as_mut() {
+            let time_s = stamped.map(|t| unit.to_seconds(t));
             p.wait(time_s.unwrap_or(stream.frames() as f64 / args.fs));
         }
-        push(stream, out, time_s, &values, &place)?;
+        push(stream, out, stamped, unit, &values, &place)?;
     }
 }
 

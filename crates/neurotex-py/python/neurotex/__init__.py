@@ -523,7 +523,9 @@ def glcm2d(
 def haralick(counts: Any, full: bool = False) -> np.ndarray:
     """Haralick features of a co-occurrence count matrix ``(L, L)`` (non-negative
     integers, as :func:`glcm3d` returns): contrast, correlation, ASM (the paper's), or the
-    13 of :data:`HARALICK_FULL_NAMES` with ``full=True``. float64."""
+    13 of :data:`HARALICK_FULL_NAMES` with ``full=True``. float64. Raises
+    :class:`DataError` for a matrix without pairs (all zeros) or whose counts total 2^55
+    or more (beyond the features' exact sums)."""
     a = np.asarray(counts)
     if a.dtype.kind not in "iu":
         raise DataError(f"counts must be non-negative integers, got dtype {a.dtype}")

@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{compare, Comparison, Context, Skip, Stop};
 use crate::analysis::{evaluate, Columns, Split};
+use crate::classify::Interval;
 use crate::recording::Selection;
 use crate::values::{BySpeed, Speed};
 
@@ -16,6 +17,10 @@ pub struct E6Speed {
     pub taxel_mean: f64,
     /// 3D-GLCM.
     pub glcm3d: f64,
+    /// 95 % interval of the single taxel's mean (bootstrap over the held-out recordings).
+    pub taxel_mean_interval: Interval,
+    /// 95 % interval of 3D-GLCM (bootstrap over the held-out recordings).
+    pub glcm3d_interval: Interval,
     /// 3D-GLCM against the single taxel (mean over taxels) on the held-out recordings.
     pub glcm3d_vs_taxel: Comparison,
 }
@@ -44,6 +49,8 @@ pub fn e6_speed_invariance(c: &Context) -> Result<BySpeed<E6Speed>, Stop> {
             train,
             taxel_mean: taxel.accuracy,
             glcm3d: glcm3d.accuracy,
+            taxel_mean_interval: taxel.accuracy_interval(c.params.seed)?,
+            glcm3d_interval: glcm3d.accuracy_interval(c.params.seed)?,
             glcm3d_vs_taxel: compare(("3D-GLCM", &glcm3d), ("single taxel", &taxel), c.params)?,
         };
         out.insert(test, e6);

@@ -586,8 +586,8 @@ fn e6(r: &Results, paper: Option<&Paper>) -> String {
     let mut header = vec![
         "test speed (mm/s)",
         "trained on (mm/s)",
-        "single taxel (%)",
-        "3D-GLCM (%)",
+        "single taxel (%) [95 % interval]",
+        "3D-GLCM (%) [95 % interval]",
     ];
     if paper.is_some() {
         header.extend(["paper: single", "paper: 3D"]);
@@ -597,8 +597,8 @@ fn e6(r: &Results, paper: Option<&Paper>) -> String {
         let mut row = vec![
             s.to_string(),
             trained_on(&r.speeds, s, &e.train),
-            pct(e.taxel_mean),
-            pct(e.glcm3d),
+            format!("{} {}", pct(e.taxel_mean), bracket(&e.taxel_mean_interval)),
+            format!("{} {}", pct(e.glcm3d), bracket(&e.glcm3d_interval)),
         ];
         if let Some(p) = paper {
             let v = p.e6_at(s);

@@ -23,7 +23,7 @@ use crate::encode::{Encoder, SpikeTrains};
 use crate::error::{ParamError, Result};
 use crate::model::{Model, Prediction};
 use crate::pipeline::{Encoded, Encoding};
-use crate::recording::Meta;
+use crate::recording::{Meta, TimeUnit};
 use crate::signal::{Butterworth2, CausalConditioning, Preprocessor, ENCODER_FS};
 use spike_log::SpikeLog;
 use window_glcm::WindowGlcm;
@@ -226,7 +226,7 @@ const MAX_EPISODE_STEPS: usize = u32::MAX as usize - 3_600_000;
 /// One episode's state.
 #[derive(Debug, Clone)]
 struct EpisodeState {
-    /// The first frame's time stamp, or its frame number without stamps.
+    /// The first frame's time stamp (in its unit), or its frame number without stamps.
     origin: f64,
     /// Frames of the episode seen by the resampler.
     frames: usize,
@@ -416,7 +416,8 @@ impl StreamClassifier {
     }
 
     /// Takes one frame: its time stamp in s (`None` for frames at the stream's fixed rate;
-    /// a stream stamps every frame or none) and one value per taxel. Returns what the
+    /// a stream stamps every frame or none) and one value per taxel; [`Self::push_in`]
+    /// with stamps in seconds. Returns what the
     /// frame completed: a classification at each bin boundary it reached, and the end of
     /// an episode it closed.
     ///
@@ -434,7 +435,26 @@ impl StreamClassifier {
     /// counted and skipped, and the stream goes on. [`StreamError::Classify`] when the
     /// model cannot classify a window.
     pub fn push(&mut self, time_s: Option<f64>, values: &[f64]) -> Result<&[Event], StreamError> {
+        self.push_in(time_s, TimeUnit::Seconds, values)
+    }
+
+    /// [`Self::push`] with the time stamp in `unit`, the unit it was logged in (a stream
+    /// gives every stamp in one unit). An episode's first stamp is subtracted in that unit
+    /// (exact for integer stamps up to 2^53, such as ms since an epoch) before the
+    /// difference becomes seconds ([`TimeUnit::to_seconds`]), as offline reading does: so
+    /// frames stamped on the encoder's 1 ms grid give their values to the encoder exactly,
+    /// and the same spikes as the same frames unstamped at 1 kHz.
+    ///
+    /// # Errors
+    /// As [`Self::push`].
+    pub fn push_in(
+        &mut self,
+        stamp: Option<f64>,
+        unit: TimeUnit,
+        values: &[f64],
+    ) -> Result<&[Event], StreamError> {
         self.events.clear();
+        let time_s = stamp.map(|t| unit.to_seconds(t));
         let checked = self.check_frame(time_s, values);
         let jumped = match (checked, time_s) {
             (Err(bad), _) => Err(bad),
@@ -479,16 +499,17 @@ impl StreamClassifier {
                     return Ok(&self.events);
                 }
             }
-            self.episode = Some(self.new_episode(time_s.unwrap_or(index)));
+            self.episode = Some(self.new_episode(stamp.unwrap_or(index)));
         }
         let origin = self
             .episode
             .as_ref()
             .expect("an episode is under way")
             .origin;
-        // As offline: stamps less the first, or frame numbers over the rate.
-        let relative = match time_s {
-            Some(t) => t - origin,
+        // As offline: stamps less the first (in their own unit), or frame numbers over the
+        // rate.
+        let relative = match stamp {
+            Some(t) => unit.to_seconds(t - origin),
             None => (index - origin) / self.params.fs,
         };
         if time_s.is_none() && self.uniform_1k {

@@ -276,13 +276,15 @@ pub(crate) fn e6(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
             "ours: single taxel, mean over taxels",
             SINGLE,
             r.e6.values().map(|e| pct(e.taxel_mean)).collect(),
-        ),
+        )
+        .with_intervals(r.e6.values().map(|e| &e.taxel_mean_interval)),
         Bars::paper("paper: single taxel", SINGLE, paper_at(&|p| p.taxel)),
         Bars::ours(
             "ours: 3D-GLCM",
             GLCM3D,
             r.e6.values().map(|e| pct(e.glcm3d)).collect(),
-        ),
+        )
+        .with_intervals(r.e6.values().map(|e| &e.glcm3d_interval)),
         Bars::paper("paper: 3D-GLCM", GLCM3D, paper_at(&|p| p.glcm3d)),
     ];
     draw(&Grouped {
@@ -349,7 +351,7 @@ pub(crate) fn e4_caption(r: &Results, paper: Option<&Paper>) -> String {
 /// E6's caption.
 pub(crate) fn e6_caption(r: &Results, paper: Option<&Paper>) -> String {
     format!(
-        "Speed invariance: trained on every other speed and tested on the one on the x axis; single taxel (mean over taxels, blue) against 3D-GLCM (vermillion).{} {}",
+        "Speed invariance: trained on every other speed and tested on the one on the x axis; single taxel (mean over taxels, blue) against 3D-GLCM (vermillion); error bars are the table's 95 % intervals.{} {}",
         paper_note(paper),
         chance_note(r, &r.e6.iter().map(|(s, _)| s).collect::<Vec<_>>(), "test speed")
     )

@@ -163,6 +163,8 @@ pub(crate) fn wide() -> Results {
                     train,
                     taxel_mean: 0.3,
                     glcm3d: acc[i] * 0.8,
+                    taxel_mean_interval: interval(0.3),
+                    glcm3d_interval: interval(acc[i] * 0.8),
                     glcm3d_vs_taxel: comparison(acc[i] * 0.8 - 0.3),
                 },
             )
