@@ -4,8 +4,8 @@ use plotters::prelude::*;
 
 use super::accuracy::plot_height;
 use super::plot::{
-    legend_size, line_with_markers, mesh, multiples, number, panel_chart, series, vline, Frame,
-    Key, Multiples, Swatch, Width, GREY, LIGHT, MARGIN, X_AXIS_H, Y_AXIS_W,
+    legend_size, line_chart, line_with_markers, mesh, multiples, number, panel_chart, series,
+    vline, Frame, Key, Multiples, Swatch, Width, GREY, LIGHT, MARGIN, X_AXIS_H,
 };
 use super::FigureError;
 use crate::experiments::E7;
@@ -83,12 +83,7 @@ pub(crate) fn e7_rate(e: &E7, source: &str) -> Result<String, FigureError> {
         keys: &keys,
     };
     frame.render(plot_height(width) + X_AXIS_H, |_, area| {
-        let mut chart = ChartBuilder::on(area)
-            .margin_top(6)
-            .margin_right(MARGIN + 4)
-            .x_label_area_size(X_AXIS_H)
-            .y_label_area_size(Y_AXIS_W)
-            .build_cartesian_2d(lo - 0.5..hi + 0.5, 0.0..top)?;
+        let mut chart = line_chart(area, lo - 0.5..hi + 0.5, 0.0..top)?;
         mesh(&mut chart)
             .x_labels(10)
             .y_labels(8)

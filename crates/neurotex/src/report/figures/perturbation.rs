@@ -1,11 +1,9 @@
 //! E3: 3D-GLCM accuracy as more taxels are moved, against the single taxel and chance.
 
-use plotters::prelude::*;
-
 use super::accuracy::plot_height;
 use super::plot::{
-    error_bar, hline, line_with_markers, mesh, number, percent, Frame, Key, Swatch, Width, GLCM3D,
-    GREY, MARGIN, SINGLE, X_AXIS_H, Y_AXIS_W,
+    error_bar, hline, line_chart, line_with_markers, mesh, number, percent, Frame, Key, Swatch,
+    Width, GLCM3D, GREY, SINGLE, X_AXIS_H,
 };
 use super::FigureError;
 use crate::experiments::{E2, E3};
@@ -52,12 +50,7 @@ pub(crate) fn e3(
         keys: &keys,
     };
     frame.render(plot_height(Width::Column) + X_AXIS_H, |_, area| {
-        let mut chart = ChartBuilder::on(area)
-            .margin_top(6)
-            .margin_right(MARGIN + 4)
-            .x_label_area_size(X_AXIS_H)
-            .y_label_area_size(Y_AXIS_W)
-            .build_cartesian_2d(-0.5..max_n + 0.5, 0.0..100.0)?;
+        let mut chart = line_chart(area, -0.5..max_n + 0.5, 0.0..100.0)?;
         mesh(&mut chart)
             .x_labels(9)
             .y_labels(11)

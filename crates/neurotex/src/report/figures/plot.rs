@@ -567,11 +567,7 @@ impl Placement {
     /// On as few lines (up to three) as let every label fit its room of slots of `slot`
     /// pixels.
     pub(crate) fn of(labels: &[String], slot: i32) -> Self {
-        let widest = labels
-            .iter()
-            .map(|l| text_width(l, TICK))
-            .max()
-            .unwrap_or(0);
+        let widest = widest(labels);
         match (1..=3).find(|lines| widest + 4 <= lines * slot) {
             Some(1) => Placement::Level,
             Some(lines) => Placement::Staggered(lines),
@@ -581,11 +577,7 @@ impl Placement {
 
     /// Whether every label fits whole.
     pub(crate) fn fits(labels: &[String], slot: i32) -> bool {
-        let widest = labels
-            .iter()
-            .map(|l| text_width(l, TICK))
-            .max()
-            .unwrap_or(0);
+        let widest = widest(labels);
         widest + 4 <= 3 * slot
     }
 
@@ -600,6 +592,15 @@ impl Placement {
     pub(crate) fn height(self) -> i32 {
         5 + self.lines() * line_height(TICK)
     }
+}
+
+/// The widest of `labels` at [`TICK`], in pixels.
+fn widest(labels: &[String]) -> i32 {
+    labels
+        .iter()
+        .map(|l| text_width(l, TICK))
+        .max()
+        .unwrap_or(0)
 }
 
 /// Draws category labels below a horizontal axis at pixel row `y`, centred on the pixel
@@ -838,6 +839,21 @@ pub(crate) fn panel_chart<'a, 'b>(
         .margin_bottom(6)
         .x_label_area_size(PANEL_X_TICKS)
         .y_label_area_size(PANEL_Y_TICKS)
+        .build_cartesian_2d(x, y)
+}
+
+/// A chart with numeric axes filling `area`, room for tick labels and descriptions left
+/// and under it.
+pub(crate) fn line_chart<'a, 'b>(
+    area: &'a Canvas<'b>,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+) -> Result<Chart<'a, 'b>, DrawingAreaErrorKind<std::io::Error>> {
+    ChartBuilder::on(area)
+        .margin_top(6)
+        .margin_right(MARGIN + 4)
+        .x_label_area_size(X_AXIS_H)
+        .y_label_area_size(Y_AXIS_W)
         .build_cartesian_2d(x, y)
 }
 

@@ -73,8 +73,10 @@ fn draw_row(chart: &mut Chart, row: &SeedAccuracy, x: f64, colour: RGBColor) -> 
     Ok(())
 }
 
-/// The speed of a group's condition (`5 mm/s held out` -> `5`), its label under the axis.
-fn speed_label(condition: &str) -> String {
+/// The speed of a group (`E6: 5 mm/s held out` -> `5`), its label under the axis; the
+/// brackets under the labels name the analysis.
+fn speed_label(group: &str) -> String {
+    let condition = group.split_once(": ").map_or(group, |(_, c)| c);
     condition
         .split(" mm/s")
         .next()
@@ -168,4 +170,13 @@ pub(crate) fn across_seeds_caption(a: &AcrossSeeds) -> String {
         a.seeds.len(),
         a.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn groups_are_labelled_by_their_speed() {
+        assert_eq!(super::speed_label("E6: -10 mm/s held out"), "-10");
+        assert_eq!(super::speed_label("E1: 5 mm/s"), "5");
+    }
 }
