@@ -95,9 +95,12 @@ fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
     let taxel = of("sa", "taxel", "knn");
     let e = dir.evaluate_json(&ds, "taxel", &["--speeds", "5", "--repeats", "2"]);
     assert_eq!(taxel["per_condition"][0]["accuracy"], e["accuracy"]);
-    for file in ["compare.json", "compare.md"] {
+    for file in ["compare.json", "compare.md", "ranking.svg"] {
         assert!(out.join(file).exists(), "{file}");
     }
+    // each figure as PNG beside its SVG
+    let png = std::fs::read(out.join("ranking.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "ranking.png");
     let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
     assert!(
         md.contains("paper's method") && md.contains("Caveat"),

@@ -67,6 +67,10 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
             svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
             "{fig}"
         );
+        // the dataset folder's name on the figure, and the same figure as PNG beside it
+        assert!(svg.contains(">\nds\n<"), "{fig}: the dataset's name");
+        let png = std::fs::read(out.join("figures").join(format!("{fig}.png"))).unwrap();
+        assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "{fig}.png");
     }
     // one speed only: E6 is skipped with a reason, not an error
     let one = dir.dataset("one", &["A", "B"], &[5.0], 5);

@@ -12,7 +12,7 @@ use neurotex::experiments::{
     Source, ValidReproduceParams,
 };
 use neurotex::pipeline::Pipeline;
-use neurotex::report::{write_report, ReportContext};
+use neurotex::report::{folder_source, simulated_source, write_report, ReportContext};
 use neurotex::sim::MAX_TRIALS;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -144,8 +144,13 @@ fn run(
             (results, describe_seeds(&simulate(seeds[0]), seeds), params)
         }
     };
+    let source = match data {
+        Data::Folder(ds) => folder_source(&ds.root),
+        Data::Simulated { seeds, .. } => simulated_source(seeds),
+    };
     let ctx = ReportContext {
         dataset: described,
+        source,
         parameters: parameters_described(&params, &results),
         total_seconds: started.elapsed().as_secs_f64(),
         command: command.to_string(),

@@ -56,6 +56,7 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
 
     let context = ReportContext {
         dataset: "a small simulated design".into(),
+        source: "a small simulated design".into(),
         parameters: Vec::new(),
         total_seconds: 1.0,
         command: "cargo test --test e9".into(),

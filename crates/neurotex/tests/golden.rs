@@ -75,6 +75,7 @@ fn small_simulated_design_renders_the_stored_report() {
         dataset:
             "The golden test's small simulated design: 4 textures x 10, 20 mm/s x 6 trials, seed 7."
                 .into(),
+        source: "small simulated design, seed 7".into(),
         parameters: vec!["CV: 3-fold, 2 repeats".into()],
         total_seconds: 1.0,
         command: "cargo test --test golden".into(),

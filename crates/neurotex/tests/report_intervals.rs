@@ -102,6 +102,7 @@ fn small_run() -> (Tables, neurotex::experiments::Results, String, u64) {
     let results = run_all(&prepared, &params, &|_| {}).unwrap();
     let context = ReportContext {
         dataset: "a small simulated design".into(),
+        source: "a small simulated design".into(),
         parameters: Vec::new(),
         total_seconds: 1.0,
         command: "cargo test --test report_intervals".into(),

@@ -15,7 +15,8 @@ use neurotex::compare::candidates::{
 use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
 use neurotex::pipeline::{Encoding, Pipeline};
 use neurotex::recording::{Dataset, Selection};
-use neurotex::report::figures::compare as figures;
+use neurotex::report::figures::{compare as figures, svg_and_png};
+use neurotex::report::folder_source;
 use neurotex::Speed;
 
 use super::{calibrated_pipeline, encode_all};
@@ -210,7 +211,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
     );
     let comparison = compare(&candidates, &params)?;
     if let Some(dir) = &args.out {
-        write_outputs(dir, &comparison)?;
+        write_outputs(dir, &comparison, &args.dataset)?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&comparison)?);
@@ -241,27 +242,30 @@ fn make_candidates(
     Ok(candidates(&encoded, &grid, &params, set, encode_s)?)
 }
 
-/// compare.json, compare.md and the figures, written as one folder `dir` that replaces an
-/// earlier comparison there as a whole ([`neurotex::io::replace_dir`]).
-fn write_outputs(dir: &std::path::Path, c: &Comparison) -> Result<()> {
+/// compare.json, compare.md and the figures (SVG and PNG), written as one folder `dir` that
+/// replaces an earlier comparison there as a whole ([`neurotex::io::replace_dir`]); the
+/// figures name the dataset folder `dataset`.
+fn write_outputs(dir: &std::path::Path, c: &Comparison, dataset: &std::path::Path) -> Result<()> {
+    let source = folder_source(dataset);
     let mut files = vec![
-        ("compare.json", serde_json::to_string_pretty(c)? + "\n"),
-        ("compare.md", markdown(c)),
         (
-            "ranking.svg",
-            figures::ranking(c).map_err(|e| anyhow::anyhow!("{e}"))?,
+            "compare.json".to_string(),
+            (serde_json::to_string_pretty(c)? + "\n").into_bytes(),
         ),
+        ("compare.md".to_string(), markdown(c).into_bytes()),
     ];
-    if let Some(svg) = figures::per_condition(c) {
-        files.push((
-            "per_condition.svg",
-            svg.map_err(|e| anyhow::anyhow!("{e}"))?,
-        ));
+    let mut svgs = vec![("ranking.svg", figures::ranking(c, &source)?)];
+    if let Some(figure) = figures::per_condition(c) {
+        svgs.push(("per_condition.svg", figure.draw(&source)?));
+    }
+    for (name, svg) in svgs {
+        files.extend(svg_and_png(name, svg)?);
     }
     neurotex::io::replace_dir(dir, |tmp| {
-        for (name, text) in &files {
+        for (name, bytes) in &files {
             let path = tmp.join(name);
-            std::fs::write(&path, text).map_err(|e| neurotex::error::DataError::write(&path, e))?;
+            std::fs::write(&path, bytes)
+                .map_err(|e| neurotex::error::DataError::write(&path, e))?;
         }
         Ok(())
     })

@@ -14,7 +14,7 @@ use neurotex::experiments::{
 };
 use neurotex::pipeline::Pipeline;
 use neurotex::recording::Dataset;
-use neurotex::report::{write_report, ReportContext};
+use neurotex::report::{folder_source, simulated_source, write_report, ReportContext};
 
 use super::say_calibration;
 use crate::open_args::OpenArgs;
@@ -153,8 +153,13 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
     let on_progress = |p: Progress| show_progress(&bar.lock().expect("progress bar"), p);
     let (results, described, params) = analyse(&args, dataset.as_ref(), &on_progress)?;
     bar.lock().expect("progress bar").finish_and_clear();
+    let source = match &args.dataset {
+        Some(dir) => folder_source(dir),
+        None => simulated_source(&args.simulation_seeds()?),
+    };
     let ctx = ReportContext {
         dataset: described,
+        source,
         parameters: parameters_described(&params, &results),
         total_seconds: started.elapsed().as_secs_f64(),
         command: command_line(),

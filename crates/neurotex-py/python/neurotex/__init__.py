@@ -777,9 +777,9 @@ class Model:
 class Reproduction:
     """What :func:`reproduce` ran and wrote.
 
-    ``report``: the path of ``report.md`` (``results.json`` and ``figures/*.svg`` beside
-    it); ``results``: ``results.json`` as a dict (every analysis: ``e1`` .. ``e9``,
-    ``encoder_sensitivity``, ``taxels``, ``provenance``, ...); ``claims``: the paper's claims
+    ``report``: the path of ``report.md`` (``results.json`` and ``figures/`` beside it,
+    each figure as SVG and PNG); ``results``: ``results.json`` as a dict (every analysis:
+    ``e1`` .. ``e9``, ``encoder_sensitivity``, ``taxels``, ``provenance``, ...); ``claims``: the paper's claims
     judged on these results, each a dict with ``statement``, ``verdict`` (``holds``,
     ``not_shown``, ``contradicted``, ``point_agrees``, ``point_disagrees``), ``holds``
     and ``detail``; ``headline``: E1 by speed in mm/s, each a dict of accuracies
@@ -824,7 +824,7 @@ def reproduce(
     perturbation, temporal information, time to recognition offline and causal, speed
     invariance, gain sweep, neighbours, the standard candidates) as ``neurotex reproduce``
     does with the same options, writes ``report.md``, ``results.json`` and
-    ``figures/*.svg`` into ``out_dir`` (whole or not at all; an existing folder's files are
+    ``figures/*.svg`` and ``*.png`` into ``out_dir`` (whole or not at all; an existing folder's files are
     replaced) and returns a :class:`Reproduction`.
 
     Without ``dataset`` the built-in simulator generates the paper's design in memory

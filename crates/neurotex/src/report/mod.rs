@@ -1,5 +1,5 @@
 //! The reproduction report: `report.md` with every table beside the paper's values,
-//! `results.json`, and SVG figures, all rendered from [`Results`].
+//! `results.json`, and the figures as SVG and PNG, all rendered from [`Results`].
 //!
 //! The report judges nothing: whether the paper's claims hold comes from
 //! [`crate::experiments::claims`]; this module only writes tables, captions and figures.
@@ -26,6 +26,9 @@ pub use table::Table;
 pub struct ReportContext {
     /// One paragraph on the dataset (simulated or a folder).
     pub dataset: String,
+    /// The dataset in a few words, drawn on every figure: [`simulated_source`] or
+    /// [`folder_source`].
+    pub source: String,
     /// The parameters, one `name: value` line each.
     pub parameters: Vec<String>,
     /// Total wall-clock seconds.
@@ -45,7 +48,32 @@ impl ReportContext {
     }
 }
 
-/// Writes `report.md`, `results.json` and `figures/*.svg` into `dir` whole or not at all
+/// The figures' name for simulated data: `simulated rig, seed 0`, or `simulated rig, seeds
+/// 0-4` over several datasets.
+pub fn simulated_source(seeds: &[u64]) -> String {
+    match seeds {
+        [one] => format!("simulated rig, seed {one}"),
+        [first, .., last] if last.checked_sub(*first) == Some(seeds.len() as u64 - 1) => {
+            format!("simulated rig, seeds {first}\u{2013}{last}")
+        }
+        _ => {
+            let list: Vec<String> = seeds.iter().map(u64::to_string).collect();
+            format!("simulated rig, seeds {}", list.join(", "))
+        }
+    }
+}
+
+/// The figures' name for a dataset folder: the folder's own name (`FabricSlide`), the
+/// path as given when it has none (`.`, `/`).
+pub fn folder_source(root: &Path) -> String {
+    root.file_name().map_or_else(
+        || root.display().to_string(),
+        |name| name.to_string_lossy().into_owned(),
+    )
+}
+
+/// Writes `report.md`, `results.json` and `figures/*.svg` and `*.png` into `dir` whole or
+/// not at all
 /// ([`replace_dir`]): everything is rendered, then written into a temporary folder beside
 /// `dir`, which takes `dir`'s place. An earlier report in `dir` is replaced as a whole (no
 /// figure of an earlier run stays beside the new report); a folder holding anything else,
@@ -56,16 +84,19 @@ impl ReportContext {
 /// The folder cannot be created, a file cannot be written or a figure cannot be drawn.
 pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Result<()> {
     check_report_dir(dir)?;
-    let mut files = Vec::new();
-    for (name, svg) in figures::all(results, ctx.paper()) {
-        let path = Path::new("figures").join(name);
-        let svg = svg.map_err(|e| DataError::invalid(dir.join(&path), e.to_string()))?;
-        files.push((path, svg));
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    for (name, svg) in figures::all(results, ctx.paper(), &ctx.source) {
+        let failed = |e: figures::FigureError| {
+            DataError::invalid(dir.join("figures").join(name), e.to_string())
+        };
+        for (file, bytes) in figures::svg_and_png(name, svg.map_err(failed)?).map_err(failed)? {
+            files.push((Path::new("figures").join(file), bytes));
+        }
     }
     let json = serde_json::to_string_pretty(results)
         .map_err(|e| DataError::invalid(dir.join("results.json"), e.to_string()))?;
-    files.push(("results.json".into(), json));
-    files.push(("report.md".into(), markdown(results, ctx)));
+    files.push(("results.json".into(), json.into_bytes()));
+    files.push(("report.md".into(), markdown(results, ctx).into_bytes()));
     replace_dir(dir, |tmp| write_files(tmp, &files))
 }
 
@@ -79,8 +110,8 @@ pub fn check_report_dir(dir: &Path) -> Result<()> {
     check_output_dir(dir)
 }
 
-/// Writes `files` (paths relative to `dir`, and their text) and the `figures` folder.
-fn write_files(dir: &Path, files: &[(PathBuf, String)]) -> Result<()> {
+/// Writes `files` (paths relative to `dir`, and their bytes) and the `figures` folder.
+fn write_files(dir: &Path, files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
     let figures_dir = dir.join("figures");
     std::fs::create_dir(&figures_dir).map_err(|e| DataError::write(&figures_dir, e))?;
     for (name, text) in files {

@@ -2,12 +2,11 @@
 //! the paper's outlined beside them, a chance line across.
 
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
-    accuracy_chart, category_labels, error_bar, hline, labels_fit, labels_height, legend,
-    legend_size, percent, render, text, Chart, Drawn, Key, Swatch, BEST, GLCM2D, GLCM3D, GREY,
-    LABEL, SINGLE,
+    accuracy_chart, category_labels, error_bar, hline, line_height, percent, Canvas, Chart, Drawn,
+    Frame, Key, Placement, Swatch, Width, BEST, GLCM2D, GLCM3D, GREY, LABEL, MARGIN, SINGLE,
+    Y_AXIS_W,
 };
 use super::{chance, chance_key, chance_per_speed, chance_values, FigureError};
 use crate::experiments::Results;
@@ -106,22 +105,44 @@ fn bars(chart: &mut Chart, series: &[&Bars]) -> Drawn {
     Ok(())
 }
 
-const PLOT_H: i32 = 300;
-const LEFT: i32 = 64;
-const TOP: i32 = 40;
+/// The height of a bar chart's plot, at a column's and at the page's width.
+pub(crate) fn plot_height(width: Width) -> i32 {
+    match width {
+        Width::Column => 190,
+        Width::Page => 230,
+    }
+}
 
-fn draw(g: &Grouped) -> Result<String, FigureError> {
+/// The width a chart of `n` categories of `slot` pixels each needs: the categories, the y
+/// axis and the margins.
+pub(crate) fn chart_width(n: usize, slot: i32) -> i32 {
+    Y_AXIS_W + slot * n as i32 + 2 * MARGIN + 2
+}
+
+fn draw(g: &Grouped, source: &str) -> Result<String, FigureError> {
     let series: Vec<&Bars> = g
         .series
         .iter()
         .filter(|s| s.values.iter().any(Option::is_some))
         .collect();
     let n = g.groups.len().max(1);
-    let slot = (series.len() as i32 * 15 + 20).max(48);
-    let plot_w = (slot * n as i32).max(360);
-    let level = labels_fit(&g.groups, plot_w / n as i32);
-    let bottom = labels_height(&g.groups, level) + 26;
-    let mut keys: Vec<Key> = series.iter().map(|s| s.key.clone()).collect();
+    // a bar at least 7 px wide, and a gap between groups
+    let width = Width::fitting(chart_width(n, series.len() as i32 * 8 + 12));
+    let slot = (width.px() - chart_width(n, 0)) / n as i32;
+    let placement = Placement::of(&g.groups, slot);
+    let bottom = placement.height() + line_height(LABEL) + 4;
+    // "ours:" tells our bars from the paper's outlined ones, when there are any
+    let compared = series.iter().any(|s| s.hollow);
+    let mut keys: Vec<Key> = series
+        .iter()
+        .map(|s| {
+            let mut key = s.key.clone();
+            if !compared {
+                key.label = key.label.trim_start_matches("ours: ").to_string();
+            }
+            key
+        })
+        .collect();
     if let Some(per) = &g.chance_per_group {
         keys.push(Key::new(chance_key(per), Swatch::Dashed(GREY)));
     } else if let Some(c) = g.chance {
@@ -130,42 +151,46 @@ fn draw(g: &Grouped) -> Result<String, FigureError> {
             Swatch::Dashed(GREY),
         ));
     }
-    let (legend_w, legend_h) = legend_size(&keys);
-    let width = LEFT + plot_w + 28 + legend_w + 12;
-    let height = TOP + PLOT_H.max(legend_h) + bottom + 8;
-    render((width as u32, height as u32), |root| {
-        let (area, _) = root.split_horizontally(LEFT + plot_w + 12);
-        let mut chart = accuracy_chart(&area, &g.title, n, (LEFT, bottom), &g.x_desc)?;
+    let frame = Frame {
+        width,
+        title: &g.title,
+        source,
+        keys: &keys,
+    };
+    frame.render(plot_height(width) + bottom, |root, area| {
+        let mut chart = accuracy_chart(area, n, (Y_AXIS_W, bottom), &g.x_desc)?;
         bars(&mut chart, &series)?;
         match (&g.chance_per_group, g.chance) {
-            (Some(per), _) => {
-                for (i, &c) in per.iter().enumerate() {
-                    let (x0, x1) = (i as f64 + 0.02, i as f64 + 0.98);
-                    let segment =
-                        DashedLineSeries::new([(x0, c), (x1, c)], 9, 6, GREY.stroke_width(2));
-                    chart.draw_series(segment)?;
-                }
-            }
-            (None, Some(c)) => hline(&mut chart, c, GREY, 9)?,
+            (Some(per), _) => chance_segments(&mut chart, per.iter().copied().map(Some))?,
+            (None, Some(c)) => hline(&mut chart, c, GREY, 6)?,
             (None, None) => {}
         }
-        let xs: Vec<i32> = (0..n)
-            .map(|i| chart.backend_coord(&(i as f64 + 0.5, 0.0)).0)
-            .collect();
-        let axis_y = chart.backend_coord(&(0.0, 0.0)).1;
-        category_labels(root, &g.groups, &xs, axis_y, level)?;
-        legend(root, (LEFT + plot_w + 28, TOP + 4), &keys)?;
-        if g.series.iter().any(|s| !s.errors.is_empty()) {
-            let note = "error bars: 95 % intervals";
-            let y = TOP + legend_h + 14;
-            root.draw(&Text::new(
-                note,
-                (LEFT + plot_w + 28, y),
-                text(LABEL - 2.0, HPos::Left, VPos::Top),
-            ))?;
-        }
-        Ok(())
+        group_labels(root, &chart, &g.groups, slot)
     })
+}
+
+/// A dashed segment at chance across each group's slot (none where it is `None`).
+pub(crate) fn chance_segments(
+    chart: &mut Chart,
+    per_group: impl Iterator<Item = Option<f64>>,
+) -> Drawn {
+    for (i, c) in per_group.enumerate() {
+        let Some(c) = c else { continue };
+        let (x0, x1) = (i as f64 + 0.02, i as f64 + 0.98);
+        let segment = DashedLineSeries::new([(x0, c), (x1, c)], 6, 4, GREY.stroke_width(1));
+        chart.draw_series(segment)?;
+    }
+    Ok(())
+}
+
+/// The groups' labels under the x axis of `chart`, one per unit of x.
+pub(crate) fn group_labels(root: &Canvas, chart: &Chart, labels: &[String], slot: i32) -> Drawn {
+    let xs: Vec<i32> = (0..labels.len())
+        .map(|i| chart.backend_coord(&(i as f64 + 0.5, 0.0)).0)
+        .collect();
+    let axis_y = chart.backend_coord(&(0.0, 0.0)).1;
+    category_labels(root, labels, &xs, axis_y, slot)?;
+    Ok(())
 }
 
 fn pct(v: f64) -> Option<f64> {
@@ -174,7 +199,7 @@ fn pct(v: f64) -> Option<f64> {
 
 /// E1: single taxel (mean over taxels and the best taxel) and 3D-GLCM with the table's 95 %
 /// intervals, per speed.
-pub(crate) fn e1(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
+pub(crate) fn e1(r: &Results, paper: Option<&Paper>, source: &str) -> Result<String, FigureError> {
     let speeds: Vec<Speed> = r.e1.iter().map(|(s, _)| s).collect();
     let at = |f: &dyn Fn(&crate::experiments::E1Speed) -> Option<f64>| -> Vec<Option<f64>> {
         r.e1.values().map(f).collect()
@@ -188,7 +213,7 @@ pub(crate) fn e1(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
     let glcm3d = Bars::ours("ours: 3D-GLCM", GLCM3D, at(&|e| pct(e.glcm3d)))
         .with_intervals(r.e1.values().map(|e| &e.glcm3d_interval));
     let taxel = Bars::ours(
-        "ours: single taxel, mean over taxels",
+        "ours: single taxel (mean)",
         SINGLE,
         at(&|e| pct(e.taxel_mean)),
     )
@@ -197,25 +222,28 @@ pub(crate) fn e1(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         taxel,
         Bars::paper("paper: single taxel", SINGLE, paper_at(&|p| p.taxel)),
         Bars::ours(
-            "ours: best taxel (chosen after the fact)",
+            "ours: best taxel (post hoc)",
             BEST,
             at(&|e| pct(e.taxel_best)),
         ),
         glcm3d,
         Bars::paper("paper: 3D-GLCM", GLCM3D, paper_at(&|p| p.glcm3d)),
     ];
-    draw(&Grouped {
-        title: "E1: accuracy per speed".into(),
-        x_desc: speed_desc(&speeds, "speed"),
-        groups: speeds.iter().map(ToString::to_string).collect(),
-        series,
-        chance: chance(r),
-        chance_per_group: Some(r.e1.values().map(|e| 100.0 * e.chance).collect()),
-    })
+    draw(
+        &Grouped {
+            title: "E1: accuracy per speed".into(),
+            x_desc: speed_desc(&speeds, "speed"),
+            groups: speeds.iter().map(ToString::to_string).collect(),
+            series,
+            chance: chance(r),
+            chance_per_group: Some(r.e1.values().map(|e| 100.0 * e.chance).collect()),
+        },
+        source,
+    )
 }
 
 /// E4: single taxel, 2D-GLCM (time collapsed) and 3D-GLCM, per speed.
-pub(crate) fn e4(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
+pub(crate) fn e4(r: &Results, paper: Option<&Paper>, source: &str) -> Result<String, FigureError> {
     let speeds: Vec<Speed> = r.e4.iter().map(|(s, _)| s).collect();
     let ours = |f: &dyn Fn(&crate::experiments::E4Speed) -> f64| -> Vec<Option<f64>> {
         r.e4.values().map(|e| pct(f(e))).collect()
@@ -235,35 +263,30 @@ pub(crate) fn e4(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
     let taxel = speeds.iter().filter_map(e1).map(|e| &e.taxel_mean_interval);
     let glcm3d = speeds.iter().filter_map(e1).map(|e| &e.glcm3d_interval);
     let series = vec![
-        Bars::ours(
-            "ours: single taxel, mean over taxels",
-            SINGLE,
-            ours(&|e| e.taxel_mean),
-        )
-        .with_intervals(taxel),
+        Bars::ours("ours: single taxel (mean)", SINGLE, ours(&|e| e.taxel_mean))
+            .with_intervals(taxel),
         Bars::paper("paper: single taxel", SINGLE, paper_e1(&|p| p.taxel)),
-        Bars::ours(
-            "ours: 2D-GLCM (time collapsed)",
-            GLCM2D,
-            ours(&|e| e.glcm2d),
-        )
-        .with_intervals(r.e4.values().map(|e| &e.glcm2d_interval)),
+        Bars::ours("ours: 2D-GLCM (no time axis)", GLCM2D, ours(&|e| e.glcm2d))
+            .with_intervals(r.e4.values().map(|e| &e.glcm2d_interval)),
         Bars::paper("paper: 2D-GLCM", GLCM2D, paper_2d),
         Bars::ours("ours: 3D-GLCM", GLCM3D, ours(&|e| e.glcm3d)).with_intervals(glcm3d),
         Bars::paper("paper: 3D-GLCM", GLCM3D, paper_e1(&|p| p.glcm3d)),
     ];
-    draw(&Grouped {
-        title: "E4: temporal information removed".into(),
-        x_desc: speed_desc(&speeds, "speed"),
-        groups: speeds.iter().map(ToString::to_string).collect(),
-        series,
-        chance: chance(r),
-        chance_per_group: chance_per_speed(r, &speeds),
-    })
+    draw(
+        &Grouped {
+            title: "E4: temporal information removed".into(),
+            x_desc: speed_desc(&speeds, "speed"),
+            groups: speeds.iter().map(ToString::to_string).collect(),
+            series,
+            chance: chance(r),
+            chance_per_group: chance_per_speed(r, &speeds),
+        },
+        source,
+    )
 }
 
 /// E6: trained on the other speeds, tested on one: single taxel and 3D-GLCM.
-pub(crate) fn e6(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
+pub(crate) fn e6(r: &Results, paper: Option<&Paper>, source: &str) -> Result<String, FigureError> {
     let speeds: Vec<Speed> = r.e6.iter().map(|(s, _)| s).collect();
     let paper_at = |f: &dyn Fn(crate::report::paper::PaperPair) -> f64| -> Vec<Option<f64>> {
         speeds
@@ -273,7 +296,7 @@ pub(crate) fn e6(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
     };
     let series = vec![
         Bars::ours(
-            "ours: single taxel, mean over taxels",
+            "ours: single taxel (mean)",
             SINGLE,
             r.e6.values().map(|e| pct(e.taxel_mean)).collect(),
         )
@@ -287,14 +310,17 @@ pub(crate) fn e6(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         .with_intervals(r.e6.values().map(|e| &e.glcm3d_interval)),
         Bars::paper("paper: 3D-GLCM", GLCM3D, paper_at(&|p| p.glcm3d)),
     ];
-    draw(&Grouped {
-        title: "E6: speed invariance".into(),
-        x_desc: speed_desc(&speeds, "test speed, trained on the others"),
-        groups: speeds.iter().map(ToString::to_string).collect(),
-        series,
-        chance: chance(r),
-        chance_per_group: chance_per_speed(r, &speeds),
-    })
+    draw(
+        &Grouped {
+            title: "E6: speed invariance".into(),
+            x_desc: speed_desc(&speeds, "test speed, trained on the others"),
+            groups: speeds.iter().map(ToString::to_string).collect(),
+            series,
+            chance: chance(r),
+            chance_per_group: chance_per_speed(r, &speeds),
+        },
+        source,
+    )
 }
 
 /// How chance is drawn: per speed from the classes recorded there when E1 knows every

@@ -1,14 +1,15 @@
-//! The figures of `neurotex compare` (issue 11): every candidate's accuracy with its 95 %
+//! The figures of `neurotex compare`: every candidate's accuracy with its 95 %
 //! interval, ranked, and the accuracy per condition of the best candidate and the paper's
 //! method. Both are drawn from a [`Comparison`] and judge nothing.
 
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
+use super::accuracy::{chart_width, group_labels, plot_height};
 use super::plot::{
-    accuracy_chart, category_labels, hline, labels_fit, labels_height, legend, legend_size,
-    line_with_markers, mesh, number, percent, render, text, text_width, vline, Chart, Drawn, Key,
-    Swatch, GLCM3D, GREY, SERIES, SINGLE, TICK, TITLE,
+    accuracy_chart, fit, hline, line_height, line_with_markers, mesh, number, percent, text,
+    text_width, vline, Chart, Drawn, Frame, Key, Placement, Swatch, Width, GLCM3D, GREY, LABEL,
+    MARGIN, SERIES, SINGLE, TICK, X_AXIS_H, Y_AXIS_W,
 };
 use super::FigureError;
 use crate::compare::{Comparison, Ranked};
@@ -28,14 +29,11 @@ const BAND: RGBColor = RGBColor(222, 222, 222);
 /// Below this p-value against the paper's method a row is starred.
 const SIGNIFICANT: f64 = 0.05;
 
-const ROW_H: i32 = 22;
-const PLOT_W: i32 = 440;
-/// Tick labels and the axis description under the rows.
-const AXIS_H: i32 = 48;
-/// Title, subtitle and the columns' headings above the rows.
-const TOP: i32 = 82;
-const MARGIN: i32 = 12;
-const NOTE_H: i32 = 18;
+const ROW_H: i32 = 16;
+/// The narrowest the ranking's plot gets, however long the names.
+const MIN_PLOT_W: i32 = 150;
+/// The widest it gets: the names stay near their dots.
+const MAX_PLOT_W: i32 = 300;
 const VALUE_HEAD: &str = "accuracy (%)";
 const VERSUS_HEAD: &str = "vs paper (points, p)";
 
@@ -104,18 +102,18 @@ fn rows(c: &Comparison) -> Vec<Row> {
 fn keys(c: &Comparison) -> Vec<Key> {
     let mut keys = vec![Key::new(
         format!(
-            "candidate: accuracy and 95 % bootstrap interval over {}",
+            "candidate: accuracy, 95 % bootstrap interval over {}",
             c.units
         ),
         Swatch::Points(CANDIDATE),
     )];
     if let Some(p) = c.results.iter().find(|r| r.paper) {
-        let label = format!("the paper's method ({})", name(p));
+        let label = format!("paper's method ({})", name(p));
         keys.push(Key::new(label, Swatch::Points(PAPER)));
     }
     if let Some(n) = &c.nested {
         let label = format!(
-            "nested selection: the best chosen inside each training set, {} outer splits",
+            "nested selection, best chosen in each of {} training sets",
             n.outer_splits
         );
         keys.push(Key::new(label, Swatch::Points(NESTED)));
@@ -169,97 +167,95 @@ fn notes(c: &Comparison) -> Vec<String> {
 struct Layout {
     /// The plot's left edge; names end just left of it.
     left: i32,
+    /// The plot's width.
+    plot_w: i32,
     /// The right edge of the accuracy column.
     value_x: i32,
     /// The left edge of the vs-paper column.
     versus_x: i32,
-    /// The top of the legend.
-    legend_y: i32,
+    /// The room for the names.
+    name_w: i32,
     width: i32,
-    height: i32,
 }
 
-fn layout(rows: &[Row], keys: &[Key], notes: &[String], titles: &[&str]) -> Layout {
-    let widest = |texts: &mut dyn Iterator<Item = &str>, size: f64| {
-        texts.map(|t| text_width(t, size)).max().unwrap_or(0)
+/// The body's rows start under the subtitle and the columns' headings.
+const ROWS_TOP: i32 = 34;
+
+fn layout(rows: &[Row]) -> Layout {
+    let width = Width::Page.px();
+    let widest = |texts: &mut dyn Iterator<Item = &str>| {
+        texts.map(|t| text_width(t, TICK)).max().unwrap_or(0)
     };
-    let left = MARGIN + widest(&mut rows.iter().map(|r| r.label.as_str()), TICK) + 12;
-    let value_w = widest(
-        &mut rows.iter().map(|r| r.value.as_str()).chain([VALUE_HEAD]),
-        TICK,
-    );
-    let value_x = left + PLOT_W + 20 + value_w;
-    let versus_x = value_x + 18;
+    let value_w = widest(&mut rows.iter().map(|r| r.value.as_str()).chain([VALUE_HEAD]));
     let versus_w = if rows.iter().all(|r| r.versus.is_empty()) {
         0
     } else {
-        widest(
-            &mut rows.iter().map(|r| r.versus.as_str()).chain([VERSUS_HEAD]),
-            TICK,
-        )
+        widest(&mut rows.iter().map(|r| r.versus.as_str()).chain([VERSUS_HEAD])) + 12
     };
-    let (legend_w, legend_h) = legend_size(keys);
-    let notes_w = widest(&mut notes.iter().map(String::as_str), TICK);
-    let titles_w = widest(&mut titles.iter().copied(), TITLE);
-    let legend_y = TOP + ROW_H * rows.len() as i32 + AXIS_H + 10;
-    let width = (versus_x + versus_w)
-        .max(left + legend_w.max(notes_w))
-        .max(MARGIN + titles_w)
-        + MARGIN;
-    let height = legend_y + legend_h + NOTE_H * notes.len() as i32 + MARGIN;
+    let columns_w = 16 + value_w + versus_w + MARGIN;
+    let names = widest(&mut rows.iter().map(|r| r.label.as_str()));
+    let name_w = names.min(width - MARGIN - 8 - MIN_PLOT_W - 16 - columns_w);
+    let left = MARGIN + name_w + 8;
+    let plot_w = (width - left - 16 - columns_w).clamp(MIN_PLOT_W, MAX_PLOT_W);
+    let value_x = left + plot_w + 16 + value_w;
     Layout {
         left,
+        plot_w,
         value_x,
-        versus_x,
-        legend_y,
+        versus_x: value_x + 12,
+        name_w,
         width,
-        height,
     }
 }
 
 /// Every candidate ranked by accuracy with its 95 % interval, best at the top, under the
-/// nested estimate when there is one; chance and the majority-class share as dashed lines.
+/// nested estimate when there is one; chance and the majority-class share as dashed lines;
+/// `source` names the data.
 ///
 /// # Errors
 /// The drawing fails.
-pub fn ranking(c: &Comparison) -> Result<String, FigureError> {
+pub fn ranking(c: &Comparison, source: &str) -> Result<String, FigureError> {
     let rows = rows(c);
     let keys = keys(c);
     let notes = notes(c);
     let title = format!("{} candidates ranked by accuracy", c.results.len());
     let subtitle = format!(
         "{}; {} classes, {} recordings, intervals over {} {}",
-        c.protocol, c.classes, c.n_recordings, c.n_units, c.units
+        plain_protocol(&c.protocol),
+        c.classes,
+        c.n_recordings,
+        c.n_units,
+        c.units
     );
-    let at = layout(&rows, &keys, &notes, &[&title, &subtitle]);
-    render((at.width as u32, at.height as u32), |root| {
-        root.draw(&Text::new(
-            title.as_str(),
-            (MARGIN, 8),
-            text(TITLE, HPos::Left, VPos::Top),
-        ))?;
-        root.draw(&Text::new(
-            subtitle.as_str(),
-            (MARGIN, 34),
-            text(TICK, HPos::Left, VPos::Top),
-        ))?;
-        stripes(root, &rows, &at)?;
-        let plot_h = ROW_H * rows.len() as i32;
-        let area = root
+    let at = layout(&rows);
+    let frame = Frame {
+        width: Width::Page,
+        title: &title,
+        source,
+        keys: &keys,
+    };
+    let plot_h = ROW_H * rows.len() as i32;
+    let notes_y = ROWS_TOP + plot_h + X_AXIS_H + 4;
+    let body_h = notes_y + line_height(TICK) * notes.len() as i32;
+    frame.render(body_h, |_, body| {
+        let style = text(TICK, HPos::Left, VPos::Top);
+        let subtitle = fit(&subtitle, TICK, at.width - 2 * MARGIN);
+        body.draw(&Text::new(subtitle, (MARGIN, 0), style))?;
+        stripes(body, &rows, &at)?;
+        let area = body
             .clone()
-            .shrink((at.left, TOP), (PLOT_W + 16, plot_h + AXIS_H));
+            .shrink((at.left, ROWS_TOP), (at.plot_w + 16, plot_h + X_AXIS_H));
         let mut chart = ChartBuilder::on(&area)
             .margin_right(16)
-            .x_label_area_size(AXIS_H)
+            .x_label_area_size(X_AXIS_H)
             .build_cartesian_2d(0.0..100.0, 0.0..rows.len() as f64)?;
         draw_rows(&mut chart, c, &rows)?;
-        row_texts(root, &rows, &at)?;
-        legend(root, (at.left, at.legend_y), &keys)?;
-        let notes_y = at.legend_y + legend_size(&keys).1 + 4;
+        row_texts(body, &rows, &at)?;
         for (k, note) in notes.iter().enumerate() {
             let style = text(TICK, HPos::Left, VPos::Top);
-            let y = notes_y + NOTE_H * k as i32;
-            root.draw(&Text::new(note.as_str(), (at.left, y), style))?;
+            let y = notes_y + line_height(TICK) * k as i32;
+            let note = fit(note, TICK, at.width - 2 * MARGIN);
+            body.draw(&Text::new(note, (MARGIN, y), style))?;
         }
         Ok(())
     })
@@ -267,13 +263,13 @@ pub fn ranking(c: &Comparison) -> Result<String, FigureError> {
 
 /// The pixel row of the centre of row `k` (0 at the top).
 fn row_y(k: usize) -> i32 {
-    TOP + ROW_H * k as i32 + ROW_H / 2
+    ROWS_TOP + ROW_H * k as i32 + ROW_H / 2
 }
 
 /// A light background behind every other row, across names, plot and columns.
 fn stripes(root: &super::plot::Canvas, rows: &[Row], at: &Layout) -> Drawn {
     for k in (1..rows.len()).step_by(2) {
-        let y = TOP + ROW_H * k as i32;
+        let y = ROWS_TOP + ROW_H * k as i32;
         let corners = [(MARGIN / 2, y), (at.width - MARGIN / 2, y + ROW_H)];
         root.draw(&Rectangle::new(corners, STRIPE.filled()))?;
     }
@@ -305,14 +301,14 @@ fn draw_rows(chart: &mut Chart, c: &Comparison, rows: &[Row]) -> Drawn {
     }
     for (k, row) in rows.iter().enumerate() {
         let y = n - k as f64 - 0.5;
-        let cap = 0.22;
-        let style = row.colour.stroke_width(2);
+        let cap = 0.25;
+        let style = row.colour.stroke_width(1);
         chart.draw_series([
             PathElement::new(vec![(row.ci[0], y), (row.ci[1], y)], style),
             PathElement::new(vec![(row.ci[0], y - cap), (row.ci[0], y + cap)], style),
             PathElement::new(vec![(row.ci[1], y - cap), (row.ci[1], y + cap)], style),
         ])?;
-        chart.draw_series([Circle::new((row.accuracy, y), 4, row.colour.filled())])?;
+        chart.draw_series([Circle::new((row.accuracy, y), 3, row.colour.filled())])?;
     }
     Ok(())
 }
@@ -320,7 +316,7 @@ fn draw_rows(chart: &mut Chart, c: &Comparison, rows: &[Row]) -> Drawn {
 /// Each row's name left of the plot and its accuracy and comparison right of it, under
 /// the columns' headings.
 fn row_texts(root: &super::plot::Canvas, rows: &[Row], at: &Layout) -> Drawn {
-    let head_y = TOP - 6;
+    let head_y = ROWS_TOP - 2;
     let right = text(TICK, HPos::Right, VPos::Bottom);
     root.draw(&Text::new(VALUE_HEAD, (at.value_x, head_y), right))?;
     if rows.iter().any(|r| !r.versus.is_empty()) {
@@ -330,7 +326,8 @@ fn row_texts(root: &super::plot::Canvas, rows: &[Row], at: &Layout) -> Drawn {
     for (k, row) in rows.iter().enumerate() {
         let y = row_y(k);
         let name = text(TICK, HPos::Right, VPos::Center).color(&row.colour);
-        root.draw(&Text::new(row.label.as_str(), (at.left - 8, y), name))?;
+        let label = fit(&row.label, TICK, at.name_w);
+        root.draw(&Text::new(label, (at.left - 8, y), name))?;
         let value = text(TICK, HPos::Right, VPos::Center);
         root.draw(&Text::new(row.value.as_str(), (at.value_x, y), value))?;
         if !row.versus.is_empty() {
@@ -363,16 +360,60 @@ fn percent_1(v: f64) -> String {
     format!("{:.1}", 100.0 * v)
 }
 
-/// The condition column named in the protocol's text (between backticks), and the x
-/// description: whether each condition was held out in turn or cross-validated within.
-fn condition_desc(protocol: &str) -> (&str, String) {
-    let column = protocol.split('`').nth(1).unwrap_or("condition");
-    let desc = if protocol.contains("held out") {
-        format!("held-out {column}, trained on the others")
-    } else {
-        format!("{column}, cross-validated within each")
+/// A manifest column in plain words, its unit from the name's suffix apart:
+/// `speed_mm_s` -> (`speed`, `speed (mm/s)`), `session` -> (`session`, `session`).
+fn column_words(column: &str) -> (String, String) {
+    const UNITS: [(&str, &str); 7] = [
+        ("_mm_s", "mm/s"),
+        ("_ms", "ms"),
+        ("_hz", "Hz"),
+        ("_mm", "mm"),
+        ("_s", "s"),
+        ("_n", "N"),
+        ("_g", "g"),
+    ];
+    let lower = column.to_ascii_lowercase();
+    let (stem, unit) = UNITS
+        .iter()
+        .find(|(suffix, _)| lower.ends_with(suffix) && lower.len() > suffix.len())
+        .map_or((column, None), |(suffix, unit)| {
+            (&column[..column.len() - suffix.len()], Some(*unit))
+        });
+    let name = stem.replace('_', " ");
+    let with_unit = match unit {
+        Some(unit) => format!("{name} ({unit})"),
+        None => name.clone(),
     };
-    (column, desc)
+    (name, with_unit)
+}
+
+/// The protocol's text with its column names (between backticks) in plain words.
+pub(crate) fn plain_protocol(protocol: &str) -> String {
+    protocol
+        .split('`')
+        .enumerate()
+        .map(|(k, part)| {
+            if k % 2 == 1 {
+                column_words(part).1
+            } else {
+                part.to_string()
+            }
+        })
+        .collect()
+}
+
+/// The condition column named in the protocol's text (between backticks), in plain words
+/// without and with its unit, and the x description: whether each condition was held out
+/// in turn or cross-validated within.
+fn condition_desc(protocol: &str) -> (String, String) {
+    let column = protocol.split('`').nth(1).unwrap_or("condition");
+    let (name, with_unit) = column_words(column);
+    let desc = if protocol.contains("held out") {
+        format!("held-out {with_unit}, trained on the others")
+    } else {
+        format!("{with_unit}, cross-validated within each")
+    };
+    (name, desc)
 }
 
 /// One line of the per-condition figure.
@@ -423,54 +464,60 @@ fn series(c: &Comparison, conditions: &[String]) -> Vec<Series> {
 }
 
 /// The accuracy at each condition of the protocol (speeds, say) of the best candidate and
-/// the paper's method; `None` when the protocol has no conditions (pooled or one split).
-///
-/// # Errors
-/// The drawing fails.
-pub fn per_condition(c: &Comparison) -> Option<Result<String, FigureError>> {
-    if c.best.per_condition.is_empty() {
-        return None;
-    }
-    let conditions: Vec<String> = c
-        .best
-        .per_condition
-        .iter()
-        .map(|p| p.condition.clone())
-        .collect();
-    let lines = series(c, &conditions);
-    // The best drawn last, on top, but named first.
-    let mut keys: Vec<Key> = lines.iter().rev().map(|s| s.key.clone()).collect();
-    keys.extend(reference_keys(c));
-    let n = conditions.len();
-    let plot_w = (56 * n as i32).max(360);
-    let level = labels_fit(&conditions, plot_w / n as i32);
-    let (left, top, plot_h) = (64, 40, 300);
-    let bottom = labels_height(&conditions, level) + 26;
-    let (legend_w, legend_h) = legend_size(&keys);
-    let width = left + plot_w + 28 + legend_w + MARGIN;
-    let height = top + plot_h.max(legend_h) + bottom + 8;
-    Some(render((width as u32, height as u32), |root| {
-        let (area, _) = root.split_horizontally(left + plot_w + 12);
+/// the paper's method, to draw; `None` when the protocol has no conditions (pooled or one
+/// split).
+pub fn per_condition(c: &Comparison) -> Option<PerCondition<'_>> {
+    (!c.best.per_condition.is_empty()).then_some(PerCondition(c))
+}
+
+/// The figure of [`per_condition`], to draw with the data's name.
+#[derive(Debug, Clone, Copy)]
+pub struct PerCondition<'a>(&'a Comparison);
+
+impl PerCondition<'_> {
+    /// Draws the figure, `source` naming the data.
+    ///
+    /// # Errors
+    /// The drawing fails.
+    pub fn draw(&self, source: &str) -> Result<String, FigureError> {
+        let c = self.0;
+        let conditions: Vec<String> = c
+            .best
+            .per_condition
+            .iter()
+            .map(|p| p.condition.clone())
+            .collect();
+        let lines = series(c, &conditions);
+        // The best drawn last, on top, but named first.
+        let mut keys: Vec<Key> = lines.iter().rev().map(|s| s.key.clone()).collect();
+        keys.extend(reference_keys(c));
+        let n = conditions.len();
+        let width = Width::fitting(chart_width(n, 28));
+        let slot = (width.px() - chart_width(n, 0)) / n as i32;
+        let bottom = Placement::of(&conditions, slot).height() + line_height(LABEL) + 4;
         let (column, x_desc) = condition_desc(&c.protocol);
         let title = format!("accuracy per {column}");
-        let mut chart = accuracy_chart(&area, &title, n, (left, bottom), &x_desc)?;
-        hline(&mut chart, 100.0 * c.chance, GREY, 9)?;
-        if (c.chance - c.majority).abs() >= 1e-9 {
-            hline(&mut chart, 100.0 * c.majority, MAJORITY, 5)?;
-        }
-        for s in &lines {
-            let points: Vec<(f64, f64)> = (s.values.iter().enumerate())
-                .filter_map(|(i, v)| v.map(|v| (i as f64 + 0.5, v)))
-                .collect();
-            line_with_markers(&mut chart, &points, s.colour, s.dashed)?;
-        }
-        let xs: Vec<i32> = (0..n)
-            .map(|i| chart.backend_coord(&(i as f64 + 0.5, 0.0)).0)
-            .collect();
-        let axis_y = chart.backend_coord(&(0.0, 0.0)).1;
-        category_labels(root, &conditions, &xs, axis_y, level)?;
-        legend(root, (left + plot_w + 28, top + 4), &keys)
-    }))
+        let frame = Frame {
+            width,
+            title: &title,
+            source,
+            keys: &keys,
+        };
+        frame.render(plot_height(width) + bottom, |root, area| {
+            let mut chart = accuracy_chart(area, n, (Y_AXIS_W, bottom), &x_desc)?;
+            hline(&mut chart, 100.0 * c.chance, GREY, 6)?;
+            if (c.chance - c.majority).abs() >= 1e-9 {
+                hline(&mut chart, 100.0 * c.majority, MAJORITY, 4)?;
+            }
+            for s in &lines {
+                let points: Vec<(f64, f64)> = (s.values.iter().enumerate())
+                    .filter_map(|(i, v)| v.map(|v| (i as f64 + 0.5, v)))
+                    .collect();
+                line_with_markers(&mut chart, &points, s.colour, s.dashed)?;
+            }
+            group_labels(root, &chart, &conditions, slot)
+        })
+    }
 }
 
 /// The caption of [`per_condition`].

@@ -2,9 +2,10 @@
 
 use plotters::prelude::*;
 
+use super::accuracy::plot_height;
 use super::plot::{
-    legend, legend_size, line_with_markers, mesh, multiples, number, panel_chart, render, series,
-    vline, Key, Multiples, Swatch, FONT, GREY, LIGHT, TITLE,
+    legend_size, line_chart, line_with_markers, mesh, multiples, number, panel_chart, series,
+    vline, Frame, Key, Multiples, Swatch, Width, GREY, LIGHT, MARGIN, X_AXIS_H,
 };
 use super::FigureError;
 use crate::experiments::E7;
@@ -42,18 +43,20 @@ fn class_keys(e: &E7, shown: &[usize], markers: bool) -> Vec<Key> {
 }
 
 /// E7: mean firing rate per taxel against gain, one line per class.
-pub(crate) fn e7_rate(e: &E7) -> Result<String, FigureError> {
+pub(crate) fn e7_rate(e: &E7, source: &str) -> Result<String, FigureError> {
     let gains = &e.sweep.gains;
     let shown = recorded(e);
     let mut keys = class_keys(e, &shown, true);
     keys.push(Key::new(
-        format!("paper's choice, G = {PAPER_GAIN}"),
+        format!("paper: G = {PAPER_GAIN}"),
         Swatch::Dashed(GREY),
     ));
-    let (legend_w, legend_h) = legend_size(&keys);
-    let (plot_w, left) = (480, 64);
-    let width = left + plot_w + 24 + legend_w + 12;
-    let height = 40 + 300.max(legend_h) + 60;
+    // a column, unless the classes' legend would take more room than the plot there
+    let width = if legend_size(&keys, Width::Column.px() - 2 * MARGIN).1 > 4 * 15 {
+        Width::Page
+    } else {
+        Width::Column
+    };
     let lo = gains
         .iter()
         .copied()
@@ -72,27 +75,24 @@ pub(crate) fn e7_rate(e: &E7) -> Result<String, FigureError> {
         .fold(0.0, f64::max)
         .max(1.0)
         * 1.08;
-    render((width as u32, height as u32), |root| {
-        let (area, _) = root.split_horizontally(left + plot_w + 12);
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                format!("E7: firing rate against gain at {} mm/s", e.speed),
-                (FONT, TITLE),
-            )
-            .margin_top(6)
-            .margin_right(12)
-            .x_label_area_size(56)
-            .y_label_area_size(left)
-            .build_cartesian_2d(lo - 0.5..hi + 0.5, 0.0..top)?;
+    let title = format!("E7: firing rate against gain at {} mm/s", e.speed);
+    let frame = Frame {
+        width,
+        title: &title,
+        source,
+        keys: &keys,
+    };
+    frame.render(plot_height(width) + X_AXIS_H, |_, area| {
+        let mut chart = line_chart(area, lo - 0.5..hi + 0.5, 0.0..top)?;
         mesh(&mut chart)
-            .x_labels(12)
+            .x_labels(10)
             .y_labels(8)
             .x_label_formatter(&|v| number(*v))
             .y_label_formatter(&|v| number(*v))
             .x_desc("gain G")
-            .y_desc("mean firing rate per taxel (Hz)")
+            .y_desc("rate per taxel (Hz)")
             .draw()?;
-        vline(&mut chart, PAPER_GAIN, GREY, 9)?;
+        vline(&mut chart, PAPER_GAIN, GREY, 6)?;
         for (k, &l) in shown.iter().enumerate() {
             let points: Vec<(f64, f64)> = gains
                 .iter()
@@ -102,7 +102,7 @@ pub(crate) fn e7_rate(e: &E7) -> Result<String, FigureError> {
             let (colour, dashed) = series(k);
             line_with_markers(&mut chart, &points, colour, dashed)?;
         }
-        legend(root, (left + plot_w + 24, 44), &keys)
+        Ok(())
     })
 }
 
@@ -129,7 +129,7 @@ fn histogram_bins(e: &E7) -> usize {
 
 /// E7: the cumulative ISI distribution per gain, one panel per gain on one scale, the ISIs
 /// beyond the histogram's range shown in a labelled band at the right.
-pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
+pub(crate) fn e7_isi(e: &E7, source: &str) -> Result<String, FigureError> {
     let bins = histogram_bins(e);
     let bin = f64::from(e.sweep.bin_ms.max(1));
     let range = bin * (bins - 1) as f64;
@@ -142,8 +142,9 @@ pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
     ));
     let layout = Multiples {
         n: e.sweep.gains.len(),
-        panel: (250, 190),
+        aspect: 0.6,
         title: &format!("E7: ISI distribution per gain at {} mm/s", e.speed),
+        source,
         x_desc: "inter-spike interval (ms)",
         y_desc: "ISIs up to this length (%)",
         keys: &keys,
@@ -168,8 +169,8 @@ pub(crate) fn e7_isi(e: &E7) -> Result<String, FigureError> {
             LIGHT.filled(),
         )])?;
         mesh(&mut chart)
-            .x_labels(5)
-            .y_labels(6)
+            .x_labels(4)
+            .y_labels(3)
             .x_label_formatter(&|v| number(*v))
             .y_label_formatter(&|v| number(*v))
             .draw()?;

@@ -1,6 +1,8 @@
 //! The report's figures, one function per figure, each drawn with plotters' SVG backend and
-//! laid out for any number of speeds, classes, taxels and gains; each figure's caption is
-//! written beside its drawing so that the two change together.
+//! laid out for any number of speeds, classes, taxels and gains, at a paper's column or
+//! page width, with the data's name under its title; each is written as PNG too
+//! ([`png`]). Each figure's caption is written beside its drawing so that the two change
+//! together.
 
 mod accuracy;
 pub mod compare;
@@ -10,6 +12,7 @@ mod neighbours;
 mod perturbation;
 mod plot;
 mod psth;
+mod raster;
 mod recognition;
 mod seeds;
 
@@ -27,6 +30,8 @@ pub(crate) use perturbation::e3_caption;
 pub(crate) use psth::e0_caption;
 pub(crate) use recognition::{e5_caption, e5c_accuracy_caption, e5c_decision_caption};
 pub(crate) use seeds::across_seeds_caption;
+
+pub use raster::png;
 
 /// A figure could not be drawn.
 #[derive(Debug, thiserror::Error)]
@@ -92,13 +97,13 @@ pub(crate) fn chance_per_speed(r: &Results, speeds: &[Speed]) -> Option<Vec<f64>
 }
 
 /// The legend key of chance lines drawn per speed: with its value when it is the same at
-/// every speed.
+/// every speed (the caption says it is one over the classes recorded at the speed).
 pub(crate) fn chance_key(per_speed: &[f64]) -> String {
     match per_speed {
         [first, rest @ ..] if rest.iter().all(|c| (c - first).abs() < 1e-9) => {
-            format!("chance, 1 / classes at the speed ({} %)", percent(*first))
+            format!("chance ({} %)", percent(*first))
         }
-        _ => "chance, 1 / classes at each speed".to_string(),
+        _ => "chance at each speed".to_string(),
     }
 }
 
@@ -160,47 +165,64 @@ pub(crate) fn panel_chance_note(r: &Results, speeds: &[Speed]) -> String {
     }
 }
 
-/// Every figure these results have, as `(file name, SVG)`, in the report's order.
+/// Every figure these results have, as `(file name, SVG)`, in the report's order;
+/// `source` names the data on each.
 pub(crate) fn all(
     r: &Results,
     paper: Option<&Paper>,
+    source: &str,
 ) -> Vec<(&'static str, Result<String, FigureError>)> {
     let mut out = Vec::new();
-    if let Some(svg) = seeds::across_seeds(r) {
+    if let Some(svg) = seeds::across_seeds(r, source) {
         out.push((file::SEEDS, svg));
     }
-    out.push((file::E1, accuracy::e1(r, paper)));
+    out.push((file::E1, accuracy::e1(r, paper, source)));
     if let Some(e2) = &r.e2 {
-        out.push((file::E2, confusion::e2(e2)));
+        out.push((file::E2, confusion::e2(e2, source)));
     }
     if let Some(e3) = &r.e3 {
-        out.push((file::E3, perturbation::e3(e3, r.e2.as_ref(), chance(r))));
+        let svg = perturbation::e3(e3, r.e2.as_ref(), chance(r), source);
+        out.push((file::E3, svg));
     }
-    out.push((file::E4, accuracy::e4(r, paper)));
-    out.push((file::E5, recognition::e5(r, paper)));
+    out.push((file::E4, accuracy::e4(r, paper, source)));
+    out.push((file::E5, recognition::e5(r, paper, source)));
     if !r.e5c.is_empty() {
-        out.push((file::E5C_ACCURACY, recognition::e5c_accuracy(r)));
-        out.push((file::E5C_DECISION, recognition::e5c_decision(r)));
+        out.push((file::E5C_ACCURACY, recognition::e5c_accuracy(r, source)));
+        out.push((file::E5C_DECISION, recognition::e5c_decision(r, source)));
     }
     if !r.e6.is_empty() {
-        out.push((file::E6, accuracy::e6(r, paper)));
+        out.push((file::E6, accuracy::e6(r, paper, source)));
     }
     if let Some(e7) = &r.e7 {
-        out.push((file::E7_RATE, gain::e7_rate(e7)));
-        out.push((file::E7_ISI, gain::e7_isi(e7)));
+        out.push((file::E7_RATE, gain::e7_rate(e7, source)));
+        out.push((file::E7_ISI, gain::e7_isi(e7, source)));
     }
-    out.push((file::E8, neighbours::e8(r)));
+    out.push((file::E8, neighbours::e8(r, source)));
     if let Some(e9) = &r.e9 {
-        out.push((file::E9_PER_SPEED, compare::ranking(&e9.per_speed)));
-        out.push((file::E9_HELD_OUT, compare::ranking(&e9.held_out)));
-        if let Some(svg) = compare::per_condition(&e9.held_out) {
-            out.push((file::E9_SPEEDS, svg));
+        out.push((file::E9_PER_SPEED, compare::ranking(&e9.per_speed, source)));
+        out.push((file::E9_HELD_OUT, compare::ranking(&e9.held_out, source)));
+        if let Some(figure) = compare::per_condition(&e9.held_out) {
+            out.push((file::E9_SPEEDS, figure.draw(source)));
         }
     }
     if let Some(e0) = &r.e0 {
-        out.push((file::E0, psth::e0(e0)));
+        out.push((file::E0, psth::e0(e0, source)));
     }
     out
+}
+
+/// A figure's files: its SVG under `svg_name` and the PNG rendered from it beside it
+/// (`e1_accuracy.svg`, `e1_accuracy.png`).
+///
+/// # Errors
+/// The PNG cannot be rendered ([`png`]).
+pub fn svg_and_png(svg_name: &str, svg: String) -> Result<[(String, Vec<u8>); 2], FigureError> {
+    let png = png(&svg)?;
+    let stem = svg_name.strip_suffix(".svg").unwrap_or(svg_name);
+    Ok([
+        (svg_name.to_string(), svg.into_bytes()),
+        (format!("{stem}.png"), png),
+    ])
 }
 
 #[cfg(test)]

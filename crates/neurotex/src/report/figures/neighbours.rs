@@ -9,9 +9,9 @@ use crate::experiments::Results;
 use crate::values::Speed;
 
 /// E8: single taxel and 3D-GLCM against k, one panel per speed.
-pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
+pub(crate) fn e8(r: &Results, source: &str) -> Result<String, FigureError> {
     let mut keys = vec![
-        Key::new("single taxel, mean over taxels", Swatch::Points(SINGLE)),
+        Key::new("single taxel (mean)", Swatch::Points(SINGLE)),
         Key::new("3D-GLCM", Swatch::Points(GLCM3D)),
     ];
     let speeds: Vec<_> = r.e8.iter().collect();
@@ -30,7 +30,8 @@ pub(crate) fn e8(r: &Results) -> Result<String, FigureError> {
     let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (1.0, 1.0) };
     let layout = Multiples {
         n: speeds.len(),
-        panel: (230, 190),
+        aspect: 0.75,
+        source,
         title: "E8: robustness to the number of neighbours k",
         x_desc: "neighbours k",
         y_desc: "accuracy (%)",

@@ -5,14 +5,14 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
-    colour_bar, heat, mesh, number, render, text, BEST, COLOUR_BAR_W, FONT, LABEL, SINGLE, TICK,
+    colour_bar, colour_bar_width, fit, heat, line_height, mesh, number, text, text_width, Frame,
+    Width, BEST, LABEL, MARGIN, SINGLE, TICK, X_AXIS_H, Y_AXIS_W,
 };
 use super::FigureError;
 use crate::experiments::{E0Example, E0};
 
-const ROW_H: i32 = 230;
-const PSTH_W: i32 = 400;
-const VOLUME_W: i32 = 470;
+const ROW_H: i32 = 170;
+const PSTH_W: i32 = 270;
 
 /// Seconds spanned by `bins` bins of `bin_ms`.
 fn seconds(bins: usize, bin_ms: usize) -> f64 {
@@ -48,16 +48,16 @@ fn volume_panel(
     t: f64,
 ) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
     let cells = ex.volume.len().max(1);
+    panel_title(area, &format!("{}: rate volume", ex.label), VOLUME_Y_AXIS)?;
     let mut chart = ChartBuilder::on(area)
-        .caption(format!("{}: rate volume", ex.label), (FONT, LABEL))
-        .margin(6)
-        .margin_top(12)
-        .x_label_area_size(44)
-        .y_label_area_size(70)
+        .margin(4)
+        .margin_top(TITLE_H)
+        .x_label_area_size(X_AXIS_H)
+        .y_label_area_size(VOLUME_Y_AXIS)
         .build_cartesian_2d(0.0..t, cells as f64..0.0)?;
     mesh(&mut chart)
         .disable_mesh()
-        .x_labels(8)
+        .x_labels(6)
         .y_labels(0)
         .x_label_formatter(&|v| number(*v))
         .x_desc("time in the slide (s)")
@@ -75,14 +75,14 @@ fn volume_panel(
         })
     }))?;
     let px_per_cell = f64::from(chart.plotting_area().dim_in_pixel().1) / cells as f64;
-    let every = ((16.0 / px_per_cell).ceil() as usize).max(1);
+    let every = ((f64::from(line_height(TICK)) / px_per_cell).ceil() as usize).max(1);
     for c in (0..cells).step_by(every) {
         let (x, y) = chart.backend_coord(&(0.0, c as f64 + 0.5));
         let base = area.get_base_pixel();
         let style = text(TICK, HPos::Right, VPos::Center);
         area.draw(&Text::new(
             c.to_string(),
-            (x - base.0 - 6, y - base.1),
+            (x - base.0 - 4, y - base.1),
             style,
         ))?;
     }
@@ -98,31 +98,29 @@ fn psth_panel(
 ) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
     let bin = e.psth_bin_ms as f64 / 1000.0;
     let top = f64::from(count_max.max(1));
+    let title = format!(
+        "{}: PSTH of taxel r{}c{} ({} spikes)",
+        ex.label,
+        e.taxel[0],
+        e.taxel[1],
+        ex.psth.iter().map(|&v| u64::from(v)).sum::<u64>()
+    );
+    panel_title(area, &title, Y_AXIS_W)?;
     let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!(
-                "{}: PSTH of taxel r{}c{} ({} spikes)",
-                ex.label,
-                e.taxel[0],
-                e.taxel[1],
-                ex.psth.iter().map(|&v| u64::from(v)).sum::<u64>()
-            ),
-            (FONT, LABEL),
-        )
-        .margin(6)
-        .margin_top(12)
-        .x_label_area_size(44)
-        .y_label_area_size(60)
+        .margin(4)
+        .margin_top(TITLE_H)
+        .x_label_area_size(X_AXIS_H)
+        .y_label_area_size(Y_AXIS_W)
         // headroom keeps the top tick label clear of the title
         .build_cartesian_2d(0.0..t, 0.0..top * 1.12)?;
     mesh(&mut chart)
         .disable_x_mesh()
-        .x_labels(8)
-        .y_labels((count_max as usize + 1).min(6))
+        .x_labels(6)
+        .y_labels((count_max as usize + 1).min(5))
         .x_label_formatter(&|v| number(*v))
         .y_label_formatter(&|v| number(*v))
         .x_desc("time in the slide (s)")
-        .y_desc(format!("spikes per {} ms", e.psth_bin_ms))
+        .y_desc(format!("spikes / {} ms", e.psth_bin_ms))
         .draw()?;
     // bars in a light tone under a dark outline stay legible when hundreds of bins leave
     // each bar a pixel wide
@@ -148,11 +146,28 @@ fn psth_panel(
     Ok(())
 }
 
+/// Room for a panel's title above its plot.
+const TITLE_H: i32 = 20;
+/// The volume's cell numbers and axis description.
+const VOLUME_Y_AXIS: i32 = 40;
+
+/// A panel's title, centred over its plot (right of `left` pixels of y axis).
+fn panel_title(
+    area: &DrawingArea<SVGBackend, plotters::coord::Shift>,
+    title: &str,
+    left: i32,
+) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
+    let w = area.dim_in_pixel().0 as i32;
+    let style = text(LABEL, HPos::Center, VPos::Top);
+    let title = fit(title, LABEL, w - 8);
+    // centred over the plot, but kept on the panel
+    let centre = ((left + w) / 2).min(w - 4 - text_width(&title, LABEL) / 2);
+    area.draw(&Text::new(title, (centre, 4), style))
+}
+
 /// E0: per example texture, the PSTH of the chosen taxel and the rate volume of every cell.
-pub(crate) fn e0(e: &E0) -> Result<String, FigureError> {
+pub(crate) fn e0(e: &E0, source: &str) -> Result<String, FigureError> {
     let rows = e.examples.len().max(1) as i32;
-    let width = PSTH_W + VOLUME_W + COLOUR_BAR_W + 24;
-    let height = 40 + ROW_H * rows + 8;
     let count_max = e
         .examples
         .iter()
@@ -170,18 +185,21 @@ pub(crate) fn e0(e: &E0) -> Result<String, FigureError> {
         .unwrap_or(0)
         .max(1);
     let t = seconds(bins, e.psth_bin_ms);
-    render((width as u32, height as u32), |root| {
-        let title = format!("E0: PSTH and rate volume at {} mm/s", e.speed);
-        root.draw(&Text::new(
-            title,
-            (width / 2, 8),
-            text(LABEL + 2.0, HPos::Center, VPos::Top),
-        ))?;
+    let title = format!("E0: PSTH and rate volume at {} mm/s", e.speed);
+    let frame = Frame {
+        width: Width::Page,
+        title: &title,
+        source,
+        keys: &[],
+    };
+    let bar_w = colour_bar_width(vmax);
+    let volume_w = frame.px() - PSTH_W - 8 - bar_w - MARGIN - 8;
+    frame.render(ROW_H * rows, |_, body| {
         for (k, ex) in e.examples.iter().enumerate() {
-            let y = 40 + ROW_H * k as i32;
-            let left = root.clone().shrink((0, y), (PSTH_W, ROW_H));
+            let y = ROW_H * k as i32;
+            let left = body.clone().shrink((0, y), (PSTH_W, ROW_H));
             psth_panel(&left, ex, e, count_max, t)?;
-            let right = root.clone().shrink((PSTH_W + 10, y), (VOLUME_W, ROW_H));
+            let right = body.clone().shrink((PSTH_W + 8, y), (volume_w, ROW_H));
             volume_panel(
                 &right,
                 ex,
@@ -190,11 +208,11 @@ pub(crate) fn e0(e: &E0) -> Result<String, FigureError> {
                 t,
             )?;
         }
-        let bar_x = PSTH_W + VOLUME_W + 18;
+        let bar_x = PSTH_W + 8 + volume_w + 8;
         colour_bar(
-            root,
-            (bar_x, 70),
-            ROW_H * rows - 110,
+            body,
+            (bar_x, TITLE_H + 4),
+            ROW_H * rows - TITLE_H - X_AXIS_H - 8,
             vmax,
             "spike rate (Hz)",
         )

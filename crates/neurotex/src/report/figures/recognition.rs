@@ -12,17 +12,14 @@ use crate::report::paper::Paper;
 
 /// E5: 3D-GLCM on the first part of the slide against the single taxel on all of it, one
 /// panel per speed.
-pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureError> {
+pub(crate) fn e5(r: &Results, paper: Option<&Paper>, source: &str) -> Result<String, FigureError> {
     let too_short = r.e5.values().any(|e| e.glcm3d.iter().any(Option::is_none));
     let paper_marks =
         r.e5.iter()
             .any(|(s, _)| paper.and_then(|p| p.e5_first_match_at(s)).is_some());
     let mut keys = vec![
-        Key::new(
-            "3D-GLCM on the first part of the slide",
-            Swatch::Points(GLCM3D),
-        ),
-        Key::new("single taxel on the whole slide", Swatch::Dashed(SINGLE)),
+        Key::new("3D-GLCM, first part of the slide", Swatch::Points(GLCM3D)),
+        Key::new("single taxel (mean), whole slide", Swatch::Dashed(SINGLE)),
     ];
     let speeds: Vec<_> = r.e5.iter().collect();
     let chances = panel_chances(
@@ -37,14 +34,12 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         ));
     }
     if too_short {
-        keys.push(Key::new(
-            "shorter than one bin: no accuracy",
-            Swatch::Cross(GREY),
-        ));
+        keys.push(Key::new("shorter than a bin", Swatch::Cross(GREY)));
     }
     let layout = Multiples {
         n: speeds.len(),
-        panel: (250, 200),
+        aspect: 0.75,
+        source,
         title: "E5: time to recognition",
         x_desc: "share of the slide used (%)",
         y_desc: "accuracy (%)",
@@ -54,7 +49,7 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
         let (speed, e) = speeds[i];
         let mut chart = panel_chart(area, &format!("{speed} mm/s"), 0.0..100.0, 0.0..100.0)?;
         mesh(&mut chart)
-            .x_labels(6)
+            .x_labels(5)
             .y_labels(6)
             .x_label_formatter(&|v| number(*v))
             .y_label_formatter(&|v| number(*v))
@@ -79,7 +74,7 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>) -> Result<String, FigureErr
             .zip(&e.glcm3d)
             .filter(|(_, a)| a.is_none());
         chart.draw_series(
-            short.map(|(&p, _)| Cross::new((100.0 * p, 3.0), 4, GREY.stroke_width(2))),
+            short.map(|(&p, _)| Cross::new((100.0 * p, 3.0), 3, GREY.stroke_width(1))),
         )?;
         Ok(())
     })
@@ -117,21 +112,12 @@ fn time_range(e: &E5CausalSpeed) -> std::ops::Range<f64> {
 
 /// E5c: causal 3D-GLCM accuracy against time into the slide beside the offline E5, one
 /// panel per speed.
-pub(crate) fn e5c_accuracy(r: &Results) -> Result<String, FigureError> {
+pub(crate) fn e5c_accuracy(r: &Results, source: &str) -> Result<String, FigureError> {
     let speeds: Vec<_> = r.e5c.iter().collect();
     let mut keys = vec![
-        Key::new(
-            "causal, the slide so far (whole-slide classifier)",
-            Swatch::Line(GLCM3D),
-        ),
-        Key::new(
-            "offline E5, first part of every slide",
-            Swatch::Points(SINGLE),
-        ),
-        Key::new(
-            "zero-phase 3D-GLCM, whole slide (E1)",
-            Swatch::Dashed(BLACK),
-        ),
+        Key::new("causal 3D-GLCM, the slide so far", Swatch::Line(GLCM3D)),
+        Key::new("offline, first part (E5)", Swatch::Points(SINGLE)),
+        Key::new("offline, whole slide (E1)", Swatch::Dashed(BLACK)),
     ];
     let chances = panel_chances(
         r,
@@ -140,7 +126,8 @@ pub(crate) fn e5c_accuracy(r: &Results) -> Result<String, FigureError> {
     );
     let layout = Multiples {
         n: speeds.len(),
-        panel: (250, 200),
+        aspect: 0.75,
+        source,
         title: "E5c: accuracy against time into the slide",
         x_desc: "time into the slide (s)",
         y_desc: "accuracy (%)",
@@ -178,7 +165,7 @@ fn e5c_panel<'a, 'b>(
 ) -> Result<Chart<'a, 'b>, DrawingAreaErrorKind<std::io::Error>> {
     let mut chart = panel_chart(area, &format!("{speed} mm/s"), time_range(e), 0.0..100.0)?;
     mesh(&mut chart)
-        .x_labels(6)
+        .x_labels(5)
         .y_labels(6)
         .x_label_formatter(&|v| number(*v))
         .y_label_formatter(&|v| number(*v))
@@ -195,7 +182,7 @@ pub(crate) fn e5c_accuracy_caption(r: &Results) -> String {
 }
 
 /// E5c: the share of slides decided by each time, one panel per speed.
-pub(crate) fn e5c_decision(r: &Results) -> Result<String, FigureError> {
+pub(crate) fn e5c_decision(r: &Results, source: &str) -> Result<String, FigureError> {
     let speeds: Vec<_> = r.e5c.iter().collect();
     let keys = vec![
         Key::new("decided by then", Swatch::Line(GLCM3D)),
@@ -204,7 +191,8 @@ pub(crate) fn e5c_decision(r: &Results) -> Result<String, FigureError> {
     ];
     let layout = Multiples {
         n: speeds.len(),
-        panel: (250, 200),
+        aspect: 0.75,
+        source,
         title: "E5c: time to decision",
         x_desc: "time into the slide (s)",
         y_desc: "share of slides (%)",

@@ -369,8 +369,8 @@ pub(crate) fn assert_well_formed(name: &str, svg: &str) {
     assert!(stack.is_empty(), "{name}: unclosed {stack:?}");
 }
 
-/// A level text's box `(x0, y0, x1, y1)` in pixels, from plotters' own size estimate (0.7 em
-/// a character, em = SVG font size / 1.24) and its anchors.
+/// A level text's box `(x0, y0, x1, y1)` in pixels, measured with the figures' font, and
+/// its anchors.
 fn text_box(tag: &str, content: &str) -> Option<(f64, f64, f64, f64)> {
     let attr = |key: &str| -> Option<&str> {
         let k = format!(" {key}=\"");
@@ -382,7 +382,7 @@ fn text_box(tag: &str, content: &str) -> Option<(f64, f64, f64, f64)> {
     }
     let (x, y): (f64, f64) = (attr("x")?.parse().ok()?, attr("y")?.parse().ok()?);
     let size: f64 = attr("font-size")?.parse().ok()?;
-    let w = 0.7 * size / 1.24 * content.chars().count() as f64;
+    let w = f64::from(plot::text_width(content, size * 1.24));
     let x0 = match attr("text-anchor")? {
         "start" => x,
         "end" => x - w,
@@ -449,14 +449,60 @@ pub(crate) fn assert_inside(name: &str, svg: &str) {
     }
 }
 
+/// The data's name the tests draw on every figure.
+const SOURCE: &str = "test design";
+
 fn check_all(r: &Results, paper: Option<&Paper>) -> Vec<&'static str> {
-    let figures = all(r, paper);
+    let figures = all(r, paper, SOURCE);
     for (name, svg) in &figures {
         let svg = svg.as_ref().unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_well_formed(name, svg);
         assert_no_overprint(name, svg);
+        assert_inside(name, svg);
+        assert_paper_width(name, svg);
+        assert!(svg.contains(SOURCE), "{name}: the data's name");
+        if let Some(dump) = std::env::var_os("NEUROTEX_DUMP_FIGURES") {
+            std::fs::write(std::path::Path::new(&dump).join(name), svg).unwrap();
+        }
     }
     figures.iter().map(|(n, _)| *n).collect()
+}
+
+/// Checks that `svg` is a column (3.5 in) or the page (7 in) wide at 96 dpi.
+pub(crate) fn assert_paper_width(name: &str, svg: &str) {
+    let (width, _) = canvas_size(svg);
+    assert!(width == 336.0 || width == 672.0, "{name}: {width} px wide");
+}
+
+/// Checks that `png` is the PNG of `svg` at 300 dpi, with ink on it and in its title's
+/// band (text drawn, not only lines).
+pub(crate) fn assert_png_of(name: &str, svg: &str, png: &[u8]) {
+    use super::raster::tests::{dark_pixels, decode};
+    let (w, h) = canvas_size(svg);
+    let image = decode(png);
+    let expected = (
+        (w * 300.0 / 96.0).round() as u32,
+        (h * 300.0 / 96.0).round() as u32,
+    );
+    assert_eq!((image.0, image.1), expected, "{name}: PNG size");
+    let all = dark_pixels(&image, (0, image.0), (0, image.1));
+    assert!(all > 2000, "{name}: {all} dark pixels");
+    // the title's band: 6 px margin and a 10 pt line, at 300 dpi
+    let title = dark_pixels(&image, (0, image.0), (15, 60));
+    assert!(title > 200, "{name}: {title} dark pixels in the title");
+}
+
+#[test]
+fn every_figure_is_also_a_png_of_the_same_figure() {
+    for (r, paper) in [(small(), Some(&PAPER)), (wide(), None)] {
+        for (name, svg) in all(&r, paper, SOURCE) {
+            let svg = svg.unwrap();
+            let files = svg_and_png(name, svg.clone()).unwrap();
+            assert_eq!(files[0].0, name);
+            assert_eq!(files[1].0, name.replace(".svg", ".png"));
+            assert_png_of(name, &svg, &files[1].1);
+        }
+    }
 }
 
 #[test]
@@ -469,16 +515,16 @@ fn every_figure_is_well_formed_on_both_designs() {
 #[test]
 fn e1_shows_paper_bars_only_when_comparable() {
     let r = small();
-    let with = accuracy::e1(&r, Some(&PAPER)).unwrap();
-    let without = accuracy::e1(&r, None).unwrap();
+    let with = accuracy::e1(&r, Some(&PAPER), SOURCE).unwrap();
+    let without = accuracy::e1(&r, None, SOURCE).unwrap();
     assert!(with.contains("paper: 3D-GLCM") && !without.contains("paper: 3D-GLCM"));
-    assert_well_formed("e1", &accuracy::e1(&wide(), None).unwrap());
+    assert_well_formed("e1", &accuracy::e1(&wide(), None, SOURCE).unwrap());
 }
 
 #[test]
 fn e2_labels_every_class_on_both_axes() {
     let r = wide();
-    let svg = confusion::e2(r.e2.as_ref().unwrap()).unwrap();
+    let svg = confusion::e2(r.e2.as_ref().unwrap(), SOURCE).unwrap();
     assert_well_formed("e2", &svg);
     for label in &r.labels {
         assert!(
@@ -488,11 +534,18 @@ fn e2_labels_every_class_on_both_axes() {
             "{label}"
         );
     }
-    // long names do not fit a cell level, so the columns' are turned
-    assert!(svg.contains("rotate(270"));
+    // long names do not fit a cell level: the columns' are staggered, never turned
+    for part in svg.split("<text").skip(1) {
+        if part.contains("rotate(") {
+            assert!(r
+                .labels
+                .iter()
+                .all(|l| !part.contains(&format!(">\n{l}\n<"))));
+        }
+    }
     assert_well_formed(
         "e2 small",
-        &confusion::e2(small().e2.as_ref().unwrap()).unwrap(),
+        &confusion::e2(small().e2.as_ref().unwrap(), SOURCE).unwrap(),
     );
 }
 
@@ -501,12 +554,12 @@ fn e3_e5_e8_draw_on_both_designs() {
     for r in [small(), wide()] {
         assert_well_formed(
             "e3",
-            &perturbation::e3(r.e3.as_ref().unwrap(), r.e2.as_ref(), chance(&r)).unwrap(),
+            &perturbation::e3(r.e3.as_ref().unwrap(), r.e2.as_ref(), chance(&r), SOURCE).unwrap(),
         );
-        assert_well_formed("e5", &recognition::e5(&r, Some(&PAPER)).unwrap());
-        assert_well_formed("e8", &neighbours::e8(&r).unwrap());
-        assert_well_formed("e4", &accuracy::e4(&r, None).unwrap());
-        assert_well_formed("e6", &accuracy::e6(&r, Some(&PAPER)).unwrap());
+        assert_well_formed("e5", &recognition::e5(&r, Some(&PAPER), SOURCE).unwrap());
+        assert_well_formed("e8", &neighbours::e8(&r, SOURCE).unwrap());
+        assert_well_formed("e4", &accuracy::e4(&r, None, SOURCE).unwrap());
+        assert_well_formed("e6", &accuracy::e6(&r, Some(&PAPER), SOURCE).unwrap());
     }
 }
 
@@ -514,16 +567,16 @@ fn e3_e5_e8_draw_on_both_designs() {
 fn e4_e5_e6_e8_draw_chance_per_speed_from_the_classes_recorded_there() {
     let figures = |r: &Results| -> Vec<(&str, String)> {
         vec![
-            ("e4", accuracy::e4(r, None).unwrap()),
-            ("e5", recognition::e5(r, None).unwrap()),
-            ("e6", accuracy::e6(r, None).unwrap()),
-            ("e8", neighbours::e8(r).unwrap()),
+            ("e4", accuracy::e4(r, None, SOURCE).unwrap()),
+            ("e5", recognition::e5(r, None, SOURCE).unwrap()),
+            ("e6", accuracy::e6(r, None, SOURCE).unwrap()),
+            ("e8", neighbours::e8(r, SOURCE).unwrap()),
         ]
     };
     // FabricSlide's design: 5 classes at the positive speeds, 7 at the negative ones
     let wide = wide();
     for (name, svg) in figures(&wide) {
-        assert!(svg.contains("chance, 1 / classes at each speed"), "{name}");
+        assert!(svg.contains("chance at each speed"), "{name}");
         assert!(!svg.contains("chance, all classes"), "{name}");
         if let Some(dump) = std::env::var_os("NEUROTEX_DUMP_FIGURES") {
             let path = std::path::Path::new(&dump).join(format!("wide_{name}.svg"));
@@ -541,7 +594,7 @@ fn e4_e5_e6_e8_draw_chance_per_speed_from_the_classes_recorded_there() {
         .all(|c| c.contains("chance there") || c.contains("chance at that speed")));
     // the same number of classes everywhere: one value in the key
     for (name, svg) in figures(&small()) {
-        assert!(svg.contains("chance, 1 / classes at the speed ("), "{name}");
+        assert!(svg.contains("chance ("), "{name}");
     }
     assert!(!neighbours::e8_caption(&small()).contains("% at"));
     // without E1 the classes per speed are unknown: one line for all classes
@@ -556,18 +609,18 @@ fn e4_e5_e6_e8_draw_chance_per_speed_from_the_classes_recorded_there() {
 fn e7_labels_the_overflow_band_and_notes_silent_classes() {
     let r = wide();
     let e7 = r.e7.as_ref().unwrap();
-    let isi = gain::e7_isi(e7).unwrap();
+    let isi = gain::e7_isi(e7, SOURCE).unwrap();
     assert_well_formed("e7 isi", &isi);
     assert!(isi.contains("ISIs of 300 ms or more"));
     assert!(
         isi.contains("G = 5, 1 silent") && isi.contains("G = 8 (paper), 1 silent"),
         "{isi}"
     );
-    assert_well_formed("e7 rate", &gain::e7_rate(e7).unwrap());
+    assert_well_formed("e7 rate", &gain::e7_rate(e7, SOURCE).unwrap());
     let small = small();
     assert_well_formed(
         "e7 small",
-        &gain::e7_isi(small.e7.as_ref().unwrap()).unwrap(),
+        &gain::e7_isi(small.e7.as_ref().unwrap(), SOURCE).unwrap(),
     );
 }
 
@@ -575,7 +628,7 @@ fn e7_labels_the_overflow_band_and_notes_silent_classes() {
 fn e0_caption_comes_from_the_data() {
     let r = wide();
     let e0 = r.e0.as_ref().unwrap();
-    assert_well_formed("e0", &psth::e0(e0).unwrap());
+    assert_well_formed("e0", &psth::e0(e0, SOURCE).unwrap());
     let caption = e0_caption(e0);
     assert!(
         caption.contains("all 16 cells") && caption.contains("27 bins of 200 ms"),
@@ -591,10 +644,13 @@ fn e0_caption_comes_from_the_data() {
         caption.contains("all 6 cells") && caption.contains("100 ms"),
         "{caption}"
     );
-    assert_well_formed("e0 small", &psth::e0(small().e0.as_ref().unwrap()).unwrap());
+    assert_well_formed(
+        "e0 small",
+        &psth::e0(small().e0.as_ref().unwrap(), SOURCE).unwrap(),
+    );
 }
 
-/// The same checks on a written report's figures, for reports of real data:
+/// The same checks on a written report's figures and their PNGs, for reports of real data:
 /// `NEUROTEX_FIGURES=report/figures cargo test -p neurotex --lib -- --ignored figures_in`.
 #[test]
 #[ignore]
@@ -608,6 +664,10 @@ fn figures_in_a_folder_are_well_formed() {
             let name = path.display().to_string();
             assert_well_formed(&name, &svg);
             assert_no_overprint(&name, &svg);
+            assert_inside(&name, &svg);
+            assert_paper_width(&name, &svg);
+            let png = std::fs::read(path.with_extension("png")).unwrap();
+            assert_png_of(&name, &svg, &png);
             checked += 1;
         }
     }
@@ -631,7 +691,7 @@ fn thirty_classes_still_lay_out() {
         glcm3d: m,
         glcm3d_vs_taxel_by_class: Vec::new(),
     };
-    let svg = confusion::e2(&e2).unwrap();
+    let svg = confusion::e2(&e2, SOURCE).unwrap();
     assert_well_formed("e2, 30 classes", &svg);
     assert_no_overprint("e2, 30 classes", &svg);
     assert!(
@@ -647,7 +707,10 @@ fn thirty_classes_still_lay_out() {
     for row in e7.sweep.taxel_seconds.iter_mut().chain(&mut e7.rate_hz) {
         row.resize(30, 1.0);
     }
-    for (name, svg) in [("e7 isi", gain::e7_isi(e7)), ("e7 rate", gain::e7_rate(e7))] {
+    for (name, svg) in [
+        ("e7 isi", gain::e7_isi(e7, SOURCE)),
+        ("e7 rate", gain::e7_rate(e7, SOURCE)),
+    ] {
         let svg = svg.unwrap();
         assert_well_formed(name, &svg);
         assert_no_overprint(name, &svg);
@@ -711,7 +774,7 @@ fn comparison(d: f64) -> crate::experiments::Comparison {
 fn across_seeds_draws_every_dataset_and_only_with_several() {
     for r in [small(), wide()] {
         assert!(
-            super::seeds::across_seeds(&r).is_none(),
+            super::seeds::across_seeds(&r, SOURCE).is_none(),
             "one dataset: no figure"
         );
         let mut other = r.clone();
@@ -730,7 +793,7 @@ fn across_seeds_draws_every_dataset_and_only_with_several() {
         let runs = [(0, &r), (1, &other), (2, &r)];
         let mut with = r.clone();
         with.across_seeds = Some(crate::experiments::across_seeds(&runs).unwrap());
-        let svg = super::seeds::across_seeds(&with).unwrap().unwrap();
+        let svg = super::seeds::across_seeds(&with, SOURCE).unwrap().unwrap();
         assert_well_formed("across_seeds", &svg);
         assert_no_overprint("across_seeds", &svg);
         // Three dots per method and group (E1 and E6 at every speed), and one marker per

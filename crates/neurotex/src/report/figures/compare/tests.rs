@@ -3,7 +3,9 @@
 
 use super::*;
 use crate::compare::{ConditionAccuracy, Nested, Protocol};
-use crate::report::figures::tests::{assert_inside, assert_no_overprint, assert_well_formed};
+use crate::report::figures::tests::{
+    assert_inside, assert_no_overprint, assert_paper_width, assert_well_formed,
+};
 
 const ENCODINGS: [&str; 3] = ["sa", "fa", "sa+fa"];
 const METHODS: [&str; 5] = [
@@ -95,6 +97,8 @@ fn plain(svg: &str) -> String {
 }
 
 fn check(name: &str, svg: &str) {
+    assert_paper_width(name, svg);
+    assert!(svg.contains("test data"), "{name}: the data's name");
     assert_well_formed(name, svg);
     assert_no_overprint(name, svg);
     assert_inside(name, svg);
@@ -109,11 +113,17 @@ fn ranking_names_every_candidate_on_the_canvas() {
     for n in [2, 10, 40] {
         for nested in [false, true] {
             let c = comparison(n, nested, 0);
-            let svg = ranking(&c).unwrap();
+            let svg = ranking(&c, "test data").unwrap();
             check(&format!("compare_ranking_{n}_{nested}"), &svg);
             let svg = plain(&svg);
-            for r in &c.results {
-                assert!(svg.contains(&name(r)), "{n}: {} missing", name(r));
+            // a name longer than the page leaves room for (the made-up
+            // haralick_all_offsets_and_directions here) is cut with an ellipsis
+            let rows = rows(&c);
+            let room = layout(&rows).name_w;
+            for row in &rows {
+                let shown = crate::report::figures::plot::fit(&row.label, TICK, room);
+                assert!(svg.contains(&shown), "{n}: {shown} missing");
+                assert!(n > 10 || !shown.ends_with('…'), "{n}: {shown} cut");
             }
             assert!(svg.contains("sa / glcm3d / knn (paper)"));
             assert!(svg.contains("chance, 1 / 7 classes (14.3 %)"));
@@ -129,7 +139,7 @@ fn ranking_names_every_candidate_on_the_canvas() {
 
 #[test]
 fn ranking_stars_only_significant_differences_from_the_paper() {
-    let svg = plain(&ranking(&comparison(10, false, 0)).unwrap());
+    let svg = plain(&ranking(&comparison(10, false, 0), "test data").unwrap());
     // p cycles through 0.0004, 0.03 and 0.4 over the nine candidates that are not the paper's
     assert!(svg.contains("p < 0.001 *") && svg.contains("p = 0.030 *"));
     assert!(svg.contains("p = 0.400") && !svg.contains("p = 0.400 *"));
@@ -144,7 +154,7 @@ fn ranking_without_the_paper_drops_its_column_and_balanced_classes_share_one_lin
         (r.p_vs_paper, r.difference_vs_paper) = (None, None);
     }
     c.majority = c.chance;
-    let svg = ranking(&c).unwrap();
+    let svg = ranking(&c, "test data").unwrap();
     check("compare_ranking_no_paper", &svg);
     let svg = plain(&svg);
     assert!(!svg.contains(VERSUS_HEAD) && !svg.contains("(paper)"));
@@ -162,7 +172,7 @@ fn per_condition_only_with_conditions_and_for_1_to_20() {
     for conditions in [1, 2, 12, 20] {
         for n in [2, 40] {
             let c = comparison(n, false, conditions);
-            let svg = per_condition(&c).unwrap().unwrap();
+            let svg = per_condition(&c).unwrap().draw("test data").unwrap();
             check(&format!("compare_per_condition_{n}_{conditions}"), &svg);
             let svg = plain(&svg);
             assert!(svg.contains(&format!("best: {}", name(&c.best))));
@@ -183,7 +193,7 @@ fn per_condition_names_the_held_out_column_and_a_paper_best() {
     c.results.swap(0, 1);
     c.best = c.results[0].clone();
     assert!(c.best.paper);
-    let svg = per_condition(&c).unwrap().unwrap();
+    let svg = per_condition(&c).unwrap().draw("test data").unwrap();
     check("compare_per_condition_paper_best", &svg);
     let svg = plain(&svg);
     assert!(svg.contains("held-out session, trained on the others"));
@@ -201,4 +211,21 @@ fn captions_say_what_is_drawn() {
     );
     assert!(!ranking_caption(&comparison(10, false, 0)).contains("nested"));
     assert!(per_condition_caption(&c).contains("dashed vermillion"));
+}
+
+#[test]
+fn column_names_read_as_words_with_their_units() {
+    assert_eq!(
+        plain_protocol("cross-validation within each `speed_mm_s`, mean over them"),
+        "cross-validation within each speed (mm/s), mean over them"
+    );
+    assert_eq!(
+        condition_desc("each `speed_mm_s` held out in turn, mean over them"),
+        (
+            "speed".to_string(),
+            "held-out speed (mm/s), trained on the others".to_string()
+        )
+    );
+    assert_eq!(column_words("session").1, "session");
+    assert_eq!(column_words("force_n").1, "force (N)");
 }
