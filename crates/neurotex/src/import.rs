@@ -17,7 +17,7 @@ pub use crate::csvlog::ChannelSelect;
 use crate::csvlog::{read_csv_log, CsvFormat, CsvLog};
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
-    create_dataset_dir, write_layout, write_manifest, Baseline, ChannelMap, LayoutFile, Meta,
+    create_dataset_dir, labels_merged_by_trimming, write_layout, write_manifest, Baseline, ChannelMap, LayoutFile, Meta,
     TimeUnit,
 };
 use crate::values::{Grid, Speed};
@@ -202,19 +202,25 @@ fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
 }
 
 fn meta_from_name(path: &Path, pattern: Option<&NamePattern>) -> Result<Meta> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    // A lossy name would turn distinct non-UTF-8 names (and the labels in them) into one.
+    let name = match path.file_name().map(|n| n.to_str()) {
+        Some(Some(name)) => name.to_string(),
+        Some(None) => {
+            let message = "the file name is not valid UTF-8, so neither it nor a label taken from it can be written into the manifest; rename the file";
+            return Err(invalid(path, message));
+        }
+        None => String::new(),
+    };
     let mut meta = Meta {
         file: name.clone(),
         ..Meta::default()
     };
     let Some(pattern) = pattern else {
-        meta.label = path
+        meta.label = Path::new(&name)
             .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+            .and_then(|s| s.to_str())
+            .unwrap_or_default()
+            .to_string();
         return Ok(meta);
     };
     let fields = pattern
@@ -319,6 +325,13 @@ pub fn import_csv(
     let Some(first) = good.first() else {
         return Err(DataError::invalid(out, "every file was left out").into());
     };
+    let labels: Vec<(String, String)> = good
+        .iter()
+        .map(|c| (c.meta.label.clone(), format!("file `{}`", c.meta.file)))
+        .collect();
+    if let Some(message) = labels_merged_by_trimming(&labels) {
+        return Err(DataError::invalid(out, message).into());
+    }
     let names = first.log.channel_names.clone();
     if let Some(other) = good.iter().find(|c| c.log.channel_names != names) {
         return Err(invalid(
@@ -631,18 +644,29 @@ fn read_labels(path: &Path) -> Result<Vec<String>> {
     let labels: Vec<String> = data
         .chunks_exact(header.item_bytes)
         .take(header.elements)
-        .map(|chunk| match header.kind {
-            'U' => chunk
-                .chunks_exact(4)
-                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                .take_while(|&c| c != 0)
-                .filter_map(char::from_u32)
-                .collect(),
-            _ => String::from_utf8_lossy(chunk)
-                .trim_end_matches('\0')
-                .to_string(),
+        .enumerate()
+        .map(|(i, chunk)| {
+            // Decoded strictly: replacing bad code points or bytes would merge labels.
+            let label = match header.kind {
+                'U' => chunk
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .take_while(|&c| c != 0)
+                    .map(char::from_u32)
+                    .collect::<Option<String>>(),
+                _ => {
+                    let end = chunk.iter().rposition(|&b| b != 0).map_or(0, |p| p + 1);
+                    std::str::from_utf8(&chunk[..end]).ok().map(String::from)
+                }
+            };
+            label.ok_or_else(|| {
+                invalid(
+                    path,
+                    format!("label {i} is not valid text (UTF-8 for `|S`, Unicode code points for `<U`)"),
+                )
+            })
         })
-        .collect();
+        .collect::<Result<_>>()?;
     if labels.iter().any(|l| l.is_empty()) {
         return Err(invalid(path, "a label is empty"));
     }
@@ -782,11 +806,19 @@ fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usiz
 
 /// One manifest row per stacked sample: its label, its speed (none without a speeds file),
 /// and a trial number counting the samples of each label and speed.
-fn stacked_metas(data: &Path, labels: &Path, speeds: Option<&Path>, n: usize) -> Result<Vec<Meta>> {
-    let labels = read_labels(labels)?.into_iter().collect::<Vec<_>>();
+fn stacked_metas(data: &Path, labels_path: &Path, speeds: Option<&Path>, n: usize) -> Result<Vec<Meta>> {
+    let labels = read_labels(labels_path)?.into_iter().collect::<Vec<_>>();
     if labels.len() != n {
         let message = format!("{} labels for {n} samples", labels.len());
         return Err(DataError::invalid(data, message).into());
+    }
+    let written: Vec<(String, String)> = labels
+        .iter()
+        .enumerate()
+        .map(|(i, l)| (l.clone(), format!("label {i}")))
+        .collect();
+    if let Some(message) = labels_merged_by_trimming(&written) {
+        return Err(DataError::invalid(labels_path, message).into());
     }
     let speeds: Vec<Option<f64>> = match speeds {
         Some(path) => {

@@ -1026,16 +1026,25 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
 
 /// Reads and checks a manifest: its column names in order, and its recordings.
 fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Meta>)> {
+    // Fields are trimmed (`a.npy, smooth` is common); the labels as written are kept to
+    // refuse two that differ only by surrounding spaces, which trimming would make one class.
     let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
+        .trim(csv::Trim::Headers)
         .from_path(path)
         .map_err(|e| csv_error(path, e))?;
     let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
     let columns = ManifestColumns::find(path, &headers)?;
     let mut out = Vec::new();
+    let mut raw_labels = Vec::new();
     for (i, record) in reader.records().enumerate() {
-        let record = record.map_err(|e| csv_error(path, e))?;
+        let mut record = record.map_err(|e| csv_error(path, e))?;
+        let raw_label = record.get(columns.required[1]).unwrap_or("").to_string();
+        record.trim();
         out.push(columns.row(path, i + 2, &headers, &record)?);
+        raw_labels.push((raw_label, format!("line {}", i + 2)));
+    }
+    if let Some(message) = labels_merged_by_trimming(&raw_labels) {
+        return Err(DataError::invalid(path, message).into());
     }
     if out.is_empty() {
         return Err(DataError::invalid(path, "the manifest lists no recordings").into());
@@ -1060,6 +1069,24 @@ fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Meta>)> {
         }
     }
     Ok((headers.iter().map(String::from).collect(), out))
+}
+
+/// Two labels that differ only by surrounding whitespace, which reading a manifest trims,
+/// so that they would silently become one class: a message naming both, or `None`.
+/// `labels` are the labels as written, each with where it was written.
+pub(crate) fn labels_merged_by_trimming(labels: &[(String, String)]) -> Option<String> {
+    let mut first: std::collections::HashMap<&str, &(String, String)> = Default::default();
+    labels.iter().find_map(|entry| {
+        let (raw, at) = entry;
+        let (first_raw, first_at) = *first.entry(raw.trim()).or_insert(entry);
+        (first_raw != raw).then(|| {
+            format!(
+                "{at}: label `{raw}` and `{first_raw}` ({first_at}) differ only by surrounding \
+                 spaces, which neurotex trims, so they would be one class; write them \
+                 identically, or as distinct names"
+            )
+        })
+    })
 }
 
 /// Where a manifest's columns are: the required ones in [`MANIFEST_COLUMNS`] order, the

@@ -752,3 +752,81 @@ fn stamps_on_the_1_ms_grid_give_the_spikes_of_the_unstamped_log_wherever_they_st
         );
     }
 }
+
+/// `numpy.save` of a `|S{width}` byte-string array.
+fn byte_labels_npy(labels: &[&[u8]], width: usize) -> Vec<u8> {
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    let shape = labels.len();
+    let mut header =
+        format!("{{'descr': '|S{width}', 'fortran_order': False, 'shape': ({shape},), }}");
+    while !(10 + header.len() + 1).is_multiple_of(64) {
+        header.push(' ');
+    }
+    header.push('\n');
+    npy.extend((header.len() as u16).to_le_bytes());
+    npy.extend(header.as_bytes());
+    for label in labels {
+        npy.extend(*label);
+        npy.extend(std::iter::repeat_n(0u8, width - label.len()));
+    }
+    npy
+}
+
+#[test]
+fn labels_that_would_merge_are_refused_not_merged() {
+    let dir = tempfile::tempdir().unwrap();
+    write_npy(dir.path().join("x.npy"), &reference(3, 4, 1, 2)).unwrap();
+    let p = StackedParams {
+        axes: "n,t,row,col".parse().unwrap(),
+        fs: 1000.0,
+        grid: None,
+    };
+    let stacked = |labels: &[&[u8]], out: &str| {
+        let path = dir.path().join(format!("{out}.npy"));
+        std::fs::write(&path, byte_labels_npy(labels, 5)).unwrap();
+        import_stacked(&dir.path().join("x.npy"), &path, None, &p, &dir.path().join(out))
+    };
+    // two non-UTF-8 byte labels would both decode to U+FFFD
+    let e = stacked(&[b"\xffa", b"\xfea", b"silk"], "bytes").unwrap_err();
+    assert!(e.to_string().contains("label 0 is not valid text"), "{e}");
+    let e = stacked(&[b"silk", b" silk", b"wool"], "spaces").unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("label 1: label ` silk` and `silk` (label 0) differ only by surrounding spaces"),
+        "{e}"
+    );
+    assert!(!dir.path().join("spaces").exists());
+    stacked(&[b"silk", b"wool", b"silk"], "fine").unwrap();
+    assert_eq!(
+        Dataset::open(&dir.path().join("fine")).unwrap().labels(),
+        vec!["silk", "wool"]
+    );
+
+    // CSV logs: labels from file names
+    let logs = dir.path().join("logs");
+    std::fs::create_dir(&logs).unwrap();
+    let text = "stamp,c0\n0,1\n1,2\n2,3\n3,4\n";
+    let a = write(&logs, "silk_V5_0.csv", text);
+    let b = write(&logs, "silk _V5_1.csv", text);
+    let e = import_csv(&[a.clone(), b], &params(), &dir.path().join("csv"), &|| {}).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("label `silk ` and `silk` (file `silk_V5_0.csv`) differ only by surrounding spaces"),
+        "{e}"
+    );
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let name = std::ffi::OsStr::from_bytes(b"\xff_V5_0.csv");
+        let bad = write(&logs, name.to_str().unwrap_or("unused"), text);
+        let bad = if name.to_str().is_none() {
+            let p = logs.join(name);
+            std::fs::rename(&bad, &p).unwrap();
+            p
+        } else {
+            bad
+        };
+        let e = import_csv(&[a, bad], &params(), &dir.path().join("csv"), &|| {}).unwrap_err();
+        assert!(e.to_string().contains("not valid UTF-8"), "{e}");
+    }
+}

@@ -321,6 +321,10 @@ fn manifest_errors_name_line_and_field() {
             "file,label\na.npy,X\n./a.npy,Y\n",
             "line 3: file `./a.npy` is listed again (first on line 2)",
         ),
+        (
+            "file,label\na.npy,X\nb.npy, X\n",
+            "line 3: label ` X` and `X` (line 2) differ only by surrounding spaces",
+        ),
     ];
     for (manifest, expected) in cases {
         std::fs::write(dir.path().join("manifest.csv"), manifest).unwrap();
@@ -333,6 +337,13 @@ fn manifest_errors_name_line_and_field() {
     std::fs::write(dir.path().join("manifest.csv"), "file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s,site\na.npy,X,5,1,0,0.05,0.25,lab\n").unwrap();
     let ds = Dataset::open(dir.path()).unwrap();
     assert_eq!(ds.entries[0].slide_end_s, Some(0.25));
+    // padding written the same way throughout is one spelling, trimmed
+    std::fs::copy(dir.path().join("a.npy"), dir.path().join("a2.npy")).unwrap();
+    std::fs::write(dir.path().join("manifest.csv"), "file, label\na.npy, X \n./a2.npy , X \n")
+        .unwrap();
+    let padded = Dataset::open(dir.path()).unwrap();
+    assert_eq!(padded.labels(), vec!["X".to_string()]);
+    std::fs::write(dir.path().join("manifest.csv"), "file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s,site\na.npy,X,5,1,0,0.05,0.25,lab\n").unwrap();
     assert_eq!(
         ds.entries[0].extra.get("site").map(String::as_str),
         Some("lab")
