@@ -194,3 +194,22 @@ fn rs_neuron_f_i_curve_is_sane() {
         "spike-frequency adaptation: {isi:?}"
     );
 }
+
+#[test]
+fn a_volume_spanning_all_doubles_keeps_its_levels() {
+    // lo = -MAX, hi = MAX, 16 levels: the level of x is floor(8 (1 + x / MAX)), capped at 15.
+    // 1e308 / MAX = 0.55627 (MAX = 1.7977e308): x = 1e308 -> floor(12.45) = 12,
+    // x = -1e308 -> floor(3.55) = 3, x = 0 -> 8 exactly (a boundary), x = MAX -> 15.
+    // `hi - lo` overflows to infinity, so the f64 formula alone would give every cell 0.
+    let data = vec![-f64::MAX, -1e308, 0.0, 1e308, f64::MAX];
+    let vol = RateVolume {
+        rows: 1,
+        cols: 1,
+        bins: data.len(),
+        present: vec![true],
+        data,
+    };
+    let mut q = Vec::new();
+    quantise(&vol, 16, None, &mut q);
+    assert_eq!(q, vec![0, 3, 8, 12, 15]);
+}
