@@ -12,7 +12,9 @@ use neurotex::experiments::{
     Source, ValidReproduceParams,
 };
 use neurotex::pipeline::Pipeline;
-use neurotex::report::{folder_source, simulated_source, write_report, ReportContext};
+use neurotex::report::{
+    check_report_dir, folder_source, simulated_source, write_report, ReportContext,
+};
 use neurotex::sim::MAX_TRIALS;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -126,6 +128,8 @@ fn run(
     command: &str,
 ) -> neurotex::Result<Outcome> {
     let started = Instant::now();
+    // claimed and checked before any work, held until the report is written
+    let _claim = check_report_dir(out)?;
     let quiet = |_: Progress| ();
     let (results, described, params) = match data {
         Data::Folder(ds) => {

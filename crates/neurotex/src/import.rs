@@ -17,8 +17,8 @@ pub use crate::csvlog::ChannelSelect;
 use crate::csvlog::{read_csv_log, CsvFormat, CsvLog};
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
-    create_dataset_dir, labels_merged_by_trimming, write_layout, write_manifest, Baseline, ChannelMap, LayoutFile, Meta,
-    TimeUnit,
+    create_dataset_dir, labels_merged_by_trimming, write_layout, write_manifest, Baseline,
+    ChannelMap, LayoutFile, Meta, TimeUnit,
 };
 use crate::values::{Grid, Speed};
 
@@ -806,7 +806,12 @@ fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usiz
 
 /// One manifest row per stacked sample: its label, its speed (none without a speeds file),
 /// and a trial number counting the samples of each label and speed.
-fn stacked_metas(data: &Path, labels_path: &Path, speeds: Option<&Path>, n: usize) -> Result<Vec<Meta>> {
+fn stacked_metas(
+    data: &Path,
+    labels_path: &Path,
+    speeds: Option<&Path>,
+    n: usize,
+) -> Result<Vec<Meta>> {
     let labels = read_labels(labels_path)?.into_iter().collect::<Vec<_>>();
     if labels.len() != n {
         let message = format!("{} labels for {n} samples", labels.len());

@@ -501,6 +501,88 @@ pub fn check_output_dir(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// One run's claim on an output folder, so that two runs writing the same folder at once
+/// do not both report it as theirs: the file `.NAME.lock` beside the folder holds the
+/// claiming process's id. It is created only where none exists, and removed when the claim
+/// is dropped (or by the signal handler, as a [`Temporary`]). A claim whose process no
+/// longer runs (`kill -9`, a power cut; told from `/proc`) is taken over. Claims are per
+/// process: a second claim by the same process is granted and holds nothing.
+#[derive(Debug)]
+#[must_use = "the folder is claimed only while the claim lives"]
+pub struct OutputClaim {
+    _lock: Option<Temporary>,
+}
+
+/// Claims output folder `dir` for this run ([`OutputClaim`]) and checks it as
+/// [`check_output_dir`] does. Hold the claim until the folder is written. A folder whose
+/// parent does not exist yet is not claimed (nothing can collide in it before it is
+/// created).
+///
+/// # Errors
+/// Another running process claims `dir` (its id and the lock file named), the lock file
+/// cannot be created, or as [`check_output_dir`].
+pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim> {
+    let claim = claim(dir)?;
+    check_output_dir(dir)?;
+    Ok(claim)
+}
+
+fn claim(dir: &Path) -> Result<OutputClaim> {
+    let unclaimed = OutputClaim { _lock: None };
+    let (Some(name), true) = (dir.file_name(), parent(dir).is_dir()) else {
+        return Ok(unclaimed);
+    };
+    let lock = parent(dir).join(format!(".{}.lock", name.to_string_lossy()));
+    let me = std::process::id();
+    let runs =
+        |pid: u32| !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{pid}")).exists();
+    for _ in 0..2 {
+        let created = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&lock);
+        match created {
+            Ok(mut file) => {
+                let lock = Temporary::new(lock);
+                file.write_all(me.to_string().as_bytes())
+                    .map_err(|e| DataError::write(lock.path(), e))?;
+                return Ok(OutputClaim { _lock: Some(lock) });
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let holder = std::fs::read_to_string(&lock)
+                    .ok()
+                    .and_then(|text| text.trim().parse::<u32>().ok());
+                match holder {
+                    Some(pid) if pid == me => return Ok(unclaimed),
+                    Some(pid) if !runs(pid) => {
+                        let _ = std::fs::remove_file(&lock);
+                    }
+                    _ => {
+                        let who = holder.map_or("another run".to_string(), |pid| {
+                            format!("another neurotex run (process {pid})")
+                        });
+                        let message = format!(
+                            "{who} is writing this folder; wait for it to finish, or choose \
+                             another folder (if no run is active, remove {})",
+                            lock.display()
+                        );
+                        return Err(DataError::invalid(dir, message).into());
+                    }
+                }
+            }
+            Err(e) => return Err(DataError::write(&lock, e).into()),
+        }
+    }
+    Err(DataError::invalid(
+        dir,
+        format!(
+            "cannot claim the folder: {} keeps reappearing",
+            lock.display()
+        ),
+    )
+    .into())
+}
+
 /// Every file under `dir/rel` (depth first, links not followed) with its SHA-256 in hex,
 /// as paths relative to `dir`.
 fn list_files(dir: &Path, rel: &Path, out: &mut Vec<(PathBuf, String)>) -> Result<()> {
@@ -554,14 +636,15 @@ fn write_record(tmp: &Path, dir: &Path) -> Result<()> {
 /// [`OUTPUT_RECORD`] of what it wrote is added, and the folder takes `dir`'s place. An
 /// earlier output there (checked by [`check_output_dir`]: nothing added or changed since)
 /// is moved aside first and removed afterwards, so `dir` never mixes two runs' files;
-/// between the two renames `dir` is briefly absent. Two runs writing the same folder at
-/// once each leave a whole output, the later one.
+/// between the two renames `dir` is briefly absent. The folder is claimed for the run
+/// ([`claim_output_dir`]) unless the caller already holds the claim: a second run writing
+/// it at once is refused.
 ///
 /// # Errors
-/// As [`check_output_dir`]; or a folder cannot be created, or `fill` or a rename fails
+/// As [`claim_output_dir`]; or a folder cannot be created, or `fill` or a rename fails
 /// (the earlier output is then put back).
 pub fn replace_dir<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
-    check_output_dir(dir)?;
+    let _claim = claim_output_dir(dir)?;
     let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
     if !dir.exists() || is_empty(dir) {
         return create_dir_atomic(dir, |tmp| {
@@ -624,6 +707,37 @@ mod tests {
             .collect();
         names.sort();
         names
+    }
+
+    #[test]
+    fn a_folder_claimed_by_a_running_process_is_refused_and_a_dead_claim_taken_over() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("report");
+        let lock = root.path().join(".report.lock");
+        // process 1 runs on every Linux machine
+        std::fs::write(&lock, "1").unwrap();
+        let message = replace_dir(&dir, |_| Ok(())).unwrap_err().to_string();
+        assert!(
+            message.contains("another neurotex run (process 1) is writing this folder")
+                && message.contains(".report.lock"),
+            "{message}"
+        );
+        assert!(!dir.exists());
+        // no process has this id (above Linux's largest, 2^22)
+        std::fs::write(&lock, "4294967295").unwrap();
+        let claim = claim_output_dir(&dir).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&lock).unwrap(),
+            std::process::id().to_string()
+        );
+        // the claiming process itself writes the folder
+        replace_dir(&dir, |tmp| {
+            std::fs::write(tmp.join("a"), "1").map_err(|e| DataError::write(tmp, e).into())
+        })
+        .unwrap();
+        assert!(lock.exists());
+        drop(claim);
+        assert_eq!(names(root.path()), vec!["report"]);
     }
 
     #[test]

@@ -784,15 +784,22 @@ fn labels_that_would_merge_are_refused_not_merged() {
     let stacked = |labels: &[&[u8]], out: &str| {
         let path = dir.path().join(format!("{out}.npy"));
         std::fs::write(&path, byte_labels_npy(labels, 5)).unwrap();
-        import_stacked(&dir.path().join("x.npy"), &path, None, &p, &dir.path().join(out))
+        import_stacked(
+            &dir.path().join("x.npy"),
+            &path,
+            None,
+            &p,
+            &dir.path().join(out),
+        )
     };
     // two non-UTF-8 byte labels would both decode to U+FFFD
     let e = stacked(&[b"\xffa", b"\xfea", b"silk"], "bytes").unwrap_err();
     assert!(e.to_string().contains("label 0 is not valid text"), "{e}");
     let e = stacked(&[b"silk", b" silk", b"wool"], "spaces").unwrap_err();
     assert!(
-        e.to_string()
-            .contains("label 1: label ` silk` and `silk` (label 0) differ only by surrounding spaces"),
+        e.to_string().contains(
+            "label 1: label ` silk` and `silk` (label 0) differ only by surrounding spaces"
+        ),
         "{e}"
     );
     assert!(!dir.path().join("spaces").exists());
@@ -810,8 +817,9 @@ fn labels_that_would_merge_are_refused_not_merged() {
     let b = write(&logs, "silk _V5_1.csv", text);
     let e = import_csv(&[a.clone(), b], &params(), &dir.path().join("csv"), &|| {}).unwrap_err();
     assert!(
-        e.to_string()
-            .contains("label `silk ` and `silk` (file `silk_V5_0.csv`) differ only by surrounding spaces"),
+        e.to_string().contains(
+            "label `silk ` and `silk` (file `silk_V5_0.csv`) differ only by surrounding spaces"
+        ),
         "{e}"
     );
     #[cfg(unix)]

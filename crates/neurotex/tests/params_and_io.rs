@@ -339,8 +339,11 @@ fn manifest_errors_name_line_and_field() {
     assert_eq!(ds.entries[0].slide_end_s, Some(0.25));
     // padding written the same way throughout is one spelling, trimmed
     std::fs::copy(dir.path().join("a.npy"), dir.path().join("a2.npy")).unwrap();
-    std::fs::write(dir.path().join("manifest.csv"), "file, label\na.npy, X \n./a2.npy , X \n")
-        .unwrap();
+    std::fs::write(
+        dir.path().join("manifest.csv"),
+        "file, label\na.npy, X \n./a2.npy , X \n",
+    )
+    .unwrap();
     let padded = Dataset::open(dir.path()).unwrap();
     assert_eq!(padded.labels(), vec!["X".to_string()]);
     std::fs::write(dir.path().join("manifest.csv"), "file,label,speed_mm_s,force_n,trial,slide_start_s,slide_end_s,site\na.npy,X,5,1,0,0.05,0.25,lab\n").unwrap();

@@ -193,9 +193,12 @@ impl CompareArgs {
 pub fn run(args: CompareArgs) -> Result<()> {
     let params = args.params()?;
     let dataset = args.open.open(&args.dataset)?;
-    if let Some(dir) = &args.out {
-        neurotex::io::check_output_dir(dir).context("checking the output folder")?;
-    }
+    let _claim = match &args.out {
+        Some(dir) => {
+            Some(neurotex::io::claim_output_dir(dir).context("checking the output folder")?)
+        }
+        None => None,
+    };
     let indices = args.indices(&dataset)?;
     let set = args.set()?;
     let n = set.len();

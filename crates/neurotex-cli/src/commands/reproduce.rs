@@ -144,7 +144,8 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         Some(dir) => Some(args.open.open(dir)?),
         None => None,
     };
-    neurotex::report::check_report_dir(&args.out).context("checking the report folder")?;
+    let _claim =
+        neurotex::report::check_report_dir(&args.out).context("checking the report folder")?;
     if let Some(path) = &args.predictions {
         let inputs = dataset.as_ref().map(Dataset::files).unwrap_or_default();
         check_output(path, &inputs)?;

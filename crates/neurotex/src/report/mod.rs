@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{DataError, Result};
 use crate::experiments::Results;
-use crate::io::{check_output_dir, replace_dir};
+use crate::io::{claim_output_dir, replace_dir, OutputClaim};
 
 pub use markdown::markdown;
 pub use paper::{
@@ -83,7 +83,7 @@ pub fn folder_source(root: &Path) -> String {
 /// # Errors
 /// The folder cannot be created, a file cannot be written or a figure cannot be drawn.
 pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Result<()> {
-    check_report_dir(dir)?;
+    let _claim = check_report_dir(dir)?;
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     for (name, svg) in figures::all(results, ctx.paper(), &ctx.source) {
         let failed = |e: figures::FigureError| {
@@ -100,14 +100,16 @@ pub fn write_report(dir: &Path, results: &Results, ctx: &ReportContext) -> Resul
     replace_dir(dir, |tmp| write_files(tmp, &files))
 }
 
-/// Checks, before any work, that `dir` is new, empty or an earlier report left as it was
-/// written ([`check_output_dir`]): a report replaces nothing else.
+/// Claims `dir` for this run and checks, before any work, that it is new, empty or an
+/// earlier report left as it was written ([`claim_output_dir`]): a report replaces
+/// nothing else, and two runs do not write one folder at once. Hold the claim until
+/// [`write_report`] returns.
 ///
 /// # Errors
-/// `dir` is not a folder, or holds a file the earlier report did not write, or one changed
-/// since (named).
-pub fn check_report_dir(dir: &Path) -> Result<()> {
-    check_output_dir(dir)
+/// Another running process claims `dir`, `dir` is not a folder, or it holds a file the
+/// earlier report did not write, or one changed since (named).
+pub fn check_report_dir(dir: &Path) -> Result<OutputClaim> {
+    claim_output_dir(dir)
 }
 
 /// Writes `files` (paths relative to `dir`, and their bytes) and the `figures` folder.
