@@ -4,12 +4,12 @@
 use ndarray::ArrayViewD;
 use neurotex::error::DataError;
 use neurotex::pipeline::Encoded;
-use neurotex::recording::{Layout, Meta, Recording, DEFAULT_MAX_DURATION_S};
+use neurotex::recording::{Layout, Meta, Recording, DEFAULT_MAX_DURATION_S, VALUES_PER_LIMIT_S};
 use numpy::PyReadonlyArrayDyn;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::errors::{raise, Kind};
+use crate::errors::{raise, try_vec, Kind};
 
 /// A borrowed numpy array of samples, float32 or float64, as the caller laid it out.
 pub enum Samples<'py> {
@@ -131,17 +131,28 @@ impl SamplesView<'_> {
                 info.fs
             )));
         }
-        // Logical (C) order whatever the strides: a C-contiguous array is one copy.
-        let samples: Vec<f64> = match self {
+        // The CLI reader's limit on what resampling to 1 kHz allocates.
+        let max_values = DEFAULT_MAX_DURATION_S * VALUES_PER_LIMIT_S;
+        let resampled = span * 1000.0 * (rows * cols) as f64;
+        if resampled > max_values {
+            return Err(bad(format!(
+                "{span} s on {} grid cells is {resampled:.3e} values once resampled to 1 kHz, \
+                 beyond the limit of {max_values:.3e} ({DEFAULT_MAX_DURATION_S} s of a \
+                 16-taxel grid); a wrong shape or rate is the usual cause",
+                rows * cols
+            )));
+        }
+        // Logical (C) order whatever the strides: a C-contiguous array is one copy. A
+        // broadcast view can be far larger than the memory behind it: reserved fallibly.
+        let mut samples: Vec<f64> =
+            neurotex::error::try_with_capacity(t * rows * cols, &format!("{name}: the samples"))?;
+        match self {
             SamplesView::F64(a) => match a.as_slice() {
-                Some(s) => s.to_vec(),
-                None => a.iter().copied().collect(),
+                Some(s) => samples.extend_from_slice(s),
+                None => samples.extend(a.iter().copied()),
             },
-            SamplesView::F32(a) => match a.as_slice() {
-                Some(s) => s.iter().map(|&v| f64::from(v)).collect(),
-                None => a.iter().map(|&v| f64::from(v)).collect(),
-            },
-        };
+            SamplesView::F32(a) => samples.extend(a.iter().map(|&v| f64::from(v))),
+        }
         let n_cells = rows * cols;
         if let Some(pos) = samples.iter().position(|v| !v.is_finite()) {
             return Err(bad(format!(
@@ -321,10 +332,7 @@ pub fn raster_of(raster: &PyReadonlyArrayDyn<'_, u8>) -> PyResult<(Vec<u8>, usiz
     if rows * cols == 0 {
         return Err(raise(Kind::Data, "spikes: the grid has no cells"));
     }
-    let data: Vec<u8> = match a.as_slice() {
-        Some(s) => s.to_vec(),
-        None => a.iter().copied().collect(),
-    };
+    let data = try_vec(a.len(), "spikes", a.iter().copied())?;
     if let Some(pos) = data.iter().position(|&v| v > 1) {
         let cells = rows * cols;
         return Err(raise(

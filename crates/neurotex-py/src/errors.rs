@@ -81,7 +81,28 @@ fn io_kind(error: &std::io::Error) -> Kind {
 
 /// A library error as the Python exception of its kind, with the library's message.
 pub fn to_py(error: neurotex::Error) -> PyErr {
+    if out_of_memory(&error) {
+        return pyo3::exceptions::PyMemoryError::new_err(error.to_string());
+    }
     raise(kind_of(&error), error.to_string())
+}
+
+/// Memory the input asked for and the machine does not have: Python's `MemoryError`,
+/// which a notebook survives.
+fn out_of_memory(error: &neurotex::Error) -> bool {
+    match error {
+        neurotex::Error::Data(DataError::OutOfMemory { .. }) => true,
+        neurotex::Error::InRecording { source, .. } => out_of_memory(source),
+        _ => false,
+    }
+}
+
+/// `len` values in a new vector reserved fallibly ([`neurotex::error::try_with_capacity`]):
+/// `MemoryError` when the machine cannot hold them.
+pub fn try_vec<T>(len: usize, what: &str, values: impl Iterator<Item = T>) -> PyResult<Vec<T>> {
+    let mut v = neurotex::error::try_with_capacity(len, what).map_err(to_py)?;
+    v.extend(values);
+    Ok(v)
 }
 
 /// A parameter error as a `neurotex.ParameterError`.

@@ -33,7 +33,7 @@ use pyo3::types::PyDict;
 
 use calibrate::{calibrated, Report};
 use convert::{raster_of, Batch, InfoTuple};
-use errors::{guarded, guarded_py, param, raise, Kind};
+use errors::{guarded, guarded_py, param, raise, to_py, try_vec, Kind};
 
 /// A raster and, for `sa+fa`, the FA population's.
 type Rasters<'py> = (Bound<'py, PyArray3<u8>>, Option<Bound<'py, PyArray3<u8>>>);
@@ -254,7 +254,10 @@ fn glcm<'py>(
             format!("volume is empty: shape {:?}", a.shape()),
         ));
     }
-    let data: Vec<f64> = a.iter().copied().collect();
+    let data = try_vec(a.len(), "volume", a.iter().copied())?;
+    // the levels, one byte per value
+    let mut q = neurotex::error::try_with_capacity::<u8>(data.len(), "volume levels")
+        .map_err(to_py)?;
     if let Some(pos) = data.iter().position(|v| !v.is_finite()) {
         return Err(raise(
             Kind::Data,
@@ -306,7 +309,6 @@ fn glcm<'py>(
                 present: present.clone(),
                 data,
             };
-            let mut q = Vec::new();
             quantise(&volume, levels, range, &mut q);
             let mut counts = vec![0u64; levels * levels];
             plan.count_wide(&q, bins, &mut counts);

@@ -131,3 +131,42 @@ def test_model_train_errors(tmp_path):
         neurotex.Model.train(recs, ["a", "b"], method="glcm3d", taxel="0,0")
     with pytest.raises(errors.ParameterError, match="labels"):
         neurotex.Model.train(recs, ["a"])
+
+
+_OUT_OF_MEMORY = """
+import resource, numpy as np, neurotex
+resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+cases = {
+    # broadcast views: a few bytes behind shapes far beyond the 3 GiB limit
+    "glcm3d": lambda: neurotex.glcm3d(np.broadcast_to(np.float64(1.0), (40, 40, 10**6))),
+    "rate_volume": lambda: neurotex.rate_volume(np.broadcast_to(np.uint8(1), (10**9, 4, 4))),
+    "spike_stats": lambda: neurotex.spike_stats(np.broadcast_to(np.uint8(0), (10**9, 4, 4))),
+}
+for name, call in cases.items():
+    try:
+        call()
+        print(name, "returned")
+    except MemoryError as e:
+        print(name, "MemoryError", e)
+print("alive")
+"""
+
+
+def test_memory_the_machine_lacks_is_a_memory_error_not_an_abort():
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "-c", _OUT_OF_MEMORY], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    lines = run.stdout.splitlines()
+    assert lines[-1] == "alive"
+    assert "glcm3d MemoryError volume: 12800000000 bytes do not fit in memory" in lines
+    assert "rate_volume MemoryError spikes: 16000000000 bytes do not fit in memory" in lines
+    assert "spike_stats MemoryError spikes: 16000000000 bytes do not fit in memory" in lines
+
+
+def test_samples_beyond_the_readers_limit_are_refused_before_copying():
+    x = np.broadcast_to(np.float64(0.5), (3_600_000, 100, 100))
+    with pytest.raises(errors.DataError, match="3.600e10 values once resampled to 1 kHz"):
+        neurotex.encode(x, fs=1000)

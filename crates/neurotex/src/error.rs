@@ -121,6 +121,15 @@ pub enum DataError {
         /// What to do about it.
         hint: &'static str,
     },
+    /// Memory for a buffer whose size the input decides could not be reserved: reported
+    /// (as `MemoryError` in Python) instead of aborting the process.
+    #[error("{what}: {bytes} bytes do not fit in memory")]
+    OutOfMemory {
+        /// What the buffer would hold.
+        what: String,
+        /// Its size in bytes.
+        bytes: u128,
+    },
     /// A file was read but its content is not what was expected.
     #[error("{path}: {message}")]
     Invalid {
@@ -129,6 +138,22 @@ pub enum DataError {
         /// What is wrong and what was expected, with line and field where they apply.
         message: String,
     },
+}
+
+/// An empty vector with room for `len` values, reserved fallibly: where the input decides
+/// a buffer's size, a request the machine cannot meet is a [`DataError::OutOfMemory`]
+/// naming `what`, not an abort.
+///
+/// # Errors
+/// The memory cannot be reserved.
+pub fn try_with_capacity<T>(len: usize, what: &str) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len)
+        .map_err(|_| DataError::OutOfMemory {
+            what: what.to_string(),
+            bytes: len as u128 * std::mem::size_of::<T>() as u128,
+        })?;
+    Ok(v)
 }
 
 impl DataError {
