@@ -2,6 +2,7 @@
 //! every bin, as `neurotex stream` prints them.
 
 use neurotex::causal::DecisionRule;
+use neurotex::recording::TimeUnit;
 use neurotex::stream::{bin_json, end_json, Event, StreamClassifier, StreamError, StreamParams};
 use pyo3::prelude::*;
 
@@ -12,6 +13,8 @@ use crate::model::NativeModel;
 #[pyclass(module = "neurotex._native")]
 pub struct NativeStream {
     inner: StreamClassifier,
+    /// The unit of every stamp pushed.
+    unit: TimeUnit,
 }
 
 /// The events as JSON lines, the lines `neurotex stream` prints (without `bad_frames`).
@@ -37,7 +40,7 @@ fn stream_error(e: StreamError) -> PyErr {
 impl NativeStream {
     /// A stream classifier for `model` (trained with `--causal`).
     #[new]
-    #[pyo3(signature = (model, window_s=None, decide=0.8, decide_bins=3, episode="whole", fs=1000.0, max_gap_s=1.0, speed=None))]
+    #[pyo3(signature = (model, window_s=None, decide=0.8, decide_bins=3, episode="whole", fs=1000.0, max_gap_s=1.0, speed=None, time_unit="s"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         model: &NativeModel,
@@ -48,7 +51,9 @@ impl NativeStream {
         fs: f64,
         max_gap_s: f64,
         speed: Option<f64>,
+        time_unit: &str,
     ) -> PyResult<Self> {
+        let unit: TimeUnit = time_unit.parse().map_err(param)?;
         let model = model.inner.clone();
         let mut params = StreamParams::for_model(&model);
         if let Some(s) = window_s {
@@ -69,14 +74,18 @@ impl NativeStream {
         params.max_gap_s = max_gap_s;
         params.speed_mm_s = speed;
         let inner = guarded(|| StreamClassifier::new(model, params))?;
-        Ok(NativeStream { inner })
+        Ok(NativeStream { inner, unit })
     }
 
-    /// Takes one frame (one value per taxel) with its time stamp in s, or none at the
-    /// stream's rate; returns the JSON lines it completed.
+    /// Takes one frame (one value per taxel) with its time stamp in the stream's unit, or
+    /// none at the stream's rate; returns the JSON lines it completed.
     #[pyo3(signature = (values, t=None))]
     fn push(&mut self, values: Vec<f64>, t: Option<f64>) -> PyResult<Vec<String>> {
-        let events = self.inner.push(t, &values).map_err(stream_error)?.to_vec();
+        let events = self
+            .inner
+            .push_in(t, self.unit, &values)
+            .map_err(stream_error)?
+            .to_vec();
         Ok(lines(&self.inner, &events))
     }
 

@@ -106,3 +106,23 @@ def test_a_stamp_far_ahead_costs_its_own_frame(sim_dir, causal_model):
     assert len(bad) == 1 and "not after the previous" in bad[0]
     with pytest.raises(ParameterError, match="largest gap"):
         neurotex.StreamClassifier(causal_model, max_gap_s=3600.0)
+
+
+def test_ms_stamps_on_the_grid_give_the_unstamped_lines(sim_dir, causal_model):
+    """Stamps in the unit they were logged in are exact: frames stamped 1.7e12 + k ms (ms
+    since an epoch) give the lines of the same frames unstamped at 1 kHz, bit for bit."""
+    row = [r for r in manifest(sim_dir) if r["speed_mm_s"] == "10"][0]
+    frames = slide_frames(sim_dir, row)
+
+    def run(stamps, **options):
+        stream = neurotex.StreamClassifier(causal_model, **options)
+        got = []
+        for t, f in zip(stamps, frames):
+            got.extend(stream.push(f, t=t) or [])
+        return got + (stream.finish() or [])
+
+    unstamped = run([None] * len(frames))
+    stamped = run([1.7e12 + k for k in range(len(frames))], time_unit="ms")
+    assert stamped == unstamped and len(unstamped) > 20
+    with pytest.raises(ParameterError, match="time-unit"):
+        neurotex.StreamClassifier(causal_model, time_unit="minutes")

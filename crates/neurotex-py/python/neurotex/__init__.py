@@ -888,24 +888,30 @@ class StreamClassifier:
     more than ``max_gap_s`` after it) raises :class:`DataError` and is skipped; the stream
     goes on. When the next frame follows such a stamp instead of the last good one, the
     clock has jumped: the episode ends (``"ended_by": "gap"``) and a new one starts at that
-    frame, as in ``neurotex stream``. ``max_gap_s`` is at most 10 s."""
+    frame, as in ``neurotex stream``. ``max_gap_s`` is at most 10 s.
+
+    ``time_unit`` (``"s"``, ``"ms"`` or ``"us"``) is the unit of every stamp pushed: give
+    stamps in the unit they were logged in. Stamps are taken relative to the episode's first
+    in that unit and only then become seconds, so integer ms stamps on the encoder's 1 ms
+    grid give the same spikes as the same frames unstamped at 1 kHz; the same stamps as
+    seconds (``0.001 * k``, not exact in binary) can move a near-threshold spike."""
 
     def __init__(self, model: Union["Model", str, os.PathLike], *, window_s: Optional[float] = None,
                  decide: float = 0.8, decide_bins: int = 3, episode: str = "whole",
                  fs: float = 1000.0, max_gap_s: float = 1.0,
-                 speed: Optional[float] = None) -> None:
+                 speed: Optional[float] = None, time_unit: str = "s") -> None:
         if not isinstance(model, Model):
             model = Model.load(model)
         self.model = model
         self._native = _native.NativeStream(model._native, window_s, decide, decide_bins,
-                                            episode, fs, max_gap_s, speed)
+                                            episode, fs, max_gap_s, speed, time_unit)
 
     @staticmethod
     def _events(lines: List[str]) -> Optional[List[Dict[str, Any]]]:
         return [json.loads(line) for line in lines] or None
 
     def push(self, frame: Any, t: Optional[float] = None) -> Optional[List[Dict[str, Any]]]:
-        """Takes one frame, with its time stamp in s (or none, at ``fs``)."""
+        """Takes one frame, with its time stamp in ``time_unit`` (or none, at ``fs``)."""
         values = np.asarray(frame, dtype=np.float64).ravel().tolist()
         return self._events(self._native.push(values, t))
 
