@@ -128,7 +128,7 @@ pub enum DataError {
         /// What the buffer would hold.
         what: String,
         /// Its size in bytes.
-        bytes: u128,
+        bytes: u64,
     },
     /// A file was read but its content is not what was expected.
     #[error("{path}: {message}")]
@@ -151,7 +151,7 @@ pub fn try_with_capacity<T>(len: usize, what: &str) -> Result<Vec<T>> {
     v.try_reserve_exact(len)
         .map_err(|_| DataError::OutOfMemory {
             what: what.to_string(),
-            bytes: len as u128 * std::mem::size_of::<T>() as u128,
+            bytes: (len as u64).saturating_mul(std::mem::size_of::<T>() as u64),
         })?;
     Ok(v)
 }

@@ -805,7 +805,7 @@ fn labels_that_would_merge_are_refused_not_merged() {
     assert!(!dir.path().join("spaces").exists());
     stacked(&[b"silk", b"wool", b"silk"], "fine").unwrap();
     assert_eq!(
-        Dataset::open(&dir.path().join("fine")).unwrap().labels(),
+        Dataset::open(dir.path().join("fine")).unwrap().labels(),
         vec!["silk", "wool"]
     );
 
