@@ -256,8 +256,8 @@ fn glcm<'py>(
     }
     let data = try_vec(a.len(), "volume", a.iter().copied())?;
     // the levels, one byte per value
-    let mut q = neurotex::error::try_with_capacity::<u8>(data.len(), "volume levels")
-        .map_err(to_py)?;
+    let mut q =
+        neurotex::error::try_with_capacity::<u8>(data.len(), "volume levels").map_err(to_py)?;
     if let Some(pos) = data.iter().position(|v| !v.is_finite()) {
         return Err(raise(
             Kind::Data,
