@@ -387,6 +387,7 @@ mod tests {
             n: vec![4, 16],
             mean: vec![0.6, 0.4],
             std: vec![0.0, 0.0],
+            interval: Vec::new(),
             glcm3d: 0.8,
             taxel_mean: 0.4,
             unperturbed_vs_moved: vec![paired.clone(); 2],
@@ -396,7 +397,9 @@ mod tests {
             E5Speed {
                 fractions: vec![0.5, 1.0],
                 glcm3d: vec![Some(0.5), Some(0.8)],
+                glcm3d_interval: Vec::new(),
                 taxel_full: 0.5,
+                taxel_full_interval: None,
                 first_match: Some(0.5),
                 longest_vs_shortest: Some(paired.clone()),
             },
@@ -407,6 +410,8 @@ mod tests {
                 k: vec![1, 5],
                 taxel_mean: vec![0.4, 0.4],
                 glcm3d: vec![0.8, 0.8],
+                taxel_mean_interval: Vec::new(),
+                glcm3d_interval: Vec::new(),
                 glcm3d_vs_taxel: vec![paired.clone(); 2],
             },
         );

@@ -9,7 +9,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{compare_shares, Comparison, Context, Skip, Stop};
-use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split};
+use crate::analysis::{
+    evaluate, seeded_bootstrap_over_encodings, Columns, FeatureTable, Outcome, Split,
+};
+use crate::classify::Interval;
 use crate::error::Result;
 use crate::pipeline::{Encoded, FeatureExtractor, Method, Quantised};
 use crate::values::Speed;
@@ -27,6 +30,11 @@ pub struct E3 {
     pub mean: Vec<f64>,
     /// Standard deviation over perturbations, per n.
     pub std: Vec<f64>,
+    /// Per n, the 95 % interval of `mean`: a percentile bootstrap that draws one
+    /// perturbation and then the recordings ([`crate::classify::bootstrap_over_encodings`]),
+    /// so it holds both the recordings' and the draws' variability.
+    #[serde(default)]
+    pub interval: Vec<Interval>,
     /// Unperturbed 3D-GLCM (E1).
     pub glcm3d: f64,
     /// Single taxel mean (E1).
@@ -76,7 +84,8 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
         extractor: &extractor,
         taxels: &taxels,
     };
-    let (mut mean, mut std, mut unperturbed_vs_moved) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut mean, mut std, mut interval, mut unperturbed_vs_moved) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &n in &counts {
         // The draws side by side: each is seeded by (n, draw, recording).
         let outcomes = (0..c.params.e3_repeats)
@@ -88,6 +97,11 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
         let var = accs.iter().map(|a| (a - m).powi(2)).sum::<f64>() / accs.len() as f64;
         mean.push(m);
         std.push(var.sqrt());
+        let per_draw: Vec<Vec<f64>> = outcomes
+            .iter()
+            .map(|o| o.correct_shares.iter().map(|&(_, s)| s).collect())
+            .collect();
+        interval.push(seeded_bootstrap_over_encodings(&per_draw, c.params.seed)?);
         let moved = pooled_shares(&outcomes, &rows);
         unperturbed_vs_moved.push(compare_shares(
             ("unperturbed 3D-GLCM", &h.glcm3d.correct_shares),
@@ -101,6 +115,7 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
         n: counts,
         mean,
         std,
+        interval,
         glcm3d: h.glcm3d.accuracy,
         taxel_mean: h.taxel.accuracy,
         unperturbed_vs_moved,

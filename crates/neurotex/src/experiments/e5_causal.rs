@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::tables::cv_at;
 use super::{compare_shares, Comparison, Context, E5Speed, Skip, Stop};
-use crate::analysis::{Columns, FeatureTable, OutOfFold, Outcome};
+use crate::analysis::{seeded_bootstrap, Columns, FeatureTable, OutOfFold, Outcome};
 use crate::causal::{ConditioningCalibration, Decider, DecisionRule};
 use crate::classify::{Classifier, Interval, Knn, KnnModel, Predict};
 use crate::error::Result;
@@ -33,8 +33,15 @@ pub struct E5cFraction {
     /// of its own slide by the whole-slide classifier; `None` when some share is shorter
     /// than one bin.
     pub causal: Option<f64>,
+    /// 95 % interval of `causal` (bootstrap over recordings, each recording's repeats
+    /// kept together).
+    #[serde(default)]
+    pub causal_interval: Option<Interval>,
     /// The offline E5 at that share (trained and tested on the first part of the slides).
     pub offline: Option<f64>,
+    /// E5's 95 % interval of `offline`.
+    #[serde(default)]
+    pub offline_interval: Option<Interval>,
 }
 
 /// The time to decision under a [`DecisionRule`], over every test recording of every CV
@@ -339,7 +346,10 @@ fn summarise(
     let most_bins = run.steps.iter().map(|s| s / bin).max().unwrap_or(0);
     let times_s: Vec<f64> = (1..=most_bins).map(|b| (b * bin) as f64 / 1000.0).collect();
     let median_steps = run.median_steps();
-    let fractions = e5.map_or(Vec::new(), |e5| run.fractions(e5, bin, median_steps));
+    let fractions = match e5 {
+        Some(e5) => run.fractions(e5, bin, median_steps, c.params.seed)?,
+        None => Vec::new(),
+    };
     let decision = run.time_to_decision(rule, &times_s);
     let offline = &c.tables.at(speed).glcm3d;
     let classes = run.labels.len().max(1);
@@ -409,34 +419,60 @@ impl SpeedRun {
     }
 
     /// Causal beside offline at each of `e5`'s shares of the slide.
-    fn fractions(&self, e5: &E5Speed, bin: usize, median_steps: f64) -> Vec<E5cFraction> {
-        e5.fractions
-            .iter()
-            .zip(&e5.glcm3d)
-            .map(|(&p, &offline)| E5cFraction {
+    fn fractions(
+        &self,
+        e5: &E5Speed,
+        bin: usize,
+        median_steps: f64,
+        seed: u64,
+    ) -> Result<Vec<E5cFraction>> {
+        let mut out = Vec::new();
+        for (i, (&p, &offline)) in e5.fractions.iter().zip(&e5.glcm3d).enumerate() {
+            let (causal, causal_interval) = match self.right_at_share(p, bin) {
+                Some(shares) => {
+                    let right: f64 = shares.iter().map(|&(r, _)| r as f64).sum();
+                    let all: usize = shares.iter().map(|&(_, n)| n).sum();
+                    let per_recording: Vec<f64> = shares
+                        .iter()
+                        .filter(|&&(_, n)| n > 0)
+                        .map(|&(r, n)| r as f64 / n as f64)
+                        .collect();
+                    (
+                        Some(right / all.max(1) as f64),
+                        Some(seeded_bootstrap(&per_recording, seed)?),
+                    )
+                }
+                None => (None, None),
+            };
+            out.push(E5cFraction {
                 fraction: p,
                 time_s: p * median_steps / 1000.0,
-                causal: self.accuracy_at_share(p, bin),
+                causal,
+                causal_interval,
                 offline,
-            })
-            .collect()
+                offline_interval: e5.glcm3d_interval.get(i).cloned().flatten(),
+            });
+        }
+        Ok(out)
     }
 
-    /// The share of episodes classified right at the last bin boundary within share `p` of
-    /// their slide; `None` when some share is shorter than one bin.
-    fn accuracy_at_share(&self, p: f64, bin: usize) -> Option<f64> {
+    /// Per recording, its episodes classified right at the last bin boundary within share
+    /// `p` of its slide and its episodes; `None` when some share is shorter than one bin.
+    fn right_at_share(&self, p: f64, bin: usize) -> Option<Vec<(usize, usize)>> {
         // The bins the offline E5 keeps of each slide: floor(p n) steps, whole bins.
         let at = |steps: usize| ((steps as f64) * p).floor() as usize / bin;
-        match self.steps.iter().any(|&s| at(s) == 0) {
-            true => None,
-            false => {
-                let right = self
-                    .traces
-                    .iter()
-                    .filter(|t| t.class_at(at(self.steps[t.recording])) == t.truth);
-                Some(right.count() as f64 / self.episodes())
+        if self.steps.iter().any(|&s| at(s) == 0) {
+            return None;
+        }
+        let mut shares = vec![(0usize, 0usize); self.steps.len()];
+        for t in &self.traces {
+            let share = &mut shares[t.recording];
+            share.1 += 1;
+            if t.class_at(at(self.steps[t.recording])) == t.truth {
+                share.0 += 1;
             }
         }
+        Some(shares)
     }
 
     /// The time to decision under `rule`, with the share of episodes decided by each of

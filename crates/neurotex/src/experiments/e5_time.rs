@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::tables::{cv_at, table};
 use super::{compare, Comparison, Context, Stop};
 use crate::analysis::{Columns, Outcome};
+use crate::classify::Interval;
 use crate::error::Result;
 use crate::pipeline::{Encoded, Method};
 use crate::values::{BySpeed, Speed};
@@ -18,8 +19,14 @@ pub struct E5Speed {
     pub fractions: Vec<f64>,
     /// 3D-GLCM accuracy per fraction (`null` where the fraction is shorter than one bin).
     pub glcm3d: Vec<Option<f64>>,
+    /// 95 % interval of each share's 3D-GLCM accuracy (bootstrap over recordings).
+    #[serde(default)]
+    pub glcm3d_interval: Vec<Option<Interval>>,
     /// Single taxel mean on the whole slide.
     pub taxel_full: f64,
+    /// 95 % interval of `taxel_full` (bootstrap over recordings).
+    #[serde(default)]
+    pub taxel_full_interval: Option<Interval>,
     /// Smallest fraction at which 3D-GLCM reaches the single taxel's accuracy.
     pub first_match: Option<f64>,
     /// 3D-GLCM on the largest fraction against the smallest one longer than a bin, on the
@@ -45,7 +52,16 @@ pub fn e5_time_to_recognition(c: &Context) -> Result<BySpeed<E5Speed>, Stop> {
             .iter()
             .map(|o| o.as_ref().map(|o| o.accuracy))
             .collect();
-        let taxel_full = c.tables.at(speed).taxel.accuracy;
+        let intervals = outcomes
+            .iter()
+            .map(|o| {
+                o.as_ref()
+                    .map(|o| o.accuracy_interval(c.params.seed))
+                    .transpose()
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let taxel = &c.tables.at(speed).taxel;
+        let taxel_full = taxel.accuracy;
         let first_match = c
             .params
             .e5_fractions
@@ -56,7 +72,9 @@ pub fn e5_time_to_recognition(c: &Context) -> Result<BySpeed<E5Speed>, Stop> {
         let e5 = E5Speed {
             fractions: c.params.e5_fractions.clone(),
             glcm3d: accs,
+            glcm3d_interval: intervals,
             taxel_full,
+            taxel_full_interval: Some(taxel.accuracy_interval(c.params.seed)?),
             first_match,
             longest_vs_shortest: longest_vs_shortest(c, &c.params.e5_fractions, &outcomes)?,
         };

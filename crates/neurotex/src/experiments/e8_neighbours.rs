@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::tables::{cv_at, cv_sweep_at};
 use super::{compare, Comparison, Context, Skip, Stop};
 use crate::analysis::{Columns, Outcome};
-use crate::classify::KnnSweep;
+use crate::classify::{Interval, KnnSweep};
 use crate::values::{BySpeed, Speed};
 
 /// E8 at one speed.
@@ -18,6 +18,12 @@ pub struct E8Speed {
     pub taxel_mean: Vec<f64>,
     /// 3D-GLCM per k.
     pub glcm3d: Vec<f64>,
+    /// 95 % interval of the single taxel's mean per k (bootstrap over recordings).
+    #[serde(default)]
+    pub taxel_mean_interval: Vec<Interval>,
+    /// 95 % interval of 3D-GLCM per k (bootstrap over recordings).
+    #[serde(default)]
+    pub glcm3d_interval: Vec<Interval>,
     /// Per k, 3D-GLCM against the single taxel (mean over taxels) on the same recordings.
     #[serde(default)]
     pub glcm3d_vs_taxel: Vec<Comparison>,
@@ -35,6 +41,8 @@ pub fn e8_neighbours(c: &Context) -> Result<(BySpeed<E8Speed>, Vec<Skip>), Stop>
             k: Vec::new(),
             taxel_mean: Vec::new(),
             glcm3d: Vec::new(),
+            taxel_mean_interval: Vec::new(),
+            glcm3d_interval: Vec::new(),
             glcm3d_vs_taxel: Vec::new(),
         };
         for (k, t, g) in evaluations(c, speed) {
@@ -44,6 +52,9 @@ pub fn e8_neighbours(c: &Context) -> Result<(BySpeed<E8Speed>, Vec<Skip>), Stop>
                     e8.k.push(k);
                     e8.taxel_mean.push(t.accuracy);
                     e8.glcm3d.push(g.accuracy);
+                    e8.taxel_mean_interval
+                        .push(t.accuracy_interval(c.params.seed)?);
+                    e8.glcm3d_interval.push(g.accuracy_interval(c.params.seed)?);
                     e8.glcm3d_vs_taxel.push(paired);
                 }
                 (Err(e), _) | (_, Err(e)) => skipped.push(Skip::Neighbours {

@@ -12,6 +12,11 @@ fn pct(a: f64) -> String {
     format!("{:.1}", 100.0 * a)
 }
 
+/// An accuracy in % with its interval in brackets, where it has one.
+fn pct_in(v: f64, interval: Option<&crate::classify::Interval>) -> String {
+    interval.map_or(pct(v), |i| format!("{} {}", pct(v), bracket(i)))
+}
+
 fn list<T: ToString>(items: impl IntoIterator<Item = T>) -> String {
     items
         .into_iter()
@@ -319,11 +324,15 @@ fn e3(r: &Results) -> String {
         return String::new();
     };
     let mut out = format!("## E3: spatial perturbation at {} mm/s\n\n\
-        For each recording, n taxels chosen at random swap places among themselves (every chosen taxel moves; each recording gets its own draw); 3D-GLCM accuracy, mean ± std over {} draws. Unperturbed 3D-GLCM {} %, single taxel {} %. The paper: accuracy falls towards or below the single taxel as n grows.\n\n",
+        For each recording, n taxels chosen at random swap places among themselves (every chosen taxel moves; each recording gets its own draw); 3D-GLCM accuracy, mean over {} draws, with a 95 % interval that holds both the recordings' and the draws' variability (a bootstrap that picks one draw, then the recordings), and the standard deviation over draws. Unperturbed 3D-GLCM {} %, single taxel {} %. The paper: accuracy falls towards or below the single taxel as n grows.\n\n",
         e3.speed, e3.repeats, pct(e3.glcm3d), pct(e3.taxel_mean));
-    let mut t = Table::new(["taxels moved", "3D-GLCM (%)"]);
-    for ((n, m), s) in e3.n.iter().zip(&e3.mean).zip(&e3.std) {
-        t.row([n.to_string(), format!("{} ± {}", pct(*m), pct(*s))]);
+    let mut t = Table::new([
+        "taxels moved",
+        "3D-GLCM (%) [95 % interval]",
+        "std over draws (points)",
+    ]);
+    for (i, ((n, m), s)) in e3.n.iter().zip(&e3.mean).zip(&e3.std).enumerate() {
+        t.row([n.to_string(), pct_in(*m, e3.interval.get(i)), pct(*s)]);
     }
     out += &t.render();
     out += "\n";
@@ -349,9 +358,7 @@ fn e4(r: &Results, paper: Option<&Paper>) -> String {
     for (s, e) in r.e4.iter() {
         // The single taxel and 3D-GLCM are E1's, with E1's intervals.
         let e1 = r.e1.get(s);
-        let with = |v: f64, i: Option<&crate::classify::Interval>| {
-            i.map_or(pct(v), |i| format!("{} {}", pct(v), bracket(i)))
-        };
+        let with = pct_in;
         let mut row = vec![
             s.to_string(),
             with(e.taxel_mean, e1.map(|e| &e.taxel_mean_interval)),
@@ -395,37 +402,41 @@ fn e5(r: &Results, paper: Option<&Paper>) -> String {
         .map(|(s, p)| format!("{:.0} % of the slide at {s} mm/s", 100.0 * p))
         .collect();
     let mut out = format!("## E5: time to recognition\n\n\
-        3D-GLCM on the first part of the slide against the single taxel (mean over taxels) on all of it; accuracy (%) per share of the slide used, \"short\" where that part is shorter than one bin. The paper: 3D-GLCM matches at {}.\n\n", stated.join(" and "));
+        3D-GLCM on the first part of the slide against the single taxel (mean over taxels) on all of it; accuracy (%) per share of the slide used with its 95 % interval (bootstrap over recordings), \"short\" where that part is shorter than one bin. The paper: 3D-GLCM matches at {}.\n\n", stated.join(" and "));
     let fractions = e5_fractions(r);
-    let mut header = vec![
-        "speed (mm/s)".to_string(),
-        "single taxel, whole slide".into(),
-    ];
-    header.extend(fractions.iter().map(|p| format!("{:.0} %", 100.0 * p)));
-    header.push("first match".into());
-    if paper.is_some() {
-        header.push("paper: first match".into());
-    }
+    let speeds: Vec<Speed> = r.e5.iter().map(|(s, _)| s).collect();
+    let header = std::iter::once("accuracy (%) [95 % interval]".to_string())
+        .chain(speeds.iter().map(|s| format!("{s} mm/s")));
     let mut t = Table::new(header);
-    for (s, e) in r.e5.iter() {
-        let mut row = vec![s.to_string(), pct(e.taxel_full)];
-        row.extend(fractions.iter().map(|&p| {
+    t.row(
+        std::iter::once("single taxel, whole slide".to_string()).chain(
+            r.e5.values()
+                .map(|e| pct_in(e.taxel_full, e.taxel_full_interval.as_ref())),
+        ),
+    );
+    for &p in &fractions {
+        let cells = r.e5.values().map(|e| {
             let at = e.fractions.iter().position(|&q| q == p);
-            match at.map(|i| e.glcm3d.get(i).copied().flatten()) {
-                Some(Some(a)) => pct(a),
-                Some(None) => "short".into(),
+            match at.map(|i| (e.glcm3d.get(i).copied().flatten(), i)) {
+                Some((Some(a), i)) => pct_in(a, e.glcm3d_interval.get(i).and_then(Option::as_ref)),
+                Some((None, _)) => "short".into(),
                 None => "-".into(),
             }
-        }));
-        row.push(
-            e.first_match
-                .map_or("never".into(), |p| format!("{:.0} %", 100.0 * p)),
+        });
+        t.row(std::iter::once(format!("3D-GLCM, first {:.0} %", 100.0 * p)).chain(cells));
+    }
+    let share = |p: Option<f64>| p.map_or("never".into(), |p| format!("{:.0} %", 100.0 * p));
+    t.row(
+        std::iter::once("3D-GLCM first matches at".to_string())
+            .chain(r.e5.values().map(|e| share(e.first_match))),
+    );
+    if let Some(p) = paper {
+        t.row(
+            std::iter::once("paper: first match".to_string()).chain(speeds.iter().map(|&s| {
+                p.e5_first_match_at(s)
+                    .map_or("not stated".into(), |p| format!("{:.0} %", 100.0 * p))
+            })),
         );
-        if let Some(p) = paper {
-            let v = p.e5_first_match_at(s);
-            row.push(v.map_or("not stated".into(), |p| format!("{:.0} %", 100.0 * p)));
-        }
-        t.row(row);
     }
     out += &t.render();
     out += "\n";
@@ -539,25 +550,29 @@ fn e5c_shares(r: &Results) -> String {
     if fractions.is_empty() {
         return String::new();
     }
-    let mut out = "\nCausal against offline at E5's shares of the slide, accuracy (%) as causal / offline: causal classifies each test recording at the last bin boundary within that share of its slide with the whole-slide classifier; the offline E5 trains and tests on that share of every slide, zero-phase (\"short\": some share is shorter than one bin).\n\n".to_string();
-    let mut header = vec!["speed (mm/s)".to_string()];
-    header.extend(fractions.iter().map(|p| format!("{:.0} %", 100.0 * p)));
+    let mut out = "\nCausal against offline at E5's shares of the slide, accuracy (%) as causal / offline, each with its 95 % interval (bootstrap over recordings): causal classifies each test recording at the last bin boundary within that share of its slide with the whole-slide classifier; the offline E5 trains and tests on that share of every slide, zero-phase (\"short\": some share is shorter than one bin).\n\n".to_string();
+    let header = std::iter::once("share of the slide".to_string()).chain(
+        r.e5c
+            .iter()
+            .map(|(s, _)| format!("{s} mm/s: causal / offline")),
+    );
     let mut t = Table::new(header);
-    for (s, e) in r.e5c.iter() {
-        let mut row = vec![s.to_string()];
-        row.extend(
-            fractions
-                .iter()
-                .map(|&p| match e.fractions.iter().find(|f| f.fraction == p) {
-                    Some(f) => format!(
-                        "{} / {}",
-                        f.causal.map_or("short".into(), pct),
-                        f.offline.map_or("short".into(), pct)
-                    ),
-                    None => "-".into(),
-                }),
-        );
-        t.row(row);
+    let cell = |v: Option<f64>, i: Option<&crate::classify::Interval>| {
+        v.map_or("short".into(), |v| pct_in(v, i))
+    };
+    for &p in &fractions {
+        let cells = r
+            .e5c
+            .values()
+            .map(|e| match e.fractions.iter().find(|f| f.fraction == p) {
+                Some(f) => format!(
+                    "{} / {}",
+                    cell(f.causal, f.causal_interval.as_ref()),
+                    cell(f.offline, f.offline_interval.as_ref())
+                ),
+                None => "-".into(),
+            });
+        t.row(std::iter::once(format!("first {:.0} %", 100.0 * p)).chain(cells));
     }
     out += &t.render();
     out
@@ -644,19 +659,22 @@ fn e7(r: &Results) -> String {
 }
 
 fn e8(r: &Results) -> String {
-    let mut out = "## E8: robustness to k\n\nSingle taxel (mean over taxels) / 3D-GLCM accuracy (%) for each number of neighbours k. The paper: the outperformance is robust to k.\n\n".to_string();
-    let mut ks: Vec<usize> = r.e8.values().flat_map(|e| e.k.iter().copied()).collect();
-    ks.sort_unstable();
-    ks.dedup();
-    let header =
-        std::iter::once("speed (mm/s)".to_string()).chain(ks.iter().map(|k| format!("k = {k}")));
-    let mut t = Table::new(header);
+    let mut out = "## E8: robustness to k\n\nSingle taxel (mean over taxels) and 3D-GLCM accuracy (%) for each number of neighbours k, with 95 % intervals (bootstrap over recordings). The paper: the outperformance is robust to k.\n\n".to_string();
+    let mut t = Table::new([
+        "speed (mm/s)",
+        "k",
+        "single taxel (%) [95 % interval]",
+        "3D-GLCM (%) [95 % interval]",
+    ]);
     for (s, e) in r.e8.iter() {
-        let cells = ks.iter().map(|k| match e.k.iter().position(|x| x == k) {
-            Some(i) => format!("{} / {}", pct(e.taxel_mean[i]), pct(e.glcm3d[i])),
-            None => "-".into(),
-        });
-        t.row(std::iter::once(s.to_string()).chain(cells));
+        for (i, k) in e.k.iter().enumerate() {
+            t.row([
+                s.to_string(),
+                k.to_string(),
+                pct_in(e.taxel_mean[i], e.taxel_mean_interval.get(i)),
+                pct_in(e.glcm3d[i], e.glcm3d_interval.get(i)),
+            ]);
+        }
     }
     out += &t.render();
     out += "\n";

@@ -1,8 +1,8 @@
 //! E8: accuracy against the number of neighbours k, one panel per speed on one scale.
 
 use super::plot::{
-    hline, line_with_markers, mesh, multiples, number, panel_chart, x_ticks_at, Key, Multiples,
-    Swatch, GLCM3D, GREY, SINGLE,
+    band, hline, line_with_markers, mesh, multiples, number, panel_chart, x_ticks_at, Key,
+    Multiples, Swatch, GLCM3D, GREY, SINGLE,
 };
 use super::{panel_chance_note, panel_chances, FigureError};
 use crate::experiments::Results;
@@ -58,6 +58,14 @@ pub(crate) fn e8(r: &Results, source: &str) -> Result<String, FigureError> {
                 .map(|(&k, &a)| (k as f64, 100.0 * a))
                 .collect()
         };
+        let span = |intervals: &[crate::classify::Interval]| -> Vec<(f64, f64, f64)> {
+            e.k.iter()
+                .zip(intervals)
+                .map(|(&k, i)| (k as f64, 100.0 * i.lower, 100.0 * i.upper))
+                .collect()
+        };
+        band(&mut chart, &span(&e.taxel_mean_interval), SINGLE)?;
+        band(&mut chart, &span(&e.glcm3d_interval), GLCM3D)?;
         line_with_markers(&mut chart, &at(&e.taxel_mean), SINGLE, false)?;
         line_with_markers(&mut chart, &at(&e.glcm3d), GLCM3D, false)
     })
@@ -67,7 +75,7 @@ pub(crate) fn e8(r: &Results, source: &str) -> Result<String, FigureError> {
 pub(crate) fn e8_caption(r: &Results) -> String {
     let speeds: Vec<Speed> = r.e8.iter().map(|(s, _)| s).collect();
     format!(
-        "Accuracy against the number of neighbours k of the KNN classifier, one panel per speed on one scale: single taxel (mean over taxels, blue) and 3D-GLCM (vermillion); {}.",
+        "Accuracy against the number of neighbours k of the KNN classifier, one panel per speed on one scale: single taxel (mean over taxels, blue) and 3D-GLCM (vermillion), shaded: the table's 95 % intervals; {}.",
         panel_chance_note(r, &speeds)
     )
 }

@@ -30,7 +30,7 @@ pub(crate) fn e3(
     let chance = chance_at(e, e2, all_chance);
     let mut keys = vec![
         Key::new(
-            format!("3D-GLCM, mean ± std of {} draws", e.repeats),
+            format!("3D-GLCM, mean of {} draws, {}", e.repeats, spread_name(e)),
             Swatch::Points(GLCM3D),
         ),
         Key::new("single taxel (mean, unperturbed)", Swatch::Dashed(SINGLE)),
@@ -63,16 +63,13 @@ pub(crate) fn e3(
         if let Some(c) = chance {
             hline(&mut chart, c, GREY, 6)?;
         }
-        for ((&n, &m), &s) in e.n.iter().zip(&e.mean).zip(&e.std) {
-            let (m, s) = (100.0 * m, 100.0 * s);
-            if s > 0.0 {
-                error_bar(
-                    &mut chart,
-                    n as f64,
-                    (m - s).max(0.0),
-                    (m + s).min(100.0),
-                    0.2,
-                )?;
+        for (i, ((&n, &m), &s)) in e.n.iter().zip(&e.mean).zip(&e.std).enumerate() {
+            let (lo, hi) = match e.interval.get(i) {
+                Some(ci) => (100.0 * ci.lower, 100.0 * ci.upper),
+                None => (100.0 * (m - s), 100.0 * (m + s)),
+            };
+            if hi > lo {
+                error_bar(&mut chart, n as f64, lo.max(0.0), hi.min(100.0), 0.2)?;
             }
         }
         let points: Vec<(f64, f64)> = std::iter::once((0.0, 100.0 * e.glcm3d))
@@ -86,10 +83,24 @@ pub(crate) fn e3(
     })
 }
 
+/// What E3's error bars show: the 95 % interval, or ± 1 std for results without one.
+fn spread_name(e: &E3) -> &'static str {
+    if e.interval.len() == e.n.len() {
+        "95 % interval"
+    } else {
+        "± 1 std"
+    }
+}
+
 /// E3's caption.
 pub(crate) fn e3_caption(e: &E3) -> String {
+    let bars = if e.interval.len() == e.n.len() {
+        "error bars: the table's 95 % intervals over recordings and draws"
+    } else {
+        "error bars: ± 1 std over draws"
+    };
     format!(
-        "3D-GLCM accuracy at {} mm/s when n taxels swap places at random (each recording its own draw), mean ± 1 std over {} draws; n = 0 is the unperturbed 3D-GLCM ({:.1} %). Dashed lines: the single taxel's mean over taxels ({:.1} %) and chance.",
+        "3D-GLCM accuracy at {} mm/s when n taxels swap places at random (each recording its own draw), mean over {} draws ({bars}); n = 0 is the unperturbed 3D-GLCM ({:.1} %). Dashed lines: the single taxel's mean over taxels ({:.1} %) and chance.",
         e.speed,
         e.repeats,
         100.0 * e.glcm3d,

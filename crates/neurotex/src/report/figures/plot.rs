@@ -248,6 +248,24 @@ pub(crate) fn vline(chart: &mut Chart, x: f64, colour: RGBColor, dash: i32) -> D
     Ok(())
 }
 
+/// A translucent band in `colour` between the lower and upper ends of `points`
+/// (`(x, lo, hi)`, in ascending x): a series' interval along its line.
+pub(crate) fn band(chart: &mut Chart, points: &[(f64, f64, f64)], colour: RGBColor) -> Drawn {
+    if points.len() < 2 {
+        return Ok(());
+    }
+    let outline: Vec<(f64, f64)> = points
+        .iter()
+        .map(|&(x, lo, _)| (x, lo))
+        .chain(points.iter().rev().map(|&(x, _, hi)| (x, hi)))
+        .collect();
+    chart.draw_series(std::iter::once(Polygon::new(
+        outline,
+        colour.mix(0.2).filled(),
+    )))?;
+    Ok(())
+}
+
 /// An error bar from `lo` to `hi` at `x`, with caps `cap` wide (in x units).
 pub(crate) fn error_bar(chart: &mut Chart, x: f64, lo: f64, hi: f64, cap: f64) -> Drawn {
     let style = BLACK.stroke_width(1);

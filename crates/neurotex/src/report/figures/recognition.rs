@@ -3,8 +3,8 @@
 use plotters::prelude::*;
 
 use super::plot::{
-    hline, line_with_markers, mesh, multiples, number, panel_chart, vline, Canvas, Chart, Key,
-    Multiples, Swatch, GLCM3D, GREY, SINGLE,
+    band, hline, line_with_markers, mesh, multiples, number, panel_chart, vline, Canvas, Chart,
+    Key, Multiples, Swatch, GLCM3D, GREY, SINGLE,
 };
 use super::{panel_chance_note, panel_chances, FigureError};
 use crate::experiments::{E5CausalSpeed, Results};
@@ -67,6 +67,16 @@ pub(crate) fn e5(r: &Results, paper: Option<&Paper>, source: &str) -> Result<Str
             .zip(&e.glcm3d)
             .filter_map(|(&p, a)| a.map(|a| (100.0 * p, 100.0 * a)))
             .collect();
+        let spans: Vec<(f64, f64, f64)> = e
+            .fractions
+            .iter()
+            .zip(&e.glcm3d_interval)
+            .filter_map(|(&p, i)| {
+                i.as_ref()
+                    .map(|i| (100.0 * p, 100.0 * i.lower, 100.0 * i.upper))
+            })
+            .collect();
+        band(&mut chart, &spans, GLCM3D)?;
         line_with_markers(&mut chart, &points, GLCM3D, false)?;
         let short = e
             .fractions
@@ -93,7 +103,7 @@ pub(crate) fn e5_caption(r: &Results, paper: Option<&Paper>) -> String {
             })
             .collect();
     format!(
-        "Time to recognition, one panel per speed on one scale: 3D-GLCM accuracy using only the first part of each slide (vermillion) against the single taxel's accuracy on the whole slide (mean over taxels, dashed blue); {}.{} 3D-GLCM first reaches the single taxel at {}.",
+        "Time to recognition, one panel per speed on one scale: 3D-GLCM accuracy using only the first part of each slide (vermillion, shaded: the table's 95 % intervals) against the single taxel's accuracy on the whole slide (mean over taxels, dashed blue); {}.{} 3D-GLCM first reaches the single taxel at {}.",
         panel_chance_note(r, &r.e5.iter().map(|(s, _)| s).collect::<Vec<_>>()),
         if paper.is_some() {
             " Black dashed: the share at which the paper's 3D-GLCM matched its single taxel, where the paper states it."

@@ -94,7 +94,7 @@ pub(crate) fn wide() -> Results {
         .iter()
         .enumerate()
         .map(|(i, &s)| {
-            let glcm3d = fractions
+            let glcm3d: Vec<Option<f64>> = fractions
                 .iter()
                 .map(|&p| (p > 0.1 || i > 3).then_some(acc[i] * (0.4 + 0.6 * p)))
                 .collect();
@@ -102,8 +102,10 @@ pub(crate) fn wide() -> Results {
                 s,
                 E5Speed {
                     fractions: fractions.clone(),
+                    glcm3d_interval: glcm3d.iter().map(|a| a.map(interval)).collect(),
                     glcm3d,
                     taxel_full: acc[i] * 0.6,
+                    taxel_full_interval: Some(interval(acc[i] * 0.6)),
                     first_match: Some(0.3),
                     longest_vs_shortest: None,
                 },
@@ -175,7 +177,7 @@ pub(crate) fn wide() -> Results {
         .iter()
         .enumerate()
         .map(|(i, &s)| {
-            let shift = |d: f64| {
+            let shift = |d: f64| -> Vec<f64> {
                 ks.iter()
                     .map(|&k| (acc[i] * d - 0.01 * k as f64).max(0.0))
                     .collect()
@@ -184,6 +186,8 @@ pub(crate) fn wide() -> Results {
                 s,
                 E8Speed {
                     k: ks.clone(),
+                    taxel_mean_interval: shift(0.6).into_iter().map(interval).collect(),
+                    glcm3d_interval: shift(1.0).into_iter().map(interval).collect(),
                     taxel_mean: shift(0.6),
                     glcm3d: shift(1.0),
                     glcm3d_vs_taxel: Vec::new(),
@@ -282,6 +286,7 @@ pub(crate) fn wide() -> Results {
             n: (2..=16).collect(),
             mean: (2..=16).map(|k| 0.7 - 0.01 * k as f64).collect(),
             std: (2..=16).map(|k| 0.02 + 0.002 * k as f64).collect(),
+            interval: (2..=16).map(|k| interval(0.7 - 0.01 * k as f64)).collect(),
             glcm3d: 0.71,
             taxel_mean: 0.36,
             unperturbed_vs_moved: Vec::new(),
@@ -735,7 +740,9 @@ fn e5_fraction_rows(
             fraction: p,
             time_s: p * slide_s,
             causal: Some(a * (0.3 + 0.6 * p)),
+            causal_interval: Some(interval(a * (0.3 + 0.6 * p))),
             offline: Some(a * (0.4 + 0.6 * p)),
+            offline_interval: Some(interval(a * (0.4 + 0.6 * p))),
         })
         .collect()
 }
