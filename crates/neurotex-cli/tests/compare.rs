@@ -1,4 +1,4 @@
-//! `neurotex compare` through the binary: the JSON the issue asks for, the same splits as
+//! `neurotex compare` through the binary: its JSON, the same splits as
 //! `evaluate`, the files of `--out`, and bad options.
 
 use serde_json::Value;

@@ -44,10 +44,11 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("## E1") && report.contains("| 5 |") && report.contains("paper"));
-    // E1 and E4 over the default eight encodings, with the section that explains them
+    // E1, E4 and E6 over the default eight encodings, with the section that explains them
     let encodings = &json["encoder_sensitivity"];
     assert_eq!(encodings["encodings"], 8);
     assert_eq!(json["e1"]["5"]["encodings"], 8);
+    assert_eq!(json["e6"]["5"]["encodings"], 8);
     let over = encodings["speeds"]["5"]["glcm3d"]["per_encoding"]
         .as_array()
         .unwrap();

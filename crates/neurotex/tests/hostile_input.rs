@@ -24,8 +24,9 @@ const HUGE: [&str; 6] = [
 struct Mutant {
     what: String,
     bytes: Vec<u8>,
-    /// Whether it sets a size the readers do not bound yet (pending issue 14's limits).
-    pending: bool,
+    /// Whether it sets a huge size (an NPY shape, a layout's rows, columns or channel map),
+    /// which the readers must refuse before allocating.
+    huge: bool,
 }
 
 /// The runs of ASCII digits in `bytes`, as (start, end), at most 24.
@@ -46,9 +47,8 @@ fn digit_runs(bytes: &[u8]) -> Vec<(usize, usize)> {
     runs
 }
 
-/// Whether position `at` sets a size that issue 14's resource limits (another change) will
-/// bound: inside an NPY header (its shape), or on a `rows`, `cols` or `channel_map` line of
-/// a layout.
+/// Whether position `at` sets a size the readers' resource limits bound: inside an NPY
+/// header (its shape), or on a `rows`, `cols` or `channel_map` line of a layout.
 fn sets_unbounded_size(bytes: &[u8], at: usize) -> bool {
     let before = &bytes[..at];
     let in_npy_header = before
@@ -76,7 +76,7 @@ fn mutants(seed: &[u8]) -> Vec<Mutant> {
         out.push(Mutant {
             what: format!("bit {} of byte {i} flipped", i % 8),
             bytes,
-            pending: false,
+            huge: false,
         });
     }
     for len in [0, 1, n / 4, n / 2, 3 * n / 4, n.saturating_sub(1)] {
@@ -84,7 +84,7 @@ fn mutants(seed: &[u8]) -> Vec<Mutant> {
         out.push(Mutant {
             what: format!("cut to {len} bytes"),
             bytes,
-            pending: false,
+            huge: false,
         });
     }
     for (start, end) in digit_runs(seed) {
@@ -94,25 +94,25 @@ fn mutants(seed: &[u8]) -> Vec<Mutant> {
             out.push(Mutant {
                 what: format!("bytes {start}..{end} set to {huge}"),
                 bytes,
-                pending: big && sets_unbounded_size(seed, start),
+                huge: big && sets_unbounded_size(seed, start),
             });
         }
     }
     out
 }
 
-/// Runs every seed and mutant with `pending` as given; returns how many ran and the panics.
-fn run_all(pending: bool) -> (usize, Vec<String>) {
+/// Runs every seed and mutant with `huge` as given; returns how many ran and the panics.
+fn run_all(huge: bool) -> (usize, Vec<String>) {
     let mut ran = 0;
     let mut panics = Vec::new();
     for (target, seed) in harness::seeds() {
         let seed_itself = Mutant {
             what: "the seed".into(),
             bytes: seed.clone(),
-            pending: false,
+            huge: false,
         };
         for m in std::iter::once(seed_itself).chain(mutants(&seed)) {
-            if m.pending != pending {
+            if m.huge != huge {
                 continue;
             }
             ran += 1;

@@ -338,8 +338,8 @@ fn digest(rec: &neurotex::recording::Recording, forces: &[(f64, f64)]) -> u64 {
 /// digests of the simulator's output, so a rewrite that moves any sample, phase or force by
 /// one bit fails here. A change to the output must update them on purpose and say why.
 /// Last taken when the sensor noise moved to its own xoshiro256++ generator with one draw
-/// per taxel and step, and the contact solve's sum was split four ways (issue 15, for
-/// speed; the physics and the noise's distribution are unchanged, the draws are new).
+/// per taxel and step, and the contact solve's sum was split four ways (for speed; the
+/// physics and the noise's distribution are unchanged, the draws are new).
 #[test]
 fn full_protocol_bits_match_the_stored_digests() {
     const STORED: [(&str, [u64; 3]); 8] = [

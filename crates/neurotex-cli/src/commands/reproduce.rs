@@ -57,7 +57,7 @@ pub struct ReproduceArgs {
     /// groups than folds at a speed, each group is held out in turn.
     #[arg(long = "group-by")]
     pub group_by: Option<String>,
-    /// Encodings of every recording behind E1's and E4's accuracies: as run, and N - 1 more
+    /// Encodings of every recording behind E1's, E4's, E6's and E8's accuracies: as run, and N - 1 more
     /// with independent rounding-level perturbations of the input (each sample times
     /// 1 + u x 1e-12). Spiking neurons near threshold turn such changes into moved spikes;
     /// the accuracies are means over the encodings and their intervals resample encodings

@@ -835,9 +835,9 @@ def reproduce(
     counts, fractions and gains (the CI run). ``seed`` also seeds the CV shuffles and the
     perturbations. ``k``, ``standardize``: the KNN. ``group_by``: keep each group of this
     manifest column in one fold. ``encoder_draws``: encodings of every recording behind
-    E1's and E4's accuracies (as run, then with independent rounding-level input
-    perturbations; their intervals resample encodings as well as recordings; default 5,
-    1 for the input as run only). ``stage_options`` are :func:`features`' (``gain``, also
+    the accuracies of E1, E4, E6 and E8 (as run, then with independent rounding-level
+    input perturbations; their intervals resample encodings as well as recordings;
+    default 8, 1 for the input as run only). ``stage_options`` are :func:`features`' (``gain``, also
     ``"auto"``, ``preset``, ``cutoff``, ``levels``, ...).
 
     The run takes minutes (the full paper-scale run with 5 seeds much longer) with the GIL

@@ -1,5 +1,5 @@
 """Times the peers of neurotex's hot stages on this machine, for ratios against the
-criterion benches (run both in one session: these machines are noisy).
+criterion benches (run both back to back on one host: these machines are noisy).
 
     python -m venv /tmp/peers && /tmp/peers/bin/pip install numpy scikit-learn \
         six pykwalify pywavelets simpleitk setuptools wheel versioneer

@@ -506,7 +506,8 @@ fn direction(
 /// gradient tolerance. `a = A_SHARE / k`: at uniform probabilities a row's curvature is
 /// `1/k`, but at the minimum of a training set the classes separate well, most rows are
 /// fitted with probabilities near 0 or 1 and their curvature is far smaller. `A_SHARE`
-/// was measured, not derived (`docs/implementation.md`, issue 15, session 17).
+/// was measured, not derived: of `(1, 0.3, 0.1, 0.03, 0.01, 0.003) / k`, `0.01 / k` gave
+/// the shortest total fit time of E9's logistic regressions on a simulated dataset.
 struct Preconditioner {
     dims: usize,
     /// `a`.

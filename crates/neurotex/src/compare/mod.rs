@@ -1,4 +1,4 @@
-//! Which encoding, feature method and classifier suit a dataset best (issue 11): every
+//! Which encoding, feature method and classifier suit a dataset best: every
 //! candidate is evaluated on the same splits of the same recordings, ranked with a 95 %
 //! interval, and compared with the paper's method (3D-GLCM + KNN) by a paired test.
 //!

@@ -408,6 +408,7 @@ mod tests {
             speed,
             E8Speed {
                 k: vec![1, 5],
+                encodings: 1,
                 taxel_mean: vec![0.4, 0.4],
                 glcm3d: vec![0.8, 0.8],
                 taxel_mean_interval: Vec::new(),

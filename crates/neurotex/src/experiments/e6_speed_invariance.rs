@@ -2,26 +2,33 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{compare, Comparison, Context, Skip, Stop};
-use crate::analysis::{evaluate, Columns, Split};
+use super::encodings::OverEncodings;
+use super::{compare_encodings, Comparison, Context, Skip, Stop};
+use crate::analysis::{evaluate, Columns, Outcome, Split};
 use crate::classify::Interval;
 use crate::recording::Selection;
 use crate::values::{BySpeed, Speed};
+use rayon::prelude::*;
 
-/// E6 at one held-out speed.
+/// E6 at one held-out speed; accuracies are means over encodings, as E1's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E6Speed {
     /// Training speeds.
     pub train: Vec<Speed>,
-    /// Single taxel mean.
+    /// Single taxel, mean over taxels (and over encodings).
     pub taxel_mean: f64,
-    /// 3D-GLCM.
+    /// 3D-GLCM (mean over encodings).
     pub glcm3d: f64,
-    /// 95 % interval of the single taxel's mean (bootstrap over the held-out recordings).
+    /// Encodings of each recording the accuracies and intervals are over (1: as run).
+    #[serde(default = "super::one")]
+    pub encodings: usize,
+    /// 95 % interval of the single taxel's mean (bootstrap over the held-out recordings and
+    /// the encodings).
     pub taxel_mean_interval: Interval,
-    /// 95 % interval of 3D-GLCM (bootstrap over the held-out recordings).
+    /// 95 % interval of 3D-GLCM (bootstrap over the held-out recordings and the encodings).
     pub glcm3d_interval: Interval,
-    /// 3D-GLCM against the single taxel (mean over taxels) on the held-out recordings.
+    /// 3D-GLCM against the single taxel (mean over taxels) on the held-out recordings and
+    /// the same encodings.
     pub glcm3d_vs_taxel: Comparison,
 }
 
@@ -43,15 +50,37 @@ pub fn e6_speed_invariance(c: &Context) -> Result<BySpeed<E6Speed>, Stop> {
             test: Selection::speeds(&[test]),
         };
         let knn = c.params.knn();
-        let taxel = evaluate(&c.tables.taxel, Columns::EachTaxel, &split, knn)?;
-        let glcm3d = evaluate(&c.tables.glcm3d, Columns::All, &split, knn)?;
+        // Every encoding's two evaluations (each deterministic), as run first.
+        let outcomes = c
+            .tables
+            .encoding_tables()
+            .into_par_iter()
+            .map(|(taxel, glcm3d)| {
+                let (t, g) = rayon::join(
+                    || evaluate(taxel, Columns::EachTaxel, &split, knn),
+                    || evaluate(glcm3d, Columns::All, &split, knn),
+                );
+                Ok((t?, g?))
+            })
+            .collect::<crate::Result<Vec<(Outcome, Outcome)>>>()?;
+        let taxel: Vec<&Outcome> = outcomes.iter().map(|o| &o.0).collect();
+        let glcm3d: Vec<&Outcome> = outcomes.iter().map(|o| &o.1).collect();
+        let (t, g) = (
+            OverEncodings::of(&taxel, c.params.seed)?,
+            OverEncodings::of(&glcm3d, c.params.seed)?,
+        );
         let e6 = E6Speed {
             train,
-            taxel_mean: taxel.accuracy,
-            glcm3d: glcm3d.accuracy,
-            taxel_mean_interval: taxel.accuracy_interval(c.params.seed)?,
-            glcm3d_interval: glcm3d.accuracy_interval(c.params.seed)?,
-            glcm3d_vs_taxel: compare(("3D-GLCM", &glcm3d), ("single taxel", &taxel), c.params)?,
+            taxel_mean: t.mean(),
+            glcm3d: g.mean(),
+            encodings: outcomes.len(),
+            taxel_mean_interval: t.combined,
+            glcm3d_interval: g.combined,
+            glcm3d_vs_taxel: compare_encodings(
+                ("3D-GLCM", &glcm3d),
+                ("single taxel", &taxel),
+                c.params,
+            )?,
         };
         out.insert(test, e6);
     }
@@ -70,6 +99,36 @@ mod tests {
         assert_eq!(e6.len(), 2);
         for (test, e) in e6.iter() {
             assert!(!e.train.contains(&test) && e.train.len() == 1);
+        }
+    }
+
+    #[test]
+    fn accuracies_are_means_over_every_encodings_own_evaluation() {
+        let run = small_run();
+        let c = run.context();
+        let e6 = e6_speed_invariance(&c).unwrap();
+        let tables = c.tables.encoding_tables();
+        assert_eq!(tables.len(), run.params.encoder_draws);
+        for (test, e) in e6.iter() {
+            assert_eq!(e.encodings, run.params.encoder_draws);
+            let split = Split::Where {
+                train: Selection::speeds(&e.train),
+                test: Selection::speeds(&[test]),
+            };
+            let (mut taxel, mut glcm3d) = (Vec::new(), Vec::new());
+            for (t, g) in &tables {
+                let knn = c.params.knn();
+                taxel.push(
+                    evaluate(t, Columns::EachTaxel, &split, knn)
+                        .unwrap()
+                        .accuracy,
+                );
+                glcm3d.push(evaluate(g, Columns::All, &split, knn).unwrap().accuracy);
+            }
+            let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+            assert!((e.taxel_mean - mean(&taxel)).abs() < 1e-12);
+            assert!((e.glcm3d - mean(&glcm3d)).abs() < 1e-12);
+            assert!((e.glcm3d_interval.estimate - e.glcm3d).abs() < 1e-12);
         }
     }
 }

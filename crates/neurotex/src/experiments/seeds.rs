@@ -19,7 +19,7 @@ use crate::error::Result;
 /// Runs every analysis on one simulated dataset per seed (`simulate(seed)` gives the
 /// design) and returns the first dataset's results with [`AcrossSeeds`] over all of them
 /// attached (none with a single seed). The further datasets skip what only the first one's
-/// report shows: the numerical sensitivity check, E5c, E7 and E9
+/// report shows: E5c, E7 and E9
 /// ([`ValidReproduceParams::for_further_datasets`]). They run one after another beside the
 /// first, so at most two datasets are in memory; the results do not depend on it (every
 /// analysis is deterministic), but the first dataset's clock (`timing_s`) is then shared

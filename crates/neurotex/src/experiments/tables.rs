@@ -35,6 +35,18 @@ pub struct Tables {
     /// The headline evaluations of each further encoding ([`Prepared::perturbed`]), on the
     /// same folds.
     pub perturbed: Vec<BySpeed<Headline>>,
+    /// The single-taxel and 3D-GLCM tables of each further encoding, in the order of
+    /// `perturbed` (the analyses beyond the headline that run over encodings read them).
+    pub perturbed_tables: Vec<EncodingTables>,
+}
+
+/// The single-taxel and 3D-GLCM feature tables of one further encoding.
+#[derive(Debug, Clone)]
+pub struct EncodingTables {
+    /// Single-taxel statistics of every taxel.
+    pub taxel: FeatureTable,
+    /// 3D-GLCM features.
+    pub glcm3d: FeatureTable,
 }
 
 impl Tables {
@@ -49,23 +61,35 @@ impl Tables {
         let glcm3d = table(encoded, Method::Glcm3d, params)?;
         let glcm2d = table(encoded, Method::Glcm2d, params)?;
         let headline = evaluate_headline(&[&taxel, &glcm3d, &glcm2d], &prepared.speeds, params)?;
-        let perturbed = prepared
+        let (perturbed, perturbed_tables) = prepared
             .perturbed
             .iter()
             .map(|encoded| {
                 let tables = [Method::Taxel, Method::Glcm3d, Method::Glcm2d]
                     .map(|m| table(encoded, m, params));
                 let [t, g3, g2] = tables;
-                evaluate_headline(&[&t?, &g3?, &g2?], &prepared.speeds, params)
+                let (taxel, glcm3d) = (t?, g3?);
+                let h = evaluate_headline(&[&taxel, &glcm3d, &g2?], &prepared.speeds, params)?;
+                Ok((h, EncodingTables { taxel, glcm3d }))
             })
-            .collect::<Result<_>>()?;
+            .collect::<Result<Vec<_>>>()?
+            .into_iter()
+            .unzip();
         Ok(Tables {
             taxel,
             glcm3d,
             glcm2d,
             headline,
             perturbed,
+            perturbed_tables,
         })
+    }
+
+    /// The single-taxel and 3D-GLCM tables of every encoding: as run, then each further one.
+    pub fn encoding_tables(&self) -> Vec<(&FeatureTable, &FeatureTable)> {
+        std::iter::once((&self.taxel, &self.glcm3d))
+            .chain(self.perturbed_tables.iter().map(|e| (&e.taxel, &e.glcm3d)))
+            .collect()
     }
 
     /// The headline evaluations at `speed` of every encoding: as run, then each further one.

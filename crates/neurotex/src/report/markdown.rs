@@ -175,7 +175,7 @@ fn across_seeds(r: &Results) -> String {
          The analyses ran on {n} independent simulated datasets of the same design (simulation seeds {}); the sections below show the first. Each headline accuracy is given here as its mean over the {n} datasets with a 95 % Student-t interval over them (the spread a new dataset of this design would see; narrower than the range when datasets agree), the first dataset's value and the range. Each claim is judged on every dataset separately.{}\n\n",
         list(&a.seeds),
         r.encoder_sensitivity.as_ref().map_or(String::new(), |s| format!(
-            " The first dataset's E1 and E4 values are means over its {} encodings; each further dataset is one encoding of new recordings, so the spread over datasets holds the encoder's variability too.",
+            " On every dataset, E1, E4, E6 and E8 are means over {} encodings of its recordings, as in the sections below; E3 uses the encoding as run.",
             s.encodings
         ))
     );
@@ -237,7 +237,7 @@ fn verdict_counts(verdicts: &[crate::experiments::Verdict]) -> String {
 fn encodings_note(r: &Results) -> String {
     r.encoder_sensitivity.as_ref().map_or(String::new(), |s| {
         format!(
-            " E1 and E4 are means over {} encodings of every recording, and their intervals resample the encodings too (see The encoder's sensitivity); the other analyses, and E1's responsive and best taxels, use the encoding as run.",
+            " E1, E4, E6 and E8 are means over {} encodings of every recording, and their intervals resample the encodings too (see The encoder's sensitivity); the other analyses, and E1's responsive and best taxels, use the encoding as run.",
             s.encodings
         )
     })
@@ -659,7 +659,11 @@ fn e7(r: &Results) -> String {
 }
 
 fn e8(r: &Results) -> String {
-    let mut out = "## E8: robustness to k\n\nSingle taxel (mean over taxels) and 3D-GLCM accuracy (%) for each number of neighbours k, with 95 % intervals (bootstrap over recordings). The paper: the outperformance is robust to k.\n\n".to_string();
+    let over = match r.e8.values().next().map_or(1, |e| e.encodings) {
+        1 => "recordings".to_string(),
+        n => format!("recordings and {n} encodings, as E1"),
+    };
+    let mut out = format!("## E8: robustness to k\n\nSingle taxel (mean over taxels) and 3D-GLCM accuracy (%) for each number of neighbours k, with 95 % intervals (bootstrap over {over}). The paper: the outperformance is robust to k.\n\n");
     let mut t = Table::new([
         "speed (mm/s)",
         "k",
@@ -786,7 +790,7 @@ fn encoder_sensitivity(r: &Results) -> String {
     };
     let out = format!(
         "## The encoder's sensitivity\n\n\
-         Spiking neurons turn a signal into threshold crossings: a neuron near its threshold fires a step earlier or later, or once more or less, when its input moves by far less than any sensor resolves, and those spikes move features and sometimes predictions. So E1 and E4 classify every recording under {n} encodings: as run, and {more} more with each input sample multiplied by 1 + u x {eps:e} (u uniform in [-1, 1), independent). Their accuracies are means over the encodings, their intervals resample encodings as well as recordings, and their claims are judged on those. One encoding's accuracy differs from another's by up to {spread} points here; the other analyses use the encoding as run, so a difference between them smaller than that is within the encoder's noise.\n\n",
+         Spiking neurons turn a signal into threshold crossings: a neuron near its threshold fires a step earlier or later, or once more or less, when its input moves by far less than any sensor resolves, and those spikes move features and sometimes predictions. So E1, E4, E6 and E8 classify every recording under {n} encodings: as run, and {more} more with each input sample multiplied by 1 + u x {eps:e} (u uniform in [-1, 1), independent). Their accuracies are means over the encodings, their intervals resample encodings as well as recordings, and their claims are judged on those. One encoding's accuracy differs from another's by up to {spread} points here; the other analyses use the encoding as run, so a difference between them smaller than that is within the encoder's noise.\n\n",
         n = s.encodings,
         more = s.encodings - 1,
         eps = s.perturbation,

@@ -164,6 +164,7 @@ pub(crate) fn wide() -> Results {
                 E6Speed {
                     train,
                     taxel_mean: 0.3,
+                    encodings: 1,
                     glcm3d: acc[i] * 0.8,
                     taxel_mean_interval: interval(0.3),
                     glcm3d_interval: interval(acc[i] * 0.8),
@@ -186,6 +187,7 @@ pub(crate) fn wide() -> Results {
                 s,
                 E8Speed {
                     k: ks.clone(),
+                    encodings: 1,
                     taxel_mean_interval: shift(0.6).into_iter().map(interval).collect(),
                     glcm3d_interval: shift(1.0).into_iter().map(interval).collect(),
                     taxel_mean: shift(0.6),
