@@ -46,8 +46,8 @@ enum Command {
     Predict(predict::PredictArgs),
     /// Simulate the paper's rig (8 textures, 4x4 taxels, 1 N, 90 mm slides) into a dataset folder.
     Simulate(simulate::SimulateArgs),
-    /// Run every analysis of the paper (E0-E8) and write a report with figures; without
-    /// --dataset, on the built-in simulated rig.
+    /// Run every analysis of the paper (E0-E8), and E5c and E9 beyond it, and write a
+    /// report with figures; without --dataset, on the built-in simulated rig.
     Reproduce(reproduce::ReproduceArgs),
     /// Classify a live taxel stream (standard input, a file, TCP or UDP) frame by frame with
     /// a model trained with --causal: one JSON line per 200 ms bin, one per episode's end.

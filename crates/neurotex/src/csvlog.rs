@@ -609,8 +609,11 @@ fn check_no_stamps_among_channels(
     }
     let message = format!(
         "column `{}` is named like time stamps and rises on every row, but no time column \
-         was chosen, so it would be read as a taxel: pass --time-column {} (and --time-unit \
-         if it is not in ms), or choose the taxel columns with --channels",
+         was chosen, so it would be read as a taxel: name it as the time column \
+         (`import csv --time-column {}`, or `time_column = \"{}\"` in the layout.toml given \
+         with these files, with its unit if it is not ms), or choose the taxel columns \
+         (`--channels`, or `channels` in the layout)",
+        excerpt(name),
         excerpt(name),
         excerpt(name),
     );

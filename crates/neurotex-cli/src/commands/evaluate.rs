@@ -269,7 +269,7 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         }
         println!("{}", serde_json::to_string(&value)?);
     } else {
-        print_outcome(&outcome, method.name(), &split, grid.cols());
+        print_outcome(&outcome, method.name(), &split, grid.cols(), args.seed)?;
         if let Some(taxels) = taxels {
             print_taxels(taxels, &outcome);
         }
@@ -310,7 +310,7 @@ fn evaluate_spike_timing(
         value["accuracy_interval"] = serde_json::to_value(interval)?;
         println!("{}", serde_json::to_string(&value)?);
     } else {
-        print_outcome(&outcome, VAN_ROSSUM, split, grid.cols());
+        print_outcome(&outcome, VAN_ROSSUM, split, grid.cols(), args.seed)?;
     }
     Ok(())
 }
@@ -353,7 +353,13 @@ fn print_taxels(taxels: &TaxelDiagnostics, outcome: &Outcome) {
 
 /// Prints the outcome as text: what was run, the accuracy (per taxel when every taxel was
 /// evaluated) and the confusion matrix.
-fn print_outcome(outcome: &Outcome, method: &str, split: &Split, cols: usize) {
+fn print_outcome(
+    outcome: &Outcome,
+    method: &str,
+    split: &Split,
+    cols: usize,
+    seed: u64,
+) -> Result<()> {
     let how = match split {
         Split::CrossValidation {
             cv,
@@ -386,7 +392,19 @@ fn print_outcome(outcome: &Outcome, method: &str, split: &Split, cols: usize) {
     };
     println!("method {method}: {} samples, {how}", outcome.n);
     print_accuracy(outcome, cols);
+    // No accuracy without its uncertainty and the level a guess reaches.
+    let interval = outcome.accuracy_interval(seed)?;
+    let metrics = Metrics::from_confusion(&outcome.confusion);
+    println!(
+        "95 % interval [{:.1}%, {:.1}%] (bootstrap over recordings); chance {:.1}% (one over {} classes), {:.1}% always answering the most frequent class",
+        100.0 * interval.lower,
+        100.0 * interval.upper,
+        100.0 * metrics.chance_uniform,
+        metrics.classes_present,
+        100.0 * metrics.chance_majority
+    );
     print_confusion(outcome);
+    Ok(())
 }
 
 /// The recordings cross-validation runs over, as text.

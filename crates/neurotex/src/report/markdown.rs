@@ -44,7 +44,7 @@ fn paper_cell(v: Option<f64>) -> String {
 pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
     let paper = ctx.paper();
     [
-        header(ctx),
+        header(r, ctx),
         data(r, ctx),
         summary(r),
         across_seeds(r),
@@ -67,12 +67,24 @@ pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
     .concat()
 }
 
-fn header(ctx: &ReportContext) -> String {
+fn header(r: &Results, ctx: &ReportContext) -> String {
+    let beyond: Vec<&str> = [
+        (!r.e5c.is_empty()).then_some("E5c (a live stream's time to recognition)"),
+        r.e9.is_some()
+            .then_some("E9 (the best of `neurotex compare`'s candidates)"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let beyond = match beyond.as_slice() {
+        [] => String::new(),
+        names => format!(", and beyond it {}", names.join(" and ")),
+    };
     format!(
         "# neurotex reproduction of Gupta, Nakagawa, Lepora and Thakor\n\n\
-         \"Spatio-temporal encoding improves neuromorphic tactile texture classification\": every analysis (E0-E8) run on the data below. **Our numbers are not the paper's**: we do not have its recordings, so the paper's values stand beside ours for comparison only; nothing was tuned to approach them.\n\n\
+         \"Spatio-temporal encoding improves neuromorphic tactile texture classification\": every analysis of the paper (E0-E8) run on the data below{}. **Our numbers are not the paper's**: we do not have its recordings, so the paper's values stand beside ours for comparison only; nothing was tuned to approach them.\n\n\
          Produced by `{}` in {:.1} s.\n\n",
-        ctx.command, ctx.total_seconds
+        beyond, ctx.command, ctx.total_seconds
     )
 }
 
@@ -233,11 +245,11 @@ fn verdict_counts(verdicts: &[crate::experiments::Verdict]) -> String {
     parts.join(", ")
 }
 
-/// What E1's and E4's numbers are over, when the run has several encodings.
+/// What E1's, E4's, E6's and E8's numbers are over, when the run has several encodings.
 fn encodings_note(r: &Results) -> String {
     r.encoder_sensitivity.as_ref().map_or(String::new(), |s| {
         format!(
-            " E1, E4, E6 and E8 are means over {} encodings of every recording, and their intervals resample the encodings too (see The encoder's sensitivity); the other analyses, and E1's responsive and best taxels, use the encoding as run.",
+            " E1, E4, E6 and E8 are means over {} encodings of every recording, and their intervals resample the encodings too (see The encoder's sensitivity); the other analyses use the encoding as run.",
             s.encodings
         )
     })
@@ -473,7 +485,7 @@ fn e5c_intro(rule: crate::causal::DecisionRule) -> String {
         "## E5c (beyond the paper): online time to recognition\n\n\
          The paper's 3D-GLCM + KNN as a live classifier runs it (`neurotex stream`): causal conditioning (a forward-only low-pass; each taxel's resting value and one normalisation scale fixed per speed on **all of that speed's recordings, labels unused**, rather than inside each training fold: each recording is in some training fold, and fixing them per fold would encode every recording once per fold), trained on whole slides in the folds and repeats of E1, and classifying each test recording at every 200 ms bin boundary from the slide so far. \
          A decision is the first time one class holds at least {} of the vote in {} consecutive bins. \
-         The cost of causal processing is E1's zero-phase 3D-GLCM minus the causal one on whole slides, per recording on the same folds (95 % bootstrap interval over recordings; a positive difference is accuracy lost).\n\n",
+         The cost of causal processing is the zero-phase 3D-GLCM (E1's folds, the encoding as run: the first column of The encoder's sensitivity, not E1's mean over encodings) minus the causal one on whole slides, per recording on the same folds (95 % bootstrap interval over recordings; a positive difference is accuracy lost).\n\n",
         rule.share, rule.bins
     )
 }

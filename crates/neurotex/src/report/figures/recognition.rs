@@ -186,7 +186,7 @@ fn e5c_panel<'a, 'b>(
 /// E5c accuracy figure's caption.
 pub(crate) fn e5c_accuracy_caption(r: &Results) -> String {
     format!(
-        "Online time to recognition, one panel per speed (each on its own time axis, up to the longest slide): the causal 3D-GLCM's accuracy at every 200 ms bin boundary from the slide so far, classified by a KNN trained on whole causal slides in the folds of E1 and pooled over its repeats (vermillion; a slide that has ended keeps its last classification); the offline E5 (blue points: trained and tested on the first part of every slide, zero-phase, plotted at that share of the median slide); E1's zero-phase 3D-GLCM on whole slides (black dashed); {}.",
+        "Online time to recognition, one panel per speed (each on its own time axis, up to the longest slide): the causal 3D-GLCM's accuracy at every 200 ms bin boundary from the slide so far, classified by a KNN trained on whole causal slides in the folds of E1 and pooled over its repeats (vermillion; a slide that has ended keeps its last classification); the offline E5 (blue points: trained and tested on the first part of every slide, zero-phase, plotted at that share of the median slide); the zero-phase 3D-GLCM on whole slides in E1's folds, the encoding as run (black dashed); {}.",
         panel_chance_note(r, &r.e5c.iter().map(|(s, _)| s).collect::<Vec<_>>())
     )
 }
