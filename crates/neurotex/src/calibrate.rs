@@ -29,6 +29,7 @@ use serde::{Deserialize, Serialize};
 use crate::causal::{calibrate_conditioning, ConditioningCalibration};
 use crate::encode::encode;
 use crate::error::{ParamError, Result};
+pub use crate::model::GainCalibration;
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recording::{Baseline, Recording};
 use crate::signal::Conditioned;
@@ -84,24 +85,6 @@ impl std::str::FromStr for GainChoice {
             },
         }
     }
-}
-
-/// The gain `--gain auto` chose and what it rests on.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GainCalibration {
-    /// The target median rate, Hz.
-    pub target_hz: f64,
-    /// The chosen gain.
-    pub gain: f64,
-    /// The median rate at the chosen gain, Hz.
-    pub median_hz: f64,
-    /// Training recordings used.
-    pub recordings: usize,
-    /// (taxel, recording) pairs with any signal, over which the median runs.
-    pub pairs: usize,
-    /// Whether the target was out of reach within the searched gains (the gain is then
-    /// the range's end).
-    pub clamped: bool,
 }
 
 /// One training recording, conditioned, with the cells that receive any signal.

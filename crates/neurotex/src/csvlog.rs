@@ -11,7 +11,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DataError, ParamError, Result};
-use crate::recording::TimeUnit;
+use crate::values::TimeUnit;
 
 /// One column of a CSV log: by its header name, or by its 0-based position.
 #[derive(Debug, Clone, PartialEq, Eq)]

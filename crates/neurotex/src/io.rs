@@ -398,6 +398,10 @@ pub fn write_atomic(
 /// fails.
 pub fn create_dir_atomic<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
     let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
+    if dir.exists() && !dir.is_dir() {
+        let why = "exists and is not a folder: the output here is a folder; name a new one";
+        return Err(DataError::invalid(dir, why).into());
+    }
     if dir.exists() && !is_empty(dir) {
         return Err(DataError::invalid(dir, "output folder exists and is not empty").into());
     }
@@ -707,6 +711,20 @@ mod tests {
             .collect();
         names.sort();
         names
+    }
+
+    #[test]
+    fn an_output_folder_that_is_a_file_is_refused_as_a_file_and_kept() {
+        let root = tempfile::tempdir().unwrap();
+        let file = root.path().join("trial_1.csv");
+        std::fs::write(&file, "t_ms,a\n0,1\n").unwrap();
+        let message = create_dir_atomic(&file, |_| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("is not a folder"), "{message}");
+        assert!(!message.contains("not empty"), "{message}");
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "t_ms,a\n0,1\n");
+        assert_eq!(names(root.path()), ["trial_1.csv"]);
     }
 
     #[test]

@@ -17,7 +17,6 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::calibrate::GainCalibration;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -27,6 +26,24 @@ use crate::error::{ClassifyError, DataError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method, Pipeline, PipelineParams};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::values::{Cell, Grid, Speed};
+
+/// The gain `--gain auto` chose and what it rests on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GainCalibration {
+    /// The target median rate, Hz.
+    pub target_hz: f64,
+    /// The chosen gain.
+    pub gain: f64,
+    /// The median rate at the chosen gain, Hz.
+    pub median_hz: f64,
+    /// Training recordings used.
+    pub recordings: usize,
+    /// (taxel, recording) pairs with any signal, over which the median runs.
+    pub pairs: usize,
+    /// Whether the target was out of reach within the searched gains (the gain is then
+    /// the range's end).
+    pub clamped: bool,
+}
 
 /// The `format` field of every model file.
 pub const FORMAT: &str = "neurotex-model";

@@ -21,6 +21,7 @@ use crate::csvlog::{
 };
 use crate::error::{DataError, ParamError, Result};
 use crate::simd::widest_or_plain;
+pub use crate::values::TimeUnit;
 use crate::values::{Cell, Grid, Speed};
 
 /// The phase of the protocol a sample belongs to (paper section II-D).
@@ -205,88 +206,6 @@ impl fmt::Display for Baseline {
             Baseline::None => f.write_str("none"),
             Baseline::Min => f.write_str("min"),
             Baseline::Mean { start_s, end_s } => write!(f, "mean over [{start_s}, {end_s}) s"),
-        }
-    }
-}
-
-/// The unit of a CSV recording's time column; written `ms`, `s` or `us` (in
-/// `layout.toml` too).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum TimeUnit {
-    /// Milliseconds, `ms`.
-    #[default]
-    #[serde(rename = "ms")]
-    Milliseconds,
-    /// Seconds, `s`.
-    #[serde(rename = "s")]
-    Seconds,
-    /// Microseconds, `us`.
-    #[serde(rename = "us")]
-    Microseconds,
-}
-
-impl TimeUnit {
-    /// Seconds per unit.
-    pub fn seconds(self) -> f64 {
-        match self {
-            TimeUnit::Milliseconds => 1e-3,
-            TimeUnit::Seconds => 1.0,
-            TimeUnit::Microseconds => 1e-6,
-        }
-    }
-
-    /// Units per second (1, 1000 or 1e6), an exact integer.
-    pub fn per_second(self) -> f64 {
-        match self {
-            TimeUnit::Milliseconds => 1e3,
-            TimeUnit::Seconds => 1.0,
-            TimeUnit::Microseconds => 1e6,
-        }
-    }
-
-    /// A time in this unit in seconds, by one correctly rounded division by
-    /// [`Self::per_second`]: the nearest double to the exact value, so an integer stamp in
-    /// ms or us lands on the same double as the encoder's 1 kHz grid point `k / 1000` at
-    /// that time (a product with `1e-3`, itself rounded, can miss it by a unit in the last
-    /// place and give an interpolation weight of 1e-13 instead of 0).
-    pub fn to_seconds(self, t: f64) -> f64 {
-        t / self.per_second()
-    }
-
-    /// Milliseconds per unit.
-    pub fn milliseconds(self) -> f64 {
-        match self {
-            TimeUnit::Milliseconds => 1.0,
-            TimeUnit::Seconds => 1e3,
-            TimeUnit::Microseconds => 1e-3,
-        }
-    }
-}
-
-impl fmt::Display for TimeUnit {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            TimeUnit::Milliseconds => "ms",
-            TimeUnit::Seconds => "s",
-            TimeUnit::Microseconds => "us",
-        })
-    }
-}
-
-impl FromStr for TimeUnit {
-    type Err = ParamError;
-
-    /// Parses `ms`, `s` or `us` (`µs` too).
-    fn from_str(text: &str) -> Result<Self, ParamError> {
-        match text.trim() {
-            "ms" => Ok(TimeUnit::Milliseconds),
-            "s" => Ok(TimeUnit::Seconds),
-            "us" | "µs" => Ok(TimeUnit::Microseconds),
-            _ => Err(ParamError::new(
-                "time-unit",
-                "a time unit is `ms`, `s` or `us`",
-                text,
-            )),
         }
     }
 }
@@ -669,6 +588,9 @@ impl Dataset {
             LayoutFile::default()
         };
         let manifest_path = root.join("manifest.csv");
+        if !manifest_path.exists() {
+            return Err(no_manifest(&root).into());
+        }
         let (columns, entries) = read_manifest_columns(&manifest_path)?;
         for (i, m) in entries.iter().enumerate() {
             if !root.join(&m.file).is_file() {
@@ -1025,6 +947,31 @@ pub fn read_manifest(path: &Path) -> Result<Vec<Meta>> {
 }
 
 /// Reads and checks a manifest: its column names in order, and its recordings.
+/// The error for a folder without `manifest.csv`: when it holds recordings (raw logs,
+/// say), it says how to make a dataset folder of them.
+fn no_manifest(root: &Path) -> DataError {
+    let recordings = std::fs::read_dir(root)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok())
+                .filter(|e| {
+                    let name = e.file_name().to_string_lossy().to_lowercase();
+                    name.ends_with(".csv") || name.ends_with(".npy")
+                })
+                .count()
+        })
+        .unwrap_or(0);
+    let why = match recordings {
+        0 => "is not a dataset folder (expected a folder with manifest.csv)".to_string(),
+        n => format!(
+            "is not a dataset folder (no manifest.csv) but holds {n} .csv/.npy file(s): \
+             import them into a dataset folder first (`neurotex import csv` for per-trial \
+             logs, `neurotex import stacked` for arrays; in Python, `neurotex.save_dataset`)"
+        ),
+    };
+    DataError::invalid(root, why)
+}
+
 fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Meta>)> {
     // Fields are trimmed (`a.npy, smooth` is common); the labels as written are kept to
     // refuse two that differ only by surrounding spaces, which trimming would make one class.

@@ -1,7 +1,8 @@
 //! Typed values that travel between stages and across the command line: a taxel [`Grid`]
 //! with its mask, a grid [`Cell`], a sliding [`Speed`] with a total order, a
-//! [`SampleRate`], plus [`BySpeed`], results keyed by speed in numeric order. Each parses
-//! from the text a user types (`FromStr`), failing with a [`ParamError`] that names the rule.
+//! [`SampleRate`], a time column's [`TimeUnit`], plus [`BySpeed`], results keyed by speed
+//! in numeric order. Each parses from the text a user types (`FromStr`), failing with a
+//! [`ParamError`] that names the rule.
 
 use std::fmt;
 use std::str::FromStr;
@@ -451,6 +452,88 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for BySpeed<T> {
                     .map_err(serde::de::Error::custom)
             })
             .collect()
+    }
+}
+
+/// The unit of a CSV recording's time column; written `ms`, `s` or `us` (in
+/// `layout.toml` too).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum TimeUnit {
+    /// Milliseconds, `ms`.
+    #[default]
+    #[serde(rename = "ms")]
+    Milliseconds,
+    /// Seconds, `s`.
+    #[serde(rename = "s")]
+    Seconds,
+    /// Microseconds, `us`.
+    #[serde(rename = "us")]
+    Microseconds,
+}
+
+impl TimeUnit {
+    /// Seconds per unit.
+    pub fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::Milliseconds => 1e-3,
+            TimeUnit::Seconds => 1.0,
+            TimeUnit::Microseconds => 1e-6,
+        }
+    }
+
+    /// Units per second (1, 1000 or 1e6), an exact integer.
+    pub fn per_second(self) -> f64 {
+        match self {
+            TimeUnit::Milliseconds => 1e3,
+            TimeUnit::Seconds => 1.0,
+            TimeUnit::Microseconds => 1e6,
+        }
+    }
+
+    /// A time in this unit in seconds, by one correctly rounded division by
+    /// [`Self::per_second`]: the nearest double to the exact value, so an integer stamp in
+    /// ms or us lands on the same double as the encoder's 1 kHz grid point `k / 1000` at
+    /// that time (a product with `1e-3`, itself rounded, can miss it by a unit in the last
+    /// place and give an interpolation weight of 1e-13 instead of 0).
+    pub fn to_seconds(self, t: f64) -> f64 {
+        t / self.per_second()
+    }
+
+    /// Milliseconds per unit.
+    pub fn milliseconds(self) -> f64 {
+        match self {
+            TimeUnit::Milliseconds => 1.0,
+            TimeUnit::Seconds => 1e3,
+            TimeUnit::Microseconds => 1e-3,
+        }
+    }
+}
+
+impl fmt::Display for TimeUnit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            TimeUnit::Milliseconds => "ms",
+            TimeUnit::Seconds => "s",
+            TimeUnit::Microseconds => "us",
+        })
+    }
+}
+
+impl FromStr for TimeUnit {
+    type Err = ParamError;
+
+    /// Parses `ms`, `s` or `us` (`µs` too).
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        match text.trim() {
+            "ms" => Ok(TimeUnit::Milliseconds),
+            "s" => Ok(TimeUnit::Seconds),
+            "us" | "µs" => Ok(TimeUnit::Microseconds),
+            _ => Err(ParamError::new(
+                "time-unit",
+                "a time unit is `ms`, `s` or `us`",
+                text,
+            )),
+        }
     }
 }
 

@@ -651,3 +651,25 @@ fn a_recording_in_both_the_training_and_the_test_set_is_an_error() {
     );
     assert_eq!(apart.unwrap().n, 2);
 }
+
+#[test]
+fn a_folder_of_raw_logs_opened_as_a_dataset_says_how_to_import_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["cotton_V10_1.csv", "cotton_V10_2.csv", "notes.txt"] {
+        std::fs::write(dir.path().join(name), "t_ms,a\n0,1\n").unwrap();
+    }
+    let message = Dataset::open(dir.path()).unwrap_err().to_string();
+    assert!(
+        message.contains("no manifest.csv")
+            && message.contains("holds 2 .csv/.npy file(s)")
+            && message.contains("neurotex import csv"),
+        "{message}"
+    );
+    // an empty folder gets the plain rule
+    let empty = tempfile::tempdir().unwrap();
+    let message = Dataset::open(empty.path()).unwrap_err().to_string();
+    assert!(
+        message.contains("is not a dataset folder (expected a folder with manifest.csv)"),
+        "{message}"
+    );
+}
