@@ -1,4 +1,4 @@
-//! The encodings and feature methods of issue #11 through the binary.
+//! The encodings and feature methods beyond the paper through the binary.
 
 use crate::util::{s, Dir};
 

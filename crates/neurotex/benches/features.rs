@@ -1,4 +1,4 @@
-//! The feature methods of issue #11 on one 4x4 recording of 18 s (a 90 mm slide at
+//! The feature methods beyond the paper on one 4x4 recording of 18 s (a 90 mm slide at
 //! 5 mm/s): the 13 Haralick features of one 16-level matrix, the multi-scale 3D-GLCM
 //! (50, 100, 200, 400 ms bins, paper and full Haralick sets), and all taxels' statistics
 //! per second and per mm of travel.

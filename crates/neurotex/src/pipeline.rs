@@ -16,7 +16,7 @@ use crate::recording::{Baseline, Dataset, Meta, Recording};
 use crate::signal::{Conditioned, PreprocessParams, Preprocessor};
 use crate::values::Grid;
 
-/// The feature sets: the paper's three and the extensions of issue #11.
+/// The feature sets: the paper's three and the methods beyond the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Method {
     /// MSR, CV_ISI and Fano factor of each taxel (approach 1), each taxel classified alone.

@@ -1,4 +1,4 @@
-//! The extensions of issue #11: FA-I encoding, per-population features, all-taxels,
+//! The extensions beyond the paper: FA-I encoding, per-population features, all-taxels,
 //! travelled-distance statistics, multi-scale 3D-GLCM and the full Haralick set.
 
 use neurotex::encode::{encode, encode_fa, FaParams, IzhikevichParams, SpikeTrains, V_PEAK};
