@@ -560,15 +560,7 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
             })
             .collect()
     });
-    // The first taxel of the highest accuracy, in grid order.
-    let best = per_taxel.as_ref().and_then(|per| {
-        per.iter()
-            .copied()
-            .fold(None, |b: Option<TaxelAccuracy>, t| match b {
-                Some(b) if b.accuracy >= t.accuracy => Some(b),
-                _ => Some(t),
-            })
-    });
+    let best = per_taxel.as_deref().and_then(best_taxel);
     Outcome {
         accuracy,
         accuracy_std,
@@ -580,6 +572,16 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
         predictions: None,
         correct_shares: Vec::new(),
     }
+}
+
+/// The first taxel of the highest accuracy, in grid order (`None` without taxels).
+pub(crate) fn best_taxel(per: &[TaxelAccuracy]) -> Option<TaxelAccuracy> {
+    per.iter()
+        .copied()
+        .fold(None, |b: Option<TaxelAccuracy>, t| match b {
+            Some(b) if b.accuracy >= t.accuracy => Some(b),
+            _ => Some(t),
+        })
 }
 
 #[cfg(test)]

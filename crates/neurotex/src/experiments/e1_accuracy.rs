@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::encodings::{Methods, OverEncodings};
 use super::{compare_encodings, Comparison, Context, Stop};
-use crate::analysis::{Outcome, TaxelAccuracy};
+use crate::analysis::{best_taxel, Outcome, TaxelAccuracy};
 use crate::classify::Interval;
 use crate::values::BySpeed;
 
@@ -67,19 +67,11 @@ pub fn e1_accuracy(c: &Context) -> Result<BySpeed<E1Speed>, Stop> {
             let taxel = OverEncodings::of(&m.taxel, c.params.seed)?;
             // Each taxel's accuracy over the encodings, as the mean over taxels is.
             let per_taxel = per_taxel_over_encodings(&m.taxel);
-            // The first taxel of the highest accuracy, in grid order.
-            let best = per_taxel
-                .iter()
-                .copied()
-                .fold(None, |b: Option<TaxelAccuracy>, t| match b {
-                    Some(b) if b.accuracy >= t.accuracy => Some(b),
-                    _ => Some(t),
-                })
-                .unwrap_or(TaxelAccuracy {
-                    row: 0,
-                    col: 0,
-                    accuracy: h.taxel.accuracy,
-                });
+            let best = best_taxel(&per_taxel).unwrap_or(TaxelAccuracy {
+                row: 0,
+                col: 0,
+                accuracy: h.taxel.accuracy,
+            });
             let truth: Vec<usize> = h
                 .glcm3d
                 .confusion
