@@ -3,38 +3,33 @@
 //! Taxel-array recordings become spikes of Izhikevich neurons, spikes become single-taxel
 //! statistics or 2D/3D gray-level co-occurrence features, and a KNN classifier scores them,
 //! as in Gupta, Nakagawa, Lepora and Thakor, "Spatio-temporal encoding improves
-//! neuromorphic tactile texture classification". Data flows down the modules:
-//! [`recording`] → [`signal`] → [`encode`] → [`features`] → [`classify`], joined by
-//! [`pipeline`] and [`analysis`] (with [`diagnostics`] of the taxels); [`model`] saves a trained classifier and applies it to
-//! new recordings.
+//! neuromorphic tactile texture classification".
+//!
+//! This crate gathers the layers, each a crate that depends only on those below it:
+//!
+//! | layer | crate | modules |
+//! |---|---|---|
+//! | values, errors, recordings, readers, import, outputs | `neurotex-core` | [`values`], [`error`], [`recording`], [`csvlog`], [`import`], [`io`] |
+//! | conditioning and spike encoding | `neurotex-signal` | [`signal`], [`encode`] |
+//! | spike statistics and GLCM features | `neurotex-features` | [`features`] |
+//! | classifiers, cross-validation, statistics | `neurotex-learn` | [`classify`] |
+//! | simulated recordings | `neurotex-sim` | [`sim`] |
+//! | pipeline, feature tables, models, streams, compare | `neurotex-pipeline` | [`pipeline`], [`analysis`], [`diagnostics`], [`model`], [`calibrate`], [`causal`], [`stream`], [`compare`] |
+//! | the paper's analyses | `neurotex-experiments` | [`experiments`] |
+//! | report and figures | `neurotex-report` | [`report`] |
 //!
 //! The library never prints and never exits: it returns [`Error`]s naming the file, line
-//! or parameter at fault.
+//! or parameter at fault. `ARCHITECTURE.md` follows one recording through the layers.
 #![deny(missing_docs)]
 
-pub mod analysis;
-pub mod calibrate;
-pub mod causal;
-pub mod classify;
-pub mod compare;
-pub mod csvlog;
-pub mod diagnostics;
-pub mod encode;
-pub mod error;
-pub mod experiments;
-pub mod features;
-pub mod import;
-pub mod io;
-pub mod model;
-mod npy;
-pub mod pipeline;
-pub mod recording;
-pub mod report;
-pub mod signal;
-pub mod sim;
-mod simd;
-pub mod stream;
-pub mod values;
-
-pub use error::{Error, Result};
-pub use values::{BySpeed, Cell, Grid, SampleRate, Speed};
+pub use neurotex_core::{csvlog, error, import, io, recording, values};
+pub use neurotex_core::{BySpeed, Cell, Error, Grid, Result, SampleRate, Speed};
+pub use neurotex_experiments::experiments;
+pub use neurotex_features::features;
+pub use neurotex_learn::classify;
+pub use neurotex_pipeline::{
+    analysis, calibrate, causal, compare, diagnostics, model, pipeline, stream,
+};
+pub use neurotex_report::report;
+pub use neurotex_signal::{encode, signal};
+pub use neurotex_sim::sim;

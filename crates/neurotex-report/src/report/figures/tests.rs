@@ -16,7 +16,7 @@ use crate::values::{BySpeed, Speed};
 pub(crate) fn small() -> Results {
     let text = include_str!(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/golden_small_design.json"
+        "/../neurotex/tests/data/golden_small_design.json"
     ));
     serde_json::from_str(text).expect("golden results parse")
 }

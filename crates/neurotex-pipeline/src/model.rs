@@ -15,7 +15,7 @@
 //! could hold a stride or a scale that no fit would produce. Files written before the
 //! forest and the regression existed (`"kind": "knn"`) read unchanged.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::analysis::{column_groups, Columns, FeatureTable};
 use crate::classify::{ChosenModel, Classifier, ClassifierChoice, ConfusionMatrix, Predict};
 use crate::error::{ClassifyError, DataError, ParamError, Result};
+pub use crate::error::{ModelError, MODEL_FORMAT as FORMAT, MODEL_VERSION as VERSION};
 use crate::pipeline::{Encoded, FeatureExtractor, Method, Pipeline, PipelineParams};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::values::{Cell, Grid, Speed};
@@ -43,62 +44,6 @@ pub struct GainCalibration {
     /// Whether the target was out of reach within the searched gains (the gain is then
     /// the range's end).
     pub clamped: bool,
-}
-
-/// The `format` field of every model file.
-pub const FORMAT: &str = "neurotex-model";
-
-/// The version of the model file format this neurotex writes and reads.
-pub const VERSION: u64 = 1;
-
-/// A model file that cannot be used, or recordings a model cannot take.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ModelError {
-    /// The file is JSON but not a neurotex model.
-    #[error("{}: not a neurotex model file (its `format` is {found}, expected \"{FORMAT}\")", .path.display())]
-    NotAModel {
-        /// The file.
-        path: PathBuf,
-        /// What its `format` field holds, as JSON, or that it has none.
-        found: String,
-    },
-    /// A model file of a format version this neurotex does not read.
-    #[error("{}: model file version {found} is not supported; neurotex {} reads version {VERSION}", .path.display(), env!("CARGO_PKG_VERSION"))]
-    UnsupportedVersion {
-        /// The file.
-        path: PathBuf,
-        /// Its `version` field, as JSON, or that it has none.
-        found: String,
-    },
-    /// The file is truncated, not JSON, or its content breaks a rule.
-    #[error("{}: damaged or truncated model file: {reason}", .path.display())]
-    Damaged {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        reason: String,
-    },
-    /// A model's parts disagree with each other (only a damaged file can make them).
-    #[error("{0}")]
-    Inconsistent(String),
-    /// A recording on another taxel grid than the model's.
-    #[error("{file}: its taxel grid ({}) differs from the model's ({}); a model applies only to recordings of the grid it was trained on", grid_text(.found, .expected), grid_text(.expected, .found))]
-    OtherGrid {
-        /// The recording.
-        file: String,
-        /// The model's grid.
-        expected: Grid,
-        /// The recording's grid.
-        found: Grid,
-    },
-}
-
-/// `4x4, 16 taxels`, saying when the mask is all that differs from `other`.
-fn grid_text(grid: &Grid, other: &Grid) -> String {
-    let same_shape = (grid.rows(), grid.cols(), grid.n_taxels())
-        == (other.rows(), other.cols(), other.n_taxels());
-    let mask = if same_shape { ", another mask" } else { "" };
-    format!("{grid}, {} taxels{mask}", grid.n_taxels())
 }
 
 /// Which features a model classifies.

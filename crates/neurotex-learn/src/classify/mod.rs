@@ -8,7 +8,7 @@
 pub mod choice;
 pub mod confusion;
 pub mod cv;
-pub(crate) mod draws;
+pub mod draws;
 pub mod forest;
 pub mod knn;
 pub mod linear;

@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 use crate::csvlog::{
     csv_error, read_csv_log, ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps,
 };
+pub use crate::error::DatasetError;
 use crate::error::{DataError, ParamError, Result};
 use crate::simd::widest_or_plain;
 pub use crate::values::TimeUnit;
@@ -745,60 +746,6 @@ fn check_inside(root: &Path, file: &str) -> std::result::Result<(), String> {
     Ok(())
 }
 
-/// A dataset that cannot serve what was asked of it.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum DatasetError {
-    /// No recording at a speed that was asked for.
-    #[error("no recordings at {speed} mm/s in {} (its speeds: {})", .root.display(), speeds_or_none(.available))]
-    NoRecordingsAt {
-        /// The speed asked for.
-        speed: Speed,
-        /// The dataset folder.
-        root: PathBuf,
-        /// The speeds the dataset has, ascending.
-        available: Vec<Speed>,
-    },
-    /// Two recordings on different taxel grids (size or mask).
-    #[error("{file}: its taxel grid differs from that of {first}; a dataset needs one layout")]
-    MixedGrids {
-        /// The first recording whose grid differs.
-        file: String,
-        /// The recording whose grid the others must share.
-        first: String,
-    },
-    /// No recording was selected.
-    #[error("no recordings selected")]
-    Empty,
-    /// A selection names a column in which no recording has a value.
-    #[error("no recording has a value in manifest column `{column}` (columns with values: {})", .columns.join(", "))]
-    NoColumn {
-        /// The column asked for.
-        column: String,
-        /// The columns in which some recording has a value.
-        columns: Vec<String>,
-    },
-    /// A selection asks for a value that no recording has.
-    #[error("no recording has {column} = {value} (values present: {})", .present.join(", "))]
-    NoRecordingsWhere {
-        /// The column.
-        column: String,
-        /// The value asked for.
-        value: String,
-        /// The column's distinct values, in order (numerically for numeric columns).
-        present: Vec<String>,
-    },
-    /// A recording selected both for training and for testing.
-    #[error("{file} is selected both for training ({train}) and for testing ({test}); the two sets must not share a recording")]
-    InBothSets {
-        /// The first recording in both sets.
-        file: String,
-        /// The training selection, as typed.
-        train: String,
-        /// The test selection, as typed.
-        test: String,
-    },
-}
-
 /// Recordings whose manifest column holds one of some values, written `COLUMN=V1,V2`:
 /// numeric columns ([`NUMERIC_COLUMNS`]) compare as numbers (`5` is `5.0`), every other
 /// column as text. Any column but `label` (selecting classes leaves the test set with
@@ -910,14 +857,6 @@ impl FromStr for Selection {
         }
         Ok(selection)
     }
-}
-
-fn speeds_or_none(speeds: &[Speed]) -> String {
-    if speeds.is_empty() {
-        return "none, the manifest gives no speed_mm_s".into();
-    }
-    let texts: Vec<String> = speeds.iter().map(Speed::to_string).collect();
-    texts.join(", ")
 }
 
 /// The one grid that recordings share, from `(file, grid)` pairs in dataset order.

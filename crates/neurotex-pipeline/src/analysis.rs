@@ -52,7 +52,7 @@ impl FeatureTable {
     }
 
     /// The table of `rows`, `method`'s features by `extractor` of the recordings `metas`.
-    pub(crate) fn from_rows(
+    pub fn from_rows(
         extractor: &FeatureExtractor,
         method: Method,
         metas: Vec<Meta>,
@@ -195,7 +195,7 @@ impl Outcome {
 ///
 /// # Errors
 /// No shares, or one outside 0..1.
-pub(crate) fn seeded_bootstrap(shares: &[f64], seed: u64) -> Result<Interval> {
+pub fn seeded_bootstrap(shares: &[f64], seed: u64) -> Result<Interval> {
     let params = BootstrapParams {
         seed,
         ..BootstrapParams::default()
@@ -210,7 +210,7 @@ pub(crate) fn seeded_bootstrap(shares: &[f64], seed: u64) -> Result<Interval> {
 ///
 /// # Errors
 /// No encodings or shares, encodings of different lengths, or a share outside 0..1.
-pub(crate) fn seeded_bootstrap_over_encodings(shares: &[Vec<f64>], seed: u64) -> Result<Interval> {
+pub fn seeded_bootstrap_over_encodings(shares: &[Vec<f64>], seed: u64) -> Result<Interval> {
     let params = BootstrapParams {
         seed,
         ..BootstrapParams::default()
@@ -575,7 +575,7 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
 }
 
 /// The first taxel of the highest accuracy, in grid order (`None` without taxels).
-pub(crate) fn best_taxel(per: &[TaxelAccuracy]) -> Option<TaxelAccuracy> {
+pub fn best_taxel(per: &[TaxelAccuracy]) -> Option<TaxelAccuracy> {
     per.iter()
         .copied()
         .fold(None, |b: Option<TaxelAccuracy>, t| match b {

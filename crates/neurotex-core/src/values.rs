@@ -62,7 +62,7 @@ impl Grid {
 
     /// A grid from parts whose consistency the caller guarantees (`present.len() == rows *
     /// cols`), for types that hold a grid's parts already checked.
-    pub(crate) fn from_parts(rows: usize, cols: usize, present: &[bool]) -> Self {
+    pub fn from_parts(rows: usize, cols: usize, present: &[bool]) -> Self {
         debug_assert_eq!(present.len(), rows * cols);
         Grid {
             rows,

@@ -229,7 +229,7 @@ fn rate_of(count: u32, bin_ms: usize) -> f64 {
 /// span the counts `min..=max`: the levels of [`CountVolume::quantise`] (the range is
 /// `range`, or the rates of `min` and `max`), for volumes kept other ways (a stream's
 /// sliding window). Exact, in integer arithmetic.
-pub(crate) fn count_levels(
+pub fn count_levels(
     bin_ms: usize,
     levels: usize,
     range: Option<(f64, f64)>,

@@ -20,6 +20,8 @@
 ///     fn name(a: &[f64], b: &mut [f64]) { for .. }
 /// }
 /// ```
+#[doc(hidden)]
+#[macro_export]
 macro_rules! widest_or_plain {
     (
         [$($feature:tt),+ $(,)?]
@@ -30,7 +32,7 @@ macro_rules! widest_or_plain {
         $vis fn $name($($arg: $ty),*) $(-> $ret)? {
             #[inline(always)]
             fn body($($arg: $ty),*) $(-> $ret)? $body
-            $crate::simd::widest_or_plain!(@try [$($feature),+] ($($arg: $ty),*) $(-> $ret)?);
+            $crate::widest_or_plain!(@try [$($feature),+] ($($arg: $ty),*) $(-> $ret)?);
             body($($arg),*)
         }
     };
@@ -48,9 +50,9 @@ macro_rules! widest_or_plain {
                 return unsafe { wide($($arg),*) };
             }
         }
-        $crate::simd::widest_or_plain!(@try [$($rest),*] ($($arg: $ty),*) $(-> $ret)?);
+        $crate::widest_or_plain!(@try [$($rest),*] ($($arg: $ty),*) $(-> $ret)?);
     };
     (@try [] ($($arg:ident: $ty:ty),*) $(-> $ret:ty)?) => {};
 }
 
-pub(crate) use widest_or_plain;
+pub use crate::widest_or_plain;

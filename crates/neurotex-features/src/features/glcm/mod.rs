@@ -141,7 +141,7 @@ impl Run {
 
 /// Counts each pair in both orders: `counts + counts^T` (`l x l`), the diagonal doubled
 /// as both orders of a pair of equal levels.
-pub(crate) fn symmetrise<T: Copy + std::ops::Add<Output = T>>(counts: &mut [T], l: usize) {
+pub fn symmetrise<T: Copy + std::ops::Add<Output = T>>(counts: &mut [T], l: usize) {
     for i in 0..l {
         for j in i..l {
             let s = counts[i * l + j] + counts[j * l + i];

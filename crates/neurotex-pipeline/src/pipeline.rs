@@ -442,7 +442,7 @@ impl Pipeline {
 
 /// One population's 3D-GLCM gray levels, `cell * bins + bin`, as the extractor quantises
 /// its rate volume (kept by E3, which counts them again with taxels moved).
-pub(crate) struct Quantised {
+pub struct Quantised {
     levels: Vec<u8>,
     bins: usize,
 }
@@ -576,7 +576,7 @@ impl FeatureExtractor {
     ///
     /// # Errors
     /// As [`FeatureExtractor::row`] with [`Method::Glcm3d`].
-    pub(crate) fn quantised_3d(&self, encoded: &Encoded) -> Result<Vec<Quantised>> {
+    pub fn quantised_3d(&self, encoded: &Encoded) -> Result<Vec<Quantised>> {
         self.populations(encoded)?
             .into_iter()
             .map(|spikes| {
@@ -606,7 +606,7 @@ impl FeatureExtractor {
     /// # Errors
     /// A permutation that is not one of the grid's cells, or that moves a taxel onto a
     /// cell without one.
-    pub(crate) fn glcm3d_moved(&self, quantised: &[Quantised], perm: &[usize]) -> Result<Vec<f64>> {
+    pub fn glcm3d_moved(&self, quantised: &[Quantised], perm: &[usize]) -> Result<Vec<f64>> {
         let present = self.grid.present();
         let keeps_taxels = perm.len() == present.len()
             && perm

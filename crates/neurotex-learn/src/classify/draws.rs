@@ -88,7 +88,7 @@ type Kept = Vec<((u64, Vec<usize>, usize), Arc<Vec<usize>>)>;
 /// same each time. So they are made once per process and kept (up to [`KEPT`] indices in
 /// all; the oldest go first), and an interval then costs its sums alone. The values are
 /// those drawn in turn either way (`tests::kept_draws_are_the_streams`).
-pub(crate) fn for_each_resample(
+pub fn for_each_resample(
     seed: u64,
     bounds: &[usize],
     rounds: usize,

@@ -2,8 +2,7 @@
 
 use std::path::PathBuf;
 
-pub use crate::model::ModelError;
-pub use crate::recording::DatasetError;
+use crate::values::{Grid, Speed};
 
 /// Everything that can go wrong in neurotex, by stage.
 #[derive(Debug, thiserror::Error)]
@@ -28,7 +27,7 @@ pub enum Error {
     },
     /// A statistic could not be computed from what it was given.
     #[error(transparent)]
-    Stats(#[from] crate::classify::stats::StatsError),
+    Stats(#[from] StatsError),
     /// A dataset cannot serve what was asked of it (speeds, one grid).
     #[error(transparent)]
     Dataset(#[from] DatasetError),
@@ -236,4 +235,174 @@ pub enum ClassifyError {
     /// Feature rows of different lengths, or a non-finite feature.
     #[error("{0}")]
     BadFeatures(String),
+}
+
+/// A dataset that cannot serve what was asked of it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DatasetError {
+    /// No recording at a speed that was asked for.
+    #[error("no recordings at {speed} mm/s in {} (its speeds: {})", .root.display(), speeds_or_none(.available))]
+    NoRecordingsAt {
+        /// The speed asked for.
+        speed: Speed,
+        /// The dataset folder.
+        root: PathBuf,
+        /// The speeds the dataset has, ascending.
+        available: Vec<Speed>,
+    },
+    /// Two recordings on different taxel grids (size or mask).
+    #[error("{file}: its taxel grid differs from that of {first}; a dataset needs one layout")]
+    MixedGrids {
+        /// The first recording whose grid differs.
+        file: String,
+        /// The recording whose grid the others must share.
+        first: String,
+    },
+    /// No recording was selected.
+    #[error("no recordings selected")]
+    Empty,
+    /// A selection names a column in which no recording has a value.
+    #[error("no recording has a value in manifest column `{column}` (columns with values: {})", .columns.join(", "))]
+    NoColumn {
+        /// The column asked for.
+        column: String,
+        /// The columns in which some recording has a value.
+        columns: Vec<String>,
+    },
+    /// A selection asks for a value that no recording has.
+    #[error("no recording has {column} = {value} (values present: {})", .present.join(", "))]
+    NoRecordingsWhere {
+        /// The column.
+        column: String,
+        /// The value asked for.
+        value: String,
+        /// The column's distinct values, in order (numerically for numeric columns).
+        present: Vec<String>,
+    },
+    /// A recording selected both for training and for testing.
+    #[error("{file} is selected both for training ({train}) and for testing ({test}); the two sets must not share a recording")]
+    InBothSets {
+        /// The first recording in both sets.
+        file: String,
+        /// The training selection, as typed.
+        train: String,
+        /// The test selection, as typed.
+        test: String,
+    },
+}
+
+fn speeds_or_none(speeds: &[Speed]) -> String {
+    if speeds.is_empty() {
+        return "none, the manifest gives no speed_mm_s".into();
+    }
+    let texts: Vec<String> = speeds.iter().map(Speed::to_string).collect();
+    texts.join(", ")
+}
+
+/// A statistic asked of data it cannot be computed from.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StatsError {
+    /// No observations at all.
+    #[error("no {what}: an interval needs at least one")]
+    Empty {
+        /// What was missing (recordings, repeats).
+        what: &'static str,
+    },
+    /// More correct predictions than predictions.
+    #[error("{correct} correct out of {n}: the correct count cannot exceed the total")]
+    CountAboveTotal {
+        /// Correct predictions given.
+        correct: usize,
+        /// Predictions given.
+        n: usize,
+    },
+    /// Two methods' per-recording results of different lengths, so they cannot be paired.
+    #[error(
+        "paired results need one entry per recording for both methods, got {first} and {second}"
+    )]
+    LengthMismatch {
+        /// Entries for the first method.
+        first: usize,
+        /// Entries for the second method.
+        second: usize,
+    },
+    /// A t interval over repeats from fewer than two repeats (no spread to estimate).
+    #[error("a t interval over repeats needs at least 2 repeats, got {got}")]
+    TooFewRepeats {
+        /// Repeats given.
+        got: usize,
+    },
+    /// A value that should be an accuracy or a share of correct predictions is not in [0, 1].
+    #[error("entry {index} is {value}, not an accuracy in [0, 1]")]
+    NotAnAccuracy {
+        /// Its position in the input.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A probability outside the open interval (0, 1).
+    #[error("a quantile needs a probability strictly between 0 and 1, got {got}")]
+    Probability {
+        /// The value given.
+        got: f64,
+    },
+    /// Student's t with zero degrees of freedom.
+    #[error("Student's t needs at least 1 degree of freedom, got 0")]
+    ZeroDegreesOfFreedom,
+}
+
+/// The `format` field of every model file.
+pub const MODEL_FORMAT: &str = "neurotex-model";
+
+/// The version of the model file format this neurotex writes and reads.
+pub const MODEL_VERSION: u64 = 1;
+
+/// A model file that cannot be used, or recordings a model cannot take.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// The file is JSON but not a neurotex model.
+    #[error("{}: not a neurotex model file (its `format` is {found}, expected \"{MODEL_FORMAT}\")", .path.display())]
+    NotAModel {
+        /// The file.
+        path: PathBuf,
+        /// What its `format` field holds, as JSON, or that it has none.
+        found: String,
+    },
+    /// A model file of a format version this neurotex does not read.
+    #[error("{}: model file version {found} is not supported; neurotex {} reads version {MODEL_VERSION}", .path.display(), env!("CARGO_PKG_VERSION"))]
+    UnsupportedVersion {
+        /// The file.
+        path: PathBuf,
+        /// Its `version` field, as JSON, or that it has none.
+        found: String,
+    },
+    /// The file is truncated, not JSON, or its content breaks a rule.
+    #[error("{}: damaged or truncated model file: {reason}", .path.display())]
+    Damaged {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A model's parts disagree with each other (only a damaged file can make them).
+    #[error("{0}")]
+    Inconsistent(String),
+    /// A recording on another taxel grid than the model's.
+    #[error("{file}: its taxel grid ({}) differs from the model's ({}); a model applies only to recordings of the grid it was trained on", grid_text(.found, .expected), grid_text(.expected, .found))]
+    OtherGrid {
+        /// The recording.
+        file: String,
+        /// The model's grid.
+        expected: Grid,
+        /// The recording's grid.
+        found: Grid,
+    },
+}
+
+/// `4x4, 16 taxels`, saying when the mask is all that differs from `other`.
+fn grid_text(grid: &Grid, other: &Grid) -> String {
+    let same_shape = (grid.rows(), grid.cols(), grid.n_taxels())
+        == (other.rows(), other.cols(), other.n_taxels());
+    let mask = if same_shape { ", another mask" } else { "" };
+    format!("{grid}, {} taxels{mask}", grid.n_taxels())
 }

@@ -5,61 +5,11 @@
 
 use std::f64::consts::{FRAC_PI_2, LN_2, PI};
 
+pub use crate::error::StatsError;
+
 /// The 0.975 quantile of the standard normal distribution (two-sided 95 %), correctly
 /// rounded; scipy's `norm.ppf(0.975)` gives the same double.
 pub const Z_95: f64 = 1.959_963_984_540_054;
-
-/// A statistic asked of data it cannot be computed from.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum StatsError {
-    /// No observations at all.
-    #[error("no {what}: an interval needs at least one")]
-    Empty {
-        /// What was missing (recordings, repeats).
-        what: &'static str,
-    },
-    /// More correct predictions than predictions.
-    #[error("{correct} correct out of {n}: the correct count cannot exceed the total")]
-    CountAboveTotal {
-        /// Correct predictions given.
-        correct: usize,
-        /// Predictions given.
-        n: usize,
-    },
-    /// Two methods' per-recording results of different lengths, so they cannot be paired.
-    #[error(
-        "paired results need one entry per recording for both methods, got {first} and {second}"
-    )]
-    LengthMismatch {
-        /// Entries for the first method.
-        first: usize,
-        /// Entries for the second method.
-        second: usize,
-    },
-    /// A t interval over repeats from fewer than two repeats (no spread to estimate).
-    #[error("a t interval over repeats needs at least 2 repeats, got {got}")]
-    TooFewRepeats {
-        /// Repeats given.
-        got: usize,
-    },
-    /// A value that should be an accuracy or a share of correct predictions is not in [0, 1].
-    #[error("entry {index} is {value}, not an accuracy in [0, 1]")]
-    NotAnAccuracy {
-        /// Its position in the input.
-        index: usize,
-        /// The value.
-        value: f64,
-    },
-    /// A probability outside the open interval (0, 1).
-    #[error("a quantile needs a probability strictly between 0 and 1, got {got}")]
-    Probability {
-        /// The value given.
-        got: f64,
-    },
-    /// Student's t with zero degrees of freedom.
-    #[error("Student's t needs at least 1 degree of freedom, got 0")]
-    ZeroDegreesOfFreedom,
-}
 
 /// The `p` quantile of Student's t distribution with `dof` degrees of freedom.
 ///

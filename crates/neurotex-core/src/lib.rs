@@ -1,0 +1,18 @@
+//! neurotex's bottom layer: the values every stage speaks in ([`values`]), the errors
+//! ([`error`]), recordings, datasets and their readers ([`recording`], [`csvlog`]), the
+//! import of raw logs into a dataset ([`import`]) and outputs written whole or not at all
+//! ([`io`]). Nothing here knows of spikes, features or classifiers.
+#![deny(missing_docs)]
+
+pub mod csvlog;
+pub mod error;
+pub mod import;
+pub mod io;
+mod npy;
+pub mod recording;
+#[doc(hidden)]
+pub mod simd;
+pub mod values;
+
+pub use error::{Error, Result};
+pub use values::{BySpeed, Cell, Grid, SampleRate, Speed};

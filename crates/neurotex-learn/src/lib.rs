@@ -1,0 +1,12 @@
+//! neurotex's learning layer: classifiers (KNN, random forest, logistic regression,
+//! spike distances), cross-validation, metrics, and the statistics of intervals and paired
+//! tests ([`classify`]). Depends on `neurotex-core` and, for spike-distance classifiers,
+//! `neurotex-signal`.
+#![deny(missing_docs)]
+
+pub mod classify;
+
+// The layers below, under the names their modules had when they were one crate, so
+// that `crate::recording` and the like read the same in every layer.
+use neurotex_core::error;
+use neurotex_signal::encode;

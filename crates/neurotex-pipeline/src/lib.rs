@@ -1,0 +1,22 @@
+//! neurotex's pipeline layer: one recording's path from samples to features
+//! ([`pipeline`]), feature tables over a dataset ([`analysis`], [`diagnostics`]), saved
+//! models ([`model`]), the gain calibration ([`calibrate`]), decisions from a window's
+//! beginning ([`causal`]) and live streams ([`stream`]), and the ranking of methods
+//! ([`compare`]). Depends on every layer below.
+#![deny(missing_docs)]
+
+pub mod analysis;
+pub mod calibrate;
+pub mod causal;
+pub mod compare;
+pub mod diagnostics;
+pub mod model;
+pub mod pipeline;
+pub mod stream;
+
+// The layers below, under the names their modules had when they were one crate, so
+// that `crate::recording` and the like read the same in every layer.
+use neurotex_core::{error, io, recording, values, Error};
+use neurotex_features::features;
+use neurotex_learn::classify;
+use neurotex_signal::{encode, signal};
