@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+pub use crate::values::ParamError;
 use crate::values::{Grid, Speed};
 
 /// Everything that can go wrong in neurotex, by stage.
@@ -55,29 +56,6 @@ impl Error {
 
 /// A shorthand for results with [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
-
-/// A parameter outside its allowed range; the message names the rule.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("invalid parameter `{name}`: {rule}, got {got}")]
-pub struct ParamError {
-    /// The parameter's name as the command line spells it.
-    pub name: &'static str,
-    /// The rule it must satisfy.
-    pub rule: &'static str,
-    /// The value that came.
-    pub got: String,
-}
-
-impl ParamError {
-    /// Builds the error for parameter `name` that broke `rule` with value `got`.
-    pub fn new(name: &'static str, rule: &'static str, got: impl ToString) -> Self {
-        Self {
-            name,
-            rule,
-            got: got.to_string(),
-        }
-    }
-}
 
 /// Bad or unreadable input data: each variant names the file and what was expected.
 #[derive(Debug, thiserror::Error)]

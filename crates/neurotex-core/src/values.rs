@@ -9,8 +9,6 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use crate::error::ParamError;
-
 /// Largest number of grid cells accepted from a user (a 1024 x 1024 skin); more is a typo
 /// or a hostile file, and would allocate per-cell state for nothing.
 pub const MAX_CELLS: usize = 1 << 20;
@@ -533,6 +531,29 @@ impl FromStr for TimeUnit {
                 "a time unit is `ms`, `s` or `us`",
                 text,
             )),
+        }
+    }
+}
+
+/// A parameter outside its allowed range; the message names the rule.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("invalid parameter `{name}`: {rule}, got {got}")]
+pub struct ParamError {
+    /// The parameter's name as the command line spells it.
+    pub name: &'static str,
+    /// The rule it must satisfy.
+    pub rule: &'static str,
+    /// The value that came.
+    pub got: String,
+}
+
+impl ParamError {
+    /// Builds the error for parameter `name` that broke `rule` with value `got`.
+    pub fn new(name: &'static str, rule: &'static str, got: impl ToString) -> Self {
+        Self {
+            name,
+            rule,
+            got: got.to_string(),
         }
     }
 }

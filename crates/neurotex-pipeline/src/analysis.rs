@@ -433,6 +433,27 @@ pub fn evaluate_sweep<C: Sweep>(
         Split::CrossValidation { .. } => y_train,
         _ => y_test,
     };
+    let each_taxel = columns == Columns::EachTaxel;
+    Ok(by_setting(
+        results,
+        &groups,
+        &labels,
+        (evaluated, truth),
+        each_taxel,
+        &table.grid,
+    ))
+}
+
+/// One [`Outcome`] per setting of a sweep from each column group's evaluations (`results`,
+/// per group, one per setting), for the rows `evaluated` whose classes are `truth`.
+fn by_setting(
+    results: Vec<Vec<Evaluation>>,
+    groups: &[(Option<usize>, Vec<usize>)],
+    labels: &[String],
+    (evaluated, truth): (&[usize], &[usize]),
+    each_taxel: bool,
+    grid: &Grid,
+) -> Vec<Outcome> {
     let settings = results.first().map_or(0, Vec::len);
     let mut by_group: Vec<_> = results.into_iter().map(Vec::into_iter).collect();
     let outcomes = (0..settings).map(|_| {
@@ -455,15 +476,10 @@ pub fn evaluate_sweep<C: Sweep>(
         Outcome {
             predictions,
             correct_shares,
-            ..combine(
-                results,
-                labels.clone(),
-                columns == Columns::EachTaxel,
-                &table.grid,
-            )
+            ..combine(results, labels.to_vec(), each_taxel, grid)
         }
     });
-    Ok(outcomes.collect())
+    outcomes.collect()
 }
 
 /// The rows `split` trains (or cross-validates) on and the rows it tests on.

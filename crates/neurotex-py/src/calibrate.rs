@@ -11,8 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde::Serialize;
 
-use crate::convert::{Batch, InfoTuple};
-use crate::dataset::open;
+use crate::convert::{open, Batch, InfoTuple};
 use crate::errors::{guarded, raise, Kind};
 use crate::params::{self, Stages};
 

@@ -1,15 +1,19 @@
 //! numpy arrays in: views of the caller's memory (any strides, float32 or float64), read
 //! without the GIL into the library's recordings and rasters.
 
+use std::path::Path;
+
 use ndarray::ArrayViewD;
 use neurotex::error::DataError;
 use neurotex::pipeline::Encoded;
-use neurotex::recording::{Layout, Meta, Recording, DEFAULT_MAX_DURATION_S, VALUES_PER_LIMIT_S};
+use neurotex::recording::{
+    Dataset, Layout, Meta, Recording, DEFAULT_MAX_DURATION_S, VALUES_PER_LIMIT_S,
+};
 use numpy::PyReadonlyArrayDyn;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::errors::{raise, try_vec, Kind};
+use crate::errors::{guarded, raise, try_vec, Kind};
 
 /// A borrowed numpy array of samples, float32 or float64, as the caller laid it out.
 pub enum Samples<'py> {
@@ -100,48 +104,8 @@ impl SamplesView<'_> {
                 info.fs
             )));
         }
-        let span = match &info.times_s {
-            Some(times) => {
-                if times.len() != t {
-                    return Err(bad(format!("{} time stamps for {t} samples", times.len())));
-                }
-                if let Some(i) = times
-                    .windows(2)
-                    .position(|w| !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]))
-                {
-                    return Err(bad(format!(
-                        "time stamps must be finite and strictly increasing; stamp {} \
-                         is {} after {}",
-                        i + 1,
-                        times[i + 1],
-                        times[i]
-                    )));
-                }
-                match times[..] {
-                    [first, .., last] => last - first,
-                    _ => 0.0,
-                }
-            }
-            None => t as f64 / info.fs,
-        };
-        if span > DEFAULT_MAX_DURATION_S {
-            return Err(bad(format!(
-                "{t} samples at {} Hz last {span} s, beyond the limit of \
-                 {DEFAULT_MAX_DURATION_S} s per recording",
-                info.fs
-            )));
-        }
-        // The CLI reader's limit on what resampling to 1 kHz allocates.
-        let max_values = DEFAULT_MAX_DURATION_S * VALUES_PER_LIMIT_S;
-        let resampled = span * 1000.0 * (rows * cols) as f64;
-        if resampled > max_values {
-            return Err(bad(format!(
-                "{span} s on {} grid cells is {resampled:.3e} values once resampled to 1 kHz, \
-                 beyond the limit of {max_values:.3e} ({DEFAULT_MAX_DURATION_S} s of a \
-                 16-taxel grid); a wrong shape or rate is the usual cause",
-                rows * cols
-            )));
-        }
+        let span = span_s(info, t).map_err(bad)?;
+        check_span(span, info.fs, t, rows * cols).map_err(bad)?;
         // Logical (C) order whatever the strides: a C-contiguous array is one copy. A
         // broadcast view can be far larger than the memory behind it: reserved fallibly.
         let mut samples: Vec<f64> =
@@ -184,6 +148,53 @@ impl SamplesView<'_> {
             },
         })
     }
+}
+
+/// The recording's span in s: from its time stamps, checked (one per sample, finite and
+/// strictly increasing), or `t` samples at its rate.
+fn span_s(info: &RecordingInfo, t: usize) -> Result<f64, String> {
+    let Some(times) = &info.times_s else {
+        return Ok(t as f64 / info.fs);
+    };
+    if times.len() != t {
+        return Err(format!("{} time stamps for {t} samples", times.len()));
+    }
+    if let Some(i) = times
+        .windows(2)
+        .position(|w| !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]))
+    {
+        return Err(format!(
+            "time stamps must be finite and strictly increasing; stamp {} is {} after {}",
+            i + 1,
+            times[i + 1],
+            times[i]
+        ));
+    }
+    Ok(match times[..] {
+        [first, .., last] => last - first,
+        _ => 0.0,
+    })
+}
+
+/// The CLI reader's limits on a recording of `span` s (`t` samples at `fs` Hz) on `cells`
+/// grid cells: its duration, and what resampling to 1 kHz allocates.
+fn check_span(span: f64, fs: f64, t: usize, cells: usize) -> Result<(), String> {
+    if span > DEFAULT_MAX_DURATION_S {
+        return Err(format!(
+            "{t} samples at {fs} Hz last {span} s, beyond the limit of \
+             {DEFAULT_MAX_DURATION_S} s per recording"
+        ));
+    }
+    let max_values = DEFAULT_MAX_DURATION_S * VALUES_PER_LIMIT_S;
+    let resampled = span * 1000.0 * cells as f64;
+    if resampled > max_values {
+        return Err(format!(
+            "{span} s on {cells} grid cells is {resampled:.3e} values once resampled to 1 kHz, \
+             beyond the limit of {max_values:.3e} ({DEFAULT_MAX_DURATION_S} s of a \
+             16-taxel grid); a wrong shape or rate is the usual cause"
+        ));
+    }
+    Ok(())
 }
 
 /// One recording's description as the Python layer passes it beside the samples:
@@ -346,4 +357,15 @@ pub fn raster_of(raster: &PyReadonlyArrayDyn<'_, u8>) -> PyResult<(Vec<u8>, usiz
         ));
     }
     Ok((data, rows, cols))
+}
+
+/// Opens a dataset folder, a missing folder raising `NotFoundError`.
+pub(crate) fn open(dir: &Path) -> PyResult<Dataset> {
+    if !dir.exists() {
+        return Err(raise(
+            Kind::NotFound,
+            format!("{}: no such dataset folder", dir.display()),
+        ));
+    }
+    guarded(|| Dataset::open(dir))
 }

@@ -1,11 +1,11 @@
 //! Dataset folders: read into arrays, features straight from the folder (the CLI's path),
 //! written from arrays, and the simulated rig written as one.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use ndarray::Array3;
 use neurotex::recording::{
-    create_dataset_dir, write_layout, write_manifest, Dataset, LayoutFile, Meta, Recording,
+    create_dataset_dir, write_layout, write_manifest, LayoutFile, Meta, Recording,
 };
 use neurotex::sim::{check_design, design, write_dataset, RigParams, Texture, ALL_TEXTURES};
 use numpy::{IntoPyArray, PyArray2};
@@ -14,20 +14,10 @@ use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 
 use crate::calibrate::{calibrated, Report};
+use crate::convert::open;
 use crate::convert::{Batch, InfoTuple};
 use crate::errors::{guarded, param, raise, Kind};
 use crate::{params, table_of};
-
-/// Opens a dataset folder, a missing folder raising `NotFoundError`.
-pub(crate) fn open(dir: &Path) -> PyResult<Dataset> {
-    if !dir.exists() {
-        return Err(raise(
-            Kind::NotFound,
-            format!("{}: no such dataset folder", dir.display()),
-        ));
-    }
-    guarded(|| Dataset::open(dir))
-}
 
 /// A recording's manifest fields as text, column by column (empty where it gives none).
 fn manifest_row<'py>(
@@ -214,7 +204,24 @@ fn save_dataset(
         meta.extra = extra[i].clone();
         metas.push(meta);
     }
-    let (rows, cols, present) = grid.ok_or_else(|| raise(Kind::Data, "no recordings to save"))?;
+    let grid = grid.ok_or_else(|| raise(Kind::Data, "no recordings to save"))?;
+    let layout = layout_file(fs, grid);
+    py.detach(|| {
+        guarded(|| {
+            create_dataset_dir(&dir, |tmp| {
+                for (i, info) in infos.iter().enumerate() {
+                    view.write_npy(i, &tmp.join(&info.name))?;
+                }
+                write_manifest(tmp, &metas)?;
+                write_layout(tmp, &layout)
+            })
+        })
+    })
+}
+
+/// The `layout.toml` of recordings at `fs` Hz on a `(rows, cols, present)` grid: the mask
+/// only when a cell is empty.
+fn layout_file(fs: f64, (rows, cols, present): (usize, usize, Vec<bool>)) -> LayoutFile {
     let mut layout = LayoutFile {
         fs: Some(fs),
         rows: Some(rows),
@@ -229,17 +236,7 @@ fn save_dataset(
                 .collect(),
         );
     }
-    py.detach(|| {
-        guarded(|| {
-            create_dataset_dir(&dir, |tmp| {
-                for (i, info) in infos.iter().enumerate() {
-                    view.write_npy(i, &tmp.join(&info.name))?;
-                }
-                write_manifest(tmp, &metas)?;
-                write_layout(tmp, &layout)
-            })
-        })
-    })
+    layout
 }
 
 /// Simulates the paper's rig into a dataset folder, as `neurotex simulate` does.

@@ -217,23 +217,10 @@ fn rate_volume<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// The summed co-occurrence counts (uint64 `(levels, levels)`) of a float volume
-/// `(rows, cols, bins)` (3D) or image `(rows, cols)` (2D), quantised as the pipeline does.
-#[pyfunction]
-#[pyo3(signature = (volume, three_d, levels, distances, symmetric, range=None, mask=None))]
-#[allow(clippy::too_many_arguments)]
-fn glcm<'py>(
-    py: Python<'py>,
-    volume: PyReadonlyArrayDyn<'py, f64>,
-    three_d: bool,
-    levels: usize,
-    distances: Vec<usize>,
-    symmetric: bool,
-    range: Option<(f64, f64)>,
-    mask: Option<Vec<bool>>,
-) -> PyResult<Bound<'py, PyArray2<u64>>> {
-    let a = volume.as_array();
-    let (rows, cols, bins) = match (three_d, a.shape()) {
+/// `(rows, cols, bins)` of a volume's `shape` (`bins` 1 for a 2D image), refusing another
+/// number of axes or an empty volume.
+fn volume_shape(shape: &[usize], three_d: bool) -> PyResult<(usize, usize, usize)> {
+    let (rows, cols, bins) = match (three_d, shape) {
         (true, &[r, c, b]) => (r, c, b),
         (false, &[r, c]) => (r, c, 1),
         (_, other) => {
@@ -251,9 +238,29 @@ fn glcm<'py>(
     if rows * cols * bins == 0 {
         return Err(raise(
             Kind::Data,
-            format!("volume is empty: shape {:?}", a.shape()),
+            format!("volume is empty: shape {shape:?}"),
         ));
     }
+    Ok((rows, cols, bins))
+}
+
+/// The summed co-occurrence counts (uint64 `(levels, levels)`) of a float volume
+/// `(rows, cols, bins)` (3D) or image `(rows, cols)` (2D), quantised as the pipeline does.
+#[pyfunction]
+#[pyo3(signature = (volume, three_d, levels, distances, symmetric, range=None, mask=None))]
+#[allow(clippy::too_many_arguments)]
+fn glcm<'py>(
+    py: Python<'py>,
+    volume: PyReadonlyArrayDyn<'py, f64>,
+    three_d: bool,
+    levels: usize,
+    distances: Vec<usize>,
+    symmetric: bool,
+    range: Option<(f64, f64)>,
+    mask: Option<Vec<bool>>,
+) -> PyResult<Bound<'py, PyArray2<u64>>> {
+    let a = volume.as_array();
+    let (rows, cols, bins) = volume_shape(a.shape(), three_d)?;
     let data = try_vec(a.len(), "volume", a.iter().copied())?;
     // the levels, one byte per value
     let mut q =

@@ -19,7 +19,7 @@ use neurotex::sim::MAX_TRIALS;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::dataset::open;
+use crate::convert::open;
 use crate::errors::{guarded, param, raise, Kind};
 use crate::params::{self, Stages};
 

@@ -455,28 +455,7 @@ impl StreamClassifier {
     ) -> Result<&[Event], StreamError> {
         self.events.clear();
         let time_s = stamp.map(|t| unit.to_seconds(t));
-        let checked = self.check_frame(time_s, values);
-        let jumped = match (checked, time_s) {
-            (Err(bad), _) => Err(bad),
-            (Ok(()), Some(t)) => self.follow(t),
-            (Ok(()), None) => Ok(false),
-        };
-        let jumped = match jumped {
-            Ok(jumped) => jumped,
-            Err(bad) => {
-                self.bad_frames += 1;
-                return Err(bad.into());
-            }
-        };
-        let index = self.frames as f64;
-        self.frames += 1;
-        if values.len() == self.cell_frame.len() {
-            self.cell_frame.copy_from_slice(values); // every cell holds a taxel
-        } else {
-            for (&v, &cell) in values.iter().zip(&self.channel_cells) {
-                self.cell_frame[cell] = v;
-            }
-        }
+        let (jumped, index) = self.accept(time_s, values)?;
         if jumped && self.episode.is_some() {
             self.end_episode(EpisodeEnd::Gap)?;
         }
@@ -520,6 +499,41 @@ impl StreamClassifier {
         } else {
             self.resample(relative)?;
         }
+        self.end_at_rest(level, relative)?;
+        Ok(&self.events)
+    }
+
+    /// Checks a frame, follows its stamp (`time_s`, seconds) and places its values on the
+    /// cells: whether the stamps jumped, and the frame's index in the stream.
+    fn accept(&mut self, time_s: Option<f64>, values: &[f64]) -> Result<(bool, f64), StreamError> {
+        let checked = self.check_frame(time_s, values);
+        let jumped = match (checked, time_s) {
+            (Err(bad), _) => Err(bad),
+            (Ok(()), Some(t)) => self.follow(t),
+            (Ok(()), None) => Ok(false),
+        };
+        let jumped = match jumped {
+            Ok(jumped) => jumped,
+            Err(bad) => {
+                self.bad_frames += 1;
+                return Err(bad.into());
+            }
+        };
+        let index = self.frames as f64;
+        self.frames += 1;
+        if values.len() == self.cell_frame.len() {
+            self.cell_frame.copy_from_slice(values); // every cell holds a taxel
+        } else {
+            for (&v, &cell) in values.iter().zip(&self.channel_cells) {
+                self.cell_frame[cell] = v;
+            }
+        }
+        Ok((jumped, index))
+    }
+
+    /// Ends an onset episode once the contact `level` has stayed below half the onset
+    /// level for the rule's rest time (`relative`: the frame's time in the episode, s).
+    fn end_at_rest(&mut self, level: f64, relative: f64) -> Result<(), StreamError> {
         if let EpisodeRule::Onset {
             level: onset,
             rest_ms,
@@ -535,7 +549,7 @@ impl StreamClassifier {
                 episode.rest_since = None;
             }
         }
-        Ok(&self.events)
+        Ok(())
     }
 
     /// Ends the current episode (a reset frame or control line); the next frame starts a

@@ -260,6 +260,30 @@ impl Profiles {
     }
 }
 
+/// The along-track smoothing kernel over `-reach..=reach` profile steps: a box of
+/// `half_box` steps either side (the taxel's length) convolved with a Gaussian of `sigma`
+/// steps (the cover's spread), normalised to sum to 1.
+fn along_track_kernel(half_box: isize, sigma: f64, reach: isize) -> Vec<f64> {
+    let k: Vec<f64> = (-reach..=reach)
+        .map(|i| {
+            (-half_box..=half_box)
+                .map(|b| {
+                    let d = (i - b) as f64;
+                    if sigma > 0.0 {
+                        (-0.5 * d * d / (sigma * sigma)).exp()
+                    } else if d == 0.0 {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                })
+                .sum()
+        })
+        .collect();
+    let total: f64 = k.iter().sum();
+    k.into_iter().map(|v| v / total).collect()
+}
+
 fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Profiles {
     let texture_seed: u64 = rng.gen();
     let origin = (
@@ -274,26 +298,7 @@ fn build_profiles(p: &RigParams, texture: Texture, rng: &mut ChaCha8Rng) -> Prof
     let half_box = (p.taxel_mm / 2.0 / step).round() as isize;
     let sigma = p.cover_spread_mm / step;
     let reach = half_box + (3.0 * sigma).ceil() as isize;
-    let kernel: Vec<f64> = {
-        let k: Vec<f64> = (-reach..=reach)
-            .map(|i| {
-                (-half_box..=half_box)
-                    .map(|b| {
-                        let d = (i - b) as f64;
-                        if sigma > 0.0 {
-                            (-0.5 * d * d / (sigma * sigma)).exp()
-                        } else if d == 0.0 {
-                            1.0
-                        } else {
-                            0.0
-                        }
-                    })
-                    .sum()
-            })
-            .collect();
-        let total: f64 = k.iter().sum();
-        k.into_iter().map(|v| v / total).collect()
-    };
+    let kernel = along_track_kernel(half_box, sigma, reach);
     let pitch = p.pitch_mm();
     let row_offset_mm: Vec<f64> = (0..p.rows)
         .map(|r| ((p.rows - 1) as f64 / 2.0 - r as f64) * pitch)
@@ -420,11 +425,8 @@ fn simulate(
     let cells = p.rows * p.cols;
     let schedule = Schedule::with_force(p, speed, force);
     let total = schedule.total();
-    let k_texture = trial.texture.stiffness_n_per_mm3();
-    let k = 1.0 / (1.0 / p.pad_stiffness_n_per_mm3 + 1.0 / k_texture);
-    let area = p.active_mm * p.active_mm / cells as f64;
-    let alpha = 1.0 - (-1.0 / p.lag_ms).exp();
-    let full_scale = ((1u64 << p.adc_bits) - 1) as f64;
+    let sensor = Sensor::of(p, trial.texture);
+    let (k, area) = (sensor.k, p.active_mm * p.active_mm / cells as f64);
     let mut samples = vec![0.0; total * cells];
     let mut phases = Vec::with_capacity(total);
     // The sensor noise has its own generator, seeded from the trial's: ChaCha8 and the
@@ -440,13 +442,6 @@ fn simulate(
         vec![0.0; cells],
         Vec::with_capacity(cells),
     );
-    let sensor = Sensor {
-        k,
-        saturation: p.saturation_n_per_mm2,
-        alpha,
-        noise: p.noise,
-        full_scale,
-    };
     let mut z = f64::INFINITY;
     // The force and the distance slid of the step whose contact `h` and `z` hold.
     let mut solved: Option<(u64, u64)> = None;
@@ -521,6 +516,18 @@ struct Sensor {
 }
 
 impl Sensor {
+    /// The rig's sensor pressed on `texture`.
+    fn of(p: &RigParams, texture: Texture) -> Self {
+        let k_texture = texture.stiffness_n_per_mm3();
+        Sensor {
+            k: 1.0 / (1.0 / p.pad_stiffness_n_per_mm3 + 1.0 / k_texture),
+            saturation: p.saturation_n_per_mm2,
+            alpha: 1.0 - (-1.0 / p.lag_ms).exp(),
+            noise: p.noise,
+            full_scale: ((1u64 << p.adc_bits) - 1) as f64,
+        }
+    }
+
     /// Each taxel's saturated response to its pressure, at heights `h` under a pad at
     /// `z`, scaled by its gain: the target its output lags towards.
     fn targets(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
