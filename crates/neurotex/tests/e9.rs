@@ -2,7 +2,7 @@
 //! same folds (a second path to the same numbers), every standard candidate is ranked, and
 //! the report shows the section and its figures.
 
-mod support;
+use crate::support;
 
 use neurotex::classify::CvParams;
 use neurotex::experiments::{prepare, run_all, ReproduceParams};
@@ -59,7 +59,7 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
         source: "a small simulated design".into(),
         parameters: Vec::new(),
         total_seconds: 1.0,
-        command: "cargo test --test e9".into(),
+        command: "cargo test --test library e9".into(),
         paper_comparable: false,
     };
     let text = markdown(&r, &context);

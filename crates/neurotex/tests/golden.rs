@@ -1,10 +1,10 @@
 //! Golden outputs of the analyses on a small simulated design with a fixed seed: the
 //! results (`golden_small_design.json`) and the report rendered from them
 //! (`golden_report.md`, with a fixed context and no timings). A change that moves either
-//! must regenerate it on purpose (`NEUROTEX_BLESS=1 cargo test -p neurotex --test golden`)
+//! must regenerate it on purpose (`NEUROTEX_BLESS=1 cargo test -p neurotex --test library golden`)
 //! and say why in its commit.
 
-mod support;
+use crate::support;
 
 use std::sync::OnceLock;
 
@@ -78,7 +78,7 @@ fn small_simulated_design_renders_the_stored_report() {
         source: "small simulated design, seed 7".into(),
         parameters: vec!["CV: 3-fold, 2 repeats".into()],
         total_seconds: 1.0,
-        command: "cargo test --test golden".into(),
+        command: "cargo test --test library golden".into(),
         paper_comparable: true,
     };
     let text = markdown(results, &ctx);

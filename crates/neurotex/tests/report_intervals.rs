@@ -23,7 +23,7 @@
 //! differently, a shifted percentile, a share counted over the wrong predictions or a
 //! mis-mapped paired interval moves them by 1e-3 or more.
 
-mod support;
+use crate::support;
 
 use std::collections::BTreeMap;
 
@@ -105,7 +105,7 @@ fn small_run() -> (Tables, neurotex::experiments::Results, String, u64) {
         source: "a small simulated design".into(),
         parameters: Vec::new(),
         total_seconds: 1.0,
-        command: "cargo test --test report_intervals".into(),
+        command: "cargo test --test library report_intervals".into(),
         paper_comparable: false,
     };
     let report = markdown(&results, &context);

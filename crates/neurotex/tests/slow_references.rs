@@ -10,7 +10,7 @@ use neurotex::features::{
 };
 use proptest::prelude::*;
 
-mod support;
+use crate::support;
 use support::{few_levels_volume, spike_train, uniform_volume, Volume, XorShift};
 
 /// Loop-built GLCM: every voxel, every direction times every distance, bounds and mask checked.

@@ -3,7 +3,7 @@
 //! decisions `causal::episode_decisions` computes from the whole recording; bad frames are
 //! skipped without changing them; memory stays within the window; onset episodes.
 
-mod support;
+use crate::support;
 
 use neurotex::analysis::{Columns, FeatureTable};
 use neurotex::causal::{
