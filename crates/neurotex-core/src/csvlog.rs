@@ -311,10 +311,7 @@ fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
     DataError::invalid(path, message).into()
 }
 
-/// Guesses the delimiter from the first lines: among `,` `;` and tab, the one found the
-/// same non-zero number of times on each of the first ten lines, the most frequent such
-/// one (tab, then `;`, then `,` on a tie: `;` files often carry decimal commas); `,` when
-/// none is.
+/// Guesses a file's delimiter from its first lines ([`detect_delimiter_in`]).
 fn detect_delimiter(path: &Path) -> Result<Delimiter> {
     let mut head = Vec::with_capacity(16 * 1024);
     std::fs::File::open(path)
@@ -326,6 +323,14 @@ fn detect_delimiter(path: &Path) -> Result<Delimiter> {
         lines.pop(); // probably cut short
     }
     lines.truncate(10);
+    Ok(detect_delimiter_in(&lines))
+}
+
+/// Guesses the delimiter from the first lines of a log (a file's first ten, or a stream's
+/// first): among `,` `;` and tab, the one found the same non-zero number of times on each
+/// line, the most frequent such one (tab, then `;`, then `,` on a tie: `;` files often
+/// carry decimal commas); `,` when none is.
+pub fn detect_delimiter_in(lines: &[&str]) -> Delimiter {
     let mut best: Option<(usize, u8)> = None;
     for candidate in [b'\t', b';', b','] {
         let counts: Vec<usize> = lines
@@ -337,7 +342,7 @@ fn detect_delimiter(path: &Path) -> Result<Delimiter> {
             best = Some((n, candidate));
         }
     }
-    Ok(Delimiter(best.map_or(b',', |(_, b)| b)))
+    Delimiter(best.map_or(b',', |(_, b)| b))
 }
 
 /// Where the time and channel columns of a log are, and the columns' names.

@@ -12,7 +12,7 @@ use crate::features::{
     distance_stats, haralick, haralick_full, spike_stats, CountVolume, GlcmParams, GlcmPlan,
     VolumeParams, FULL_NAMES,
 };
-use crate::recording::{Baseline, Dataset, Meta, Recording};
+use crate::recording::{one_grid, Baseline, Dataset, Meta, Recording};
 use crate::signal::{Conditioned, PreprocessParams, Preprocessor};
 use crate::values::Grid;
 
@@ -246,6 +246,24 @@ impl PipelineParams {
         self.fa.check()?;
         self.features.check()
     }
+}
+
+/// The taxel grid every encoded recording shares (size and mask).
+///
+/// # Errors
+/// Recordings on different grids, the first that differs named; no recording.
+pub fn shared_grid(encoded: &[Encoded]) -> Result<Grid> {
+    let grids = encoded
+        .iter()
+        .map(|e| {
+            let s = &e.spikes;
+            Ok((
+                e.meta.file.as_str(),
+                Grid::masked(s.rows, s.cols, s.present.clone())?,
+            ))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    one_grid(grids)
 }
 
 /// One recording's spikes with what the conditioning noticed.

@@ -24,9 +24,7 @@ use neurotex::features::{
     haralick, haralick_full, quantise, spike_stats as stats_of, GlcmParams, GlcmPlan, RateVolume,
     VolumeParams,
 };
-use neurotex::pipeline::{Encoded, Pipeline};
-use neurotex::recording::one_grid;
-use neurotex::Grid;
+use neurotex::pipeline::{shared_grid, Encoded, Pipeline};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -115,31 +113,13 @@ fn features<'py>(
     Ok((values.into_pyarray(py), names, c.report()?))
 }
 
-/// The grid every encoded recording shares.
-///
-/// # Errors
-/// Recordings on different grids, named.
-pub(crate) fn grid_of(encoded: &[Encoded]) -> neurotex::Result<Grid> {
-    let grids = encoded
-        .iter()
-        .map(|e| {
-            let s = &e.spikes;
-            Ok((
-                e.meta.file.as_str(),
-                Grid::masked(s.rows, s.cols, s.present.clone())?,
-            ))
-        })
-        .collect::<neurotex::Result<Vec<_>>>()?;
-    one_grid(grids)
-}
-
 /// The feature table of encoded recordings, as the CLI's `features` command builds it.
 pub(crate) fn table_of(
     encoded: &[Encoded],
     pipeline: &Pipeline,
     method: neurotex::pipeline::Method,
 ) -> neurotex::Result<(Array2<f64>, Vec<String>)> {
-    let extractor = pipeline.extractor(&grid_of(encoded)?)?;
+    let extractor = pipeline.extractor(&shared_grid(encoded)?)?;
     let table = neurotex::analysis::FeatureTable::build(encoded, &extractor, method)?;
     let n = table.metas.len();
     let k = table.dims();

@@ -13,7 +13,7 @@ use pyo3::types::PyDict;
 use crate::calibrate::{calibrated, json};
 use crate::convert::{Batch, InfoTuple};
 use crate::errors::{guarded, param, raise, Kind};
-use crate::{grid_of, params};
+use crate::params;
 
 /// A trained classifier with its pipeline, as `neurotex train` writes it.
 #[pyclass(module = "neurotex._native", frozen)]
@@ -161,7 +161,7 @@ fn train_model<'py>(
         guarded(|| {
             let c = calibrated(&stages, &|i| view.load(i), &all, dataset_baseline)?;
             let encoded = view.encode(|rec| c.pipeline.encode(rec, dataset_baseline))?;
-            let grid = grid_of(&encoded)?;
+            let grid = neurotex::pipeline::shared_grid(&encoded)?;
             let extractor = c.pipeline.extractor(&grid)?;
             let table = FeatureTable::build(&encoded, &extractor, method)?;
             if let Columns::Taxel(cell) = columns {

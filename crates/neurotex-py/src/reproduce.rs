@@ -5,16 +5,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use neurotex::calibrate::GainCalibration;
 use neurotex::classify::KnnParams;
-use neurotex::experiments::{
-    claims, prepare, run_all, run_seeds, HeadlinePrediction, Progress, ReproduceParams, Results,
-    Source, ValidReproduceParams,
-};
-use neurotex::pipeline::Pipeline;
-use neurotex::report::{
-    check_report_dir, folder_source, simulated_source, write_report, ReportContext,
-};
+use neurotex::experiments::{claims, HeadlinePrediction, ReproduceParams};
+use neurotex::report::reproduce::{reproduce as run_analyses, Data as Input, Run};
 use neurotex::sim::MAX_TRIALS;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -119,7 +112,8 @@ fn reproduce(
     py.detach(|| guarded(|| run(&out, &data, &stages, params, &command)))
 }
 
-/// The run itself, without the GIL.
+/// Runs the library's [`run_analyses`] (the report written as the CLI writes it) and hands
+/// back the results and claims as JSON, the headline predictions and the seconds taken.
 fn run(
     out: &std::path::Path,
     data: &Data,
@@ -128,39 +122,20 @@ fn run(
     command: &str,
 ) -> neurotex::Result<Outcome> {
     let started = Instant::now();
-    // claimed and checked before any work, held until the report is written
-    let _claim = check_report_dir(out)?;
-    let quiet = |_: Progress| ();
-    let (results, described, params) = match data {
-        Data::Folder(ds) => {
-            let source = Source::Dataset(ds);
-            let (params, calibration) = calibrated(params, stages, &source)?;
-            let prepared = prepare(&source, &params, &quiet)?;
-            let mut results = run_all(&prepared, &params, &quiet)?;
-            results.gain_calibration = calibration;
-            (results, source.describe(), params)
-        }
-        Data::Simulated { trials, seeds } => {
-            let simulate = |seed| Source::paper_design(*trials, seed);
-            let (params, calibration) = calibrated(params, stages, &simulate(seeds[0]))?;
-            let mut results = run_seeds(&simulate, seeds, &params, &quiet)?;
-            results.gain_calibration = calibration;
-            (results, describe_seeds(&simulate(seeds[0]), seeds), params)
-        }
+    let input = match data {
+        Data::Folder(ds) => Input::Folder(ds),
+        Data::Simulated { trials, seeds } => Input::Simulated {
+            trials: *trials,
+            seeds,
+        },
     };
-    let source = match data {
-        Data::Folder(ds) => folder_source(&ds.root),
-        Data::Simulated { seeds, .. } => simulated_source(seeds),
-    };
-    let ctx = ReportContext {
-        dataset: described,
-        source,
-        parameters: parameters_described(&params, &results),
-        total_seconds: started.elapsed().as_secs_f64(),
+    let run = Run {
+        gain_target: stages.gain_target(),
         command: command.to_string(),
-        paper_comparable: matches!(data, Data::Simulated { .. }),
+        on_progress: &|_| (),
+        on_gain: &|_| (),
     };
-    write_report(out, &results, &ctx)?;
+    let results = run_analyses(out, input, params, &run)?;
     let json = |what: &str, text: serde_json::Result<String>| {
         text.map_err(|e| neurotex::error::DataError::invalid(out.join(what), e.to_string()))
     };
@@ -175,25 +150,6 @@ fn run(
     ))
 }
 
-/// The checked parameters, with the gain calibrated on `first` (the dataset, or the first
-/// simulated one) under `gain="auto"`, as the CLI calibrates it.
-fn calibrated(
-    mut params: ReproduceParams,
-    stages: &Stages,
-    first: &Source,
-) -> neurotex::Result<(ValidReproduceParams, Option<GainCalibration>)> {
-    let calibration = match stages.gain_target() {
-        Some(target) => {
-            let pipeline = Pipeline::new(params.pipeline.clone())?;
-            let c = first.calibrate_gain(&pipeline, target)?;
-            params.pipeline.encoder.gain = c.gain;
-            Some(c)
-        }
-        None => None,
-    };
-    Ok((params.check()?, calibration))
-}
-
 fn prediction_row(p: &HeadlinePrediction) -> PredictionRow {
     (
         p.speed.mm_s(),
@@ -204,46 +160,6 @@ fn prediction_row(p: &HeadlinePrediction) -> PredictionRow {
         p.fold,
         p.repeat,
     )
-}
-
-// The report's two paragraphs below are worded as the CLI words them
-// (crates/neurotex-cli/src/commands/reproduce.rs), so that a report written from Python
-// reads as one written by `neurotex reproduce`.
-
-/// The report's parameter lines: the run's parameters and, under `gain="auto"`, the gain
-/// chosen.
-fn parameters_described(params: &ValidReproduceParams, results: &Results) -> Vec<String> {
-    let mut lines = params.describe();
-    if let Some(c) = &results.gain_calibration {
-        let shared = if results.across_seeds.is_some() {
-            "; calibrated on the first simulated dataset and used for all"
-        } else {
-            ""
-        };
-        lines.push(format!(
-            "gain: --gain auto chose G = {} so that the median taxel with signal fires at {} Hz (median {:.1} Hz over {} taxel x recording pairs of {} recordings; labels unused{shared})",
-            c.gain, c.target_hz, c.median_hz, c.pairs, c.recordings
-        ));
-    }
-    lines
-}
-
-/// The report's data paragraph for a run over simulated datasets: the first dataset's
-/// description and, with several, which further seeds were run.
-fn describe_seeds(first: &Source, seeds: &[u64]) -> String {
-    let mut text = first.describe();
-    if let [_, rest @ ..] = seeds {
-        if !rest.is_empty() {
-            let list: Vec<String> = rest.iter().map(u64::to_string).collect();
-            text.push_str(&format!(
-                " {} further independent datasets of the same design (seeds {}) were simulated and analysed the same way; the sections below show the first, and \"Across simulated datasets\" gives every headline accuracy over all {}.",
-                rest.len(),
-                list.join(", "),
-                seeds.len()
-            ));
-        }
-    }
-    text
 }
 
 /// Registers `reproduce`.

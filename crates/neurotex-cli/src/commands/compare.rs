@@ -12,11 +12,10 @@ use neurotex::compare::candidates::{
     candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
     STANDARD_METHODS, STANDARD_TAU_MS,
 };
-use neurotex::compare::{compare, Candidate, CompareParams, Comparison, Protocol};
+use neurotex::compare::{compare, Candidate, CompareParams, Protocol};
 use neurotex::pipeline::{Encoding, Pipeline};
 use neurotex::recording::{Dataset, Selection};
-use neurotex::report::figures::{compare as figures, svg_and_png};
-use neurotex::report::folder_source;
+use neurotex::report::comparison::{text_lines, write_comparison};
 use neurotex::Speed;
 
 use super::{calibrated_pipeline, encode_all};
@@ -214,12 +213,15 @@ pub fn run(args: CompareArgs) -> Result<()> {
     );
     let comparison = compare(&candidates, &params)?;
     if let Some(dir) = &args.out {
-        write_outputs(dir, &comparison, &args.dataset)?;
+        write_comparison(dir, &comparison, &args.dataset).context("writing the comparison")?;
+        eprintln!("wrote {}", dir.display());
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&comparison)?);
     } else {
-        print_comparison(&comparison);
+        for line in text_lines(&comparison) {
+            println!("{line}");
+        }
     }
     Ok(())
 }
@@ -243,143 +245,4 @@ fn make_candidates(
     let (encoded, grid) = encode_all(dataset, &pipeline, indices)?;
     let encode_s = start.elapsed().as_secs_f64();
     Ok(candidates(&encoded, &grid, &params, set, encode_s)?)
-}
-
-/// compare.json, compare.md and the figures (SVG and PNG), written as one folder `dir` that
-/// replaces an earlier comparison there as a whole ([`neurotex::io::replace_dir`]); the
-/// figures name the dataset folder `dataset`.
-fn write_outputs(dir: &std::path::Path, c: &Comparison, dataset: &std::path::Path) -> Result<()> {
-    let source = folder_source(dataset);
-    let mut files = vec![
-        (
-            "compare.json".to_string(),
-            (serde_json::to_string_pretty(c)? + "\n").into_bytes(),
-        ),
-        ("compare.md".to_string(), markdown(c).into_bytes()),
-    ];
-    let mut svgs = vec![("ranking.svg", figures::ranking(c, &source)?)];
-    if let Some(figure) = figures::per_condition(c) {
-        svgs.push(("per_condition.svg", figure.draw(&source)?));
-    }
-    for (name, svg) in svgs {
-        files.extend(svg_and_png(name, svg)?);
-    }
-    neurotex::io::replace_dir(dir, |tmp| {
-        for (name, bytes) in &files {
-            let path = tmp.join(name);
-            std::fs::write(&path, bytes)
-                .map_err(|e| neurotex::error::DataError::write(&path, e))?;
-        }
-        Ok(())
-    })
-    .context("writing the comparison")?;
-    eprintln!("wrote {}", dir.display());
-    Ok(())
-}
-
-/// `87.5% [85.1, 89.8]`.
-fn with_interval(accuracy: f64, ci: [f64; 2]) -> String {
-    format!(
-        "{:.1}% [{:.1}, {:.1}]",
-        100.0 * accuracy,
-        100.0 * ci[0],
-        100.0 * ci[1]
-    )
-}
-
-/// The ranking as a Markdown document.
-fn markdown(c: &Comparison) -> String {
-    let mut out = format!(
-        "# Comparison\n\n{} recordings ({} units: {}), {} classes; {}.\n\
-         Chance {:.1}%, majority class {:.1}%.\n\n\
-         | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) | seconds |\n\
-         |---:|---|---|---|---|---|---:|\n",
-        c.n_recordings,
-        c.n_units,
-        c.units,
-        c.classes,
-        c.protocol,
-        100.0 * c.chance,
-        100.0 * c.majority
-    );
-    for (i, r) in c.results.iter().enumerate() {
-        out.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {:.2} |\n",
-            i + 1,
-            r.encoding,
-            r.method,
-            r.classifier,
-            with_interval(r.accuracy, r.ci),
-            versus_paper(r),
-            r.seconds
-        ));
-    }
-    if let Some(n) = &c.nested {
-        out.push_str(&format!("\nNested selection: {}\n", nested_text(n)));
-    }
-    out.push_str(&format!("\nCaveat: {}.\n", c.caveat));
-    out
-}
-
-/// `+12.3 points (p 0.0004)`, `paper's method`, or `-`.
-fn versus_paper(r: &neurotex::compare::Ranked) -> String {
-    match (r.paper, r.difference_vs_paper, r.p_vs_paper) {
-        (true, ..) => "paper's method".into(),
-        (false, Some(d), Some(p)) => format!("{:+.1} points (p {})", 100.0 * d, p_text(p)),
-        _ => "-".into(),
-    }
-}
-
-fn p_text(p: f64) -> String {
-    if p < 0.001 {
-        "< 0.001".into()
-    } else {
-        format!("{p:.3}")
-    }
-}
-
-fn nested_text(n: &neurotex::compare::Nested) -> String {
-    let chosen: Vec<String> = n
-        .chosen
-        .iter()
-        .map(|(name, times)| format!("{name} ({times} of {})", n.outer_splits))
-        .collect();
-    format!(
-        "{} over {} outer splits; chosen: {}",
-        with_interval(n.accuracy, n.ci),
-        n.outer_splits,
-        chosen.join(", ")
-    )
-}
-
-/// The ranking as text.
-fn print_comparison(c: &Comparison) {
-    println!(
-        "{} recordings, {} classes ({}); chance {:.1}%, majority {:.1}%",
-        c.n_recordings,
-        c.classes,
-        c.protocol,
-        100.0 * c.chance,
-        100.0 * c.majority
-    );
-    let width = c
-        .results
-        .iter()
-        .map(|r| r.encoding.len() + r.method.len() + r.classifier.len() + 6)
-        .max()
-        .unwrap_or(0);
-    for (i, r) in c.results.iter().enumerate() {
-        let name = format!("{} / {} / {}", r.encoding, r.method, r.classifier);
-        println!(
-            "{:>3}. {name:<width$}  {:<24} {:<28} {:>7.2} s",
-            i + 1,
-            with_interval(r.accuracy, r.ci),
-            versus_paper(r),
-            r.seconds
-        );
-    }
-    if let Some(n) = &c.nested {
-        println!("nested selection: {}", nested_text(n));
-    }
-    println!("caveat: {}", c.caveat);
 }

@@ -16,8 +16,8 @@ use anyhow::Result;
 use neurotex::analysis::FeatureTable;
 use neurotex::calibrate::{calibrate_pipeline, CalibratedParams, GainCalibration};
 use neurotex::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
-use neurotex::pipeline::{Encoded, Method, Pipeline};
-use neurotex::recording::{one_grid, Dataset};
+use neurotex::pipeline::{shared_grid, Encoded, Method, Pipeline};
+use neurotex::recording::Dataset;
 use neurotex::{Grid, Speed};
 
 use crate::output::progress;
@@ -77,17 +77,7 @@ fn encode_all(
     bar.finish_and_clear();
     let encoded = encoded?;
     report_conditions(&encoded);
-    let grids = encoded
-        .iter()
-        .map(|e| {
-            let s = &e.spikes;
-            Ok((
-                e.meta.file.as_str(),
-                Grid::masked(s.rows, s.cols, s.present.clone())?,
-            ))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let grid = one_grid(grids)?;
+    let grid = shared_grid(&encoded)?;
     Ok((encoded, grid))
 }
 

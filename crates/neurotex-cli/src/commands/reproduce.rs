@@ -7,14 +7,9 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::ProgressBar;
-use neurotex::calibrate::GainCalibration;
-use neurotex::experiments::{
-    claims, prepare, run_all, run_seeds, HeadlinePrediction, Progress, ReproduceParams, Results,
-    Source, ValidReproduceParams,
-};
-use neurotex::pipeline::Pipeline;
+use neurotex::experiments::{claims, Progress, ReproduceParams};
 use neurotex::recording::Dataset;
-use neurotex::report::{folder_source, simulated_source, write_report, ReportContext};
+use neurotex::report::reproduce::{reproduce, write_headline_predictions, Data, Run};
 
 use super::say_calibration;
 use crate::open_args::OpenArgs;
@@ -97,26 +92,6 @@ impl ReproduceArgs {
         Ok(params)
     }
 
-    /// The checked parameters, with the gain calibrated on `first` (the dataset, or the first
-    /// simulated one) under `--gain auto`.
-    fn calibrated(
-        &self,
-        first: &Source,
-    ) -> Result<(ValidReproduceParams, Option<GainCalibration>)> {
-        let mut params = self.params()?;
-        let calibration = match self.stages.gain_target() {
-            Some(target) => {
-                let pipeline = Pipeline::new(params.pipeline.clone())?;
-                let c = first.calibrate_gain(&pipeline, target)?;
-                say_calibration(&c);
-                params.pipeline.encoder.gain = c.gain;
-                Some(c)
-            }
-            None => None,
-        };
-        Ok((params.check()?, calibration))
-    }
-
     /// Simulated trials per texture and speed.
     fn trials_per(&self) -> Result<u32> {
         let trials_per = self.trials.unwrap_or(if self.quick { 10 } else { 20 });
@@ -150,23 +125,27 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         let inputs = dataset.as_ref().map(Dataset::files).unwrap_or_default();
         check_output(path, &inputs)?;
     }
+    let seeds = match dataset {
+        Some(_) => Vec::new(),
+        None => args.simulation_seeds()?,
+    };
+    let data = match &dataset {
+        Some(ds) => Data::Folder(ds),
+        None => Data::Simulated {
+            trials: args.trials_per()?,
+            seeds: &seeds,
+        },
+    };
     let bar = Mutex::new(progress(0, "starting"));
     let on_progress = |p: Progress| show_progress(&bar.lock().expect("progress bar"), p);
-    let (results, described, params) = analyse(&args, dataset.as_ref(), &on_progress)?;
-    bar.lock().expect("progress bar").finish_and_clear();
-    let source = match &args.dataset {
-        Some(dir) => folder_source(dir),
-        None => simulated_source(&args.simulation_seeds()?),
-    };
-    let ctx = ReportContext {
-        dataset: described,
-        source,
-        parameters: parameters_described(&params, &results),
-        total_seconds: started.elapsed().as_secs_f64(),
+    let run = Run {
+        gain_target: args.stages.gain_target(),
         command: command_line(),
-        paper_comparable: dataset.is_none(),
+        on_progress: &on_progress,
+        on_gain: &say_calibration,
     };
-    write_report(&args.out, &results, &ctx)?;
+    let results = reproduce(&args.out, data, args.params()?, &run)?;
+    bar.lock().expect("progress bar").finish_and_clear();
     if let Some(path) = &args.predictions {
         write_file(path, "out-of-fold predictions", |w| {
             write_headline_predictions(w, &results.predictions)
@@ -181,100 +160,6 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
-}
-
-/// Every analysis on the dataset folder, or on the simulated datasets; returns the results,
-/// the report's paragraph on the data and the parameters run with.
-fn analyse(
-    args: &ReproduceArgs,
-    dataset: Option<&Dataset>,
-    on_progress: &(dyn Fn(Progress) + Sync),
-) -> Result<(Results, String, ValidReproduceParams)> {
-    Ok(match dataset {
-        Some(ds) => {
-            let source = Source::Dataset(ds);
-            let (params, calibration) = args.calibrated(&source)?;
-            let prepared = prepare(&source, &params, on_progress)?;
-            let mut results = run_all(&prepared, &params, on_progress)?;
-            results.gain_calibration = calibration;
-            (results, source.describe(), params)
-        }
-        None => {
-            let (trials, seeds) = (args.trials_per()?, args.simulation_seeds()?);
-            let simulate = |seed| Source::paper_design(trials, seed);
-            let (params, calibration) = args.calibrated(&simulate(seeds[0]))?;
-            let mut results = run_seeds(&simulate, &seeds, &params, on_progress)?;
-            results.gain_calibration = calibration;
-            (results, describe_seeds(&simulate(seeds[0]), &seeds), params)
-        }
-    })
-}
-
-/// The report's parameter lines: the run's parameters and, under `--gain auto`, the gain
-/// chosen.
-fn parameters_described(params: &ValidReproduceParams, results: &Results) -> Vec<String> {
-    let mut lines = params.describe();
-    if let Some(c) = &results.gain_calibration {
-        let shared = if results.across_seeds.is_some() {
-            "; calibrated on the first simulated dataset and used for all"
-        } else {
-            ""
-        };
-        lines.push(format!(
-            "gain: --gain auto chose G = {} so that the median taxel with signal fires at {} Hz (median {:.1} Hz over {} taxel x recording pairs of {} recordings; labels unused{shared})",
-            c.gain, c.target_hz, c.median_hz, c.pairs, c.recordings
-        ));
-    }
-    lines
-}
-
-/// Writes `speed_mm_s,method,file,label,predicted,fold,repeat`, one row per prediction.
-fn write_headline_predictions(
-    w: &mut dyn std::io::Write,
-    predictions: &[HeadlinePrediction],
-) -> std::io::Result<()> {
-    let mut out = csv::Writer::from_writer(w);
-    let header = [
-        "speed_mm_s",
-        "method",
-        "file",
-        "label",
-        "predicted",
-        "fold",
-        "repeat",
-    ];
-    out.write_record(header)?;
-    for p in predictions {
-        let fold = p.fold.map_or("test".to_string(), |f| f.to_string());
-        out.write_record([
-            p.speed.to_string().as_str(),
-            p.method,
-            &p.file,
-            &p.label,
-            &p.predicted,
-            &fold,
-            &p.repeat.to_string(),
-        ])?;
-    }
-    out.flush()
-}
-
-/// The report's data paragraph for a run over simulated datasets: the first dataset's
-/// description and, with several, which further seeds were run.
-fn describe_seeds(first: &Source, seeds: &[u64]) -> String {
-    let mut text = first.describe();
-    if let [_, rest @ ..] = seeds {
-        if !rest.is_empty() {
-            let list: Vec<String> = rest.iter().map(u64::to_string).collect();
-            text.push_str(&format!(
-                " {} further independent datasets of the same design (seeds {}) were simulated and analysed the same way; the sections below show the first, and \"Across simulated datasets\" gives every headline accuracy over all {}.",
-                rest.len(),
-                list.join(", "),
-                seeds.len()
-            ));
-        }
-    }
-    text
 }
 
 /// Moves the progress bar on one event of the analyses.

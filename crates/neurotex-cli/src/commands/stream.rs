@@ -4,17 +4,15 @@
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, UdpSocket};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use neurotex::causal::DecisionRule;
-use neurotex::csvlog::{ChannelSelect, Column, Columns, CsvFormat, Delimiter};
+use neurotex::csvlog::{ChannelSelect, Column, CsvFormat, Delimiter};
 use neurotex::model::Model;
 use neurotex::recording::TimeUnit;
-use neurotex::stream::{
-    bin_json, end_json, EpisodeRule, Event, StreamClassifier, StreamError, StreamParams,
-};
+use neurotex::stream::frames::{event_json, feed, FrameReader, Replay, Sink};
+use neurotex::stream::{EpisodeRule, Event, StreamClassifier, StreamParams};
 
 /// How the per-bin classifications of an episode become a decision, and over which window:
 /// the options `stream` and `predict --causal` share.
@@ -143,21 +141,25 @@ pub fn run(args: StreamArgs) -> Result<()> {
     }
     let mut stream = StreamClassifier::new(model, params)?;
     let input = open_input(&args.input)?;
-    let mut out = Output::new(std::io::stdout().lock());
-    let pace = args.realtime.then(|| Pace::new(stream.params().max_gap_s));
+    let mut frames = FrameReader::new(input, &args.input, frame_format(&args), stream.channels());
+    let mut out = Output {
+        out: std::io::stdout().lock(),
+        episodes: 0,
+    };
+    let replay = args
+        .realtime
+        .then(|| Replay::new(stream.params().max_gap_s));
     crate::interrupt::end_input_on_signal();
-    match args.format {
-        FrameFormat::Csv => read_csv(&args, input, &mut stream, &mut out, pace)?,
-        FrameFormat::F32le => read_f32le(&args, input, &mut stream, &mut out, pace)?,
-    }
-    let events = match crate::interrupt::stop_requested() {
+    let stop = crate::interrupt::stop_requested;
+    feed(&mut frames, &mut stream, replay, &mut out, &stop)?;
+    let events = match stop() {
         true => {
             eprintln!("interrupted: the stream stopped at its next frame");
             stream.stop()
         }
         false => stream.finish(),
     };
-    let events = events.map_err(fatal)?.to_vec();
+    let events = events.map_err(anyhow::Error::new)?.to_vec();
     out.events(&stream, &events)?;
     eprintln!(
         "{} frames, {} bad frame(s) skipped, {} episode(s)",
@@ -166,6 +168,27 @@ pub fn run(args: StreamArgs) -> Result<()> {
         out.episodes
     );
     Ok(())
+}
+
+/// The frame format the options describe (CSV: the time column found by name when there
+/// is a header and no --time-column; f32le stamps in s unless --time-unit says otherwise).
+fn frame_format(args: &StreamArgs) -> neurotex::stream::frames::FrameFormat {
+    use neurotex::stream::frames::FrameFormat as Format;
+    match args.format {
+        FrameFormat::Csv => Format::Csv(CsvFormat {
+            header: !args.no_header,
+            delimiter: args.delimiter,
+            time_column: args.time_column.clone(),
+            time_unit: args.time_unit.unwrap_or_default(),
+            detect_time: !args.no_header && args.time_column.is_none(),
+            channels: args.channels.clone().unwrap_or(ChannelSelect::All),
+            ..CsvFormat::default()
+        }),
+        FrameFormat::F32le => Format::F32le {
+            stamped: args.stamped,
+            unit: args.time_unit.unwrap_or(TimeUnit::Seconds),
+        },
+    }
 }
 
 /// The input as a byte reader.
@@ -221,358 +244,26 @@ impl Read for Datagrams {
     }
 }
 
-/// Replays frames at their own pace.
-struct Pace {
-    start: Instant,
-    first: Option<f64>,
-    /// The longest wait for one frame: a frame further ahead is bad (or starts an episode
-    /// after a gap), and a stamp far ahead must not hold the replay for days.
-    longest: Duration,
-}
-
-impl Pace {
-    /// A replay whose longest wait is `max_gap_s`, checked by the stream (finite, in
-    /// (0, 10] s).
-    fn new(max_gap_s: f64) -> Self {
-        Pace {
-            start: Instant::now(),
-            first: None,
-            longest: Duration::from_secs_f64(max_gap_s.clamp(0.0, 3600.0)),
-        }
-    }
-
-    /// Waits until `t_s` (the frame's time) has come, counted from the first frame's, or
-    /// for the largest gap at most.
-    fn wait(&mut self, t_s: f64) {
-        // A stamp that is not a finite number is a bad frame later; `from_secs_f64` would
-        // panic on it.
-        if !t_s.is_finite() {
-            return;
-        }
-        let first = *self.first.get_or_insert(t_s);
-        let due = Duration::from_secs_f64((t_s - first).clamp(0.0, 1e6));
-        if let Some(left) = due.checked_sub(self.start.elapsed()) {
-            std::thread::sleep(left.min(self.longest));
-        }
-    }
-}
-
-/// A classification failure ends the stream (a bad frame does not).
-fn fatal(e: StreamError) -> anyhow::Error {
-    anyhow::Error::new(e)
-}
-
-/// Pushes one frame (its stamp in `unit`) and prints what it completed; a bad frame is said on standard error,
-/// with where it was, and skipped.
-fn push(
-    stream: &mut StreamClassifier,
-    out: &mut Output<impl Write>,
-    stamp: Option<f64>,
-    unit: TimeUnit,
-    values: &[f64],
-    place: &dyn Fn() -> String,
-) -> Result<()> {
-    match stream.push_in(stamp, unit, values) {
-        Ok(events) => {
-            let events = events.to_vec();
-            out.events(stream, &events)
-        }
-        Err(StreamError::Bad(bad)) => {
-            eprintln!("warning: {}: bad frame skipped: {bad}", place());
-            Ok(())
-        }
-        Err(e) => Err(fatal(e)),
-    }
-}
-
-/// The longest CSV line taken, bytes, for `channels` taxels: 64 bytes a taxel (the longest
-/// f64 text, `-2.2250738585072014e-308`, has 24 characters; the rest leaves room for
-/// spaces, a time column and a few unselected ones), and at least 1 MiB for headers.
-fn line_limit(channels: usize) -> usize {
-    channels.saturating_mul(64).max(1 << 20)
-}
-
-/// Reads the next line of `input` into `line` (without its newline), keeping at most
-/// `limit` bytes of it: a longer line is read to its end and the rest dropped, so a peer
-/// cannot make the stream buffer more. Returns the line's whole length in bytes, `None`
-/// at the end of the input or once a signal asked the stream to stop (a line that never
-/// ends does not hold the stream past the signal).
-fn read_line(
-    input: &mut dyn BufRead,
-    line: &mut Vec<u8>,
-    limit: usize,
-) -> std::io::Result<Option<usize>> {
-    line.clear();
-    let mut length: Option<usize> = None;
-    loop {
-        if crate::interrupt::stop_requested() {
-            return Ok(None);
-        }
-        let available = match input.fill_buf() {
-            Ok(bytes) => bytes,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => return Err(e),
-        };
-        if available.is_empty() {
-            return Ok(length);
-        }
-        let newline = available.iter().position(|&b| b == b'\n');
-        let part = &available[..newline.unwrap_or(available.len())];
-        let room = limit.saturating_sub(line.len());
-        line.extend_from_slice(&part[..part.len().min(room)]);
-        let length = length.get_or_insert(0);
-        *length = length.saturating_add(part.len());
-        let used = newline.map_or(available.len(), |i| i + 1);
-        input.consume(used);
-        if newline.is_some() {
-            return Ok(Some(*length));
-        }
-    }
-}
-
-/// Counts a frame that could not be parsed and says so on standard error.
-fn skip(stream: &mut StreamClassifier, place: &str, why: impl std::fmt::Display) {
-    stream.skip_bad_frame();
-    eprintln!("warning: {place}: bad frame skipped: {why}");
-}
-
-/// The CSV frames of `input`: a header line (unless --no-header), then one frame per line.
-/// A line longer than [`line_limit`] or not UTF-8 is a bad frame (the header or first line
-/// is needed, so there it is an error).
-fn read_csv(
-    args: &StreamArgs,
-    mut input: Box<dyn BufRead>,
-    stream: &mut StreamClassifier,
-    out: &mut Output<impl Write>,
-    mut pace: Option<Pace>,
-) -> Result<()> {
-    let format = csv_format(args);
-    let mut plan: Option<(u8, Columns)> = None;
-    let mut fields: Vec<f64> = Vec::new();
-    let mut values: Vec<f64> = Vec::new();
-    let limit = line_limit(stream.channels());
-    let mut line: Vec<u8> = Vec::new();
-    let mut line_no = 0usize;
-    loop {
-        let read = read_line(&mut *input, &mut line, limit);
-        let read =
-            read.with_context(|| format!("reading line {} of {}", line_no + 1, args.input))?;
-        let Some(length) = read else { break };
-        line_no += 1;
-        let place = || format!("line {line_no}");
-        let text = match (length > limit, std::str::from_utf8(&line)) {
-            (true, _) => Err(format!(
-                "the line is longer than a frame of {} values may be ({length} bytes, at most {limit})",
-                stream.channels()
-            )),
-            (false, Err(e)) => Err(format!(
-                "the line is not UTF-8 text (its byte {} is not valid UTF-8)",
-                e.valid_up_to() + 1
-            )),
-            (false, Ok(text)) => Ok(text.trim()),
-        };
-        let text = match (text, &plan) {
-            (Ok(text), _) => text,
-            (Err(why), None) => bail!("{}: {}: {why}", args.input, place()),
-            (Err(why), Some(_)) => {
-                skip(stream, &place(), why);
-                continue;
-            }
-        };
-        if text.is_empty() || text.starts_with('#') {
-            continue;
-        }
-        if text.eq_ignore_ascii_case("reset") {
-            let events = stream.reset().map_err(fatal)?.to_vec();
-            out.events(stream, &events)?;
-            continue;
-        }
-        let (delimiter, columns) = match &plan {
-            Some(p) => p,
-            None => {
-                plan = Some(plan_columns(args, &format, text, stream)?);
-                if format.header {
-                    continue;
-                }
-                plan.as_ref().expect("just set")
-            }
-        };
-        if let Err(why) = parse_fields(text, *delimiter, columns.names.len(), &mut fields) {
-            skip(stream, &place(), why);
-            continue;
-        }
-        let stamp = columns.time.map(|j| fields[j]);
-        values.clear();
-        values.extend(columns.channels.iter().map(|&j| fields[j]));
-        if let Some(p) = pace.as_mut() {
-            let time_s = stamp.map(|t| columns.unit.to_seconds(t));
-            p.wait(time_s.unwrap_or(stream.frames() as f64 / args.fs));
-        }
-        push(stream, out, stamp, columns.unit, &values, &place)?;
-    }
-    Ok(())
-}
-
-/// The CSV format the options describe (time column found by name when there is a header
-/// and no --time-column).
-fn csv_format(args: &StreamArgs) -> CsvFormat {
-    CsvFormat {
-        header: !args.no_header,
-        delimiter: args.delimiter,
-        time_column: args.time_column.clone(),
-        time_unit: args.time_unit.unwrap_or_default(),
-        detect_time: !args.no_header && args.time_column.is_none(),
-        channels: args.channels.clone().unwrap_or(ChannelSelect::All),
-        ..CsvFormat::default()
-    }
-}
-
-/// The delimiter and the columns from the first line (the header, or the first frame),
-/// checked against the model's taxels.
-fn plan_columns(
-    args: &StreamArgs,
-    format: &CsvFormat,
-    text: &str,
-    stream: &StreamClassifier,
-) -> Result<(u8, Columns)> {
-    let source = PathBuf::from(&args.input);
-    let delimiter = format.delimiter.map_or_else(|| detect(text), |d| d.byte());
-    let split: Vec<&str> = text.split(delimiter as char).map(str::trim).collect();
-    let names: Vec<String> = match format.header {
-        true => split.iter().map(|s| s.to_string()).collect(),
-        false => (0..split.len()).map(|j| format!("column{j}")).collect(),
-    };
-    let columns = Columns::find(&source, format, names)?;
-    if columns.channels.len() != stream.channels() {
-        bail!(
-            "{}: {} channel columns selected, the model has {} taxels",
-            args.input,
-            columns.channels.len(),
-            stream.channels()
-        );
-    }
-    Ok((delimiter, columns))
-}
-
-/// Parses a frame's line into `fields`, `expected` numbers split at `delimiter`, or says
-/// why it is a bad frame.
-fn parse_fields(
-    text: &str,
-    delimiter: u8,
-    expected: usize,
-    fields: &mut Vec<f64>,
-) -> std::result::Result<(), String> {
-    fields.clear();
-    for field in text.split(delimiter as char) {
-        match field.trim().parse::<f64>() {
-            Ok(v) => fields.push(v),
-            Err(_) => return Err("a field is not a number".to_string()),
-        }
-    }
-    if fields.len() != expected {
-        return Err(format!("{} fields, expected {expected}", fields.len()));
-    }
-    Ok(())
-}
-
-/// The delimiter of a first line: tab, `;` or `,`, whichever it holds most of.
-fn detect(line: &str) -> u8 {
-    [b'\t', b';', b',']
-        .into_iter()
-        .max_by_key(|&d| line.bytes().filter(|&b| b == d).count())
-        .filter(|&d| line.bytes().any(|b| b == d))
-        .unwrap_or(b',')
-}
-
-/// The raw frames of `input`.
-fn read_f32le(
-    args: &StreamArgs,
-    mut input: Box<dyn BufRead>,
-    stream: &mut StreamClassifier,
-    out: &mut Output<impl Write>,
-    mut pace: Option<Pace>,
-) -> Result<()> {
-    let stamp = if args.stamped { 8 } else { 0 };
-    let size = stamp + 4 * stream.channels();
-    let mut frame = vec![0u8; size];
-    let mut values = vec![0.0; stream.channels()];
-    let mut number = 0u64;
-    loop {
-        let got = read_full(&mut input, &mut frame)?;
-        if got == 0 || crate::interrupt::stop_requested() {
-            return Ok(());
-        }
-        number += 1;
-        let place = || format!("frame {number}");
-        if got < size {
-            eprintln!(
-                "warning: {}: bad frame skipped: the input ended after {got} of its {size} bytes",
-                place()
-            );
-            stream.skip_bad_frame();
-            return Ok(());
-        }
-        let unit = args.time_unit.unwrap_or(TimeUnit::Seconds);
-        let stamped = args
-            .stamped
-            .then(|| f64::from_le_bytes(frame[..8].try_into().expect("8 bytes")));
-        for (v, bytes) in values.iter_mut().zip(frame[stamp..].chunks_exact(4)) {
-            *v = f64::from(f32::from_le_bytes(bytes.try_into().expect("4 bytes")));
-        }
-        if values.iter().all(|v| v.is_nan()) {
-            let events = stream.reset().map_err(fatal)?.to_vec();
-            out.events(stream, &events)?;
-            continue;
-        }
-        if let Some(p) = pace.as_mut() {
-            let time_s = stamped.map(|t| unit.to_seconds(t));
-            p.wait(time_s.unwrap_or(stream.frames() as f64 / args.fs));
-        }
-        push(stream, out, stamped, unit, &values, &place)?;
-    }
-}
-
-/// Reads until `buf` is full or the input ends; the bytes read.
-fn read_full(input: &mut dyn Read, buf: &mut [u8]) -> Result<usize> {
-    let mut filled = 0;
-    while filled < buf.len() {
-        match input.read(&mut buf[filled..]) {
-            Ok(0) => break,
-            Ok(n) => filled += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e).context("reading frames"),
-        }
-    }
-    Ok(filled)
-}
-
-/// The JSON lines: one per bin boundary, one per episode's end, each flushed at once.
+/// The JSON lines on standard output, one per bin boundary and one per episode's end,
+/// each flushed at once; bad frames said on standard error.
 struct Output<W: Write> {
     out: W,
     /// Episodes ended so far.
     episodes: usize,
 }
 
-impl<W: Write> Output<W> {
-    fn new(out: W) -> Self {
-        Output { out, episodes: 0 }
+impl<W: Write> Sink for Output<W> {
+    fn events(&mut self, stream: &StreamClassifier, events: &[Event]) -> neurotex::Result<()> {
+        let write = |e| neurotex::error::DataError::write("standard output", e);
+        for event in events {
+            self.episodes += usize::from(matches!(event, Event::End(_)));
+            writeln!(self.out, "{}", event_json(stream, event)).map_err(write)?;
+        }
+        self.out.flush().map_err(write)?;
+        Ok(())
     }
 
-    fn events(&mut self, stream: &StreamClassifier, events: &[Event]) -> Result<()> {
-        let labels = stream.model().labels();
-        for event in events {
-            let line = match event {
-                Event::Bin(bin) => bin_json(labels, bin, None),
-                Event::End(summary) => {
-                    let mut line = end_json(labels, summary, None);
-                    line["bad_frames"] = stream.bad_frames().into();
-                    self.episodes += 1;
-                    line
-                }
-            };
-            writeln!(self.out, "{line}")?;
-        }
-        self.out.flush()?;
-        Ok(())
+    fn bad_frame(&mut self, place: &str, why: &str) {
+        eprintln!("warning: {place}: bad frame skipped: {why}");
     }
 }

@@ -12,6 +12,7 @@
 //! Memory is bounded by the window, not the stream: per taxel the filter, neuron and
 //! resampler state (a few f64) and the spike times of the current window (as u32).
 
+pub mod frames;
 mod spike_log;
 mod window_glcm;
 

@@ -4,9 +4,11 @@
 //! The report judges nothing: whether the paper's claims hold comes from
 //! [`crate::experiments::claims`]; this module only writes tables, captions and figures.
 
+pub mod comparison;
 pub mod figures;
 mod markdown;
 mod paper;
+pub mod reproduce;
 mod table;
 
 use std::path::{Path, PathBuf};

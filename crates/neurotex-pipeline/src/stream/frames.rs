@@ -1,0 +1,463 @@
+//! A live stream's frames decoded from bytes, and fed to a [`StreamClassifier`]: CSV lines
+//! (a header, or none; the fields split by the `csv` crate, the delimiter detected as a
+//! CSV log's is) or raw records of little-endian `f32` values (optionally after an `f64`
+//! stamp). The front ends open the input (a file, standard input, a socket) and print what
+//! the stream decides; everything between is here, so the binary and any other front end
+//! read frames alike.
+//!
+//! A frame that cannot be decoded is a bad frame: counted, reported to the caller, and
+//! skipped, as a frame the classifier refuses is. Only what makes the rest of the input
+//! unreadable is an error: the first line (the header, or the frame the columns are
+//! planned from), columns that do not fit the model, a failing read.
+
+use std::io::{BufRead, ErrorKind, Read};
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+use super::{bin_json, end_json, Event, StreamClassifier, StreamError};
+use crate::csvlog::{detect_delimiter_in, Columns, CsvFormat, Delimiter};
+use crate::error::{DataError, Result};
+use crate::recording::TimeUnit;
+
+/// How frames are written on the input.
+#[derive(Debug, Clone)]
+pub enum FrameFormat {
+    /// Text, one frame per line; `reset` on a line of its own ends the episode.
+    Csv(CsvFormat),
+    /// Records of one `f32` per taxel, little-endian, after an `f64` stamp in `unit` when
+    /// `stamped`; a record of NaN values ends the episode.
+    F32le {
+        /// Whether each record starts with its stamp.
+        stamped: bool,
+        /// The stamps' unit.
+        unit: TimeUnit,
+    },
+}
+
+/// What the input holds next.
+#[derive(Debug, PartialEq)]
+pub enum Frame<'a> {
+    /// One frame: its stamp (in `unit`) when it has one, and one value per taxel.
+    Values {
+        /// The stamp, as written.
+        stamp: Option<f64>,
+        /// The stamp's unit.
+        unit: TimeUnit,
+        /// One value per taxel, in the model's channel order.
+        values: &'a [f64],
+    },
+    /// The sender asked for the episode to end.
+    Reset,
+    /// A frame that could not be decoded, to be counted and skipped.
+    Bad {
+        /// Where it was: `line 12`, `frame 7`.
+        place: String,
+        /// Why it could not be decoded.
+        why: String,
+    },
+}
+
+/// The longest CSV line taken, bytes, for `channels` taxels: 64 bytes a taxel (the longest
+/// f64 text, `-2.2250738585072014e-308`, has 24 characters; the rest leaves room for
+/// spaces, a time column and a few unselected ones), and at least 1 MiB for headers.
+pub fn line_limit(channels: usize) -> usize {
+    channels.saturating_mul(64).max(1 << 20)
+}
+
+/// Decodes frames of `channels` values from `input`, named `source` in messages.
+pub struct FrameReader<R> {
+    input: R,
+    source: String,
+    format: FrameFormat,
+    channels: usize,
+    /// The CSV delimiter and columns, planned from the first line.
+    plan: Option<(Delimiter, Columns)>,
+    line: Vec<u8>,
+    record: csv::ByteRecord,
+    fields: Vec<f64>,
+    values: Vec<f64>,
+    /// Lines (CSV) or records (f32le) read so far.
+    count: u64,
+}
+
+impl<R: BufRead> FrameReader<R> {
+    /// A reader of `format` frames of `channels` values (the model's taxels).
+    pub fn new(input: R, source: &str, format: FrameFormat, channels: usize) -> Self {
+        FrameReader {
+            input,
+            source: source.to_string(),
+            format,
+            channels,
+            plan: None,
+            line: Vec::new(),
+            record: csv::ByteRecord::new(),
+            fields: Vec::new(),
+            values: vec![0.0; channels],
+            count: 0,
+        }
+    }
+
+    /// The next frame; `None` at the end of the input, or once `stop()` says so (checked
+    /// while waiting for bytes, so a line that never ends does not hold the stream).
+    ///
+    /// # Errors
+    /// The input cannot be read; the first CSV line is not text or its columns do not fit
+    /// the model.
+    pub fn next(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Frame<'_>>> {
+        match self.format.clone() {
+            FrameFormat::Csv(format) => self.next_csv(&format, stop),
+            FrameFormat::F32le { stamped, unit } => self.next_record(stamped, unit, stop),
+        }
+    }
+
+    fn read_error(&self, e: std::io::Error) -> crate::Error {
+        DataError::io(&self.source, e).into()
+    }
+
+    fn next_csv(
+        &mut self,
+        format: &CsvFormat,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Option<Frame<'_>>> {
+        let limit = line_limit(self.channels);
+        loop {
+            let read = read_line(&mut self.input, &mut self.line, limit, stop);
+            let Some(length) = read.map_err(|e| self.read_error(e))? else {
+                return Ok(None);
+            };
+            self.count += 1;
+            let place = format!("line {}", self.count);
+            let text = match (length > limit, std::str::from_utf8(&self.line)) {
+                (true, _) => Err(format!(
+                    "the line is longer than a frame of {} values may be ({length} bytes, at most {limit})",
+                    self.channels
+                )),
+                (false, Err(e)) => Err(format!(
+                    "the line is not UTF-8 text (its byte {} is not valid UTF-8)",
+                    e.valid_up_to() + 1
+                )),
+                (false, Ok(text)) => Ok(text.trim()),
+            };
+            let text = match (text, &self.plan) {
+                (Ok(text), _) => text.to_string(),
+                (Err(why), None) => {
+                    let message = format!("{place}: {why}");
+                    return Err(DataError::invalid(&self.source, message).into());
+                }
+                (Err(why), Some(_)) => return Ok(Some(Frame::Bad { place, why })),
+            };
+            if text.is_empty() || text.starts_with('#') {
+                continue;
+            }
+            if text.eq_ignore_ascii_case("reset") {
+                return Ok(Some(Frame::Reset));
+            }
+            if self.plan.is_none() {
+                self.plan = Some(self.plan_columns(format, &text)?);
+                if format.header {
+                    continue;
+                }
+            }
+            let (delimiter, columns) = self.plan.as_ref().expect("planned above");
+            let n = columns.names.len();
+            let parsed = parse_fields(&text, *delimiter, n, &mut self.record, &mut self.fields);
+            if let Err(why) = parsed {
+                return Ok(Some(Frame::Bad { place, why }));
+            }
+            let stamp = columns.time.map(|j| self.fields[j]);
+            for (v, &j) in self.values.iter_mut().zip(&columns.channels) {
+                *v = self.fields[j];
+            }
+            let unit = columns.unit;
+            return Ok(Some(Frame::Values {
+                stamp,
+                unit,
+                values: &self.values,
+            }));
+        }
+    }
+
+    /// The delimiter and the columns from the first line (the header, or the first frame),
+    /// checked against the model's taxels.
+    fn plan_columns(&self, format: &CsvFormat, text: &str) -> Result<(Delimiter, Columns)> {
+        let delimiter = format
+            .delimiter
+            .unwrap_or_else(|| detect_delimiter_in(&[text]));
+        let mut record = csv::ByteRecord::new();
+        let mut names = Vec::new();
+        if split_fields(text, delimiter, &mut record).is_ok() {
+            names = record
+                .iter()
+                .map(|f| String::from_utf8_lossy(f).into_owned())
+                .collect();
+        }
+        if !format.header {
+            names = (0..names.len()).map(|j| format!("column{j}")).collect();
+        }
+        let columns = Columns::find(Path::new(&self.source), format, names)?;
+        if columns.channels.len() != self.channels {
+            let message = format!(
+                "{} channel columns selected, the model has {} taxels",
+                columns.channels.len(),
+                self.channels
+            );
+            return Err(DataError::invalid(&self.source, message).into());
+        }
+        Ok((delimiter, columns))
+    }
+
+    fn next_record(
+        &mut self,
+        stamped: bool,
+        unit: TimeUnit,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Option<Frame<'_>>> {
+        let stamp_bytes = if stamped { 8 } else { 0 };
+        let size = stamp_bytes + 4 * self.channels;
+        self.line.resize(size, 0);
+        let got = read_full(&mut self.input, &mut self.line).map_err(|e| self.read_error(e))?;
+        if got == 0 || stop() {
+            return Ok(None);
+        }
+        self.count += 1;
+        if got < size {
+            let place = format!("frame {}", self.count);
+            let why = format!("the input ended after {got} of its {size} bytes");
+            return Ok(Some(Frame::Bad { place, why }));
+        }
+        let stamp =
+            stamped.then(|| f64::from_le_bytes(self.line[..8].try_into().expect("8 bytes")));
+        for (v, bytes) in self
+            .values
+            .iter_mut()
+            .zip(self.line[stamp_bytes..].chunks_exact(4))
+        {
+            *v = f64::from(f32::from_le_bytes(bytes.try_into().expect("4 bytes")));
+        }
+        if self.values.iter().all(|v| v.is_nan()) {
+            return Ok(Some(Frame::Reset));
+        }
+        Ok(Some(Frame::Values {
+            stamp,
+            unit,
+            values: &self.values,
+        }))
+    }
+
+    /// Where the last frame was (`line 12`, `frame 7`).
+    pub fn place(&self) -> String {
+        match self.format {
+            FrameFormat::Csv(_) => format!("line {}", self.count),
+            FrameFormat::F32le { .. } => format!("frame {}", self.count),
+        }
+    }
+}
+
+/// Splits one line at `delimiter` into `record` with the `csv` crate (fields trimmed,
+/// quotes honoured).
+fn split_fields(
+    text: &str,
+    delimiter: Delimiter,
+    record: &mut csv::ByteRecord,
+) -> csv::Result<bool> {
+    csv::ReaderBuilder::new()
+        .delimiter(delimiter.byte())
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes())
+        .read_byte_record(record)
+}
+
+/// Parses a frame's line into `fields`, `expected` numbers split at `delimiter`, or says
+/// why it is a bad frame.
+fn parse_fields(
+    text: &str,
+    delimiter: Delimiter,
+    expected: usize,
+    record: &mut csv::ByteRecord,
+    fields: &mut Vec<f64>,
+) -> std::result::Result<(), String> {
+    fields.clear();
+    if split_fields(text, delimiter, record).is_err() {
+        return Err("the line is not CSV".to_string());
+    }
+    for field in record.iter() {
+        match std::str::from_utf8(field)
+            .ok()
+            .and_then(|f| f.parse::<f64>().ok())
+        {
+            Some(v) => fields.push(v),
+            None => return Err("a field is not a number".to_string()),
+        }
+    }
+    if fields.len() != expected {
+        return Err(format!("{} fields, expected {expected}", fields.len()));
+    }
+    Ok(())
+}
+
+/// Reads the next line of `input` into `line` (without its newline), keeping at most
+/// `limit` bytes of it: a longer line is read to its end and the rest dropped, so a peer
+/// cannot make the stream buffer more. Returns the line's whole length in bytes, `None`
+/// at the end of the input or once `stop()` says so.
+fn read_line(
+    input: &mut dyn BufRead,
+    line: &mut Vec<u8>,
+    limit: usize,
+    stop: &dyn Fn() -> bool,
+) -> std::io::Result<Option<usize>> {
+    line.clear();
+    let mut length: Option<usize> = None;
+    loop {
+        if stop() {
+            return Ok(None);
+        }
+        let available = match input.fill_buf() {
+            Ok(bytes) => bytes,
+            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if available.is_empty() {
+            return Ok(length);
+        }
+        let newline = available.iter().position(|&b| b == b'\n');
+        let part = &available[..newline.unwrap_or(available.len())];
+        let room = limit.saturating_sub(line.len());
+        line.extend_from_slice(&part[..part.len().min(room)]);
+        let length = length.get_or_insert(0);
+        *length = length.saturating_add(part.len());
+        let used = newline.map_or(available.len(), |i| i + 1);
+        input.consume(used);
+        if newline.is_some() {
+            return Ok(Some(*length));
+        }
+    }
+}
+
+/// Reads until `buf` is full or the input ends; the bytes read.
+fn read_full(input: &mut dyn Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match input.read(&mut buf[filled..]) {
+            Ok(0) => break,
+            Ok(n) => filled += n,
+            Err(e) if e.kind() == ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(filled)
+}
+
+/// Replays frames at their own pace: each frame waits until its time, counted from the
+/// first frame's, has come.
+#[derive(Debug)]
+pub struct Replay {
+    start: Instant,
+    first: Option<f64>,
+    /// The longest wait for one frame: a frame further ahead is bad (or starts an episode
+    /// after a gap), and a stamp far ahead must not hold the replay for days.
+    longest: Duration,
+}
+
+impl Replay {
+    /// A replay whose longest wait is `max_gap_s` (the stream's, checked finite, in
+    /// (0, 10] s).
+    pub fn new(max_gap_s: f64) -> Self {
+        Replay {
+            start: Instant::now(),
+            first: None,
+            longest: Duration::from_secs_f64(max_gap_s.clamp(0.0, 3600.0)),
+        }
+    }
+
+    /// Waits until `t_s` (the frame's time) has come, counted from the first frame's, or
+    /// for the longest wait at most.
+    pub fn wait(&mut self, t_s: f64) {
+        // A stamp that is not a finite number is a bad frame later; `from_secs_f64` would
+        // panic on it.
+        if !t_s.is_finite() {
+            return;
+        }
+        let first = *self.first.get_or_insert(t_s);
+        let due = Duration::from_secs_f64((t_s - first).clamp(0.0, 1e6));
+        if let Some(left) = due.checked_sub(self.start.elapsed()) {
+            std::thread::sleep(left.min(self.longest));
+        }
+    }
+}
+
+/// The JSON line of one event: a bin boundary's decision, or an episode's summary with the
+/// stream's bad frames so far.
+pub fn event_json(stream: &StreamClassifier, event: &Event) -> Value {
+    let labels = stream.model().labels();
+    match event {
+        Event::Bin(bin) => bin_json(labels, bin, None),
+        Event::End(summary) => {
+            let mut line = end_json(labels, summary, None);
+            line["bad_frames"] = stream.bad_frames().into();
+            line
+        }
+    }
+}
+
+/// What [`feed`] reports to its caller as it goes.
+pub trait Sink {
+    /// Events the last frame completed (bin decisions, episode ends), in order.
+    ///
+    /// # Errors
+    /// The caller could not pass them on (a closed pipe); the stream stops.
+    fn events(&mut self, stream: &StreamClassifier, events: &[Event]) -> Result<()>;
+    /// A frame skipped as bad: where it was and why.
+    fn bad_frame(&mut self, place: &str, why: &str);
+}
+
+/// Feeds every frame of `frames` to `stream` until the input ends or `stop()` says so,
+/// passing each frame's events to `sink`; frames wait for their time when `replay` is
+/// given (a frame without stamps is `1 / fs` s after the one before). Bad frames are
+/// counted, reported and skipped. The stream is not finished: the caller ends it
+/// ([`StreamClassifier::finish`] or [`StreamClassifier::stop`]).
+///
+/// # Errors
+/// As [`FrameReader::next`]; the model could not classify a window; `sink` failed.
+pub fn feed<R: BufRead>(
+    frames: &mut FrameReader<R>,
+    stream: &mut StreamClassifier,
+    mut replay: Option<Replay>,
+    sink: &mut dyn Sink,
+    stop: &dyn Fn() -> bool,
+) -> Result<()> {
+    let fs = stream.params().fs;
+    loop {
+        let events = match frames.next(stop)? {
+            None => return Ok(()),
+            Some(Frame::Reset) => stream.reset(),
+            Some(Frame::Bad { place, why }) => {
+                stream.skip_bad_frame();
+                sink.bad_frame(&place, &why);
+                continue;
+            }
+            Some(Frame::Values {
+                stamp,
+                unit,
+                values,
+            }) => {
+                if let Some(r) = replay.as_mut() {
+                    let time_s = stamp.map(|t| unit.to_seconds(t));
+                    r.wait(time_s.unwrap_or(stream.frames() as f64 / fs));
+                }
+                stream.push_in(stamp, unit, values)
+            }
+        };
+        match events {
+            Ok(events) => {
+                let events = events.to_vec();
+                sink.events(stream, &events)?;
+            }
+            Err(StreamError::Bad(bad)) => sink.bad_frame(&frames.place(), &bad.to_string()),
+            Err(StreamError::Classify(e)) => return Err(e),
+        }
+    }
+}

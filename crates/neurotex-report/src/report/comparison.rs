@@ -1,0 +1,152 @@
+//! `compare`'s outputs: the ranking as Markdown and as text lines, and the folder of
+//! `compare.json`, `compare.md` and the figures. The binary prints and writes these; the
+//! wording lives here once.
+
+use std::path::Path;
+
+use crate::compare::{Comparison, Nested, Ranked};
+use crate::error::{DataError, Result};
+use crate::io::replace_dir;
+
+use super::figures::{compare as figures, svg_and_png, FigureError};
+use super::folder_source;
+
+/// `87.5% [85.1, 89.8]`.
+pub fn with_interval(accuracy: f64, ci: [f64; 2]) -> String {
+    format!(
+        "{:.1}% [{:.1}, {:.1}]",
+        100.0 * accuracy,
+        100.0 * ci[0],
+        100.0 * ci[1]
+    )
+}
+
+/// The ranking as a Markdown document.
+pub fn markdown(c: &Comparison) -> String {
+    let mut out = format!(
+        "# Comparison\n\n{} recordings ({} units: {}), {} classes; {}.\n\
+         Chance {:.1}%, majority class {:.1}%.\n\n\
+         | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) | seconds |\n\
+         |---:|---|---|---|---|---|---:|\n",
+        c.n_recordings,
+        c.n_units,
+        c.units,
+        c.classes,
+        c.protocol,
+        100.0 * c.chance,
+        100.0 * c.majority
+    );
+    for (i, r) in c.results.iter().enumerate() {
+        out.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {:.2} |\n",
+            i + 1,
+            r.encoding,
+            r.method,
+            r.classifier,
+            with_interval(r.accuracy, r.ci),
+            versus_paper(r),
+            r.seconds
+        ));
+    }
+    if let Some(n) = &c.nested {
+        out.push_str(&format!("\nNested selection: {}\n", nested_text(n)));
+    }
+    out.push_str(&format!("\nCaveat: {}.\n", c.caveat));
+    out
+}
+
+/// The ranking as lines of text for a terminal.
+pub fn text_lines(c: &Comparison) -> Vec<String> {
+    let mut lines = vec![format!(
+        "{} recordings, {} classes ({}); chance {:.1}%, majority {:.1}%",
+        c.n_recordings,
+        c.classes,
+        c.protocol,
+        100.0 * c.chance,
+        100.0 * c.majority
+    )];
+    let width = c
+        .results
+        .iter()
+        .map(|r| r.encoding.len() + r.method.len() + r.classifier.len() + 6)
+        .max()
+        .unwrap_or(0);
+    for (i, r) in c.results.iter().enumerate() {
+        let name = format!("{} / {} / {}", r.encoding, r.method, r.classifier);
+        lines.push(format!(
+            "{:>3}. {name:<width$}  {:<24} {:<28} {:>7.2} s",
+            i + 1,
+            with_interval(r.accuracy, r.ci),
+            versus_paper(r),
+            r.seconds
+        ));
+    }
+    if let Some(n) = &c.nested {
+        lines.push(format!("nested selection: {}", nested_text(n)));
+    }
+    lines.push(format!("caveat: {}", c.caveat));
+    lines
+}
+
+/// `+12.3 points (p 0.0004)`, `paper's method`, or `-`.
+fn versus_paper(r: &Ranked) -> String {
+    match (r.paper, r.difference_vs_paper, r.p_vs_paper) {
+        (true, ..) => "paper's method".into(),
+        (false, Some(d), Some(p)) => format!("{:+.1} points (p {})", 100.0 * d, p_text(p)),
+        _ => "-".into(),
+    }
+}
+
+fn p_text(p: f64) -> String {
+    if p < 0.001 {
+        "< 0.001".into()
+    } else {
+        format!("{p:.3}")
+    }
+}
+
+fn nested_text(n: &Nested) -> String {
+    let chosen: Vec<String> = n
+        .chosen
+        .iter()
+        .map(|(name, times)| format!("{name} ({times} of {})", n.outer_splits))
+        .collect();
+    format!(
+        "{} over {} outer splits; chosen: {}",
+        with_interval(n.accuracy, n.ci),
+        n.outer_splits,
+        chosen.join(", ")
+    )
+}
+
+/// compare.json, compare.md and the figures (SVG and PNG), written as one folder `dir`
+/// that replaces an earlier comparison there as a whole ([`replace_dir`]); the figures name
+/// the dataset folder `dataset`.
+///
+/// # Errors
+/// A figure cannot be drawn; the folder cannot be written or holds files that are not an
+/// earlier comparison's.
+pub fn write_comparison(dir: &Path, c: &Comparison, dataset: &Path) -> Result<()> {
+    let source = folder_source(dataset);
+    let json = serde_json::to_string_pretty(c)
+        .map_err(|e| DataError::invalid(dir.join("compare.json"), e.to_string()))?;
+    let mut files = vec![
+        ("compare.json".to_string(), (json + "\n").into_bytes()),
+        ("compare.md".to_string(), markdown(c).into_bytes()),
+    ];
+    let mut svgs = vec![("ranking.svg", figures::ranking(c, &source))];
+    if let Some(figure) = figures::per_condition(c) {
+        svgs.push(("per_condition.svg", figure.draw(&source)));
+    }
+    for (name, svg) in svgs {
+        let failed = |e: FigureError| DataError::invalid(dir.join(name), e.to_string());
+        files.extend(svg_and_png(name, svg.map_err(failed)?).map_err(failed)?);
+    }
+    replace_dir(dir, |tmp| {
+        for (name, bytes) in &files {
+            let path = tmp.join(name);
+            std::fs::write(&path, bytes).map_err(|e| DataError::write(&path, e))?;
+        }
+        Ok(())
+    })
+}
