@@ -1,12 +1,15 @@
-//! Options shared by every command that runs the pipeline.
+//! Options shared by every command that runs the pipeline. Every default is the library's
+//! (`PipelineParams::default()` and its parts), so it is written once, there.
 
 use anyhow::Result;
 use clap::Args;
 use neurotex::calibrate::GainChoice;
 use neurotex::classify::KnnParams;
 use neurotex::encode::{FaParams, FiringType, IzhikevichParams};
+use neurotex::features::{GlcmParams, VolumeParams};
 use neurotex::pipeline::{Encoding, FeatureParams, HaralickSet, PipelineParams};
 use neurotex::recording::Baseline;
+use neurotex::signal::PreprocessParams;
 
 /// Stage parameters; defaults are the paper's values (or SPEC's choice where it gives none).
 #[derive(Args, Debug, Clone)]
@@ -14,13 +17,13 @@ pub struct StageArgs {
     /// Gain G from normalised signal to Izhikevich input current (paper: 8). `auto` chooses
     /// it on the training recordings (labels unused) so that the median taxel with any
     /// signal fires at 20 Hz during the slide; `auto:HZ` sets another target rate.
-    #[arg(long, default_value = "8", allow_negative_numbers = true)]
+    #[arg(long, default_value_t = GainChoice::default(), allow_negative_numbers = true)]
     pub gain: GainChoice,
     /// Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ.
-    #[arg(long, default_value = "RS")]
+    #[arg(long, default_value_t = FiringType::default())]
     pub preset: FiringType,
     /// Low-pass cutoff in Hz (zero-phase 2nd-order Butterworth); 0 turns the filter off.
-    #[arg(long, default_value_t = 50.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = PreprocessParams::default().cutoff_hz, allow_negative_numbers = true)]
     pub cutoff: f64,
     /// Baseline removal: `none`, or `min` (each taxel's minimum). Default: the dataset's layout.toml.
     #[arg(long)]
@@ -29,13 +32,13 @@ pub struct StageArgs {
     #[arg(long)]
     pub whole: bool,
     /// Gray levels for GLCM quantisation.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = VolumeParams::default().levels)]
     pub levels: usize,
     /// Rate-volume bin and Fano window in ms.
-    #[arg(long = "bin-ms", default_value_t = 200)]
+    #[arg(long = "bin-ms", default_value_t = VolumeParams::default().bin_ms)]
     pub bin_ms: usize,
     /// GLCM offset distances, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1,2,4,8")]
+    #[arg(long, value_delimiter = ',', default_values_t = GlcmParams::default().distances)]
     pub distances: Vec<usize>,
     /// Count co-occurrences in both directions.
     #[arg(long)]
@@ -43,7 +46,7 @@ pub struct StageArgs {
     /// Mechanoreceptor populations: `sa` (slowly adapting, driven by the signal; the
     /// paper's), `fa` (fast adapting, driven by its rectified rate of change) or `sa+fa`
     /// (both, each with its own features, names prefixed `sa_` and `fa_`).
-    #[arg(long, default_value = "sa")]
+    #[arg(long, default_value_t = Encoding::default())]
     pub encoding: Encoding,
     /// Gain of the FA neurons from rate of change (normalised units per ms) to current;
     /// the default 8000 gives FA neurons about the SA neurons' rate on a typical simulated slide.
@@ -51,13 +54,13 @@ pub struct StageArgs {
     pub fa_gain: f64,
     /// Haralick features of the GLCM methods: `paper` (contrast, correlation, ASM) or
     /// `full` (the 13 of Haralick 1973, as mahotas defines them).
-    #[arg(long, default_value = "paper")]
+    #[arg(long, default_value_t = HaralickSet::default())]
     pub haralick: HaralickSet,
     /// Rate-volume bin widths in ms of `--method glcm3d-multi`, comma-separated.
     #[arg(
         long = "bin-widths",
         value_delimiter = ',',
-        default_value = "50,100,200,400"
+        default_values_t = FeatureParams::default().bin_widths_ms
     )]
     pub bin_widths: Vec<usize>,
     /// Fano window of `--method all-taxels-mm`, in mm of travel.

@@ -8,6 +8,62 @@
 //! feature brings along changes nothing). Their bodies are plain `for` loops over slices:
 //! iterator adaptors that take closures (`fold`, `for_each`) were seen compiled out of
 //! line, without the feature.
+//!
+//! Every dispatch in neurotex, these passes and the hand-written kernels alike, asks
+//! [`has_feature!`](crate::has_feature): the processor must have the feature and the run
+//! must allow it. `NEUROTEX_SIMD=portable` allows none (every pass runs its plain code),
+//! `NEUROTEX_SIMD=avx2` allows all but AVX-512; unset (or `native`), the processor decides.
+//! It is read once, at the first dispatch, so a process never mixes paths; the tests run
+//! under each setting the machine supports (`.ci/run`), and every path must give the
+//! reference's bits.
+
+use std::sync::OnceLock;
+
+/// The widest instructions a run may use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cap {
+    /// Whatever the processor has.
+    Native,
+    /// AVX2 and narrower (no AVX-512).
+    Avx2,
+    /// Plain code only.
+    Portable,
+}
+
+/// The run's cap, from `NEUROTEX_SIMD` (read once; an unknown value is `Native`).
+pub fn cap() -> Cap {
+    // Set once from the environment and never changed: a process-wide value, but not
+    // mutable state (the dispatch must not change in the middle of a run).
+    static CAP: OnceLock<Cap> = OnceLock::new();
+    *CAP.get_or_init(|| match std::env::var("NEUROTEX_SIMD").as_deref() {
+        Ok("portable") => Cap::Portable,
+        Ok("avx2") => Cap::Avx2,
+        _ => Cap::Native,
+    })
+}
+
+/// Whether the run's [`cap`] allows the target feature `feature` (`"avx2"`, `"avx512f"`,
+/// `"popcnt"`, ...).
+#[inline]
+pub fn allows(feature: &str) -> bool {
+    match cap() {
+        Cap::Native => true,
+        Cap::Avx2 => !feature.starts_with("avx512"),
+        Cap::Portable => false,
+    }
+}
+
+/// Whether the processor has the target feature and the run allows it ([`allows`]): the
+/// one test every SIMD dispatch makes. x86-64 only.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! has_feature {
+    ($feature:tt) => {
+        $crate::simd::allows($feature) && std::arch::is_x86_feature_detected!($feature)
+    };
+}
+
+pub use crate::has_feature;
 
 /// Defines a function whose body is compiled once as plain code and once per listed target
 /// feature, the first listed feature the processor has chosen at run time (list the widest
@@ -45,7 +101,7 @@ macro_rules! widest_or_plain {
             unsafe fn wide($($arg: $ty),*) $(-> $ret)? {
                 body($($arg),*)
             }
-            if std::arch::is_x86_feature_detected!($feature) {
+            if $crate::has_feature!($feature) {
                 // SAFETY: the CPU supports the feature, the only one `wide` enables.
                 return unsafe { wide($($arg),*) };
             }

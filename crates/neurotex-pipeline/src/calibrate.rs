@@ -57,6 +57,23 @@ pub enum GainChoice {
     },
 }
 
+impl Default for GainChoice {
+    /// The encoder's default gain, the paper's.
+    fn default() -> Self {
+        GainChoice::Fixed(crate::encode::IzhikevichParams::default().gain)
+    }
+}
+
+impl std::fmt::Display for GainChoice {
+    /// As it is typed: `8`, `auto:20`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            GainChoice::Fixed(g) => write!(f, "{g}"),
+            GainChoice::Auto { target_hz } => write!(f, "auto:{target_hz}"),
+        }
+    }
+}
+
 impl std::str::FromStr for GainChoice {
     type Err = String;
 

@@ -126,6 +126,12 @@ impl Encoding {
     }
 }
 
+impl std::fmt::Display for Encoding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl std::str::FromStr for Encoding {
     type Err = ParamError;
     fn from_str(s: &str) -> Result<Self, ParamError> {
@@ -145,6 +151,15 @@ pub enum HaralickSet {
     Paper,
     /// The 13 features of [`crate::features::haralick_full`].
     Full,
+}
+
+impl std::fmt::Display for HaralickSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            HaralickSet::Paper => "paper",
+            HaralickSet::Full => "full",
+        })
+    }
 }
 
 impl std::str::FromStr for HaralickSet {

@@ -291,12 +291,12 @@ struct Bank<'a> {
 fn run_fastest(p: &IzhikevichParams, bank: Bank<'_>) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f") {
+        if neurotex_core::has_feature!("avx512f") {
             // SAFETY: the CPU supports AVX-512F, the only feature the function enables.
             unsafe { run_avx512(p, bank) };
             return;
         }
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if neurotex_core::has_feature!("avx2") {
             // SAFETY: the CPU supports AVX2, the only feature the function enables.
             unsafe { run_avx2(p, bank) };
             return;

@@ -80,10 +80,10 @@ pub struct CompareArgs {
     #[arg(long = "tau-ms", default_value_t = STANDARD_TAU_MS)]
     pub tau_ms: f64,
     /// Neighbours in KNN.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = neurotex::classify::KnnParams::default().k)]
     pub k: usize,
     /// Cross-validation folds.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = neurotex::classify::CvParams::default().folds)]
     pub folds: usize,
     /// Cross-validation repeats (every candidate gets the same folds in each).
     #[arg(long, default_value_t = 2)]

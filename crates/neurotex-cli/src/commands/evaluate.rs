@@ -48,16 +48,16 @@ pub struct EvaluateArgs {
     #[arg(long)]
     pub taxel: Option<Cell>,
     /// Neighbours in KNN.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = neurotex::classify::KnnParams::default().k)]
     pub k: usize,
     /// Cross-validation folds (stratified, shuffled).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = neurotex::classify::CvParams::default().folds)]
     pub folds: usize,
     /// Seed of the fold shuffle (repeat r uses seed + r).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Cross-validation repeats with different shuffles.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = neurotex::classify::CvParams::default().repeats)]
     pub repeats: usize,
     /// Only recordings at these speeds (mm/s, comma-separated); default all.
     #[arg(

@@ -45,7 +45,7 @@ pub struct ReproduceArgs {
     #[arg(long, conflicts_with = "dataset", value_parser = clap::value_parser!(u64).range(1..=MAX_SEEDS))]
     pub seeds: Option<u64>,
     /// Neighbours in KNN.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = neurotex::classify::KnnParams::default().k)]
     pub k: usize,
     /// Every cross-validation of the analyses keeps each group of this manifest column in
     /// one fold (`trial` for repeats of one run, or a session or subject column); with fewer

@@ -34,7 +34,7 @@ pub struct TrainArgs {
     #[arg(long)]
     pub taxel: Option<Cell>,
     /// Neighbours in KNN; at most the number of training recordings.
-    #[arg(short = 'k', long = "k", default_value_t = 5)]
+    #[arg(short = 'k', long = "k", default_value_t = neurotex::classify::KnnParams::default().k)]
     pub k: usize,
     /// The model file to write (JSON: pipeline, features, grid, classifier, training rows,
     /// the dataset's fingerprint).

@@ -376,7 +376,7 @@ fn count_range<'a>(rows: impl Iterator<Item = &'a [u32]>) -> (u32, u32) {
         unsafe fn fold_avx2<'a>(rows: impl Iterator<Item = &'a [u32]>) -> (u32, u32) {
             fold(rows)
         }
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if neurotex_core::has_feature!("avx2") {
             // SAFETY: the CPU supports AVX2, checked just above.
             return unsafe { fold_avx2(rows) };
         }

@@ -238,7 +238,7 @@ impl KnnModel {
         );
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if neurotex_core::has_feature!("avx2") {
                 // SAFETY: the CPU supports AVX2, the only feature the function enables.
                 return unsafe { self.neighbours_avx2(x, on_row) };
             }

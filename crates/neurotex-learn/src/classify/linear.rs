@@ -288,7 +288,7 @@ impl Kernels {
     fn fastest() -> Self {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if neurotex_core::has_feature!("avx2") {
                 return Kernels {
                     // SAFETY (both): the CPU supports AVX2, the only feature they enable.
                     logits: |z, w, d, out| unsafe { avx2::logits(z, w, d, out) },

@@ -942,7 +942,7 @@ impl Conditioning<'_> {
             ) {
                 cells.run_portable(filter, scale, first);
             }
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if neurotex_core::has_feature!("avx2") {
                 // SAFETY: the CPU supports AVX2, checked just above.
                 return unsafe { run_avx2(self, filter, scale, first) };
             }

@@ -533,7 +533,7 @@ impl Sensor {
     fn targets(&self, h: &[f64], z: f64, gains: &[f64], target: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if neurotex_core::has_feature!("avx2") {
                 // SAFETY: the CPU supports AVX2, the only feature the function enables.
                 return unsafe { self.targets_avx2(h, z, gains, target) };
             }
@@ -566,7 +566,7 @@ impl Sensor {
     fn read(&self, targets: &[f64], y: &mut [f64], draws: &[f64], frames: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if neurotex_core::has_feature!("avx2") {
                 // SAFETY: the CPU supports AVX2, the only feature the function enables.
                 return unsafe { self.read_avx2(targets, y, draws, frames) };
             }

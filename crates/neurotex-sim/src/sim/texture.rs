@@ -314,7 +314,7 @@ impl FibreLanes {
     fn height(&self, x: f64, y: f64) -> f64 {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx") {
+            if neurotex_core::has_feature!("avx") {
                 // SAFETY: the CPU supports AVX, the only feature the function enables.
                 return unsafe { self.height_avx(x, y) };
             }

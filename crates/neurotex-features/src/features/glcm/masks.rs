@@ -122,7 +122,7 @@ impl LevelMasks {
     pub(super) fn count_runs(&self, runs: &[Run], levels: usize, counts: &mut [u32]) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("popcnt") {
+            if neurotex_core::has_feature!("popcnt") {
                 // SAFETY: the CPU supports POPCNT, checked just above.
                 unsafe { self.count_runs_popcnt(runs, levels, counts) };
                 return;

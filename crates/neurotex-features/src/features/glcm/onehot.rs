@@ -23,7 +23,7 @@ const MAX_RUNS: usize = 255;
 pub(super) fn available(levels: usize) -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        levels <= 16 && std::arch::is_x86_feature_detected!("avx2")
+        levels <= 16 && neurotex_core::has_feature!("avx2")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
