@@ -75,7 +75,10 @@ pub struct FrameReader<R> {
     /// The CSV delimiter and columns, planned from the first line.
     plan: Option<(Delimiter, Columns)>,
     line: Vec<u8>,
-    record: csv::ByteRecord,
+    /// The CSV splitter (quotes honoured), built once the delimiter is known, and the
+    /// bytes of the field it is reading.
+    splitter: Option<csv_core::Reader>,
+    field: Vec<u8>,
     fields: Vec<f64>,
     values: Vec<f64>,
     /// Lines (CSV) or records (f32le) read so far.
@@ -92,7 +95,8 @@ impl<R: BufRead> FrameReader<R> {
             channels,
             plan: None,
             line: Vec::new(),
-            record: csv::ByteRecord::new(),
+            splitter: None,
+            field: Vec::new(),
             fields: Vec::new(),
             values: vec![0.0; channels],
             count: 0,
@@ -155,14 +159,19 @@ impl<R: BufRead> FrameReader<R> {
                 return Ok(Some(Frame::Reset));
             }
             if self.plan.is_none() {
-                self.plan = Some(self.plan_columns(format, &text)?);
+                let (delimiter, columns) = self.plan_columns(format, &text)?;
+                let splitter = csv_core::ReaderBuilder::new()
+                    .delimiter(delimiter.byte())
+                    .build();
+                (self.plan, self.splitter) = (Some((delimiter, columns)), Some(splitter));
                 if format.header {
                     continue;
                 }
             }
-            let (delimiter, columns) = self.plan.as_ref().expect("planned above");
-            let n = columns.names.len();
-            let parsed = parse_fields(&text, *delimiter, n, &mut self.record, &mut self.fields);
+            let (_, columns) = self.plan.as_ref().expect("planned above");
+            let splitter = self.splitter.as_mut().expect("built with the plan");
+            let (field, fields) = (&mut self.field, &mut self.fields);
+            let parsed = parse_fields(splitter, &text, columns.names.len(), field, fields);
             if let Err(why) = parsed {
                 return Ok(Some(Frame::Bad { place, why }));
             }
@@ -185,14 +194,14 @@ impl<R: BufRead> FrameReader<R> {
         let delimiter = format
             .delimiter
             .unwrap_or_else(|| detect_delimiter_in(&[text]));
-        let mut record = csv::ByteRecord::new();
+        let mut splitter = csv_core::ReaderBuilder::new()
+            .delimiter(delimiter.byte())
+            .build();
         let mut names = Vec::new();
-        if split_fields(text, delimiter, &mut record).is_ok() {
-            names = record
-                .iter()
-                .map(|f| String::from_utf8_lossy(f).into_owned())
-                .collect();
-        }
+        for_each_field(&mut splitter, text, &mut Vec::new(), |f| {
+            names.push(String::from_utf8_lossy(f).into_owned());
+            true
+        });
         if !format.header {
             names = (0..names.len()).map(|j| format!("column{j}")).collect();
         }
@@ -255,43 +264,61 @@ impl<R: BufRead> FrameReader<R> {
     }
 }
 
-/// Splits one line at `delimiter` into `record` with the `csv` crate (fields trimmed,
-/// quotes honoured).
-fn split_fields(
+/// Calls `each` with every field of the line `text` (split as the `csv` crate splits a
+/// log's rows: quotes honoured; each field trimmed of spaces) until it returns `false`.
+fn for_each_field(
+    splitter: &mut csv_core::Reader,
     text: &str,
-    delimiter: Delimiter,
-    record: &mut csv::ByteRecord,
-) -> csv::Result<bool> {
-    csv::ReaderBuilder::new()
-        .delimiter(delimiter.byte())
-        .has_headers(false)
-        .flexible(true)
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes())
-        .read_byte_record(record)
+    field: &mut Vec<u8>,
+    mut each: impl FnMut(&[u8]) -> bool,
+) {
+    use csv_core::ReadFieldResult;
+    splitter.reset();
+    let mut input = text.as_bytes();
+    field.clear();
+    let mut len = 0;
+    loop {
+        if field.len() < len + input.len() + 1 {
+            field.resize(len + input.len() + 1, 0);
+        }
+        let (result, read, written) = splitter.read_field(input, &mut field[len..]);
+        input = &input[read..];
+        len += written;
+        match result {
+            ReadFieldResult::InputEmpty | ReadFieldResult::OutputFull => continue,
+            ReadFieldResult::End => return,
+            ReadFieldResult::Field { record_end } => {
+                if !each(field[..len].trim_ascii()) || record_end {
+                    return;
+                }
+                len = 0;
+            }
+        }
+    }
 }
 
-/// Parses a frame's line into `fields`, `expected` numbers split at `delimiter`, or says
-/// why it is a bad frame.
+/// Parses a frame's line into `fields`, `expected` numbers, or says why it is a bad frame.
 fn parse_fields(
+    splitter: &mut csv_core::Reader,
     text: &str,
-    delimiter: Delimiter,
     expected: usize,
-    record: &mut csv::ByteRecord,
+    field: &mut Vec<u8>,
     fields: &mut Vec<f64>,
 ) -> std::result::Result<(), String> {
     fields.clear();
-    if split_fields(text, delimiter, record).is_err() {
-        return Err("the line is not CSV".to_string());
-    }
-    for field in record.iter() {
-        match std::str::from_utf8(field)
+    let mut number = true;
+    for_each_field(splitter, text, field, |f| {
+        let parsed = std::str::from_utf8(f)
             .ok()
-            .and_then(|f| f.parse::<f64>().ok())
-        {
-            Some(v) => fields.push(v),
-            None => return Err("a field is not a number".to_string()),
+            .and_then(|f| f.parse::<f64>().ok());
+        if let Some(v) = parsed {
+            fields.push(v);
         }
+        number = parsed.is_some();
+        number
+    });
+    if !number {
+        return Err("a field is not a number".to_string());
     }
     if fields.len() != expected {
         return Err(format!("{} fields, expected {expected}", fields.len()));
