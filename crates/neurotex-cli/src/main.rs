@@ -71,6 +71,11 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     interrupt::install();
+    if let Ok(value) = std::env::var("NEUROTEX_SIMD") {
+        if !matches!(value.as_str(), "native" | "avx2" | "portable") {
+            eprintln!("warning: NEUROTEX_SIMD={value} is not native, avx2 or portable; the processor's widest instructions are used");
+        }
+    }
     let result = match cli.command {
         Command::Encode(args) => encode::run(args),
         Command::Features(args) => features::run(args),
