@@ -110,8 +110,8 @@ impl<R: BufRead> FrameReader<R> {
     /// The input cannot be read; the first CSV line is not text or its columns do not fit
     /// the model.
     pub fn next(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Frame<'_>>> {
-        match self.format.clone() {
-            FrameFormat::Csv(format) => self.next_csv(&format, stop),
+        match self.format {
+            FrameFormat::Csv(_) => self.next_csv(stop),
             FrameFormat::F32le { stamped, unit } => self.next_record(stamped, unit, stop),
         }
     }
@@ -120,11 +120,10 @@ impl<R: BufRead> FrameReader<R> {
         DataError::io(&self.source, e).into()
     }
 
-    fn next_csv(
-        &mut self,
-        format: &CsvFormat,
-        stop: &dyn Fn() -> bool,
-    ) -> Result<Option<Frame<'_>>> {
+    fn next_csv(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Frame<'_>>> {
+        let FrameFormat::Csv(format) = &self.format else {
+            unreachable!("next_csv reads CSV frames only")
+        };
         let limit = line_limit(self.channels);
         loop {
             let read = read_line(&mut self.input, &mut self.line, limit, stop);
@@ -132,7 +131,6 @@ impl<R: BufRead> FrameReader<R> {
                 return Ok(None);
             };
             self.count += 1;
-            let place = format!("line {}", self.count);
             let text = match (length > limit, std::str::from_utf8(&self.line)) {
                 (true, _) => Err(format!(
                     "the line is longer than a frame of {} values may be ({length} bytes, at most {limit})",
@@ -145,12 +143,15 @@ impl<R: BufRead> FrameReader<R> {
                 (false, Ok(text)) => Ok(text.trim()),
             };
             let text = match (text, &self.plan) {
-                (Ok(text), _) => text.to_string(),
+                (Ok(text), _) => text,
                 (Err(why), None) => {
-                    let message = format!("{place}: {why}");
+                    let message = format!("{}: {why}", self.place());
                     return Err(DataError::invalid(&self.source, message).into());
                 }
-                (Err(why), Some(_)) => return Ok(Some(Frame::Bad { place, why })),
+                (Err(why), Some(_)) => {
+                    let place = self.place();
+                    return Ok(Some(Frame::Bad { place, why }));
+                }
             };
             if text.is_empty() || text.starts_with('#') {
                 continue;
@@ -159,7 +160,7 @@ impl<R: BufRead> FrameReader<R> {
                 return Ok(Some(Frame::Reset));
             }
             if self.plan.is_none() {
-                let (delimiter, columns) = self.plan_columns(format, &text)?;
+                let (delimiter, columns) = self.plan_columns(format, text)?;
                 let splitter = csv_core::ReaderBuilder::new()
                     .delimiter(delimiter.byte())
                     .build();
@@ -171,8 +172,9 @@ impl<R: BufRead> FrameReader<R> {
             let (_, columns) = self.plan.as_ref().expect("planned above");
             let splitter = self.splitter.as_mut().expect("built with the plan");
             let (field, fields) = (&mut self.field, &mut self.fields);
-            let parsed = parse_fields(splitter, &text, columns.names.len(), field, fields);
+            let parsed = parse_fields(splitter, text, columns.names.len(), field, fields);
             if let Err(why) = parsed {
+                let place = self.place();
                 return Ok(Some(Frame::Bad { place, why }));
             }
             let stamp = columns.time.map(|j| self.fields[j]);
