@@ -11,6 +11,7 @@ pub mod causal;
 pub mod compare;
 pub mod diagnostics;
 pub mod model;
+pub mod options;
 pub mod pipeline;
 pub mod stream;
 

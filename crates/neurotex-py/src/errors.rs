@@ -105,9 +105,18 @@ pub fn try_vec<T>(len: usize, what: &str, values: impl Iterator<Item = T>) -> Py
     Ok(v)
 }
 
-/// A parameter error as a `neurotex.ParameterError`.
+/// A parameter error as a `neurotex.ParameterError`, the parameter named as Python spells
+/// it (`bin_ms` for the command line's `--bin-ms`).
 pub fn param(error: ParamError) -> PyErr {
-    raise(Kind::Parameter, error.to_string())
+    raise(
+        Kind::Parameter,
+        format!(
+            "invalid parameter `{}`: {}, got {}",
+            error.name.replace('-', "_"),
+            error.rule,
+            error.got
+        ),
+    )
 }
 
 /// Runs `f`, turning a panic into a `neurotex.InternalError` (no panic crosses into

@@ -386,6 +386,7 @@ fn library_version() -> &'static str {
 /// The native half of the `neurotex` package.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(params::stage_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(features, m)?)?;
     m.add_function(wrap_pyfunction!(spike_stats, m)?)?;

@@ -2,12 +2,11 @@
 //! are: the one place where the Python layer parses options (the pipeline's, the
 //! classifiers', the feature method).
 
-use neurotex::calibrate::GainChoice;
 use neurotex::classify::{
     ChosenClassifier, ClassifierChoice, ForestParams, KnnParams, LinearParams,
 };
-use neurotex::encode::{FiringType, IzhikevichParams};
-use neurotex::pipeline::{Encoding, HaralickSet, Method, PipelineParams};
+use neurotex::options::{CheckedStages, OptionKind, OptionSpec, StageOptions, STAGE_OPTIONS};
+use neurotex::pipeline::Method;
 use neurotex::recording::Baseline;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -36,17 +35,6 @@ fn invalid(key: &str, reason: impl std::fmt::Display) -> PyErr {
     )
 }
 
-/// Parses a text option with the library's `FromStr`.
-fn parsed<T>(options: &Bound<'_, PyDict>, key: &str) -> PyResult<Option<T>>
-where
-    T: std::str::FromStr<Err = neurotex::error::ParamError>,
-{
-    match get::<String>(options, key)? {
-        Some(s) => s.parse().map(Some).map_err(param),
-        None => Ok(None),
-    }
-}
-
 /// Refuses keys of `options` that are not in `known`; `what` names the options' owner
 /// in the message.
 fn only_known(options: &Bound<'_, PyDict>, known: &[&str], what: &str) -> PyResult<()> {
@@ -62,123 +50,87 @@ fn only_known(options: &Bound<'_, PyDict>, known: &[&str], what: &str) -> PyResu
     Ok(())
 }
 
-/// The stage options: the pipeline's parameters and what is still to be calibrated on
-/// the training recordings before they apply (the CLI's `StageArgs`).
-#[derive(Debug, Clone)]
-pub struct Stages {
-    /// The pipeline parameters, checked; under `gain="auto"` the gain is a placeholder
-    /// replaced by the calibrated one before anything is encoded.
-    pub params: PipelineParams,
-    /// A gain given as a number, or `auto` with its target rate.
-    pub gain: GainChoice,
-    /// Causal conditioning (`--causal`): resting values and a scale fixed on the training
-    /// recordings.
-    pub causal: bool,
-}
+/// The stage options checked (the library's [`CheckedStages`]): the pipeline's
+/// parameters and what is still to be calibrated on the training recordings.
+pub type Stages = CheckedStages;
 
-impl Stages {
-    /// The target rate of `gain="auto"`, or `None` for a gain given as a number.
-    pub fn gain_target(&self) -> Option<f64> {
-        match self.gain {
-            GainChoice::Auto { target_hz } => Some(target_hz),
-            GainChoice::Fixed(_) => None,
-        }
-    }
-}
-
-/// The gain option: a number, or `"auto"` / `"auto:HZ"` (the CLI's `--gain`).
-fn gain(options: &Bound<'_, PyDict>) -> PyResult<GainChoice> {
-    match options.get_item("gain")? {
-        None => Ok(GainChoice::Fixed(IzhikevichParams::default().gain)),
-        Some(v) if v.is_none() => Ok(GainChoice::Fixed(IzhikevichParams::default().gain)),
-        Some(v) => match v.extract::<f64>() {
-            Ok(g) => Ok(GainChoice::Fixed(g)),
-            Err(_) => match v.extract::<String>() {
-                Ok(text) => text.parse().map_err(|e: String| invalid("gain", e)),
-                Err(_) => Err(invalid(
-                    "gain",
-                    format!(
-                        "expected a number, `auto` or `auto:HZ`, got {}",
-                        v.get_type().name()?
-                    ),
-                )),
+/// A Python value as the text the library's option parser reads: `True` as `true`, a
+/// sequence of counts as `1,2`, a number or a name as it is written.
+fn option_text(spec: &OptionSpec, value: &Bound<'_, PyAny>) -> PyResult<String> {
+    let text = match spec.kind {
+        OptionKind::Flag => value.extract::<bool>().map(|b| b.to_string()),
+        OptionKind::Count => value.extract::<usize>().map(|n| n.to_string()),
+        OptionKind::Counts => value.extract::<Vec<usize>>().map(|v| {
+            let v: Vec<String> = v.iter().map(usize::to_string).collect();
+            v.join(",")
+        }),
+        OptionKind::Number => value.extract::<f64>().map(|x| x.to_string()),
+        // A number (the gain) or a name; anything else as Python prints it, for the
+        // option's own parser to say what it expects.
+        OptionKind::Text => match value.extract::<f64>() {
+            Ok(x) => Ok(x.to_string()),
+            Err(_) => match value.extract::<String>() {
+                Ok(text) => Ok(text),
+                Err(_) => Ok(value.str()?.to_string()),
             },
         },
-    }
+    };
+    text.map_err(|e| invalid(spec.name, e))
 }
 
-/// The stage options (the paper's defaults for the absent ones), checked: `gain` (a
-/// number, `"auto"` or `"auto:HZ"`), `causal`, `preset`, `cutoff`, `baseline`, `whole`,
-/// `levels`, `bin_ms`, `distances`, `symmetric`, `encoding`, `fa_gain`, `haralick`,
-/// `bin_widths`, `window_mm`.
+/// The stage options of [`STAGE_OPTIONS`] by their names (the paper's defaults for the
+/// absent ones and those given as `None`), checked once.
 pub fn stages(options: &Bound<'_, PyDict>) -> PyResult<Stages> {
-    let known = [
-        "gain",
-        "causal",
-        "preset",
-        "cutoff",
-        "baseline",
-        "whole",
-        "levels",
-        "bin_ms",
-        "distances",
-        "symmetric",
-        "encoding",
-        "fa_gain",
-        "haralick",
-        "bin_widths",
-        "window_mm",
-    ];
+    let known: Vec<&str> = STAGE_OPTIONS.iter().map(|o| o.name).collect();
     only_known(options, &known, "; the options are")?;
-    let preset: FiringType = parsed(options, "preset")?.unwrap_or_default();
-    let mut p = PipelineParams {
-        encoder: preset.params(),
-        ..PipelineParams::default()
-    };
-    let gain = gain(options)?;
-    if let GainChoice::Fixed(g) = gain {
-        p.encoder = p.encoder.with_gain(g);
+    let mut chosen = StageOptions::default();
+    for spec in STAGE_OPTIONS {
+        match options.get_item(spec.name)? {
+            Some(v) if !v.is_none() => {
+                let text = option_text(spec, &v)?;
+                (spec.set)(&mut chosen, &text).map_err(|e| invalid(spec.name, e))?;
+            }
+            _ => {}
+        }
     }
-    if let Some(c) = get::<f64>(options, "cutoff")? {
-        p.preprocess.cutoff_hz = c;
+    chosen.check().map_err(param)
+}
+
+/// Every stage option's default as the Python value a keyword argument takes (`None` for
+/// an option without one): the one source of the package's keyword defaults.
+#[pyfunction]
+pub fn stage_defaults<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    let defaults = StageOptions::default();
+    for spec in STAGE_OPTIONS {
+        let key = spec.name;
+        let Some(text) = (spec.get)(&defaults) else {
+            out.set_item(key, py.None())?;
+            continue;
+        };
+        let bad = |e: String| raise(Kind::Internal, format!("default of `{key}`: {e}"));
+        match spec.kind {
+            OptionKind::Flag => out.set_item(key, text == "true")?,
+            OptionKind::Count => {
+                out.set_item(key, text.parse::<usize>().map_err(|e| bad(e.to_string()))?)?
+            }
+            OptionKind::Counts => {
+                let v: Result<Vec<usize>, _> = text.split(',').map(str::parse).collect();
+                out.set_item(
+                    key,
+                    pyo3::types::PyTuple::new(py, v.map_err(|e| bad(e.to_string()))?)?,
+                )?
+            }
+            OptionKind::Number => {
+                out.set_item(key, text.parse::<f64>().map_err(|e| bad(e.to_string()))?)?
+            }
+            OptionKind::Text => match text.parse::<f64>() {
+                Ok(x) => out.set_item(key, x)?,
+                Err(_) => out.set_item(key, text)?,
+            },
+        }
     }
-    p.preprocess.baseline = parsed::<Baseline>(options, "baseline")?;
-    if let Some(w) = get::<bool>(options, "whole")? {
-        p.preprocess.slide_only = !w;
-    }
-    if let Some(l) = get::<usize>(options, "levels")? {
-        p.volume.levels = l;
-    }
-    if let Some(b) = get::<usize>(options, "bin_ms")? {
-        p.volume.bin_ms = b;
-    }
-    if let Some(d) = get::<Vec<usize>>(options, "distances")? {
-        p.glcm.distances = d;
-    }
-    if let Some(s) = get::<bool>(options, "symmetric")? {
-        p.glcm.symmetric = s;
-    }
-    if let Some(e) = parsed::<Encoding>(options, "encoding")? {
-        p.encoding = e;
-    }
-    if let Some(g) = get::<f64>(options, "fa_gain")? {
-        p.fa.gain = g;
-    }
-    if let Some(h) = parsed::<HaralickSet>(options, "haralick")? {
-        p.features.haralick = h;
-    }
-    if let Some(w) = get::<Vec<usize>>(options, "bin_widths")? {
-        p.features.bin_widths_ms = w;
-    }
-    if let Some(w) = get::<f64>(options, "window_mm")? {
-        p.features.window_mm = w;
-    }
-    p.check().map_err(param)?;
-    Ok(Stages {
-        params: p,
-        gain,
-        causal: get::<bool>(options, "causal")?.unwrap_or(false),
-    })
+    Ok(out)
 }
 
 /// The baseline of the recordings' dataset (its layout's, as the Python layer passes it

@@ -98,7 +98,7 @@ def test_bad_gains_and_flat_recordings():
     for bad, match in [("fast", "expected a number, `auto` or `auto:HZ`, got `fast`"),
                        ("auto:0", "target rate in \\(0, 1000\\]"),
                        ("auto:x", "`x` is not a number"),
-                       ([8], "expected a number, `auto` or `auto:HZ`, got list")]:
+                       ([8], "expected a number, `auto` or `auto:HZ`, got `\\[8\\]`")]:
         with pytest.raises(ParameterError, match=match):
             neurotex.features([x], gain=bad)
     with pytest.raises(ParameterError, match="target rate in \\(0, 1000\\] Hz, got 2000"):

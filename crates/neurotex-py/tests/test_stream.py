@@ -124,5 +124,5 @@ def test_ms_stamps_on_the_grid_give_the_unstamped_lines(sim_dir, causal_model):
     unstamped = run([None] * len(frames))
     stamped = run([1.7e12 + k for k in range(len(frames))], time_unit="ms")
     assert stamped == unstamped and len(unstamped) > 20
-    with pytest.raises(ParameterError, match="time-unit"):
+    with pytest.raises(ParameterError, match="time_unit"):
         neurotex.StreamClassifier(causal_model, time_unit="minutes")

@@ -14,7 +14,7 @@
 //! | spike statistics and GLCM features | `neurotex-features` | [`features`] |
 //! | classifiers, cross-validation, statistics | `neurotex-learn` | [`classify`] |
 //! | simulated recordings | `neurotex-sim` | [`sim`] |
-//! | pipeline, feature tables, models, streams, compare | `neurotex-pipeline` | [`pipeline`], [`analysis`], [`diagnostics`], [`model`], [`calibrate`], [`causal`], [`stream`], [`compare`] |
+//! | stage options, pipeline, feature tables, models, streams, compare | `neurotex-pipeline` | [`pipeline`], [`analysis`], [`diagnostics`], [`model`], [`options`], [`calibrate`], [`causal`], [`stream`], [`compare`] |
 //! | the paper's analyses | `neurotex-experiments` | [`experiments`] |
 //! | report and figures | `neurotex-report` | [`report`] |
 //!
@@ -28,7 +28,7 @@ pub use neurotex_experiments::experiments;
 pub use neurotex_features::features;
 pub use neurotex_learn::classify;
 pub use neurotex_pipeline::{
-    analysis, calibrate, causal, compare, diagnostics, model, pipeline, stream,
+    analysis, calibrate, causal, compare, diagnostics, model, options, pipeline, stream,
 };
 pub use neurotex_report::report;
 pub use neurotex_signal::{encode, signal};

@@ -51,7 +51,7 @@ pub struct EncodeArgs {
 
 /// Runs `neurotex encode`.
 pub fn run(args: EncodeArgs) -> Result<()> {
-    if args.stages.causal {
+    if args.stages.options.causal {
         bail!("--causal fixes resting values and a scale on training recordings: use it with train, evaluate, features or compare (then predict or stream with the model)");
     }
     let pipeline = Pipeline::new(args.stages.pipeline()?)?;

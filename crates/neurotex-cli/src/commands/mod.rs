@@ -92,7 +92,7 @@ fn calibrated_pipeline(
 ) -> Result<CalibratedParams> {
     let baseline = dataset.layout.baseline.unwrap_or_default();
     let load = |i: usize| dataset.load(i);
-    let (causal, gain) = (stages.causal, stages.gain);
+    let (causal, gain) = (stages.options.causal, stages.options.gain);
     let calibrated =
         calibrate_pipeline(stages.pipeline()?, causal, gain, &load, indices, baseline)?;
     if let Some(c) = &calibrated.causal {

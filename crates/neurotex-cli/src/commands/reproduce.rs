@@ -80,7 +80,7 @@ impl ReproduceArgs {
         } else {
             ReproduceParams::default()
         };
-        if self.stages.causal {
+        if self.stages.options.causal {
             bail!("reproduce runs the causal pipeline itself (its causal E5 beside the paper's offline E5); --causal is for train, evaluate, features and compare");
         }
         params.pipeline = self.stages.pipeline()?;

@@ -38,6 +38,8 @@ from .errors import (
 )
 
 __version__ = _native.library_version()
+# Every stage option's default, from the library's one definition of the options.
+_DEFAULTS: Dict[str, Any] = _native.stage_defaults()
 
 HARALICK_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(False))
 """Names of the paper's Haralick features, in the order :func:`haralick` returns them."""
@@ -304,14 +306,14 @@ def _prepare(
 def encode(
     x: Any,
     fs: float = 1000.0,
-    gain: Union[float, str] = 8.0,
-    cutoff: float = 50.0,
+    gain: Union[float, str] = _DEFAULTS["gain"],
+    cutoff: float = _DEFAULTS["cutoff"],
     *,
-    preset: str = "RS",
+    preset: str = _DEFAULTS["preset"],
     baseline: Optional[str] = None,
-    encoding: str = "sa",
-    fa_gain: float = 8000.0,
-    whole: bool = False,
+    encoding: str = _DEFAULTS["encoding"],
+    fa_gain: float = _DEFAULTS["fa_gain"],
+    whole: bool = _DEFAULTS["whole"],
     slide: Optional[Tuple[float, float]] = None,
     times: Any = None,
     mask: Any = None,
@@ -344,25 +346,25 @@ def encode(
 def features(
     recordings: Any,
     method: str = "glcm3d",
-    encoding: str = "sa",
+    encoding: str = _DEFAULTS["encoding"],
     *,
     fs: float = 1000.0,
     mask: Any = None,
     speeds: Any = None,
-    gain: Union[float, str] = 8.0,
-    causal: bool = False,
-    preset: str = "RS",
-    cutoff: float = 50.0,
+    gain: Union[float, str] = _DEFAULTS["gain"],
+    causal: bool = _DEFAULTS["causal"],
+    preset: str = _DEFAULTS["preset"],
+    cutoff: float = _DEFAULTS["cutoff"],
     baseline: Optional[str] = None,
-    whole: bool = False,
-    levels: int = 16,
-    bin_ms: int = 200,
-    distances: Sequence[int] = (1, 2, 4, 8),
-    symmetric: bool = False,
-    fa_gain: float = 8000.0,
-    haralick: str = "paper",
-    bin_widths: Sequence[int] = (50, 100, 200, 400),
-    window_mm: float = 2.0,
+    whole: bool = _DEFAULTS["whole"],
+    levels: int = _DEFAULTS["levels"],
+    bin_ms: int = _DEFAULTS["bin_ms"],
+    distances: Sequence[int] = _DEFAULTS["distances"],
+    symmetric: bool = _DEFAULTS["symmetric"],
+    fa_gain: float = _DEFAULTS["fa_gain"],
+    haralick: str = _DEFAULTS["haralick"],
+    bin_widths: Sequence[int] = _DEFAULTS["bin_widths"],
+    window_mm: float = _DEFAULTS["window_mm"],
 ) -> FeatureTable:
     """One feature row per recording, as ``neurotex features`` computes it.
 
@@ -427,7 +429,7 @@ def calibrate_gain(
     *,
     fs: float = 1000.0,
     mask: Any = None,
-    causal: bool = False,
+    causal: bool = _DEFAULTS["causal"],
     **stage_options: Any,
 ) -> GainCalibration:
     """The gain ``gain="auto"`` chooses on these recordings (``gain="auto:HZ"`` for
@@ -469,13 +471,13 @@ def _raster(spikes: Any) -> np.ndarray:
     return a
 
 
-def spike_stats(spikes: Any, bin_ms: int = 200) -> np.ndarray:
+def spike_stats(spikes: Any, bin_ms: int = _DEFAULTS["bin_ms"]) -> np.ndarray:
     """MSR (Hz), CV_ISI and Fano factor (``bin_ms`` windows) of every cell of a spike
     raster ``(T, rows, cols)`` (as :func:`encode` returns): float64 ``(rows, cols, 3)``."""
     return _native.spike_stats(_raster(spikes), int(bin_ms))
 
 
-def rate_volume(spikes: Any, bin_ms: Optional[int] = 200) -> np.ndarray:
+def rate_volume(spikes: Any, bin_ms: Optional[int] = _DEFAULTS["bin_ms"]) -> np.ndarray:
     """Mean rates (Hz) in ``bin_ms`` bins of a spike raster ``(T, rows, cols)``:
     float64 ``(rows, cols, bins)``; a last partial bin is dropped. ``bin_ms=None`` gives
     one bin over the whole raster (the 2D-GLCM's image)."""
@@ -491,9 +493,9 @@ def _volume(v: Any) -> np.ndarray:
 
 def glcm3d(
     volume: Any,
-    levels: int = 16,
-    distances: Sequence[int] = (1, 2, 4, 8),
-    symmetric: bool = False,
+    levels: int = _DEFAULTS["levels"],
+    distances: Sequence[int] = _DEFAULTS["distances"],
+    symmetric: bool = _DEFAULTS["symmetric"],
     range: Optional[Tuple[float, float]] = None,
     mask: Any = None,
 ) -> np.ndarray:
@@ -507,9 +509,9 @@ def glcm3d(
 
 def glcm2d(
     image: Any,
-    levels: int = 16,
-    distances: Sequence[int] = (1, 2, 4, 8),
-    symmetric: bool = False,
+    levels: int = _DEFAULTS["levels"],
+    distances: Sequence[int] = _DEFAULTS["distances"],
+    symmetric: bool = _DEFAULTS["symmetric"],
     range: Optional[Tuple[float, float]] = None,
     mask: Any = None,
 ) -> np.ndarray:
@@ -677,7 +679,7 @@ class Model:
         speeds: Any = None,
         taxel: Optional[str] = None,
         classifier_options: Optional[Dict[str, Any]] = None,
-        causal: bool = False,
+        causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "Model":
         """Trains ``classifier`` (``knn``, ``forest``, ``linear``; knobs in

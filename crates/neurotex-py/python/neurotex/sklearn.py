@@ -21,6 +21,9 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from . import _native, features as _features
 
+# Every stage option's default, from the library's one definition of the options.
+_DEFAULTS: Dict[str, Any] = _native.stage_defaults()
+
 __all__ = ["SpikeFeatures", "KNNClassifier", "RandomForestClassifier", "LogisticRegression"]
 
 
@@ -44,20 +47,20 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
     def __init__(
         self,
         method: str = "glcm3d",
-        encoding: str = "sa",
-        gain: Union[float, str] = 8.0,
-        preset: str = "RS",
-        cutoff: float = 50.0,
+        encoding: str = _DEFAULTS["encoding"],
+        gain: Union[float, str] = _DEFAULTS["gain"],
+        preset: str = _DEFAULTS["preset"],
+        cutoff: float = _DEFAULTS["cutoff"],
         baseline: Optional[str] = None,
-        whole: bool = False,
-        levels: int = 16,
-        bin_ms: int = 200,
-        distances: Sequence[int] = (1, 2, 4, 8),
-        symmetric: bool = False,
-        fa_gain: float = 8000.0,
-        haralick: str = "paper",
-        bin_widths: Sequence[int] = (50, 100, 200, 400),
-        window_mm: float = 2.0,
+        whole: bool = _DEFAULTS["whole"],
+        levels: int = _DEFAULTS["levels"],
+        bin_ms: int = _DEFAULTS["bin_ms"],
+        distances: Sequence[int] = _DEFAULTS["distances"],
+        symmetric: bool = _DEFAULTS["symmetric"],
+        fa_gain: float = _DEFAULTS["fa_gain"],
+        haralick: str = _DEFAULTS["haralick"],
+        bin_widths: Sequence[int] = _DEFAULTS["bin_widths"],
+        window_mm: float = _DEFAULTS["window_mm"],
         fs: float = 1000.0,
     ) -> None:
         self.method = method
