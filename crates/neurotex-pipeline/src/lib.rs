@@ -10,6 +10,7 @@ pub mod calibrate;
 pub mod causal;
 pub mod compare;
 pub mod diagnostics;
+pub mod evaluation;
 pub mod model;
 pub mod options;
 pub mod pipeline;

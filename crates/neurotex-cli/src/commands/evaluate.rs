@@ -3,29 +3,24 @@
 //! prints accuracy and confusion matrix, and for the single-taxel method which taxels
 //! stay silent or saturate.
 
-use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
-use neurotex::analysis::{
-    evaluate, Columns, FeatureTable, OutOfFold, Outcome, Split, TaxelAccuracy,
-};
-use neurotex::classify::{CvParams, Metrics};
-use neurotex::diagnostics::TaxelDiagnostics;
+use neurotex::analysis::{Columns, Split};
+use neurotex::classify::CvParams;
+use neurotex::evaluation::{Evaluation, Spikes};
 use neurotex::pipeline::{Method, Pipeline};
 use neurotex::recording::{Dataset, Selection};
 use neurotex::{Cell, Speed};
 
-use super::{calibrated_pipeline, encode_all, encoded_features};
+use super::{calibrated_pipeline, encode_all};
 use crate::classifier_args::ClassifierArgs;
 use crate::open_args::OpenArgs;
 use crate::output::{check_output, write_file};
 use crate::stage_args::StageArgs;
 use neurotex::classify::ClassifierChoice;
-use neurotex::compare::candidates::{
-    candidates, CandidateSet, MethodChoice, STANDARD_TAU_MS, VAN_ROSSUM,
-};
+use neurotex::compare::candidates::{MethodChoice, STANDARD_TAU_MS};
 
 /// Options of `neurotex evaluate`.
 #[derive(Args)]
@@ -216,6 +211,15 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     if args.predictions.is_some() && columns == Columns::EachTaxel {
         bail!("--predictions needs one classifier, not one per taxel: add --taxel ROW,COL");
     }
+    let spike_timing = args.method == MethodChoice::VanRossum;
+    let knn = match (spike_timing, classifier) {
+        (false, _) => None,
+        (true, ClassifierChoice::Knn(knn)) => Some(knn),
+        (true, _) => bail!("--method van-rossum classifies with KNN only (--classifier knn)"),
+    };
+    if spike_timing && (args.taxel.is_some() || args.predictions.is_some()) {
+        bail!("--taxel and --predictions do not apply to --method van-rossum");
+    }
     let dataset = args.open.open(&args.dataset)?;
     if let Some(path) = &args.predictions {
         check_output(path, &dataset.files())?;
@@ -226,293 +230,41 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         &dataset,
         &args.calibration_indices(&dataset, &indices)?,
     )?;
-    let calibration = calibrated.gain;
-    let causal = calibrated.causal;
     let pipeline = Pipeline::new(calibrated.params)?;
-    let MethodChoice::Features(method) = args.method else {
-        return evaluate_spike_timing(&args, &dataset, &indices, &pipeline, &split);
+    let (encoded, grid) = encode_all(&dataset, &pipeline, &indices)?;
+    let spikes = Spikes {
+        encoded: &encoded,
+        grid: &grid,
+        pipeline: &pipeline,
     };
-    let features = encoded_features(&dataset, &pipeline, &indices, method)?;
-    let (table, grid) = (&features.table, &features.grid);
-    if let Some(cell) = args.taxel {
-        grid.locate(cell)?;
-    }
-    let outcome = evaluate(table, columns, &split, &classifier.check()?)?;
+    let evaluation = match (args.method, knn) {
+        (MethodChoice::Features(method), _) => Evaluation::of_features(
+            spikes,
+            method,
+            columns,
+            &split,
+            &classifier.check()?,
+            args.seed,
+        )?,
+        (_, Some(knn)) => Evaluation::of_spike_timing(spikes, knn, args.tau_ms, &split, args.seed)?,
+        (_, None) => unreachable!("spike timing has its KNN"),
+    };
     if let Some(path) = &args.predictions {
-        let predictions = outcome
-            .predictions
-            .as_deref()
-            .context("one classifier's predictions for --predictions")?;
         write_file(path, "out-of-fold predictions", |w| {
-            write_out_of_fold(w, table, &outcome.labels, predictions)
+            evaluation.write_out_of_fold(w)
         })?;
     }
-    // Silent and saturated taxels matter where taxels are scored one by one.
-    let taxels = (columns == Columns::EachTaxel).then_some(&features.taxels);
     if args.json {
-        let mut value = serde_json::to_value(&outcome)?;
-        value["method"] = method.name().into();
-        // Balanced accuracy, per-class recall and precision and both chance levels from the
-        // confusion matrix; the interval resamples recordings, keeping each one's
-        // predictions over repeats (and taxels) together.
-        value["metrics"] = serde_json::to_value(Metrics::from_confusion(&outcome.confusion))?;
-        let interval = outcome.accuracy_interval(args.seed)?;
-        value["accuracy_interval"] = serde_json::to_value(interval)?;
-        if let Some(taxels) = taxels {
-            value["taxels"] = taxels_json(taxels, &outcome)?;
-        }
-        if let Some(c) = &causal {
+        let mut value = evaluation.json()?;
+        if let Some(c) = &calibrated.causal {
             value["causal_conditioning"] = serde_json::to_value(c)?;
         }
-        if let Some(c) = &calibration {
+        if let Some(c) = &calibrated.gain {
             value["gain_calibration"] = serde_json::to_value(c)?;
         }
         println!("{}", serde_json::to_string(&value)?);
     } else {
-        print_outcome(&outcome, method.name(), &split, grid.cols(), args.seed)?;
-        if let Some(taxels) = taxels {
-            print_taxels(taxels, &outcome);
-        }
+        print!("{}", evaluation.text());
     }
     Ok(())
-}
-
-/// `evaluate --method van-rossum`: KNN over the van Rossum distances between the
-/// recordings' spike trains (of the encoding's populations), the matrix computed once.
-fn evaluate_spike_timing(
-    args: &EvaluateArgs,
-    dataset: &Dataset,
-    indices: &[usize],
-    pipeline: &Pipeline,
-    split: &Split,
-) -> Result<()> {
-    let ClassifierChoice::Knn(knn) = args.classifier.choice(args.stages.knn(args.k)?)? else {
-        bail!("--method van-rossum classifies with KNN only (--classifier knn)");
-    };
-    if args.taxel.is_some() || args.predictions.is_some() {
-        bail!("--taxel and --predictions do not apply to --method van-rossum");
-    }
-    let (encoded, grid) = encode_all(dataset, pipeline, indices)?;
-    let set = CandidateSet {
-        encodings: vec![pipeline.params().encoding],
-        methods: vec![MethodChoice::VanRossum],
-        classifiers: vec![ClassifierChoice::Knn(knn)],
-        tau_ms: args.tau_ms,
-    };
-    let candidate = candidates(&encoded, &grid, pipeline.params(), &set, 0.0)?.remove(0);
-    let outcome = (candidate.evaluate)(&candidate.table, Columns::All, split)?;
-    if args.json {
-        let mut value = serde_json::to_value(&outcome)?;
-        value["method"] = VAN_ROSSUM.into();
-        value["tau_ms"] = args.tau_ms.into();
-        value["metrics"] = serde_json::to_value(Metrics::from_confusion(&outcome.confusion))?;
-        let interval = outcome.accuracy_interval(args.seed)?;
-        value["accuracy_interval"] = serde_json::to_value(interval)?;
-        println!("{}", serde_json::to_string(&value)?);
-    } else {
-        print_outcome(&outcome, VAN_ROSSUM, split, grid.cols(), args.seed)?;
-    }
-    Ok(())
-}
-
-/// The taxel diagnostics for `evaluate --json`: every taxel's silent and saturated shares,
-/// the silent and saturated ones by name, and the mean accuracy over responsive taxels
-/// (`null` when none responds) beside the mean over all.
-fn taxels_json(taxels: &TaxelDiagnostics, outcome: &Outcome) -> Result<serde_json::Value> {
-    let per = outcome.per_taxel.as_deref().unwrap_or_default();
-    let mut value = serde_json::to_value(taxels)?;
-    value["silent"] = serde_json::to_value(taxels.silent())?;
-    value["saturated"] = serde_json::to_value(taxels.saturated())?;
-    value["mean_all"] = outcome.accuracy.into();
-    value["mean_responsive"] = serde_json::to_value(taxels.responsive_mean(per))?;
-    Ok(value)
-}
-
-/// Prints the silent and saturated taxels and the mean over the responsive ones.
-fn print_taxels(taxels: &TaxelDiagnostics, outcome: &Outcome) {
-    let names = |list: Vec<&str>| match list.is_empty() {
-        true => "none".to_string(),
-        false => list.join(", "),
-    };
-    println!(
-        "taxels silent (no spike) in most recordings: {}; at the encoder's ceiling ({:.0} Hz) in most recordings: {}",
-        names(taxels.silent()),
-        taxels.ceiling_hz,
-        names(taxels.saturated())
-    );
-    let per = outcome.per_taxel.as_deref().unwrap_or_default();
-    let all = 100.0 * outcome.accuracy;
-    match taxels.responsive_mean(per) {
-        Some(mean) => println!(
-            "accuracy {:.1}% (mean over responsive taxels) beside {all:.1}% (mean over all taxels)",
-            100.0 * mean
-        ),
-        None => println!("no taxel responds in most recordings; mean over all taxels {all:.1}%"),
-    }
-}
-
-/// Prints the outcome as text: what was run, the accuracy (per taxel when every taxel was
-/// evaluated) and the confusion matrix.
-fn print_outcome(
-    outcome: &Outcome,
-    method: &str,
-    split: &Split,
-    cols: usize,
-    seed: u64,
-) -> Result<()> {
-    let how = match split {
-        Split::CrossValidation {
-            cv,
-            group_by: Some(column),
-            speeds,
-        } => format!(
-            "{}, up to {}-fold CV keeping each `{column}` group in one fold, seed {}, {} repeat(s)",
-            recordings_at(speeds.as_deref()),
-            cv.folds,
-            cv.seed,
-            cv.repeats
-        ),
-        Split::CrossValidation { cv, speeds, .. } => format!(
-            "{}, {}-fold stratified CV, seed {}, {} repeat(s)",
-            recordings_at(speeds.as_deref()),
-            cv.folds,
-            cv.seed,
-            cv.repeats
-        ),
-        Split::Where { train, test } => {
-            format!("train on {}, test on {}", selected(train), selected(test))
-        }
-        Split::Rows { train, test } => {
-            format!(
-                "train on {} recordings, test on {}",
-                train.len(),
-                test.len()
-            )
-        }
-    };
-    println!("method {method}: {} samples, {how}", outcome.n);
-    print_accuracy(outcome, cols);
-    // No accuracy without its uncertainty and the level a guess reaches.
-    let interval = outcome.accuracy_interval(seed)?;
-    let metrics = Metrics::from_confusion(&outcome.confusion);
-    println!(
-        "95 % interval [{:.1}%, {:.1}%] (bootstrap over recordings); chance {:.1}% (one over {} classes), {:.1}% always answering the most frequent class",
-        100.0 * interval.lower,
-        100.0 * interval.upper,
-        100.0 * metrics.chance_uniform,
-        metrics.classes_present,
-        100.0 * metrics.chance_majority
-    );
-    print_confusion(outcome);
-    Ok(())
-}
-
-/// The recordings cross-validation runs over, as text.
-fn recordings_at(speeds: Option<&[Speed]>) -> String {
-    match speeds {
-        None => "all recordings".into(),
-        Some(speeds) => format!("recordings at {}", selected(&Selection::speeds(speeds))),
-    }
-}
-
-/// A selection as text: `[5, 10] mm/s` for speeds, `session in [s1, s2]` otherwise.
-fn selected(selection: &Selection) -> String {
-    let values = selection.values.join(", ");
-    match selection.column.as_str() {
-        "speed_mm_s" => format!("[{values}] mm/s"),
-        column => format!("{column} in [{values}]"),
-    }
-}
-
-/// Prints the accuracy: per taxel with the mean and best when every taxel was evaluated,
-/// with its spread over repeats when there is one.
-fn print_accuracy(outcome: &Outcome, cols: usize) {
-    if let (Some(per), Some(best)) = (&outcome.per_taxel, &outcome.best) {
-        print_taxel_grid(per, cols);
-        println!(
-            "accuracy {:.1}% (mean over taxels); best taxel r{}c{} {:.1}% (chosen after the fact)",
-            100.0 * outcome.accuracy,
-            best.row,
-            best.col,
-            100.0 * best.accuracy
-        );
-    } else if outcome.accuracy_std > 0.0 {
-        println!(
-            "accuracy {:.1}% ± {:.1}%",
-            100.0 * outcome.accuracy,
-            100.0 * outcome.accuracy_std
-        );
-    } else {
-        println!("accuracy {:.1}%", 100.0 * outcome.accuracy);
-    }
-}
-
-/// Prints each taxel's accuracy in its place on the grid; `-` for cells without a taxel.
-fn print_taxel_grid(per: &[TaxelAccuracy], cols: usize) {
-    println!("accuracy per taxel (%):");
-    let rows = per.iter().map(|t| t.row).max().unwrap_or(0) + 1;
-    for r in 0..rows {
-        let line: Vec<String> = (0..cols)
-            .map(|c| {
-                per.iter()
-                    .find(|t| t.row == r && t.col == c)
-                    .map_or("    -".to_string(), |t| {
-                        format!("{:5.1}", 100.0 * t.accuracy)
-                    })
-            })
-            .collect();
-        println!("  {}", line.join(" "));
-    }
-}
-
-/// Prints the confusion matrix, rows the true labels.
-fn print_confusion(outcome: &Outcome) {
-    let summed = if outcome.per_taxel.is_some() {
-        ", summed over taxels"
-    } else {
-        ""
-    };
-    println!("confusion (rows = true, columns = predicted{summed}):");
-    let width = outcome
-        .labels
-        .iter()
-        .map(|l| l.len())
-        .max()
-        .unwrap_or(1)
-        .max(5);
-    print!("{:width$}", "");
-    for l in &outcome.labels {
-        print!(" {l:>width$}");
-    }
-    println!();
-    for (l, row) in outcome.labels.iter().zip(outcome.confusion.rows()) {
-        print!("{l:width$}");
-        for v in row {
-            print!(" {v:>width$}");
-        }
-        println!();
-    }
-}
-
-/// Writes `file,label,predicted,fold,repeat`, one row per prediction.
-fn write_out_of_fold(
-    w: &mut dyn Write,
-    table: &FeatureTable,
-    labels: &[String],
-    predictions: &[OutOfFold],
-) -> std::io::Result<()> {
-    let mut out = csv::Writer::from_writer(w);
-    out.write_record(["file", "label", "predicted", "fold", "repeat"])?;
-    for p in predictions {
-        let meta = &table.metas[p.row];
-        let fold = p.fold.map_or("test".to_string(), |f| f.to_string());
-        out.write_record([
-            meta.file.as_str(),
-            meta.label.as_str(),
-            labels[p.predicted].as_str(),
-            fold.as_str(),
-            p.repeat.to_string().as_str(),
-        ])?;
-    }
-    out.flush()
 }

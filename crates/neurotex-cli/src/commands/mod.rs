@@ -15,7 +15,6 @@ pub mod train;
 use anyhow::Result;
 use neurotex::analysis::FeatureTable;
 use neurotex::calibrate::{calibrate_pipeline, CalibratedParams, GainCalibration};
-use neurotex::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
 use neurotex::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use neurotex::recording::Dataset;
 use neurotex::{Grid, Speed};
@@ -35,34 +34,9 @@ fn feature_table(
         Some(speeds) => dataset.indices_at(speeds)?,
         None => (0..dataset.entries.len()).collect(),
     };
-    let features = encoded_features(dataset, pipeline, &indices, method)?;
-    Ok((features.table, features.grid))
-}
-
-/// A feature table, the grid its recordings share, and which taxels respond in them.
-struct Features {
-    table: FeatureTable,
-    grid: Grid,
-    taxels: TaxelDiagnostics,
-}
-
-/// Encodes the dataset's recordings `indices` with a progress bar and extracts `method`'s
-/// features.
-fn encoded_features(
-    dataset: &Dataset,
-    pipeline: &Pipeline,
-    indices: &[usize],
-    method: Method,
-) -> Result<Features> {
-    let (encoded, grid) = encode_all(dataset, pipeline, indices)?;
+    let (encoded, grid) = encode_all(dataset, pipeline, &indices)?;
     let extractor = pipeline.extractor(&grid)?;
-    let table = FeatureTable::build(&encoded, &extractor, method)?;
-    let taxels = taxel_diagnostics(&encoded, &grid, pipeline.params().encoder)?;
-    Ok(Features {
-        table,
-        grid,
-        taxels,
-    })
+    Ok((FeatureTable::build(&encoded, &extractor, method)?, grid))
 }
 
 /// Encodes the dataset's recordings `indices` with a progress bar, saying what the

@@ -1,0 +1,391 @@
+//! `evaluate`'s workflow on encoded recordings: a feature method's table (or the van Rossum
+//! distances between spike trains) classified by cross-validation or a train/test split,
+//! with the accuracy's interval and chance levels, which taxels respond when taxels are
+//! scored one by one, the result as JSON and as text, and each recording's out-of-fold
+//! prediction as CSV.
+
+use std::fmt::Write as _;
+use std::io::Write;
+
+use serde_json::Value;
+
+use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split, TaxelAccuracy};
+use crate::classify::{ChosenClassifier, ClassifierChoice, Interval, KnnParams, Metrics};
+use crate::compare::candidates::{candidates, CandidateSet, MethodChoice, VAN_ROSSUM};
+use crate::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
+use crate::pipeline::{Encoded, Method, Pipeline};
+use crate::recording::{Meta, Selection};
+use crate::values::{Grid, Speed};
+use neurotex_core::Result;
+
+/// A dataset's recordings as encoded: what every evaluation starts from.
+#[derive(Debug, Clone, Copy)]
+pub struct Spikes<'a> {
+    /// The encoded recordings, in table order.
+    pub encoded: &'a [Encoded],
+    /// The grid they share.
+    pub grid: &'a Grid,
+    /// The pipeline that encoded them (its features are extracted with it).
+    pub pipeline: &'a Pipeline,
+}
+
+/// One evaluation's result, with everything its JSON and text need.
+#[derive(Debug, Clone)]
+pub struct Evaluation {
+    /// Accuracy, confusion, per-taxel accuracies and out-of-fold predictions.
+    pub outcome: Outcome,
+    /// The feature method's name (`van-rossum` for spike timing).
+    pub method: &'static str,
+    /// The van Rossum kernel's time constant, for spike timing.
+    pub tau_ms: Option<f64>,
+    /// How the recordings were split.
+    pub split: Split,
+    /// Balanced accuracy, per-class recall and precision, both chance levels.
+    pub metrics: Metrics,
+    /// The accuracy's 95 % bootstrap interval over recordings.
+    pub interval: Interval,
+    /// Silent and saturated taxels, when every taxel was scored alone.
+    pub taxels: Option<TaxelDiagnostics>,
+    /// The grid's columns, to print per-taxel accuracies in place.
+    pub cols: usize,
+    /// Each table row's recording, for the out-of-fold predictions.
+    pub metas: Vec<Meta>,
+}
+
+impl Evaluation {
+    /// Classifies `method`'s features of the encoded recordings with
+    /// `classifier` under `split`; `seed` draws the interval's bootstrap.
+    ///
+    /// # Errors
+    /// A taxel outside the grid, a split the recordings cannot support, a classifier that
+    /// cannot fit.
+    pub fn of_features(
+        spikes: Spikes<'_>,
+        method: Method,
+        columns: Columns,
+        split: &Split,
+        classifier: &ChosenClassifier,
+        seed: u64,
+    ) -> Result<Self> {
+        let Spikes {
+            encoded,
+            grid,
+            pipeline,
+        } = spikes;
+        if let Columns::Taxel(cell) = columns {
+            grid.locate(cell)?;
+        }
+        let extractor = pipeline.extractor(grid)?;
+        let table = FeatureTable::build(encoded, &extractor, method)?;
+        let outcome = evaluate(&table, columns, split, classifier)?;
+        // Silent and saturated taxels matter where taxels are scored one by one.
+        let taxels = match columns {
+            Columns::EachTaxel => {
+                Some(taxel_diagnostics(encoded, grid, pipeline.params().encoder)?)
+            }
+            _ => None,
+        };
+        Self::new(
+            outcome,
+            method.name(),
+            None,
+            split,
+            grid,
+            taxels,
+            table.metas,
+            seed,
+        )
+    }
+
+    /// KNN over the van Rossum distances (kernel `tau_ms`) between the encoded
+    /// recordings' spike trains of the pipeline's populations, the matrix computed once.
+    ///
+    /// # Errors
+    /// As [`Evaluation::of_features`].
+    pub fn of_spike_timing(
+        spikes: Spikes<'_>,
+        knn: KnnParams,
+        tau_ms: f64,
+        split: &Split,
+        seed: u64,
+    ) -> Result<Self> {
+        let Spikes {
+            encoded,
+            grid,
+            pipeline,
+        } = spikes;
+        let set = CandidateSet {
+            encodings: vec![pipeline.params().encoding],
+            methods: vec![MethodChoice::VanRossum],
+            classifiers: vec![ClassifierChoice::Knn(knn)],
+            tau_ms,
+        };
+        let candidate = candidates(encoded, grid, pipeline.params(), &set, 0.0)?.remove(0);
+        let outcome = (candidate.evaluate)(&candidate.table, Columns::All, split)?;
+        let metas = candidate.table.metas.clone();
+        Self::new(
+            outcome,
+            VAN_ROSSUM,
+            Some(tau_ms),
+            split,
+            grid,
+            None,
+            metas,
+            seed,
+        )
+    }
+
+    /// The evaluation of `outcome`, its metrics and interval computed.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        outcome: Outcome,
+        method: &'static str,
+        tau_ms: Option<f64>,
+        split: &Split,
+        grid: &Grid,
+        taxels: Option<TaxelDiagnostics>,
+        metas: Vec<Meta>,
+        seed: u64,
+    ) -> Result<Self> {
+        Ok(Self {
+            metrics: Metrics::from_confusion(&outcome.confusion),
+            interval: outcome.accuracy_interval(seed)?,
+            outcome,
+            method,
+            tau_ms,
+            split: split.clone(),
+            taxels,
+            cols: grid.cols(),
+            metas,
+        })
+    }
+
+    /// The result as one JSON object: the outcome's fields, `method`, `metrics`,
+    /// `accuracy_interval`, `tau_ms` for spike timing, and `taxels` (every taxel's silent
+    /// and saturated shares, those by name, the mean over responsive taxels beside the
+    /// mean over all) when every taxel was scored alone.
+    ///
+    /// # Errors
+    /// A value JSON cannot hold.
+    pub fn json(&self) -> serde_json::Result<Value> {
+        let mut value = serde_json::to_value(&self.outcome)?;
+        value["method"] = self.method.into();
+        if let Some(tau) = self.tau_ms {
+            value["tau_ms"] = tau.into();
+        }
+        value["metrics"] = serde_json::to_value(&self.metrics)?;
+        value["accuracy_interval"] = serde_json::to_value(&self.interval)?;
+        if let Some(taxels) = &self.taxels {
+            let per = self.outcome.per_taxel.as_deref().unwrap_or_default();
+            let mut t = serde_json::to_value(taxels)?;
+            t["silent"] = serde_json::to_value(taxels.silent())?;
+            t["saturated"] = serde_json::to_value(taxels.saturated())?;
+            t["mean_all"] = self.outcome.accuracy.into();
+            t["mean_responsive"] = serde_json::to_value(taxels.responsive_mean(per))?;
+            value["taxels"] = t;
+        }
+        Ok(value)
+    }
+
+    /// The result as text: what was run, the accuracy (per taxel when every taxel was
+    /// evaluated), its interval and chance levels, the confusion matrix, and the silent
+    /// and saturated taxels when taxels were scored one by one.
+    pub fn text(&self) -> String {
+        let mut out = String::new();
+        let (outcome, metrics, interval) = (&self.outcome, &self.metrics, &self.interval);
+        let how = split_text(&self.split);
+        // Writing to a String cannot fail.
+        let _ = writeln!(out, "method {}: {} samples, {how}", self.method, outcome.n);
+        accuracy_text(&mut out, outcome, self.cols);
+        // No accuracy without its uncertainty and the level a guess reaches.
+        let _ = writeln!(
+            out,
+            "95 % interval [{:.1}%, {:.1}%] (bootstrap over recordings); chance {:.1}% (one over {} classes), {:.1}% always answering the most frequent class",
+            100.0 * interval.lower,
+            100.0 * interval.upper,
+            100.0 * metrics.chance_uniform,
+            metrics.classes_present,
+            100.0 * metrics.chance_majority
+        );
+        confusion_text(&mut out, outcome);
+        if let Some(taxels) = &self.taxels {
+            taxels_text(&mut out, taxels, outcome);
+        }
+        out
+    }
+
+    /// Writes `file,label,predicted,fold,repeat`, one row per out-of-fold prediction
+    /// (`fold` is `test` with a train/test split; folds and repeats count from 0).
+    ///
+    /// # Errors
+    /// One classifier's predictions are not kept (every taxel scored alone), or `w` fails.
+    pub fn write_out_of_fold(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let predictions =
+            self.outcome.predictions.as_deref().ok_or_else(|| {
+                std::io::Error::other("out-of-fold predictions need one classifier")
+            })?;
+        let labels = &self.outcome.labels;
+        let mut out = csv::Writer::from_writer(w);
+        out.write_record(["file", "label", "predicted", "fold", "repeat"])?;
+        for p in predictions {
+            let meta = &self.metas[p.row];
+            let fold = p.fold.map_or("test".to_string(), |f| f.to_string());
+            out.write_record([
+                meta.file.as_str(),
+                meta.label.as_str(),
+                labels[p.predicted].as_str(),
+                fold.as_str(),
+                p.repeat.to_string().as_str(),
+            ])?;
+        }
+        out.flush()
+    }
+}
+
+/// How the recordings were split, as text.
+fn split_text(split: &Split) -> String {
+    match split {
+        Split::CrossValidation {
+            cv,
+            group_by: Some(column),
+            speeds,
+        } => format!(
+            "{}, up to {}-fold CV keeping each `{column}` group in one fold, seed {}, {} repeat(s)",
+            recordings_at(speeds.as_deref()),
+            cv.folds,
+            cv.seed,
+            cv.repeats
+        ),
+        Split::CrossValidation { cv, speeds, .. } => format!(
+            "{}, {}-fold stratified CV, seed {}, {} repeat(s)",
+            recordings_at(speeds.as_deref()),
+            cv.folds,
+            cv.seed,
+            cv.repeats
+        ),
+        Split::Where { train, test } => {
+            format!("train on {}, test on {}", selected(train), selected(test))
+        }
+        Split::Rows { train, test } => format!(
+            "train on {} recordings, test on {}",
+            train.len(),
+            test.len()
+        ),
+    }
+}
+
+/// The recordings cross-validation runs over, as text.
+fn recordings_at(speeds: Option<&[Speed]>) -> String {
+    match speeds {
+        None => "all recordings".into(),
+        Some(speeds) => format!("recordings at {}", selected(&Selection::speeds(speeds))),
+    }
+}
+
+/// A selection as text: `[5, 10] mm/s` for speeds, `session in [s1, s2]` otherwise.
+fn selected(selection: &Selection) -> String {
+    let values = selection.values.join(", ");
+    match selection.column.as_str() {
+        "speed_mm_s" => format!("[{values}] mm/s"),
+        column => format!("{column} in [{values}]"),
+    }
+}
+
+/// The accuracy: per taxel with the mean and best when every taxel was evaluated, with
+/// its spread over repeats when there is one.
+fn accuracy_text(out: &mut String, outcome: &Outcome, cols: usize) {
+    let _ = match (&outcome.per_taxel, &outcome.best) {
+        (Some(per), Some(best)) => {
+            taxel_grid_text(out, per, cols);
+            writeln!(
+                out,
+                "accuracy {:.1}% (mean over taxels); best taxel r{}c{} {:.1}% (chosen after the fact)",
+                100.0 * outcome.accuracy,
+                best.row,
+                best.col,
+                100.0 * best.accuracy
+            )
+        }
+        _ if outcome.accuracy_std > 0.0 => writeln!(
+            out,
+            "accuracy {:.1}% ± {:.1}%",
+            100.0 * outcome.accuracy,
+            100.0 * outcome.accuracy_std
+        ),
+        _ => writeln!(out, "accuracy {:.1}%", 100.0 * outcome.accuracy),
+    };
+}
+
+/// Each taxel's accuracy in its place on the grid; `-` for cells without a taxel.
+fn taxel_grid_text(out: &mut String, per: &[TaxelAccuracy], cols: usize) {
+    out.push_str("accuracy per taxel (%):\n");
+    let rows = per.iter().map(|t| t.row).max().unwrap_or(0) + 1;
+    for r in 0..rows {
+        let line: Vec<String> = (0..cols)
+            .map(|c| {
+                per.iter()
+                    .find(|t| t.row == r && t.col == c)
+                    .map_or("    -".to_string(), |t| {
+                        format!("{:5.1}", 100.0 * t.accuracy)
+                    })
+            })
+            .collect();
+        let _ = writeln!(out, "  {}", line.join(" "));
+    }
+}
+
+/// The confusion matrix, rows the true labels.
+fn confusion_text(out: &mut String, outcome: &Outcome) {
+    let summed = match outcome.per_taxel {
+        Some(_) => ", summed over taxels",
+        None => "",
+    };
+    let _ = writeln!(out, "confusion (rows = true, columns = predicted{summed}):");
+    let width = outcome
+        .labels
+        .iter()
+        .map(|l| l.len())
+        .max()
+        .unwrap_or(1)
+        .max(5);
+    let _ = write!(out, "{:width$}", "");
+    for l in &outcome.labels {
+        let _ = write!(out, " {l:>width$}");
+    }
+    out.push('\n');
+    for (l, row) in outcome.labels.iter().zip(outcome.confusion.rows()) {
+        let _ = write!(out, "{l:width$}");
+        for v in row {
+            let _ = write!(out, " {v:>width$}");
+        }
+        out.push('\n');
+    }
+}
+
+/// The silent and saturated taxels and the mean over the responsive ones.
+fn taxels_text(out: &mut String, taxels: &TaxelDiagnostics, outcome: &Outcome) {
+    let names = |list: Vec<&str>| match list.is_empty() {
+        true => "none".to_string(),
+        false => list.join(", "),
+    };
+    let _ = writeln!(
+        out,
+        "taxels silent (no spike) in most recordings: {}; at the encoder's ceiling ({:.0} Hz) in most recordings: {}",
+        names(taxels.silent()),
+        taxels.ceiling_hz,
+        names(taxels.saturated())
+    );
+    let per = outcome.per_taxel.as_deref().unwrap_or_default();
+    let all = 100.0 * outcome.accuracy;
+    let _ = match taxels.responsive_mean(per) {
+        Some(mean) => writeln!(
+            out,
+            "accuracy {:.1}% (mean over responsive taxels) beside {all:.1}% (mean over all taxels)",
+            100.0 * mean
+        ),
+        None => writeln!(
+            out,
+            "no taxel responds in most recordings; mean over all taxels {all:.1}%"
+        ),
+    };
+}
