@@ -15,7 +15,7 @@
 //! could hold a stride or a scale that no fit would produce. Files written before the
 //! forest and the regression existed (`"kind": "knn"`) read unchanged.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -25,7 +25,7 @@ use crate::classify::{ChosenModel, Classifier, ClassifierChoice, ConfusionMatrix
 use crate::error::{ClassifyError, DataError, ParamError, Result};
 pub use crate::error::{ModelError, MODEL_FORMAT as FORMAT, MODEL_VERSION as VERSION};
 use crate::pipeline::{Encoded, FeatureExtractor, Method, Pipeline, PipelineParams};
-use crate::recording::{Baseline, Dataset, Recording};
+use crate::recording::{read_recording, Baseline, Dataset, LayoutFile, Recording};
 use crate::values::{Cell, Grid, Speed};
 
 /// The gain `--gain auto` chose and what it rests on.
@@ -335,6 +335,52 @@ impl Model {
     /// A recording the pipeline cannot take (empty sliding phase, shorter than one bin).
     pub fn encode(&self, recording: &Recording) -> Result<Encoded> {
         self.pipeline.encode(recording, self.baseline())
+    }
+
+    /// Reads and encodes the recordings `files` (`.npy` or `.csv`, placed on the grid as
+    /// `layout` says) as the training recordings were, in parallel; each is named by its
+    /// path as given.
+    ///
+    /// # Errors
+    /// A file that cannot be read, or that the pipeline cannot take, named.
+    pub fn encode_files(&self, files: &[PathBuf], layout: &LayoutFile) -> Result<Vec<Encoded>> {
+        files
+            .par_iter()
+            .map(|path| {
+                let file = path.display().to_string();
+                let mut recording = read_recording(path, layout)?;
+                recording.meta.file = file.clone();
+                self.encode(&recording).map_err(|e| e.in_recording(&file))
+            })
+            .collect()
+    }
+
+    /// Writes one CSV row per recording: `file,label,predicted`, then `share_<class>` for
+    /// each class of the model; `label` is empty unless `known`.
+    ///
+    /// # Errors
+    /// `w` fails.
+    pub fn write_predictions(
+        &self,
+        w: &mut dyn std::io::Write,
+        encoded: &[Encoded],
+        predictions: &[Prediction],
+        known: bool,
+    ) -> std::io::Result<()> {
+        let mut out = csv::Writer::from_writer(w);
+        let shares = self.labels().iter().map(|l| format!("share_{l}"));
+        let header: Vec<String> = ["file", "label", "predicted"]
+            .map(String::from)
+            .into_iter()
+            .chain(shares)
+            .collect();
+        out.write_record(&header)?;
+        for (e, p) in encoded.iter().zip(predictions) {
+            let label = if known { e.meta.label.as_str() } else { "" };
+            let ids = [e.meta.file.as_str(), label, p.predicted.as_str()].map(String::from);
+            out.write_record(ids.into_iter().chain(p.shares.iter().map(f64::to_string)))?;
+        }
+        out.flush()
     }
 
     /// Predicts the class of each encoded recording, in parallel.

@@ -2,16 +2,15 @@
 //! files, with its own pipeline; one CSV row per recording, and the accuracy when the
 //! labels are known.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use neurotex::causal::episode_decisions;
-use neurotex::model::{Model, Prediction};
+use neurotex::model::Model;
 use neurotex::pipeline::Encoded;
-use neurotex::recording::{read_recording, Dataset, LayoutFile};
-use neurotex::stream::{bin_json, end_json};
+use neurotex::recording::{Dataset, LayoutFile};
+use neurotex::stream::write_episodes;
 use rayon::prelude::*;
 
 use super::report_conditions;
@@ -79,10 +78,13 @@ pub fn run(args: PredictArgs) -> Result<()> {
     let model = Model::load(&args.model)?;
     let (encoded, known) = match &dataset {
         Some(dataset) => (encode_dataset(&model, dataset)?, true),
-        None => (
-            encode_files(&model, &args.files, args.layout.as_deref())?,
-            false,
-        ),
+        None => {
+            let layout = match &args.layout {
+                Some(path) => LayoutFile::read(path)?,
+                None => LayoutFile::default(),
+            };
+            (model.encode_files(&args.files, &layout)?, false)
+        }
     };
     report_conditions(&encoded);
     if args.causal {
@@ -97,7 +99,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
         false => None,
     };
     write_file(&args.out, "predictions", |w| {
-        write_predictions(w, &model, &encoded, &predictions, known)
+        model.write_predictions(w, &encoded, &predictions, known)
     })?;
     if let Some(score) = score {
         println!("{}", serde_json::to_string(&score)?);
@@ -124,14 +126,7 @@ fn predict_causal(args: &PredictArgs, model: &Model, encoded: &[Encoded]) -> Res
         .collect::<neurotex::Result<Vec<_>>>()?;
     let labels = model.labels();
     write_file(&args.out, "causal decisions", |w| {
-        for (e, episode) in encoded.iter().zip(&episodes) {
-            let file = Some(e.meta.file.as_str());
-            for bin in &episode.bins {
-                writeln!(w, "{}", bin_json(labels, bin, file))?;
-            }
-            writeln!(w, "{}", end_json(labels, &episode.summary, file))?;
-        }
-        Ok(())
+        write_episodes(w, labels, encoded, &episodes)
     })?;
     let decided = episodes
         .iter()
@@ -162,47 +157,4 @@ fn encode_dataset(model: &Model, dataset: &Dataset) -> Result<Vec<Encoded>> {
         .encode_dataset(dataset, &all, &|| bar.inc(1));
     bar.finish_and_clear();
     Ok(encoded?)
-}
-
-/// Reads and encodes the recordings `files` with the model's pipeline; each is named by
-/// its path as given.
-fn encode_files(model: &Model, files: &[PathBuf], layout: Option<&Path>) -> Result<Vec<Encoded>> {
-    let layout = match layout {
-        Some(path) => LayoutFile::read(path)?,
-        None => LayoutFile::default(),
-    };
-    files
-        .par_iter()
-        .map(|path| {
-            let mut recording = read_recording(path, &layout)?;
-            recording.meta.file = path.display().to_string();
-            model
-                .encode(&recording)
-                .with_context(|| format!("encoding {}", path.display()))
-        })
-        .collect()
-}
-
-/// Writes one row per recording: `file,label,predicted`, then each class's vote share.
-fn write_predictions(
-    w: &mut dyn Write,
-    model: &Model,
-    encoded: &[Encoded],
-    predictions: &[Prediction],
-    known: bool,
-) -> std::io::Result<()> {
-    let mut out = csv::Writer::from_writer(w);
-    let shares = model.labels().iter().map(|l| format!("share_{l}"));
-    let header: Vec<String> = ["file", "label", "predicted"]
-        .map(String::from)
-        .into_iter()
-        .chain(shares)
-        .collect();
-    out.write_record(&header)?;
-    for (e, p) in encoded.iter().zip(predictions) {
-        let label = if known { e.meta.label.as_str() } else { "" };
-        let ids = [e.meta.file.as_str(), label, p.predicted.as_str()].map(String::from);
-        out.write_record(ids.into_iter().chain(p.shares.iter().map(f64::to_string)))?;
-    }
-    out.flush()
 }

@@ -1,11 +1,10 @@
 //! `neurotex stream`: a causal model classifies a live taxel stream frame by frame and
 //! prints one JSON line per bin boundary and one per episode's end.
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::{TcpListener, UdpSocket};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use neurotex::causal::DecisionRule;
 use neurotex::csvlog::{ChannelSelect, Column, CsvFormat, Delimiter};
@@ -140,7 +139,7 @@ pub fn run(args: StreamArgs) -> Result<()> {
         bail!("--stamped is for --format f32le; CSV frames carry their stamp in --time-column");
     }
     let mut stream = StreamClassifier::new(model, params)?;
-    let input = open_input(&args.input)?;
+    let input = neurotex::stream::input::open(&args.input, &|said| eprintln!("{said}"))?;
     let mut frames = FrameReader::new(input, &args.input, frame_format(&args), stream.channels());
     let mut out = Output {
         out: std::io::stdout().lock(),
@@ -188,59 +187,6 @@ fn frame_format(args: &StreamArgs) -> neurotex::stream::frames::FrameFormat {
             stamped: args.stamped,
             unit: args.time_unit.unwrap_or(TimeUnit::Seconds),
         },
-    }
-}
-
-/// The input as a byte reader.
-fn open_input(input: &str) -> Result<Box<dyn BufRead>> {
-    if input == "-" {
-        return Ok(Box::new(BufReader::new(std::io::stdin())));
-    }
-    if let Some(address) = input.strip_prefix("tcp://") {
-        let listener =
-            TcpListener::bind(address).with_context(|| format!("listening on tcp://{address}"))?;
-        eprintln!("listening on tcp://{}", listener.local_addr()?);
-        let (socket, peer) = listener.accept().context("accepting a connection")?;
-        eprintln!("connection from {peer}");
-        return Ok(Box::new(BufReader::new(socket)));
-    }
-    if let Some(address) = input.strip_prefix("udp://") {
-        let socket =
-            UdpSocket::bind(address).with_context(|| format!("binding udp://{address}"))?;
-        eprintln!("receiving on udp://{}", socket.local_addr()?);
-        return Ok(Box::new(BufReader::new(Datagrams {
-            socket,
-            buffer: vec![0; 65_536],
-            start: 0,
-            end: 0,
-        })));
-    }
-    let path = Path::new(input);
-    let file = std::fs::File::open(path).with_context(|| format!("opening {}", path.display()))?;
-    Ok(Box::new(BufReader::new(file)))
-}
-
-/// UDP datagrams read as one byte stream; an empty datagram is its end.
-struct Datagrams {
-    socket: UdpSocket,
-    buffer: Vec<u8>,
-    start: usize,
-    end: usize,
-}
-
-impl Read for Datagrams {
-    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
-        if self.start == self.end {
-            self.end = self.socket.recv(&mut self.buffer)?;
-            self.start = 0;
-            if self.end == 0 {
-                return Ok(0);
-            }
-        }
-        let n = out.len().min(self.end - self.start);
-        out[..n].copy_from_slice(&self.buffer[self.start..self.start + n]);
-        self.start += n;
-        Ok(n)
     }
 }
 

@@ -13,6 +13,7 @@
 //! resampler state (a few f64) and the spike times of the current window (as u32).
 
 pub mod frames;
+pub mod input;
 mod spike_log;
 mod window_glcm;
 
@@ -985,6 +986,28 @@ fn interpolate(a: &[f64], b: &[f64], w: f64, out: &mut [f64]) {
     for ((o, &x), &y) in out.iter_mut().zip(a).zip(b) {
         *o = x + (y - x) * w;
     }
+}
+
+/// Writes each recording's episode as `neurotex stream --episode whole` prints it for that
+/// recording's frames: a line per bin boundary, then its end, each with the recording's
+/// `file` (`predict --causal`).
+///
+/// # Errors
+/// `w` fails.
+pub fn write_episodes(
+    w: &mut dyn std::io::Write,
+    labels: &[String],
+    encoded: &[Encoded],
+    episodes: &[crate::causal::Episode],
+) -> std::io::Result<()> {
+    for (e, episode) in encoded.iter().zip(episodes) {
+        let file = Some(e.meta.file.as_str());
+        for bin in &episode.bins {
+            writeln!(w, "{}", bin_json(labels, bin, file))?;
+        }
+        writeln!(w, "{}", end_json(labels, &episode.summary, file))?;
+    }
+    Ok(())
 }
 
 /// A bin boundary's line: `{"t_s", "label", "scores", "decided", "decision"}`, with the
