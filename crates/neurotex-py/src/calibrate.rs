@@ -11,8 +11,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde::Serialize;
 
-use crate::convert::{open, Batch, InfoTuple};
-use crate::errors::{guarded, raise, Kind};
+use crate::convert::{open, to_object, Batch, InfoTuple};
+use crate::errors::guarded;
 use crate::params::{self, Stages};
 
 /// Reads the training recordings by index.
@@ -28,24 +28,21 @@ pub struct Calibrated {
     pub causal: Option<ConditioningCalibration>,
 }
 
-/// What was calibrated, for Python: the JSON of the gain calibration and of the causal
-/// conditioning (the library's serialised forms, as a model file holds them), each `None`
-/// when not asked for.
-pub type Report = (Option<String>, Option<String>);
+/// What was calibrated, for Python: the gain calibration and the causal conditioning as
+/// dicts (the library's serialised forms, as a model file holds them), each `None` when
+/// not asked for.
+pub type Report = (Option<Py<PyAny>>, Option<Py<PyAny>>);
 
 impl Calibrated {
-    /// What was calibrated, as JSON for the Python layer.
-    pub fn report(&self) -> PyResult<Report> {
-        Ok((json(&self.gain)?, json(&self.causal)?))
+    /// What was calibrated, as objects for the Python layer.
+    pub fn report(&self, py: Python<'_>) -> PyResult<Report> {
+        Ok((object(py, &self.gain)?, object(py, &self.causal)?))
     }
 }
 
-/// `value` as JSON, `None` for `None`.
-pub fn json<T: Serialize>(value: &Option<T>) -> PyResult<Option<String>> {
-    value
-        .as_ref()
-        .map(|v| serde_json::to_string(v).map_err(|e| raise(Kind::Internal, e.to_string())))
-        .transpose()
+/// `value` as a Python object ([`to_object`]), `None` for `None`.
+pub fn object<T: Serialize>(py: Python<'_>, value: &Option<T>) -> PyResult<Option<Py<PyAny>>> {
+    value.as_ref().map(|v| to_object(py, v)).transpose()
 }
 
 /// The pipeline the stage options name, calibrated on the recordings `indices` (read by
@@ -85,7 +82,7 @@ fn calibrate<'py>(
     let view = batch.view();
     let all: Vec<usize> = (0..view.len()).collect();
     let c = py.detach(|| guarded(|| calibrated(&stages, &|i| view.load(i), &all, baseline)))?;
-    c.report()
+    c.report(py)
 }
 
 /// Calibrates the stage options on every recording of a dataset folder, as `neurotex
@@ -101,7 +98,7 @@ fn calibrate_dataset(
     let baseline = dataset.layout.baseline.unwrap_or_default();
     let all: Vec<usize> = (0..dataset.entries.len()).collect();
     let c = py.detach(|| guarded(|| calibrated(&stages, &|i| dataset.load(i), &all, baseline)))?;
-    c.report()
+    c.report(py)
 }
 
 /// Registers the calibration functions.

@@ -369,3 +369,44 @@ pub(crate) fn open(dir: &Path) -> PyResult<Dataset> {
     }
     guarded(|| Dataset::open(dir))
 }
+
+/// A value serialised by the library as the Python object `json.loads` gives for its
+/// JSON text (dicts with the same keys in the same order, lists, `int` for integers,
+/// `float` for the rest, `None` for null), built directly, without the text.
+///
+/// # Errors
+/// A value serde cannot represent (never for the library's result types).
+pub fn to_object<T: serde::Serialize>(py: Python<'_>, value: &T) -> PyResult<Py<PyAny>> {
+    let value = serde_json::to_value(value).map_err(|e| raise(Kind::Internal, e.to_string()))?;
+    Ok(value_object(py, &value)?.unbind())
+}
+
+/// One JSON value as a Python object (see [`to_object`]).
+fn value_object<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use pyo3::types::{PyBool, PyDict, PyList, PyString};
+    use serde_json::Value;
+    Ok(match value {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => PyBool::new(py, *b).to_owned().into_any(),
+        Value::Number(n) => match (n.as_u64(), n.as_i64()) {
+            (Some(u), _) => u.into_pyobject(py)?.into_any(),
+            (_, Some(i)) => i.into_pyobject(py)?.into_any(),
+            _ => n.as_f64().unwrap_or(f64::NAN).into_pyobject(py)?.into_any(),
+        },
+        Value::String(s) => PyString::new(py, s).into_any(),
+        Value::Array(items) => {
+            let items = items
+                .iter()
+                .map(|v| value_object(py, v))
+                .collect::<PyResult<Vec<_>>>()?;
+            PyList::new(py, items)?.into_any()
+        }
+        Value::Object(map) => {
+            let dict = PyDict::new(py);
+            for (k, v) in map {
+                dict.set_item(k, value_object(py, v)?)?;
+            }
+            dict.into_any()
+        }
+    })
+}

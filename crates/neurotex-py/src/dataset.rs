@@ -140,7 +140,7 @@ fn features_dataset<'py>(
     for m in &metas {
         rows.append(manifest_row(py, &dataset.columns, m)?)?;
     }
-    Ok((values.into_pyarray(py), names, rows, c.report()?))
+    Ok((values.into_pyarray(py), names, rows, c.report(py)?))
 }
 
 /// Writes arrays as a dataset folder (whole or not at all): one `.npy` per recording named

@@ -37,7 +37,7 @@ use errors::{guarded, guarded_py, param, raise, to_py, try_vec, Kind};
 type Rasters<'py> = (Bound<'py, PyArray3<u8>>, Option<Bound<'py, PyArray3<u8>>>);
 
 /// Encodes one recording: `((first population's raster, FA raster of sa+fa or None), gain
-/// calibration as JSON or None)`, each raster uint8 `(T, rows, cols)` at 1 kHz. Under
+/// calibration as a dict or None)`, each raster uint8 `(T, rows, cols)` at 1 kHz. Under
 /// `gain="auto"` the gain is calibrated on this recording, as `neurotex encode --gain auto`
 /// does.
 #[pyfunction]
@@ -48,7 +48,7 @@ fn encode<'py>(
     info: InfoTuple,
     options: &Bound<'py, PyDict>,
     baseline: Option<&str>,
-) -> PyResult<(Rasters<'py>, Option<String>)> {
+) -> PyResult<(Rasters<'py>, Option<Py<PyAny>>)> {
     let stages = params::stages(options)?;
     if stages.causal {
         return Err(raise(
@@ -65,7 +65,7 @@ fn encode<'py>(
             Ok((view.encode(|rec| c.pipeline.encode(rec, baseline))?, c))
         })
     })?;
-    let (gain, _) = c.report()?;
+    let (gain, _) = c.report(py)?;
     let e = encoded.remove(0);
     let raster = |s: &SpikeTrains| {
         Array3::from_shape_vec((s.n_steps, s.rows, s.cols), s.to_raster())
@@ -110,7 +110,7 @@ fn features<'py>(
             Ok((values, names, c))
         })
     })?;
-    Ok((values.into_pyarray(py), names, c.report()?))
+    Ok((values.into_pyarray(py), names, c.report(py)?))
 }
 
 /// The feature table of encoded recordings, as the CLI's `features` command builds it.

@@ -10,7 +10,7 @@ use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::calibrate::{calibrated, json};
+use crate::calibrate::{calibrated, object};
 use crate::convert::{Batch, InfoTuple};
 use crate::errors::{guarded, param, raise, Kind};
 use crate::params;
@@ -100,17 +100,17 @@ impl NativeModel {
         self.inner.provenance().fingerprint.clone()
     }
 
-    /// How `gain="auto"` (`--gain auto`) chose the gain, as JSON; `None` for a gain given
-    /// as a number.
+    /// How `gain="auto"` (`--gain auto`) chose the gain, as a dict; `None` for a gain
+    /// given as a number.
     #[getter]
-    fn gain_calibration(&self) -> PyResult<Option<String>> {
-        json(&self.inner.provenance().gain_calibration)
+    fn gain_calibration(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        object(py, &self.inner.provenance().gain_calibration)
     }
 
-    /// The causal conditioning (`offsets`, `scale`) as JSON; `None` for an offline model.
+    /// The causal conditioning (`offsets`, `scale`) as a dict; `None` for an offline model.
     #[getter]
-    fn causal(&self) -> PyResult<Option<String>> {
-        json(&self.inner.causal())
+    fn causal(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        object(py, &self.inner.causal())
     }
 
     /// A causal model's median training phase in ms (a stream's default window).

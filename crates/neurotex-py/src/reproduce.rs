@@ -12,7 +12,7 @@ use neurotex::sim::MAX_TRIALS;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::open;
+use crate::convert::{open, to_object};
 use crate::errors::{guarded, param, raise, Kind};
 use crate::params::{self, Stages};
 
@@ -23,9 +23,18 @@ const MAX_SEEDS: u64 = 1000;
 /// fold or None for a held-out test set, repeat)`, the CLI's `--predictions` row.
 type PredictionRow = (f64, String, String, String, String, Option<usize>, usize);
 
-/// What a run hands back: `results.json`'s text, the claims as JSON, the headline
+/// What a run hands back: `results.json` and the claims as dicts and lists, the headline
 /// predictions and the run's wall-clock seconds.
-type Outcome = (String, String, Vec<PredictionRow>, f64);
+type Outcome = (Py<PyAny>, Py<PyAny>, Vec<PredictionRow>, f64);
+
+/// A run's results as the detached run hands them over: `results.json`'s and the claims'
+/// values, the headline predictions, the wall-clock seconds.
+type Finished = (
+    serde_json::Value,
+    serde_json::Value,
+    Vec<PredictionRow>,
+    f64,
+);
 
 /// Which data a run analyses.
 enum Data {
@@ -109,18 +118,25 @@ fn reproduce(
             Data::Simulated { trials, seeds }
         }
     };
-    py.detach(|| guarded(|| run(&out, &data, &stages, params, &command)))
+    let (results, claims, predictions, seconds) =
+        py.detach(|| guarded(|| run(&out, &data, &stages, params, &command)))?;
+    Ok((
+        to_object(py, &results)?,
+        to_object(py, &claims)?,
+        predictions,
+        seconds,
+    ))
 }
 
 /// Runs the library's [`run_analyses`] (the report written as the CLI writes it) and hands
-/// back the results and claims as JSON, the headline predictions and the seconds taken.
+/// back the results and claims as JSON values, the headline predictions and the seconds taken.
 fn run(
     out: &std::path::Path,
     data: &Data,
     stages: &Stages,
     params: ReproduceParams,
     command: &str,
-) -> neurotex::Result<Outcome> {
+) -> neurotex::Result<Finished> {
     let started = Instant::now();
     let input = match data {
         Data::Folder(ds) => Input::Folder(ds),
@@ -136,11 +152,11 @@ fn run(
         on_gain: &|_| (),
     };
     let results = run_analyses(out, input, params, &run)?;
-    let json = |what: &str, text: serde_json::Result<String>| {
-        text.map_err(|e| neurotex::error::DataError::invalid(out.join(what), e.to_string()))
+    let json = |what: &str, value: serde_json::Result<serde_json::Value>| {
+        value.map_err(|e| neurotex::error::DataError::invalid(out.join(what), e.to_string()))
     };
-    let results_json = json("results.json", serde_json::to_string(&results))?;
-    let claims_json = json("claims", serde_json::to_string(&claims(&results)))?;
+    let results_json = json("results.json", serde_json::to_value(&results))?;
+    let claims_json = json("claims", serde_json::to_value(claims(&results)))?;
     let predictions = results.predictions.iter().map(prediction_row).collect();
     Ok((
         results_json,

@@ -6,6 +6,7 @@ use neurotex::recording::TimeUnit;
 use neurotex::stream::{bin_json, end_json, Event, StreamClassifier, StreamError, StreamParams};
 use pyo3::prelude::*;
 
+use crate::convert::to_object;
 use crate::errors::{guarded, param, raise, to_py, Kind};
 use crate::model::NativeModel;
 
@@ -17,14 +18,14 @@ pub struct NativeStream {
     unit: TimeUnit,
 }
 
-/// The events as JSON lines, the lines `neurotex stream` prints (without `bad_frames`).
-fn lines(stream: &StreamClassifier, events: &[Event]) -> Vec<String> {
+/// The events as dicts, the lines `neurotex stream` prints (without `bad_frames`).
+fn lines(py: Python<'_>, stream: &StreamClassifier, events: &[Event]) -> PyResult<Vec<Py<PyAny>>> {
     let labels = stream.model().labels();
     events
         .iter()
         .map(|e| match e {
-            Event::Bin(b) => bin_json(labels, b, None).to_string(),
-            Event::End(s) => end_json(labels, s, None).to_string(),
+            Event::Bin(b) => to_object(py, &bin_json(labels, b, None)),
+            Event::End(s) => to_object(py, &end_json(labels, s, None)),
         })
         .collect()
 }
@@ -78,27 +79,32 @@ impl NativeStream {
     }
 
     /// Takes one frame (one value per taxel) with its time stamp in the stream's unit, or
-    /// none at the stream's rate; returns the JSON lines it completed.
+    /// none at the stream's rate; returns the lines it completed, as dicts.
     #[pyo3(signature = (values, t=None))]
-    fn push(&mut self, values: Vec<f64>, t: Option<f64>) -> PyResult<Vec<String>> {
+    fn push(
+        &mut self,
+        py: Python<'_>,
+        values: Vec<f64>,
+        t: Option<f64>,
+    ) -> PyResult<Vec<Py<PyAny>>> {
         let events = self
             .inner
             .push_in(t, self.unit, &values)
             .map_err(stream_error)?
             .to_vec();
-        Ok(lines(&self.inner, &events))
+        lines(py, &self.inner, &events)
     }
 
     /// Ends the current episode; its summary line.
-    fn reset(&mut self) -> PyResult<Vec<String>> {
+    fn reset(&mut self, py: Python<'_>) -> PyResult<Vec<Py<PyAny>>> {
         let events = self.inner.reset().map_err(stream_error)?.to_vec();
-        Ok(lines(&self.inner, &events))
+        lines(py, &self.inner, &events)
     }
 
     /// Ends the stream; the last lines.
-    fn finish(&mut self) -> PyResult<Vec<String>> {
+    fn finish(&mut self, py: Python<'_>) -> PyResult<Vec<Py<PyAny>>> {
         let events = self.inner.finish().map_err(stream_error)?.to_vec();
-        Ok(lines(&self.inner, &events))
+        lines(py, &self.inner, &events)
     }
 
     /// Values a frame holds.

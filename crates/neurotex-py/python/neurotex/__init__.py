@@ -16,7 +16,6 @@ zero-phase low-pass, 200 ms bins, 16 gray levels, distances 1, 2, 4, 8.
 from __future__ import annotations
 
 import hashlib
-import json
 import logging
 import os
 import tempfile
@@ -123,10 +122,9 @@ class GainCalibration:
     clamped: bool
 
     @classmethod
-    def _from_json(cls, text: Optional[str]) -> Optional["GainCalibration"]:
-        if text is None:
+    def _from_dict(cls, d: Optional[Dict[str, Any]]) -> Optional["GainCalibration"]:
+        if d is None:
             return None
-        d = json.loads(text)
         return cls(gain=d["gain"], target_hz=d["target_hz"], median_hz=d["median_hz"],
                    recordings=d["recordings"], pairs=d["pairs"], clamped=d["clamped"])
 
@@ -154,10 +152,9 @@ class CausalConditioning:
     median_duration_ms: Optional[int] = None
 
     @classmethod
-    def _from_json(cls, text: Optional[str]) -> Optional["CausalConditioning"]:
-        if text is None:
+    def _from_dict(cls, d: Optional[Dict[str, Any]]) -> Optional["CausalConditioning"]:
+        if d is None:
             return None
-        d = json.loads(text)
         # a calibration nests the conditioning; a model file holds the conditioning alone
         c = d.get("conditioning", d)
         return cls(offsets=np.array(c["offsets"], dtype=np.float64), scale=c["scale"],
@@ -172,12 +169,12 @@ class CausalConditioning:
                 f"fixed{on}{phase}")
 
 
-def _calibrations(report: Tuple[Optional[str], Optional[str]]
+def _calibrations(report: Tuple[Optional[Dict[str, Any]], Optional[Dict[str, Any]]]
                   ) -> Tuple[Optional[GainCalibration], Optional[CausalConditioning]]:
     """The library's calibration report as objects, said on the ``neurotex`` logger (at
     INFO, as the CLI says it on standard error)."""
-    gain = GainCalibration._from_json(report[0])
-    causal = CausalConditioning._from_json(report[1])
+    gain = GainCalibration._from_dict(report[0])
+    causal = CausalConditioning._from_dict(report[1])
     for c in (causal, gain):
         if c is not None:
             _log.info("%s", c)
@@ -757,14 +754,14 @@ class Model:
     def gain_calibration(self) -> Optional[GainCalibration]:
         """How ``gain="auto"`` chose :attr:`gain` on the training recordings; ``None`` for
         a gain given as a number."""
-        return GainCalibration._from_json(self._native.gain_calibration)
+        return GainCalibration._from_dict(self._native.gain_calibration)
 
     @property
     def causal(self) -> Optional[CausalConditioning]:
         """The causal conditioning of a model trained with ``causal=True`` (or
         ``neurotex train --causal``): what :class:`StreamClassifier` needs; ``None`` for
         the paper's offline pipeline."""
-        c = CausalConditioning._from_json(self._native.causal)
+        c = CausalConditioning._from_dict(self._native.causal)
         if c is None:
             return None
         return CausalConditioning(c.offsets, c.scale, None, self._native.median_duration_ms)
@@ -858,13 +855,12 @@ def reproduce(
                            if v is not None and defaults.get(key) != v]
     shown += [f"{key}={v!r}" for key, v in stage_options.items()]
     command = f"neurotex.reproduce({', '.join(shown)})  # Python {__version__}"
-    results_json, claims_json, predictions, seconds = _native.reproduce(
+    results, claims, predictions, seconds = _native.reproduce(
         out, opts, given["dataset"], bool(quick), int(seed),
         None if trials is None else int(trials), None if seeds is None else int(seeds),
         int(k), bool(standardize), group_by,
         None if encoder_draws is None else int(encoder_draws), command)
-    results = json.loads(results_json)
-    claims = [dict(c, holds=c["verdict"] in _HOLDS) for c in json.loads(claims_json)]
+    claims = [dict(c, holds=c["verdict"] in _HOLDS) for c in claims]
     headline = {float(speed): {key: e[key] for key in _HEADLINE}
                 for speed, e in results.get("e1", {}).items()}
     gain = results.get("gain_calibration")
@@ -874,7 +870,7 @@ def reproduce(
         results=results,
         claims=claims,
         headline=headline,
-        gain_calibration=None if gain is None else GainCalibration._from_json(json.dumps(gain)),
+        gain_calibration=None if gain is None else GainCalibration._from_dict(gain),
         predictions=[dict(zip(fields, row)) for row in predictions],
         seconds=seconds,
     )
@@ -909,8 +905,8 @@ class StreamClassifier:
                                             episode, fs, max_gap_s, speed, time_unit)
 
     @staticmethod
-    def _events(lines: List[str]) -> Optional[List[Dict[str, Any]]]:
-        return [json.loads(line) for line in lines] or None
+    def _events(lines: List[Dict[str, Any]]) -> Optional[List[Dict[str, Any]]]:
+        return lines or None
 
     def push(self, frame: Any, t: Optional[float] = None) -> Optional[List[Dict[str, Any]]]:
         """Takes one frame, with its time stamp in ``time_unit`` (or none, at ``fs``)."""
