@@ -21,6 +21,11 @@ use std::sync::{Mutex, MutexGuard};
 use crate::error::{DataError, Result};
 
 /// The temporaries that exist now (or are about to be created).
+///
+/// Process-wide on purpose, the one piece of mutable state the library's outputs keep: a
+/// signal handler has no handle on the call that is writing (it may be any thread, deep in
+/// any workflow), and whatever it removes on SIGINT must be known to it. Only paths of
+/// temporaries live here; no result depends on it.
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// The registry, even after a panic on another thread poisoned it (its list stays valid:

@@ -88,6 +88,11 @@ type Kept = Vec<((u64, Vec<usize>, usize), Arc<Vec<usize>>)>;
 /// same each time. So they are made once per process and kept (up to [`KEPT`] indices in
 /// all; the oldest go first), and an interval then costs its sums alone. The values are
 /// those drawn in turn either way (`tests::kept_draws_are_the_streams`).
+///
+/// The kept draws are process-wide state on purpose: a memo of a pure function of its key
+/// (seed, bounds, rounds), so no result depends on what is kept or on the order of calls,
+/// and it is shared by every interval and test of a run (E1 to E9, `compare`'s candidates)
+/// without threading a cache through each of their signatures.
 pub fn for_each_resample(
     seed: u64,
     bounds: &[usize],
