@@ -387,7 +387,7 @@ fn offline_models_and_bad_options_are_refused() {
     for (args, says) in [
         (vec!["--decide", "1.5"], "decision share"),
         (vec!["--decide-bins", "0"], "consecutive bins"),
-        (vec!["--window-s", "-1"], "--window-s"),
+        (vec!["--window-s", "-1"], "`window-s`"),
         (vec!["--episode", "onset:x"], "episodes are"),
         (vec!["--fs", "0"], "frame rate"),
         (vec!["--max-gap-s", "3600"], "largest gap"),

@@ -7,17 +7,15 @@ use std::time::Instant;
 
 use neurotex::classify::KnnParams;
 use neurotex::experiments::{claims, HeadlinePrediction, ReproduceParams};
-use neurotex::report::reproduce::{reproduce as run_analyses, Data as Input, Run};
-use neurotex::sim::MAX_TRIALS;
+use neurotex::report::reproduce::{
+    reproduce as run_analyses, simulated_design, Data as Input, Run,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{open, to_object};
 use crate::errors::{guarded, param, raise, Kind};
 use crate::params::{self, Stages};
-
-/// Most simulated datasets one run accepts (the CLI's `--seeds` limit).
-const MAX_SEEDS: u64 = 1000;
 
 /// One headline out-of-fold prediction: `(speed_mm_s, method, file, label, predicted,
 /// fold or None for a held-out test set, repeat)`, the CLI's `--predictions` row.
@@ -97,24 +95,7 @@ fn reproduce(
             Data::Folder(Box::new(open(&dir)?))
         }
         None => {
-            let trials = trials.unwrap_or(if quick { 10 } else { 20 });
-            if !(1..=MAX_TRIALS).contains(&trials) {
-                return Err(raise(
-                    Kind::Parameter,
-                    format!("trials must be between 1 and {MAX_TRIALS}, got {trials}"),
-                ));
-            }
-            let n = seeds.unwrap_or(if quick { 1 } else { 5 });
-            if !(1..=MAX_SEEDS).contains(&n) {
-                return Err(raise(
-                    Kind::Parameter,
-                    format!("seeds must be between 1 and {MAX_SEEDS}, got {n}"),
-                ));
-            }
-            let seeds = (0..n)
-                .map(|i| seed.checked_add(i))
-                .collect::<Option<Vec<u64>>>()
-                .ok_or_else(|| raise(Kind::Parameter, "seed plus seeds overflows a 64-bit seed"))?;
+            let (trials, seeds) = simulated_design(quick, trials, seeds, seed).map_err(param)?;
             Data::Simulated { trials, seeds }
         }
     };

@@ -57,15 +57,7 @@ impl NativeStream {
         let unit: TimeUnit = time_unit.parse().map_err(param)?;
         let model = model.inner.clone();
         let mut params = StreamParams::for_model(&model);
-        if let Some(s) = window_s {
-            if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
-                return Err(raise(
-                    Kind::Parameter,
-                    format!("window_s must be in (0, 3600] s, got {s}"),
-                ));
-            }
-            params.window_ms = (s * 1000.0).round() as usize;
-        }
+        params.window_ms = StreamParams::window_ms(&model, window_s).map_err(param)?;
         params.rule = DecisionRule {
             share: decide,
             bins: decide_bins,

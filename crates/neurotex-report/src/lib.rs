@@ -12,3 +12,4 @@ use neurotex_learn::classify;
 use neurotex_pipeline::{calibrate, causal, compare, pipeline};
 #[cfg(test)]
 use neurotex_signal::signal;
+use neurotex_sim::sim;

@@ -9,15 +9,14 @@ use clap::Args;
 use indicatif::ProgressBar;
 use neurotex::experiments::{claims, Progress, ReproduceParams};
 use neurotex::recording::Dataset;
-use neurotex::report::reproduce::{reproduce, write_headline_predictions, Data, Run};
+use neurotex::report::reproduce::{
+    reproduce, simulated_design, write_headline_predictions, Data, Run, MAX_SEEDS,
+};
 
 use super::say_calibration;
 use crate::open_args::OpenArgs;
 use crate::output::{check_output, progress, write_file};
 use crate::stage_args::StageArgs;
-
-/// Most simulated datasets one run accepts (each takes seconds; more is a typo).
-const MAX_SEEDS: u64 = 1000;
 
 /// Options of `neurotex reproduce`.
 #[derive(Args)]
@@ -91,25 +90,6 @@ impl ReproduceArgs {
         params.encoder_draws = usize::try_from(self.encoder_draws)?;
         Ok(params)
     }
-
-    /// Simulated trials per texture and speed.
-    fn trials_per(&self) -> Result<u32> {
-        let trials_per = self.trials.unwrap_or(if self.quick { 10 } else { 20 });
-        if !(1..=neurotex::sim::MAX_TRIALS).contains(&trials_per) {
-            let max = neurotex::sim::MAX_TRIALS;
-            bail!("--trials must be between 1 and {max}, got {trials_per}");
-        }
-        Ok(trials_per)
-    }
-
-    /// The simulation seeds, one per simulated dataset.
-    fn simulation_seeds(&self) -> Result<Vec<u64>> {
-        let n = self.seeds.unwrap_or(if self.quick { 1 } else { 5 });
-        (0..n)
-            .map(|i| self.seed.checked_add(i))
-            .collect::<Option<Vec<u64>>>()
-            .context("--seed plus --seeds overflows a 64-bit seed")
-    }
 }
 
 /// Runs `neurotex reproduce`.
@@ -125,14 +105,14 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         let inputs = dataset.as_ref().map(Dataset::files).unwrap_or_default();
         check_output(path, &inputs)?;
     }
-    let seeds = match dataset {
-        Some(_) => Vec::new(),
-        None => args.simulation_seeds()?,
+    let (trials, seeds) = match dataset {
+        Some(_) => (0, Vec::new()),
+        None => simulated_design(args.quick, args.trials, args.seeds, args.seed)?,
     };
     let data = match &dataset {
         Some(ds) => Data::Folder(ds),
         None => Data::Simulated {
-            trials: args.trials_per()?,
+            trials,
             seeds: &seeds,
         },
     };

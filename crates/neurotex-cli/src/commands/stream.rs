@@ -43,11 +43,7 @@ impl DecisionArgs {
 
     /// The window in ms for `model`.
     pub fn window_ms(&self, model: &Model) -> Result<usize> {
-        match self.window_s {
-            None => Ok(StreamParams::for_model(model).window_ms),
-            Some(s) if s.is_finite() && s > 0.0 && s <= 3600.0 => Ok((s * 1000.0).round() as usize),
-            Some(s) => bail!("--window-s must be in (0, 3600] s, got {s}"),
-        }
+        Ok(StreamParams::window_ms(model, self.window_s)?)
     }
 }
 

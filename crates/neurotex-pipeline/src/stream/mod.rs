@@ -134,6 +134,23 @@ impl StreamParams {
         }
     }
 
+    /// The window classified at each bin boundary for `model`, in ms: `window_s` seconds
+    /// when given, else the model's default ([`StreamParams::for_model`]).
+    ///
+    /// # Errors
+    /// A window outside (0, 3600] s.
+    pub fn window_ms(model: &Model, window_s: Option<f64>) -> Result<usize, ParamError> {
+        match window_s {
+            None => Ok(Self::for_model(model).window_ms),
+            Some(s) if s.is_finite() && s > 0.0 && s <= 3600.0 => Ok((s * 1000.0).round() as usize),
+            Some(s) => Err(ParamError::new(
+                "window-s",
+                "the window must be in (0, 3600] s",
+                s,
+            )),
+        }
+    }
+
     fn check(&self) -> Result<(), ParamError> {
         self.rule.check()?;
         if !(1..=3_600_000).contains(&self.window_ms) {

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use crate::calibrate::GainCalibration;
-use crate::error::Result;
+use crate::error::{ParamError, Result};
 use crate::experiments::{
     prepare, run_all, run_seeds, HeadlinePrediction, Progress, ReproduceParams, Results, Source,
     ValidReproduceParams,
@@ -16,6 +16,44 @@ use crate::pipeline::Pipeline;
 use crate::recording::Dataset;
 
 use super::{check_report_dir, folder_source, simulated_source, write_report, ReportContext};
+
+/// Most simulated datasets one run makes (each takes seconds; more is a typo).
+pub const MAX_SEEDS: u64 = 1000;
+
+/// The built-in simulator's design for a run: `trials` per texture and speed (default 20,
+/// or 10 for a quick run) and one simulation seed per dataset, `seed`, `seed + 1`, ...
+/// (`seeds` of them; default 5, or 1 for a quick run).
+///
+/// # Errors
+/// Trials outside 1 to [`crate::sim::MAX_TRIALS`], seeds outside 1 to [`MAX_SEEDS`], or
+/// seeds that overflow a 64-bit seed.
+pub fn simulated_design(
+    quick: bool,
+    trials: Option<u32>,
+    seeds: Option<u64>,
+    seed: u64,
+) -> std::result::Result<(u32, Vec<u64>), ParamError> {
+    // The rules name the limits as literals; these keep them the limits.
+    const _: () = assert!(crate::sim::MAX_TRIALS == 10_000 && MAX_SEEDS == 1000);
+    let trials = trials.unwrap_or(if quick { 10 } else { 20 });
+    if !(1..=crate::sim::MAX_TRIALS).contains(&trials) {
+        let rule = "trials must be between 1 and 10000";
+        return Err(ParamError::new("trials", rule, trials));
+    }
+    let n = seeds.unwrap_or(if quick { 1 } else { 5 });
+    if !(1..=MAX_SEEDS).contains(&n) {
+        return Err(ParamError::new(
+            "seeds",
+            "seeds must be between 1 and 1000",
+            n,
+        ));
+    }
+    let seeds = (0..n)
+        .map(|i| seed.checked_add(i))
+        .collect::<Option<Vec<u64>>>()
+        .ok_or_else(|| ParamError::new("seeds", "seed plus seeds overflows a 64-bit seed", seed))?;
+    Ok((trials, seeds))
+}
 
 /// Where the analyses' recordings come from.
 #[derive(Debug, Clone, Copy)]
