@@ -46,7 +46,7 @@ enum Data {
 /// `report.md`, `results.json` and `figures/` into `out` (whole or not at all) and returns
 /// the results. The GIL is released for the whole run.
 #[pyfunction]
-#[pyo3(signature = (out, options, dataset=None, quick=false, seed=0, trials=None, seeds=None, k=5, standardize=true, group_by=None, encoder_draws=None, command=String::new()))]
+#[pyo3(signature = (out, options, dataset=None, quick=false, seed=0, trials=None, seeds=None, k=5, standardize=true, group_by=None, encoder_draws=None, command=String::new(), folds=None, repeats=None))]
 #[allow(clippy::too_many_arguments)]
 fn reproduce(
     py: Python<'_>,
@@ -62,6 +62,8 @@ fn reproduce(
     group_by: Option<String>,
     encoder_draws: Option<usize>,
     command: String,
+    folds: Option<usize>,
+    repeats: Option<usize>,
 ) -> PyResult<Outcome> {
     let stages = params::stages(options)?;
     if stages.causal {
@@ -80,6 +82,8 @@ fn reproduce(
     params.knn.check().map_err(param)?;
     params.seed = seed;
     params.cv.seed = seed;
+    params.cv.folds = folds.unwrap_or(params.cv.folds);
+    params.cv.repeats = repeats.unwrap_or(params.cv.repeats);
     params.group_by = group_by;
     if let Some(draws) = encoder_draws {
         params.encoder_draws = draws;

@@ -119,6 +119,10 @@ def test_bad_options(sim_dir, tmp_path):
         neurotex.reproduce(tmp_path / "a", seeds=1001)
     with pytest.raises(ParameterError, match="k"):
         neurotex.reproduce(tmp_path / "a", dataset=sim_dir, k=0)
+    with pytest.raises(ParameterError, match="folds"):
+        neurotex.reproduce(tmp_path / "a", dataset=sim_dir, folds=1)
+    with pytest.raises(ParameterError, match="repeats"):
+        neurotex.reproduce(tmp_path / "a", dataset=sim_dir, repeats=0)
     with pytest.raises(ParameterError, match="encoder draws must be between 1 and 100"):
         neurotex.reproduce(tmp_path / "a", dataset=sim_dir, encoder_draws=0)
     with pytest.raises(ParameterError, match="levels"):

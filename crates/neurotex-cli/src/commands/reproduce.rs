@@ -46,6 +46,13 @@ pub struct ReproduceArgs {
     /// Neighbours in KNN.
     #[arg(long, default_value_t = neurotex::classify::KnnParams::default().k)]
     pub k: usize,
+    /// Cross-validation folds of every analysis (stratified, shuffled) [default: 5]. A small
+    /// pilot needs fewer: each class needs at least this many recordings at each speed.
+    #[arg(long)]
+    pub folds: Option<usize>,
+    /// Cross-validation repeats with different shuffles [default: 10, or 2 with --quick].
+    #[arg(long)]
+    pub repeats: Option<usize>,
     /// Every cross-validation of the analyses keeps each group of this manifest column in
     /// one fold (`trial` for repeats of one run, or a session or subject column); with fewer
     /// groups than folds at a speed, each group is held out in turn.
@@ -86,6 +93,8 @@ impl ReproduceArgs {
         params.knn = self.stages.knn(self.k)?;
         params.seed = self.seed;
         params.cv.seed = self.seed;
+        params.cv.folds = self.folds.unwrap_or(params.cv.folds);
+        params.cv.repeats = self.repeats.unwrap_or(params.cv.repeats);
         params.group_by = self.group_by.clone();
         params.encoder_draws = usize::try_from(self.encoder_draws)?;
         Ok(params)

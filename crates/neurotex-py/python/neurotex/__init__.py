@@ -815,6 +815,8 @@ def reproduce(
     seeds: Optional[int] = None,
     k: int = 5,
     standardize: bool = True,
+    folds: Optional[int] = None,
+    repeats: Optional[int] = None,
     group_by: Optional[str] = None,
     encoder_draws: Optional[int] = None,
     **stage_options: Any,
@@ -832,7 +834,10 @@ def reproduce(
     (default 5, or 1 with ``quick``); ``dataset`` names a dataset folder instead, whose
     manifest must give each recording's speed. ``quick``: fewer CV repeats, perturbation
     counts, fractions and gains (the CI run). ``seed`` also seeds the CV shuffles and the
-    perturbations. ``k``, ``standardize``: the KNN. ``group_by``: keep each group of this
+    perturbations. ``k``, ``standardize``: the KNN. ``folds``, ``repeats``: every
+    cross-validation's folds (default 5; a small pilot needs fewer, as each class needs
+    that many recordings at each speed) and shuffles (default 10, or 2 with ``quick``).
+    ``group_by``: keep each group of this
     manifest column in one fold. ``encoder_draws``: encodings of every recording behind
     the accuracies of E1, E4, E6 and E8 (as run, then with independent rounding-level
     input perturbations; their intervals resample encodings as well as recordings;
@@ -848,8 +853,8 @@ def reproduce(
     opts = _stage_options(**stage_options)
     given = {"dataset": None if dataset is None else os.fspath(dataset), "quick": quick,
              "seed": seed, "trials": trials, "seeds": seeds, "k": k,
-             "standardize": standardize, "group_by": group_by,
-             "encoder_draws": encoder_draws}
+             "standardize": standardize, "folds": folds, "repeats": repeats,
+             "group_by": group_by, "encoder_draws": encoder_draws}
     defaults = {"quick": False, "seed": 0, "k": 5, "standardize": True}
     shown = [repr(out)] + [f"{key}={v!r}" for key, v in given.items()
                            if v is not None and defaults.get(key) != v]
@@ -859,7 +864,8 @@ def reproduce(
         out, opts, given["dataset"], bool(quick), int(seed),
         None if trials is None else int(trials), None if seeds is None else int(seeds),
         int(k), bool(standardize), group_by,
-        None if encoder_draws is None else int(encoder_draws), command)
+        None if encoder_draws is None else int(encoder_draws), command,
+        None if folds is None else int(folds), None if repeats is None else int(repeats))
     claims = [dict(c, holds=c["verdict"] in _HOLDS) for c in claims]
     headline = {float(speed): {key: e[key] for key in _HEADLINE}
                 for speed, e in results.get("e1", {}).items()}

@@ -59,7 +59,10 @@ def reproduce(
     k: int = 5,
     standardize: bool = True,
     group_by: Optional[str] = None,
+    encoder_draws: Optional[int] = None,
     command: str = "",
+    folds: Optional[int] = None,
+    repeats: Optional[int] = None,
 ) -> Tuple[Dict[str, Any], List[Dict[str, Any]], List[PredictionRow], float]: ...
 def spike_stats(spikes: npt.NDArray[np.uint8], bin_ms: int = 200) -> npt.NDArray[np.float64]: ...
 def rate_volume(
