@@ -233,15 +233,40 @@ fn a_twelve_recording_pilot_runs_with_fewer_folds_and_the_error_says_how() {
     // 3 classes x 2 speeds x 2 trials: two recordings per class at each speed.
     let ds = dir.dataset("pilot", &["A", "B", "C"], &[5.0, 10.0], 2);
     let out = dir.join("report");
-    let base = ["reproduce", "--dataset", s(&ds), "--out", s(&out), "--quick"];
+    let base = [
+        "reproduce",
+        "--dataset",
+        s(&ds),
+        "--out",
+        s(&out),
+        "--quick",
+    ];
     let err = dir.fails(&base);
-    assert!(err.contains("fewer than the 5 folds") && err.contains("hint: --folds"), "{err}");
+    assert!(
+        err.contains("fewer than the 5 folds") && err.contains("hint: --folds"),
+        "{err}"
+    );
     let err = dir.fails(&[&base[..], &["--folds", "2"]].concat());
-    assert!(err.contains("neighbours") && err.contains("hint: --k"), "{err}");
-    dir.ok(&[&base[..], &["--folds", "2", "--k", "1", "--repeats", "1"]].concat());
+    assert!(
+        err.contains("neighbours") && err.contains("hint: --k"),
+        "{err}"
+    );
+    let run = dir.run(&[&base[..], &["--folds", "2", "--k", "1", "--repeats", "1"]].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    // Standard error is not a terminal here: every analysis is said as it ends.
+    for said in [
+        "recordings (12 steps)",
+        "done: e1, accuracy at each speed",
+        "done: e9",
+    ] {
+        assert!(run.stderr.contains(said), "{said}: {}", run.stderr);
+    }
     let json: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
     assert!(json["e1"]["5"]["glcm3d"].as_f64().is_some());
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(report.contains("2-fold"), "the report states the folds used");
+    assert!(
+        report.contains("2-fold"),
+        "the report states the folds used"
+    );
 }

@@ -151,15 +151,27 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
     Ok(())
 }
 
-/// Moves the progress bar on one event of the analyses.
+/// Moves the progress bar on one event of the analyses; where no bar is drawn (standard
+/// error is not a terminal: a log file, a pipe), says each stage on a line of its own with
+/// the time since the start, so a long run is never silent.
 fn show_progress(bar: &ProgressBar, event: Progress) {
     match event {
         Progress::Stage(name, n) => {
+            if bar.is_hidden() {
+                eprintln!("[{:7.1} s] {name} ({n} steps)", bar.elapsed().as_secs_f64());
+            }
             bar.set_length(n as u64);
             bar.set_position(0);
             bar.set_message(name.to_string());
         }
         Progress::Tick => bar.inc(1),
+        Progress::Done(id, asks) => {
+            bar.inc(1);
+            if bar.is_hidden() {
+                let t = bar.elapsed().as_secs_f64();
+                eprintln!("[{t:7.1} s]   done: {id}, {asks}");
+            }
+        }
     }
 }
 

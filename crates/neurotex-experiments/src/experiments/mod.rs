@@ -75,6 +75,8 @@ pub enum Progress<'a> {
     Stage(&'a str, usize),
     /// One step of the current stage is done.
     Tick,
+    /// One step of the current stage is done: the named analysis (id, what it asks) ended.
+    Done(&'a str, &'a str),
 }
 
 /// What every analysis reads: the prepared recordings, their tables and the parameters.
@@ -232,6 +234,8 @@ fn headline_predictions(tables: &Tables) -> Vec<HeadlinePrediction> {
 pub struct Analysis {
     /// `e0` .. `e8`.
     pub id: &'static str,
+    /// What it asks, in a few words, for progress and logs.
+    pub asks: &'static str,
     /// Runs the analysis and stores its result.
     pub run: fn(&Context, &mut Results) -> Result<(), Stop>,
 }
@@ -242,6 +246,7 @@ pub struct Analysis {
 pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e1",
+        asks: "accuracy at each speed",
         run: |c, r| {
             r.e1 = e1_accuracy(c)?;
             Ok(())
@@ -249,6 +254,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e2",
+        asks: "which classes are confused",
         run: |c, r| {
             r.e2 = Some(e2_confusion(c)?);
             Ok(())
@@ -256,6 +262,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e3",
+        asks: "spatial perturbation: taxels moved",
         run: |c, r| {
             r.e3 = Some(e3_perturbation(c)?);
             Ok(())
@@ -263,6 +270,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e4",
+        asks: "temporal information: 2D against 3D",
         run: |c, r| {
             r.e4 = e4_temporal(c)?;
             Ok(())
@@ -270,6 +278,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e5",
+        asks: "time to recognition (offline)",
         run: |c, r| {
             r.e5 = e5_time_to_recognition(c)?;
             Ok(())
@@ -277,6 +286,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e5c",
+        asks: "time to recognition (causal, online)",
         run: |c, r| {
             let (e5c, skipped) = e5_causal(c, &r.e5)?;
             skipped.iter().for_each(|s| r.skip(s));
@@ -286,6 +296,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e6",
+        asks: "speed invariance: a speed held out",
         run: |c, r| {
             r.e6 = e6_speed_invariance(c)?;
             Ok(())
@@ -293,6 +304,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e7",
+        asks: "the encoder's gain and intervals between spikes",
         run: |c, r| {
             if c.params.e7 {
                 r.e7 = Some(e7_gain_sweep(c)?);
@@ -302,6 +314,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e8",
+        asks: "the number of neighbours",
         run: |c, r| {
             let (e8, skipped) = e8_neighbours(c)?;
             skipped.iter().for_each(|s| r.skip(s));
@@ -311,6 +324,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "encoder sensitivity",
+        asks: "the encoder's sensitivity to rounding",
         run: |c, r| {
             r.encoder_sensitivity = encoder_sensitivity(c)?;
             Ok(())
@@ -318,6 +332,7 @@ pub const ANALYSES: [Analysis; 11] = [
     },
     Analysis {
         id: "e0",
+        asks: "example spike trains and volumes",
         run: |c, r| {
             r.e0 = Some(e0_psth(c)?);
             Ok(())
@@ -358,7 +373,7 @@ pub fn run_all(
         } else {
             Ok(None)
         };
-        progress(Progress::Tick);
+        progress(Progress::Done("e9", "the standard candidates compared"));
         (e9, clock.elapsed().as_secs_f64())
     };
     let (ordered, (e9, e9_seconds)) =
@@ -394,7 +409,10 @@ fn run_ordered(
     results
         .timing_s
         .insert("tables".into(), clock.elapsed().as_secs_f64());
-    progress(Progress::Tick);
+    progress(Progress::Done(
+        "tables",
+        "feature tables and headline evaluations",
+    ));
     let context = Context {
         prepared,
         tables: &tables,
@@ -410,7 +428,7 @@ fn run_ordered(
         }
         let seconds = clock.elapsed().as_secs_f64();
         results.timing_s.insert(analysis.id.into(), seconds);
-        progress(Progress::Tick);
+        progress(Progress::Done(analysis.id, analysis.asks));
         before_e9 &= analysis.id != "e8";
     }
     Ok(())
