@@ -101,25 +101,15 @@ fn main() -> ExitCode {
 }
 
 /// What to change when a dataset is too small for the folds or neighbours asked for.
-fn hint(err: &anyhow::Error) -> Option<&'static str> {
+fn hint(err: &anyhow::Error) -> Option<String> {
     use neurotex::error::ClassifyError;
-    let classify = |e: &ClassifyError| {
-        match e {
-        ClassifyError::ClassTooSmall { .. } => Some(
-            "--folds sets the cross-validation folds (evaluate, compare, reproduce): each class needs at least that many recordings (at each speed for reproduce); --folds 2 suits a small pilot",
-        ),
-        ClassifyError::KTooLarge { .. } => Some(
-            "--k sets the neighbours of KNN: a training fold must hold at least that many recordings; fewer neighbours or more folds (each trains on more) fit a small dataset",
-        ),
-        _ => None,
-    }
-    };
+    let option = |name: &str, value: &str| format!("--{name} {value}");
     err.chain().find_map(|e| {
         if let Some(c) = e.downcast_ref::<ClassifyError>() {
-            return classify(c);
+            return c.hint(&option);
         }
         match e.downcast_ref::<neurotex::Error>()? {
-            neurotex::Error::Classify(c) => classify(c),
+            neurotex::Error::Classify(c) => c.hint(&option),
             _ => None,
         }
     })

@@ -215,6 +215,26 @@ pub enum ClassifyError {
     BadFeatures(String),
 }
 
+impl ClassifyError {
+    /// What to change when the data is too small for the folds or neighbours asked for,
+    /// the options spelled by `option(name, value)` (`--folds 2` on the command line,
+    /// `folds=2` in Python); `None` for the other errors.
+    pub fn hint(&self, option: &dyn Fn(&str, &str) -> String) -> Option<String> {
+        let pilot = format!("{} {}", option("folds", "2"), option("k", "1"));
+        match self {
+            ClassifyError::ClassTooSmall { .. } => Some(format!(
+                "{} sets the cross-validation folds: each class needs at least that many recordings (in reproduce, at each speed); a small pilot runs with {pilot}",
+                option("folds", "N")
+            )),
+            ClassifyError::KTooLarge { .. } => Some(format!(
+                "{} sets the neighbours of KNN: each training fold must hold at least that many recordings (in reproduce, at each speed); a small pilot runs with {pilot}",
+                option("k", "N")
+            )),
+            _ => None,
+        }
+    }
+}
+
 /// A dataset that cannot serve what was asked of it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DatasetError {

@@ -220,6 +220,14 @@ where
     })
 }
 
+/// Parses a name from a fixed set with its type's `FromStr`; the error is the rule and the
+/// value (the front end names the option).
+fn choice<T: std::str::FromStr<Err = ParamError>>(text: &str) -> Result<T, String> {
+    text.trim()
+        .parse()
+        .map_err(|e: ParamError| format!("{}, got {}", e.rule, e.got))
+}
+
 /// `on` or `off` as a flag's text: `true`/`false`.
 fn flag(text: &str) -> Result<bool, String> {
     match text.trim() {
@@ -283,7 +291,9 @@ pub static STAGE_OPTIONS: &[OptionSpec] = &[
     spec!(
         preset,
         Text,
-        "Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ."
+        "Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ.",
+        get: shown,
+        set: choice
     ),
     spec!(
         cutoff,
@@ -294,7 +304,7 @@ pub static STAGE_OPTIONS: &[OptionSpec] = &[
         "Baseline removal: `none`, or `min` (each taxel's minimum). Default: the dataset's \
          layout.toml.",
         get: |b: &Option<Baseline>| b.map(|b| b.to_string()),
-        set: |t: &str| parse(t).map(Some)),
+        set: |t: &str| choice(t).map(Some)),
     spec!(whole, Flag, "Use the whole recording instead of only its sliding phase.",
         get: shown, set: flag),
     spec!(levels, Count, "Gray levels for GLCM quantisation."),
@@ -308,7 +318,9 @@ pub static STAGE_OPTIONS: &[OptionSpec] = &[
         Text,
         "Mechanoreceptor populations: `sa` (slowly adapting, driven by the signal; the \
          paper's), `fa` (fast adapting, driven by its rectified rate of change) or `sa+fa` \
-         (both, each with its own features, names prefixed `sa_` and `fa_`)."
+         (both, each with its own features, names prefixed `sa_` and `fa_`).",
+        get: shown,
+        set: choice
     ),
     spec!(
         fa_gain,
@@ -320,7 +332,9 @@ pub static STAGE_OPTIONS: &[OptionSpec] = &[
         haralick,
         Text,
         "Haralick features of the GLCM methods: `paper` (contrast, correlation, ASM) or \
-         `full` (the 13 of Haralick 1973, as mahotas defines them)."
+         `full` (the 13 of Haralick 1973, as mahotas defines them).",
+        get: shown,
+        set: choice
     ),
     spec!(bin_widths, Counts,
         "Rate-volume bin widths in ms of the `glcm3d-multi` method, comma-separated.",

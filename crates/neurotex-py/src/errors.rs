@@ -84,7 +84,14 @@ pub fn to_py(error: neurotex::Error) -> PyErr {
     if out_of_memory(&error) {
         return pyo3::exceptions::PyMemoryError::new_err(error.to_string());
     }
-    raise(kind_of(&error), error.to_string())
+    let hint = match &error {
+        neurotex::Error::Classify(c) => c.hint(&|name, value| format!("{name}={value}")),
+        _ => None,
+    };
+    match hint {
+        Some(hint) => raise(kind_of(&error), format!("{error}\nhint: {hint}")),
+        None => raise(kind_of(&error), error.to_string()),
+    }
 }
 
 /// Memory the input asked for and the machine does not have: Python's `MemoryError`,

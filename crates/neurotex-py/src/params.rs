@@ -75,7 +75,21 @@ fn option_text(spec: &OptionSpec, value: &Bound<'_, PyAny>) -> PyResult<String> 
             },
         },
     };
-    text.map_err(|e| invalid(spec.name, e))
+    text.map_err(|e| {
+        // A negative whole number is a value out of range, not a type to convert.
+        let negative = match spec.kind {
+            OptionKind::Count => value.extract::<i64>().ok().map(|i| i.to_string()),
+            OptionKind::Counts => value.extract::<Vec<i64>>().ok().map(|v| format!("{v:?}")),
+            _ => None,
+        };
+        match negative {
+            Some(got) => invalid(
+                spec.name,
+                format!("expected whole numbers of at least 0, got {got}"),
+            ),
+            None => invalid(spec.name, e),
+        }
+    })
 }
 
 /// The stage options of [`STAGE_OPTIONS`] by their names (the paper's defaults for the

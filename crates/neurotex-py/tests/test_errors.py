@@ -32,6 +32,9 @@ def test_bad_samples(x, exc, match):
     ({"levels": 1}, "levels"),
     ({"levels": 300}, "levels"),
     ({"bin_ms": 0}, "bin_ms"),
+    ({"bin_ms": -5}, "bin_ms`: expected whole numbers of at least 0, got -5"),
+    ({"baseline": "max"}, "^invalid parameter `baseline`: a baseline is"),
+    ({"encoding": "xa"}, "^invalid parameter `encoding`: (?!.*invalid parameter).*got xa$"),
     ({"distances": ()}, "distances"),
     ({"distances": (0,)}, "distances"),
     ({"cutoff": -5.0}, "cutoff"),
@@ -114,6 +117,9 @@ def test_classifiers():
     with pytest.raises(errors.ClassifyError, match="k = 9 neighbours"):
         neurotex.cross_validate(X, y, "knn", k=9, folds=2)
     with pytest.raises(errors.ClassifyError, match="class `b` has 2 samples, fewer than the 5"):
+        neurotex.cross_validate(np.random.default_rng(0).random((12, 3)), ["a"] * 10 + ["b"] * 2)
+    # the hint names the keyword as Python spells it
+    with pytest.raises(errors.ClassifyError, match="hint: folds=N sets the cross-validation"):
         neurotex.cross_validate(np.random.default_rng(0).random((12, 3)), ["a"] * 10 + ["b"] * 2)
     with pytest.raises(errors.ParameterError, match="classifier"):
         neurotex.cross_validate(X, y, "svm")
