@@ -23,11 +23,15 @@ fn flag(spec: &'static OptionSpec) -> Arg {
     let arg = Arg::new(spec.name)
         .long(spec.flag())
         .help(spec.help.trim_end_matches('.'));
-    if spec.kind == OptionKind::Flag {
-        return arg.action(ArgAction::SetTrue);
-    }
+    let action = match spec.kind {
+        OptionKind::Flag => return arg.action(ArgAction::SetTrue),
+        // `--distances 1 --distances 2,4` is `1,2,4`.
+        OptionKind::Counts => ArgAction::Append,
+        _ => ArgAction::Set,
+    };
     let arg = arg
         .value_name(spec.name.to_uppercase())
+        .action(action)
         .allow_negative_numbers(true)
         .value_parser(move |text: &str| {
             (spec.set)(&mut StageOptions::default(), text).map(|()| text.to_string())
@@ -47,7 +51,7 @@ impl Args for StageArgs {
                 Arg::new("no_standardize")
                     .long("no-standardize")
                     .action(ArgAction::SetTrue)
-                    .help("Do not z-score features with training-fold statistics before KNN."),
+                    .help("Do not z-score features with training-fold statistics before KNN"),
             )
     }
 
@@ -67,6 +71,9 @@ impl FromArgMatches for StageArgs {
         for spec in STAGE_OPTIONS {
             let text = match spec.kind {
                 OptionKind::Flag => matches.get_flag(spec.name).then(|| "true".to_string()),
+                OptionKind::Counts => matches
+                    .get_many::<String>(spec.name)
+                    .map(|v| v.cloned().collect::<Vec<_>>().join(",")),
                 _ => matches.get_one::<String>(spec.name).cloned(),
             };
             if let Some(text) = text {
@@ -101,5 +108,43 @@ impl StageArgs {
         };
         knn.check()?;
         Ok(knn)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        stages: StageArgs,
+    }
+
+    #[test]
+    fn flags_read_into_the_librarys_options_with_its_defaults() {
+        let none = Cli::try_parse_from(["neurotex"]).unwrap();
+        assert_eq!(none.stages.options, StageOptions::default());
+        let args = [
+            "neurotex",
+            "--distances",
+            "1",
+            "--distances",
+            "2,4",
+            "--bin-ms",
+            "100",
+            "--symmetric",
+            "--gain",
+            "auto:15",
+            "--cutoff",
+            "-0",
+        ];
+        let o = Cli::try_parse_from(args).unwrap().stages.options;
+        assert_eq!(o.distances, [1, 2, 4]);
+        assert_eq!((o.bin_ms, o.symmetric), (100, true));
+        assert_eq!(o.gain.to_string(), "auto:15");
+        assert!(Cli::try_parse_from(["neurotex", "--bin-ms", "-1"]).is_err());
+        assert!(Cli::try_parse_from(["neurotex", "--levels", "8", "--levels", "9"]).is_err());
     }
 }
