@@ -94,10 +94,7 @@ impl StageArgs {
 
     /// The target rate of `--gain auto`, or `None` for a fixed gain.
     pub fn gain_target(&self) -> Option<f64> {
-        match self.options.gain {
-            neurotex::calibrate::GainChoice::Auto { target_hz } => Some(target_hz),
-            neurotex::calibrate::GainChoice::Fixed(_) => None,
-        }
+        self.options.gain.target_hz()
     }
 
     /// KNN parameters with `k` neighbours, checked.

@@ -64,6 +64,16 @@ impl Default for GainChoice {
     }
 }
 
+impl GainChoice {
+    /// The target rate of `auto`, or `None` for a gain given as a number.
+    pub fn target_hz(self) -> Option<f64> {
+        match self {
+            GainChoice::Auto { target_hz } => Some(target_hz),
+            GainChoice::Fixed(_) => None,
+        }
+    }
+}
+
 impl std::fmt::Display for GainChoice {
     /// As it is typed: `8`, `auto:20`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

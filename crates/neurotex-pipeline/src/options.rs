@@ -140,10 +140,7 @@ pub struct CheckedStages {
 impl CheckedStages {
     /// The target rate of an `auto` gain, or `None` for a gain given as a number.
     pub fn gain_target(&self) -> Option<f64> {
-        match self.gain {
-            GainChoice::Auto { target_hz } => Some(target_hz),
-            GainChoice::Fixed(_) => None,
-        }
+        self.gain.target_hz()
     }
 }
 
