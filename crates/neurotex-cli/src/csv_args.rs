@@ -1,9 +1,14 @@
-//! How to read CSV logs: the options `import csv` and `encode` share, parsed into the
-//! library's [`CsvFormat`] so both read a log the same way.
+//! How to read recording files and CSV logs: the options `import csv`, `encode` and
+//! `predict` share, turned into the library's [`FileReading`] and [`CsvOverrides`] so every
+//! command reads a log the same way.
 
+use std::path::PathBuf;
+
+use anyhow::Result;
 use clap::Args;
-use neurotex::csvlog::{ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps};
-use neurotex::recording::TimeUnit;
+use neurotex::csvlog::{ChannelSelect, Column, CsvOverrides, Delimiter, DuplicateStamps};
+use neurotex::recording::{FileReading, LayoutFile, LayoutFrom, TimeUnit};
+use neurotex::{Grid, SampleRate};
 
 /// CSV reading options.
 #[derive(Args, Debug, Clone)]
@@ -41,32 +46,71 @@ pub struct CsvArgs {
 }
 
 impl CsvArgs {
-    /// `base` with every option given on the command line put in place of its setting.
-    pub fn apply(&self, mut base: CsvFormat) -> CsvFormat {
-        if self.no_header {
-            base.header = false;
-            base.detect_time = false;
+    /// The options given, for the library to put in place of a layout's settings.
+    pub fn overrides(&self) -> CsvOverrides {
+        CsvOverrides {
+            no_header: self.no_header,
+            delimiter: self.delimiter,
+            time_column: self.time_column.clone(),
+            time_unit: self.time_unit,
+            channels: self.channels.clone(),
+            duplicate_stamps: self.duplicate_stamps,
+            max_gap_s: self.max_gap_s,
         }
-        if let Some(d) = self.delimiter {
-            base.delimiter = Some(d);
+    }
+}
+
+/// How a command reads recording files given by path: their layout, rate, grid and CSV
+/// columns. The same options on `encode` and `predict`.
+#[derive(Args, Debug, Clone)]
+pub struct ReadArgs {
+    /// A `layout.toml` giving grid, channel map, mask, rate, baseline or CSV columns for
+    /// the files (default: the `layout.toml` beside each file, else the one a model
+    /// remembers from its training dataset, else the defaults). An imported dataset's
+    /// layout also reads the raw logs it was imported from.
+    #[arg(long)]
+    pub layout: Option<PathBuf>,
+    /// Sampling rate in Hz (default: the layout's, else 1000; ignored when a CSV file has
+    /// a time column: its stamps give the rate).
+    #[arg(long, allow_negative_numbers = true)]
+    pub fs: Option<SampleRate>,
+    /// Grid `ROWSxCOLS` to place the channels on, row-major (replaces the layout's grid,
+    /// channel map and mask).
+    #[arg(long)]
+    pub grid: Option<Grid>,
+    #[command(flatten)]
+    pub csv: CsvArgs,
+}
+
+impl ReadArgs {
+    /// The library's reading options; the layout file is read here.
+    pub fn reading(&self) -> Result<FileReading> {
+        Ok(FileReading {
+            layout: self.layout.as_deref().map(LayoutFile::read).transpose()?,
+            fs: self.fs.map(SampleRate::hz),
+            grid: self.grid.as_ref().map(|g| (g.rows(), g.cols())),
+            csv: self.csv.overrides(),
+        })
+    }
+
+    /// Says on standard error where a layout came from when neither given nor the
+    /// defaults: once per distinct source.
+    pub fn say_layouts(&self, from: &[LayoutFrom]) {
+        let mut said: Vec<&LayoutFrom> = Vec::new();
+        for f in from {
+            if said.contains(&f) {
+                continue;
+            }
+            said.push(f);
+            match f {
+                LayoutFrom::Beside(path) => {
+                    eprintln!("note: reading the layout beside the recording, {}", path.display())
+                }
+                LayoutFrom::Remembered => eprintln!(
+                    "note: reading with the layout of the model's training dataset (rate, grid, CSV columns)"
+                ),
+                LayoutFrom::Given | LayoutFrom::Default => {}
+            }
         }
-        if let Some(col) = &self.time_column {
-            base.time_column = Some(col.clone());
-            base.detect_time = false;
-        }
-        if let Some(unit) = self.time_unit {
-            base.time_unit = unit;
-            base.unit_given = true;
-        }
-        if let Some(channels) = &self.channels {
-            base.channels = channels.clone();
-        }
-        if let Some(policy) = self.duplicate_stamps {
-            base.duplicate_stamps = policy;
-        }
-        if let Some(gap) = self.max_gap_s {
-            base.max_gap_s = gap;
-        }
-        base
     }
 }

@@ -13,6 +13,7 @@ mod features;
 mod hostile;
 mod import;
 mod model;
+mod raw_logs;
 mod reproduce;
 mod simulate;
 mod stream;

@@ -14,7 +14,7 @@ use ndarray_npy::ReadNpyExt;
 use rayon::prelude::*;
 
 pub use crate::csvlog::ChannelSelect;
-use crate::csvlog::{read_csv_log, CsvFormat, CsvLog};
+use crate::csvlog::{read_csv_log, CsvFormat, CsvLog, LogColumns};
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
     create_dataset_dir, labels_merged_by_trimming, write_layout, write_manifest, Baseline,
@@ -347,7 +347,7 @@ pub fn import_csv(
         None => nominal_fs(&good, out)?,
     };
     let unit = first.log.times.is_some().then_some(first.log.time_unit);
-    let layout = csv_layout(p, &names, fs, unit)?;
+    let layout = csv_layout(p, &names, fs, unit, &first.log.columns)?;
     create_dataset_dir(out, |tmp| {
         write_layout(tmp, &layout)?;
         // validates the layout before anything else is written
@@ -436,12 +436,14 @@ fn nominal_fs(good: &[ParsedCsv], out: &Path) -> Result<f64> {
 }
 
 /// The layout of the imported dataset: channels fill the grid row-major unless mapped, and
-/// cells no channel reaches are masked; `unit` is the logs' time unit when they have stamps.
+/// cells no channel reaches are masked; `unit` is the logs' time unit when they have stamps,
+/// `source` how they were read.
 fn csv_layout(
     p: &CsvImportParams,
     names: &[String],
     fs: f64,
     unit: Option<TimeUnit>,
+    source: &LogColumns,
 ) -> Result<LayoutFile> {
     let timed = unit.is_some();
     let n = names.len();
@@ -485,6 +487,7 @@ fn csv_layout(
         channels: Some(names.to_vec()),
         max_gap_s: (timed && p.format.max_gap_s != crate::csvlog::DEFAULT_MAX_GAP_S)
             .then_some(p.format.max_gap_s),
+        source: Some(source.clone()),
         ..LayoutFile::default()
     })
 }

@@ -17,7 +17,8 @@ use ndarray_npy::ReadNpyExt;
 use serde::{Deserialize, Serialize};
 
 use crate::csvlog::{
-    csv_error, read_csv_log, ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps,
+    choose_format, csv_error, read_csv_log, CsvFormat, CsvOverrides, Delimiter, DuplicateStamps,
+    LogColumns,
 };
 pub use crate::error::DatasetError;
 use crate::error::{DataError, ParamError, Result};
@@ -302,6 +303,11 @@ pub struct LayoutFile {
     /// CSV recordings: rows sharing a time stamp (default `average`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub duplicate_stamps: Option<DuplicateStamps>,
+    /// How the raw logs an imported dataset came from were read (`import csv` writes it):
+    /// a CSV file outside the dataset whose columns are not the dataset's is read this
+    /// way, so a raw log of the same logger needs no options.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<LogColumns>,
 }
 
 /// The longest recording accepted unless `layout.toml` sets `max_duration_s`: one hour.
@@ -332,47 +338,39 @@ impl LayoutFile {
     /// # Errors
     /// Without a header row, a time column or channel that is not an index.
     pub fn csv_format(&self) -> Result<CsvFormat, ParamError> {
-        let header = self.header.unwrap_or(true);
-        let column = |text: &str| -> Result<Column, ParamError> {
-            let col: Column = text.parse()?;
-            match col {
-                Column::Name(_) if !header => Err(ParamError::new(
-                    "layout.toml",
-                    "without a header row (header = false) columns are 0-based indices",
-                    text,
-                )),
-                col => Ok(col),
-            }
-        };
-        let channels = match &self.channels {
-            None => ChannelSelect::All,
-            Some(names) if header => ChannelSelect::Names(names.clone()),
-            Some(names) => ChannelSelect::Indices(
-                names
-                    .iter()
-                    .map(|n| match column(n)? {
-                        Column::Index(i) => Ok(i),
-                        Column::Name(_) => unreachable!("names are refused above"),
-                    })
-                    .collect::<Result<_, _>>()?,
-            ),
-        };
-        Ok(CsvFormat {
-            header,
+        self.own_columns().csv_format(self.max_gap_s)
+    }
+
+    /// The formats a CSV file read with this layout may be in, by preference: the layout's
+    /// own (its dataset's files), then its `[source]` (the raw logs they were imported
+    /// from), each with `overrides` applied; only the overridden own format when the
+    /// overrides say where the columns are.
+    ///
+    /// # Errors
+    /// As [`LayoutFile::csv_format`].
+    pub fn csv_formats(&self, overrides: &CsvOverrides) -> Result<Vec<CsvFormat>, ParamError> {
+        let mut formats = vec![overrides.apply(self.csv_format()?)];
+        if let Some(source) = self.source.as_ref().filter(|_| !overrides.place_columns()) {
+            formats.push(overrides.apply(source.csv_format(self.max_gap_s)?));
+        }
+        Ok(formats)
+    }
+
+    /// The layout's own CSV fields.
+    fn own_columns(&self) -> LogColumns {
+        LogColumns {
+            header: self.header,
             delimiter: self.delimiter,
-            time_column: self.time_column.as_deref().map(column).transpose()?,
-            time_unit: self.time_unit.unwrap_or_default(),
-            unit_given: self.time_unit.is_some(),
-            detect_time: header && self.time_column.is_none(),
-            channels,
-            duplicate_stamps: self.duplicate_stamps.unwrap_or_default(),
-            max_gap_s: self.max_gap_s.unwrap_or(crate::csvlog::DEFAULT_MAX_GAP_S),
-        })
+            time_column: self.time_column.clone(),
+            time_unit: self.time_unit,
+            channels: self.channels.clone(),
+            duplicate_stamps: self.duplicate_stamps,
+        }
     }
 
     fn check(&self, path: &Path) -> Result<()> {
         let bad = |m: String| -> Result<()> { Err(DataError::invalid(path, m).into()) };
-        if let Err(e) = self.csv_format() {
+        if let Err(e) = self.csv_formats(&CsvOverrides::default()) {
             return bad(e.to_string());
         }
         if let Some(fs) = self.fs {
@@ -1087,6 +1085,103 @@ pub fn read_recording(path: &Path, layout: &LayoutFile) -> Result<Recording> {
         .csv_format()
         .map_err(|e| DataError::invalid(path, e.to_string()))?;
     read_recording_as(path, layout, &format)
+}
+
+/// Where the layout a recording file was read with came from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LayoutFrom {
+    /// The caller's (`--layout FILE`).
+    Given,
+    /// The `layout.toml` beside the file, at this path.
+    Beside(PathBuf),
+    /// The one remembered with a model: its training dataset's.
+    Remembered,
+    /// None: the defaults.
+    Default,
+}
+
+/// How a recording file given by path (not through a dataset's manifest) is read: the
+/// options `encode`, `predict` and `stream` take alike. Its layout is the given one, else
+/// the `layout.toml` beside the file, else one remembered (a model's training dataset's),
+/// else the defaults; `fs` and `grid` then replace the layout's, and a CSV file is read in
+/// the first of the layout's formats that fits it ([`LayoutFile::csv_formats`]) with the
+/// CSV overrides applied.
+#[derive(Debug, Clone, Default)]
+pub struct FileReading {
+    /// A layout given for every file.
+    pub layout: Option<LayoutFile>,
+    /// Sampling rate in Hz, in place of the layout's.
+    pub fs: Option<f64>,
+    /// Grid `(rows, cols)`, channels row-major: replaces the layout's grid, map and mask.
+    pub grid: Option<(usize, usize)>,
+    /// CSV reading options, in place of the layout's.
+    pub csv: CsvOverrides,
+}
+
+impl FileReading {
+    /// The layout for `file` and where it came from (see [`FileReading`]).
+    ///
+    /// # Errors
+    /// A `layout.toml` beside the file that cannot be read.
+    pub fn layout_for(
+        &self,
+        file: &Path,
+        remembered: Option<&LayoutFile>,
+    ) -> Result<(LayoutFile, LayoutFrom)> {
+        let beside = file
+            .parent()
+            .map(|dir| dir.join("layout.toml"))
+            .filter(|p| p.is_file());
+        let (mut layout, from) = match (&self.layout, beside, remembered) {
+            (Some(given), _, _) => (given.clone(), LayoutFrom::Given),
+            (None, Some(path), _) => (LayoutFile::read(&path)?, LayoutFrom::Beside(path)),
+            (None, None, Some(model)) => (model.clone(), LayoutFrom::Remembered),
+            (None, None, None) => (LayoutFile::default(), LayoutFrom::Default),
+        };
+        if let Some(fs) = self.fs {
+            layout.fs = Some(fs);
+        }
+        if let Some((rows, cols)) = self.grid {
+            layout.rows = Some(rows);
+            layout.cols = Some(cols);
+            layout.channel_map = None;
+            layout.mask = None;
+        }
+        Ok((layout, from))
+    }
+
+    /// The CSV format to read `file` with under `layout`: the first of its formats whose
+    /// columns the file has ([`LayoutFile::csv_formats`]).
+    ///
+    /// # Errors
+    /// A layout whose CSV fields are broken, or a file that fits none of its formats.
+    pub fn csv_format(&self, file: &Path, layout: &LayoutFile) -> Result<CsvFormat> {
+        let mut formats = layout
+            .csv_formats(&self.csv)
+            .map_err(|e| DataError::invalid(file, e.to_string()))?;
+        let is_csv = file
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+        match is_csv {
+            true => choose_format(file, &formats, &|_| Ok(())),
+            false => Ok(formats.swap_remove(0)),
+        }
+    }
+
+    /// Reads `file` (see [`FileReading`]), saying where its layout came from.
+    ///
+    /// # Errors
+    /// As [`FileReading::layout_for`], [`FileReading::csv_format`] and
+    /// [`read_recording_as`].
+    pub fn read(
+        &self,
+        file: &Path,
+        remembered: Option<&LayoutFile>,
+    ) -> Result<(Recording, LayoutFrom)> {
+        let (layout, from) = self.layout_for(file, remembered)?;
+        let format = self.csv_format(file, &layout)?;
+        Ok((read_recording_as(file, &layout, &format)?, from))
+    }
 }
 
 /// Reads one recording file (`.npy` or `.csv`) with the layout's grid, map, mask and rate,

@@ -25,7 +25,7 @@ use crate::classify::{ChosenModel, Classifier, ClassifierChoice, ConfusionMatrix
 use crate::error::{ClassifyError, DataError, ParamError, Result};
 pub use crate::error::{ModelError, MODEL_FORMAT as FORMAT, MODEL_VERSION as VERSION};
 use crate::pipeline::{Encoded, FeatureExtractor, Method, Pipeline, PipelineParams};
-use crate::recording::{read_recording, Baseline, Dataset, LayoutFile, Recording};
+use crate::recording::{Baseline, Dataset, FileReading, LayoutFile, LayoutFrom, Recording};
 use crate::values::{Cell, Grid, Speed};
 
 /// The gain `--gain auto` chose and what it rests on.
@@ -76,6 +76,12 @@ pub struct Provenance {
     /// ms (a stream's default window).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub median_duration_ms: Option<usize>,
+    /// How the training dataset's recordings were read (its `layout.toml`: rate, grid,
+    /// channel map, CSV columns, and the raw logs' columns an import keeps): recording
+    /// files given later without a layout of their own are read the same way. `None` for
+    /// a model trained on arrays, or written before models kept it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layout: Option<LayoutFile>,
 }
 
 impl Provenance {
@@ -90,6 +96,7 @@ impl Provenance {
             speeds,
             gain_calibration: None,
             median_duration_ms: None,
+            layout: Some(dataset.layout.clone()),
         })
     }
 }
@@ -337,22 +344,30 @@ impl Model {
         self.pipeline.encode(recording, self.baseline())
     }
 
-    /// Reads and encodes the recordings `files` (`.npy` or `.csv`, placed on the grid as
-    /// `layout` says) as the training recordings were, in parallel; each is named by its
-    /// path as given.
+    /// Reads and encodes the recordings `files` as `reading` says (a file without a layout
+    /// given or beside it is read with the training dataset's, its raw logs' columns
+    /// included: [`FileReading`]) and as the training recordings were encoded, in
+    /// parallel; each is named by its path as given, with where its layout came from.
     ///
     /// # Errors
     /// A file that cannot be read, or that the pipeline cannot take, named.
-    pub fn encode_files(&self, files: &[PathBuf], layout: &LayoutFile) -> Result<Vec<Encoded>> {
+    pub fn encode_files(
+        &self,
+        files: &[PathBuf],
+        reading: &FileReading,
+    ) -> Result<(Vec<Encoded>, Vec<LayoutFrom>)> {
+        let remembered = self.provenance().layout.as_ref();
         files
             .par_iter()
             .map(|path| {
                 let file = path.display().to_string();
-                let mut recording = read_recording(path, layout)?;
+                let (mut recording, from) = reading.read(path, remembered)?;
                 recording.meta.file = file.clone();
-                self.encode(&recording).map_err(|e| e.in_recording(&file))
+                let encoded = self.encode(&recording).map_err(|e| e.in_recording(&file))?;
+                Ok((encoded, from))
             })
-            .collect()
+            .collect::<Result<Vec<_>>>()
+            .map(|pairs| pairs.into_iter().unzip())
     }
 
     /// Writes one CSV row per recording: `file,label,predicted`, then `share_<class>` for

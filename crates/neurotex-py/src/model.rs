@@ -173,6 +173,7 @@ fn train_model<'py>(
                 speeds: None,
                 gain_calibration: c.gain,
                 median_duration_ms: c.causal.map(|c| c.median_duration_ms),
+                layout: None,
             };
             LibModel::train(c.pipeline.params(), &table, columns, choice, provenance)
         })

@@ -3,16 +3,15 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use neurotex::calibrate::calibrate_gain;
 use neurotex::encode::SpikeTrains;
 use neurotex::pipeline::Pipeline;
-use neurotex::recording::{read_recording_as, LayoutFile};
-use neurotex::{Grid, SampleRate};
+use neurotex::recording::{read_recording_as, LayoutFrom};
 
 use super::{report_conditions, say_calibration};
-use crate::csv_args::CsvArgs;
+use crate::csv_args::ReadArgs;
 use crate::output::{check_output, stage_file};
 use crate::stage_args::StageArgs;
 
@@ -28,20 +27,8 @@ pub struct EncodeArgs {
     /// Where to write the spikes: u8 `.npy` of shape `(T, rows, cols)` at 1 kHz.
     #[arg(long)]
     pub out: PathBuf,
-    /// Sampling rate of the input in Hz (default: the layout's, else 1000; ignored when the
-    /// CSV has a time column: its stamps give the rate).
-    #[arg(long, allow_negative_numbers = true)]
-    pub fs: Option<SampleRate>,
-    /// A `layout.toml` giving grid, channel map, mask, rate, baseline or CSV columns for the
-    /// input (default: the `layout.toml` beside the input, if any).
-    #[arg(long)]
-    pub layout: Option<PathBuf>,
-    /// Grid `ROWSxCOLS` to place the channels on, row-major (replaces the layout's grid,
-    /// channel map and mask).
-    #[arg(long)]
-    pub grid: Option<Grid>,
     #[command(flatten)]
-    pub csv: CsvArgs,
+    pub read: ReadArgs,
     /// Also write the spikes as address events `t_ms,row,col` to this CSV file.
     #[arg(long)]
     pub events: Option<PathBuf>,
@@ -55,8 +42,13 @@ pub fn run(args: EncodeArgs) -> Result<()> {
         bail!("--causal fixes resting values and a scale on training recordings: use it with train, evaluate, features or compare (then predict or stream with the model)");
     }
     let pipeline = Pipeline::new(args.stages.pipeline()?)?;
+    let reading = args.read.reading()?;
+    let (layout, from) = reading.layout_for(&args.input, None)?;
     let mut inputs = vec![args.input.clone()];
-    inputs.extend(layout_path(&args));
+    inputs.extend(args.read.layout.clone());
+    if let LayoutFrom::Beside(path) = &from {
+        inputs.push(path.clone());
+    }
     check_output(&args.out, &inputs)?;
     if let Some(events) = &args.events {
         if events == &args.out || neurotex::io::same_file(events, &args.out) {
@@ -67,11 +59,8 @@ pub fn run(args: EncodeArgs) -> Result<()> {
         }
         check_output(events, &inputs)?;
     }
-    let layout = input_layout(&args)?;
-    let format = layout
-        .csv_format()
-        .with_context(|| format!("reading the layout for {}", args.input.display()))?;
-    let format = args.csv.apply(format);
+    args.read.say_layouts(std::slice::from_ref(&from));
+    let format = reading.csv_format(&args.input, &layout)?;
     let recording = read_recording_as(&args.input, &layout, &format)?;
     let baseline = layout.baseline.unwrap_or_default();
     // `--gain auto` on the one recording being encoded.
@@ -115,43 +104,6 @@ pub fn run(args: EncodeArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
-}
-
-/// The layout file read for the input: `--layout FILE`, else `layout.toml` beside it.
-fn layout_path(args: &EncodeArgs) -> Option<PathBuf> {
-    let beside = args
-        .input
-        .parent()
-        .map(|dir| dir.join("layout.toml"))
-        .filter(|p| p.is_file());
-    args.layout.clone().or(beside)
-}
-
-/// The input's layout: `--layout FILE`, else `layout.toml` beside the input, else the
-/// defaults; then `--fs` and `--grid` in place of the layout's.
-fn input_layout(args: &EncodeArgs) -> Result<LayoutFile> {
-    let mut layout = match layout_path(args).as_ref() {
-        Some(path) => {
-            if args.layout.is_none() {
-                eprintln!(
-                    "note: reading the layout beside the recording, {}",
-                    path.display()
-                );
-            }
-            LayoutFile::read(path)?
-        }
-        None => LayoutFile::default(),
-    };
-    if let Some(fs) = args.fs {
-        layout.fs = Some(fs.hz());
-    }
-    if let Some(grid) = &args.grid {
-        layout.rows = Some(grid.rows());
-        layout.cols = Some(grid.cols());
-        layout.channel_map = None;
-        layout.mask = None;
-    }
-    Ok(layout)
 }
 
 /// Writes `t_ms,row,col`, one spike a line.

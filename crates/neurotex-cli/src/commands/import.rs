@@ -97,7 +97,7 @@ pub fn run(command: ImportCommand) -> Result<()> {
 fn csv(args: ImportCsvArgs) -> Result<()> {
     let params = CsvImportParams {
         pattern: args.name_pattern,
-        format: args.csv.apply(CsvFormat::default()),
+        format: args.csv.overrides().apply(CsvFormat::default()),
         grid: args.grid,
         channel_map: args.channel_map,
         fs: args.fs.map(SampleRate::hz),

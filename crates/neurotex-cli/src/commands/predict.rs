@@ -9,12 +9,13 @@ use clap::Args;
 use neurotex::causal::episode_decisions;
 use neurotex::model::Model;
 use neurotex::pipeline::Encoded;
-use neurotex::recording::{Dataset, LayoutFile};
+use neurotex::recording::Dataset;
 use neurotex::stream::write_episodes;
 use rayon::prelude::*;
 
 use super::report_conditions;
 use super::stream::DecisionArgs;
+use crate::csv_args::ReadArgs;
 use crate::open_args::OpenArgs;
 use crate::output::{check_output, progress, write_file};
 
@@ -27,14 +28,20 @@ pub struct PredictArgs {
     pub model: PathBuf,
     /// A dataset folder to predict; its manifest's labels are written beside the
     /// predictions and scored with --json.
-    #[arg(long, required_unless_present = "files", conflicts_with_all = ["files", "layout"])]
+    #[arg(
+        long,
+        required_unless_present = "files",
+        conflicts_with_all = ["files", "layout", "fs", "grid", "no_header", "delimiter", "time_column", "time_unit", "channels", "duplicate_stamps", "max_gap_s"]
+    )]
     pub dataset: Option<PathBuf>,
     /// Recordings to predict instead of a dataset (`.npy` or `.csv`); their labels are
-    /// unknown. They must have the model's taxel grid.
+    /// unknown. They must have the model's taxel grid. A file with no layout given or
+    /// beside it is read as the model's training recordings were: raw logs of the logger
+    /// the training dataset was imported from need no options.
     pub files: Vec<PathBuf>,
-    /// With FILES: a `layout.toml` giving their sampling rate, grid, channel map or mask.
-    #[arg(long)]
-    pub layout: Option<PathBuf>,
+    /// With FILES: how to read them (the options of `encode`).
+    #[command(flatten)]
+    pub read: ReadArgs,
     /// The CSV file to write: `file,label,predicted`, then `share_<class>` for each class
     /// of the model (KNN: its share of the votes among the k neighbours; forest: its mean
     /// leaf share over the trees; linear: its probability); `label` is empty when unknown.
@@ -72,18 +79,16 @@ pub fn run(args: PredictArgs) -> Result<()> {
     let mut inputs = vec![args.model.clone()];
     match &dataset {
         Some(dataset) => inputs.extend(dataset.files()),
-        None => inputs.extend(args.files.iter().chain(&args.layout).cloned()),
+        None => inputs.extend(args.files.iter().chain(&args.read.layout).cloned()),
     }
     check_output(&args.out, &inputs)?;
     let model = Model::load(&args.model)?;
     let (encoded, known) = match &dataset {
         Some(dataset) => (encode_dataset(&model, dataset)?, true),
         None => {
-            let layout = match &args.layout {
-                Some(path) => LayoutFile::read(path)?,
-                None => LayoutFile::default(),
-            };
-            (model.encode_files(&args.files, &layout)?, false)
+            let (encoded, from) = model.encode_files(&args.files, &args.read.reading()?)?;
+            args.read.say_layouts(&from);
+            (encoded, false)
         }
     };
     report_conditions(&encoded);

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use neurotex::causal::DecisionRule;
-use neurotex::csvlog::{ChannelSelect, Column, CsvFormat, Delimiter};
+use neurotex::csvlog::{ChannelSelect, Column, CsvFormat, CsvOverrides, Delimiter};
 use neurotex::model::Model;
 use neurotex::recording::TimeUnit;
 use neurotex::stream::frames::{event_json, feed, FrameReader, Replay, Sink};
@@ -134,9 +134,10 @@ pub fn run(args: StreamArgs) -> Result<()> {
     if args.format == FrameFormat::Csv && args.stamped {
         bail!("--stamped is for --format f32le; CSV frames carry their stamp in --time-column");
     }
+    let format = frame_format(&args, &model)?;
     let mut stream = StreamClassifier::new(model, params)?;
     let input = neurotex::stream::input::open(&args.input, &|said| eprintln!("{said}"))?;
-    let mut frames = FrameReader::new(input, &args.input, frame_format(&args), stream.channels());
+    let mut frames = FrameReader::new(input, &args.input, format, stream.channels());
     let mut out = Output {
         out: std::io::stdout().lock(),
         episodes: 0,
@@ -165,25 +166,41 @@ pub fn run(args: StreamArgs) -> Result<()> {
     Ok(())
 }
 
-/// The frame format the options describe (CSV: the time column found by name when there
-/// is a header and no --time-column; f32le stamps in s unless --time-unit says otherwise).
-fn frame_format(args: &StreamArgs) -> neurotex::stream::frames::FrameFormat {
+/// The frame format the options describe. CSV: with no option saying where the columns
+/// are, the lines are read as the model's training recordings were (its dataset's columns,
+/// then the raw logs' an import kept), else with a header as every column but a time column
+/// named t_ms/time_ms or t_s/time_s. f32le stamps are in s unless --time-unit says.
+fn frame_format(args: &StreamArgs, model: &Model) -> Result<neurotex::stream::frames::FrameFormat> {
     use neurotex::stream::frames::FrameFormat as Format;
-    match args.format {
-        FrameFormat::Csv => Format::Csv(CsvFormat {
-            header: !args.no_header,
-            delimiter: args.delimiter,
-            time_column: args.time_column.clone(),
-            time_unit: args.time_unit.unwrap_or_default(),
-            detect_time: !args.no_header && args.time_column.is_none(),
-            channels: args.channels.clone().unwrap_or(ChannelSelect::All),
-            ..CsvFormat::default()
-        }),
+    Ok(match args.format {
+        FrameFormat::Csv => {
+            let overrides = CsvOverrides {
+                no_header: args.no_header,
+                delimiter: args.delimiter,
+                time_column: args.time_column.clone(),
+                time_unit: args.time_unit,
+                channels: args.channels.clone(),
+                ..CsvOverrides::default()
+            };
+            let plain = CsvFormat {
+                detect_time: true,
+                ..CsvFormat::default()
+            };
+            let mut formats = match (
+                model.provenance().layout.as_ref(),
+                overrides.place_columns(),
+            ) {
+                (Some(layout), false) => layout.csv_formats(&overrides)?,
+                _ => Vec::new(),
+            };
+            formats.push(overrides.apply(plain));
+            Format::Csv(formats)
+        }
         FrameFormat::F32le => Format::F32le {
             stamped: args.stamped,
             unit: args.time_unit.unwrap_or(TimeUnit::Seconds),
         },
-    }
+    })
 }
 
 /// The JSON lines on standard output, one per bin boundary and one per episode's end,

@@ -611,6 +611,7 @@ mod tests {
             speeds: Some(vec![speed]),
             gain_calibration: None,
             median_duration_ms: None,
+            layout: None,
         };
         let model = Model::train(
             &params,

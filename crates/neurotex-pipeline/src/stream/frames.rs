@@ -17,15 +17,17 @@ use std::time::{Duration, Instant};
 use serde_json::Value;
 
 use super::{bin_json, end_json, Event, StreamClassifier, StreamError};
-use crate::csvlog::{detect_delimiter_in, Columns, CsvFormat, Delimiter};
+use crate::csvlog::{choose_columns, detect_delimiter_in, Columns, CsvFormat, Delimiter};
 use crate::error::{DataError, Result};
 use crate::recording::TimeUnit;
 
 /// How frames are written on the input.
 #[derive(Debug, Clone)]
 pub enum FrameFormat {
-    /// Text, one frame per line; `reset` on a line of its own ends the episode.
-    Csv(CsvFormat),
+    /// Text, one frame per line; `reset` on a line of its own ends the episode. The lines
+    /// are read in the first of these formats whose columns the first line holds and fit
+    /// the model (a model's training layout, its raw logs' columns, then the defaults).
+    Csv(Vec<CsvFormat>),
     /// Records of one `f32` per taxel, little-endian, after an `f64` stamp in `unit` when
     /// `stamped`; a record of NaN values ends the episode.
     F32le {
@@ -121,7 +123,7 @@ impl<R: BufRead> FrameReader<R> {
     }
 
     fn next_csv(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Frame<'_>>> {
-        let FrameFormat::Csv(format) = &self.format else {
+        let FrameFormat::Csv(formats) = &self.format else {
             unreachable!("next_csv reads CSV frames only")
         };
         let limit = line_limit(self.channels);
@@ -160,12 +162,12 @@ impl<R: BufRead> FrameReader<R> {
                 return Ok(Some(Frame::Reset));
             }
             if self.plan.is_none() {
-                let (delimiter, columns) = self.plan_columns(format, text)?;
+                let (header, delimiter, columns) = self.plan_columns(formats, text)?;
                 let splitter = csv_core::ReaderBuilder::new()
                     .delimiter(delimiter.byte())
                     .build();
                 (self.plan, self.splitter) = (Some((delimiter, columns)), Some(splitter));
-                if format.header {
+                if header {
                     continue;
                 }
             }
@@ -190,33 +192,43 @@ impl<R: BufRead> FrameReader<R> {
         }
     }
 
-    /// The delimiter and the columns from the first line (the header, or the first frame),
-    /// checked against the model's taxels.
-    fn plan_columns(&self, format: &CsvFormat, text: &str) -> Result<(Delimiter, Columns)> {
-        let delimiter = format
-            .delimiter
-            .unwrap_or_else(|| detect_delimiter_in(&[text]));
-        let mut splitter = csv_core::ReaderBuilder::new()
-            .delimiter(delimiter.byte())
-            .build();
-        let mut names = Vec::new();
-        for_each_field(&mut splitter, text, &mut Vec::new(), |f| {
-            names.push(String::from_utf8_lossy(f).into_owned());
-            true
-        });
-        if !format.header {
-            names = (0..names.len()).map(|j| format!("column{j}")).collect();
-        }
-        let columns = Columns::find(Path::new(&self.source), format, names)?;
-        if columns.channels.len() != self.channels {
-            let message = format!(
+    /// The header flag, delimiter and columns from the first line (the header, or the
+    /// first frame), of the first format whose columns it holds and fit the model's taxels.
+    fn plan_columns(
+        &self,
+        formats: &[CsvFormat],
+        text: &str,
+    ) -> Result<(bool, Delimiter, Columns)> {
+        let delimiter = |format: &CsvFormat| {
+            format
+                .delimiter
+                .unwrap_or_else(|| detect_delimiter_in(&[text]))
+        };
+        let names = |format: &CsvFormat| {
+            let mut splitter = csv_core::ReaderBuilder::new()
+                .delimiter(delimiter(format).byte())
+                .build();
+            let mut names = Vec::new();
+            for_each_field(&mut splitter, text, &mut Vec::new(), |f| {
+                names.push(String::from_utf8_lossy(f).into_owned());
+                true
+            });
+            if !format.header {
+                names = (0..names.len()).map(|j| format!("column{j}")).collect();
+            }
+            Ok(names)
+        };
+        let fits = |columns: &Columns| match columns.channels.len() == self.channels {
+            true => Ok(()),
+            false => Err(format!(
                 "{} channel columns selected, the model has {} taxels",
                 columns.channels.len(),
                 self.channels
-            );
-            return Err(DataError::invalid(&self.source, message).into());
-        }
-        Ok((delimiter, columns))
+            )),
+        };
+        let path = Path::new(&self.source);
+        let (i, columns) = choose_columns(path, formats, &names, &fits)?;
+        Ok((formats[i].header, delimiter(&formats[i]), columns))
     }
 
     fn next_record(
