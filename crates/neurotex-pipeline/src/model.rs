@@ -715,6 +715,7 @@ mod tests {
             speeds: Some(vec![Speed::of(5.0)]),
             gain_calibration: None,
             median_duration_ms: None,
+            layout: None,
         }
     }
 

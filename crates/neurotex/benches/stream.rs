@@ -38,6 +38,7 @@ fn model(side: usize) -> Model {
         speeds: None,
         gain_calibration: None,
         median_duration_ms: Some(4000),
+        layout: None,
     };
     let knn = ClassifierChoice::Knn(KnnParams::default());
     Model::train(&params, &table, Columns::All, knn, provenance).unwrap()

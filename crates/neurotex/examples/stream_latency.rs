@@ -88,6 +88,7 @@ fn latency() {
         speeds: None,
         gain_calibration: None,
         median_duration_ms: Some(calibration.median_duration_ms),
+        layout: None,
     };
     let knn = ClassifierChoice::Knn(KnnParams::default());
     let model = Model::train(&params, &table, Columns::All, knn, provenance).unwrap();
@@ -183,6 +184,7 @@ fn large_model(side: usize) -> Model {
         speeds: None,
         gain_calibration: None,
         median_duration_ms: None,
+        layout: None,
     };
     let knn = ClassifierChoice::Knn(KnnParams::default());
     Model::train(&params, &table, Columns::All, knn, provenance).unwrap()

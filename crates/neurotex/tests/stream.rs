@@ -59,6 +59,7 @@ fn causal_model(
         speeds: None,
         gain_calibration: None,
         median_duration_ms: Some(calibration.median_duration_ms),
+        layout: None,
     };
     Model::train(&params, &table, Columns::All, classifier, provenance).unwrap()
 }
@@ -379,6 +380,7 @@ fn an_offline_model_cannot_stream() {
         speeds: None,
         gain_calibration: None,
         median_duration_ms: None,
+        layout: None,
     };
     let model = Model::train(
         &params,
