@@ -145,13 +145,19 @@ fn headerless_semicolon_logs_are_read_by_index_as_imported() {
     assert!(layout.contains("header = false"), "{layout}");
     assert!(layout.contains("delimiter = \";\""), "{layout}");
     let raw = predict(&dir, &model, &each_log(&logs), "raw.csv");
-    assert_eq!(raw, predict(&dir, &model, &each_log(&dataset), "copies.csv"));
+    assert_eq!(
+        raw,
+        predict(&dir, &model, &each_log(&dataset), "copies.csv")
+    );
 
     // a file in neither the dataset's columns nor the raw logs' says both
     let other = dir.join("other.csv");
     std::fs::write(&other, "a,b\n1,2\n2,3\n").unwrap();
     let out = dir.join("other_p.csv");
     let err = dir.fails(&["predict", "--model", s(&model), "--out", s(&out), s(&other)]);
-    assert!(err.contains("t_ms") && err.contains("nor read another way"), "{err}");
+    assert!(
+        err.contains("t_ms") && err.contains("nor read another way"),
+        "{err}"
+    );
     assert!(!out.exists());
 }
