@@ -91,13 +91,30 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", message(&err));
             if let Some(hint) = hint(&err) {
                 eprintln!("hint: {hint}");
             }
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes, each said once: a library error that names its recording or
+/// analysis already ends with its cause's text.
+fn message(err: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in err.chain() {
+        let said = cause.to_string();
+        if text.ends_with(&said) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&said);
+    }
+    text
 }
 
 /// What to change when a dataset is too small for the folds or neighbours asked for.
@@ -108,9 +125,8 @@ fn hint(err: &anyhow::Error) -> Option<String> {
         if let Some(c) = e.downcast_ref::<ClassifyError>() {
             return c.hint(&option);
         }
-        match e.downcast_ref::<neurotex::Error>()? {
-            neurotex::Error::Classify(c) => c.hint(&option),
-            _ => None,
-        }
+        e.downcast_ref::<neurotex::Error>()?
+            .classify()?
+            .hint(&option)
     })
 }

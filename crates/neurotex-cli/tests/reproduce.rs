@@ -246,10 +246,30 @@ fn a_twelve_recording_pilot_runs_with_fewer_folds_and_the_error_says_how() {
         err.contains("fewer than the 5 folds") && err.contains("hint: --folds"),
         "{err}"
     );
+    // Folds and neighbours are checked on the manifest, before any recording is read, and
+    // the message names the speed and what the design supports.
     let err = dir.fails(&[&base[..], &["--folds", "2"]].concat());
+    for said in [
+        "at 5 mm/s",
+        "at most 2 folds, and with 2 folds at most 3 neighbours",
+        "k = 5 neighbours needs at least 5 training samples, got 3",
+        "hint: --k",
+    ] {
+        assert!(err.contains(said), "{said}: {err}");
+    }
+    assert!(!err.contains("recordings (12 steps)"), "{err}");
+    assert_eq!(err.matches("got 3").count(), 1, "said once: {err}");
+    // Under --group-by the folds follow the groups; the error still names the speed.
+    let err = dir.fails(&[&base[..], &["--folds", "2", "--group-by", "trial"]].concat());
     assert!(
-        err.contains("neighbours") && err.contains("hint: --k"),
+        err.contains("at 5 mm/s") && err.contains("hint: --k"),
         "{err}"
+    );
+    let run = dir.run(&[&base[..], &["--folds", "2", "--k", "3", "--repeats", "1"]].concat());
+    assert!(
+        run.status.success(),
+        "the largest k said fits: {}",
+        run.stderr
     );
     let run = dir.run(&[&base[..], &["--folds", "2", "--k", "1", "--repeats", "1"]].concat());
     assert!(run.status.success(), "{}", run.stderr);

@@ -26,6 +26,15 @@ pub enum Error {
         /// What went wrong.
         source: Box<Error>,
     },
+    /// An error in one analysis or condition of a larger run, naming it (`at 5 mm/s, the
+    /// cross-validation within a speed`).
+    #[error("{what}: {source}")]
+    InAnalysis {
+        /// The analysis and condition, and what the design supports when that helps.
+        what: String,
+        /// What went wrong.
+        source: Box<Error>,
+    },
     /// A statistic could not be computed from what it was given.
     #[error(transparent)]
     Stats(#[from] StatsError),
@@ -50,6 +59,28 @@ impl Error {
                 file: file.to_string(),
                 source: Box::new(other),
             },
+        }
+    }
+}
+
+impl Error {
+    /// This error within the analysis or condition `what`.
+    pub fn in_analysis(self, what: impl Into<String>) -> Error {
+        Error::InAnalysis {
+            what: what.into(),
+            source: Box::new(self),
+        }
+    }
+
+    /// The classification error at the heart of this one, through the recording or
+    /// analysis it is named in: what a front end's hint is drawn from.
+    pub fn classify(&self) -> Option<&ClassifyError> {
+        match self {
+            Error::Classify(c) => Some(c),
+            Error::InRecording { source, .. } | Error::InAnalysis { source, .. } => {
+                source.classify()
+            }
+            _ => None,
         }
     }
 }

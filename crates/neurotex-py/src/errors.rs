@@ -63,7 +63,7 @@ fn kind_of(error: &neurotex::Error) -> Kind {
         E::Data(_) | E::Dataset(_) => Kind::Data,
         E::Classify(_) | E::Stats(_) => Kind::Classify,
         E::Model(_) => Kind::Model,
-        E::InRecording { source, .. } => kind_of(source),
+        E::InRecording { source, .. } | E::InAnalysis { source, .. } => kind_of(source),
         // The library's error enum may grow; a new stage's errors are bad input until
         // this layer learns better.
         #[allow(unreachable_patterns)]
@@ -84,10 +84,9 @@ pub fn to_py(error: neurotex::Error) -> PyErr {
     if out_of_memory(&error) {
         return pyo3::exceptions::PyMemoryError::new_err(error.to_string());
     }
-    let hint = match &error {
-        neurotex::Error::Classify(c) => c.hint(&|name, value| format!("{name}={value}")),
-        _ => None,
-    };
+    let hint = error
+        .classify()
+        .and_then(|c| c.hint(&|name, value| format!("{name}={value}")));
     match hint {
         Some(hint) => raise(kind_of(&error), format!("{error}\nhint: {hint}")),
         None => raise(kind_of(&error), error.to_string()),
@@ -99,7 +98,8 @@ pub fn to_py(error: neurotex::Error) -> PyErr {
 fn out_of_memory(error: &neurotex::Error) -> bool {
     match error {
         neurotex::Error::Data(DataError::OutOfMemory { .. }) => true,
-        neurotex::Error::InRecording { source, .. } => out_of_memory(source),
+        neurotex::Error::InRecording { source, .. }
+        | neurotex::Error::InAnalysis { source, .. } => out_of_memory(source),
         _ => false,
     }
 }

@@ -369,7 +369,14 @@ pub fn run_all(
     let e9 = || {
         let clock = Instant::now();
         let e9 = if params.e9 {
-            e9_compare(prepared, params).map(Some)
+            e9_compare(prepared, params)
+                .map(Some)
+                .map_err(|stop| match stop {
+                    Stop::Failed(e) => {
+                        Stop::Failed(e.in_analysis("E9 (the standard candidates compared)"))
+                    }
+                    skipped => skipped,
+                })
         } else {
             Ok(None)
         };
@@ -424,7 +431,10 @@ fn run_ordered(
         match (analysis.run)(&context, results) {
             Ok(()) => {}
             Err(Stop::Skipped(skip)) => results.skip(&skip),
-            Err(Stop::Failed(error)) => return Err((before_e9, error)),
+            Err(Stop::Failed(error)) => {
+                let what = format!("{} ({})", analysis.id.to_uppercase(), analysis.asks);
+                return Err((before_e9, error.in_analysis(what)));
+            }
         }
         let seconds = clock.elapsed().as_secs_f64();
         results.timing_s.insert(analysis.id.into(), seconds);

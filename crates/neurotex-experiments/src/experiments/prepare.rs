@@ -12,7 +12,7 @@ use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidRepr
 use crate::calibrate::{calibrate_gain, GainCalibration};
 use crate::causal::{calibrate_conditioning, ConditioningCalibration};
 use crate::encode::encode_banks;
-use crate::error::{DataError, DatasetError, Result};
+use crate::error::{ClassifyError, DataError, DatasetError, Result};
 use crate::pipeline::{Encoded, Encoding, Pipeline};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
@@ -288,6 +288,82 @@ fn causal_pipelines(
     Ok(Some(out))
 }
 
+/// Whether the cross-validation within each speed, which E1-E5, E7, E8, E9 and E0 rest on,
+/// can run with the folds and neighbours asked for: checked on the recordings' labels and
+/// speeds before any is read, so that a design too small stops at once, naming the speed,
+/// what the design supports and the option to change. Under `group_by` the folds follow
+/// the groups and are checked where they are made.
+///
+/// # Errors
+/// A class with fewer recordings than folds at some speed, or training folds smaller than
+/// `k` there.
+fn check_design(conditions: &[(Speed, String)], params: &ValidReproduceParams) -> Result<()> {
+    let (cv, group_by) = params.folds();
+    if group_by.is_some() {
+        return Ok(());
+    }
+    let k = params.knn().params().k;
+    let mut speeds: Vec<Speed> = conditions.iter().map(|c| c.0).collect();
+    speeds.sort_by(|a, b| a.mm_s().total_cmp(&b.mm_s()));
+    speeds.dedup();
+    // The most folds every class at every speed can fill, and with them the fewest
+    // training recordings of any fold.
+    let counts = |speed: Speed| {
+        let mut counts: Vec<(String, usize)> = Vec::new();
+        for (_, label) in conditions.iter().filter(|c| c.0 == speed) {
+            match counts.iter_mut().find(|(l, _)| l == label) {
+                Some((_, n)) => *n += 1,
+                None => counts.push((label.clone(), 1)),
+            }
+        }
+        counts
+    };
+    let max_folds = speeds
+        .iter()
+        .filter_map(|&s| counts(s).iter().map(|c| c.1).min())
+        .min()
+        .unwrap_or(0);
+    let smallest_training = |folds: usize| {
+        speeds
+            .iter()
+            .map(|&s| {
+                let n: usize = counts(s).iter().map(|c| c.1).sum();
+                n - n.div_ceil(folds.max(1))
+            })
+            .min()
+            .unwrap_or(0)
+    };
+    let supports = match max_folds {
+        0 | 1 => "this design supports no cross-validation within a speed: each class needs at least 2 recordings at each speed".to_string(),
+        f => {
+            let folds = cv.folds.min(f);
+            format!(
+                "this design supports at most {f} folds, and with {folds} folds at most {} neighbours",
+                smallest_training(folds)
+            )
+        }
+    };
+    for &speed in &speeds {
+        let what = format!("at {speed} mm/s, the cross-validation within a speed that E1-E5, E7, E8, E9 and E0 rest on ({supports})");
+        let counts = counts(speed);
+        if let Some((label, count)) = counts.iter().find(|c| c.1 < cv.folds) {
+            let error = ClassifyError::ClassTooSmall {
+                label: label.clone(),
+                count: *count,
+                folds: cv.folds,
+            };
+            return Err(crate::Error::from(error).in_analysis(what));
+        }
+        let n: usize = counts.iter().map(|c| c.1).sum();
+        let n_train = n - n.div_ceil(cv.folds);
+        if k > n_train {
+            let error = ClassifyError::KTooLarge { k, n_train };
+            return Err(crate::Error::from(error).in_analysis(what));
+        }
+    }
+    Ok(())
+}
+
 /// One pass over the recordings: condition, encode at the pipeline's gain, and for the
 /// slowest speed also at every E7 gain (accumulating ISI histograms). Parallel across
 /// recordings; a recording's raw samples are dropped as soon as it is encoded.
@@ -305,6 +381,7 @@ pub fn prepare(
     let conditions: Vec<(Speed, String)> =
         (0..n).map(|i| source.condition(i)).collect::<Result<_>>()?;
     let slowest = Speed::slowest(conditions.iter().map(|c| c.0)).ok_or(DatasetError::Empty)?;
+    check_design(&conditions, params)?;
     let mut labels: Vec<String> = Vec::new();
     for (_, l) in &conditions {
         if !labels.contains(l) {

@@ -120,10 +120,15 @@ fn evaluate_headline(
     speeds
         .iter()
         .map(|&s| {
+            let at = |e: crate::Error| {
+                e.in_analysis(format!(
+                    "at {s} mm/s, the cross-validation within a speed that E1-E5, E7, E8 and E0 rest on"
+                ))
+            };
             let h = Headline {
-                taxel: cv_at(taxel, Columns::EachTaxel, s, knn, folds)?,
-                glcm3d: cv_at(glcm3d, Columns::All, s, knn, folds)?,
-                glcm2d: cv_at(glcm2d, Columns::All, s, knn, folds)?,
+                taxel: cv_at(taxel, Columns::EachTaxel, s, knn, folds).map_err(at)?,
+                glcm3d: cv_at(glcm3d, Columns::All, s, knn, folds).map_err(at)?,
+                glcm2d: cv_at(glcm2d, Columns::All, s, knn, folds).map_err(at)?,
             };
             Ok((s, h))
         })
