@@ -186,7 +186,7 @@ impl Outcome {
     /// An outcome without per-recording results.
     pub fn accuracy_interval(&self, seed: u64) -> Result<Interval> {
         let shares: Vec<f64> = self.correct_shares.iter().map(|&(_, s)| s).collect();
-        seeded_bootstrap(&shares, seed)
+        Ok(seeded_bootstrap(&shares, seed)?.or_wilson_at_the_bounds(shares.len()))
     }
 }
 

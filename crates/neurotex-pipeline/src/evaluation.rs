@@ -200,9 +200,10 @@ impl Evaluation {
         // No accuracy without its uncertainty and the level a guess reaches.
         let _ = writeln!(
             out,
-            "95 % interval [{:.1}%, {:.1}%] (bootstrap over recordings); chance {:.1}% (one over {} classes), {:.1}% always answering the most frequent class",
+            "95 % interval [{:.1}%, {:.1}%] ({}); chance {:.1}% (one over {} classes), {:.1}% always answering the most frequent class",
             100.0 * interval.lower,
             100.0 * interval.upper,
+            interval.described(),
             100.0 * metrics.chance_uniform,
             metrics.classes_present,
             100.0 * metrics.chance_majority

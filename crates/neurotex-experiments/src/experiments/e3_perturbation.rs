@@ -101,7 +101,11 @@ pub fn e3_perturbation(c: &Context) -> Result<E3, Stop> {
             .iter()
             .map(|o| o.correct_shares.iter().map(|&(_, s)| s).collect())
             .collect();
-        interval.push(seeded_bootstrap_over_encodings(&per_draw, c.params.seed)?);
+        let recordings = per_draw.first().map_or(0, Vec::len);
+        interval.push(
+            seeded_bootstrap_over_encodings(&per_draw, c.params.seed)?
+                .or_wilson_at_the_bounds(recordings),
+        );
         let moved = pooled_shares(&outcomes, &rows);
         unperturbed_vs_moved.push(compare_shares(
             ("unperturbed 3D-GLCM", &h.glcm3d.correct_shares),

@@ -439,7 +439,10 @@ impl SpeedRun {
                         .collect();
                     (
                         Some(right / all.max(1) as f64),
-                        Some(seeded_bootstrap(&per_recording, seed)?),
+                        Some(
+                            seeded_bootstrap(&per_recording, seed)?
+                                .or_wilson_at_the_bounds(per_recording.len()),
+                        ),
                     )
                 }
                 None => (None, None),

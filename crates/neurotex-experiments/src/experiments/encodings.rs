@@ -43,7 +43,8 @@ impl OverEncodings {
         Ok(OverEncodings {
             per_encoding: outcomes.iter().map(|o| o.accuracy).collect(),
             recordings_only: first.accuracy_interval(seed)?,
-            combined: seeded_bootstrap_over_encodings(&shares, seed)?,
+            combined: seeded_bootstrap_over_encodings(&shares, seed)?
+                .or_wilson_at_the_bounds(first.correct_shares.len()),
         })
     }
 

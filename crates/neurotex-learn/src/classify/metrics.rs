@@ -165,6 +165,39 @@ pub struct Interval {
     pub method: IntervalMethod,
 }
 
+impl Interval {
+    /// An accuracy's bootstrap interval, or where it is a point at 0 or 1 (every recording
+    /// right, or every one wrong, in every resample and encoding: no resample can differ)
+    /// the [`wilson_interval`] of the `n` recordings: 12 of 12 right is [75.8 %, 100 %],
+    /// not [100 %, 100 %]. Any other interval is returned as it is.
+    pub fn or_wilson_at_the_bounds(self, n: usize) -> Interval {
+        let point = self.lower == self.upper;
+        let bound = self.estimate == 0.0 || self.estimate == 1.0;
+        match (point && bound, n) {
+            (true, 1..) => {
+                let correct = if self.estimate == 1.0 { n } else { 0 };
+                wilson_interval(correct, n).unwrap_or(self)
+            }
+            _ => self,
+        }
+    }
+
+    /// How the interval was computed, in a few words for a report or a terminal:
+    /// `bootstrap over recordings`, `Wilson score over 12 recordings`.
+    pub fn described(&self) -> String {
+        match &self.method {
+            IntervalMethod::Wilson { n, .. } => format!("Wilson score over {n} recordings"),
+            IntervalMethod::PercentileBootstrap { .. } => "bootstrap over recordings".into(),
+            IntervalMethod::EncodingBootstrap { .. } => {
+                "bootstrap over recordings and encodings".into()
+            }
+            IntervalMethod::StudentT { repeats, .. } => {
+                format!("Student t over {repeats} repeats")
+            }
+        }
+    }
+}
+
 /// The 95 % Wilson score interval for `correct` successes in `n` independent trials (Wilson
 /// 1927, "Probable inference, the law of succession, and statistical inference", JASA 22):
 /// the accuracies `p` that a two-sided score test at 5 % would not reject,
@@ -685,6 +718,26 @@ mod tests {
         ));
         let one = bootstrap_accuracy(&[true], &params).unwrap();
         assert_eq!((one.lower, one.estimate, one.upper), (1.0, 1.0, 1.0));
+    }
+
+    #[test]
+    fn a_bootstrap_point_at_the_bounds_becomes_the_wilson_interval() {
+        let params = BootstrapParams::default().check().unwrap();
+        // 12 of 12 right: every resample is 100 %. Wilson's lower bound at k = n is
+        // n / (n + z²) = 12 / (12 + 1.959964²) = 0.757506 (by hand).
+        let all = bootstrap_accuracy(&[true; 12], &params).unwrap();
+        assert_eq!((all.lower, all.upper), (1.0, 1.0));
+        let all = all.or_wilson_at_the_bounds(12);
+        assert!((all.lower - 0.757_506).abs() < 1e-6, "{all:?}");
+        assert_eq!(all.upper, 1.0);
+        assert_eq!(all.described(), "Wilson score over 12 recordings");
+        let none = bootstrap_accuracy(&[false; 12], &params).unwrap();
+        let none = none.or_wilson_at_the_bounds(12);
+        assert_eq!(none.lower, 0.0);
+        assert!((none.upper - (1.0 - 0.757_506)).abs() < 1e-6, "{none:?}");
+        // An interval with spread is kept as it is.
+        let mixed = bootstrap_accuracy(&[true, false, true, true], &params).unwrap();
+        assert_eq!(mixed.clone().or_wilson_at_the_bounds(4), mixed);
     }
 
     #[test]

@@ -257,7 +257,7 @@ fn encodings_note(r: &Results) -> String {
 
 fn e1(r: &Results, paper: Option<&Paper>) -> String {
     let mut out = format!("## E1: accuracy per speed, single taxel vs 3D-GLCM\n\n\
-        Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline, the mean over the responsive taxels (neither silent nor at the encoder's ceiling in most recordings; see Data) and the best taxel beside it (chosen after the fact, so optimistic). Chance is one over the classes recorded at that speed. Stratified cross-validation, mean over repeats (folds and repeats under Parameters); the 95 % intervals come from a percentile bootstrap over recordings (2000 resamples), each recording's predictions over repeats (and taxels) kept together.{}\n\n",
+        Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline, the mean over the responsive taxels (neither silent nor at the encoder's ceiling in most recordings; see Data) and the best taxel beside it (chosen after the fact, so optimistic). Chance is one over the classes recorded at that speed. Stratified cross-validation, mean over repeats (folds and repeats under Parameters); the 95 % intervals come from a percentile bootstrap over recordings (2000 resamples), each recording's predictions over repeats (and taxels) kept together; where every recording was right (or every one wrong) the bootstrap has no spread, and the Wilson score interval over the recordings is given instead.{}\n\n",
         encodings_note(r)
     );
     let mut header = vec![
