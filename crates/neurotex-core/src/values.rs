@@ -413,6 +413,11 @@ impl<T> BySpeed<T> {
         self.0.iter().map(|(_, v)| v)
     }
 
+    /// The values in ascending speed, to change in place.
+    pub fn values_mut(&mut self) -> impl Iterator<Item = &mut T> {
+        self.0.iter_mut().map(|(_, v)| v)
+    }
+
     /// Number of speeds.
     pub fn len(&self) -> usize {
         self.0.len()

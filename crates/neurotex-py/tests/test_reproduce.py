@@ -35,7 +35,7 @@ def report_text(path):
     """report.md without the command line, the clock and the commit."""
     text = path.read_text()
     text = text.split("## Timing")[0]
-    text = re.sub(r"Produced by `.*` in [0-9.]+ s\.", "Produced by", text)
+    text = re.sub(r"Produced by `.*`; its analyses took [0-9.]+ s", "Produced by", text)
     text = re.sub(r"\(commit \w+\), started \S+;", "", text)
     return text
 
@@ -91,6 +91,7 @@ def cli_verdict(claim):
         "contradicted": "Contradicted (paired test)",
         "point_agrees": "Agrees in point estimates (no test)",
         "point_disagrees": "Disagrees in point estimates (no test)",
+        "not_judged": "Not judged here",
     }[claim["verdict"]]
 
 

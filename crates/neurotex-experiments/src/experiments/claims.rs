@@ -21,6 +21,9 @@ pub enum Verdict {
     PointAgrees,
     /// No test: our point estimates disagree with the claim.
     PointDisagrees,
+    /// These results cannot speak to the claim (an accuracy at the ceiling, a single `k`
+    /// evaluated); the detail says why.
+    NotJudged,
 }
 
 impl Verdict {
@@ -58,6 +61,7 @@ impl Verdict {
             Verdict::Contradicted => "Contradicted (paired test)",
             Verdict::PointAgrees => "Agrees in point estimates (no test)",
             Verdict::PointDisagrees => "Disagrees in point estimates (no test)",
+            Verdict::NotJudged => "Not judged here",
         }
     }
 }
@@ -152,17 +156,29 @@ fn e1_claims(r: &Results) -> Vec<Claim> {
             .iter()
             .map(|(_, e)| e.glcm3d - e.taxel_mean)
             .collect();
-        out.push(Claim::new(
-            "E1: the margin shrinks from the slowest to the fastest speed",
-            margins.first() > margins.last(),
-            by_magnitude
-                .iter()
-                .zip(&margins)
-                .map(|((s, _), m)| format!("{s} mm/s: {:+.1}", 100.0 * m))
-                .collect::<Vec<_>>()
-                .join(", ")
-                + " points",
-        ));
+        let numbers = by_magnitude
+            .iter()
+            .zip(&margins)
+            .map(|((s, _), m)| format!("{s} mm/s: {:+.1}", 100.0 * m))
+            .collect::<Vec<_>>()
+            .join(", ")
+            + " points";
+        let statement = "E1: 3D-GLCM's lead over the single taxel shrinks from the slowest to the fastest speed";
+        let (slowest, first) = (by_magnitude[0].0, margins[0]);
+        let claim = if by_magnitude.iter().any(|(_, e)| e.glcm3d >= 1.0) {
+            let why = "3D-GLCM is at 100 % at some speed, where its lead is capped by the ceiling";
+            Claim::judged(statement, Verdict::NotJudged, format!("{why}: {numbers}"))
+        } else if first <= 0.0 {
+            let why = format!("3D-GLCM is not ahead at the slowest speed ({slowest} mm/s), so it has no lead to shrink");
+            Claim::judged(
+                statement,
+                Verdict::PointDisagrees,
+                format!("{why}: {numbers}"),
+            )
+        } else {
+            Claim::new(statement, margins.first() > margins.last(), numbers)
+        };
+        out.push(claim);
     }
     out
 }
@@ -331,6 +347,39 @@ fn e8_claim(r: &Results) -> Option<Claim> {
     if r.e8.is_empty() {
         return None;
     }
+    // The k skipped at some speed (training folds too small), said beside the verdict; a
+    // claim over every k says nothing on one.
+    let mut skipped: Vec<usize> = r
+        .skipped
+        .keys()
+        .filter_map(|key| key.strip_prefix("e8 k=")?.split(' ').next()?.parse().ok())
+        .collect();
+    skipped.sort_unstable();
+    skipped.dedup();
+    let ks = |list: &[usize]| {
+        list.iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let not_run = match skipped.is_empty() {
+        true => String::new(),
+        false => format!(
+            "; k = {} not evaluated at every speed: their training folds are too small, as Skipped lists",
+            ks(&skipped)
+        ),
+    };
+    if r.e8.values().all(|e| e.k.len() < 2) {
+        let evaluated: Vec<usize> = r.e8.values().flat_map(|e| e.k.clone()).collect();
+        return Some(Claim::judged(
+            "E8: 3D-GLCM stays ahead for every k",
+            Verdict::NotJudged,
+            format!(
+                "a single k evaluated at each speed (k = {}){not_run}",
+                ks(&evaluated)
+            ),
+        ));
+    }
     let paired = r.e8.values().all(|e| e.glcm3d_vs_taxel.len() == e.k.len());
     if !paired {
         return Some(Claim::new(
@@ -356,7 +405,8 @@ fn e8_claim(r: &Results) -> Option<Claim> {
                 format!("{s} mm/s: {}", per_k.join(", "))
             })
             .collect::<Vec<_>>()
-            .join("; "),
+            .join("; ")
+            + &not_run,
     ))
 }
 
@@ -465,6 +515,65 @@ mod tests {
                 assert_eq!(verdict, expected, "{statement}");
             }
         }
+    }
+
+    #[test]
+    fn a_lead_at_the_ceiling_or_on_one_k_is_not_judged_and_no_lead_cannot_shrink() {
+        let run = small_run();
+        let mut r = results_with(
+            &compare_shares(
+                ("a", &[(0, 1.0), (1, 1.0)]),
+                ("b", &[(0, 0.0), (1, 0.0)]),
+                &run.params,
+            )
+            .unwrap(),
+        );
+        r.e1 = super::super::e1_accuracy(&run.context()).unwrap();
+        assert!(r.e1.len() >= 2, "the small run has two speeds");
+        let lead = |r: &Results| {
+            claims(r)
+                .into_iter()
+                .find(|c| c.statement.contains("lead over the single taxel shrinks"))
+                .unwrap()
+        };
+        let set = |r: &mut Results, glcm3d: [f64; 2], taxel: [f64; 2]| {
+            for (i, e) in r.e1.values_mut().enumerate() {
+                (e.glcm3d, e.taxel_mean) = (glcm3d[i], taxel[i]);
+            }
+        };
+        set(&mut r, [0.9, 0.7], [0.5, 0.5]);
+        assert_eq!(lead(&r).verdict, Verdict::PointAgrees);
+        set(&mut r, [1.0, 0.9], [0.5, 0.5]);
+        let at_ceiling = lead(&r);
+        assert_eq!(at_ceiling.verdict, Verdict::NotJudged);
+        assert!(
+            at_ceiling.detail.contains("ceiling"),
+            "{}",
+            at_ceiling.detail
+        );
+        // behind at both speeds, and less so at the fastest: no lead shrank
+        set(&mut r, [0.3, 0.45], [0.5, 0.5]);
+        let behind = lead(&r);
+        assert_eq!(behind.verdict, Verdict::PointDisagrees);
+        assert!(
+            behind.detail.contains("no lead to shrink"),
+            "{}",
+            behind.detail
+        );
+
+        // E8 with one k left at each speed, the others skipped
+        for e in r.e8.values_mut() {
+            e.k.truncate(1);
+            e.glcm3d_vs_taxel.truncate(1);
+        }
+        r.skipped
+            .insert("e8 k=5 at 10 mm/s".into(), "too few".into());
+        let e8 = claims(&r)
+            .into_iter()
+            .find(|c| c.statement.starts_with("E8"))
+            .unwrap();
+        assert_eq!(e8.verdict, Verdict::NotJudged);
+        assert!(e8.detail.contains("a single k") && e8.detail.contains("k = 5 not evaluated"));
     }
 
     #[test]

@@ -45,6 +45,20 @@ pub struct E3 {
     pub unperturbed_vs_moved: Vec<Comparison>,
 }
 
+/// The counts of taxels to move that were asked for but exceed the grid's taxels (a 3x3
+/// grid cannot move 16), said in the report's Skipped list rather than dropped unseen.
+pub fn counts_beyond_the_grid(c: &Context) -> Option<Skip> {
+    let taxels = c.prepared.grid.taxels().count();
+    let counts: Vec<usize> = c
+        .params
+        .e3_counts
+        .iter()
+        .copied()
+        .filter(|&n| n > taxels)
+        .collect();
+    (!counts.is_empty() && taxels >= 2).then_some(Skip::TaxelsBeyondTheGrid { counts, taxels })
+}
+
 /// E3 for every asked n the grid allows (2 up to its taxel count), each over
 /// `e3_repeats` draws with a single CV shuffle each.
 ///
@@ -194,6 +208,32 @@ fn perturbation(taxels: &[usize], cells: usize, n: usize, rng: &mut ChaCha8Rng) 
 mod tests {
     use super::super::testing::small_run;
     use super::*;
+
+    #[test]
+    fn counts_beyond_the_grid_are_said_not_dropped() {
+        let run = small_run();
+        let taxels = run.prepared.grid.taxels().count();
+        let params = super::super::ReproduceParams {
+            e3_counts: vec![4, taxels, taxels + 1, 99],
+            ..super::super::ReproduceParams::default()
+        }
+        .check()
+        .unwrap();
+        let c = Context {
+            params: &params,
+            ..run.context()
+        };
+        let skip = counts_beyond_the_grid(&c).expect("two counts beyond the grid");
+        assert_eq!(
+            skip,
+            Skip::TaxelsBeyondTheGrid {
+                counts: vec![taxels + 1, 99],
+                taxels
+            }
+        );
+        assert_eq!(skip.key(), format!("e3 n > {taxels}"));
+        assert!(counts_beyond_the_grid(&run.context()).is_none());
+    }
 
     #[test]
     fn every_chosen_taxel_moves_and_no_other_cell_does() {

@@ -264,6 +264,9 @@ pub const ANALYSES: [Analysis; 11] = [
         id: "e3",
         asks: "spatial perturbation: taxels moved",
         run: |c, r| {
+            if let Some(skip) = e3_perturbation::counts_beyond_the_grid(c) {
+                r.skip(&skip);
+            }
             r.e3 = Some(e3_perturbation(c)?);
             Ok(())
         },

@@ -8,6 +8,14 @@ pub enum Skip {
     /// E3 needs at least two taxels to move.
     #[error("fewer than 2 taxels to move")]
     TooFewTaxels,
+    /// E3: counts of taxels to move beyond the grid's taxels, left out.
+    #[error("{} taxels moved asked for, but the grid has {taxels} taxels", list(.counts))]
+    TaxelsBeyondTheGrid {
+        /// The counts left out.
+        counts: Vec<usize>,
+        /// The grid's taxels.
+        taxels: usize,
+    },
     /// E6 trains on other speeds.
     #[error("the dataset has only one speed; E6 needs at least two")]
     OneSpeed,
@@ -39,12 +47,19 @@ impl Skip {
     pub fn key(&self) -> String {
         match self {
             Skip::TooFewTaxels => "e3".into(),
+            Skip::TaxelsBeyondTheGrid { taxels, .. } => format!("e3 n > {taxels}"),
             Skip::OneSpeed => "e6".into(),
             Skip::OneSpeedE9 => "e9".into(),
             Skip::Causal { speed, .. } => format!("e5c at {speed} mm/s"),
             Skip::Neighbours { k, speed, .. } => format!("e8 k={k} at {speed} mm/s"),
         }
     }
+}
+
+/// `2, 3, 4` for the counts `[2, 3, 4]`.
+fn list(counts: &[usize]) -> String {
+    let all: Vec<String> = counts.iter().map(usize::to_string).collect();
+    all.join(", ")
 }
 
 /// How an analysis stops early: skipped for a reason of the data, or failed.

@@ -780,7 +780,7 @@ class Reproduction:
     each figure as SVG and PNG); ``results``: ``results.json`` as a dict (every analysis:
     ``e1`` .. ``e9``, ``encoder_sensitivity``, ``taxels``, ``provenance``, ...); ``claims``: the paper's claims
     judged on these results, each a dict with ``statement``, ``verdict`` (``holds``,
-    ``not_shown``, ``contradicted``, ``point_agrees``, ``point_disagrees``), ``holds``
+    ``not_shown``, ``contradicted``, ``point_agrees``, ``point_disagrees``, ``not_judged``), ``holds``
     and ``detail``; ``headline``: E1 by speed in mm/s, each a dict of accuracies
     (``glcm3d``, ``taxel_mean``, ``taxel_best``, ``chance``, ``majority``, ``n``);
     ``gain_calibration``: what ``gain="auto"`` chose; ``predictions``: the headline

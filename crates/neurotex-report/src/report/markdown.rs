@@ -83,7 +83,7 @@ fn header(r: &Results, ctx: &ReportContext) -> String {
     format!(
         "# neurotex reproduction of Gupta, Nakagawa, Lepora and Thakor\n\n\
          \"Spatio-temporal encoding improves neuromorphic tactile texture classification\": every analysis of the paper (E0-E8) run on the data below{}. **Our numbers are not the paper's**: we do not have its recordings, so the paper's values stand beside ours for comparison only; nothing was tuned to approach them.\n\n\
-         Produced by `{}` in {:.1} s.\n\n",
+         Produced by `{}`; its analyses took {:.1} s, reading and encoding the recordings included (writing this report and its figures not).\n\n",
         beyond, ctx.command, ctx.total_seconds
     )
 }
