@@ -127,6 +127,33 @@ fn raw_logs_predict_stream_and_encode_as_their_imported_copies() {
     dir.ok(&["encode", s(&each_log(&dataset)[0]), "--out", s(&b)]);
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
 
+    // Another time column than the layout's has its own unit: the same log stamped in
+    // seconds from 0 under `time_s` is read in seconds, not in the layout's ms.
+    let text = std::fs::read_to_string(first).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().replacen("timestamp", "time_s", 1);
+    let mut seconds = format!("{header}\n");
+    let mut t0 = None;
+    for line in lines {
+        let (stamp, rest) = line.split_once(',').unwrap();
+        let ms: u64 = stamp.parse().unwrap();
+        let rel = ms - *t0.get_or_insert(ms);
+        seconds.push_str(&format!("{}.{:03},{rest}\n", rel / 1000, rel % 1000));
+    }
+    let in_seconds = dir.join("seconds.csv");
+    std::fs::write(&in_seconds, seconds).unwrap();
+    let c = dir.join("seconds.npy");
+    let args = [
+        "--layout",
+        s(&layout),
+        "--time-column",
+        "time_s",
+        "--out",
+        s(&c),
+    ];
+    dir.ok(&[&["encode", s(&in_seconds)][..], &args].concat());
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&c).unwrap());
+
     // stream: a causal model streams the raw log with no options, line for line as the copy
     let (_, causal) = import_and_train(&dir, &logs, "dc", &reading, true);
     let stream = |file: &Path| dir.ok(&["stream", "--model", s(&causal), "--input", s(file)]);

@@ -399,6 +399,12 @@ impl CsvOverrides {
             base.delimiter = Some(d);
         }
         if let Some(col) = &self.time_column {
+            // Another time column than the layout's: its unit is its own (a `_s` in its
+            // name, else the rate check), not the one the layout gave for its column.
+            if base.time_column.as_ref() != Some(col) {
+                base.time_unit = TimeUnit::default();
+                base.unit_given = false;
+            }
             base.time_column = Some(col.clone());
             base.detect_time = false;
         }
@@ -464,7 +470,7 @@ pub fn choose_columns(
     let message = match reasons.as_slice() {
         [one] => one.clone(),
         [own, others @ ..] => format!(
-            "{own}; nor read another way it may be written ({})",
+            "{own}; nor read another way it may be written ({}); name its columns with --time-column and --channels (or --no-header), or give a --layout",
             others.join("; ")
         ),
         [] => "no format to read it with".to_string(),

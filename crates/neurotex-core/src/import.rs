@@ -93,6 +93,17 @@ impl NamePattern {
         })
     }
 
+    /// The pattern as written: literal text and `{field}`s.
+    pub fn text(&self) -> String {
+        self.parts
+            .iter()
+            .map(|part| match part {
+                Part::Literal(text) => text.clone(),
+                Part::Field(name) => format!("{{{name}}}"),
+            })
+            .collect()
+    }
+
     /// The fields of `name`, or `None` when it does not match. Fields match as few
     /// characters as possible (at least one) such that the rest still matches; `speed` and
     /// `force` only match numbers and `trial` only integers, so a label may contain the
@@ -225,7 +236,13 @@ fn meta_from_name(path: &Path, pattern: Option<&NamePattern>) -> Result<Meta> {
     };
     let fields = pattern
         .matches(&name)
-        .ok_or_else(|| invalid(path, "file name does not match --name-pattern"))?;
+        .ok_or_else(|| {
+            let message = format!(
+                "the file name does not match --name-pattern `{}` (text outside {{fields}} must match exactly, case included)",
+                pattern.text()
+            );
+            invalid(path, message)
+        })?;
     for (key, value) in fields {
         let number = |what: &str| -> Result<f64> {
             value

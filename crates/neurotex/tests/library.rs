@@ -4,6 +4,7 @@
 
 mod calibration;
 mod classifiers;
+mod docs_numbers;
 mod e9;
 mod extensions;
 mod golden;

@@ -28,7 +28,7 @@ use crate::analysis::{Columns, FeatureTable, Outcome, Split};
 use crate::classify::draws::for_each_resample;
 use crate::classify::metrics::sign_flip_p;
 use crate::classify::stats::percentile;
-use crate::classify::{group_folds, stratified_folds, ValidCv};
+use crate::classify::{group_folds, stratified_folds, wilson_interval, ValidCv};
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::recording::{Meta, Selection};
 
@@ -144,7 +144,8 @@ pub struct Ranked {
     pub classifier: String,
     /// Accuracy, 0..1: the mean over conditions of the protocol.
     pub accuracy: f64,
-    /// 95 % percentile-bootstrap interval of the accuracy over units.
+    /// 95 % percentile-bootstrap interval of the accuracy over units (the Wilson score
+    /// interval over the units where every one was right, or every one wrong).
     pub ci: [f64; 2],
     /// Two-sided p-value of the paired sign-flip test against the paper's method (`None`
     /// for the paper's method itself, or when it is not among the candidates).
@@ -502,7 +503,17 @@ impl Units {
             })));
         });
         means.sort_by(f64::total_cmp);
-        [percentile(&means, 0.025), percentile(&means, 0.975)]
+        let (lower, upper) = (percentile(&means, 0.025), percentile(&means, 0.975));
+        // Every unit right (or every one wrong): no resample differs, and the bootstrap is
+        // a point; the Wilson score interval over the units gives the spread instead.
+        if lower == upper && (lower == 0.0 || lower == 1.0) {
+            let n: usize = sizes.iter().sum();
+            let correct = if lower == 1.0 { n } else { 0 };
+            if let Ok(w) = wilson_interval(correct, n) {
+                return [w.lower, w.upper];
+            }
+        }
+        [lower, upper]
     }
 
     /// Per unit, the mean share of `a` minus that of `b`.
