@@ -166,6 +166,23 @@ fn raw_logs_predict_stream_and_encode_as_their_imported_copies() {
 fn headerless_semicolon_logs_are_read_by_index_as_imported() {
     let dir = Dir::new();
     let logs = raw_logs(&dir, "logs", true);
+    // Without --time-column the epoch stamps would be a seventeenth taxel: refused.
+    let out = dir.join("stamps_as_taxel");
+    let err = dir.fails(&[
+        "import",
+        "csv",
+        s(&logs),
+        "--out",
+        s(&out),
+        "--no-header",
+        "--fs",
+        "500",
+    ]);
+    assert!(
+        err.contains("column `0` rises on every row") && err.contains("--time-column 0"),
+        "{err}"
+    );
+    assert!(!out.exists());
     let reading = ["--no-header", "--time-column", "0", "--channels", "1-16"];
     let (dataset, model) = import_and_train(&dir, &logs, "ds", &reading, false);
     let layout = std::fs::read_to_string(dataset.join("layout.toml")).unwrap();

@@ -821,32 +821,50 @@ fn check_no_stamps_among_channels(
     log: &CsvLog,
 ) -> Result<()> {
     let n = columns.channels.len();
-    if columns.time.is_some() || !format.header || n < 2 || log.samples.len() < 3 * n {
+    if columns.time.is_some() || n < 2 || log.samples.len() < 3 * n {
         return Ok(());
     }
-    let name = &columns.names[columns.channels[0]];
+    let column = columns.channels[0];
+    let name = match format.header {
+        true => columns.names[column].clone(),
+        false => column.to_string(),
+    };
     let lower = name.trim().to_lowercase();
-    let timelike = lower == "t"
-        || lower.starts_with("time")
-        || lower.contains("stamp")
-        || unit_in_name(&lower).is_some_and(|_| lower.starts_with("t"));
+    let timelike = format.header
+        && (lower == "t"
+            || lower.starts_with("time")
+            || lower.contains("stamp")
+            || unit_in_name(&lower).is_some_and(|_| lower.starts_with("t")));
     let first = log.samples.iter().step_by(n);
     let rising = first.clone().zip(first.skip(1)).all(|(a, b)| b > a);
-    if !(timelike && rising) {
+    // A host's clock since the Unix epoch: 1.7e9 s, 1.7e12 ms, 1.7e15 us; no taxel reads
+    // that much while rising on every row.
+    let epoch = log.samples[0] >= EPOCH_LIKE;
+    if !(rising && (timelike || epoch)) {
         return Ok(());
     }
+    let why = match timelike {
+        true => "is named like time stamps and rises on every row".to_string(),
+        false => format!(
+            "rises on every row from {}, like a clock's stamps since an epoch",
+            log.samples[0]
+        ),
+    };
     let message = format!(
-        "column `{}` is named like time stamps and rises on every row, but no time column \
-         was chosen, so it would be read as a taxel: name it as the time column \
-         (`import csv --time-column {}`, or `time_column = \"{}\"` in the layout.toml given \
-         with these files, with its unit if it is not ms), or choose the taxel columns \
-         (`--channels`, or `channels` in the layout)",
-        excerpt(name),
-        excerpt(name),
-        excerpt(name),
+        "column `{}` {why}, but no time column was chosen, so it would be read as a taxel: \
+         name it as the time column (`import csv --time-column {}`, or `time_column = \"{}\"` \
+         in the layout.toml given with these files, with its unit if it is not ms), or \
+         choose the taxel columns (`--channels`, or `channels` in the layout)",
+        excerpt(&name),
+        excerpt(&name),
+        excerpt(&name),
     );
     Err(invalid(path, message))
 }
+
+/// The least first value of a rising first column taken for a clock's stamps since an
+/// epoch rather than a taxel (a billion: 2001 in seconds since 1970).
+const EPOCH_LIKE: f64 = 1e9;
 
 /// A column named `t_ms` or `time_ms` (in ms), else `t_s` or `time_s` (in s).
 fn detect_time_column(names: &[String]) -> (Option<usize>, TimeUnit) {
