@@ -66,6 +66,25 @@ impl TaxelDiagnostics {
         saturated.map(|t| t.taxel.as_str()).collect()
     }
 
+    /// What to change when most taxels do not respond: silent ones want a higher gain,
+    /// ones at the ceiling most often a signal riding on a resting offset (normalised by
+    /// its maximum, it stays near 1 throughout) or a lower gain. `None` when most respond.
+    pub fn advice(&self) -> Option<String> {
+        let n = self.taxels.len();
+        let (silent, saturated) = (self.silent().len(), self.saturated().len());
+        if 2 * saturated > n {
+            Some(format!(
+                "{saturated} of {n} taxels fire at the encoder's ceiling in most recordings, so they carry little of the texture: a signal riding on a large resting offset stays near its maximum throughout; remove the offset (--baseline min, or baseline in layout.toml), or let --gain auto choose a lower gain"
+            ))
+        } else if 2 * silent > n {
+            Some(format!(
+                "{silent} of {n} taxels never fire in most recordings, so they carry nothing of the texture: --gain auto chooses a gain from the data (a median rate over the training recordings)"
+            ))
+        } else {
+            None
+        }
+    }
+
     /// Whether taxel `name` (`r{row}c{col}`) responds; unknown names do not.
     pub fn responsive(&self, name: &str) -> bool {
         self.taxels
@@ -162,5 +181,40 @@ mod tests {
         let per = [acc(0, 0, 0.2), acc(0, 1, 0.9), acc(1, 0, 0.4)];
         assert_eq!(d.responsive_mean(&per), Some(0.9));
         assert_eq!(d.responsive_mean(&per[..1]), None);
+    }
+
+    #[test]
+    fn most_taxels_silent_or_at_the_ceiling_say_what_to_change() {
+        let taxel = |name: &str, silent_share: f64, saturated_share: f64| TaxelResponse {
+            taxel: name.into(),
+            silent_share,
+            saturated_share,
+        };
+        let of = |taxels: Vec<TaxelResponse>| TaxelDiagnostics {
+            ceiling_hz: 16.0,
+            taxels,
+        };
+        let saturated = of(vec![
+            taxel("r0c0", 0.0, 1.0),
+            taxel("r0c1", 0.0, 0.9),
+            taxel("r1c0", 0.0, 0.6),
+            taxel("r1c1", 0.0, 0.0),
+        ]);
+        let advice = saturated.advice().expect("3 of 4 at the ceiling");
+        assert!(
+            advice.starts_with("3 of 4 taxels fire at the encoder's ceiling"),
+            "{advice}"
+        );
+        assert!(advice.contains("--baseline min"), "{advice}");
+        let silent = of(vec![
+            taxel("r0c0", 1.0, 0.0),
+            taxel("r0c1", 0.8, 0.0),
+            taxel("r1c0", 0.0, 0.0),
+        ]);
+        let advice = silent.advice().expect("2 of 3 silent");
+        assert!(advice.starts_with("2 of 3 taxels never fire") && advice.contains("--gain auto"));
+        // half silent is not most
+        let half = of(vec![taxel("r0c0", 1.0, 0.0), taxel("r0c1", 0.0, 0.0)]);
+        assert_eq!(half.advice(), None);
     }
 }

@@ -46,6 +46,9 @@ pub struct Evaluation {
     pub interval: Interval,
     /// Silent and saturated taxels, when every taxel was scored alone.
     pub taxels: Option<TaxelDiagnostics>,
+    /// What to change when most taxels are silent or at the encoder's ceiling
+    /// ([`TaxelDiagnostics::advice`]), whatever the method.
+    pub advice: Option<String>,
     /// The grid's columns, to print per-taxel accuracies in place.
     pub cols: usize,
     /// Each table row's recording, for the out-of-fold predictions.
@@ -85,6 +88,7 @@ impl Evaluation {
             }
             _ => None,
         };
+        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?.advice();
         Self::new(
             outcome,
             method.name(),
@@ -95,6 +99,7 @@ impl Evaluation {
             table.metas,
             seed,
         )
+        .map(|e| Self { advice, ..e })
     }
 
     /// KNN over the van Rossum distances (kernel `tau_ms`) between the encoded
@@ -123,6 +128,7 @@ impl Evaluation {
         let candidate = candidates(encoded, grid, pipeline.params(), &set, 0.0)?.remove(0);
         let outcome = (candidate.evaluate)(&candidate.table, Columns::All, split)?;
         let metas = candidate.table.metas.clone();
+        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?.advice();
         Self::new(
             outcome,
             VAN_ROSSUM,
@@ -133,6 +139,7 @@ impl Evaluation {
             metas,
             seed,
         )
+        .map(|e| Self { advice, ..e })
     }
 
     /// The evaluation of `outcome`, its metrics and interval computed.
@@ -155,6 +162,7 @@ impl Evaluation {
             tau_ms,
             split: split.clone(),
             taxels,
+            advice: None,
             cols: grid.cols(),
             metas,
         })
@@ -175,6 +183,9 @@ impl Evaluation {
         }
         value["metrics"] = serde_json::to_value(&self.metrics)?;
         value["accuracy_interval"] = serde_json::to_value(&self.interval)?;
+        if let Some(advice) = &self.advice {
+            value["warning"] = advice.as_str().into();
+        }
         if let Some(taxels) = &self.taxels {
             let per = self.outcome.per_taxel.as_deref().unwrap_or_default();
             let mut t = serde_json::to_value(taxels)?;
@@ -211,6 +222,9 @@ impl Evaluation {
         confusion_text(&mut out, outcome);
         if let Some(taxels) = &self.taxels {
             taxels_text(&mut out, taxels, outcome);
+        }
+        if let Some(advice) = &self.advice {
+            let _ = writeln!(out, "warning: {advice}");
         }
         out
     }

@@ -148,8 +148,12 @@ fn taxel_diagnostics(r: &Results) -> String {
             _ => "no taxel in any recording".to_string(),
         }
     };
+    let advice = match d.advice() {
+        Some(advice) => format!("**Warning:** {advice}.\n\n"),
+        None => String::new(),
+    };
     format!(
-        "Taxels silent (no spike) in most recordings: {}; most often silent: {}. Taxels at the encoder's ceiling (at least {:.0} % of the {:.0} Hz a neuron reaches at the largest normalised input) in most recordings: {}; most often: {}. A silent or saturated taxel scores about the majority share whatever the texture, so the single-taxel mean is also given over the responsive taxels.\n\n",
+        "Taxels silent (no spike) in most recordings: {}; most often silent: {}. Taxels at the encoder's ceiling (at least {:.0} % of the {:.0} Hz a neuron reaches at the largest normalised input) in most recordings: {}; most often: {}. A silent or saturated taxel scores about the majority share whatever the texture, so the single-taxel mean is also given over the responsive taxels.\n\n{advice}",
         named(d.silent()),
         busiest(|t| t.silent_share),
         100.0 * crate::experiments::SATURATION_SHARE,
