@@ -242,15 +242,27 @@ fn e3_claims(r: &Results) -> Vec<Claim> {
             ),
         ));
     }
-    out.push(Claim::new(
-        "E3: with the most taxels moved, 3D-GLCM falls to the single taxel (within 5 points) or below",
-        last <= e3.taxel_mean + 0.05,
-        format!(
-            "no test, a claim of similarity: {n} moved {} %, single taxel {} %",
-            pct(last),
-            pct(e3.taxel_mean)
-        ),
-    ));
+    let statement =
+        "E3: with the most taxels moved, 3D-GLCM falls to the single taxel (within 5 points) or below";
+    let numbers = format!(
+        "{n} moved {} %, single taxel {} %",
+        pct(last),
+        pct(e3.taxel_mean)
+    );
+    out.push(if e3.glcm3d <= e3.taxel_mean + 0.05 {
+        // Already there unperturbed: moving taxels cannot show the fall the claim is about.
+        let why = format!(
+            "3D-GLCM is not above the single taxel before any taxel moves (unperturbed {} %), so it has nothing to fall",
+            pct(e3.glcm3d)
+        );
+        Claim::judged(statement, Verdict::NotJudged, format!("{why}: {numbers}"))
+    } else {
+        Claim::new(
+            statement,
+            last <= e3.taxel_mean + 0.05,
+            format!("no test, a claim of similarity: {numbers}"),
+        )
+    });
     out
 }
 
@@ -560,6 +572,16 @@ mod tests {
             "{}",
             behind.detail
         );
+
+        // E3 when 3D-GLCM starts at or below the single taxel: nothing to fall
+        let e3 = r.e3.as_mut().unwrap();
+        (e3.glcm3d, e3.taxel_mean) = (0.42, 0.45);
+        let fall = claims(&r)
+            .into_iter()
+            .find(|c| c.statement.contains("falls to the single taxel"))
+            .unwrap();
+        assert_eq!(fall.verdict, Verdict::NotJudged);
+        assert!(fall.detail.contains("nothing to fall"), "{}", fall.detail);
 
         // E8 with one k left at each speed, the others skipped
         for e in r.e8.values_mut() {
