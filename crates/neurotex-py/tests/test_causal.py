@@ -17,8 +17,12 @@ from test_stream import manifest, slide_frames
 
 
 def model_json(path):
+    """A model file without what differs by design between the front ends: the training
+    data's fingerprint, and the layout files are read with (a model trained on arrays in
+    Python reads no files; the CLI's remembers its dataset's layout.toml)."""
     m = json.loads(path.read_text())
     m["training"]["dataset"].pop("fingerprint")
+    m["training"]["dataset"].pop("layout", None)
     return m
 
 
