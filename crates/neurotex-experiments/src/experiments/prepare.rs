@@ -288,6 +288,17 @@ fn causal_pipelines(
     Ok(Some(out))
 }
 
+/// The labels of `conditions` in the order they first appear.
+fn distinct_labels(conditions: &[(Speed, String)]) -> Vec<String> {
+    let mut labels: Vec<String> = Vec::new();
+    for (_, l) in conditions {
+        if !labels.contains(l) {
+            labels.push(l.clone());
+        }
+    }
+    labels
+}
+
 /// Whether the cross-validation within each speed, which E1-E5, E7, E8, E9 and E0 rest on,
 /// can run with the folds and neighbours asked for: checked on the recordings' labels and
 /// speeds before any is read, so that a design too small stops at once, naming the speed,
@@ -382,12 +393,7 @@ pub fn prepare(
         (0..n).map(|i| source.condition(i)).collect::<Result<_>>()?;
     let slowest = Speed::slowest(conditions.iter().map(|c| c.0)).ok_or(DatasetError::Empty)?;
     check_design(&conditions, params)?;
-    let mut labels: Vec<String> = Vec::new();
-    for (_, l) in &conditions {
-        if !labels.contains(l) {
-            labels.push(l.clone());
-        }
-    }
+    let labels = distinct_labels(&conditions);
     let clock = Instant::now();
     let causal = causal_pipelines(source, params, &conditions)?;
     let causal_seconds = clock.elapsed().as_secs_f64();
