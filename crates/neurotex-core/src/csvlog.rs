@@ -489,6 +489,16 @@ fn reason_of(path: &Path, e: crate::Error) -> String {
 /// The first line's fields as `format` splits them: header names, or `column{index}`
 /// without a header.
 fn first_line_names(path: &Path, format: &CsvFormat) -> Result<Vec<String>> {
+    open_log(path, format).map(|(_, _, names)| names)
+}
+
+/// A reader of the log at `path` as `format` says, past its first line: the reader, the
+/// delimiter (given or detected) and the first line's fields as column names (header
+/// names, or `column{index}` without a header, the first line then still to be read).
+fn open_log(
+    path: &Path,
+    format: &CsvFormat,
+) -> Result<(csv::Reader<std::fs::File>, Delimiter, Vec<String>)> {
     let delimiter = match format.delimiter {
         Some(d) => d,
         None => detect_delimiter(path)?,
@@ -500,10 +510,11 @@ fn first_line_names(path: &Path, format: &CsvFormat) -> Result<Vec<String>> {
         .from_path(path)
         .map_err(|e| csv_error(path, e))?;
     let first = reader.headers().map_err(|e| csv_error(path, e))?;
-    Ok(match format.header {
+    let names = match format.header {
         true => first.iter().map(str::to_string).collect(),
         false => (0..first.len()).map(|j| format!("column{j}")).collect(),
-    })
+    };
+    Ok((reader, delimiter, names))
 }
 
 /// A CSV log read: its frames and what was done to its rows.
@@ -888,22 +899,7 @@ pub fn read_csv_log(path: &Path, format: &CsvFormat) -> Result<CsvLog> {
         let rule = "the largest gap between stamps must be a positive number of s";
         return Err(ParamError::new("max-gap-s", rule, format.max_gap_s).into());
     }
-    let delimiter = match format.delimiter {
-        Some(d) => d,
-        None => detect_delimiter(path)?,
-    };
-    let mut reader = csv::ReaderBuilder::new()
-        .delimiter(delimiter.byte())
-        .has_headers(format.header)
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| csv_error(path, e))?;
-    let first = reader.headers().map_err(|e| csv_error(path, e))?;
-    let names: Vec<String> = if format.header {
-        first.iter().map(str::to_string).collect()
-    } else {
-        (0..first.len()).map(|j| format!("column{j}")).collect()
-    };
+    let (mut reader, delimiter, names) = open_log(path, format)?;
     if names.is_empty() {
         return Err(invalid(path, "the file is empty"));
     }

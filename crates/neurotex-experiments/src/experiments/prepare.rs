@@ -314,33 +314,38 @@ fn check_design(conditions: &[(Speed, String)], params: &ValidReproduceParams) -
         return Ok(());
     }
     let k = params.knn().params().k;
-    let mut speeds: Vec<Speed> = conditions.iter().map(|c| c.0).collect();
-    speeds.sort_by(|a, b| a.mm_s().total_cmp(&b.mm_s()));
-    speeds.dedup();
+    // Each speed's recordings per class, counted once.
+    let per_speed: Vec<(Speed, Vec<(&str, usize)>)> =
+        Speed::distinct(conditions.iter().map(|c| c.0))
+            .into_iter()
+            .map(|speed| {
+                let mut counts: Vec<(&str, usize)> = Vec::new();
+                for (_, label) in conditions.iter().filter(|c| c.0 == speed) {
+                    match counts.iter_mut().find(|(l, _)| *l == label) {
+                        Some((_, n)) => *n += 1,
+                        None => counts.push((label, 1)),
+                    }
+                }
+                (speed, counts)
+            })
+            .collect();
+    // Stratified folds deal a speed's n recordings round-robin: the largest test fold
+    // holds ceil(n / folds), the smallest training fold the rest.
+    let training = |counts: &[(&str, usize)], folds: usize| {
+        let n: usize = counts.iter().map(|c| c.1).sum();
+        n - n.div_ceil(folds.max(1))
+    };
     // The most folds every class at every speed can fill, and with them the fewest
     // training recordings of any fold.
-    let counts = |speed: Speed| {
-        let mut counts: Vec<(String, usize)> = Vec::new();
-        for (_, label) in conditions.iter().filter(|c| c.0 == speed) {
-            match counts.iter_mut().find(|(l, _)| l == label) {
-                Some((_, n)) => *n += 1,
-                None => counts.push((label.clone(), 1)),
-            }
-        }
-        counts
-    };
-    let max_folds = speeds
+    let max_folds = per_speed
         .iter()
-        .filter_map(|&s| counts(s).iter().map(|c| c.1).min())
+        .filter_map(|(_, counts)| counts.iter().map(|c| c.1).min())
         .min()
         .unwrap_or(0);
     let smallest_training = |folds: usize| {
-        speeds
+        per_speed
             .iter()
-            .map(|&s| {
-                let n: usize = counts(s).iter().map(|c| c.1).sum();
-                n - n.div_ceil(folds.max(1))
-            })
+            .map(|(_, counts)| training(counts, folds))
             .min()
             .unwrap_or(0)
     };
@@ -354,19 +359,17 @@ fn check_design(conditions: &[(Speed, String)], params: &ValidReproduceParams) -
             )
         }
     };
-    for &speed in &speeds {
+    for (speed, counts) in &per_speed {
         let what = format!("at {speed} mm/s, the cross-validation within a speed that E1-E5, E7, E8, E9 and E0 rest on ({supports})");
-        let counts = counts(speed);
         if let Some((label, count)) = counts.iter().find(|c| c.1 < cv.folds) {
             let error = ClassifyError::ClassTooSmall {
-                label: label.clone(),
+                label: label.to_string(),
                 count: *count,
                 folds: cv.folds,
             };
             return Err(crate::Error::from(error).in_analysis(what));
         }
-        let n: usize = counts.iter().map(|c| c.1).sum();
-        let n_train = n - n.div_ceil(cv.folds);
+        let n_train = training(counts, cv.folds);
         if k > n_train {
             let error = ClassifyError::KTooLarge { k, n_train };
             return Err(crate::Error::from(error).in_analysis(what));

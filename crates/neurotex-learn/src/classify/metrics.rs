@@ -171,15 +171,7 @@ impl Interval {
     /// the [`wilson_interval`] of the `n` recordings: 12 of 12 right is [75.8 %, 100 %],
     /// not [100 %, 100 %]. Any other interval is returned as it is.
     pub fn or_wilson_at_the_bounds(self, n: usize) -> Interval {
-        let point = self.lower == self.upper;
-        let bound = self.estimate == 0.0 || self.estimate == 1.0;
-        match (point && bound, n) {
-            (true, 1..) => {
-                let correct = if self.estimate == 1.0 { n } else { 0 };
-                wilson_interval(correct, n).unwrap_or(self)
-            }
-            _ => self,
-        }
+        wilson_at_the_bounds(self.lower, self.upper, n).unwrap_or(self)
     }
 
     /// How the interval was computed, in a few words for a report or a terminal:
@@ -196,6 +188,17 @@ impl Interval {
             }
         }
     }
+}
+
+/// The [`wilson_interval`] of `n` units all right (or all wrong) when a bootstrap interval
+/// of their accuracy, `[lower, upper]`, is a point at 1 (or 0): no resample can differ
+/// there. `None` for any other interval, or no units.
+pub fn wilson_at_the_bounds(lower: f64, upper: f64, n: usize) -> Option<Interval> {
+    let point_at_a_bound = lower == upper && (lower == 0.0 || lower == 1.0);
+    if !point_at_a_bound || n == 0 {
+        return None;
+    }
+    wilson_interval(if lower == 1.0 { n } else { 0 }, n).ok()
 }
 
 /// The 95 % Wilson score interval for `correct` successes in `n` independent trials (Wilson

@@ -27,8 +27,9 @@ pub use knn::{Knn, KnnModel, KnnParams, KnnSweep, KnnSweepModel};
 pub use linear::{Linear, LinearModel, LinearParams};
 pub use metrics::{
     bootstrap_accuracy, bootstrap_mean_share, bootstrap_over_encodings, mcnemar_exact,
-    mcnemar_exact_p, t_interval_over_repeats, wilson_interval, BootstrapParams, ClassMetrics,
-    Interval, IntervalMethod, Metrics, PairedTest, PairedVerdict, Side, ValidBootstrap,
+    mcnemar_exact_p, t_interval_over_repeats, wilson_at_the_bounds, wilson_interval,
+    BootstrapParams, ClassMetrics, Interval, IntervalMethod, Metrics, PairedTest, PairedVerdict,
+    Side, ValidBootstrap,
 };
 pub use spike_distance::{
     van_rossum, van_rossum_squared, DistanceMatrix, SpikeDistanceKnn, SpikeDistanceKnnModel,

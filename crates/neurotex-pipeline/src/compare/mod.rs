@@ -28,7 +28,7 @@ use crate::analysis::{Columns, FeatureTable, Outcome, Split};
 use crate::classify::draws::for_each_resample;
 use crate::classify::metrics::sign_flip_p;
 use crate::classify::stats::percentile;
-use crate::classify::{group_folds, stratified_folds, wilson_interval, ValidCv};
+use crate::classify::{group_folds, stratified_folds, wilson_at_the_bounds, ValidCv};
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::recording::{Meta, Selection};
 
@@ -504,16 +504,10 @@ impl Units {
         });
         means.sort_by(f64::total_cmp);
         let (lower, upper) = (percentile(&means, 0.025), percentile(&means, 0.975));
-        // Every unit right (or every one wrong): no resample differs, and the bootstrap is
-        // a point; the Wilson score interval over the units gives the spread instead.
-        if lower == upper && (lower == 0.0 || lower == 1.0) {
-            let n: usize = sizes.iter().sum();
-            let correct = if lower == 1.0 { n } else { 0 };
-            if let Ok(w) = wilson_interval(correct, n) {
-                return [w.lower, w.upper];
-            }
+        match wilson_at_the_bounds(lower, upper, sizes.iter().sum()) {
+            Some(w) => [w.lower, w.upper],
+            None => [lower, upper],
         }
-        [lower, upper]
     }
 
     /// Per unit, the mean share of `a` minus that of `b`.
