@@ -119,14 +119,20 @@ fn message(err: &anyhow::Error) -> String {
 
 /// What to change when a dataset is too small for the folds or neighbours asked for.
 fn hint(err: &anyhow::Error) -> Option<String> {
-    use neurotex::error::ClassifyError;
-    let option = |name: &str, value: &str| format!("--{name} {value}");
     err.chain().find_map(|e| {
-        if let Some(c) = e.downcast_ref::<ClassifyError>() {
+        if let Some(c) = e.downcast_ref::<neurotex::error::ClassifyError>() {
             return c.hint(&option);
         }
-        e.downcast_ref::<neurotex::Error>()?
-            .classify()?
-            .hint(&option)
+        design_hint(e.downcast_ref::<neurotex::Error>()?)
     })
+}
+
+/// What to change when `err` says the data is too small for the folds or neighbours.
+fn design_hint(err: &neurotex::Error) -> Option<String> {
+    err.classify()?.hint(&option)
+}
+
+/// An option as the command line spells it (`--folds 2`).
+fn option(name: &str, value: &str) -> String {
+    format!("--{name} {value}")
 }

@@ -5,6 +5,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use neurotex::experiments::WITHIN_SPEED;
+use neurotex::progress::Progress;
 
 /// Writes `what` to `path` through `fill` with the library's [`neurotex::io::write_atomic`]
 /// (a temporary file beside it, renamed into place only when everything succeeded).
@@ -43,4 +45,41 @@ pub fn progress(len: usize, what: &str) -> ProgressBar {
     );
     bar.set_message(what.to_string());
     bar
+}
+
+/// Moves the progress bar on one event of a long workflow; where no bar is drawn (standard
+/// error is not a terminal: a log file, a pipe), says each stage on a line of its own with
+/// the time since the start, so a long run is never silent.
+pub fn show_progress(bar: &ProgressBar, event: Progress) {
+    match event {
+        Progress::Stage(name, n) => {
+            if bar.is_hidden() {
+                eprintln!("[{:7.1} s] {name} ({n} steps)", bar.elapsed().as_secs_f64());
+            }
+            bar.set_length(n as u64);
+            bar.set_position(0);
+            bar.set_message(name.to_string());
+        }
+        Progress::Tick => bar.inc(1),
+        Progress::Done(id, asks) => {
+            bar.inc(1);
+            if bar.is_hidden() {
+                let t = bar.elapsed().as_secs_f64();
+                eprintln!("[{t:7.1} s]   done: {id}, {asks}");
+            }
+        }
+        Progress::Skipped(id, asks, _) => {
+            bar.inc(1);
+            if bar.is_hidden() {
+                let t = bar.elapsed().as_secs_f64();
+                eprintln!("[{t:7.1} s]   skipped: {id}, {asks} (the report says why)");
+            }
+        }
+        Progress::TooSmall(error) => bar.suspend(|| {
+            eprintln!("warning: {WITHIN_SPEED}, which cannot run: {error}; they are skipped");
+            if let Some(hint) = crate::design_hint(error) {
+                eprintln!("hint: {hint}");
+            }
+        }),
+    }
 }

@@ -43,7 +43,7 @@ fn reproduce_on_a_dataset_writes_report_json_and_figures() {
         assert!(json["timing_s"][key].as_f64().is_some(), "timing {key}");
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(report.contains("## E1") && report.contains("| 5 |") && report.contains("paper"));
+    assert!(report.contains("(E1)\n") && report.contains("| 5 |") && report.contains("paper"));
     // E1, E4 and E6 over the default eight encodings, with the section that explains them
     let encodings = &json["encoder_sensitivity"];
     assert_eq!(encodings["encodings"], 8);
@@ -228,7 +228,7 @@ fn reproduce_group_by_keeps_groups_in_folds_and_names_a_missing_column() {
 }
 
 #[test]
-fn a_twelve_recording_pilot_runs_with_fewer_folds_and_the_error_says_how() {
+fn a_twelve_recording_pilot_runs_skipping_what_its_design_cannot_support() {
     let dir = Dir::new();
     // 3 classes x 2 speeds x 2 trials: two recordings per class at each speed.
     let ds = dir.dataset("pilot", &["A", "B", "C"], &[5.0, 10.0], 2);
@@ -241,29 +241,81 @@ fn a_twelve_recording_pilot_runs_with_fewer_folds_and_the_error_says_how() {
         s(&out),
         "--quick",
     ];
-    let err = dir.fails(&base);
+    let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap();
+    // Too few recordings for 5 folds: the analyses resting on the cross-validation within a
+    // speed are skipped, saying why and what to change, and the rest run (E6 trains on one
+    // speed and tests on the other: no folds).
+    let run = dir.run(&base);
+    assert!(run.status.success(), "{}", run.stderr);
+    for said in [
+        "warning: E1-E5, E5c, E8, E9 and the encoder's sensitivity rest on",
+        "fewer than the 5 folds",
+        "hint: --folds",
+        "skipped: e1, accuracy at each speed",
+        "skipped: e9",
+        "done: e6",
+        "done: e0",
+    ] {
+        assert!(run.stderr.contains(said), "{said}: {}", run.stderr);
+    }
+    let report = read("report.md");
     assert!(
-        err.contains("fewer than the 5 folds") && err.contains("hint: --folds"),
-        "{err}"
+        report.contains("# neurotex analyses of a tactile dataset"),
+        "{report}"
     );
-    // Folds and neighbours are checked on the manifest, before any recording is read, and
-    // the message names the speed and what the design supports.
-    let err = dir.fails(&[&base[..], &["--folds", "2"]].concat());
+    assert!(
+        report.contains("(E1)\n\nSkipped, with 8 other analyses"),
+        "{report}"
+    );
+    assert!(
+        report.contains("- e1, e2, e3, e4, e5, e5c, e8, e9, encoder sensitivity: at 5 mm/s"),
+        "{report}"
+    );
+    assert!(report.contains("| 5 | 10 |"), "E6's table: {report}");
+    assert!(
+        !out.join("figures/e1_accuracy.svg").exists(),
+        "no empty figure"
+    );
+    // With 2 folds, the training folds hold 3 recordings, fewer than k = 5: checked on the
+    // manifest before any recording is read, naming the speed and what the design supports.
+    let run = dir.run(&[&base[..], &["--folds", "2"]].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    let warned = run.stderr.split("recordings (12 steps)").next().unwrap();
     for said in [
         "at 5 mm/s",
         "at most 2 folds, and with 2 folds at most 3 neighbours",
         "k = 5 neighbours needs at least 5 training samples, got 3",
         "hint: --k",
     ] {
-        assert!(err.contains(said), "{said}: {err}");
+        assert!(warned.contains(said), "{said}: {}", run.stderr);
     }
-    assert!(!err.contains("recordings (12 steps)"), "{err}");
-    assert_eq!(err.matches("got 3").count(), 1, "said once: {err}");
-    // Under --group-by the folds follow the groups; the error still names the speed.
-    let err = dir.fails(&[&base[..], &["--folds", "2", "--group-by", "trial"]].concat());
+    assert_eq!(
+        run.stderr.matches("got 3").count(),
+        1,
+        "said once: {}",
+        run.stderr
+    );
+    let json: Value = serde_json::from_str(&read("results.json")).unwrap();
+    assert!(json
+        .get("e1")
+        .is_none_or(|e1| e1.as_object().is_some_and(|m| m.is_empty())));
     assert!(
-        err.contains("at 5 mm/s") && err.contains("hint: --k"),
-        "{err}"
+        json["skipped"]["e1"].as_str().unwrap().contains("got 3"),
+        "{json}"
+    );
+    assert!(json["e6"]["5"].is_object(), "{json}");
+    // Under --group-by the folds follow the groups and are checked where they are made:
+    // the analyses are skipped all the same, with the speed named.
+    let run = dir.run(&[&base[..], &["--folds", "2", "--group-by", "trial"]].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(run.stderr.contains("skipped: e1"), "{}", run.stderr);
+    let json: Value = serde_json::from_str(&read("results.json")).unwrap();
+    assert!(
+        json["skipped"]["e1"]
+            .as_str()
+            .unwrap()
+            .contains("at 5 mm/s"),
+        "{json}"
     );
     let run = dir.run(&[&base[..], &["--folds", "2", "--k", "3", "--repeats", "1"]].concat());
     assert!(
@@ -281,10 +333,13 @@ fn a_twelve_recording_pilot_runs_with_fewer_folds_and_the_error_says_how() {
     ] {
         assert!(run.stderr.contains(said), "{said}: {}", run.stderr);
     }
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let json: Value = serde_json::from_str(&read("results.json")).unwrap();
     assert!(json["e1"]["5"]["glcm3d"].as_f64().is_some());
-    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        json.get("skipped").is_none_or(|s| s.get("e1").is_none()),
+        "{json}"
+    );
+    let report = read("report.md");
     assert!(
         report.contains("2-fold"),
         "the report states the folds used"

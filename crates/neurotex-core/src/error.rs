@@ -247,6 +247,16 @@ pub enum ClassifyError {
 }
 
 impl ClassifyError {
+    /// Whether the data is too small for the folds or neighbours asked for: a design a
+    /// larger run skips with this reason instead of stopping (fewer folds or neighbours
+    /// would run it).
+    pub fn is_design(&self) -> bool {
+        matches!(
+            self,
+            ClassifyError::KTooLarge { .. } | ClassifyError::ClassTooSmall { .. }
+        )
+    }
+
     /// What to change when the data is too small for the folds or neighbours asked for,
     /// the options spelled by `option(name, value)` (`--folds 2` on the command line,
     /// `folds=2` in Python); `None` for the other errors.

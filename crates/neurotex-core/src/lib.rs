@@ -9,6 +9,7 @@ pub mod error;
 pub mod import;
 pub mod io;
 mod npy;
+pub mod progress;
 pub mod recording;
 #[doc(hidden)]
 pub mod simd;

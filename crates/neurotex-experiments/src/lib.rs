@@ -6,7 +6,7 @@ pub mod experiments;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
-use neurotex_core::{error, recording, values, Error, Result};
+use neurotex_core::{error, progress, recording, values, Error, Result};
 use neurotex_features::features;
 use neurotex_learn::classify;
 #[cfg(test)]

@@ -63,7 +63,7 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
         paper_comparable: false,
     };
     let text = markdown(&r, &context);
-    assert!(text.contains("## E9 (beyond the paper)"), "{text}");
+    assert!(text.contains("(E9, beyond the paper)\n"), "{text}");
     for figure in ["e9_per_speed.svg", "e9_held_out.svg", "e9_speeds.svg"] {
         assert!(text.contains(figure), "{figure}");
     }

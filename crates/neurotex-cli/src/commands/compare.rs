@@ -12,14 +12,16 @@ use neurotex::compare::candidates::{
     candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
     STANDARD_METHODS, STANDARD_TAU_MS,
 };
-use neurotex::compare::{compare, Candidate, CompareParams, Protocol};
+use neurotex::compare::{compare_with_progress, Candidate, CompareParams, Protocol};
 use neurotex::pipeline::{Encoding, Pipeline};
+use neurotex::progress::Progress;
 use neurotex::recording::{Dataset, Selection};
 use neurotex::report::comparison::{text_lines, write_comparison};
 use neurotex::Speed;
 
 use super::{calibrated_pipeline, encode_all};
 use crate::open_args::OpenArgs;
+use crate::output::{progress, show_progress};
 use crate::stage_args::StageArgs;
 
 /// Most candidates one run compares (encodings x methods x classifiers).
@@ -211,7 +213,10 @@ pub fn run(args: CompareArgs) -> Result<()> {
         indices.len(),
         params.protocol
     );
-    let comparison = compare(&candidates, &params)?;
+    let bar = progress(0, "candidates");
+    let on_progress = |p: Progress| show_progress(&bar, p);
+    let comparison = compare_with_progress(&candidates, &params, &on_progress)?;
+    bar.finish_and_clear();
     if let Some(dir) = &args.out {
         write_comparison(dir, &comparison, &args.dataset).context("writing the comparison")?;
         eprintln!("wrote {}", dir.display());

@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::ProgressBar;
-use neurotex::experiments::{claims, Progress, ReproduceParams};
+use neurotex::experiments::{claims, ReproduceParams};
+use neurotex::progress::Progress;
 use neurotex::recording::Dataset;
 use neurotex::report::reproduce::{
     reproduce, simulated_design, write_headline_predictions, Data, Run, MAX_SEEDS,
@@ -15,7 +15,7 @@ use neurotex::report::reproduce::{
 
 use super::say_calibration;
 use crate::open_args::OpenArgs;
-use crate::output::{check_output, progress, write_file};
+use crate::output::{check_output, progress, show_progress, write_file};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex reproduce`.
@@ -149,30 +149,6 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
-}
-
-/// Moves the progress bar on one event of the analyses; where no bar is drawn (standard
-/// error is not a terminal: a log file, a pipe), says each stage on a line of its own with
-/// the time since the start, so a long run is never silent.
-fn show_progress(bar: &ProgressBar, event: Progress) {
-    match event {
-        Progress::Stage(name, n) => {
-            if bar.is_hidden() {
-                eprintln!("[{:7.1} s] {name} ({n} steps)", bar.elapsed().as_secs_f64());
-            }
-            bar.set_length(n as u64);
-            bar.set_position(0);
-            bar.set_message(name.to_string());
-        }
-        Progress::Tick => bar.inc(1),
-        Progress::Done(id, asks) => {
-            bar.inc(1);
-            if bar.is_hidden() {
-                let t = bar.elapsed().as_secs_f64();
-                eprintln!("[{t:7.1} s]   done: {id}, {asks}");
-            }
-        }
-    }
 }
 
 /// The command line that produced the report, as `neurotex ...` with quoted arguments.

@@ -53,7 +53,7 @@ pub use encodings::{encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, Ove
 pub use params::{
     ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS, MAX_REPEATS,
 };
-pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, Source};
+pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, Source, WITHIN_SPEED};
 pub use provenance::Provenance;
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
 pub use skip::{Skip, Stop};
@@ -68,16 +68,7 @@ use crate::calibrate::GainCalibration;
 use crate::error::Result;
 use crate::values::{BySpeed, Speed};
 
-/// Progress events for a progress bar.
-#[derive(Debug, Clone, Copy)]
-pub enum Progress<'a> {
-    /// A stage begins with this many steps.
-    Stage(&'a str, usize),
-    /// One step of the current stage is done.
-    Tick,
-    /// One step of the current stage is done: the named analysis (id, what it asks) ended.
-    Done(&'a str, &'a str),
-}
+pub use crate::progress::Progress;
 
 /// What every analysis reads: the prepared recordings, their tables and the parameters.
 #[derive(Clone, Copy)]
@@ -236,6 +227,9 @@ pub struct Analysis {
     pub id: &'static str,
     /// What it asks, in a few words, for progress and logs.
     pub asks: &'static str,
+    /// Whether it rests on the cross-validation within each speed (the headline
+    /// evaluations); when that cannot run, the analysis is skipped with the reason.
+    pub within_speed: bool,
     /// Runs the analysis and stores its result.
     pub run: fn(&Context, &mut Results) -> Result<(), Stop>,
 }
@@ -247,6 +241,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e1",
         asks: "accuracy at each speed",
+        within_speed: true,
         run: |c, r| {
             r.e1 = e1_accuracy(c)?;
             Ok(())
@@ -255,6 +250,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e2",
         asks: "which classes are confused",
+        within_speed: true,
         run: |c, r| {
             r.e2 = Some(e2_confusion(c)?);
             Ok(())
@@ -263,6 +259,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e3",
         asks: "spatial perturbation: taxels moved",
+        within_speed: true,
         run: |c, r| {
             if let Some(skip) = e3_perturbation::counts_beyond_the_grid(c) {
                 r.skip(&skip);
@@ -274,6 +271,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e4",
         asks: "temporal information: 2D against 3D",
+        within_speed: true,
         run: |c, r| {
             r.e4 = e4_temporal(c)?;
             Ok(())
@@ -282,6 +280,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e5",
         asks: "time to recognition (offline)",
+        within_speed: true,
         run: |c, r| {
             r.e5 = e5_time_to_recognition(c)?;
             Ok(())
@@ -290,6 +289,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e5c",
         asks: "time to recognition (causal, online)",
+        within_speed: true,
         run: |c, r| {
             let (e5c, skipped) = e5_causal(c, &r.e5)?;
             skipped.iter().for_each(|s| r.skip(s));
@@ -300,6 +300,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e6",
         asks: "speed invariance: a speed held out",
+        within_speed: false,
         run: |c, r| {
             r.e6 = e6_speed_invariance(c)?;
             Ok(())
@@ -308,6 +309,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e7",
         asks: "the encoder's gain and intervals between spikes",
+        within_speed: false,
         run: |c, r| {
             if c.params.e7 {
                 r.e7 = Some(e7_gain_sweep(c)?);
@@ -318,6 +320,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e8",
         asks: "the number of neighbours",
+        within_speed: true,
         run: |c, r| {
             let (e8, skipped) = e8_neighbours(c)?;
             skipped.iter().for_each(|s| r.skip(s));
@@ -328,6 +331,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "encoder sensitivity",
         asks: "the encoder's sensitivity to rounding",
+        within_speed: true,
         run: |c, r| {
             r.encoder_sensitivity = encoder_sensitivity(c)?;
             Ok(())
@@ -336,6 +340,7 @@ pub const ANALYSES: [Analysis; 11] = [
     Analysis {
         id: "e0",
         asks: "example spike trains and volumes",
+        within_speed: false,
         run: |c, r| {
             r.e0 = Some(e0_psth(c)?);
             Ok(())
@@ -371,19 +376,24 @@ pub fn run_all(
     progress(Progress::Stage("analyses", ANALYSES.len() + 2));
     let e9 = || {
         let clock = Instant::now();
-        let e9 = if params.e9 {
-            e9_compare(prepared, params)
-                .map(Some)
-                .map_err(|stop| match stop {
-                    Stop::Failed(e) => {
-                        Stop::Failed(e.in_analysis("E9 (the standard candidates compared)"))
-                    }
+        let asks = "the standard candidates compared";
+        let e9 = match (&prepared.within_speed, params.e9) {
+            (_, false) => Ok(None),
+            (Some(reason), true) => Err(Stop::Skipped(Skip::Design {
+                analysis: "e9",
+                reason: reason.clone(),
+            })),
+            (None, true) => e9_compare(prepared, params).map(Some).map_err(|stop| {
+                match stop.design_skipped("e9") {
+                    Stop::Failed(e) => Stop::Failed(e.in_analysis(format!("E9 ({asks})"))),
                     skipped => skipped,
-                })
-        } else {
-            Ok(None)
+                }
+            }),
         };
-        progress(Progress::Done("e9", "the standard candidates compared"));
+        match &e9 {
+            Err(Stop::Skipped(skip)) => progress(Progress::Skipped("e9", asks, &skip.to_string())),
+            _ => progress(Progress::Done("e9", asks)),
+        }
         (e9, clock.elapsed().as_secs_f64())
     };
     let (ordered, (e9, e9_seconds)) =
@@ -431,9 +441,23 @@ fn run_ordered(
     let mut before_e9 = true;
     for analysis in &ANALYSES {
         let clock = Instant::now();
-        match (analysis.run)(&context, results) {
-            Ok(()) => {}
-            Err(Stop::Skipped(skip)) => results.skip(&skip),
+        let ran = match (&tables.within_speed, analysis.within_speed) {
+            (Some(reason), true) => Err(Stop::Skipped(Skip::Design {
+                analysis: analysis.id,
+                reason: reason.clone(),
+            })),
+            _ => (analysis.run)(&context, results),
+        };
+        match ran.map_err(|stop| stop.design_skipped(analysis.id)) {
+            Ok(()) => progress(Progress::Done(analysis.id, analysis.asks)),
+            Err(Stop::Skipped(skip)) => {
+                progress(Progress::Skipped(
+                    analysis.id,
+                    analysis.asks,
+                    &skip.to_string(),
+                ));
+                results.skip(&skip);
+            }
             Err(Stop::Failed(error)) => {
                 let what = format!("{} ({})", analysis.id.to_uppercase(), analysis.asks);
                 return Err((before_e9, error.in_analysis(what)));
@@ -441,7 +465,6 @@ fn run_ordered(
         }
         let seconds = clock.elapsed().as_secs_f64();
         results.timing_s.insert(analysis.id.into(), seconds);
-        progress(Progress::Done(analysis.id, analysis.asks));
         before_e9 &= analysis.id != "e8";
     }
     Ok(())

@@ -226,9 +226,17 @@ pub struct Prepared {
     ///
     /// [`ReproduceParams::encoder_draws`]: super::ReproduceParams::encoder_draws
     pub perturbed: Vec<Vec<Encoded>>,
+    /// Why the cross-validation within a speed cannot run with the folds and neighbours
+    /// asked for ([`WITHIN_SPEED`]), found on the labels and speeds before any recording
+    /// was read; the analyses resting on it are skipped with this reason.
+    pub within_speed: Option<String>,
     /// Seconds the pass took.
     pub seconds: f64,
 }
+
+/// The analyses that rest on the cross-validation within each speed.
+pub const WITHIN_SPEED: &str =
+    "E1-E5, E5c, E8, E9 and the encoder's sensitivity rest on the cross-validation within each speed";
 
 impl Prepared {
     /// The recordings at `speed`.
@@ -299,11 +307,11 @@ fn distinct_labels(conditions: &[(Speed, String)]) -> Vec<String> {
     labels
 }
 
-/// Whether the cross-validation within each speed, which E1-E5, E7, E8, E9 and E0 rest on,
-/// can run with the folds and neighbours asked for: checked on the recordings' labels and
-/// speeds before any is read, so that a design too small stops at once, naming the speed,
-/// what the design supports and the option to change. Under `group_by` the folds follow
-/// the groups and are checked where they are made.
+/// Whether the cross-validation within each speed ([`WITHIN_SPEED`]) can run with the
+/// folds and neighbours asked for: checked on the recordings' labels and speeds before any
+/// is read, so that a design too small is known at once, naming the speed and what the
+/// design supports. Under `group_by` the folds follow the groups and are checked where
+/// they are made.
 ///
 /// # Errors
 /// A class with fewer recordings than folds at some speed, or training folds smaller than
@@ -360,7 +368,7 @@ fn check_design(conditions: &[(Speed, String)], params: &ValidReproduceParams) -
         }
     };
     for (speed, counts) in &per_speed {
-        let what = format!("at {speed} mm/s, the cross-validation within a speed that E1-E5, E7, E8, E9 and E0 rest on ({supports})");
+        let what = format!("at {speed} mm/s, the cross-validation within a speed ({supports})");
         if let Some((label, count)) = counts.iter().find(|c| c.1 < cv.folds) {
             let error = ClassifyError::ClassTooSmall {
                 label: label.to_string(),
@@ -395,7 +403,10 @@ pub fn prepare(
     let conditions: Vec<(Speed, String)> =
         (0..n).map(|i| source.condition(i)).collect::<Result<_>>()?;
     let slowest = Speed::slowest(conditions.iter().map(|c| c.0)).ok_or(DatasetError::Empty)?;
-    check_design(&conditions, params)?;
+    let within_speed = check_design(&conditions, params).err().map(|e| {
+        progress(Progress::TooSmall(&e));
+        e.to_string()
+    });
     let labels = distinct_labels(&conditions);
     let clock = Instant::now();
     let causal = causal_pipelines(source, params, &conditions)?;
@@ -458,6 +469,7 @@ pub fn prepare(
         grid,
         slowest,
         labels,
+        within_speed,
         seconds: start.elapsed().as_secs_f64(),
     })
 }

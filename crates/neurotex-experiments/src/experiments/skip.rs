@@ -30,6 +30,16 @@ pub enum Skip {
         /// The calibration's reason.
         reason: String,
     },
+    /// The design is too small for the folds or neighbours asked for (the cross-validation
+    /// within each speed that most analyses rest on, or E6's training speeds): the analysis
+    /// cannot run. The key is the analysis's own.
+    #[error("{reason}")]
+    Design {
+        /// The analysis's id (`e1`, `encoder sensitivity`).
+        analysis: &'static str,
+        /// Why, with what the design supports.
+        reason: String,
+    },
     /// E8: this `k` cannot be evaluated at this speed.
     #[error("{reason}")]
     Neighbours {
@@ -52,6 +62,7 @@ impl Skip {
             Skip::OneSpeedE9 => "e9".into(),
             Skip::Causal { speed, .. } => format!("e5c at {speed} mm/s"),
             Skip::Neighbours { k, speed, .. } => format!("e8 k={k} at {speed} mm/s"),
+            Skip::Design { analysis, .. } => (*analysis).into(),
         }
     }
 }
@@ -71,6 +82,25 @@ pub enum Stop {
     /// The analysis failed; the run stops.
     #[error(transparent)]
     Failed(#[from] crate::Error),
+}
+
+impl Stop {
+    /// This stop, a failure because the data is too small for the folds or neighbours
+    /// asked for ([`ClassifyError::is_design`]) turned into a skip of `analysis` with the
+    /// reason: a larger run goes on without it.
+    ///
+    /// [`ClassifyError::is_design`]: crate::error::ClassifyError::is_design
+    pub fn design_skipped(self, analysis: &'static str) -> Stop {
+        match self {
+            Stop::Failed(e) if e.classify().is_some_and(|c| c.is_design()) => {
+                Stop::Skipped(Skip::Design {
+                    analysis,
+                    reason: e.to_string(),
+                })
+            }
+            other => other,
+        }
+    }
 }
 
 impl From<Skip> for Stop {

@@ -5,7 +5,7 @@
 use super::{Prepared, ValidReproduceParams};
 use crate::analysis::{evaluate, evaluate_sweep, Columns, FeatureTable, Outcome, Split};
 use crate::classify::{Knn, Sweep, ValidCv};
-use crate::error::Result;
+use crate::error::{ClassifyError, Result};
 use crate::pipeline::{Encoded, Method};
 use crate::values::{BySpeed, Speed};
 
@@ -30,8 +30,12 @@ pub struct Tables {
     pub glcm3d: FeatureTable,
     /// 2D-GLCM features.
     pub glcm2d: FeatureTable,
-    /// Both approaches by cross-validation at each speed.
+    /// Both approaches by cross-validation at each speed; empty when that cannot run
+    /// (`within_speed` says why).
     pub headline: BySpeed<Headline>,
+    /// Why the cross-validation within each speed cannot run with the folds and neighbours
+    /// asked for; the analyses resting on it are skipped with this reason.
+    pub within_speed: Option<String>,
     /// The headline evaluations of each further encoding ([`Prepared::perturbed`]), on the
     /// same folds.
     pub perturbed: Vec<BySpeed<Headline>>,
@@ -60,7 +64,23 @@ impl Tables {
         let taxel = table(encoded, Method::Taxel, params)?;
         let glcm3d = table(encoded, Method::Glcm3d, params)?;
         let glcm2d = table(encoded, Method::Glcm2d, params)?;
-        let headline = evaluate_headline(&[&taxel, &glcm3d, &glcm2d], &prepared.speeds, params)?;
+        let speeds: &[Speed] = match prepared.within_speed {
+            Some(_) => &[],
+            None => &prepared.speeds,
+        };
+        let (headline, within_speed) =
+            match evaluate_headline(&[&taxel, &glcm3d, &glcm2d], speeds, params) {
+                Ok(h) => (h, prepared.within_speed.clone()),
+                // Folds made by groups are checked only here.
+                Err(e) if e.classify().is_some_and(ClassifyError::is_design) => {
+                    (BySpeed::new(), Some(e.to_string()))
+                }
+                Err(e) => return Err(e),
+            };
+        let speeds: &[Speed] = match within_speed {
+            Some(_) => &[],
+            None => speeds,
+        };
         let (perturbed, perturbed_tables) = prepared
             .perturbed
             .iter()
@@ -69,7 +89,7 @@ impl Tables {
                     .map(|m| table(encoded, m, params));
                 let [t, g3, g2] = tables;
                 let (taxel, glcm3d) = (t?, g3?);
-                let h = evaluate_headline(&[&taxel, &glcm3d, &g2?], &prepared.speeds, params)?;
+                let h = evaluate_headline(&[&taxel, &glcm3d, &g2?], speeds, params)?;
                 Ok((h, EncodingTables { taxel, glcm3d }))
             })
             .collect::<Result<Vec<_>>>()?
@@ -80,6 +100,7 @@ impl Tables {
             glcm3d,
             glcm2d,
             headline,
+            within_speed,
             perturbed,
             perturbed_tables,
         })
@@ -102,7 +123,8 @@ impl Tables {
     /// The headline evaluations at `speed`, a speed of the prepared data.
     ///
     /// # Panics
-    /// If `speed` is not one of the prepared speeds (a caller bug).
+    /// If `speed` is not one of the prepared speeds, or the cross-validation within each
+    /// speed could not run (a caller bug: such analyses are skipped before they run).
     pub fn at(&self, speed: Speed) -> &Headline {
         self.headline
             .get(speed)
@@ -121,9 +143,7 @@ fn evaluate_headline(
         .iter()
         .map(|&s| {
             let at = |e: crate::Error| {
-                e.in_analysis(format!(
-                    "at {s} mm/s, the cross-validation within a speed that E1-E5, E7, E8 and E0 rest on"
-                ))
+                e.in_analysis(format!("at {s} mm/s, the cross-validation within a speed"))
             };
             let h = Headline {
                 taxel: cv_at(taxel, Columns::EachTaxel, s, knn, folds).map_err(at)?,

@@ -30,6 +30,7 @@ use crate::classify::metrics::sign_flip_p;
 use crate::classify::stats::percentile;
 use crate::classify::{group_folds, stratified_folds, wilson_at_the_bounds, ValidCv};
 use crate::error::{ClassifyError, ParamError, Result};
+use crate::progress::Progress;
 use crate::recording::{Meta, Selection};
 
 /// Evaluates a candidate's table (or a subset of it) under a split.
@@ -221,6 +222,19 @@ struct Scored {
 /// No candidates, tables of different recordings, or an evaluation that fails (a class
 /// smaller than the folds, a protocol column the manifest lacks).
 pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Comparison> {
+    compare_with_progress(candidates, params, &crate::progress::silent)
+}
+
+/// [`compare`], saying its progress: a step per candidate scored, then with nested
+/// selection a step per outer split.
+///
+/// # Errors
+/// As [`compare`].
+pub fn compare_with_progress(
+    candidates: &[Candidate],
+    params: &CompareParams,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Comparison> {
     let first = candidates.first().ok_or(ClassifyError::Empty {
         what: "compare: no candidates",
     })?;
@@ -232,9 +246,14 @@ pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Compa
     // Candidates are scored side by side (each is deterministic, so the order of work
     // changes nothing but its clock): one candidate's folds are too few and too unequal
     // to keep every core busy.
+    progress(Progress::Stage("candidates", candidates.len()));
     let scored: Vec<Scored> = candidates
         .par_iter()
-        .map(|c| score(c, params))
+        .map(|c| {
+            let scored = score(c, params);
+            progress(Progress::Tick);
+            scored
+        })
         .collect::<Result<_>>()?;
     let units = Units::new(metas, &scored[0].shares, params)?;
     let paper = candidates.iter().position(Candidate::is_paper);
@@ -247,7 +266,7 @@ pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Compa
         .collect::<Result<_>>()?;
     results.sort_by(|a, b| b.accuracy.total_cmp(&a.accuracy));
     let nested = if params.nested {
-        Some(nested(candidates, params, &units)?)
+        Some(nested(candidates, params, &units, progress)?)
     } else {
         None
     };
@@ -398,8 +417,13 @@ fn hold_out(column: &str, values: &[String], value: &str) -> Split {
     }
 }
 
-/// An error of one condition's evaluation, saying which condition.
+/// An error of one condition's evaluation, saying which condition; a condition too small
+/// for the folds or neighbours keeps its classification error, so that the hint and a
+/// larger run's skip can tell it apart.
 fn in_condition(e: crate::Error, column: &str, value: &str) -> crate::Error {
+    if e.classify().is_some_and(|c| c.is_design()) {
+        return e.in_analysis(format!("{column} = {value}"));
+    }
     let rule = "every condition must be evaluable on its own";
     ParamError::new("per", rule, format!("{column} = {value}: {e}")).into()
 }
@@ -675,9 +699,15 @@ fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
 /// Nested selection: inside each outer split's training rows every candidate is
 /// cross-validated (one repeat), the best is trained on all of them and tested on the
 /// split's test rows.
-fn nested(candidates: &[Candidate], params: &CompareParams, units: &Units) -> Result<Nested> {
+fn nested(
+    candidates: &[Candidate],
+    params: &CompareParams,
+    units: &Units,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Nested> {
     let metas = &candidates[0].table.metas;
     let splits = outer_splits(metas, params)?;
+    progress(Progress::Stage("nested selection", splits.len()));
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
         .map(|split| {
@@ -713,6 +743,7 @@ fn nested(candidates: &[Candidate], params: &CompareParams, units: &Units) -> Re
                 test: split.test.clone(),
             };
             let outcome = (c.evaluate)(&c.table, c.columns, &rows)?;
+            progress(Progress::Tick);
             Ok(OuterResult {
                 condition: split.condition.clone(),
                 chosen: best.1,

@@ -1022,7 +1022,10 @@ pub fn write_episodes(
         for bin in &episode.bins {
             writeln!(w, "{}", bin_json(labels, bin, file))?;
         }
-        writeln!(w, "{}", end_json(labels, &episode.summary, file))?;
+        // A whole recording was read or refused as a whole: it had no bad frame.
+        let mut end = end_json(labels, &episode.summary, file);
+        end["bad_frames"] = 0.into();
+        writeln!(w, "{end}")?;
     }
     Ok(())
 }

@@ -40,6 +40,25 @@ fn paper_cell(v: Option<f64>) -> String {
     v.map_or("-".into(), |v| v.to_string())
 }
 
+/// A section's heading: what the analysis asks, then the paper's number for it (`E6`).
+fn heading(asks: &str, id: &str) -> String {
+    format!("## {asks} ({id})\n\n")
+}
+
+/// The section of an analysis that did not run: its heading and why (`None` when it ran).
+fn skipped_section(r: &Results, key: &str, asks: &str, id: &str) -> Option<String> {
+    let why = r.skipped.get(key)?;
+    let sharing = r.skipped.values().filter(|w| *w == why).count();
+    let text = match sharing {
+        1 => format!("Skipped: {why}"),
+        n => format!(
+            "Skipped, with {} other analyses, for the reason under Skipped below.",
+            n - 1
+        ),
+    };
+    Some(heading(asks, id) + &text + "\n\n")
+}
+
 /// The whole report for `r`; deterministic for a given `r` and `ctx`.
 pub fn markdown(r: &Results, ctx: &ReportContext) -> String {
     let paper = ctx.paper();
@@ -80,11 +99,22 @@ fn header(r: &Results, ctx: &ReportContext) -> String {
         [] => String::new(),
         names => format!(", and beyond it {}", names.join(" and ")),
     };
+    let (title, what) = if ctx.paper_comparable {
+        (
+            "neurotex reproduction of Gupta, Nakagawa, Lepora and Thakor",
+            "every analysis of the paper (E0-E8) run on the data below",
+        )
+    } else {
+        (
+            "neurotex analyses of a tactile dataset",
+            "the paper's analyses, each named by what it asks with the paper's number for it (E0-E8), run on the data below",
+        )
+    };
     format!(
-        "# neurotex reproduction of Gupta, Nakagawa, Lepora and Thakor\n\n\
-         \"Spatio-temporal encoding improves neuromorphic tactile texture classification\": every analysis of the paper (E0-E8) run on the data below{}. **Our numbers are not the paper's**: we do not have its recordings, so the paper's values stand beside ours for comparison only; nothing was tuned to approach them.\n\n\
+        "# {title}\n\n\
+         Gupta, Nakagawa, Lepora and Thakor, \"Spatio-temporal encoding improves neuromorphic tactile texture classification\": {what}{beyond}. **Our numbers are not the paper's**: we do not have its recordings, so the paper's values stand beside ours for comparison only; nothing was tuned to approach them.\n\n\
          Produced by `{}`; its analyses took {:.1} s, reading and encoding the recordings included (writing this report and its figures not).\n\n",
-        beyond, ctx.command, ctx.total_seconds
+        ctx.command, ctx.total_seconds
     )
 }
 
@@ -164,7 +194,7 @@ fn taxel_diagnostics(r: &Results) -> String {
 }
 
 fn summary(r: &Results) -> String {
-    let mut out = format!("## Summary: where we agree with the paper\n\n\
+    let mut out = format!("## Summary: the paper's claims on these data\n\n\
         A claim *holds* only when a paired comparison on the same recordings (95 % bootstrap interval of the per-recording difference, resampling recordings) puts it on the paper's side at every speed; it is *not shown* when an interval holds 0, and *contradicted* when one lies on the other side. Claims without such a comparison are judged on point estimates and say so. Intervals are in brackets.{}\n\n",
         encodings_note(r)
     );
@@ -260,7 +290,11 @@ fn encodings_note(r: &Results) -> String {
 }
 
 fn e1(r: &Results, paper: Option<&Paper>) -> String {
-    let mut out = format!("## E1: accuracy per speed, single taxel vs 3D-GLCM\n\n\
+    let asks = "Accuracy per speed: single taxel against 3D-GLCM";
+    if let Some(skipped) = skipped_section(r, "e1", asks, "E1") {
+        return skipped;
+    }
+    let mut out = heading(asks, "E1") + &format!("\
         Single taxel: the paper used \"a representative taxel\" without saying which; we report the mean over all taxels as the headline, the mean over the responsive taxels (neither silent nor at the encoder's ceiling in most recordings; see Data) and the best taxel beside it (chosen after the fact, so optimistic). Chance is one over the classes recorded at that speed. Stratified cross-validation, mean over repeats (folds and repeats under Parameters); the 95 % intervals come from a percentile bootstrap over recordings (2000 resamples), each recording's predictions over repeats (and taxels) kept together; where every recording was right (or every one wrong) the bootstrap has no spread, and the Wilson score interval over the recordings is given instead.{}\n\n",
         encodings_note(r)
     );
@@ -305,11 +339,12 @@ fn e1(r: &Results, paper: Option<&Paper>) -> String {
 }
 
 fn e2(r: &Results) -> String {
+    let asks = "Which classes are confused";
     let Some(e2) = &r.e2 else {
-        return String::new();
+        return skipped_section(r, "e2", asks, "E2").unwrap_or_default();
     };
-    let mut out = format!("## E2: confusion matrices at {} mm/s\n\n\
-        Rows are the true texture, columns the prediction; counts summed over CV repeats (and over taxels for the single taxel). The paper: the single taxel confuses scotch brite (SB) and styrofoam (STF) with the rug (TRug).\n\n", e2.speed);
+    let mut out = heading(&format!("{asks}, at {} mm/s", e2.speed), "E2") + "\
+        Rows are the true texture, columns the prediction; counts summed over CV repeats (and over taxels for the single taxel). The paper: the single taxel confuses scotch brite (SB) and styrofoam (STF) with the rug (TRug).\n\n";
     for (name, m) in [
         ("single taxel (all taxels)", &e2.taxel),
         ("3D-GLCM", &e2.glcm3d),
@@ -336,12 +371,13 @@ fn e2(r: &Results) -> String {
 }
 
 fn e3(r: &Results) -> String {
+    let asks = "Spatial perturbation: taxels moved";
     let Some(e3) = &r.e3 else {
-        return String::new();
+        return skipped_section(r, "e3", asks, "E3").unwrap_or_default();
     };
-    let mut out = format!("## E3: spatial perturbation at {} mm/s\n\n\
+    let mut out = heading(&format!("{asks}, at {} mm/s", e3.speed), "E3") + &format!("\
         For each recording, n taxels chosen at random swap places among themselves (every chosen taxel moves; each recording gets its own draw); 3D-GLCM accuracy, mean over {} draws, with a 95 % interval that holds both the recordings' and the draws' variability (a bootstrap that picks one draw, then the recordings), and the standard deviation over draws. Unperturbed 3D-GLCM {} %, single taxel {} %. The paper: accuracy falls towards or below the single taxel as n grows.\n\n",
-        e3.speed, e3.repeats, pct(e3.glcm3d), pct(e3.taxel_mean));
+        e3.repeats, pct(e3.glcm3d), pct(e3.taxel_mean));
     let mut t = Table::new([
         "taxels moved",
         "3D-GLCM (%) [95 % interval]",
@@ -360,7 +396,11 @@ fn e3(r: &Results) -> String {
 }
 
 fn e4(r: &Results, paper: Option<&Paper>) -> String {
-    let mut out = "## E4: temporal information removed (2D-GLCM)\n\n".to_string();
+    let asks = "Temporal information: 2D-GLCM without the time axis";
+    if let Some(skipped) = skipped_section(r, "e4", asks, "E4") {
+        return skipped;
+    }
+    let mut out = heading(asks, "E4");
     let mut header = vec![
         "speed (mm/s)",
         "single taxel (%) [95 % interval]",
@@ -417,7 +457,11 @@ fn e5(r: &Results, paper: Option<&Paper>) -> String {
         .iter()
         .map(|(s, p)| format!("{:.0} % of the slide at {s} mm/s", 100.0 * p))
         .collect();
-    let mut out = format!("## E5: time to recognition\n\n\
+    let asks = "Time to recognition";
+    if let Some(skipped) = skipped_section(r, "e5", asks, "E5") {
+        return skipped;
+    }
+    let mut out = heading(asks, "E5") + &format!("\
         3D-GLCM on the first part of the slide against the single taxel (mean over taxels) on all of it; accuracy (%) per share of the slide used with its 95 % interval (bootstrap over recordings), \"short\" where that part is shorter than one bin. The paper: 3D-GLCM matches at {}.\n\n", stated.join(" and "));
     let fractions = e5_fractions(r);
     let speeds: Vec<Speed> = r.e5.iter().map(|(s, _)| s).collect();
@@ -466,7 +510,8 @@ fn e5(r: &Results, paper: Option<&Paper>) -> String {
 /// E5c: the causal pipeline over time, its time to decision and its cost.
 fn e5c(r: &Results) -> String {
     let Some(first) = r.e5c.values().next() else {
-        return String::new();
+        let asks = "Online time to recognition, causal";
+        return skipped_section(r, "e5c", asks, "E5c, beyond the paper").unwrap_or_default();
     };
     let mut out = e5c_intro(first.decision.rule);
     out += &e5c_whole_slides(r);
@@ -486,7 +531,7 @@ fn e5c(r: &Results) -> String {
 /// E5c's heading and what it measures, with the decision rule's numbers.
 fn e5c_intro(rule: crate::causal::DecisionRule) -> String {
     format!(
-        "## E5c (beyond the paper): online time to recognition\n\n\
+        "## Online time to recognition, causal (E5c, beyond the paper)\n\n\
          The paper's 3D-GLCM + KNN as a live classifier runs it (`neurotex stream`): causal conditioning (a forward-only low-pass; each taxel's resting value and one normalisation scale fixed per speed on **all of that speed's recordings, labels unused**, rather than inside each training fold: each recording is in some training fold, and fixing them per fold would encode every recording once per fold), trained on whole slides in the folds and repeats of E1, and classifying each test recording at every 200 ms bin boundary from the slide so far. \
          A decision is the first time one class holds at least {} of the vote in {} consecutive bins. \
          The cost of causal processing is the zero-phase 3D-GLCM (E1's folds, the encoding as run: the first column of The encoder's sensitivity, not E1's mean over encodings) minus the causal one on whole slides, per recording on the same folds (95 % bootstrap interval over recordings; a positive difference is accuracy lost).\n\n",
@@ -605,8 +650,10 @@ fn trained_on(all: &[Speed], test: Speed, train: &[Speed]) -> String {
 }
 
 fn e6(r: &Results, paper: Option<&Paper>) -> String {
-    let mut out =
-        "## E6: speed invariance (train on the other speeds, test on one)\n\n".to_string();
+    let mut out = heading(
+        "Speed invariance: trained on the other speeds, tested on one",
+        "E6",
+    );
     if r.e6.is_empty() {
         let why = r
             .skipped
@@ -653,9 +700,13 @@ fn e7(r: &Results) -> String {
     let Some(e7) = &r.e7 else {
         return String::new();
     };
-    let mut out = format!("## E7: gain sweep at {} mm/s\n\n\
+    let asks = format!(
+        "The encoder's gain: firing rates and intervals, at {} mm/s",
+        e7.speed
+    );
+    let mut out = heading(&asks, "E7") + &format!("\
         Mean firing rate per taxel (Hz) for each gain and texture; the paper chose G = {} as the balance between sparse responses (low G) and saturated, less discriminative ones (high G).\n\n",
-        e7.speed, super::paper::PAPER_GAIN);
+        super::paper::PAPER_GAIN);
     let mut t = Table::new(std::iter::once("G").chain(e7.sweep.labels.iter().map(String::as_str)));
     for (g, rates) in e7.sweep.gains.iter().zip(&e7.rate_hz) {
         t.row(std::iter::once(g.to_string()).chain(rates.iter().map(|r| format!("{r:.1}"))));
@@ -675,11 +726,15 @@ fn e7(r: &Results) -> String {
 }
 
 fn e8(r: &Results) -> String {
+    let asks = "Robustness to the number of neighbours k";
+    if let Some(skipped) = skipped_section(r, "e8", asks, "E8") {
+        return skipped;
+    }
     let over = match r.e8.values().next().map_or(1, |e| e.encodings) {
         1 => "recordings".to_string(),
         n => format!("recordings and {n} encodings, as E1"),
     };
-    let mut out = format!("## E8: robustness to k\n\nSingle taxel (mean over taxels) and 3D-GLCM accuracy (%) for each number of neighbours k, with 95 % intervals (bootstrap over {over}). The paper: the outperformance is robust to k.\n\n");
+    let mut out = heading(asks, "E8") + &format!("Single taxel (mean over taxels) and 3D-GLCM accuracy (%) for each number of neighbours k, with 95 % intervals (bootstrap over {over}). The paper: the outperformance is robust to k.\n\n");
     let mut t = Table::new([
         "speed (mm/s)",
         "k",
@@ -706,12 +761,13 @@ fn e8(r: &Results) -> String {
 }
 
 fn e9(r: &Results) -> String {
+    let asks = "The best of `neurotex compare`'s candidates";
     let Some(e9) = &r.e9 else {
-        return String::new();
+        return skipped_section(r, "e9", asks, "E9, beyond the paper").unwrap_or_default();
     };
     let (within, held) = (&e9.per_speed, &e9.held_out);
     let mut out = format!(
-        "## E9 (beyond the paper): the best of `neurotex compare`'s candidates\n\n\
+        "## {asks} (E9, beyond the paper)\n\n\
          {} candidates (encodings, feature methods, classifiers: see `neurotex compare --help`) on the same folds: \
          accuracy (%) of the paper's method (SA, 3D-GLCM, KNN) and of the best candidate, cross-validated within each speed \
          and with each speed held out (trained on the others, E6's question). Intervals: 95 % bootstrap over {}. \
@@ -792,7 +848,7 @@ fn e0(r: &Results) -> String {
     let Some(e0) = &r.e0 else {
         return String::new();
     };
-    "## E0: PSTH and rate volume\n\n".to_string()
+    heading("Spike trains and rate volumes of two classes", "E0")
         + &figure(
             file::E0,
             "E0: PSTH of one taxel beside the rate volume of the array, for two textures",
@@ -846,10 +902,17 @@ fn skipped(r: &Results) -> String {
     if r.skipped.is_empty() {
         return String::new();
     }
-    let lines: String = r
-        .skipped
+    // One line per reason: a design too small skips every analysis of one kind alike.
+    let mut reasons: Vec<(Vec<&str>, &str)> = Vec::new();
+    for (key, why) in &r.skipped {
+        match reasons.iter_mut().find(|(_, w)| w == why) {
+            Some((keys, _)) => keys.push(key),
+            None => reasons.push((vec![key.as_str()], why.as_str())),
+        }
+    }
+    let lines: String = reasons
         .iter()
-        .map(|(k, v)| format!("- {k}: {v}\n"))
+        .map(|(keys, why)| format!("- {}: {why}\n", keys.join(", ")))
         .collect();
     format!("## Skipped\n\n{lines}\n")
 }

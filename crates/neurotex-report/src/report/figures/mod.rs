@@ -183,7 +183,9 @@ pub(crate) fn all(
         .and_then(|a| a.seeds.first())
         .map(|&seed| super::simulated_source(&[seed]));
     let source = first.as_deref().unwrap_or(source);
-    out.push((file::E1, accuracy::e1(r, paper, source)));
+    if !r.e1.is_empty() {
+        out.push((file::E1, accuracy::e1(r, paper, source)));
+    }
     if let Some(e2) = &r.e2 {
         out.push((file::E2, confusion::e2(e2, source)));
     }
@@ -191,8 +193,12 @@ pub(crate) fn all(
         let svg = perturbation::e3(e3, r.e2.as_ref(), chance(r), source);
         out.push((file::E3, svg));
     }
-    out.push((file::E4, accuracy::e4(r, paper, source)));
-    out.push((file::E5, recognition::e5(r, paper, source)));
+    if !r.e4.is_empty() {
+        out.push((file::E4, accuracy::e4(r, paper, source)));
+    }
+    if !r.e5.is_empty() {
+        out.push((file::E5, recognition::e5(r, paper, source)));
+    }
     if !r.e5c.is_empty() {
         out.push((file::E5C_ACCURACY, recognition::e5c_accuracy(r, source)));
         out.push((file::E5C_DECISION, recognition::e5c_decision(r, source)));
@@ -204,7 +210,9 @@ pub(crate) fn all(
         out.push((file::E7_RATE, gain::e7_rate(e7, source)));
         out.push((file::E7_ISI, gain::e7_isi(e7, source)));
     }
-    out.push((file::E8, neighbours::e8(r, source)));
+    if !r.e8.is_empty() {
+        out.push((file::E8, neighbours::e8(r, source)));
+    }
     if let Some(e9) = &r.e9 {
         out.push((file::E9_PER_SPEED, compare::ranking(&e9.per_speed, source)));
         out.push((file::E9_HELD_OUT, compare::ranking(&e9.held_out, source)));

@@ -1,0 +1,23 @@
+//! Progress of a long workflow (`reproduce`'s analyses, `compare`'s candidates), as events
+//! a front end turns into a progress bar or log lines.
+
+/// One event of a long workflow's progress.
+#[derive(Debug, Clone, Copy)]
+pub enum Progress<'a> {
+    /// A stage begins with this many steps.
+    Stage(&'a str, usize),
+    /// One step of the current stage is done.
+    Tick,
+    /// One step of the current stage is done: the named analysis (id, what it asks) ended.
+    Done(&'a str, &'a str),
+    /// One step of the current stage is done: the named analysis (id, what it asks) was
+    /// skipped, for the reason given.
+    Skipped(&'a str, &'a str, &'a str),
+    /// The design is too small for the folds or neighbours asked for, found before any
+    /// recording is read: the analyses resting on the cross-validation within each speed
+    /// will be skipped for this error.
+    TooSmall(&'a crate::Error),
+}
+
+/// A progress callback that ignores every event.
+pub fn silent(_: Progress) {}
