@@ -398,9 +398,11 @@ pub fn run_all(
     };
     let (ordered, (e9, e9_seconds)) =
         rayon::join(|| run_ordered(prepared, params, progress, &mut results), e9);
-    results.timing_s.insert("e9".into(), e9_seconds);
     let e9 = match e9 {
-        Ok(e9) => e9,
+        Ok(e9) => {
+            results.timing_s.insert("e9".into(), e9_seconds);
+            e9
+        }
         Err(Stop::Skipped(skip)) => {
             results.skip(&skip);
             None
@@ -449,7 +451,12 @@ fn run_ordered(
             _ => (analysis.run)(&context, results),
         };
         match ran.map_err(|stop| stop.design_skipped(analysis.id)) {
-            Ok(()) => progress(Progress::Done(analysis.id, analysis.asks)),
+            Ok(()) => {
+                progress(Progress::Done(analysis.id, analysis.asks));
+                let seconds = clock.elapsed().as_secs_f64();
+                results.timing_s.insert(analysis.id.into(), seconds);
+            }
+            // A skipped analysis has no time of its own to report.
             Err(Stop::Skipped(skip)) => {
                 progress(Progress::Skipped(
                     analysis.id,
@@ -463,8 +470,6 @@ fn run_ordered(
                 return Err((before_e9, error.in_analysis(what)));
             }
         }
-        let seconds = clock.elapsed().as_secs_f64();
-        results.timing_s.insert(analysis.id.into(), seconds);
         before_e9 &= analysis.id != "e8";
     }
     Ok(())

@@ -361,10 +361,20 @@ fn check_design(conditions: &[(Speed, String)], params: &ValidReproduceParams) -
         0 | 1 => "this design supports no cross-validation within a speed: each class needs at least 2 recordings at each speed".to_string(),
         f => {
             let folds = cv.folds.min(f);
-            format!(
-                "this design supports at most {f} folds, and with {folds} folds at most {} neighbours",
-                smallest_training(folds)
-            )
+            let most = smallest_training(folds);
+            // A class's fewest recordings in a training fold: more neighbours than that
+            // let the other classes tie or outvote it whatever the features say.
+            let per_class = per_speed
+                .iter()
+                .flat_map(|(_, counts)| counts.iter().map(|c| c.1 - c.1.div_ceil(folds)))
+                .min()
+                .unwrap_or(0);
+            let votes = if per_class < most {
+                format!("; a class has as few as {per_class} recording(s) in a training fold, so more than {per_class} neighbours can tie or outvote it")
+            } else {
+                String::new()
+            };
+            format!("this design supports at most {f} folds, and with {folds} folds at most {most} neighbours{votes}")
         }
     };
     for (speed, counts) in &per_speed {

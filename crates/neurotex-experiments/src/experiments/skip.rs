@@ -9,7 +9,7 @@ pub enum Skip {
     #[error("fewer than 2 taxels to move")]
     TooFewTaxels,
     /// E3: counts of taxels to move beyond the grid's taxels, left out.
-    #[error("{} taxels moved asked for, but the grid has {taxels} taxels", list(.counts))]
+    #[error("the counts of taxels to move {} are left out: the grid has {taxels} taxels", list(.counts))]
     TaxelsBeyondTheGrid {
         /// The counts left out.
         counts: Vec<usize>,

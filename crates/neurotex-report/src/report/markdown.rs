@@ -771,6 +771,8 @@ fn e9(r: &Results) -> String {
          {} candidates (encodings, feature methods, classifiers: see `neurotex compare --help`) on the same folds: \
          accuracy (%) of the paper's method (SA, 3D-GLCM, KNN) and of the best candidate, cross-validated within each speed \
          and with each speed held out (trained on the others, E6's question). Intervals: 95 % bootstrap over {}. \
+         E9 runs every candidate with its own number of cross-validation repeats (under Parameters; fewer than E1's by default) and on the encoding as run, \
+         so its paper's-method accuracy may differ from E1's (a mean over more repeats and encodings) by a few points. \
          **Caveat**: {}.\n\n",
         within.results.len(),
         within.units,
