@@ -167,3 +167,27 @@ fn bad_compare_options_are_clear_errors() {
         &out,
     );
 }
+
+#[test]
+fn nested_selection_too_small_for_its_inner_folds_stops_before_any_candidate_runs() {
+    let dir = Dir::new();
+    // Two recordings per class at each speed: 2 folds leave one per class in each outer
+    // training set, too few for the inner cross-validation.
+    let ds = dir.dataset("pilot", &["A", "B", "C"], &[5.0, 10.0], 2);
+    let base = ["compare", "--dataset", s(&ds), "--folds", "2", "--k", "1"];
+    let err = dir.fails(&[&base[..], &["--nested", "--per", "speed_mm_s"]].concat());
+    assert!(
+        err.contains("every class needs at least 2 recordings there")
+            && err.contains("speed_mm_s = 5"),
+        "{err}"
+    );
+    assert!(!err.contains("candidates ("), "no candidate scored: {err}");
+    // Without --nested the caveat's nested estimate is named as an option.
+    let run = dir.run(&base);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("note: --nested computes"),
+        "{}",
+        run.stderr
+    );
+}

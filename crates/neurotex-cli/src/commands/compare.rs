@@ -217,6 +217,9 @@ pub fn run(args: CompareArgs) -> Result<()> {
     let on_progress = |p: Progress| show_progress(&bar, p);
     let comparison = compare_with_progress(&candidates, &params, &on_progress)?;
     bar.finish_and_clear();
+    if !params.nested {
+        eprintln!("note: --nested computes the nested estimate the caveat below speaks of");
+    }
     if let Some(dir) = &args.out {
         write_comparison(dir, &comparison, &args.dataset).context("writing the comparison")?;
         eprintln!("wrote {}", dir.display());

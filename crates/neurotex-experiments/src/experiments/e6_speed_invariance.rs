@@ -15,6 +15,9 @@ use rayon::prelude::*;
 pub struct E6Speed {
     /// Training speeds.
     pub train: Vec<Speed>,
+    /// Chance at the test speed: one over the classes recorded there.
+    #[serde(default)]
+    pub chance: f64,
     /// Single taxel, mean over taxels (and over encodings).
     pub taxel_mean: f64,
     /// 3D-GLCM (mean over encodings).
@@ -69,8 +72,12 @@ pub fn e6_speed_invariance(c: &Context) -> Result<BySpeed<E6Speed>, Stop> {
             OverEncodings::of(&taxel, c.params.seed)?,
             OverEncodings::of(&glcm3d, c.params.seed)?,
         );
+        let mut classes: Vec<&str> = c.prepared.at(test).map(|e| e.meta.label.as_str()).collect();
+        classes.sort_unstable();
+        classes.dedup();
         let e6 = E6Speed {
             train,
+            chance: 1.0 / classes.len().max(1) as f64,
             taxel_mean: t.mean(),
             glcm3d: g.mean(),
             encodings: outcomes.len(),

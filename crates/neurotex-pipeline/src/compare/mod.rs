@@ -205,7 +205,8 @@ pub struct Comparison {
 /// The caveat every comparison carries.
 pub const CAVEAT: &str = "the best of several candidates chosen on the same recordings \
     scores higher than it will on new recordings of the same kind; the nested estimate \
-    (selection inside each training set) is the one to quote for the chosen procedure";
+    (selection inside each training set, computed when nested selection is asked for) is the \
+    one to quote for the chosen procedure";
 
 /// One candidate's scores under the protocol.
 struct Scored {
@@ -246,6 +247,9 @@ pub fn compare_with_progress(
     // Candidates are scored side by side (each is deterministic, so the order of work
     // changes nothing but its clock): one candidate's folds are too few and too unequal
     // to keep every core busy.
+    if params.nested {
+        check_nested(metas, params)?;
+    }
     progress(Progress::Stage("candidates", candidates.len()));
     let scored: Vec<Scored> = candidates
         .par_iter()
@@ -694,6 +698,27 @@ fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
         }
     }
     counts.iter().map(|c| c.1).min().unwrap_or(0)
+}
+
+/// Whether nested selection can run, checked before any candidate is scored: its inner
+/// cross-validation needs at least 2 folds, so every class at least 2 recordings in each
+/// outer training set.
+fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<()> {
+    for split in outer_splits(metas, params)? {
+        if smallest_class(metas, &split.train) < 2 {
+            let rule = "nested selection cross-validates inside each outer training set: every class needs at least 2 recordings there";
+            let at = match (&params.protocol, split.condition.as_str()) {
+                (_, "") => "an outer training set".to_string(),
+                (Protocol::Per(column) | Protocol::HoldOut(column), c) => {
+                    format!("the outer training set at {column} = {c}")
+                }
+                (_, c) => format!("the outer training set of {c}"),
+            };
+            let got = format!("1 recording or none of some class in {at} (more recordings per class and condition run it)");
+            return Err(ParamError::new("nested", rule, got).into());
+        }
+    }
+    Ok(())
 }
 
 /// Nested selection: inside each outer split's training rows every candidate is

@@ -376,8 +376,9 @@ fn e3(r: &Results) -> String {
         return skipped_section(r, "e3", asks, "E3").unwrap_or_default();
     };
     let mut out = heading(&format!("{asks}, at {} mm/s", e3.speed), "E3") + &format!("\
-        For each recording, n taxels chosen at random swap places among themselves (every chosen taxel moves; each recording gets its own draw); 3D-GLCM accuracy, mean over {} draws, with a 95 % interval that holds both the recordings' and the draws' variability (a bootstrap that picks one draw, then the recordings), and the standard deviation over draws. Unperturbed 3D-GLCM {} %, single taxel {} %. The paper: accuracy falls towards or below the single taxel as n grows.\n\n",
-        e3.repeats, pct(e3.glcm3d), pct(e3.taxel_mean));
+        For each recording, n taxels chosen at random swap places among themselves (every chosen taxel moves; each recording gets its own draw); 3D-GLCM accuracy, mean over {} draws, with a 95 % interval that holds both the recordings' and the draws' variability (a bootstrap that picks one draw, then the recordings), and the standard deviation over draws. Unperturbed 3D-GLCM {} %, single taxel {} %{}. The paper: accuracy falls towards or below the single taxel as n grows.\n\n",
+        e3.repeats, pct(e3.glcm3d), pct(e3.taxel_mean),
+        r.e1.get(e3.speed).map_or(String::new(), |e| format!(", chance {} %", pct(e.chance))));
     let mut t = Table::new([
         "taxels moved",
         "3D-GLCM (%) [95 % interval]",
@@ -403,6 +404,7 @@ fn e4(r: &Results, paper: Option<&Paper>) -> String {
     let mut out = heading(asks, "E4");
     let mut header = vec![
         "speed (mm/s)",
+        "chance (%)",
         "single taxel (%) [95 % interval]",
         "2D-GLCM (%) [95 % interval]",
         "3D-GLCM (%) [95 % interval]",
@@ -417,6 +419,7 @@ fn e4(r: &Results, paper: Option<&Paper>) -> String {
         let with = pct_in;
         let mut row = vec![
             s.to_string(),
+            e1.map_or("-".into(), |e| pct(e.chance)),
             with(e.taxel_mean, e1.map(|e| &e.taxel_mean_interval)),
             with(e.glcm2d, Some(&e.glcm2d_interval)),
             with(e.glcm3d, e1.map(|e| &e.glcm3d_interval)),
@@ -468,6 +471,13 @@ fn e5(r: &Results, paper: Option<&Paper>) -> String {
     let header = std::iter::once("accuracy (%) [95 % interval]".to_string())
         .chain(speeds.iter().map(|s| format!("{s} mm/s")));
     let mut t = Table::new(header);
+    t.row(
+        std::iter::once("chance".to_string()).chain(
+            speeds
+                .iter()
+                .map(|&s| r.e1.get(s).map_or("-".into(), |e| pct(e.chance))),
+        ),
+    );
     t.row(
         std::iter::once("single taxel, whole slide".to_string()).chain(
             r.e5.values()
@@ -664,6 +674,7 @@ fn e6(r: &Results, paper: Option<&Paper>) -> String {
     let mut header = vec![
         "test speed (mm/s)",
         "trained on (mm/s)",
+        "chance (%)",
         "single taxel (%) [95 % interval]",
         "3D-GLCM (%) [95 % interval]",
     ];
@@ -675,6 +686,7 @@ fn e6(r: &Results, paper: Option<&Paper>) -> String {
         let mut row = vec![
             s.to_string(),
             trained_on(&r.speeds, s, &e.train),
+            pct(e.chance),
             format!("{} {}", pct(e.taxel_mean), bracket(&e.taxel_mean_interval)),
             format!("{} {}", pct(e.glcm3d), bracket(&e.glcm3d_interval)),
         ];
@@ -737,14 +749,17 @@ fn e8(r: &Results) -> String {
     let mut out = heading(asks, "E8") + &format!("Single taxel (mean over taxels) and 3D-GLCM accuracy (%) for each number of neighbours k, with 95 % intervals (bootstrap over {over}). The paper: the outperformance is robust to k.\n\n");
     let mut t = Table::new([
         "speed (mm/s)",
+        "chance (%)",
         "k",
         "single taxel (%) [95 % interval]",
         "3D-GLCM (%) [95 % interval]",
     ]);
     for (s, e) in r.e8.iter() {
+        let chance = r.e1.get(s).map_or("-".into(), |e| pct(e.chance));
         for (i, k) in e.k.iter().enumerate() {
             t.row([
                 s.to_string(),
+                chance.clone(),
                 k.to_string(),
                 pct_in(e.taxel_mean[i], e.taxel_mean_interval.get(i)),
                 pct_in(e.glcm3d[i], e.glcm3d_interval.get(i)),

@@ -87,12 +87,15 @@ fn chance(r: &Results) -> Option<f64> {
     (!r.labels.is_empty()).then(|| 100.0 / r.labels.len() as f64)
 }
 
-/// Chance (%) at each of `speeds`, one over the classes E1 found recorded there; `None`
-/// unless E1 ran at every one of them.
+/// Chance (%) at each of `speeds`, one over the classes E1 (or else E6, with each speed
+/// held out) found recorded there; `None` unless one of them ran at every speed.
 pub(crate) fn chance_per_speed(r: &Results, speeds: &[Speed]) -> Option<Vec<f64>> {
     speeds
         .iter()
-        .map(|&s| r.e1.get(s).map(|e| 100.0 * e.chance))
+        .map(|&s| {
+            let e6 = || r.e6.get(s).map(|e| e.chance).filter(|&c| c > 0.0);
+            r.e1.get(s).map(|e| e.chance).or_else(e6).map(|c| 100.0 * c)
+        })
         .collect()
 }
 

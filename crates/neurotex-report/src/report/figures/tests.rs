@@ -163,6 +163,7 @@ pub(crate) fn wide() -> Results {
                 s,
                 E6Speed {
                     train,
+                    chance: 0.125,
                     taxel_mean: 0.3,
                     encodings: 1,
                     glcm3d: acc[i] * 0.8,
