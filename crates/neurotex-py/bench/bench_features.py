@@ -1,7 +1,7 @@
 """Paper-scale timing: 3D-GLCM features of 480 simulated recordings (8 textures x 3 speeds
 x 20 trials, the paper's design) from Python, against the CLI on the same folder and
 against a numpy/scipy implementation of the same pipeline
-(`crates/neurotex/benches/peers/numpy_pipeline.py`), all in one run on one host.
+(`crates/neurotex-bench/benches/peers/numpy_pipeline.py`), all in one run on one host.
 
     python bench/bench_features.py [--cli PATH] [--repeats 5] [--data DIR]
 

@@ -1,11 +1,11 @@
 //! Latency and capacity of the stream classifier, on one thread.
 //!
 //! ```sh
-//! cargo run --release -p neurotex --features examples --example stream_latency            # both parts
-//! cargo run --release -p neurotex --features examples --example stream_latency -- latency
-//! cargo run --release -p neurotex --features examples --example stream_latency -- capacity
-//! cargo run --release -p neurotex --features examples --example stream_latency -- capacity 316   # one grid
-//! cargo run --release -p neurotex --features examples --example stream_latency -- memory         # 10 minutes
+//! cargo run --release -p neurotex-bench --example stream_latency            # both parts
+//! cargo run --release -p neurotex-bench --example stream_latency -- latency
+//! cargo run --release -p neurotex-bench --example stream_latency -- capacity
+//! cargo run --release -p neurotex-bench --example stream_latency -- capacity 316   # one grid
+//! cargo run --release -p neurotex-bench --example stream_latency -- memory         # 10 minutes
 //! ```
 //!
 //! Latency: a causal 3D-GLCM + KNN model trained on simulated slides (4x4 taxels); the slide

@@ -3,7 +3,7 @@
 //! recordings of one speed through the matrix for tau = 10, 50 and 200 ms.
 //!
 //! ```text
-//! cargo run --release -p neurotex --features examples --example van_rossum_fabricslide -- /tmp/fsc 10
+//! cargo run --release -p neurotex-bench --example van_rossum_fabricslide -- /tmp/fsc 10
 //! ```
 
 use std::sync::Arc;
