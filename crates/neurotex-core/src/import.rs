@@ -190,6 +190,104 @@ pub struct ImportSummary {
     pub layout: LayoutFile,
     /// Each imported file in which rows were merged or dropped, in file order.
     pub merged: Vec<MergedRows>,
+    /// What the import did that is probably not what was meant (the dataset is written all
+    /// the same).
+    pub warnings: Vec<ImportWarning>,
+}
+
+/// A choice of the import that is probably a mistake, found on the logs it read.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ImportWarning {
+    /// Fewer channels than grid cells and no channel map: the channels fill the grid row by
+    /// row, so cells that are neighbours on the grid need not be on the sensor.
+    #[error("{channels} channels on a {rows}x{cols} grid fill it row by row and leave {} cells empty, so taxels that are neighbours on the grid (what the GLCM compares) need not be neighbours on the sensor; {}", rows * cols - channels, grid_advice(*channels))]
+    GridNotFilled {
+        /// Channels imported.
+        channels: usize,
+        /// Grid rows.
+        rows: usize,
+        /// Grid columns.
+        cols: usize,
+    },
+    /// Most recordings rest far above their range and no baseline is removed: the
+    /// encoder, normalising by each recording's maximum, sees mostly the offset.
+    #[error("in {files} of {total} recordings the channels rest at about {ratio:.0} times their range above zero (median channel) and no baseline is removed, so the encoder sees mostly the resting offset; --baseline min removes each channel's minimum")]
+    RestingOffset {
+        /// The median over those recordings of the median channel's minimum over its range.
+        ratio: f64,
+        /// Recordings resting that high.
+        files: usize,
+        /// Recordings imported.
+        total: usize,
+    },
+}
+
+/// What places `channels` channels on the grid the sensor has.
+fn grid_advice(channels: usize) -> String {
+    let side = (channels as f64).sqrt().round() as usize;
+    if side * side == channels {
+        format!("--grid {side}x{side} (or a channel map) places them as a square sensor has them")
+    } else {
+        "a grid of the sensor's shape (--grid) or a channel map places them".to_string()
+    }
+}
+
+/// A resting value this many times the signal's range, or more, is an offset the encoder
+/// should not see: normalised by the recording's maximum, the input then spans half its
+/// scale or less (FabricSlide's capacitive channels rest at 2 to 12 times their range).
+const OFFSET_RATIO: f64 = 1.0;
+
+/// The import's warnings on the logs it read ([`ImportWarning`]).
+fn import_warnings(
+    p: &CsvImportParams,
+    layout: &LayoutFile,
+    good: &[ParsedCsv],
+) -> Vec<ImportWarning> {
+    let mut out = Vec::new();
+    let channels = layout.channels.as_ref().map_or(0, Vec::len);
+    let (rows, cols) = (layout.rows.unwrap_or(1), layout.cols.unwrap_or(channels));
+    if p.channel_map.is_none() && channels < rows * cols {
+        out.push(ImportWarning::GridNotFilled {
+            channels,
+            rows,
+            cols,
+        });
+    }
+    if p.baseline.is_none() {
+        let mut high: Vec<f64> = good
+            .iter()
+            .filter_map(|c| resting_ratio(&c.log.samples, c.log.channel_names.len()))
+            .filter(|&r| r >= OFFSET_RATIO)
+            .collect();
+        if 2 * high.len() > good.len() {
+            high.sort_by(f64::total_cmp);
+            out.push(ImportWarning::RestingOffset {
+                ratio: high[high.len() / 2],
+                files: high.len(),
+                total: good.len(),
+            });
+        }
+    }
+    out
+}
+
+/// The median over a log's channels (`frames x channels`, time-major) of each channel's
+/// minimum over its range; channels that never move are left out, `None` without any.
+fn resting_ratio(samples: &[f64], channels: usize) -> Option<f64> {
+    let mut ratios: Vec<f64> = (0..channels)
+        .filter_map(|c| {
+            let column = samples.iter().skip(c).step_by(channels.max(1));
+            let (lo, hi) = column.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+            (hi > lo && lo > 0.0).then(|| lo / (hi - lo))
+        })
+        .collect();
+    if ratios.is_empty() {
+        return None;
+    }
+    ratios.sort_by(f64::total_cmp);
+    Some(ratios[ratios.len() / 2])
 }
 
 /// Rows of one file that did not become frames of their own: they shared a time stamp.
@@ -377,6 +475,7 @@ pub fn import_csv(
         read_back(tmp)
     })?;
     summary.written = good.len();
+    summary.warnings = import_warnings(p, &layout, &good);
     summary.layout = layout;
     summary.merged = good
         .iter()

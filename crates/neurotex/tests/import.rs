@@ -6,8 +6,8 @@ use ndarray::{Array, Array1, ArrayD, IxDyn};
 use ndarray_npy::write_npy;
 use neurotex::csvlog::{read_csv_log, Column, CsvFormat, DuplicateStamps};
 use neurotex::import::{
-    csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, NamePattern,
-    StackedParams,
+    csv_files, import_csv, import_stacked, Axes, ChannelSelect, CsvImportParams, ImportWarning,
+    NamePattern, StackedParams,
 };
 use neurotex::pipeline::{Pipeline, PipelineParams};
 use neurotex::recording::{
@@ -837,4 +837,67 @@ fn labels_that_would_merge_are_refused_not_merged() {
         let e = import_csv(&[a, bad], &params(), &dir.path().join("csv"), &|| {}).unwrap_err();
         assert!(e.to_string().contains("not valid UTF-8"), "{e}");
     }
+}
+
+#[test]
+fn import_warns_of_channels_short_of_the_grid_and_of_resting_offsets() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir(&src).unwrap();
+    // Nine channels resting at 300 with a swing of 100 (a ratio of 3 by hand), and one
+    // file resting at 0, in the minority.
+    let log = |rest: f64| {
+        let mut text = String::from("stamp,c0,c1,c2,c3,c4,c5,c6,c7,c8\n");
+        for i in 0..20 {
+            let v = rest + 100.0 * f64::from(i % 2);
+            let row: Vec<String> = (0..9).map(|_| v.to_string()).collect();
+            text.push_str(&format!("{},{}\n", 10 * i, row.join(",")));
+        }
+        text
+    };
+    write(&src, "A_V5_0.csv", &log(300.0));
+    write(&src, "B_V5_0.csv", &log(300.0));
+    write(&src, "C_V5_0.csv", &log(0.0));
+    let files = csv_files(&[src]).unwrap();
+    let import = |p: &CsvImportParams, name: &str| {
+        import_csv(&files, p, &dir.path().join(name), &|| {})
+            .unwrap()
+            .warnings
+    };
+    let on_4x4 = CsvImportParams {
+        grid: Some(neurotex::Grid::full(4, 4).unwrap()),
+        ..params()
+    };
+    assert_eq!(
+        import(&on_4x4, "a"),
+        [
+            ImportWarning::GridNotFilled {
+                channels: 9,
+                rows: 4,
+                cols: 4
+            },
+            ImportWarning::RestingOffset {
+                ratio: 3.0,
+                files: 2,
+                total: 3
+            },
+        ]
+    );
+    let text = ImportWarning::GridNotFilled {
+        channels: 9,
+        rows: 4,
+        cols: 4,
+    }
+    .to_string();
+    assert!(
+        text.contains("leave 7 cells empty") && text.contains("--grid 3x3"),
+        "{text}"
+    );
+    // The sensor's own grid and a baseline: nothing to say.
+    let fitting = CsvImportParams {
+        grid: Some(neurotex::Grid::full(3, 3).unwrap()),
+        baseline: Some(Baseline::Min),
+        ..params()
+    };
+    assert!(import(&fitting, "b").is_empty());
 }

@@ -113,6 +113,9 @@ fn csv(args: ImportCsvArgs) -> Result<()> {
     for (_, why) in &summary.skipped {
         eprintln!("warning: left out {why}");
     }
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
     say_summary(&summary, &args.out);
     Ok(())
 }
