@@ -75,6 +75,7 @@ pub fn show_progress(bar: &ProgressBar, event: Progress) {
                 eprintln!("[{t:7.1} s]   skipped: {id}, {asks} (the report says why)");
             }
         }
+        Progress::Advice(text) => bar.suspend(|| eprintln!("warning: {text}")),
         Progress::TooSmall(error) => bar.suspend(|| {
             eprintln!("warning: {WITHIN_SPEED}, which cannot run: {error}; they are skipped");
             if let Some(hint) = crate::design_hint(error) {

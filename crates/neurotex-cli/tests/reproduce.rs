@@ -264,6 +264,10 @@ fn a_twelve_recording_pilot_runs_skipping_what_its_design_cannot_support() {
         "{report}"
     );
     assert!(
+        report.contains("layout.toml: baseline removed: none."),
+        "the layout said: {report}"
+    );
+    assert!(
         report.contains("(E1)\n\nSkipped, with 8 other analyses"),
         "{report}"
     );

@@ -17,6 +17,9 @@ pub enum Progress<'a> {
     /// recording is read: the analyses resting on the cross-validation within each speed
     /// will be skipped for this error.
     TooSmall(&'a crate::Error),
+    /// What the recordings suggest changing (most taxels silent or at the encoder's
+    /// ceiling), said at once rather than only in the report.
+    Advice(&'a str),
 }
 
 /// A progress callback that ignores every event.

@@ -49,13 +49,26 @@ impl Source<'_> {
     pub fn describe(&self) -> String {
         match self {
             Source::Dataset(ds) => {
-                let baseline = match ds.layout.baseline {
-                    Some(b) => format!(", baseline removal {b:?} (layout.toml)"),
-                    None => String::new(),
-                };
+                let layout = &ds.layout;
+                let baseline = layout.baseline.unwrap_or_default();
                 let (root, n) = (ds.root.display(), ds.entries.len());
+                let grid = match (layout.rows, layout.cols) {
+                    (Some(rows), Some(cols)) => {
+                        let channels = layout.channels.as_ref().map(Vec::len);
+                        let empty = match channels {
+                            Some(c) if c < rows * cols => {
+                                format!(" ({} cells without a channel)", rows * cols - c)
+                            }
+                            _ => String::new(),
+                        };
+                        let channels =
+                            channels.map_or(String::new(), |c| format!("{c} channels on "));
+                        format!(" {channels}a {rows}x{cols} grid{empty};")
+                    }
+                    _ => String::new(),
+                };
                 format!(
-                    "Dataset folder `{root}`: {n} recordings as listed in its manifest{baseline}."
+                    "Dataset folder `{root}`: {n} recordings as listed in its manifest; layout.toml:{grid} baseline removed: {baseline}."
                 )
             }
             Source::Simulated { rig, trials, seed } => describe_simulated(rig, trials, *seed),
@@ -460,6 +473,9 @@ pub fn prepare(
         return Err(DataError::invalid(&e.meta.file, message).into());
     }
     let taxels = taxel_diagnostics(&encoded, &grid, params)?;
+    if let Some(advice) = taxels.advice() {
+        progress(Progress::Advice(&advice));
+    }
     let causal = causal.map(|all| CausalPrepared {
         calibration: all
             .into_iter()
