@@ -127,7 +127,7 @@ impl ReproduceParams {
                 enc.a, enc.b, enc.c, enc.d, enc.gain
             ),
             format!(
-                "low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only: {}",
+                "low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only, where the manifest gives the slide's times (else the whole recording): {}",
                 pre.cutoff_hz, pre.slide_only
             ),
             format!(
