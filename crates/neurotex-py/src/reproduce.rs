@@ -3,10 +3,12 @@
 //! results handed back.
 
 use std::path::PathBuf;
+use std::sync::Mutex;
 use std::time::Instant;
 
 use neurotex::classify::KnnParams;
-use neurotex::experiments::{claims, HeadlinePrediction, ReproduceParams};
+use neurotex::experiments::{claims, HeadlinePrediction, ReproduceParams, WITHIN_SPEED};
+use neurotex::progress::Progress;
 use neurotex::report::reproduce::{
     reproduce as run_analyses, simulated_design, Data as Input, Run,
 };
@@ -26,12 +28,14 @@ type PredictionRow = (f64, String, String, String, String, Option<usize>, usize)
 type Outcome = (Py<PyAny>, Py<PyAny>, Vec<PredictionRow>, f64);
 
 /// A run's results as the detached run hands them over: `results.json`'s and the claims'
-/// values, the headline predictions, the wall-clock seconds.
+/// values, the headline predictions, the wall-clock seconds, and what the CLI says as a
+/// `warning:` (to be raised as Python warnings once the run is back under the GIL).
 type Finished = (
     serde_json::Value,
     serde_json::Value,
     Vec<PredictionRow>,
     f64,
+    Vec<String>,
 );
 
 /// Which data a run analyses.
@@ -103,8 +107,12 @@ fn reproduce(
             Data::Simulated { trials, seeds }
         }
     };
-    let (results, claims, predictions, seconds) =
+    let (results, claims, predictions, seconds, warnings) =
         py.detach(|| guarded(|| run(&out, &data, &stages, params, &command)))?;
+    let warn = PyModule::import(py, "warnings")?;
+    for text in warnings {
+        warn.call_method1("warn", (text,))?;
+    }
     Ok((
         to_object(py, &results)?,
         to_object(py, &claims)?,
@@ -130,10 +138,21 @@ fn run(
             seeds,
         },
     };
+    let warnings = Mutex::new(Vec::new());
+    let say = |text: String| warnings.lock().expect("warnings").push(text);
+    let on_progress = |p: Progress| match p {
+        Progress::TooSmall(e) => {
+            say(format!(
+                "{WITHIN_SPEED}, which cannot run: {e}; they are skipped"
+            ));
+        }
+        Progress::Advice(text) => say(text.to_string()),
+        _ => (),
+    };
     let run = Run {
         gain_target: stages.gain_target(),
         command: command.to_string(),
-        on_progress: &|_| (),
+        on_progress: &on_progress,
         on_gain: &|_| (),
     };
     let results = run_analyses(out, input, params, &run)?;
@@ -148,6 +167,7 @@ fn run(
         claims_json,
         predictions,
         started.elapsed().as_secs_f64(),
+        warnings.into_inner().expect("warnings"),
     ))
 }
 

@@ -142,3 +142,12 @@ def test_a_folder_without_speeds_is_refused_with_the_library_message(sim, tmp_pa
     with pytest.raises(neurotex.DataError, match="has no speed_mm_s; reproduce compares speeds"):
         neurotex.reproduce(tmp_path / "out", dataset=tmp_path / "ds", quick=True)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_design_too_small_for_the_folds_warns_and_runs_the_rest(sim_dir, tmp_path):
+    # 5 recordings per class at each speed: 6 folds cannot hold a class
+    with pytest.warns(UserWarning, match="at most 5 folds"):
+        run = neurotex.reproduce(tmp_path / "r", dataset=sim_dir, quick=True, folds=6)
+    assert "fewer than the 6 folds" in run.results["skipped"]["e1"]
+    assert not run.results.get("e1")
+    assert sorted(run.results["e6"]) == ["10", "5"]

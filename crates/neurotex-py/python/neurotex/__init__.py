@@ -847,6 +847,11 @@ def reproduce(
     The run takes minutes (the full paper-scale run with 5 seeds much longer) with the GIL
     released; it cannot be interrupted from Python before it ends.
 
+    A design too small for ``folds`` or ``k`` does not stop the run: the analyses resting
+    on the cross-validation within each speed are skipped (``results["skipped"]`` says
+    why) and a :class:`UserWarning` says so, as one does when most taxels are silent or at
+    the encoder's ceiling.
+
     Raises :class:`ParameterError` for a broken option, :class:`NotFoundError` for a
     missing dataset folder, :class:`DataError` for recordings the analyses cannot use."""
     out = os.fspath(out_dir)
