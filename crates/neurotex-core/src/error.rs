@@ -72,6 +72,12 @@ impl Error {
         }
     }
 
+    /// Whether this error says the data is too small for the folds or neighbours asked
+    /// for ([`ClassifyError::is_design`]), through the recording or analysis it is named in.
+    pub fn is_design(&self) -> bool {
+        self.classify().is_some_and(ClassifyError::is_design)
+    }
+
     /// The classification error at the heart of this one, through the recording or
     /// analysis it is named in: what a front end's hint is drawn from.
     pub fn classify(&self) -> Option<&ClassifyError> {

@@ -86,18 +86,14 @@ pub enum Stop {
 
 impl Stop {
     /// This stop, a failure because the data is too small for the folds or neighbours
-    /// asked for ([`ClassifyError::is_design`]) turned into a skip of `analysis` with the
+    /// asked for ([`crate::Error::is_design`]) turned into a skip of `analysis` with the
     /// reason: a larger run goes on without it.
-    ///
-    /// [`ClassifyError::is_design`]: crate::error::ClassifyError::is_design
     pub fn design_skipped(self, analysis: &'static str) -> Stop {
         match self {
-            Stop::Failed(e) if e.classify().is_some_and(|c| c.is_design()) => {
-                Stop::Skipped(Skip::Design {
-                    analysis,
-                    reason: e.to_string(),
-                })
-            }
+            Stop::Failed(e) if e.is_design() => Stop::Skipped(Skip::Design {
+                analysis,
+                reason: e.to_string(),
+            }),
             other => other,
         }
     }

@@ -5,7 +5,7 @@
 use super::{Prepared, ValidReproduceParams};
 use crate::analysis::{evaluate, evaluate_sweep, Columns, FeatureTable, Outcome, Split};
 use crate::classify::{Knn, Sweep, ValidCv};
-use crate::error::{ClassifyError, Result};
+use crate::error::Result;
 use crate::pipeline::{Encoded, Method};
 use crate::values::{BySpeed, Speed};
 
@@ -64,22 +64,21 @@ impl Tables {
         let taxel = table(encoded, Method::Taxel, params)?;
         let glcm3d = table(encoded, Method::Glcm3d, params)?;
         let glcm2d = table(encoded, Method::Glcm2d, params)?;
-        let speeds: &[Speed] = match prepared.within_speed {
-            Some(_) => &[],
-            None => &prepared.speeds,
-        };
-        let (headline, within_speed) =
-            match evaluate_headline(&[&taxel, &glcm3d, &glcm2d], speeds, params) {
-                Ok(h) => (h, prepared.within_speed.clone()),
-                // Folds made by groups are checked only here.
-                Err(e) if e.classify().is_some_and(ClassifyError::is_design) => {
-                    (BySpeed::new(), Some(e.to_string()))
+        let (headline, within_speed) = match &prepared.within_speed {
+            Some(why) => (BySpeed::new(), Some(why.clone())),
+            None => {
+                match evaluate_headline(&[&taxel, &glcm3d, &glcm2d], &prepared.speeds, params) {
+                    Ok(h) => (h, None),
+                    // Folds made by groups are checked only here.
+                    Err(e) if e.is_design() => (BySpeed::new(), Some(e.to_string())),
+                    Err(e) => return Err(e),
                 }
-                Err(e) => return Err(e),
-            };
+            }
+        };
+        // The further encodings are evaluated where the encoding as run was.
         let speeds: &[Speed] = match within_speed {
             Some(_) => &[],
-            None => speeds,
+            None => &prepared.speeds,
         };
         let (perturbed, perturbed_tables) = prepared
             .perturbed

@@ -247,9 +247,11 @@ pub fn compare_with_progress(
     // Candidates are scored side by side (each is deterministic, so the order of work
     // changes nothing but its clock): one candidate's folds are too few and too unequal
     // to keep every core busy.
-    if params.nested {
-        check_nested(metas, params)?;
-    }
+    // Nested selection's outer splits, checked before any candidate is scored.
+    let outer = match params.nested {
+        true => Some(check_nested(metas, params)?),
+        false => None,
+    };
     progress(Progress::Stage("candidates", candidates.len()));
     let scored: Vec<Scored> = candidates
         .par_iter()
@@ -269,10 +271,9 @@ pub fn compare_with_progress(
         .map(|(c, s)| units.rank(c, s, paper.map(|p| &scored[p]), params))
         .collect::<Result<_>>()?;
     results.sort_by(|a, b| b.accuracy.total_cmp(&a.accuracy));
-    let nested = if params.nested {
-        Some(nested(candidates, params, &units, progress)?)
-    } else {
-        None
+    let nested = match outer {
+        Some(splits) => Some(nested(candidates, &splits, params, &units, progress)?),
+        None => None,
     };
     let (classes, majority) = class_shares(metas, &scored[0].shares);
     Ok(Comparison {
@@ -425,7 +426,7 @@ fn hold_out(column: &str, values: &[String], value: &str) -> Split {
 /// for the folds or neighbours keeps its classification error, so that the hint and a
 /// larger run's skip can tell it apart.
 fn in_condition(e: crate::Error, column: &str, value: &str) -> crate::Error {
-    if e.classify().is_some_and(|c| c.is_design()) {
+    if e.is_design() {
         return e.in_analysis(format!("{column} = {value}"));
     }
     let rule = "every condition must be evaluable on its own";
@@ -700,11 +701,11 @@ fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
     counts.iter().map(|c| c.1).min().unwrap_or(0)
 }
 
-/// Whether nested selection can run, checked before any candidate is scored: its inner
-/// cross-validation needs at least 2 folds, so every class at least 2 recordings in each
-/// outer training set.
-fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<()> {
-    for split in outer_splits(metas, params)? {
+/// Nested selection's outer splits, when it can run on them: its inner cross-validation
+/// needs at least 2 folds, so every class at least 2 recordings in each outer training set.
+fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
+    let splits = outer_splits(metas, params)?;
+    for split in &splits {
         if smallest_class(metas, &split.train) < 2 {
             let rule = "nested selection cross-validates inside each outer training set: every class needs at least 2 recordings there";
             let at = match (&params.protocol, split.condition.as_str()) {
@@ -718,7 +719,7 @@ fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<()> {
             return Err(ParamError::new("nested", rule, got).into());
         }
     }
-    Ok(())
+    Ok(splits)
 }
 
 /// Nested selection: inside each outer split's training rows every candidate is
@@ -726,12 +727,12 @@ fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<()> {
 /// split's test rows.
 fn nested(
     candidates: &[Candidate],
+    splits: &[OuterSplit],
     params: &CompareParams,
     units: &Units,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Nested> {
     let metas = &candidates[0].table.metas;
-    let splits = outer_splits(metas, params)?;
     progress(Progress::Stage("nested selection", splits.len()));
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
