@@ -6,8 +6,11 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use neurotex::csvlog::{ChannelSelect, Column, CsvOverrides, Delimiter, DuplicateStamps};
-use neurotex::recording::{FileReading, LayoutFile, LayoutFrom, TimeUnit};
+use neurotex::csvlog::{
+    ChannelSelect, Column, CsvFormat, CsvOverrides, Delimiter, DuplicateStamps,
+};
+use neurotex::import::{CsvImportParams, NamePattern};
+use neurotex::recording::{ChannelMap, FileReading, LayoutFile, LayoutFrom, TimeUnit};
 use neurotex::{Grid, SampleRate};
 
 /// CSV reading options.
@@ -112,5 +115,56 @@ impl ReadArgs {
                 LayoutFrom::Given | LayoutFrom::Default => {}
             }
         }
+    }
+}
+
+/// How raw logs are read into recordings: the options `import csv` and `inspect` share.
+#[derive(Args, Debug, Clone)]
+pub struct LogArgs {
+    /// Fields from file names, e.g. `{label}_F{force}_V{speed}mmps_{trial}.csv`; `label`,
+    /// `speed` (mm/s), `force` and `trial` fill the manifest, other fields become columns.
+    /// Without it the label is the file name.
+    #[arg(long = "name-pattern")]
+    pub name_pattern: Option<NamePattern>,
+    #[command(flatten)]
+    pub csv: CsvArgs,
+    /// Grid `ROWSxCOLS` to place the channels on, row-major (default one row).
+    #[arg(long)]
+    pub grid: Option<Grid>,
+    /// Each channel's cell as `row,col;row,col;...` (needs --grid).
+    #[arg(long = "channel-map", requires = "grid")]
+    pub channel_map: Option<ChannelMap>,
+    /// Nominal sampling rate in Hz (needed without a time column; else the median interval).
+    #[arg(long, allow_negative_numbers = true)]
+    pub fs: Option<SampleRate>,
+}
+
+impl LogArgs {
+    /// The import's reading options (no baseline, stopping at a bad file).
+    pub fn params(&self) -> CsvImportParams {
+        CsvImportParams {
+            pattern: self.name_pattern.clone(),
+            format: self.csv.overrides().apply(CsvFormat::default()),
+            grid: self.grid.clone(),
+            channel_map: self.channel_map.clone(),
+            fs: self.fs.map(SampleRate::hz),
+            baseline: None,
+            skip_bad: false,
+        }
+    }
+
+    /// Whether any option was given (they apply to raw logs, not to a dataset folder).
+    pub fn any(&self) -> bool {
+        let c = &self.csv;
+        self.name_pattern.is_some()
+            || self.grid.is_some()
+            || self.channel_map.is_some()
+            || self.fs.is_some()
+            || c.overrides().place_columns()
+            || c.no_header
+            || c.delimiter.is_some()
+            || c.duplicate_stamps.is_some()
+            || c.max_gap_s.is_some()
+            || c.time_unit.is_some()
     }
 }

@@ -14,7 +14,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use commands::{
-    compare, encode, evaluate, features, import, predict, reproduce, simulate, stream, train,
+    compare, encode, evaluate, features, import, inspect, predict, reproduce, simulate, stream,
+    train,
 };
 
 /// Neuromorphic tactile texture classification: taxel recordings → Izhikevich spikes →
@@ -28,6 +29,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Check a dataset or raw logs before analysing them: the design and what it supports,
+    /// the signals (rate, gaps, offsets, dead, clipped, copied channels, a clock read as a
+    /// channel), the layout and the encoder at the gain; each finding with the option that
+    /// addresses it.
+    Inspect(inspect::InspectArgs),
     /// Encode one recording into spikes (u8 raster `(T, rows, cols)` at 1 kHz, .npy).
     Encode(encode::EncodeArgs),
     /// Extract one feature row per recording of a dataset into a CSV file.
@@ -77,6 +83,10 @@ fn main() -> ExitCode {
         }
     }
     let result = match cli.command {
+        Command::Inspect(args) => match inspect::run(args) {
+            Ok(false) => return ExitCode::from(2),
+            other => other.map(|_| ()),
+        },
         Command::Encode(args) => encode::run(args),
         Command::Features(args) => features::run(args),
         Command::Evaluate(args) => evaluate::run(args),

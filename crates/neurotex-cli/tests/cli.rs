@@ -12,6 +12,7 @@ mod extensions;
 mod features;
 mod hostile;
 mod import;
+mod inspect;
 mod model;
 mod raw_logs;
 mod reproduce;

@@ -17,8 +17,8 @@ pub use crate::csvlog::ChannelSelect;
 use crate::csvlog::{read_csv_log, CsvFormat, CsvLog, LogColumns};
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
-    create_dataset_dir, labels_merged_by_trimming, write_layout, write_manifest, Baseline,
-    ChannelMap, LayoutFile, Meta, TimeUnit,
+    create_dataset_dir, labels_merged_by_trimming, recording_from_channels, write_layout,
+    write_manifest, Baseline, ChannelMap, LayoutFile, Meta, Recording, TimeUnit,
 };
 use crate::values::{Grid, Speed};
 
@@ -223,7 +223,7 @@ pub enum ImportWarning {
 }
 
 /// What places `channels` channels on the grid the sensor has.
-fn grid_advice(channels: usize) -> String {
+pub fn grid_advice(channels: usize) -> String {
     let side = (channels as f64).sqrt().round() as usize;
     if side * side == channels {
         format!("--grid {side}x{side} (or a channel map) places them as a square sensor has them")
@@ -235,7 +235,7 @@ fn grid_advice(channels: usize) -> String {
 /// A resting value this many times the signal's range, or more, is an offset the encoder
 /// should not see: normalised by the recording's maximum, the input then spans half its
 /// scale or less (FabricSlide's capacitive channels rest at 2 to 12 times their range).
-const OFFSET_RATIO: f64 = 1.0;
+pub const OFFSET_RATIO: f64 = 1.0;
 
 /// The import's warnings on the logs it read ([`ImportWarning`]).
 fn import_warnings(
@@ -288,6 +288,92 @@ fn resting_ratio(samples: &[f64], channels: usize) -> Option<f64> {
     }
     ratios.sort_by(f64::total_cmp);
     Some(ratios[ratios.len() / 2])
+}
+
+/// CSV logs read one at a time as `import csv` reads them, with the layout the import would
+/// write, and no dataset written: what `neurotex inspect` checks before an import.
+#[derive(Debug, Clone)]
+pub struct Logs {
+    /// The log files, sorted.
+    pub files: Vec<PathBuf>,
+    /// The layout an import of these logs would write (its rate from the options, or from
+    /// the first readable log's median stamp interval).
+    pub layout: LayoutFile,
+    params: CsvImportParams,
+}
+
+impl Logs {
+    /// The logs `files` under the import's options `p`: the first log that reads gives the
+    /// channels and the layout.
+    ///
+    /// # Errors
+    /// No files, no time column and no rate, no log that reads, or a grid or channel map
+    /// that does not fit the channels.
+    pub fn open(files: Vec<PathBuf>, p: CsvImportParams) -> Result<Self> {
+        if p.format.time_column.is_none() && p.fs.is_none() {
+            let rule = "without --time-column the sampling rate --fs is needed";
+            return Err(ParamError::new("fs", rule, "none").into());
+        }
+        let mut first_error = None;
+        for f in &files {
+            match parse_csv(f, &p) {
+                Ok(first) => {
+                    let fs = match p.fs {
+                        Some(fs) => fs,
+                        None => nominal_fs(std::slice::from_ref(&first), f)?,
+                    };
+                    let unit = first.log.times.is_some().then_some(first.log.time_unit);
+                    let names = &first.log.channel_names;
+                    let layout = csv_layout(&p, names, fs, unit, &first.log.columns)?;
+                    return Ok(Logs {
+                        files,
+                        layout,
+                        params: p,
+                    });
+                }
+                Err(e) => {
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+        Err(first_error.unwrap_or_else(|| {
+            DataError::invalid(Path::new("."), "no .csv files to inspect").into()
+        }))
+    }
+
+    /// The channels' names, in log order.
+    pub fn channel_names(&self) -> &[String] {
+        self.layout.channels.as_deref().unwrap_or_default()
+    }
+
+    /// Reads log `i`: its recording on the layout (stamps from the first, in s; metadata
+    /// from the file name) and the rows the reader merged or dropped.
+    ///
+    /// # Errors
+    /// A log that does not read, whose name does not fit the pattern, or whose channels
+    /// differ from the first log's.
+    pub fn read(&self, i: usize) -> Result<(Recording, MergedRows)> {
+        let path = &self.files[i];
+        let ParsedCsv { meta, log } = parse_csv(path, &self.params)?;
+        let names = self.channel_names();
+        if log.channel_names != names {
+            let message = format!("its channels {:?} differ from {names:?}", log.channel_names);
+            return Err(invalid(path, message));
+        }
+        let unit = log.time_unit.seconds();
+        let times_s = log
+            .times
+            .as_ref()
+            .map(|t| t.iter().map(|&v| (v - t[0]) * unit).collect());
+        let merged = MergedRows {
+            file: meta.file.clone(),
+            merged_rows: log.merged_rows,
+            duplicate_rows: log.duplicate_rows,
+        };
+        let n = names.len();
+        let rec = recording_from_channels(path, &self.layout, log.samples, n, times_s, meta)?;
+        Ok((rec, merged))
+    }
 }
 
 /// Rows of one file that did not become frames of their own: they shared a time stamp.

@@ -1216,6 +1216,43 @@ pub fn read_recording_as(
     })
 }
 
+/// A recording from frame-major channel samples (`n_channels` values a frame) placed on
+/// the layout's grid, map and mask at its rate, as a CSV log of those channels reads;
+/// `times_s` are stamps in s from the first.
+///
+/// # Errors
+/// Channels that do not fit the layout, or more samples than its limits allow.
+pub fn recording_from_channels(
+    path: &Path,
+    layout: &LayoutFile,
+    raw: Vec<f64>,
+    n_channels: usize,
+    times_s: Option<Vec<f64>>,
+    meta: Meta,
+) -> Result<Recording> {
+    let finite = all_finite(&raw);
+    let n_channels = checked_channels(path, Shape::Channels(n_channels), &raw, finite)?;
+    let lay = layout.layout_for(path, Shape::Channels(n_channels))?;
+    let frames = raw.len() / n_channels;
+    check_duration(
+        path,
+        layout,
+        frames,
+        times_s.as_deref(),
+        lay.cells(),
+        raw.len(),
+    )?;
+    let samples = onto_cells(raw, n_channels, &lay);
+    Ok(Recording {
+        fs: layout.fs.unwrap_or(1000.0),
+        layout: lay,
+        samples,
+        times_s,
+        phases: None,
+        meta,
+    })
+}
+
 /// A `.npy` or `.csv` recording's shape, samples (frame-major), time stamps in seconds
 /// (CSV only) and whether every sample is finite.
 ///

@@ -146,7 +146,7 @@ pub fn taxel_diagnostics(
 
 /// Spikes per second of one neuron held at input 1 for two seconds, counted over the second
 /// (after the onset transient).
-fn ceiling_rate(encoder: IzhikevichParams) -> Result<f64> {
+pub fn ceiling_rate(encoder: IzhikevichParams) -> Result<f64> {
     let input = vec![1.0; 2000];
     let trains = encode(&input, 1, 1, &[true], encoder)?;
     Ok(trains.train(0).iter().filter(|&&t| t >= 1000).count() as f64)

@@ -11,6 +11,7 @@ pub mod causal;
 pub mod compare;
 pub mod diagnostics;
 pub mod evaluation;
+pub mod inspect;
 pub mod model;
 pub mod options;
 pub mod pipeline;
@@ -18,7 +19,7 @@ pub mod stream;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
-use neurotex_core::{csvlog, error, io, progress, recording, values, Error};
+use neurotex_core::{csvlog, error, import, io, progress, recording, values, Error};
 use neurotex_features::features;
 use neurotex_learn::classify;
 use neurotex_signal::{encode, signal};

@@ -9,7 +9,7 @@ pub mod report;
 use neurotex_core::{error, io, recording, values};
 use neurotex_experiments::experiments;
 use neurotex_learn::classify;
-use neurotex_pipeline::{calibrate, causal, compare, pipeline};
+use neurotex_pipeline::{calibrate, causal, compare, inspect, pipeline};
 #[cfg(test)]
 use neurotex_signal::signal;
 use neurotex_sim::sim;

@@ -28,7 +28,8 @@ pub use neurotex_experiments::experiments;
 pub use neurotex_features::features;
 pub use neurotex_learn::classify;
 pub use neurotex_pipeline::{
-    analysis, calibrate, causal, compare, diagnostics, evaluation, model, options, pipeline, stream,
+    analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, options,
+    pipeline, stream,
 };
 pub use neurotex_report::report;
 pub use neurotex_signal::{encode, signal};

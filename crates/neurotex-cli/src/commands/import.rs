@@ -4,15 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use neurotex::csvlog::CsvFormat;
 use neurotex::import::{
-    csv_files, import_csv, import_stacked, Axes, CsvImportParams, ImportSummary, NamePattern,
-    StackedParams,
+    csv_files, import_csv, import_stacked, Axes, CsvImportParams, ImportSummary, StackedParams,
 };
-use neurotex::recording::{Baseline, ChannelMap};
+use neurotex::recording::Baseline;
 use neurotex::{Grid, SampleRate};
 
-use crate::csv_args::CsvArgs;
+use crate::csv_args::LogArgs;
 use crate::output::progress;
 
 /// `neurotex import`: bring recordings from other layouts into the dataset format.
@@ -34,22 +32,8 @@ pub struct ImportCsvArgs {
     /// The dataset folder to create (must not exist, or be empty).
     #[arg(long)]
     pub out: PathBuf,
-    /// Fields from file names, e.g. `{label}_F{force}_V{speed}mmps_{trial}.csv`; `label`,
-    /// `speed` (mm/s), `force` and `trial` fill the manifest, other fields become columns.
-    /// Without it the label is the file name.
-    #[arg(long = "name-pattern")]
-    pub name_pattern: Option<NamePattern>,
     #[command(flatten)]
-    pub csv: CsvArgs,
-    /// Grid `ROWSxCOLS` to place the channels on, row-major (default one row).
-    #[arg(long)]
-    pub grid: Option<Grid>,
-    /// Each channel's cell as `row,col;row,col;...` (needs --grid).
-    #[arg(long = "channel-map", requires = "grid")]
-    pub channel_map: Option<ChannelMap>,
-    /// Nominal sampling rate in Hz (needed without a time column; else the median interval).
-    #[arg(long, allow_negative_numbers = true)]
-    pub fs: Option<SampleRate>,
+    pub logs: LogArgs,
     /// Baseline removal to record in layout.toml: `none` or `min` (capacitive sensors rest
     /// at a large offset).
     #[arg(long)]
@@ -96,14 +80,10 @@ pub fn run(command: ImportCommand) -> Result<()> {
 
 fn csv(args: ImportCsvArgs) -> Result<()> {
     let params = CsvImportParams {
-        pattern: args.name_pattern,
-        format: args.csv.overrides().apply(CsvFormat::default()),
-        grid: args.grid,
-        channel_map: args.channel_map,
-        fs: args.fs.map(SampleRate::hz),
         // `none` is what a layout without a baseline means; it is not written out
         baseline: args.baseline.filter(|b| *b != Baseline::None),
         skip_bad: args.skip_bad,
+        ..args.logs.params()
     };
     let files = csv_files(&args.inputs)?;
     let bar = progress(files.len(), "importing");

@@ -6,6 +6,7 @@ pub mod encode;
 pub mod evaluate;
 pub mod features;
 pub mod import;
+pub mod inspect;
 pub mod predict;
 pub mod reproduce;
 pub mod simulate;

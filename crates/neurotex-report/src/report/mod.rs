@@ -6,6 +6,7 @@
 
 pub mod comparison;
 pub mod figures;
+pub mod inspection;
 mod markdown;
 mod paper;
 pub mod reproduce;

@@ -8,6 +8,7 @@ mod accuracy;
 pub mod compare;
 mod confusion;
 mod gain;
+pub mod inspect;
 mod neighbours;
 mod perturbation;
 mod plot;

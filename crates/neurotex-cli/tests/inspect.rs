@@ -1,0 +1,261 @@
+//! `neurotex inspect` on fabricated raw logs, each with one footgun a newcomer meets: the
+//! finding's code and its suggested option, and its absence on the clean logs.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::util::{s, Dir};
+
+/// How the fabricated logs go wrong.
+#[derive(Clone, Copy, Default)]
+struct Footguns {
+    /// Every channel rests this far above zero (the signals span about 1).
+    offset: f64,
+    /// Channels whose signal is a thousandth of the others'.
+    weak: usize,
+    /// The last channel repeats the one before it.
+    copy: bool,
+    /// The first class has three times the trials of the others.
+    unbalanced: bool,
+    /// The first log has a 60 ms hole in its 10 ms stamps.
+    gap: bool,
+    /// The stamps' column is `tick`, a name the reader does not take for time (a sample
+    /// counter's), instead of `timestamp`.
+    tick: bool,
+}
+
+/// Logs of a 3x3 sensor at 100 Hz: `timestamp` in ms (not a name the reader finds alone),
+/// then `c0`..`c8`; three classes at 5 and 10 mm/s, 5 trials each (15 for the first class
+/// when unbalanced), named `{label}_V{speed}_{trial}.csv`.
+fn logs(dir: &Dir, name: &str, f: Footguns) -> PathBuf {
+    let out = dir.join(name);
+    std::fs::create_dir_all(&out).unwrap();
+    for (k, label) in ["silk", "denim", "felt"].iter().enumerate() {
+        let trials = if f.unbalanced && k == 0 { 15 } else { 5 };
+        for speed in [5, 10] {
+            for trial in 0..trials {
+                let clock = if f.tick { "tick" } else { "timestamp" };
+                let mut text = format!("{clock},c0,c1,c2,c3,c4,c5,c6,c7,c8\n");
+                let period = 0.3 + 0.2 * k as f64 + 0.01 * trial as f64;
+                let mut t_ms = 1000.0;
+                for step in 0..400 {
+                    t_ms += if f.gap && k == 0 && trial == 0 && speed == 5 && step == 200 {
+                        60.0
+                    } else {
+                        10.0
+                    };
+                    let t = step as f64 / 100.0;
+                    let mut values: Vec<f64> = (0..9)
+                        .map(|c| {
+                            let phase = 2.0 * std::f64::consts::PI * (t / period + c as f64 / 9.0);
+                            let amp = if c < f.weak { 1e-3 } else { 1.0 };
+                            f.offset + 0.05 + amp * 0.5 * (1.0 + phase.sin())
+                        })
+                        .collect();
+                    if f.copy {
+                        values[8] = values[7];
+                    }
+                    let row: Vec<String> = values.iter().map(|v| format!("{v:.6}")).collect();
+                    writeln!(text, "{t_ms},{}", row.join(",")).unwrap();
+                }
+                let file = format!("{label}_V{speed}_{trial}.csv");
+                std::fs::write(out.join(file), text).unwrap();
+            }
+        }
+    }
+    out
+}
+
+/// `inspect --json` on `logs` with the import's options and `extra`: the findings as
+/// `(code, suggestion)`.
+fn findings(dir: &Dir, logs: &Path, extra: &[&str]) -> Vec<(String, String)> {
+    let mut args = vec![
+        "inspect",
+        s(logs),
+        "--name-pattern",
+        "{label}_V{speed}_{trial}.csv",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    let json: Value = serde_json::from_str(&dir.ok(&args)).expect("inspect --json prints JSON");
+    json["findings"]
+        .as_array()
+        .expect("findings")
+        .iter()
+        .map(|f| {
+            (
+                f["code"].as_str().unwrap().to_string(),
+                f["suggestion"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+fn suggestion<'a>(found: &'a [(String, String)], code: &str) -> &'a str {
+    match found.iter().find(|f| f.0 == code) {
+        Some(f) => &f.1,
+        None => panic!("no `{code}` among {found:?}"),
+    }
+}
+
+const FOOTGUNS: [&str; 8] = [
+    "grid-not-filled",
+    "resting-offset",
+    "taxels-unresponsive",
+    "copied-channel",
+    "time-as-channel",
+    "unbalanced",
+    "gaps",
+    "one-row",
+];
+
+#[test]
+fn clean_logs_have_none_of_the_footguns() {
+    let dir = Dir::new();
+    let clean = logs(&dir, "clean", Footguns::default());
+    let found = findings(
+        &dir,
+        &clean,
+        &["--time-column", "timestamp", "--grid", "3x3"],
+    );
+    for code in FOOTGUNS {
+        assert!(found.iter().all(|f| f.0 != code), "{code} in {found:?}");
+    }
+}
+
+#[test]
+fn each_footgun_is_named_with_its_option() {
+    let dir = Dir::new();
+    let timed = ["--time-column", "timestamp"];
+    let clean = logs(&dir, "clean", Footguns::default());
+    // nine channels on the README's 4x4 grid; and on no grid at all
+    let found = findings(&dir, &clean, &[&timed[..], &["--grid", "4x4"]].concat());
+    assert!(suggestion(&found, "grid-not-filled").contains("--grid 3x3"));
+    let found = findings(&dir, &clean, &timed);
+    assert!(suggestion(&found, "one-row").contains("--grid 3x3"));
+    // a clock column left among the channels (a rate given instead)
+    let tick = logs(
+        &dir,
+        "tick",
+        Footguns {
+            tick: true,
+            ..Footguns::default()
+        },
+    );
+    let found = findings(&dir, &tick, &["--fs", "100", "--grid", "2x5"]);
+    assert!(suggestion(&found, "time-as-channel").contains("--time-column tick"));
+    let grid = [&timed[..], &["--grid", "3x3"]].concat();
+    // a large resting offset without a baseline; none with one
+    let offset = logs(
+        &dir,
+        "offset",
+        Footguns {
+            offset: 20.0,
+            ..Footguns::default()
+        },
+    );
+    let found = findings(&dir, &offset, &grid);
+    assert!(suggestion(&found, "resting-offset").contains("--baseline min"));
+    let found = findings(&dir, &offset, &[&grid[..], &["--baseline", "min"]].concat());
+    assert!(found.iter().all(|f| f.0 != "resting-offset"), "{found:?}");
+    // most taxels silent at the gain
+    let weak = logs(
+        &dir,
+        "weak",
+        Footguns {
+            weak: 6,
+            ..Footguns::default()
+        },
+    );
+    let found = findings(&dir, &weak, &grid);
+    assert!(suggestion(&found, "taxels-unresponsive").contains("--gain auto"));
+    // a copied channel, unbalanced classes, a gap in the stamps
+    let copy = logs(
+        &dir,
+        "copy",
+        Footguns {
+            copy: true,
+            ..Footguns::default()
+        },
+    );
+    let found = findings(&dir, &copy, &grid);
+    assert!(suggestion(&found, "copied-channel").contains("--channels without `c8`"));
+    let unbalanced = logs(
+        &dir,
+        "unbalanced",
+        Footguns {
+            unbalanced: true,
+            ..Footguns::default()
+        },
+    );
+    let found = findings(&dir, &unbalanced, &grid);
+    assert!(suggestion(&found, "unbalanced").contains("chance"));
+    let gap = logs(
+        &dir,
+        "gap",
+        Footguns {
+            gap: true,
+            ..Footguns::default()
+        },
+    );
+    let found = findings(&dir, &gap, &grid);
+    assert!(suggestion(&found, "gaps").contains("--max-gap-s"));
+}
+
+#[test]
+fn a_dataset_folder_is_inspected_and_written_whole() {
+    let dir = Dir::new();
+    let clean = logs(
+        &dir,
+        "clean",
+        Footguns {
+            offset: 20.0,
+            ..Footguns::default()
+        },
+    );
+    let pattern = "{label}_V{speed}_{trial}.csv";
+    dir.ok(&[
+        "import",
+        "csv",
+        s(&clean),
+        "--out",
+        "ds",
+        "--name-pattern",
+        pattern,
+        "--time-column",
+        "timestamp",
+        "--grid",
+        "3x3",
+    ]);
+    // the same findings as on the raw logs with the same options
+    let text = dir.ok(&["inspect", "ds", "--out", "checked"]);
+    assert!(
+        text.contains("severe: [signals]") && text.contains("--baseline min"),
+        "{text}"
+    );
+    for f in [
+        "inspect.md",
+        "inspect.json",
+        "figures/traces.png",
+        "figures/taxels.svg",
+        "figures/design.png",
+    ] {
+        assert!(dir.join("checked").join(f).is_file(), "{f}");
+    }
+    let md = std::fs::read_to_string(dir.join("checked/inspect.md")).unwrap();
+    assert!(
+        md.contains("## Design") && md.contains("resting-offset"),
+        "{md}"
+    );
+    // reading options are for raw logs; --strict turns a severe finding into status 2
+    let err = dir.fails(&["inspect", "ds", "--grid", "3x3"]);
+    assert!(err.contains("dataset folder"), "{err}");
+    assert_eq!(
+        dir.run(&["inspect", "ds", "--strict", "--no-encoder"])
+            .status
+            .code(),
+        Some(2)
+    );
+}

@@ -1,0 +1,358 @@
+//! The rules that turn an inspection's numbers into findings, each with its severity and
+//! the option that addresses it.
+
+use serde::Serialize;
+
+use super::{InspectParams, Inspection};
+use crate::diagnostics::{TaxelDiagnostics, TaxelResponse};
+use crate::import::{grid_advice, ImportWarning, OFFSET_RATIO};
+use crate::recording::LayoutFile;
+
+/// How much a finding matters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Severity {
+    /// Worth knowing; nothing is wrong.
+    Note,
+    /// Probably not what was meant, or weakens an analysis.
+    Warning,
+    /// An analysis will fail or mislead unless it is addressed.
+    Severe,
+}
+
+impl std::fmt::Display for Severity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Severity::Note => "note",
+            Severity::Warning => "warning",
+            Severity::Severe => "severe",
+        })
+    }
+}
+
+/// One finding.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Finding {
+    /// How much it matters.
+    pub severity: Severity,
+    /// `design`, `layout`, `signals` or `encoder`.
+    pub area: &'static str,
+    /// A short name for the rule, stable for scripts and tests (`grid-not-filled`).
+    pub code: &'static str,
+    /// What was found, in numbers.
+    pub message: String,
+    /// What to do about it: the option first.
+    pub suggestion: String,
+}
+
+fn finding(
+    severity: Severity,
+    area: &'static str,
+    code: &'static str,
+    message: String,
+    suggestion: impl Into<String>,
+) -> Finding {
+    Finding {
+        severity,
+        area,
+        code,
+        message,
+        suggestion: suggestion.into(),
+    }
+}
+
+/// At most the first three names, and how many more.
+fn names(list: &[String]) -> String {
+    let shown: Vec<String> = list.iter().take(3).map(|n| format!("`{n}`")).collect();
+    match list.len() {
+        n if n > 3 => format!("{} and {} more", shown.join(", "), n - 3),
+        _ => shown.join(", "),
+    }
+}
+
+/// Every finding of `i`, the most severe first.
+pub(super) fn findings(i: &Inspection, file: &LayoutFile, p: &InspectParams) -> Vec<Finding> {
+    let mut out = Vec::new();
+    design(i, &mut out);
+    layout(i, &mut out);
+    signals(i, file, p, &mut out);
+    encoder(i, &mut out);
+    out.sort_by_key(|f| std::cmp::Reverse(f.severity));
+    out
+}
+
+fn design(i: &Inspection, out: &mut Vec<Finding>) {
+    use Severity::*;
+    let d = &i.design;
+    if d.classes.len() < 2 {
+        out.push(finding(
+            Severe,
+            "design",
+            "one-class",
+            format!(
+                "{} class(es) among the recordings: a classifier needs at least 2",
+                d.classes.len()
+            ),
+            "--name-pattern with a {label} field, or a manifest with each recording's class",
+        ));
+        return;
+    }
+    let [pooled, within, held_out, knn] = &d.support[..] else {
+        return;
+    };
+    if !pooled.supported {
+        out.push(finding(
+            Severe,
+            "design",
+            "folds",
+            format!("{}: {}", pooled.analysis, pooled.why),
+            fewer_folds(pooled.limit),
+        ));
+    }
+    let speeds = d.speeds();
+    if speeds.is_empty() {
+        out.push(finding(
+            Warning,
+            "design",
+            "no-speeds",
+            "the recordings have no speed_mm_s: reproduce's analyses by speed cannot run".into(),
+            "--name-pattern with a {speed} field (mm/s), or a speed_mm_s column in the manifest",
+        ));
+    } else {
+        if !within.supported {
+            out.push(finding(
+                Severe,
+                "design",
+                "folds-within-speed",
+                format!("{}: {}", within.analysis, within.why),
+                fewer_folds(within.limit),
+            ));
+        }
+        if !held_out.supported {
+            out.push(finding(
+                Note,
+                "design",
+                "one-speed",
+                format!("{}: {}", held_out.analysis, held_out.why),
+                "recordings at a second speed",
+            ));
+        }
+    }
+    if !knn.supported && pooled.supported {
+        out.push(finding(
+            Warning,
+            "design",
+            "neighbours",
+            format!("{}: {}", knn.analysis, knn.why),
+            match knn.limit {
+                0 => {
+                    "more recordings per class (or fewer folds, leaving more in each training fold)"
+                        .to_string()
+                }
+                n => format!("--k {n} or fewer, or more recordings per class"),
+            },
+        ));
+    }
+    let worst = d
+        .conditions
+        .iter()
+        .max_by(|a, b| a.imbalance().total_cmp(&b.imbalance()));
+    if let Some(c) = worst.filter(|c| c.imbalance() >= 1.5) {
+        let at = c.speed_mm_s.map_or("over all recordings".to_string(), |s| {
+            format!("at {s} mm/s")
+        });
+        let present = c.counts.iter().filter(|&&n| n > 0).count().max(1);
+        out.push(finding(Warning, "design", "unbalanced", format!("the classes are unbalanced {at}: from {} to {} recordings a class, so chance there is the largest class's share, {:.2}, not 1/{present} = {:.2}", c.counts.iter().filter(|&&n| n > 0).min().unwrap_or(&0), c.counts.iter().max().unwrap_or(&0), c.chance, 1.0 / present as f64), "read each accuracy against its chance column (the reports give the largest class's share)"));
+    }
+}
+
+fn fewer_folds(smallest: usize) -> String {
+    match smallest {
+        0 | 1 => "more recordings: each class needs at least 2 for any cross-validation".into(),
+        n => format!("--folds {n} (each class has at least {n} recordings), or more recordings"),
+    }
+}
+
+fn layout(i: &Inspection, out: &mut Vec<Finding>) {
+    use Severity::*;
+    let l = &i.layout;
+    let n = l.channels.len();
+    if l.rows == 1 && n >= 4 {
+        out.push(finding(Warning, "layout", "one-row", format!("the {n} channels form one row (1x{n}), so the GLCM's neighbours run along a line and the 2D- and 3D-GLCM see no second dimension of the sensor (ignore this if the taxels do lie on a line)"), grid_advice(n)));
+    } else if !l.mapped && l.empty_cells > 0 {
+        let w = ImportWarning::GridNotFilled {
+            channels: n,
+            rows: l.rows,
+            cols: l.cols,
+        };
+        out.push(finding(
+            Warning,
+            "layout",
+            "grid-not-filled",
+            w.to_string(),
+            grid_advice(n),
+        ));
+    }
+}
+
+fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<Finding>) {
+    use Severity::*;
+    let s = &i.signals;
+    let logs = i.kind == "raw logs";
+    if !s.unreadable.is_empty() {
+        let first = &s.unreadable[0];
+        let fix = match logs {
+            true => "fix the files, or --skip-bad to import the others",
+            false => "fix the files, or remove their rows from manifest.csv",
+        };
+        out.push(finding(
+            Severe,
+            "signals",
+            "unreadable",
+            format!(
+                "{} of {} file(s) cannot be read; the first: {}",
+                s.unreadable.len(),
+                i.files,
+                first.reason
+            ),
+            fix,
+        ));
+    }
+    if !s.too_short.is_empty() {
+        out.push(finding(
+            Severe,
+            "signals",
+            "too-short",
+            format!(
+                "{} recording(s) last less than one {} ms bin of the rate volume: {}",
+                s.too_short.len(),
+                p.pipeline.volume.bin_ms,
+                names(&s.too_short)
+            ),
+            "leave them out, or --bin-ms smaller than the shortest recording",
+        ));
+    }
+    let most = |share: f64| share > 0.5;
+    let chans = &s.channels;
+    let list = |f: &dyn Fn(&super::ChannelSummary) -> bool| -> Vec<String> {
+        chans
+            .iter()
+            .filter(|c| f(c))
+            .map(|c| c.name.clone())
+            .collect()
+    };
+    let rising = list(&|c| most(c.rising_share));
+    if let Some(clock) = rising.first() {
+        let how = match logs {
+            true => format!("--time-column {clock}, and --channels without it"),
+            false => format!("re-import with --time-column {clock}"),
+        };
+        out.push(finding(Severe, "signals", "time-as-channel", format!("channel(s) {} rise at every frame in most recordings, as a clock or counter does: a time column read as a taxel", names(&rising)), how));
+    }
+    let dead = list(&|c| most(c.dead_share));
+    if !dead.is_empty() {
+        out.push(finding(Warning, "signals", "dead-channel", format!("channel(s) {} hold one value throughout most recordings: unconnected or dead, they give silent taxels", names(&dead)), "--channels listing only the live channels"));
+    }
+    for c in chans.iter().filter(|c| most(c.copy_share)) {
+        let of = c.copy_of.as_deref().unwrap_or("another channel");
+        out.push(finding(Warning, "signals", "copied-channel", format!("channel `{}` equals `{of}` at every frame in {:.0} % of the recordings: one signal counted as two taxels", c.name, 100.0 * c.copy_share), format!("--channels without `{}`", c.name)));
+    }
+    let clipped = list(&|c| most(c.clipped_share));
+    if !clipped.is_empty() {
+        out.push(finding(Warning, "signals", "clipped", format!("channel(s) {} sit at a converter's full scale (255, 1023, 4095, 16383 or 65535) in at least 1 % of the samples of most recordings: clipped, the pressure beyond is lost", names(&clipped)), "a lower sensor gain or wider range; or --channels without them if they are not taxels"));
+    }
+    let ratios: Vec<f64> = chans.iter().filter_map(|c| c.resting_ratio).collect();
+    let resting = super::median(ratios);
+    let baseline = p
+        .pipeline
+        .preprocess
+        .baseline
+        .or(file.baseline)
+        .unwrap_or_default();
+    if baseline == crate::recording::Baseline::None && resting >= OFFSET_RATIO {
+        out.push(finding(Severe, "signals", "resting-offset", format!("the channels rest at about {resting:.1} times their range above zero (median channel) and no baseline is removed, so the encoder, dividing by each recording's maximum, sees mostly the resting offset"), "--baseline min (each channel's minimum removed)"));
+    }
+    if !s.gappy.is_empty() {
+        let worst = s
+            .gappy
+            .iter()
+            .max_by(|a, b| a.longest_s.total_cmp(&b.longest_s))
+            .expect("not empty");
+        out.push(finding(Warning, "signals", "gaps", format!("{} recording(s) have gaps of {} or more median intervals in their stamps; the longest, {:.3} s, in `{}`; resampling draws a straight line through each", s.gappy.len(), super::signals::GAP_FACTOR, worst.longest_s, worst.file), "--max-gap-s, the longest pause a reader may fill (longer ones are refused)"));
+    }
+    if let (false, Some([_, mid, _])) = (s.off_rate.is_empty(), s.fs_hz) {
+        out.push(finding(
+            Warning,
+            "signals",
+            "rate-differs",
+            format!(
+                "{} recording(s) are sampled more than 5 % off the median rate of {mid:.2} Hz: {}",
+                s.off_rate.len(),
+                names(&s.off_rate)
+            ),
+            "check the logger's settings; each file's stamps are used to resample it to 1 kHz",
+        ));
+    }
+    if let Some([mid, _]) = s.jitter.filter(|j| j[0] > 0.5) {
+        out.push(finding(Note, "signals", "jitter", format!("the intervals between stamps spread over {:.0} % of the median interval (5th to 95th percentile, median recording)", 100.0 * mid), "nothing to do: irregular stamps are resampled onto 1 ms"));
+    }
+    if s.merged_rows[0] > 0 {
+        out.push(finding(Note, "signals", "repeated-stamps", format!("{} row(s) in {} file(s) share a time stamp with another row and were merged or dropped", s.merged_rows[0], s.merged_rows[1]), "--duplicate-stamps average|first|last|error chooses what repeated stamps become"));
+    }
+}
+
+fn encoder(i: &Inspection, out: &mut Vec<Finding>) {
+    use Severity::*;
+    let Some(e) = &i.encoder else { return };
+    let diagnostics = TaxelDiagnostics {
+        ceiling_hz: e.ceiling_hz,
+        taxels: (e.taxels.iter())
+            .map(|t| TaxelResponse {
+                taxel: t.name.clone(),
+                silent_share: t.silent_share,
+                saturated_share: t.saturated_share,
+            })
+            .collect(),
+    };
+    let auto = match &e.auto {
+        Some(a) => format!(
+            "--gain auto (it would choose {} here, a median of {:.1} Hz)",
+            a.gain, a.median_hz
+        ),
+        None => "--gain auto".to_string(),
+    };
+    if let Some(advice) = diagnostics.advice() {
+        out.push(finding(
+            Severe,
+            "encoder",
+            "taxels-unresponsive",
+            format!("at gain {}: {advice}", e.gain),
+            auto.clone(),
+        ));
+    } else {
+        let silent: Vec<String> = diagnostics.silent().iter().map(|s| s.to_string()).collect();
+        if !silent.is_empty() {
+            out.push(finding(
+                Warning,
+                "encoder",
+                "silent-taxels",
+                format!(
+                    "at gain {}, {} of {} taxels never fire in most recordings: {}",
+                    e.gain,
+                    silent.len(),
+                    e.taxels.len(),
+                    names(&silent)
+                ),
+                auto.clone(),
+            ));
+        }
+    }
+    if e.flat > 0 {
+        out.push(finding(Warning, "encoder", "flat-recordings", format!("{} recording(s) have no positive signal in the selected phase and encode to no spikes", e.flat), "--baseline none if the baseline removes the whole signal; check slide_start_s and slide_end_s"));
+    }
+    match (&e.auto, &e.auto_error) {
+        (Some(a), _) => out.push(finding(Note, "encoder", "gain-auto", format!("--gain auto would choose a gain of {} (median {:.1} Hz over {} taxel x recording pairs with signal; target {} Hz); checked here: {}", a.gain, a.median_hz, a.pairs, a.target_hz, e.gain), "--gain auto on evaluate, train, compare and reproduce")),
+        (None, Some(why)) => out.push(finding(Note, "encoder", "gain-auto", format!("--gain auto cannot choose a gain here: {why}"), "nothing, or more recordings with signal")),
+        (None, None) => {}
+    }
+}

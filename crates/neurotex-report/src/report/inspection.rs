@@ -1,0 +1,372 @@
+//! `inspect`'s outputs: lines for a terminal, `inspect.md` with its figures, and
+//! `inspect.json`, all rendered from an [`Inspection`].
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::figures::inspect as figs;
+use super::figures::{svg_and_png, FigureError};
+use super::folder_source;
+use crate::error::{DataError, Result};
+use crate::inspect::{Finding, Inspection, Severity};
+use crate::io::replace_dir;
+
+/// `a, b and 3 more`.
+fn short_list(names: &[String], max: usize) -> String {
+    let shown = names
+        .iter()
+        .take(max)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    match names.len() > max {
+        true => format!("{shown} and {} more", names.len() - max),
+        false => shown,
+    }
+}
+
+/// A finding on one line, then its suggestion.
+fn finding_lines(f: &Finding) -> [String; 2] {
+    [
+        format!("{}: [{}] {}", f.severity, f.area, f.message),
+        format!("    try: {}", f.suggestion),
+    ]
+}
+
+/// The inspection in a few lines for a terminal: what was read, the design, then every
+/// finding with its suggestion.
+pub fn text_lines(i: &Inspection) -> Vec<String> {
+    let d = &i.design;
+    let s = &i.signals;
+    let l = &i.layout;
+    let mut out = vec![format!(
+        "{} recordings ({}): {} read, {} unreadable; {} classes ({})",
+        i.files,
+        i.kind,
+        s.recordings,
+        s.unreadable.len(),
+        d.classes.len(),
+        short_list(&d.classes, 6)
+    )];
+    let speeds: Vec<String> = (d.speeds().iter())
+        .filter_map(|c| c.speed_mm_s)
+        .map(|v| v.to_string())
+        .collect();
+    if !speeds.is_empty() {
+        out.push(format!("speeds (mm/s): {}", short_list(&speeds, 12)));
+    }
+    let rate = match s.fs_hz {
+        Some([lo, mid, hi]) => format!("stamps at {mid:.2} Hz (from {lo:.2} to {hi:.2})"),
+        None => format!("no stamps; {:.2} Hz nominal", l.fs_hz),
+    };
+    let [dmin, dmid, dmax] = s.duration_s;
+    out.push(format!(
+        "{} channels on a {}x{} grid; {rate}; {dmid:.1} s a recording (from {dmin:.1} to {dmax:.1}); baseline removed: {}",
+        l.channels.len(), l.rows, l.cols, l.baseline
+    ));
+    if let Some(e) = &i.encoder {
+        let silent = e.taxels.iter().filter(|t| t.silent_share > 0.5).count();
+        let mut rates: Vec<f64> = e.taxels.iter().map(|t| t.median_hz).collect();
+        rates.sort_by(f64::total_cmp);
+        let mid = rates.get(rates.len() / 2).copied().unwrap_or(0.0);
+        out.push(format!(
+            "encoder at gain {}: median taxel {mid:.1} Hz, {silent} of {} taxels silent in most recordings",
+            e.gain,
+            e.taxels.len()
+        ));
+    }
+    match i.findings.is_empty() {
+        true => out.push("no findings".to_string()),
+        false => {
+            for f in &i.findings {
+                out.extend(finding_lines(f));
+            }
+        }
+    }
+    out
+}
+
+/// A markdown table.
+fn table(header: &[&str], rows: &[Vec<String>]) -> String {
+    let mut out = format!("| {} |\n", header.join(" | "));
+    let _ = writeln!(out, "|{}", "---|".repeat(header.len()));
+    for r in rows {
+        let _ = writeln!(out, "| {} |", r.join(" | "));
+    }
+    out
+}
+
+fn optional(v: Option<f64>, digits: usize) -> String {
+    v.map_or("-".to_string(), |v| format!("{v:.digits$}"))
+}
+
+fn percent(share: f64) -> String {
+    format!("{:.0} %", 100.0 * share)
+}
+
+/// `inspect.md`: the findings first, then the design, the layout, the signals, the encoder
+/// and the figures (`figures` names the ones written).
+pub fn markdown(i: &Inspection, source: &str, figures: &[(&str, String)]) -> String {
+    let mut md = format!("# Inspection of {source}\n\n");
+    md += &format!(
+        "{} recordings ({}) found; {} read.\n\n",
+        i.files, i.kind, i.signals.recordings
+    );
+    md += "## Findings\n\n";
+    if i.findings.is_empty() {
+        md += "No findings.\n\n";
+    }
+    for sev in [Severity::Severe, Severity::Warning, Severity::Note] {
+        for f in i.findings.iter().filter(|f| f.severity == sev) {
+            md += &format!(
+                "- **{}** ({}, `{}`): {}. Try: {}.\n",
+                f.severity, f.area, f.code, f.message, f.suggestion
+            );
+        }
+    }
+    md += "\n## Design\n\n";
+    let d = &i.design;
+    let mut header: Vec<String> = vec!["class".into(), "all".into()];
+    header.extend(
+        d.speeds()
+            .iter()
+            .filter_map(|c| c.speed_mm_s)
+            .map(|s| format!("{s} mm/s")),
+    );
+    let rows: Vec<Vec<String>> = (0..d.classes.len())
+        .map(|k| {
+            let mut row = vec![d.classes[k].clone()];
+            row.extend(d.conditions.iter().map(|c| c.counts[k].to_string()));
+            row
+        })
+        .chain(std::iter::once({
+            let mut row = vec!["chance (largest class)".to_string()];
+            row.extend(d.conditions.iter().map(|c| format!("{:.3}", c.chance)));
+            row
+        }))
+        .collect();
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
+    md += &table(&header, &rows);
+    md += "\nGroups the manifest names: ";
+    let groups: Vec<String> = d
+        .groups
+        .iter()
+        .map(|g| format!("`{}` ({} values)", g.column, g.values))
+        .collect();
+    md += &match groups.is_empty() {
+        true => "none.\n\n".to_string(),
+        false => format!(
+            "{}; `--group-by COLUMN` keeps each group in one fold.\n\n",
+            groups.join(", ")
+        ),
+    };
+    let support: Vec<Vec<String>> = (d.support.iter())
+        .map(|s| {
+            vec![
+                s.analysis.clone(),
+                if s.supported { "yes" } else { "**no**" }.into(),
+                s.why.clone(),
+            ]
+        })
+        .collect();
+    md += &table(&["analysis", "supported", "why"], &support);
+    md += &layout_section(i);
+    md += &signals_section(i);
+    md += &encoder_section(i);
+    md += "\n## Figures\n\n";
+    for (name, caption) in figures {
+        md += &format!("![{name}](figures/{name}.png)\n\n{caption}\n\n");
+    }
+    md
+}
+
+fn layout_section(i: &Inspection) -> String {
+    let l = &i.layout;
+    let mut md = format!(
+        "\n## Layout\n\n{} channels on a {}x{} grid ({}), {} cell(s) without a channel, {} neighbouring pairs for the GLCM; baseline removed: {}; nominal rate {:.2} Hz.\n\n```\n",
+        l.channels.len(), l.rows, l.cols,
+        if l.mapped { "placed by a channel map" } else { "row by row in channel order" },
+        l.empty_cells, l.neighbour_pairs, l.baseline, l.fs_hz
+    );
+    let width = l.channels.iter().map(String::len).max().unwrap_or(1).max(1);
+    for r in 0..l.rows {
+        let cells: Vec<String> = (0..l.cols)
+            .map(|c| {
+                let name = l
+                    .cells
+                    .iter()
+                    .position(|&x| x == [r, c])
+                    .map_or(".", |k| l.channels[k].as_str());
+                format!("{name:>width$}")
+            })
+            .collect();
+        md += &cells.join(" ");
+        md += "\n";
+    }
+    md + "```\n"
+}
+
+fn signals_section(i: &Inspection) -> String {
+    let s = &i.signals;
+    let mut md = "\n## Signals\n\n".to_string();
+    if let Some([lo, mid, hi]) = s.fs_hz {
+        md += &format!("Stamps: {mid:.2} Hz median rate (from {lo:.2} to {hi:.2} over recordings)");
+        if let Some([j, jmax]) = s.jitter {
+            md += &format!(
+                "; intervals spread over {:.0} % of the median interval (largest {:.0} %)",
+                100.0 * j,
+                100.0 * jmax
+            );
+        }
+        md += &format!("; {} recording(s) with gaps.\n", s.gappy.len());
+    } else {
+        md += "No time stamps: the nominal rate is used.\n";
+    }
+    let [lo, mid, hi] = s.duration_s;
+    md += &format!("Durations: {mid:.2} s median (from {lo:.2} to {hi:.2}).\n\n");
+    let rows: Vec<Vec<String>> = (s.channels.iter())
+        .map(|c| {
+            vec![
+                format!("`{}`", c.name),
+                format!("{:.4}", c.range),
+                optional(c.resting_ratio, 2),
+                percent(c.dead_share),
+                percent(c.rising_share),
+                percent(c.clipped_share),
+                c.copy_of
+                    .as_ref()
+                    .map_or("-".into(), |o| format!("`{o}` ({})", percent(c.copy_share))),
+            ]
+        })
+        .collect();
+    md += &table(
+        &[
+            "channel",
+            "range (median)",
+            "resting offset / range",
+            "dead",
+            "rising",
+            "clipped",
+            "copy of",
+        ],
+        &rows,
+    );
+    md += "\nShares are of the recordings read. Range and offset are medians over them.\n";
+    if !s.unreadable.is_empty() {
+        md += "\nUnreadable files:\n\n";
+        for u in s.unreadable.iter().take(20) {
+            md += &format!("- `{}`: {}\n", u.file, u.reason);
+        }
+        if s.unreadable.len() > 20 {
+            md += &format!(
+                "- and {} more (inspect.json lists them all)\n",
+                s.unreadable.len() - 20
+            );
+        }
+    }
+    md
+}
+
+fn encoder_section(i: &Inspection) -> String {
+    let Some(e) = &i.encoder else {
+        return "\n## Encoder\n\nNot checked.\n".to_string();
+    };
+    let mut md = format!(
+        "\n## Encoder at gain {}\n\nA neuron held at the largest input fires at {:.0} Hz (the ceiling). {} recording(s) had no positive signal.",
+        e.gain, e.ceiling_hz, e.flat
+    );
+    match (&e.auto, &e.auto_error) {
+        (Some(a), _) => {
+            md += &format!(
+                " `--gain auto` would choose {} (median {:.1} Hz, target {} Hz).\n\n",
+                a.gain, a.median_hz, a.target_hz
+            )
+        }
+        (None, Some(why)) => md += &format!(" `--gain auto` cannot choose: {why}.\n\n"),
+        (None, None) => md += "\n\n",
+    }
+    let rows: Vec<Vec<String>> = (e.taxels.iter())
+        .map(|t| {
+            vec![
+                format!("`{}`", t.name),
+                format!("r{}c{}", t.cell[0], t.cell[1]),
+                format!("{:.1}", t.median_hz),
+                percent(t.silent_share),
+                percent(t.saturated_share),
+            ]
+        })
+        .collect();
+    md + &table(
+        &[
+            "channel",
+            "cell",
+            "median rate (Hz)",
+            "silent",
+            "at the ceiling",
+        ],
+        &rows,
+    )
+}
+
+/// The figures with their captions, as `(name, svg, caption)`.
+fn figures(
+    i: &Inspection,
+    source: &str,
+) -> Vec<(
+    &'static str,
+    std::result::Result<String, FigureError>,
+    String,
+)> {
+    let mut out = Vec::new();
+    if let Some(svg) = figs::traces(i, source) {
+        let files: Vec<String> = i.traces.iter().map(|t| format!("`{}`", t.file)).collect();
+        let caption = format!("The first recording of each class (up to six classes, in name order: {}): left, its channels as logged; right, the encoder's input after conditioning (selected phase, 1 kHz, baseline removed, low-passed, divided by the recording's maximum). One colour per channel, in channel order.", files.join(", "));
+        out.push(("traces", svg, caption));
+    }
+    let encoder = match i.encoder.is_some() {
+        true => " Right: each taxel's median firing rate over the recordings at the gain checked.",
+        false => "",
+    };
+    let caption = format!("Left: each taxel's resting offset, its smallest value over its range (median over recordings); far above 1 the encoder sees mostly the offset unless a baseline is removed.{encoder} Grey cells have no channel.");
+    out.push(("taxels", figs::taxel_map(i, source), caption));
+    out.push(("design", figs::design(i, source), "Recordings of each class at each speed (or over all recordings when the manifest has no speeds).".to_string()));
+    out
+}
+
+/// `inspect.md`, `inspect.json` and `figures/` (SVG and PNG) as one folder `dir`, written
+/// whole and replacing an earlier inspection there; `inspected` names the data on the
+/// figures.
+///
+/// # Errors
+/// A figure cannot be drawn; the folder cannot be written or holds files that are not an
+/// earlier output's.
+pub fn write_inspection(dir: &Path, i: &Inspection, inspected: &Path) -> Result<()> {
+    let source = folder_source(inspected);
+    let json = serde_json::to_string_pretty(i)
+        .map_err(|e| DataError::invalid(dir.join("inspect.json"), e.to_string()))?;
+    let mut files = vec![("inspect.json".to_string(), (json + "\n").into_bytes())];
+    let mut captions = Vec::new();
+    for (name, svg, caption) in figures(i, &source) {
+        let svg_name = format!("{name}.svg");
+        let failed =
+            |e: FigureError| DataError::invalid(dir.join("figures").join(&svg_name), e.to_string());
+        let svg = svg.map_err(failed)?;
+        for (file, bytes) in svg_and_png(&svg_name, svg).map_err(failed)? {
+            files.push((format!("figures/{file}"), bytes));
+        }
+        captions.push((name, caption));
+    }
+    files.push((
+        "inspect.md".to_string(),
+        markdown(i, &source, &captions).into_bytes(),
+    ));
+    replace_dir(dir, |tmp| {
+        std::fs::create_dir(tmp.join("figures"))
+            .map_err(|e| DataError::write(dir.join("figures"), e))?;
+        for (name, bytes) in &files {
+            let path = tmp.join(name);
+            std::fs::write(&path, bytes).map_err(|e| DataError::write(dir.join(name), e))?;
+        }
+        Ok(())
+    })
+}
