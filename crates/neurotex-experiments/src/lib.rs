@@ -11,6 +11,6 @@ use neurotex_features::features;
 use neurotex_learn::classify;
 #[cfg(test)]
 use neurotex_pipeline::model;
-use neurotex_pipeline::{analysis, calibrate, causal, compare, diagnostics, pipeline};
+use neurotex_pipeline::{analysis, calibrate, causal, compare, diagnostics, inspect, pipeline};
 use neurotex_signal::{encode, signal};
 use neurotex_sim::sim;

@@ -38,9 +38,11 @@ def main() -> None:
     stats = neurotex.spike_stats(spikes)          # (rows, cols, 3): MSR, CV_ISI, Fano
     volume = neurotex.rate_volume(spikes)         # (rows, cols, bins) in Hz
     counts = neurotex.glcm3d(volume)              # (16, 16) co-occurrence counts
+    haralick = {k: round(float(v), 4)
+                for k, v in zip(neurotex.HARALICK_NAMES, neurotex.haralick(counts))}
     print(f"{rec.label}: {int(spikes.sum())} spikes over {spikes.shape[0]} ms; "
           f"taxel (0,0) fires at {stats[0, 0, 0]:.1f} Hz; "
-          f"rate volume {volume.shape}; Haralick {{k: round(float(v), 4) for k, v in zip(neurotex.HARALICK_NAMES, neurotex.haralick(counts))}}")
+          f"rate volume {volume.shape}; Haralick {haralick}")
 
     # 3. The paper's comparison at 5 mm/s, with scikit-learn's cross-validation.
     at5 = [r for r in ds.recordings if r.speed == 5.0]

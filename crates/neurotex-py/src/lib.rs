@@ -11,6 +11,7 @@ mod convert;
 mod dataset;
 mod errors;
 mod estimator;
+mod inspect;
 mod model;
 mod params;
 mod reproduce;
@@ -399,6 +400,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     calibrate::register(m)?;
     dataset::register(m)?;
     reproduce::register(m)?;
+    inspect::register(m)?;
     model::register(m)?;
     estimator::register(m)?;
     stream::register(m)?;

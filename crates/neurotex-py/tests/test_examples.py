@@ -32,4 +32,6 @@ def test_worked_example_runs(tmp_path):
                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr
     assert "neurotex.cross_validate" in out.stdout
+    # the Haralick values are printed, not the f-string's template
+    assert "Haralick {'" in out.stdout and "{k:" not in out.stdout, out.stdout
     assert (tmp_path / "model.json").is_file()

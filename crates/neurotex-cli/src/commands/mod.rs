@@ -56,7 +56,8 @@ fn encode_all(
     Ok((encoded, grid))
 }
 
-/// The pipeline the options name; with `--causal`, its resting values and scale fixed on
+/// The pipeline the options name, after saying the dataset's severe findings on its signals
+/// and layout ([`neurotex::inspect::severe_findings`]); with `--causal`, its resting values and scale fixed on
 /// `dataset`'s recordings `indices` (the training recordings: never a test one); with
 /// `--gain auto`, its gain calibrated on them too ([`calibrate_pipeline`]). Each choice is
 /// said on standard error.
@@ -65,6 +66,9 @@ fn calibrated_pipeline(
     dataset: &Dataset,
     indices: &[usize],
 ) -> Result<CalibratedParams> {
+    for finding in neurotex::inspect::severe_findings(dataset, &stages.pipeline()?)? {
+        eprintln!("warning: {} (neurotex inspect says more)", finding.line());
+    }
     let baseline = dataset.layout.baseline.unwrap_or_default();
     let load = |i: usize| dataset.load(i);
     let (causal, gain) = (stages.options.causal, stages.options.gain);

@@ -13,6 +13,7 @@ use crate::calibrate::{calibrate_gain, GainCalibration};
 use crate::causal::{calibrate_conditioning, ConditioningCalibration};
 use crate::encode::encode_banks;
 use crate::error::{ClassifyError, DataError, DatasetError, Result};
+use crate::inspect::severe_findings;
 use crate::pipeline::{Encoded, Encoding, Pipeline};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
@@ -430,6 +431,11 @@ pub fn prepare(
         progress(Progress::TooSmall(&e));
         e.to_string()
     });
+    if let Source::Dataset(ds) = source {
+        for finding in severe_findings(ds, params.pipeline().params())? {
+            progress(Progress::Advice(&finding.line()));
+        }
+    }
     let labels = distinct_labels(&conditions);
     let clock = Instant::now();
     let causal = causal_pipelines(source, params, &conditions)?;

@@ -20,6 +20,13 @@ pub enum Severity {
     Severe,
 }
 
+impl Finding {
+    /// The finding and what to try, on one line.
+    pub fn line(&self) -> String {
+        format!("{}; try: {}", self.message, self.suggestion)
+    }
+}
+
 impl std::fmt::Display for Severity {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {

@@ -273,6 +273,23 @@ impl Inspection {
     }
 }
 
+/// The severe findings on a dataset's signals and layout, for a workflow to say at its start
+/// (its design and its taxels' responses it judges itself): reads every recording once,
+/// without encoding.
+///
+/// # Errors
+/// As [`inspect`].
+pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<Vec<Finding>> {
+    let params = InspectParams {
+        pipeline: pipeline.clone(),
+        encoder: false,
+        ..InspectParams::default()
+    };
+    let i = inspect(Source::Dataset(dataset), &params, &|| {})?;
+    let severe = i.at_least(Severity::Severe).filter(|f| f.area != "design");
+    Ok(severe.cloned().collect())
+}
+
 /// One recording, reduced.
 struct Checked {
     /// The recording's index in the source.

@@ -59,7 +59,9 @@ class Recording:
     ``slide`` is the sliding phase ``(start_s, end_s)`` (the rest is ignored unless
     ``whole=True``); ``times`` are per-sample time stamps in seconds for irregular
     sampling (then resampled to 1 kHz); ``mask`` marks the grid cells holding a taxel
-    (``(rows, cols)`` bool); ``speed`` in mm/s is needed by ``all-taxels-mm``."""
+    (``(rows, cols)`` bool); ``speed`` in mm/s is needed by ``all-taxels-mm``.
+    ``meta``: every column of its manifest row as text (``trial``, ``force_n`` and any
+    further column such as a session or subject), for grouped cross-validation."""
 
     x: np.ndarray
     fs: float = 1000.0
@@ -69,6 +71,7 @@ class Recording:
     times: Optional[np.ndarray] = None
     mask: Optional[np.ndarray] = None
     name: Optional[str] = None
+    meta: Dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -98,6 +101,24 @@ class Dataset:
     def speeds(self) -> np.ndarray:
         """Every recording's sliding speed in mm/s (NaN where unknown)."""
         return np.array([np.nan if r.speed is None else r.speed for r in self.recordings])
+
+    def column(self, name: str) -> np.ndarray:
+        """Every recording's value of manifest column ``name`` (``trial``, ``force_n``, a
+        session or subject column, ...): floats when every value is a number (NaN where
+        empty), else text. For grouped cross-validation in scikit-learn::
+
+            GroupKFold(5).split(X, y, groups=ds.column("trial"))
+
+        Raises :class:`ParameterError` for a column the manifest does not have."""
+        if name not in self.columns:
+            raise ParameterError(
+                f"invalid parameter `name`: the manifest has no column `{name}`; it has "
+                + ", ".join(self.columns))
+        values = [r.meta.get(name, "") for r in self.recordings]
+        try:
+            return np.array([np.nan if v == "" else float(v) for v in values])
+        except ValueError:
+            return np.array(values, dtype=object)
 
     def __len__(self) -> int:
         return len(self.recordings)
@@ -567,7 +588,7 @@ def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = 
     d = _native.load_dataset(os.fspath(path), None if rows is None else [int(i) for i in rows])
     mask = None
     recs = []
-    for a, info in zip(d["arrays"], d["infos"]):
+    for a, info, row in zip(d["arrays"], d["infos"], d["rows"]):
         name, fs, present, label, speed, start, end, times = info
         m = None
         if present is not None and not all(present):
@@ -576,7 +597,8 @@ def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = 
         recs.append(Recording(
             x=a, fs=fs, label=label, speed=speed,
             slide=None if start is None and end is None else (start, end),
-            times=None if times is None else np.array(times), mask=m, name=name))
+            times=None if times is None else np.array(times), mask=m, name=name,
+            meta=dict(row)))
     return Dataset(recordings=recs, rows=list(d["rows"]), columns=list(d["columns"]),
                    fs=d["fs"], baseline=d["baseline"], mask=mask, path=os.fspath(path))
 
@@ -887,6 +909,85 @@ def reproduce(
     )
 
 
+
+@dataclass
+class Inspection:
+    """What :func:`inspect` found. ``findings``: each a dict with ``severity``
+    (``severe``, ``warning`` or ``note``), ``area`` (``design``, ``layout``, ``signals``,
+    ``encoder``), ``code`` (a stable name such as ``grid-not-filled``), ``message`` and
+    ``suggestion`` (the option first); ``design``, ``layout``, ``signals``, ``encoder``:
+    the numbers behind them, as ``inspect.json`` holds them; ``text``: the lines the CLI
+    prints; ``out_dir``: where ``inspect.md``, ``inspect.json`` and ``figures/`` were
+    written, if anywhere."""
+
+    findings: List[Dict[str, Any]]
+    design: Dict[str, Any]
+    layout: Dict[str, Any]
+    signals: Dict[str, Any]
+    encoder: Optional[Dict[str, Any]]
+    text: List[str]
+    out_dir: Optional[str] = None
+
+    @property
+    def severe(self) -> List[Dict[str, Any]]:
+        """The severe findings: an analysis will fail or mislead unless they are addressed."""
+        return [f for f in self.findings if f["severity"] == "severe"]
+
+    def __str__(self) -> str:
+        return "\n".join(self.text)
+
+
+def inspect(
+    paths: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
+    *,
+    out: Optional[Union[str, os.PathLike]] = None,
+    encoder: bool = True,
+    folds: int = 5,
+    k: int = 5,
+    name_pattern: Optional[str] = None,
+    time_column: Optional[Union[str, int]] = None,
+    time_unit: Optional[str] = None,
+    channels: Optional[str] = None,
+    grid: Optional[str] = None,
+    channel_map: Optional[str] = None,
+    fs: Optional[float] = None,
+    header: Optional[bool] = None,
+    delimiter: Optional[str] = None,
+    duplicate_stamps: Optional[str] = None,
+    max_gap_s: Optional[float] = None,
+    **stage_options: Any,
+) -> Inspection:
+    """Checks a dataset folder, or raw CSV logs (files or folders) read as ``neurotex
+    import csv`` would read them, before any analysis, as ``neurotex inspect`` does: the
+    design (recordings per class and speed, chance, what the folds and ``k`` need), the
+    signals (rate, jitter, gaps, resting offsets, dead, clipped and copied channels, a clock
+    read as a channel), the layout, and, with ``encoder``, the encoder at the gain (silent
+    and saturated taxels, the gain ``gain="auto"`` would choose). Read-only; ``out`` also
+    writes ``inspect.md``, ``inspect.json`` and ``figures/`` there.
+
+    The reading options (``name_pattern``, ``time_column``, ``channels``, ``grid`` such as
+    ``"3x3"``, ``channel_map``, ``fs``, ``header``, ``delimiter``, ...) are the import's and
+    apply to raw logs only; ``stage_options`` are :func:`features`' (``gain``, ``baseline``,
+    ``bin_ms``, ...).
+
+    Raises :class:`ParameterError` for a broken option (or reading options given with a
+    dataset folder), :class:`NotFoundError` for a missing path."""
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    reading = {"name_pattern": name_pattern, "time_column": time_column,
+               "time_unit": time_unit, "channels": channels, "grid": grid,
+               "channel_map": channel_map, "fs": fs, "header": header,
+               "delimiter": delimiter, "duplicate_stamps": duplicate_stamps,
+               "max_gap_s": max_gap_s}
+    found, text = _native.inspect(
+        [os.fspath(p) for p in paths], _stage_options(**stage_options), reading,
+        None if out is None else os.fspath(out), bool(encoder), int(folds), int(k))
+    return Inspection(findings=found["findings"], design=found["design"],
+                      layout=found["layout"], signals=found["signals"],
+                      encoder=found.get("encoder"), text=list(text),
+                      out_dir=None if out is None else os.fspath(out))
+
+
 class StreamClassifier:
     """A causal model (``neurotex train --causal``) classifying a live stream frame by
     frame, as ``neurotex stream`` does: ``push`` one frame (one value per taxel, in
@@ -941,7 +1042,7 @@ __all__ = [
     "encode", "features", "spike_stats", "rate_volume", "glcm3d", "glcm2d", "haralick",
     "cross_validate", "load_dataset", "save_dataset", "simulate", "Model", "Recording",
     "StreamClassifier", "reproduce", "Reproduction", "calibrate_gain", "GainCalibration",
-    "CausalConditioning", "FeatureTable",
+    "CausalConditioning", "FeatureTable", "inspect", "Inspection",
     "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",
     "ParameterError", "DataError", "NotFoundError", "ReadWriteError", "ModelError",
     "ClassifyError", "InternalError",

@@ -64,6 +64,15 @@ def reproduce(
     folds: Optional[int] = None,
     repeats: Optional[int] = None,
 ) -> Tuple[Dict[str, Any], List[Dict[str, Any]], List[PredictionRow], float]: ...
+def inspect(
+    paths: List[str],
+    options: Dict[str, Any],
+    reading: Dict[str, Any],
+    out: Optional[str] = None,
+    encoder: bool = True,
+    folds: int = 5,
+    k: int = 5,
+) -> Tuple[Dict[str, Any], List[str]]: ...
 def spike_stats(spikes: npt.NDArray[np.uint8], bin_ms: int = 200) -> npt.NDArray[np.float64]: ...
 def rate_volume(
     spikes: npt.NDArray[np.uint8], bin_ms: Optional[int] = 200
