@@ -8,13 +8,33 @@ use indicatif::{ProgressBar, ProgressStyle};
 use neurotex::experiments::WITHIN_SPEED;
 use neurotex::progress::Progress;
 
+/// Whether `path` is `-`: standard output, so that a table or predictions go down a pipe.
+pub fn is_stdout(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// `path` as the messages name it: `standard output` for `-`.
+pub fn shown(path: &Path) -> String {
+    match is_stdout(path) {
+        true => "standard output".to_string(),
+        false => path.display().to_string(),
+    }
+}
+
 /// Writes `what` to `path` through `fill` with the library's [`neurotex::io::write_atomic`]
-/// (a temporary file beside it, renamed into place only when everything succeeded).
+/// (a temporary file beside it, renamed into place only when everything succeeded), or
+/// to standard output for `-`.
 pub fn write_file(
     path: &Path,
     what: &str,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
+    if is_stdout(path) {
+        let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+        return fill(&mut out)
+            .and_then(|()| out.flush())
+            .with_context(|| format!("writing {what} to standard output"));
+    }
     neurotex::io::write_atomic(path, fill).with_context(|| format!("writing {what}"))
 }
 
@@ -28,10 +48,13 @@ pub fn stage_file(
     neurotex::io::stage(path, fill).with_context(|| format!("writing {what}"))
 }
 
-/// Checks, before any work, that output file `path` can be written and is none of `inputs`
+/// Checks, before any work, that output file `path` (not `-`, standard output) can be written and is none of `inputs`
 /// ([`neurotex::io::check_output`]): neurotex never renames over a device, a link or a
 /// file with other hard links, nor writes over what it reads.
 pub fn check_output<P: AsRef<Path>>(path: &Path, inputs: &[P]) -> Result<()> {
+    if is_stdout(path) {
+        return Ok(());
+    }
     neurotex::io::check_output(path, inputs).context("checking the output")
 }
 
@@ -47,6 +70,19 @@ pub fn progress(len: usize, what: &str) -> ProgressBar {
     bar
 }
 
+/// Moves `bar` one step; where no bar is drawn (standard error is not a terminal), says
+/// the step count on a line of its own at each tenth of the way once the stage has run a
+/// second (`[   2.1 s] encoding 97/966`), so a log shows a long stage moving and a quick
+/// one stays quiet.
+pub fn tick(bar: &ProgressBar) {
+    bar.inc(1);
+    let (pos, len) = (bar.position(), bar.length().unwrap_or(0));
+    let t = bar.elapsed().as_secs_f64();
+    if bar.is_hidden() && t >= 1.0 && len >= 20 && (pos * 10 / len) != ((pos - 1) * 10 / len) {
+        eprintln!("[{t:7.1} s] {} {pos}/{len}", bar.message());
+    }
+}
+
 /// Moves the progress bar on one event of a long workflow; where no bar is drawn (standard
 /// error is not a terminal: a log file, a pipe), says each stage on a line of its own with
 /// the time since the start, so a long run is never silent.
@@ -60,7 +96,7 @@ pub fn show_progress(bar: &ProgressBar, event: Progress) {
             bar.set_position(0);
             bar.set_message(name.to_string());
         }
-        Progress::Tick => bar.inc(1),
+        Progress::Tick => tick(bar),
         Progress::Done(id, asks) => {
             bar.inc(1);
             if bar.is_hidden() {

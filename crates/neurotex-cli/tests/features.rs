@@ -132,3 +132,50 @@ fn row_of_channels(channels: usize, steps: usize) -> String {
     }
     text
 }
+
+#[test]
+fn tables_and_predictions_go_to_standard_output_with_a_dash() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 5);
+    let to_file = dir.join("table.csv");
+    dir.ok(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&to_file),
+    ]);
+    let piped = dir.ok(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        "-",
+    ]);
+    assert_eq!(piped, std::fs::read_to_string(&to_file).unwrap());
+    assert!(!dir.join("-").exists(), "no file named `-`");
+    // evaluate's predictions take standard output; the evaluation goes to standard error
+    let args = [
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--predictions",
+        "-",
+    ];
+    let run = dir.run(&args);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stdout.starts_with("file,label,predicted,fold,repeat\n"),
+        "{}",
+        run.stdout
+    );
+    assert!(run.stderr.contains("accuracy"), "{}", run.stderr);
+    let err = dir.fails(&[&args[..], &["--json"]].concat());
+    assert!(err.contains("both write standard output"), "{err}");
+}

@@ -17,7 +17,7 @@ use neurotex::{Cell, Speed};
 use super::{calibrated_pipeline, encode_all};
 use crate::classifier_args::ClassifierArgs;
 use crate::open_args::OpenArgs;
-use crate::output::{check_output, write_file};
+use crate::output::{check_output, is_stdout, write_file};
 use crate::stage_args::StageArgs;
 use neurotex::classify::ClassifierChoice;
 use neurotex::compare::candidates::{MethodChoice, STANDARD_TAU_MS};
@@ -109,7 +109,8 @@ pub struct EvaluateArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Write each recording's out-of-fold prediction to this CSV file:
+    /// Write each recording's out-of-fold prediction to this CSV file (`-`: standard
+    /// output, the evaluation then said on standard error):
     /// `file,label,predicted,fold,repeat`, one row per recording and CV repeat (folds and
     /// repeats count from 0; `fold` is `test` with a train/test split). Needs one
     /// classifier: a GLCM method, or --method taxel with --taxel.
@@ -205,6 +206,10 @@ impl EvaluateArgs {
 
 /// Runs `neurotex evaluate`.
 pub fn run(args: EvaluateArgs) -> Result<()> {
+    let to_stdout = args.predictions.as_deref().is_some_and(is_stdout);
+    if args.json && to_stdout {
+        bail!("--predictions - and --json would both write standard output; write the predictions to a file with --json");
+    }
     let classifier = args.classifier.choice(args.stages.knn(args.k)?)?;
     let split = args.split()?;
     let columns = args.columns()?;
@@ -263,6 +268,8 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
             value["gain_calibration"] = serde_json::to_value(c)?;
         }
         println!("{}", serde_json::to_string(&value)?);
+    } else if to_stdout {
+        eprint!("{}", evaluation.text());
     } else {
         print!("{}", evaluation.text());
     }

@@ -10,7 +10,7 @@ use neurotex::pipeline::{Method, Pipeline};
 
 use super::{calibrated_pipeline, feature_table};
 use crate::open_args::OpenArgs;
-use crate::output::{check_output, write_file};
+use crate::output::{check_output, shown, write_file};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex features`.
@@ -24,7 +24,7 @@ pub struct FeaturesArgs {
     /// or `glcm3d-multi` (Haralick features, at each of `--bin-widths` for the last).
     #[arg(long)]
     pub method: Method,
-    /// The CSV file to write: every manifest column in the manifest's order (extra ones
+    /// The CSV file to write (`-`: standard output): every manifest column in the manifest's order (extra ones
     /// such as a session or subject included), then the features.
     #[arg(long)]
     pub out: PathBuf,
@@ -51,7 +51,7 @@ pub fn run(args: FeaturesArgs) -> Result<()> {
         "{} recordings x {} features -> {}",
         table.metas.len(),
         table.dims(),
-        args.out.display()
+        shown(&args.out)
     );
     Ok(())
 }

@@ -11,7 +11,7 @@ use neurotex::recording::Baseline;
 use neurotex::{Grid, SampleRate};
 
 use crate::csv_args::LogArgs;
-use crate::output::progress;
+use crate::output::{progress, tick};
 
 /// `neurotex import`: bring recordings from other layouts into the dataset format.
 #[derive(Subcommand)]
@@ -87,7 +87,7 @@ fn csv(args: ImportCsvArgs) -> Result<()> {
     };
     let files = csv_files(&args.inputs)?;
     let bar = progress(files.len(), "importing");
-    let summary = import_csv(&files, &params, &args.out, &|| bar.inc(1));
+    let summary = import_csv(&files, &params, &args.out, &|| tick(&bar));
     bar.finish_and_clear();
     let summary = summary?;
     for (_, why) in &summary.skipped {

@@ -11,7 +11,7 @@ use neurotex::report::inspection::{text_lines, write_inspection};
 
 use crate::csv_args::LogArgs;
 use crate::open_args::OpenArgs;
-use crate::output::progress;
+use crate::output::{progress, tick};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex inspect`.
@@ -87,7 +87,7 @@ pub fn run(args: InspectArgs) -> Result<bool> {
         Source::Logs(l) => l.files.len(),
     };
     let bar = progress(n, "inspecting");
-    let inspection = inspect(source, &params, &|| bar.inc(1));
+    let inspection = inspect(source, &params, &|| tick(&bar));
     bar.finish_and_clear();
     let inspection = inspection?;
     if let Some(dir) = &args.out {

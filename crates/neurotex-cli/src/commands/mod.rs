@@ -20,7 +20,7 @@ use neurotex::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use neurotex::recording::Dataset;
 use neurotex::{Grid, Speed};
 
-use crate::output::progress;
+use crate::output::{progress, tick};
 use crate::stage_args::StageArgs;
 
 /// Encodes the dataset's recordings at `speeds` (all when `None`) with a progress bar and
@@ -48,7 +48,7 @@ fn encode_all(
     indices: &[usize],
 ) -> Result<(Vec<Encoded>, Grid)> {
     let bar = progress(indices.len(), "encoding");
-    let encoded = pipeline.encode_dataset(dataset, indices, &|| bar.inc(1));
+    let encoded = pipeline.encode_dataset(dataset, indices, &|| tick(&bar));
     bar.finish_and_clear();
     let encoded = encoded?;
     report_conditions(&encoded);

@@ -17,7 +17,7 @@ use super::report_conditions;
 use super::stream::DecisionArgs;
 use crate::csv_args::ReadArgs;
 use crate::open_args::OpenArgs;
-use crate::output::{check_output, progress, write_file};
+use crate::output::{check_output, is_stdout, progress, shown, tick, write_file};
 
 /// Options of `neurotex predict`.
 #[derive(Args)]
@@ -42,7 +42,7 @@ pub struct PredictArgs {
     /// With FILES: how to read them (the options of `encode`).
     #[command(flatten)]
     pub read: ReadArgs,
-    /// The CSV file to write: `file,label,predicted`, then `share_<class>` for each class
+    /// The CSV file to write (`-`: standard output): `file,label,predicted`, then `share_<class>` for each class
     /// of the model (KNN: its share of the votes among the k neighbours; forest: its mean
     /// leaf share over the trees; linear: its probability); `label` is empty when unknown.
     #[arg(long)]
@@ -67,6 +67,9 @@ pub struct PredictArgs {
 pub fn run(args: PredictArgs) -> Result<()> {
     if args.causal && args.json {
         bail!("--causal writes per-bin decisions; score whole recordings without it (a causal model's whole-recording predictions are its episodes' end labels)");
+    }
+    if args.json && is_stdout(&args.out) {
+        bail!("--out - and --json would both write standard output; write the predictions to a file with --json");
     }
     if args.json && args.dataset.is_none() {
         bail!("--json scores the predictions against known labels: it needs --dataset");
@@ -113,7 +116,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
         "{} recordings predicted with {} -> {}",
         predictions.len(),
         args.model.display(),
-        args.out.display()
+        shown(&args.out)
     );
     Ok(())
 }
@@ -140,7 +143,7 @@ fn predict_causal(args: &PredictArgs, model: &Model, encoded: &[Encoded]) -> Res
     eprintln!(
         "{} recordings, {decided} decided before their end -> {}",
         episodes.len(),
-        args.out.display()
+        shown(&args.out)
     );
     Ok(())
 }
@@ -159,7 +162,7 @@ fn encode_dataset(model: &Model, dataset: &Dataset) -> Result<Vec<Encoded>> {
     let bar = progress(all.len(), "encoding");
     let encoded = model
         .pipeline()
-        .encode_dataset(dataset, &all, &|| bar.inc(1));
+        .encode_dataset(dataset, &all, &|| tick(&bar));
     bar.finish_and_clear();
     Ok(encoded?)
 }

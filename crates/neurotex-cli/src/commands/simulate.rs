@@ -7,7 +7,7 @@ use clap::Args;
 use neurotex::sim::{check_design, design, write_dataset, RigParams, Texture, ALL_TEXTURES};
 use neurotex::Speed;
 
-use crate::output::progress;
+use crate::output::{progress, tick};
 
 /// Options of `neurotex simulate`.
 #[derive(Args)]
@@ -45,7 +45,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     check_design(&rig, &textures, &speeds, args.trials)?;
     let trials = design(&textures, &speeds, args.trials);
     let bar = progress(trials.len(), "simulating");
-    let result = write_dataset(&args.out, &rig, &trials, args.seed, &|| bar.inc(1));
+    let result = write_dataset(&args.out, &rig, &trials, args.seed, &|| tick(&bar));
     bar.finish_and_clear();
     result?;
     eprintln!("{} recordings -> {}", trials.len(), args.out.display());
