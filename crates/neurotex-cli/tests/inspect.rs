@@ -259,3 +259,38 @@ fn a_dataset_folder_is_inspected_and_written_whole() {
         Some(2)
     );
 }
+
+#[test]
+fn import_warns_on_a_clock_read_as_a_channel() {
+    let dir = Dir::new();
+    let tick = logs(
+        &dir,
+        "tick",
+        Footguns {
+            tick: true,
+            ..Footguns::default()
+        },
+    );
+    let pattern = "{label}_V{speed}_{trial}.csv";
+    let run = dir.run(&[
+        "import",
+        "csv",
+        s(&tick),
+        "--out",
+        "ds",
+        "--name-pattern",
+        pattern,
+        "--fs",
+        "100",
+        "--grid",
+        "2x5",
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("warning: channel `tick` rises at every row in 30 of 30 logs"),
+        "{}",
+        run.stderr
+    );
+    assert!(run.stderr.contains("--time-column tick"), "{}", run.stderr);
+}

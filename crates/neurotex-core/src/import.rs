@@ -209,6 +209,17 @@ pub enum ImportWarning {
         /// Grid columns.
         cols: usize,
     },
+    /// A channel rises at every row of most logs, as a clock or a sample counter does: a
+    /// time column read as a taxel.
+    #[error("channel `{channel}` rises at every row in {files} of {total} logs, as a clock or a sample counter does: a time column read as a taxel; --time-column {channel} reads it as time (and --channels can leave it out)")]
+    RisingChannel {
+        /// The channel.
+        channel: String,
+        /// Logs in which it rises at every row.
+        files: usize,
+        /// Logs imported.
+        total: usize,
+    },
     /// Most recordings rest far above their range and no baseline is removed: the
     /// encoder, normalising by each recording's maximum, sees mostly the offset.
     #[error("in {files} of {total} recordings the channels rest at about {ratio:.0} times their range above zero (median channel) and no baseline is removed, so the encoder sees mostly the resting offset; --baseline min removes each channel's minimum")]
@@ -253,6 +264,20 @@ fn import_warnings(
             cols,
         });
     }
+    let names = good.first().map_or(&[][..], |c| &c.log.channel_names[..]);
+    for (k, channel) in names.iter().enumerate() {
+        let n = names.len();
+        let rising = (good.iter())
+            .filter(|c| clock_like(c.log.samples.iter().skip(k).step_by(n).copied()))
+            .count();
+        if 2 * rising > good.len() {
+            out.push(ImportWarning::RisingChannel {
+                channel: channel.clone(),
+                files: rising,
+                total: good.len(),
+            });
+        }
+    }
     if p.baseline.is_none() {
         let mut high: Vec<f64> = good
             .iter()
@@ -269,6 +294,22 @@ fn import_warnings(
         }
     }
     out
+}
+
+/// Whether `values` never fall and rise at (nearly) every step, as a clock or a sample
+/// counter does: at least two steps, none falling, and at least 99 % rising (a rare equal
+/// pair is a repeated reading).
+pub fn clock_like(values: impl Iterator<Item = f64>) -> bool {
+    let (mut rises, mut falls, mut steps, mut prev) = (0usize, 0usize, 0usize, None);
+    for v in values {
+        if let Some(p) = prev {
+            steps += 1;
+            rises += usize::from(v > p);
+            falls += usize::from(v < p);
+        }
+        prev = Some(v);
+    }
+    steps >= 2 && falls == 0 && rises as f64 >= 0.99 * steps as f64
 }
 
 /// The median over a log's channels (`frames x channels`, time-major) of each channel's

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
+use crate::import::clock_like;
 use crate::recording::Recording;
 
 /// An interval this many times the median interval, or longer, is a gap in the stamps.
@@ -82,20 +83,13 @@ pub fn signal_stats(rec: &Recording) -> SignalStats {
 
 fn channel(values: impl Iterator<Item = f64> + Clone) -> Channel {
     let (mut lo, mut hi, mut frames) = (f64::INFINITY, f64::NEG_INFINITY, 0usize);
-    let (mut rises, mut falls, mut prev) = (0usize, 0usize, None);
     for v in values.clone() {
         lo = lo.min(v);
         hi = hi.max(v);
         frames += 1;
-        if let Some(p) = prev {
-            rises += usize::from(v > p);
-            falls += usize::from(v < p);
-        }
-        prev = Some(v);
     }
-    let steps = frames.saturating_sub(1);
     let full_scale = if FULL_SCALES.contains(&hi) && hi > lo {
-        values.filter(|&v| v == hi).count() as f64 / frames.max(1) as f64
+        values.clone().filter(|&v| v == hi).count() as f64 / frames.max(1) as f64
     } else {
         0.0
     };
@@ -105,8 +99,7 @@ fn channel(values: impl Iterator<Item = f64> + Clone) -> Channel {
         resting_ratio: (hi > lo && lo > 0.0).then(|| lo / (hi - lo)),
         full_scale_share: full_scale,
         dead: frames > 0 && hi == lo,
-        // a clock rises at (nearly) every frame; a rare equal pair is a repeated reading
-        rising: steps >= 2 && falls == 0 && rises as f64 >= 0.99 * steps as f64,
+        rising: clock_like(values),
     }
 }
 
