@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 use neurotex::experiments::WITHIN_SPEED;
 use neurotex::progress::Progress;
 
@@ -58,12 +58,33 @@ pub fn check_output<P: AsRef<Path>>(path: &Path, inputs: &[P]) -> Result<()> {
     neurotex::io::check_output(path, inputs).context("checking the output")
 }
 
+/// The time a stage has left: its elapsed time times the steps left over the steps done,
+/// the average over the whole stage, said only once a fiftieth of it (and two steps) is
+/// done. The first steps carry the stage's start-up (threads, first files) and a recent
+/// rate extrapolates it: a tenth of a second's first step would promise minutes.
+fn time_left(state: &ProgressState, w: &mut dyn std::fmt::Write) {
+    let (pos, len) = (state.pos(), state.len().unwrap_or(0));
+    let text = if pos >= 2 && pos * 50 >= len && pos < len {
+        let left = state.elapsed().as_secs_f64() * (len - pos) as f64 / pos as f64;
+        match left {
+            s if s < 60.0 => format!("{s:.0} s left"),
+            s => format!("{:.0} min left", s / 60.0),
+        }
+    } else if pos >= len && len > 0 {
+        "done".to_string()
+    } else {
+        "estimating".to_string()
+    };
+    let _ = w.write_str(&text);
+}
+
 /// A progress bar on standard error, drawn only on a terminal.
 pub fn progress(len: usize, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len as u64);
     bar.set_style(
-        ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({eta})")
+        ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({left})")
             .expect("valid template")
+            .with_key("left", time_left)
             .progress_chars("=> "),
     );
     bar.set_message(what.to_string());

@@ -86,6 +86,7 @@ fn inspect(
         folds,
         k,
         gain_target,
+        traces: out.is_some(),
     };
     let Some(first) = paths.first().cloned() else {
         return Err(raise(

@@ -56,6 +56,7 @@ pub fn run(args: InspectArgs) -> Result<bool> {
         folds: args.folds,
         k: args.k,
         gain_target: args.stages.gain_target(),
+        traces: args.out.is_some(),
     };
     let _claim = match &args.out {
         Some(dir) => {

@@ -48,6 +48,8 @@ pub struct InspectParams {
     /// `--gain auto`'s target rate, Hz: the encoder is then checked at the gain it
     /// chooses on these recordings rather than at the pipeline's.
     pub gain_target: Option<f64>,
+    /// Whether to read again the recordings drawn as traces (for the figures).
+    pub traces: bool,
 }
 
 impl Default for InspectParams {
@@ -58,6 +60,7 @@ impl Default for InspectParams {
             folds: CvParams::default().folds,
             k: KnnParams::default().k,
             gain_target: None,
+            traces: true,
         }
     }
 }
@@ -283,6 +286,7 @@ pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<V
     let params = InspectParams {
         pipeline: pipeline.clone(),
         encoder: false,
+        traces: false,
         ..InspectParams::default()
     };
     let i = inspect(Source::Dataset(dataset), &params, &|| {})?;
@@ -361,7 +365,10 @@ pub fn inspect(
         )?),
         false => None,
     };
-    let traces = traces(source, &pipeline, &checked, baseline);
+    let traces = match params.traces {
+        true => traces(source, &pipeline, &checked, baseline),
+        false => Vec::new(),
+    };
     let mut inspection = Inspection {
         kind: match source {
             Source::Dataset(_) => "dataset",
