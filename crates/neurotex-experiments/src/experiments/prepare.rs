@@ -410,6 +410,24 @@ fn check_design(conditions: &[(Speed, String)], params: &ValidReproduceParams) -
     Ok(())
 }
 
+/// Says a dataset's severe findings on its signals and layout ([`severe_findings`]) as
+/// advice, before anything is encoded.
+///
+/// # Errors
+/// As [`severe_findings`].
+fn say_severe_findings(
+    source: &Source,
+    params: &ValidReproduceParams,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<()> {
+    if let Source::Dataset(ds) = source {
+        for finding in severe_findings(ds, params.pipeline().params())? {
+            progress(Progress::Advice(&finding.line()));
+        }
+    }
+    Ok(())
+}
+
 /// One pass over the recordings: condition, encode at the pipeline's gain, and for the
 /// slowest speed also at every E7 gain (accumulating ISI histograms). Parallel across
 /// recordings; a recording's raw samples are dropped as soon as it is encoded.
@@ -431,11 +449,7 @@ pub fn prepare(
         progress(Progress::TooSmall(&e));
         e.to_string()
     });
-    if let Source::Dataset(ds) = source {
-        for finding in severe_findings(ds, params.pipeline().params())? {
-            progress(Progress::Advice(&finding.line()));
-        }
-    }
+    say_severe_findings(source, params, progress)?;
     let labels = distinct_labels(&conditions);
     let clock = Instant::now();
     let causal = causal_pipelines(source, params, &conditions)?;
@@ -473,11 +487,7 @@ pub fn prepare(
         }
         encoded.push(one.encoded);
     }
-    let grid = encoded[0].spikes.grid();
-    if let Some(e) = encoded.iter().find(|e| e.spikes.present != grid.present()) {
-        let message = "its taxel grid differs from the first recording's";
-        return Err(DataError::invalid(&e.meta.file, message).into());
-    }
+    let grid = one_grid(&encoded)?;
     let taxels = taxel_diagnostics(&encoded, &grid, params)?;
     if let Some(advice) = taxels.advice() {
         progress(Progress::Advice(&advice));
@@ -504,6 +514,19 @@ pub fn prepare(
         within_speed,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The taxel grid every recording shares.
+///
+/// # Errors
+/// A recording whose grid differs from the first's.
+fn one_grid(encoded: &[Encoded]) -> Result<Grid> {
+    let grid = encoded[0].spikes.grid();
+    if let Some(e) = encoded.iter().find(|e| e.spikes.present != grid.present()) {
+        let message = "its taxel grid differs from the first recording's";
+        return Err(DataError::invalid(&e.meta.file, message).into());
+    }
+    Ok(grid)
 }
 
 /// One recording's share of the pass.

@@ -722,6 +722,53 @@ fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit
     Ok(splits)
 }
 
+/// One outer split of nested selection: every candidate cross-validated on its training
+/// rows (one repeat), the best trained on all of them and tested on its test rows.
+fn outer(
+    candidates: &[Candidate],
+    split: &OuterSplit,
+    params: &CompareParams,
+    metas: &[Meta],
+) -> Result<OuterResult> {
+    // One repeat; fewer folds when a class of the training set is smaller than
+    // the folds (an outer training set is a part of one condition's recordings).
+    let smallest = smallest_class(metas, &split.train);
+    let inner = CompareParams {
+        cv: crate::classify::CvParams {
+            repeats: 1,
+            folds: params.cv.folds.min(smallest).max(2),
+            ..*params.cv
+        }
+        .check()?,
+        ..params.clone()
+    };
+    let accuracies: Vec<f64> = candidates
+        .par_iter()
+        .map(|c| {
+            let sub = c.table.subset(&split.train);
+            Ok((c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy)
+        })
+        .collect::<Result<_>>()?;
+    // The first candidate of the highest accuracy.
+    let mut best = (f64::NEG_INFINITY, 0);
+    for (k, &accuracy) in accuracies.iter().enumerate() {
+        if accuracy > best.0 {
+            best = (accuracy, k);
+        }
+    }
+    let c = &candidates[best.1];
+    let rows = Split::Rows {
+        train: split.train.clone(),
+        test: split.test.clone(),
+    };
+    let outcome = (c.evaluate)(&c.table, c.columns, &rows)?;
+    Ok(OuterResult {
+        condition: split.condition.clone(),
+        chosen: best.1,
+        shares: outcome.correct_shares,
+    })
+}
+
 /// Nested selection: inside each outer split's training rows every candidate is
 /// cross-validated (one repeat), the best is trained on all of them and tested on the
 /// split's test rows.
@@ -737,44 +784,9 @@ fn nested(
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
         .map(|split| {
-            // One repeat; fewer folds when a class of the training set is smaller than
-            // the folds (an outer training set is a part of one condition's recordings).
-            let smallest = smallest_class(metas, &split.train);
-            let inner = CompareParams {
-                cv: crate::classify::CvParams {
-                    repeats: 1,
-                    folds: params.cv.folds.min(smallest).max(2),
-                    ..*params.cv
-                }
-                .check()?,
-                ..params.clone()
-            };
-            let accuracies: Vec<f64> = candidates
-                .par_iter()
-                .map(|c| {
-                    let sub = c.table.subset(&split.train);
-                    Ok((c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy)
-                })
-                .collect::<Result<_>>()?;
-            // The first candidate of the highest accuracy.
-            let mut best = (f64::NEG_INFINITY, 0);
-            for (k, &accuracy) in accuracies.iter().enumerate() {
-                if accuracy > best.0 {
-                    best = (accuracy, k);
-                }
-            }
-            let c = &candidates[best.1];
-            let rows = Split::Rows {
-                train: split.train.clone(),
-                test: split.test.clone(),
-            };
-            let outcome = (c.evaluate)(&c.table, c.columns, &rows)?;
+            let outcome = outer(candidates, split, params, metas);
             progress(Progress::Tick);
-            Ok(OuterResult {
-                condition: split.condition.clone(),
-                chosen: best.1,
-                shares: outcome.correct_shares,
-            })
+            outcome
         })
         .collect::<Result<_>>()?;
     let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();

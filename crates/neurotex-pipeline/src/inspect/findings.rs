@@ -160,6 +160,12 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
             },
         ));
     }
+    unbalanced(i, out);
+}
+
+/// Classes of very different sizes at some condition.
+fn unbalanced(i: &Inspection, out: &mut Vec<Finding>) {
+    let d = &i.design;
     let worst = d
         .conditions
         .iter()
@@ -169,7 +175,7 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
             format!("at {s} mm/s")
         });
         let present = c.counts.iter().filter(|&&n| n > 0).count().max(1);
-        out.push(finding(Warning, "design", "unbalanced", format!("the classes are unbalanced {at}: from {} to {} recordings a class, so chance there is the largest class's share, {:.2}, not 1/{present} = {:.2}", c.counts.iter().filter(|&&n| n > 0).min().unwrap_or(&0), c.counts.iter().max().unwrap_or(&0), c.chance, 1.0 / present as f64), "read each accuracy against its chance column (the reports give the largest class's share)"));
+        out.push(finding(Severity::Warning, "design", "unbalanced", format!("the classes are unbalanced {at}: from {} to {} recordings a class, so chance there is the largest class's share, {:.2}, not 1/{present} = {:.2}", c.counts.iter().filter(|&&n| n > 0).min().unwrap_or(&0), c.counts.iter().max().unwrap_or(&0), c.chance, 1.0 / present as f64), "read each accuracy against its chance column (the reports give the largest class's share)"));
     }
 }
 
@@ -239,6 +245,41 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
             "leave them out, or --bin-ms smaller than the shortest recording",
         ));
     }
+    channels(i, file, p, out);
+    if !s.gappy.is_empty() {
+        let worst = s
+            .gappy
+            .iter()
+            .max_by(|a, b| a.longest_s.total_cmp(&b.longest_s))
+            .expect("not empty");
+        out.push(finding(Warning, "signals", "gaps", format!("{} recording(s) have gaps of {} or more median intervals in their stamps; the longest, {:.3} s, in `{}`; resampling draws a straight line through each", s.gappy.len(), super::signals::GAP_FACTOR, worst.longest_s, worst.file), "--max-gap-s, the longest pause a reader may fill (longer ones are refused)"));
+    }
+    if let (false, Some([_, mid, _])) = (s.off_rate.is_empty(), s.fs_hz) {
+        out.push(finding(
+            Warning,
+            "signals",
+            "rate-differs",
+            format!(
+                "{} recording(s) are sampled more than 5 % off the median rate of {mid:.2} Hz: {}",
+                s.off_rate.len(),
+                names(&s.off_rate)
+            ),
+            "check the logger's settings; each file's stamps are used to resample it to 1 kHz",
+        ));
+    }
+    if let Some([mid, _]) = s.jitter.filter(|j| j[0] > 0.5) {
+        out.push(finding(Note, "signals", "jitter", format!("the intervals between stamps spread over {:.0} % of the median interval (5th to 95th percentile, median recording)", 100.0 * mid), "nothing to do: irregular stamps are resampled onto 1 ms"));
+    }
+    if s.merged_rows[0] > 0 {
+        out.push(finding(Note, "signals", "repeated-stamps", format!("{} row(s) in {} file(s) share a time stamp with another row and were merged or dropped", s.merged_rows[0], s.merged_rows[1]), "--duplicate-stamps average|first|last|error chooses what repeated stamps become"));
+    }
+}
+
+/// What the channels say: a clock, dead, copied or clipped channels, a resting offset.
+fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<Finding>) {
+    use Severity::*;
+    let s = &i.signals;
+    let logs = i.kind == "raw logs";
     let most = |share: f64| share > 0.5;
     let chans = &s.channels;
     let list = |f: &dyn Fn(&super::ChannelSummary) -> bool| -> Vec<String> {
@@ -278,33 +319,6 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
         .unwrap_or_default();
     if baseline == crate::recording::Baseline::None && resting >= OFFSET_RATIO {
         out.push(finding(Severe, "signals", "resting-offset", format!("the channels rest at about {resting:.1} times their range above zero (median channel) and no baseline is removed, so the encoder, dividing by each recording's maximum, sees mostly the resting offset"), "--baseline min (each channel's minimum removed)"));
-    }
-    if !s.gappy.is_empty() {
-        let worst = s
-            .gappy
-            .iter()
-            .max_by(|a, b| a.longest_s.total_cmp(&b.longest_s))
-            .expect("not empty");
-        out.push(finding(Warning, "signals", "gaps", format!("{} recording(s) have gaps of {} or more median intervals in their stamps; the longest, {:.3} s, in `{}`; resampling draws a straight line through each", s.gappy.len(), super::signals::GAP_FACTOR, worst.longest_s, worst.file), "--max-gap-s, the longest pause a reader may fill (longer ones are refused)"));
-    }
-    if let (false, Some([_, mid, _])) = (s.off_rate.is_empty(), s.fs_hz) {
-        out.push(finding(
-            Warning,
-            "signals",
-            "rate-differs",
-            format!(
-                "{} recording(s) are sampled more than 5 % off the median rate of {mid:.2} Hz: {}",
-                s.off_rate.len(),
-                names(&s.off_rate)
-            ),
-            "check the logger's settings; each file's stamps are used to resample it to 1 kHz",
-        ));
-    }
-    if let Some([mid, _]) = s.jitter.filter(|j| j[0] > 0.5) {
-        out.push(finding(Note, "signals", "jitter", format!("the intervals between stamps spread over {:.0} % of the median interval (5th to 95th percentile, median recording)", 100.0 * mid), "nothing to do: irregular stamps are resampled onto 1 ms"));
-    }
-    if s.merged_rows[0] > 0 {
-        out.push(finding(Note, "signals", "repeated-stamps", format!("{} row(s) in {} file(s) share a time stamp with another row and were merged or dropped", s.merged_rows[0], s.merged_rows[1]), "--duplicate-stamps average|first|last|error chooses what repeated stamps become"));
     }
 }
 
