@@ -5,13 +5,13 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use neurotex::csvlog::CsvOverrides;
-use neurotex::import::{csv_files, CsvImportParams, Logs};
-use neurotex::inspect::{inspect as run_inspection, InspectParams, Source};
+use neurotex::import::CsvImportParams;
+use neurotex::inspect::{inspect as run_inspection, InspectParams, Opened};
 use neurotex::report::inspection::{text_lines, write_inspection};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{open, to_object};
+use crate::convert::to_object;
 use crate::errors::{guarded, raise, Kind};
 use crate::params;
 
@@ -94,28 +94,12 @@ fn inspect(
             "inspect needs a dataset folder or raw logs",
         ));
     };
-    let is_dataset = paths.len() == 1 && first.join("manifest.csv").is_file();
-    let read_any = reading.values().iter().any(|v| !v.is_none());
-    if is_dataset && read_any {
-        let message = format!("{} is a dataset folder, read with its layout.toml: the reading options (time_column, grid, ...) are for raw logs", first.display());
-        return Err(raise(Kind::Parameter, message));
-    }
-    let dataset = match is_dataset {
-        true => Some(open(&first)?),
-        false => None,
-    };
-    let logs_params = log_params(reading)?;
+    let reading_given = reading.values().iter().any(|v| !v.is_none());
+    let logs = log_params(reading)?;
     let inspection = py.detach(|| {
         guarded(|| {
-            let logs;
-            let source = match &dataset {
-                Some(d) => Source::Dataset(d),
-                None => {
-                    logs = Logs::open(csv_files(&paths)?, logs_params)?;
-                    Source::Logs(&logs)
-                }
-            };
-            let inspection = run_inspection(source, &params, &|| {})?;
+            let opened = Opened::open(&paths, logs, reading_given, false)?;
+            let inspection = run_inspection(opened.source(), &params, &|| {})?;
             if let Some(dir) = &out {
                 write_inspection(dir, &inspection, &first)?;
             }

@@ -3,10 +3,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
-use neurotex::import::{csv_files, Logs};
-use neurotex::inspect::{inspect, InspectParams, Severity, Source};
+use neurotex::inspect::{inspect, InspectParams, Opened, Severity};
 use neurotex::report::inspection::{text_lines, write_inspection};
 
 use crate::csv_args::LogArgs;
@@ -64,35 +63,19 @@ pub fn run(args: InspectArgs) -> Result<bool> {
         }
         None => None,
     };
-    let first = &args.inputs[0];
-    let is_dataset = args.inputs.len() == 1 && first.join("manifest.csv").is_file();
-    let (dataset, logs) = match is_dataset {
-        true => {
-            if args.logs.any() {
-                bail!("{} is a dataset folder, read with its layout.toml: the reading options (--time-column, --grid, ...) are for raw logs", first.display());
-            }
-            (Some(args.open.open(first)?), None)
-        }
-        false => (
-            None,
-            Some(Logs::open(csv_files(&args.inputs)?, args.logs.params())?),
-        ),
-    };
-    let source = match (&dataset, &logs) {
-        (Some(d), _) => Source::Dataset(d),
-        (_, Some(l)) => Source::Logs(l),
-        _ => unreachable!("one of the two"),
-    };
-    let n = match source {
-        Source::Dataset(d) => d.entries.len(),
-        Source::Logs(l) => l.files.len(),
-    };
+    let opened = Opened::open(
+        &args.inputs,
+        args.logs.params(),
+        args.logs.any(),
+        args.open.allow_outside_paths,
+    )?;
+    let n = opened.len();
     let bar = progress(n, "inspecting");
-    let inspection = inspect(source, &params, &|| tick(&bar));
+    let inspection = inspect(opened.source(), &params, &|| tick(&bar));
     bar.finish_and_clear();
     let inspection = inspection?;
     if let Some(dir) = &args.out {
-        write_inspection(dir, &inspection, first).context("writing the inspection")?;
+        write_inspection(dir, &inspection, &args.inputs[0]).context("writing the inspection")?;
         eprintln!("wrote {}", dir.join("inspect.md").display());
     }
     if args.json {

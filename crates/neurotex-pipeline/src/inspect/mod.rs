@@ -20,7 +20,10 @@ use crate::calibrate::{calibrate_gain, DEFAULT_TARGET_HZ};
 use crate::classify::{CvParams, KnnParams};
 use crate::diagnostics::ceiling_rate;
 use crate::error::Result;
-use crate::import::{Logs, MergedRows};
+use std::path::{Path, PathBuf};
+
+use crate::error::ParamError;
+use crate::import::{csv_files, CsvImportParams, Logs, MergedRows};
 use crate::model::GainCalibration;
 use crate::pipeline::{Pipeline, PipelineParams};
 use crate::recording::{Baseline, Dataset, LayoutFile, Meta, Recording};
@@ -104,6 +107,63 @@ impl Source<'_> {
             Source::Dataset(d) => Ok((d.load(i)?, None)),
             Source::Logs(l) => l.read(i).map(|(r, m)| (r, Some(m))),
         }
+    }
+}
+
+/// What `inspect` reads, opened: a dataset folder, or raw logs.
+#[derive(Debug)]
+pub enum Opened {
+    /// A dataset folder.
+    Dataset(Box<Dataset>),
+    /// Raw CSV logs.
+    Logs(Logs),
+}
+
+impl Opened {
+    /// `paths` opened: one folder holding `manifest.csv` is a dataset (refused when
+    /// `reading_given`: the reading options are for raw logs); anything else is raw logs,
+    /// files or folders whose `.csv` files are all read, under `reading`.
+    ///
+    /// # Errors
+    /// A dataset given reading options, a dataset that does not open, no logs, or logs
+    /// that cannot be read under `reading`.
+    pub fn open(
+        paths: &[PathBuf],
+        reading: CsvImportParams,
+        reading_given: bool,
+        allow_outside_paths: bool,
+    ) -> Result<Self> {
+        let first = paths
+            .first()
+            .map_or_else(|| Path::new("."), |p| p.as_path());
+        if paths.len() == 1 && first.join("manifest.csv").is_file() {
+            if reading_given {
+                let rule = "the reading options (time column, grid, channels, ...) are for raw logs; a dataset folder is read with its layout.toml";
+                let got = format!("a dataset folder, {}", first.display());
+                return Err(ParamError::new("reading options", rule, got).into());
+            }
+            let dataset = Dataset::open_with(first, allow_outside_paths)?;
+            return Ok(Opened::Dataset(Box::new(dataset)));
+        }
+        Ok(Opened::Logs(Logs::open(csv_files(paths)?, reading)?))
+    }
+
+    /// The source to inspect.
+    pub fn source(&self) -> Source<'_> {
+        match self {
+            Opened::Dataset(d) => Source::Dataset(d),
+            Opened::Logs(l) => Source::Logs(l),
+        }
+    }
+
+    /// Recordings (files) to read.
+    pub fn len(&self) -> usize {
+        self.source().len()
+    }
+
+    /// Whether there is nothing to read.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 }
 
