@@ -116,7 +116,7 @@ pub enum Opened {
     /// A dataset folder.
     Dataset(Box<Dataset>),
     /// Raw CSV logs.
-    Logs(Logs),
+    Logs(Box<Logs>),
 }
 
 impl Opened {
@@ -145,7 +145,7 @@ impl Opened {
             let dataset = Dataset::open_with(first, allow_outside_paths)?;
             return Ok(Opened::Dataset(Box::new(dataset)));
         }
-        Ok(Opened::Logs(Logs::open(csv_files(paths)?, reading)?))
+        Ok(Opened::Logs(Box::new(Logs::open(csv_files(paths)?, reading)?)))
     }
 
     /// The source to inspect.
