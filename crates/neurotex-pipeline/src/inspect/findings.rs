@@ -166,11 +166,16 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
 /// Classes of very different sizes at some condition.
 fn unbalanced(i: &Inspection, out: &mut Vec<Finding>) {
     let d = &i.design;
-    let worst = d
-        .conditions
-        .iter()
-        .max_by(|a, b| a.imbalance().total_cmp(&b.imbalance()));
-    if let Some(c) = worst.filter(|c| c.imbalance() >= 1.5) {
+    // Unbalanced enough to matter: a largest class at least 1.5 times the smallest, and
+    // its share at least 1.2 times one over the classes.
+    let matters = |c: &&super::Condition| {
+        let present = c.counts.iter().filter(|&&n| n > 0).count().max(1);
+        c.imbalance() >= 1.5 && c.chance >= 1.2 / present as f64
+    };
+    let worst = (d.conditions.iter())
+        .filter(matters)
+        .max_by(|a, b| a.chance.total_cmp(&b.chance));
+    if let Some(c) = worst {
         let at = c.speed_mm_s.map_or("over all recordings".to_string(), |s| {
             format!("at {s} mm/s")
         });

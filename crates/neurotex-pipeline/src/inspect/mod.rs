@@ -22,7 +22,7 @@ use crate::diagnostics::ceiling_rate;
 use crate::error::Result;
 use std::path::{Path, PathBuf};
 
-use crate::error::ParamError;
+use crate::error::{DataError, ParamError};
 use crate::import::{csv_files, CsvImportParams, Logs, MergedRows};
 use crate::model::GainCalibration;
 use crate::pipeline::{Pipeline, PipelineParams};
@@ -145,7 +145,12 @@ impl Opened {
             let dataset = Dataset::open_with(first, allow_outside_paths)?;
             return Ok(Opened::Dataset(Box::new(dataset)));
         }
-        Ok(Opened::Logs(Box::new(Logs::open(csv_files(paths)?, reading)?)))
+        let files = csv_files(paths)?;
+        if files.is_empty() {
+            let message = "holds no manifest.csv and no .csv logs: give a dataset folder, or raw CSV logs (files or folders)";
+            return Err(DataError::invalid(first, message).into());
+        }
+        Ok(Opened::Logs(Box::new(Logs::open(files, reading)?)))
     }
 
     /// The source to inspect.

@@ -5,7 +5,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
-    colour_bar, colour_bar_width, dark, fit, heat, line_height, mesh, multiples, number,
+    colour_bar, colour_bar_width, dark, fit, heat, line_height, mesh, multiples_in, number,
     panel_chart, text, text_width, Canvas, Drawn, Frame, Multiples, Width, LABEL, LIGHT, MARGIN,
     SERIES, SMALL, TICK,
 };
@@ -67,10 +67,13 @@ pub fn traces(i: &Inspection, source: &str) -> Option<Result<String, FigureError
         title: "Recordings, raw and as the encoder sees them",
         source,
         x_desc: "time (s; as encoded: in the selected phase)",
-        y_desc: "raw units, or the encoder's input (0-1)",
+        y_desc: "raw, or encoder input (0-1)",
         keys: &[],
     };
-    Some(multiples(&m, |k, area| {
+    // raw beside as-encoded: two classes a row, or one when a class could not be conditioned
+    let paired = panels.len() == 2 * i.traces.len();
+    let cols = if paired && panels.len() > 2 { 4 } else { 2 };
+    Some(multiples_in(&m, cols, |k, area| {
         trace_panel(area, &panels[k].0, panels[k].1)
     }))
 }

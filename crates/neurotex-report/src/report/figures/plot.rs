@@ -807,9 +807,19 @@ const PANEL_X_TICKS: i32 = 16;
 /// Draws the grid of `m`, calling `panel(i, area)` to draw panel `i` in its area.
 pub(crate) fn multiples(
     m: &Multiples,
+    panel: impl FnMut(usize, &Canvas) -> Drawn,
+) -> Result<String, FigureError> {
+    multiples_in(m, grid(m.n).0, panel)
+}
+
+/// [`multiples`] in `cols` columns (panels that belong together side by side).
+pub(crate) fn multiples_in(
+    m: &Multiples,
+    cols: usize,
     mut panel: impl FnMut(usize, &Canvas) -> Drawn,
 ) -> Result<String, FigureError> {
-    let (cols, rows) = grid(m.n);
+    let cols = cols.clamp(1, m.n.max(1));
+    let rows = m.n.div_ceil(cols).max(1);
     let frame = Frame {
         width: Width::Page,
         title: m.title,
