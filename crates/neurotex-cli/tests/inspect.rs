@@ -191,7 +191,7 @@ fn each_footgun_is_named_with_its_option() {
         },
     );
     let found = findings(&dir, &unbalanced, &grid);
-    assert!(suggestion(&found, "unbalanced").contains("chance"));
+    assert!(suggestion(&found, "unbalanced").contains("largest class's share"));
     let gap = logs(
         &dir,
         "gap",
@@ -249,6 +249,22 @@ fn a_dataset_folder_is_inspected_and_written_whole() {
         md.contains("## Design") && md.contains("resting-offset"),
         "{md}"
     );
+    // nine channels imported row by row onto 4x4: the dataset's inspection says so too
+    dir.ok(&[
+        "import",
+        "csv",
+        s(&clean),
+        "--out",
+        "ds44",
+        "--name-pattern",
+        pattern,
+        "--time-column",
+        "timestamp",
+        "--grid",
+        "4x4",
+    ]);
+    let text = dir.ok(&["inspect", "ds44", "--no-encoder"]);
+    assert!(text.contains("--grid 3x3"), "{text}");
     // reading options are for raw logs; --strict turns a severe finding into status 2
     let err = dir.fails(&["inspect", "ds", "--grid", "3x3"]);
     assert!(err.contains("dataset folder"), "{err}");

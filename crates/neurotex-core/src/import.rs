@@ -200,7 +200,7 @@ pub struct ImportSummary {
 pub enum ImportWarning {
     /// Fewer channels than grid cells and no channel map: the channels fill the grid row by
     /// row, so cells that are neighbours on the grid need not be on the sensor.
-    #[error("{channels} channels on a {rows}x{cols} grid fill it row by row and leave {} cells empty, so taxels that are neighbours on the grid (what the GLCM compares) need not be neighbours on the sensor; {}", rows * cols - channels, grid_advice(*channels))]
+    #[error("{channels} channels on a {rows}x{cols} grid fill it row by row and leave {} cell(s) empty, so taxels that are neighbours on the grid (what the GLCM compares) need not be neighbours on the sensor; {}", rows * cols - channels, grid_advice(*channels))]
     GridNotFilled {
         /// Channels imported.
         channels: usize,
@@ -380,6 +380,11 @@ impl Logs {
         Err(first_error.unwrap_or_else(|| {
             DataError::invalid(Path::new("."), "no .csv files to inspect").into()
         }))
+    }
+
+    /// Whether a channel map places the channels (rather than row-major order).
+    pub fn mapped(&self) -> bool {
+        self.params.channel_map.is_some()
     }
 
     /// The channels' names, in log order.

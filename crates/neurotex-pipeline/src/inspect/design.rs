@@ -203,7 +203,7 @@ fn support(
         .min()
         .unwrap_or_else(|| in_training(n_small, folds));
     out.push(Support {
-        analysis: format!("KNN with k = {k} neighbours"),
+        analysis: format!("KNN with k = {k} neighbours, within each speed"),
         supported: k <= fewest,
         why: format!("a class has as few as {fewest} recording(s) in a training fold; more than {fewest} neighbours can tie or outvote it whatever the features say"),
         limit: fewest,

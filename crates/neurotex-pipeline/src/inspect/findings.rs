@@ -83,7 +83,7 @@ pub(super) fn findings(i: &Inspection, file: &LayoutFile, p: &InspectParams) -> 
     design(i, &mut out);
     layout(i, &mut out);
     signals(i, file, p, &mut out);
-    encoder(i, &mut out);
+    encoder(i, p, &mut out);
     out.sort_by_key(|f| std::cmp::Reverse(f.severity));
     out
 }
@@ -107,12 +107,19 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
     let [pooled, within, held_out, knn] = &d.support[..] else {
         return;
     };
+    // Counts are of the recordings read: an unreadable file is one fewer.
+    let read = match i.signals.unreadable.len() {
+        0 => String::new(),
+        n => format!(
+            " (counted over the recordings read: {n} file(s) could not be read, see `unreadable`)"
+        ),
+    };
     if !pooled.supported {
         out.push(finding(
             Severe,
             "design",
             "folds",
-            format!("{}: {}", pooled.analysis, pooled.why),
+            format!("{}: {}{read}", pooled.analysis, pooled.why),
             fewer_folds(pooled.limit),
         ));
     }
@@ -131,7 +138,7 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
                 Severe,
                 "design",
                 "folds-within-speed",
-                format!("{}: {}", within.analysis, within.why),
+                format!("{}: {}{read}", within.analysis, within.why),
                 fewer_folds(within.limit),
             ));
         }
@@ -180,7 +187,7 @@ fn unbalanced(i: &Inspection, out: &mut Vec<Finding>) {
             format!("at {s} mm/s")
         });
         let present = c.counts.iter().filter(|&&n| n > 0).count().max(1);
-        out.push(finding(Severity::Warning, "design", "unbalanced", format!("the classes are unbalanced {at}: from {} to {} recordings a class, so chance there is the largest class's share, {:.2}, not 1/{present} = {:.2}", c.counts.iter().filter(|&&n| n > 0).min().unwrap_or(&0), c.counts.iter().max().unwrap_or(&0), c.chance, 1.0 / present as f64), "read each accuracy against its chance column (the reports give the largest class's share)"));
+        out.push(finding(Severity::Warning, "design", "unbalanced", format!("the classes are unbalanced {at}: from {} to {} recordings a class, so chance there is the largest class's share, {:.2}, not 1/{present} = {:.2}", c.counts.iter().filter(|&&n| n > 0).min().unwrap_or(&0), c.counts.iter().max().unwrap_or(&0), c.chance, 1.0 / present as f64), "read each accuracy against the largest class's share (evaluate gives it beside one over the classes)"));
     }
 }
 
@@ -220,7 +227,7 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
     if !s.unreadable.is_empty() {
         let first = &s.unreadable[0];
         let fix = match logs {
-            true => "fix the files, or --skip-bad to import the others",
+            true => "fix the files (a pause longer than the reader fills is refused: --max-gap-s raises the limit), or leave them out (import csv --skip-bad)",
             false => "fix the files, or remove their rows from manifest.csv",
         };
         out.push(finding(
@@ -285,6 +292,20 @@ fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<
     use Severity::*;
     let s = &i.signals;
     let logs = i.kind == "raw logs";
+    if !s.short.is_empty() {
+        out.push(finding(
+            Warning,
+            "signals",
+            "short-recordings",
+            format!(
+                "{} recording(s) last less than a quarter of the median recording ({:.2} s): {}",
+                s.short.len(),
+                s.duration_s[1],
+                names(&s.short)
+            ),
+            "check them (an aborted trial?); leave them out of the manifest or the logs if so",
+        ));
+    }
     let most = |share: f64| share > 0.5;
     let chans = &s.channels;
     let list = |f: &dyn Fn(&super::ChannelSummary) -> bool| -> Vec<String> {
@@ -296,15 +317,20 @@ fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<
     };
     let rising = list(&|c| most(c.rising_share));
     if let Some(clock) = rising.first() {
-        let how = match logs {
-            true => format!("--time-column {clock}, and --channels without it"),
-            false => format!("re-import with --time-column {clock}"),
+        let how = match (file.time_column.is_some(), logs) {
+            (true, _) => format!("--channels without `{clock}` (a counter beside the time column)"),
+            (false, true) => {
+                format!("--time-column {clock} if it holds the stamps, else --channels without it")
+            }
+            (false, false) => {
+                format!("re-import with --time-column {clock}, or --channels without it")
+            }
         };
         out.push(finding(Severe, "signals", "time-as-channel", format!("channel(s) {} rise at every frame in most recordings, as a clock or counter does: a time column read as a taxel", names(&rising)), how));
     }
     let dead = list(&|c| most(c.dead_share));
     if !dead.is_empty() {
-        out.push(finding(Warning, "signals", "dead-channel", format!("channel(s) {} hold one value throughout most recordings: unconnected or dead, they give silent taxels", names(&dead)), "--channels listing only the live channels"));
+        out.push(finding(Warning, "signals", "dead-channel", format!("channel(s) {} hold one value throughout most recordings: unconnected or stuck, they carry nothing of the texture (silent taxels, or steady firing when no baseline is removed)", names(&dead)), "--channels listing only the live channels"));
     }
     for c in chans.iter().filter(|c| most(c.copy_share)) {
         let of = c.copy_of.as_deref().unwrap_or("another channel");
@@ -327,7 +353,7 @@ fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<
     }
 }
 
-fn encoder(i: &Inspection, out: &mut Vec<Finding>) {
+fn encoder(i: &Inspection, p: &InspectParams, out: &mut Vec<Finding>) {
     use Severity::*;
     let Some(e) = &i.encoder else { return };
     let diagnostics = TaxelDiagnostics {
@@ -377,6 +403,7 @@ fn encoder(i: &Inspection, out: &mut Vec<Finding>) {
         out.push(finding(Warning, "encoder", "flat-recordings", format!("{} recording(s) have no positive signal in the selected phase and encode to no spikes", e.flat), "--baseline none if the baseline removes the whole signal; check slide_start_s and slide_end_s"));
     }
     match (&e.auto, &e.auto_error) {
+        (Some(a), _) if p.gain_target.is_some() => out.push(finding(Note, "encoder", "gain-auto", format!("--gain auto chose a gain of {} (median {:.1} Hz over {} taxel x recording pairs with signal; target {} Hz), the gain checked here", a.gain, a.median_hz, a.pairs, a.target_hz), "nothing: evaluate, train, compare and reproduce choose it the same way with --gain auto")),
         (Some(a), _) => out.push(finding(Note, "encoder", "gain-auto", format!("--gain auto would choose a gain of {} (median {:.1} Hz over {} taxel x recording pairs with signal; target {} Hz); checked here: {}", a.gain, a.median_hz, a.pairs, a.target_hz, e.gain), "--gain auto on evaluate, train, compare and reproduce")),
         (None, Some(why)) => out.push(finding(Note, "encoder", "gain-auto", format!("--gain auto cannot choose a gain here: {why}"), "nothing, or more recordings with signal")),
         (None, None) => {}

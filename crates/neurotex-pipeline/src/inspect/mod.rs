@@ -258,6 +258,8 @@ pub struct SignalSummary {
     pub duration_s: [f64; 3],
     /// Recordings shorter than one bin of the rate volume.
     pub too_short: Vec<String>,
+    /// Recordings shorter than a quarter of the median recording.
+    pub short: Vec<String>,
     /// Per channel.
     pub channels: Vec<ChannelSummary>,
 }
@@ -559,7 +561,18 @@ fn layout_summary(source: Source<'_>, checked: &[Checked], baseline: Baseline) -
         rows: l.rows,
         cols: l.cols,
         channels: channel_names(file, &cells),
-        mapped: !l.channel_map.iter().copied().eq(0..l.channel_map.len()),
+        mapped: match source {
+            Source::Logs(logs) => logs.mapped(),
+            // A dataset's layout keeps no trace of whether its map was chosen: a map other
+            // than row-major order was, and so was a row-major one unless the channels
+            // make a square other than the grid (9 channels row by row on 4x4).
+            Source::Dataset(_) => {
+                let n = l.channel_map.len();
+                let side = (n as f64).sqrt().round() as usize;
+                let square_elsewhere = side * side == n && (side, side) != (l.rows, l.cols);
+                !l.channel_map.iter().copied().eq(0..n) || !square_elsewhere
+            }
+        },
         empty_cells: l.rows * l.cols - cells.len(),
         cells,
         neighbour_pairs: pairs,
@@ -618,6 +631,11 @@ fn signal_summary(
         .filter(|c| c.stats.duration_s < bin_s)
         .map(|c| c.meta.file.clone())
         .collect();
+    let quarter = 0.25 * median(durations.clone());
+    let short = (checked.iter())
+        .filter(|c| c.stats.duration_s < quarter && c.stats.duration_s >= bin_s)
+        .map(|c| c.meta.file.clone())
+        .collect();
     SignalSummary {
         recordings: checked.len(),
         unreadable,
@@ -628,6 +646,7 @@ fn signal_summary(
         merged_rows: [merged.clone().sum(), merged.count()],
         duration_s: spread(durations).unwrap_or_default(),
         too_short,
+        short,
         channels: channel_summaries(checked, names),
     }
 }

@@ -327,7 +327,7 @@ fn figures(
         true => " Right: each taxel's median firing rate over the recordings at the gain checked.",
         false => "",
     };
-    let caption = format!("Left: each taxel's resting offset, its smallest value over its range (median over recordings); far above 1 the encoder sees mostly the offset unless a baseline is removed.{encoder} Grey cells have no channel.");
+    let caption = format!("Left: each taxel's resting offset in the raw samples, before any baseline is removed: its smallest value over its range (median over recordings); far above 1 the encoder sees mostly the offset unless a baseline is removed (baseline here: {}).{encoder} Grey cells have no channel.", i.layout.baseline);
     out.push(("taxels", figs::taxel_map(i, source), caption));
     out.push(("design", figs::design(i, source), "Recordings of each class at each speed (or over all recordings when the manifest has no speeds).".to_string()));
     out

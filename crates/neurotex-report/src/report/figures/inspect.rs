@@ -78,6 +78,9 @@ pub fn traces(i: &Inspection, source: &str) -> Option<Result<String, FigureError
     }))
 }
 
+/// The least height of a map's colour bar, pixels.
+const BAR_MIN: i32 = 90;
+
 /// A map of values on a grid, one colour scale from 0 to its largest value.
 struct Map<'a> {
     title: &'a str,
@@ -109,8 +112,14 @@ impl Map<'_> {
         self.row_w() + cell * self.cols.len() as i32 + 10 + colour_bar_width(self.max()) + 8
     }
 
+    /// The grid's height, at least [`BAR_MIN`] so that a one-row grid's colour bar can
+    /// hold its ticks.
+    fn grid_h(&self, cell: i32) -> i32 {
+        (cell * self.rows.len() as i32).max(BAR_MIN)
+    }
+
     fn height(&self, cell: i32) -> i32 {
-        line_height(LABEL) + line_height(TICK) + 6 + cell * self.rows.len() as i32 + 4
+        line_height(LABEL) + line_height(TICK) + 6 + self.grid_h(cell) + 4
     }
 
     fn draw(&self, canvas: &Canvas, (x, y): (i32, i32), cell: i32) -> Drawn {
@@ -119,10 +128,11 @@ impl Map<'_> {
         let left = x + self.row_w();
         let top = y + line_height(LABEL) + line_height(TICK) + 6;
         let w = cell * self.cols.len() as i32;
-        let style = text(LABEL, HPos::Center, VPos::Top);
+        // left-aligned over the map, so a title wider than a narrow grid stays on the page
+        let style = text(LABEL, HPos::Left, VPos::Top);
         canvas.draw(&Text::new(
             fit(self.title, LABEL, self.width(cell)),
-            (left + w / 2, y),
+            (x, y),
             style,
         ))?;
         for (j, c) in self.cols.iter().enumerate() {
@@ -160,7 +170,13 @@ impl Map<'_> {
             [(left, top), (left + w, top + h)],
             BLACK.stroke_width(1),
         ))?;
-        colour_bar(canvas, (left + w + 10, top), h, max, self.unit)
+        colour_bar(
+            canvas,
+            (left + w + 10, top),
+            self.grid_h(cell),
+            max,
+            self.unit,
+        )
     }
 }
 
@@ -175,8 +191,13 @@ fn round3(v: f64) -> f64 {
 
 /// Draws `maps` side by side (wrapping onto further rows) under one frame.
 fn maps(title: &str, source: &str, maps: &[Map], cell: i32) -> Result<String, FigureError> {
+    // a column's width when the maps and their titles fit one, else the page's
+    let widest = (maps.iter())
+        .map(|m| m.width(cell).max(super::plot::text_width(m.title, LABEL)))
+        .max()
+        .unwrap_or(0);
     let frame = Frame {
-        width: Width::Page,
+        width: Width::fitting(widest + 2 * MARGIN + super::plot::text_width(source, TICK)),
         title,
         source,
         keys: &[],
@@ -228,7 +249,7 @@ pub fn taxel_map(i: &Inspection, source: &str) -> Result<String, FigureError> {
     let chans = &i.signals.channels;
     let mut out = vec![Map {
         title: "resting offset, in ranges above zero",
-        unit: "min / (max - min)",
+        unit: "ranges",
         rows: rows.clone(),
         cols: cols.clone(),
         values: on_grid(&|k| Some(chans.get(k)?.resting_ratio.unwrap_or(0.0))),
@@ -236,7 +257,7 @@ pub fn taxel_map(i: &Inspection, source: &str) -> Result<String, FigureError> {
     if let Some(e) = &i.encoder {
         out.push(Map {
             title: "median firing rate at the gain",
-            unit: "spikes / s",
+            unit: "Hz",
             rows,
             cols,
             values: on_grid(&|k| Some(e.taxels.get(k)?.median_hz)),
@@ -269,7 +290,7 @@ pub fn design(i: &Inspection, source: &str) -> Result<String, FigureError> {
     let map = Map {
         title: match d.speeds().is_empty() {
             true => "recordings per class",
-            false => "recordings per class at each speed (mm/s)",
+            false => "recordings per speed (mm/s)",
         },
         unit: "recordings",
         rows: d.classes.clone(),
