@@ -3,6 +3,7 @@
 
 use serde::Serialize;
 
+use super::design::{Design, Support};
 use super::{InspectParams, Inspection};
 use crate::diagnostics::{TaxelDiagnostics, TaxelResponse};
 use crate::import::{grid_advice, ImportWarning, OFFSET_RATIO};
@@ -123,8 +124,29 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
             fewer_folds(pooled.limit),
         ));
     }
-    let speeds = d.speeds();
-    if speeds.is_empty() {
+    by_speed(d, within, held_out, &read, out);
+    if !knn.supported && pooled.supported {
+        out.push(finding(
+            Warning,
+            "design",
+            "neighbours",
+            format!("{}: {}", knn.analysis, knn.why),
+            match knn.limit {
+                0 => {
+                    "more recordings per class (or fewer folds, leaving more in each training fold)"
+                        .to_string()
+                }
+                n => format!("--k {n} or fewer, or more recordings per class"),
+            },
+        ));
+    }
+    unbalanced(i, out);
+}
+
+/// The analyses by speed: none without speeds, folds within each, one held out.
+fn by_speed(d: &Design, within: &Support, held_out: &Support, read: &str, out: &mut Vec<Finding>) {
+    use Severity::*;
+    if d.speeds().is_empty() {
         out.push(finding(
             Warning,
             "design",
@@ -152,22 +174,6 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
             ));
         }
     }
-    if !knn.supported && pooled.supported {
-        out.push(finding(
-            Warning,
-            "design",
-            "neighbours",
-            format!("{}: {}", knn.analysis, knn.why),
-            match knn.limit {
-                0 => {
-                    "more recordings per class (or fewer folds, leaving more in each training fold)"
-                        .to_string()
-                }
-                n => format!("--k {n} or fewer, or more recordings per class"),
-            },
-        ));
-    }
-    unbalanced(i, out);
 }
 
 /// Classes of very different sizes at some condition.
