@@ -2,11 +2,8 @@
 //! library, shows progress and writes files (always to a temporary name, then renamed, so a
 //! failed run leaves no partial output).
 
-mod classifier_args;
 mod commands;
-mod csv_args;
 mod interrupt;
-mod open_args;
 mod output;
 mod stage_args;
 
@@ -68,7 +65,7 @@ enum Command {
     /// one, the clock has jumped (a pause, a restarted sensor): the episode ends
     /// ("ended_by":"gap") and a new one starts at that next frame. So one wrong stamp (a bit
     /// flip far ahead) costs its own frame, and a jump that stays costs one frame.
-    Stream(stream::StreamArgs),
+    Stream(neurotex::workflows::stream::StreamOptions),
     /// Import CSV logs or stacked arrays into a dataset folder.
     #[command(subcommand)]
     Import(import::ImportCommand),

@@ -133,11 +133,37 @@ pub fn show_progress(bar: &ProgressBar, event: Progress) {
             }
         }
         Progress::Advice(text) => bar.suspend(|| eprintln!("warning: {text}")),
+        Progress::Say(text) => bar.suspend(|| eprintln!("{text}")),
         Progress::TooSmall(error) => bar.suspend(|| {
             eprintln!("warning: {WITHIN_SPEED}, which cannot run: {error}; they are skipped");
             if let Some(hint) = crate::design_hint(error) {
                 eprintln!("hint: {hint}");
             }
         }),
+    }
+}
+
+/// A workflow's progress bar: its stages and steps drawn on a terminal (a line per stage
+/// elsewhere), what it says on standard error.
+pub struct Shown {
+    bar: ProgressBar,
+}
+
+impl Shown {
+    /// A bar showing `what` until the workflow's first stage names itself.
+    pub fn new(what: &str) -> Self {
+        Self {
+            bar: progress(0, what),
+        }
+    }
+
+    /// The callback the workflow reports on.
+    pub fn callback(&self) -> impl Fn(Progress) + Sync + '_ {
+        |event| show_progress(&self.bar, event)
+    }
+
+    /// Clears the bar once the workflow ended.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
     }
 }

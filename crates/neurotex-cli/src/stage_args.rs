@@ -1,21 +1,17 @@
 //! Options shared by every command that runs the pipeline: the library's stage options
-//! ([`STAGE_OPTIONS`]), each made a flag with its help and default, plus KNN's
-//! `--no-standardize`. Nothing here names a default or a rule.
+//! ([`STAGE_OPTIONS`]), each made a flag with its help and default. Nothing here names a
+//! default or a rule.
 
 use anyhow::Result;
 use clap::error::ErrorKind;
 use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
-use neurotex::classify::KnnParams;
 use neurotex::options::{OptionKind, OptionSpec, StageOptions, STAGE_OPTIONS};
-use neurotex::pipeline::PipelineParams;
 
 /// Stage parameters; defaults are the paper's values (or SPEC's choice where it gives none).
 #[derive(Debug, Clone, Default)]
 pub struct StageArgs {
     /// The stage options as given, unchecked.
     pub options: StageOptions,
-    /// Do not z-score features with training-fold statistics before KNN.
-    pub no_standardize: bool,
 }
 
 /// The flag of one stage option.
@@ -47,12 +43,6 @@ impl Args for StageArgs {
         STAGE_OPTIONS
             .iter()
             .fold(cmd, |cmd, spec| cmd.arg(flag(spec)))
-            .arg(
-                Arg::new("no_standardize")
-                    .long("no-standardize")
-                    .action(ArgAction::SetTrue)
-                    .help("Do not z-score features with training-fold statistics before KNN"),
-            )
     }
 
     fn augment_args_for_update(cmd: Command) -> Command {
@@ -81,30 +71,7 @@ impl FromArgMatches for StageArgs {
                     .map_err(|e| clap::Error::raw(ErrorKind::ValueValidation, e))?;
             }
         }
-        self.no_standardize |= matches.get_flag("no_standardize");
         Ok(())
-    }
-}
-
-impl StageArgs {
-    /// The pipeline parameters these options name, checked.
-    pub fn pipeline(&self) -> Result<PipelineParams> {
-        Ok(self.options.check()?.params)
-    }
-
-    /// The target rate of `--gain auto`, or `None` for a fixed gain.
-    pub fn gain_target(&self) -> Option<f64> {
-        self.options.gain.target_hz()
-    }
-
-    /// KNN parameters with `k` neighbours, checked.
-    pub fn knn(&self, k: usize) -> Result<KnnParams> {
-        let knn = KnnParams {
-            k,
-            standardize: !self.no_standardize,
-        };
-        knn.check()?;
-        Ok(knn)
     }
 }
 

@@ -160,6 +160,18 @@ fn reproduce_rejects_seeds_it_cannot_run() {
                 ],
                 "overflows",
             ),
+            (
+                vec![
+                    "reproduce",
+                    "--out",
+                    s(&out),
+                    "--trials",
+                    "3",
+                    "--dataset",
+                    s(&ds),
+                ],
+                "--trials and --seeds apply to the built-in simulator",
+            ),
         ],
         &out,
     );

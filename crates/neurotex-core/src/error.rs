@@ -44,6 +44,9 @@ pub enum Error {
     /// A model file cannot be used, or recordings do not fit a model.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// Options that do not go together, or one given where it does not apply.
+    #[error(transparent)]
+    Options(#[from] OptionsError),
 }
 
 impl Error {
@@ -450,4 +453,22 @@ fn grid_text(grid: &Grid, other: &Grid) -> String {
         == (other.rows(), other.cols(), other.n_taxels());
     let mask = if same_shape { ", another mask" } else { "" };
     format!("{grid}, {} taxels{mask}", grid.n_taxels())
+}
+
+/// Options that do not go together, or one given where it does not apply; the options are
+/// named as the command line spells them.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OptionsError {
+    /// An option that applies only with another choice.
+    #[error("{option} applies only to {applies_to}")]
+    NotApplicable {
+        /// The option given.
+        option: &'static str,
+        /// The choice it applies to.
+        applies_to: &'static str,
+    },
+    /// Options, or an option and the input, that cannot go together; the message says why
+    /// and what to do instead.
+    #[error("{0}")]
+    Conflict(String),
 }

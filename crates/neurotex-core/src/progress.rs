@@ -20,6 +20,8 @@ pub enum Progress<'a> {
     /// What the recordings suggest changing (most taxels silent or at the encoder's
     /// ceiling), said at once rather than only in the report.
     Advice(&'a str),
+    /// A line for the user as it stands (`note: ...`, or what a calibration chose).
+    Say(&'a str),
 }
 
 /// A progress callback that ignores every event.

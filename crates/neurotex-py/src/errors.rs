@@ -58,7 +58,7 @@ pub fn raise(kind: Kind, message: impl Into<String>) -> PyErr {
 fn kind_of(error: &neurotex::Error) -> Kind {
     use neurotex::Error as E;
     match error {
-        E::Param(_) => Kind::Parameter,
+        E::Param(_) | E::Options(_) => Kind::Parameter,
         E::Data(DataError::Io { reason, .. } | DataError::Write { reason, .. }) => io_kind(reason),
         E::Data(_) | E::Dataset(_) => Kind::Data,
         E::Classify(_) | E::Stats(_) => Kind::Classify,
@@ -87,10 +87,33 @@ pub fn to_py(error: neurotex::Error) -> PyErr {
     let hint = error
         .classify()
         .and_then(|c| c.hint(&|name, value| format!("{name}={value}")));
+    let text = match &error {
+        // The workflows name options as the command line spells them.
+        neurotex::Error::Options(_) => keywords(&error.to_string()),
+        _ => error.to_string(),
+    };
     match hint {
-        Some(hint) => raise(kind_of(&error), format!("{error}\nhint: {hint}")),
-        None => raise(kind_of(&error), error.to_string()),
+        Some(hint) => raise(kind_of(&error), format!("{text}\nhint: {hint}")),
+        None => raise(kind_of(&error), text),
     }
+}
+
+/// `text` with each command-line option (`--forest-seed`) spelled as Python's keyword
+/// (`forest_seed`).
+fn keywords(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find("--") {
+        out.push_str(&rest[..at]);
+        let name = &rest[at + 2..];
+        let end = name
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+            .unwrap_or(name.len());
+        out.push_str(&name[..end].replace('-', "_"));
+        rest = &name[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Memory the input asked for and the machine does not have: Python's `MemoryError`,
@@ -153,4 +176,18 @@ fn panic_message(panic: Box<dyn std::any::Any + Send>) -> String {
         .or_else(|| panic.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".to_string());
     format!("internal error in neurotex (please report it): {text}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::keywords;
+
+    #[test]
+    fn options_are_spelled_as_keywords() {
+        assert_eq!(
+            keywords("--trees and --forest-seed apply only to --classifier forest"),
+            "trees and forest_seed apply only to classifier forest"
+        );
+        assert_eq!(keywords("a - b -- c"), "a - b  c");
+    }
 }

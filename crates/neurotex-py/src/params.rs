@@ -95,6 +95,11 @@ fn option_text(spec: &OptionSpec, value: &Bound<'_, PyAny>) -> PyResult<String> 
 /// The stage options of [`STAGE_OPTIONS`] by their names (the paper's defaults for the
 /// absent ones and those given as `None`), checked once.
 pub fn stages(options: &Bound<'_, PyDict>) -> PyResult<Stages> {
+    stage_options(options)?.check().map_err(param)
+}
+
+/// The stage options given as keywords, read but not yet checked.
+pub fn stage_options(options: &Bound<'_, PyDict>) -> PyResult<StageOptions> {
     let known: Vec<&str> = STAGE_OPTIONS.iter().map(|o| o.name).collect();
     only_known(options, &known, "; the options are")?;
     let mut chosen = StageOptions::default();
@@ -107,7 +112,7 @@ pub fn stages(options: &Bound<'_, PyDict>) -> PyResult<Stages> {
             _ => {}
         }
     }
-    chosen.check().map_err(param)
+    Ok(chosen)
 }
 
 /// Every stage option's default as the Python value a keyword argument takes (`None` for

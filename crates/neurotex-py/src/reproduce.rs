@@ -6,18 +6,18 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Instant;
 
-use neurotex::classify::KnnParams;
-use neurotex::experiments::{claims, HeadlinePrediction, ReproduceParams, WITHIN_SPEED};
+use neurotex::experiments::{claims, HeadlinePrediction, DEFAULT_ENCODER_DRAWS, WITHIN_SPEED};
+use neurotex::options::StageOptions;
 use neurotex::progress::Progress;
-use neurotex::report::reproduce::{
-    reproduce as run_analyses, simulated_design, Data as Input, Run,
-};
+use neurotex::recording::Dataset;
+use neurotex::workflows::reproduce::ReproduceOptions;
+use neurotex::workflows::{KnnOptions, OpenOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{open, to_object};
-use crate::errors::{guarded, param, raise, Kind};
-use crate::params::{self, Stages};
+use crate::errors::guarded;
+use crate::params;
 
 /// One headline out-of-fold prediction: `(speed_mm_s, method, file, label, predicted,
 /// fold or None for a held-out test set, repeat)`, the CLI's `--predictions` row.
@@ -37,14 +37,6 @@ type Finished = (
     f64,
     Vec<String>,
 );
-
-/// Which data a run analyses.
-enum Data {
-    /// A dataset folder.
-    Folder(Box<neurotex::recording::Dataset>),
-    /// `trials` per texture and speed of the paper's design, one simulated dataset per seed.
-    Simulated { trials: u32, seeds: Vec<u64> },
-}
 
 /// Runs every analysis as `neurotex reproduce` does with the same options, writes
 /// `report.md`, `results.json` and `figures/` into `out` (whole or not at all) and returns
@@ -69,46 +61,26 @@ fn reproduce(
     folds: Option<usize>,
     repeats: Option<usize>,
 ) -> PyResult<Outcome> {
-    let stages = params::stages(options)?;
-    if stages.causal {
-        return Err(raise(
-            Kind::Parameter,
-            "reproduce runs the causal pipeline itself (its causal E5 beside the paper's offline E5); causal=True is for features and Model.train",
-        ));
-    }
-    let mut params = if quick {
-        ReproduceParams::quick()
-    } else {
-        ReproduceParams::default()
+    let stages = params::stage_options(options)?;
+    let reproduce = ReproduceOptions {
+        dataset: None,
+        seed,
+        quick,
+        trials,
+        seeds,
+        knn: KnnOptions {
+            k,
+            no_standardize: !standardize,
+        },
+        folds,
+        repeats,
+        group_by,
+        encoder_draws: encoder_draws.map_or(DEFAULT_ENCODER_DRAWS as u64, |n| n as u64),
+        open: OpenOptions::default(),
     };
-    params.pipeline = stages.params.clone();
-    params.knn = KnnParams { k, standardize };
-    params.knn.check().map_err(param)?;
-    params.seed = seed;
-    params.cv.seed = seed;
-    params.cv.folds = folds.unwrap_or(params.cv.folds);
-    params.cv.repeats = repeats.unwrap_or(params.cv.repeats);
-    params.group_by = group_by;
-    if let Some(draws) = encoder_draws {
-        params.encoder_draws = draws;
-    }
-    let data = match dataset {
-        Some(dir) => {
-            if trials.is_some() || seeds.is_some() {
-                return Err(raise(
-                    Kind::Parameter,
-                    "trials and seeds apply to the built-in simulator; a dataset folder is one draw of its own size",
-                ));
-            }
-            Data::Folder(Box::new(open(&dir)?))
-        }
-        None => {
-            let (trials, seeds) = simulated_design(quick, trials, seeds, seed).map_err(param)?;
-            Data::Simulated { trials, seeds }
-        }
-    };
+    let dataset = dataset.map(|dir| open(&dir)).transpose()?;
     let (results, claims, predictions, seconds, warnings) =
-        py.detach(|| guarded(|| run(&out, &data, &stages, params, &command)))?;
+        py.detach(|| guarded(|| run(&out, dataset.as_ref(), &stages, &reproduce, command)))?;
     let warn = PyModule::import(py, "warnings")?;
     for text in warnings {
         warn.call_method1("warn", (text,))?;
@@ -121,23 +93,17 @@ fn reproduce(
     ))
 }
 
-/// Runs the library's [`run_analyses`] (the report written as the CLI writes it) and hands
-/// back the results and claims as JSON values, the headline predictions and the seconds taken.
+/// Runs the library's `reproduce` workflow (the report written as the CLI writes it) and
+/// hands back the results and claims as JSON values, the headline predictions and the
+/// seconds taken.
 fn run(
     out: &std::path::Path,
-    data: &Data,
-    stages: &Stages,
-    params: ReproduceParams,
-    command: &str,
+    dataset: Option<&Dataset>,
+    stages: &StageOptions,
+    reproduce: &ReproduceOptions,
+    command: String,
 ) -> neurotex::Result<Finished> {
     let started = Instant::now();
-    let input = match data {
-        Data::Folder(ds) => Input::Folder(ds),
-        Data::Simulated { trials, seeds } => Input::Simulated {
-            trials: *trials,
-            seeds,
-        },
-    };
     let warnings = Mutex::new(Vec::new());
     let say = |text: String| warnings.lock().expect("warnings").push(text);
     let on_progress = |p: Progress| match p {
@@ -149,13 +115,7 @@ fn run(
         Progress::Advice(text) => say(text.to_string()),
         _ => (),
     };
-    let run = Run {
-        gain_target: stages.gain_target(),
-        command: command.to_string(),
-        on_progress: &on_progress,
-        on_gain: &|_| (),
-    };
-    let results = run_analyses(out, input, params, &run)?;
+    let results = reproduce.run(out, dataset, stages, command, &on_progress)?;
     let json = |what: &str, value: serde_json::Result<serde_json::Value>| {
         value.map_err(|e| neurotex::error::DataError::invalid(out.join(what), e.to_string()))
     };

@@ -17,6 +17,7 @@
 //! | stage options, pipeline, feature tables, models, streams, compare | `neurotex-pipeline` | [`pipeline`], [`analysis`], [`diagnostics`], [`model`], [`options`], [`calibrate`], [`causal`], [`stream`], [`compare`] |
 //! | the paper's analyses | `neurotex-experiments` | [`experiments`] |
 //! | report and figures | `neurotex-report` | [`report`] |
+//! | the commands' options and workflows, shared by the command line and Python | `neurotex` | [`workflows`] |
 //!
 //! The library never prints and never exits: it returns [`Error`]s naming the file, line
 //! or parameter at fault. `ARCHITECTURE.md` follows one recording through the layers.
@@ -34,3 +35,5 @@ pub use neurotex_pipeline::{
 pub use neurotex_report::report;
 pub use neurotex_signal::{encode, signal};
 pub use neurotex_sim::sim;
+
+pub mod workflows;

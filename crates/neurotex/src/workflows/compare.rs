@@ -1,0 +1,251 @@
+//! `compare`: every encoding x feature method x classifier on the same splits of a dataset,
+//! ranked with 95 % intervals and a paired test against the paper's method (SA encoding,
+//! 3D-GLCM, KNN); to find what suits a sensor best.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use super::{calibrated_pipeline, encode_all, KnnOptions, OnProgress, OpenOptions};
+use crate::classify::{ClassifierChoice, CvParams, ForestParams};
+use crate::compare::candidates::{
+    candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
+    STANDARD_METHODS, STANDARD_TAU_MS,
+};
+use crate::compare::{compare_with_progress, Candidate, CompareParams, Comparison, Protocol};
+use crate::error::OptionsError;
+use crate::options::StageOptions;
+use crate::pipeline::{Encoding, Pipeline};
+use crate::progress::Progress;
+use crate::recording::{Dataset, Selection};
+use crate::{Result, Speed};
+
+/// Most candidates one run compares (encodings x methods x classifiers).
+const MAX_CANDIDATES: usize = 200;
+
+/// Options of `neurotex compare`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct CompareOptions {
+    /// The dataset folder.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub dataset: PathBuf,
+    /// Only recordings at these speeds (mm/s, comma-separated); default all.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_delimiter = ',', allow_hyphen_values = true)
+    )]
+    pub speeds: Option<Vec<Speed>>,
+    /// Cross-validate within each value of this manifest column (each speed:
+    /// `speed_mm_s`) and rank by the mean over values. Default: all recordings pooled.
+    #[cfg_attr(feature = "cli", arg(long, conflicts_with_all = ["hold_out", "train_where"]))]
+    pub per: Option<String>,
+    /// Hold out each value of this manifest column in turn (train on the others), and rank
+    /// by the mean over held-out values: `speed_mm_s` asks which method generalises to an
+    /// unseen speed.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long = "hold-out", conflicts_with = "train_where")
+    )]
+    pub hold_out: Option<String>,
+    /// Train on the recordings whose column holds one of the values (needs --test-where).
+    #[cfg_attr(
+        feature = "cli",
+        arg(
+            long = "train-where",
+            value_name = "COL=V1,V2",
+            requires = "test_where"
+        )
+    )]
+    pub train_where: Option<Selection>,
+    /// Test on the recordings whose column holds one of the values.
+    #[cfg_attr(
+        feature = "cli",
+        arg(
+            long = "test-where",
+            value_name = "COL=V1,V2",
+            requires = "train_where"
+        )
+    )]
+    pub test_where: Option<Selection>,
+    /// Folds never split a group of this manifest column; intervals and tests resample
+    /// its groups.
+    #[cfg_attr(feature = "cli", arg(long = "group-by"))]
+    pub group_by: Option<String>,
+    /// Encodings to compare, comma-separated: `sa` (the paper's slowly adapting neurons),
+    /// `fa` (fast adapting, driven by the rectified rate of change), `sa+fa` (both).
+    /// Overrides --encoding.
+    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_ENCODINGS))]
+    pub encodings: Vec<Encoding>,
+    /// Feature methods to compare, comma-separated. `taxel` is the paper's single-taxel
+    /// method (each taxel alone, mean over taxels; KNN only); `van-rossum` classifies by
+    /// spike-train distances (KNN only).
+    /// `all-taxels-mm` (statistics per mm travelled) needs the manifest's speeds.
+    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_METHODS))]
+    pub methods: Vec<String>,
+    /// Classifiers to compare, comma-separated: knn, forest, linear.
+    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_CLASSIFIERS))]
+    pub classifiers: Vec<String>,
+    /// Time constant of the van Rossum kernel in ms (method `van-rossum`). Default: the
+    /// rate volume's 200 ms bin, the time resolution the paper's rate code keeps.
+    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = STANDARD_TAU_MS))]
+    pub tau_ms: f64,
+    /// KNN's neighbours and z-scoring.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub knn: KnnOptions,
+    /// Cross-validation folds.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().folds))]
+    pub folds: usize,
+    /// Cross-validation repeats (every candidate gets the same folds in each).
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = 2))]
+    pub repeats: usize,
+    /// Seed of the folds, the bootstrap and the sign-flip test.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = 0))]
+    pub seed: u64,
+    /// Also estimate the accuracy of choosing the best candidate inside each training set
+    /// (nested selection): the number to quote for "the best method".
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub nested: bool,
+    /// How the dataset folder is opened.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub open: OpenOptions,
+}
+
+impl CompareOptions {
+    fn protocol(&self) -> Protocol {
+        match (
+            &self.per,
+            &self.hold_out,
+            &self.train_where,
+            &self.test_where,
+        ) {
+            (Some(column), ..) => Protocol::Per(column.clone()),
+            (_, Some(column), ..) => Protocol::HoldOut(column.clone()),
+            (_, _, Some(train), Some(test)) => Protocol::Where {
+                train: train.clone(),
+                test: test.clone(),
+            },
+            _ => Protocol::Pooled,
+        }
+    }
+
+    fn params(&self) -> Result<CompareParams> {
+        let cv = CvParams {
+            folds: self.folds,
+            seed: self.seed,
+            repeats: self.repeats,
+        }
+        .check()?;
+        Ok(CompareParams {
+            protocol: self.protocol(),
+            cv,
+            group_by: self.group_by.clone(),
+            resamples: 2000,
+            nested: self.nested,
+        })
+    }
+
+    /// The recordings compared: those at `--speeds`, or both sides of a train/test split.
+    fn indices(&self, dataset: &Dataset) -> Result<Vec<usize>> {
+        let entries = &dataset.entries;
+        let mut rows = match &self.speeds {
+            Some(speeds) => dataset.indices_at(speeds)?,
+            None => (0..entries.len()).collect(),
+        };
+        if let (Some(train), Some(test)) = (&self.train_where, &self.test_where) {
+            let (train, test) = (train.rows(entries)?, test.rows(entries)?);
+            rows.retain(|i| train.contains(i) || test.contains(i));
+        }
+        if rows.is_empty() {
+            return Err(OptionsError::Conflict("no recordings to compare".into()).into());
+        }
+        Ok(rows)
+    }
+
+    /// The candidates to compare, checked.
+    fn set(&self) -> Result<CandidateSet> {
+        let methods = self
+            .methods
+            .iter()
+            .map(|m| m.parse::<MethodChoice>())
+            .collect::<Result<Vec<_>, _>>()?;
+        let classifiers = self
+            .classifiers
+            .iter()
+            .map(|name| {
+                Ok(match name.parse::<ClassifierChoice>()? {
+                    ClassifierChoice::Knn(_) => ClassifierChoice::Knn(self.knn.params()?),
+                    ClassifierChoice::Forest(p) => ClassifierChoice::Forest(ForestParams {
+                        seed: self.seed,
+                        ..p
+                    }),
+                    linear => linear,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(CandidateSet {
+            encodings: self.encodings.clone(),
+            methods,
+            classifiers,
+            tau_ms: self.tau_ms,
+        })
+    }
+
+    /// Compares the candidates on `dataset` with the stage options `stages`.
+    ///
+    /// # Errors
+    /// Options out of range or that do not go together, recordings that cannot be read,
+    /// or a design too small for the protocol.
+    pub fn run(
+        &self,
+        dataset: &Dataset,
+        stages: &StageOptions,
+        on: OnProgress,
+    ) -> Result<Comparison> {
+        let params = self.params()?;
+        let indices = self.indices(dataset)?;
+        let set = self.set()?;
+        let n = set.len();
+        if n == 0 || n > MAX_CANDIDATES {
+            return Err(OptionsError::Conflict(format!(
+                "{n} candidates to compare; between 1 and {MAX_CANDIDATES} are allowed"
+            ))
+            .into());
+        }
+        let candidates = make_candidates(stages, dataset, &indices, &set, on)?;
+        on(Progress::Say(&format!(
+            "comparing {} candidates on {} recordings: {}",
+            candidates.len(),
+            indices.len(),
+            params.protocol
+        )));
+        let comparison = compare_with_progress(&candidates, &params, on)?;
+        if !params.nested {
+            on(Progress::Say(
+                "note: --nested computes the nested estimate the caveat below speaks of",
+            ));
+        }
+        Ok(comparison)
+    }
+}
+
+/// Encodes the recordings once (both populations when an encoding needs the fast-adapting
+/// one) and makes every candidate of `set` from them.
+fn make_candidates(
+    stages: &StageOptions,
+    dataset: &Dataset,
+    indices: &[usize],
+    set: &CandidateSet,
+    on: OnProgress,
+) -> Result<Vec<Candidate>> {
+    let start = Instant::now();
+    let mut params = calibrated_pipeline(stages, dataset, indices, on)?.params;
+    params.encoding = if set.needs_fa() {
+        Encoding::SaFa
+    } else {
+        Encoding::Sa
+    };
+    let pipeline = Pipeline::new(params.clone())?;
+    let (encoded, grid) = encode_all(dataset, &pipeline, indices, on)?;
+    let encode_s = start.elapsed().as_secs_f64();
+    candidates(&encoded, &grid, &params, set, encode_s)
+}

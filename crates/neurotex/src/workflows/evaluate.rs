@@ -1,0 +1,321 @@
+//! `evaluate`: a classifier on a dataset's features, by cross-validation or by training on
+//! some conditions (speeds, trials, sessions: any manifest column) and testing on others.
+
+use std::path::PathBuf;
+
+use super::{
+    calibrated_pipeline, encode_all, ClassifierOptions, KnnOptions, OnProgress, OpenOptions,
+};
+use crate::analysis::{Columns, Split};
+use crate::calibrate::CalibratedParams;
+use crate::classify::{ClassifierChoice, CvParams};
+use crate::compare::candidates::{MethodChoice, STANDARD_TAU_MS};
+use crate::error::OptionsError;
+use crate::evaluation::{Evaluation, Spikes};
+use crate::options::StageOptions;
+use crate::pipeline::{Method, Pipeline};
+use crate::progress::Progress;
+use crate::recording::{Dataset, Selection};
+use crate::{Cell, Result, Speed};
+
+/// Options of `neurotex evaluate`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct EvaluateOptions {
+    /// The dataset folder.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub dataset: PathBuf,
+    /// Feature set: `taxel` (each taxel alone, the mean reported), `glcm2d`, `glcm3d`,
+    /// `all-taxels` (every taxel's statistics in one vector), `all-taxels-mm` (the same per
+    /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`) or `van-rossum`
+    /// (KNN over van Rossum distances between the recordings' spike trains).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub method: MethodChoice,
+    /// With `--method van-rossum`: the kernel's time constant in ms (default: the rate
+    /// volume's 200 ms bin).
+    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = STANDARD_TAU_MS))]
+    pub tau_ms: f64,
+    /// With `--method taxel`: the taxel to use, as `ROW,COL`. Without it every taxel is
+    /// evaluated and the mean over taxels is reported, with the best beside it.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub taxel: Option<Cell>,
+    /// KNN's neighbours and z-scoring.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub knn: KnnOptions,
+    /// Cross-validation folds (stratified, shuffled).
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().folds))]
+    pub folds: usize,
+    /// Seed of the fold shuffle (repeat r uses seed + r).
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = 0))]
+    pub seed: u64,
+    /// Cross-validation repeats with different shuffles.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().repeats))]
+    pub repeats: usize,
+    /// Only recordings at these speeds (mm/s, comma-separated); default all.
+    #[cfg_attr(
+        feature = "cli",
+        arg(
+            long,
+            value_delimiter = ',',
+            allow_hyphen_values = true,
+            conflicts_with = "train_speeds"
+        )
+    )]
+    pub speeds: Option<Vec<Speed>>,
+    /// Train on these speeds instead of cross-validating (needs --test-speeds); the same
+    /// as --train-where speed_mm_s=SPEEDS.
+    #[cfg_attr(
+        feature = "cli",
+        arg(
+            long = "train-speeds",
+            value_delimiter = ',',
+            allow_hyphen_values = true,
+            requires = "test_speeds",
+            conflicts_with = "train_where"
+        )
+    )]
+    pub train_speeds: Option<Vec<Speed>>,
+    /// Test on these speeds (needs --train-speeds).
+    #[cfg_attr(
+        feature = "cli",
+        arg(
+            long = "test-speeds",
+            value_delimiter = ',',
+            allow_hyphen_values = true,
+            requires = "train_speeds",
+            conflicts_with = "test_where"
+        )
+    )]
+    pub test_speeds: Option<Vec<Speed>>,
+    /// Train on the recordings whose manifest column COL holds one of the values, instead
+    /// of cross-validating (needs --test-where): COL=V1,V2. Any column but `label`;
+    /// `speed_mm_s`, `force_n` and `trial` compare as numbers, other columns as text.
+    #[cfg_attr(feature = "cli", arg(
+        long = "train-where",
+        value_name = "COL=V1,V2",
+        allow_hyphen_values = true,
+        requires = "test_where",
+        conflicts_with_all = ["speeds", "group_by"]
+    ))]
+    pub train_where: Option<Selection>,
+    /// Test on the recordings whose column COL holds one of the values (needs
+    /// --train-where; no recording may be in both sets).
+    #[cfg_attr(
+        feature = "cli",
+        arg(
+            long = "test-where",
+            value_name = "COL=V1,V2",
+            allow_hyphen_values = true,
+            requires = "train_where"
+        )
+    )]
+    pub test_where: Option<Selection>,
+    /// Cross-validation folds never split a group of this manifest column (`trial`,
+    /// `force_n`, or any further column such as a session or subject); with fewer groups
+    /// than folds, each group is held out in turn.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long = "group-by", conflicts_with = "train_speeds")
+    )]
+    pub group_by: Option<String>,
+    /// The classifier and its knobs.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub classifier: ClassifierOptions,
+    /// How the dataset folder is opened.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub open: OpenOptions,
+}
+
+impl EvaluateOptions {
+    /// Cross-validation, or training and testing on the selected recordings.
+    fn split(&self) -> Result<Split> {
+        let cv = CvParams {
+            folds: self.folds,
+            seed: self.seed,
+            repeats: self.repeats,
+        }
+        .check()?;
+        Ok(match self.selections() {
+            Some((train, test)) => Split::Where { train, test },
+            None => Split::CrossValidation {
+                speeds: self.speeds.clone(),
+                cv,
+                group_by: self.group_by.clone(),
+            },
+        })
+    }
+
+    /// The training and test selections of a train/test split, `--train-speeds` and
+    /// `--test-speeds` as selections on `speed_mm_s`.
+    fn selections(&self) -> Option<(Selection, Selection)> {
+        match (&self.train_where, &self.test_where) {
+            (Some(train), Some(test)) => Some((train.clone(), test.clone())),
+            _ => match (&self.train_speeds, &self.test_speeds) {
+                (Some(train), Some(test)) => {
+                    Some((Selection::speeds(train), Selection::speeds(test)))
+                }
+                _ => None,
+            },
+        }
+    }
+
+    /// The dataset's recordings the evaluation uses, in manifest order.
+    fn indices(&self, dataset: &Dataset) -> Result<Vec<usize>> {
+        let entries = &dataset.entries;
+        if let (Some(train), Some(test)) = (&self.train_speeds, &self.test_speeds) {
+            // A speed the dataset lacks is named as --speeds names it, with the speeds it has.
+            dataset.indices_at(&[&train[..], test].concat())?;
+        }
+        Ok(match (self.selections(), &self.speeds) {
+            (Some((train, test)), _) => {
+                let mut rows = train.rows(entries)?;
+                rows.extend(test.rows(entries)?);
+                rows.sort_unstable();
+                rows.dedup();
+                rows
+            }
+            (None, Some(speeds)) => dataset.indices_at(speeds)?,
+            (None, None) => (0..entries.len()).collect(),
+        })
+    }
+
+    /// The recordings `--gain auto` calibrates on: the training set of a train/test split;
+    /// under cross-validation every recording evaluated (each is in some training fold, and
+    /// labels are not read; calibrating again inside every fold is not done), said on
+    /// standard error.
+    fn calibration_indices(
+        &self,
+        dataset: &Dataset,
+        all: &[usize],
+        stages: &StageOptions,
+        on: OnProgress,
+    ) -> Result<Vec<usize>> {
+        match self.selections() {
+            Some((train, _)) => Ok(train.rows(&dataset.entries)?),
+            None => {
+                if stages.gain.target_hz().is_some() {
+                    on(Progress::Say("note: under cross-validation --gain auto calibrates on every recording evaluated (labels unused), test folds included; a train/test split calibrates on the training set only"));
+                }
+                Ok(all.to_vec())
+            }
+        }
+    }
+
+    /// The feature columns to classify with.
+    ///
+    /// # Errors
+    /// `--taxel` with another method than `taxel`.
+    pub fn columns(&self) -> Result<Columns> {
+        Ok(match (self.method, self.taxel) {
+            (MethodChoice::Features(Method::Taxel), Some(cell)) => Columns::Taxel(cell),
+            (MethodChoice::Features(Method::Taxel), None) => Columns::EachTaxel,
+            (_, Some(_)) => return Err(super::taxel_not_applicable()),
+            (_, None) => Columns::All,
+        })
+    }
+
+    /// Checks that the options name one classifier, whose out-of-fold predictions can be
+    /// written: a GLCM method, or `taxel` with `--taxel`.
+    ///
+    /// # Errors
+    /// One classifier per taxel, or spike-train distances.
+    pub fn one_classifier(&self) -> Result<()> {
+        if self.method == MethodChoice::VanRossum {
+            return Err(OptionsError::NotApplicable {
+                option: "--predictions",
+                applies_to: "feature methods, not --method van-rossum",
+            }
+            .into());
+        }
+        if self.columns()? == Columns::EachTaxel {
+            return Err(OptionsError::Conflict(
+                "--predictions needs one classifier, not one per taxel: add --taxel ROW,COL".into(),
+            )
+            .into());
+        }
+        Ok(())
+    }
+
+    /// Runs the evaluation on `dataset` with the stage options `stages`.
+    ///
+    /// # Errors
+    /// Options that do not go together, a parameter out of range, recordings that cannot
+    /// be read, or a design too small for the split.
+    pub fn run(
+        &self,
+        dataset: &Dataset,
+        stages: &StageOptions,
+        on: OnProgress,
+    ) -> Result<Evaluated> {
+        let classifier = self.classifier.choice(self.knn.params()?)?;
+        let split = self.split()?;
+        let columns = self.columns()?;
+        let spike_timing = self.method == MethodChoice::VanRossum;
+        let knn = match (spike_timing, classifier) {
+            (false, _) => None,
+            (true, ClassifierChoice::Knn(knn)) => Some(knn),
+            (true, _) => {
+                return Err(OptionsError::NotApplicable {
+                    option: "--method van-rossum",
+                    applies_to: "KNN (--classifier knn)",
+                }
+                .into())
+            }
+        };
+        let indices = self.indices(dataset)?;
+        let calibration = self.calibration_indices(dataset, &indices, stages, on)?;
+        let calibrated = calibrated_pipeline(stages, dataset, &calibration, on)?;
+        let pipeline = Pipeline::new(calibrated.params.clone())?;
+        let (encoded, grid) = encode_all(dataset, &pipeline, &indices, on)?;
+        let spikes = Spikes {
+            encoded: &encoded,
+            grid: &grid,
+            pipeline: &pipeline,
+        };
+        let evaluation = match (self.method, knn) {
+            (MethodChoice::Features(method), _) => Evaluation::of_features(
+                spikes,
+                method,
+                columns,
+                &split,
+                &classifier.check()?,
+                self.seed,
+            )?,
+            (_, Some(knn)) => {
+                Evaluation::of_spike_timing(spikes, knn, self.tau_ms, &split, self.seed)?
+            }
+            (_, None) => unreachable!("spike timing has its KNN"),
+        };
+        Ok(Evaluated {
+            evaluation,
+            calibrated,
+        })
+    }
+}
+
+/// An evaluation and the calibrations its pipeline went through.
+#[derive(Debug)]
+pub struct Evaluated {
+    /// The evaluation.
+    pub evaluation: Evaluation,
+    /// The pipeline as run, with what `--causal` and `--gain auto` fixed.
+    pub calibrated: CalibratedParams,
+}
+
+impl Evaluated {
+    /// The evaluation as one JSON object, with the calibrations under
+    /// `causal_conditioning` and `gain_calibration`.
+    ///
+    /// # Errors
+    /// A value JSON cannot hold.
+    pub fn json(&self) -> serde_json::Result<serde_json::Value> {
+        let mut value = self.evaluation.json()?;
+        if let Some(c) = &self.calibrated.causal {
+            value["causal_conditioning"] = serde_json::to_value(c)?;
+        }
+        if let Some(c) = &self.calibrated.gain {
+            value["gain_calibration"] = serde_json::to_value(c)?;
+        }
+        Ok(value)
+    }
+}

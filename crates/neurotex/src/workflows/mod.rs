@@ -1,0 +1,250 @@
+//! The commands' workflows, one module each, shared by the command line and the Python
+//! package. Each module defines its command's options once (their help, defaults and
+//! rules; with the `cli` feature the command line's flags are derived from them), checks
+//! them, and runs the library on them. A workflow never prints: what it has to say (a
+//! note, a warning, what a calibration chose) and its progress go to the caller's
+//! [`Progress`] callback, which the command line shows on standard error and Python turns
+//! into warnings.
+
+pub mod compare;
+pub mod encode;
+pub mod evaluate;
+pub mod features;
+pub mod import;
+pub mod inspect;
+pub mod predict;
+pub mod reading;
+pub mod reproduce;
+pub mod simulate;
+pub mod stream;
+pub mod train;
+
+use crate::analysis::FeatureTable;
+use crate::calibrate::{calibrate_pipeline, CalibratedParams, GainCalibration};
+use crate::classify::{ClassifierChoice, ForestParams, KnnParams, LinearParams};
+use crate::error::OptionsError;
+use crate::options::StageOptions;
+use crate::pipeline::{shared_grid, Encoded, Method, Pipeline};
+use crate::progress::Progress;
+use crate::recording::Dataset;
+use crate::{Grid, Result};
+
+pub use reading::{CsvOptions, LogOptions, OpenOptions, ReadOptions};
+
+/// Where a workflow reports its progress and what it has to say.
+pub type OnProgress<'a> = &'a (dyn Fn(Progress) + Sync);
+
+/// KNN's options: the neighbours and the z-scoring of features.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct KnnOptions {
+    /// Neighbours in KNN; at most the number of recordings in a training set.
+    #[cfg_attr(feature = "cli", arg(short = 'k', long = "k", default_value_t = KnnParams::default().k))]
+    pub k: usize,
+    /// Do not z-score features with training-fold statistics before KNN.
+    #[cfg_attr(feature = "cli", arg(long = "no-standardize"))]
+    pub no_standardize: bool,
+}
+
+impl Default for KnnOptions {
+    fn default() -> Self {
+        Self {
+            k: KnnParams::default().k,
+            no_standardize: !KnnParams::default().standardize,
+        }
+    }
+}
+
+impl KnnOptions {
+    /// KNN's parameters, checked.
+    ///
+    /// # Errors
+    /// `k` is zero.
+    pub fn params(&self) -> Result<KnnParams> {
+        let knn = KnnParams {
+            k: self.k,
+            standardize: !self.no_standardize,
+        };
+        knn.check()?;
+        Ok(knn)
+    }
+}
+
+/// Options choosing the classifier (KNN's own are [`KnnOptions`]).
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct ClassifierOptions {
+    /// Classifier: `knn` (the paper's), `forest` (random forest of CART trees, √d features
+    /// tried per split) or `linear` (multinomial logistic regression, L2 penalty). The
+    /// regression always z-scores features with training statistics and the forest needs no
+    /// scaling: --no-standardize applies to KNN only.
+    #[cfg_attr(feature = "cli", arg(long, default_value = "knn"))]
+    pub classifier: ClassifierChoice,
+    /// With `--classifier forest`: trees in the forest [default: 200].
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub trees: Option<usize>,
+    /// With `--classifier forest`: seed of the trees' random streams [default: 0].
+    #[cfg_attr(feature = "cli", arg(long = "forest-seed"))]
+    pub forest_seed: Option<u64>,
+    /// With `--classifier linear`: inverse penalty strength, scikit-learn's C [default: 1].
+    #[cfg_attr(feature = "cli", arg(long = "c"))]
+    pub c: Option<f64>,
+}
+
+impl ClassifierOptions {
+    /// The chosen classifier with its options applied, checked; `knn` is used as it is for
+    /// `--classifier knn`.
+    ///
+    /// # Errors
+    /// An option of another classifier, or a parameter out of its range.
+    pub fn choice(&self, knn: KnnParams) -> Result<ClassifierChoice> {
+        let choice = match self.classifier {
+            ClassifierChoice::Knn(_) => ClassifierChoice::Knn(knn),
+            ClassifierChoice::Forest(defaults) => ClassifierChoice::Forest(ForestParams {
+                trees: self.trees.unwrap_or(defaults.trees),
+                seed: self.forest_seed.unwrap_or(defaults.seed),
+                ..defaults
+            }),
+            ClassifierChoice::Linear(defaults) => ClassifierChoice::Linear(LinearParams {
+                c: self.c.unwrap_or(defaults.c),
+                ..defaults
+            }),
+        };
+        let forest = matches!(choice, ClassifierChoice::Forest(_));
+        if !forest && (self.trees.is_some() || self.forest_seed.is_some()) {
+            return Err(OptionsError::Conflict(
+                "--trees and --forest-seed apply only to --classifier forest".into(),
+            )
+            .into());
+        }
+        if !matches!(choice, ClassifierChoice::Linear(_)) && self.c.is_some() {
+            return Err(OptionsError::NotApplicable {
+                option: "--c",
+                applies_to: "--classifier linear",
+            }
+            .into());
+        }
+        choice.check()?;
+        Ok(choice)
+    }
+}
+
+/// `--taxel` given with another method than `taxel`.
+fn taxel_not_applicable() -> crate::Error {
+    OptionsError::NotApplicable {
+        option: "--taxel",
+        applies_to: "--method taxel",
+    }
+    .into()
+}
+
+/// The recordings of `dataset` at `speeds` (all when `None`), in manifest order.
+///
+/// # Errors
+/// A speed the dataset has no recording at.
+pub fn indices_at(dataset: &Dataset, speeds: Option<&[crate::Speed]>) -> Result<Vec<usize>> {
+    Ok(match speeds {
+        Some(speeds) => dataset.indices_at(speeds)?,
+        None => (0..dataset.entries.len()).collect(),
+    })
+}
+
+/// Encodes the dataset's recordings `indices` and extracts `method`'s features; also
+/// returns the grid the recordings share.
+///
+/// # Errors
+/// A recording that cannot be read or encoded, or recordings on different grids.
+pub fn feature_table(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+    method: Method,
+    on: OnProgress,
+) -> Result<(FeatureTable, Grid)> {
+    let (encoded, grid) = encode_all(dataset, pipeline, indices, on)?;
+    let extractor = pipeline.extractor(&grid)?;
+    Ok((FeatureTable::build(&encoded, &extractor, method)?, grid))
+}
+
+/// Encodes the dataset's recordings `indices` (a stage `encoding` of one step each),
+/// saying what the conditioning noticed; also returns the grid the recordings share.
+///
+/// # Errors
+/// A recording that cannot be read or encoded, or recordings on different grids.
+pub fn encode_all(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+    on: OnProgress,
+) -> Result<(Vec<Encoded>, Grid)> {
+    on(Progress::Stage("encoding", indices.len()));
+    let encoded = pipeline.encode_dataset(dataset, indices, &|| on(Progress::Tick))?;
+    say_conditions(&encoded, on);
+    let grid = shared_grid(&encoded)?;
+    Ok((encoded, grid))
+}
+
+/// The pipeline the stage options name, after saying the dataset's severe findings on its
+/// signals and layout ([`crate::inspect::severe_findings`]); with `--causal`, its resting
+/// values and scale fixed on `dataset`'s recordings `indices` (the training recordings:
+/// never a test one); with `--gain auto`, its gain calibrated on them too
+/// ([`calibrate_pipeline`]). Each choice is said.
+///
+/// # Errors
+/// A stage option out of range, or a recording that cannot be read.
+pub fn calibrated_pipeline(
+    stages: &StageOptions,
+    dataset: &Dataset,
+    indices: &[usize],
+    on: OnProgress,
+) -> Result<CalibratedParams> {
+    let params = stages.check()?.params;
+    for finding in crate::inspect::severe_findings(dataset, &params)? {
+        on(Progress::Advice(&format!(
+            "{} (neurotex inspect says more)",
+            finding.line()
+        )));
+    }
+    let baseline = dataset.layout.baseline.unwrap_or_default();
+    let load = |i: usize| dataset.load(i);
+    let calibrated =
+        calibrate_pipeline(params, stages.causal, stages.gain, &load, indices, baseline)?;
+    if let Some(c) = &calibrated.causal {
+        on(Progress::Say(&format!(
+            "--causal: forward-only filter; resting values and scale {:.6} fixed on {} training recording(s) (median selected phase {} ms)",
+            c.conditioning.scale, c.recordings, c.median_duration_ms
+        )));
+    }
+    if let Some(c) = &calibrated.gain {
+        on(Progress::Say(&calibration_line(c)));
+    }
+    Ok(calibrated)
+}
+
+/// What `--gain auto` chose, as said to the user.
+pub fn calibration_line(c: &GainCalibration) -> String {
+    let reached = if c.clamped {
+        " (target out of reach: the end of the searched range)"
+    } else {
+        ""
+    };
+    format!(
+        "--gain auto: G = {} gives a median of {:.1} Hz (target {} Hz) over {} taxel x recording pairs with signal in {} training recording(s){reached}",
+        c.gain, c.median_hz, c.target_hz, c.pairs, c.recordings
+    )
+}
+
+/// Says what conditioning did that the user should know: recordings resampled to 1 kHz,
+/// recordings without positive signal.
+pub fn say_conditions(encoded: &[Encoded], on: OnProgress) {
+    let resampled = encoded.iter().filter(|e| e.resampled).count();
+    if resampled > 0 {
+        on(Progress::Say(&format!("note: {resampled} recording(s) resampled to the encoder's 1 kHz by linear interpolation")));
+    }
+    for e in encoded.iter().filter(|e| e.flat) {
+        on(Progress::Advice(&format!(
+            "{}: no positive signal in the selected phase; left at zero (no spikes)",
+            e.meta.file
+        )));
+    }
+}

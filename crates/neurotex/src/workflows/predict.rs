@@ -1,0 +1,134 @@
+//! `predict`: a saved model applied to new recordings, a dataset folder or plain files,
+//! with its own pipeline: whole recordings, or bin by bin as `stream` decides.
+
+use std::path::PathBuf;
+
+use rayon::prelude::*;
+
+use super::stream::DecisionOptions;
+use super::{say_conditions, OnProgress, OpenOptions, ReadOptions};
+use crate::causal::{episode_decisions, Episode};
+use crate::error::OptionsError;
+use crate::model::Model;
+use crate::pipeline::Encoded;
+use crate::progress::Progress;
+use crate::recording::Dataset;
+use crate::Result;
+
+/// Options of `predict`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct PredictOptions {
+    /// The model file written by `neurotex train`. Its pipeline (filter, neurons, bins,
+    /// GLCM offsets, baseline) is applied to the recordings, not this command's defaults.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub model: PathBuf,
+    /// A dataset folder to predict; its manifest's labels are written beside the
+    /// predictions and scored with --json.
+    #[cfg_attr(feature = "cli", arg(
+        long,
+        required_unless_present = "files",
+        conflicts_with_all = ["files", "layout", "fs", "grid", "no_header", "delimiter", "time_column", "time_unit", "channels", "duplicate_stamps", "max_gap_s"]
+    ))]
+    pub dataset: Option<PathBuf>,
+    /// Recordings to predict instead of a dataset (`.npy` or `.csv`); their labels are
+    /// unknown. They must have the model's taxel grid. A file with no layout given or
+    /// beside it is read as the model's training recordings were: raw logs of the logger
+    /// the training dataset was imported from need no options.
+    pub files: Vec<PathBuf>,
+    /// With FILES: how to read them (the options of `encode`).
+    /// How the files are read.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub read: ReadOptions,
+    /// Decide as `neurotex stream` would, bin by bin (needs a model trained with
+    /// --causal): --out gets JSON lines, one per bin boundary of each recording's selected
+    /// phase and one for its end, each with the recording's `file`; the same lines
+    /// `neurotex stream --episode whole` prints for that recording's frames.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub causal: bool,
+    /// How an episode is decided.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub decision: DecisionOptions,
+    /// How the dataset folder is opened.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub open: OpenOptions,
+}
+
+impl PredictOptions {
+    /// The dataset, when the options name one.
+    ///
+    /// # Errors
+    /// The folder, its manifest or its layout cannot be read.
+    pub fn dataset(&self) -> Result<Option<Dataset>> {
+        self.dataset.as_ref().map(|d| self.open.open(d)).transpose()
+    }
+
+    /// The files the prediction reads besides the model: the dataset's recordings, or the
+    /// files and the layout given.
+    pub fn inputs(&self, dataset: Option<&Dataset>) -> Vec<PathBuf> {
+        let mut inputs = vec![self.model.clone()];
+        match dataset {
+            Some(dataset) => inputs.extend(dataset.files()),
+            None => inputs.extend(self.files.iter().chain(&self.read.layout).cloned()),
+        }
+        inputs
+    }
+
+    /// Encodes the recordings (`dataset`'s, else the files given) with `model`'s pipeline,
+    /// saying where layouts came from and what conditioning noticed.
+    ///
+    /// # Errors
+    /// A recording that cannot be read, or does not fit the model.
+    pub fn encode(
+        &self,
+        model: &Model,
+        dataset: Option<&Dataset>,
+        on: OnProgress,
+    ) -> Result<Vec<Encoded>> {
+        let encoded = match dataset {
+            Some(dataset) => encode_dataset(model, dataset, on)?,
+            None => {
+                let (encoded, from) = model.encode_files(&self.files, &self.read.reading()?)?;
+                for note in ReadOptions::layout_notes(&from) {
+                    on(Progress::Say(&note));
+                }
+                encoded
+            }
+        };
+        say_conditions(&encoded, on);
+        Ok(encoded)
+    }
+
+    /// Every recording's per-bin decisions and end, as `stream` decides them.
+    ///
+    /// # Errors
+    /// A model not trained with `--causal`, or a decision rule out of range.
+    pub fn episodes(&self, model: &Model, encoded: &[Encoded]) -> Result<Vec<Episode>> {
+        if model.causal().is_none() {
+            return Err(OptionsError::Conflict(format!("{}: --causal needs a model trained with --causal (this one conditions each recording with the zero-phase filter and its own maximum, which need the whole recording)", self.model.display())).into());
+        }
+        let window_ms = self.decision.window_ms(model)?;
+        let rule = self.decision.rule()?;
+        encoded
+            .par_iter()
+            .map(|e| episode_decisions(model, e, window_ms, rule))
+            .collect()
+    }
+}
+
+/// Encodes every recording of `dataset` with the model's pipeline.
+fn encode_dataset(model: &Model, dataset: &Dataset, on: OnProgress) -> Result<Vec<Encoded>> {
+    let layout_baseline = dataset.layout.baseline.unwrap_or_default();
+    if layout_baseline != model.baseline() {
+        on(Progress::Say(&format!(
+            "note: the model removes baseline `{}` as in training; {} says `{layout_baseline}`",
+            model.baseline(),
+            dataset.root.join("layout.toml").display()
+        )));
+    }
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    on(Progress::Stage("encoding", all.len()));
+    model
+        .pipeline()
+        .encode_dataset(dataset, &all, &|| on(Progress::Tick))
+}
