@@ -23,6 +23,7 @@ static STOP: AtomicBool = AtomicBool::new(false);
 /// finished outputs are never among them) and the process exits with 130.
 pub fn install() {
     ignore_file_size_signal();
+    quiet_on_closed_pipe();
     let installed = ctrlc::set_handler(|| {
         if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
             // The command ends by itself at its next frame; the process exits then.
@@ -67,3 +68,20 @@ fn ignore_file_size_signal() {
 
 #[cfg(not(unix))]
 fn ignore_file_size_signal() {}
+
+/// Ends the process quietly when the reader of its standard output has gone
+/// (`neurotex features --out - | head`), as other Unix tools do, instead of Rust's default
+/// of ignoring SIGPIPE, which turns the next `println!` into a panic. Files are written to
+/// temporaries and renamed before anything is printed, so a reader that stops early costs
+/// no output file.
+#[cfg(unix)]
+fn quiet_on_closed_pipe() {
+    // SAFETY: restoring a standard signal's default disposition installs no handler code;
+    // it is done once, at start, before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+#[cfg(not(unix))]
+fn quiet_on_closed_pipe() {}

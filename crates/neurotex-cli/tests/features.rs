@@ -179,3 +179,47 @@ fn tables_and_predictions_go_to_standard_output_with_a_dash() {
     let err = dir.fails(&[&args[..], &["--json"]].concat());
     assert!(err.contains("both write standard output"), "{err}");
 }
+
+/// A reader that stops early (`| head`) ends the command quietly: no panic, no error.
+#[cfg(unix)]
+#[test]
+fn a_reader_that_stops_early_ends_the_command_quietly() {
+    use std::process::{Command, Stdio};
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 5);
+    for args in [
+        vec![
+            "features",
+            "--dataset",
+            s(&ds),
+            "--method",
+            "glcm3d",
+            "--out",
+            "-",
+        ],
+        vec![
+            "evaluate",
+            "--dataset",
+            s(&ds),
+            "--method",
+            "taxel",
+            "--folds",
+            "2",
+        ],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_neurotex"))
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The reader goes before anything is written.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !stderr.contains("panicked") && !stderr.contains("Broken pipe"),
+            "{args:?}: {stderr}"
+        );
+    }
+}
