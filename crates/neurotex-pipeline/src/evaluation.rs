@@ -124,6 +124,7 @@ impl Evaluation {
             methods: vec![MethodChoice::VanRossum],
             classifiers: vec![ClassifierChoice::Knn(knn)],
             tau_ms,
+            baselines: false,
         };
         let candidate = candidates(encoded, grid, pipeline.params(), &set, 0.0)?.remove(0);
         let outcome = (candidate.evaluate)(&candidate.table, Columns::All, split)?;

@@ -97,6 +97,12 @@ pub struct StageOptions {
     pub bin_widths: Vec<usize>,
     /// Fano window of `all-taxels-mm`, in mm of travel.
     pub window_mm: f64,
+    /// Bins of the `spectrum` method's span.
+    pub spectrum_bins: usize,
+    /// Logarithmic bands of the `spectrum` method.
+    pub spectrum_bands: usize,
+    /// The `spectrum` method's span in mm of travel; 0 for the whole selected phase.
+    pub travel_mm: f64,
 }
 
 impl Default for StageOptions {
@@ -120,6 +126,9 @@ impl Default for StageOptions {
             haralick: features.haralick,
             bin_widths: features.bin_widths_ms,
             window_mm: features.window_mm,
+            spectrum_bins: features.spectrum_bins,
+            spectrum_bands: features.spectrum_bands,
+            travel_mm: features.travel_mm,
         }
     }
 }
@@ -172,6 +181,9 @@ impl StageOptions {
             haralick: self.haralick,
             bin_widths_ms: self.bin_widths.clone(),
             window_mm: self.window_mm,
+            spectrum_bins: self.spectrum_bins,
+            spectrum_bands: self.spectrum_bands,
+            travel_mm: self.travel_mm,
         };
         p.check()?;
         Ok(CheckedStages {
@@ -340,6 +352,26 @@ pub static STAGE_OPTIONS: &[OptionSpec] = &[
         window_mm,
         Number,
         "Fano window of the `all-taxels-mm` method, in mm of travel."
+    ),
+    spec!(
+        spectrum_bins,
+        Count,
+        "Equal bins of travel the `spectrum` method counts each taxel's spikes in before \
+         its Fourier transform (8 to 4096)."
+    ),
+    spec!(
+        spectrum_bands,
+        Count,
+        "Logarithmically spaced bands of spatial frequency the `spectrum` method averages \
+         the transform's magnitudes in (bands falling on the same frequency merge)."
+    ),
+    spec!(
+        travel_mm,
+        Number,
+        "Span of the `spectrum` method in mm of travel from the start of the slide (needs \
+         each recording's speed); 0 takes each recording's whole slide, whose frequencies \
+         are then cycles per slide: spatial frequencies when every slide travels the same \
+         distance."
     ),
     spec!(causal, Flag,
         "Condition causally, as a live stream can (`neurotex stream`): a forward-only \

@@ -10,7 +10,7 @@ use crate::error::{DataError, ParamError, Result};
 use crate::features::glcm::GlcmKind;
 use crate::features::{
     distance_stats, haralick, haralick_full, spike_stats, CountVolume, GlcmParams, GlcmPlan,
-    VolumeParams, FULL_NAMES,
+    Spectrum, SpectrumParams, VolumeParams, FULL_NAMES,
 };
 use crate::recording::{one_grid, Baseline, Dataset, Meta, Recording};
 use crate::signal::{Conditioned, PreprocessParams, Preprocessor};
@@ -40,17 +40,23 @@ pub enum Method {
     /// The 3D-GLCM features at each of [`FeatureParams::bin_widths_ms`], concatenated.
     #[serde(rename = "glcm3d-multi")]
     Glcm3dMulti,
+    /// Each taxel's spike counts in equal bins of travel, their Fourier magnitudes in
+    /// logarithmic bands of spatial frequency ([`crate::features::spectrum`]): the texture's
+    /// spatial periods, whatever the speed, as Wang et al. (2022) read them from the signal.
+    #[serde(rename = "spectrum")]
+    Spectrum,
 }
 
 impl Method {
     /// Every method, in the order of the enum.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 7] = [
         Method::Taxel,
         Method::Glcm2d,
         Method::Glcm3d,
         Method::AllTaxels,
         Method::AllTaxelsMm,
         Method::Glcm3dMulti,
+        Method::Spectrum,
     ];
 
     /// The command-line name.
@@ -62,6 +68,7 @@ impl Method {
             Method::AllTaxels => "all-taxels",
             Method::AllTaxelsMm => "all-taxels-mm",
             Method::Glcm3dMulti => "glcm3d-multi",
+            Method::Spectrum => "spectrum",
         }
     }
 
@@ -83,7 +90,7 @@ impl std::str::FromStr for Method {
             .ok_or_else(|| {
                 ParamError::new(
                     "method",
-                    "method must be taxel, glcm2d, glcm3d, all-taxels, all-taxels-mm or glcm3d-multi",
+                    "method must be taxel, glcm2d, glcm3d, all-taxels, all-taxels-mm, glcm3d-multi or spectrum",
                     s,
                 )
             })
@@ -188,6 +195,15 @@ pub struct FeatureParams {
     /// The Fano window of [`Method::AllTaxelsMm`] in mm of travel (2 mm: the paper's
     /// 200 ms window at 10 mm/s).
     pub window_mm: f64,
+    /// The equal bins [`Method::Spectrum`] counts spikes in (128: at FabricSlide's 590 mm
+    /// slides about 4.6 mm each, near its samples' spacing at 150 mm/s; on the simulated
+    /// rig's 90 mm, 0.7 mm).
+    pub spectrum_bins: usize,
+    /// The logarithmic bands of [`Method::Spectrum`] (16, 14 after merging at 128 bins).
+    pub spectrum_bands: usize,
+    /// The span of [`Method::Spectrum`] in mm of travel from the start of the selected
+    /// phase; 0 (the default) for each recording's whole phase.
+    pub travel_mm: f64,
 }
 
 impl Default for FeatureParams {
@@ -196,6 +212,9 @@ impl Default for FeatureParams {
             haralick: HaralickSet::Paper,
             bin_widths_ms: vec![50, 100, 200, 400],
             window_mm: 2.0,
+            spectrum_bins: 128,
+            spectrum_bands: 16,
+            travel_mm: 0.0,
         }
     }
 }
@@ -220,7 +239,33 @@ impl FeatureParams {
                 self.window_mm,
             ));
         }
+        if !(8..=crate::features::spectrum::MAX_BINS).contains(&self.spectrum_bins) {
+            return Err(ParamError::new(
+                "spectrum-bins",
+                "the spectrum's bins must be 8 to 4096",
+                self.spectrum_bins,
+            ));
+        }
+        if self.spectrum_bands == 0 {
+            let rule = "the spectrum needs at least one band";
+            return Err(ParamError::new("spectrum-bands", rule, 0));
+        }
+        if !(self.travel_mm.is_finite() && self.travel_mm >= 0.0) {
+            return Err(ParamError::new(
+                "travel-mm",
+                "the spectrum's travel must be 0 (the whole slide) or a positive number of mm",
+                self.travel_mm,
+            ));
+        }
         Ok(())
+    }
+
+    /// The spectrum's bins and bands.
+    pub fn spectrum(&self) -> SpectrumParams {
+        SpectrumParams {
+            bins: self.spectrum_bins,
+            bands: self.spectrum_bands,
+        }
     }
 }
 
@@ -490,6 +535,7 @@ pub struct FeatureExtractor {
     grid: Grid,
     plan3d: GlcmPlan,
     plan2d: GlcmPlan,
+    spectrum: Spectrum,
 }
 
 impl FeatureExtractor {
@@ -510,6 +556,7 @@ impl FeatureExtractor {
             grid: grid.clone(),
             plan3d: GlcmPlan::new(rows, cols, present, levels, &params.glcm, GlcmKind::ThreeD)?,
             plan2d: GlcmPlan::new(rows, cols, present, levels, &params.glcm, GlcmKind::TwoD)?,
+            spectrum: Spectrum::new(params.features.spectrum()),
         })
     }
 
@@ -559,6 +606,18 @@ impl FeatureExtractor {
                 .iter()
                 .flat_map(|w| haralick.iter().map(move |h| format!("{w}ms_{h}")))
                 .collect(),
+            Method::Spectrum => {
+                let edges = self.features.spectrum().edges();
+                self.grid
+                    .taxels()
+                    .flat_map(|cell| {
+                        let cell = self.grid.cell(cell);
+                        edges
+                            .windows(2)
+                            .map(move |w| format!("{cell}_f{}_{}", w[0], w[1]))
+                    })
+                    .collect()
+            }
         }
     }
 
@@ -576,6 +635,10 @@ impl FeatureExtractor {
             .filter(|s| s.is_finite() && *s != 0.0);
         if method == Method::AllTaxelsMm && speed.is_none() {
             return Err(DataError::invalid(&encoded.meta.file, NO_SPEED).into());
+        }
+        if method == Method::Spectrum {
+            let span = spectrum_span(encoded.spikes.n_steps, speed, &self.features);
+            span.map_err(|why| DataError::invalid(&encoded.meta.file, why))?;
         }
         let mut row = Vec::new();
         for spikes in populations {
@@ -728,6 +791,15 @@ impl FeatureExtractor {
                 }
                 Ok(row)
             }
+            Method::Spectrum => {
+                let span = spectrum_span(n, speed_mm_s, &self.features)
+                    .map_err(|why| DataError::invalid("the recording", why))?;
+                let mut row = Vec::new();
+                for cell in taxel_cells(&spikes.present) {
+                    self.spectrum.train(spikes.train(cell), span, &mut row);
+                }
+                Ok(row)
+            }
         }
     }
 
@@ -798,6 +870,43 @@ impl FeatureExtractor {
 /// Why [`Method::AllTaxelsMm`] refuses a recording without a speed.
 const NO_SPEED: &str =
     "the all-taxels-mm method needs the recording's sliding speed (manifest column speed_mm_s, nonzero)";
+
+/// The steps [`Method::Spectrum`] reads of a phase of `n_steps` at `speed_mm_s`: all of
+/// them, or those of `travel_mm` of travel.
+///
+/// # Errors
+/// Why the recording cannot give that span: no speed, or a slide shorter than the travel
+/// or than one step per bin.
+pub fn spectrum_span(
+    n_steps: usize,
+    speed_mm_s: Option<f64>,
+    features: &FeatureParams,
+) -> std::result::Result<usize, String> {
+    let span = if features.travel_mm > 0.0 {
+        let Some(speed) = speed_mm_s.filter(|s| s.is_finite() && *s != 0.0) else {
+            return Err("the spectrum's --travel-mm needs the recording's sliding speed (manifest column speed_mm_s, nonzero); --travel-mm 0 uses the whole slide without it".into());
+        };
+        let steps = (features.travel_mm / speed.abs() * 1e3).round() as usize;
+        if steps > n_steps {
+            return Err(format!(
+                "its slide travels {:.1} mm ({n_steps} ms at {} mm/s), less than --travel-mm {}",
+                n_steps as f64 * 1e-3 * speed.abs(),
+                speed.abs(),
+                features.travel_mm
+            ));
+        }
+        steps
+    } else {
+        n_steps
+    };
+    if span < features.spectrum_bins {
+        return Err(format!(
+            "the spectrum's span is {span} ms, fewer than its {} bins (--spectrum-bins)",
+            features.spectrum_bins
+        ));
+    }
+    Ok(span)
+}
 
 /// The error of trains shorter than one bin of `bin_ms`.
 fn too_short(spikes: &SpikeTrains, bin_ms: usize) -> crate::Error {

@@ -92,7 +92,7 @@ impl Default for ReproduceParams {
             group_by: None,
             e9: true,
             // One repeat: the intervals come from the bootstrap over recordings, and the
-            // search over 28 candidates is the longest analysis of the run.
+            // search over 34 candidates is the longest analysis of the run.
             e9_repeats: 1,
             e5_causal: true,
         }

@@ -45,7 +45,7 @@ impl std::str::FromStr for MethodChoice {
             return Ok(MethodChoice::VanRossum);
         }
         s.parse().map(MethodChoice::Features).map_err(|_| {
-            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi or van-rossum";
+            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi, spectrum or van-rossum";
             ParamError::new("methods", rule, s)
         })
     }
@@ -64,13 +64,17 @@ pub struct CandidateSet {
     pub classifiers: Vec<ClassifierChoice>,
     /// Time constant of the van Rossum kernel, ms.
     pub tau_ms: f64,
+    /// Also the baselines without spikes (encoding `none`; [`super::signal`]), each with
+    /// every classifier.
+    pub baselines: bool,
 }
 
 /// The encodings `neurotex compare` and E9 compare by default.
 pub const STANDARD_ENCODINGS: &str = "sa,sa+fa";
 /// The methods compared by default (`all-taxels-mm` needs every recording's speed, so it is
 /// asked for by name).
-pub const STANDARD_METHODS: &str = "taxel,all-taxels,glcm2d,glcm3d,glcm3d-multi,van-rossum";
+pub const STANDARD_METHODS: &str =
+    "taxel,all-taxels,glcm2d,glcm3d,glcm3d-multi,spectrum,van-rossum";
 /// The classifiers compared by default.
 pub const STANDARD_CLASSIFIERS: &str = "knn,forest,linear";
 /// The van Rossum time constant by default: the rate volume's 200 ms bin, the time
@@ -104,6 +108,7 @@ impl CandidateSet {
             methods,
             classifiers,
             tau_ms: STANDARD_TAU_MS,
+            baselines: false,
         }
     }
 
@@ -132,7 +137,11 @@ impl CandidateSet {
 
     /// How many candidates the set makes.
     pub fn len(&self) -> usize {
-        self.encodings.len() * self.pairs().len()
+        let baselines = match self.baselines {
+            true => super::signal::SIGNAL_METHODS.len() * self.classifiers.len(),
+            false => 0,
+        };
+        self.encodings.len() * self.pairs().len() + baselines
     }
 
     /// Whether the set makes no candidate.
@@ -205,7 +214,7 @@ pub fn candidates(
 }
 
 /// The classifier as a [`Candidate::evaluate`]; with a distance matrix, KNN over it.
-fn evaluator(
+pub(crate) fn evaluator(
     classifier: ClassifierChoice,
     distances: Option<Arc<crate::classify::DistanceMatrix>>,
 ) -> Result<Arc<super::EvaluateFn>> {

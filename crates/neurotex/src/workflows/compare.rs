@@ -11,12 +11,14 @@ use crate::compare::candidates::{
     candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
     STANDARD_METHODS, STANDARD_TAU_MS,
 };
+use crate::compare::signal::{signal_candidates, NO_ENCODING};
 use crate::compare::{compare_with_progress, Candidate, CompareParams, Comparison, Protocol};
-use crate::error::OptionsError;
+use crate::error::{OptionsError, ParamError};
 use crate::options::StageOptions;
 use crate::pipeline::{Encoding, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{Dataset, Selection};
+use crate::values::Grid;
 use crate::{Result, Speed};
 
 /// Most candidates one run compares (encodings x methods x classifiers).
@@ -72,10 +74,13 @@ pub struct CompareOptions {
     #[cfg_attr(feature = "cli", arg(long = "group-by"))]
     pub group_by: Option<String>,
     /// Encodings to compare, comma-separated: `sa` (the paper's slowly adapting neurons),
-    /// `fa` (fast adapting, driven by the rectified rate of change), `sa+fa` (both).
-    /// Overrides --encoding.
+    /// `fa` (fast adapting, driven by the rectified rate of change), `sa+fa` (both), and
+    /// `none`: the baselines without spikes, from the signal the encoder would receive
+    /// (`spectrum`, its speed-normalised spectrum, and `signal-stats`, moments and
+    /// quantiles per taxel, each with every classifier; --methods does not apply to
+    /// them). Overrides --encoding.
     #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_ENCODINGS))]
-    pub encodings: Vec<Encoding>,
+    pub encodings: Vec<String>,
     /// Feature methods to compare, comma-separated. `taxel` is the paper's single-taxel
     /// method (each taxel alone, mean over taxels; KNN only); `van-rossum` classifies by
     /// spike-train distances (KNN only).
@@ -182,11 +187,23 @@ impl CompareOptions {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let baselines = self.encodings.iter().any(|e| e.trim() == NO_ENCODING);
+        let encodings = self
+            .encodings
+            .iter()
+            .filter(|e| e.trim() != NO_ENCODING)
+            .map(|e| e.parse::<Encoding>())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| {
+                let rule = "encodings must be sa, fa, sa+fa or none (the baselines without spikes)";
+                ParamError::new("encodings", rule, e.got)
+            })?;
         Ok(CandidateSet {
-            encodings: self.encodings.clone(),
+            encodings,
             methods,
             classifiers,
             tau_ms: self.tau_ms,
+            baselines,
         })
     }
 
@@ -245,7 +262,27 @@ fn make_candidates(
         Encoding::Sa
     };
     let pipeline = Pipeline::new(params.clone())?;
-    let (encoded, grid) = encode_all(dataset, &pipeline, indices, on)?;
-    let encode_s = start.elapsed().as_secs_f64();
-    candidates(&encoded, &grid, &params, set, encode_s)
+    let mut out = Vec::new();
+    let grid = if set.encodings.is_empty() {
+        let first = dataset.load(indices[0])?.layout;
+        Grid::masked(first.rows, first.cols, first.present)?
+    } else {
+        let (encoded, grid) = encode_all(dataset, &pipeline, indices, on)?;
+        let encode_s = start.elapsed().as_secs_f64();
+        out = candidates(&encoded, &grid, &params, set, encode_s)?;
+        grid
+    };
+    if set.baselines {
+        on(Progress::Stage("signal baselines", indices.len()));
+        let tick = || on(Progress::Tick);
+        out.extend(signal_candidates(
+            dataset,
+            &pipeline,
+            indices,
+            &grid,
+            &set.classifiers,
+            &tick,
+        )?);
+    }
+    Ok(out)
 }

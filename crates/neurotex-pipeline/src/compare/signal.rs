@@ -1,0 +1,137 @@
+//! Baselines without spikes: candidates computed from the same conditioned signal the
+//! encoder receives (resampled to 1 kHz, baseline removed, low-pass filtered, divided by
+//! the recording's maximum, over the selected phase), so that a comparison shows what
+//! the spikes cost or gain against the signal itself, on the same folds.
+//!
+//! - `spectrum`: each taxel's signal averaged in the spectrum's equal bins of travel, the
+//!   magnitudes of its Fourier transform in logarithmic bands of spatial frequency
+//!   ([`crate::features::Spectrum::signal`]), the same transform and bands the spike
+//!   method `spectrum` applies to spike counts. After the speed-normalised spectrum of
+//!   Wang, Albini, Maiolino, Mastrogiovanni and Cannata (Front. Neurorobot. 16:808222,
+//!   2022), who resample each taxel's signal to samples per millimetre over a fixed
+//!   travel, take its FFT and reduce it by PCA for a nearest-class rule. Here the bands
+//!   reduce the spectrum instead of PCA (fixed a priori, nothing fitted to a fold), and
+//!   the classifiers are the comparison's.
+//! - `signal-stats`: each taxel's moments, quantiles and turns per second
+//!   ([`crate::features::signal_stats`]), a common hand-made baseline.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::candidates::evaluator;
+use super::Candidate;
+use crate::analysis::{Columns, FeatureTable};
+use crate::classify::ClassifierChoice;
+use crate::error::{DataError, Result};
+use crate::features::{signal_stats, Spectrum, SIGNAL_STAT_NAMES};
+use crate::pipeline::{spectrum_span, taxel_cells, Method, Pipeline};
+use crate::recording::{Dataset, Meta};
+use crate::values::Grid;
+
+/// The encoding name of the baselines.
+pub const NO_ENCODING: &str = "none";
+
+/// The baseline methods, in the order they are listed.
+pub const SIGNAL_METHODS: [&str; 2] = ["spectrum", "signal-stats"];
+
+/// One recording's rows of both baselines.
+struct SignalRows {
+    meta: Meta,
+    spectrum: Vec<f64>,
+    stats: Vec<f64>,
+}
+
+/// The baseline candidates (both methods with each of `classifiers`) of the dataset's
+/// recordings `indices`, conditioned by `pipeline` (its encoder unused) on `grid`;
+/// `on_done` is called once per recording.
+///
+/// # Errors
+/// A recording that cannot be read or conditioned, one on another grid, or one whose
+/// slide cannot give the spectrum's span (named, with the option).
+pub fn signal_candidates(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+    grid: &Grid,
+    classifiers: &[ClassifierChoice],
+    on_done: &(dyn Fn() + Sync),
+) -> Result<Vec<Candidate>> {
+    let start = Instant::now();
+    let baseline = dataset.layout.baseline.unwrap_or_default();
+    let features = &pipeline.params().features;
+    let spectrum = Spectrum::new(features.spectrum());
+    let rows = indices
+        .par_iter()
+        .map(|&i| {
+            let rec = dataset.load(i)?;
+            let cond = pipeline.condition(&rec, baseline)?;
+            let file = &rec.meta.file;
+            if rec.layout.present != grid.present() {
+                let why = "its taxel grid differs from the other recordings'";
+                return Err(DataError::invalid(file, why).into());
+            }
+            let n = cond.n_steps();
+            let span = spectrum_span(n, rec.meta.speed_mm_s, features)
+                .map_err(|why| DataError::invalid(file, format!("none / spectrum: {why}")))?;
+            let mut row = SignalRows {
+                meta: rec.meta.clone(),
+                spectrum: Vec::new(),
+                stats: Vec::new(),
+            };
+            let mut x = Vec::with_capacity(n);
+            for cell in taxel_cells(&rec.layout.present) {
+                x.clear();
+                x.extend((0..n).map(|t| cond.samples[t * cond.cells + cell]));
+                spectrum.signal(&x[..span], &mut row.spectrum);
+                row.stats.extend(signal_stats(&x));
+            }
+            on_done();
+            Ok(row)
+        })
+        .collect::<Result<Vec<SignalRows>>>()?;
+    let metas: Vec<Meta> = rows.iter().map(|r| r.meta.clone()).collect();
+    let edges = features.spectrum().edges();
+    let cells: Vec<String> = grid.taxels().map(|c| grid.cell(c).to_string()).collect();
+    let spectrum_names = cells
+        .iter()
+        .flat_map(|c| {
+            edges
+                .windows(2)
+                .map(move |w| format!("{c}_f{}_{}", w[0], w[1]))
+        })
+        .collect();
+    let stats_names = cells
+        .iter()
+        .flat_map(|c| SIGNAL_STAT_NAMES.map(|s| format!("{c}_{s}")))
+        .collect();
+    let table = |names: Vec<String>, pick: fn(&SignalRows) -> &Vec<f64>| FeatureTable {
+        // The nearest spike method's; a comparison reads only the names and values.
+        method: Method::Spectrum,
+        grid: grid.clone(),
+        names,
+        metas: metas.clone(),
+        values: rows.iter().flat_map(|r| pick(r).iter().copied()).collect(),
+    };
+    let tables = [
+        Arc::new(table(spectrum_names, |r| &r.spectrum)),
+        Arc::new(table(stats_names, |r| &r.stats)),
+    ];
+    let prepare_s = start.elapsed().as_secs_f64() / 2.0;
+    let mut out = Vec::new();
+    for (method, table) in SIGNAL_METHODS.iter().zip(tables) {
+        for &classifier in classifiers {
+            out.push(Candidate {
+                encoding: NO_ENCODING.to_string(),
+                method: method.to_string(),
+                classifier: classifier.name().to_string(),
+                table: Arc::clone(&table),
+                columns: Columns::All,
+                evaluate: evaluator(classifier, None)?,
+                prepare_s,
+            });
+        }
+    }
+    Ok(out)
+}
