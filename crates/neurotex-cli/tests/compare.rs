@@ -53,9 +53,9 @@ fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
     ]);
     let v: Value = serde_json::from_str(&text).unwrap();
     let results = v["results"].as_array().unwrap();
-    // 2 encodings x (the paper's taxel method with KNN, 4 feature methods x 3 classifiers,
+    // 2 encodings x (the paper's taxel method with KNN, 5 feature methods x 3 classifiers,
     // van Rossum with KNN)
-    assert_eq!(results.len(), 28);
+    assert_eq!(results.len(), 34);
     has_the_issues_shape(&v);
     // The paper's method at each speed is exactly what `evaluate` gives with the same folds.
     let paper = results.iter().find(|r| r["paper"] == true).unwrap();
@@ -148,6 +148,81 @@ fn nested_selection_over_held_out_speeds_names_its_choices() {
 }
 
 #[test]
+fn baselines_without_spikes_join_the_ranking_on_the_same_folds() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 6);
+    let text = dir.ok(&[
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--per",
+        "speed_mm_s",
+        "--encodings",
+        "none,sa",
+        "--methods",
+        "spectrum",
+        "--classifiers",
+        "knn,linear",
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(&text).unwrap();
+    has_the_issues_shape(&v);
+    let mut names: Vec<String> = v["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| format!("{}/{}/{}", r["encoding"], r["method"], r["classifier"]).replace('"', ""))
+        .collect();
+    names.sort();
+    // --methods applies to the spike encodings; `none` brings both baselines.
+    assert_eq!(
+        names,
+        [
+            "none/signal-stats/knn",
+            "none/signal-stats/linear",
+            "none/spectrum/knn",
+            "none/spectrum/linear",
+            "sa/spectrum/knn",
+            "sa/spectrum/linear"
+        ]
+    );
+    // Baselines alone need no encoding.
+    let alone = dir.ok(&[
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--encodings",
+        "none",
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(&alone).unwrap();
+    assert_eq!(v["results"].as_array().unwrap().len(), 6);
+}
+
+#[test]
+fn a_spectrum_span_longer_than_a_slide_names_the_recording_and_the_option() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0, 10.0], 4);
+    for encodings in ["sa", "none"] {
+        let err = dir.fails(&[
+            "compare",
+            "--dataset",
+            s(&ds),
+            "--encodings",
+            encodings,
+            "--methods",
+            "spectrum",
+            "--travel-mm",
+            "100000",
+        ]);
+        assert!(
+            err.contains("--travel-mm 100000") && err.contains("A_5_0.npy"),
+            "{encodings}: {err}"
+        );
+    }
+}
+
+#[test]
 fn bad_compare_options_are_clear_errors() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[5.0], 6);
@@ -161,6 +236,8 @@ fn bad_compare_options_are_clear_errors() {
             (with(&["--methods", "glcm9d"]), "glcm9d"),
             (with(&["--classifiers", "svm"]), "svm"),
             (with(&["--encodings", "xy"]), "xy"),
+            (with(&["--spectrum-bins", "4"]), "spectrum-bins"),
+            (with(&["--spectrum-bands", "0"]), "spectrum-bands"),
             (with(&["--per", "session"]), "session"),
             (with(&["--per", "speed_mm_s"]), "at least two values"),
         ],
