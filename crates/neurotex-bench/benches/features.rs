@@ -56,7 +56,7 @@ fn bench(c: &mut Criterion) {
         });
     }
     let e = extractor(HaralickSet::Paper);
-    for method in [Method::AllTaxels, Method::AllTaxelsMm] {
+    for method in [Method::AllTaxels, Method::AllTaxelsMm, Method::Spectrum] {
         let id = BenchmarkId::new(method.name(), "4x4x18000ms");
         group.bench_function(id, |b| {
             b.iter(|| e.population_row(&spikes, Some(5.0), method).unwrap())

@@ -43,6 +43,42 @@ struct SignalRows {
     stats: Vec<f64>,
 }
 
+/// Recording `index`'s rows of both baselines.
+///
+/// # Errors
+/// As [`signal_candidates`].
+fn signal_rows(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    index: usize,
+    grid: &Grid,
+    spectrum: &Spectrum,
+) -> Result<SignalRows> {
+    let rec = dataset.load(index)?;
+    let cond = pipeline.condition(&rec, dataset.layout.baseline.unwrap_or_default())?;
+    let file = &rec.meta.file;
+    if rec.layout.present != grid.present() {
+        let why = "its taxel grid differs from the other recordings'";
+        return Err(DataError::invalid(file, why).into());
+    }
+    let n = cond.n_steps();
+    let span = spectrum_span(n, rec.meta.speed_mm_s, &pipeline.params().features)
+        .map_err(|why| DataError::invalid(file, format!("none / spectrum: {why}")))?;
+    let mut row = SignalRows {
+        meta: rec.meta.clone(),
+        spectrum: Vec::new(),
+        stats: Vec::new(),
+    };
+    let mut x = Vec::with_capacity(n);
+    for cell in taxel_cells(&rec.layout.present) {
+        x.clear();
+        x.extend((0..n).map(|t| cond.samples[t * cond.cells + cell]));
+        spectrum.signal(&x[..span], &mut row.spectrum);
+        row.stats.extend(signal_stats(&x));
+    }
+    Ok(row)
+}
+
 /// The baseline candidates (both methods with each of `classifiers`) of the dataset's
 /// recordings `indices`, conditioned by `pipeline` (its encoder unused) on `grid`;
 /// `on_done` is called once per recording.
@@ -59,36 +95,14 @@ pub fn signal_candidates(
     on_done: &(dyn Fn() + Sync),
 ) -> Result<Vec<Candidate>> {
     let start = Instant::now();
-    let baseline = dataset.layout.baseline.unwrap_or_default();
     let features = &pipeline.params().features;
     let spectrum = Spectrum::new(features.spectrum());
     let rows = indices
         .par_iter()
         .map(|&i| {
-            let rec = dataset.load(i)?;
-            let cond = pipeline.condition(&rec, baseline)?;
-            let file = &rec.meta.file;
-            if rec.layout.present != grid.present() {
-                let why = "its taxel grid differs from the other recordings'";
-                return Err(DataError::invalid(file, why).into());
-            }
-            let n = cond.n_steps();
-            let span = spectrum_span(n, rec.meta.speed_mm_s, features)
-                .map_err(|why| DataError::invalid(file, format!("none / spectrum: {why}")))?;
-            let mut row = SignalRows {
-                meta: rec.meta.clone(),
-                spectrum: Vec::new(),
-                stats: Vec::new(),
-            };
-            let mut x = Vec::with_capacity(n);
-            for cell in taxel_cells(&rec.layout.present) {
-                x.clear();
-                x.extend((0..n).map(|t| cond.samples[t * cond.cells + cell]));
-                spectrum.signal(&x[..span], &mut row.spectrum);
-                row.stats.extend(signal_stats(&x));
-            }
+            let row = signal_rows(dataset, pipeline, i, grid, &spectrum);
             on_done();
-            Ok(row)
+            row
         })
         .collect::<Result<Vec<SignalRows>>>()?;
     let metas: Vec<Meta> = rows.iter().map(|r| r.meta.clone()).collect();

@@ -47,7 +47,9 @@ HARALICK_FULL_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(True))
 
 _log = logging.getLogger("neurotex")
 
-METHODS = ("taxel", "glcm2d", "glcm3d", "all-taxels", "all-taxels-mm", "glcm3d-multi")
+METHODS = (
+    "taxel", "glcm2d", "glcm3d", "all-taxels", "all-taxels-mm", "glcm3d-multi", "spectrum",
+)
 """Feature methods of :func:`features`, as the CLI's ``--method``."""
 
 
@@ -383,6 +385,9 @@ def features(
     haralick: str = _DEFAULTS["haralick"],
     bin_widths: Sequence[int] = _DEFAULTS["bin_widths"],
     window_mm: float = _DEFAULTS["window_mm"],
+    spectrum_bins: int = _DEFAULTS["spectrum_bins"],
+    spectrum_bands: int = _DEFAULTS["spectrum_bands"],
+    travel_mm: float = _DEFAULTS["travel_mm"],
 ) -> FeatureTable:
     """One feature row per recording, as ``neurotex features`` computes it.
 
@@ -393,8 +398,10 @@ def features(
 
     ``method``: ``taxel``/``all-taxels`` (MSR, CV_ISI, Fano of every taxel),
     ``all-taxels-mm`` (per mm of travel; needs ``speeds``), ``glcm2d``, ``glcm3d`` (the
-    paper's contrast, correlation, ASM), ``glcm3d-multi``. ``encoding``: ``sa``, ``fa``
-    or ``sa+fa``.
+    paper's contrast, correlation, ASM), ``glcm3d-multi``, ``spectrum`` (each taxel's
+    spike counts in ``spectrum_bins`` bins of the slide, Fourier magnitudes in
+    ``spectrum_bands`` logarithmic bands; ``travel_mm`` > 0 reads that many mm of each
+    slide and needs ``speeds``). ``encoding``: ``sa``, ``fa`` or ``sa+fa``.
 
     ``gain="auto"`` (or ``"auto:HZ"``, a target median rate other than 20 Hz) calibrates
     the gain on these recordings, labels unused, as ``neurotex features --gain auto`` does
@@ -415,7 +422,8 @@ def features(
         gain=gain, causal=causal, preset=preset, cutoff=cutoff, baseline=baseline,
         whole=whole, levels=levels, bin_ms=bin_ms, distances=tuple(distances),
         symmetric=symmetric, encoding=encoding, fa_gain=fa_gain, haralick=haralick,
-        bin_widths=tuple(bin_widths), window_mm=window_mm,
+        bin_widths=tuple(bin_widths), window_mm=window_mm, spectrum_bins=spectrum_bins,
+        spectrum_bands=spectrum_bands, travel_mm=travel_mm,
     )
     if isinstance(recordings, (str, os.PathLike)):
         values, names, _, report = _native.features_dataset(os.fspath(recordings), method, opts)

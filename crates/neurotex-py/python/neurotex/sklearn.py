@@ -42,7 +42,8 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
     Parameters are those of :func:`neurotex.features`: ``method``, ``encoding``, ``gain``,
     ``preset``, ``cutoff``, ``baseline``, ``whole``, ``levels``, ``bin_ms``,
     ``distances``, ``symmetric``, ``fa_gain``, ``haralick``, ``bin_widths``,
-    ``window_mm``, and ``fs`` for bare arrays."""
+    ``window_mm``, ``spectrum_bins``, ``spectrum_bands``, ``travel_mm``, and ``fs`` for bare
+    arrays."""
 
     def __init__(
         self,
@@ -61,6 +62,9 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         haralick: str = _DEFAULTS["haralick"],
         bin_widths: Sequence[int] = _DEFAULTS["bin_widths"],
         window_mm: float = _DEFAULTS["window_mm"],
+        spectrum_bins: int = _DEFAULTS["spectrum_bins"],
+        spectrum_bands: int = _DEFAULTS["spectrum_bands"],
+        travel_mm: float = _DEFAULTS["travel_mm"],
         fs: float = 1000.0,
     ) -> None:
         self.method = method
@@ -78,6 +82,9 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         self.haralick = haralick
         self.bin_widths = bin_widths
         self.window_mm = window_mm
+        self.spectrum_bins = spectrum_bins
+        self.spectrum_bands = spectrum_bands
+        self.travel_mm = travel_mm
         self.fs = fs
 
     def _kwargs(self) -> Dict[str, Any]:
@@ -97,6 +104,8 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
             distances=tuple(self.distances), symmetric=self.symmetric,
             encoding=self.encoding, fa_gain=self.fa_gain, haralick=self.haralick,
             bin_widths=tuple(self.bin_widths), window_mm=self.window_mm,
+            spectrum_bins=self.spectrum_bins, spectrum_bands=self.spectrum_bands,
+            travel_mm=self.travel_mm,
         )
         _native.check_options(self.method, opts)
         if isinstance(self.gain, str):
