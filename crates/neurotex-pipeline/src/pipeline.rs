@@ -475,7 +475,15 @@ impl Pipeline {
     /// An empty sliding phase or a selected phase shorter than one bin.
     pub fn encode(&self, rec: &Recording, dataset_baseline: Baseline) -> Result<Encoded> {
         let cond = self.condition(rec, dataset_baseline)?;
-        let (spikes, fa) = self.encode_populations(rec, &cond)?;
+        self.encode_recording(rec, &cond)
+    }
+
+    /// Encodes a conditioned recording with the populations of the pipeline's encoding.
+    ///
+    /// # Errors
+    /// A broken encoder rule.
+    fn encode_recording(&self, rec: &Recording, cond: &Conditioned) -> Result<Encoded> {
+        let (spikes, fa) = self.encode_populations(rec, cond)?;
         Ok(Encoded {
             meta: rec.meta.clone(),
             spikes,
@@ -497,14 +505,33 @@ impl Pipeline {
         indices: &[usize],
         on_done: &(dyn Fn() + Sync),
     ) -> Result<Vec<Encoded>> {
+        let pairs = self.encode_dataset_with(dataset, indices, on_done, &|_, _| Ok(()))?;
+        Ok(pairs.into_iter().map(|(e, ())| e).collect())
+    }
+
+    /// [`Pipeline::encode_dataset`], also applying `also` to each recording and its
+    /// conditioned signal while both are in memory (the baselines without spikes read
+    /// the signal the encoder receives without conditioning it twice).
+    ///
+    /// # Errors
+    /// The first failing recording's error, from the encoding or from `also`.
+    pub fn encode_dataset_with<T: Send>(
+        &self,
+        dataset: &Dataset,
+        indices: &[usize],
+        on_done: &(dyn Fn() + Sync),
+        also: &(dyn Fn(&Recording, &Conditioned) -> Result<T> + Sync),
+    ) -> Result<Vec<(Encoded, T)>> {
         let baseline = dataset.layout.baseline.unwrap_or_default();
         indices
             .par_iter()
             .map(|&i| {
                 let rec = dataset.load(i)?;
-                let out = self.encode(&rec, baseline);
+                let cond = self.condition(&rec, baseline)?;
+                let encoded = self.encode_recording(&rec, &cond)?;
+                let extra = also(&rec, &cond)?;
                 on_done();
-                out
+                Ok((encoded, extra))
             })
             .collect()
     }

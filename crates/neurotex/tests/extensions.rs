@@ -177,6 +177,51 @@ fn distance_statistics_are_time_statistics_rescaled_by_speed() {
 }
 
 #[test]
+fn the_spectrum_reads_the_whole_slide_or_a_travel_and_names_what_it_lacks() {
+    use neurotex::features::{Spectrum, SpectrumParams};
+    let whole = extractor(PipelineParams::default());
+    let e = encoded(None, false);
+    let row = whole.row(&e, Method::Spectrum).unwrap();
+    let names = whole.names(Method::Spectrum);
+    assert_eq!(row.len(), names.len());
+    assert_eq!(names.len(), 4 * 14);
+    assert_eq!(names[0], "r0c0_f1_2");
+    // The whole slide: each taxel's train over its 1000 ms, by the spectrum itself.
+    let spectrum = Spectrum::new(SpectrumParams {
+        bins: 128,
+        bands: 16,
+    });
+    let mut expected = Vec::new();
+    for cell in 0..4 {
+        spectrum.train(e.spikes.train(cell), 1000, &mut expected);
+    }
+    assert_eq!(row, expected);
+    // 300 mm of travel at 500 mm/s: the first 600 ms of each train.
+    let mut params = PipelineParams::default();
+    params.features.travel_mm = 300.0;
+    let travel = extractor(params);
+    let row = travel
+        .row(&encoded(Some(-500.0), false), Method::Spectrum)
+        .unwrap();
+    let mut expected = Vec::new();
+    for cell in 0..4 {
+        spectrum.train(e.spikes.train(cell), 600, &mut expected);
+    }
+    assert_eq!(row, expected);
+    // No speed, or a slide shorter than the travel: errors naming the file and option.
+    let err = travel.row(&e, Method::Spectrum).unwrap_err().to_string();
+    assert!(err.contains("x.npy") && err.contains("speed"), "{err}");
+    let err = travel
+        .row(&encoded(Some(100.0), false), Method::Spectrum)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("x.npy") && err.contains("100.0 mm") && err.contains("--travel-mm 300"),
+        "{err}"
+    );
+}
+
+#[test]
 fn full_haralick_matches_mahotas() {
     let text = include_str!("data/haralick_full.json");
     let reference: serde_json::Value = serde_json::from_str(text).unwrap();

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::{Prepared, Skip, Stop, ValidReproduceParams};
 use crate::classify::CvParams;
 use crate::compare::candidates::{candidates, CandidateSet};
+use crate::compare::signal::baseline_candidates;
 use crate::compare::{compare, CompareParams, Comparison, Protocol};
 
 /// E9's two comparisons.
@@ -20,6 +21,24 @@ pub struct E9 {
     pub per_speed: Comparison,
     /// Each speed held out in turn (trained on the others), with nested selection.
     pub held_out: Comparison,
+    /// The baselines without spikes on the same folds (`compare --encodings none`),
+    /// within each speed and with each speed held out; not among the candidates.
+    #[serde(default)]
+    pub baselines: Option<Baselines>,
+}
+
+/// E9's baselines without spikes, or why they were not run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Baselines {
+    /// Within each speed and with each speed held out.
+    Compared {
+        /// Cross-validation within each speed.
+        per_speed: Box<Comparison>,
+        /// Each speed held out.
+        held_out: Box<Comparison>,
+    },
+    /// A recording's signal could not give a baseline's row.
+    Skipped(String),
 }
 
 /// Runs E9 on the prepared recordings (both populations encoded).
@@ -47,8 +66,32 @@ pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<
         nested,
     };
     let column = "speed_mm_s".to_string();
+    let per = || Protocol::Per(column.clone());
+    let held = || Protocol::HoldOut(column.clone());
+    let baselines = match prepared
+        .signal
+        .iter()
+        .cloned()
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(rows) => {
+            let list = baseline_candidates(
+                &rows,
+                &prepared.grid,
+                &pipeline.features,
+                &set.classifiers,
+                0.0,
+            )?;
+            Baselines::Compared {
+                per_speed: Box::new(compare(&list, &with(per(), false))?),
+                held_out: Box::new(compare(&list, &with(held(), false))?),
+            }
+        }
+        Err(why) => Baselines::Skipped(why),
+    };
     Ok(E9 {
-        per_speed: compare(&list, &with(Protocol::Per(column.clone()), false))?,
-        held_out: compare(&list, &with(Protocol::HoldOut(column), true))?,
+        per_speed: compare(&list, &with(per(), false))?,
+        held_out: compare(&list, &with(held(), true))?,
+        baselines: Some(baselines),
     })
 }

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::{taxel_diagnostics, Progress, Provenance, TaxelDiagnostics, ValidReproduceParams};
 use crate::calibrate::{calibrate_gain, GainCalibration};
 use crate::causal::{calibrate_conditioning, ConditioningCalibration};
+use crate::compare::signal::SignalRows;
 use crate::encode::encode_banks;
 use crate::error::{ClassifyError, DataError, DatasetError, Result};
 use crate::inspect::severe_findings;
@@ -244,6 +245,9 @@ pub struct Prepared {
     /// asked for ([`WITHIN_SPEED`]), found on the labels and speeds before any recording
     /// was read; the analyses resting on it are skipped with this reason.
     pub within_speed: Option<String>,
+    /// With E9: each recording's rows of the baselines without spikes, from the signal it
+    /// was encoded from, in the order of `encoded`; or why a recording has none.
+    pub signal: Vec<std::result::Result<SignalRows, String>>,
     /// Seconds the pass took.
     pub seconds: f64,
 }
@@ -477,8 +481,10 @@ pub fn prepare(
         .map(|_| Vec::with_capacity(n))
         .collect();
     let mut causal_encoded = Vec::with_capacity(n);
+    let mut signal = Vec::new();
     for one in results {
         causal_encoded.push(one.causal);
+        signal.extend(one.signal);
         if let Some(points) = one.sweep {
             isi.add(&one.encoded.meta.label, points);
         }
@@ -488,10 +494,7 @@ pub fn prepare(
         encoded.push(one.encoded);
     }
     let grid = one_grid(&encoded)?;
-    let taxels = taxel_diagnostics(&encoded, &grid, params)?;
-    if let Some(advice) = taxels.advice() {
-        progress(Progress::Advice(&advice));
-    }
+    let taxels = advised_taxels(&encoded, &grid, params, progress)?;
     let causal = causal.map(|all| CausalPrepared {
         calibration: all
             .into_iter()
@@ -512,8 +515,26 @@ pub fn prepare(
         slowest,
         labels,
         within_speed,
+        signal,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The taxels silent or at the encoder's ceiling, with the advice about them said.
+///
+/// # Errors
+/// As [`taxel_diagnostics`].
+fn advised_taxels(
+    encoded: &[Encoded],
+    grid: &Grid,
+    params: &ValidReproduceParams,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<TaxelDiagnostics> {
+    let taxels = taxel_diagnostics(encoded, grid, params)?;
+    if let Some(advice) = taxels.advice() {
+        progress(Progress::Advice(&advice));
+    }
+    Ok(taxels)
 }
 
 /// The taxel grid every recording shares.
@@ -538,6 +559,8 @@ struct EncodedOne {
     perturbed: Vec<Encoded>,
     /// The spikes through the causal pipeline of the recording's speed, with E5c.
     causal: Option<Encoded>,
+    /// With E9, the baselines' rows of the signal the recording was encoded from.
+    signal: Option<std::result::Result<SignalRows, String>>,
 }
 
 /// Loads, conditions and encodes recording `i`; with `sweep`, also encodes it at every E7
@@ -569,6 +592,9 @@ fn encode_one(
     } else {
         None
     };
+    let signal = params.e9.then(|| {
+        SignalRows::of(&rec, &cond, &pipeline.params().features).map_err(|e| e.to_string())
+    });
     let encoded = Encoded {
         meta: rec.meta.clone(),
         spikes,
@@ -593,6 +619,7 @@ fn encode_one(
         sweep,
         perturbed,
         causal,
+        signal,
     })
 }
 

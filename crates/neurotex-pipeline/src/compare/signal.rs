@@ -16,7 +16,6 @@
 //!   ([`crate::features::signal_stats`]), a common hand-made baseline.
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use rayon::prelude::*;
 
@@ -26,8 +25,9 @@ use crate::analysis::{Columns, FeatureTable};
 use crate::classify::ClassifierChoice;
 use crate::error::{DataError, Result};
 use crate::features::{signal_stats, Spectrum, SIGNAL_STAT_NAMES};
-use crate::pipeline::{spectrum_span, taxel_cells, Method, Pipeline};
-use crate::recording::{Dataset, Meta};
+use crate::pipeline::{spectrum_span, taxel_cells, FeatureParams, Method, Pipeline};
+use crate::recording::{Dataset, Meta, Recording};
+use crate::signal::Conditioned;
 use crate::values::Grid;
 
 /// The encoding name of the baselines.
@@ -37,74 +37,87 @@ pub const NO_ENCODING: &str = "none";
 pub const SIGNAL_METHODS: [&str; 2] = ["spectrum", "signal-stats"];
 
 /// One recording's rows of both baselines.
-struct SignalRows {
-    meta: Meta,
-    spectrum: Vec<f64>,
-    stats: Vec<f64>,
+#[derive(Debug, Clone, PartialEq)]
+pub struct SignalRows {
+    /// The recording's manifest fields.
+    pub meta: Meta,
+    /// Which cells of its grid hold a taxel.
+    pub present: Vec<bool>,
+    /// The `spectrum` row.
+    pub spectrum: Vec<f64>,
+    /// The `signal-stats` row.
+    pub stats: Vec<f64>,
 }
 
-/// Recording `index`'s rows of both baselines.
-///
-/// # Errors
-/// As [`signal_candidates`].
-fn signal_rows(
-    dataset: &Dataset,
-    pipeline: &Pipeline,
-    index: usize,
-    grid: &Grid,
-    spectrum: &Spectrum,
-) -> Result<SignalRows> {
-    let rec = dataset.load(index)?;
-    let cond = pipeline.condition(&rec, dataset.layout.baseline.unwrap_or_default())?;
-    let file = &rec.meta.file;
-    if rec.layout.present != grid.present() {
-        let why = "its taxel grid differs from the other recordings'";
-        return Err(DataError::invalid(file, why).into());
+impl SignalRows {
+    /// The rows of `rec`, conditioned into `cond`, with the spectrum of `features`.
+    ///
+    /// # Errors
+    /// A slide that cannot give the spectrum's span (named, with the option).
+    pub fn of(rec: &Recording, cond: &Conditioned, features: &FeatureParams) -> Result<Self> {
+        let n = cond.n_steps();
+        let span = spectrum_span(n, rec.meta.speed_mm_s, features)
+            .map_err(|why| DataError::invalid(&rec.meta.file, format!("none / spectrum: {why}")))?;
+        let spectrum = Spectrum::new(features.spectrum());
+        let mut row = SignalRows {
+            meta: rec.meta.clone(),
+            present: rec.layout.present.clone(),
+            spectrum: Vec::new(),
+            stats: Vec::new(),
+        };
+        let mut x = Vec::with_capacity(n);
+        for cell in taxel_cells(&rec.layout.present) {
+            x.clear();
+            x.extend((0..n).map(|t| cond.samples[t * cond.cells + cell]));
+            spectrum.signal(&x[..span], &mut row.spectrum);
+            row.stats.extend(signal_stats(&x));
+        }
+        Ok(row)
     }
-    let n = cond.n_steps();
-    let span = spectrum_span(n, rec.meta.speed_mm_s, &pipeline.params().features)
-        .map_err(|why| DataError::invalid(file, format!("none / spectrum: {why}")))?;
-    let mut row = SignalRows {
-        meta: rec.meta.clone(),
-        spectrum: Vec::new(),
-        stats: Vec::new(),
-    };
-    let mut x = Vec::with_capacity(n);
-    for cell in taxel_cells(&rec.layout.present) {
-        x.clear();
-        x.extend((0..n).map(|t| cond.samples[t * cond.cells + cell]));
-        spectrum.signal(&x[..span], &mut row.spectrum);
-        row.stats.extend(signal_stats(&x));
-    }
-    Ok(row)
 }
 
-/// The baseline candidates (both methods with each of `classifiers`) of the dataset's
-/// recordings `indices`, conditioned by `pipeline` (its encoder unused) on `grid`;
-/// `on_done` is called once per recording.
+/// The baseline rows of the dataset's recordings `indices`, conditioned by `pipeline`
+/// (its encoder unused); `on_done` is called once per recording. For a comparison
+/// without spike encodings; with them, [`Pipeline::encode_dataset_with`] makes the rows
+/// in the encoding's pass.
 ///
 /// # Errors
-/// A recording that cannot be read or conditioned, one on another grid, or one whose
-/// slide cannot give the spectrum's span (named, with the option).
-pub fn signal_candidates(
+/// A recording that cannot be read or conditioned, or as [`SignalRows::of`].
+pub fn signal_rows(
     dataset: &Dataset,
     pipeline: &Pipeline,
     indices: &[usize],
-    grid: &Grid,
-    classifiers: &[ClassifierChoice],
     on_done: &(dyn Fn() + Sync),
-) -> Result<Vec<Candidate>> {
-    let start = Instant::now();
-    let features = &pipeline.params().features;
-    let spectrum = Spectrum::new(features.spectrum());
-    let rows = indices
+) -> Result<Vec<SignalRows>> {
+    let baseline = dataset.layout.baseline.unwrap_or_default();
+    indices
         .par_iter()
         .map(|&i| {
-            let row = signal_rows(dataset, pipeline, i, grid, &spectrum);
+            let rec = dataset.load(i)?;
+            let cond = pipeline.condition(&rec, baseline)?;
+            let rows = SignalRows::of(&rec, &cond, &pipeline.params().features);
             on_done();
-            row
+            rows
         })
-        .collect::<Result<Vec<SignalRows>>>()?;
+        .collect()
+}
+
+/// The baseline candidates, both methods with each of `classifiers`, from the recordings'
+/// `rows` on `grid`; `prepare_s` is each method's share of the time the rows took.
+///
+/// # Errors
+/// A recording on another grid (named), or a classifier's broken parameter.
+pub fn baseline_candidates(
+    rows: &[SignalRows],
+    grid: &Grid,
+    features: &FeatureParams,
+    classifiers: &[ClassifierChoice],
+    prepare_s: f64,
+) -> Result<Vec<Candidate>> {
+    if let Some(r) = rows.iter().find(|r| r.present != grid.present()) {
+        let why = "its taxel grid differs from the other recordings'";
+        return Err(DataError::invalid(&r.meta.file, why).into());
+    }
     let metas: Vec<Meta> = rows.iter().map(|r| r.meta.clone()).collect();
     let edges = features.spectrum().edges();
     let cells: Vec<String> = grid.taxels().map(|c| grid.cell(c).to_string()).collect();
@@ -132,7 +145,6 @@ pub fn signal_candidates(
         Arc::new(table(spectrum_names, |r| &r.spectrum)),
         Arc::new(table(stats_names, |r| &r.stats)),
     ];
-    let prepare_s = start.elapsed().as_secs_f64() / 2.0;
     let mut out = Vec::new();
     for (method, table) in SIGNAL_METHODS.iter().zip(tables) {
         for &classifier in classifiers {

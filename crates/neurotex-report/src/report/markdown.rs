@@ -805,6 +805,7 @@ fn e9(r: &Results) -> String {
             pct(n.accuracy), pct(n.ci[0]), pct(n.ci[1]), chosen.join(", ")
         );
     }
+    out += &e9_baselines(e9.baselines.as_ref());
     out += "\n";
     out + &figure(
         file::E9_PER_SPEED,
@@ -822,6 +823,37 @@ fn e9(r: &Results) -> String {
         )
     } else {
         String::new()
+    }
+}
+
+/// E9's baselines without spikes beside the spike candidates: the best of each protocol.
+fn e9_baselines(baselines: Option<&crate::experiments::Baselines>) -> String {
+    use crate::experiments::Baselines;
+    let best = |c: &crate::compare::Comparison| {
+        let b = &c.best;
+        format!(
+            "{} % [{}, {}] ({} / {} / {})",
+            pct(b.accuracy),
+            pct(b.ci[0]),
+            pct(b.ci[1]),
+            b.encoding,
+            b.method,
+            b.classifier
+        )
+    };
+    match baselines {
+        None => String::new(),
+        Some(Baselines::Skipped(why)) => {
+            format!("\nThe baselines without spikes were not run: {why}.\n")
+        }
+        Some(Baselines::Compared {
+            per_speed,
+            held_out,
+        }) => format!(
+            "\nBaselines without spikes on the same folds (`neurotex compare --encodings none`: the spectrum and the statistics of the conditioned signal the encoder receives, with each classifier; not among the candidates above): the best within each speed {}, with each speed held out {}. They say what the spikes cost or gain against the signal they are made from.\n",
+            best(per_speed),
+            best(held_out)
+        ),
     }
 }
 

@@ -5,19 +5,22 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{calibrated_pipeline, encode_all, KnnOptions, OnProgress, OpenOptions};
+use super::{calibrated_pipeline, encode_all, say_conditions, KnnOptions, OnProgress, OpenOptions};
 use crate::classify::{ClassifierChoice, CvParams, ForestParams};
 use crate::compare::candidates::{
     candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
     STANDARD_METHODS, STANDARD_TAU_MS,
 };
-use crate::compare::signal::{signal_candidates, NO_ENCODING};
+use crate::compare::signal::{
+    baseline_candidates, signal_rows, SignalRows, NO_ENCODING, SIGNAL_METHODS,
+};
 use crate::compare::{compare_with_progress, Candidate, CompareParams, Comparison, Protocol};
 use crate::error::{OptionsError, ParamError};
 use crate::options::StageOptions;
-use crate::pipeline::{Encoding, Pipeline};
+use crate::pipeline::{shared_grid, Encoding, Pipeline};
 use crate::progress::Progress;
-use crate::recording::{Dataset, Selection};
+use crate::recording::{Dataset, Recording, Selection};
+use crate::signal::Conditioned;
 use crate::values::Grid;
 use crate::{Result, Speed};
 
@@ -262,26 +265,39 @@ fn make_candidates(
         Encoding::Sa
     };
     let pipeline = Pipeline::new(params.clone())?;
-    let mut out = Vec::new();
-    let grid = if set.encodings.is_empty() {
+    let tick = || on(Progress::Tick);
+    let features = &params.features;
+    if set.encodings.is_empty() {
+        // The baselines alone: conditioning without encoding.
+        on(Progress::Stage("conditioning", indices.len()));
+        let rows = signal_rows(dataset, &pipeline, indices, &tick)?;
         let first = dataset.load(indices[0])?.layout;
-        Grid::masked(first.rows, first.cols, first.present)?
+        let grid = Grid::masked(first.rows, first.cols, first.present)?;
+        let share = start.elapsed().as_secs_f64() / SIGNAL_METHODS.len() as f64;
+        return baseline_candidates(&rows, &grid, features, &set.classifiers, share);
+    }
+    let (encoded, rows) = if set.baselines {
+        // One pass: the baselines' rows from the signal each recording is encoded from.
+        on(Progress::Stage("encoding", indices.len()));
+        let also = |rec: &Recording, cond: &Conditioned| SignalRows::of(rec, cond, features);
+        let pairs = pipeline.encode_dataset_with(dataset, indices, &tick, &also)?;
+        let (encoded, rows): (Vec<_>, Vec<_>) = pairs.into_iter().unzip();
+        say_conditions(&encoded, on);
+        (encoded, rows)
     } else {
-        let (encoded, grid) = encode_all(dataset, &pipeline, indices, on)?;
-        let encode_s = start.elapsed().as_secs_f64();
-        out = candidates(&encoded, &grid, &params, set, encode_s)?;
-        grid
+        (encode_all(dataset, &pipeline, indices, on)?.0, Vec::new())
     };
+    let grid = shared_grid(&encoded)?;
+    let encode_s = start.elapsed().as_secs_f64();
+    let mut out = candidates(&encoded, &grid, &params, set, encode_s)?;
     if set.baselines {
-        on(Progress::Stage("signal baselines", indices.len()));
-        let tick = || on(Progress::Tick);
-        out.extend(signal_candidates(
-            dataset,
-            &pipeline,
-            indices,
+        let share = encode_s / (set.encodings.len() + 1) as f64;
+        out.extend(baseline_candidates(
+            &rows,
             &grid,
+            features,
             &set.classifiers,
-            &tick,
+            share,
         )?);
     }
     Ok(out)
