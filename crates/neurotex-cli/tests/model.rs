@@ -318,3 +318,44 @@ fn gain_auto_in_evaluate_calibrates_on_the_training_speeds_only() {
         s(&features),
     ]);
 }
+
+#[test]
+fn a_spectrum_model_trains_and_predicts_but_is_refused_for_streams() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 6);
+    let model = dir.join("spectrum.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "spectrum",
+        "--out",
+        s(&model),
+    ]);
+    let out = dir.join("p.csv");
+    dir.ok(&[
+        "predict",
+        "--model",
+        s(&model),
+        "--dataset",
+        s(&ds),
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(csv_rows(&out).len(), 1 + 12);
+    // A stream sees growing windows, not a span of the slide: refused before training.
+    let causal = dir.join("causal.json");
+    let err = dir.fails(&[
+        "train",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "spectrum",
+        "--causal",
+        "--out",
+        s(&causal),
+    ]);
+    assert!(err.contains("no running form"), "{err}");
+    assert!(!causal.exists());
+}

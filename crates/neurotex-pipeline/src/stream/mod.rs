@@ -315,6 +315,9 @@ pub struct StreamClassifier {
     raster: Vec<u8>,
 }
 
+/// Why a model of the `spectrum` method neither streams nor runs `predict --causal`.
+pub const NO_RUNNING_SPECTRUM: &str = "the spectrum method transforms a whole span of the slide at once and has no running form for a stream's growing windows; train the stream's model with another method";
+
 impl StreamClassifier {
     /// A stream classifier for a causal `model`; frames hold one value per taxel of the
     /// model's grid, in row-major order of the cells holding a taxel.
@@ -333,6 +336,9 @@ impl StreamClassifier {
         {
             let rule = "the model's all-taxels-mm features need the sliding speed (--speed)";
             return Err(ParamError::new("speed", rule, "none").into());
+        }
+        if model.features().method == crate::pipeline::Method::Spectrum {
+            return Err(ParamError::new("model", NO_RUNNING_SPECTRUM, "spectrum").into());
         }
         let grid = model.grid().clone();
         let (rows, cols) = (grid.rows(), grid.cols());

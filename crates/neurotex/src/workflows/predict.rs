@@ -107,6 +107,10 @@ impl PredictOptions {
         if model.causal().is_none() {
             return Err(OptionsError::Conflict(format!("{}: --causal needs a model trained with --causal (this one conditions each recording with the zero-phase filter and its own maximum, which need the whole recording)", self.model.display())).into());
         }
+        if model.features().method == crate::pipeline::Method::Spectrum {
+            let why = crate::stream::NO_RUNNING_SPECTRUM;
+            return Err(OptionsError::Conflict(format!("{}: {why}", self.model.display())).into());
+        }
         let window_ms = self.decision.window_ms(model)?;
         let rule = self.decision.rule()?;
         encoded

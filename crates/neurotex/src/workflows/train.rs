@@ -60,6 +60,11 @@ impl TrainOptions {
     /// Options out of range or that do not go together, recordings that cannot be read,
     /// or too few recordings for the classifier.
     pub fn run(&self, dataset: &Dataset, stages: &StageOptions, on: OnProgress) -> Result<Trained> {
+        if stages.causal && self.method == Method::Spectrum {
+            let why = crate::stream::NO_RUNNING_SPECTRUM;
+            let message = format!("--causal trains a model for streams: {why}");
+            return Err(crate::error::OptionsError::Conflict(message).into());
+        }
         let indices = indices_at(dataset, self.speeds.as_deref())?;
         let calibrated = calibrated_pipeline(stages, dataset, &indices, on)?;
         let params = calibrated.params;
