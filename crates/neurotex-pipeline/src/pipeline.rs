@@ -914,15 +914,16 @@ pub fn spectrum_span(
             return Err("the spectrum's --travel-mm needs the recording's sliding speed (manifest column speed_mm_s, nonzero); --travel-mm 0 uses the whole slide without it".into());
         };
         let steps = (features.travel_mm / speed.abs() * 1e3).round() as usize;
-        if steps > n_steps {
+        // A slide's stamps span one sample less than its travel: up to 1 % short reads whole.
+        if steps > n_steps + n_steps / 100 {
             return Err(format!(
-                "its slide travels {:.1} mm ({n_steps} ms at {} mm/s), less than --travel-mm {}",
+                "its slide travels {:.2} mm ({n_steps} ms at {} mm/s), less than the spectrum's travel (--travel-mm {})",
                 n_steps as f64 * 1e-3 * speed.abs(),
                 speed.abs(),
                 features.travel_mm
             ));
         }
-        steps
+        steps.min(n_steps)
     } else {
         n_steps
     };

@@ -53,7 +53,11 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
         assert_eq!(at.condition, speed.to_string());
         assert_eq!(at.accuracy, e6.glcm3d, "held out {speed} mm/s");
     }
-    assert!(e9.held_out.nested.is_some() && e9.per_speed.nested.is_none());
+    assert!(e9.held_out.nested.is_some() && e9.per_speed.nested.is_some());
+    assert!(matches!(
+        e9.baselines,
+        Some(neurotex::experiments::Baselines::Compared { .. })
+    ));
 
     let context = ReportContext {
         dataset: "a small simulated design".into(),

@@ -208,6 +208,12 @@ fn the_spectrum_reads_the_whole_slide_or_a_travel_and_names_what_it_lacks() {
         spectrum.train(e.spikes.train(cell), 600, &mut expected);
     }
     assert_eq!(row, expected);
+    // A slide up to 1 % short of the travel (its stamps span one sample less) reads whole:
+    // 300 mm at 297 mm/s is 1010 ms of a 1000 ms slide.
+    let short = travel
+        .row(&encoded(Some(297.0), false), Method::Spectrum)
+        .unwrap();
+    assert_eq!(short, whole.row(&e, Method::Spectrum).unwrap());
     // No speed, or a slide shorter than the travel: errors naming the file and option.
     let err = travel.row(&e, Method::Spectrum).unwrap_err().to_string();
     assert!(err.contains("x.npy") && err.contains("speed"), "{err}");
@@ -216,7 +222,7 @@ fn the_spectrum_reads_the_whole_slide_or_a_travel_and_names_what_it_lacks() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("x.npy") && err.contains("100.0 mm") && err.contains("--travel-mm 300"),
+        err.contains("x.npy") && err.contains("100.00 mm") && err.contains("--travel-mm 300"),
         "{err}"
     );
 }

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use crate::compare::signal::NO_ENCODING;
 use crate::compare::{Comparison, Nested, Ranked};
 use crate::error::{DataError, Result};
 use crate::io::replace_dir;
@@ -51,9 +52,18 @@ pub fn markdown(c: &Comparison) -> String {
     if let Some(n) = &c.nested {
         out.push_str(&format!("\nNested selection: {}\n", nested_text(n)));
     }
+    if c.results.iter().any(|r| r.encoding == NO_ENCODING) {
+        out.push_str(BASELINES_NOTE);
+    }
+    if !c.results.iter().any(|r| r.paper) {
+        out.push_str("\nThe paper's method (sa / glcm3d / knn) is not among the candidates, so no difference from it is given.\n");
+    }
     out.push_str(&format!("\nCaveat: {}.\n", c.caveat));
     out
 }
+
+/// What the encoding `none` means, under a ranking that holds it.
+const BASELINES_NOTE: &str = "\nEncoding `none`: baselines without spikes, computed from the conditioned signal the encoder receives (resampled to 1 kHz, baseline removed, low-pass filtered, divided by the recording's maximum): `spectrum` is the same transform and bands as the spike method's applied to each taxel's signal, `signal-stats` each taxel's moments, quantiles and turns per second. They tell what the spikes cost or gain against the signal.\n";
 
 /// The ranking as lines of text for a terminal.
 pub fn text_lines(c: &Comparison) -> Vec<String> {

@@ -794,22 +794,27 @@ fn e9(r: &Results) -> String {
         within.caveat
     );
     out += &e9_table(within, held);
-    if let Some(n) = &held.nested {
-        let chosen: Vec<String> = n
-            .chosen
-            .iter()
-            .map(|(c, k)| format!("{c} ({k} of {})", n.outer_splits))
-            .collect();
-        out += &format!(
-            "\nWith each speed held out and the candidate chosen inside each training set (nested selection): {} [{}, {}] % (chose {}).\n",
-            pct(n.accuracy), pct(n.ci[0]), pct(n.ci[1]), chosen.join(", ")
-        );
+    for (protocol, c) in [
+        ("within each speed", within),
+        ("with each speed held out", held),
+    ] {
+        if let Some(n) = &c.nested {
+            let chosen: Vec<String> = n
+                .chosen
+                .iter()
+                .map(|(c, k)| format!("{c} ({k} of {})", n.outer_splits))
+                .collect();
+            out += &format!(
+                "\nNested selection {protocol} (the candidate chosen inside each training set; the number to quote): {} [{}, {}] % (chose {}).\n",
+                pct(n.accuracy), pct(n.ci[0]), pct(n.ci[1]), chosen.join(", ")
+            );
+        }
     }
     out += &e9_baselines(e9.baselines.as_ref());
     out += "\n";
     out + &figure(
         file::E9_PER_SPEED,
-        "E9: every candidate's accuracy within each speed, ranked",
+        "E9: every candidate's accuracy within each speed, ranked, with nested selection",
         &figures::compare::ranking_caption(within),
     ) + &figure(
         file::E9_HELD_OUT,

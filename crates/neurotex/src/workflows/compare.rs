@@ -88,6 +88,8 @@ pub struct CompareOptions {
     /// method (each taxel alone, mean over taxels; KNN only); `van-rossum` classifies by
     /// spike-train distances (KNN only).
     /// `all-taxels-mm` (statistics per mm travelled) needs the manifest's speeds.
+    /// `spectrum`: each taxel's spike counts along the slide, their Fourier magnitudes in
+    /// logarithmic bands of spatial frequency.
     #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_METHODS))]
     pub methods: Vec<String>,
     /// Classifiers to compare, comma-separated: knn, forest, linear.

@@ -27,7 +27,8 @@ pub struct EvaluateOptions {
     pub dataset: PathBuf,
     /// Feature set: `taxel` (each taxel alone, the mean reported), `glcm2d`, `glcm3d`,
     /// `all-taxels` (every taxel's statistics in one vector), `all-taxels-mm` (the same per
-    /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`) or `van-rossum`
+    /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`), `spectrum` (each
+    /// taxel's spike counts along the slide in bands of spatial frequency) or `van-rossum`
     /// (KNN over van Rossum distances between the recordings' spike trains).
     #[cfg_attr(feature = "cli", arg(long))]
     pub method: MethodChoice,

@@ -26,7 +26,8 @@ pub struct TrainOptions {
     )]
     pub speeds: Option<Vec<Speed>>,
     /// Feature set: `taxel`, `glcm2d`, `glcm3d` (the paper's spatio-temporal approach),
-    /// `all-taxels`, `all-taxels-mm` or `glcm3d-multi`.
+    /// `all-taxels`, `all-taxels-mm`, `glcm3d-multi` or `spectrum` (spike counts along the
+    /// slide in bands of spatial frequency; not with `--causal`).
     #[cfg_attr(feature = "cli", arg(long, default_value = "glcm3d"))]
     pub method: Method,
     /// With `--method taxel`: classify with this one taxel's statistics, as `ROW,COL`.
