@@ -28,6 +28,16 @@ pub struct E9 {
     pub baselines: Option<Baselines>,
 }
 
+impl E9 {
+    /// The best baseline without spikes with each speed held out, when they ran.
+    pub fn held_out_baseline(&self) -> Option<&crate::compare::Ranked> {
+        match &self.baselines {
+            Some(Baselines::Compared { held_out, .. }) => Some(&held_out.best),
+            _ => None,
+        }
+    }
+}
+
 /// E9's baselines without spikes, or why they were not run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Baselines {

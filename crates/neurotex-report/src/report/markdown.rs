@@ -823,8 +823,8 @@ fn e9(r: &Results) -> String {
     ) + &if figures::compare::per_condition(held).is_some() {
         figure(
             file::E9_SPEEDS,
-            "E9: the best candidate and the paper's method at each held-out speed",
-            &figures::compare::per_condition_caption(held),
+            "E9: the best candidate, the paper's method and the best baseline without spikes at each held-out speed",
+            &figures::compare::per_condition_caption(held, e9.held_out_baseline()),
         )
     } else {
         String::new()

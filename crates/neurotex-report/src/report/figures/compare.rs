@@ -20,6 +20,8 @@ const CANDIDATE: RGBColor = SINGLE;
 const PAPER: RGBColor = GLCM3D;
 /// The nested estimate: black, apart from every candidate.
 const NESTED: RGBColor = BLACK;
+/// The best baseline without spikes beside the candidates (bluish green, dashed).
+const BASELINE: RGBColor = SERIES[2];
 /// The majority-class line (reddish purple, apart from chance's grey).
 const MAJORITY: RGBColor = SERIES[4];
 /// Every other row's background, so that a name can be followed to its dot.
@@ -425,7 +427,7 @@ struct Series {
     values: Vec<Option<f64>>,
 }
 
-fn series(c: &Comparison, conditions: &[String]) -> Vec<Series> {
+fn series(c: &Comparison, baseline: Option<&Ranked>, conditions: &[String]) -> Vec<Series> {
     let at = |r: &Ranked| -> Vec<Option<f64>> {
         let value = |condition: &String| {
             let found = r.per_condition.iter().find(|p| p.condition == *condition);
@@ -435,6 +437,17 @@ fn series(c: &Comparison, conditions: &[String]) -> Vec<Series> {
     };
     let best = &c.best;
     let mut out = Vec::new();
+    if let Some(b) = baseline {
+        out.push(Series {
+            key: Key::new(
+                format!("best baseline without spikes: {}", name(b)),
+                Swatch::DashedPoints(BASELINE),
+            ),
+            colour: BASELINE,
+            dashed: true,
+            values: at(b),
+        });
+    }
     if let Some(paper) = c.results.iter().find(|r| r.paper && !best.paper) {
         out.push(Series {
             key: Key::new(
@@ -467,14 +480,20 @@ fn series(c: &Comparison, conditions: &[String]) -> Vec<Series> {
 /// the paper's method, to draw; `None` when the protocol has no conditions (pooled or one
 /// split).
 pub fn per_condition(c: &Comparison) -> Option<PerCondition<'_>> {
-    (!c.best.per_condition.is_empty()).then_some(PerCondition(c))
+    (!c.best.per_condition.is_empty()).then_some(PerCondition(c, None))
 }
 
 /// The figure of [`per_condition`], to draw with the data's name.
 #[derive(Debug, Clone, Copy)]
-pub struct PerCondition<'a>(&'a Comparison);
+pub struct PerCondition<'a>(&'a Comparison, Option<&'a Ranked>);
 
-impl PerCondition<'_> {
+impl<'a> PerCondition<'a> {
+    /// The same figure with `baseline` (the best baseline without spikes, evaluated on the
+    /// same splits) drawn beside the candidates.
+    pub fn with_baseline(self, baseline: Option<&'a Ranked>) -> Self {
+        PerCondition(self.0, baseline)
+    }
+
     /// Draws the figure, `source` naming the data.
     ///
     /// # Errors
@@ -487,7 +506,7 @@ impl PerCondition<'_> {
             .iter()
             .map(|p| p.condition.clone())
             .collect();
-        let lines = series(c, &conditions);
+        let lines = series(c, self.1, &conditions);
         // The best drawn last, on top, but named first.
         let mut keys: Vec<Key> = lines.iter().rev().map(|s| s.key.clone()).collect();
         keys.extend(reference_keys(c));
@@ -520,15 +539,22 @@ impl PerCondition<'_> {
     }
 }
 
-/// The caption of [`per_condition`].
-pub fn per_condition_caption(c: &Comparison) -> String {
+/// The caption of [`per_condition`], with `baseline` as given to
+/// [`PerCondition::with_baseline`].
+pub fn per_condition_caption(c: &Comparison, baseline: Option<&Ranked>) -> String {
     let paper = if c.best.paper {
         "The best candidate is the paper's method."
     } else {
         "The paper's method (sa / glcm3d / knn) is dashed vermillion, where it was among the candidates."
     };
+    let baseline = baseline.map_or(String::new(), |b| {
+        format!(
+            " Dashed bluish green: the best baseline without spikes on the same splits ({}, from the conditioned signal, not a candidate).",
+            name(b)
+        )
+    });
     format!(
-        "Accuracy at each condition ({}) of the best candidate (solid); the ranking's accuracy is the mean over these. {paper} Grey dashed: chance, one over {} classes; purple dashed: the largest class's share over all conditions (when it differs from chance). No intervals per condition are computed.",
+        "Accuracy at each condition ({}) of the best candidate (solid); the ranking's accuracy is the mean over these. {paper}{baseline} Grey dashed: chance, one over {} classes; purple dashed: the largest class's share over all conditions (when it differs from chance). No intervals per condition are computed.",
         c.protocol, c.classes
     )
 }

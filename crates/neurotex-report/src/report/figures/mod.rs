@@ -221,6 +221,7 @@ pub(crate) fn all(
         out.push((file::E9_PER_SPEED, compare::ranking(&e9.per_speed, source)));
         out.push((file::E9_HELD_OUT, compare::ranking(&e9.held_out, source)));
         if let Some(figure) = compare::per_condition(&e9.held_out) {
+            let figure = figure.with_baseline(e9.held_out_baseline());
             out.push((file::E9_SPEEDS, figure.draw(source)));
         }
     }

@@ -210,7 +210,7 @@ fn captions_say_what_is_drawn() {
         "{caption}"
     );
     assert!(!ranking_caption(&comparison(10, false, 0)).contains("nested"));
-    assert!(per_condition_caption(&c).contains("dashed vermillion"));
+    assert!(per_condition_caption(&c, None).contains("dashed vermillion"));
 }
 
 #[test]
