@@ -268,3 +268,47 @@ fn nested_selection_too_small_for_its_inner_folds_stops_before_any_candidate_run
         run.stderr
     );
 }
+
+#[test]
+fn gain_auto_calibrates_on_the_training_side_of_a_split_and_says_so_otherwise() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 10);
+    let base = [
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--gain",
+        "auto",
+        "--methods",
+        "all-taxels",
+        "--classifiers",
+        "knn",
+    ];
+    // 30 recordings at 5 mm/s train; the 30 at 10 mm/s are never read by the calibration.
+    let split = dir.run(
+        &[
+            &base[..],
+            &[
+                "--train-where",
+                "speed_mm_s=5",
+                "--test-where",
+                "speed_mm_s=10",
+            ],
+        ]
+        .concat(),
+    );
+    assert!(split.status.success(), "{}", split.stderr);
+    assert!(
+        split.stderr.contains("in 30 training recording(s)"),
+        "{}",
+        split.stderr
+    );
+    assert!(
+        !split.stderr.contains("test folds included"),
+        "{}",
+        split.stderr
+    );
+    let cv = dir.run(&[&base[..], &["--per", "speed_mm_s"]].concat());
+    assert!(cv.status.success(), "{}", cv.stderr);
+    assert!(cv.stderr.contains("test folds included"), "{}", cv.stderr);
+}

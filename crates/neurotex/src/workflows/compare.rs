@@ -233,7 +233,12 @@ impl CompareOptions {
             ))
             .into());
         }
-        let candidates = make_candidates(stages, dataset, &indices, &set, on)?;
+        let train = match (&self.train_where, &self.test_where) {
+            (Some(train), Some(_)) => Some(train),
+            _ => None,
+        };
+        let calibration = super::calibration_rows(train, dataset, &indices, stages, on)?;
+        let candidates = make_candidates(stages, dataset, &indices, &calibration, &set, on)?;
         on(Progress::Say(&format!(
             "comparing {} candidates on {} recordings: {}",
             candidates.len(),
@@ -251,16 +256,18 @@ impl CompareOptions {
 }
 
 /// Encodes the recordings once (both populations when an encoding needs the fast-adapting
-/// one) and makes every candidate of `set` from them.
+/// one), with the pipeline calibrated on the recordings `calibration`, and makes every
+/// candidate of `set` from them.
 fn make_candidates(
     stages: &StageOptions,
     dataset: &Dataset,
     indices: &[usize],
+    calibration: &[usize],
     set: &CandidateSet,
     on: OnProgress,
 ) -> Result<Vec<Candidate>> {
     let start = Instant::now();
-    let mut params = calibrated_pipeline(stages, dataset, indices, on)?.params;
+    let mut params = calibrated_pipeline(stages, dataset, calibration, on)?.params;
     params.encoding = if set.needs_fa() {
         Encoding::SaFa
     } else {

@@ -14,7 +14,6 @@ use crate::error::OptionsError;
 use crate::evaluation::{Evaluation, Spikes};
 use crate::options::StageOptions;
 use crate::pipeline::{Method, Pipeline};
-use crate::progress::Progress;
 use crate::recording::{Dataset, Selection};
 use crate::{Cell, Result, Speed};
 
@@ -191,15 +190,8 @@ impl EvaluateOptions {
         stages: &StageOptions,
         on: OnProgress,
     ) -> Result<Vec<usize>> {
-        match self.selections() {
-            Some((train, _)) => Ok(train.rows(&dataset.entries)?),
-            None => {
-                if stages.gain.target_hz().is_some() {
-                    on(Progress::Say("note: under cross-validation --gain auto calibrates on every recording evaluated (labels unused), test folds included; a train/test split calibrates on the training set only"));
-                }
-                Ok(all.to_vec())
-            }
-        }
+        let split = self.selections();
+        super::calibration_rows(split.as_ref().map(|s| &s.0), dataset, all, stages, on)
     }
 
     /// The feature columns to classify with.

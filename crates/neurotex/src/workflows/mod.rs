@@ -221,6 +221,34 @@ pub fn calibrated_pipeline(
     Ok(calibrated)
 }
 
+/// The recordings `--gain auto` and `--causal` calibrate on: those of `all` that `train`
+/// selects under a train/test split; otherwise every recording evaluated (each is in some
+/// training fold, and labels are not read; calibrating again inside every fold is not
+/// done), which is said when a calibration happens.
+///
+/// # Errors
+/// A selection naming a column the manifest lacks.
+pub fn calibration_rows(
+    train: Option<&crate::recording::Selection>,
+    dataset: &Dataset,
+    all: &[usize],
+    stages: &StageOptions,
+    on: OnProgress,
+) -> Result<Vec<usize>> {
+    match train {
+        Some(train) => {
+            let rows = train.rows(&dataset.entries)?;
+            Ok(all.iter().copied().filter(|i| rows.contains(i)).collect())
+        }
+        None => {
+            if stages.gain.target_hz().is_some() || stages.causal {
+                on(Progress::Say("note: under cross-validation --gain auto and --causal calibrate on every recording evaluated (labels unused), test folds included; a train/test split calibrates on the training set only"));
+            }
+            Ok(all.to_vec())
+        }
+    }
+}
+
 /// What `--gain auto` chose, as said to the user.
 pub fn calibration_line(c: &GainCalibration) -> String {
     let reached = if c.clamped {
