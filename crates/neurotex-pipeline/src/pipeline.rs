@@ -633,18 +633,7 @@ impl FeatureExtractor {
                 .iter()
                 .flat_map(|w| haralick.iter().map(move |h| format!("{w}ms_{h}")))
                 .collect(),
-            Method::Spectrum => {
-                let edges = self.features.spectrum().edges();
-                self.grid
-                    .taxels()
-                    .flat_map(|cell| {
-                        let cell = self.grid.cell(cell);
-                        edges
-                            .windows(2)
-                            .map(move |w| format!("{cell}_f{}_{}", w[0], w[1]))
-                    })
-                    .collect()
-            }
+            Method::Spectrum => spectrum_names(&self.grid, &self.features),
         }
     }
 
@@ -897,6 +886,20 @@ impl FeatureExtractor {
 /// Why [`Method::AllTaxelsMm`] refuses a recording without a speed.
 const NO_SPEED: &str =
     "the all-taxels-mm method needs the recording's sliding speed (manifest column speed_mm_s, nonzero)";
+
+/// One population's [`Method::Spectrum`] column names on `grid`: `{cell}_f{lo}_{hi}` for
+/// each taxel's band of frequencies `lo` to `hi - 1` cycles over the span.
+pub fn spectrum_names(grid: &Grid, features: &FeatureParams) -> Vec<String> {
+    let edges = features.spectrum().edges();
+    grid.taxels()
+        .flat_map(|cell| {
+            let cell = grid.cell(cell);
+            edges
+                .windows(2)
+                .map(move |w| format!("{cell}_f{}_{}", w[0], w[1]))
+        })
+        .collect()
+}
 
 /// The steps [`Method::Spectrum`] reads of a phase of `n_steps` at `speed_mm_s`: all of
 /// them, or those of `travel_mm` of travel.

@@ -25,7 +25,9 @@ use crate::analysis::{Columns, FeatureTable};
 use crate::classify::ClassifierChoice;
 use crate::error::{DataError, Result};
 use crate::features::{signal_stats, Spectrum, SIGNAL_STAT_NAMES};
-use crate::pipeline::{spectrum_span, taxel_cells, FeatureParams, Method, Pipeline};
+use crate::pipeline::{
+    spectrum_names, spectrum_span, taxel_cells, FeatureParams, Method, Pipeline,
+};
 use crate::recording::{Dataset, Meta, Recording};
 use crate::signal::Conditioned;
 use crate::values::Grid;
@@ -119,16 +121,8 @@ pub fn baseline_candidates(
         return Err(DataError::invalid(&r.meta.file, why).into());
     }
     let metas: Vec<Meta> = rows.iter().map(|r| r.meta.clone()).collect();
-    let edges = features.spectrum().edges();
+    let spectrum_names = spectrum_names(grid, features);
     let cells: Vec<String> = grid.taxels().map(|c| grid.cell(c).to_string()).collect();
-    let spectrum_names = cells
-        .iter()
-        .flat_map(|c| {
-            edges
-                .windows(2)
-                .map(move |w| format!("{c}_f{}_{}", w[0], w[1]))
-        })
-        .collect();
     let stats_names = cells
         .iter()
         .flat_map(|c| SIGNAL_STAT_NAMES.map(|s| format!("{c}_{s}")))
