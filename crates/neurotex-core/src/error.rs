@@ -253,6 +253,14 @@ pub enum ClassifyError {
     /// Feature rows of different lengths, or a non-finite feature.
     #[error("{0}")]
     BadFeatures(String),
+    /// A class too small for the spiking classifier's validation split.
+    #[error("class {class} has {count} training recording(s): the spiking classifier sets at least one aside for early stopping and trains on the rest, so each class needs at least 2")]
+    ValidationTooSmall {
+        /// The class index.
+        class: usize,
+        /// Its training recordings.
+        count: usize,
+    },
 }
 
 impl ClassifyError {
@@ -262,7 +270,9 @@ impl ClassifyError {
     pub fn is_design(&self) -> bool {
         matches!(
             self,
-            ClassifyError::KTooLarge { .. } | ClassifyError::ClassTooSmall { .. }
+            ClassifyError::KTooLarge { .. }
+                | ClassifyError::ClassTooSmall { .. }
+                | ClassifyError::ValidationTooSmall { .. }
         )
     }
 

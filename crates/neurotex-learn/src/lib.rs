@@ -5,6 +5,7 @@
 #![deny(missing_docs)]
 
 pub mod classify;
+pub mod snn;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.

@@ -21,5 +21,5 @@ pub mod stream;
 // that `crate::recording` and the like read the same in every layer.
 use neurotex_core::{csvlog, error, import, io, progress, recording, values, Error};
 use neurotex_features::features;
-use neurotex_learn::classify;
+use neurotex_learn::{classify, snn};
 use neurotex_signal::{encode, signal};

@@ -8,6 +8,7 @@ use neurotex::classify::{
 use neurotex::options::{CheckedStages, OptionKind, OptionSpec, StageOptions, STAGE_OPTIONS};
 use neurotex::pipeline::Method;
 use neurotex::recording::Baseline;
+use neurotex::snn::SnnParams;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -190,6 +191,7 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             "forest_seed",
         ],
         ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
+        ClassifierChoice::Snn(_) => &["hidden", "dt_ms", "epochs", "seed"],
     };
     only_known(
         options,
@@ -216,6 +218,13 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             c: get(options, "c")?.unwrap_or(d.c),
             max_iter: get(options, "max_iter")?.unwrap_or(d.max_iter),
             tol: get(options, "tol")?.unwrap_or(d.tol),
+        }),
+        ClassifierChoice::Snn(d) => ClassifierChoice::Snn(SnnParams {
+            hidden: get(options, "hidden")?.unwrap_or(d.hidden),
+            dt_ms: get(options, "dt_ms")?.unwrap_or(d.dt_ms),
+            epochs: get(options, "epochs")?.unwrap_or(d.epochs),
+            seed: get(options, "seed")?.unwrap_or(d.seed),
+            ..d
         }),
     };
     choice.check().map_err(param)?;

@@ -28,6 +28,7 @@ pub use neurotex_core::{BySpeed, Cell, Error, Grid, Result, SampleRate, Speed};
 pub use neurotex_experiments::experiments;
 pub use neurotex_features::features;
 pub use neurotex_learn::classify;
+pub use neurotex_learn::snn;
 pub use neurotex_pipeline::{
     analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, options,
     pipeline, stream,

@@ -13,6 +13,11 @@ use super::{
     LinearParams, Predict,
 };
 use crate::error::{ClassifyError, ParamError};
+use crate::snn::SnnParams;
+
+/// Why the spiking classifier cannot fit feature rows.
+pub const SNN_READS_SPIKES: &str =
+    "the snn classifier reads spike trains, not features: it runs with the spikes method";
 
 /// A classifier and its parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -24,6 +29,10 @@ pub enum ClassifierChoice {
     Forest(ForestParams),
     /// Multinomial logistic regression with an L2 penalty.
     Linear(LinearParams),
+    /// The spiking network ([`crate::snn`]): it reads spike trains, not feature rows, so
+    /// it pairs with the `spikes` method only and is fitted by the pipeline, not by
+    /// [`ClassifierChoice::check`].
+    Snn(SnnParams),
 }
 
 impl Default for ClassifierChoice {
@@ -34,7 +43,7 @@ impl Default for ClassifierChoice {
 
 impl ClassifierChoice {
     /// The names [`FromStr`] takes, in order.
-    pub const NAMES: [&'static str; 3] = ["knn", "forest", "linear"];
+    pub const NAMES: [&'static str; 4] = ["knn", "forest", "linear", "snn"];
 
     /// The classifier's name: `knn`, `forest` or `linear` (its `kind` in JSON).
     pub fn name(&self) -> &'static str {
@@ -42,6 +51,7 @@ impl ClassifierChoice {
             ClassifierChoice::Knn(_) => "knn",
             ClassifierChoice::Forest(_) => "forest",
             ClassifierChoice::Linear(_) => "linear",
+            ClassifierChoice::Snn(_) => "snn",
         }
     }
 
@@ -54,6 +64,9 @@ impl ClassifierChoice {
             ClassifierChoice::Knn(p) => ChosenClassifier::Knn(p.check()?),
             ClassifierChoice::Forest(p) => ChosenClassifier::Forest(p.check()?),
             ClassifierChoice::Linear(p) => ChosenClassifier::Linear(p.check()?),
+            ClassifierChoice::Snn(_) => {
+                return Err(ParamError::new("classifier", SNN_READS_SPIKES, "snn"))
+            }
         })
     }
 }
@@ -67,9 +80,10 @@ impl FromStr for ClassifierChoice {
             "knn" => Ok(ClassifierChoice::Knn(KnnParams::default())),
             "forest" => Ok(ClassifierChoice::Forest(ForestParams::default())),
             "linear" => Ok(ClassifierChoice::Linear(LinearParams::default())),
+            "snn" => Ok(ClassifierChoice::Snn(SnnParams::default())),
             _ => Err(ParamError::new(
                 "classifier",
-                "classifier must be knn, forest or linear",
+                "classifier must be knn, forest, linear or snn",
                 s,
             )),
         }
@@ -85,6 +99,14 @@ impl fmt::Display for ClassifierChoice {
                 write!(f, "random forest ({} trees, seed {})", p.trees, p.seed)
             }
             ClassifierChoice::Linear(p) => write!(f, "logistic regression (C = {})", p.c),
+            ClassifierChoice::Snn(p) => write!(
+                f,
+                "spiking network ({} LIF neurons, {} ms steps, {} readout, seed {})",
+                p.hidden,
+                p.dt_ms,
+                p.readout.name(),
+                p.seed
+            ),
         }
     }
 }

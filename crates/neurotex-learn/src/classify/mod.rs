@@ -149,7 +149,7 @@ fn check_training(x: &[f64], dims: usize, y: &[usize]) -> Result<(), ClassifyErr
 }
 
 /// The first class with the largest share (ties go to the lower class index).
-fn first_max(shares: &[f64]) -> usize {
+pub(crate) fn first_max(shares: &[f64]) -> usize {
     let mut best = 0;
     for (c, &s) in shares.iter().enumerate() {
         if s > shares[best] {

@@ -14,10 +14,13 @@ use crate::classify::{
 use crate::encode::SpikeTrains;
 use crate::error::{ParamError, Result};
 use crate::pipeline::{Encoded, Encoding, FeatureExtractor, Method, PipelineParams};
+use crate::snn::{SnnClassifier, SnnParams, SpikeInput};
 use crate::values::Grid;
 
 /// The spike-timing method's name.
 pub const VAN_ROSSUM: &str = "van-rossum";
+/// The spike trains themselves, the spiking classifier's input.
+pub const SPIKES: &str = "spikes";
 
 /// A feature method, or the spike-timing method.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,6 +29,8 @@ pub enum MethodChoice {
     Features(Method),
     /// KNN over van Rossum distances between the recordings' spike trains.
     VanRossum,
+    /// The spike trains as they are, for the spiking classifier (`snn`).
+    Spikes,
 }
 
 impl MethodChoice {
@@ -34,6 +39,7 @@ impl MethodChoice {
         match self {
             MethodChoice::Features(m) => m.name(),
             MethodChoice::VanRossum => VAN_ROSSUM,
+            MethodChoice::Spikes => SPIKES,
         }
     }
 }
@@ -44,8 +50,11 @@ impl std::str::FromStr for MethodChoice {
         if s == VAN_ROSSUM {
             return Ok(MethodChoice::VanRossum);
         }
+        if s == SPIKES {
+            return Ok(MethodChoice::Spikes);
+        }
         s.parse().map(MethodChoice::Features).map_err(|_| {
-            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi, spectrum or van-rossum";
+            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi, spectrum, van-rossum or spikes";
             ParamError::new("methods", rule, s)
         })
     }
@@ -120,6 +129,12 @@ impl CandidateSet {
             .find(|c| matches!(c, ClassifierChoice::Knn(_)))
             .copied()
             .unwrap_or(ClassifierChoice::Knn(KnnParams::default()));
+        let snn = self
+            .classifiers
+            .iter()
+            .find(|c| matches!(c, ClassifierChoice::Snn(_)))
+            .copied()
+            .unwrap_or(ClassifierChoice::Snn(SnnParams::default()));
         let mut out = Vec::new();
         for &method in &self.methods {
             let knn_only = matches!(
@@ -128,8 +143,14 @@ impl CandidateSet {
             );
             if knn_only {
                 out.push((method, knn));
+            } else if method == MethodChoice::Spikes {
+                out.push((method, snn));
             } else {
-                out.extend(self.classifiers.iter().map(|&c| (method, c)));
+                let features = self
+                    .classifiers
+                    .iter()
+                    .filter(|c| !matches!(c, ClassifierChoice::Snn(_)));
+                out.extend(features.map(|&c| (method, c)));
             }
         }
         out
@@ -138,7 +159,13 @@ impl CandidateSet {
     /// How many candidates the set makes.
     pub fn len(&self) -> usize {
         let baselines = match self.baselines {
-            true => super::signal::SIGNAL_METHODS.len() * self.classifiers.len(),
+            true => {
+                let features = self
+                    .classifiers
+                    .iter()
+                    .filter(|c| !matches!(c, ClassifierChoice::Snn(_)));
+                super::signal::SIGNAL_METHODS.len() * features.count()
+            }
             false => 0,
         };
         self.encodings.len() * self.pairs().len() + baselines
@@ -187,11 +214,12 @@ pub fn candidates(
             let start = Instant::now();
             let table = Arc::new(match method {
                 MethodChoice::Features(m) => FeatureTable::build(&view, &extractor, m)?,
-                MethodChoice::VanRossum => index_table(&view, grid),
+                MethodChoice::VanRossum | MethodChoice::Spikes => index_table(&view, grid),
             });
-            let knn_distances = match method {
-                MethodChoice::VanRossum => Some(van_rossum.matrix(&view, encoding)?),
-                MethodChoice::Features(_) => None,
+            let shared = match method {
+                MethodChoice::VanRossum => Shared::Distances(van_rossum.matrix(&view, encoding)?),
+                MethodChoice::Spikes => Shared::Spikes(spike_inputs(&view, encoding, &pairs)?),
+                MethodChoice::Features(_) => Shared::None,
             };
             let prepare_s = share + start.elapsed().as_secs_f64();
             for &(_, classifier) in pairs.iter().filter(|p| p.0 == method) {
@@ -204,7 +232,7 @@ pub fn candidates(
                         MethodChoice::Features(Method::Taxel) => Columns::EachTaxel,
                         _ => Columns::All,
                     },
-                    evaluate: evaluator(classifier, knn_distances.clone())?,
+                    evaluate: evaluator(classifier, shared.clone())?,
                     prepare_s,
                 });
             }
@@ -213,25 +241,76 @@ pub fn candidates(
     Ok(out)
 }
 
-/// The classifier as a [`Candidate::evaluate`]; with a distance matrix, KNN over it.
+/// What a method's classifier shares across folds besides its table.
+#[derive(Clone)]
+pub(crate) enum Shared {
+    /// Nothing: feature rows.
+    None,
+    /// Van Rossum distances between every two recordings.
+    Distances(Arc<DistanceMatrix>),
+    /// Every recording's spikes as the spiking network's input.
+    Spikes(Arc<Vec<SpikeInput>>),
+}
+
+/// The classifier as a [`Candidate::evaluate`]; with a distance matrix, KNN over it; with
+/// spike inputs, the spiking network.
 pub(crate) fn evaluator(
     classifier: ClassifierChoice,
-    distances: Option<Arc<crate::classify::DistanceMatrix>>,
+    shared: Shared,
 ) -> Result<Arc<super::EvaluateFn>> {
-    Ok(match (distances, classifier) {
-        (Some(matrix), ClassifierChoice::Knn(p)) => {
+    Ok(match (shared, classifier) {
+        (Shared::Distances(matrix), ClassifierChoice::Knn(p)) => {
             let knn = SpikeDistanceKnn::new(matrix, p.k)?;
             Arc::new(move |t, c, s| evaluate(t, c, s, &knn))
         }
-        (Some(_), other) => {
+        (Shared::Distances(_), other) => {
             let rule = "the van-rossum method classifies with KNN only";
             return Err(ParamError::new("classifiers", rule, other.name()).into());
         }
-        (None, classifier) => {
+        (Shared::Spikes(inputs), ClassifierChoice::Snn(p)) => {
+            let snn = SnnClassifier::new(p.check()?, inputs);
+            Arc::new(move |t, c, s| evaluate(t, c, s, &snn))
+        }
+        (Shared::Spikes(_), other) => {
+            let rule = "the spikes method classifies with the spiking network (snn) only";
+            return Err(ParamError::new("classifiers", rule, other.name()).into());
+        }
+        (Shared::None, classifier) => {
             let chosen = classifier.check()?;
             Arc::new(move |t, c, s| evaluate(t, c, s, &chosen))
         }
     })
+}
+
+/// Every recording's spikes under `encoding` binned to the spiking network's time step
+/// (that of the `spikes` method's pair in `pairs`).
+fn spike_inputs(
+    view: &[Encoded],
+    encoding: Encoding,
+    pairs: &[(MethodChoice, ClassifierChoice)],
+) -> Result<Arc<Vec<SpikeInput>>> {
+    let dt_ms = pairs
+        .iter()
+        .find_map(|p| match p {
+            (MethodChoice::Spikes, ClassifierChoice::Snn(s)) => Some(s.dt_ms),
+            _ => None,
+        })
+        .unwrap_or(SnnParams::default().dt_ms);
+    let inputs = view
+        .iter()
+        .map(|e| {
+            let pops: Vec<&SpikeTrains> = match encoding {
+                Encoding::SaFa => e.populations().collect(),
+                _ => vec![&e.spikes],
+            };
+            if encoding == Encoding::SaFa && pops.len() < 2 {
+                let rule = "the sa+fa encoding needs both populations of every recording";
+                return Err(ParamError::new("encodings", rule, "one population"));
+            }
+            Ok(SpikeInput::from_trains(&pops, dt_ms))
+        })
+        .collect::<Result<Vec<_>, ParamError>>()?;
+    Ok(Arc::new(inputs))
 }
 
 /// The recordings as `encoding` sees them: for `fa` alone, the fast-adapting population

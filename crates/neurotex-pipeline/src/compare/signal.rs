@@ -141,14 +141,18 @@ pub fn baseline_candidates(
     ];
     let mut out = Vec::new();
     for (method, table) in SIGNAL_METHODS.iter().zip(tables) {
-        for &classifier in classifiers {
+        // The spiking network reads spikes: it has no baseline without them.
+        let features = classifiers
+            .iter()
+            .filter(|c| !matches!(c, ClassifierChoice::Snn(_)));
+        for &classifier in features {
             out.push(Candidate {
                 encoding: NO_ENCODING.to_string(),
                 method: method.to_string(),
                 classifier: classifier.name().to_string(),
                 table: Arc::clone(&table),
                 columns: Columns::All,
-                evaluate: evaluator(classifier, None)?,
+                evaluate: evaluator(classifier, super::candidates::Shared::None)?,
                 prepare_s,
             });
         }

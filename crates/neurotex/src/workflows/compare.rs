@@ -5,7 +5,10 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{calibrated_pipeline, encode_all, say_conditions, KnnOptions, OnProgress, OpenOptions};
+use super::{
+    calibrated_pipeline, encode_all, say_conditions, KnnOptions, OnProgress, OpenOptions,
+    SnnOptions,
+};
 use crate::classify::{ClassifierChoice, CvParams, ForestParams};
 use crate::compare::candidates::{
     candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
@@ -21,6 +24,7 @@ use crate::pipeline::{shared_grid, Encoding, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{Dataset, Recording, Selection};
 use crate::signal::Conditioned;
+use crate::snn::SnnParams;
 use crate::values::Grid;
 use crate::{Result, Speed};
 
@@ -89,10 +93,12 @@ pub struct CompareOptions {
     /// spike-train distances (KNN only).
     /// `all-taxels-mm` (statistics per mm travelled) needs the manifest's speeds.
     /// `spectrum`: each taxel's spike counts along the slide, their Fourier magnitudes in
-    /// logarithmic bands of spatial frequency.
+    /// logarithmic bands of spatial frequency. `spikes`: the spike trains themselves,
+    /// classified by the spiking network (`snn`, its options --snn-*).
     #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_METHODS))]
     pub methods: Vec<String>,
-    /// Classifiers to compare, comma-separated: knn, forest, linear.
+    /// Classifiers to compare, comma-separated: knn, forest, linear, snn (the spiking
+    /// network; it reads spike trains, so it runs with the `spikes` method only).
     #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_CLASSIFIERS))]
     pub classifiers: Vec<String>,
     /// Time constant of the van Rossum kernel in ms (method `van-rossum`). Default: the
@@ -102,6 +108,10 @@ pub struct CompareOptions {
     /// KNN's neighbours and z-scoring.
     #[cfg_attr(feature = "cli", command(flatten))]
     pub knn: KnnOptions,
+    /// The spiking network's options (method `spikes`); its seed is --seed unless
+    /// --snn-seed is given.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub snn: SnnOptions,
     /// Cross-validation folds.
     #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().folds))]
     pub folds: usize,
@@ -178,7 +188,11 @@ impl CompareOptions {
             .iter()
             .map(|m| m.parse::<MethodChoice>())
             .collect::<Result<Vec<_>, _>>()?;
-        let classifiers = self
+        let snn = ClassifierChoice::Snn(self.snn.params(SnnParams {
+            seed: self.seed,
+            ..SnnParams::default()
+        })?);
+        let mut classifiers = self
             .classifiers
             .iter()
             .map(|name| {
@@ -188,10 +202,20 @@ impl CompareOptions {
                         seed: self.seed,
                         ..p
                     }),
+                    ClassifierChoice::Snn(_) => snn,
                     linear => linear,
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let has_snn = classifiers.contains(&snn);
+        match (methods.contains(&MethodChoice::Spikes), has_snn) {
+            (true, false) => classifiers.push(snn),
+            (false, true) => {
+                let rule = "the snn classifier reads spike trains: add spikes to --methods";
+                return Err(ParamError::new("classifiers", rule, "snn").into());
+            }
+            _ => {}
+        }
         let baselines = self.encodings.iter().any(|e| e.trim() == NO_ENCODING);
         let encodings = self
             .encodings

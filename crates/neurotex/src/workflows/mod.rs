@@ -27,6 +27,7 @@ use crate::options::StageOptions;
 use crate::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::Dataset;
+use crate::snn::SnnParams;
 use crate::{Grid, Result};
 
 pub use reading::{CsvOptions, LogOptions, OpenOptions, ReadOptions};
@@ -89,6 +90,61 @@ pub struct ClassifierOptions {
     /// With `--classifier linear`: inverse penalty strength, scikit-learn's C [default: 1].
     #[cfg_attr(feature = "cli", arg(long = "c"))]
     pub c: Option<f64>,
+    /// The spiking network's options (`--classifier snn`).
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub snn: SnnOptions,
+}
+
+/// Options of the spiking classifier (`--classifier snn`, `docs/spiking-classifier.md`).
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct SnnOptions {
+    /// With `--classifier snn`: hidden LIF neurons [default: 128].
+    #[cfg_attr(feature = "cli", arg(long = "snn-hidden", id = "snn-hidden"))]
+    pub hidden: Option<usize>,
+    /// With `--classifier snn`: the network's time step in ms; the encoder's 1 ms spikes
+    /// are counted in bins this wide [default: 10].
+    #[cfg_attr(feature = "cli", arg(long = "snn-dt-ms", id = "snn-dt-ms"))]
+    pub dt_ms: Option<u32>,
+    /// With `--classifier snn`: most training epochs; early stopping on a validation split
+    /// of the training recordings may end sooner [default: 60].
+    #[cfg_attr(feature = "cli", arg(long = "snn-epochs", id = "snn-epochs"))]
+    pub epochs: Option<usize>,
+    /// With `--classifier snn`: class scores are the readout's `mean` over time or its
+    /// `max` [default: mean].
+    #[cfg_attr(feature = "cli", arg(long = "snn-readout", id = "snn-readout"))]
+    pub readout: Option<neurotex_learn::snn::Readout>,
+    /// With `--classifier snn`: seed of the initial weights, validation split and batch
+    /// order [default: 0].
+    #[cfg_attr(feature = "cli", arg(long = "snn-seed", id = "snn-seed"))]
+    pub seed: Option<u64>,
+}
+
+impl SnnOptions {
+    /// Whether any option was given.
+    pub fn any(&self) -> bool {
+        self.hidden.is_some()
+            || self.dt_ms.is_some()
+            || self.epochs.is_some()
+            || self.readout.is_some()
+            || self.seed.is_some()
+    }
+
+    /// `defaults` with the options given applied, checked.
+    ///
+    /// # Errors
+    /// A parameter out of its range.
+    pub fn params(&self, defaults: SnnParams) -> Result<SnnParams> {
+        Ok(SnnParams {
+            hidden: self.hidden.unwrap_or(defaults.hidden),
+            dt_ms: self.dt_ms.unwrap_or(defaults.dt_ms),
+            epochs: self.epochs.unwrap_or(defaults.epochs),
+            readout: self.readout.unwrap_or(defaults.readout),
+            seed: self.seed.unwrap_or(defaults.seed),
+            ..defaults
+        }
+        .check()?)
+    }
 }
 
 impl ClassifierOptions {
@@ -109,7 +165,15 @@ impl ClassifierOptions {
                 c: self.c.unwrap_or(defaults.c),
                 ..defaults
             }),
+            ClassifierChoice::Snn(defaults) => ClassifierChoice::Snn(self.snn.params(defaults)?),
         };
+        if !matches!(choice, ClassifierChoice::Snn(_)) && self.snn.any() {
+            return Err(OptionsError::NotApplicable {
+                option: "--snn-*",
+                applies_to: "--classifier snn",
+            }
+            .into());
+        }
         let forest = matches!(choice, ClassifierChoice::Forest(_));
         if !forest && (self.trees.is_some() || self.forest_seed.is_some()) {
             return Err(OptionsError::Conflict(
@@ -124,7 +188,9 @@ impl ClassifierOptions {
             }
             .into());
         }
-        choice.check()?;
+        if !matches!(choice, ClassifierChoice::Snn(_)) {
+            choice.check()?;
+        }
         Ok(choice)
     }
 }

@@ -1,0 +1,382 @@
+//! The loss of one recording and its gradient by backpropagation through time, written out
+//! by hand: the networks are small (tens of inputs, about a hundred hidden neurons, a few
+//! classes) and their inputs sparse, so a loop over steps that touches only the inputs
+//! that spiked is faster than a dense tensor graph, and needs no autodiff framework in the
+//! build (`docs/spiking-classifier.md` weighs the two).
+//!
+//! With `g` the loss's gradient and the forward pass of [`super`]:
+//!
+//! ```text
+//! gO[t] = ∂L/∂O[t] + κ gO[t+1]                   readout, backwards
+//! gS[t] = W_out gO[t]  (- P[t] gV[t] unless the reset is detached)
+//! gP[t] = gV[t] (1 - S[t]) + gS[t] H'(P[t] - 1)  H' the surrogate
+//! gI[t] = gP[t] + α gI[t+1]
+//! gV[t-1] = β gP[t]
+//! ∂L/∂W_in += gI[t] x[t]ᵀ, ∂L/∂b_in += gI[t], ∂L/∂W_out += S[t] gO[t]ᵀ, ∂L/∂b_out += gO[t]
+//! ```
+
+use super::{softmax, Network, Readout, SpikeInput};
+
+/// The spike nonlinearity of the forward pass and the derivative the backward pass uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Activation {
+    /// A spike when the membrane reaches the threshold; the fast-sigmoid surrogate
+    /// `1 / (1 + slope |x|)²` stands in for its derivative (SuperSpike).
+    Spike {
+        /// The surrogate's slope.
+        slope: f64,
+    },
+    /// A smooth logistic `1 / (1 + e^{-k x})` with its exact derivative: a network whose
+    /// loss is differentiable, so the backward pass can be checked against finite
+    /// differences.
+    Smooth {
+        /// The logistic's steepness.
+        k: f64,
+    },
+}
+
+impl Activation {
+    fn value(self, x: f64) -> f64 {
+        match self {
+            Activation::Spike { .. } => f64::from(u8::from(x >= 0.0)),
+            Activation::Smooth { k } => 1.0 / (1.0 + (-k * x).exp()),
+        }
+    }
+
+    fn derivative(self, x: f64) -> f64 {
+        match self {
+            Activation::Spike { slope } => {
+                let d = 1.0 + slope * x.abs();
+                1.0 / (d * d)
+            }
+            Activation::Smooth { k } => {
+                let s = self.value(x);
+                k * s * (1.0 - s)
+            }
+        }
+    }
+}
+
+/// How the backward pass treats the spike: the nonlinearity and whether the reset is kept
+/// out of the gradient.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Backprop {
+    /// The spike nonlinearity and its derivative.
+    pub act: Activation,
+    /// Keep the reset out of the gradient (Zenke & Vogels 2021).
+    pub detach_reset: bool,
+}
+
+/// Gradients of the loss with respect to the network's parameters, laid out as they are.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gradient {
+    /// ∂L/∂W_in, input-major.
+    pub w_in: Vec<f64>,
+    /// ∂L/∂b_in.
+    pub b_in: Vec<f64>,
+    /// ∂L/∂W_out, hidden-major.
+    pub w_out: Vec<f64>,
+    /// ∂L/∂b_out.
+    pub b_out: Vec<f64>,
+}
+
+impl Gradient {
+    /// Zeros shaped as `net`.
+    pub fn zeros(net: &Network) -> Gradient {
+        Gradient {
+            w_in: vec![0.0; net.w_in.len()],
+            b_in: vec![0.0; net.b_in.len()],
+            w_out: vec![0.0; net.w_out.len()],
+            b_out: vec![0.0; net.b_out.len()],
+        }
+    }
+
+    /// Adds `other` to this gradient.
+    pub fn add(&mut self, other: &Gradient) {
+        for (a, b) in self.parts_mut().into_iter().zip(other.parts()) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
+            }
+        }
+    }
+
+    /// The four parts in order (w_in, b_in, w_out, b_out).
+    pub fn parts(&self) -> [&[f64]; 4] {
+        [&self.w_in, &self.b_in, &self.w_out, &self.b_out]
+    }
+
+    fn parts_mut(&mut self) -> [&mut Vec<f64>; 4] {
+        [
+            &mut self.w_in,
+            &mut self.b_in,
+            &mut self.w_out,
+            &mut self.b_out,
+        ]
+    }
+}
+
+/// What the forward pass keeps for the backward pass: each step's membrane before the
+/// spike, the spike, and the readout.
+#[derive(Debug, Default)]
+pub struct Trajectory {
+    pre: Vec<f64>,
+    spikes: Vec<f64>,
+    out: Vec<f64>,
+}
+
+/// Runs `net` over `input`, keeping the trajectory, and returns the class scores.
+pub fn forward(
+    net: &Network,
+    input: &SpikeInput,
+    act: Activation,
+    tr: &mut Trajectory,
+) -> Vec<f64> {
+    let (alpha, beta, kappa) = net.decays();
+    let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
+    tr.pre.clear();
+    tr.pre.resize(steps * h_n, 0.0);
+    tr.spikes.clear();
+    tr.spikes.resize(steps * h_n, 0.0);
+    tr.out.clear();
+    tr.out.resize(steps * c_n, 0.0);
+    let mut current = vec![0.0; h_n];
+    let mut membrane = vec![0.0; h_n];
+    let mut out = vec![0.0; c_n];
+    for t in 0..steps {
+        for (c, b) in current.iter_mut().zip(&net.b_in) {
+            *c = alpha * *c + b;
+        }
+        for &i in input.at(t) {
+            let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
+            for (c, w) in current.iter_mut().zip(w) {
+                *c += w;
+            }
+        }
+        for (o, b) in out.iter_mut().zip(&net.b_out) {
+            *o = kappa * *o + b;
+        }
+        let (pre, spikes) = (&mut tr.pre[t * h_n..], &mut tr.spikes[t * h_n..]);
+        for h in 0..h_n {
+            let p = beta * membrane[h] + current[h];
+            let s = act.value(p - 1.0);
+            pre[h] = p;
+            spikes[h] = s;
+            membrane[h] = p * (1.0 - s);
+            if s != 0.0 {
+                let w = &net.w_out[h * c_n..(h + 1) * c_n];
+                for (o, w) in out.iter_mut().zip(w) {
+                    *o += s * w;
+                }
+            }
+        }
+        tr.out[t * c_n..(t + 1) * c_n].copy_from_slice(&out);
+    }
+    read_scores(net.readout, &tr.out, c_n, steps)
+}
+
+/// The scores read from a readout trace (`steps x classes`).
+fn read_scores(readout: Readout, trace: &[f64], classes: usize, steps: usize) -> Vec<f64> {
+    let mut scores = vec![0.0; classes];
+    for (c, s) in scores.iter_mut().enumerate() {
+        let values = (0..steps).map(|t| trace[t * classes + c]);
+        *s = match readout {
+            Readout::Mean => values.sum::<f64>() / steps.max(1) as f64,
+            Readout::Max => values.fold(f64::NEG_INFINITY, f64::max),
+        };
+    }
+    scores
+}
+
+/// The cross-entropy loss of one recording of class `label` and its gradient, added to
+/// `grad` (scaled by `weight`, the recording's share of its batch).
+pub fn loss_and_gradient(
+    net: &Network,
+    input: &SpikeInput,
+    label: usize,
+    rule: Backprop,
+    weight: f64,
+    tr: &mut Trajectory,
+    grad: &mut Gradient,
+) -> f64 {
+    let scores = forward(net, input, rule.act, tr);
+    let p = softmax(&scores);
+    let loss = -p[label].max(f64::MIN_POSITIVE).ln();
+    let dscore: Vec<f64> = p
+        .iter()
+        .enumerate()
+        .map(|(c, &pc)| weight * (pc - f64::from(u8::from(c == label))))
+        .collect();
+    backward(net, input, rule, &dscore, tr, grad);
+    loss
+}
+
+/// Backpropagation through time of the score gradient `dscore` (see the module's
+/// equations).
+fn backward(
+    net: &Network,
+    input: &SpikeInput,
+    rule: Backprop,
+    dscore: &[f64],
+    tr: &Trajectory,
+    grad: &mut Gradient,
+) {
+    let (alpha, beta, kappa) = net.decays();
+    let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
+    let argmax = match net.readout {
+        Readout::Max => Some(argmax_steps(&tr.out, c_n, steps)),
+        Readout::Mean => None,
+    };
+    let mut g_out = vec![0.0; c_n];
+    let mut g_v = vec![0.0; h_n];
+    let mut g_i = vec![0.0; h_n];
+    let mean_share = 1.0 / steps.max(1) as f64;
+    for t in (0..steps).rev() {
+        for c in 0..c_n {
+            let direct = match &argmax {
+                None => dscore[c] * mean_share,
+                Some(at) if at[c] == t => dscore[c],
+                Some(_) => 0.0,
+            };
+            g_out[c] = direct + kappa * g_out[c];
+            grad.b_out[c] += g_out[c];
+        }
+        let pre = &tr.pre[t * h_n..(t + 1) * h_n];
+        let spikes = &tr.spikes[t * h_n..(t + 1) * h_n];
+        for h in 0..h_n {
+            let w = &net.w_out[h * c_n..(h + 1) * c_n];
+            let mut g_s: f64 = w.iter().zip(&g_out).map(|(w, g)| w * g).sum();
+            if spikes[h] != 0.0 {
+                let gw = &mut grad.w_out[h * c_n..(h + 1) * c_n];
+                for (gw, g) in gw.iter_mut().zip(&g_out) {
+                    *gw += spikes[h] * g;
+                }
+            }
+            if !rule.detach_reset {
+                g_s -= pre[h] * g_v[h];
+            }
+            let g_p = g_v[h] * (1.0 - spikes[h]) + g_s * rule.act.derivative(pre[h] - 1.0);
+            g_i[h] = g_p + alpha * g_i[h];
+            g_v[h] = beta * g_p;
+            grad.b_in[h] += g_i[h];
+        }
+        for &i in input.at(t) {
+            let gw = &mut grad.w_in[i as usize * h_n..(i as usize + 1) * h_n];
+            for (gw, g) in gw.iter_mut().zip(&g_i) {
+                *gw += g;
+            }
+        }
+    }
+}
+
+/// For each class, the first step where its readout is largest.
+fn argmax_steps(trace: &[f64], classes: usize, steps: usize) -> Vec<usize> {
+    (0..classes)
+        .map(|c| {
+            let mut best = 0;
+            for t in 1..steps {
+                if trace[t * classes + c] > trace[best * classes + c] {
+                    best = t;
+                }
+            }
+            best
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_net(readout: Readout, seed: u64) -> (Network, SpikeInput) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (inputs, hidden, classes, steps) = (5, 7, 3, 40);
+        let mut w =
+            |n: usize, s: f64| -> Vec<f64> { (0..n).map(|_| rng.gen_range(-s..s)).collect() };
+        let net = Network {
+            inputs,
+            hidden,
+            classes,
+            dt_ms: 5,
+            tau_syn_ms: 10.0,
+            tau_mem_ms: 20.0,
+            tau_out_ms: 15.0,
+            readout,
+            w_in: w(inputs * hidden, 1.5),
+            b_in: w(hidden, 0.2),
+            w_out: w(hidden * classes, 1.0),
+            b_out: w(classes, 0.3),
+        };
+        let mut events = Vec::new();
+        for t in 0..steps as u32 {
+            for i in 0..inputs as u32 {
+                if rng.gen_bool(0.2) {
+                    events.push((t, i));
+                }
+            }
+        }
+        (net, SpikeInput::from_events(inputs, steps, &events))
+    }
+
+    fn loss(net: &Network, input: &SpikeInput, act: Activation) -> f64 {
+        let scores = forward(net, input, act, &mut Trajectory::default());
+        -softmax(&scores)[1].ln()
+    }
+
+    /// The hand-written backward pass against central finite differences of the loss, on
+    /// a network with a smooth spike function (whose loss has a true gradient), the reset
+    /// kept in the graph, and both readouts.
+    #[test]
+    fn gradient_matches_finite_differences() {
+        for (readout, seed) in [(Readout::Mean, 1), (Readout::Max, 2)] {
+            let (net, input) = random_net(readout, seed);
+            let act = Activation::Smooth { k: 4.0 };
+            let mut grad = Gradient::zeros(&net);
+            let mut tr = Trajectory::default();
+            let rule = Backprop {
+                act,
+                detach_reset: false,
+            };
+            loss_and_gradient(&net, &input, 1, rule, 1.0, &mut tr, &mut grad);
+            let eps = 1e-6;
+            let mut checked = 0;
+            for part in 0..4 {
+                for j in 0..grad.parts()[part].len() {
+                    let bump = |d: f64| {
+                        let mut n = net.clone();
+                        [&mut n.w_in, &mut n.b_in, &mut n.w_out, &mut n.b_out][part][j] += d;
+                        loss(&n, &input, act)
+                    };
+                    let numeric = (bump(eps) - bump(-eps)) / (2.0 * eps);
+                    let analytic = grad.parts()[part][j];
+                    let tol = 1e-6 + 1e-4 * numeric.abs().max(analytic.abs());
+                    assert!(
+                        (numeric - analytic).abs() <= tol,
+                        "{readout:?} part {part} [{j}]: numeric {numeric}, backward {analytic}"
+                    );
+                    checked += 1;
+                }
+            }
+            assert_eq!(checked, 5 * 7 + 7 + 7 * 3 + 3);
+            assert!(
+                grad.w_in.iter().any(|g| g.abs() > 1e-4),
+                "a gradient that is all zero checks nothing"
+            );
+        }
+    }
+
+    /// The training forward pass with the spike nonlinearity gives the scores prediction's
+    /// step-by-step runner gives, bit for bit.
+    #[test]
+    fn training_forward_equals_the_runner() {
+        for readout in [Readout::Mean, Readout::Max] {
+            let (net, input) = random_net(readout, 3);
+            let act = Activation::Spike { slope: 10.0 };
+            let mut tr = Trajectory::default();
+            let trained = forward(&net, &input, act, &mut tr);
+            assert_eq!(trained, net.scores(&input));
+            assert!(tr.spikes.contains(&1.0) && tr.spikes.contains(&0.0));
+        }
+    }
+}

@@ -1,0 +1,467 @@
+//! A spiking classifier: a feed-forward network of current-based leaky integrate-and-fire
+//! (LIF) neurons read out by non-spiking leaky integrators, trained with surrogate
+//! gradients through time (Zenke & Ganguli 2018, SuperSpike; Neftci, Mostafa & Zenke 2019).
+//! Its input is the encoder's spike trains, one input per taxel and population, binned to
+//! the network's time step ([`SpikeInput`]); no feature is computed.
+//!
+//! **The network** (discrete time, step `dt`; `α = e^{-dt/τ_syn}`, `β = e^{-dt/τ_mem}`,
+//! `κ = e^{-dt/τ_out}`, threshold 1, reset to 0):
+//!
+//! ```text
+//! I[t] = α I[t-1] + W_in x[t] + b_in        synaptic current of each hidden neuron
+//! P[t] = β V[t-1] + I[t]                     membrane before the spike
+//! S[t] = H(P[t] - 1)                         spike
+//! V[t] = P[t] (1 - S[t])                     reset to zero
+//! O[t] = κ O[t-1] + W_out S[t] + b_out       leaky readout, one per class
+//! ```
+//!
+//! A class's score is the **mean of its readout over time** ([`Readout::Mean`]): a texture
+//! slid over the skin is a stationary process, so evidence is gathered over the whole
+//! window rather than at the one most confident step ([`Readout::Max`], Zenke & Vogels
+//! 2021, is the option). The running mean is what a stream reads as its window grows.
+//!
+//! **Training** ([`train`]): softmax cross-entropy on the scores, gradients by
+//! backpropagation through time written out in [`grad`] (`H'` replaced by the fast-sigmoid
+//! surrogate `1 / (1 + slope |P - 1|)²` of SuperSpike), Adam on mini-batches, and early
+//! stopping on a stratified validation split drawn from the training data. Reset is
+//! detached from the graph by default, as Zenke & Vogels (2021) recommend.
+
+pub mod grad;
+pub mod model;
+pub mod train;
+
+use serde::{Deserialize, Serialize};
+
+use crate::encode::SpikeTrains;
+use crate::error::ParamError;
+
+pub use model::{SnnClassifier, SnnModel};
+pub use train::fit;
+
+/// How a class's score is read from its readout trace.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Readout {
+    /// The mean over the window's steps (the default).
+    Mean,
+    /// The largest value over the window's steps.
+    Max,
+}
+
+impl Readout {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Readout::Mean => "mean",
+            Readout::Max => "max",
+        }
+    }
+}
+
+impl std::str::FromStr for Readout {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        match s {
+            "mean" => Ok(Readout::Mean),
+            "max" => Ok(Readout::Max),
+            _ => Err(ParamError::new(
+                "snn-readout",
+                "readout must be mean or max",
+                s,
+            )),
+        }
+    }
+}
+
+/// The spiking classifier's parameters (defaults chosen a priori; SPEC 11 and
+/// `docs/spiking-classifier.md` give the reasons).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SnnParams {
+    /// Hidden LIF neurons (128).
+    pub hidden: usize,
+    /// The network's time step in ms (10): the encoder's 1 ms spikes are counted in bins
+    /// of this width.
+    pub dt_ms: u32,
+    /// Synaptic time constant, ms (20).
+    pub tau_syn_ms: f64,
+    /// Membrane time constant, ms (40).
+    pub tau_mem_ms: f64,
+    /// Readout time constant, ms (40).
+    pub tau_out_ms: f64,
+    /// How scores are read from the readout.
+    pub readout: Readout,
+    /// Most passes over the training data (60).
+    pub epochs: usize,
+    /// Recordings per gradient step (8).
+    pub batch: usize,
+    /// Adam's step size (0.005).
+    pub learning_rate: f64,
+    /// Share of each class's training recordings held out for early stopping (0.2).
+    pub validation: f64,
+    /// Epochs without a better validation loss before training stops (15).
+    pub patience: usize,
+    /// Slope of the fast-sigmoid surrogate (10).
+    pub slope: f64,
+    /// Keep the reset out of the gradient (true).
+    pub detach_reset: bool,
+    /// Seed of the initial weights, the validation split and the batch order.
+    pub seed: u64,
+}
+
+impl Default for SnnParams {
+    fn default() -> Self {
+        SnnParams {
+            hidden: 128,
+            dt_ms: 10,
+            tau_syn_ms: 20.0,
+            tau_mem_ms: 40.0,
+            tau_out_ms: 40.0,
+            readout: Readout::Mean,
+            epochs: 60,
+            batch: 8,
+            learning_rate: 0.005,
+            validation: 0.2,
+            patience: 15,
+            slope: 10.0,
+            detach_reset: true,
+            seed: 0,
+        }
+    }
+}
+
+/// Largest hidden layer accepted: beyond it a model file and a training run grow past
+/// what these small tactile datasets can fit.
+pub const MAX_HIDDEN: usize = 4096;
+
+impl SnnParams {
+    /// Checks the rules and returns the parameters.
+    ///
+    /// # Errors
+    /// The first rule broken, named by its command-line option.
+    pub fn check(self) -> Result<SnnParams, ParamError> {
+        let positive = |v: f64| v > 0.0 && v.is_finite();
+        if self.hidden == 0 || self.hidden > MAX_HIDDEN {
+            let rule = "the hidden layer must hold 1 to 4096 neurons";
+            return Err(ParamError::new("snn-hidden", rule, self.hidden));
+        }
+        if self.dt_ms == 0 || self.dt_ms > 1000 {
+            let rule = "the time step must be 1 to 1000 ms";
+            return Err(ParamError::new("snn-dt-ms", rule, self.dt_ms));
+        }
+        for (name, v) in [
+            ("snn-tau-syn-ms", self.tau_syn_ms),
+            ("snn-tau-mem-ms", self.tau_mem_ms),
+            ("snn-tau-out-ms", self.tau_out_ms),
+        ] {
+            if !positive(v) {
+                return Err(ParamError::new(
+                    name,
+                    "a time constant must be positive and finite",
+                    v,
+                ));
+            }
+        }
+        if self.epochs == 0 || self.batch == 0 || self.patience == 0 {
+            let rule = "epochs, batch and patience must be at least 1";
+            let got = format!("{} / {} / {}", self.epochs, self.batch, self.patience);
+            return Err(ParamError::new("snn-epochs", rule, got));
+        }
+        if !positive(self.learning_rate) || !positive(self.slope) {
+            let rule = "the learning rate and the surrogate's slope must be positive and finite";
+            let got = format!("{} / {}", self.learning_rate, self.slope);
+            return Err(ParamError::new("snn-learning-rate", rule, got));
+        }
+        if !(self.validation > 0.0 && self.validation < 1.0) {
+            let rule = "the validation share must lie strictly between 0 and 1";
+            return Err(ParamError::new("snn-validation", rule, self.validation));
+        }
+        Ok(self)
+    }
+
+    /// The decay factors `(α, β, κ)` of one step.
+    pub fn decays(&self) -> (f64, f64, f64) {
+        let dt = f64::from(self.dt_ms);
+        (
+            (-dt / self.tau_syn_ms).exp(),
+            (-dt / self.tau_mem_ms).exp(),
+            (-dt / self.tau_out_ms).exp(),
+        )
+    }
+}
+
+/// A recording's spikes as the network's input: for each step of `dt` ms, the inputs that
+/// spiked in it (an input spiking twice in one step is listed twice). Input `p * taxels +
+/// k` is population `p`'s (SA, then FA) `k`-th taxel in row-major grid order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpikeInput {
+    /// Inputs (taxels x populations).
+    pub inputs: usize,
+    /// `offsets[t]..offsets[t + 1]` indexes step `t`'s events in `events`.
+    offsets: Vec<u32>,
+    events: Vec<u32>,
+}
+
+impl SpikeInput {
+    /// Bins `populations` (one or two grids of the same taxels) to steps of `dt_ms`; the
+    /// last step may be partial. The window's steps are `ceil(n_steps / dt_ms)` of the
+    /// first population.
+    ///
+    /// # Panics
+    /// If there is no population or `dt_ms` is 0 (caller bugs).
+    pub fn from_trains(populations: &[&SpikeTrains], dt_ms: u32) -> SpikeInput {
+        assert!(!populations.is_empty() && dt_ms > 0);
+        let dt = dt_ms as usize;
+        let steps = populations[0].n_steps.div_ceil(dt);
+        let mut lists: Vec<(u32, u32)> = Vec::new();
+        let mut input = 0u32;
+        for pop in populations {
+            for cell in (0..pop.cells()).filter(|&c| pop.present[c]) {
+                for &t in pop.train(cell) {
+                    lists.push(((t as usize / dt).min(steps.saturating_sub(1)) as u32, input));
+                }
+                input += 1;
+            }
+        }
+        lists.sort_unstable();
+        SpikeInput::from_events(input as usize, steps, &lists)
+    }
+
+    /// Builds the input from `(step, input)` events sorted by step.
+    ///
+    /// # Panics
+    /// If an event's step or input is out of range or the events are unsorted (caller bugs).
+    pub fn from_events(inputs: usize, steps: usize, events: &[(u32, u32)]) -> SpikeInput {
+        assert!(events.windows(2).all(|w| w[0].0 <= w[1].0));
+        let mut offsets = vec![0u32; steps + 1];
+        for &(t, i) in events {
+            assert!((t as usize) < steps && (i as usize) < inputs);
+            offsets[t as usize + 1] += 1;
+        }
+        for t in 0..steps {
+            offsets[t + 1] += offsets[t];
+        }
+        SpikeInput {
+            inputs,
+            offsets,
+            events: events.iter().map(|e| e.1).collect(),
+        }
+    }
+
+    /// Steps in the window.
+    pub fn steps(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// The inputs that spiked in step `t`.
+    pub fn at(&self, t: usize) -> &[u32] {
+        &self.events[self.offsets[t] as usize..self.offsets[t + 1] as usize]
+    }
+
+    /// Spikes in the window.
+    pub fn total(&self) -> usize {
+        self.events.len()
+    }
+
+    /// The window as a dense `steps x inputs` table of spike counts, row-major (what a
+    /// network's input node receives, step by step).
+    pub fn dense(&self) -> Vec<f32> {
+        let mut out = vec![0f32; self.steps() * self.inputs];
+        for t in 0..self.steps() {
+            for &i in self.at(t) {
+                out[t * self.inputs + i as usize] += 1.0;
+            }
+        }
+        out
+    }
+}
+
+/// The network's weights and constants: everything prediction needs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Network {
+    /// Inputs (taxels x populations).
+    pub inputs: usize,
+    /// Hidden LIF neurons.
+    pub hidden: usize,
+    /// Classes (readout neurons).
+    pub classes: usize,
+    /// The time step, ms.
+    pub dt_ms: u32,
+    /// Synaptic, membrane and readout time constants, ms.
+    pub tau_syn_ms: f64,
+    /// Membrane time constant, ms.
+    pub tau_mem_ms: f64,
+    /// Readout time constant, ms.
+    pub tau_out_ms: f64,
+    /// How scores are read.
+    pub readout: Readout,
+    /// Input weights, input-major: `w_in[i * hidden + h]` from input `i` to neuron `h`.
+    pub w_in: Vec<f64>,
+    /// Hidden biases (a constant current each step).
+    pub b_in: Vec<f64>,
+    /// Readout weights, hidden-major: `w_out[h * classes + c]` from neuron `h` to class `c`.
+    pub w_out: Vec<f64>,
+    /// Readout biases.
+    pub b_out: Vec<f64>,
+}
+
+impl Network {
+    /// The decay factors `(α, β, κ)` of one step.
+    pub fn decays(&self) -> (f64, f64, f64) {
+        let dt = f64::from(self.dt_ms);
+        (
+            (-dt / self.tau_syn_ms).exp(),
+            (-dt / self.tau_mem_ms).exp(),
+            (-dt / self.tau_out_ms).exp(),
+        )
+    }
+
+    /// Checks the shapes and that every weight is finite.
+    ///
+    /// # Errors
+    /// The rule broken, as a sentence.
+    pub fn check(&self) -> Result<(), String> {
+        let shapes = [
+            ("w_in", self.w_in.len(), self.inputs * self.hidden),
+            ("b_in", self.b_in.len(), self.hidden),
+            ("w_out", self.w_out.len(), self.hidden * self.classes),
+            ("b_out", self.b_out.len(), self.classes),
+        ];
+        for (name, got, want) in shapes {
+            if got != want {
+                return Err(format!(
+                    "the network's {name} holds {got} values, not {want}"
+                ));
+            }
+        }
+        if self.inputs == 0 || self.hidden == 0 || self.classes == 0 || self.dt_ms == 0 {
+            return Err("the network has an empty layer or a zero time step".into());
+        }
+        for (name, w) in [
+            ("w_in", &self.w_in),
+            ("b_in", &self.b_in),
+            ("w_out", &self.w_out),
+            ("b_out", &self.b_out),
+        ] {
+            if let Some(pos) = w.iter().position(|v| !v.is_finite()) {
+                return Err(format!("the network's {name}[{pos}] is not finite"));
+            }
+        }
+        let taus = [self.tau_syn_ms, self.tau_mem_ms, self.tau_out_ms];
+        if taus.iter().any(|t| !(*t > 0.0 && t.is_finite())) {
+            return Err("the network's time constants must be positive and finite".into());
+        }
+        Ok(())
+    }
+
+    /// A running copy of the network, for spikes that arrive step by step.
+    pub fn runner(&self) -> Runner<'_> {
+        Runner::new(self)
+    }
+
+    /// The class scores of a whole window.
+    ///
+    /// # Panics
+    /// If the input's width is not the network's (a caller bug).
+    pub fn scores(&self, input: &SpikeInput) -> Vec<f64> {
+        assert_eq!(input.inputs, self.inputs);
+        let mut run = self.runner();
+        for t in 0..input.steps() {
+            run.step(input.at(t));
+        }
+        run.scores()
+    }
+}
+
+/// The network's state, advanced one step at a time.
+#[derive(Debug, Clone)]
+pub struct Runner<'a> {
+    net: &'a Network,
+    decays: (f64, f64, f64),
+    current: Vec<f64>,
+    membrane: Vec<f64>,
+    out: Vec<f64>,
+    /// The readout's sum (mean) or largest value (max) so far.
+    acc: Vec<f64>,
+    steps: usize,
+}
+
+impl<'a> Runner<'a> {
+    fn new(net: &'a Network) -> Self {
+        Runner {
+            net,
+            decays: net.decays(),
+            current: vec![0.0; net.hidden],
+            membrane: vec![0.0; net.hidden],
+            out: vec![0.0; net.classes],
+            acc: vec![0.0; net.classes],
+            steps: 0,
+        }
+    }
+
+    /// Advances one step with the inputs that spiked in it.
+    ///
+    /// # Panics
+    /// If an input index is out of range (a caller bug).
+    pub fn step(&mut self, spiked: &[u32]) {
+        let (alpha, beta, kappa) = self.decays;
+        let net = self.net;
+        let h_n = net.hidden;
+        for (c, b) in self.current.iter_mut().zip(&net.b_in) {
+            *c = alpha * *c + b;
+        }
+        for &i in spiked {
+            let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
+            for (c, w) in self.current.iter_mut().zip(w) {
+                *c += w;
+            }
+        }
+        for (o, b) in self.out.iter_mut().zip(&net.b_out) {
+            *o = kappa * *o + b;
+        }
+        for h in 0..h_n {
+            let p = beta * self.membrane[h] + self.current[h];
+            if p >= 1.0 {
+                self.membrane[h] = 0.0;
+                let w = &net.w_out[h * net.classes..(h + 1) * net.classes];
+                for (o, w) in self.out.iter_mut().zip(w) {
+                    *o += w;
+                }
+            } else {
+                self.membrane[h] = p;
+            }
+        }
+        for (a, &o) in self.acc.iter_mut().zip(&self.out) {
+            *a = match (net.readout, self.steps) {
+                (Readout::Mean, _) => *a + o,
+                (Readout::Max, 0) => o,
+                (Readout::Max, _) => a.max(o),
+            };
+        }
+        self.steps += 1;
+    }
+
+    /// Steps run so far.
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The class scores so far (zeros before the first step).
+    pub fn scores(&self) -> Vec<f64> {
+        match self.net.readout {
+            Readout::Mean => {
+                let n = self.steps.max(1) as f64;
+                self.acc.iter().map(|a| a / n).collect()
+            }
+            Readout::Max => self.acc.clone(),
+        }
+    }
+}
+
+/// Softmax of scores (shifted by their largest value, so nothing overflows).
+pub fn softmax(scores: &[f64]) -> Vec<f64> {
+    let top = scores.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let exp: Vec<f64> = scores.iter().map(|s| (s - top).exp()).collect();
+    let sum: f64 = exp.iter().sum();
+    exp.iter().map(|e| e / sum).collect()
+}

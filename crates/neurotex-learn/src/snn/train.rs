@@ -1,0 +1,348 @@
+//! Training: initial weights scaled to the data, a stratified validation split for early
+//! stopping, Adam on shuffled mini-batches. Every random choice comes from one seeded
+//! ChaCha stream, and a batch's gradients are summed in recording order whatever thread
+//! computed them, so a seed gives the same network on any number of threads.
+
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use rayon::prelude::*;
+
+use super::grad::{forward, loss_and_gradient, Activation, Backprop, Gradient, Trajectory};
+use super::{softmax, Network, SnnParams, SpikeInput};
+use crate::error::ClassifyError;
+
+/// How training went: the epochs run and the one whose network was kept.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrainingLog {
+    /// Epochs run (early stopping may end before [`SnnParams::epochs`]).
+    pub epochs: usize,
+    /// The epoch (1-based) with the lowest validation loss, whose weights are kept.
+    pub best_epoch: usize,
+    /// That validation loss (mean cross-entropy per recording).
+    pub validation_loss: f64,
+}
+
+/// Trains a network on `inputs` with class indices `y` (`classes` of them).
+///
+/// # Errors
+/// No recording, inputs of different widths, no input spike at all, or a class with
+/// too few recordings to put one aside for validation and keep one to train on.
+pub fn fit(
+    params: &SnnParams,
+    inputs: &[&SpikeInput],
+    y: &[usize],
+    classes: usize,
+) -> Result<(Network, TrainingLog), ClassifyError> {
+    check_inputs(inputs, y)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    let (train, valid) = validation_split(y, classes, params.validation, &mut rng)?;
+    let mut net = initial(params, inputs, &train, classes, &mut rng)?;
+    let rule = Backprop {
+        act: Activation::Spike {
+            slope: params.slope,
+        },
+        detach_reset: params.detach_reset,
+    };
+    let mut adam = Adam::new(&net, params.learning_rate);
+    let mut best = (f64::INFINITY, net.clone(), 0);
+    let mut order = train.clone();
+    let mut epochs = 0;
+    for epoch in 1..=params.epochs {
+        epochs = epoch;
+        order.shuffle(&mut rng);
+        for batch in order.chunks(params.batch) {
+            let grad = batch_gradient(&net, inputs, y, batch, rule);
+            adam.step(&mut net, &grad);
+        }
+        let loss = mean_loss(&net, inputs, y, &valid);
+        if loss < best.0 {
+            best = (loss, net.clone(), epoch);
+        } else if epoch - best.2 >= params.patience {
+            break;
+        }
+    }
+    let (validation_loss, mut net, best_epoch) = best;
+    // Weights a float32 file (NIR, NumPy) holds exactly: the model file and its export
+    // predict alike.
+    for w in [&mut net.w_in, &mut net.b_in, &mut net.w_out, &mut net.b_out] {
+        w.iter_mut().for_each(|v| *v = f64::from(*v as f32));
+    }
+    let log = TrainingLog {
+        epochs,
+        best_epoch,
+        validation_loss,
+    };
+    Ok((net, log))
+}
+
+fn check_inputs(inputs: &[&SpikeInput], y: &[usize]) -> Result<(), ClassifyError> {
+    if inputs.is_empty() || inputs.len() != y.len() {
+        return Err(ClassifyError::Empty { what: "train on" });
+    }
+    let width = inputs[0].inputs;
+    if let Some(i) = inputs.iter().position(|x| x.inputs != width) {
+        return Err(ClassifyError::BadFeatures(format!(
+            "recording {i} has {} spike inputs, the first has {width}",
+            inputs[i].inputs
+        )));
+    }
+    if inputs.iter().all(|x| x.total() == 0) {
+        return Err(ClassifyError::BadFeatures(
+            "no training recording has a spike: the spiking classifier has nothing to learn from"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Each class's recordings shuffled, `share` of them (rounded, at least one) set aside for
+/// validation; every class must keep at least one to train on.
+fn validation_split(
+    y: &[usize],
+    classes: usize,
+    share: f64,
+    rng: &mut ChaCha8Rng,
+) -> Result<(Vec<usize>, Vec<usize>), ClassifyError> {
+    let (mut train, mut valid) = (Vec::new(), Vec::new());
+    for c in 0..classes {
+        let mut members: Vec<usize> = (0..y.len()).filter(|&i| y[i] == c).collect();
+        if members.is_empty() {
+            continue;
+        }
+        if members.len() < 2 {
+            return Err(ClassifyError::ValidationTooSmall {
+                class: c,
+                count: members.len(),
+            });
+        }
+        members.shuffle(rng);
+        let held = ((members.len() as f64 * share).round() as usize).clamp(1, members.len() - 1);
+        valid.extend_from_slice(&members[..held]);
+        train.extend_from_slice(&members[held..]);
+    }
+    train.sort_unstable();
+    valid.sort_unstable();
+    Ok((train, valid))
+}
+
+/// Initial weights. The input weights are drawn with mean 0 and the spread that gives the
+/// hidden membranes a standard deviation of about one threshold under the training data's
+/// mean input rate (fluctuation-driven initialisation, Rossbroich, Gygax & Zenke 2022,
+/// with Campbell's theorem for Poisson inputs): `σ² n ν Σ_t k_t² = 1`, `k` the membrane's
+/// response to one input spike. Readout weights are uniform in `±1/√hidden`; biases start
+/// at zero.
+fn initial(
+    params: &SnnParams,
+    inputs: &[&SpikeInput],
+    train: &[usize],
+    classes: usize,
+    rng: &mut ChaCha8Rng,
+) -> Result<Network, ClassifyError> {
+    let n = inputs[0].inputs;
+    let (spikes, steps) = train.iter().fold((0usize, 0usize), |(s, t), &i| {
+        (s + inputs[i].total(), t + inputs[i].steps())
+    });
+    let rate = spikes as f64 / (steps.max(1) * n) as f64;
+    if rate <= 0.0 {
+        return Err(ClassifyError::BadFeatures(
+            "the training recordings of the spiking classifier have no spike".into(),
+        ));
+    }
+    let (alpha, beta, _) = params.decays();
+    let sigma = 1.0 / (n as f64 * rate * kernel_energy(alpha, beta)).sqrt();
+    let normal = Normal::new(0.0, sigma).expect("a finite positive spread");
+    let h = params.hidden;
+    let bound = 1.0 / (h as f64).sqrt();
+    Ok(Network {
+        inputs: n,
+        hidden: h,
+        classes,
+        dt_ms: params.dt_ms,
+        tau_syn_ms: params.tau_syn_ms,
+        tau_mem_ms: params.tau_mem_ms,
+        tau_out_ms: params.tau_out_ms,
+        readout: params.readout,
+        w_in: (0..n * h).map(|_| normal.sample(rng)).collect(),
+        b_in: vec![0.0; h],
+        w_out: (0..h * classes)
+            .map(|_| rng.gen_range(-bound..bound))
+            .collect(),
+        b_out: vec![0.0; classes],
+    })
+}
+
+/// `Σ_t k_t²` of the membrane's response to one unit input,
+/// `k_t = Σ_{s ≤ t} α^s β^{t-s}` (no threshold), summed until it no longer changes.
+fn kernel_energy(alpha: f64, beta: f64) -> f64 {
+    let (mut current, mut membrane, mut energy) = (1.0f64, 0.0f64, 0.0f64);
+    for _ in 0..100_000 {
+        membrane = beta * membrane + current;
+        current *= alpha;
+        energy += membrane * membrane;
+        if membrane < 1e-9 * energy.sqrt() {
+            break;
+        }
+    }
+    energy
+}
+
+/// The batch's mean gradient: each recording's on some thread, summed in batch order.
+fn batch_gradient(
+    net: &Network,
+    inputs: &[&SpikeInput],
+    y: &[usize],
+    batch: &[usize],
+    rule: Backprop,
+) -> Gradient {
+    let weight = 1.0 / batch.len() as f64;
+    let parts: Vec<Gradient> = batch
+        .par_iter()
+        .map_init(Trajectory::default, |tr, &i| {
+            let mut g = Gradient::zeros(net);
+            loss_and_gradient(net, inputs[i], y[i], rule, weight, tr, &mut g);
+            g
+        })
+        .collect();
+    let mut sum = Gradient::zeros(net);
+    for g in &parts {
+        sum.add(g);
+    }
+    sum
+}
+
+/// The mean cross-entropy over `which` (in recording order, so the sum is the same on
+/// any number of threads).
+fn mean_loss(net: &Network, inputs: &[&SpikeInput], y: &[usize], which: &[usize]) -> f64 {
+    let act = Activation::Spike { slope: 1.0 };
+    let losses: Vec<f64> = which
+        .par_iter()
+        .map_init(Trajectory::default, |tr, &i| {
+            let p = softmax(&forward(net, inputs[i], act, tr));
+            -p[y[i]].max(f64::MIN_POSITIVE).ln()
+        })
+        .collect();
+    losses.iter().sum::<f64>() / which.len().max(1) as f64
+}
+
+/// Adam (Kingma & Ba 2015) with its usual constants.
+struct Adam {
+    rate: f64,
+    m: Gradient,
+    v: Gradient,
+    t: i32,
+}
+
+impl Adam {
+    fn new(net: &Network, rate: f64) -> Self {
+        Adam {
+            rate,
+            m: Gradient::zeros(net),
+            v: Gradient::zeros(net),
+            t: 0,
+        }
+    }
+
+    fn step(&mut self, net: &mut Network, grad: &Gradient) {
+        const B1: f64 = 0.9;
+        const B2: f64 = 0.999;
+        const EPS: f64 = 1e-8;
+        self.t += 1;
+        let c1 = 1.0 - B1.powi(self.t);
+        let c2 = 1.0 - B2.powi(self.t);
+        let params = [&mut net.w_in, &mut net.b_in, &mut net.w_out, &mut net.b_out];
+        let ms = [
+            &mut self.m.w_in,
+            &mut self.m.b_in,
+            &mut self.m.w_out,
+            &mut self.m.b_out,
+        ];
+        let vs = [
+            &mut self.v.w_in,
+            &mut self.v.b_in,
+            &mut self.v.w_out,
+            &mut self.v.b_out,
+        ];
+        for (((p, m), v), g) in params.into_iter().zip(ms).zip(vs).zip(grad.parts()) {
+            for j in 0..p.len() {
+                m[j] = B1 * m[j] + (1.0 - B1) * g[j];
+                v[j] = B2 * v[j] + (1.0 - B2) * g[j] * g[j];
+                p[j] -= self.rate * (m[j] / c1) / ((v[j] / c2).sqrt() + EPS);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The kernel's energy against a direct sum of the closed form
+    /// `k_t = (α^{t+1} - β^{t+1}) / (α - β)`.
+    #[test]
+    fn kernel_energy_matches_the_closed_form() {
+        let (a, b) = (0.6f64, 0.8f64);
+        let direct: f64 = (0..5000)
+            .map(|t| ((a.powi(t + 1) - b.powi(t + 1)) / (a - b)).powi(2))
+            .sum();
+        assert!((kernel_energy(a, b) - direct).abs() < 1e-9 * direct);
+    }
+
+    /// Two classes told apart by which input fires: the network learns them, and the same
+    /// seed gives the same network on one thread and on several.
+    #[test]
+    fn learns_a_separable_task_deterministically() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut data = Vec::new();
+        let mut y = Vec::new();
+        for k in 0..40 {
+            let class = k % 2;
+            let mut events = Vec::new();
+            for t in 0..50u32 {
+                for i in 0..4u32 {
+                    let rate = if (i < 2) == (class == 0) { 0.3 } else { 0.05 };
+                    if rng.gen_bool(rate) {
+                        events.push((t, i));
+                    }
+                }
+            }
+            data.push(SpikeInput::from_events(4, 50, &events));
+            y.push(class);
+        }
+        let refs: Vec<&SpikeInput> = data.iter().collect();
+        let params = SnnParams {
+            hidden: 16,
+            epochs: 30,
+            ..SnnParams::default()
+        };
+        let (net, log) = fit(&params, &refs, &y, 2).unwrap();
+        let correct = refs
+            .iter()
+            .zip(&y)
+            .filter(|(x, &c)| {
+                let s = net.scores(x);
+                (s[1] > s[0]) == (c == 1)
+            })
+            .count();
+        assert!(correct >= 36, "{correct} of 40 right, log {log:?}");
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let (again, _) = one.install(|| fit(&params, &refs, &y, 2)).unwrap();
+        assert_eq!(again, net);
+        assert!(log.best_epoch >= 1 && log.epochs <= 30);
+    }
+
+    #[test]
+    fn a_class_of_one_cannot_be_split() {
+        let x = SpikeInput::from_events(2, 3, &[(0, 0)]);
+        let refs = vec![&x, &x, &x];
+        let err = fit(&SnnParams::default(), &refs, &[0, 0, 1], 2).unwrap_err();
+        assert!(matches!(
+            err,
+            ClassifyError::ValidationTooSmall { class: 1, count: 1 }
+        ));
+    }
+}
