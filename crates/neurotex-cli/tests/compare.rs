@@ -313,3 +313,105 @@ fn gain_auto_calibrates_on_the_training_side_of_a_split_and_says_so_otherwise() 
     assert!(cv.status.success(), "{}", cv.stderr);
     assert!(cv.stderr.contains("test folds included"), "{}", cv.stderr);
 }
+
+#[test]
+fn the_spiking_network_runs_in_compare_and_evaluate_on_the_same_folds() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[10.0], 10);
+    let text = dir.ok(&[
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--methods",
+        "spikes,all-taxels",
+        "--classifiers",
+        "linear",
+        "--encodings",
+        "sa+fa",
+        "--snn-epochs",
+        "20",
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let results = v["results"].as_array().unwrap();
+    // all-taxels with linear, spikes with the network (added by the spikes method)
+    assert_eq!(results.len(), 2, "{text}");
+    let snn = results.iter().find(|r| r["method"] == "spikes").unwrap();
+    assert_eq!(snn["classifier"], "snn");
+    let accuracy = snn["accuracy"].as_f64().unwrap();
+    // Three simulated textures at one speed, 10 trials each: well above the 1/3 chance.
+    assert!(accuracy > 0.6, "{accuracy}");
+    let e = dir.evaluate_json(
+        &ds,
+        "spikes",
+        &[
+            "--classifier",
+            "snn",
+            "--encoding",
+            "sa+fa",
+            "--snn-epochs",
+            "20",
+        ],
+    );
+    assert_eq!(e["method"], "spikes");
+    assert_eq!(snn["accuracy"], e["accuracy"]);
+}
+
+#[test]
+fn the_spiking_network_options_are_checked() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 6);
+    let out = dir.join("never");
+    let cmp = |extra: &[&'static str]| -> Vec<&str> {
+        let base = ["compare", "--dataset", s(&ds), "--out", s(&out)];
+        base.iter().copied().chain(extra.iter().copied()).collect()
+    };
+    let eval = |extra: &[&'static str]| -> Vec<&str> {
+        let base = ["evaluate", "--dataset", s(&ds)];
+        base.iter().copied().chain(extra.iter().copied()).collect()
+    };
+    let model = dir.join("never.json");
+    let train = |extra: &[&'static str]| -> Vec<&str> {
+        let base = [
+            "train",
+            "--dataset",
+            s(&ds),
+            "--method",
+            "glcm3d",
+            "--out",
+            s(&model),
+        ];
+        base.iter().copied().chain(extra.iter().copied()).collect()
+    };
+    dir.fails_each(
+        &[
+            (cmp(&["--classifiers", "snn"]), "add spikes to --methods"),
+            (
+                cmp(&["--methods", "spikes", "--snn-hidden", "0"]),
+                "snn-hidden",
+            ),
+            (
+                cmp(&["--methods", "spikes", "--snn-dt-ms", "0"]),
+                "snn-dt-ms",
+            ),
+            (
+                cmp(&["--methods", "spikes", "--snn-readout", "last"]),
+                "mean or max",
+            ),
+            (eval(&["--method", "spikes"]), "spikes with snn"),
+            (
+                eval(&["--method", "glcm3d", "--classifier", "snn"]),
+                "spikes with snn",
+            ),
+            (
+                eval(&["--method", "glcm3d", "--snn-epochs", "3"]),
+                "--classifier snn",
+            ),
+            (
+                train(&["--classifier", "snn"]),
+                "model files do not hold a spiking network",
+            ),
+        ],
+        &out,
+    );
+}

@@ -10,8 +10,8 @@ use std::io::Write;
 use serde_json::Value;
 
 use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split, TaxelAccuracy};
-use crate::classify::{ChosenClassifier, ClassifierChoice, Interval, KnnParams, Metrics};
-use crate::compare::candidates::{candidates, CandidateSet, MethodChoice, VAN_ROSSUM};
+use crate::classify::{ChosenClassifier, ClassifierChoice, Interval, Metrics};
+use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
 use crate::pipeline::{Encoded, Method, Pipeline};
 use crate::recording::{Meta, Selection};
@@ -101,15 +101,17 @@ impl Evaluation {
         )
         .map(|e| Self { advice, ..e })
     }
-
-    /// KNN over the van Rossum distances (kernel `tau_ms`) between the encoded
-    /// recordings' spike trains of the pipeline's populations, the matrix computed once.
+    /// The evaluation of a method that reads spike trains rather than feature rows: KNN
+    /// over van Rossum distances (`van-rossum`, time constant `tau_ms`) or the spiking
+    /// network (`spikes` with [`ClassifierChoice::Snn`]).
     ///
     /// # Errors
-    /// As [`Evaluation::of_features`].
-    pub fn of_spike_timing(
+    /// A classifier the method does not run with, a broken parameter, or a design too
+    /// small for the split.
+    pub fn of_spike_method(
         spikes: Spikes<'_>,
-        knn: KnnParams,
+        method: MethodChoice,
+        classifier: ClassifierChoice,
         tau_ms: f64,
         split: &Split,
         seed: u64,
@@ -121,8 +123,8 @@ impl Evaluation {
         } = spikes;
         let set = CandidateSet {
             encodings: vec![pipeline.params().encoding],
-            methods: vec![MethodChoice::VanRossum],
-            classifiers: vec![ClassifierChoice::Knn(knn)],
+            methods: vec![method],
+            classifiers: vec![classifier],
             tau_ms,
             baselines: false,
         };
@@ -132,8 +134,8 @@ impl Evaluation {
         let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?.advice();
         Self::new(
             outcome,
-            VAN_ROSSUM,
-            Some(tau_ms),
+            method.name(),
+            (method == MethodChoice::VanRossum).then_some(tau_ms),
             split,
             grid,
             None,

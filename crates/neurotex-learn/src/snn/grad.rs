@@ -131,6 +131,19 @@ pub fn forward(
     act: Activation,
     tr: &mut Trajectory,
 ) -> Vec<f64> {
+    // One copy of the loop per nonlinearity, so that each inlines and vectorises.
+    match act {
+        Activation::Spike { .. } => forward_with(net, input, tr, |x| f64::from(u8::from(x >= 0.0))),
+        Activation::Smooth { .. } => forward_with(net, input, tr, |x| act.value(x)),
+    }
+}
+
+fn forward_with(
+    net: &Network,
+    input: &SpikeInput,
+    tr: &mut Trajectory,
+    value: impl Fn(f64) -> f64,
+) -> Vec<f64> {
     let (alpha, beta, kappa) = net.decays();
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
     tr.pre.clear();
@@ -155,13 +168,19 @@ pub fn forward(
         for (o, b) in out.iter_mut().zip(&net.b_out) {
             *o = kappa * *o + b;
         }
-        let (pre, spikes) = (&mut tr.pre[t * h_n..], &mut tr.spikes[t * h_n..]);
-        for h in 0..h_n {
-            let p = beta * membrane[h] + current[h];
-            let s = act.value(p - 1.0);
-            pre[h] = p;
-            spikes[h] = s;
-            membrane[h] = p * (1.0 - s);
+        let pre = &mut tr.pre[t * h_n..(t + 1) * h_n];
+        let spikes = &mut tr.spikes[t * h_n..(t + 1) * h_n];
+        for (((p, s), m), c) in pre
+            .iter_mut()
+            .zip(spikes.iter_mut())
+            .zip(&mut membrane)
+            .zip(&current)
+        {
+            *p = beta * *m + c;
+            *s = value(*p - 1.0);
+            *m = *p * (1.0 - *s);
+        }
+        for (h, &s) in spikes.iter().enumerate() {
             if s != 0.0 {
                 let w = &net.w_out[h * c_n..(h + 1) * c_n];
                 for (o, w) in out.iter_mut().zip(w) {
@@ -220,6 +239,27 @@ fn backward(
     tr: &Trajectory,
     grad: &mut Gradient,
 ) {
+    let detach = rule.detach_reset;
+    match rule.act {
+        Activation::Spike { slope } => backward_with(net, input, detach, dscore, tr, grad, |x| {
+            let d = 1.0 + slope * x.abs();
+            1.0 / (d * d)
+        }),
+        act @ Activation::Smooth { .. } => {
+            backward_with(net, input, detach, dscore, tr, grad, |x| act.derivative(x))
+        }
+    }
+}
+
+fn backward_with(
+    net: &Network,
+    input: &SpikeInput,
+    detach_reset: bool,
+    dscore: &[f64],
+    tr: &Trajectory,
+    grad: &mut Gradient,
+    derivative: impl Fn(f64) -> f64,
+) {
     let (alpha, beta, kappa) = net.decays();
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
     let argmax = match net.readout {
@@ -229,6 +269,14 @@ fn backward(
     let mut g_out = vec![0.0; c_n];
     let mut g_v = vec![0.0; h_n];
     let mut g_i = vec![0.0; h_n];
+    let mut g_s = vec![0.0; h_n];
+    // W_out class-major, for gS = W_out gO over contiguous hidden neurons.
+    let mut w_out_t = vec![0.0; h_n * c_n];
+    for h in 0..h_n {
+        for c in 0..c_n {
+            w_out_t[c * h_n + h] = net.w_out[h * c_n + c];
+        }
+    }
     let mean_share = 1.0 / steps.max(1) as f64;
     for t in (0..steps).rev() {
         for c in 0..c_n {
@@ -242,22 +290,31 @@ fn backward(
         }
         let pre = &tr.pre[t * h_n..(t + 1) * h_n];
         let spikes = &tr.spikes[t * h_n..(t + 1) * h_n];
-        for h in 0..h_n {
-            let w = &net.w_out[h * c_n..(h + 1) * c_n];
-            let mut g_s: f64 = w.iter().zip(&g_out).map(|(w, g)| w * g).sum();
-            if spikes[h] != 0.0 {
+        // gS = W_out gO, class by class over the hidden layer (so the loop vectorises).
+        g_s.iter_mut().for_each(|g| *g = 0.0);
+        for (c, &g) in g_out.iter().enumerate() {
+            for (gs, w) in g_s.iter_mut().zip(&w_out_t[c * h_n..(c + 1) * h_n]) {
+                *gs += w * g;
+            }
+        }
+        for (h, &s) in spikes.iter().enumerate() {
+            if s != 0.0 {
                 let gw = &mut grad.w_out[h * c_n..(h + 1) * c_n];
                 for (gw, g) in gw.iter_mut().zip(&g_out) {
-                    *gw += spikes[h] * g;
+                    *gw += s * g;
                 }
             }
-            if !rule.detach_reset {
-                g_s -= pre[h] * g_v[h];
-            }
-            let g_p = g_v[h] * (1.0 - spikes[h]) + g_s * rule.act.derivative(pre[h] - 1.0);
-            g_i[h] = g_p + alpha * g_i[h];
-            g_v[h] = beta * g_p;
-            grad.b_in[h] += g_i[h];
+        }
+        let reset = f64::from(u8::from(!detach_reset));
+        let neurons = g_s.iter().zip(pre).zip(spikes).zip(&mut g_v).zip(&mut g_i);
+        for ((((&g_s, &p), &s), g_v), g_i) in neurons {
+            let g_sh = g_s - reset * p * *g_v;
+            let g_p = *g_v * (1.0 - s) + g_sh * derivative(p - 1.0);
+            *g_i = g_p + alpha * *g_i;
+            *g_v = beta * g_p;
+        }
+        for (b, g) in grad.b_in.iter_mut().zip(&g_i) {
+            *b += g;
         }
         for &i in input.at(t) {
             let gw = &mut grad.w_in[i as usize * h_n..(i as usize + 1) * h_n];

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
 
-use super::grad::{forward, loss_and_gradient, Activation, Backprop, Gradient, Trajectory};
+use super::grad::{loss_and_gradient, Activation, Backprop, Gradient, Trajectory};
 use super::{softmax, Network, SnnParams, SpikeInput};
 use crate::error::ClassifyError;
 
@@ -215,11 +215,10 @@ fn batch_gradient(
 /// The mean cross-entropy over `which` (in recording order, so the sum is the same on
 /// any number of threads).
 fn mean_loss(net: &Network, inputs: &[&SpikeInput], y: &[usize], which: &[usize]) -> f64 {
-    let act = Activation::Spike { slope: 1.0 };
     let losses: Vec<f64> = which
         .par_iter()
-        .map_init(Trajectory::default, |tr, &i| {
-            let p = softmax(&forward(net, inputs[i], act, tr));
+        .map(|&i| {
+            let p = softmax(&net.scores(inputs[i]));
             -p[y[i]].max(f64::MIN_POSITIVE).ln()
         })
         .collect();

@@ -27,8 +27,9 @@ pub struct EvaluateOptions {
     /// Feature set: `taxel` (each taxel alone, the mean reported), `glcm2d`, `glcm3d`,
     /// `all-taxels` (every taxel's statistics in one vector), `all-taxels-mm` (the same per
     /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`), `spectrum` (each
-    /// taxel's spike counts along the slide in bands of spatial frequency) or `van-rossum`
-    /// (KNN over van Rossum distances between the recordings' spike trains).
+    /// taxel's spike counts along the slide in bands of spatial frequency), `van-rossum`
+    /// (KNN over van Rossum distances between the recordings' spike trains) or `spikes`
+    /// (the spike trains themselves, for the spiking network: `--classifier snn`).
     #[cfg_attr(feature = "cli", arg(long))]
     pub method: MethodChoice,
     /// With `--method van-rossum`: the kernel's time constant in ms (default: the rate
@@ -213,10 +214,10 @@ impl EvaluateOptions {
     /// # Errors
     /// One classifier per taxel, or spike-train distances.
     pub fn one_classifier(&self) -> Result<()> {
-        if self.method == MethodChoice::VanRossum {
+        if !matches!(self.method, MethodChoice::Features(_)) {
             return Err(OptionsError::NotApplicable {
                 option: "--predictions",
-                applies_to: "feature methods, not --method van-rossum",
+                applies_to: "feature methods, not --method van-rossum or spikes",
             }
             .into());
         }
@@ -243,18 +244,19 @@ impl EvaluateOptions {
         let classifier = self.classifier.choice(self.knn.params()?)?;
         let split = self.split()?;
         let columns = self.columns()?;
-        let spike_timing = self.method == MethodChoice::VanRossum;
-        let knn = match (spike_timing, classifier) {
-            (false, _) => None,
-            (true, ClassifierChoice::Knn(knn)) => Some(knn),
-            (true, _) => {
-                return Err(OptionsError::NotApplicable {
-                    option: "--method van-rossum",
-                    applies_to: "KNN (--classifier knn)",
-                }
-                .into())
-            }
+        let fits = match (self.method, classifier) {
+            (MethodChoice::VanRossum, c) => matches!(c, ClassifierChoice::Knn(_)),
+            (MethodChoice::Spikes, c) => matches!(c, ClassifierChoice::Snn(_)),
+            (MethodChoice::Features(_), c) => !matches!(c, ClassifierChoice::Snn(_)),
         };
+        if !fits {
+            return Err(OptionsError::Conflict(format!(
+                "--method {} does not run with --classifier {}: van-rossum classifies with knn, spikes with snn (the spiking network), and the feature methods with knn, forest or linear",
+                self.method.name(),
+                classifier.name()
+            ))
+            .into());
+        }
         let indices = self.indices(dataset)?;
         let calibration = self.calibration_indices(dataset, &indices, stages, on)?;
         let calibrated = calibrated_pipeline(stages, dataset, &calibration, on)?;
@@ -265,8 +267,8 @@ impl EvaluateOptions {
             grid: &grid,
             pipeline: &pipeline,
         };
-        let evaluation = match (self.method, knn) {
-            (MethodChoice::Features(method), _) => Evaluation::of_features(
+        let evaluation = match self.method {
+            MethodChoice::Features(method) => Evaluation::of_features(
                 spikes,
                 method,
                 columns,
@@ -274,10 +276,14 @@ impl EvaluateOptions {
                 &classifier.check()?,
                 self.seed,
             )?,
-            (_, Some(knn)) => {
-                Evaluation::of_spike_timing(spikes, knn, self.tau_ms, &split, self.seed)?
-            }
-            (_, None) => unreachable!("spike timing has its KNN"),
+            spike_method => Evaluation::of_spike_method(
+                spikes,
+                spike_method,
+                classifier,
+                self.tau_ms,
+                &split,
+                self.seed,
+            )?,
         };
         Ok(Evaluated {
             evaluation,

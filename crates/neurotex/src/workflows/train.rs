@@ -71,6 +71,10 @@ impl TrainOptions {
         let params = calibrated.params;
         let pipeline = Pipeline::new(params.clone())?;
         let classifier = self.classifier.choice(self.knn.params()?)?;
+        if matches!(classifier, crate::classify::ClassifierChoice::Snn(_)) {
+            let message = "model files do not hold a spiking network yet: `evaluate --method spikes --classifier snn` and `compare --methods spikes` run it";
+            return Err(crate::error::OptionsError::Conflict(message.into()).into());
+        }
         let columns = match (self.method, self.taxel) {
             (Method::Taxel, Some(cell)) => Columns::Taxel(cell),
             (_, Some(_)) => return Err(super::taxel_not_applicable()),
