@@ -15,6 +15,7 @@ pub mod inspect;
 pub mod model;
 pub mod options;
 pub mod pipeline;
+pub mod spiking_model;
 pub mod stream;
 
 // The layers below, under the names their modules had when they were one crate, so

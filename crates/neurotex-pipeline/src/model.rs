@@ -357,17 +357,7 @@ impl Model {
         reading: &FileReading,
     ) -> Result<(Vec<Encoded>, Vec<LayoutFrom>)> {
         let remembered = self.provenance().layout.as_ref();
-        files
-            .par_iter()
-            .map(|path| {
-                let file = path.display().to_string();
-                let (mut recording, from) = reading.read(path, remembered)?;
-                recording.meta.file = file.clone();
-                let encoded = self.encode(&recording).map_err(|e| e.in_recording(&file))?;
-                Ok((encoded, from))
-            })
-            .collect::<Result<Vec<_>>>()
-            .map(|pairs| pairs.into_iter().unzip())
+        encode_files(&self.pipeline, self.baseline(), remembered, files, reading)
     }
 
     /// Writes one CSV row per recording: `file,label,predicted`, then `share_<class>` for
@@ -382,20 +372,7 @@ impl Model {
         predictions: &[Prediction],
         known: bool,
     ) -> std::io::Result<()> {
-        let mut out = csv::Writer::from_writer(w);
-        let shares = self.labels().iter().map(|l| format!("share_{l}"));
-        let header: Vec<String> = ["file", "label", "predicted"]
-            .map(String::from)
-            .into_iter()
-            .chain(shares)
-            .collect();
-        out.write_record(&header)?;
-        for (e, p) in encoded.iter().zip(predictions) {
-            let label = if known { e.meta.label.as_str() } else { "" };
-            let ids = [e.meta.file.as_str(), label, p.predicted.as_str()].map(String::from);
-            out.write_record(ids.into_iter().chain(p.shares.iter().map(f64::to_string)))?;
-        }
-        out.flush()
+        write_predictions(w, self.labels(), encoded, predictions, known)
     }
 
     /// Predicts the class of each encoded recording, in parallel.
@@ -511,31 +488,7 @@ impl Model {
     /// # Panics
     /// If `truth` and `predictions` differ in length (a caller bug).
     pub fn score(&self, truth: &[String], predictions: &[Prediction]) -> Result<Score> {
-        assert_eq!(
-            truth.len(),
-            predictions.len(),
-            "one true label per prediction"
-        );
-        if truth.is_empty() {
-            return Err(ClassifyError::Empty { what: "score" }.into());
-        }
-        let labels = &self.file.labels;
-        let index = |label: &str| labels.iter().position(|l| l == label);
-        let y = truth
-            .iter()
-            .map(|t| index(t).ok_or_else(|| ClassifyError::UnknownTestLabel { label: t.clone() }))
-            .collect::<Result<Vec<_>, _>>()?;
-        let predicted: Vec<usize> = predictions
-            .iter()
-            .map(|p| index(&p.predicted).unwrap_or(0))
-            .collect();
-        let confusion = ConfusionMatrix::from_predictions(&y, &predicted, labels.len());
-        Ok(Score {
-            accuracy: confusion.accuracy(),
-            n: y.len(),
-            labels: labels.clone(),
-            confusion,
-        })
+        score(&self.file.labels, truth, predictions)
     }
 
     /// The class labels, in the order of [`Prediction::shares`].
@@ -663,6 +616,97 @@ fn fit(file: &ModelFile, dims: usize) -> Result<ChosenModel> {
         .collect::<Result<Vec<_>>>()?;
     let classifier = file.classifier.check()?;
     Ok(classifier.fit(&training.rows.concat(), dims, &y)?)
+}
+
+/// Scores `predictions` against the true labels `truth` for a model of classes `labels`
+/// (see [`Model::score`]).
+///
+/// # Errors
+/// As [`Model::score`].
+pub(crate) fn score(
+    labels: &[String],
+    truth: &[String],
+    predictions: &[Prediction],
+) -> Result<Score> {
+    assert_eq!(
+        truth.len(),
+        predictions.len(),
+        "one true label per prediction"
+    );
+    if truth.is_empty() {
+        return Err(ClassifyError::Empty { what: "score" }.into());
+    }
+    let index = |label: &str| labels.iter().position(|l| l == label);
+    let y = truth
+        .iter()
+        .map(|t| index(t).ok_or_else(|| ClassifyError::UnknownTestLabel { label: t.clone() }))
+        .collect::<Result<Vec<_>, _>>()?;
+    let predicted: Vec<usize> = predictions
+        .iter()
+        .map(|p| index(&p.predicted).unwrap_or(0))
+        .collect();
+    let confusion = ConfusionMatrix::from_predictions(&y, &predicted, labels.len());
+    Ok(Score {
+        accuracy: confusion.accuracy(),
+        n: y.len(),
+        labels: labels.to_vec(),
+        confusion,
+    })
+}
+
+/// Reads and encodes `files` with `pipeline` and `baseline` (see [`Model::encode_files`];
+/// `remembered` is the training dataset's layout).
+///
+/// # Errors
+/// As [`Model::encode_files`].
+pub(crate) fn encode_files(
+    pipeline: &Pipeline,
+    baseline: Baseline,
+    remembered: Option<&LayoutFile>,
+    files: &[PathBuf],
+    reading: &FileReading,
+) -> Result<(Vec<Encoded>, Vec<LayoutFrom>)> {
+    files
+        .par_iter()
+        .map(|path| {
+            let file = path.display().to_string();
+            let (mut recording, from) = reading.read(path, remembered)?;
+            recording.meta.file = file.clone();
+            let encoded = pipeline
+                .encode(&recording, baseline)
+                .map_err(|e| e.in_recording(&file))?;
+            Ok((encoded, from))
+        })
+        .collect::<Result<Vec<_>>>()
+        .map(|pairs| pairs.into_iter().unzip())
+}
+
+/// Writes one CSV row per recording for a model of classes `labels` (see
+/// [`Model::write_predictions`]).
+///
+/// # Errors
+/// `w` fails.
+pub fn write_predictions(
+    w: &mut dyn std::io::Write,
+    labels: &[String],
+    encoded: &[Encoded],
+    predictions: &[Prediction],
+    known: bool,
+) -> std::io::Result<()> {
+    let mut out = csv::Writer::from_writer(w);
+    let shares = labels.iter().map(|l| format!("share_{l}"));
+    let header: Vec<String> = ["file", "label", "predicted"]
+        .map(String::from)
+        .into_iter()
+        .chain(shares)
+        .collect();
+    out.write_record(&header)?;
+    for (e, p) in encoded.iter().zip(predictions) {
+        let label = if known { e.meta.label.as_str() } else { "" };
+        let ids = [e.meta.file.as_str(), label, p.predicted.as_str()].map(String::from);
+        out.write_record(ids.into_iter().chain(p.shares.iter().map(f64::to_string)))?;
+    }
+    out.flush()
 }
 
 #[cfg(test)]

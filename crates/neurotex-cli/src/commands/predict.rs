@@ -8,6 +8,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 use neurotex::model::Model;
 use neurotex::pipeline::Encoded;
+use neurotex::spiking_model::SpikingModel;
 use neurotex::stream::write_episodes;
 use neurotex::workflows::predict::PredictOptions;
 
@@ -43,6 +44,9 @@ pub fn run(args: PredictArgs) -> Result<()> {
     }
     let dataset = o.dataset()?;
     check_output(&args.out, &o.inputs(dataset.as_ref()))?;
+    if SpikingModel::is_spiking(&o.model) {
+        return predict_spiking(&args, dataset.as_ref());
+    }
     let model = Model::load(&o.model)?;
     let progress = Shown::new("starting");
     let encoded = o.encode(&model, dataset.as_ref(), &progress.callback());
@@ -68,6 +72,51 @@ pub fn run(args: PredictArgs) -> Result<()> {
     }
     eprintln!(
         "{} recordings predicted with {} -> {}",
+        predictions.len(),
+        o.model.display(),
+        shown(&args.out)
+    );
+    Ok(())
+}
+
+/// Predicts with a spiking network (a model trained with `--classifier snn`).
+fn predict_spiking(
+    args: &PredictArgs,
+    dataset: Option<&neurotex::recording::Dataset>,
+) -> Result<()> {
+    let o = &args.options;
+    if o.causal {
+        bail!(
+            "{}: --causal is not yet run for spiking networks; predict whole recordings without it",
+            o.model.display()
+        );
+    }
+    let model = SpikingModel::load(&o.model)?;
+    let progress = Shown::new("starting");
+    let encoded = o.encode_with(
+        model.pipeline(),
+        model.baseline(),
+        dataset,
+        &progress.callback(),
+        |files, reading| model.encode_files(files, reading),
+    );
+    progress.finish();
+    let encoded = encoded?;
+    let predictions = model.predict(&encoded)?;
+    let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
+    let score = match args.json {
+        true => Some(model.score(&truth, &predictions)?),
+        false => None,
+    };
+    let known = dataset.is_some();
+    write_file(&args.out, "predictions", |w| {
+        neurotex::model::write_predictions(w, model.labels(), &encoded, &predictions, known)
+    })?;
+    if let Some(score) = score {
+        println!("{}", serde_json::to_string(&score)?);
+    }
+    eprintln!(
+        "{} recordings predicted with the spiking network of {} -> {}",
         predictions.len(),
         o.model.display(),
         shown(&args.out)

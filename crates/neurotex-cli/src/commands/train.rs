@@ -30,6 +30,27 @@ pub fn run(args: TrainArgs) -> Result<()> {
     let dataset = o.open.open(&o.dataset)?;
     check_output(&args.out, &dataset.files())?;
     let shown = Shown::new("starting");
+    if o.spiking() {
+        let trained = o.run_spiking(&dataset, &args.stages.options, &shown.callback());
+        shown.finish();
+        let trained = trained?;
+        let model = &trained.model;
+        model.save(&args.out)?;
+        let net = model.network();
+        eprintln!(
+            "{} on {} recordings of {} classes ({} inputs: taxels x populations; best validation loss {:.3} at epoch {} of {}) on the {} grid -> {}",
+            neurotex::classify::ClassifierChoice::Snn(model.params()),
+            model.training().recordings,
+            model.labels().len(),
+            net.inputs,
+            trained.log.validation_loss,
+            trained.log.best_epoch,
+            trained.log.epochs,
+            trained.grid,
+            args.out.display()
+        );
+        return Ok(());
+    }
     let trained = o.run(&dataset, &args.stages.options, &shown.callback())?;
     shown.finish();
     let model = &trained.model;

@@ -10,9 +10,9 @@ use super::{say_conditions, OnProgress, OpenOptions, ReadOptions};
 use crate::causal::{episode_decisions, Episode};
 use crate::error::OptionsError;
 use crate::model::Model;
-use crate::pipeline::Encoded;
+use crate::pipeline::{Encoded, Pipeline};
 use crate::progress::Progress;
-use crate::recording::Dataset;
+use crate::recording::{Baseline, Dataset, FileReading, LayoutFrom};
 use crate::Result;
 
 /// Options of `predict`.
@@ -85,10 +85,32 @@ impl PredictOptions {
         dataset: Option<&Dataset>,
         on: OnProgress,
     ) -> Result<Vec<Encoded>> {
+        self.encode_with(
+            model.pipeline(),
+            model.baseline(),
+            dataset,
+            on,
+            |files, reading| model.encode_files(files, reading),
+        )
+    }
+
+    /// Encodes the recordings with `pipeline` and `baseline` (a model's), the files given
+    /// through `encode_files` (the model's reading of plain files).
+    ///
+    /// # Errors
+    /// A recording that cannot be read, or does not fit the model.
+    pub fn encode_with(
+        &self,
+        pipeline: &Pipeline,
+        baseline: Baseline,
+        dataset: Option<&Dataset>,
+        on: OnProgress,
+        encode_files: impl Fn(&[PathBuf], &FileReading) -> Result<(Vec<Encoded>, Vec<LayoutFrom>)>,
+    ) -> Result<Vec<Encoded>> {
         let encoded = match dataset {
-            Some(dataset) => encode_dataset(model, dataset, on)?,
+            Some(dataset) => encode_dataset(pipeline, baseline, dataset, on)?,
             None => {
-                let (encoded, from) = model.encode_files(&self.files, &self.read.reading()?)?;
+                let (encoded, from) = encode_files(&self.files, &self.read.reading()?)?;
                 for note in ReadOptions::layout_notes(&from) {
                     on(Progress::Say(&note));
                 }
@@ -120,19 +142,21 @@ impl PredictOptions {
     }
 }
 
-/// Encodes every recording of `dataset` with the model's pipeline.
-fn encode_dataset(model: &Model, dataset: &Dataset, on: OnProgress) -> Result<Vec<Encoded>> {
+/// Encodes every recording of `dataset` with a model's pipeline and baseline.
+fn encode_dataset(
+    pipeline: &Pipeline,
+    baseline: Baseline,
+    dataset: &Dataset,
+    on: OnProgress,
+) -> Result<Vec<Encoded>> {
     let layout_baseline = dataset.layout.baseline.unwrap_or_default();
-    if layout_baseline != model.baseline() {
+    if layout_baseline != baseline {
         on(Progress::Say(&format!(
-            "note: the model removes baseline `{}` as in training; {} says `{layout_baseline}`",
-            model.baseline(),
+            "note: the model removes baseline `{baseline}` as in training; {} says `{layout_baseline}`",
             dataset.root.join("layout.toml").display()
         )));
     }
     let all: Vec<usize> = (0..dataset.entries.len()).collect();
     on(Progress::Stage("encoding", all.len()));
-    model
-        .pipeline()
-        .encode_dataset(dataset, &all, &|| on(Progress::Tick))
+    pipeline.encode_dataset(dataset, &all, &|| on(Progress::Tick))
 }

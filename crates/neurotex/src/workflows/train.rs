@@ -3,13 +3,19 @@
 
 use std::path::PathBuf;
 
-use super::{calibrated_pipeline, feature_table, indices_at, ClassifierOptions, KnnOptions};
+use super::{
+    calibrated_pipeline, encode_all, feature_table, indices_at, ClassifierOptions, KnnOptions,
+};
 use super::{OnProgress, OpenOptions};
 use crate::analysis::Columns;
+use crate::classify::ClassifierChoice;
 use crate::model::{Model, Provenance};
 use crate::options::StageOptions;
 use crate::pipeline::{Method, Pipeline};
+use crate::progress::Progress;
 use crate::recording::Dataset;
+use crate::snn::train::TrainingLog;
+use crate::spiking_model::SpikingModel;
 use crate::{Cell, Grid, Result, Speed};
 
 /// Options of `train`.
@@ -27,7 +33,8 @@ pub struct TrainOptions {
     pub speeds: Option<Vec<Speed>>,
     /// Feature set: `taxel`, `glcm2d`, `glcm3d` (the paper's spatio-temporal approach),
     /// `all-taxels`, `all-taxels-mm`, `glcm3d-multi` or `spectrum` (spike counts along the
-    /// slide in bands of spatial frequency; not with `--causal`).
+    /// slide in bands of spatial frequency; not with `--causal`). Not read by
+    /// `--classifier snn`, whose network reads the spike trains themselves.
     #[cfg_attr(feature = "cli", arg(long, default_value = "glcm3d"))]
     pub method: Method,
     /// With `--method taxel`: classify with this one taxel's statistics, as `ROW,COL`.
@@ -71,8 +78,8 @@ impl TrainOptions {
         let params = calibrated.params;
         let pipeline = Pipeline::new(params.clone())?;
         let classifier = self.classifier.choice(self.knn.params()?)?;
-        if matches!(classifier, crate::classify::ClassifierChoice::Snn(_)) {
-            let message = "model files do not hold a spiking network yet: `evaluate --method spikes --classifier snn` and `compare --methods spikes` run it";
+        if matches!(classifier, ClassifierChoice::Snn(_)) {
+            let message = "a spiking network is trained with TrainOptions::run_spiking";
             return Err(crate::error::OptionsError::Conflict(message.into()).into());
         }
         let columns = match (self.method, self.taxel) {
@@ -91,5 +98,62 @@ impl TrainOptions {
         };
         let model = Model::train(&params, &table, columns, classifier, provenance)?;
         Ok(Trained { model, grid })
+    }
+}
+
+/// A spiking network, how its training went, and the grid of its training recordings.
+#[derive(Debug)]
+pub struct TrainedSpiking {
+    /// The model.
+    pub model: SpikingModel,
+    /// Epochs run and the one kept.
+    pub log: TrainingLog,
+    /// The training recordings' grid.
+    pub grid: Grid,
+}
+
+impl TrainOptions {
+    /// Whether the options train the spiking network (`--classifier snn`).
+    pub fn spiking(&self) -> bool {
+        matches!(self.classifier.classifier, ClassifierChoice::Snn(_))
+    }
+
+    /// Trains the spiking network (`--classifier snn`) on the spike trains of `dataset`'s
+    /// recordings, encoded with the stage options `stages`.
+    ///
+    /// # Errors
+    /// Options out of range, recordings that cannot be read, or a training set too small
+    /// for the validation split.
+    pub fn run_spiking(
+        &self,
+        dataset: &Dataset,
+        stages: &StageOptions,
+        on: OnProgress,
+    ) -> Result<TrainedSpiking> {
+        let ClassifierChoice::Snn(snn) = self.classifier.choice(self.knn.params()?)? else {
+            let message = "run_spiking trains --classifier snn";
+            return Err(crate::error::OptionsError::Conflict(message.into()).into());
+        };
+        if self.taxel.is_some() {
+            return Err(super::taxel_not_applicable());
+        }
+        let indices = indices_at(dataset, self.speeds.as_deref())?;
+        let calibrated = calibrated_pipeline(stages, dataset, &indices, on)?;
+        let params = calibrated.params;
+        let pipeline = Pipeline::new(params.clone())?;
+        let (encoded, grid) = encode_all(dataset, &pipeline, &indices, on)?;
+        let provenance = Provenance {
+            gain_calibration: calibrated.gain,
+            median_duration_ms: calibrated.causal.map(|c| c.median_duration_ms),
+            ..Provenance::of(dataset, self.speeds.clone())?
+        };
+        on(Progress::Say(&format!(
+            "training a {} on {} recordings; {:.0} % of each class held out for early stopping",
+            ClassifierChoice::Snn(snn),
+            encoded.len(),
+            snn.validation * 100.0
+        )));
+        let (model, log) = SpikingModel::train(&params, &encoded, &grid, snn, provenance)?;
+        Ok(TrainedSpiking { model, log, grid })
     }
 }

@@ -1,0 +1,326 @@
+//! Saved spiking classifiers: a network trained on a dataset's spike trains
+//! ([`crate::snn`]), with the pipeline that makes those spikes, in one versioned JSON file
+//! of its own format (`neurotex-snn-model`). Unlike a feature model ([`crate::model`]),
+//! which keeps its training rows and re-fits on load, it keeps the trained weights:
+//! training a network takes seconds to minutes, and its weights are what a neuromorphic
+//! chip or another simulator runs. The weights are float32 values, so a float32 export
+//! holds them exactly.
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{ClassifyError, DataError, ModelError, Result};
+use crate::model::{Prediction, Provenance, Score};
+use crate::pipeline::{taxel_cells, Encoded, Pipeline, PipelineParams};
+use crate::recording::{Baseline, FileReading, LayoutFrom};
+use crate::snn::{softmax, train::TrainingLog, Network, SnnParams, SpikeInput};
+use crate::values::Grid;
+
+/// The `format` field of a spiking model file.
+pub const FORMAT: &str = "neurotex-snn-model";
+/// The version of the spiking model format this neurotex writes and reads.
+pub const VERSION: u64 = 1;
+
+/// How the network was trained.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpikingTraining {
+    /// The training dataset.
+    pub dataset: Provenance,
+    /// Training recordings (validation split included).
+    pub recordings: usize,
+    /// Epochs run.
+    pub epochs: usize,
+    /// The epoch whose weights were kept (lowest validation loss).
+    pub best_epoch: usize,
+    /// Its validation loss.
+    pub validation_loss: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct SpikingFile {
+    format: String,
+    version: u64,
+    neurotex_version: String,
+    pipeline: PipelineParams,
+    grid: Grid,
+    /// The training parameters.
+    classifier: SnnParams,
+    labels: Vec<String>,
+    training: SpikingTraining,
+    network: Network,
+}
+
+/// A trained spiking classifier and the pipeline that feeds it.
+#[derive(Debug, Clone)]
+pub struct SpikingModel {
+    file: SpikingFile,
+    pipeline: Pipeline,
+}
+
+impl PartialEq for SpikingModel {
+    fn eq(&self, other: &Self) -> bool {
+        self.file == other.file
+    }
+}
+
+/// A recording's spikes as the network's input: its populations in the pipeline's order
+/// (SA then FA for `sa+fa`), each taxel one input, binned to `dt_ms`.
+pub fn spike_input(encoded: &Encoded, dt_ms: u32) -> SpikeInput {
+    let populations: Vec<_> = encoded.populations().collect();
+    SpikeInput::from_trains(&populations, dt_ms)
+}
+
+impl SpikingModel {
+    /// Trains a network with `snn` on the recordings `encoded` (conditioned and encoded
+    /// with `params`, all on `grid`).
+    ///
+    /// # Errors
+    /// Fewer than two classes, a class too small for the validation split, recordings
+    /// without spikes, or a broken parameter.
+    pub fn train(
+        params: &PipelineParams,
+        encoded: &[Encoded],
+        grid: &Grid,
+        snn: SnnParams,
+        dataset: Provenance,
+    ) -> Result<(SpikingModel, TrainingLog)> {
+        let snn = snn.check()?;
+        let mut labels: Vec<String> = Vec::new();
+        for e in encoded {
+            if !labels.contains(&e.meta.label) {
+                labels.push(e.meta.label.clone());
+            }
+        }
+        if labels.len() < 2 {
+            let label = labels.first().cloned().unwrap_or_default();
+            return Err(ClassifyError::OneClass {
+                label,
+                what: "train",
+            }
+            .into());
+        }
+        let y: Vec<usize> = encoded
+            .iter()
+            .map(|e| labels.iter().position(|l| *l == e.meta.label).unwrap_or(0))
+            .collect();
+        let inputs: Vec<SpikeInput> = encoded
+            .par_iter()
+            .map(|e| spike_input(e, snn.dt_ms))
+            .collect();
+        let refs: Vec<&SpikeInput> = inputs.iter().collect();
+        let (network, log) = crate::snn::fit(&snn, &refs, &y, labels.len())?;
+        let file = SpikingFile {
+            format: FORMAT.into(),
+            version: VERSION,
+            neurotex_version: env!("CARGO_PKG_VERSION").into(),
+            pipeline: params.clone(),
+            grid: grid.clone(),
+            classifier: snn,
+            labels,
+            training: SpikingTraining {
+                dataset,
+                recordings: encoded.len(),
+                epochs: log.epochs,
+                best_epoch: log.best_epoch,
+                validation_loss: log.validation_loss,
+            },
+            network,
+        };
+        Ok((SpikingModel::assemble(file)?, log))
+    }
+
+    /// Checks a file's content: the network's weights, and that its shape fits the
+    /// pipeline (one input per taxel and population, one readout per label).
+    fn assemble(file: SpikingFile) -> Result<SpikingModel> {
+        let inconsistent = |what: String| -> crate::Error { ModelError::Inconsistent(what).into() };
+        file.network.check().map_err(inconsistent)?;
+        let grid = Grid::masked(
+            file.grid.rows(),
+            file.grid.cols(),
+            file.grid.present().to_vec(),
+        )?;
+        let taxels = taxel_cells(grid.present()).count();
+        let populations = file.pipeline.encoding.prefixes().len();
+        let net = &file.network;
+        if net.inputs != taxels * populations {
+            return Err(inconsistent(format!(
+                "the network has {} inputs, but the pipeline gives {taxels} taxels x {populations} population(s) = {}",
+                net.inputs,
+                taxels * populations
+            )));
+        }
+        if net.classes != file.labels.len() {
+            return Err(inconsistent(format!(
+                "the network has {} outputs for {} labels",
+                net.classes,
+                file.labels.len()
+            )));
+        }
+        let mut resolved = file.pipeline.clone();
+        let baseline = resolved.preprocess.baseline;
+        resolved.preprocess.baseline = Some(baseline.unwrap_or(file.training.dataset.baseline));
+        let pipeline = Pipeline::new(resolved)?;
+        Ok(SpikingModel { file, pipeline })
+    }
+
+    /// Writes the model to `path` as pretty-printed JSON, whole or not at all.
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        crate::io::write_atomic(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &self.file).map_err(std::io::Error::other)?;
+            writeln!(w)
+        })
+    }
+
+    /// Whether the file at `path` claims to be a spiking model (its `format`), read
+    /// without checking the rest.
+    pub fn is_spiking(path: &Path) -> bool {
+        #[derive(Deserialize)]
+        struct Header {
+            format: Option<serde_json::Value>,
+        }
+        let Ok(bytes) = std::fs::read(path) else {
+            return false;
+        };
+        serde_json::from_slice::<Header>(&bytes)
+            .ok()
+            .and_then(|h| h.format)
+            .is_some_and(|f| f == FORMAT)
+    }
+
+    /// Reads a spiking model file written by [`SpikingModel::save`].
+    ///
+    /// # Errors
+    /// An unreadable file, another format or version, or damaged content (a non-finite
+    /// weight, a network that does not fit the pipeline), naming the file and the rule.
+    pub fn load(path: &Path) -> Result<SpikingModel> {
+        let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+        let damaged = |reason: String| -> crate::Error {
+            ModelError::Damaged {
+                path: path.to_path_buf(),
+                reason,
+            }
+            .into()
+        };
+        let value: serde_json::Value =
+            serde_json::from_slice(&bytes).map_err(|e| damaged(e.to_string()))?;
+        let text = |v: Option<&serde_json::Value>| v.map_or("missing".into(), |v| v.to_string());
+        if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
+            return Err(ModelError::NotAModel {
+                path: path.to_path_buf(),
+                found: text(value.get("format")),
+            }
+            .into());
+        }
+        if value.get("version").and_then(|v| v.as_u64()) != Some(VERSION) {
+            return Err(ModelError::UnsupportedVersion {
+                path: path.to_path_buf(),
+                found: text(value.get("version")),
+            }
+            .into());
+        }
+        let file: SpikingFile =
+            serde_json::from_value(value).map_err(|e| damaged(e.to_string()))?;
+        SpikingModel::assemble(file).map_err(|e| damaged(e.to_string()))
+    }
+
+    /// Reads and encodes `files` as the training recordings were (see
+    /// [`crate::model::Model::encode_files`]).
+    ///
+    /// # Errors
+    /// A file that cannot be read or encoded, named.
+    pub fn encode_files(
+        &self,
+        files: &[PathBuf],
+        reading: &FileReading,
+    ) -> Result<(Vec<Encoded>, Vec<LayoutFrom>)> {
+        let remembered = self.file.training.dataset.layout.as_ref();
+        crate::model::encode_files(&self.pipeline, self.baseline(), remembered, files, reading)
+    }
+
+    /// Predicts each encoded recording's class, in parallel.
+    ///
+    /// # Errors
+    /// A recording on another grid than the model's.
+    pub fn predict(&self, encoded: &[Encoded]) -> Result<Vec<Prediction>> {
+        for e in encoded {
+            if e.spikes.grid() != self.file.grid {
+                return Err(ModelError::OtherGrid {
+                    file: e.meta.file.clone(),
+                    found: e.spikes.grid(),
+                    expected: self.file.grid.clone(),
+                }
+                .into());
+            }
+        }
+        let net = &self.file.network;
+        Ok(encoded
+            .par_iter()
+            .map(|e| {
+                let shares = softmax(&net.scores(&spike_input(e, net.dt_ms)));
+                let best =
+                    (0..shares.len()).fold(0, |b, c| if shares[c] > shares[b] { c } else { b });
+                Prediction {
+                    predicted: self.file.labels[best].clone(),
+                    shares,
+                }
+            })
+            .collect())
+    }
+
+    /// Scores predictions against true labels (see [`crate::model::Model::score`]).
+    ///
+    /// # Errors
+    /// No predictions, or a label the model does not know.
+    pub fn score(&self, truth: &[String], predictions: &[Prediction]) -> Result<Score> {
+        crate::model::score(&self.file.labels, truth, predictions)
+    }
+
+    /// The class labels, in the order of the network's outputs.
+    pub fn labels(&self) -> &[String] {
+        &self.file.labels
+    }
+
+    /// The network.
+    pub fn network(&self) -> &Network {
+        &self.file.network
+    }
+
+    /// The training parameters.
+    pub fn params(&self) -> SnnParams {
+        self.file.classifier
+    }
+
+    /// How training went.
+    pub fn training(&self) -> &SpikingTraining {
+        &self.file.training
+    }
+
+    /// The taxel grid recordings must have.
+    pub fn grid(&self) -> &Grid {
+        &self.file.grid
+    }
+
+    /// The pipeline as trained.
+    pub fn pipeline_params(&self) -> &PipelineParams {
+        &self.file.pipeline
+    }
+
+    /// The planned pipeline, the baseline resolved.
+    pub fn pipeline(&self) -> &Pipeline {
+        &self.pipeline
+    }
+
+    /// The baseline applied to every recording.
+    pub fn baseline(&self) -> Baseline {
+        self.file
+            .pipeline
+            .preprocess
+            .baseline
+            .unwrap_or(self.file.training.dataset.baseline)
+    }
+}
