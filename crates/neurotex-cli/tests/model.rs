@@ -359,3 +359,89 @@ fn a_spectrum_model_trains_and_predicts_but_is_refused_for_streams() {
     assert!(err.contains("no running form"), "{err}");
     assert!(!causal.exists());
 }
+
+#[test]
+fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[10.0], 8);
+    let model = dir.join("snn.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&ds),
+        "--classifier",
+        "snn",
+        "--encoding",
+        "sa+fa",
+        "--snn-epochs",
+        "15",
+        "--out",
+        s(&model),
+    ]);
+    let file: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(file["format"], "neurotex-snn-model");
+    let net = &file["network"];
+    // 4x4 simulated taxels, SA and FA: 32 inputs; 3 classes.
+    assert_eq!(net["inputs"], 32);
+    assert_eq!(net["classes"], 3);
+    let out = dir.join("pred.csv");
+    let text = dir.ok(&[
+        "predict",
+        "--model",
+        s(&model),
+        "--dataset",
+        s(&ds),
+        "--out",
+        s(&out),
+        "--json",
+    ]);
+    let score: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(score["n"], 24);
+    // Trained on these recordings (80 % of them; 20 % for early stopping).
+    assert!(score["accuracy"].as_f64().unwrap() > 0.6, "{score}");
+    let csv = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        csv.starts_with("file,label,predicted,share_A,share_B,share_C"),
+        "{csv}"
+    );
+    // A network that does not fit its pipeline: one population where it was trained on two.
+    let mut wrong = file.clone();
+    wrong["pipeline"]["encoding"] = Value::from("sa");
+    let damaged = dir.join("damaged.json");
+    std::fs::write(&damaged, serde_json::to_string(&wrong).unwrap()).unwrap();
+    let never = dir.join("never.csv");
+    let predict = |m: &Path| -> Vec<String> {
+        [
+            "predict",
+            "--model",
+            s(m),
+            "--dataset",
+            s(&ds),
+            "--out",
+            s(&never),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let args = predict(&damaged);
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        err.contains("damaged.json") && err.contains("32 inputs"),
+        "{err}"
+    );
+    // A weight list of the wrong length, and a weight JSON cannot hold as a number.
+    let mut short = file.clone();
+    short["network"]["b_in"].as_array_mut().unwrap().pop();
+    std::fs::write(&damaged, serde_json::to_string(&short).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        err.contains("damaged.json") && err.contains("b_in"),
+        "{err}"
+    );
+    let mut nan = file.clone();
+    nan["network"]["w_out"][0] = Value::Null;
+    std::fs::write(&damaged, serde_json::to_string(&nan).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("damaged.json"), "{err}");
+    assert!(!never.exists());
+}

@@ -254,10 +254,10 @@ pub enum ClassifyError {
     #[error("{0}")]
     BadFeatures(String),
     /// A class too small for the spiking classifier's validation split.
-    #[error("class {class} has {count} training recording(s): the spiking classifier sets at least one aside for early stopping and trains on the rest, so each class needs at least 2")]
+    #[error("class `{class}` has {count} training recording(s): the spiking classifier sets at least one aside for early stopping and trains on the rest, so each class needs at least 2")]
     ValidationTooSmall {
-        /// The class index.
-        class: usize,
+        /// The class (its label where known, else its index).
+        class: String,
         /// Its training recordings.
         count: usize,
     },

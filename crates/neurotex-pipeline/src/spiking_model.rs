@@ -110,7 +110,16 @@ impl SpikingModel {
             .map(|e| spike_input(e, snn.dt_ms))
             .collect();
         let refs: Vec<&SpikeInput> = inputs.iter().collect();
-        let (network, log) = crate::snn::fit(&snn, &refs, &y, labels.len())?;
+        let (network, log) =
+            crate::snn::fit(&snn, &refs, &y, labels.len()).map_err(|e| match e {
+                ClassifyError::ValidationTooSmall { class, count } => {
+                    ClassifyError::ValidationTooSmall {
+                        class: class.parse::<usize>().map_or(class, |c| labels[c].clone()),
+                        count,
+                    }
+                }
+                other => other,
+            })?;
         let file = SpikingFile {
             format: FORMAT.into(),
             version: VERSION,
