@@ -11,8 +11,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use commands::{
-    compare, encode, evaluate, features, import, inspect, predict, reproduce, simulate, stream,
-    train,
+    compare, encode, evaluate, export, features, import, inspect, predict, reproduce, simulate,
+    stream, train,
 };
 
 /// Neuromorphic tactile texture classification: taxel recordings → Izhikevich spikes →
@@ -69,6 +69,10 @@ enum Command {
     /// Import CSV logs or stacked arrays into a dataset folder.
     #[command(subcommand)]
     Import(import::ImportCommand),
+    /// Export a spiking model's network as a NIR graph (for snnTorch, Norse, Rockpool and
+    /// neuromorphic hardware), or the spike tensors its input receives.
+    #[command(subcommand)]
+    Export(export::ExportCommand),
 }
 
 fn main() -> ExitCode {
@@ -94,6 +98,7 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => reproduce::run(args),
         Command::Stream(args) => stream::run(args),
         Command::Import(command) => import::run(command),
+        Command::Export(command) => export::run(command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -13,6 +13,7 @@ pub mod diagnostics;
 pub mod evaluation;
 pub mod inspect;
 pub mod model;
+pub mod nir;
 pub mod options;
 pub mod pipeline;
 pub mod spiking_model;

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{ClassifyError, DataError, ModelError, Result};
 use crate::model::{Prediction, Provenance, Score};
+use crate::nir::Convention;
 use crate::pipeline::{taxel_cells, Encoded, Pipeline, PipelineParams};
 use crate::recording::{Baseline, FileReading, LayoutFrom};
 use crate::snn::{softmax, train::TrainingLog, Network, SnnParams, SpikeInput};
@@ -63,6 +64,15 @@ impl PartialEq for SpikingModel {
     fn eq(&self, other: &Self) -> bool {
         self.file == other.file
     }
+}
+
+/// Whether the file starts with HDF5's signature (a NIR graph).
+pub fn is_hdf5(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| head == *b"\x89HDF\r\n\x1a\n")
 }
 
 /// A recording's spikes as the network's input: its populations in the pipeline's order
@@ -185,9 +195,57 @@ impl SpikingModel {
         })
     }
 
-    /// Whether the file at `path` claims to be a spiking model (its `format`), read
-    /// without checking the rest.
+    /// The network as a NIR graph (HDF5 bytes), the model file without its weights in the
+    /// graph's metadata ([`crate::nir`]).
+    ///
+    /// # Errors
+    /// The graph cannot be written.
+    pub fn to_nir(&self, convention: Convention) -> Result<Vec<u8>> {
+        let mut value = serde_json::to_value(&self.file)
+            .map_err(|e| ModelError::Inconsistent(e.to_string()))?;
+        if let Some(map) = value.as_object_mut() {
+            map.remove("network");
+        }
+        crate::nir::to_bytes(&self.file.network, &value.to_string(), convention)
+    }
+
+    /// A model from a NIR graph at `path`: its network, and the pipeline, grid and labels
+    /// from the graph's `neurotex_model` metadata, or else from `like` (a spiking model
+    /// whose pipeline feeds the network: a graph trained elsewhere on neurotex's inputs).
+    ///
+    /// # Errors
+    /// A graph of another shape (see [`crate::nir::read`]), a graph without neurotex's
+    /// metadata and no `like`, or a network that does not fit the pipeline, naming the file.
+    pub fn from_nir(path: &Path, like: Option<&SpikingModel>) -> Result<SpikingModel> {
+        let graph = crate::nir::read(path)?;
+        let damaged = |reason: String| -> crate::Error {
+            ModelError::Damaged {
+                path: path.to_path_buf(),
+                reason,
+            }
+            .into()
+        };
+        let mut file = match (like, &graph.neurotex_model) {
+            (Some(like), _) => like.file.clone(),
+            (None, Some(json)) => {
+                let mut value: serde_json::Value = serde_json::from_str(json).map_err(|e| damaged(format!("its neurotex_model metadata: {e}")))?;
+                value["network"] = serde_json::to_value(&graph.network).map_err(|e| damaged(e.to_string()))?;
+                serde_json::from_value::<SpikingFile>(value).map_err(|e| damaged(format!("its neurotex_model metadata: {e}")))?
+            }
+            (None, None) => {
+                return Err(damaged("a NIR graph not written by neurotex does not say which pipeline makes its input spikes: give a neurotex spiking model trained with that pipeline (--like MODEL.json)".into()))
+            }
+        };
+        file.network = graph.network;
+        SpikingModel::assemble(file).map_err(|e| damaged(e.to_string()))
+    }
+
+    /// Whether the file at `path` claims to be a spiking model (its `format`, or HDF5's
+    /// signature: a NIR graph), read without checking the rest.
     pub fn is_spiking(path: &Path) -> bool {
+        if is_hdf5(path) {
+            return true;
+        }
         #[derive(Deserialize)]
         struct Header {
             format: Option<serde_json::Value>,
@@ -207,6 +265,9 @@ impl SpikingModel {
     /// An unreadable file, another format or version, or damaged content (a non-finite
     /// weight, a network that does not fit the pipeline), naming the file and the rule.
     pub fn load(path: &Path) -> Result<SpikingModel> {
+        if is_hdf5(path) {
+            return SpikingModel::from_nir(path, None);
+        }
         let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
         let damaged = |reason: String| -> crate::Error {
             ModelError::Damaged {

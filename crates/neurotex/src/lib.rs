@@ -30,7 +30,7 @@ pub use neurotex_features::features;
 pub use neurotex_learn::classify;
 pub use neurotex_learn::snn;
 pub use neurotex_pipeline::{
-    analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, options,
+    analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, nir, options,
     pipeline, spiking_model, stream,
 };
 pub use neurotex_report::report;

@@ -9,6 +9,7 @@
 pub mod compare;
 pub mod encode;
 pub mod evaluate;
+pub mod export;
 pub mod features;
 pub mod import;
 pub mod inspect;

@@ -1,0 +1,97 @@
+//! `neurotex export`: a spiking model's network as a NIR graph, and the spike tensors its
+//! input node receives, for other simulators and neuromorphic hardware.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::{Args, Subcommand};
+use neurotex::workflows::export::{export_inputs, export_nir, load_spiking, NirConvention};
+use neurotex::workflows::OpenOptions;
+
+use crate::output::{check_output, Shown};
+
+/// `neurotex export`: what other tools read.
+#[derive(Subcommand)]
+pub enum ExportCommand {
+    /// A spiking model's network (`train --classifier snn`) as a NIR graph (HDF5, NIR 1.0:
+    /// Input → Affine → CubaLIF → Affine → LI → Output), the time step as `dt` (seconds)
+    /// and the model's pipeline, grid and labels in the graph's metadata. snnTorch, Norse,
+    /// Rockpool and the neuromorphic toolchains read it; `neurotex predict --model
+    /// FILE.nir` runs it again.
+    Nir(ExportNirArgs),
+    /// The spike tensors a spiking model's input node receives: one `(steps, inputs)`
+    /// float32 NPY per recording of a dataset (spike counts per time step; inputs are the
+    /// SA then the FA taxels in row-major order) and `index.csv` (`file,label,array`), so
+    /// that the same network can be run or trained elsewhere on exactly neurotex's spikes.
+    Inputs(ExportInputsArgs),
+}
+
+/// Options of `neurotex export nir`.
+#[derive(Args)]
+pub struct ExportNirArgs {
+    /// The spiking model file (`train --classifier snn`).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// The NIR file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The importer the time constants are written for: `physical` (seconds, with `dt` in
+    /// the metadata: Norse, Rockpool, NIR's equations) or `snntorch` (whose importer steps
+    /// every graph at 0.1 ms: the constants are scaled to give the network's decays there).
+    #[arg(long, value_enum, default_value_t = NirConvention::Physical)]
+    pub convention: NirConvention,
+}
+
+/// Options of `neurotex export inputs`.
+#[derive(Args)]
+pub struct ExportInputsArgs {
+    /// The spiking model whose pipeline and time step make the tensors.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// The dataset folder whose recordings are exported.
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// The folder to create (new, or empty).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// How the dataset folder is opened.
+    #[command(flatten)]
+    pub open: OpenOptions,
+}
+
+/// Runs `neurotex export nir` or `neurotex export inputs`.
+pub fn run(command: ExportCommand) -> Result<()> {
+    match command {
+        ExportCommand::Nir(args) => {
+            check_output(&args.out, std::slice::from_ref(&args.model))?;
+            let model = load_spiking(&args.model)?;
+            export_nir(&model, &args.out, args.convention)?;
+            let net = model.network();
+            eprintln!(
+                "NIR graph: {} inputs -> {} CubaLIF -> {} LI outputs ({}), dt {} ms -> {}",
+                net.inputs,
+                net.hidden,
+                net.classes,
+                model.labels().join(", "),
+                net.dt_ms,
+                args.out.display()
+            );
+        }
+        ExportCommand::Inputs(args) => {
+            let model = load_spiking(&args.model)?;
+            let dataset = args.open.open(&args.dataset)?;
+            neurotex::io::check_output_dir(&args.out)?;
+            let shown = Shown::new("starting");
+            let n = export_inputs(&model, &dataset, &args.out, &shown.callback());
+            shown.finish();
+            let n = n?;
+            eprintln!(
+                "{n} recordings' input tensors ({} inputs, {} ms steps) -> {}",
+                model.network().inputs,
+                model.network().dt_ms,
+                args.out.display()
+            );
+        }
+    }
+    Ok(())
+}

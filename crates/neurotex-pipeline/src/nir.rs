@@ -1,0 +1,535 @@
+//! NIR, the Neuromorphic Intermediate Representation (Pedersen et al., Nature
+//! Communications 2024; the `nir` Python package, 1.0): a spiking model's network as a
+//! graph of continuous-time nodes in an HDF5 file, which snnTorch, Norse, Rockpool, Lava
+//! and the toolchains of Loihi, SpiNNaker, Xylo and Speck read.
+//!
+//! **The graph** neurotex writes and reads: `input` (Input, one channel per taxel and
+//! population) → `fc1` (Affine) → `lif1` (CubaLIF) → `fc2` (Affine) → `li` (LI) →
+//! `output` (Output), with the time step in the graph's metadata (`dt`, seconds) and, under
+//! `neurotex_model`, the model file without its weights (pipeline, grid, labels, training):
+//! the Izhikevich encoder in front of the network has no NIR node, so its parameters travel
+//! as metadata. Output `i` is the model's `i`-th label.
+//!
+//! **From discrete to continuous time.** NIR's nodes are ODEs
+//! (`τ_syn dI/dt = -I + w_in a`, `τ_mem dv/dt = v_leak - v + r I`, spike and reset to
+//! `v_reset` when `v > v_threshold`; `τ dv/dt = v_leak - v + r a` for LI). neurotex's
+//! network ([`crate::snn`]) is their forward-Euler step at `dt`, the current first and the
+//! membrane with the new current, as snnTorch's `Synaptic` and Norse's `LIFBox` step:
+//! `α = 1 - dt/τ_syn`, `β = 1 - dt/τ_mem`, `κ = 1 - dt/τ`, so the export writes
+//! `τ_syn = dt/(1-α)`, `τ_mem = dt/(1-β)`, `τ = dt/(1-κ)` and the gains that make each
+//! step add its input once: `w_in = τ_syn/dt`, `r = τ_mem/dt` (LIF), `r = τ/dt` (LI),
+//! `v_leak = 0`, `v_threshold = 1`, `v_reset = 0`. Reading a graph inverts this; gains,
+//! thresholds and leaks that differ per neuron are folded into the weights and biases
+//! (dividing by the threshold, adding the leak to the readout's bias), while the decays must
+//! be one per layer, as neurotex's network has.
+
+use std::path::Path;
+
+use hdf5_pure::{DType, File, FileBuilder, GroupBuilder};
+
+use crate::error::{DataError, ModelError, Result};
+use crate::snn::{Network, Readout};
+
+/// The nodes of the graph, in order along its one path.
+pub const NODES: [(&str, &str); 6] = [
+    ("input", "Input"),
+    ("fc1", "Affine"),
+    ("lif1", "CubaLIF"),
+    ("fc2", "Affine"),
+    ("li", "LI"),
+    ("output", "Output"),
+];
+
+/// How the exported time constants are scaled for the importer that will read them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Convention {
+    /// Physical time: `dt` in the metadata and the constants in seconds (Norse, Rockpool,
+    /// and NIR's own equations).
+    Physical,
+    /// snnTorch's importer, which steps every graph at `dt = 1e-4` s whatever its metadata:
+    /// the constants are scaled by `1e-4 / dt` so that its decays are neurotex's.
+    Snntorch,
+}
+
+/// snnTorch's fixed import step, s.
+pub const SNNTORCH_DT_S: f64 = 1e-4;
+
+/// A network and what the graph's metadata says about it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NirNetwork {
+    /// The network, in neurotex's discrete form.
+    pub network: Network,
+    /// The time step, s, from the metadata.
+    pub dt_s: f64,
+    /// The neurotex model file without its weights, when the graph was written by
+    /// neurotex (`neurotex_model` in the metadata).
+    pub neurotex_model: Option<String>,
+}
+
+/// The graph's bytes (HDF5) for `net`, with `model_json` (the model file without its
+/// network) in the metadata.
+///
+/// # Errors
+/// The HDF5 writer fails (it should not for these shapes).
+pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Result<Vec<u8>> {
+    let (alpha, beta, kappa) = net.decays();
+    let dt = f64::from(net.dt_ms) / 1000.0;
+    let scale = match convention {
+        Convention::Physical => 1.0,
+        Convention::Snntorch => SNNTORCH_DT_S / dt,
+    };
+    let (tau_syn, tau_mem, tau_out) = (dt / (1.0 - alpha), dt / (1.0 - beta), dt / (1.0 - kappa));
+    let (h, c, n) = (net.hidden, net.classes, net.inputs);
+    let mut fb = FileBuilder::new();
+    fb.create_dataset("version")
+        .with_vlen_strings(&["1.0.0"])
+        .with_shape(&[]);
+    let mut node = fb.create_group("node");
+    put_str(&mut node, "type", "NIRGraph");
+    let edges: Vec<&str> = NODES.windows(2).flat_map(|w| [w[0].0, w[1].0]).collect();
+    node.create_dataset("edges")
+        .with_vlen_strings(&edges)
+        .with_shape(&[edges.len() as u64 / 2, 2]);
+    let mut meta = node.create_group("metadata");
+    meta.create_dataset("dt")
+        .with_f64_data(&[dt * scale])
+        .with_shape(&[]);
+    put_str(&mut meta, "readout", net.readout.name());
+    put_str(&mut meta, "neurotex_model", model_json);
+    node.add_group(meta.finish());
+    let mut nodes = node.create_group("nodes");
+    let io = |nodes: &mut GroupBuilder, name: &str, kind: &str, width: usize| {
+        let mut g = nodes.create_group(name);
+        put_str(&mut g, "type", kind);
+        g.create_dataset("shape")
+            .with_i64_data(&[width as i64])
+            .with_shape(&[1]);
+        nodes.add_group(g.finish());
+    };
+    io(&mut nodes, "input", "Input", n);
+    let transposed = |w: &[f64], rows: usize, cols: usize| -> Vec<f32> {
+        // neurotex keeps weights source-major; NIR's Affine is (out, in).
+        (0..cols)
+            .flat_map(|o| (0..rows).map(move |i| w[i * cols + o] as f32))
+            .collect()
+    };
+    affine(
+        &mut nodes,
+        "fc1",
+        &transposed(&net.w_in, n, h),
+        &net.b_in,
+        (h, n),
+    );
+    // The neurons' constants in float64, so that reading them back gives the decays to the
+    // last bits; the weights are float32 values already.
+    let full = |v: f64, len: usize| vec![v; len];
+    let mut g = nodes.create_group("lif1");
+    put_str(&mut g, "type", "CubaLIF");
+    for (field, v) in [
+        ("tau_syn", tau_syn * scale),
+        ("tau_mem", tau_mem * scale),
+        ("r", tau_mem / dt),
+        ("v_leak", 0.0),
+        ("v_threshold", 1.0),
+        ("v_reset", 0.0),
+        ("w_in", tau_syn / dt),
+    ] {
+        g.create_dataset(field).with_f64_data(&full(v, h)).with_shape(&[h as u64]);
+    }
+    nodes.add_group(g.finish());
+    affine(
+        &mut nodes,
+        "fc2",
+        &transposed(&net.w_out, h, c),
+        &net.b_out,
+        (c, h),
+    );
+    let mut g = nodes.create_group("li");
+    put_str(&mut g, "type", "LI");
+    for (field, v) in [
+        ("tau", tau_out * scale),
+        ("r", tau_out / dt),
+        ("v_leak", 0.0),
+    ] {
+        g.create_dataset(field).with_f64_data(&full(v, c)).with_shape(&[c as u64]);
+    }
+    nodes.add_group(g.finish());
+    io(&mut nodes, "output", "Output", c);
+    node.add_group(nodes.finish());
+    fb.add_group(node.finish());
+    fb.finish()
+        .map_err(|e| ModelError::Inconsistent(format!("writing the NIR graph: {e}")).into())
+}
+
+fn put_str(g: &mut GroupBuilder, name: &str, value: &str) {
+    g.create_dataset(name)
+        .with_vlen_strings(&[value])
+        .with_shape(&[]);
+}
+
+fn put_f32(g: &mut GroupBuilder, name: &str, values: &[f32], shape: &[u64]) {
+    g.create_dataset(name)
+        .with_f32_data(values)
+        .with_shape(shape);
+}
+
+fn affine(
+    nodes: &mut GroupBuilder,
+    name: &str,
+    weight: &[f32],
+    bias: &[f64],
+    (out, inp): (usize, usize),
+) {
+    let mut g = nodes.create_group(name);
+    put_str(&mut g, "type", "Affine");
+    put_f32(&mut g, "weight", weight, &[out as u64, inp as u64]);
+    let bias: Vec<f32> = bias.iter().map(|&b| b as f32).collect();
+    put_f32(&mut g, "bias", &bias, &[out as u64]);
+    nodes.add_group(g.finish());
+}
+
+/// Writes `net`'s graph to `path`, whole or not at all.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write(path: &Path, net: &Network, model_json: &str, convention: Convention) -> Result<()> {
+    let bytes = to_bytes(net, model_json, convention)?;
+    crate::io::write_atomic(path, |w| w.write_all(&bytes))
+}
+
+/// Reads a NIR graph of the shape neurotex runs (see the module) from `path`.
+///
+/// # Errors
+/// An unreadable file, not HDF5, or a graph of another shape: an unknown or missing node,
+/// edges that are not the one path (recurrent edges), inputs or outputs that do not match
+/// the weights, per-neuron decays, a missing or non-whole-millisecond `dt`, or a
+/// non-finite weight, each naming the node.
+pub fn read(path: &Path) -> Result<NirNetwork> {
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    let damaged = |reason: String| -> crate::Error {
+        ModelError::Damaged {
+            path: path.to_path_buf(),
+            reason,
+        }
+        .into()
+    };
+    // The parser is a young crate: whatever a damaged file makes it do, neurotex reports
+    // an error rather than stopping.
+    let parsed = std::panic::catch_unwind(|| from_bytes(bytes));
+    match parsed {
+        Ok(result) => result.map_err(damaged),
+        Err(_) => Err(damaged("not a readable HDF5 file".into())),
+    }
+}
+
+/// The graph's arrays, read as f64.
+struct Reader {
+    file: File,
+}
+
+impl Reader {
+    fn group(&self, path: &[&str]) -> Result<hdf5_pure::Group, String> {
+        let mut g = self.file.root();
+        let mut at = String::new();
+        for name in path {
+            at.push('/');
+            at.push_str(name);
+            g = g
+                .group(name)
+                .map_err(|_| format!("the graph has no group {at}"))?;
+        }
+        Ok(g)
+    }
+}
+
+fn read_string(g: &hdf5_pure::Group, name: &str, at: &str) -> Result<Vec<String>, String> {
+    let ds = g
+        .dataset(name)
+        .map_err(|_| format!("{at} has no `{name}`"))?;
+    ds.read_string()
+        .map_err(|e| format!("{at}/{name} is not a string: {e}"))
+}
+
+fn read_array(g: &hdf5_pure::Group, name: &str, at: &str) -> Result<(Vec<f64>, Vec<u64>), String> {
+    let ds = g
+        .dataset(name)
+        .map_err(|_| format!("node {at} has no `{name}`"))?;
+    let shape = ds.shape().map_err(|e| format!("node {at}: {name}: {e}"))?;
+    let numeric = matches!(
+        ds.dtype(),
+        Ok(DType::F32 | DType::F64 | DType::I32 | DType::I64)
+    );
+    if !numeric {
+        return Err(format!("node {at}: `{name}` is not a numeric array"));
+    }
+    let values = ds
+        .read_f64()
+        .map_err(|e| format!("node {at}: {name}: {e}"))?;
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(format!(
+            "node {at}: `{name}`[{i}] is not finite ({})",
+            values[i]
+        ));
+    }
+    Ok((values, shape))
+}
+
+fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
+    let file = File::from_bytes(bytes).map_err(|e| format!("not an HDF5 file: {e}"))?;
+    let reader = Reader { file };
+    let node = reader.group(&["node"])?;
+    let kind = read_string(&node, "type", "/node")?;
+    if kind.first().map(String::as_str) != Some("NIRGraph") {
+        return Err(format!("/node is a {kind:?}, not a NIRGraph"));
+    }
+    let names = path_of_nodes(&reader)?;
+    let meta = reader.group(&["node", "metadata"]).map_err(|_| {
+        "the graph has no metadata, so no `dt` (its time step in seconds)".to_string()
+    })?;
+    let dt = meta
+        .dataset("dt")
+        .and_then(|d| d.read_f64())
+        .map_err(|_| "the graph's metadata has no `dt` (its time step in seconds)".to_string())?;
+    let dt_s = *dt.first().ok_or("the graph's `dt` is empty")?;
+    let dt_ms = dt_s * 1000.0;
+    if !((1.0..=1000.0).contains(&dt_ms) && (dt_ms - dt_ms.round()).abs() < 1e-6) {
+        return Err(format!("the graph's dt is {dt_s} s; neurotex's networks step a whole number of ms (1 to 1000) on the encoder's 1 ms spikes"));
+    }
+    let readout = match read_string(&meta, "readout", "/node/metadata") {
+        Ok(r) => r.first().map_or(Ok(Readout::Mean), |r| {
+            r.parse()
+                .map_err(|e: crate::error::ParamError| e.rule.to_string())
+        })?,
+        Err(_) => Readout::Mean,
+    };
+    let neurotex_model = read_string(&meta, "neurotex_model", "/node/metadata")
+        .ok()
+        .and_then(|v| v.into_iter().next());
+    let network = network_of(&reader, &names, dt_s, dt_ms.round() as u32, readout)?;
+    network.check()?;
+    Ok(NirNetwork {
+        network,
+        dt_s,
+        neurotex_model,
+    })
+}
+
+/// The nodes along the graph's one path from its Input to its Output, checked to be the
+/// six neurotex runs, in order.
+fn path_of_nodes(reader: &Reader) -> Result<Vec<String>, String> {
+    let nodes = reader.group(&["node", "nodes"])?;
+    let names = nodes.groups().map_err(|e| format!("/node/nodes: {e}"))?;
+    let mut kinds = Vec::new();
+    for name in &names {
+        let g = nodes.group(name).map_err(|e| format!("node {name}: {e}"))?;
+        let kind = read_string(&g, "type", &format!("node {name}"))?.concat();
+        if !NODES.iter().any(|(_, k)| *k == kind) && kind != "Linear" {
+            return Err(format!("node {name} is a {kind}; neurotex runs Input → Affine/Linear → CubaLIF → Affine/Linear → LI → Output"));
+        }
+        kinds.push((name.clone(), kind));
+    }
+    let node = reader.group(&["node"])?;
+    let flat = read_string(&node, "edges", "/node")?;
+    if flat.len() % 2 != 0 {
+        return Err("the graph's edges are not pairs".into());
+    }
+    let edges: Vec<(&str, &str)> = flat
+        .chunks(2)
+        .map(|e| (e[0].as_str(), e[1].as_str()))
+        .collect();
+    let start = kinds
+        .iter()
+        .filter(|(_, k)| k == "Input")
+        .map(|(n, _)| n.clone())
+        .collect::<Vec<_>>();
+    let [start] = start.as_slice() else {
+        return Err(format!(
+            "the graph has {} Input nodes; neurotex runs one",
+            start.len()
+        ));
+    };
+    let mut path = vec![start.clone()];
+    while path.len() < kinds.len() {
+        let at = path.last().cloned().unwrap_or_default();
+        let next: Vec<&str> = edges.iter().filter(|e| e.0 == at).map(|e| e.1).collect();
+        let [next] = next.as_slice() else {
+            return Err(format!(
+                "node {at} has {} outgoing edges; neurotex runs one feed-forward path",
+                next.len()
+            ));
+        };
+        if path.iter().any(|p| p == next) {
+            return Err(format!("the edge {at} → {next} makes a loop (a recurrent edge); neurotex runs feed-forward networks"));
+        }
+        path.push(next.to_string());
+    }
+    if edges.len() != kinds.len() - 1 {
+        return Err(format!(
+            "the graph has {} edges for {} nodes; neurotex runs one path without recurrent edges",
+            edges.len(),
+            kinds.len()
+        ));
+    }
+    let order: Vec<&str> = path
+        .iter()
+        .map(|n| {
+            kinds
+                .iter()
+                .find(|(m, _)| m == n)
+                .map_or("", |(_, k)| k.as_str())
+        })
+        .collect();
+    let want = ["Input", "Affine", "CubaLIF", "Affine", "LI", "Output"];
+    for (i, (got, want)) in order.iter().zip(want).enumerate() {
+        let fits = *got == want || (want == "Affine" && *got == "Linear");
+        if !fits {
+            return Err(format!("node {} is a {got} where neurotex runs a {want} (Input → Affine → CubaLIF → Affine → LI → Output)", path[i]));
+        }
+    }
+    if order.len() != want.len() {
+        return Err(format!("the graph has {} nodes; neurotex runs the six of Input → Affine → CubaLIF → Affine → LI → Output", order.len()));
+    }
+    Ok(path)
+}
+
+/// One value per neuron of a layer of `len` (a single value applies to all).
+fn per_neuron(g: &hdf5_pure::Group, field: &str, at: &str, len: usize) -> Result<Vec<f64>, String> {
+    let (values, _) = read_array(g, field, at)?;
+    match values.len() {
+        1 => Ok(vec![values[0]; len]),
+        n if n == len => Ok(values),
+        n => Err(format!(
+            "node {at}: `{field}` has {n} values for {len} neurons"
+        )),
+    }
+}
+
+/// An Affine's (or Linear's) weight, `(out, in)` row-major, and bias.
+fn read_affine(reader: &Reader, name: &str) -> Result<(Vec<f64>, Vec<f64>, usize, usize), String> {
+    let g = reader.group(&["node", "nodes", name])?;
+    let (weight, shape) = read_array(&g, "weight", name)?;
+    let [out, inp] = shape.as_slice() else {
+        return Err(format!(
+            "node {name}: the weight has shape {shape:?}, not (out, in)"
+        ));
+    };
+    let (out, inp) = (*out as usize, *inp as usize);
+    let bias = match g.dataset("bias") {
+        Ok(_) => read_array(&g, "bias", name)?.0,
+        Err(_) => vec![0.0; out],
+    };
+    if bias.len() != out {
+        return Err(format!(
+            "node {name}: {} biases for {out} outputs",
+            bias.len()
+        ));
+    }
+    Ok((weight, bias, out, inp))
+}
+
+/// The one decay `1 - dt/τ` of a layer's neurons.
+fn one_decay(taus: &[f64], dt_s: f64, at: &str, field: &str) -> Result<f64, String> {
+    let decays: Vec<f64> = taus.iter().map(|t| 1.0 - dt_s / t).collect();
+    let first = decays[0];
+    if !(first > 0.0 && first < 1.0) {
+        return Err(format!("node {at}: `{field}` {} s gives the decay {first} per step of {dt_s} s; it must lie between 0 and 1 (tau above dt)", taus[0]));
+    }
+    if decays
+        .iter()
+        .any(|d| (d - first).abs() > 1e-9 * first.max(1e-12) + 1e-12)
+    {
+        return Err(format!(
+            "node {at}: `{field}` differs between neurons; neurotex's network has one per layer"
+        ));
+    }
+    Ok(first)
+}
+
+fn network_of(
+    reader: &Reader,
+    names: &[String],
+    dt_s: f64,
+    dt_ms: u32,
+    readout: Readout,
+) -> Result<Network, String> {
+    let (w1, b1, h, n) = read_affine(reader, &names[1])?;
+    let (w2, b2, c, h2) = read_affine(reader, &names[3])?;
+    let io_width = |name: &str| -> Result<usize, String> {
+        let g = reader.group(&["node", "nodes", name])?;
+        let (shape, _) = read_array(&g, "shape", name)?;
+        Ok(shape.iter().product::<f64>() as usize)
+    };
+    if io_width(&names[0])? != n {
+        return Err(format!(
+            "node {}: its shape is not the {n} inputs of {}",
+            names[0], names[1]
+        ));
+    }
+    if h2 != h {
+        return Err(format!(
+            "node {}: {h2} inputs, but {} has {h} neurons",
+            names[3], names[2]
+        ));
+    }
+    if io_width(&names[5])? != c {
+        return Err(format!(
+            "node {}: its shape is not the {c} outputs of {}",
+            names[5], names[3]
+        ));
+    }
+    let lif_at = names[2].as_str();
+    let lif = reader.group(&["node", "nodes", lif_at])?;
+    let field = |f: &str| per_neuron(&lif, f, lif_at, h);
+    let (tau_syn, tau_mem, r, w_in) = (
+        field("tau_syn")?,
+        field("tau_mem")?,
+        field("r")?,
+        field("w_in")?,
+    );
+    let (v_leak, v_threshold, v_reset) =
+        (field("v_leak")?, field("v_threshold")?, field("v_reset")?);
+    let alpha = one_decay(&tau_syn, dt_s, lif_at, "tau_syn")?;
+    let beta = one_decay(&tau_mem, dt_s, lif_at, "tau_mem")?;
+    if v_leak.iter().chain(&v_reset).any(|v| *v != 0.0) {
+        return Err(format!(
+            "node {lif_at}: v_leak and v_reset must be 0 (neurotex's neurons rest and reset at 0)"
+        ));
+    }
+    if v_threshold.iter().any(|v| *v <= 0.0) {
+        return Err(format!("node {lif_at}: v_threshold must be positive"));
+    }
+    // Each step adds (dt/τ_mem) r (dt/τ_syn) w_in a / v_threshold to the scaled membrane.
+    let gain: Vec<f64> = (0..h)
+        .map(|j| (dt_s / tau_mem[j]) * r[j] * (dt_s / tau_syn[j]) * w_in[j] / v_threshold[j])
+        .collect();
+    let li_at = names[4].as_str();
+    let li = reader.group(&["node", "nodes", li_at])?;
+    let (tau, r_out, leak) = (
+        per_neuron(&li, "tau", li_at, c)?,
+        per_neuron(&li, "r", li_at, c)?,
+        per_neuron(&li, "v_leak", li_at, c)?,
+    );
+    let kappa = one_decay(&tau, dt_s, li_at, "tau")?;
+    let out_gain: Vec<f64> = (0..c).map(|k| (dt_s / tau[k]) * r_out[k]).collect();
+    let tau_ms = |decay: f64| -f64::from(dt_ms) / decay.ln();
+    Ok(Network {
+        inputs: n,
+        hidden: h,
+        classes: c,
+        dt_ms,
+        tau_syn_ms: tau_ms(alpha),
+        tau_mem_ms: tau_ms(beta),
+        tau_out_ms: tau_ms(kappa),
+        readout,
+        w_in: (0..n * h)
+            .map(|k| gain[k % h] * w1[(k % h) * n + k / h])
+            .collect(),
+        b_in: (0..h).map(|j| gain[j] * b1[j]).collect(),
+        w_out: (0..h * c)
+            .map(|k| out_gain[k % c] * w2[(k % c) * h + k / c])
+            .collect(),
+        b_out: (0..c)
+            .map(|k| out_gain[k] * b2[k] + (dt_s / tau[k]) * leak[k])
+            .collect(),
+    })
+}
