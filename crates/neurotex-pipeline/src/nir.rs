@@ -72,14 +72,11 @@ pub struct NirNetwork {
 /// # Errors
 /// The HDF5 writer fails (it should not for these shapes).
 pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Result<Vec<u8>> {
-    let (alpha, beta, kappa) = net.decays();
     let dt = f64::from(net.dt_ms) / 1000.0;
     let scale = match convention {
         Convention::Physical => 1.0,
         Convention::Snntorch => SNNTORCH_DT_S / dt,
     };
-    let (tau_syn, tau_mem, tau_out) = (dt / (1.0 - alpha), dt / (1.0 - beta), dt / (1.0 - kappa));
-    let (h, c, n) = (net.hidden, net.classes, net.inputs);
     let mut fb = FileBuilder::new();
     fb.create_dataset("version")
         .with_vlen_strings(&["1.0.0"])
@@ -98,6 +95,18 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
     put_str(&mut meta, "neurotex_model", model_json);
     node.add_group(meta.finish());
     let mut nodes = node.create_group("nodes");
+    layers(&mut nodes, net, dt, scale);
+    node.add_group(nodes.finish());
+    fb.add_group(node.finish());
+    fb.finish()
+        .map_err(|e| ModelError::Inconsistent(format!("writing the NIR graph: {e}")).into())
+}
+
+/// The six nodes of `net`'s graph (see the module's mapping).
+fn layers(nodes: &mut GroupBuilder, net: &Network, dt: f64, scale: f64) {
+    let (alpha, beta, kappa) = net.decays();
+    let (tau_syn, tau_mem, tau_out) = (dt / (1.0 - alpha), dt / (1.0 - beta), dt / (1.0 - kappa));
+    let (h, c, n) = (net.hidden, net.classes, net.inputs);
     let io = |nodes: &mut GroupBuilder, name: &str, kind: &str, width: usize| {
         let mut g = nodes.create_group(name);
         put_str(&mut g, "type", kind);
@@ -106,26 +115,21 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
             .with_shape(&[1]);
         nodes.add_group(g.finish());
     };
-    io(&mut nodes, "input", "Input", n);
     let transposed = |w: &[f64], rows: usize, cols: usize| -> Vec<f32> {
         // neurotex keeps weights source-major; NIR's Affine is (out, in).
         (0..cols)
             .flat_map(|o| (0..rows).map(move |i| w[i * cols + o] as f32))
             .collect()
     };
+    io(nodes, "input", "Input", n);
     affine(
-        &mut nodes,
+        nodes,
         "fc1",
         &transposed(&net.w_in, n, h),
         &net.b_in,
         (h, n),
     );
-    // The neurons' constants in float64, so that reading them back gives the decays to the
-    // last bits; the weights are float32 values already.
-    let full = |v: f64, len: usize| vec![v; len];
-    let mut g = nodes.create_group("lif1");
-    put_str(&mut g, "type", "CubaLIF");
-    for (field, v) in [
+    let lif = [
         ("tau_syn", tau_syn * scale),
         ("tau_mem", tau_mem * scale),
         ("r", tau_mem / dt),
@@ -133,32 +137,36 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
         ("v_threshold", 1.0),
         ("v_reset", 0.0),
         ("w_in", tau_syn / dt),
-    ] {
-        g.create_dataset(field).with_f64_data(&full(v, h)).with_shape(&[h as u64]);
-    }
-    nodes.add_group(g.finish());
+    ];
+    neurons(nodes, "lif1", "CubaLIF", &lif, h);
     affine(
-        &mut nodes,
+        nodes,
         "fc2",
         &transposed(&net.w_out, h, c),
         &net.b_out,
         (c, h),
     );
-    let mut g = nodes.create_group("li");
-    put_str(&mut g, "type", "LI");
-    for (field, v) in [
+    let li = [
         ("tau", tau_out * scale),
         ("r", tau_out / dt),
         ("v_leak", 0.0),
-    ] {
-        g.create_dataset(field).with_f64_data(&full(v, c)).with_shape(&[c as u64]);
+    ];
+    neurons(nodes, "li", "LI", &li, c);
+    io(nodes, "output", "Output", c);
+}
+
+/// A node of `len` neurons whose fields each hold one value for all. The constants are
+/// written in float64, so that reading them back gives the decays to the last bit (the
+/// weights are float32 values already).
+fn neurons(nodes: &mut GroupBuilder, name: &str, kind: &str, fields: &[(&str, f64)], len: usize) {
+    let mut g = nodes.create_group(name);
+    put_str(&mut g, "type", kind);
+    for &(field, v) in fields {
+        g.create_dataset(field)
+            .with_f64_data(&vec![v; len])
+            .with_shape(&[len as u64]);
     }
     nodes.add_group(g.finish());
-    io(&mut nodes, "output", "Output", c);
-    node.add_group(nodes.finish());
-    fb.add_group(node.finish());
-    fb.finish()
-        .map_err(|e| ModelError::Inconsistent(format!("writing the NIR graph: {e}")).into())
 }
 
 fn put_str(g: &mut GroupBuilder, name: &str, value: &str) {
@@ -445,6 +453,36 @@ fn one_decay(taus: &[f64], dt_s: f64, at: &str, field: &str) -> Result<f64, Stri
     Ok(first)
 }
 
+/// The CubaLIF node's decays and, per neuron, the gain each step gives its input on the
+/// membrane scaled to a threshold of 1: `(dt/τ_mem) r (dt/τ_syn) w_in / v_threshold`.
+fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<(f64, f64, Vec<f64>), String> {
+    let lif_at = at;
+    let lif = reader.group(&["node", "nodes", lif_at])?;
+    let field = |f: &str| per_neuron(&lif, f, lif_at, h);
+    let (tau_syn, tau_mem, r, w_in) = (
+        field("tau_syn")?,
+        field("tau_mem")?,
+        field("r")?,
+        field("w_in")?,
+    );
+    let (v_leak, v_threshold, v_reset) =
+        (field("v_leak")?, field("v_threshold")?, field("v_reset")?);
+    let alpha = one_decay(&tau_syn, dt_s, lif_at, "tau_syn")?;
+    let beta = one_decay(&tau_mem, dt_s, lif_at, "tau_mem")?;
+    if v_leak.iter().chain(&v_reset).any(|v| *v != 0.0) {
+        return Err(format!(
+            "node {lif_at}: v_leak and v_reset must be 0 (neurotex's neurons rest and reset at 0)"
+        ));
+    }
+    if v_threshold.iter().any(|v| *v <= 0.0) {
+        return Err(format!("node {lif_at}: v_threshold must be positive"));
+    }
+    let gain: Vec<f64> = (0..h)
+        .map(|j| (dt_s / tau_mem[j]) * r[j] * (dt_s / tau_syn[j]) * w_in[j] / v_threshold[j])
+        .collect();
+    Ok((alpha, beta, gain))
+}
+
 fn network_of(
     reader: &Reader,
     names: &[String],
@@ -477,31 +515,7 @@ fn network_of(
             names[5], names[3]
         ));
     }
-    let lif_at = names[2].as_str();
-    let lif = reader.group(&["node", "nodes", lif_at])?;
-    let field = |f: &str| per_neuron(&lif, f, lif_at, h);
-    let (tau_syn, tau_mem, r, w_in) = (
-        field("tau_syn")?,
-        field("tau_mem")?,
-        field("r")?,
-        field("w_in")?,
-    );
-    let (v_leak, v_threshold, v_reset) =
-        (field("v_leak")?, field("v_threshold")?, field("v_reset")?);
-    let alpha = one_decay(&tau_syn, dt_s, lif_at, "tau_syn")?;
-    let beta = one_decay(&tau_mem, dt_s, lif_at, "tau_mem")?;
-    if v_leak.iter().chain(&v_reset).any(|v| *v != 0.0) {
-        return Err(format!(
-            "node {lif_at}: v_leak and v_reset must be 0 (neurotex's neurons rest and reset at 0)"
-        ));
-    }
-    if v_threshold.iter().any(|v| *v <= 0.0) {
-        return Err(format!("node {lif_at}: v_threshold must be positive"));
-    }
-    // Each step adds (dt/τ_mem) r (dt/τ_syn) w_in a / v_threshold to the scaled membrane.
-    let gain: Vec<f64> = (0..h)
-        .map(|j| (dt_s / tau_mem[j]) * r[j] * (dt_s / tau_syn[j]) * w_in[j] / v_threshold[j])
-        .collect();
+    let (alpha, beta, gain) = lif_of(reader, &names[2], dt_s, h)?;
     let li_at = names[4].as_str();
     let li = reader.group(&["node", "nodes", li_at])?;
     let (tau, r_out, leak) = (

@@ -14,6 +14,7 @@ pub mod knn;
 pub mod linear;
 pub mod metrics;
 pub mod spike_distance;
+pub mod spiking;
 pub mod stats;
 
 pub use choice::{ChosenClassifier, ChosenModel, ClassifierChoice};
@@ -35,6 +36,7 @@ pub use spike_distance::{
     van_rossum, van_rossum_squared, DistanceMatrix, SpikeDistanceKnn, SpikeDistanceKnnModel,
     VanRossum, VanRossumParams,
 };
+pub use spiking::{SnnClassifier, SnnModel};
 pub use stats::StatsError;
 
 use crate::error::ClassifyError;

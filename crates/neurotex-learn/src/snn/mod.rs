@@ -27,7 +27,6 @@
 //! detached from the graph by default, as Zenke & Vogels (2021) recommend.
 
 pub mod grad;
-pub mod model;
 pub mod train;
 
 use serde::{Deserialize, Serialize};
@@ -35,7 +34,6 @@ use serde::{Deserialize, Serialize};
 use crate::encode::SpikeTrains;
 use crate::error::ParamError;
 
-pub use model::{SnnClassifier, SnnModel};
 pub use train::fit;
 
 /// How a class's score is read from its readout trace.

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use super::Candidate;
 use crate::analysis::{evaluate, Columns, FeatureTable};
+use crate::classify::SnnClassifier;
 use crate::classify::{
     ClassifierChoice, DistanceMatrix, ForestParams, KnnParams, SpikeDistanceKnn, VanRossum,
     VanRossumParams,
@@ -14,7 +15,7 @@ use crate::classify::{
 use crate::encode::SpikeTrains;
 use crate::error::{ParamError, Result};
 use crate::pipeline::{Encoded, Encoding, FeatureExtractor, Method, PipelineParams};
-use crate::snn::{SnnClassifier, SnnParams, SpikeInput};
+use crate::snn::{SnnParams, SpikeInput};
 use crate::values::Grid;
 
 /// The spike-timing method's name.

@@ -1,4 +1,4 @@
-//! The spiking classifier under the [`Classifier`] machinery (cross-validation,
+//! The spiking classifier ([`crate::snn`]) under the [`Classifier`] machinery (cross-validation,
 //! train/test). Its input is spike trains, not a feature row, so, as with
 //! [`crate::classify::SpikeDistanceKnn`], every recording's [`SpikeInput`] is built once
 //! and shared, and the table the classifier is given holds, as its single "feature", each
@@ -6,9 +6,9 @@
 
 use std::sync::Arc;
 
-use super::{fit, softmax, Network, SnnParams, SpikeInput};
-use crate::classify::{Classifier, Predict};
+use super::{Classifier, Predict};
 use crate::error::ClassifyError;
+use crate::snn::{fit, softmax, Network, SnnParams, SpikeInput};
 
 /// An unfitted spiking classifier over a shared list of recordings' inputs.
 #[derive(Debug, Clone)]
@@ -100,7 +100,7 @@ impl Predict for SnnModel {
             .map(|&v| {
                 let scores = self.network.scores(&self.inputs[v as usize]);
                 let shares = softmax(&scores);
-                (crate::classify::first_max(&shares), shares)
+                (super::first_max(&shares), shares)
             })
             .collect()
     }
