@@ -547,3 +547,209 @@ fn network_of(
             .collect(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A node as the tests edit it: name, type, and each field's values and shape.
+    type Node = (String, String, Vec<(String, Vec<f64>, Vec<u64>)>);
+
+    fn net() -> Network {
+        let (n, h, c) = (3, 4, 2);
+        let w = |len: usize, k: f64| {
+            (0..len)
+                .map(|i| ((i as f64 * 0.37 + k).sin() as f32).into())
+                .collect()
+        };
+        Network {
+            inputs: n,
+            hidden: h,
+            classes: c,
+            dt_ms: 10,
+            tau_syn_ms: 20.0,
+            tau_mem_ms: 40.0,
+            tau_out_ms: 30.0,
+            readout: Readout::Max,
+            w_in: w(n * h, 0.1),
+            b_in: w(h, 0.2),
+            w_out: w(h * c, 0.3),
+            b_out: w(c, 0.4),
+        }
+    }
+
+    /// A graph like neurotex's with `edit` applied to its node table before writing:
+    /// `(name, type, fields)` and the edges; `dt` in the metadata or none.
+    fn graph(edit: impl Fn(&mut Vec<Node>, &mut Vec<[String; 2]>), dt: Option<f64>) -> Vec<u8> {
+        let written =
+            File::from_bytes(to_bytes(&net(), "{}", Convention::Physical).unwrap()).unwrap();
+        let nodes_group = written
+            .root()
+            .group("node")
+            .unwrap()
+            .group("nodes")
+            .unwrap();
+        let mut nodes = Vec::new();
+        for (name, _) in NODES {
+            let g = nodes_group.group(name).unwrap();
+            let kind = g.dataset("type").unwrap().read_string().unwrap().concat();
+            let fields = g
+                .datasets()
+                .unwrap()
+                .into_iter()
+                .filter(|f| f != "type")
+                .map(|f| {
+                    let d = g.dataset(&f).unwrap();
+                    (f, d.read_f64().unwrap(), d.shape().unwrap())
+                })
+                .collect();
+            nodes.push((name.to_string(), kind, fields));
+        }
+        let mut edges: Vec<[String; 2]> = NODES
+            .windows(2)
+            .map(|w| [w[0].0.to_string(), w[1].0.to_string()])
+            .collect();
+        edit(&mut nodes, &mut edges);
+        let mut fb = FileBuilder::new();
+        let mut node = fb.create_group("node");
+        put_str(&mut node, "type", "NIRGraph");
+        let flat: Vec<&str> = edges
+            .iter()
+            .flat_map(|e| [e[0].as_str(), e[1].as_str()])
+            .collect();
+        node.create_dataset("edges")
+            .with_vlen_strings(&flat)
+            .with_shape(&[edges.len() as u64, 2]);
+        let mut meta = node.create_group("metadata");
+        if let Some(dt) = dt {
+            meta.create_dataset("dt")
+                .with_f64_data(&[dt])
+                .with_shape(&[]);
+        }
+        put_str(&mut meta, "readout", "max");
+        node.add_group(meta.finish());
+        let mut group = node.create_group("nodes");
+        for (name, kind, fields) in &nodes {
+            let mut g = group.create_group(name);
+            put_str(&mut g, "type", kind);
+            for (f, v, shape) in fields {
+                g.create_dataset(f).with_f64_data(v).with_shape(shape);
+            }
+            group.add_group(g.finish());
+        }
+        node.add_group(group.finish());
+        fb.add_group(node.finish());
+        fb.finish().unwrap()
+    }
+
+    fn field(nodes: &mut [Node], node: &str, f: &str) -> Vec<f64> {
+        let n = nodes.iter_mut().find(|n| n.0 == node).unwrap();
+        n.2.iter().find(|x| x.0 == f).unwrap().1.clone()
+    }
+
+    fn set(nodes: &mut [Node], node: &str, f: &str, v: Vec<f64>) {
+        let n = nodes.iter_mut().find(|n| n.0 == node).unwrap();
+        n.2.iter_mut().find(|x| x.0 == f).unwrap().1 = v;
+    }
+
+    #[test]
+    fn a_graph_round_trips_and_one_written_in_other_units_reads_the_same() {
+        let bytes = to_bytes(&net(), "{}", Convention::Physical).unwrap();
+        let back = from_bytes(bytes).unwrap();
+        assert_eq!(back.dt_s, 0.01);
+        let scores = |n: &Network| {
+            let x = crate::snn::SpikeInput::from_events(
+                3,
+                20,
+                &[(0, 1), (2, 0), (2, 2), (5, 1), (9, 0)],
+            );
+            n.scores(&x)
+        };
+        for (a, b) in scores(&net()).iter().zip(scores(&back.network)) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+        // A threshold of 2 with every input weight doubled, and an LI gain r halved with
+        // the readout weights doubled: the same network.
+        let doubled = graph(
+            |nodes, _| {
+                set(nodes, "lif1", "v_threshold", vec![2.0; 4]);
+                let w = field(nodes, "fc1", "weight")
+                    .iter()
+                    .map(|w| 2.0 * w)
+                    .collect();
+                set(nodes, "fc1", "weight", w);
+                let b = field(nodes, "fc1", "bias")
+                    .iter()
+                    .map(|w| 2.0 * w)
+                    .collect();
+                set(nodes, "fc1", "bias", b);
+                let r = field(nodes, "li", "r").iter().map(|r| r / 2.0).collect();
+                set(nodes, "li", "r", r);
+                let w = field(nodes, "fc2", "weight")
+                    .iter()
+                    .map(|w| 2.0 * w)
+                    .collect();
+                set(nodes, "fc2", "weight", w);
+                let b = field(nodes, "fc2", "bias")
+                    .iter()
+                    .map(|w| 2.0 * w)
+                    .collect();
+                set(nodes, "fc2", "bias", b);
+            },
+            Some(0.01),
+        );
+        let same = from_bytes(doubled).unwrap().network;
+        for (a, b) in scores(&net()).iter().zip(scores(&same)) {
+            assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn graphs_of_another_shape_name_the_node_and_the_rule() {
+        let cases: Vec<(Vec<u8>, &str)> = vec![
+            (graph(|_, _| {}, None), "no `dt`"),
+            (graph(|_, _| {}, Some(0.0001)), "whole number of ms"),
+            (
+                graph(|n, _| n[2].1 = "IF".into(), Some(0.01)),
+                "node lif1 is a IF",
+            ),
+            (
+                graph(|_, e| e.push(["lif1".into(), "fc1".into()]), Some(0.01)),
+                "node lif1 has 2 outgoing edges",
+            ),
+            (
+                graph(|_, e| e[4] = ["li".into(), "fc2".into()], Some(0.01)),
+                "recurrent edge",
+            ),
+            (
+                graph(|n, _| set(n, "input", "shape", vec![5.0]), Some(0.01)),
+                "node input",
+            ),
+            (
+                graph(
+                    |n, _| set(n, "fc2", "bias", vec![f64::NAN, 0.0]),
+                    Some(0.01),
+                ),
+                "node fc2: `bias`[0] is not finite",
+            ),
+            (
+                graph(
+                    |n, _| set(n, "lif1", "tau_mem", vec![0.04, 0.04, 0.05, 0.04]),
+                    Some(0.01),
+                ),
+                "differs between neurons",
+            ),
+            (
+                graph(|n, _| set(n, "lif1", "v_reset", vec![0.5; 4]), Some(0.01)),
+                "v_reset must be 0",
+            ),
+        ];
+        for (bytes, want) in cases {
+            let err = from_bytes(bytes).unwrap_err();
+            assert!(err.contains(want), "{err:?} should say {want:?}");
+        }
+        assert!(from_bytes(b"not hdf5 at all".to_vec())
+            .unwrap_err()
+            .contains("not an HDF5 file"));
+    }
+}
