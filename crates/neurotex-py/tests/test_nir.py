@@ -81,3 +81,39 @@ def test_exported_graph_runs_in_nirs_equations_as_in_neurotex(cli, sim_dir, tmp_
     assert agree == len(rows)
     # The graph read back by neurotex predicts exactly what the model file does.
     assert open(again).read() == open(predicted).read()
+
+
+def test_a_graph_written_by_the_nir_package_runs_with_a_pipeline_given_by_like(cli, sim_dir, tmp_path):
+    """A graph as another tool writes it (`nir.write`, h5py's layout, only `dt` in the
+    metadata, constants in float32) runs in `neurotex predict` with --like."""
+    model = tmp_path / "snn.json"
+    cli("train", "--dataset", sim_dir, "--speeds", "10", "--classifier", "snn",
+        "--snn-epochs", "8", "--out", model)
+    ours = tmp_path / "ours.nir"
+    cli("export", "nir", "--model", model, "--out", ours)
+    graph = nir.read(str(ours))
+    nodes = {}
+    for name, node in graph.nodes.items():
+        if isinstance(node, nir.CubaLIF):
+            node = nir.CubaLIF(**{k: np.asarray(getattr(node, k), dtype=np.float32) for k in (
+                "tau_syn", "tau_mem", "r", "v_leak", "v_threshold", "v_reset", "w_in")})
+        elif isinstance(node, nir.LI):
+            node = nir.LI(tau=node.tau.astype(np.float32), r=node.r.astype(np.float32),
+                          v_leak=node.v_leak.astype(np.float32))
+        nodes[name] = node
+    theirs = tmp_path / "theirs.nir"
+    nir.write(str(theirs), nir.NIRGraph(nodes=nodes, edges=graph.edges,
+                                        metadata={"dt": float(np.asarray(graph.metadata["dt"]))}))
+    out = tmp_path / "never.csv"
+    err = cli("predict", "--model", theirs, "--dataset", sim_dir, "--out", out, ok=False)
+    assert err.returncode != 0 and "--like" in err.stderr and not out.exists()
+    expected = tmp_path / "pred.csv"
+    cli("predict", "--model", model, "--dataset", sim_dir, "--out", expected)
+    got = tmp_path / "pred_theirs.csv"
+    cli("predict", "--model", theirs, "--like", model, "--dataset", sim_dir, "--out", got)
+    a = list(csv.reader(open(expected)))
+    b = list(csv.reader(open(got)))
+    assert [r[:3] for r in a] == [r[:3] for r in b]
+    # float32 constants shift the decays by about 1e-7: shares agree closely, not exactly.
+    np.testing.assert_allclose(np.array([r[3:] for r in a[1:]], dtype=float),
+                               np.array([r[3:] for r in b[1:]], dtype=float), atol=1e-4)

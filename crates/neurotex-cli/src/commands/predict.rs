@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 use neurotex::model::Model;
 use neurotex::pipeline::Encoded;
-use neurotex::spiking_model::SpikingModel;
+use neurotex::spiking_model::{is_hdf5, SpikingModel};
 use neurotex::stream::write_episodes;
 use neurotex::workflows::predict::PredictOptions;
 
@@ -24,6 +24,11 @@ pub struct PredictArgs {
     /// leaf share over the trees; linear: its probability); `label` is empty when unknown.
     #[arg(long)]
     pub out: PathBuf,
+    /// With --model FILE.nir from another tool (snnTorch, Norse, Rockpool: no neurotex
+    /// metadata in the graph): a neurotex spiking model whose pipeline, grid and labels the
+    /// graph's network runs with (the network must have its inputs and outputs).
+    #[arg(long)]
+    pub like: Option<PathBuf>,
     /// Also print `{"accuracy", "n", "labels", "confusion"}` (rows = true label) as JSON;
     /// needs --dataset, and every label there must be a class of the model.
     #[arg(long)]
@@ -46,6 +51,9 @@ pub fn run(args: PredictArgs) -> Result<()> {
     check_output(&args.out, &o.inputs(dataset.as_ref()))?;
     if SpikingModel::is_spiking(&o.model) {
         return predict_spiking(&args, dataset.as_ref());
+    }
+    if args.like.is_some() {
+        bail!("--like applies to a NIR graph given as --model");
     }
     let model = Model::load(&o.model)?;
     let progress = Shown::new("starting");
@@ -91,7 +99,13 @@ fn predict_spiking(
             o.model.display()
         );
     }
-    let model = SpikingModel::load(&o.model)?;
+    let model = match &args.like {
+        Some(like) if is_hdf5(&o.model) => {
+            SpikingModel::from_nir(&o.model, Some(&SpikingModel::load(like)?))?
+        }
+        Some(_) => bail!("--like applies to a NIR graph given as --model, not to a model file"),
+        None => SpikingModel::load(&o.model)?,
+    };
     let progress = Shown::new("starting");
     let encoded = o.encode_with(
         model.pipeline(),
