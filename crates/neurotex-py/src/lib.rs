@@ -15,6 +15,7 @@ mod inspect;
 mod model;
 mod params;
 mod reproduce;
+mod spiking;
 mod stream;
 
 use ndarray::{Array2, Array3};
@@ -402,6 +403,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     reproduce::register(m)?;
     inspect::register(m)?;
     model::register(m)?;
+    spiking::register(m)?;
     estimator::register(m)?;
     stream::register(m)?;
     Ok(())

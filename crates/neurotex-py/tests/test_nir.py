@@ -117,3 +117,25 @@ def test_a_graph_written_by_the_nir_package_runs_with_a_pipeline_given_by_like(c
     # float32 constants shift the decays by about 1e-7: shares agree closely, not exactly.
     np.testing.assert_allclose(np.array([r[3:] for r in a[1:]], dtype=float),
                                np.array([r[3:] for r in b[1:]], dtype=float), atol=1e-4)
+
+
+def test_the_python_package_moves_a_spiking_model_to_nir_and_back(cli, sim_dir, sim, tmp_path):
+    import neurotex
+
+    path = tmp_path / "snn.json"
+    cli("train", "--dataset", sim_dir, "--speeds", "5", "--classifier", "snn",
+        "--snn-epochs", "8", "--out", path)
+    model = neurotex.SpikingModel.load(path)
+    assert "128 LIF neurons" in repr(model) and model.classes_ == ["FT1", "SB", "CP"]
+    graph = model.to_nir()
+    assert isinstance(graph, nir.NIRGraph) and float(np.asarray(graph.metadata["dt"])) == 0.01
+    back = neurotex.SpikingModel.from_nir(graph)
+    expected = tmp_path / "pred.csv"
+    cli("predict", "--model", path, "--dataset", sim_dir, "--out", expected)
+    rows = list(csv.DictReader(open(expected)))
+    for m in (model, back):
+        labels = m.predict(sim)
+        assert list(labels) == [r["predicted"] for r in rows]
+        shares = m.predict_proba(sim)
+        np.testing.assert_allclose(shares, [[float(r[f"share_{c}"]) for c in m.classes_] for r in rows],
+                                   rtol=1e-12, atol=1e-15)

@@ -802,6 +802,86 @@ class Model:
 
 
 
+
+class SpikingModel:
+    """A trained spiking network with its pipeline: the model file of ``neurotex train
+    --classifier snn``, or a NIR graph (:meth:`to_nir`, :meth:`from_nir`; see
+    docs/spiking-classifier.md). Its input is the recordings' spikes, encoded with the
+    model's own pipeline."""
+
+    def __init__(self, native: Any) -> None:
+        self._native = native
+
+    @classmethod
+    def load(cls, path: Union[str, os.PathLike]) -> "SpikingModel":
+        """Reads a spiking model file, or a NIR graph written by neurotex."""
+        return cls(_native.NativeSpikingModel.load(os.fspath(path)))
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the model file (whole or not at all)."""
+        self._native.save(os.fspath(path))
+
+    def to_nir(self, convention: str = "physical") -> Any:
+        """The network as a ``nir.NIRGraph`` (needs the ``nir`` package): Input, Affine,
+        CubaLIF, Affine, LI, Output, with ``dt`` (seconds) and the pipeline in its
+        metadata. ``convention="snntorch"`` scales the time constants for snnTorch's
+        importer, which steps every graph at 0.1 ms."""
+        import tempfile
+
+        import nir
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "model.nir")
+            self._native.write_nir(path, convention)
+            return nir.read(path)
+
+    def save_nir(self, path: Union[str, os.PathLike], convention: str = "physical") -> None:
+        """Writes the network as a NIR file (as ``neurotex export nir``)."""
+        self._native.write_nir(os.fspath(path), convention)
+
+    @classmethod
+    def from_nir(cls, graph: Any, like: Optional["SpikingModel"] = None) -> "SpikingModel":
+        """A model from a NIR graph (a ``nir.NIRGraph`` or a path to a ``.nir`` file). A
+        graph that does not carry neurotex's metadata (trained in snnTorch, Norse,
+        Rockpool on :func:`neurotex export inputs` tensors) takes its pipeline, grid and
+        labels from ``like``."""
+        native_like = like._native if like is not None else None
+        if isinstance(graph, (str, os.PathLike)):
+            return cls(_native.NativeSpikingModel.from_nir(os.fspath(graph), native_like))
+        import tempfile
+
+        import nir
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "model.nir")
+            nir.write(path, graph)
+            return cls(_native.NativeSpikingModel.from_nir(path, native_like))
+
+    def predict(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
+        """The predicted label of each recording."""
+        return self._predict(recordings, fs, mask)[0]
+
+    def predict_proba(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
+        """Each class's share: the softmax of the readout's scores (columns in
+        :attr:`classes_` order)."""
+        return self._predict(recordings, fs, mask)[1]
+
+    def _predict(self, recordings: Any, fs: float, mask: Any) -> Tuple[np.ndarray, np.ndarray]:
+        items = _recording_list(recordings)
+        arrays, infos = _prepare(items, fs, mask)
+        labels, shares = self._native.predict(arrays, infos)
+        return np.array(labels, dtype=object), shares
+
+    @property
+    def classes_(self) -> List[str]:
+        """The classes, in the order of the network's outputs."""
+        return list(self._native.labels)
+
+    def __repr__(self) -> str:
+        inputs, hidden, classes, dt = self._native.shape
+        return f"SpikingModel({inputs} inputs, {hidden} LIF neurons, {classes} classes, dt {dt} ms)"
+
+
 @dataclass
 class Reproduction:
     """What :func:`reproduce` ran and wrote.
@@ -1048,7 +1128,7 @@ class StreamClassifier:
 
 __all__ = [
     "encode", "features", "spike_stats", "rate_volume", "glcm3d", "glcm2d", "haralick",
-    "cross_validate", "load_dataset", "save_dataset", "simulate", "Model", "Recording",
+    "cross_validate", "load_dataset", "save_dataset", "simulate", "Model", "SpikingModel", "Recording",
     "StreamClassifier", "reproduce", "Reproduction", "calibrate_gain", "GainCalibration",
     "CausalConditioning", "FeatureTable", "inspect", "Inspection",
     "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",

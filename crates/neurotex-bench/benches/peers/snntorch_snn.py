@@ -1,0 +1,212 @@
+"""The snnTorch peer of the criterion bench `snn/train_epoch/55x32x1200`
+(crates/neurotex-bench/benches/snn.rs): one training epoch of the same spiking classifier
+on data of the same shapes and rates, written the way an snnTorch user would write it.
+
+Needs torch and snntorch, in a throwaway virtual environment outside the repository; it is
+never run in CI and nothing imports it:
+
+    python3 -m venv /tmp/snnpeer
+    /tmp/snnpeer/bin/pip install torch --index-url https://download.pytorch.org/whl/cpu
+    /tmp/snnpeer/bin/pip install snntorch "numpy<2"   # numpy<2 only for a torch built on 1.x
+    /tmp/snnpeer/bin/python crates/neurotex-bench/benches/peers/snntorch_snn.py \
+        [--dtype float64|float32|both] [--reset manual|delay|nodelay] [--hoist] [--epochs 7]
+
+and, back to back on the same host (these machines are noisy),
+`cargo bench -p neurotex-bench --bench snn -- train_epoch`, whose median is
+`median.point_estimate` (ns) in target/criterion/snn_train_epoch_55x32x1200/new/estimates.json.
+
+The work, as the Rust bench's `fit` with one epoch does it (neurotex-learn src/snn):
+55 recordings of 32 inputs x 1200 steps of 10 ms, class `i % 5`, an input spiking with
+probability 0.08 per step when `input * 5 // 32` is its recording's class and 0.02
+otherwise (numpy, seeded; the Rust bench draws its own with xorshift: same rates, not the
+same spikes). A stratified validation split of round(0.2 * 11) = 2 recordings per class:
+45 trained in shuffled batches of 8 (5 of 8 and one of 5) and 10 held out. The network:
+
+    input (32) -> Linear -> snn.Synaptic, 128 hidden (alpha = exp(-10/20), beta =
+    exp(-10/40), threshold 1, reset to zero, fast-sigmoid surrogate of slope 10)
+    -> Linear -> snn.Leaky(beta = exp(-10/40), reset_mechanism="none"), whose membrane is
+    the readout O[t] = k O[t-1] + W_out S[t] + b_out; class scores = mean of O over time
+
+with neurotex's initial weights (input weights normal with the fluctuation-driven spread
+from the training data's mean rate, readout weights uniform in +-1/sqrt(128), biases 0),
+softmax cross-entropy (mean over the batch), BPTT over all 1200 steps, Adam lr 0.005, then
+a no-grad forward over the 10 validation recordings for the validation loss. Each timed
+epoch starts from a fresh network and optimizer, as each iteration of the Rust bench does.
+torch.set_num_threads(2), as neurotex uses 2 rayon threads on these 2-core machines.
+snnTorch's fast_sigmoid returns float32 spikes whatever its input, so in float64 the spikes
+are cast back to float64 (one more graph node per step).
+
+The reset (`--reset`):
+  manual   (default) snn.Synaptic with reset_mechanism="none" and the reset to zero applied
+           by hand with the spike detached, V[t] = P[t] (1 - S[t].detach()): neurotex's
+           dynamics and gradient exactly (a spike at P >= 1 in neurotex, P > 1 in snnTorch).
+  delay    snn.Synaptic(reset_mechanism="zero", reset_delay=True), snnTorch's default: the
+           reset is detached (`mem_reset` detaches it) but applied one step late, to the
+           next step's whole membrane, so a neuron that spiked sits at 0 for a step.
+  nodelay  snn.Synaptic(reset_mechanism="zero", reset_delay=False): neurotex's timing, but
+           the reset is not detached (the gradient flows through the spike in V = P(1-S)).
+`--hoist` applies the input Linear to all 1200 steps in one call before the time loop
+instead of step by step as the snnTorch tutorials do (same result, fewer graph nodes).
+
+Differences that stay: snnTorch runs a batch as one (batch x hidden) tensor per step and
+autograd records the graph, where neurotex runs each recording's forward and hand-written
+backward pass separately (the batch's recordings split over 2 threads) and touches only
+the inputs and hidden neurons that spiked; the dense tensors cost the same whatever spikes.
+
+Prints one JSON line per dtype: median and samples of the epoch time in ms, versions, setup.
+"""
+
+import argparse
+import json
+import math
+import statistics
+import time
+
+import numpy as np
+import snntorch
+import snntorch as snn
+import torch
+from snntorch import surrogate
+from torch import nn
+
+INPUTS, STEPS, CLASSES, RECORDINGS, HIDDEN = 32, 1200, 5, 55, 128
+DT_MS, TAU_SYN_MS, TAU_MEM_MS, TAU_OUT_MS = 10.0, 20.0, 40.0, 40.0
+BATCH, LEARNING_RATE, VALIDATION, SLOPE = 8, 0.005, 0.2, 10.0
+ALPHA, BETA, KAPPA = (math.exp(-DT_MS / t) for t in (TAU_SYN_MS, TAU_MEM_MS, TAU_OUT_MS))
+
+
+def recordings(rng):
+    """(RECORDINGS, STEPS, INPUTS) of 0/1 spikes and the class of each."""
+    y = np.arange(RECORDINGS) % CLASSES
+    own = (np.arange(INPUTS) * CLASSES // INPUTS)[None, :] == y[:, None]
+    rate = np.where(own, 0.08, 0.02)[:, None, :]
+    x = (rng.random((RECORDINGS, STEPS, INPUTS)) < rate).astype(np.float64)
+    return x, y
+
+
+def validation_split(y, rng):
+    """Each class's recordings shuffled, round(share * n) (at least 1) held out."""
+    train, valid = [], []
+    for c in range(CLASSES):
+        members = rng.permutation(np.flatnonzero(y == c))
+        held = min(max(int(round(len(members) * VALIDATION)), 1), len(members) - 1)
+        valid += members[:held].tolist()
+        train += members[held:].tolist()
+    return sorted(train), sorted(valid)
+
+
+def kernel_energy(alpha, beta):
+    """Sum over t of the squared membrane response to one unit input (as neurotex)."""
+    current, membrane, energy = 1.0, 0.0, 0.0
+    for _ in range(100_000):
+        membrane = beta * membrane + current
+        current *= alpha
+        energy += membrane * membrane
+        if membrane < 1e-9 * math.sqrt(energy):
+            break
+    return energy
+
+
+class Net(nn.Module):
+    def __init__(self, reset, hoist, sigma, gen):
+        super().__init__()
+        self.reset, self.hoist = reset, hoist
+        grad = surrogate.fast_sigmoid(slope=SLOPE)
+        self.fc1 = nn.Linear(INPUTS, HIDDEN)
+        if reset == "manual":
+            self.lif = snn.Synaptic(alpha=ALPHA, beta=BETA, threshold=1.0, spike_grad=grad,
+                                    reset_mechanism="none")
+        else:
+            self.lif = snn.Synaptic(alpha=ALPHA, beta=BETA, threshold=1.0, spike_grad=grad,
+                                    reset_mechanism="zero", reset_delay=(reset == "delay"))
+        self.fc2 = nn.Linear(HIDDEN, CLASSES)
+        self.out = snn.Leaky(beta=KAPPA, reset_mechanism="none")
+        bound = 1.0 / math.sqrt(HIDDEN)
+        with torch.no_grad():
+            self.fc1.weight.normal_(0.0, sigma, generator=gen)
+            self.fc1.bias.zero_()
+            self.fc2.weight.uniform_(-bound, bound, generator=gen)
+            self.fc2.bias.zero_()
+
+    def forward(self, x):
+        """x: (steps, batch, inputs) -> class scores (batch, classes)."""
+        syn = mem = out = None
+        acc = 0.0
+        cur_all = self.fc1(x) if self.hoist else None
+        for t in range(x.shape[0]):
+            cur = cur_all[t] if self.hoist else self.fc1(x[t])
+            if syn is None:
+                syn, mem = torch.zeros_like(cur), torch.zeros_like(cur)
+                out = torch.zeros(cur.shape[0], CLASSES, dtype=cur.dtype)
+            spk, syn, mem = self.lif(cur, syn, mem)
+            spk = spk.to(cur.dtype)  # fast_sigmoid's spikes are float32 whatever the input
+            if self.reset == "manual":
+                mem = mem * (1.0 - spk.detach())
+            _, out = self.out(self.fc2(spk), out)
+            acc = acc + out
+        return acc / x.shape[0]
+
+
+def epoch(x, y, train, valid, reset, hoist, sigma, dtype, rng, gen):
+    """One `fit` with one epoch: a fresh network and Adam, the training batches, the
+    validation loss."""
+    net = Net(reset, hoist, sigma, gen).to(dtype)
+    opt = torch.optim.Adam(net.parameters(), lr=LEARNING_RATE)
+    loss_fn = nn.CrossEntropyLoss()
+    order = rng.permutation(train)
+    for start in range(0, len(order), BATCH):
+        batch = order[start:start + BATCH]
+        opt.zero_grad()
+        loss = loss_fn(net(x[:, batch]), y[batch])
+        loss.backward()
+        opt.step()
+    with torch.no_grad():
+        return loss_fn(net(x[:, valid]), y[valid]).item()
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--dtype", choices=["float64", "float32", "both"], default="float64")
+    ap.add_argument("--reset", choices=["manual", "delay", "nodelay"], default="manual")
+    ap.add_argument("--hoist", action="store_true",
+                    help="apply the input Linear to all steps at once before the time loop")
+    ap.add_argument("--epochs", type=int, default=7, help="timed epochs (after 1 warm-up)")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    torch.set_num_threads(args.threads)
+
+    rng = np.random.default_rng(args.seed)
+    x_np, y_np = recordings(rng)
+    train, valid = validation_split(y_np, rng)
+    rate = x_np[train].mean()
+    sigma = 1.0 / math.sqrt(INPUTS * rate * kernel_energy(ALPHA, BETA))
+    dtypes = ["float64", "float32"] if args.dtype == "both" else [args.dtype]
+    for name in dtypes:
+        dtype = getattr(torch, name)
+        # Time-major, as the loop steps through it: (steps, recordings, inputs).
+        x = torch.from_numpy(x_np.transpose(1, 0, 2).copy()).to(dtype)
+        y = torch.from_numpy(y_np).long()
+        gen = torch.Generator().manual_seed(args.seed)
+        times, losses = [], []
+        for i in range(1 + args.epochs):
+            t0 = time.perf_counter()
+            loss = epoch(x, y, train, valid, args.reset, args.hoist, sigma, dtype, rng, gen)
+            elapsed = (time.perf_counter() - t0) * 1e3
+            if i > 0:
+                times.append(elapsed)
+                losses.append(loss)
+        print(json.dumps({
+            "peer": "snntorch", "of": "snn/train_epoch/55x32x1200",
+            "median_ms": round(statistics.median(times), 2),
+            "samples_ms": [round(t, 2) for t in times],
+            "dtype": name, "reset": args.reset, "hoist": args.hoist,
+            "threads": torch.get_num_threads(),
+            "train": len(train), "valid": len(valid), "batch": BATCH,
+            "validation_loss_median": round(statistics.median(losses), 4),
+            "torch": torch.__version__, "snntorch": snntorch.__version__,
+        }), flush=True)
+
+
+if __name__ == "__main__":
+    main()
