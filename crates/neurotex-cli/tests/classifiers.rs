@@ -118,7 +118,7 @@ fn options_of_another_classifier_are_refused() {
     let cases = [
         (
             train(&["--classifier", "svm"]),
-            "classifier must be knn, forest or linear",
+            "classifier must be knn, forest, linear or snn",
         ),
         (
             train(&["--trees", "10"]),

@@ -393,7 +393,10 @@ fn the_spiking_network_options_are_checked() {
                 cmp(&["--methods", "spikes", "--snn-readout", "last"]),
                 "mean or max",
             ),
-            (eval(&["--method", "spikes"]), "spikes with snn"),
+            (
+                eval(&["--method", "spikes", "--classifier", "forest"]),
+                "spikes with snn",
+            ),
             (
                 eval(&["--method", "glcm3d", "--classifier", "snn"]),
                 "spikes with snn",

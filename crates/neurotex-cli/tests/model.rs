@@ -444,4 +444,57 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(err.contains("damaged.json"), "{err}");
     assert!(!never.exists());
+    // A graph that is not HDF5, and a feature model where a spiking one is needed.
+    let junk = dir.join("junk.nir");
+    std::fs::write(&junk, b"not a graph").unwrap();
+    let err = dir.fails(&[
+        "predict",
+        "--model",
+        s(&junk),
+        "--dataset",
+        s(&ds),
+        "--out",
+        s(&never),
+    ]);
+    assert!(
+        err.contains("junk.nir: cannot run this NIR graph: not an HDF5 file"),
+        "{err}"
+    );
+    let feature = dir.join("feature.json");
+    dir.ok(&["train", "--dataset", s(&ds), "--out", s(&feature)]);
+    let graph = dir.join("snn.nir");
+    dir.ok(&["export", "nir", "--model", s(&model), "--out", s(&graph)]);
+    let args = [
+        "predict",
+        "--model",
+        s(&graph),
+        "--like",
+        s(&feature),
+        "--dataset",
+        s(&ds),
+        "--out",
+        s(&never),
+    ];
+    let err = dir.fails(&args);
+    assert!(err.contains("feature.json: a feature model"), "{err}");
+    let err = dir.fails(&["export", "nir", "--model", s(&feature), "--out", s(&never)]);
+    assert!(err.contains("not a spiking model"), "{err}");
+    // The input tensors, written twice into the same folder: the second run replaces the
+    // first.
+    let inputs = dir.join("inputs");
+    for _ in 0..2 {
+        dir.ok(&[
+            "export",
+            "inputs",
+            "--model",
+            s(&model),
+            "--dataset",
+            s(&ds),
+            "--out",
+            s(&inputs),
+        ]);
+    }
+    let index = std::fs::read_to_string(inputs.join("index.csv")).unwrap();
+    assert_eq!(index.lines().count(), 25, "{index}");
+    assert!(index.starts_with("file,label,array\n"));
 }

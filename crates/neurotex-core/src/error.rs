@@ -276,6 +276,25 @@ impl ClassifyError {
         )
     }
 
+    /// The error with a class given by its index named by `names` (the spiking
+    /// classifier's validation split sees class indices only), and, inside
+    /// cross-validation, said to be a training fold.
+    pub fn with_class_names(self, names: &[String]) -> Self {
+        match self {
+            ClassifyError::ValidationTooSmall { class, count } => {
+                ClassifyError::ValidationTooSmall {
+                    class: class
+                        .parse::<usize>()
+                        .ok()
+                        .and_then(|c| names.get(c).cloned())
+                        .unwrap_or(class),
+                    count,
+                }
+            }
+            other => other,
+        }
+    }
+
     /// What to change when the data is too small for the folds or neighbours asked for,
     /// the options spelled by `option(name, value)` (`--folds 2` on the command line,
     /// `folds=2` in Python); `None` for the other errors.
@@ -285,6 +304,10 @@ impl ClassifyError {
             ClassifyError::ClassTooSmall { .. } => Some(format!(
                 "{} sets the cross-validation folds: each class needs at least that many recordings (in reproduce, at each speed); a small pilot runs with {pilot}",
                 option("folds", "N")
+            )),
+            ClassifyError::ValidationTooSmall { .. } => Some(format!(
+                "the spiking network sets 20 % of each class's training recordings aside for early stopping: each class needs at least 2 in every training set (inside cross-validation, a training fold); fewer folds ({}) or more recordings help",
+                option("folds", "2")
             )),
             ClassifyError::KTooLarge { .. } => Some(format!(
                 "{} sets the neighbours of KNN: each training fold must hold at least that many recordings (in reproduce, at each speed); a small pilot runs with {pilot}",
@@ -441,6 +464,20 @@ pub enum ModelError {
         path: PathBuf,
         /// What is wrong.
         reason: String,
+    },
+    /// A NIR graph neurotex cannot run: not HDF5, damaged, or of another shape.
+    #[error("{}: cannot run this NIR graph: {reason}", .path.display())]
+    Nir {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, naming the node or the rule.
+        reason: String,
+    },
+    /// A feature model where a spiking model is needed.
+    #[error("{}: a feature model (`{MODEL_FORMAT}`), not a spiking model: train one with --classifier snn", .path.display())]
+    NotSpiking {
+        /// The file.
+        path: PathBuf,
     },
     /// A model's parts disagree with each other (only a damaged file can make them).
     #[error("{0}")]

@@ -215,7 +215,7 @@ pub fn write(path: &Path, net: &Network, model_json: &str, convention: Conventio
 pub fn read(path: &Path) -> Result<NirNetwork> {
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     let damaged = |reason: String| -> crate::Error {
-        ModelError::Damaged {
+        ModelError::Nir {
             path: path.to_path_buf(),
             reason,
         }
@@ -283,7 +283,12 @@ fn read_array(g: &hdf5_pure::Group, name: &str, at: &str) -> Result<(Vec<f64>, V
 }
 
 fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
-    let file = File::from_bytes(bytes).map_err(|e| format!("not an HDF5 file: {e}"))?;
+    if !bytes.starts_with(b"\x89HDF\r\n\x1a\n") {
+        return Err(
+            "not an HDF5 file (a NIR graph is HDF5, which starts with its signature)".into(),
+        );
+    }
+    let file = File::from_bytes(bytes).map_err(|e| format!("a damaged HDF5 file: {e}"))?;
     let reader = Reader { file };
     let node = reader.group(&["node"])?;
     let kind = read_string(&node, "type", "/node")?;
@@ -294,10 +299,12 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
     let meta = reader.group(&["node", "metadata"]).map_err(|_| {
         "the graph has no metadata, so no `dt` (its time step in seconds)".to_string()
     })?;
-    let dt = meta
-        .dataset("dt")
-        .and_then(|d| d.read_f64())
-        .map_err(|_| "the graph's metadata has no `dt` (its time step in seconds)".to_string())?;
+    let dt = match meta.dataset("dt") {
+        Err(_) => return Err("the graph's metadata has no `dt` (its time step in seconds)".into()),
+        Ok(d) => d.read_f64().map_err(|_| {
+            "the graph's metadata `dt` is not a number (its time step in seconds)".to_string()
+        })?,
+    };
     let dt_s = *dt.first().ok_or("the graph's `dt` is empty")?;
     let dt_ms = dt_s * 1000.0;
     if !((1.0..=1000.0).contains(&dt_ms) && (dt_ms - dt_ms.round()).abs() < 1e-6) {

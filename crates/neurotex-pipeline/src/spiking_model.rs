@@ -219,7 +219,7 @@ impl SpikingModel {
     pub fn from_nir(path: &Path, like: Option<&SpikingModel>) -> Result<SpikingModel> {
         let graph = crate::nir::read(path)?;
         let damaged = |reason: String| -> crate::Error {
-            ModelError::Damaged {
+            ModelError::Nir {
                 path: path.to_path_buf(),
                 reason,
             }
@@ -240,10 +240,14 @@ impl SpikingModel {
         SpikingModel::assemble(file).map_err(|e| damaged(e.to_string()))
     }
 
-    /// Whether the file at `path` claims to be a spiking model (its `format`, or HDF5's
-    /// signature: a NIR graph), read without checking the rest.
+    /// Whether the file at `path` claims to be a spiking model (its `format`, HDF5's
+    /// signature or a `.nir` name: a NIR graph), read without checking the rest.
     pub fn is_spiking(path: &Path) -> bool {
-        if is_hdf5(path) {
+        if is_hdf5(path)
+            || path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("nir"))
+        {
             return true;
         }
         #[derive(Deserialize)]
@@ -265,7 +269,11 @@ impl SpikingModel {
     /// An unreadable file, another format or version, or damaged content (a non-finite
     /// weight, a network that does not fit the pipeline), naming the file and the rule.
     pub fn load(path: &Path) -> Result<SpikingModel> {
-        if is_hdf5(path) {
+        if is_hdf5(path)
+            || path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("nir"))
+        {
             return SpikingModel::from_nir(path, None);
         }
         let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
@@ -279,6 +287,12 @@ impl SpikingModel {
         let value: serde_json::Value =
             serde_json::from_slice(&bytes).map_err(|e| damaged(e.to_string()))?;
         let text = |v: Option<&serde_json::Value>| v.map_or("missing".into(), |v| v.to_string());
+        if value.get("format").and_then(|f| f.as_str()) == Some(crate::model::FORMAT) {
+            return Err(ModelError::NotSpiking {
+                path: path.to_path_buf(),
+            }
+            .into());
+        }
         if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
             return Err(ModelError::NotAModel {
                 path: path.to_path_buf(),

@@ -51,7 +51,7 @@ pub struct ExportInputsArgs {
     /// The dataset folder whose recordings are exported.
     #[arg(long)]
     pub dataset: PathBuf,
-    /// The folder to create (new, or empty).
+    /// The folder to write (new, empty, or an earlier export, which is replaced).
     #[arg(long)]
     pub out: PathBuf,
     /// How the dataset folder is opened.

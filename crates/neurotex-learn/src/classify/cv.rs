@@ -362,7 +362,8 @@ pub fn cross_validate_sweep<C: Sweep>(
                 cv.folds,
             ),
         };
-        let each = out_of_fold_sweep(sweep, (x, dims), y, &fold_of, folds)?;
+        let each = out_of_fold_sweep(sweep, (x, dims), y, &fold_of, folds)
+            .map_err(|e| e.with_class_names(class_names))?;
         for (s, predicted) in each.into_iter().enumerate() {
             if s == settings.len() {
                 settings.push(Repeats::new(n_classes, cv.repeats));
@@ -442,7 +443,9 @@ pub fn train_test_sweep<C: Sweep>(
             label: class_names.get(c).cloned().unwrap_or_else(|| c.to_string()),
         });
     }
-    let model = sweep.fit_sweep(x_train, dims, y_train)?;
+    let model = sweep
+        .fit_sweep(x_train, dims, y_train)
+        .map_err(|e| e.with_class_names(class_names))?;
     if x_test.len() != y_test.len() * dims || x_test.iter().any(|v| !v.is_finite()) {
         return Err(ClassifyError::BadFeatures(
             "test features are ragged or not finite".into(),

@@ -29,7 +29,8 @@ pub struct EvaluateOptions {
     /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`), `spectrum` (each
     /// taxel's spike counts along the slide in bands of spatial frequency), `van-rossum`
     /// (KNN over van Rossum distances between the recordings' spike trains) or `spikes`
-    /// (the spike trains themselves, for the spiking network: `--classifier snn`).
+    /// (the spike trains themselves, classified by the spiking network, `--classifier snn`,
+    /// which `--method spikes` chooses when no other classifier is given).
     #[cfg_attr(feature = "cli", arg(long))]
     pub method: MethodChoice,
     /// With `--method van-rossum`: the kernel's time constant in ms (default: the rate
@@ -244,6 +245,15 @@ impl EvaluateOptions {
         let classifier = self.classifier.choice(self.knn.params()?)?;
         let split = self.split()?;
         let columns = self.columns()?;
+        // `--method spikes` runs the spiking network: KNN, the default, is replaced by it.
+        let classifier = match (self.method, classifier) {
+            (MethodChoice::Spikes, ClassifierChoice::Knn(_)) => ClassifierChoice::Snn(
+                self.classifier
+                    .snn
+                    .params(crate::snn::SnnParams::default())?,
+            ),
+            (_, c) => c,
+        };
         let fits = match (self.method, classifier) {
             (MethodChoice::VanRossum, c) => matches!(c, ClassifierChoice::Knn(_)),
             (MethodChoice::Spikes, c) => matches!(c, ClassifierChoice::Snn(_)),

@@ -57,12 +57,13 @@ pub fn load_spiking(path: &Path) -> Result<SpikingModel> {
     SpikingModel::load(path)
 }
 
-/// Writes, into the new folder `out`, every recording of `dataset` as the `(steps,
+/// Writes, into the folder `out` (new, or an earlier export), every recording of `dataset` as the `(steps,
 /// inputs)` float32 spike counts the network's input node receives (`<n>.npy`, row-major),
 /// and `index.csv` (`file,label,array`). Returns the recordings written.
 ///
 /// # Errors
-/// A recording that cannot be read or encoded, or `out` exists and is not empty.
+/// A recording that cannot be read or encoded, or `out` holds files neurotex did not write
+/// there (an earlier export is replaced).
 pub fn export_inputs(
     model: &SpikingModel,
     dataset: &Dataset,
@@ -75,7 +76,7 @@ pub fn export_inputs(
         .pipeline()
         .encode_dataset(dataset, &all, &|| on(Progress::Tick))?;
     let dt = model.network().dt_ms;
-    crate::io::create_dir_atomic(out, |dir| {
+    crate::io::replace_dir(out, |dir| {
         let names: Vec<String> = (0..encoded.len()).map(|i| format!("{i:05}.npy")).collect();
         encoded
             .par_iter()

@@ -77,9 +77,11 @@ impl KnnOptions {
 #[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct ClassifierOptions {
     /// Classifier: `knn` (the paper's), `forest` (random forest of CART trees, √d features
-    /// tried per split) or `linear` (multinomial logistic regression, L2 penalty). The
-    /// regression always z-scores features with training statistics and the forest needs no
-    /// scaling: --no-standardize applies to KNN only.
+    /// tried per split), `linear` (multinomial logistic regression, L2 penalty) or `snn` (a
+    /// spiking network that reads the spike trains themselves, not features: `evaluate
+    /// --method spikes`; in `train` the feature method is then not read). The regression
+    /// always z-scores features with training statistics and the forest needs no scaling:
+    /// --no-standardize applies to KNN only.
     #[cfg_attr(feature = "cli", arg(long, default_value = "knn"))]
     pub classifier: ClassifierChoice,
     /// With `--classifier forest`: trees in the forest [default: 200].
