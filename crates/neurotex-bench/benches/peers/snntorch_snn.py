@@ -1,4 +1,4 @@
-"""The snnTorch peer of the criterion bench `snn/train_epoch/55x32x1200`
+r"""The snnTorch peer of the criterion bench `snn/train_epoch/55x32x1200`
 (crates/neurotex-bench/benches/snn.rs): one training epoch of the same spiking classifier
 on data of the same shapes and rates, written the way an snnTorch user would write it.
 
@@ -10,6 +10,19 @@ never run in CI and nothing imports it:
     /tmp/snnpeer/bin/pip install snntorch "numpy<2"   # numpy<2 only for a torch built on 1.x
     /tmp/snnpeer/bin/python crates/neurotex-bench/benches/peers/snntorch_snn.py \
         [--dtype float64|float32|both] [--reset manual|delay|nodelay] [--hoist] [--epochs 7]
+
+Where the PyTorch index cannot be reached (PyPI's Linux x86-64 torch is the CUDA build,
+which does not import without its nvidia-* libraries), Debian bookworm's CPU-only
+python3-torch 1.13.1 serves, unpacked rather than installed:
+
+    mkdir -p /tmp/debtorch/debs && cd /tmp/debtorch/debs && apt-get download $(apt-get -s \
+        install --no-install-recommends python3-torch libopenblas0-pthread | awk '/^Inst/ \
+        {print $2}' | grep -v '^python3-\(numpy\|sympy\|mpmath\)$')
+    for f in *.deb; do dpkg-deb -x "$f" /tmp/debtorch/root; done
+    R=/tmp/debtorch/root; /tmp/snnpeer/bin/pip install "numpy<2" sympy typing_extensions
+    L=$R/usr/lib/x86_64-linux-gnu; L=$L:$L/openblas-pthread:$R/usr/lib:$R/lib/x86_64-linux-gnu
+    cd /work/main && PYTHONPATH=$R/usr/lib/python3/dist-packages LD_LIBRARY_PATH=$L \
+        /tmp/snnpeer/bin/python crates/neurotex-bench/benches/peers/snntorch_snn.py
 
 and, back to back on the same host (these machines are noisy),
 `cargo bench -p neurotex-bench --bench snn -- train_epoch`, whose median is
@@ -46,7 +59,8 @@ The reset (`--reset`):
   nodelay  snn.Synaptic(reset_mechanism="zero", reset_delay=False): neurotex's timing, but
            the reset is not detached (the gradient flows through the spike in V = P(1-S)).
 `--hoist` applies the input Linear to all 1200 steps in one call before the time loop
-instead of step by step as the snnTorch tutorials do (same result, fewer graph nodes).
+instead of step by step as the snnTorch tutorials do (same result, fewer graph nodes), and
+splits it with `unbind` (indexing it step by step makes the backward pass quadratic).
 
 Differences that stay: snnTorch runs a batch as one (batch x hidden) tensor per step and
 autograd records the graph, where neurotex runs each recording's forward and hand-written
@@ -132,7 +146,9 @@ class Net(nn.Module):
         """x: (steps, batch, inputs) -> class scores (batch, classes)."""
         syn = mem = out = None
         acc = 0.0
-        cur_all = self.fc1(x) if self.hoist else None
+        # unbind, not cur_all[t]: indexing's backward writes a whole (steps x batch x
+        # hidden) zero tensor for each step, quadratic in the steps.
+        cur_all = self.fc1(x).unbind(0) if self.hoist else None
         for t in range(x.shape[0]):
             cur = cur_all[t] if self.hoist else self.fc1(x[t])
             if syn is None:
