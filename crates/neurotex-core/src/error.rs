@@ -473,6 +473,12 @@ pub enum ModelError {
         /// What is wrong, naming the node or the rule.
         reason: String,
     },
+    /// A spiking model where a feature model is needed.
+    #[error("{}: a spiking model (`neurotex-snn-model`): `predict` and `export` run it; `stream` and `predict --causal` do not run spiking networks yet", .path.display())]
+    SpikingModel {
+        /// The file.
+        path: PathBuf,
+    },
     /// A feature model where a spiking model is needed.
     #[error("{}: a feature model (`{MODEL_FORMAT}`), not a spiking model: train one with --classifier snn", .path.display())]
     NotSpiking {

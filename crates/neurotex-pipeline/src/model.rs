@@ -317,6 +317,12 @@ impl Model {
         })?;
         let text =
             |field: Option<serde_json::Value>| field.map_or("missing".into(), |v| v.to_string());
+        if header.format.as_ref().and_then(|f| f.as_str()) == Some(crate::spiking_model::FORMAT) {
+            return Err(ModelError::SpikingModel {
+                path: path.to_path_buf(),
+            }
+            .into());
+        }
         if header.format.as_ref().and_then(|f| f.as_str()) != Some(FORMAT) {
             return Err(ModelError::NotAModel {
                 path: path.to_path_buf(),
