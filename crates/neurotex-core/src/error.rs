@@ -435,6 +435,9 @@ pub enum StatsError {
 /// The `format` field of every model file.
 pub const MODEL_FORMAT: &str = "neurotex-model";
 
+/// The `format` field of a spiking model file (`train --classifier snn`).
+pub const SNN_MODEL_FORMAT: &str = "neurotex-snn-model";
+
 /// The version of the model file format this neurotex writes and reads.
 pub const MODEL_VERSION: u64 = 1;
 
@@ -474,7 +477,7 @@ pub enum ModelError {
         reason: String,
     },
     /// A spiking model where a feature model is needed.
-    #[error("{}: a spiking model (`neurotex-snn-model`): `predict` and `export` run it; `stream` and `predict --causal` do not run spiking networks yet", .path.display())]
+    #[error("{}: a spiking model (`{SNN_MODEL_FORMAT}`): `predict` and `export` run it; `stream` and `predict --causal` do not run spiking networks yet", .path.display())]
     SpikingModel {
         /// The file.
         path: PathBuf,

@@ -317,7 +317,7 @@ impl Model {
         })?;
         let text =
             |field: Option<serde_json::Value>| field.map_or("missing".into(), |v| v.to_string());
-        if header.format.as_ref().and_then(|f| f.as_str()) == Some(crate::spiking_model::FORMAT) {
+        if header.format.as_ref().and_then(|f| f.as_str()) == Some(crate::error::SNN_MODEL_FORMAT) {
             return Err(ModelError::SpikingModel {
                 path: path.to_path_buf(),
             }

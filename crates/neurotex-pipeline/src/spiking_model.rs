@@ -20,7 +20,7 @@ use crate::snn::{softmax, train::TrainingLog, Network, SnnParams, SpikeInput};
 use crate::values::Grid;
 
 /// The `format` field of a spiking model file.
-pub const FORMAT: &str = "neurotex-snn-model";
+pub const FORMAT: &str = crate::error::SNN_MODEL_FORMAT;
 /// The version of the spiking model format this neurotex writes and reads.
 pub const VERSION: u64 = 1;
 
