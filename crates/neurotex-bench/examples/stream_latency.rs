@@ -8,7 +8,8 @@
 //! cargo run --release -p neurotex-bench --example stream_latency -- memory         # 10 minutes
 //! ```
 //!
-//! Latency: a causal 3D-GLCM + KNN model trained on simulated slides (4x4 taxels); the slide
+//! Latency: a causal 3D-GLCM + KNN model and a causal spiking network (16 SA inputs, 128
+//! hidden neurons, 10 ms steps) trained on simulated slides (4x4 taxels); the slide
 //! of one recording streamed 20 times over as one 1 kHz episode (no time stamps, so no
 //! resampling; `--window-s` default: the training slides' median length). Each frame is
 //! timed from the call that takes it to the JSON lines of what it completed written into
@@ -30,8 +31,11 @@ use neurotex::classify::{ClassifierChoice, KnnParams};
 use neurotex::model::{Model, Provenance};
 use neurotex::pipeline::{Method, Pipeline, PipelineParams};
 use neurotex::recording::{Baseline, Meta, Phase, Recording};
+use neurotex::saved::SavedModel;
 use neurotex::signal::CausalConditioning;
 use neurotex::sim::{design, simulate_trial, RigParams, Texture};
+use neurotex::snn::SnnParams;
+use neurotex::spiking_model::SpikingModel;
 use neurotex::stream::{bin_json, end_json, Event, StreamClassifier, StreamParams};
 use neurotex::Grid;
 
@@ -91,13 +95,21 @@ fn latency() {
         layout: None,
     };
     let knn = ClassifierChoice::Knn(KnnParams::default());
-    let model = Model::train(&params, &table, Columns::All, knn, provenance).unwrap();
+    let model = Model::train(&params, &table, Columns::All, knn, provenance.clone()).unwrap();
+    let snn = SnnParams::default();
+    let (network, _) = SpikingModel::train(&params, &encoded, &grid, snn, provenance).unwrap();
 
     let rec = &recs[0];
     let phases = rec.phases.as_ref().unwrap();
     let lo = phases.iter().position(|&p| p == Phase::Slide).unwrap();
     let hi = phases.iter().rposition(|&p| p == Phase::Slide).unwrap() + 1;
     let frames: Vec<&[f64]> = rec.samples[lo * 16..hi * 16].chunks_exact(16).collect();
+    time_stream("glcm3d + KNN", model.into(), &frames);
+    time_stream("spiking network 16x128, dt 10 ms", network.into(), &frames);
+}
+
+/// Streams `frames` 20 times over through `model` and prints the latency percentiles.
+fn time_stream(name: &str, model: SavedModel, frames: &[&[f64]]) {
     let labels = model.labels().to_vec();
     let params = StreamParams::for_model(&model);
     let window_ms = params.window_ms;
@@ -106,7 +118,7 @@ fn latency() {
     let (mut between, mut at_bin) = (Vec::new(), Vec::new());
     let mut most_spikes = 0;
     for _ in 0..20 {
-        for frame in &frames {
+        for frame in frames {
             let start = Instant::now();
             let events = stream.push(None, frame).unwrap();
             for event in events {
@@ -130,7 +142,7 @@ fn latency() {
     between.sort_unstable();
     at_bin.sort_unstable();
     println!(
-        "latency, 4x4 taxels, glcm3d + KNN, window {window_ms} ms, {} frames ({} s of stream):",
+        "latency, 4x4 taxels, {name}, window {window_ms} ms, {} frames ({} s of stream):",
         between.len() + at_bin.len(),
         (between.len() + at_bin.len()) / 1000
     );

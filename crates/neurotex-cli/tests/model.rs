@@ -479,9 +479,9 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     assert!(err.contains("feature.json: a feature model"), "{err}");
     let err = dir.fails(&["export", "nir", "--model", s(&feature), "--out", s(&never)]);
     assert!(err.contains("not a spiking model"), "{err}");
-    // A spiking model where a stream needs a causal feature model.
+    // A spiking model trained without --causal where a stream needs one trained with it.
     let err = dir.fails(&["stream", "--model", s(&model), "--input", s(&never)]);
-    assert!(err.contains("snn.json: a spiking model"), "{err}");
+    assert!(err.contains("trained with --causal"), "{err}");
     // The input tensors, written twice into the same folder: the second run replaces the
     // first.
     let inputs = dir.join("inputs");

@@ -477,7 +477,7 @@ pub enum ModelError {
         reason: String,
     },
     /// A spiking model where a feature model is needed.
-    #[error("{}: a spiking model (`{SNN_MODEL_FORMAT}`): `predict` and `export` run it; `stream` and `predict --causal` do not run spiking networks yet", .path.display())]
+    #[error("{}: a spiking model (`{SNN_MODEL_FORMAT}`), where a feature model is needed: `predict`, `stream` and `export` take it (in Python: SpikingModel.load)", .path.display())]
     SpikingModel {
         /// The file.
         path: PathBuf,

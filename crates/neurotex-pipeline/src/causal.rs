@@ -22,6 +22,8 @@ use crate::model::Model;
 use crate::pipeline::{Encoded, PipelineParams};
 use crate::recording::{Baseline, Recording};
 use crate::signal::{baseline_offsets, relative_times, CausalConditioning, Preprocessor};
+use crate::snn::Windowed;
+use crate::spiking_model::{decide, spike_input, SpikingModel};
 
 /// The default share of the vote a label needs in a bin to count towards a decision: four
 /// of KNN's five neighbours. A choice, not fitted to any accuracy.
@@ -30,6 +32,9 @@ pub const DEFAULT_DECIDE_SHARE: f64 = 0.8;
 /// The default number of consecutive bins that must agree: 3 bins of 200 ms, 0.6 s. A
 /// choice, not fitted to any accuracy.
 pub const DEFAULT_DECIDE_BINS: usize = 3;
+
+/// Why a model of the `spectrum` method neither streams nor runs `predict --causal`.
+pub const NO_RUNNING_SPECTRUM: &str = "the spectrum method transforms a whole span of the slide at once and has no running form for a stream's growing windows; train the stream's model with another method";
 
 /// When the per-bin classifications of an episode become a decision.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -235,6 +240,69 @@ pub fn episode_decisions(
         ended_by: EpisodeEnd::EndOfInput,
     };
     Ok(Episode { bins, summary })
+}
+
+/// The offline twin of a stream run by a spiking network: the network runs over the whole
+/// causally encoded recording, its time steps of `dt` ms completed as the 1 ms steps reach
+/// them; at each bin boundary its class scores over the last `window_ms` (whole bins, at
+/// least one network step) or all of the episode so far give the bin's classification,
+/// the shares being their softmax. At the end the last partial time step is run, as
+/// [`SpikingModel::predict`] runs it, and the summary reads the scores over the last window:
+/// a recording shorter than the window gets `predict`'s shares.
+///
+/// # Errors
+/// A rule out of range, or a recording on another grid than the model's.
+pub fn spiking_episode_decisions(
+    model: &SpikingModel,
+    encoded: &Encoded,
+    window_ms: usize,
+    rule: DecisionRule,
+) -> Result<Episode> {
+    rule.check()?;
+    model.check_grid(encoded)?;
+    let bin = model.pipeline_params().volume.bin_ms;
+    let net = model.network();
+    let dt = net.dt_ms as usize;
+    let input = spike_input(encoded, net.dt_ms);
+    let mut run = Windowed::new(net, network_window(window_ms, bin, dt));
+    let n = encoded.spikes.n_steps;
+    let mut decider = Decider::new(rule);
+    let mut bins = Vec::with_capacity(n / bin);
+    for end in (1..=n / bin).map(|b| b * bin) {
+        while run.steps() < end / dt {
+            run.step(net, input.at(run.steps()));
+        }
+        let (class, shares) = decide(&run.scores(net));
+        let t_s = end as f64 / 1000.0;
+        let decided = decider.observe(t_s, class, shares[class]);
+        bins.push(BinDecision {
+            t_s,
+            class,
+            shares,
+            decided,
+            decision: decider.decision().map(|d| d.0),
+        });
+    }
+    while run.steps() < input.steps() {
+        run.step(net, input.at(run.steps()));
+    }
+    let last = (n.min(window_steps(window_ms, bin)) >= bin).then(|| decide(&run.scores(net)));
+    let summary = EpisodeSummary {
+        duration_s: n as f64 / 1000.0,
+        class: last.as_ref().map(|l| l.0),
+        shares: last.map(|l| l.1),
+        decision: decider.decision().map(|d| d.0),
+        decided_at_s: decider.decision().map(|d| d.1),
+        bins: bins.len(),
+        ended_by: EpisodeEnd::EndOfInput,
+    };
+    Ok(Episode { bins, summary })
+}
+
+/// The window of a spiking network's scores in its time steps of `dt_ms`: the window of
+/// `window_ms` in whole bins, at least one step.
+pub fn network_window(window_ms: usize, bin_ms: usize, dt_ms: usize) -> usize {
+    (window_steps(window_ms, bin_ms) / dt_ms).max(1)
 }
 
 /// What [`calibrate_conditioning`] found.

@@ -315,28 +315,8 @@ impl Model {
             .into(),
             _ => damaged(e.to_string()),
         })?;
-        let text =
-            |field: Option<serde_json::Value>| field.map_or("missing".into(), |v| v.to_string());
-        if header.format.as_ref().and_then(|f| f.as_str()) == Some(crate::error::SNN_MODEL_FORMAT) {
-            return Err(ModelError::SpikingModel {
-                path: path.to_path_buf(),
-            }
-            .into());
-        }
-        if header.format.as_ref().and_then(|f| f.as_str()) != Some(FORMAT) {
-            return Err(ModelError::NotAModel {
-                path: path.to_path_buf(),
-                found: text(header.format),
-            }
-            .into());
-        }
-        if header.version.as_ref().and_then(|v| v.as_u64()) != Some(VERSION) {
-            return Err(ModelError::UnsupportedVersion {
-                path: path.to_path_buf(),
-                found: text(header.version),
-            }
-            .into());
-        }
+        let (format, version) = (header.format.as_ref(), header.version.as_ref());
+        check_header(path, format, version, (FORMAT, VERSION))?;
         let file: ModelFile = serde_json::from_slice(&bytes).map_err(|e| damaged(e.to_string()))?;
         Model::assemble(file).map_err(|e| damaged(e.to_string()))
     }
@@ -685,6 +665,39 @@ pub(crate) fn encode_files(
         })
         .collect::<Result<Vec<_>>>()
         .map(|pairs| pairs.into_iter().unzip())
+}
+
+/// Checks a model file's `format` and `version` fields (`None` when missing) against the
+/// `expected` format and version: the other kind of model file is named as such.
+///
+/// # Errors
+/// [`ModelError::NotSpiking`] or [`ModelError::SpikingModel`] for the other kind,
+/// [`ModelError::NotAModel`] for another format, [`ModelError::UnsupportedVersion`].
+pub fn check_header(
+    path: &Path,
+    format: Option<&serde_json::Value>,
+    version: Option<&serde_json::Value>,
+    expected: (&str, u64),
+) -> Result<()> {
+    let path = path.to_path_buf();
+    let text =
+        |field: Option<&serde_json::Value>| field.map_or("missing".into(), |v| v.to_string());
+    match format.and_then(|f| f.as_str()) {
+        Some(f) if f == expected.0 => {}
+        Some(FORMAT) => return Err(ModelError::NotSpiking { path }.into()),
+        Some(crate::error::SNN_MODEL_FORMAT) => {
+            return Err(ModelError::SpikingModel { path }.into())
+        }
+        _ => {
+            let found = text(format);
+            return Err(ModelError::NotAModel { path, found }.into());
+        }
+    }
+    if version.and_then(|v| v.as_u64()) != Some(expected.1) {
+        let found = text(version);
+        return Err(ModelError::UnsupportedVersion { path, found }.into());
+    }
+    Ok(())
 }
 
 /// Writes one CSV row per recording for a model of classes `labels` (see

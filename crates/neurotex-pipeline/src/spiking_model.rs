@@ -82,6 +82,14 @@ pub fn spike_input(encoded: &Encoded, dt_ms: u32) -> SpikeInput {
     SpikeInput::from_trains(&populations, dt_ms)
 }
 
+/// The class a network's scores choose (the first of the highest) and every class's
+/// share: the softmax of the scores.
+pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
+    let shares = softmax(scores);
+    let best = (0..shares.len()).fold(0, |b, c| if shares[c] > shares[b] { c } else { b });
+    (best, shares)
+}
+
 impl SpikingModel {
     /// Trains a network with `snn` on the recordings `encoded` (conditioned and encoded
     /// with `params`, all on `grid`).
@@ -286,27 +294,8 @@ impl SpikingModel {
         };
         let value: serde_json::Value =
             serde_json::from_slice(&bytes).map_err(|e| damaged(e.to_string()))?;
-        let text = |v: Option<&serde_json::Value>| v.map_or("missing".into(), |v| v.to_string());
-        if value.get("format").and_then(|f| f.as_str()) == Some(crate::model::FORMAT) {
-            return Err(ModelError::NotSpiking {
-                path: path.to_path_buf(),
-            }
-            .into());
-        }
-        if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
-            return Err(ModelError::NotAModel {
-                path: path.to_path_buf(),
-                found: text(value.get("format")),
-            }
-            .into());
-        }
-        if value.get("version").and_then(|v| v.as_u64()) != Some(VERSION) {
-            return Err(ModelError::UnsupportedVersion {
-                path: path.to_path_buf(),
-                found: text(value.get("version")),
-            }
-            .into());
-        }
+        let (format, version) = (value.get("format"), value.get("version"));
+        crate::model::check_header(path, format, version, (FORMAT, VERSION))?;
         let file: SpikingFile =
             serde_json::from_value(value).map_err(|e| damaged(e.to_string()))?;
         SpikingModel::assemble(file).map_err(|e| damaged(e.to_string()))
@@ -332,28 +321,35 @@ impl SpikingModel {
     /// A recording on another grid than the model's.
     pub fn predict(&self, encoded: &[Encoded]) -> Result<Vec<Prediction>> {
         for e in encoded {
-            if e.spikes.grid() != self.file.grid {
-                return Err(ModelError::OtherGrid {
-                    file: e.meta.file.clone(),
-                    found: e.spikes.grid(),
-                    expected: self.file.grid.clone(),
-                }
-                .into());
-            }
+            self.check_grid(e)?;
         }
         let net = &self.file.network;
         Ok(encoded
             .par_iter()
             .map(|e| {
-                let shares = softmax(&net.scores(&spike_input(e, net.dt_ms)));
-                let best =
-                    (0..shares.len()).fold(0, |b, c| if shares[c] > shares[b] { c } else { b });
+                let (best, shares) = decide(&net.scores(&spike_input(e, net.dt_ms)));
                 Prediction {
                     predicted: self.file.labels[best].clone(),
                     shares,
                 }
             })
             .collect())
+    }
+
+    /// Checks that a recording is on the model's grid.
+    ///
+    /// # Errors
+    /// [`ModelError::OtherGrid`], naming the recording.
+    pub fn check_grid(&self, encoded: &Encoded) -> Result<()> {
+        if encoded.spikes.grid() == self.file.grid {
+            return Ok(());
+        }
+        Err(ModelError::OtherGrid {
+            file: encoded.meta.file.clone(),
+            found: encoded.spikes.grid(),
+            expected: self.file.grid.clone(),
+        }
+        .into())
     }
 
     /// Scores predictions against true labels (see [`crate::model::Model::score`]).

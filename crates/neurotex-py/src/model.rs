@@ -3,15 +3,16 @@
 use std::path::PathBuf;
 
 use neurotex::analysis::{Columns, FeatureTable};
-use neurotex::model::{Model as LibModel, Provenance};
-use neurotex::pipeline::Method;
-use neurotex::Cell;
+use neurotex::model::{Model as LibModel, Prediction, Provenance};
+use neurotex::pipeline::{Encoded, Method, Pipeline};
+use neurotex::recording::Baseline;
+use neurotex::{Cell, Grid};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::calibrate::{calibrated, object};
-use crate::convert::{Batch, InfoTuple};
+use crate::convert::{Batch, BatchView, InfoTuple};
 use crate::errors::{guarded, param, raise, Kind};
 use crate::params;
 
@@ -50,12 +51,7 @@ impl NativeModel {
                 self.inner.predict(&encoded)
             })
         })?;
-        let classes = self.inner.labels().len();
-        let shares: Vec<f64> = predictions.iter().flat_map(|p| p.shares.clone()).collect();
-        let shares = ndarray::Array2::from_shape_vec((predictions.len(), classes), shares)
-            .map_err(|e| raise(Kind::Internal, e.to_string()))?;
-        let labels = predictions.into_iter().map(|p| p.predicted).collect();
-        Ok((labels, shares.into_pyarray(py)))
+        labels_and_shares(py, predictions, self.inner.labels().len())
     }
 
     /// The classes, in the order of the shares' columns.
@@ -156,29 +152,73 @@ fn train_model<'py>(
     };
     let batch = Batch::new(&recordings, infos)?;
     let view = batch.view();
-    let all: Vec<usize> = (0..view.len()).collect();
     let inner = py.detach(|| {
         guarded(|| {
-            let c = calibrated(&stages, &|i| view.load(i), &all, dataset_baseline)?;
-            let encoded = view.encode(|rec| c.pipeline.encode(rec, dataset_baseline))?;
-            let grid = neurotex::pipeline::shared_grid(&encoded)?;
-            let extractor = c.pipeline.extractor(&grid)?;
-            let table = FeatureTable::build(&encoded, &extractor, method)?;
+            let t = Training::encode(&stages, &view, dataset_baseline, fingerprint)?;
+            let extractor = t.pipeline.extractor(&t.grid)?;
+            let table = FeatureTable::build(&t.encoded, &extractor, method)?;
             if let Columns::Taxel(cell) = columns {
-                grid.locate(cell)?;
+                t.grid.locate(cell)?;
             }
-            let provenance = Provenance {
-                fingerprint,
-                baseline: dataset_baseline,
-                speeds: None,
-                gain_calibration: c.gain,
-                median_duration_ms: c.causal.map(|c| c.median_duration_ms),
-                layout: None,
-            };
-            LibModel::train(c.pipeline.params(), &table, columns, choice, provenance)
+            LibModel::train(t.pipeline.params(), &table, columns, choice, t.provenance)
         })
     })?;
     Ok(NativeModel { inner })
+}
+
+/// Training recordings encoded with the pipeline calibrated on them.
+pub(crate) struct Training {
+    /// The pipeline, gain and causal conditioning calibrated.
+    pub pipeline: Pipeline,
+    /// The recordings' spikes.
+    pub encoded: Vec<Encoded>,
+    /// Their grid.
+    pub grid: Grid,
+    /// What a model keeps of them.
+    pub provenance: Provenance,
+}
+
+impl Training {
+    /// Calibrates the stage options `stages` on every recording of `view` (as
+    /// `neurotex train` does), then encodes them.
+    pub(crate) fn encode(
+        stages: &params::Stages,
+        view: &BatchView<'_>,
+        baseline: Baseline,
+        fingerprint: String,
+    ) -> neurotex::Result<Training> {
+        let all: Vec<usize> = (0..view.len()).collect();
+        let c = calibrated(stages, &|i| view.load(i), &all, baseline)?;
+        let encoded = view.encode(|rec| c.pipeline.encode(rec, baseline))?;
+        let grid = neurotex::pipeline::shared_grid(&encoded)?;
+        let provenance = Provenance {
+            fingerprint,
+            baseline,
+            speeds: None,
+            gain_calibration: c.gain,
+            median_duration_ms: c.causal.map(|c| c.median_duration_ms),
+            layout: None,
+        };
+        Ok(Training {
+            pipeline: c.pipeline,
+            encoded,
+            grid,
+            provenance,
+        })
+    }
+}
+
+/// Predictions as `(labels, shares (n, classes))`.
+pub(crate) fn labels_and_shares(
+    py: Python<'_>,
+    predictions: Vec<Prediction>,
+    classes: usize,
+) -> PyResult<(Vec<String>, Bound<'_, PyArray2<f64>>)> {
+    let shares: Vec<f64> = predictions.iter().flat_map(|p| p.shares.clone()).collect();
+    let shares = ndarray::Array2::from_shape_vec((predictions.len(), classes), shares)
+        .map_err(|e| raise(Kind::Internal, e.to_string()))?;
+    let labels = predictions.into_iter().map(|p| p.predicted).collect();
+    Ok((labels, shares.into_pyarray(py)))
 }
 
 /// Registers the model class and training.

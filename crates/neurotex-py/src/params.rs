@@ -191,7 +191,7 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             "forest_seed",
         ],
         ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
-        ClassifierChoice::Snn(_) => &["hidden", "dt_ms", "epochs", "seed"],
+        ClassifierChoice::Snn(_) => &["hidden", "dt_ms", "epochs", "readout", "seed"],
     };
     only_known(
         options,
@@ -219,14 +219,36 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             max_iter: get(options, "max_iter")?.unwrap_or(d.max_iter),
             tol: get(options, "tol")?.unwrap_or(d.tol),
         }),
-        ClassifierChoice::Snn(d) => ClassifierChoice::Snn(SnnParams {
-            hidden: get(options, "hidden")?.unwrap_or(d.hidden),
-            dt_ms: get(options, "dt_ms")?.unwrap_or(d.dt_ms),
-            epochs: get(options, "epochs")?.unwrap_or(d.epochs),
-            seed: get(options, "seed")?.unwrap_or(d.seed),
-            ..d
-        }),
+        ClassifierChoice::Snn(d) => ClassifierChoice::Snn(snn_params(options, d)?),
     };
     choice.check().map_err(param)?;
     Ok(choice)
+}
+
+/// The spiking network's training knobs (`hidden`, `dt_ms`, `epochs`, `readout`, `seed`)
+/// over `d`, unchecked.
+fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> {
+    Ok(SnnParams {
+        hidden: get(options, "hidden")?.unwrap_or(d.hidden),
+        dt_ms: get(options, "dt_ms")?.unwrap_or(d.dt_ms),
+        epochs: get(options, "epochs")?.unwrap_or(d.epochs),
+        readout: match get::<String>(options, "readout")? {
+            Some(r) => r.parse().map_err(param)?,
+            None => d.readout,
+        },
+        seed: get(options, "seed")?.unwrap_or(d.seed),
+        ..d
+    })
+}
+
+/// The spiking network's training knobs, checked.
+pub fn snn(options: &Bound<'_, PyDict>) -> PyResult<SnnParams> {
+    only_known(
+        options,
+        &["hidden", "dt_ms", "epochs", "readout", "seed"],
+        " for the spiking network; its options are",
+    )?;
+    snn_params(options, SnnParams::default())?
+        .check()
+        .map_err(param)
 }

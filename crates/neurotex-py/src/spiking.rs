@@ -5,16 +5,19 @@ use std::path::PathBuf;
 
 use neurotex::spiking_model::SpikingModel;
 use neurotex::workflows::export::{export_nir, NirConvention};
-use numpy::{IntoPyArray, PyArray2};
+use numpy::PyArray2;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::convert::{Batch, InfoTuple};
 use crate::errors::{guarded, raise, Kind};
+use crate::model::{labels_and_shares, Training};
+use crate::params;
 
 /// A trained spiking network with its pipeline.
 #[pyclass(module = "neurotex._native", frozen)]
 pub struct NativeSpikingModel {
-    inner: SpikingModel,
+    pub(crate) inner: SpikingModel,
 }
 
 #[pymethods]
@@ -76,12 +79,7 @@ impl NativeSpikingModel {
                 self.inner.predict(&encoded)
             })
         })?;
-        let classes = self.inner.labels().len();
-        let shares: Vec<f64> = predictions.iter().flat_map(|p| p.shares.clone()).collect();
-        let shares = ndarray::Array2::from_shape_vec((predictions.len(), classes), shares)
-            .map_err(|e| raise(Kind::Internal, e.to_string()))?;
-        let labels = predictions.into_iter().map(|p| p.predicted).collect();
-        Ok((labels, shares.into_pyarray(py)))
+        labels_and_shares(py, predictions, self.inner.labels().len())
     }
 
     /// The classes, in the order of the network's outputs.
@@ -98,7 +96,45 @@ impl NativeSpikingModel {
     }
 }
 
-/// Adds the class to the module.
+/// Trains a spiking network (`neurotex train --classifier snn`) on recordings (arrays with
+/// their infos): the stage options calibrated on them, then the network on their spikes;
+/// `(model, epochs run, best epoch, its validation loss)`.
+#[pyfunction]
+#[pyo3(signature = (recordings, infos, options, snn_options, fingerprint, baseline=None))]
+fn train_spiking_model<'py>(
+    py: Python<'py>,
+    recordings: Vec<Bound<'py, PyAny>>,
+    infos: Vec<InfoTuple>,
+    options: &Bound<'py, PyDict>,
+    snn_options: &Bound<'py, PyDict>,
+    fingerprint: String,
+    baseline: Option<&str>,
+) -> PyResult<(NativeSpikingModel, usize, usize, f64)> {
+    let stages = params::stages(options)?;
+    let snn = params::snn(snn_options)?;
+    let baseline = params::baseline(baseline)?;
+    let batch = Batch::new(&recordings, infos)?;
+    let view = batch.view();
+    let (inner, log) = py.detach(|| {
+        guarded(|| {
+            let t = Training::encode(&stages, &view, baseline, fingerprint)?;
+            let params = t.pipeline.params();
+            SpikingModel::train(params, &t.encoded, &t.grid, snn, t.provenance)
+        })
+    })?;
+    let model = NativeSpikingModel { inner };
+    Ok((model, log.epochs, log.best_epoch, log.validation_loss))
+}
+
+/// Whether the file claims to be a spiking model (its format, or a NIR graph).
+#[pyfunction]
+fn is_spiking_model(path: PathBuf) -> bool {
+    SpikingModel::is_spiking(&path)
+}
+
+/// Adds the class and training to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<NativeSpikingModel>()
+    m.add_class::<NativeSpikingModel>()?;
+    m.add_function(wrap_pyfunction!(is_spiking_model, m)?)?;
+    m.add_function(wrap_pyfunction!(train_spiking_model, m)?)
 }

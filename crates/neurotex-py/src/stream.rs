@@ -3,12 +3,14 @@
 
 use neurotex::causal::DecisionRule;
 use neurotex::recording::TimeUnit;
+use neurotex::saved::SavedModel;
 use neurotex::stream::{bin_json, end_json, Event, StreamClassifier, StreamError, StreamParams};
 use pyo3::prelude::*;
 
 use crate::convert::to_object;
 use crate::errors::{guarded, param, raise, to_py, Kind};
 use crate::model::NativeModel;
+use crate::spiking::NativeSpikingModel;
 
 /// A causal model classifying a live stream.
 #[pyclass(module = "neurotex._native")]
@@ -39,12 +41,13 @@ fn stream_error(e: StreamError) -> PyErr {
 
 #[pymethods]
 impl NativeStream {
-    /// A stream classifier for `model` (trained with `--causal`).
+    /// A stream classifier for `model` (a feature model or a spiking network, trained with
+    /// `--causal`).
     #[new]
     #[pyo3(signature = (model, window_s=None, decide=0.8, decide_bins=3, episode="whole", fs=1000.0, max_gap_s=1.0, speed=None, time_unit="s"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        model: &NativeModel,
+        model: &Bound<'_, PyAny>,
         window_s: Option<f64>,
         decide: f64,
         decide_bins: usize,
@@ -55,7 +58,19 @@ impl NativeStream {
         time_unit: &str,
     ) -> PyResult<Self> {
         let unit: TimeUnit = time_unit.parse().map_err(param)?;
-        let model = model.inner.clone();
+        let model: SavedModel = match (
+            model.cast::<NativeModel>(),
+            model.cast::<NativeSpikingModel>(),
+        ) {
+            (Ok(m), _) => m.get().inner.clone().into(),
+            (_, Ok(m)) => m.get().inner.clone().into(),
+            _ => {
+                return Err(raise(
+                    Kind::Parameter,
+                    "a stream runs a Model or a SpikingModel",
+                ))
+            }
+        };
         let mut params = StreamParams::for_model(&model);
         params.window_ms = StreamParams::window_ms(&model, window_s).map_err(param)?;
         params.rule = DecisionRule {

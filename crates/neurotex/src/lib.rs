@@ -31,7 +31,7 @@ pub use neurotex_learn::classify;
 pub use neurotex_learn::snn;
 pub use neurotex_pipeline::{
     analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, nir, options,
-    pipeline, spiking_model, stream,
+    pipeline, saved, spiking_model, stream,
 };
 pub use neurotex_report::report;
 pub use neurotex_signal::{encode, signal};

@@ -7,13 +7,16 @@ use crate::support;
 
 use neurotex::analysis::{Columns, FeatureTable};
 use neurotex::causal::{
-    calibrate_conditioning, episode_decisions, DecisionRule, Episode, EpisodeEnd,
+    calibrate_conditioning, episode_decisions, spiking_episode_decisions, DecisionRule, Episode,
+    EpisodeEnd,
 };
 use neurotex::classify::{ClassifierChoice, ForestParams, KnnParams};
 use neurotex::model::{Model, Provenance};
 use neurotex::pipeline::{Encoding, Method, Pipeline, PipelineParams};
 use neurotex::recording::{Baseline, Phase, Recording, TimeUnit};
 use neurotex::sim::{design, simulate_trial, RigParams, Texture};
+use neurotex::snn::SnnParams;
+use neurotex::spiking_model::SpikingModel;
 use neurotex::stream::{BadFrame, EpisodeRule, Event, StreamClassifier, StreamError, StreamParams};
 use support::XorShift;
 
@@ -543,6 +546,86 @@ fn frames_stamped_on_the_1_ms_grid_give_the_spikes_of_unstamped_frames_at_1_khz(
                 "stamped from {origin} ms, {}",
                 rec.meta.file
             );
+        }
+    }
+}
+
+/// A spiking network trained (briefly: the weights need not classify well) on the spike
+/// trains of `train`, causally conditioned, with time steps of `dt_ms`.
+fn causal_network(train: &[Recording], dt_ms: u32) -> SpikingModel {
+    let mut params = PipelineParams {
+        encoding: Encoding::SaFa,
+        ..PipelineParams::default()
+    };
+    let load = |i: usize| Ok(train[i].clone());
+    let indices: Vec<usize> = (0..train.len()).collect();
+    let calibration = calibrate_conditioning(&params, &load, &indices, Baseline::Min).unwrap();
+    params.preprocess.causal = Some(calibration.conditioning);
+    let pipeline = Pipeline::new(params.clone()).unwrap();
+    let encoded: Vec<_> = train
+        .iter()
+        .map(|r| pipeline.encode(r, Baseline::Min).unwrap())
+        .collect();
+    let snn = SnnParams {
+        hidden: 24,
+        dt_ms,
+        epochs: 4,
+        ..SnnParams::default()
+    };
+    let provenance = Provenance {
+        fingerprint: "test".into(),
+        baseline: Baseline::Min,
+        speeds: None,
+        gain_calibration: None,
+        median_duration_ms: Some(calibration.median_duration_ms),
+        layout: None,
+    };
+    let grid = train[0].layout_grid();
+    SpikingModel::train(&params, &encoded, &grid, snn, provenance)
+        .unwrap()
+        .0
+}
+
+#[test]
+fn a_spiking_network_streams_as_its_offline_twin_and_as_predict() {
+    // The network runs step by step on the stream's spikes; offline it runs over the whole
+    // causal encoding. Windows shorter and longer than the slide; a time step that divides
+    // the 200 ms bins and one (30 ms) that does not, so that bins and the end fall inside a
+    // time step; frames at 1 kHz and irregular stamped frames.
+    let recs = recordings();
+    for dt in [10, 30] {
+        let model = causal_network(&recs, dt);
+        let mut p = StreamParams::for_model(&model);
+        for window_ms in [600, 3_600_000] {
+            p.window_ms = window_ms;
+            for (k, rec) in recs.iter().step_by(4).enumerate() {
+                for (what, frames) in [
+                    ("1 kHz", slide_only(rec)),
+                    ("stamped", irregular(&slide_only(rec), 9, k as u64 + 1)),
+                ] {
+                    let offline = model.pipeline().encode(&frames, model.baseline()).unwrap();
+                    let expected =
+                        spiking_episode_decisions(&model, &offline, p.window_ms, p.rule).unwrap();
+                    assert!(expected.bins.len() >= 5, "a slide of several bins");
+                    let mut stream = StreamClassifier::new(model.clone(), p.clone()).unwrap();
+                    let got = stream_events(&mut stream, &frames_of(&frames));
+                    let file = &rec.meta.file;
+                    assert_eq!(
+                        got,
+                        offline_events(expected.clone()),
+                        "dt {dt}, {what}, {file}"
+                    );
+                    assert_eq!(stream.retained_spikes(), 0);
+                    if window_ms > 10_000 {
+                        // The whole slide in the window: the end's shares are predict's.
+                        let whole = model.predict(std::slice::from_ref(&offline)).unwrap();
+                        assert_eq!(expected.summary.shares.as_ref(), Some(&whole[0].shares));
+                    }
+                    // The running scores move as the slide goes on.
+                    let first = &expected.bins[0].shares;
+                    assert!(expected.bins.iter().any(|b| b.shares != *first), "{file}");
+                }
+            }
         }
     }
 }

@@ -6,9 +6,9 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::Args;
-use neurotex::model::Model;
+use neurotex::model::write_predictions;
 use neurotex::pipeline::Encoded;
-use neurotex::spiking_model::{is_hdf5, SpikingModel};
+use neurotex::saved::SavedModel;
 use neurotex::stream::write_episodes;
 use neurotex::workflows::predict::PredictOptions;
 
@@ -49,13 +49,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
     }
     let dataset = o.dataset()?;
     check_output(&args.out, &o.inputs(dataset.as_ref()))?;
-    if SpikingModel::is_spiking(&o.model) {
-        return predict_spiking(&args, dataset.as_ref());
-    }
-    if args.like.is_some() {
-        bail!("--like applies to a NIR graph given as --model");
-    }
-    let model = Model::load(&o.model)?;
+    let model = SavedModel::load(&o.model, args.like.as_deref())?;
     let progress = Shown::new("starting");
     let encoded = o.encode(&model, dataset.as_ref(), &progress.callback());
     progress.finish();
@@ -73,64 +67,17 @@ pub fn run(args: PredictArgs) -> Result<()> {
     };
     let known = dataset.is_some();
     write_file(&args.out, "predictions", |w| {
-        model.write_predictions(w, &encoded, &predictions, known)
+        write_predictions(w, model.labels(), &encoded, &predictions, known)
     })?;
     if let Some(score) = score {
         println!("{}", serde_json::to_string(&score)?);
     }
-    eprintln!(
-        "{} recordings predicted with {} -> {}",
-        predictions.len(),
-        o.model.display(),
-        shown(&args.out)
-    );
-    Ok(())
-}
-
-/// Predicts with a spiking network (a model trained with `--classifier snn`).
-fn predict_spiking(
-    args: &PredictArgs,
-    dataset: Option<&neurotex::recording::Dataset>,
-) -> Result<()> {
-    let o = &args.options;
-    if o.causal {
-        bail!(
-            "{}: --causal is not yet run for spiking networks; predict whole recordings without it",
-            o.model.display()
-        );
-    }
-    let model = match &args.like {
-        Some(like) if is_hdf5(&o.model) => {
-            SpikingModel::from_nir(&o.model, Some(&SpikingModel::load(like)?))?
-        }
-        Some(_) => bail!("--like applies to a NIR graph given as --model, not to a model file"),
-        None => SpikingModel::load(&o.model)?,
+    let with = match model {
+        SavedModel::Features(_) => "",
+        SavedModel::Spiking(_) => "the spiking network of ",
     };
-    let progress = Shown::new("starting");
-    let encoded = o.encode_with(
-        model.pipeline(),
-        model.baseline(),
-        dataset,
-        &progress.callback(),
-        |files, reading| model.encode_files(files, reading),
-    );
-    progress.finish();
-    let encoded = encoded?;
-    let predictions = model.predict(&encoded)?;
-    let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
-    let score = match args.json {
-        true => Some(model.score(&truth, &predictions)?),
-        false => None,
-    };
-    let known = dataset.is_some();
-    write_file(&args.out, "predictions", |w| {
-        neurotex::model::write_predictions(w, model.labels(), &encoded, &predictions, known)
-    })?;
-    if let Some(score) = score {
-        println!("{}", serde_json::to_string(&score)?);
-    }
     eprintln!(
-        "{} recordings predicted with the spiking network of {} -> {}",
+        "{} recordings predicted with {with}{} -> {}",
         predictions.len(),
         o.model.display(),
         shown(&args.out)
@@ -139,7 +86,7 @@ fn predict_spiking(
 }
 
 /// Writes every recording's per-bin decisions and end, as `neurotex stream` prints them.
-fn predict_causal(args: &PredictArgs, model: &Model, encoded: &[Encoded]) -> Result<()> {
+fn predict_causal(args: &PredictArgs, model: &SavedModel, encoded: &[Encoded]) -> Result<()> {
     let episodes = args.options.episodes(model, encoded)?;
     write_file(&args.out, "causal decisions", |w| {
         write_episodes(w, model.labels(), encoded, &episodes)

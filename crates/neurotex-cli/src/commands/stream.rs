@@ -4,14 +4,14 @@
 use std::io::Write;
 
 use anyhow::Result;
-use neurotex::model::Model;
+use neurotex::saved::SavedModel;
 use neurotex::stream::frames::{event_json, feed, FrameReader, Replay, Sink};
 use neurotex::stream::{Event, StreamClassifier};
 use neurotex::workflows::stream::StreamOptions;
 
 /// Runs `neurotex stream`.
 pub fn run(args: StreamOptions) -> Result<()> {
-    let model = Model::load(&args.model)?;
+    let model = SavedModel::load(&args.model, args.like.as_deref())?;
     let params = args.params(&model)?;
     let format = args.frame_format(&model)?;
     let mut stream = StreamClassifier::new(model, params)?;

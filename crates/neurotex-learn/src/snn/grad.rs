@@ -195,15 +195,11 @@ fn forward_with(
 
 /// The scores read from a readout trace (`steps x classes`).
 fn read_scores(readout: Readout, trace: &[f64], classes: usize, steps: usize) -> Vec<f64> {
-    let mut scores = vec![0.0; classes];
-    for (c, s) in scores.iter_mut().enumerate() {
-        let values = (0..steps).map(|t| trace[t * classes + c]);
-        *s = match readout {
-            Readout::Mean => values.sum::<f64>() / steps.max(1) as f64,
-            Readout::Max => values.fold(f64::NEG_INFINITY, f64::max),
-        };
+    let mut acc = vec![0.0; classes];
+    for (t, out) in trace.chunks_exact(classes).take(steps).enumerate() {
+        readout.fold(t, &mut acc, out);
     }
-    scores
+    readout.finish(steps, acc)
 }
 
 /// The cross-entropy loss of one recording of class `label` and its gradient, added to
@@ -434,6 +430,41 @@ mod tests {
             let trained = forward(&net, &input, act, &mut tr);
             assert_eq!(trained, net.scores(&input));
             assert!(tr.spikes.contains(&1.0) && tr.spikes.contains(&0.0));
+        }
+    }
+
+    /// A network run step by step and read over its last `w` steps: over a window as long
+    /// as the run, the whole run's scores; over a shorter one, the mean (or largest value)
+    /// of the readout trace's last `w` rows, computed here by hand.
+    #[test]
+    fn windowed_scores_read_the_last_steps_of_the_readout() {
+        for readout in [Readout::Mean, Readout::Max] {
+            let (net, input) = random_net(readout, 4);
+            let mut tr = Trajectory::default();
+            forward(&net, &input, Activation::Spike { slope: 10.0 }, &mut tr);
+            let steps = input.steps();
+            for w in [1, 7, steps, steps + 5] {
+                let mut run = crate::snn::Windowed::new(&net, w);
+                for t in 0..steps {
+                    run.step(&net, input.at(t));
+                }
+                let last = &tr.out[steps.saturating_sub(w) * 3..steps * 3];
+                let rows = last.len() / 3;
+                for (c, &got) in run.scores(&net).iter().enumerate() {
+                    let values: Vec<f64> = (0..rows).map(|r| last[r * 3 + c]).collect();
+                    let want = match readout {
+                        Readout::Mean => values.iter().sum::<f64>() / rows as f64,
+                        Readout::Max => values.iter().copied().fold(f64::MIN, f64::max),
+                    };
+                    assert!(
+                        (got - want).abs() <= 1e-12,
+                        "{readout:?} w {w} class {c}: {got} vs {want}"
+                    );
+                }
+                if w >= steps {
+                    assert_eq!(run.scores(&net), net.scores(&input));
+                }
+            }
         }
     }
 }

@@ -354,7 +354,12 @@ impl Network {
 
     /// A running copy of the network, for spikes that arrive step by step.
     pub fn runner(&self) -> Runner<'_> {
-        Runner::new(self)
+        Runner {
+            net: self,
+            state: State::new(self),
+            acc: vec![0.0; self.classes],
+            steps: 0,
+        }
     }
 
     /// The class scores of a whole window.
@@ -369,41 +374,71 @@ impl Network {
         }
         run.scores()
     }
+
+    /// Reduces readout values over time to scores as [`Network::readout`] says: their mean
+    /// or their largest value, class by class, in the order given (zeros for none).
+    fn reduce<'r>(&self, readouts: impl Iterator<Item = &'r [f64]>) -> Vec<f64> {
+        let mut acc = vec![0.0; self.classes];
+        let mut n = 0usize;
+        for out in readouts {
+            self.readout.fold(n, &mut acc, out);
+            n += 1;
+        }
+        self.readout.finish(n, acc)
+    }
 }
 
-/// The network's state, advanced one step at a time.
-#[derive(Debug, Clone)]
-pub struct Runner<'a> {
-    net: &'a Network,
+impl Readout {
+    /// Folds the `n`-th step's (0-based) readout values `out` into `acc`.
+    pub(crate) fn fold(self, n: usize, acc: &mut [f64], out: &[f64]) {
+        for (a, &o) in acc.iter_mut().zip(out) {
+            *a = match (self, n) {
+                (Readout::Mean, _) => *a + o,
+                (Readout::Max, 0) => o,
+                (Readout::Max, _) => a.max(o),
+            };
+        }
+    }
+
+    /// The scores of `n` steps folded into `acc`.
+    pub(crate) fn finish(self, n: usize, mut acc: Vec<f64>) -> Vec<f64> {
+        if self == Readout::Mean {
+            let n = n.max(1) as f64;
+            acc.iter_mut().for_each(|a| *a /= n);
+        }
+        acc
+    }
+}
+
+/// The network's neuron state, advanced one step at a time; it owns no weights, so it can
+/// live beside the network that drives it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
     decays: (f64, f64, f64),
     current: Vec<f64>,
     membrane: Vec<f64>,
     out: Vec<f64>,
-    /// The readout's sum (mean) or largest value (max) so far.
-    acc: Vec<f64>,
-    steps: usize,
 }
 
-impl<'a> Runner<'a> {
-    fn new(net: &'a Network) -> Self {
-        Runner {
-            net,
+impl State {
+    /// The network at rest.
+    pub fn new(net: &Network) -> Self {
+        State {
             decays: net.decays(),
             current: vec![0.0; net.hidden],
             membrane: vec![0.0; net.hidden],
             out: vec![0.0; net.classes],
-            acc: vec![0.0; net.classes],
-            steps: 0,
         }
     }
 
-    /// Advances one step with the inputs that spiked in it.
+    /// Advances one step of `net` (the network this state was made for) with the inputs
+    /// that spiked in it, listed in ascending order for results that do not depend on how
+    /// the spikes arrived.
     ///
     /// # Panics
     /// If an input index is out of range (a caller bug).
-    pub fn step(&mut self, spiked: &[u32]) {
+    pub fn step(&mut self, net: &Network, spiked: &[u32]) {
         let (alpha, beta, kappa) = self.decays;
-        let net = self.net;
         let h_n = net.hidden;
         for (c, b) in self.current.iter_mut().zip(&net.b_in) {
             *c = alpha * *c + b;
@@ -429,13 +464,33 @@ impl<'a> Runner<'a> {
                 self.membrane[h] = p;
             }
         }
-        for (a, &o) in self.acc.iter_mut().zip(&self.out) {
-            *a = match (net.readout, self.steps) {
-                (Readout::Mean, _) => *a + o,
-                (Readout::Max, 0) => o,
-                (Readout::Max, _) => a.max(o),
-            };
-        }
+    }
+
+    /// The readout's values after the last step.
+    pub fn readout(&self) -> &[f64] {
+        &self.out
+    }
+}
+
+/// The network's state, advanced one step at a time, with the scores of every step so far.
+#[derive(Debug, Clone)]
+pub struct Runner<'a> {
+    net: &'a Network,
+    state: State,
+    /// The readout's sum (mean) or largest value (max) so far.
+    acc: Vec<f64>,
+    steps: usize,
+}
+
+impl Runner<'_> {
+    /// Advances one step with the inputs that spiked in it (see [`State::step`]).
+    ///
+    /// # Panics
+    /// If an input index is out of range (a caller bug).
+    pub fn step(&mut self, spiked: &[u32]) {
+        self.state.step(self.net, spiked);
+        let readout = self.net.readout;
+        readout.fold(self.steps, &mut self.acc, self.state.readout());
         self.steps += 1;
     }
 
@@ -446,13 +501,55 @@ impl<'a> Runner<'a> {
 
     /// The class scores so far (zeros before the first step).
     pub fn scores(&self) -> Vec<f64> {
-        match self.net.readout {
-            Readout::Mean => {
-                let n = self.steps.max(1) as f64;
-                self.acc.iter().map(|a| a / n).collect()
-            }
-            Readout::Max => self.acc.clone(),
+        self.net.readout.finish(self.steps, self.acc.clone())
+    }
+}
+
+/// A network run on spikes as they come, its scores read over its last `window` steps:
+/// the readout's mean or largest value over those steps (over every step while fewer have
+/// run), while the neurons carry their state from the first step. For a run no longer than
+/// the window, the scores are [`Network::scores`]'s, bit for bit.
+#[derive(Debug, Clone)]
+pub struct Windowed {
+    state: State,
+    window: usize,
+    /// The readout values of the last `window` steps, oldest first.
+    readouts: std::collections::VecDeque<Vec<f64>>,
+    steps: usize,
+}
+
+impl Windowed {
+    /// `net` at rest, its scores read over `window` steps (at least one).
+    pub fn new(net: &Network, window: usize) -> Self {
+        Windowed {
+            state: State::new(net),
+            window: window.max(1),
+            readouts: std::collections::VecDeque::with_capacity(window.clamp(1, 1 << 16)),
+            steps: 0,
         }
+    }
+
+    /// Advances one step of `net` (see [`State::step`]).
+    pub fn step(&mut self, net: &Network, spiked: &[u32]) {
+        self.state.step(net, spiked);
+        let mut oldest = match self.readouts.len() == self.window {
+            true => self.readouts.pop_front().unwrap_or_default(),
+            false => Vec::with_capacity(net.classes),
+        };
+        oldest.clear();
+        oldest.extend_from_slice(self.state.readout());
+        self.readouts.push_back(oldest);
+        self.steps += 1;
+    }
+
+    /// Steps run so far.
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The class scores over the window (zeros before the first step).
+    pub fn scores(&self, net: &Network) -> Vec<f64> {
+        net.reduce(self.readouts.iter().map(Vec::as_slice))
     }
 }
 

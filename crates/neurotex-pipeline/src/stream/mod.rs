@@ -14,19 +14,25 @@
 
 pub mod frames;
 pub mod input;
+mod network;
 mod spike_log;
 mod window_glcm;
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
 
-use crate::causal::{window_steps, BinDecision, Decider, DecisionRule, EpisodeEnd, EpisodeSummary};
+use crate::causal::{
+    network_window, window_steps, BinDecision, Decider, DecisionRule, EpisodeEnd, EpisodeSummary,
+};
 use crate::encode::{Encoder, SpikeTrains};
 use crate::error::{ParamError, Result};
 use crate::model::{Model, Prediction};
 use crate::pipeline::{Encoded, Encoding};
 use crate::recording::{Meta, TimeUnit};
+use crate::saved::{SavedModel, Trained};
 use crate::signal::{Butterworth2, CausalConditioning, Preprocessor, ENCODER_FS};
+use crate::spiking_model::decide;
+use network::NetworkFeed;
 use spike_log::SpikeLog;
 use window_glcm::WindowGlcm;
 
@@ -120,7 +126,7 @@ pub struct StreamParams {
 impl StreamParams {
     /// The defaults for `model`: its training recordings' median length as the window
     /// ([`DEFAULT_WINDOW_MS`] when unknown), the default rule, whole episodes, 1 kHz.
-    pub fn for_model(model: &Model) -> Self {
+    pub fn for_model(model: &impl Trained) -> Self {
         StreamParams {
             window_ms: model
                 .provenance()
@@ -139,7 +145,7 @@ impl StreamParams {
     ///
     /// # Errors
     /// A window outside (0, 3600] s.
-    pub fn window_ms(model: &Model, window_s: Option<f64>) -> Result<usize, ParamError> {
+    pub fn window_ms(model: &impl Trained, window_s: Option<f64>) -> Result<usize, ParamError> {
         match window_s {
             None => Ok(Self::for_model(model).window_ms),
             Some(s) if s.is_finite() && s > 0.0 && s <= 3600.0 => Ok((s * 1000.0).round() as usize),
@@ -264,8 +270,11 @@ struct EpisodeState {
     /// The populations' neurons, in the order of [`Encoded::populations`], each marked
     /// whether it is FA (driven by the rectified rate of change).
     neurons: Vec<(Encoder, bool)>,
-    /// The spikes of the current window, per population.
+    /// The spikes of the current window, per population (none for a spiking network,
+    /// which takes them as they come).
     spikes: Vec<SpikeLog>,
+    /// A spiking network's state.
+    network: Option<NetworkFeed>,
     /// Per population, the window's co-occurrence counts kept bin by bin, for 3D-GLCM
     /// models (empty for others, which count the window's spike times afresh).
     glcm: Vec<WindowGlcm>,
@@ -278,7 +287,7 @@ struct EpisodeState {
 /// A causal model classifying a live stream frame by frame.
 #[derive(Debug)]
 pub struct StreamClassifier {
-    model: Model,
+    model: SavedModel,
     params: StreamParams,
     conditioning: CausalConditioning,
     filter: Option<Butterworth2>,
@@ -315,30 +324,30 @@ pub struct StreamClassifier {
     raster: Vec<u8>,
 }
 
-/// Why a model of the `spectrum` method neither streams nor runs `predict --causal`.
-pub const NO_RUNNING_SPECTRUM: &str = "the spectrum method transforms a whole span of the slide at once and has no running form for a stream's growing windows; train the stream's model with another method";
+pub use crate::causal::NO_RUNNING_SPECTRUM;
 
 impl StreamClassifier {
-    /// A stream classifier for a causal `model`; frames hold one value per taxel of the
-    /// model's grid, in row-major order of the cells holding a taxel.
+    /// A stream classifier for a causal `model` (a feature model or a spiking network);
+    /// frames hold one value per taxel of the model's grid, in row-major order of the
+    /// cells holding a taxel.
     ///
     /// # Errors
     /// A model trained without `--causal` (its filter needs the future), a model whose
     /// features need a speed when none is given, or broken parameters.
-    pub fn new(model: Model, params: StreamParams) -> Result<Self> {
+    pub fn new(model: impl Into<SavedModel>, params: StreamParams) -> Result<Self> {
+        let model = model.into();
         params.check()?;
-        let Some(conditioning) = model.causal().cloned() else {
-            let rule = "streaming needs a model trained with --causal (this one uses the zero-phase filter and each recording's own maximum, which need the whole recording)";
-            return Err(ParamError::new("model", rule, "an offline model").into());
+        let conditioning = match model.streams() {
+            Ok(conditioning) => conditioning.clone(),
+            Err(rule) => return Err(ParamError::new("model", rule, "this model").into()),
         };
-        if model.features().method == crate::pipeline::Method::AllTaxelsMm
-            && !params.speed_mm_s.is_some_and(|v| v.is_finite() && v != 0.0)
-        {
-            let rule = "the model's all-taxels-mm features need the sliding speed (--speed)";
-            return Err(ParamError::new("speed", rule, "none").into());
-        }
-        if model.features().method == crate::pipeline::Method::Spectrum {
-            return Err(ParamError::new("model", NO_RUNNING_SPECTRUM, "spectrum").into());
+        if let SavedModel::Features(m) = &model {
+            if m.features().method == crate::pipeline::Method::AllTaxelsMm
+                && !params.speed_mm_s.is_some_and(|v| v.is_finite() && v != 0.0)
+            {
+                let rule = "the model's all-taxels-mm features need the sliding speed (--speed)";
+                return Err(ParamError::new("speed", rule, "none").into());
+            }
         }
         let grid = model.grid().clone();
         let (rows, cols) = (grid.rows(), grid.cols());
@@ -354,15 +363,17 @@ impl StreamClassifier {
             .copied();
         let bin = model.params().volume.bin_ms;
         let window = window_steps(params.window_ms, bin);
-        let empty_glcm = match model.features().method {
-            crate::pipeline::Method::Glcm3d => WindowGlcm::new(
-                rows,
-                cols,
-                &present,
-                bin,
-                model.extractor().glcm_params(),
-                window / bin,
-            ),
+        let empty_glcm = match &model {
+            SavedModel::Features(m) if m.features().method == crate::pipeline::Method::Glcm3d => {
+                WindowGlcm::new(
+                    rows,
+                    cols,
+                    &present,
+                    bin,
+                    m.extractor().glcm_params(),
+                    window / bin,
+                )
+            }
             _ => None,
         };
         let buffer = vec![0.0; cells];
@@ -397,7 +408,7 @@ impl StreamClassifier {
     }
 
     /// The model.
-    pub fn model(&self) -> &Model {
+    pub fn model(&self) -> &SavedModel {
         &self.model
     }
 
@@ -688,6 +699,17 @@ impl StreamClassifier {
             Encoding::Fa => vec![(neuron(p.fa.gain), true)],
             Encoding::SaFa => vec![(neuron(p.encoder.gain), false), (neuron(p.fa.gain), true)],
         };
+        let (spikes, network) = match &self.model {
+            SavedModel::Features(_) => (vec![SpikeLog::default(); neurons.len()], None),
+            SavedModel::Spiking(m) => {
+                let net = m.network();
+                let window = network_window(self.window, self.bin, net.dt_ms as usize);
+                (
+                    Vec::new(),
+                    Some(NetworkFeed::new(net, &self.present, window)),
+                )
+            }
+        };
         EpisodeState {
             origin,
             frames: 0,
@@ -697,7 +719,8 @@ impl StreamClassifier {
             steps: 0,
             filter_state: [vec![0.0; cells], vec![0.0; cells]],
             has_previous: false,
-            spikes: vec![SpikeLog::default(); neurons.len()],
+            spikes,
+            network,
             glcm: match &self.empty_glcm {
                 Some(empty) => vec![empty.clone(); neurons.len()],
                 None => Vec::new(),
@@ -816,11 +839,12 @@ impl StreamClassifier {
                 if let Some(window) = episode.glcm.get_mut(population) {
                     window.add_spikes(part.start, raster);
                 }
-                episode.spikes[population].add_part(
-                    part.start,
-                    raster,
-                    &self.present[part.clone()],
-                );
+                if let Some(log) = episode.spikes.get_mut(population) {
+                    log.add_part(part.start, raster, &self.present[part.clone()]);
+                }
+                if let Some(feed) = &mut episode.network {
+                    feed.add(population, part.start, raster);
+                }
             }
         }
         if has_fa {
@@ -828,6 +852,9 @@ impl StreamClassifier {
             episode.has_previous = true;
         }
         episode.steps += 1;
+        if let (Some(feed), SavedModel::Spiking(m)) = (&mut episode.network, &self.model) {
+            feed.end_ms(m.network());
+        }
         if episode.steps.is_multiple_of(self.bin) {
             for window in &mut episode.glcm {
                 window.close_bin();
@@ -846,22 +873,26 @@ impl StreamClassifier {
         for log in &mut episode.spikes {
             log.drop_before(start);
         }
-        let prediction = match episode.glcm.is_empty() {
-            true => self.classify(start, end)?,
-            false => self.classify_window()?,
+        let (class, shares) = match (&self.model, &episode.network) {
+            (SavedModel::Spiking(m), Some(feed)) => decide(&feed.scores(m.network())),
+            (SavedModel::Features(m), _) => {
+                let prediction = match episode.glcm.is_empty() {
+                    true => self.classify(m, start, end)?,
+                    false => self.classify_window(m)?,
+                };
+                (m.class_index(&prediction.predicted), prediction.shares)
+            }
+            (SavedModel::Spiking(_), None) => unreachable!("a spiking model's episode runs it"),
         };
-        let class = self.model.class_index(&prediction.predicted);
         let t_s = end as f64 / 1000.0;
         let episode = self.episode.as_mut().expect("an episode is under way");
-        let decided = episode
-            .decider
-            .observe(t_s, class, prediction.shares[class]);
+        let decided = episode.decider.observe(t_s, class, shares[class]);
         episode.bins += 1;
         let decision = episode.decider.decision().map(|d| d.0);
         self.events.push(Event::Bin(BinDecision {
             t_s,
             class,
-            shares: prediction.shares,
+            shares,
             decided,
             decision,
         }));
@@ -869,7 +900,7 @@ impl StreamClassifier {
     }
 
     /// The model's prediction for the steps `[start, end)` of the episode.
-    fn classify(&self, start: usize, end: usize) -> Result<Prediction, StreamError> {
+    fn classify(&self, model: &Model, start: usize, end: usize) -> Result<Prediction, StreamError> {
         let episode = self.episode.as_ref().expect("an episode is under way");
         let trains: Vec<SpikeTrains> = episode
             .spikes
@@ -888,15 +919,15 @@ impl StreamClassifier {
             resampled: false,
             flat: false,
         };
-        Ok(self.model.predict_one(&encoded)?)
+        Ok(model.predict_one(&encoded)?)
     }
 
     /// The model's prediction for the current window from its co-occurrence counts kept
     /// bin by bin (3D-GLCM models): the same features as [`StreamClassifier::classify`]
     /// gives at a bin boundary, without counting the window afresh.
-    fn classify_window(&self) -> Result<Prediction, StreamError> {
+    fn classify_window(&self, model: &Model) -> Result<Prediction, StreamError> {
         let episode = self.episode.as_ref().expect("an episode is under way");
-        let extractor = self.model.extractor();
+        let extractor = model.extractor();
         let volume = extractor.volume_params();
         let symmetric = extractor.glcm_params().symmetric;
         let mut row = Vec::new();
@@ -905,26 +936,34 @@ impl StreamClassifier {
             window.counts(volume.levels, volume.range, symmetric, &mut counts);
             row.extend(extractor.haralick_row(&counts));
         }
-        Ok(self.model.predict_extracted(&row)?)
+        Ok(model.predict_extracted(&row)?)
     }
 
     /// Conditions the episode's last steps, then summarises it: the classification of its
     /// last window (all of it when shorter) and the decision.
     fn end_episode(&mut self, ended_by: EpisodeEnd) -> Result<(), StreamError> {
         self.flush()?;
-        let episode = self.episode.as_ref().expect("an episode is under way");
+        let episode = self.episode.as_mut().expect("an episode is under way");
         let n = episode.steps;
         let whole = n.min(self.window);
-        let last = match whole >= self.bin {
-            true => Some(self.classify(n - whole, n)?),
-            false => None,
+        let last = match (&self.model, &mut episode.network) {
+            _ if whole < self.bin => None,
+            (SavedModel::Spiking(m), Some(feed)) => {
+                feed.flush(m.network());
+                Some(decide(&feed.scores(m.network())))
+            }
+            (SavedModel::Features(m), _) => {
+                let p = self.classify(m, n - whole, n)?;
+                Some((m.class_index(&p.predicted), p.shares))
+            }
+            (SavedModel::Spiking(_), None) => unreachable!("a spiking model's episode runs it"),
         };
         let episode = self.episode.take().expect("an episode is under way");
         let decision = episode.decider.decision();
         self.events.push(Event::End(EpisodeSummary {
             duration_s: n as f64 / 1000.0,
-            class: last.as_ref().map(|p| self.model.class_index(&p.predicted)),
-            shares: last.map(|p| p.shares),
+            class: last.as_ref().map(|l| l.0),
+            shares: last.map(|l| l.1),
             decision: decision.map(|d| d.0),
             decided_at_s: decision.map(|d| d.1),
             bins: episode.bins,

@@ -677,7 +677,50 @@ def _fingerprint(arrays: Sequence[np.ndarray], labels: Sequence[str]) -> str:
     return "python-arrays-sha256:" + h.hexdigest()
 
 
-class Model:
+class _Predicting:
+    """What both kinds of model share: prediction on recordings encoded with the model's own
+    pipeline, and the class order."""
+
+    _native: Any
+
+    def predict(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
+        """The predicted label of each recording (encoded with the model's own pipeline)."""
+        return self._predict(recordings, fs, mask)[0]
+
+    def predict_proba(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
+        """Each class's share (columns in :attr:`classes_` order): KNN's votes, the
+        forest's mean leaf shares, the logistic regression's probabilities, the softmax of
+        a spiking network's scores."""
+        return self._predict(recordings, fs, mask)[1]
+
+    def _predict(self, recordings: Any, fs: float, mask: Any) -> Tuple[np.ndarray, np.ndarray]:
+        items = _recording_list(recordings)
+        arrays, infos = _prepare(items, fs, mask)
+        labels, shares = self._native.predict(arrays, infos)
+        return np.array(labels, dtype=object), shares
+
+    @property
+    def classes_(self) -> List[str]:
+        """The classes, in the order of :meth:`predict_proba`'s columns."""
+        return list(self._native.labels)
+
+
+def _training_set(recordings: Any, labels: Optional[Sequence[Any]], fs: float, mask: Any,
+                  speeds: Any) -> Tuple[Any, Any, str, Optional[str]]:
+    """The training recordings as arrays and infos, their fingerprint and baseline, with
+    ``labels`` (when given) replacing the recordings' own."""
+    baseline = recordings.baseline if isinstance(recordings, Dataset) else None
+    items = _recording_list(recordings)
+    if labels is not None:
+        if len(labels) != len(items):
+            raise ParameterError(f"{len(labels)} labels for {len(items)} recordings")
+        items = [r if isinstance(r, Recording) else Recording(x=r, fs=fs) for r in items]
+        items = [Recording(**{**r.__dict__, "label": str(l)}) for r, l in zip(items, labels)]
+    arrays, infos = _prepare(items, fs, mask, speeds)
+    return arrays, infos, _fingerprint(arrays, [i[3] for i in infos]), baseline
+
+
+class Model(_Predicting):
     """A trained classifier with its pipeline: the model file of ``neurotex train``
     (read with :meth:`load`, written with :meth:`save`, which the CLI reads back)."""
 
@@ -721,16 +764,11 @@ class Model:
         :class:`StreamClassifier` can classify a live stream with it. ``gain="auto"``
         calibrates the gain on these recordings (after the causal conditioning, when
         both); the model keeps the calibration (:attr:`gain_calibration`)."""
-        baseline = recordings.baseline if isinstance(recordings, Dataset) else None
-        items = _recording_list(recordings)
-        if labels is not None:
-            if len(labels) != len(items):
-                raise ParameterError(f"{len(labels)} labels for {len(items)} recordings")
-            items = [r if isinstance(r, Recording) else Recording(x=r, fs=fs) for r in items]
-            items = [Recording(**{**r.__dict__, "label": str(l)}) for r, l in zip(items, labels)]
-        arrays, infos = _prepare(items, fs, mask, speeds)
+        if classifier == "snn":
+            raise ParameterError("a spiking network classifies spike trains, not features: "
+                                 "train it with SpikingModel.train")
+        arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
         opts = _stage_options(**stage_options)
-        fp = _fingerprint(arrays, [i[3] for i in infos])
         opts["causal"] = bool(causal)
         native = _native.train_model(arrays, infos, method, opts, classifier,
                                      dict(classifier_options or {}), fp, baseline, taxel)
@@ -739,26 +777,6 @@ class Model:
             if c is not None:
                 _log.info("%s", c)
         return model
-
-    def predict(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
-        """The predicted label of each recording (encoded with the model's own pipeline)."""
-        return self._predict(recordings, fs, mask)[0]
-
-    def predict_proba(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
-        """Each class's share (columns in :attr:`classes_` order): KNN's votes, the
-        forest's mean leaf shares, the logistic regression's probabilities."""
-        return self._predict(recordings, fs, mask)[1]
-
-    def _predict(self, recordings: Any, fs: float, mask: Any) -> Tuple[np.ndarray, np.ndarray]:
-        items = _recording_list(recordings)
-        arrays, infos = _prepare(items, fs, mask)
-        labels, shares = self._native.predict(arrays, infos)
-        return np.array(labels, dtype=object), shares
-
-    @property
-    def classes_(self) -> List[str]:
-        """The classes, in the order of :meth:`predict_proba`'s columns."""
-        return list(self._native.labels)
 
     @property
     def method(self) -> str:
@@ -803,14 +821,49 @@ class Model:
 
 
 
-class SpikingModel:
+class SpikingModel(_Predicting):
     """A trained spiking network with its pipeline: the model file of ``neurotex train
     --classifier snn``, or a NIR graph (:meth:`to_nir`, :meth:`from_nir`; see
     docs/spiking-classifier.md). Its input is the recordings' spikes, encoded with the
-    model's own pipeline."""
+    model's own pipeline; its shares are the softmax of the readout's scores."""
 
-    def __init__(self, native: Any) -> None:
+    def __init__(self, native: Any, training: Optional[Dict[str, Any]] = None) -> None:
         self._native = native
+        #: How training went (``epochs``, ``best_epoch``, ``validation_loss``) for a model
+        #: trained by :meth:`train`; ``None`` for one read from a file.
+        self.training = training
+
+    @classmethod
+    def train(
+        cls,
+        recordings: Any,
+        labels: Optional[Sequence[Any]] = None,
+        *,
+        fs: float = 1000.0,
+        mask: Any = None,
+        speeds: Any = None,
+        hidden: int = 128,
+        dt_ms: int = 10,
+        epochs: int = 60,
+        readout: str = "mean",
+        seed: int = 0,
+        causal: bool = _DEFAULTS["causal"],
+        **stage_options: Any,
+    ) -> "SpikingModel":
+        """Trains a spiking network on the recordings' spike trains, as ``neurotex train
+        --classifier snn`` does: ``hidden`` LIF neurons, time steps of ``dt_ms``, at most
+        ``epochs`` passes with early stopping on 20 % of each class, scores read as the
+        readout's ``mean`` or ``max`` over time, weights seeded by ``seed`` (the same on
+        any number of threads). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
+        ...) as :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
+        arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
+        opts = _stage_options(**stage_options)
+        opts["causal"] = bool(causal)
+        snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
+               "seed": seed}
+        native, ran, best, loss = _native.train_spiking_model(arrays, infos, opts, snn, fp,
+                                                              baseline)
+        return cls(native, {"epochs": ran, "best_epoch": best, "validation_loss": loss})
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "SpikingModel":
@@ -856,26 +909,6 @@ class SpikingModel:
             path = os.path.join(tmp, "model.nir")
             nir.write(path, graph)
             return cls(_native.NativeSpikingModel.from_nir(path, native_like))
-
-    def predict(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
-        """The predicted label of each recording."""
-        return self._predict(recordings, fs, mask)[0]
-
-    def predict_proba(self, recordings: Any, *, fs: float = 1000.0, mask: Any = None) -> np.ndarray:
-        """Each class's share: the softmax of the readout's scores (columns in
-        :attr:`classes_` order)."""
-        return self._predict(recordings, fs, mask)[1]
-
-    def _predict(self, recordings: Any, fs: float, mask: Any) -> Tuple[np.ndarray, np.ndarray]:
-        items = _recording_list(recordings)
-        arrays, infos = _prepare(items, fs, mask)
-        labels, shares = self._native.predict(arrays, infos)
-        return np.array(labels, dtype=object), shares
-
-    @property
-    def classes_(self) -> List[str]:
-        """The classes, in the order of the network's outputs."""
-        return list(self._native.labels)
 
     def __repr__(self) -> str:
         inputs, hidden, classes, dt = self._native.shape
@@ -1077,8 +1110,9 @@ def inspect(
 
 
 class StreamClassifier:
-    """A causal model (``neurotex train --causal``) classifying a live stream frame by
-    frame, as ``neurotex stream`` does: ``push`` one frame (one value per taxel, in
+    """A causal model (``neurotex train --causal``: a :class:`Model`, or a
+    :class:`SpikingModel` whose network runs step by step on the spikes as they come)
+    classifying a live stream frame by frame, as ``neurotex stream`` does: ``push`` one frame (one value per taxel, in
     row-major order of the model's taxels) and get ``None``, or the list of what it
     completed: a dict per bin boundary (``t_s``, ``label``, ``scores``, ``decided``,
     ``decision``) and one per episode's end (``end``, ``label``, ``decided_at_s``, ...).
@@ -1094,12 +1128,14 @@ class StreamClassifier:
     grid give the same spikes as the same frames unstamped at 1 kHz; the same stamps as
     seconds (``0.001 * k``, not exact in binary) can move a near-threshold spike."""
 
-    def __init__(self, model: Union["Model", str, os.PathLike], *, window_s: Optional[float] = None,
+    def __init__(self, model: Union["Model", "SpikingModel", str, os.PathLike], *,
+                 window_s: Optional[float] = None,
                  decide: float = 0.8, decide_bins: int = 3, episode: str = "whole",
                  fs: float = 1000.0, max_gap_s: float = 1.0,
                  speed: Optional[float] = None, time_unit: str = "s") -> None:
-        if not isinstance(model, Model):
-            model = Model.load(model)
+        if not isinstance(model, (Model, SpikingModel)):
+            spiking = _native.is_spiking_model(os.fspath(model))
+            model = (SpikingModel if spiking else Model).load(model)
         self.model = model
         self._native = _native.NativeStream(model._native, window_s, decide, decide_bins,
                                             episode, fs, max_gap_s, speed, time_unit)

@@ -1,6 +1,7 @@
 """scikit-learn estimators over neurotex: a transformer from recordings to features
-(:class:`SpikeFeatures`) and the library's classifiers (:class:`KNNClassifier`,
-:class:`RandomForestClassifier`, :class:`LogisticRegression`). They follow scikit-learn's
+(:class:`SpikeFeatures`), the library's classifiers of features (:class:`KNNClassifier`,
+:class:`RandomForestClassifier`, :class:`LogisticRegression`) and a spiking network that
+classifies the recordings' spike trains themselves (:class:`SpikingClassifier`). They follow scikit-learn's
 conventions (``get_params``/``set_params``, ``clone``, ``Pipeline``, ``GridSearchCV``)::
 
     from sklearn.pipeline import make_pipeline
@@ -24,7 +25,10 @@ from . import _native, features as _features
 # Every stage option's default, from the library's one definition of the options.
 _DEFAULTS: Dict[str, Any] = _native.stage_defaults()
 
-__all__ = ["SpikeFeatures", "KNNClassifier", "RandomForestClassifier", "LogisticRegression"]
+__all__ = [
+    "SpikeFeatures", "KNNClassifier", "RandomForestClassifier", "LogisticRegression",
+    "SpikingClassifier",
+]
 
 
 class SpikeFeatures(TransformerMixin, BaseEstimator):
@@ -256,3 +260,108 @@ class LogisticRegression(_LibraryClassifier):
         super().fit(X, y)
         self.n_iter_ = np.array([self._fitted.n_iter])
         return self
+
+
+class SpikingClassifier(ClassifierMixin, BaseEstimator):
+    """A spiking network trained on the recordings' spike trains (``neurotex train
+    --classifier snn``; docs/spiking-classifier.md): recordings in, labels out, no
+    features. ``X`` is what :class:`SpikeFeatures` takes (arrays ``(T, rows, cols)``, a
+    4-D array, or :class:`neurotex.Recording` objects); ``fit`` encodes them with the
+    pipeline (``encoding``, ``gain``, ``causal``; the paper's defaults otherwise) and trains
+    ``hidden`` LIF neurons with time steps of ``dt_ms`` for at most ``epochs`` passes, early
+    stopping on 20 % of each class of ``X``, seeded by ``seed``. ``model_`` is the trained
+    :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
+    it to NIR)."""
+
+    def __init__(
+        self,
+        hidden: int = 128,
+        dt_ms: int = 10,
+        epochs: int = 60,
+        readout: str = "mean",
+        seed: int = 0,
+        encoding: str = _DEFAULTS["encoding"],
+        gain: Union[float, str] = _DEFAULTS["gain"],
+        causal: bool = False,
+        fs: float = 1000.0,
+    ) -> None:
+        self.hidden = hidden
+        self.dt_ms = dt_ms
+        self.epochs = epochs
+        self.readout = readout
+        self.seed = seed
+        self.encoding = encoding
+        self.gain = gain
+        self.causal = causal
+        self.fs = fs
+
+    def fit(self, X: Any, y: Any) -> "SpikingClassifier":
+        """Trains on recordings ``X`` and labels ``y``."""
+        from sklearn.utils.multiclass import check_classification_targets
+
+        from . import SpikingModel
+
+        y = np.asarray(y)
+        check_classification_targets(y)
+        if len(y) != len(X):
+            raise ValueError(f"{len(y)} labels for {len(X)} recordings")
+        self.classes_ = np.unique(y)
+        self.model_ = SpikingModel.train(
+            X, [str(label) for label in y], fs=self.fs, hidden=self.hidden,
+            dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
+            causal=self.causal, encoding=self.encoding, gain=self.gain,
+        )
+        # the network's outputs (labels as text) -> columns in classes_ order
+        text = [str(c) for c in self.classes_]
+        self._columns = np.array([self.model_.classes_.index(t) for t in text])
+        return self
+
+    def predict(self, X: Any) -> np.ndarray:
+        """The predicted label of each recording (the network's: a tie goes to the class
+        of its first output)."""
+        check_is_fitted(self, "model_")
+        of_text = {str(c): c for c in self.classes_}
+        return np.array([of_text[t] for t in self.model_.predict(X, fs=self.fs)],
+                        dtype=self.classes_.dtype)
+
+    def predict_proba(self, X: Any) -> np.ndarray:
+        """Each class's share (the softmax of the network's scores), columns in
+        ``classes_`` order."""
+        check_is_fitted(self, "model_")
+        return self.model_.predict_proba(X, fs=self.fs)[:, self._columns]
+
+    def __getstate__(self) -> Dict[str, Any]:
+        # The native model is not picklable; its model file is kept instead.
+        import os
+        import tempfile
+
+        state = self.__dict__.copy()
+        model = state.pop("model_", None)
+        if model is not None:
+            with tempfile.TemporaryDirectory() as tmp:
+                path = os.path.join(tmp, "model.json")
+                model.save(path)
+                with open(path, "rb") as f:
+                    state["_model_file"] = f.read()
+        return state
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        import os
+        import tempfile
+
+        from . import SpikingModel
+
+        data = state.pop("_model_file", None)
+        self.__dict__.update(state)
+        if data is not None:
+            with tempfile.TemporaryDirectory() as tmp:
+                path = os.path.join(tmp, "model.json")
+                with open(path, "wb") as f:
+                    f.write(data)
+                self.model_ = SpikingModel.load(path)
+
+    def __sklearn_tags__(self):  # noqa: D105
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        return tags

@@ -10,10 +10,7 @@ use super::{
     SnnOptions,
 };
 use crate::classify::{ClassifierChoice, CvParams, ForestParams};
-use crate::compare::candidates::{
-    candidates, CandidateSet, MethodChoice, STANDARD_CLASSIFIERS, STANDARD_ENCODINGS,
-    STANDARD_METHODS, STANDARD_TAU_MS,
-};
+use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::compare::signal::{
     baseline_candidates, signal_rows, SignalRows, NO_ENCODING, SIGNAL_METHODS,
 };
@@ -86,7 +83,7 @@ pub struct CompareOptions {
     /// (`spectrum`, its speed-normalised spectrum, and `signal-stats`, moments and
     /// quantiles per taxel, each with every classifier; --methods does not apply to
     /// them). Overrides --encoding.
-    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_ENCODINGS))]
+    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = crate::compare::candidates::STANDARD_ENCODINGS))]
     pub encodings: Vec<String>,
     /// Feature methods to compare, comma-separated. `taxel` is the paper's single-taxel
     /// method (each taxel alone, mean over taxels; KNN only); `van-rossum` classifies by
@@ -95,15 +92,15 @@ pub struct CompareOptions {
     /// `spectrum`: each taxel's spike counts along the slide, their Fourier magnitudes in
     /// logarithmic bands of spatial frequency. `spikes`: the spike trains themselves,
     /// classified by the spiking network (`snn`, its options --snn-*).
-    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_METHODS))]
+    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = crate::compare::candidates::STANDARD_METHODS))]
     pub methods: Vec<String>,
     /// Classifiers to compare, comma-separated: knn, forest, linear, snn (the spiking
     /// network; it reads spike trains, so it runs with the `spikes` method only).
-    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = STANDARD_CLASSIFIERS))]
+    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = crate::compare::candidates::STANDARD_CLASSIFIERS))]
     pub classifiers: Vec<String>,
     /// Time constant of the van Rossum kernel in ms (method `van-rossum`). Default: the
     /// rate volume's 200 ms bin, the time resolution the paper's rate code keeps.
-    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = STANDARD_TAU_MS))]
+    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = crate::compare::candidates::STANDARD_TAU_MS))]
     pub tau_ms: f64,
     /// KNN's neighbours and z-scoring.
     #[cfg_attr(feature = "cli", command(flatten))]

@@ -9,7 +9,7 @@ use super::{
 use crate::analysis::{Columns, Split};
 use crate::calibrate::CalibratedParams;
 use crate::classify::{ClassifierChoice, CvParams};
-use crate::compare::candidates::{MethodChoice, STANDARD_TAU_MS};
+use crate::compare::candidates::MethodChoice;
 use crate::error::OptionsError;
 use crate::evaluation::{Evaluation, Spikes};
 use crate::options::StageOptions;
@@ -35,7 +35,7 @@ pub struct EvaluateOptions {
     pub method: MethodChoice,
     /// With `--method van-rossum`: the kernel's time constant in ms (default: the rate
     /// volume's 200 ms bin).
-    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = STANDARD_TAU_MS))]
+    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = crate::compare::candidates::STANDARD_TAU_MS))]
     pub tau_ms: f64,
     /// With `--method taxel`: the taxel to use, as `ROW,COL`. Without it every taxel is
     /// evaluated and the mean over taxels is reported, with the best beside it.

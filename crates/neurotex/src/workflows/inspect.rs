@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 
 use super::{LogOptions, OnProgress, OpenOptions};
-use crate::classify::{CvParams, KnnParams};
 use crate::inspect::{inspect, InspectParams, Inspection, Opened};
 use crate::options::StageOptions;
 use crate::progress::Progress;
@@ -23,10 +22,10 @@ pub struct InspectOptions {
     #[cfg_attr(feature = "cli", arg(long = "no-encoder"))]
     pub no_encoder: bool,
     /// Cross-validation folds the design is judged for.
-    #[cfg_attr(feature = "cli", arg(long, default_value_t = CvParams::default().folds))]
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().folds))]
     pub folds: usize,
     /// KNN's neighbours the design is judged for.
-    #[cfg_attr(feature = "cli", arg(long, default_value_t = KnnParams::default().k))]
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::KnnParams::default().k))]
     pub k: usize,
     /// How raw logs are read.
     #[cfg_attr(feature = "cli", command(flatten))]

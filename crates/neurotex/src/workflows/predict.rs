@@ -7,19 +7,20 @@ use rayon::prelude::*;
 
 use super::stream::DecisionOptions;
 use super::{say_conditions, OnProgress, OpenOptions, ReadOptions};
-use crate::causal::{episode_decisions, Episode};
+use crate::causal::Episode;
 use crate::error::OptionsError;
-use crate::model::Model;
 use crate::pipeline::{Encoded, Pipeline};
 use crate::progress::Progress;
-use crate::recording::{Baseline, Dataset, FileReading, LayoutFrom};
+use crate::recording::{Baseline, Dataset};
+use crate::saved::SavedModel;
 use crate::Result;
 
 /// Options of `predict`.
 #[derive(Debug, Clone)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct PredictOptions {
-    /// The model file written by `neurotex train`. Its pipeline (filter, neurons, bins,
+    /// The model file written by `neurotex train` (a spiking network's too, or a NIR
+    /// graph). Its pipeline (filter, neurons, bins,
     /// GLCM offsets, baseline) is applied to the recordings, not this command's defaults.
     #[cfg_attr(feature = "cli", arg(long))]
     pub model: PathBuf,
@@ -81,36 +82,14 @@ impl PredictOptions {
     /// A recording that cannot be read, or does not fit the model.
     pub fn encode(
         &self,
-        model: &Model,
+        model: &SavedModel,
         dataset: Option<&Dataset>,
         on: OnProgress,
-    ) -> Result<Vec<Encoded>> {
-        self.encode_with(
-            model.pipeline(),
-            model.baseline(),
-            dataset,
-            on,
-            |files, reading| model.encode_files(files, reading),
-        )
-    }
-
-    /// Encodes the recordings with `pipeline` and `baseline` (a model's), the files given
-    /// through `encode_files` (the model's reading of plain files).
-    ///
-    /// # Errors
-    /// A recording that cannot be read, or does not fit the model.
-    pub fn encode_with(
-        &self,
-        pipeline: &Pipeline,
-        baseline: Baseline,
-        dataset: Option<&Dataset>,
-        on: OnProgress,
-        encode_files: impl Fn(&[PathBuf], &FileReading) -> Result<(Vec<Encoded>, Vec<LayoutFrom>)>,
     ) -> Result<Vec<Encoded>> {
         let encoded = match dataset {
-            Some(dataset) => encode_dataset(pipeline, baseline, dataset, on)?,
+            Some(dataset) => encode_dataset(model.pipeline(), model.baseline(), dataset, on)?,
             None => {
-                let (encoded, from) = encode_files(&self.files, &self.read.reading()?)?;
+                let (encoded, from) = model.encode_files(&self.files, &self.read.reading()?)?;
                 for note in ReadOptions::layout_notes(&from) {
                     on(Progress::Say(&note));
                 }
@@ -125,19 +104,19 @@ impl PredictOptions {
     ///
     /// # Errors
     /// A model not trained with `--causal`, or a decision rule out of range.
-    pub fn episodes(&self, model: &Model, encoded: &[Encoded]) -> Result<Vec<Episode>> {
-        if model.causal().is_none() {
-            return Err(OptionsError::Conflict(format!("{}: --causal needs a model trained with --causal (this one conditions each recording with the zero-phase filter and its own maximum, which need the whole recording)", self.model.display())).into());
-        }
-        if model.features().method == crate::pipeline::Method::Spectrum {
-            let why = crate::stream::NO_RUNNING_SPECTRUM;
-            return Err(OptionsError::Conflict(format!("{}: {why}", self.model.display())).into());
+    pub fn episodes(&self, model: &SavedModel, encoded: &[Encoded]) -> Result<Vec<Episode>> {
+        if let Err(why) = model.streams() {
+            let message = format!(
+                "{}: --causal decides as a stream: {why}",
+                self.model.display()
+            );
+            return Err(OptionsError::Conflict(message).into());
         }
         let window_ms = self.decision.window_ms(model)?;
         let rule = self.decision.rule()?;
         encoded
             .par_iter()
-            .map(|e| episode_decisions(model, e, window_ms, rule))
+            .map(|e| model.episode(e, window_ms, rule))
             .collect()
     }
 }

@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use crate::causal::DecisionRule;
 use crate::csvlog::{ChannelSelect, Column, CsvFormat, CsvOverrides, Delimiter};
 use crate::error::OptionsError;
-use crate::model::Model;
 use crate::recording::TimeUnit;
+use crate::saved::Trained;
 use crate::stream::frames::FrameFormat as Format;
 use crate::stream::{EpisodeRule, StreamParams};
 use crate::Result;
@@ -49,7 +49,7 @@ impl DecisionOptions {
     ///
     /// # Errors
     /// A window that is not a positive whole number of the model's bins.
-    pub fn window_ms(&self, model: &Model) -> Result<usize> {
+    pub fn window_ms(&self, model: &impl Trained) -> Result<usize> {
         Ok(StreamParams::window_ms(model, self.window_s)?)
     }
 }
@@ -70,9 +70,15 @@ pub enum FrameFormat {
 #[derive(Debug, Clone)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct StreamOptions {
-    /// A model trained with `--causal` (`neurotex train --causal`).
+    /// A model trained with `--causal` (`neurotex train --causal`, with any classifier:
+    /// a spiking network runs step by step on the spikes as they come).
     #[cfg_attr(feature = "cli", arg(long))]
     pub model: PathBuf,
+    /// With --model FILE.nir from another tool (no neurotex metadata in the graph): a
+    /// neurotex spiking model trained with --causal whose pipeline, grid and labels the
+    /// graph's network runs with.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub like: Option<PathBuf>,
     /// Where frames come from: `-` (standard input), a file, `tcp://HOST:PORT` (listens
     /// there and takes one connection: the sensor's driver connects and sends frames
     /// until it closes) or `udp://HOST:PORT` (binds there; each datagram holds whole lines
@@ -135,7 +141,7 @@ impl StreamOptions {
     ///
     /// # Errors
     /// A decision rule or window out of range.
-    pub fn params(&self, model: &Model) -> Result<StreamParams> {
+    pub fn params(&self, model: &impl Trained) -> Result<StreamParams> {
         Ok(StreamParams {
             window_ms: self.decision.window_ms(model)?,
             rule: self.decision.rule()?,
@@ -153,7 +159,7 @@ impl StreamOptions {
     ///
     /// # Errors
     /// `--stamped` with CSV frames, or a layout the model remembers that does not read.
-    pub fn frame_format(&self, model: &Model) -> Result<Format> {
+    pub fn frame_format(&self, model: &impl Trained) -> Result<Format> {
         if self.format == FrameFormat::Csv && self.stamped {
             return Err(OptionsError::NotApplicable {
                 option: "--stamped",

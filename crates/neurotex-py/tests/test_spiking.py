@@ -1,0 +1,90 @@
+"""The spiking network from Python: `SpikingModel.train` trains the network `neurotex train
+--classifier snn` trains (the same weights), a `StreamClassifier` runs it as `neurotex
+stream` does, and `neurotex.sklearn.SpikingClassifier` follows scikit-learn's
+conventions."""
+
+import json
+import pickle
+
+import numpy as np
+import pytest
+
+import neurotex
+
+from conftest import run_cli
+from test_stream import manifest, slide_frames
+
+OPTIONS = {"hidden": 24, "epochs": 4, "encoding": "sa+fa"}
+
+
+@pytest.fixture(scope="module")
+def trained(sim, sim_dir, tmp_path_factory):
+    """A causal network trained from Python and the one the CLI trains with the same
+    options, saved."""
+    d = tmp_path_factory.mktemp("snn")
+    model = neurotex.SpikingModel.train(sim, causal=True, **OPTIONS)
+    model.save(d / "py.json")
+    run_cli("train", "--dataset", sim_dir, "--causal", "--classifier", "snn",
+            "--snn-hidden", "24", "--snn-epochs", "4", "--encoding", "sa+fa",
+            "--out", d / "cli.json")
+    return model, d
+
+
+def test_python_trains_the_network_the_cli_trains(trained):
+    model, d = trained
+    py = json.loads((d / "py.json").read_text())
+    cli = json.loads((d / "cli.json").read_text())
+    assert py["format"] == "neurotex-snn-model"
+    assert py["labels"] == cli["labels"] == ["FT1", "SB", "CP"]
+    assert py["network"] == cli["network"]
+    assert py["pipeline"] == cli["pipeline"]
+    assert set(model.training) == {"epochs", "best_epoch", "validation_loss"}
+    assert 1 <= model.training["best_epoch"] <= model.training["epochs"] <= 4
+
+
+def test_a_spiking_stream_gives_the_lines_of_the_cli(trained, sim_dir, tmp_path):
+    model, d = trained
+    row = manifest(sim_dir)[7]
+    frames = slide_frames(sim_dir, row)
+    csv = tmp_path / "slide.csv"
+    header = ",".join(f"t{i}" for i in range(16))
+    csv.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in f) for f in frames) + "\n")
+    out = run_cli("stream", "--model", d / "cli.json", "--input", csv).stdout
+    expected = [json.loads(l) for l in out.splitlines()]
+    for e in expected:
+        e.pop("bad_frames", None)
+    for source in (model, d / "cli.json"):
+        stream = neurotex.StreamClassifier(source)
+        got = []
+        for f in frames:
+            got.extend(stream.push(f) or [])
+        got.extend(stream.finish() or [])
+        assert got == expected
+    assert len(expected) > 20 and expected[-1]["end"] is True
+
+
+def test_the_sklearn_estimator_fits_predicts_clones_and_pickles(sim):
+    from sklearn.base import clone
+    from sklearn.model_selection import cross_val_score
+
+    from neurotex.sklearn import SpikingClassifier
+
+    # Classes whose sorted order (classes_) is not the network's (first appearance).
+    labels = np.array([{"FT1": 2, "SB": 0, "CP": 1}[l] for l in sim.labels])
+    est = SpikingClassifier(hidden=24, epochs=4, encoding="sa+fa")
+    assert clone(est).get_params() == est.get_params()
+    est.fit(sim.recordings, labels)
+    assert list(est.classes_) == [0, 1, 2]
+    proba = est.predict_proba(sim.recordings)
+    assert proba.shape == (len(labels), 3)
+    np.testing.assert_allclose(proba.sum(axis=1), 1.0)
+    # Columns in classes_ order 0, 1, 2; the network's outputs are 2, 0, 1.
+    assert est.model_.classes_ == ["2", "0", "1"]
+    np.testing.assert_array_equal(proba, est.model_.predict_proba(sim.recordings)[:, [1, 2, 0]])
+    predicted = est.predict(sim.recordings)
+    assert predicted.dtype == labels.dtype
+    assert (predicted == labels).mean() > 0.5
+    again = pickle.loads(pickle.dumps(est))
+    np.testing.assert_array_equal(again.predict_proba(sim.recordings), proba)
+    scores = cross_val_score(SpikingClassifier(hidden=16, epochs=3), sim.recordings, labels, cv=2)
+    assert scores.shape == (2,) and np.all((0 <= scores) & (scores <= 1))
