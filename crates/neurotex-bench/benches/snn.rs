@@ -33,6 +33,7 @@ fn network(inputs: usize, hidden: usize, classes: usize) -> Network {
         b_in: w(hidden, 0.2),
         w_out: w(hidden * classes, 1.0),
         b_out: w(classes, 0.1),
+        w_rec: Vec::new(),
     }
 }
 

@@ -208,40 +208,49 @@ fn stream_and_predict_causal_agree_on_simulated_recordings() {
 fn a_spiking_network_streams_as_predict_causal_decides_and_exports_to_nir() {
     // `train --classifier snn --causal`: the network runs on the stream's spikes step by
     // step; `predict --causal` runs it over the whole recording; the same lines. The same
-    // network read back from its NIR graph streams the same lines too.
-    let dir = Dir::new();
-    let args = [
-        "--classifier",
-        "snn",
-        "--snn-epochs",
-        "5",
-        "--snn-hidden",
-        "32",
-    ];
-    let (data, model) = trained(&dir, &args);
-    let graph = dir.join("model.nir");
-    dir.ok(&["export", "nir", "--model", s(&model), "--out", s(&graph)]);
-    let row = &slides(&data)[4];
-    let expected = predicted(&dir, &model, &data, &row.0);
-    assert!(expected.len() > 40, "a bin every 200 ms of a 9 s slide");
-    assert_eq!(expected.last().unwrap()["end"], true);
-    let csv = dir.join("slide.csv");
-    std::fs::write(&csv, csv_text(&slide_frames(&data, row))).unwrap();
-    for m in [&model, &graph] {
-        let text = dir.ok(&["stream", "--model", s(m), "--input", s(&csv)]);
-        assert_eq!(lines(&text), expected, "{}", m.display());
+    // network read back from its NIR graph streams the same lines too. Feed-forward and
+    // recurrent.
+    for recurrent in [false, true] {
+        let dir = Dir::new();
+        let mut args = vec![
+            "--classifier",
+            "snn",
+            "--snn-epochs",
+            "5",
+            "--snn-hidden",
+            "32",
+        ];
+        if recurrent {
+            args.push("--snn-recurrent");
+        }
+        let (data, model) = trained(&dir, &args);
+        let file: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+        let weights = file["network"]["w_rec"].as_array().map_or(0, Vec::len);
+        assert_eq!(weights, if recurrent { 32 * 32 } else { 0 });
+        let graph = dir.join("model.nir");
+        dir.ok(&["export", "nir", "--model", s(&model), "--out", s(&graph)]);
+        let row = &slides(&data)[4];
+        let expected = predicted(&dir, &model, &data, &row.0);
+        assert!(expected.len() > 40, "a bin every 200 ms of a 9 s slide");
+        assert_eq!(expected.last().unwrap()["end"], true);
+        let csv = dir.join("slide.csv");
+        std::fs::write(&csv, csv_text(&slide_frames(&data, row))).unwrap();
+        for m in [&model, &graph] {
+            let text = dir.ok(&["stream", "--model", s(m), "--input", s(&csv)]);
+            assert_eq!(lines(&text), expected, "{}", m.display());
+        }
+        // A window of 1 s: the scores read over the network's last 100 time steps.
+        let one = [
+            "stream",
+            "--model",
+            s(&model),
+            "--input",
+            s(&csv),
+            "--window-s",
+            "1",
+        ];
+        assert_ne!(lines(&dir.ok(&one)), expected);
     }
-    // A window of 1 s: the scores read over the network's last 100 time steps.
-    let text = dir.ok(&[
-        "stream",
-        "--model",
-        s(&model),
-        "--input",
-        s(&csv),
-        "--window-s",
-        "1",
-    ]);
-    assert_ne!(lines(&text), expected);
 }
 
 #[test]

@@ -464,7 +464,8 @@ pub fn choose_columns(
             .and_then(|c| fits(&c).map(|()| c))
         {
             Ok(columns) => return Ok((i, columns)),
-            Err(why) => reasons.push(why),
+            Err(why) if !reasons.contains(&why) => reasons.push(why),
+            Err(_) => {}
         }
     }
     let message = match reasons.as_slice() {
@@ -840,12 +841,7 @@ fn check_no_stamps_among_channels(
         true => columns.names[column].clone(),
         false => column.to_string(),
     };
-    let lower = name.trim().to_lowercase();
-    let timelike = format.header
-        && (lower == "t"
-            || lower.starts_with("time")
-            || lower.contains("stamp")
-            || unit_in_name(&lower).is_some_and(|_| lower.starts_with("t")));
+    let timelike = format.header && is_timelike_name(&name);
     let first = log.samples.iter().step_by(n);
     let rising = first.clone().zip(first.skip(1)).all(|(a, b)| b > a);
     // A host's clock since the Unix epoch: 1.7e9 s, 1.7e12 ms, 1.7e15 us; no taxel reads
@@ -871,6 +867,16 @@ fn check_no_stamps_among_channels(
         excerpt(&name),
     );
     Err(invalid(path, message))
+}
+
+/// Whether a column's name says it holds time stamps: `t`, `time...`, `...stamp...`, or
+/// `t...` with a unit (`t_ms`), in any case.
+pub fn is_timelike_name(name: &str) -> bool {
+    let lower = name.trim().to_lowercase();
+    lower == "t"
+        || lower.starts_with("time")
+        || lower.contains("stamp")
+        || unit_in_name(&lower).is_some_and(|_| lower.starts_with("t"))
 }
 
 /// The least first value of a rising first column taken for a clock's stamps since an

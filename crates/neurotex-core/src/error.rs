@@ -477,13 +477,13 @@ pub enum ModelError {
         reason: String,
     },
     /// A spiking model where a feature model is needed.
-    #[error("{}: a spiking model (`{SNN_MODEL_FORMAT}`), where a feature model is needed: `predict`, `stream` and `export` take it (in Python: SpikingModel.load)", .path.display())]
+    #[error("{}: a spiking model (a `{SNN_MODEL_FORMAT}` file or a NIR graph), where a feature model is needed: `predict`, `stream` and `export` take it (in Python: SpikingModel.load)", .path.display())]
     SpikingModel {
         /// The file.
         path: PathBuf,
     },
     /// A feature model where a spiking model is needed.
-    #[error("{}: a feature model (`{MODEL_FORMAT}`), not a spiking model: train one with --classifier snn", .path.display())]
+    #[error("{}: a feature model (`{MODEL_FORMAT}`), not a spiking model: train one with --classifier snn (in Python: SpikingModel.train); only a spiking network has a NIR graph and input tensors", .path.display())]
     NotSpiking {
         /// The file.
         path: PathBuf,

@@ -300,6 +300,11 @@ impl Model {
     /// breaks a rule.
     pub fn load(path: &Path) -> Result<Model> {
         let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+        if bytes.starts_with(b"\x89HDF\r\n\x1a\n") {
+            // HDF5: a NIR graph, which holds a spiking network.
+            let path = path.to_path_buf();
+            return Err(ModelError::SpikingModel { path }.into());
+        }
         let damaged = |reason: String| -> crate::Error {
             ModelError::Damaged {
                 path: path.to_path_buf(),

@@ -22,6 +22,11 @@
 //! thresholds and leaks that differ per neuron are folded into the weights and biases
 //! (dividing by the threshold, adding the leak to the readout's bias), while the decays must
 //! be one per layer, as neurotex's network has.
+//!
+//! **Recurrent networks** (`--snn-recurrent`) add a `rec` node (Linear, `(hidden, hidden)`)
+//! on the edges `lif1 → rec → lif1`, the form snnTorch's and Norse's importers read as a
+//! recurrent layer. NIR's equations leave the loop's delay to the simulator; neurotex's
+//! network, like theirs, feeds a step's spikes into the next step's current.
 
 use std::path::Path;
 
@@ -59,7 +64,8 @@ pub const SNNTORCH_DT_S: f64 = 1e-4;
 pub struct NirNetwork {
     /// The network, in neurotex's discrete form.
     pub network: Network,
-    /// The time step, s, from the metadata.
+    /// The network's time step, s, from the metadata (`neurotex_dt` when the graph has it,
+    /// else `dt`).
     pub dt_s: f64,
     /// The neurotex model file without its weights, when the graph was written by
     /// neurotex (`neurotex_model` in the metadata).
@@ -83,7 +89,10 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
         .with_shape(&[]);
     let mut node = fb.create_group("node");
     put_str(&mut node, "type", "NIRGraph");
-    let edges: Vec<&str> = NODES.windows(2).flat_map(|w| [w[0].0, w[1].0]).collect();
+    let mut edges: Vec<&str> = NODES.windows(2).flat_map(|w| [w[0].0, w[1].0]).collect();
+    if net.recurrent() {
+        edges.extend(["lif1", "rec", "rec", "lif1"]);
+    }
     node.create_dataset("edges")
         .with_vlen_strings(&edges)
         .with_shape(&[edges.len() as u64 / 2, 2]);
@@ -91,6 +100,12 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
     meta.create_dataset("dt")
         .with_f64_data(&[dt * scale])
         .with_shape(&[]);
+    if convention == Convention::Snntorch {
+        // The network's own step, beside snnTorch's: neurotex reads its own export back.
+        meta.create_dataset("neurotex_dt")
+            .with_f64_data(&[dt])
+            .with_shape(&[]);
+    }
     put_str(&mut meta, "readout", net.readout.name());
     put_str(&mut meta, "neurotex_model", model_json);
     node.add_group(meta.finish());
@@ -139,6 +154,17 @@ fn layers(nodes: &mut GroupBuilder, net: &Network, dt: f64, scale: f64) {
         ("w_in", tau_syn / dt),
     ];
     neurons(nodes, "lif1", "CubaLIF", &lif, h);
+    if net.recurrent() {
+        let mut g = nodes.create_group("rec");
+        put_str(&mut g, "type", "Linear");
+        put_f32(
+            &mut g,
+            "weight",
+            &transposed(&net.w_rec, h, h),
+            &[h as u64, h as u64],
+        );
+        nodes.add_group(g.finish());
+    }
     affine(
         nodes,
         "fc2",
@@ -295,7 +321,7 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
     if kind.first().map(String::as_str) != Some("NIRGraph") {
         return Err(format!("/node is a {kind:?}, not a NIRGraph"));
     }
-    let names = path_of_nodes(&reader)?;
+    let (names, rec) = path_of_nodes(&reader)?;
     let meta = reader.group(&["node", "metadata"]).map_err(|_| {
         "the graph has no metadata, so no `dt` (its time step in seconds)".to_string()
     })?;
@@ -306,9 +332,16 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
         })?,
     };
     let dt_s = *dt.first().ok_or("the graph's `dt` is empty")?;
-    let dt_ms = dt_s * 1000.0;
+    // A graph written for snnTorch's importer (its constants scaled to `dt` = 0.1 ms) keeps
+    // the network's own step as `neurotex_dt`; the decays follow from `dt`, the spikes'
+    // binning from the network's step.
+    let step_s = match meta.dataset("neurotex_dt").and_then(|d| d.read_f64()) {
+        Ok(v) => *v.first().ok_or("the graph's `neurotex_dt` is empty")?,
+        Err(_) => dt_s,
+    };
+    let dt_ms = step_s * 1000.0;
     if !((1.0..=1000.0).contains(&dt_ms) && (dt_ms - dt_ms.round()).abs() < 1e-6) {
-        return Err(format!("the graph's dt is {dt_s} s; neurotex's networks step a whole number of ms (1 to 1000) on the encoder's 1 ms spikes"));
+        return Err(format!("the graph's dt is {step_s} s; neurotex's networks step a whole number of ms (1 to 1000) on the encoder's 1 ms spikes"));
     }
     let readout = match read_string(&meta, "readout", "/node/metadata") {
         Ok(r) => r.first().map_or(Ok(Readout::Mean), |r| {
@@ -320,18 +353,22 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
     let neurotex_model = read_string(&meta, "neurotex_model", "/node/metadata")
         .ok()
         .and_then(|v| v.into_iter().next());
-    let network = network_of(&reader, &names, dt_s, dt_ms.round() as u32, readout)?;
+    let mut network = network_of(&reader, &names, dt_s, dt_ms.round() as u32, readout)?;
+    if let Some(rec) = rec {
+        recurrent_of(&reader, &rec, &names[2], dt_s, &mut network)?;
+    }
     network.check()?;
     Ok(NirNetwork {
         network,
-        dt_s,
+        dt_s: step_s,
         neurotex_model,
     })
 }
 
 /// The nodes along the graph's one path from its Input to its Output, checked to be the
-/// six neurotex runs, in order.
-fn path_of_nodes(reader: &Reader) -> Result<Vec<String>, String> {
+/// six neurotex runs, in order, and the Linear (or Affine) node of a recurrent loop on the
+/// CubaLIF node (`lif → rec → lif`), if there is one.
+fn path_of_nodes(reader: &Reader) -> Result<(Vec<String>, Option<String>), String> {
     let nodes = reader.group(&["node", "nodes"])?;
     let names = nodes.groups().map_err(|e| format!("/node/nodes: {e}"))?;
     let mut kinds = Vec::new();
@@ -348,10 +385,11 @@ fn path_of_nodes(reader: &Reader) -> Result<Vec<String>, String> {
     if flat.len() % 2 != 0 {
         return Err("the graph's edges are not pairs".into());
     }
-    let edges: Vec<(&str, &str)> = flat
+    let mut edges: Vec<(&str, &str)> = flat
         .chunks(2)
         .map(|e| (e[0].as_str(), e[1].as_str()))
         .collect();
+    let rec = take_loop(&mut kinds, &mut edges)?;
     let start = kinds
         .iter()
         .filter(|(_, k)| k == "Input")
@@ -404,7 +442,67 @@ fn path_of_nodes(reader: &Reader) -> Result<Vec<String>, String> {
     if order.len() != want.len() {
         return Err(format!("the graph has {} nodes; neurotex runs the six of Input → Affine → CubaLIF → Affine → LI → Output", order.len()));
     }
-    Ok(path)
+    Ok((path, rec))
+}
+
+/// Reads the recurrent loop's weights (node `rec` on the CubaLIF node `lif`) into `net`,
+/// with the CubaLIF's gain per neuron as for its feed-forward input; a bias on the loop is
+/// a constant current, added to the hidden biases.
+fn recurrent_of(
+    reader: &Reader,
+    rec: &str,
+    lif: &str,
+    dt_s: f64,
+    net: &mut Network,
+) -> Result<(), String> {
+    let h = net.hidden;
+    let (w, bias, out, inp) = read_affine(reader, rec)?;
+    if (out, inp) != (h, h) {
+        return Err(format!(
+            "node {rec}: the recurrent weight is ({out}, {inp}), not ({h}, {h}) for the {h} neurons of {lif}"
+        ));
+    }
+    let (_, _, gain) = lif_of(reader, lif, dt_s, h)?;
+    net.w_rec = (0..h * h)
+        .map(|k| gain[k % h] * w[(k % h) * h + k / h])
+        .collect();
+    for (b, (g, extra)) in net.b_in.iter_mut().zip(gain.iter().zip(&bias)) {
+        *b += g * extra;
+    }
+    Ok(())
+}
+
+/// Takes the one recurrent loop `CubaLIF → Linear/Affine → CubaLIF` (the Linear node with
+/// no other edge) out of the node list and edges, and returns its Linear node's name.
+fn take_loop(
+    kinds: &mut Vec<(String, String)>,
+    edges: &mut Vec<(&str, &str)>,
+) -> Result<Option<String>, String> {
+    let kind_of = |n: &str| kinds.iter().find(|(m, _)| m == n).map(|(_, k)| k.clone());
+    let loops: Vec<(String, String)> = edges
+        .iter()
+        .filter(|(a, b)| {
+            kind_of(a).as_deref() == Some("CubaLIF")
+                && matches!(kind_of(b).as_deref(), Some("Linear" | "Affine"))
+                && edges.contains(&(*b, *a))
+                && edges.iter().filter(|e| e.0 == *b || e.1 == *b).count() == 2
+        })
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    Ok(match loops.as_slice() {
+        [] => None,
+        [(lif, rec)] => {
+            edges.retain(|e| {
+                *e != (lif.as_str(), rec.as_str()) && *e != (rec.as_str(), lif.as_str())
+            });
+            kinds.retain(|(n, _)| n != rec);
+            Some(rec.clone())
+        }
+        _ => return Err(
+            "the graph has more than one recurrent loop; neurotex runs one, on its CubaLIF layer"
+                .into(),
+        ),
+    })
 }
 
 /// One value per neuron of a layer of `len` (a single value applies to all).
@@ -552,6 +650,7 @@ fn network_of(
         b_out: (0..c)
             .map(|k| out_gain[k] * b2[k] + (dt_s / tau[k]) * leak[k])
             .collect(),
+        w_rec: Vec::new(),
     })
 }
 
@@ -582,6 +681,7 @@ mod tests {
             b_in: w(h, 0.2),
             w_out: w(h * c, 0.3),
             b_out: w(c, 0.4),
+            w_rec: Vec::new(),
         }
     }
 
@@ -675,6 +775,13 @@ mod tests {
         for (a, b) in scores(&net()).iter().zip(scores(&back.network)) {
             assert!((a - b).abs() < 1e-12, "{a} vs {b}");
         }
+        // Written for snnTorch's importer (`dt` 0.1 ms, the constants scaled to it): read
+        // back as the same network, its own step from `neurotex_dt`.
+        let snntorch = from_bytes(to_bytes(&net(), "{}", Convention::Snntorch).unwrap()).unwrap();
+        assert_eq!((snntorch.dt_s, snntorch.network.dt_ms), (0.01, 10));
+        for (a, b) in scores(&net()).iter().zip(scores(&snntorch.network)) {
+            assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+        }
         // A threshold of 2 with every input weight doubled, and an LI gain r halved with
         // the readout weights doubled: the same network.
         let doubled = graph(
@@ -709,6 +816,42 @@ mod tests {
         for (a, b) in scores(&net()).iter().zip(scores(&same)) {
             assert!((a - b).abs() < 1e-9, "{a} vs {b}");
         }
+    }
+
+    /// A recurrent network's graph carries its loop (`lif1 → rec → lif1`) and reads back
+    /// as the same network; the loop's weights matter to its scores.
+    #[test]
+    fn a_recurrent_network_round_trips_through_its_loop() {
+        let mut rec = net();
+        rec.w_rec = (0..16)
+            .map(|i| f64::from(((i as f32) * 0.91).cos() * 0.6))
+            .collect();
+        let bytes = to_bytes(&rec, "{}", Convention::Physical).unwrap();
+        let back = from_bytes(bytes).unwrap().network;
+        assert!(back.recurrent());
+        let x = crate::snn::SpikeInput::from_events(3, 30, &[(0, 1), (1, 0), (2, 2), (3, 1)]);
+        let (a, b) = (rec.scores(&x), back.scores(&x));
+        for (a, b) in a.iter().zip(&b) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+        assert_ne!(a, net().scores(&x), "the loop changes the scores");
+        for (w, v) in rec.w_rec.iter().zip(&back.w_rec) {
+            assert!((w - v).abs() < 1e-12);
+        }
+        // Two loops on the hidden layer are refused.
+        let two = graph(
+            |n, e| {
+                for name in ["r1", "r2"] {
+                    let weight = ("weight".to_string(), vec![0.1; 16], vec![4, 4]);
+                    n.push((name.into(), "Linear".into(), vec![weight]));
+                    e.push(["lif1".into(), name.into()]);
+                    e.push([name.into(), "lif1".into()]);
+                }
+            },
+            Some(0.01),
+        );
+        let err = from_bytes(two).unwrap_err();
+        assert!(err.contains("more than one recurrent loop"), "{err}");
     }
 
     #[test]

@@ -234,7 +234,10 @@ impl SpikingModel {
             .into()
         };
         let mut file = match (like, &graph.neurotex_model) {
-            (Some(like), _) => like.file.clone(),
+            (Some(_), Some(_)) => {
+                return Err(damaged("the graph carries its own neurotex pipeline (it was written by neurotex export nir); a pipeline to run with (--like) applies only to a graph without one: run it without --like".into()))
+            }
+            (Some(like), None) => like.file.clone(),
             (None, Some(json)) => {
                 let mut value: serde_json::Value = serde_json::from_str(json).map_err(|e| damaged(format!("its neurotex_model metadata: {e}")))?;
                 value["network"] = serde_json::to_value(&graph.network).map_err(|e| damaged(e.to_string()))?;

@@ -191,7 +191,7 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             "forest_seed",
         ],
         ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
-        ClassifierChoice::Snn(_) => &["hidden", "dt_ms", "epochs", "readout", "seed"],
+        ClassifierChoice::Snn(_) => &["hidden", "dt_ms", "epochs", "readout", "seed", "recurrent"],
     };
     only_known(
         options,
@@ -237,6 +237,7 @@ fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> 
             None => d.readout,
         },
         seed: get(options, "seed")?.unwrap_or(d.seed),
+        recurrent: get(options, "recurrent")?.unwrap_or(d.recurrent),
         ..d
     })
 }
@@ -245,7 +246,7 @@ fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> 
 pub fn snn(options: &Bound<'_, PyDict>) -> PyResult<SnnParams> {
     only_known(
         options,
-        &["hidden", "dt_ms", "epochs", "readout", "seed"],
+        &["hidden", "dt_ms", "epochs", "readout", "seed", "recurrent"],
         " for the spiking network; its options are",
     )?;
     snn_params(options, SnnParams::default())?

@@ -8,13 +8,19 @@ import csv
 
 import nir
 import numpy as np
+import pytest
 
 
 def run_graph(graph, x):
     """Class scores of one recording `x` (steps, inputs): NIR's node equations stepped at
-    the metadata's dt, scores the readout's mean (or max) over time."""
+    the metadata's dt, scores the readout's mean (or max) over time. A recurrent loop
+    (`lif → Linear → lif`) feeds a step's spikes into the next step's input."""
     dt = float(np.asarray(graph.metadata["dt"]))
-    follow = {src: dst for src, dst in graph.edges}
+    edges = [tuple(e) for e in graph.edges]
+    loops = {src: dst for src, dst in edges
+             if (dst, src) in edges and isinstance(graph.nodes[dst], nir.Linear)}
+    follow = {src: dst for src, dst in edges
+              if src not in loops.values() and dst not in loops.values()}
     order = [name for name, node in graph.nodes.items() if isinstance(node, nir.Input)]
     while order[-1] in follow:
         order.append(follow[order[-1]])
@@ -28,12 +34,16 @@ def run_graph(graph, x):
                 a = node.weight.astype(np.float64) @ a + node.bias
             elif isinstance(node, nir.CubaLIF):
                 i, v = state.get(name, (np.zeros_like(node.tau_syn), np.zeros_like(node.tau_mem)))
+                if name in loops:
+                    fired = state.get(name + "/spikes", np.zeros_like(node.tau_mem))
+                    a = a + graph.nodes[loops[name]].weight.astype(np.float64) @ fired
                 i = i + dt / node.tau_syn * (-i + node.w_in * a)
                 v = v + dt / node.tau_mem * (node.v_leak - v + node.r * i)
                 spikes = v >= node.v_threshold
                 v = np.where(spikes, node.v_reset, v)
                 state[name] = (i, v)
                 a = spikes.astype(np.float64)
+                state[name + "/spikes"] = a
             elif isinstance(node, nir.LI):
                 v = state.get(name, np.zeros_like(node.tau))
                 v = v + dt / node.tau * (node.v_leak - v + node.r * a)
@@ -47,10 +57,12 @@ def run_graph(graph, x):
     return trace.max(axis=0) if readout == "max" else trace.mean(axis=0)
 
 
-def test_exported_graph_runs_in_nirs_equations_as_in_neurotex(cli, sim_dir, tmp_path):
+@pytest.mark.parametrize("recurrent", [False, True])
+def test_exported_graph_runs_in_nirs_equations_as_in_neurotex(cli, sim_dir, tmp_path, recurrent):
     model = tmp_path / "snn.json"
     cli("train", "--dataset", sim_dir, "--speeds", "5", "--classifier", "snn",
-        "--encoding", "sa+fa", "--snn-epochs", "10", "--out", model)
+        "--encoding", "sa+fa", "--snn-epochs", "10", "--out", model,
+        *(["--snn-recurrent"] if recurrent else []))
     graph_file = tmp_path / "snn.nir"
     cli("export", "nir", "--model", model, "--out", graph_file)
     inputs = tmp_path / "inputs"
@@ -63,6 +75,7 @@ def test_exported_graph_runs_in_nirs_equations_as_in_neurotex(cli, sim_dir, tmp_
     graph = nir.read(str(graph_file))
     assert [type(graph.nodes[n]).__name__ for n in ("input", "fc1", "lif1", "fc2", "li", "output")] == [
         "Input", "Affine", "CubaLIF", "Affine", "LI", "Output"]
+    assert ("rec" in graph.nodes) == recurrent
     labels = [c[len("share_"):] for c in next(csv.reader(open(predicted)))[3:]]
     rows = list(csv.DictReader(open(predicted)))
     index = list(csv.DictReader(open(inputs / "index.csv")))

@@ -12,6 +12,17 @@ use neurotex::workflows::stream::StreamOptions;
 /// Runs `neurotex stream`.
 pub fn run(args: StreamOptions) -> Result<()> {
     let model = SavedModel::load(&args.model, args.like.as_deref())?;
+    if let Err(why) = model.streams() {
+        let from = match &args.like {
+            Some(like) => format!(
+                "{} (its pipeline from {})",
+                args.model.display(),
+                like.display()
+            ),
+            None => args.model.display().to_string(),
+        };
+        anyhow::bail!("{from}: {why}");
+    }
     let params = args.params(&model)?;
     let format = args.frame_format(&model)?;
     let mut stream = StreamClassifier::new(model, params)?;

@@ -102,8 +102,9 @@ impl fmt::Display for ClassifierChoice {
             ClassifierChoice::Linear(p) => write!(f, "logistic regression (C = {})", p.c),
             ClassifierChoice::Snn(p) => write!(
                 f,
-                "spiking network ({} LIF neurons, {} ms steps, {} readout, seed {})",
+                "spiking network ({} {}LIF neurons, {} ms steps, {} readout, seed {})",
                 p.hidden,
+                if p.recurrent { "recurrent " } else { "" },
                 p.dt_ms,
                 p.readout.name(),
                 p.seed

@@ -8,11 +8,12 @@
 //!
 //! ```text
 //! gO[t] = ∂L/∂O[t] + κ gO[t+1]                   readout, backwards
-//! gS[t] = W_out gO[t]  (- P[t] gV[t] unless the reset is detached)
+//! gS[t] = W_out gO[t] + W_rec gI[t+1]  (- P[t] gV[t] unless the reset is detached)
 //! gP[t] = gV[t] (1 - S[t]) + gS[t] H'(P[t] - 1)  H' the surrogate
 //! gI[t] = gP[t] + α gI[t+1]
 //! gV[t-1] = β gP[t]
 //! ∂L/∂W_in += gI[t] x[t]ᵀ, ∂L/∂b_in += gI[t], ∂L/∂W_out += S[t] gO[t]ᵀ, ∂L/∂b_out += gO[t]
+//! ∂L/∂W_rec += S[t-1] gI[t]ᵀ                      (recurrent networks)
 //! ```
 
 use super::{softmax, Network, Readout, SpikeInput};
@@ -78,6 +79,8 @@ pub struct Gradient {
     pub w_out: Vec<f64>,
     /// ∂L/∂b_out.
     pub b_out: Vec<f64>,
+    /// ∂L/∂W_rec, hidden-major (empty for a feed-forward network).
+    pub w_rec: Vec<f64>,
 }
 
 impl Gradient {
@@ -88,6 +91,7 @@ impl Gradient {
             b_in: vec![0.0; net.b_in.len()],
             w_out: vec![0.0; net.w_out.len()],
             b_out: vec![0.0; net.b_out.len()],
+            w_rec: vec![0.0; net.w_rec.len()],
         }
     }
 
@@ -100,17 +104,25 @@ impl Gradient {
         }
     }
 
-    /// The four parts in order (w_in, b_in, w_out, b_out).
-    pub fn parts(&self) -> [&[f64]; 4] {
-        [&self.w_in, &self.b_in, &self.w_out, &self.b_out]
+    /// The parts in the order of [`Network::params_mut`] (w_in, b_in, w_out, b_out, w_rec).
+    pub fn parts(&self) -> [&[f64]; 5] {
+        [
+            &self.w_in,
+            &self.b_in,
+            &self.w_out,
+            &self.b_out,
+            &self.w_rec,
+        ]
     }
 
-    fn parts_mut(&mut self) -> [&mut Vec<f64>; 4] {
+    /// The parts, mutable, in the same order.
+    pub fn parts_mut(&mut self) -> [&mut Vec<f64>; 5] {
         [
             &mut self.w_in,
             &mut self.b_in,
             &mut self.w_out,
             &mut self.b_out,
+            &mut self.w_rec,
         ]
     }
 }
@@ -163,6 +175,17 @@ fn forward_with(
             let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
             for (c, w) in current.iter_mut().zip(w) {
                 *c += w;
+            }
+        }
+        if net.recurrent() && t > 0 {
+            let (before, _) = tr.spikes.split_at(t * h_n);
+            for (j, &s) in before[(t - 1) * h_n..].iter().enumerate() {
+                if s != 0.0 {
+                    let w = &net.w_rec[j * h_n..(j + 1) * h_n];
+                    for (c, w) in current.iter_mut().zip(w) {
+                        *c += s * w;
+                    }
+                }
             }
         }
         for (o, b) in out.iter_mut().zip(&net.b_out) {
@@ -274,6 +297,7 @@ fn backward_with(
         }
     }
     let mean_share = 1.0 / steps.max(1) as f64;
+    let recurrent = net.recurrent();
     for t in (0..steps).rev() {
         for c in 0..c_n {
             let direct = match &argmax {
@@ -293,13 +317,10 @@ fn backward_with(
                 *gs += w * g;
             }
         }
-        for (h, &s) in spikes.iter().enumerate() {
-            if s != 0.0 {
-                let gw = &mut grad.w_out[h * c_n..(h + 1) * c_n];
-                for (gw, g) in gw.iter_mut().zip(&g_out) {
-                    *gw += s * g;
-                }
-            }
+        add_outer(&mut grad.w_out, spikes, &g_out);
+        if recurrent {
+            // S[t] drives I[t+1]: g_i still holds step t+1's.
+            add_recurrent_spike_gradient(net, &g_i, &mut g_s);
         }
         let reset = f64::from(u8::from(!detach_reset));
         let neurons = g_s.iter().zip(pre).zip(spikes).zip(&mut g_v).zip(&mut g_i);
@@ -317,6 +338,31 @@ fn backward_with(
             for (gw, g) in gw.iter_mut().zip(&g_i) {
                 *gw += g;
             }
+        }
+        if recurrent && t > 0 {
+            let before = &tr.spikes[(t - 1) * h_n..t * h_n];
+            add_outer(&mut grad.w_rec, before, &g_i);
+        }
+    }
+}
+
+/// `g_s += W_rec g_next`: the spike gradient through the recurrent weights (`g_next` the
+/// next step's current gradient).
+fn add_recurrent_spike_gradient(net: &Network, g_next: &[f64], g_s: &mut [f64]) {
+    let h_n = net.hidden;
+    for (j, gs) in g_s.iter_mut().enumerate() {
+        let w = &net.w_rec[j * h_n..(j + 1) * h_n];
+        *gs += w.iter().zip(g_next).map(|(w, g)| w * g).sum::<f64>();
+    }
+}
+
+/// `grad += s gᵀ` over the rows `j` where `s[j]` is not zero (source-major, `g.len()`
+/// columns).
+fn add_outer(grad: &mut [f64], s: &[f64], g: &[f64]) {
+    let n = g.len();
+    for (j, &s) in s.iter().enumerate().filter(|(_, &s)| s != 0.0) {
+        for (gw, g) in grad[j * n..(j + 1) * n].iter_mut().zip(g) {
+            *gw += s * g;
         }
     }
 }
@@ -342,7 +388,8 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    fn random_net(readout: Readout, seed: u64) -> (Network, SpikeInput) {
+    /// A random network (recurrent when `recurrent`) and a random input.
+    fn random_net_of(readout: Readout, seed: u64, recurrent: bool) -> (Network, SpikeInput) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let (inputs, hidden, classes, steps) = (5, 7, 3, 40);
         let mut w =
@@ -360,6 +407,10 @@ mod tests {
             b_in: w(hidden, 0.2),
             w_out: w(hidden * classes, 1.0),
             b_out: w(classes, 0.3),
+            w_rec: match recurrent {
+                true => w(hidden * hidden, 0.8),
+                false => Vec::new(),
+            },
         };
         let mut events = Vec::new();
         for t in 0..steps as u32 {
@@ -372,6 +423,10 @@ mod tests {
         (net, SpikeInput::from_events(inputs, steps, &events))
     }
 
+    fn random_net(readout: Readout, seed: u64) -> (Network, SpikeInput) {
+        random_net_of(readout, seed, false)
+    }
+
     fn loss(net: &Network, input: &SpikeInput, act: Activation) -> f64 {
         let scores = forward(net, input, act, &mut Trajectory::default());
         -softmax(&scores)[1].ln()
@@ -379,11 +434,15 @@ mod tests {
 
     /// The hand-written backward pass against central finite differences of the loss, on
     /// a network with a smooth spike function (whose loss has a true gradient), the reset
-    /// kept in the graph, and both readouts.
+    /// kept in the graph, both readouts, feed-forward and recurrent.
     #[test]
     fn gradient_matches_finite_differences() {
-        for (readout, seed) in [(Readout::Mean, 1), (Readout::Max, 2)] {
-            let (net, input) = random_net(readout, seed);
+        for (readout, seed, recurrent) in [
+            (Readout::Mean, 1, false),
+            (Readout::Max, 2, false),
+            (Readout::Mean, 5, true),
+        ] {
+            let (net, input) = random_net_of(readout, seed, recurrent);
             let act = Activation::Smooth { k: 4.0 };
             let mut grad = Gradient::zeros(&net);
             let mut tr = Trajectory::default();
@@ -394,11 +453,11 @@ mod tests {
             loss_and_gradient(&net, &input, 1, rule, 1.0, &mut tr, &mut grad);
             let eps = 1e-6;
             let mut checked = 0;
-            for part in 0..4 {
+            for part in 0..5 {
                 for j in 0..grad.parts()[part].len() {
                     let bump = |d: f64| {
                         let mut n = net.clone();
-                        [&mut n.w_in, &mut n.b_in, &mut n.w_out, &mut n.b_out][part][j] += d;
+                        n.params_mut()[part][j] += d;
                         loss(&n, &input, act)
                     };
                     let numeric = (bump(eps) - bump(-eps)) / (2.0 * eps);
@@ -411,11 +470,13 @@ mod tests {
                     checked += 1;
                 }
             }
-            assert_eq!(checked, 5 * 7 + 7 + 7 * 3 + 3);
+            let rec = if recurrent { 7 * 7 } else { 0 };
+            assert_eq!(checked, 5 * 7 + 7 + 7 * 3 + 3 + rec);
             assert!(
                 grad.w_in.iter().any(|g| g.abs() > 1e-4),
                 "a gradient that is all zero checks nothing"
             );
+            assert!(!recurrent || grad.w_rec.iter().any(|g| g.abs() > 1e-4));
         }
     }
 
@@ -423,8 +484,12 @@ mod tests {
     /// step-by-step runner gives, bit for bit.
     #[test]
     fn training_forward_equals_the_runner() {
-        for readout in [Readout::Mean, Readout::Max] {
-            let (net, input) = random_net(readout, 3);
+        for (readout, recurrent) in [
+            (Readout::Mean, false),
+            (Readout::Max, false),
+            (Readout::Mean, true),
+        ] {
+            let (net, input) = random_net_of(readout, 3, recurrent);
             let act = Activation::Spike { slope: 10.0 };
             let mut tr = Trajectory::default();
             let trained = forward(&net, &input, act, &mut tr);

@@ -105,6 +105,9 @@ pub struct SnnParams {
     pub detach_reset: bool,
     /// Seed of the initial weights, the validation split and the batch order.
     pub seed: u64,
+    /// Recurrent connections within the hidden layer (false: feed-forward): each
+    /// neuron's spikes of one step drive every hidden neuron's current at the next.
+    pub recurrent: bool,
 }
 
 impl Default for SnnParams {
@@ -124,6 +127,7 @@ impl Default for SnnParams {
             slope: 10.0,
             detach_reset: true,
             seed: 0,
+            recurrent: false,
         }
     }
 }
@@ -301,6 +305,10 @@ pub struct Network {
     pub w_out: Vec<f64>,
     /// Readout biases.
     pub b_out: Vec<f64>,
+    /// Recurrent weights, hidden-major: `w_rec[j * hidden + h]` from neuron `j`'s spike of
+    /// one step to neuron `h`'s current at the next; empty for a feed-forward network.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub w_rec: Vec<f64>,
 }
 
 impl Network {
@@ -312,6 +320,23 @@ impl Network {
             (-dt / self.tau_mem_ms).exp(),
             (-dt / self.tau_out_ms).exp(),
         )
+    }
+
+    /// Whether the hidden layer has recurrent connections.
+    pub fn recurrent(&self) -> bool {
+        !self.w_rec.is_empty()
+    }
+
+    /// Every weight and bias: `w_in`, `b_in`, `w_out`, `b_out`, `w_rec` (empty when
+    /// feed-forward).
+    pub fn params_mut(&mut self) -> [&mut Vec<f64>; 5] {
+        [
+            &mut self.w_in,
+            &mut self.b_in,
+            &mut self.w_out,
+            &mut self.b_out,
+            &mut self.w_rec,
+        ]
     }
 
     /// Checks the shapes and that every weight is finite.
@@ -332,6 +357,13 @@ impl Network {
                 ));
             }
         }
+        let square = self.hidden * self.hidden;
+        if self.recurrent() && self.w_rec.len() != square {
+            let got = self.w_rec.len();
+            return Err(format!(
+                "the network's w_rec holds {got} values, not hidden x hidden = {square} (or none)"
+            ));
+        }
         if self.inputs == 0 || self.hidden == 0 || self.classes == 0 || self.dt_ms == 0 {
             return Err("the network has an empty layer or a zero time step".into());
         }
@@ -340,6 +372,7 @@ impl Network {
             ("b_in", &self.b_in),
             ("w_out", &self.w_out),
             ("b_out", &self.b_out),
+            ("w_rec", &self.w_rec),
         ] {
             if let Some(pos) = w.iter().position(|v| !v.is_finite()) {
                 return Err(format!("the network's {name}[{pos}] is not finite"));
@@ -418,6 +451,9 @@ pub struct State {
     current: Vec<f64>,
     membrane: Vec<f64>,
     out: Vec<f64>,
+    /// The hidden neurons that spiked in the last step, ascending (kept for a recurrent
+    /// network).
+    fired: Vec<u32>,
 }
 
 impl State {
@@ -428,6 +464,7 @@ impl State {
             current: vec![0.0; net.hidden],
             membrane: vec![0.0; net.hidden],
             out: vec![0.0; net.classes],
+            fired: Vec::new(),
         }
     }
 
@@ -449,6 +486,14 @@ impl State {
                 *c += w;
             }
         }
+        for &j in &self.fired {
+            let w = &net.w_rec[j as usize * h_n..(j as usize + 1) * h_n];
+            for (c, w) in self.current.iter_mut().zip(w) {
+                *c += w;
+            }
+        }
+        self.fired.clear();
+        let recurrent = net.recurrent();
         for (o, b) in self.out.iter_mut().zip(&net.b_out) {
             *o = kappa * *o + b;
         }
@@ -456,6 +501,9 @@ impl State {
             let p = beta * self.membrane[h] + self.current[h];
             if p >= 1.0 {
                 self.membrane[h] = 0.0;
+                if recurrent {
+                    self.fired.push(h as u32);
+                }
                 let w = &net.w_out[h * net.classes..(h + 1) * net.classes];
                 for (o, w) in self.out.iter_mut().zip(w) {
                     *o += w;

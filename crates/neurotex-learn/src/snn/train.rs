@@ -66,7 +66,7 @@ pub fn fit(
     let (validation_loss, mut net, best_epoch) = best;
     // Weights a float32 file (NIR, NumPy) holds exactly: the model file and its export
     // predict alike.
-    for w in [&mut net.w_in, &mut net.b_in, &mut net.w_out, &mut net.b_out] {
+    for w in net.params_mut() {
         w.iter_mut().for_each(|v| *v = f64::from(*v as f32));
     }
     let log = TrainingLog {
@@ -132,7 +132,8 @@ fn validation_split(
 /// mean input rate (fluctuation-driven initialisation, Rossbroich, Gygax & Zenke 2022,
 /// with Campbell's theorem for Poisson inputs): `σ² n ν Σ_t k_t² = 1`, `k` the membrane's
 /// response to one input spike. Readout weights are uniform in `±1/√hidden`; biases start
-/// at zero.
+/// at zero. Recurrent weights start uniform in `±0.1/√hidden`: small against the
+/// threshold, so that training starts from the feed-forward dynamics.
 fn initial(
     params: &SnnParams,
     inputs: &[&SpikeInput],
@@ -170,6 +171,12 @@ fn initial(
             .map(|_| rng.gen_range(-bound..bound))
             .collect(),
         b_out: vec![0.0; classes],
+        w_rec: match params.recurrent {
+            true => (0..h * h)
+                .map(|_| 0.1 * rng.gen_range(-bound..bound))
+                .collect(),
+            false => Vec::new(),
+        },
     })
 }
 
@@ -250,20 +257,14 @@ impl Adam {
         self.t += 1;
         let c1 = 1.0 - B1.powi(self.t);
         let c2 = 1.0 - B2.powi(self.t);
-        let params = [&mut net.w_in, &mut net.b_in, &mut net.w_out, &mut net.b_out];
-        let ms = [
-            &mut self.m.w_in,
-            &mut self.m.b_in,
-            &mut self.m.w_out,
-            &mut self.m.b_out,
-        ];
-        let vs = [
-            &mut self.v.w_in,
-            &mut self.v.b_in,
-            &mut self.v.w_out,
-            &mut self.v.b_out,
-        ];
-        for (((p, m), v), g) in params.into_iter().zip(ms).zip(vs).zip(grad.parts()) {
+        let (ms, vs) = (self.m.parts_mut(), self.v.parts_mut());
+        for (((p, m), v), g) in net
+            .params_mut()
+            .into_iter()
+            .zip(ms)
+            .zip(vs)
+            .zip(grad.parts())
+        {
             for j in 0..p.len() {
                 m[j] = B1 * m[j] + (1.0 - B1) * g[j];
                 v[j] = B2 * v[j] + (1.0 - B2) * g[j] * g[j];

@@ -218,13 +218,21 @@ impl<R: BufRead> FrameReader<R> {
             }
             Ok(names)
         };
-        let fits = |columns: &Columns| match columns.channels.len() == self.channels {
-            true => Ok(()),
-            false => Err(format!(
-                "{} channel columns selected, the model has {} taxels",
-                columns.channels.len(),
-                self.channels
-            )),
+        let fits = |columns: &Columns| {
+            let first = columns.channels.first().map(|&c| columns.names[c].as_str());
+            if let (None, Some(name)) = (columns.time, first) {
+                if crate::csvlog::is_timelike_name(name) {
+                    return Err(format!("column `{name}` is named like time stamps but would be read as a taxel: name it with --time-column (and --time-unit), or choose the taxels with --channels"));
+                }
+            }
+            match columns.channels.len() == self.channels {
+                true => Ok(()),
+                false => Err(format!(
+                    "{} channel columns selected, the model has {} taxels",
+                    columns.channels.len(),
+                    self.channels
+                )),
+            }
         };
         let path = Path::new(&self.source);
         let (i, columns) = choose_columns(path, formats, &names, &fits)?;

@@ -339,7 +339,7 @@ impl StreamClassifier {
         params.check()?;
         let conditioning = match model.streams() {
             Ok(conditioning) => conditioning.clone(),
-            Err(rule) => return Err(ParamError::new("model", rule, "this model").into()),
+            Err(why) => return Err(crate::error::OptionsError::Conflict(why.into()).into()),
         };
         if let SavedModel::Features(m) = &model {
             if m.features().method == crate::pipeline::Method::AllTaxelsMm

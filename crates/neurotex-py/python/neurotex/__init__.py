@@ -821,6 +821,16 @@ class Model(_Predicting):
 
 
 
+def _nir() -> Any:
+    """The ``nir`` package, or an error that says how to get it."""
+    try:
+        import nir
+    except ImportError as e:
+        raise ImportError("NIR graphs as objects need the `nir` package: pip install nir "
+                          "(files need nothing: save_nir, SpikingModel.load)") from e
+    return nir
+
+
 class SpikingModel(_Predicting):
     """A trained spiking network with its pipeline: the model file of ``neurotex train
     --classifier snn``, or a NIR graph (:meth:`to_nir`, :meth:`from_nir`; see
@@ -847,6 +857,7 @@ class SpikingModel(_Predicting):
         epochs: int = 60,
         readout: str = "mean",
         seed: int = 0,
+        recurrent: bool = False,
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -854,13 +865,14 @@ class SpikingModel(_Predicting):
         --classifier snn`` does: ``hidden`` LIF neurons, time steps of ``dt_ms``, at most
         ``epochs`` passes with early stopping on 20 % of each class, scores read as the
         readout's ``mean`` or ``max`` over time, weights seeded by ``seed`` (the same on
-        any number of threads). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
+        any number of threads); ``recurrent=True`` connects the hidden layer to itself
+        (``--snn-recurrent``). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
         ...) as :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
         opts = _stage_options(**stage_options)
         opts["causal"] = bool(causal)
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
-               "seed": seed}
+               "seed": seed, "recurrent": recurrent}
         native, ran, best, loss = _native.train_spiking_model(arrays, infos, opts, snn, fp,
                                                               baseline)
         return cls(native, {"epochs": ran, "best_epoch": best, "validation_loss": loss})
@@ -881,7 +893,7 @@ class SpikingModel(_Predicting):
         importer, which steps every graph at 0.1 ms."""
         import tempfile
 
-        import nir
+        nir = _nir()
 
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "model.nir")
@@ -903,7 +915,7 @@ class SpikingModel(_Predicting):
             return cls(_native.NativeSpikingModel.from_nir(os.fspath(graph), native_like))
         import tempfile
 
-        import nir
+        nir = _nir()
 
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "model.nir")

@@ -267,7 +267,9 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     --classifier snn``; docs/spiking-classifier.md): recordings in, labels out, no
     features. ``X`` is what :class:`SpikeFeatures` takes (arrays ``(T, rows, cols)``, a
     4-D array, or :class:`neurotex.Recording` objects); ``fit`` encodes them with the
-    pipeline (``encoding``, ``gain``, ``causal``; the paper's defaults otherwise) and trains
+    pipeline (``encoding``, ``gain``, ``baseline``, ``causal``; the paper's defaults
+    otherwise: a list of recordings does not carry its dataset's baseline, so give
+    ``baseline=dataset.baseline``) and trains
     ``hidden`` LIF neurons with time steps of ``dt_ms`` for at most ``epochs`` passes, early
     stopping on 20 % of each class of ``X``, seeded by ``seed``. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
@@ -280,8 +282,10 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         epochs: int = 60,
         readout: str = "mean",
         seed: int = 0,
+        recurrent: bool = False,
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
+        baseline: Optional[str] = None,
         causal: bool = False,
         fs: float = 1000.0,
     ) -> None:
@@ -290,8 +294,10 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.epochs = epochs
         self.readout = readout
         self.seed = seed
+        self.recurrent = recurrent
         self.encoding = encoding
         self.gain = gain
+        self.baseline = baseline
         self.causal = causal
         self.fs = fs
 
@@ -309,7 +315,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.model_ = SpikingModel.train(
             X, [str(label) for label in y], fs=self.fs, hidden=self.hidden,
             dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
-            causal=self.causal, encoding=self.encoding, gain=self.gain,
+            recurrent=self.recurrent, causal=self.causal, encoding=self.encoding, gain=self.gain,
+            baseline=self.baseline,
         )
         # the network's outputs (labels as text) -> columns in classes_ order
         text = [str(c) for c in self.classes_]

@@ -7,7 +7,7 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use super::OnProgress;
-use crate::error::{DataError, OptionsError};
+use crate::error::DataError;
 use crate::nir::Convention;
 use crate::progress::Progress;
 use crate::recording::Dataset;
@@ -45,15 +45,13 @@ pub fn export_nir(model: &SpikingModel, out: &Path, convention: NirConvention) -
     crate::io::write_atomic(out, |w| w.write_all(&bytes))
 }
 
-/// Loads the spiking model at `path` (a model file or a NIR graph written by neurotex).
+/// Loads the spiking model at `path` (a model file or a NIR graph written by neurotex):
+/// only a spiking network has a NIR graph and input tensors.
 ///
 /// # Errors
-/// Not a spiking model: a feature model is named as such.
+/// What [`SpikingModel::load`] refuses: a feature model is named as such, a damaged file as
+/// damaged.
 pub fn load_spiking(path: &Path) -> Result<SpikingModel> {
-    if !SpikingModel::is_spiking(path) && path.exists() {
-        let why = "not a spiking model (train one with --classifier snn): only a spiking network has a NIR graph and input tensors";
-        return Err(OptionsError::Conflict(format!("{}: {why}", path.display())).into());
-    }
     SpikingModel::load(path)
 }
 

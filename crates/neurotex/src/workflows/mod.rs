@@ -121,6 +121,10 @@ pub struct SnnOptions {
     /// order [default: 0].
     #[cfg_attr(feature = "cli", arg(long = "snn-seed", id = "snn-seed"))]
     pub seed: Option<u64>,
+    /// With `--classifier snn`: recurrent connections within the hidden layer (each step's
+    /// spikes drive the next step's currents); default feed-forward.
+    #[cfg_attr(feature = "cli", arg(long = "snn-recurrent", id = "snn-recurrent"))]
+    pub recurrent: bool,
 }
 
 impl SnnOptions {
@@ -131,6 +135,7 @@ impl SnnOptions {
             || self.epochs.is_some()
             || self.readout.is_some()
             || self.seed.is_some()
+            || self.recurrent
     }
 
     /// `defaults` with the options given applied, checked.
@@ -144,6 +149,7 @@ impl SnnOptions {
             epochs: self.epochs.unwrap_or(defaults.epochs),
             readout: self.readout.unwrap_or(defaults.readout),
             seed: self.seed.unwrap_or(defaults.seed),
+            recurrent: self.recurrent || defaults.recurrent,
             ..defaults
         }
         .check()?)
