@@ -479,9 +479,22 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     assert!(err.contains("feature.json: a feature model"), "{err}");
     let err = dir.fails(&["export", "nir", "--model", s(&feature), "--out", s(&never)]);
     assert!(err.contains("not a spiking model"), "{err}");
+    // A graph that carries its own pipeline takes no other; a truncated spiking model is
+    // named as damaged, not as another kind.
+    let mut args = args.to_vec();
+    args[4] = s(&model);
+    let err = dir.fails(&args);
+    assert!(err.contains("carries its own neurotex pipeline"), "{err}");
+    let text = std::fs::read_to_string(&model).unwrap();
+    std::fs::write(&damaged, &text[..text.len() / 2]).unwrap();
+    let err = dir.fails(&["export", "nir", "--model", s(&damaged), "--out", s(&never)]);
+    assert!(err.contains("damaged or truncated"), "{err}");
     // A spiking model trained without --causal where a stream needs one trained with it.
     let err = dir.fails(&["stream", "--model", s(&model), "--input", s(&never)]);
-    assert!(err.contains("trained with --causal"), "{err}");
+    assert!(
+        err.contains("snn.json: a stream needs a model trained for streams (--causal)"),
+        "{err}"
+    );
     // The input tensors, written twice into the same folder: the second run replaces the
     // first.
     let inputs = dir.join("inputs");

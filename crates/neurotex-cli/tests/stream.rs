@@ -239,6 +239,31 @@ fn a_spiking_network_streams_as_predict_causal_decides_and_exports_to_nir() {
             let text = dir.ok(&["stream", "--model", s(m), "--input", s(&csv)]);
             assert_eq!(lines(&text), expected, "{}", m.display());
         }
+        if recurrent {
+            // A time-stamp column read as a taxel (the header names it so) is refused
+            // rather than streamed as one more taxel.
+            let frames = slide_frames(&data, row);
+            let stamped: String = std::iter::once(format!(
+                "timestamp,{}",
+                (0..15)
+                    .map(|i| format!("c{i}"))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ))
+            .chain(frames.iter().enumerate().map(|(k, f)| {
+                let values: Vec<String> = f[..15].iter().map(|v| v.to_string()).collect();
+                format!("{k},{}", values.join(","))
+            }))
+            .collect::<Vec<_>>()
+            .join("\n");
+            let bad = dir.join("stamped.csv");
+            std::fs::write(&bad, stamped).unwrap();
+            let err = dir.fails(&["stream", "--model", s(&model), "--input", s(&bad)]);
+            assert!(
+                err.contains("column `timestamp` is named like time stamps"),
+                "{err}"
+            );
+        }
         // A window of 1 s: the scores read over the network's last 100 time steps.
         let one = [
             "stream",

@@ -142,7 +142,7 @@ impl SavedModel {
                 return Err(crate::causal::NO_RUNNING_SPECTRUM);
             }
         }
-        self.causal().ok_or("a stream needs a model trained with --causal (causal=True in Python); this one conditions each recording with the zero-phase filter and its own maximum, which need the whole recording")
+        self.causal().ok_or("a stream needs a model trained for streams (--causal); this one conditions each recording with the zero-phase filter and its own maximum, which need the whole recording")
     }
 
     /// Reads and encodes `files` as the training recordings were (see

@@ -39,6 +39,11 @@ def test_python_trains_the_network_the_cli_trains(trained):
     assert py["network"] == cli["network"]
     assert py["pipeline"] == cli["pipeline"]
     assert set(model.training) == {"epochs", "best_epoch", "validation_loss"}
+    # Either kind of model file, given where the other is needed, is named as such.
+    model.save_nir(d / "py.nir")
+    for path in (d / "py.json", d / "py.nir"):
+        with pytest.raises(neurotex.ModelError, match="a spiking model"):
+            neurotex.Model.load(path)
     assert 1 <= model.training["best_epoch"] <= model.training["epochs"] <= 4
 
 

@@ -67,7 +67,7 @@ def test_bad_frames_raise_and_are_skipped(causal_model):
 def test_offline_models_and_bad_options_are_refused(sim_dir, tmp_path):
     offline = tmp_path / "offline.json"
     run_cli("train", "--dataset", sim_dir, "--speeds", "10", "--out", offline)
-    with pytest.raises(neurotex.Error, match="--causal"):
+    with pytest.raises(neurotex.Error, match=r"trained for streams \(causal\)"):
         neurotex.StreamClassifier(offline)
     with pytest.raises(ParameterError):
         neurotex.StreamClassifier(offline, episode="sometimes")
