@@ -75,6 +75,14 @@ pub fn is_hdf5(path: &Path) -> bool {
         .is_ok_and(|()| head == *b"\x89HDF\r\n\x1a\n")
 }
 
+/// Whether the file is a NIR graph: HDF5's signature, or a `.nir` name.
+fn is_graph(path: &Path) -> bool {
+    is_hdf5(path)
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("nir"))
+}
+
 /// A recording's spikes as the network's input: its populations in the pipeline's order
 /// (SA then FA for `sa+fa`), each taxel one input, binned to `dt_ms`.
 pub fn spike_input(encoded: &Encoded, dt_ms: u32) -> SpikeInput {
@@ -254,11 +262,7 @@ impl SpikingModel {
     /// Whether the file at `path` claims to be a spiking model (its `format`, HDF5's
     /// signature or a `.nir` name: a NIR graph), read without checking the rest.
     pub fn is_spiking(path: &Path) -> bool {
-        if is_hdf5(path)
-            || path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("nir"))
-        {
+        if is_graph(path) {
             return true;
         }
         #[derive(Deserialize)]
@@ -280,11 +284,7 @@ impl SpikingModel {
     /// An unreadable file, another format or version, or damaged content (a non-finite
     /// weight, a network that does not fit the pipeline), naming the file and the rule.
     pub fn load(path: &Path) -> Result<SpikingModel> {
-        if is_hdf5(path)
-            || path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("nir"))
-        {
+        if is_graph(path) {
             return SpikingModel::from_nir(path, None);
         }
         let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;

@@ -43,15 +43,10 @@ impl NativeModel {
         recordings: Vec<Bound<'py, PyAny>>,
         infos: Vec<InfoTuple>,
     ) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
-        let batch = Batch::new(&recordings, infos)?;
-        let view = batch.view();
-        let predictions = py.detach(|| {
-            guarded(|| {
-                let encoded = view.encode(|rec| self.inner.encode(rec))?;
-                self.inner.predict(&encoded)
-            })
-        })?;
-        labels_and_shares(py, predictions, self.inner.labels().len())
+        let m = &self.inner;
+        let predict = |encoded: &[Encoded]| m.predict(encoded);
+        let model = (m.pipeline(), m.baseline(), m.labels().len());
+        predict_recordings(py, &recordings, infos, model, predict)
     }
 
     /// The classes, in the order of the shares' columns.
@@ -208,8 +203,29 @@ impl Training {
     }
 }
 
+/// Recordings (arrays with their infos) encoded with a model's `(pipeline, baseline,
+/// classes)` and predicted by `predict`, with the GIL released: `(labels, shares (n,
+/// classes))`.
+pub(crate) fn predict_recordings<'py>(
+    py: Python<'py>,
+    recordings: &[Bound<'py, PyAny>],
+    infos: Vec<InfoTuple>,
+    (pipeline, baseline, classes): (&Pipeline, Baseline, usize),
+    predict: impl Fn(&[Encoded]) -> neurotex::Result<Vec<Prediction>> + Sync,
+) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
+    let batch = Batch::new(recordings, infos)?;
+    let view = batch.view();
+    let predictions = py.detach(|| {
+        guarded(|| {
+            let encoded = view.encode(|rec| pipeline.encode(rec, baseline))?;
+            predict(&encoded)
+        })
+    })?;
+    labels_and_shares(py, predictions, classes)
+}
+
 /// Predictions as `(labels, shares (n, classes))`.
-pub(crate) fn labels_and_shares(
+fn labels_and_shares(
     py: Python<'_>,
     predictions: Vec<Prediction>,
     classes: usize,

@@ -242,6 +242,21 @@ fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> 
     })
 }
 
+/// The spiking network's knobs Python takes, with their defaults: the one source of
+/// `SpikingModel.train`'s and `SpikingClassifier`'s keyword defaults.
+#[pyfunction]
+pub fn snn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = SnnParams::default();
+    let out = PyDict::new(py);
+    out.set_item("hidden", d.hidden)?;
+    out.set_item("dt_ms", d.dt_ms)?;
+    out.set_item("epochs", d.epochs)?;
+    out.set_item("readout", d.readout.name())?;
+    out.set_item("seed", d.seed)?;
+    out.set_item("recurrent", d.recurrent)?;
+    Ok(out)
+}
+
 /// The spiking network's training knobs, checked.
 pub fn snn(options: &Bound<'_, PyDict>) -> PyResult<SnnParams> {
     only_known(

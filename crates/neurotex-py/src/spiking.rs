@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use neurotex::pipeline::Encoded;
 use neurotex::spiking_model::SpikingModel;
 use neurotex::workflows::export::{export_nir, NirConvention};
 use numpy::PyArray2;
@@ -11,7 +12,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::{Batch, InfoTuple};
 use crate::errors::{guarded, raise, Kind};
-use crate::model::{labels_and_shares, Training};
+use crate::model::{predict_recordings, Training};
 use crate::params;
 
 /// A trained spiking network with its pipeline.
@@ -70,16 +71,10 @@ impl NativeSpikingModel {
         recordings: Vec<Bound<'py, PyAny>>,
         infos: Vec<InfoTuple>,
     ) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
-        let batch = Batch::new(&recordings, infos)?;
-        let view = batch.view();
-        let predictions = py.detach(|| {
-            guarded(|| {
-                let encoded =
-                    view.encode(|rec| self.inner.pipeline().encode(rec, self.inner.baseline()))?;
-                self.inner.predict(&encoded)
-            })
-        })?;
-        labels_and_shares(py, predictions, self.inner.labels().len())
+        let m = &self.inner;
+        let predict = |encoded: &[Encoded]| m.predict(encoded);
+        let model = (m.pipeline(), m.baseline(), m.labels().len());
+        predict_recordings(py, &recordings, infos, model, predict)
     }
 
     /// The classes, in the order of the network's outputs.

@@ -12,7 +12,7 @@ use neurotex::causal::{
 };
 use neurotex::classify::{ClassifierChoice, ForestParams, KnnParams};
 use neurotex::model::{Model, Provenance};
-use neurotex::pipeline::{Encoding, Method, Pipeline, PipelineParams};
+use neurotex::pipeline::{Encoded, Encoding, Method, Pipeline, PipelineParams};
 use neurotex::recording::{Baseline, Phase, Recording, TimeUnit};
 use neurotex::sim::{design, simulate_trial, RigParams, Texture};
 use neurotex::snn::SnnParams;
@@ -34,13 +34,12 @@ fn recordings() -> Vec<Recording> {
         .collect()
 }
 
-/// A causal model trained on `train` (conditioning fixed on them, labels unused).
-fn causal_model(
+/// The causal pipeline with `encoding` calibrated on `train` (conditioning fixed on them,
+/// labels unused), their spikes, and what a model keeps of them.
+fn causal_training(
     train: &[Recording],
     encoding: Encoding,
-    method: Method,
-    classifier: ClassifierChoice,
-) -> Model {
+) -> (PipelineParams, Vec<Encoded>, Provenance) {
     let mut params = PipelineParams {
         encoding,
         ..PipelineParams::default()
@@ -54,8 +53,6 @@ fn causal_model(
         .iter()
         .map(|r| pipeline.encode(r, Baseline::Min).unwrap())
         .collect();
-    let extractor = pipeline.extractor(&train[0].layout_grid()).unwrap();
-    let table = FeatureTable::build(&encoded, &extractor, method).unwrap();
     let provenance = Provenance {
         fingerprint: "test".into(),
         baseline: Baseline::Min,
@@ -64,6 +61,20 @@ fn causal_model(
         median_duration_ms: Some(calibration.median_duration_ms),
         layout: None,
     };
+    (params, encoded, provenance)
+}
+
+/// A causal model trained on `train` (conditioning fixed on them, labels unused).
+fn causal_model(
+    train: &[Recording],
+    encoding: Encoding,
+    method: Method,
+    classifier: ClassifierChoice,
+) -> Model {
+    let (params, encoded, provenance) = causal_training(train, encoding);
+    let pipeline = Pipeline::new(params.clone()).unwrap();
+    let extractor = pipeline.extractor(&train[0].layout_grid()).unwrap();
+    let table = FeatureTable::build(&encoded, &extractor, method).unwrap();
     Model::train(&params, &table, Columns::All, classifier, provenance).unwrap()
 }
 
@@ -553,32 +564,12 @@ fn frames_stamped_on_the_1_ms_grid_give_the_spikes_of_unstamped_frames_at_1_khz(
 /// A spiking network trained (briefly: the weights need not classify well) on the spike
 /// trains of `train`, causally conditioned, with time steps of `dt_ms`.
 fn causal_network(train: &[Recording], dt_ms: u32) -> SpikingModel {
-    let mut params = PipelineParams {
-        encoding: Encoding::SaFa,
-        ..PipelineParams::default()
-    };
-    let load = |i: usize| Ok(train[i].clone());
-    let indices: Vec<usize> = (0..train.len()).collect();
-    let calibration = calibrate_conditioning(&params, &load, &indices, Baseline::Min).unwrap();
-    params.preprocess.causal = Some(calibration.conditioning);
-    let pipeline = Pipeline::new(params.clone()).unwrap();
-    let encoded: Vec<_> = train
-        .iter()
-        .map(|r| pipeline.encode(r, Baseline::Min).unwrap())
-        .collect();
+    let (params, encoded, provenance) = causal_training(train, Encoding::SaFa);
     let snn = SnnParams {
         hidden: 24,
         dt_ms,
         epochs: 4,
         ..SnnParams::default()
-    };
-    let provenance = Provenance {
-        fingerprint: "test".into(),
-        baseline: Baseline::Min,
-        speeds: None,
-        gain_calibration: None,
-        median_duration_ms: Some(calibration.median_duration_ms),
-        layout: None,
     };
     let grid = train[0].layout_grid();
     SpikingModel::train(&params, &encoded, &grid, snn, provenance)

@@ -39,6 +39,8 @@ from .errors import (
 __version__ = _native.library_version()
 # Every stage option's default, from the library's one definition of the options.
 _DEFAULTS: Dict[str, Any] = _native.stage_defaults()
+# The spiking network's defaults (SpikingModel.train), from the library's.
+_SNN_DEFAULTS: Dict[str, Any] = _native.snn_defaults()
 
 HARALICK_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(False))
 """Names of the paper's Haralick features, in the order :func:`haralick` returns them."""
@@ -852,12 +854,12 @@ class SpikingModel(_Predicting):
         fs: float = 1000.0,
         mask: Any = None,
         speeds: Any = None,
-        hidden: int = 128,
-        dt_ms: int = 10,
-        epochs: int = 60,
-        readout: str = "mean",
-        seed: int = 0,
-        recurrent: bool = False,
+        hidden: int = _SNN_DEFAULTS["hidden"],
+        dt_ms: int = _SNN_DEFAULTS["dt_ms"],
+        epochs: int = _SNN_DEFAULTS["epochs"],
+        readout: str = _SNN_DEFAULTS["readout"],
+        seed: int = _SNN_DEFAULTS["seed"],
+        recurrent: bool = _SNN_DEFAULTS["recurrent"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":

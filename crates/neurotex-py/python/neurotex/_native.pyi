@@ -2,7 +2,7 @@
 which give these their keyword signatures; the descriptions below are the tuples they
 pass."""
 
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -29,6 +29,7 @@ PredictionRow = Tuple[float, str, str, str, str, Optional[int], int]
 
 def library_version() -> str: ...
 def stage_defaults() -> Dict[str, Any]: ...
+def snn_defaults() -> Dict[str, Any]: ...
 def check_options(method: str, options: Dict[str, Any]) -> None: ...
 def haralick_names(full: bool) -> List[str]: ...
 def encode(
@@ -125,7 +126,7 @@ def train_model(
 ) -> NativeModel: ...
 
 class NativeStream:
-    def __init__(self, model: NativeModel, window_s: Optional[float] = ..., decide: float = ...,
+    def __init__(self, model: Union[NativeModel, "NativeSpikingModel"], window_s: Optional[float] = ..., decide: float = ...,
                  decide_bins: int = ..., episode: str = ..., fs: float = ...,
                  max_gap_s: float = ..., speed: Optional[float] = ...,
                  time_unit: str = ...) -> None: ...
@@ -151,6 +152,16 @@ class NativeSpikingModel:
     def labels(self) -> List[str]: ...
     @property
     def shape(self) -> Tuple[int, int, int, int]: ...
+
+def train_spiking_model(
+    recordings: Sequence[Samples],
+    infos: Sequence[Info],
+    options: Dict[str, Any],
+    snn_options: Dict[str, Any],
+    fingerprint: str,
+    baseline: Optional[str] = ...,
+) -> Tuple[NativeSpikingModel, int, int, float]: ...
+def is_spiking_model(path: str) -> bool: ...
 
 class NativeModel:
     @staticmethod

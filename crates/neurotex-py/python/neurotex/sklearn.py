@@ -24,6 +24,8 @@ from . import _native, features as _features
 
 # Every stage option's default, from the library's one definition of the options.
 _DEFAULTS: Dict[str, Any] = _native.stage_defaults()
+# The spiking network's defaults, from the library's.
+_SNN_DEFAULTS: Dict[str, Any] = _native.snn_defaults()
 
 __all__ = [
     "SpikeFeatures", "KNNClassifier", "RandomForestClassifier", "LogisticRegression",
@@ -277,12 +279,12 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
 
     def __init__(
         self,
-        hidden: int = 128,
-        dt_ms: int = 10,
-        epochs: int = 60,
-        readout: str = "mean",
-        seed: int = 0,
-        recurrent: bool = False,
+        hidden: int = _SNN_DEFAULTS["hidden"],
+        dt_ms: int = _SNN_DEFAULTS["dt_ms"],
+        epochs: int = _SNN_DEFAULTS["epochs"],
+        readout: str = _SNN_DEFAULTS["readout"],
+        seed: int = _SNN_DEFAULTS["seed"],
+        recurrent: bool = _SNN_DEFAULTS["recurrent"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
