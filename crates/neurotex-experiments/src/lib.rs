@@ -8,7 +8,7 @@ pub mod experiments;
 // that `crate::recording` and the like read the same in every layer.
 use neurotex_core::{error, progress, recording, values, Error, Result};
 use neurotex_features::features;
-use neurotex_learn::classify;
+use neurotex_learn::{classify, snn};
 #[cfg(test)]
 use neurotex_pipeline::model;
 use neurotex_pipeline::{analysis, calibrate, causal, compare, diagnostics, inspect, pipeline};

@@ -42,7 +42,7 @@ type Finished = (
 /// `report.md`, `results.json` and `figures/` into `out` (whole or not at all) and returns
 /// the results. The GIL is released for the whole run.
 #[pyfunction]
-#[pyo3(signature = (out, options, dataset=None, quick=false, seed=0, trials=None, seeds=None, k=5, standardize=true, group_by=None, encoder_draws=None, command=String::new(), folds=None, repeats=None))]
+#[pyo3(signature = (out, options, dataset=None, quick=false, seed=0, trials=None, seeds=None, k=5, standardize=true, group_by=None, encoder_draws=None, command=String::new(), folds=None, repeats=None, snn=false))]
 #[allow(clippy::too_many_arguments)]
 fn reproduce(
     py: Python<'_>,
@@ -60,6 +60,7 @@ fn reproduce(
     command: String,
     folds: Option<usize>,
     repeats: Option<usize>,
+    snn: bool,
 ) -> PyResult<Outcome> {
     let stages = params::stage_options(options)?;
     let reproduce = ReproduceOptions {
@@ -76,6 +77,7 @@ fn reproduce(
         repeats,
         group_by,
         encoder_draws: encoder_draws.map_or(DEFAULT_ENCODER_DRAWS as u64, |n| n as u64),
+        snn,
         open: OpenOptions::default(),
     };
     let dataset = dataset.map(|dir| open(&dir)).transpose()?;

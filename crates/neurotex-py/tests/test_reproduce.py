@@ -53,11 +53,14 @@ def same_report(ours, theirs):
 
 def test_quick_run_on_a_folder_equals_the_cli(sim_dir, tmp_path):
     cli = run_cli("reproduce", "--quick", "--dataset", sim_dir, "--seed", "2", "--k", "3",
-                  "--encoder-draws", "3", "--out", tmp_path / "cli",
+                  "--encoder-draws", "3", "--snn", "--out", tmp_path / "cli",
                   "--predictions", tmp_path / "p.csv")
     run = neurotex.reproduce(tmp_path / "py", dataset=sim_dir, quick=True, seed=2, k=3,
-                             encoder_draws=3)
+                             encoder_draws=3, snn=True)
     same_report(tmp_path / "py", tmp_path / "cli")
+    spiking = run.results["e9"]["spiking"]["per_speed"]["results"]
+    assert sorted(r["classifier"] for r in spiking) == ["knn", "snn"]
+    assert "### The spiking network beside the paper's method" in open(run.report).read()
     assert run.report == str(tmp_path / "py" / "report.md")
     assert run.results == json.loads((tmp_path / "py" / "results.json").read_text())
     assert run.results["recordings"] == 30 and run.gain_calibration is None

@@ -1,6 +1,7 @@
 //! E9 on a small simulated design: its paper's-method column is E1's and E6's 3D-GLCM on the
 //! same folds (a second path to the same numbers), every standard candidate is ranked, and
-//! the report shows the section and its figures.
+//! the report shows the section and its figures. With `e9_snn`, the spiking network runs
+//! beside the paper's method on the same folds, whose column is E1's again.
 
 use crate::support;
 
@@ -17,6 +18,7 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
             repeats: 2,
         },
         e9_repeats: 2,
+        e9_snn: true,
         e3_counts: vec![4],
         e5_fractions: vec![1.0],
         e7_gains: vec![8.0],
@@ -59,6 +61,22 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
         Some(neurotex::experiments::Baselines::Compared { .. })
     ));
 
+    let spiking = e9.spiking.as_ref().expect("the network ran");
+    for (c, paper_column) in [(&spiking.per_speed, &within), (&spiking.held_out, &held)] {
+        assert_eq!(c.results.len(), 2);
+        let (network, paper) = neurotex::experiments::Spiking::pair(c).unwrap();
+        assert_eq!(paper.per_condition, paper_column.per_condition);
+        assert_eq!(
+            (network.encoding.as_str(), network.method.as_str()),
+            ("sa+fa", "spikes")
+        );
+        let gap = network.difference_vs_paper.unwrap();
+        assert!((gap - (network.accuracy - paper.accuracy)).abs() < 1e-12);
+        assert!((0.0..=1.0).contains(&network.p_vs_paper.unwrap()));
+        assert!(network.ci[0] <= network.accuracy && network.accuracy <= network.ci[1]);
+        assert!(c.chance > 0.0 && c.chance < 1.0);
+    }
+
     let context = ReportContext {
         dataset: "a small simulated design".into(),
         source: "a small simulated design".into(),
@@ -69,6 +87,18 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
     };
     let text = markdown(&r, &context);
     assert!(text.contains("(E9, beyond the paper)\n"), "{text}");
+    assert!(
+        text.contains("### The spiking network beside the paper's method"),
+        "{text}"
+    );
+    let (network, _) = neurotex::experiments::Spiking::pair(&spiking.per_speed).unwrap();
+    let mean = format!(
+        "{:.1} [{:.1}, {:.1}]",
+        100.0 * network.accuracy,
+        100.0 * network.ci[0],
+        100.0 * network.ci[1]
+    );
+    assert!(text.contains(&mean), "{mean} not in the report");
     for figure in ["e9_per_speed.svg", "e9_held_out.svg", "e9_speeds.svg"] {
         assert!(text.contains(figure), "{figure}");
     }

@@ -5,14 +5,22 @@
 //! The best candidate is chosen on the same recordings it is scored on, so its accuracy
 //! flatters it; both comparisons also run nested selection (the candidates ranked inside
 //! each training set), whose accuracy is the honest one for "the best method".
+//!
+//! With [`ValidReproduceParams::e9_snn`], the spiking network (`snn` on the SA+FA spikes)
+//! runs beside the paper's method on the same folds. Its hyperparameters are its defaults,
+//! fixed before any data, so it needs no nested selection: its accuracy is honest as it
+//! stands.
 
 use serde::{Deserialize, Serialize};
 
 use super::{Prepared, Skip, Stop, ValidReproduceParams};
+use crate::classify::ClassifierChoice;
 use crate::classify::CvParams;
-use crate::compare::candidates::{candidates, CandidateSet};
+use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::compare::signal::baseline_candidates;
 use crate::compare::{compare, CompareParams, Comparison, Protocol};
+use crate::pipeline::{Encoding, Method};
+use crate::snn::SnnParams;
 
 /// E9's two comparisons.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -26,6 +34,28 @@ pub struct E9 {
     /// within each speed and with each speed held out; not among the candidates.
     #[serde(default)]
     pub baselines: Option<Baselines>,
+    /// The spiking network beside the paper's method, when asked for.
+    #[serde(default)]
+    pub spiking: Option<Spiking>,
+}
+
+/// The spiking network (`sa+fa / spikes / snn`) and the paper's method (`sa / glcm3d /
+/// knn`) on E9's folds; each comparison's non-paper result carries the paired test.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Spiking {
+    /// Cross-validation within each speed.
+    pub per_speed: Comparison,
+    /// Each speed held out.
+    pub held_out: Comparison,
+}
+
+impl Spiking {
+    /// The network's and the paper's method's results in `c`, when both ran.
+    pub fn pair(c: &Comparison) -> Option<(&crate::compare::Ranked, &crate::compare::Ranked)> {
+        let network = c.results.iter().find(|r| r.classifier == "snn")?;
+        let paper = c.results.iter().find(|r| r.paper)?;
+        Some((network, paper))
+    }
 }
 
 impl E9 {
@@ -100,6 +130,15 @@ pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<
         }
         Err(why) => Baselines::Skipped(why),
     };
+    let spiking = match params.e9_snn {
+        true => Some(spiking(
+            prepared,
+            params,
+            &with(per(), false),
+            &with(held(), false),
+        )?),
+        false => None,
+    };
     Ok(E9 {
         // A pilot too small for folds inside each speed's training folds is ranked
         // without the nested estimate (the held-out comparison trains on other speeds).
@@ -107,5 +146,45 @@ pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<
             .or_else(|_| compare(&list, &with(per(), false)))?,
         held_out: compare(&list, &with(held(), true))?,
         baselines: Some(baselines),
+        spiking,
+    })
+}
+
+/// The spiking network with its default hyperparameters and the paper's method, compared
+/// under `per` and `held`.
+fn spiking(
+    prepared: &Prepared,
+    params: &ValidReproduceParams,
+    per: &CompareParams,
+    held: &CompareParams,
+) -> Result<Spiking, Stop> {
+    let pipeline = params.pipeline().params().clone();
+    let set = |encoding, method, classifier| CandidateSet {
+        encodings: vec![encoding],
+        methods: vec![method],
+        classifiers: vec![classifier],
+        ..CandidateSet::standard(params.knn, params.seed)
+    };
+    let paper = set(
+        Encoding::Sa,
+        MethodChoice::Features(Method::Glcm3d),
+        ClassifierChoice::Knn(params.knn),
+    );
+    let network = set(
+        Encoding::SaFa,
+        MethodChoice::Spikes,
+        ClassifierChoice::Snn(SnnParams::default()),
+    );
+    let mut list = candidates(&prepared.encoded, &prepared.grid, &pipeline, &paper, 0.0)?;
+    list.extend(candidates(
+        &prepared.encoded,
+        &prepared.grid,
+        &pipeline,
+        &network,
+        0.0,
+    )?);
+    Ok(Spiking {
+        per_speed: compare(&list, per)?,
+        held_out: compare(&list, held)?,
     })
 }

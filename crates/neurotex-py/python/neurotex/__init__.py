@@ -976,6 +976,7 @@ def reproduce(
     repeats: Optional[int] = None,
     group_by: Optional[str] = None,
     encoder_draws: Optional[int] = None,
+    snn: bool = False,
     **stage_options: Any,
 ) -> Reproduction:
     """Runs the paper's analyses (E0-E9: accuracy per speed, confusion, spatial
@@ -998,7 +999,9 @@ def reproduce(
     manifest column in one fold. ``encoder_draws``: encodings of every recording behind
     the accuracies of E1, E4, E6 and E8 (as run, then with independent rounding-level
     input perturbations; their intervals resample encodings as well as recordings;
-    default 8, 1 for the input as run only). ``stage_options`` are :func:`features`' (``gain``, also
+    default 8, 1 for the input as run only). ``snn``: E9 also runs the spiking network
+    (SA+FA spikes, its default hyperparameters) beside the paper's method on the same
+    folds (minutes more). ``stage_options`` are :func:`features`' (``gain``, also
     ``"auto"``, ``preset``, ``cutoff``, ``levels``, ...).
 
     The run takes minutes (the full paper-scale run with 5 seeds much longer) with the GIL
@@ -1016,8 +1019,8 @@ def reproduce(
     given = {"dataset": None if dataset is None else os.fspath(dataset), "quick": quick,
              "seed": seed, "trials": trials, "seeds": seeds, "k": k,
              "standardize": standardize, "folds": folds, "repeats": repeats,
-             "group_by": group_by, "encoder_draws": encoder_draws}
-    defaults = {"quick": False, "seed": 0, "k": 5, "standardize": True}
+             "group_by": group_by, "encoder_draws": encoder_draws, "snn": snn}
+    defaults = {"quick": False, "seed": 0, "k": 5, "standardize": True, "snn": False}
     shown = [repr(out)] + [f"{key}={v!r}" for key, v in given.items()
                            if v is not None and defaults.get(key) != v]
     shown += [f"{key}={v!r}" for key, v in stage_options.items()]
@@ -1027,7 +1030,8 @@ def reproduce(
         None if trials is None else int(trials), None if seeds is None else int(seeds),
         int(k), bool(standardize), group_by,
         None if encoder_draws is None else int(encoder_draws), command,
-        None if folds is None else int(folds), None if repeats is None else int(repeats))
+        None if folds is None else int(folds), None if repeats is None else int(repeats),
+        bool(snn))
     claims = [dict(c, holds=c["verdict"] in _HOLDS) for c in claims]
     headline = {float(speed): {key: e[key] for key in _HEADLINE}
                 for speed, e in results.get("e1", {}).items()}

@@ -64,6 +64,7 @@ def reproduce(
     command: str = "",
     folds: Optional[int] = None,
     repeats: Optional[int] = None,
+    snn: bool = False,
 ) -> Tuple[Dict[str, Any], List[Dict[str, Any]], List[PredictionRow], float]: ...
 def inspect(
     paths: List[str],

@@ -99,7 +99,7 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
 }
 
 /// `+12.3 points (p 0.0004)`, `paper's method`, or `-`.
-fn versus_paper(r: &Ranked) -> String {
+pub(super) fn versus_paper(r: &Ranked) -> String {
     match (r.paper, r.difference_vs_paper, r.p_vs_paper) {
         (true, ..) => "paper's method".into(),
         (false, Some(d), Some(p)) => format!("{:+.1} points (p {})", 100.0 * d, p_text(p)),
