@@ -8,6 +8,7 @@ mod compare;
 mod conditions;
 mod encode;
 mod evaluate;
+mod events;
 mod extensions;
 mod features;
 mod hostile;

@@ -6,6 +6,7 @@
 
 pub mod csvlog;
 pub mod error;
+pub mod events;
 pub mod import;
 pub mod io;
 mod npy;

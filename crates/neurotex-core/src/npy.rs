@@ -36,6 +36,55 @@ pub(crate) struct NpyHeader {
     pub data_offset: usize,
     /// Whether the data is in column-major (Fortran) order.
     pub fortran_order: bool,
+    /// The fields of a structured dtype (`kind` is `V`), in record order; empty for a
+    /// simple dtype.
+    pub fields: Vec<NpyField>,
+}
+
+/// One field of a structured dtype such as tonic's `[('t', '<i8'), ('x', '<i8'), ...]`.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct NpyField {
+    /// The field's name.
+    pub name: String,
+    /// Kind letter: `f`, `i`, `u`, `b` (booleans), `V` (padding), ...
+    pub kind: char,
+    /// Bytes of the field.
+    pub bytes: usize,
+    /// Byte offset inside a record.
+    pub offset: usize,
+    /// Whether the field is big-endian (`>`).
+    pub big_endian: bool,
+}
+
+impl NpyField {
+    /// The field of record `record` (a slice of one record's bytes) as an integer, when it
+    /// is a little-endian (or one-byte) integer or boolean; `None` for any other type.
+    pub fn int(&self, record: &[u8]) -> Option<i128> {
+        let b = &record[self.offset..self.offset + self.bytes];
+        if self.big_endian && self.bytes > 1 {
+            return None;
+        }
+        let mut raw = [0u8; 8];
+        raw[..self.bytes.min(8)].copy_from_slice(&b[..self.bytes.min(8)]);
+        Some(match (self.kind, self.bytes) {
+            ('b', 1) | ('u', 1 | 2 | 4 | 8) => i128::from(u64::from_le_bytes(raw)),
+            ('i', 1) => i128::from(b[0] as i8),
+            ('i', 2) => i128::from(i16::from_le_bytes([b[0], b[1]])),
+            ('i', 4) => i128::from(i32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            ('i', 8) => i128::from(i64::from_le_bytes(raw)),
+            _ => return None,
+        })
+    }
+
+    /// The field as a float, when it is a little-endian float.
+    pub fn float(&self, record: &[u8]) -> Option<f64> {
+        let b = &record[self.offset..self.offset + self.bytes];
+        match (self.kind, self.bytes, self.big_endian) {
+            ('f', 8, false) => Some(f64::from_le_bytes(b.try_into().ok()?)),
+            ('f', 4, false) => Some(f64::from(f32::from_le_bytes(b.try_into().ok()?))),
+            _ => None,
+        }
+    }
 }
 
 impl NpyHeader {
@@ -230,17 +279,30 @@ fn check_data_size(header: &NpyHeader, file_len: u64) -> std::result::Result<(),
 /// Parses the header dictionary `{'descr': '<f8', 'fortran_order': False, 'shape': (3, 4), }`.
 fn parse_dict(text: &str) -> std::result::Result<NpyHeader, String> {
     let descr = value_after(text, "descr")?;
-    let descr = quoted(descr).ok_or_else(|| {
-        "field `descr` must be a simple dtype string such as '<f8' (structured dtypes are not supported)"
-            .to_string()
-    })?;
+    let fields = match descr.starts_with('[') {
+        true => parse_fields(descr)?,
+        false => Vec::new(),
+    };
+    let list = descr
+        .get(..descr.find(']').map_or(0, |e| e + 1))
+        .unwrap_or("");
+    let descr = match fields.is_empty() {
+        true => quoted(descr).ok_or_else(|| {
+            "field `descr` must be a dtype string such as '<f8' or a list of named fields"
+                .to_string()
+        })?,
+        false => list,
+    };
     let order = value_after(text, "fortran_order")?;
     if !(order.starts_with("False") || order.starts_with("True")) {
         return Err("field `fortran_order` must be True or False".into());
     }
     let fortran_order = order.starts_with("True");
     let shape = parse_shape(value_after(text, "shape")?)?;
-    let (kind, item_bytes) = parse_descr(descr)?;
+    let (kind, item_bytes) = match fields.last() {
+        Some(last) => ('V', last.offset + last.bytes),
+        None => parse_descr(descr)?,
+    };
     // ndarray needs the product of the non-zero axes to fit in isize even when another
     // axis is 0, so a zero axis beside huge ones is refused rather than passed on.
     let nonzero = shape
@@ -258,7 +320,69 @@ fn parse_dict(text: &str) -> std::result::Result<NpyHeader, String> {
         elements,
         data_offset: 0,
         fortran_order,
+        fields,
     })
+}
+
+/// A structured dtype's list `[('t', '<i8'), ('x', '<i8'), ...]` into its fields with
+/// their offsets. Fields with a shape of their own, nested structures and empty records
+/// are refused.
+fn parse_fields(text: &str) -> std::result::Result<Vec<NpyField>, String> {
+    let end = text
+        .find(']')
+        .ok_or("field `descr`: a list of fields without its closing `]`")?;
+    let inner = &text[1..end];
+    let mut fields = Vec::new();
+    let mut offset = 0usize;
+    for part in inner.split(')').map(str::trim) {
+        let part = part.trim_start_matches(',').trim();
+        if part.is_empty() {
+            continue;
+        }
+        let bad = || format!("unsupported structured dtype field `{part})`");
+        let body = part.strip_prefix('(').ok_or_else(bad)?.trim();
+        let name = quoted(body).ok_or_else(bad)?;
+        let rest = body[name.len() + 2..].trim_start();
+        let rest = rest.strip_prefix(',').ok_or_else(bad)?.trim_start();
+        let dtype = quoted(rest).ok_or_else(bad)?;
+        if !rest[dtype.len() + 2..].trim().is_empty() {
+            return Err(format!(
+                "{}: fields with a shape of their own are not supported",
+                bad()
+            ));
+        }
+        let (kind, bytes) = match dtype.strip_prefix('|').and_then(|w| w.strip_prefix('V')) {
+            Some(width) => ('V', width.parse::<usize>().map_err(|_| bad())?),
+            None => parse_descr(dtype)?,
+        };
+        fields.push(NpyField {
+            name: name.to_string(),
+            kind,
+            bytes,
+            offset,
+            big_endian: dtype.starts_with('>'),
+        });
+        offset = offset.checked_add(bytes).ok_or_else(bad)?;
+    }
+    if offset == 0 {
+        return Err("field `descr`: a structured dtype without fields".into());
+    }
+    Ok(fields)
+}
+
+/// The data section of a `.npy` whose header [`read_header`] checked, as bytes.
+///
+/// # Errors
+/// The file cannot be read, or changed size since its header was read.
+pub(crate) fn read_data(path: &Path, header: &NpyHeader) -> Result<Vec<u8>> {
+    use std::io::{Seek, SeekFrom};
+    let io = |e| DataError::io(path, e);
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    file.seek(SeekFrom::Start(header.data_offset as u64))
+        .map_err(io)?;
+    let mut bytes = vec![0u8; header.elements * header.item_bytes];
+    file.read_exact(&mut bytes).map_err(io)?;
+    Ok(bytes)
 }
 
 /// The text after `'key':` (or `"key":`), leading blanks removed.
@@ -377,6 +501,42 @@ mod tests {
         // one byte too few or too many
         assert!(header_of(&npy_bytes("<f4", "(2, 3)", &[0; 23])).is_err());
         assert!(header_of(&npy_bytes("<f4", "(2, 3)", &[0; 25])).is_err());
+    }
+
+    #[test]
+    fn a_structured_dtype_is_read_field_by_field() {
+        // numpy: np.array([(5, 1, 2, True)], dtype=[('t','<i8'),('x','<i2'),('y','<u1'),('p','|b1')])
+        let descr = "[('t', '<i8'), ('x', '<i2'), ('y', '|u1'), ('p', '|b1')]";
+        let mut h = format!("{{'descr': {descr}, 'fortran_order': False, 'shape': (1,), }}");
+        while (10 + h.len() + 1) % 64 != 0 {
+            h.push(' ');
+        }
+        h.push('\n');
+        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+        bytes.extend((h.len() as u16).to_le_bytes());
+        bytes.extend(h.as_bytes());
+        bytes.extend(5i64.to_le_bytes());
+        bytes.extend((-1i16).to_le_bytes());
+        bytes.extend([2u8, 1]);
+        let header = header_of(&bytes).unwrap();
+        assert_eq!((header.kind, header.item_bytes), ('V', 12));
+        let names: Vec<&str> = header.fields.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(names, ["t", "x", "y", "p"]);
+        let record = &bytes[header.data_offset..];
+        let values: Vec<i128> = header
+            .fields
+            .iter()
+            .map(|f| f.int(record).unwrap())
+            .collect();
+        assert_eq!(values, [5, -1, 2, 1]);
+        assert!(!header.is_number());
+        for bad in ["[('t', '<i8', (2,))]", "[]", "[('t')]"] {
+            let h = format!("{{'descr': {bad}, 'fortran_order': False, 'shape': (0,), }}");
+            let mut b = b"\x93NUMPY\x01\x00".to_vec();
+            b.extend((h.len() as u16).to_le_bytes());
+            b.extend(h.as_bytes());
+            assert!(header_of(&b).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -308,6 +308,10 @@ pub struct LayoutFile {
     /// way, so a raw log of the same logger needs no options.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source: Option<LogColumns>,
+    /// The recordings are address events, not samples: how to read them
+    /// ([`crate::events`]). Needs `rows` and `cols`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub events: Option<crate::events::EventsFormat>,
 }
 
 /// The longest recording accepted unless `layout.toml` sets `max_duration_s`: one hour.
@@ -435,6 +439,9 @@ impl LayoutFile {
         } else if self.channel_map.is_some() || self.mask.is_some() {
             return bad("fields `channel_map` and `mask` need `rows` and `cols`".into());
         }
+        if self.events.is_some() && self.rows.is_none() {
+            return bad("an [events] table needs the grid: give `rows` and `cols`".into());
+        }
         if let Some(Baseline::Mean { start_s, end_s }) = self.baseline {
             if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
                 return bad(format!(
@@ -546,6 +553,9 @@ pub struct Dataset {
     pub layout: LayoutFile,
 }
 
+/// Why a step that reads sampled signals refuses an address-event recording.
+const EVENTS_NOT_SAMPLES: &str = "is an address-event recording (its layout.toml has an [events] table), not sampled signals: this step needs samples (the encoder, the signal baselines, --gain auto and --causal condition a signal; features, evaluate, train, predict and compare read events)";
+
 /// The manifest's required columns.
 pub const MANIFEST_COLUMNS: [&str; 2] = ["file", "label"];
 
@@ -646,10 +656,71 @@ impl Dataset {
     /// If `index` is out of range (a caller bug).
     pub fn load(&self, index: usize) -> Result<Recording> {
         let meta = &self.entries[index];
+        if self.is_events() {
+            return Err(DataError::invalid(self.root.join(&meta.file), EVENTS_NOT_SAMPLES).into());
+        }
         let path = self.root.join(&meta.file);
         let mut rec = read_recording(&path, &self.layout)?;
         rec.meta = meta.clone();
         Ok(rec)
+    }
+
+    /// Whether the recordings are address events (`layout.toml` has an `[events]` table).
+    pub fn is_events(&self) -> bool {
+        self.layout.events.is_some()
+    }
+
+    /// Loads event recording `index` as spike trains ([`crate::events`]); the manifest's
+    /// optional `duration_s` column gives its length.
+    ///
+    /// # Errors
+    /// Not an event dataset, an unreadable file, a bad `duration_s`, or an event that breaks
+    /// a rule.
+    ///
+    /// # Panics
+    /// If `index` is out of range (a caller bug).
+    pub fn load_events(&self, index: usize) -> Result<crate::events::Events> {
+        let meta = &self.entries[index];
+        let path = self.root.join(&meta.file);
+        let (Some(format), Some(rows), Some(cols)) =
+            (&self.layout.events, self.layout.rows, self.layout.cols)
+        else {
+            let why = "is a sampled recording: its dataset's layout.toml has no [events] table";
+            return Err(DataError::invalid(&path, why).into());
+        };
+        let manifest = || self.root.join("manifest.csv");
+        let duration = match meta.field("duration_s").filter(|d| !d.is_empty()) {
+            None => None,
+            Some(text) => match text.parse::<f64>() {
+                Ok(s) if s.is_finite() && s >= 0.0 => Some((s * 1000.0).round() as u64),
+                _ => {
+                    let why = format!(
+                        "line {}: duration_s `{text}` is not a non-negative number of seconds",
+                        index + 2
+                    );
+                    return Err(DataError::invalid(manifest(), why).into());
+                }
+            },
+        };
+        let present: Vec<bool> = match &self.layout.mask {
+            Some(m) => m
+                .iter()
+                .flat_map(|row| row.chars().map(|ch| ch == '1'))
+                .collect(),
+            None => vec![true; rows * cols],
+        };
+        let taxels = match &self.layout.channel_map {
+            Some(map) => map.iter().map(|&[r, c]| r * cols + c).collect(),
+            None => (0..rows * cols).collect(),
+        };
+        let grid = crate::events::EventGrid {
+            rows,
+            cols,
+            present,
+            taxels,
+        };
+        let max_s = self.layout.max_duration_s.unwrap_or(DEFAULT_MAX_DURATION_S);
+        crate::events::read_events(&path, format, &grid, duration, (max_s * 1000.0) as u64)
     }
 
     /// A fingerprint of the dataset as its manifest lists it, `sha256:` and 64 hex digits:
@@ -1194,6 +1265,9 @@ pub fn read_recording_as(
     layout: &LayoutFile,
     format: &CsvFormat,
 ) -> Result<Recording> {
+    if layout.events.is_some() {
+        return Err(DataError::invalid(path, EVENTS_NOT_SAMPLES).into());
+    }
     let (shape, raw, times_s, finite) = read_samples(path, format)?;
     let n_channels = checked_channels(path, shape, &raw, finite)?;
     let t = raw.len() / n_channels;

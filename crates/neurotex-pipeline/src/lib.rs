@@ -22,7 +22,7 @@ pub mod stream;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
-use neurotex_core::{csvlog, error, import, io, progress, recording, values, Error};
+use neurotex_core::{csvlog, error, events, import, io, progress, recording, values, Error};
 use neurotex_features::features;
 use neurotex_learn::{classify, snn};
 use neurotex_signal::{encode, signal};

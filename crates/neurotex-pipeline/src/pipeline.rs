@@ -2,11 +2,14 @@
 //! Every stage is planned once (filter, GLCM offsets) and applied to many recordings,
 //! in parallel across recordings.
 
+use std::path::Path;
+
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::encode::{encode, encode_fa, encode_sa_fa, FaParams, IzhikevichParams, SpikeTrains};
 use crate::error::{DataError, ParamError, Result};
+use crate::events::Events;
 use crate::features::glcm::GlcmKind;
 use crate::features::{
     distance_stats, haralick, haralick_full, spike_stats, CountVolume, GlcmParams, GlcmPlan,
@@ -505,8 +508,59 @@ impl Pipeline {
         indices: &[usize],
         on_done: &(dyn Fn() + Sync),
     ) -> Result<Vec<Encoded>> {
+        if dataset.is_events() {
+            return indices
+                .par_iter()
+                .map(|&i| {
+                    let events = dataset.load_events(i)?;
+                    let path = dataset.root.join(&dataset.entries[i].file);
+                    let encoded = self.from_events(dataset.entries[i].clone(), events, &path)?;
+                    on_done();
+                    Ok(encoded)
+                })
+                .collect();
+        }
         let pairs = self.encode_dataset_with(dataset, indices, on_done, &|_, _| Ok(()))?;
         Ok(pairs.into_iter().map(|(e, ())| e).collect())
+    }
+
+    /// An address-event recording as the pipeline's encoding reads it: its ON trains in
+    /// the SA population's place and its OFF trains in the FA population's (`sa` reads ON,
+    /// `fa` OFF, `sa+fa` both). The encoder does not run.
+    ///
+    /// # Errors
+    /// `fa` or `sa+fa` on a recording without polarities.
+    pub fn from_events(&self, meta: Meta, events: Events, path: &Path) -> Result<Encoded> {
+        let trains = |lists: &[Vec<u32>]| {
+            SpikeTrains::from_lists(
+                lists,
+                events.rows,
+                events.cols,
+                &events.present,
+                events.n_steps,
+            )
+        };
+        let off = || {
+            events.off.as_deref().map(trains).ok_or_else(|| {
+                let why = format!(
+                    "has no polarity column, so no OFF events: the `{}` encoding reads OFF events as its FA population; use --encoding sa (ON events)",
+                    self.params.encoding.name()
+                );
+                crate::Error::from(DataError::invalid(path, why))
+            })
+        };
+        let (spikes, fa) = match self.params.encoding {
+            Encoding::Sa => (trains(&events.on), None),
+            Encoding::Fa => (off()?, None),
+            Encoding::SaFa => (trains(&events.on), Some(off()?)),
+        };
+        Ok(Encoded {
+            meta,
+            spikes,
+            fa,
+            resampled: false,
+            flat: events.count == 0,
+        })
     }
 
     /// [`Pipeline::encode_dataset`], also applying `also` to each recording and its

@@ -23,7 +23,7 @@
 //! or parameter at fault. `ARCHITECTURE.md` follows one recording through the layers.
 #![deny(missing_docs)]
 
-pub use neurotex_core::{csvlog, error, import, io, progress, recording, values};
+pub use neurotex_core::{csvlog, error, events, import, io, progress, recording, values};
 pub use neurotex_core::{BySpeed, Cell, Error, Grid, Result, SampleRate, Speed};
 pub use neurotex_experiments::experiments;
 pub use neurotex_features::features;

@@ -5,10 +5,15 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use neurotex::workflows::export::{export_inputs, export_nir, load_spiking, NirConvention};
+use neurotex::pipeline::Pipeline;
+use neurotex::workflows::calibrated_pipeline;
+use neurotex::workflows::export::{
+    export_events, export_inputs, export_nir, load_spiking, EventFormat, NirConvention,
+};
 use neurotex::workflows::OpenOptions;
 
 use crate::output::{check_output, Shown};
+use crate::stage_args::StageArgs;
 
 /// `neurotex export`: what other tools read.
 #[derive(Subcommand)]
@@ -24,6 +29,32 @@ pub enum ExportCommand {
     /// SA then the FA taxels in row-major order) and `index.csv` (`file,label,array`), so
     /// that the same network can be run or trained elsewhere on exactly neurotex's spikes.
     Inputs(ExportInputsArgs),
+    /// A dataset's recordings encoded into spikes, written as a new address-event dataset:
+    /// one event file per recording (`t,x,y,p` CSV in ms, or tonic's structured `.npy` in
+    /// microseconds), ON (`p` 1) for the SA population and OFF (`p` 0) for the FA one,
+    /// `manifest.csv` with each recording's `duration_s`, and `layout.toml` with the grid
+    /// and its `[events]` table. Every command reads it back as the same spikes, so the
+    /// spikes can go to event-based tools (tonic) and back.
+    Events(ExportEventsArgs),
+}
+
+/// Options of `neurotex export events`.
+#[derive(Args)]
+pub struct ExportEventsArgs {
+    /// The dataset folder whose recordings are encoded.
+    #[arg(long)]
+    pub dataset: PathBuf,
+    /// The event dataset folder to create (new or empty).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The event files' kind.
+    #[arg(long, value_enum, default_value_t = EventFormat::Csv)]
+    pub format: EventFormat,
+    /// How the dataset folder is opened.
+    #[command(flatten)]
+    pub open: OpenOptions,
+    #[command(flatten)]
+    pub stages: StageArgs,
 }
 
 /// Options of `neurotex export nir`.
@@ -59,7 +90,7 @@ pub struct ExportInputsArgs {
     pub open: OpenOptions,
 }
 
-/// Runs `neurotex export nir` or `neurotex export inputs`.
+/// Runs `neurotex export nir`, `inputs` or `events`.
 pub fn run(command: ExportCommand) -> Result<()> {
     match command {
         ExportCommand::Nir(args) => {
@@ -89,6 +120,26 @@ pub fn run(command: ExportCommand) -> Result<()> {
                 "{n} recordings' input tensors ({} inputs, {} ms steps) -> {}",
                 model.network().inputs,
                 model.network().dt_ms,
+                args.out.display()
+            );
+        }
+        ExportCommand::Events(args) => {
+            let dataset = args.open.open(&args.dataset)?;
+            neurotex::io::check_output_dir(&args.out)?;
+            let shown = Shown::new("starting");
+            let on = shown.callback();
+            let all: Vec<usize> = (0..dataset.entries.len()).collect();
+            let written = calibrated_pipeline(&args.stages.options, &dataset, &all, &on)
+                .and_then(|c| Ok(Pipeline::new(c.params)?))
+                .and_then(|p| {
+                    let n = export_events(&dataset, &p, &args.out, args.format, &on)?;
+                    Ok((n, p.params().encoding))
+                });
+            shown.finish();
+            let (n, encoding) = written?;
+            eprintln!(
+                "{n} recordings' {} spikes as address events -> {}",
+                encoding.name(),
                 args.out.display()
             );
         }

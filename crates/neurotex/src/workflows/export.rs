@@ -1,5 +1,6 @@
 //! `export`: a spiking model's network as a NIR graph for other simulators and
-//! neuromorphic hardware, and the spike tensors its input node receives.
+//! neuromorphic hardware, the spike tensors its input node receives, and a dataset's spikes
+//! as an address-event dataset.
 use ndarray::Array2;
 use ndarray_npy::write_npy;
 use std::path::Path;
@@ -8,9 +9,13 @@ use rayon::prelude::*;
 
 use super::OnProgress;
 use crate::error::DataError;
+use crate::events::{write_events, Event, EventFile, EventsFormat};
 use crate::nir::Convention;
+use crate::pipeline::{Encoded, Encoding, Pipeline};
 use crate::progress::Progress;
-use crate::recording::Dataset;
+use crate::recording::{
+    create_dataset_dir, write_layout, write_manifest, Dataset, LayoutFile, Meta,
+};
 use crate::spiking_model::{spike_input, SpikingModel};
 use crate::Result;
 
@@ -108,4 +113,131 @@ fn quote(field: &str) -> String {
         true => format!("\"{}\"", field.replace('"', "\"\"")),
         false => field.to_string(),
     }
+}
+
+/// The file kind `export events` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum EventFormat {
+    /// CSV `t,x,y,p`, `t` in ms.
+    #[default]
+    Csv,
+    /// tonic's structured `.npy` (`x, y, t, p` as int64), `t` in microseconds.
+    Npy,
+}
+
+impl From<EventFormat> for EventFile {
+    fn from(f: EventFormat) -> Self {
+        match f {
+            EventFormat::Csv => EventFile::Csv,
+            EventFormat::Npy => EventFile::Npy,
+        }
+    }
+}
+
+/// The events of one encoded recording: its first population's spikes as ON (`p` 1) and
+/// its FA population's as OFF (`p` 0), or the FA spikes of an `fa` encoding as OFF; in
+/// time order.
+pub fn encoded_events(encoded: &Encoded, encoding: Encoding) -> Vec<Event> {
+    let first = match encoding {
+        Encoding::Fa => 0,
+        Encoding::Sa | Encoding::SaFa => 1,
+    };
+    let mut events: Vec<Event> = std::iter::once((&encoded.spikes, first))
+        .chain(encoded.fa.as_ref().map(|fa| (fa, 0)))
+        .flat_map(|(trains, p)| {
+            trains
+                .events()
+                .into_iter()
+                .map(move |(t_ms, row, col)| Event {
+                    t_ms,
+                    y: row as u32,
+                    x: col as u32,
+                    p,
+                })
+        })
+        .collect();
+    events.sort_unstable_by_key(|e| (e.t_ms, std::cmp::Reverse(e.p), e.y, e.x));
+    events
+}
+
+/// Writes `dataset`'s recordings, encoded by `pipeline`, as a new event dataset in `out`
+/// (which must not exist or be empty): one event file per recording (`<n>_<name>.csv` or
+/// `.npy`), `manifest.csv` with each recording's fields and its `duration_s` (the encoded
+/// length; the slide's times are dropped, as the events hold only the selected phase), and
+/// `layout.toml` with the grid and the `[events]` table. Reading it back gives the same
+/// spike trains. Returns the recordings written.
+///
+/// # Errors
+/// A recording that cannot be read or encoded, recordings on different grids, or `out`
+/// cannot be created.
+pub fn export_events(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    out: &Path,
+    kind: EventFormat,
+    on: OnProgress,
+) -> Result<usize> {
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    let (encoded, grid) = super::encode_all(dataset, pipeline, &all, on)?;
+    let kind = EventFile::from(kind);
+    let encoding = pipeline.params().encoding;
+    create_dataset_dir(out, |dir| {
+        let names: Vec<String> = encoded
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                let stem = Path::new(&e.meta.file)
+                    .file_stem()
+                    .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+                format!("{i:05}_{stem}.{}", kind.extension())
+            })
+            .collect();
+        encoded
+            .par_iter()
+            .zip(&names)
+            .map(|(e, name)| {
+                let path = dir.join(name);
+                let events = encoded_events(e, encoding);
+                std::fs::File::create(&path)
+                    .and_then(|f| {
+                        let mut w = std::io::BufWriter::new(f);
+                        write_events(&mut w, &events, kind)?;
+                        std::io::Write::flush(&mut w)
+                    })
+                    .map_err(|err| DataError::write(&path, err).into())
+            })
+            .collect::<Result<Vec<()>>>()?;
+        let metas: Vec<Meta> = encoded
+            .iter()
+            .zip(&names)
+            .map(|(e, name)| {
+                let mut meta = Meta {
+                    file: name.clone(),
+                    slide_start_s: None,
+                    slide_end_s: None,
+                    ..e.meta.clone()
+                };
+                let duration = e.spikes.n_steps as f64 / 1000.0;
+                meta.extra.insert("duration_s".into(), duration.to_string());
+                meta
+            })
+            .collect();
+        write_manifest(dir, &metas)?;
+        let masked = grid.present().iter().any(|&p| !p);
+        let layout = LayoutFile {
+            rows: Some(grid.rows()),
+            cols: Some(grid.cols()),
+            mask: masked.then(|| {
+                grid.present()
+                    .chunks(grid.cols())
+                    .map(|row| row.iter().map(|&p| if p { '1' } else { '0' }).collect())
+                    .collect()
+            }),
+            events: Some(EventsFormat::new(kind.time_unit())),
+            ..LayoutFile::default()
+        };
+        write_layout(dir, &layout)?;
+        Ok(encoded.len())
+    })
 }

@@ -274,6 +274,13 @@ pub fn calibrated_pipeline(
     on: OnProgress,
 ) -> Result<CalibratedParams> {
     let params = stages.check()?.params;
+    if dataset.is_events() && (stages.causal || stages.gain.target_hz().is_some()) {
+        return Err(OptionsError::Conflict(format!(
+            "{} holds address events, which skip the encoder: --gain auto and --causal condition and encode a sampled signal",
+            dataset.root.display()
+        ))
+        .into());
+    }
     for finding in crate::inspect::severe_findings(dataset, &params)? {
         on(Progress::Advice(&format!(
             "{} (neurotex inspect says more)",

@@ -1,0 +1,320 @@
+//! Address-event datasets: a dataset's spikes written as events (`export events`, CSV and
+//! tonic's `.npy`) read back as the same spikes, bit for bit, through features, evaluate,
+//! compare and predict; and every broken event rule is an error naming the file and line.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::util::{s, Dir};
+
+/// Feature rows keyed by column, without the manifest's columns (the event dataset's
+/// manifest has `duration_s` where the sampled one has the slide's times).
+fn feature_columns(path: &Path) -> Vec<Vec<(String, String)>> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    reader
+        .records()
+        .map(|r| {
+            let r = r.unwrap();
+            header
+                .iter()
+                .zip(r.iter())
+                .filter(|(h, _)| h.starts_with("sa_") || h.starts_with("fa_") || *h == "label")
+                .map(|(h, v)| (h.clone(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+/// The `predicted` column and every share column of a predictions file.
+fn predictions(path: &Path) -> Vec<Vec<String>> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    reader
+        .records()
+        .map(|r| {
+            let r = r.unwrap();
+            header
+                .iter()
+                .zip(r.iter())
+                .filter(|(h, _)| *h != "file")
+                .map(|(_, v)| v.to_string())
+                .collect()
+        })
+        .collect()
+}
+
+fn accuracy_and_confusion(v: &Value) -> (Value, Value, Value) {
+    (
+        v["accuracy"].clone(),
+        v["confusion"].clone(),
+        v["labels"].clone(),
+    )
+}
+
+#[test]
+fn exported_events_give_the_encoded_spikes_results_bit_for_bit() {
+    let dir = Dir::new();
+    let sim = dir.join("sim");
+    dir.ok(&[
+        "simulate",
+        "--out",
+        s(&sim),
+        "--trials",
+        "5",
+        "--speeds",
+        "10,15",
+        "--textures",
+        "FT1,SB,CP",
+    ]);
+    let (csv, npy) = (dir.join("ev_csv"), dir.join("ev_npy"));
+    for (out, format) in [(&csv, "csv"), (&npy, "npy")] {
+        dir.ok(&[
+            "export",
+            "events",
+            "--dataset",
+            s(&sim),
+            "--out",
+            s(out),
+            "--format",
+            format,
+            "--encoding",
+            "sa+fa",
+        ]);
+    }
+    let layout = std::fs::read_to_string(npy.join("layout.toml")).unwrap();
+    assert!(layout.contains("time_unit = \"us\""), "{layout}");
+    for method in ["glcm3d", "taxel", "spectrum"] {
+        let of = |ds: &Path| {
+            let out = dir.join(&format!(
+                "{}_{method}.csv",
+                ds.file_name().unwrap().to_string_lossy()
+            ));
+            dir.ok(&[
+                "features",
+                "--dataset",
+                s(ds),
+                "--method",
+                method,
+                "--encoding",
+                "sa+fa",
+                "--out",
+                s(&out),
+            ]);
+            feature_columns(&out)
+        };
+        let sampled = of(&sim);
+        assert_eq!(sampled.len(), 30);
+        assert!(
+            sampled[0].len() > 2,
+            "{method}: features of both populations"
+        );
+        assert_eq!(of(&csv), sampled, "{method} from CSV events");
+        assert_eq!(of(&npy), sampled, "{method} from .npy events");
+    }
+    // each population alone: `sa` reads the ON events, `fa` the OFF ones
+    for encoding in ["sa", "fa"] {
+        let sampled = dir.evaluate_json(&sim, "glcm3d", &["--encoding", encoding, "--folds", "3"]);
+        let events = dir.evaluate_json(&npy, "glcm3d", &["--encoding", encoding, "--folds", "3"]);
+        assert_eq!(
+            accuracy_and_confusion(&events),
+            accuracy_and_confusion(&sampled),
+            "{encoding}"
+        );
+    }
+    // a model trained on the sampled recordings predicts the events as it predicts them
+    let model = dir.join("m.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&sim),
+        "--method",
+        "glcm3d",
+        "--encoding",
+        "sa+fa",
+        "--out",
+        s(&model),
+    ]);
+    let (p_sim, p_ev) = (dir.join("p_sim.csv"), dir.join("p_ev.csv"));
+    dir.ok(&[
+        "predict",
+        "--model",
+        s(&model),
+        "--dataset",
+        s(&sim),
+        "--out",
+        s(&p_sim),
+    ]);
+    dir.ok(&[
+        "predict",
+        "--model",
+        s(&model),
+        "--dataset",
+        s(&csv),
+        "--out",
+        s(&p_ev),
+    ]);
+    assert_eq!(predictions(&p_ev), predictions(&p_sim));
+    // compare ranks the same candidates with the same accuracies
+    let ranked = |ds: &Path| -> Value {
+        let text = dir.ok(&[
+            "compare",
+            "--dataset",
+            s(ds),
+            "--per",
+            "speed_mm_s",
+            "--folds",
+            "3",
+            "--repeats",
+            "1",
+            "--methods",
+            "glcm3d,van-rossum",
+            "--classifiers",
+            "knn",
+            "--json",
+        ]);
+        let v: Value = serde_json::from_str(&text).unwrap();
+        v["results"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| serde_json::json!([r["encoding"], r["method"], r["accuracy"]]))
+            .collect()
+    };
+    assert_eq!(ranked(&npy), ranked(&sim));
+}
+
+/// An event dataset of 2x2 cells with `files` (name, CSV text) and the layout's `[events]`
+/// lines.
+fn event_dataset(
+    dir: &Dir,
+    name: &str,
+    events: &str,
+    files: &[(&str, &str)],
+) -> std::path::PathBuf {
+    let ds = dir.join(name);
+    std::fs::create_dir_all(&ds).unwrap();
+    let mut manifest = String::from("file,label\n");
+    for (i, (file, text)) in files.iter().enumerate() {
+        std::fs::write(ds.join(file), text).unwrap();
+        manifest.push_str(&format!("{file},{}\n", ["A", "B"][i % 2]));
+    }
+    std::fs::write(ds.join("manifest.csv"), manifest).unwrap();
+    std::fs::write(
+        ds.join("layout.toml"),
+        format!("rows = 2\ncols = 2\n\n[events]\n{events}"),
+    )
+    .unwrap();
+    ds
+}
+
+#[test]
+fn broken_event_files_are_named_with_their_line() {
+    let dir = Dir::new();
+    let out = dir.join("f.csv");
+    let good = "t,x,y,p\n0,0,0,1\n300,1,1,0\n";
+    let features = |ds: &Path, extra: &[&str]| -> String {
+        let mut args = vec![
+            "features",
+            "--dataset",
+            s(ds),
+            "--method",
+            "glcm3d",
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        dir.fails(&args)
+    };
+    let cases = [
+        (
+            "order",
+            "t,x,y,p\n0,0,0,1\n300,1,1,0\n200,0,1,1\n",
+            "line 4: time 200 comes before",
+        ),
+        (
+            "grid",
+            "t,x,y,p\n0,0,0,1\n300,2,1,0\n",
+            "line 3: x = 2, y = 1 is outside the 2x2 grid",
+        ),
+        (
+            "polarity",
+            "t,x,y,p\n0,0,0,1\n300,1,1,5\n",
+            "polarity 5 is neither ON (1) nor OFF (0)",
+        ),
+        ("column", "t,col,y,p\n0,0,0,1\n", "no column `x`"),
+    ];
+    for (name, text, says) in cases {
+        let ds = event_dataset(
+            &dir,
+            name,
+            "time_unit = \"ms\"\n",
+            &[("a.csv", good), ("b.csv", text)],
+        );
+        let err = features(&ds, &[]);
+        assert!(err.contains(says) && err.contains("b.csv"), "{name}: {err}");
+        assert!(!out.exists());
+    }
+    let ds = event_dataset(
+        &dir,
+        "fine",
+        "time_unit = \"ms\"\n",
+        &[("a.csv", good), ("b.csv", good)],
+    );
+    dir.ok(&[
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ]);
+    std::fs::remove_file(&out).unwrap();
+    for (extra, says) in [
+        (
+            &["--gain", "auto"][..],
+            "--gain auto and --causal condition and encode a sampled signal",
+        ),
+        (&["--causal"][..], "holds address events"),
+    ] {
+        let err = features(&ds, extra);
+        assert!(err.contains(says), "{extra:?}: {err}");
+    }
+    // without a polarity column there are no OFF events for the FA population
+    let on_only = "t,x,y\n0,0,0\n300,1,1\n";
+    let ds = event_dataset(
+        &dir,
+        "on",
+        "time_unit = \"ms\"\n",
+        &[("a.csv", on_only), ("b.csv", on_only)],
+    );
+    let err = features(&ds, &["--encoding", "sa+fa"]);
+    assert!(
+        err.contains("no polarity column") && err.contains("--encoding sa"),
+        "{err}"
+    );
+    // no unit
+    let ds = event_dataset(&dir, "unit", "", &[("a.csv", good), ("b.csv", good)]);
+    let err = features(&ds, &[]);
+    assert!(
+        err.contains("layout.toml") && err.contains("time_unit"),
+        "{err}"
+    );
+    // a sampled-signal step names the event file
+    let ds = event_dataset(
+        &dir,
+        "signal",
+        "time_unit = \"ms\"\n",
+        &[("a.csv", good), ("b.csv", good)],
+    );
+    let err = dir.fails(&[
+        "encode",
+        "--input",
+        s(&ds.join("a.csv")),
+        "--out",
+        s(&dir.join("r.npy")),
+    ]);
+    assert!(!err.contains("panicked"), "{err}");
+}
