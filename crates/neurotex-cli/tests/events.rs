@@ -318,3 +318,167 @@ fn broken_event_files_are_named_with_their_line() {
     ]);
     assert!(!err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn imported_logs_read_as_the_events_they_hold() {
+    let dir = Dir::new();
+    let logs = dir.join("logs");
+    std::fs::create_dir_all(&logs).unwrap();
+    // Each log: seconds on a clock, a taxel index (row-major on 2x3), polarity 1 / -1,
+    // and its lines out of time order; beside it, the same events by x and y in order.
+    let direct = dir.join("direct");
+    std::fs::create_dir_all(&direct).unwrap();
+    let mut manifest = String::from("file,label,trial\n");
+    let mut state = 7u64;
+    let mut next = move |n: u64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state % n
+    };
+    for label in ["silk", "wool"] {
+        for trial in 0..4 {
+            let mut events: Vec<(u64, u64, i64)> = (0..300)
+                .map(|_| (next(900_000), next(6), if next(2) == 0 { 1 } else { -1 }))
+                .collect();
+            events.sort();
+            let first = events[0].0;
+            let mut ordered = String::from("t,x,y,p\n");
+            for &(t, taxel, p) in &events {
+                ordered.push_str(&format!(
+                    "{},{},{},{p}\n",
+                    (t - first) as f64 / 1e6,
+                    taxel % 3,
+                    taxel / 3
+                ));
+            }
+            let name = format!("{label}_{trial}.csv");
+            std::fs::write(direct.join(&name), ordered).unwrap();
+            manifest.push_str(&format!("{name},{label},{trial}\n"));
+            // event 9 moved to line 3: the five after it and the old event 3 are below it
+            events.swap(3, 9);
+            let mut log = String::from("clock,taxel,pol\n");
+            for &(t, taxel, p) in &events {
+                log.push_str(&format!("{},{taxel},{p}\n", (1_000_000 + t) as f64 / 1e6));
+            }
+            std::fs::write(logs.join(&name), log).unwrap();
+        }
+    }
+    std::fs::write(direct.join("manifest.csv"), manifest).unwrap();
+    std::fs::write(
+        direct.join("layout.toml"),
+        "rows = 2\ncols = 3\n\n[events]\ntime_unit = \"s\"\nvalues = [1, -1]\n",
+    )
+    .unwrap();
+    let imported = dir.join("imported");
+    let run = dir.run(&[
+        "import",
+        "events",
+        s(&logs),
+        "--out",
+        s(&imported),
+        "--grid",
+        "2x3",
+        "--time-unit",
+        "s",
+        "--time-column",
+        "clock",
+        "--taxel",
+        "taxel",
+        "--polarity",
+        "pol",
+        "--polarity-values",
+        "1,-1",
+        "--origin",
+        "first",
+        "--name-pattern",
+        "{label}_{trial}.csv",
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("silk_0.csv: 6 event(s) came before"),
+        "{}",
+        run.stderr
+    );
+    assert!(
+        run.stderr.contains("8 recordings, 2400 events"),
+        "{}",
+        run.stderr
+    );
+    for method in ["glcm3d", "taxel"] {
+        let of = |ds: &Path| {
+            let out = dir.join(&format!(
+                "{}_{method}.csv",
+                ds.file_name().unwrap().to_string_lossy()
+            ));
+            dir.ok(&[
+                "features",
+                "--dataset",
+                s(ds),
+                "--method",
+                method,
+                "--encoding",
+                "sa+fa",
+                "--out",
+                s(&out),
+            ]);
+            feature_columns(&out)
+        };
+        assert_eq!(of(&imported), of(&direct), "{method}");
+    }
+    // a taxel past the grid names the log and its line; nothing is written
+    std::fs::write(
+        logs.join("wool_9.csv"),
+        "clock,taxel,pol\n1.0,2,1\n1.5,6,1\n",
+    )
+    .unwrap();
+    let out = dir.join("bad");
+    let err = dir.fails(&[
+        "import",
+        "events",
+        s(&logs),
+        "--out",
+        s(&out),
+        "--grid",
+        "2x3",
+        "--time-unit",
+        "s",
+        "--time-column",
+        "clock",
+        "--taxel",
+        "taxel",
+        "--polarity",
+        "pol",
+        "--polarity-values",
+        "1,-1",
+        "--origin",
+        "first",
+    ]);
+    assert!(
+        err.contains("wool_9.csv: line 3: taxel 6 is outside the layout's 6 taxels"),
+        "{err}"
+    );
+    assert!(!out.exists() && !dir.partial_left());
+    for (extra, says) in [
+        (
+            ["--polarity-values", "1,1"],
+            "polarity values are two different integers",
+        ),
+        (["--origin", "start"], "the origin is `zero` or `first`"),
+    ] {
+        let mut args = vec![
+            "import",
+            "events",
+            s(&logs),
+            "--out",
+            s(&out),
+            "--grid",
+            "2x3",
+            "--time-unit",
+            "s",
+        ];
+        args.extend_from_slice(&extra);
+        let err = dir.fails(&args);
+        assert!(err.contains(says), "{err}");
+    }
+}

@@ -393,12 +393,49 @@ pub fn read_events(
     duration_ms: Option<u64>,
     max_steps: u64,
 ) -> Result<Events> {
+    let mut gather: Option<Gather> = None;
+    parse(path, format, &mut |event| match event {
+        Parsed::Columns { polarity } => {
+            gather = Some(Gather::new(format, grid, polarity, duration_ms, max_steps));
+            Ok(())
+        }
+        Parsed::Event { t, cell, p, .. } => gather
+            .as_mut()
+            .expect("the columns come first")
+            .push(t, cell, p),
+    })?;
+    Ok(gather
+        .unwrap_or_else(|| Gather::new(format, grid, false, duration_ms, max_steps))
+        .finish())
+}
+
+/// What a parser hands on: the file's columns once, then each event in file order.
+enum Parsed {
+    Columns {
+        polarity: bool,
+    },
+    Event {
+        t: Stamp,
+        cell: (i128, i128),
+        p: Option<i128>,
+        /// The CSV line (1-based, the header is line 1) or the `.npy` record (0-based).
+        at: usize,
+    },
+}
+
+/// Parses an event file, CSV or `.npy` by its extension, handing each event to `sink`;
+/// an `Err` from the sink is named with the line or record.
+fn parse(
+    path: &Path,
+    format: &EventsFormat,
+    sink: &mut dyn FnMut(Parsed) -> Result<(), String>,
+) -> Result<()> {
     let npy = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
     match npy {
-        true => read_npy(path, format, grid, duration_ms, max_steps),
-        false => read_csv(path, format, grid, duration_ms, max_steps),
+        true => parse_npy(path, format, sink),
+        false => parse_csv(path, format, sink),
     }
 }
 
@@ -424,13 +461,11 @@ fn columns(names: &[&str], format: &EventsFormat) -> Result<Columns, String> {
     })
 }
 
-fn read_csv(
+fn parse_csv(
     path: &Path,
     format: &EventsFormat,
-    grid: &EventGrid,
-    duration_ms: Option<u64>,
-    max_steps: u64,
-) -> Result<Events> {
+    sink: &mut dyn FnMut(Parsed) -> Result<(), String>,
+) -> Result<()> {
     let bad = |m: String| -> crate::Error { DataError::invalid(path, m).into() };
     let file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
     let mut reader = csv::ReaderBuilder::new()
@@ -446,13 +481,10 @@ fn read_csv(
         .map(|h| std::str::from_utf8(h).unwrap_or(""))
         .collect();
     let cols = columns(&names, format).map_err(bad)?;
-    let mut gather = Gather::new(
-        format,
-        grid,
-        cols.polarity.is_some(),
-        duration_ms,
-        max_steps,
-    );
+    sink(Parsed::Columns {
+        polarity: cols.polarity.is_some(),
+    })
+    .map_err(bad)?;
     let mut record = csv::ByteRecord::new();
     let mut line = 1usize;
     loop {
@@ -467,7 +499,7 @@ fn read_csv(
         let int = |i: usize, what: &str| -> Result<i128> {
             field(i)
                 .parse::<i128>()
-                .or_else(|_| match field(i) {
+                .or(match field(i) {
                     "True" | "true" => Ok(1),
                     "False" | "false" => Ok(0),
                     _ => Err(()),
@@ -487,18 +519,22 @@ fn read_csv(
             CellColumns::Taxel(i) => (int(i, "taxel")?, 0),
         };
         let p = cols.polarity.map(|i| int(i, "polarity")).transpose()?;
-        gather.push(t, cell, p).map_err(at)?;
+        sink(Parsed::Event {
+            t,
+            cell,
+            p,
+            at: line,
+        })
+        .map_err(at)?;
     }
-    Ok(gather.finish())
+    Ok(())
 }
 
-fn read_npy(
+fn parse_npy(
     path: &Path,
     format: &EventsFormat,
-    grid: &EventGrid,
-    duration_ms: Option<u64>,
-    max_steps: u64,
-) -> Result<Events> {
+    sink: &mut dyn FnMut(Parsed) -> Result<(), String>,
+) -> Result<()> {
     let bad = |m: String| -> crate::Error { DataError::invalid(path, m).into() };
     let header = read_header(path)?;
     if header.fields.is_empty() || header.shape.len() != 1 {
@@ -510,19 +546,19 @@ fn read_npy(
     let names: Vec<&str> = header.fields.iter().map(|f| f.name.as_str()).collect();
     let cols = columns(&names, format).map_err(bad)?;
     let fields = &header.fields;
+    let cell_fields = match cols.cell {
+        CellColumns::Xy(x, y) => vec![x, y],
+        CellColumns::Taxel(i) => vec![i],
+    };
     for f in [Some(cols.time), cols.polarity]
         .into_iter()
         .flatten()
-        .chain(match cols.cell {
-            CellColumns::Xy(x, y) => vec![x, y],
-            CellColumns::Taxel(i) => vec![i],
-        })
+        .chain(cell_fields)
     {
         let field: &NpyField = &fields[f];
-        let time = f == cols.time;
         let ok = match field.kind {
             'i' | 'u' | 'b' => !field.big_endian || field.bytes == 1,
-            'f' => time && !field.big_endian,
+            'f' => f == cols.time && !field.big_endian,
             _ => false,
         };
         if !ok {
@@ -532,17 +568,13 @@ fn read_npy(
             )));
         }
     }
+    sink(Parsed::Columns {
+        polarity: cols.polarity.is_some(),
+    })
+    .map_err(bad)?;
     let data = read_data(path, &header)?;
-    let mut gather = Gather::new(
-        format,
-        grid,
-        cols.polarity.is_some(),
-        duration_ms,
-        max_steps,
-    );
     let time = &fields[cols.time];
     for (i, record) in data.chunks_exact(header.item_bytes).enumerate() {
-        let at = |m: String| bad(format!("event {i} (0-based): {m}"));
         let int = |f: usize| fields[f].int(record).unwrap_or_default();
         let t = match time.kind {
             'f' => Stamp::Float(time.float(record).unwrap_or(f64::NAN)),
@@ -552,9 +584,224 @@ fn read_npy(
             CellColumns::Xy(x, y) => (int(x), int(y)),
             CellColumns::Taxel(x) => (int(x), 0),
         };
-        gather.push(t, cell, cols.polarity.map(int)).map_err(at)?;
+        let p = cols.polarity.map(int);
+        sink(Parsed::Event { t, cell, p, at: i })
+            .map_err(|m| bad(format!("{}: {m}", place(path, i))))?;
     }
-    Ok(gather.finish())
+    Ok(())
+}
+
+/// Where event `at` of a [`Parsed::Event`] is, as the messages say it.
+fn place(path: &Path, at: usize) -> String {
+    let npy = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+    match npy {
+        true => format!("event {at} (0-based)"),
+        false => format!("line {at}"),
+    }
+}
+
+/// What `import events` did with one file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportedFile {
+    /// The file written into the dataset.
+    pub file: String,
+    /// Events imported.
+    pub events: usize,
+    /// Events that came before an earlier line's time and were moved into time order.
+    pub reordered: usize,
+    /// Events that share a millisecond with another of their cell and polarity.
+    pub merged: usize,
+}
+
+/// Options of [`import_events`].
+#[derive(Debug, Clone)]
+pub struct EventImportParams {
+    /// Metadata from file names; without it the label is the file stem.
+    pub pattern: Option<crate::import::NamePattern>,
+    /// How the logs are read.
+    pub format: EventsFormat,
+    /// The sensor's grid (and, for a taxel column, each taxel's cell).
+    pub grid: EventGrid,
+}
+
+/// The `.csv` and `.npy` files among `inputs` (folders are searched one level deep),
+/// sorted.
+///
+/// # Errors
+/// An input that does not exist or a folder that cannot be read.
+pub fn event_files(inputs: &[std::path::PathBuf]) -> Result<Vec<std::path::PathBuf>> {
+    let mut out = Vec::new();
+    let wanted = |p: &Path| {
+        p.extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("csv") || x.eq_ignore_ascii_case("npy"))
+    };
+    for input in inputs {
+        if input.is_dir() {
+            let entries = std::fs::read_dir(input).map_err(|e| DataError::io(input, e))?;
+            for e in entries {
+                let path = e.map_err(|e| DataError::io(input, e))?.path();
+                if wanted(&path) {
+                    out.push(path);
+                }
+            }
+        } else if input.is_file() {
+            out.push(input.clone());
+        } else {
+            return Err(DataError::invalid(input, "does not exist").into());
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Imports event logs into a new dataset folder `out`: each file's events sorted into time
+/// order (a stable sort: events of one time keep their order) and checked as a dataset's
+/// reader checks them, written as `<stem>.csv` with columns `t,x,y,p` (times and
+/// polarities as the log wrote them, taxel indices turned into x and y); a manifest from
+/// the file names; `layout.toml` with the grid and the `[events]` table. Files are read in
+/// parallel; `on_done` is called once per file.
+///
+/// Sorting rather than refusing: a logger that writes events from several buffers
+/// interleaves them a little, and the order carries no information a stable sort loses. A
+/// dataset's reader, in contrast, refuses events out of order, so a dataset is always in
+/// the order every command reads.
+///
+/// # Errors
+/// A file that cannot be read or breaks a rule (named with its line), two files of one
+/// stem, or `out` not empty.
+pub fn import_events(
+    files: &[std::path::PathBuf],
+    p: &EventImportParams,
+    out: &Path,
+    on_done: &(dyn Fn() + Sync),
+) -> Result<Vec<ImportedFile>> {
+    use rayon::prelude::*;
+    if files.is_empty() {
+        return Err(DataError::invalid(out, "no .csv or .npy event files to import").into());
+    }
+    let mut stems = std::collections::BTreeMap::new();
+    for f in files {
+        let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned());
+        if let Some(first) = stems.insert(stem.clone(), f) {
+            let why = format!(
+                "`{}` and `{}` would both be {}.csv in the dataset; rename one",
+                first.display(),
+                f.display(),
+                stem.unwrap_or_default()
+            );
+            return Err(DataError::invalid(f, why).into());
+        }
+    }
+    let read: Vec<(crate::recording::Meta, String, ImportedFile)> = files
+        .par_iter()
+        .map(|f| {
+            let meta = crate::import::meta_from_name(f, p.pattern.as_ref())?;
+            let (text, summary) = sorted_log(f, p)?;
+            on_done();
+            Ok((meta, text, summary))
+        })
+        .collect::<Result<_>>()?;
+    crate::recording::create_dataset_dir(out, |dir| {
+        let mut metas = Vec::new();
+        let mut summaries = Vec::new();
+        for (meta, text, summary) in read {
+            let path = dir.join(&summary.file);
+            std::fs::write(&path, text).map_err(|e| DataError::write(&path, e))?;
+            metas.push(crate::recording::Meta {
+                file: summary.file.clone(),
+                ..meta
+            });
+            summaries.push(summary);
+        }
+        crate::recording::write_manifest(dir, &metas)?;
+        crate::recording::write_layout(dir, &imported_layout(p))?;
+        crate::recording::Dataset::open(dir)?;
+        Ok(summaries)
+    })
+}
+
+/// The layout an import writes: the grid, its mask, and the columns it writes.
+fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
+    let g = &p.grid;
+    let masked = g.present.iter().any(|&x| !x);
+    crate::recording::LayoutFile {
+        rows: Some(g.rows),
+        cols: Some(g.cols),
+        mask: masked.then(|| {
+            g.present
+                .chunks(g.cols)
+                .map(|row| row.iter().map(|&x| if x { '1' } else { '0' }).collect())
+                .collect()
+        }),
+        events: Some(EventsFormat {
+            values: p.format.values,
+            origin: p.format.origin,
+            ..EventsFormat::new(p.format.time_unit)
+        }),
+        ..Default::default()
+    }
+}
+
+/// One log's events in time order as the CSV text an import writes, and what was done.
+fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {
+    let mut events: Vec<(Stamp, (i128, i128), Option<i128>, usize)> = Vec::new();
+    let mut polarity = false;
+    parse(path, &p.format, &mut |event| {
+        match event {
+            Parsed::Columns { polarity: has } => polarity = has,
+            Parsed::Event { t, cell, p, at } => events.push((t, cell, p, at)),
+        }
+        Ok(())
+    })?;
+    let key = |t: &Stamp| as_f64(*t);
+    let mut reordered = 0;
+    let mut latest = f64::NEG_INFINITY;
+    for (t, ..) in &events {
+        let v = key(t);
+        if v < latest {
+            reordered += 1;
+        }
+        latest = latest.max(v);
+    }
+    if reordered > 0 {
+        events.sort_by(|a, b| match (a.0, b.0) {
+            (Stamp::Int(x), Stamp::Int(y)) => x.cmp(&y),
+            (x, y) => key(&x).total_cmp(&key(&y)),
+        });
+    }
+    let max_steps = (crate::recording::DEFAULT_MAX_DURATION_S * 1000.0) as u64;
+    let mut gather = Gather::new(&p.format, &p.grid, polarity, None, max_steps);
+    let name = format!(
+        "{}.csv",
+        path.file_stem()
+            .map_or(String::new(), |s| s.to_string_lossy().into_owned())
+    );
+    let mut text = String::from(if polarity { "t,x,y,p\n" } else { "t,x,y\n" });
+    for &(t, cell, pol, at) in &events {
+        let named = |m: String| -> crate::Error {
+            DataError::invalid(path, format!("{}: {m}", place(path, at))).into()
+        };
+        gather.push(t, cell, pol).map_err(named)?;
+        let c = gather.cell(cell).map_err(named)?;
+        use std::fmt::Write as _;
+        let _ = write!(text, "{},{},{}", show(t), c % p.grid.cols, c / p.grid.cols);
+        let _ = match pol {
+            Some(v) => writeln!(text, ",{v}"),
+            None => writeln!(text),
+        };
+    }
+    let done = gather.finish();
+    Ok((
+        text,
+        ImportedFile {
+            file: name,
+            events: done.count,
+            reordered,
+            merged: done.merged,
+        },
+    ))
 }
 
 /// One event to write: its millisecond, grid column (x) and row (y), and polarity (1 ON,

@@ -451,7 +451,7 @@ fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
     DataError::invalid(path, message).into()
 }
 
-fn meta_from_name(path: &Path, pattern: Option<&NamePattern>) -> Result<Meta> {
+pub(crate) fn meta_from_name(path: &Path, pattern: Option<&NamePattern>) -> Result<Meta> {
     // A lossy name would turn distinct non-UTF-8 names (and the labels in them) into one.
     let name = match path.file_name().map(|n| n.to_str()) {
         Some(Some(name)) => name.to_string(),

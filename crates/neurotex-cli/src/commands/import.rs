@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use neurotex::workflows::import::{ImportCsvOptions, ImportStackedOptions};
+use neurotex::workflows::import::{ImportCsvOptions, ImportEventsOptions, ImportStackedOptions};
 
 use crate::output::Shown;
 
@@ -16,6 +16,23 @@ pub enum ImportCommand {
     Csv(ImportCsvArgs),
     /// A stacked array `(N, ...)` with one label (and optionally one speed) per sample.
     Stacked(ImportStackedArgs),
+    /// Address-event logs of an event sensor (one file per trial: a time, x and y or a
+    /// taxel index, and optionally a polarity per event; CSV with a header row or tonic's
+    /// structured `.npy`), with metadata from the file names. Events out of time order are
+    /// sorted (and counted); every other rule is checked as a dataset's reader checks it.
+    /// The dataset's recordings skip the encoder: ON events are the SA population's spikes,
+    /// OFF events the FA population's.
+    Events(ImportEventsArgs),
+}
+
+/// Options of `neurotex import events`.
+#[derive(Args)]
+pub struct ImportEventsArgs {
+    #[command(flatten)]
+    pub options: ImportEventsOptions,
+    /// The dataset folder to create (must not exist, or be empty).
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// Options of `neurotex import csv`.
@@ -38,7 +55,7 @@ pub struct ImportStackedArgs {
     pub out: PathBuf,
 }
 
-/// Runs `neurotex import csv` or `neurotex import stacked`.
+/// Runs `neurotex import csv`, `stacked` or `events`.
 pub fn run(command: ImportCommand) -> Result<()> {
     match command {
         ImportCommand::Csv(args) => {
@@ -46,6 +63,12 @@ pub fn run(command: ImportCommand) -> Result<()> {
             let summary = args.options.run(&args.out, &shown.callback());
             shown.finish();
             summary?;
+        }
+        ImportCommand::Events(args) => {
+            let shown = Shown::new("importing");
+            let imported = args.options.run(&args.out, &shown.callback());
+            shown.finish();
+            imported?;
         }
         ImportCommand::Stacked(args) => {
             let n = args.options.run(&args.out)?;

@@ -1,14 +1,20 @@
-//! `import`: recordings from other layouts into the dataset format: per-trial CSV logs,
-//! or a stacked array with one label per sample.
+//! `import`: recordings from other layouts into the dataset format: per-trial CSV logs, a
+//! stacked array with one label per sample, or address-event logs.
 
 use std::path::{Path, PathBuf};
 
 use super::{LogOptions, OnProgress};
+use crate::error::ParamError;
+use crate::events::{
+    event_files, import_events, EventGrid, EventImportParams, EventsFormat, ImportedFile, Origin,
+};
+use crate::import::NamePattern;
 use crate::import::{
     csv_files, import_csv, import_stacked, Axes, CsvImportParams, ImportSummary, StackedParams,
 };
 use crate::progress::Progress;
-use crate::recording::Baseline;
+use crate::recording::{Baseline, ChannelMap};
+use crate::values::TimeUnit;
 use crate::{Grid, Result, SampleRate};
 
 /// Options of `import csv`.
@@ -125,5 +131,149 @@ impl ImportStackedOptions {
             &params,
             out,
         )
+    }
+}
+
+/// Options of `import events`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct ImportEventsOptions {
+    /// Event logs (CSV with a header row, or `.npy` with a structured dtype such as
+    /// tonic's), or folders whose .csv and .npy files are all imported.
+    #[cfg_attr(feature = "cli", arg(required = true))]
+    pub inputs: Vec<PathBuf>,
+    /// The sensor's grid, `ROWSxCOLS`: x is the column (0 to COLS - 1), y the row.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub grid: Grid,
+    /// The unit of the time stamps: `us` (tonic's), `ms` or `s`.
+    #[cfg_attr(feature = "cli", arg(long = "time-unit"))]
+    pub time_unit: TimeUnit,
+    /// Metadata from file names, e.g. `{label}_v{speed}_{trial}` (without it the label is
+    /// the file stem).
+    #[cfg_attr(feature = "cli", arg(long = "name-pattern"))]
+    pub name_pattern: Option<NamePattern>,
+    /// The time column or field.
+    #[cfg_attr(feature = "cli", arg(long = "time-column", default_value = "t"))]
+    pub time_column: String,
+    /// The column (x) and row (y) columns or fields.
+    #[cfg_attr(feature = "cli", arg(long, default_value = "x"))]
+    pub x: String,
+    /// See --x.
+    #[cfg_attr(feature = "cli", arg(long, default_value = "y"))]
+    pub y: String,
+    /// Instead of --x and --y: a 0-based taxel index column, placed on the grid by
+    /// --channel-map (row-major without one).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub taxel: Option<String>,
+    /// Each taxel index's cell, `row,col;row,col;...` in index order.
+    #[cfg_attr(feature = "cli", arg(long = "channel-map"))]
+    pub channel_map: Option<ChannelMap>,
+    /// The polarity column or field (a log without it holds ON events only).
+    #[cfg_attr(feature = "cli", arg(long, default_value = "p"))]
+    pub polarity: String,
+    /// The ON and OFF polarity values, `ON,OFF` (booleans read as 1 and 0).
+    #[cfg_attr(
+        feature = "cli",
+        arg(
+            long = "polarity-values",
+            default_value = "1,0",
+            allow_hyphen_values = true
+        )
+    )]
+    pub polarity_values: String,
+    /// Time 0: `zero` (the stamps count from the recording's start) or `first` (the first
+    /// event's stamp, for logs stamped with a clock).
+    #[cfg_attr(feature = "cli", arg(long, default_value = "zero"))]
+    pub origin: String,
+}
+
+impl ImportEventsOptions {
+    /// The import's parameters.
+    ///
+    /// # Errors
+    /// Polarity values or an origin that do not parse, or a channel map that does not fit
+    /// the grid.
+    pub fn params(&self) -> Result<EventImportParams> {
+        let values: Vec<i64> = self
+            .polarity_values
+            .split(',')
+            .map(|v| v.trim().parse::<i64>())
+            .collect::<Result<_, _>>()
+            .ok()
+            .filter(|v: &Vec<i64>| v.len() == 2 && v[0] != v[1])
+            .ok_or_else(|| {
+                let rule =
+                    "polarity values are two different integers, ON,OFF (for example 1,0 or 1,-1)";
+                ParamError::new("polarity-values", rule, &self.polarity_values)
+            })?;
+        let origin = match self.origin.as_str() {
+            "zero" => Origin::Zero,
+            "first" => Origin::First,
+            other => {
+                let rule = "the origin is `zero` or `first`";
+                return Err(ParamError::new("origin", rule, other).into());
+            }
+        };
+        let (rows, cols) = (self.grid.rows(), self.grid.cols());
+        let taxels: Vec<usize> = match &self.channel_map {
+            Some(map) => map.cells().iter().map(|c| c.row * cols + c.col).collect(),
+            None => (0..rows * cols).collect(),
+        };
+        if let Some(map) = &self.channel_map {
+            if let Some(c) = map.cells().iter().find(|c| c.row >= rows || c.col >= cols) {
+                let rule = "every channel-map cell must lie on the grid";
+                return Err(
+                    ParamError::new("channel-map", rule, format!("{c} on {rows}x{cols}")).into(),
+                );
+            }
+        }
+        Ok(EventImportParams {
+            pattern: self.name_pattern.clone(),
+            format: EventsFormat {
+                time_unit: self.time_unit,
+                time: self.time_column.clone(),
+                x: self.x.clone(),
+                y: self.y.clone(),
+                taxel: self.taxel.clone(),
+                polarity: self.polarity.clone(),
+                values: [values[0], values[1]],
+                origin,
+            },
+            grid: EventGrid {
+                rows,
+                cols,
+                present: self.grid.present().to_vec(),
+                taxels,
+            },
+        })
+    }
+
+    /// Imports the logs into the dataset folder `out`, saying what was reordered and
+    /// written.
+    ///
+    /// # Errors
+    /// A log that cannot be read or breaks a rule, or a folder that cannot be written.
+    pub fn run(&self, out: &Path, on: OnProgress) -> Result<Vec<ImportedFile>> {
+        let params = self.params()?;
+        let files = event_files(&self.inputs)?;
+        on(Progress::Stage("importing", files.len()));
+        let imported = import_events(&files, &params, out, &|| on(Progress::Tick))?;
+        for f in imported.iter().filter(|f| f.reordered > 0) {
+            on(Progress::Advice(&format!(
+                "{}: {} event(s) came before an earlier line's time and were sorted into time order",
+                f.file, f.reordered
+            )));
+        }
+        let events: usize = imported.iter().map(|f| f.events).sum();
+        let merged: usize = imported.iter().map(|f| f.merged).sum();
+        on(Progress::Say(&format!(
+            "{} recordings, {events} events ({merged} in a millisecond already holding an event of their cell and polarity, so one spike) -> {}; {}x{} grid, times in {}",
+            imported.len(),
+            out.display(),
+            params.grid.rows,
+            params.grid.cols,
+            self.time_unit
+        )));
+        Ok(imported)
     }
 }
