@@ -744,9 +744,12 @@ fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
     }
 }
 
+/// An event as parsed: time, cell fields, polarity, and its line or record.
+type RawEvent = (Stamp, (i128, i128), Option<i128>, usize);
+
 /// One log's events in time order as the CSV text an import writes, and what was done.
 fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {
-    let mut events: Vec<(Stamp, (i128, i128), Option<i128>, usize)> = Vec::new();
+    let mut events: Vec<RawEvent> = Vec::new();
     let mut polarity = false;
     parse(path, &p.format, &mut |event| {
         match event {
