@@ -183,6 +183,55 @@ fn exported_events_give_the_encoded_spikes_results_bit_for_bit() {
             .collect()
     };
     assert_eq!(ranked(&npy), ranked(&sim));
+    // reproduce: every analysis the events can have gives the sampled run's numbers, and
+    // those they cannot have are skipped with the reason
+    let report = |ds: &Path, extra: &[&str]| -> Value {
+        let out = dir.join(&format!(
+            "rep_{}",
+            ds.file_name().unwrap().to_string_lossy()
+        ));
+        let mut args = vec![
+            "reproduce",
+            "--dataset",
+            s(ds),
+            "--out",
+            s(&out),
+            "--quick",
+            "--folds",
+            "3",
+            "--k",
+            "1",
+        ];
+        args.extend_from_slice(extra);
+        dir.ok(&args);
+        let text = std::fs::read_to_string(out.join("results.json")).unwrap();
+        without_clock_and_files(serde_json::from_str(&text).unwrap())
+    };
+    let (sampled, events) = (report(&sim, &["--encoder-draws", "1"]), report(&npy, &[]));
+    for analysis in ["e1", "e2", "e3", "e4", "e5", "e6", "e8", "e0"] {
+        assert!(!sampled[analysis].is_null(), "{analysis}");
+        assert_eq!(events[analysis], sampled[analysis], "{analysis}");
+    }
+    assert_eq!(events["e9"]["per_speed"], sampled["e9"]["per_speed"]);
+    assert_eq!(events["e9"]["held_out"], sampled["e9"]["held_out"]);
+    for skipped in ["e7", "e5c", "encoder sensitivity"] {
+        let why = events["skipped"][skipped].as_str().unwrap_or_default();
+        assert!(why.contains("address events"), "{skipped}: {why}");
+    }
+}
+
+/// `results.json` without wall-clock times and the recordings' file names (the event
+/// dataset's are numbered).
+fn without_clock_and_files(value: Value) -> Value {
+    match value {
+        Value::Object(map) => map
+            .into_iter()
+            .filter(|(k, _)| k != "seconds" && k != "file")
+            .map(|(k, v)| (k, without_clock_and_files(v)))
+            .collect(),
+        Value::Array(items) => items.into_iter().map(without_clock_and_files).collect(),
+        other => other,
+    }
 }
 
 /// An event dataset of 2x2 cells with `files` (name, CSV text) and the layout's `[events]`

@@ -531,38 +531,8 @@ impl Pipeline {
     /// # Errors
     /// `fa` or `sa+fa` on a recording without polarities.
     pub fn from_events(&self, meta: Meta, events: Events, path: &Path) -> Result<Encoded> {
-        let trains = |lists: &[Vec<u32>]| {
-            SpikeTrains::from_lists(
-                lists,
-                events.rows,
-                events.cols,
-                &events.present,
-                events.n_steps,
-            )
-        };
-        let off = || {
-            events.off.as_deref().map(trains).ok_or_else(|| {
-                let why = format!(
-                    "has no polarity column, so no OFF events: the `{}` encoding reads OFF events as its FA population; use --encoding sa (ON events)",
-                    self.params.encoding.name()
-                );
-                crate::Error::from(DataError::invalid(path, why))
-            })
-        };
-        let (spikes, fa) = match self.params.encoding {
-            Encoding::Sa => (trains(&events.on), None),
-            Encoding::Fa => (off()?, None),
-            Encoding::SaFa => (trains(&events.on), Some(off()?)),
-        };
-        Ok(Encoded {
-            meta,
-            spikes,
-            fa,
-            resampled: false,
-            flat: events.count == 0,
-        })
+        events_encoded(self.params.encoding, meta, events, path)
     }
-
     /// [`Pipeline::encode_dataset`], also applying `also` to each recording and its
     /// conditioned signal while both are in memory (the baselines without spikes read
     /// the signal the encoder receives without conditioning it twice).
@@ -597,6 +567,48 @@ impl Pipeline {
     pub fn extractor(&self, grid: &Grid) -> Result<FeatureExtractor, ParamError> {
         FeatureExtractor::new(&self.params, grid)
     }
+}
+
+/// [`Pipeline::from_events`] for `encoding`.
+///
+/// # Errors
+/// `fa` or `sa+fa` on a recording without polarities.
+pub fn events_encoded(
+    encoding: Encoding,
+    meta: Meta,
+    events: Events,
+    path: &Path,
+) -> Result<Encoded> {
+    let trains = |lists: &[Vec<u32>]| {
+        SpikeTrains::from_lists(
+            lists,
+            events.rows,
+            events.cols,
+            &events.present,
+            events.n_steps,
+        )
+    };
+    let off = || {
+        events.off.as_deref().map(trains).ok_or_else(|| {
+                let why = format!(
+                    "has no polarity column, so no OFF events: the `{}` encoding reads OFF events as its FA population; use --encoding sa (ON events)",
+                    encoding.name()
+                );
+                crate::Error::from(DataError::invalid(path, why))
+            })
+    };
+    let (spikes, fa) = match encoding {
+        Encoding::Sa => (trains(&events.on), None),
+        Encoding::Fa => (off()?, None),
+        Encoding::SaFa => (trains(&events.on), Some(off()?)),
+    };
+    Ok(Encoded {
+        meta,
+        spikes,
+        fa,
+        resampled: false,
+        flat: events.count == 0,
+    })
 }
 
 /// One population's 3D-GLCM gray levels, `cell * bins + bin`, as the extractor quantises

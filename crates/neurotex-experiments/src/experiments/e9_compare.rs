@@ -90,6 +90,9 @@ pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<
     if prepared.speeds.len() < 2 {
         return Err(Stop::Skipped(Skip::OneSpeedE9));
     }
+    if prepared.encoded.iter().any(|e| e.fa.is_none()) {
+        return Err(Stop::Skipped(Skip::NoOffEvents));
+    }
     let set = CandidateSet::standard(params.knn, params.seed);
     let pipeline = params.pipeline().params().clone();
     let list = candidates(&prepared.encoded, &prepared.grid, &pipeline, &set, 0.0)?;

@@ -15,7 +15,7 @@ use crate::compare::signal::SignalRows;
 use crate::encode::encode_banks;
 use crate::error::{ClassifyError, DataError, DatasetError, Result};
 use crate::inspect::severe_findings;
-use crate::pipeline::{Encoded, Encoding, Pipeline};
+use crate::pipeline::{events_encoded, Encoded, Encoding, Pipeline};
 use crate::recording::{Baseline, Dataset, Recording};
 use crate::signal::Conditioned;
 use crate::sim::{design, simulate_trial, RigParams, Trial, ALL_TEXTURES};
@@ -69,9 +69,15 @@ impl Source<'_> {
                     }
                     _ => String::new(),
                 };
-                format!(
-                    "Dataset folder `{root}`: {n} recordings as listed in its manifest; layout.toml:{grid} baseline removed: {baseline}."
-                )
+                match &layout.events {
+                    Some(e) => format!(
+                        "Dataset folder `{root}`: {n} address-event recordings as listed in its manifest; layout.toml:{grid} times in {}; the events skip the encoder (ON events are the SA population's spikes, OFF events the FA population's), so the encoder's parameters below do not apply.",
+                        e.time_unit
+                    ),
+                    None => format!(
+                        "Dataset folder `{root}`: {n} recordings as listed in its manifest; layout.toml:{grid} baseline removed: {baseline}."
+                    ),
+                }
             }
             Source::Simulated { rig, trials, seed } => describe_simulated(rig, trials, *seed),
         }
@@ -574,6 +580,11 @@ fn encode_one(
     params: &ValidReproduceParams,
 ) -> Result<EncodedOne> {
     let pipeline = params.pipeline();
+    if let Source::Dataset(ds) = source {
+        if ds.is_events() {
+            return events_one(ds, i, params);
+        }
+    }
     let rec = source.load(i)?;
     let causal = match causal {
         Some(p) => Some(p.encode(&rec, source.baseline())?),
@@ -620,6 +631,29 @@ fn encode_one(
         perturbed,
         causal,
         signal,
+    })
+}
+
+/// An address-event recording as [`encode_one`] gives an encoded one: its ON and OFF
+/// trains, both when E9 compares the `sa+fa` encoding and the events have polarities; no
+/// sweep, perturbation or causal twin (the events skip the encoder), and no signal for
+/// E9's baselines.
+fn events_one(ds: &Dataset, i: usize, params: &ValidReproduceParams) -> Result<EncodedOne> {
+    let events = ds.load_events(i)?;
+    let path = ds.root.join(&ds.entries[i].file);
+    let mut encoding = params.pipeline().params().encoding;
+    if params.e9 && encoding == Encoding::Sa && events.off.is_some() {
+        encoding = Encoding::SaFa;
+    }
+    let encoded = events_encoded(encoding, ds.entries[i].clone(), events, &path)?;
+    Ok(EncodedOne {
+        encoded,
+        sweep: None,
+        perturbed: Vec::new(),
+        causal: None,
+        signal: params
+            .e9
+            .then(|| Err("the recordings are address events, which carry no signal".into())),
     })
 }
 

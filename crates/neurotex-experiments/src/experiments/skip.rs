@@ -22,6 +22,12 @@ pub enum Skip {
     /// E9 compares within and across speeds.
     #[error("the dataset has only one speed; E9 compares within and across speeds")]
     OneSpeedE9,
+    /// E9 compares the `sa+fa` encoding; address events without polarities have no OFF
+    /// events for its FA population.
+    #[error(
+        "the address events have no polarity column, so no OFF events for E9's sa+fa candidates"
+    )]
+    NoOffEvents,
     /// E5c: the causal conditioning cannot be fixed on this speed's recordings.
     #[error("{reason}")]
     Causal {
@@ -59,7 +65,7 @@ impl Skip {
             Skip::TooFewTaxels => "e3".into(),
             Skip::TaxelsBeyondTheGrid { taxels, .. } => format!("e3 n > {taxels}"),
             Skip::OneSpeed => "e6".into(),
-            Skip::OneSpeedE9 => "e9".into(),
+            Skip::OneSpeedE9 | Skip::NoOffEvents => "e9".into(),
             Skip::Causal { speed, .. } => format!("e5c at {speed} mm/s"),
             Skip::Neighbours { k, speed, .. } => format!("e8 k={k} at {speed} mm/s"),
             Skip::Design { analysis, .. } => (*analysis).into(),

@@ -124,9 +124,19 @@ fn analyse(
     Ok(match data {
         Data::Folder(ds) => {
             let source = Source::Dataset(ds);
+            let events = ds.is_events();
+            let params = match events {
+                true => for_events(params, run)?,
+                false => params,
+            };
             let (params, calibration) = calibrated(params, run, &source)?;
             let prepared = prepare(&source, &params, run.on_progress)?;
             let mut results = run_all(&prepared, &params, run.on_progress)?;
+            if events {
+                for (id, why) in EVENTS_SKIP {
+                    results.skipped.insert(id.into(), why.into());
+                }
+            }
             results.gain_calibration = calibration;
             (results, source.describe(), params)
         }
@@ -138,6 +148,32 @@ fn analyse(
             results.gain_calibration = calibration;
             (results, describe_seeds(&first, seeds), params)
         }
+    })
+}
+
+/// The analyses an address-event dataset cannot have, and why: its spikes come from the
+/// sensor, not from neurotex's encoder.
+const EVENTS_SKIP: [(&str, &str); 3] = [
+    ("e7", "the recordings are address events, which skip the encoder: there is no gain to sweep"),
+    ("e5c", "the recordings are address events, which skip the encoder: there is no signal to condition causally"),
+    ("encoder sensitivity", "the recordings are address events, which skip the encoder: there is no input to perturb"),
+];
+
+/// The parameters of a run on address events: no gain sweep, causal conditioning or
+/// perturbed encodings (see [`EVENTS_SKIP`]).
+///
+/// # Errors
+/// `--gain auto`, which calibrates the encoder.
+fn for_events(params: ReproduceParams, run: &Run<'_>) -> Result<ReproduceParams> {
+    if run.gain_target.is_some() {
+        let why = "--gain auto calibrates the encoder, and address events skip it";
+        return Err(crate::error::OptionsError::Conflict(why.into()).into());
+    }
+    Ok(ReproduceParams {
+        e7: false,
+        e5_causal: false,
+        encoder_draws: 1,
+        ..params
     })
 }
 
