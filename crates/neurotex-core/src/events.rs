@@ -138,7 +138,7 @@ pub struct Events {
 /// One event as read: its time in the file's unit (exact for integers) and its fields.
 #[derive(Debug, Clone, Copy)]
 enum Stamp {
-    Int(i128),
+    Int(i64),
     Float(f64),
 }
 
@@ -194,13 +194,13 @@ impl<'a> Gather<'a> {
     }
 
     /// Adds one event; `Err` holds the reason, the caller adds where.
-    fn push(&mut self, t: Stamp, cell: (i128, i128), p: Option<i128>) -> Result<(), String> {
+    fn push(&mut self, t: Stamp, cell: (i64, i64), p: Option<i64>) -> Result<(), String> {
         let step = self.step(t)?;
         let cell = self.cell(cell)?;
         let trains = match p {
             None => &mut self.on,
-            Some(v) if v == i128::from(self.format.values[0]) => &mut self.on,
-            Some(v) if v == i128::from(self.format.values[1]) => self
+            Some(v) if v == i64::from(self.format.values[0]) => &mut self.on,
+            Some(v) if v == i64::from(self.format.values[1]) => self
                 .off
                 .as_mut()
                 .expect("a polarity column gives OFF trains"),
@@ -224,6 +224,29 @@ impl<'a> Gather<'a> {
 
     /// The event's 1 ms step, checking order, origin and duration.
     fn step(&mut self, t: Stamp) -> Result<u64, String> {
+        // The common case, an integer stamp in order after the first: exact integer
+        // arithmetic, no branch on the origin's kind.
+        if let (Stamp::Int(t), Some(Stamp::Int(last)), Some(Stamp::Int(first))) =
+            (t, self.last, self.first)
+        {
+            let from = match self.format.origin {
+                Origin::Zero => 0,
+                Origin::First => first,
+            };
+            let d = t.saturating_sub(from);
+            if t >= last && d >= 0 {
+                let ms = match self.format.time_unit {
+                    TimeUnit::Microseconds => d / 1000,
+                    TimeUnit::Milliseconds => d,
+                    TimeUnit::Seconds => d.saturating_mul(1000),
+                } as u64;
+                if ms < self.duration.unwrap_or(self.max_steps) {
+                    self.last = Some(Stamp::Int(t));
+                    self.last_step = Some(self.last_step.map_or(ms, |s| s.max(ms)));
+                    return Ok(ms);
+                }
+            }
+        }
         if let Some(last) = self.last {
             let back = match (last, t) {
                 (Stamp::Int(a), Stamp::Int(b)) => b < a,
@@ -263,7 +286,7 @@ impl<'a> Gather<'a> {
     }
 
     /// The event's cell (row-major index), checked against the grid and its mask.
-    fn cell(&self, (a, b): (i128, i128)) -> Result<usize, String> {
+    fn cell(&self, (a, b): (i64, i64)) -> Result<usize, String> {
         let g = self.grid;
         let (row, col) = match self.format.taxel {
             Some(_) => {
@@ -280,7 +303,7 @@ impl<'a> Gather<'a> {
                 (cell / g.cols, cell % g.cols)
             }
             None => {
-                let inside = |v: i128, n: usize| usize::try_from(v).ok().filter(|&v| v < n);
+                let inside = |v: i64, n: usize| usize::try_from(v).ok().filter(|&v| v < n);
                 match (inside(b, g.rows), inside(a, g.cols)) {
                     (Some(r), Some(c)) => (r, c),
                     _ => {
@@ -352,7 +375,7 @@ fn to_step(t: Stamp, from: Stamp, unit: TimeUnit) -> Result<u64, String> {
     };
     match (t, from) {
         (Stamp::Int(t), Stamp::Int(from)) => {
-            let d = t - from;
+            let d = t.saturating_sub(from);
             if d < 0 {
                 return Err(before());
             }
@@ -416,8 +439,8 @@ enum Parsed {
     },
     Event {
         t: Stamp,
-        cell: (i128, i128),
-        p: Option<i128>,
+        cell: (i64, i64),
+        p: Option<i64>,
         /// The CSV line (1-based, the header is line 1) or the `.npy` record (0-based).
         at: usize,
     },
@@ -428,7 +451,7 @@ enum Parsed {
 fn parse(
     path: &Path,
     format: &EventsFormat,
-    sink: &mut dyn FnMut(Parsed) -> Result<(), String>,
+    sink: &mut impl FnMut(Parsed) -> Result<(), String>,
 ) -> Result<()> {
     let npy = path
         .extension()
@@ -464,7 +487,7 @@ fn columns(names: &[&str], format: &EventsFormat) -> Result<Columns, String> {
 fn parse_csv(
     path: &Path,
     format: &EventsFormat,
-    sink: &mut dyn FnMut(Parsed) -> Result<(), String>,
+    sink: &mut impl FnMut(Parsed) -> Result<(), String>,
 ) -> Result<()> {
     let bad = |m: String| -> crate::Error { DataError::invalid(path, m).into() };
     let file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
@@ -496,9 +519,9 @@ fn parse_csv(
         line += 1;
         let at = |m: String| bad(format!("line {line}: {m}"));
         let field = |i: usize| std::str::from_utf8(&record[i]).unwrap_or("").trim();
-        let int = |i: usize, what: &str| -> Result<i128> {
+        let int = |i: usize, what: &str| -> Result<i64> {
             field(i)
-                .parse::<i128>()
+                .parse::<i64>()
                 .or(match field(i) {
                     "True" | "true" => Ok(1),
                     "False" | "false" => Ok(0),
@@ -506,7 +529,7 @@ fn parse_csv(
                 })
                 .map_err(|_| at(format!("{what} `{}` is not an integer", field(i))))
         };
-        let t = match field(cols.time).parse::<i128>() {
+        let t = match field(cols.time).parse::<i64>() {
             Ok(v) => Stamp::Int(v),
             Err(_) => Stamp::Float(
                 field(cols.time)
@@ -533,7 +556,7 @@ fn parse_csv(
 fn parse_npy(
     path: &Path,
     format: &EventsFormat,
-    sink: &mut dyn FnMut(Parsed) -> Result<(), String>,
+    sink: &mut impl FnMut(Parsed) -> Result<(), String>,
 ) -> Result<()> {
     let bad = |m: String| -> crate::Error { DataError::invalid(path, m).into() };
     let header = read_header(path)?;
@@ -745,7 +768,7 @@ fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
 }
 
 /// An event as parsed: time, cell fields, polarity, and its line or record.
-type RawEvent = (Stamp, (i128, i128), Option<i128>, usize);
+type RawEvent = (Stamp, (i64, i64), Option<i64>, usize);
 
 /// One log's events in time order as the CSV text an import writes, and what was done.
 fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {

@@ -59,19 +59,25 @@ pub(crate) struct NpyField {
 impl NpyField {
     /// The field of record `record` (a slice of one record's bytes) as an integer, when it
     /// is a little-endian (or one-byte) integer or boolean; `None` for any other type.
-    pub fn int(&self, record: &[u8]) -> Option<i128> {
-        let b = &record[self.offset..self.offset + self.bytes];
+    /// Unsigned 64-bit values above `i64::MAX` saturate there.
+    #[inline]
+    pub fn int(&self, record: &[u8]) -> Option<i64> {
         if self.big_endian && self.bytes > 1 {
             return None;
         }
-        let mut raw = [0u8; 8];
-        raw[..self.bytes.min(8)].copy_from_slice(&b[..self.bytes.min(8)]);
+        let b = &record[self.offset..];
+        let le = |n: usize| {
+            let mut raw = [0u8; 8];
+            raw[..n].copy_from_slice(&b[..n]);
+            u64::from_le_bytes(raw)
+        };
         Some(match (self.kind, self.bytes) {
-            ('b', 1) | ('u', 1 | 2 | 4 | 8) => i128::from(u64::from_le_bytes(raw)),
-            ('i', 1) => i128::from(b[0] as i8),
-            ('i', 2) => i128::from(i16::from_le_bytes([b[0], b[1]])),
-            ('i', 4) => i128::from(i32::from_le_bytes([b[0], b[1], b[2], b[3]])),
-            ('i', 8) => i128::from(i64::from_le_bytes(raw)),
+            ('i', 8) => i64::from_le_bytes(b[..8].try_into().ok()?),
+            ('i', 4) => i64::from(i32::from_le_bytes(b[..4].try_into().ok()?)),
+            ('i', 2) => i64::from(i16::from_le_bytes(b[..2].try_into().ok()?)),
+            ('i', 1) => i64::from(b[0] as i8),
+            ('b', 1) | ('u', 1 | 2 | 4) => le(self.bytes) as i64,
+            ('u', 8) => i64::try_from(le(8)).unwrap_or(i64::MAX),
             _ => return None,
         })
     }

@@ -20,6 +20,8 @@ pub mod simulate;
 pub mod stream;
 pub mod train;
 
+use rayon::prelude::*;
+
 use crate::analysis::FeatureTable;
 use crate::calibrate::{calibrate_pipeline, CalibratedParams, GainCalibration};
 use crate::classify::{ClassifierChoice, ForestParams, KnnParams, LinearParams};
@@ -27,7 +29,7 @@ use crate::error::OptionsError;
 use crate::options::StageOptions;
 use crate::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use crate::progress::Progress;
-use crate::recording::Dataset;
+use crate::recording::{one_grid, Dataset, Meta};
 use crate::snn::SnnParams;
 use crate::{Grid, Result};
 
@@ -236,9 +238,45 @@ pub fn feature_table(
     method: Method,
     on: OnProgress,
 ) -> Result<(FeatureTable, Grid)> {
-    let (encoded, grid) = encode_all(dataset, pipeline, indices, on)?;
+    // Each recording's spikes are dropped once its row is made: a dataset's spikes are
+    // never all in memory at once (the first recording, encoded twice, gives the grid).
+    on(Progress::Stage("encoding", indices.len()));
+    let one = |i: usize| -> Result<Encoded> {
+        let mut e = pipeline.encode_dataset(dataset, &[i], &|| ())?;
+        Ok(e.pop().expect("one recording encoded"))
+    };
+    let first = match indices.first() {
+        Some(&i) => one(i)?,
+        None => return Err(crate::error::DatasetError::Empty.into()),
+    };
+    let grid = shared_grid(std::slice::from_ref(&first))?;
     let extractor = pipeline.extractor(&grid)?;
-    Ok((FeatureTable::build(&encoded, &extractor, method)?, grid))
+    type Row = (Meta, bool, bool, Vec<f64>);
+    let rows: Vec<Row> = indices
+        .par_iter()
+        .map(|&i| {
+            let e = one(i)?;
+            let grids = [
+                (first.meta.file.as_str(), grid.clone()),
+                (e.meta.file.as_str(), e.spikes.grid()),
+            ];
+            one_grid(grids)?;
+            let row = extractor
+                .row(&e, method)
+                .map_err(|err| err.in_recording(&e.meta.file))?;
+            on(Progress::Tick);
+            Ok((e.meta, e.resampled, e.flat, row))
+        })
+        .collect::<Result<_>>()?;
+    let resampled = rows.iter().filter(|r| r.1).count();
+    let flat = rows.iter().filter(|r| r.2).map(|r| r.0.file.as_str());
+    say_noticed(resampled, flat, on);
+    let (metas, rows): (Vec<Meta>, Vec<Vec<f64>>) =
+        rows.into_iter().map(|(m, _, _, row)| (m, row)).unzip();
+    Ok((
+        FeatureTable::from_rows(&extractor, method, metas, &rows),
+        grid,
+    ))
 }
 
 /// Encodes the dataset's recordings `indices` (a stage `encoding` of one step each),
@@ -348,13 +386,21 @@ pub fn calibration_line(c: &GainCalibration) -> String {
 /// recordings without positive signal.
 pub fn say_conditions(encoded: &[Encoded], on: OnProgress) {
     let resampled = encoded.iter().filter(|e| e.resampled).count();
+    let flat = encoded
+        .iter()
+        .filter(|e| e.flat)
+        .map(|e| e.meta.file.as_str());
+    say_noticed(resampled, flat, on);
+}
+
+/// [`say_conditions`] from the count of resampled recordings and the flat ones' files.
+fn say_noticed<'a>(resampled: usize, flat: impl Iterator<Item = &'a str>, on: OnProgress) {
     if resampled > 0 {
         on(Progress::Say(&format!("note: {resampled} recording(s) resampled to the encoder's 1 kHz by linear interpolation")));
     }
-    for e in encoded.iter().filter(|e| e.flat) {
+    for file in flat {
         on(Progress::Advice(&format!(
-            "{}: no positive signal in the selected phase; left at zero (no spikes)",
-            e.meta.file
+            "{file}: no positive signal in the selected phase; left at zero (no spikes)"
         )));
     }
 }
