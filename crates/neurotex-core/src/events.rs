@@ -199,8 +199,8 @@ impl<'a> Gather<'a> {
         let cell = self.cell(cell)?;
         let trains = match p {
             None => &mut self.on,
-            Some(v) if v == i64::from(self.format.values[0]) => &mut self.on,
-            Some(v) if v == i64::from(self.format.values[1]) => self
+            Some(v) if v == self.format.values[0] => &mut self.on,
+            Some(v) if v == self.format.values[1] => self
                 .off
                 .as_mut()
                 .expect("a polarity column gives OFF trains"),

@@ -529,7 +529,7 @@ mod tests {
         let names: Vec<&str> = header.fields.iter().map(|f| f.name.as_str()).collect();
         assert_eq!(names, ["t", "x", "y", "p"]);
         let record = &bytes[header.data_offset..];
-        let values: Vec<i128> = header
+        let values: Vec<i64> = header
             .fields
             .iter()
             .map(|f| f.int(record).unwrap())
