@@ -8,7 +8,10 @@ use neurotex::recording::{
     create_dataset_dir, write_layout, write_manifest, LayoutFile, Meta, Recording,
 };
 use neurotex::sim::{check_design, design, write_dataset, RigParams, Texture, ALL_TEXTURES};
-use numpy::{IntoPyArray, PyArray2};
+use neurotex::events::Event;
+use neurotex::pipeline::Pipeline;
+use neurotex::workflows::export::encoded_events;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
@@ -141,6 +144,70 @@ fn features_dataset<'py>(
         rows.append(manifest_row(py, &dataset.columns, m)?)?;
     }
     Ok((values.into_pyarray(py), names, rows, c.report(py)?))
+}
+
+/// One recording's events as tonic's fields: x, y, t (microseconds), p.
+type EventColumns<'py> = (
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+);
+
+/// The spikes of a dataset folder's recordings `indices` as address events (`export
+/// events`' convention: ON `p` 1 for the SA population, OFF `p` 0 for the FA one; `t` in
+/// microseconds): an event dataset's events as read, a sampled one's encoded with the stage
+/// options. Returns the events of each recording asked for, every recording's manifest row,
+/// and the grid `(rows, cols)` of the first recording asked for (`None` with none).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn dataset_events<'py>(
+    py: Python<'py>,
+    dir: PathBuf,
+    options: &Bound<'py, PyDict>,
+    indices: Vec<usize>,
+) -> PyResult<(Vec<EventColumns<'py>>, Bound<'py, PyList>, Option<(usize, usize)>)> {
+    let stages = params::stages(options)?;
+    if stages.causal || stages.gain.target_hz().is_some() {
+        let why = "gain='auto' and causal=True calibrate on a whole dataset; pass the gain (neurotex.calibrate_gain chooses one) and leave causal off";
+        return Err(raise(Kind::Parameter, why.to_string()));
+    }
+    let dataset = open(&dir)?;
+    let n = dataset.entries.len();
+    if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
+        let why = format!("row {bad} is beyond the manifest's {n} recordings");
+        return Err(raise(Kind::Parameter, why));
+    }
+    let encoding = stages.params.encoding;
+    let (events, grid) = py.detach(|| {
+        guarded(|| {
+            let pipeline = Pipeline::new(stages.params.clone())?;
+            let encoded = pipeline.encode_dataset(&dataset, &indices, &|| ())?;
+            let grid = encoded.first().map(|e| (e.spikes.rows, e.spikes.cols));
+            let events: Vec<Vec<Event>> = encoded
+                .par_iter()
+                .map(|e| encoded_events(e, encoding))
+                .collect();
+            Ok((events, grid))
+        })
+    })?;
+    let columns = events
+        .into_iter()
+        .map(|ev| {
+            let column = |f: fn(&Event) -> i64| ev.iter().map(f).collect::<Vec<i64>>().into_pyarray(py);
+            (
+                column(|e| i64::from(e.x)),
+                column(|e| i64::from(e.y)),
+                column(|e| i64::from(e.t_ms) * 1000),
+                column(|e| i64::from(e.p)),
+            )
+        })
+        .collect();
+    let rows = PyList::empty(py);
+    for m in &dataset.entries {
+        rows.append(manifest_row(py, &dataset.columns, m)?)?;
+    }
+    Ok((columns, rows, grid))
 }
 
 /// Writes arrays as a dataset folder (whole or not at all): one `.npy` per recording named
@@ -285,5 +352,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(features_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(save_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset_events, m)?)?;
     Ok(())
 }

@@ -613,6 +613,42 @@ def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = 
                    fs=d["fs"], baseline=d["baseline"], mask=mask, path=os.fspath(path))
 
 
+#: tonic's event dtype, as neurotex writes events: ``x`` the grid column, ``y`` the row,
+#: ``t`` in microseconds, ``p`` 1 for ON (the SA population's spikes) and 0 for OFF (FA).
+EVENT_DTYPE = np.dtype([("x", np.int64), ("y", np.int64), ("t", np.int64), ("p", np.int64)])
+
+
+def _event_arrays(columns: Any) -> List[np.ndarray]:
+    """The native ``(x, y, t, p)`` columns of each recording as :data:`EVENT_DTYPE` arrays."""
+    out = []
+    for x, y, t, p in columns:
+        a = np.empty(len(t), dtype=EVENT_DTYPE)
+        a["x"], a["y"], a["t"], a["p"] = x, y, t, p
+        out.append(a)
+    return out
+
+
+def events(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = None, *,
+           encoding: str = _DEFAULTS["encoding"], **stage_options: Any) -> List[np.ndarray]:
+    """The spikes of a dataset folder's recordings as tonic's event arrays
+    (:data:`EVENT_DTYPE`: ``x``, ``y``, ``t`` in microseconds, ``p``; in time order), one
+    per manifest row (or per row of ``rows``, 0-based). An address-event dataset's events
+    are read as every command reads them; a sampled one's recordings are encoded with the
+    stage options (``encoding``, ``gain``, ``preset``, ...), the SA population's spikes as
+    ON (``p`` 1) and the FA population's as OFF (``p`` 0), as ``neurotex export events``
+    writes them. ``gain="auto"`` and ``causal=True`` are refused: they calibrate on a whole
+    dataset.
+
+    Raises :class:`NotFoundError` for a missing folder, :class:`DataError` for a bad
+    recording and :class:`ParameterError` for a broken option."""
+    opts = _stage_options(encoding=encoding, **stage_options)
+    if rows is None:
+        _, manifest, _ = _native.dataset_events(os.fspath(path), opts, [])
+        rows = range(len(manifest))
+    columns, _, _ = _native.dataset_events(os.fspath(path), opts, [int(i) for i in rows])
+    return _event_arrays(columns)
+
+
 def save_dataset(
     path: Union[str, os.PathLike],
     recordings: Any,
@@ -1182,7 +1218,7 @@ class StreamClassifier:
 
 __all__ = [
     "encode", "features", "spike_stats", "rate_volume", "glcm3d", "glcm2d", "haralick",
-    "cross_validate", "load_dataset", "save_dataset", "simulate", "Model", "SpikingModel", "Recording",
+    "cross_validate", "load_dataset", "save_dataset", "simulate", "events", "EVENT_DTYPE", "Model", "SpikingModel", "Recording",
     "StreamClassifier", "reproduce", "Reproduction", "calibrate_gain", "GainCalibration",
     "CausalConditioning", "FeatureTable", "inspect", "Inspection",
     "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",

@@ -99,6 +99,13 @@ def cross_validate(
     repeats: int = 1,
 ) -> Dict[str, Any]: ...
 def load_dataset(dir: str, indices: Optional[List[int]] = None) -> Dict[str, Any]: ...
+def dataset_events(
+    dir: str, options: Dict[str, Any], indices: List[int]
+) -> Tuple[
+    List[Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.int64]]],
+    List[Dict[str, str]],
+    Optional[Tuple[int, int]],
+]: ...
 def features_dataset(
     dir: str, method: str, options: Dict[str, Any]
 ) -> Tuple[npt.NDArray[np.float64], List[str], List[Dict[str, str]], Report]: ...

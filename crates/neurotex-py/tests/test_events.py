@@ -1,0 +1,85 @@
+"""Spikes as tonic's event arrays: neurotex.events gives the events `neurotex export events`
+writes, an exported event dataset gives them back, and neurotex.tonic.Dataset serves them
+with tonic's dataset interface (tested against tonic itself where it is installed)."""
+
+import csv
+
+import numpy as np
+import pytest
+
+import neurotex
+import neurotex.tonic
+from neurotex.errors import ParameterError
+
+from conftest import run_cli
+
+
+@pytest.fixture(scope="module")
+def exported(sim_dir, tmp_path_factory):
+    """The simulated dataset's sa+fa spikes written by the CLI as tonic .npy events."""
+    out = tmp_path_factory.mktemp("events") / "ev"
+    run_cli("export", "events", "--dataset", sim_dir, "--out", out, "--format", "npy",
+            "--encoding", "sa+fa")
+    return out
+
+
+def exported_arrays(folder):
+    with open(folder / "manifest.csv") as f:
+        return [np.load(folder / row["file"]) for row in csv.DictReader(f)]
+
+
+def test_events_are_the_cli_export_and_read_back_unchanged(sim_dir, exported):
+    written = exported_arrays(exported)
+    assert len(written) == 30
+    ours = neurotex.events(sim_dir, encoding="sa+fa")
+    again = neurotex.events(exported, encoding="sa+fa")
+    for w, a, b in zip(written, ours, again):
+        assert w.dtype.names == ("x", "y", "t", "p") and a.dtype == neurotex.EVENT_DTYPE
+        assert np.array_equal(a, w.astype(neurotex.EVENT_DTYPE))
+        assert np.array_equal(b, a)
+        assert np.all(np.diff(a["t"]) >= 0) and set(np.unique(a["p"])) <= {0, 1}
+        assert np.all(a["t"] % 1000 == 0), "1 ms spikes, in microseconds"
+    # sa alone is the ON half of sa+fa; rows picks recordings
+    sa = neurotex.events(sim_dir, [3, 0], encoding="sa")
+    assert np.array_equal(sa[1], ours[0][ours[0]["p"] == 1])
+    assert np.array_equal(sa[0], ours[3][ours[3]["p"] == 1])
+
+
+def test_the_tonic_dataset_interface(exported):
+    data = neurotex.tonic.Dataset(exported, encoding="sa+fa")
+    assert len(data) == 30 and data.sensor_size == (4, 4, 2) and data.ordering == "xytp"
+    assert data.classes == ["CP", "FT1", "SB"]
+    labels = [r["label"] for r in csv.DictReader(open(exported / "manifest.csv"))]
+    assert [data.classes[t] for t in data.targets] == labels
+    events, target = data[4]
+    assert np.array_equal(events, neurotex.events(exported, [4], encoding="sa+fa")[0])
+    assert target == data.targets[4]
+    assert np.array_equal(data[-1][0], data[29][0])
+    with pytest.raises(IndexError):
+        data[30]
+    shifted = neurotex.tonic.Dataset(
+        exported, encoding="sa+fa", transform=lambda e: len(e),
+        target_transform=lambda t: data.classes[t],
+        transforms=lambda e, t: (e * 2, t.lower()))
+    assert shifted[4] == (2 * len(events), data.classes[target].lower())
+    with pytest.raises(ParameterError, match="gain='auto'"):
+        neurotex.tonic.Dataset(exported, gain="auto")
+
+
+def test_tonic_transforms_take_the_events(exported):
+    tonic = pytest.importorskip("tonic")
+    data = neurotex.tonic.Dataset(
+        exported, encoding="sa+fa",
+        transform=tonic.transforms.ToFrame(sensor_size=(4, 4, 2), time_window=200_000))
+    frames, _ = data[0]
+    events, _ = neurotex.tonic.Dataset(exported, encoding="sa+fa")[0]
+    # ToFrame: (frames, polarities, y, x) counts of whole 200 ms windows from the first
+    # event (a last, partial window is dropped); every event inside lands in one frame
+    assert frames.shape[1:] == (2, 4, 4)
+    inside = events[events["t"] < events["t"][0] + frames.shape[0] * 200_000]
+    assert 0 < len(events) - len(inside) < len(events) / 10
+    assert frames.sum() == len(inside)
+    on = inside[inside["p"] == 1]
+    assert frames[:, 1].sum() == len(on)
+    assert frames[:, 1, on["y"][0], on["x"][0]].sum() == np.sum(
+        (on["y"] == on["y"][0]) & (on["x"] == on["x"][0]))
