@@ -13,7 +13,8 @@
 //! Reading is strict, as for sampled recordings: a time that goes backwards, a cell outside
 //! the grid or masked, an unknown polarity, or a time past the recording's duration is an
 //! error naming the file and the line (CSV) or record (`.npy`). `neurotex import events`
-//! sorts logs whose events are out of order as it copies them.
+//! ([`crate::import::import_events`]) sorts logs whose events are out of order as it copies
+//! them.
 
 use std::path::Path;
 
@@ -137,7 +138,7 @@ pub struct Events {
 
 /// One event as read: its time in the file's unit (exact for integers) and its fields.
 #[derive(Debug, Clone, Copy)]
-enum Stamp {
+pub(crate) enum Stamp {
     Int(i64),
     Float(f64),
 }
@@ -155,7 +156,7 @@ enum CellColumns {
 }
 
 /// Gathers events into trains, checking each as it comes.
-struct Gather<'a> {
+pub(crate) struct Gather<'a> {
     format: &'a EventsFormat,
     grid: &'a EventGrid,
     max_steps: u64,
@@ -170,7 +171,7 @@ struct Gather<'a> {
 }
 
 impl<'a> Gather<'a> {
-    fn new(
+    pub(crate) fn new(
         format: &'a EventsFormat,
         grid: &'a EventGrid,
         polarity: bool,
@@ -194,7 +195,12 @@ impl<'a> Gather<'a> {
     }
 
     /// Adds one event; `Err` holds the reason, the caller adds where.
-    fn push(&mut self, t: Stamp, cell: (i64, i64), p: Option<i64>) -> Result<(), String> {
+    pub(crate) fn push(
+        &mut self,
+        t: Stamp,
+        cell: (i64, i64),
+        p: Option<i64>,
+    ) -> Result<(), String> {
         let step = self.step(t)?;
         let cell = self.cell(cell)?;
         let trains = match p {
@@ -286,7 +292,7 @@ impl<'a> Gather<'a> {
     }
 
     /// The event's cell (row-major index), checked against the grid and its mask.
-    fn cell(&self, (a, b): (i64, i64)) -> Result<usize, String> {
+    pub(crate) fn cell(&self, (a, b): (i64, i64)) -> Result<usize, String> {
         let g = self.grid;
         let (row, col) = match self.format.taxel {
             Some(_) => {
@@ -327,7 +333,7 @@ impl<'a> Gather<'a> {
         Ok(cell)
     }
 
-    fn finish(self) -> Events {
+    pub(crate) fn finish(self) -> Events {
         let n_steps = match (self.duration, self.last_step) {
             (Some(d), _) => d as usize,
             (None, Some(s)) => s as usize + 1,
@@ -346,14 +352,14 @@ impl<'a> Gather<'a> {
     }
 }
 
-fn as_f64(t: Stamp) -> f64 {
+pub(crate) fn as_f64(t: Stamp) -> f64 {
     match t {
         Stamp::Int(v) => v as f64,
         Stamp::Float(v) => v,
     }
 }
 
-fn show(t: Stamp) -> String {
+pub(crate) fn show(t: Stamp) -> String {
     match t {
         Stamp::Int(v) => v.to_string(),
         Stamp::Float(v) => v.to_string(),
@@ -433,7 +439,7 @@ pub fn read_events(
 }
 
 /// What a parser hands on: the file's columns once, then each event in file order.
-enum Parsed {
+pub(crate) enum Parsed {
     Columns {
         polarity: bool,
     },
@@ -448,7 +454,7 @@ enum Parsed {
 
 /// Parses an event file, CSV or `.npy` by its extension, handing each event to `sink`;
 /// an `Err` from the sink is named with the line or record.
-fn parse(
+pub(crate) fn parse(
     path: &Path,
     format: &EventsFormat,
     sink: &mut impl FnMut(Parsed) -> Result<(), String>,
@@ -615,7 +621,7 @@ fn parse_npy(
 }
 
 /// Where event `at` of a [`Parsed::Event`] is, as the messages say it.
-fn place(path: &Path, at: usize) -> String {
+pub(crate) fn place(path: &Path, at: usize) -> String {
     let npy = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
@@ -623,211 +629,6 @@ fn place(path: &Path, at: usize) -> String {
         true => format!("event {at} (0-based)"),
         false => format!("line {at}"),
     }
-}
-
-/// What `import events` did with one file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ImportedFile {
-    /// The file written into the dataset.
-    pub file: String,
-    /// Events imported.
-    pub events: usize,
-    /// Events that came before an earlier line's time and were moved into time order.
-    pub reordered: usize,
-    /// Events that share a millisecond with another of their cell and polarity.
-    pub merged: usize,
-}
-
-/// Options of [`import_events`].
-#[derive(Debug, Clone)]
-pub struct EventImportParams {
-    /// Metadata from file names; without it the label is the file stem.
-    pub pattern: Option<crate::import::NamePattern>,
-    /// How the logs are read.
-    pub format: EventsFormat,
-    /// The sensor's grid (and, for a taxel column, each taxel's cell).
-    pub grid: EventGrid,
-}
-
-/// The `.csv` and `.npy` files among `inputs` (folders are searched one level deep),
-/// sorted.
-///
-/// # Errors
-/// An input that does not exist or a folder that cannot be read.
-pub fn event_files(inputs: &[std::path::PathBuf]) -> Result<Vec<std::path::PathBuf>> {
-    let mut out = Vec::new();
-    let wanted = |p: &Path| {
-        p.extension()
-            .is_some_and(|x| x.eq_ignore_ascii_case("csv") || x.eq_ignore_ascii_case("npy"))
-    };
-    for input in inputs {
-        if input.is_dir() {
-            let entries = std::fs::read_dir(input).map_err(|e| DataError::io(input, e))?;
-            for e in entries {
-                let path = e.map_err(|e| DataError::io(input, e))?.path();
-                if wanted(&path) {
-                    out.push(path);
-                }
-            }
-        } else if input.is_file() {
-            out.push(input.clone());
-        } else {
-            return Err(DataError::invalid(input, "does not exist").into());
-        }
-    }
-    out.sort();
-    Ok(out)
-}
-
-/// Imports event logs into a new dataset folder `out`: each file's events sorted into time
-/// order (a stable sort: events of one time keep their order) and checked as a dataset's
-/// reader checks them, written as `<stem>.csv` with columns `t,x,y,p` (times and
-/// polarities as the log wrote them, taxel indices turned into x and y); a manifest from
-/// the file names; `layout.toml` with the grid and the `[events]` table. Files are read in
-/// parallel; `on_done` is called once per file.
-///
-/// Sorting rather than refusing: a logger that writes events from several buffers
-/// interleaves them a little, and the order carries no information a stable sort loses. A
-/// dataset's reader, in contrast, refuses events out of order, so a dataset is always in
-/// the order every command reads.
-///
-/// # Errors
-/// A file that cannot be read or breaks a rule (named with its line), two files of one
-/// stem, or `out` not empty.
-pub fn import_events(
-    files: &[std::path::PathBuf],
-    p: &EventImportParams,
-    out: &Path,
-    on_done: &(dyn Fn() + Sync),
-) -> Result<Vec<ImportedFile>> {
-    use rayon::prelude::*;
-    if files.is_empty() {
-        return Err(DataError::invalid(out, "no .csv or .npy event files to import").into());
-    }
-    let mut stems = std::collections::BTreeMap::new();
-    for f in files {
-        let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned());
-        if let Some(first) = stems.insert(stem.clone(), f) {
-            let why = format!(
-                "`{}` and `{}` would both be {}.csv in the dataset; rename one",
-                first.display(),
-                f.display(),
-                stem.unwrap_or_default()
-            );
-            return Err(DataError::invalid(f, why).into());
-        }
-    }
-    let read: Vec<(crate::recording::Meta, String, ImportedFile)> = files
-        .par_iter()
-        .map(|f| {
-            let meta = crate::import::meta_from_name(f, p.pattern.as_ref())?;
-            let (text, summary) = sorted_log(f, p)?;
-            on_done();
-            Ok((meta, text, summary))
-        })
-        .collect::<Result<_>>()?;
-    crate::recording::create_dataset_dir(out, |dir| {
-        let mut metas = Vec::new();
-        let mut summaries = Vec::new();
-        for (meta, text, summary) in read {
-            let path = dir.join(&summary.file);
-            std::fs::write(&path, text).map_err(|e| DataError::write(&path, e))?;
-            metas.push(crate::recording::Meta {
-                file: summary.file.clone(),
-                ..meta
-            });
-            summaries.push(summary);
-        }
-        crate::recording::write_manifest(dir, &metas)?;
-        crate::recording::write_layout(dir, &imported_layout(p))?;
-        crate::recording::Dataset::open(dir)?;
-        Ok(summaries)
-    })
-}
-
-/// The layout an import writes: the grid, its mask, and the columns it writes.
-fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
-    let g = &p.grid;
-    let masked = g.present.iter().any(|&x| !x);
-    crate::recording::LayoutFile {
-        rows: Some(g.rows),
-        cols: Some(g.cols),
-        mask: masked.then(|| {
-            g.present
-                .chunks(g.cols)
-                .map(|row| row.iter().map(|&x| if x { '1' } else { '0' }).collect())
-                .collect()
-        }),
-        events: Some(EventsFormat {
-            values: p.format.values,
-            origin: p.format.origin,
-            ..EventsFormat::new(p.format.time_unit)
-        }),
-        ..Default::default()
-    }
-}
-
-/// An event as parsed: time, cell fields, polarity, and its line or record.
-type RawEvent = (Stamp, (i64, i64), Option<i64>, usize);
-
-/// One log's events in time order as the CSV text an import writes, and what was done.
-fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {
-    let mut events: Vec<RawEvent> = Vec::new();
-    let mut polarity = false;
-    parse(path, &p.format, &mut |event| {
-        match event {
-            Parsed::Columns { polarity: has } => polarity = has,
-            Parsed::Event { t, cell, p, at } => events.push((t, cell, p, at)),
-        }
-        Ok(())
-    })?;
-    let key = |t: &Stamp| as_f64(*t);
-    let mut reordered = 0;
-    let mut latest = f64::NEG_INFINITY;
-    for (t, ..) in &events {
-        let v = key(t);
-        if v < latest {
-            reordered += 1;
-        }
-        latest = latest.max(v);
-    }
-    if reordered > 0 {
-        events.sort_by(|a, b| match (a.0, b.0) {
-            (Stamp::Int(x), Stamp::Int(y)) => x.cmp(&y),
-            (x, y) => key(&x).total_cmp(&key(&y)),
-        });
-    }
-    let max_steps = (crate::recording::DEFAULT_MAX_DURATION_S * 1000.0) as u64;
-    let mut gather = Gather::new(&p.format, &p.grid, polarity, None, max_steps);
-    let name = format!(
-        "{}.csv",
-        path.file_stem()
-            .map_or(String::new(), |s| s.to_string_lossy().into_owned())
-    );
-    let mut text = String::from(if polarity { "t,x,y,p\n" } else { "t,x,y\n" });
-    for &(t, cell, pol, at) in &events {
-        let named = |m: String| -> crate::Error {
-            DataError::invalid(path, format!("{}: {m}", place(path, at))).into()
-        };
-        gather.push(t, cell, pol).map_err(named)?;
-        let c = gather.cell(cell).map_err(named)?;
-        use std::fmt::Write as _;
-        let _ = write!(text, "{},{},{}", show(t), c % p.grid.cols, c / p.grid.cols);
-        let _ = match pol {
-            Some(v) => writeln!(text, ",{v}"),
-            None => writeln!(text),
-        };
-    }
-    let done = gather.finish();
-    Ok((
-        text,
-        ImportedFile {
-            file: name,
-            events: done.count,
-            reordered,
-            merged: done.merged,
-        },
-    ))
 }
 
 /// One event to write: its millisecond, grid column (x) and row (y), and polarity (1 ON,

@@ -4,12 +4,12 @@
 use std::path::PathBuf;
 
 use ndarray::Array3;
+use neurotex::events::Event;
+use neurotex::pipeline::Pipeline;
 use neurotex::recording::{
     create_dataset_dir, write_layout, write_manifest, LayoutFile, Meta, Recording,
 };
 use neurotex::sim::{check_design, design, write_dataset, RigParams, Texture, ALL_TEXTURES};
-use neurotex::events::Event;
-use neurotex::pipeline::Pipeline;
 use neurotex::workflows::export::encoded_events;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -166,7 +166,11 @@ fn dataset_events<'py>(
     dir: PathBuf,
     options: &Bound<'py, PyDict>,
     indices: Vec<usize>,
-) -> PyResult<(Vec<EventColumns<'py>>, Bound<'py, PyList>, Option<(usize, usize)>)> {
+) -> PyResult<(
+    Vec<EventColumns<'py>>,
+    Bound<'py, PyList>,
+    Option<(usize, usize)>,
+)> {
     let stages = params::stages(options)?;
     if stages.causal || stages.gain.target_hz().is_some() {
         let why = "gain='auto' and causal=True calibrate on a whole dataset; pass the gain (neurotex.calibrate_gain chooses one) and leave causal off";
@@ -194,7 +198,8 @@ fn dataset_events<'py>(
     let columns = events
         .into_iter()
         .map(|ev| {
-            let column = |f: fn(&Event) -> i64| ev.iter().map(f).collect::<Vec<i64>>().into_pyarray(py);
+            let column =
+                |f: fn(&Event) -> i64| ev.iter().map(f).collect::<Vec<i64>>().into_pyarray(py);
             (
                 column(|e| i64::from(e.x)),
                 column(|e| i64::from(e.y)),

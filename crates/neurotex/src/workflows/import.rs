@@ -5,13 +5,12 @@ use std::path::{Path, PathBuf};
 
 use super::{LogOptions, OnProgress};
 use crate::error::ParamError;
-use crate::events::{
-    event_files, import_events, EventGrid, EventImportParams, EventsFormat, ImportedFile, Origin,
-};
+use crate::events::{EventGrid, EventsFormat, Origin};
 use crate::import::NamePattern;
 use crate::import::{
     csv_files, import_csv, import_stacked, Axes, CsvImportParams, ImportSummary, StackedParams,
 };
+use crate::import::{event_files, import_events, EventImportParams, ImportedFile};
 use crate::progress::Progress;
 use crate::recording::{Baseline, ChannelMap};
 use crate::values::TimeUnit;
