@@ -351,6 +351,41 @@ fn broken_event_files_are_named_with_their_line() {
         err.contains("layout.toml") && err.contains("time_unit"),
         "{err}"
     );
+    // inspect summarises the events and names an unreadable file instead of stopping
+    let ds = event_dataset(
+        &dir,
+        "inspected",
+        "time_unit = \"ms\"\n",
+        &[
+            ("a.csv", good),
+            ("b.csv", "t,x,y,p\n0,0,0,1\n300,2,1,0\n"),
+            ("c.csv", good),
+        ],
+    );
+    let text = dir.ok(&["inspect", s(&ds)]);
+    assert!(
+        text.contains("3 recordings (address-event dataset): 2 read, 1 unreadable"),
+        "{text}"
+    );
+    assert!(
+        text.contains("address events on a 2x2 grid (4 cells), times in ms"),
+        "{text}"
+    );
+    assert!(
+        text.contains("2 events a recording (from 2 to 2), 50 % ON"),
+        "{text}"
+    );
+    let json: Value = serde_json::from_str(&dir.ok(&["inspect", s(&ds), "--json"])).unwrap();
+    let cells = json["events"]["cells"].as_array().unwrap();
+    // cell r1c1 holds one OFF event at 300 ms of a 301 ms recording in both files read
+    assert_eq!(cells.len(), 4);
+    let hz = cells[3]["off_hz"].as_f64().unwrap();
+    assert!((hz - 1000.0 / 301.0).abs() < 1e-9, "{hz}");
+    assert_eq!(cells[1]["silent_share"].as_f64(), Some(1.0));
+    assert!(json["signals"]["unreadable"][0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("line 3"));
     // a sampled-signal step names the event file
     let ds = event_dataset(
         &dir,

@@ -6,7 +6,7 @@ pub mod report;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
-use neurotex_core::{error, io, recording, values};
+use neurotex_core::{error, events, io, recording, values};
 use neurotex_experiments::experiments;
 use neurotex_learn::classify;
 use neurotex_pipeline::{calibrate, causal, compare, inspect, pipeline};

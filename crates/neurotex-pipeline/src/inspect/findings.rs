@@ -53,7 +53,7 @@ pub struct Finding {
     pub suggestion: String,
 }
 
-fn finding(
+pub(super) fn finding(
     severity: Severity,
     area: &'static str,
     code: &'static str,

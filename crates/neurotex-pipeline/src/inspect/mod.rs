@@ -10,6 +10,7 @@
 //! person looks at.
 
 pub mod design;
+pub mod events;
 mod findings;
 pub mod signals;
 
@@ -329,6 +330,9 @@ pub struct Inspection {
     pub signals: SignalSummary,
     /// The encoder at the gain, when checked.
     pub encoder: Option<EncoderCheck>,
+    /// An address-event dataset's events (its `signals` hold the recordings' lengths only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub events: Option<crate::events::EventSummary>,
     /// Findings, the most severe first.
     pub findings: Vec<Finding>,
     /// A trace of the first recording of each of the first [`TRACE_CLASSES`] classes.
@@ -389,6 +393,11 @@ pub fn inspect(
     on_done: &(dyn Fn() + Sync),
 ) -> Result<Inspection> {
     params.pipeline.check()?;
+    if let Source::Dataset(ds) = source {
+        if ds.is_events() {
+            return events::inspect_events(ds, params, on_done);
+        }
+    }
     let mut pipeline = Pipeline::new(params.pipeline.clone())?;
     let baseline = params
         .pipeline
@@ -451,6 +460,7 @@ pub fn inspect(
         layout,
         signals,
         encoder,
+        events: None,
         findings: Vec::new(),
         traces,
     };

@@ -55,15 +55,20 @@ pub fn text_lines(i: &Inspection) -> Vec<String> {
     if !speeds.is_empty() {
         out.push(format!("speeds (mm/s): {}", short_list(&speeds, 12)));
     }
+    let [dmin, dmid, dmax] = s.duration_s;
+    if let Some(e) = &i.events {
+        out.extend(event_lines(e, l, [dmin, dmid, dmax]));
+    }
     let rate = match s.fs_hz {
         Some([lo, mid, hi]) => format!("stamps at {mid:.2} Hz (from {lo:.2} to {hi:.2})"),
         None => format!("no stamps; {:.2} Hz nominal", l.fs_hz),
     };
-    let [dmin, dmid, dmax] = s.duration_s;
-    out.push(format!(
+    if i.events.is_none() {
+        out.push(format!(
         "{} channels on a {}x{} grid; {rate}; {dmid:.1} s a recording (from {dmin:.1} to {dmax:.1}); baseline removed: {}",
         l.channels.len(), l.rows, l.cols, l.baseline
     ));
+    }
     if let Some(e) = &i.encoder {
         let silent = e.taxels.iter().filter(|t| t.silent_share > 0.5).count();
         let mut rates: Vec<f64> = e.taxels.iter().map(|t| t.median_hz).collect();
@@ -84,6 +89,41 @@ pub fn text_lines(i: &Inspection) -> Vec<String> {
         }
     }
     out
+}
+
+/// An event dataset's grid, lengths and events, for [`text_lines`].
+fn event_lines(
+    e: &crate::events::EventSummary,
+    l: &crate::inspect::LayoutSummary,
+    [dmin, dmid, dmax]: [f64; 3],
+) -> Vec<String> {
+    let [emin, emid, emax] = e.events;
+    let silent = e.cells.iter().filter(|c| c.silent_share > 0.5).count();
+    let mut rates: Vec<f64> = e
+        .cells
+        .iter()
+        .map(|c| c.on_hz + c.off_hz.unwrap_or(0.0))
+        .collect();
+    rates.sort_by(f64::total_cmp);
+    let mid = rates.get(rates.len() / 2).copied().unwrap_or(0.0);
+    let polarity = match e.on_share {
+        Some(share) => format!("{} ON", percent(share)),
+        None => "ON only (no polarity column)".to_string(),
+    };
+    vec![
+        format!(
+            "address events on a {}x{} grid ({} cells), times in {}; {dmid:.1} s a recording (from {dmin:.1} to {dmax:.1})",
+            l.rows,
+            l.cols,
+            e.cells.len(),
+            e.time_unit
+        ),
+        format!(
+            "{emid} events a recording (from {emin} to {emax}), {polarity}; median cell {mid:.1} events/s; {silent} of {} cells silent in most recordings; {} of the events merged into the spike of their millisecond",
+            e.cells.len(),
+            percent(e.merged_share)
+        ),
+    ]
 }
 
 /// A markdown table.
@@ -171,8 +211,13 @@ pub fn markdown(i: &Inspection, source: &str, figures: &[(&str, String)]) -> Str
         .collect();
     md += &table(&["analysis", "supported", "why"], &support);
     md += &layout_section(i);
-    md += &signals_section(i);
-    md += &encoder_section(i);
+    match &i.events {
+        Some(e) => md += &events_section(i, e),
+        None => {
+            md += &signals_section(i);
+            md += &encoder_section(i);
+        }
+    }
     md += "\n## Figures\n\n";
     for (name, caption) in figures {
         md += &format!("![{name}](figures/{name}.png)\n\n{caption}\n\n");
@@ -309,6 +354,44 @@ fn encoder_section(i: &Inspection) -> String {
 }
 
 /// The figures with their captions, as `(name, svg, caption)`.
+/// An event dataset's lengths and events, in place of the signals and the encoder.
+fn events_section(i: &Inspection, e: &crate::events::EventSummary) -> String {
+    let s = &i.signals;
+    let [dmin, dmid, dmax] = s.duration_s;
+    let [emin, emid, emax] = e.events;
+    let mut md = format!(
+        "\n## Events\n\nAddress events, times in {}: they skip the encoder (ON events are the SA population's spikes, OFF events the FA population's). Durations: {dmid:.2} s median (from {dmin:.2} to {dmax:.2}). Events a recording: {emid} median (from {emin} to {emax}); {}; {} of the events fell in a millisecond already holding an event of their cell and polarity (one spike for both).\n\n",
+        e.time_unit,
+        e.on_share.map_or("ON events only (no polarity column)".to_string(), |x| format!("{} of them ON", percent(x))),
+        percent(e.merged_share)
+    );
+    for u in &s.unreadable {
+        md += &format!("- cannot be read: `{}`: {}\n", u.file, u.reason);
+    }
+    let rows: Vec<Vec<String>> = e
+        .cells
+        .iter()
+        .map(|c| {
+            vec![
+                format!("r{}c{}", c.cell[0], c.cell[1]),
+                format!("{:.1}", c.on_hz),
+                optional(c.off_hz, 1),
+                percent(c.silent_share),
+            ]
+        })
+        .collect();
+    md += &table(
+        &[
+            "cell",
+            "ON events/s (median)",
+            "OFF events/s (median)",
+            "silent in",
+        ],
+        &rows,
+    );
+    md + "\nRates are medians over the recordings read; a cell is silent in a recording without any event of either polarity.\n"
+}
+
 fn figures(
     i: &Inspection,
     source: &str,
@@ -328,7 +411,9 @@ fn figures(
         false => "",
     };
     let caption = format!("Left: each taxel's resting offset in the raw samples, before any baseline is removed: its smallest value over its range (median over recordings); far above 1 the encoder sees mostly the offset unless a baseline is removed (baseline here: {}).{encoder} Grey cells have no channel.", i.layout.baseline);
-    out.push(("taxels", figs::taxel_map(i, source), caption));
+    if i.events.is_none() {
+        out.push(("taxels", figs::taxel_map(i, source), caption));
+    }
     out.push(("design", figs::design(i, source), "Recordings of each class at each speed (or over all recordings when the manifest has no speeds).".to_string()));
     out
 }
