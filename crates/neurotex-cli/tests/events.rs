@@ -344,6 +344,23 @@ fn broken_event_files_are_named_with_their_line() {
         err.contains("no polarity column") && err.contains("--encoding sa"),
         "{err}"
     );
+    // a duration past the longest recording accepted is refused before anything is allocated
+    let ds = event_dataset(
+        &dir,
+        "long",
+        "time_unit = \"ms\"\n",
+        &[("a.csv", good), ("b.csv", good)],
+    );
+    std::fs::write(
+        ds.join("manifest.csv"),
+        "file,label,duration_s\na.csv,A,1e9\nb.csv,B,1\n",
+    )
+    .unwrap();
+    let err = features(&ds, &[]);
+    assert!(
+        err.contains("line 2: duration_s 1000000000 s is longer than"),
+        "{err}"
+    );
     // no unit
     let ds = event_dataset(&dir, "unit", "", &[("a.csv", good), ("b.csv", good)]);
     let err = features(&ds, &[]);
@@ -510,46 +527,11 @@ fn imported_logs_read_as_the_events_they_hold() {
         };
         assert_eq!(of(&imported), of(&direct), "{method}");
     }
-    // a taxel past the grid names the log and its line; nothing is written
-    std::fs::write(
-        logs.join("wool_9.csv"),
-        "clock,taxel,pol\n1.0,2,1\n1.5,6,1\n",
-    )
-    .unwrap();
+    // The import's checks, on these logs: each run must fail, naming what is wrong, and
+    // leave nothing behind, unless `ok`.
     let out = dir.join("bad");
-    let err = dir.fails(&[
-        "import",
-        "events",
-        s(&logs),
-        "--out",
-        s(&out),
-        "--grid",
-        "2x3",
-        "--time-unit",
-        "s",
-        "--time-column",
-        "clock",
-        "--taxel",
-        "taxel",
-        "--polarity",
-        "pol",
-        "--polarity-values",
-        "1,-1",
-        "--origin",
-        "first",
-    ]);
-    assert!(
-        err.contains("wool_9.csv: line 3: taxel 6 is outside the layout's 6 taxels"),
-        "{err}"
-    );
-    assert!(!out.exists() && !dir.partial_left());
-    for (extra, says) in [
-        (
-            ["--polarity-values", "1,1"],
-            "polarity values are two different integers",
-        ),
-        (["--origin", "start"], "the origin is `zero` or `first`"),
-    ] {
+    let polar = ["--polarity", "pol", "--polarity-values", "1,-1"];
+    let import = |extra: &[&str], ok: bool| -> String {
         let mut args = vec![
             "import",
             "events",
@@ -558,11 +540,65 @@ fn imported_logs_read_as_the_events_they_hold() {
             s(&out),
             "--grid",
             "2x3",
-            "--time-unit",
-            "s",
+            "--time-column",
+            "clock",
+            "--taxel",
+            "taxel",
         ];
-        args.extend_from_slice(&extra);
-        let err = dir.fails(&args);
-        assert!(err.contains(says), "{err}");
+        args.extend_from_slice(extra);
+        for (flag, value) in [("--time-unit", "s"), ("--origin", "first")] {
+            if !args.contains(&flag) {
+                args.extend([flag, value]);
+            }
+        }
+        let run = dir.run(&args);
+        assert_eq!(run.status.success(), ok, "{args:?}: {}", run.stderr);
+        if !ok {
+            assert!(!out.exists() && !dir.partial_left(), "{args:?}");
+        }
+        run.stderr
+    };
+    let line = "clock,taxel,pol\n1.0,2,1\n1.5,6,1\n";
+    std::fs::write(logs.join("wool_9.csv"), line).unwrap();
+    let err = import(&polar, false);
+    assert!(
+        err.contains("wool_9.csv: line 3: taxel 6 is outside the layout's 6 taxels"),
+        "{err}"
+    );
+    // a named polarity column missing from one log, or a log without events
+    std::fs::write(logs.join("wool_9.csv"), "clock,taxel\n1.0,2\n").unwrap();
+    let err = import(&polar, false);
+    assert!(
+        err.contains("wool_9.csv: no polarity column `pol`"),
+        "{err}"
+    );
+    std::fs::write(logs.join("wool_9.csv"), "clock,taxel,pol\n").unwrap();
+    assert!(import(&polar, false).contains("wool_9.csv: holds no events"));
+    std::fs::remove_file(logs.join("wool_9.csv")).unwrap();
+    // values given without the column's name ask for the default column, `p`
+    let err = import(&["--polarity-values", "1,-1"], false);
+    assert!(err.contains("no polarity column `p`"), "{err}");
+    // one taxel per cell; a taxel past a shorter map is named
+    let map = |cells: &'static str| [&polar[..], &["--channel-map", cells]].concat();
+    assert!(import(&map("0,0;0,0"), false).contains("each cell takes one taxel"));
+    let err = import(&map("1,2;1,1;1,0;0,2;0,1"), false);
+    assert!(
+        err.contains("taxel 5 is outside the layout's 5 taxels"),
+        "{err}"
+    );
+    // a wrong time unit shows in the spans and is said; the dataset is written
+    let err = import(&[&polar[..], &["--time-unit", "ms"]].concat(), true);
+    assert!(err.contains("the unit is probably wrong"), "{err}");
+    std::fs::remove_dir_all(&out).unwrap();
+    for (extra, says) in [
+        (
+            &["--polarity-values", "1,1"][..],
+            "polarity values are two different integers",
+        ),
+        (&["--origin", "start"], "the origin is `zero` or `first`"),
+        (&["--channel-map", "0,0", "--x", "c"], "--x"),
+    ] {
+        let err = import(extra, false);
+        assert!(err.contains(says), "{extra:?}: {err}");
     }
 }

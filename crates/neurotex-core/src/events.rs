@@ -213,7 +213,7 @@ impl<'a> Gather<'a> {
             Some(v) => {
                 let [on, off] = self.format.values;
                 return Err(format!(
-                    "polarity {v} is neither ON ({on}) nor OFF ({off}); layout.toml's `[events] values = [on, off]` names them"
+                    "polarity {v} is neither ON ({on}) nor OFF ({off}); `import events --polarity-values ON,OFF` (or layout.toml's `[events] values = [on, off]`) names them"
                 ));
             }
         };
@@ -280,11 +280,18 @@ impl<'a> Gather<'a> {
                     "time {} is at {step} ms, past the recording's duration_s ({d} ms) in the manifest",
                     show(t)
                 ),
-                None => format!(
-                    "time {} is at {step} ms, past the longest recording accepted ({} s, layout.toml's max_duration_s): a clock's stamps need `origin = \"first\"`, or the time unit is wrong",
-                    show(t),
-                    self.max_steps / 1000
-                ),
+                None => match self.format.origin {
+                    Origin::Zero => format!(
+                        "time {} is at {step} ms, past the longest recording accepted ({} s, layout.toml's max_duration_s): a clock's stamps need `--origin first` (`origin = \"first\"` in layout.toml), or the time unit is wrong",
+                        show(t),
+                        self.max_steps / 1000
+                    ),
+                    Origin::First => format!(
+                        "time {} is {step} ms after the first event, past the longest recording accepted ({} s, layout.toml's max_duration_s): is the time unit right?",
+                        show(t),
+                        self.max_steps / 1000
+                    ),
+                },
             });
         }
         self.last_step = Some(self.last_step.map_or(step, |s| s.max(step)));
@@ -375,7 +382,7 @@ const BOUNDARY_TOLERANCE_MS: f64 = 1e-6;
 fn to_step(t: Stamp, from: Stamp, unit: TimeUnit) -> Result<u64, String> {
     let before = || {
         format!(
-            "time {} is before the recording's start: stamps from a clock need layout.toml's `[events] origin = \"first\"`",
+            "time {} is before the recording's start: stamps from a clock need `--origin first` (`origin = \"first\"` in layout.toml's [events])",
             show(t)
         )
     };
@@ -474,7 +481,7 @@ fn columns(names: &[&str], format: &EventsFormat) -> Result<Columns, String> {
     let need = |name: &str| {
         find(name).ok_or_else(|| {
             format!(
-                "no column `{name}` (it has {}); layout.toml's [events] table names the columns",
+                "no column `{name}` (it has {}); `import events` options (--time-column, --x, --y, --taxel, --polarity) or layout.toml's [events] table name the columns",
                 names.join(", ")
             )
         })

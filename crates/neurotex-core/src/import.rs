@@ -1125,6 +1125,10 @@ pub struct ImportedFile {
     pub reordered: usize,
     /// Events that share a millisecond with another of their cell and polarity.
     pub merged: usize,
+    /// The recording's span from its start (by the origin) to its last event, s.
+    pub span_s: f64,
+    /// Whether the log has a polarity column.
+    pub polarity: bool,
 }
 
 /// Options of [`import_events`].
@@ -1136,6 +1140,9 @@ pub struct EventImportParams {
     pub format: crate::events::EventsFormat,
     /// The sensor's grid (and, for a taxel column, each taxel's cell).
     pub grid: crate::events::EventGrid,
+    /// The polarity column was named (or its values given): a log without it is an error,
+    /// not ON events only.
+    pub require_polarity: bool,
 }
 
 /// The `.csv` and `.npy` files among `inputs` (folders are searched one level deep),
@@ -1215,6 +1222,17 @@ pub fn import_events(
             Ok((meta, text, summary))
         })
         .collect::<Result<_>>()?;
+    // `read` is in the order of `files`.
+    let with = read.iter().zip(files).find(|(r, _)| r.2.polarity);
+    let without = read.iter().zip(files).find(|(r, _)| !r.2.polarity);
+    if let (Some((_, with)), Some((_, without))) = (with, without) {
+        let why = format!(
+            "has no polarity column `{}`, which {} has: its OFF events would be read as ON",
+            p.format.polarity,
+            with.display()
+        );
+        return Err(DataError::invalid(without, why).into());
+    }
     crate::recording::create_dataset_dir(out, |dir| {
         let mut metas = Vec::new();
         let mut summaries = Vec::new();
@@ -1270,6 +1288,18 @@ fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFil
         }
         Ok(())
     })?;
+    let bad = |why: String| -> crate::Error { DataError::invalid(path, why).into() };
+    if p.require_polarity && !polarity {
+        return Err(bad(format!(
+            "no polarity column `{}`, which --polarity or --polarity-values asks for",
+            p.format.polarity
+        )));
+    }
+    if events.is_empty() {
+        return Err(bad(
+            "holds no events (a header only, or an empty array)".into()
+        ));
+    }
     let key = |t: &crate::events::Stamp| crate::events::as_f64(*t);
     let mut reordered = 0;
     let mut latest = f64::NEG_INFINITY;
@@ -1321,6 +1351,8 @@ fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFil
             events: done.count,
             reordered,
             merged: done.merged,
+            span_s: done.n_steps as f64 / 1000.0,
+            polarity,
         },
     ))
 }

@@ -554,7 +554,7 @@ pub struct Dataset {
 }
 
 /// Why a step that reads sampled signals refuses an address-event recording.
-const EVENTS_NOT_SAMPLES: &str = "is an address-event recording (its layout.toml has an [events] table), not sampled signals: this step needs samples (the encoder, the signal baselines, --gain auto and --causal condition a signal; features, evaluate, train, predict and compare read events)";
+const EVENTS_NOT_SAMPLES: &str = "is an address-event recording (its layout.toml has an [events] table), not sampled signals, and this step needs samples (encode, the signal baselines of compare --encodings none, --gain auto, --causal, stream, and predict on single files); an event dataset goes to features, evaluate, train, compare, reproduce, inspect and predict --dataset, and raw event logs through `neurotex import events` first";
 
 /// The manifest's required columns.
 pub const MANIFEST_COLUMNS: [&str; 2] = ["file", "label"];
@@ -720,7 +720,17 @@ impl Dataset {
             taxels,
         };
         let max_s = self.layout.max_duration_s.unwrap_or(DEFAULT_MAX_DURATION_S);
-        crate::events::read_events(&path, format, &grid, duration, (max_s * 1000.0) as u64)
+        // Spike times are u32 milliseconds: at most 49 days, far past any limit one sets.
+        let max_steps = ((max_s * 1000.0) as u64).min(u64::from(u32::MAX));
+        if let Some(d) = duration.filter(|&d| d > max_steps) {
+            let why = format!(
+                "line {}: duration_s {} s is longer than the longest recording accepted ({max_s} s, layout.toml's max_duration_s)",
+                index + 2,
+                d as f64 / 1000.0
+            );
+            return Err(DataError::invalid(manifest(), why).into());
+        }
+        crate::events::read_events(&path, format, &grid, duration, max_steps)
     }
 
     /// A fingerprint of the dataset as its manifest lists it, `sha256:` and 64 hex digits:

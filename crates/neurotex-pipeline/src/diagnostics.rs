@@ -122,7 +122,12 @@ pub fn taxel_diagnostics(
     grid: &Grid,
     encoder: IzhikevichParams,
 ) -> Result<TaxelDiagnostics> {
-    let ceiling_hz = ceiling_rate(encoder)?;
+    // A sensor's address events are not the encoder's: their ceiling is the spike trains'
+    // own, one spike per millisecond.
+    let ceiling_hz = match encoded.iter().any(|e| e.from_events) {
+        true => 1000.0,
+        false => ceiling_rate(encoder)?,
+    };
     let n = encoded.len().max(1) as f64;
     let taxels = grid
         .taxels()

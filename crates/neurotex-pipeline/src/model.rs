@@ -1037,6 +1037,7 @@ mod tests {
             fa: None,
             resampled: false,
             flat: false,
+            from_events: false,
         };
         assert_eq!(model.predict(&[encoded("a.npy", 2, 2)]).unwrap().len(), 1);
         let err = model

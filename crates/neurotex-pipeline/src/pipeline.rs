@@ -343,6 +343,8 @@ pub struct Encoded {
     pub resampled: bool,
     /// The recording had no positive signal and was left at zero.
     pub flat: bool,
+    /// The spikes are a sensor's address events, not the encoder's.
+    pub from_events: bool,
 }
 
 impl Encoded {
@@ -493,6 +495,7 @@ impl Pipeline {
             fa,
             resampled: cond.resampled,
             flat: cond.flat,
+            from_events: false,
         })
     }
 
@@ -607,7 +610,8 @@ pub fn events_encoded(
         spikes,
         fa,
         resampled: false,
-        flat: events.count == 0,
+        flat: false,
+        from_events: true,
     })
 }
 
@@ -1066,6 +1070,7 @@ mod tests {
                 fa,
                 resampled: false,
                 flat: false,
+                from_events: false,
             };
             let levels = extractor.quantised_3d(&encoded).unwrap();
             for _ in 0..20 {

@@ -612,6 +612,7 @@ fn encode_one(
         fa,
         resampled: cond.resampled,
         flat: cond.flat,
+        from_events: false,
     };
     let perturbed = (1..params.encoder_draws)
         .map(|encoding| {

@@ -918,6 +918,7 @@ impl StreamClassifier {
             fa: populations.next(),
             resampled: false,
             flat: false,
+            from_events: false,
         };
         Ok(model.predict_one(&encoded)?)
     }

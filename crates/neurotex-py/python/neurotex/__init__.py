@@ -629,15 +629,18 @@ def _event_arrays(columns: Any) -> List[np.ndarray]:
 
 
 def events(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = None, *,
-           encoding: str = _DEFAULTS["encoding"], **stage_options: Any) -> List[np.ndarray]:
+           encoding: str = "sa+fa", **stage_options: Any) -> List[np.ndarray]:
     """The spikes of a dataset folder's recordings as tonic's event arrays
     (:data:`EVENT_DTYPE`: ``x``, ``y``, ``t`` in microseconds, ``p``; in time order), one
     per manifest row (or per row of ``rows``, 0-based). An address-event dataset's events
     are read as every command reads them; a sampled one's recordings are encoded with the
     stage options (``encoding``, ``gain``, ``preset``, ...), the SA population's spikes as
     ON (``p`` 1) and the FA population's as OFF (``p`` 0), as ``neurotex export events``
-    writes them. ``gain="auto"`` and ``causal=True`` are refused: they calibrate on a whole
-    dataset.
+    writes them. ``encoding`` defaults to ``"sa+fa"``, both polarities (``"sa"``: ON only,
+    ``"fa"``: OFF only; a dataset without polarities needs ``"sa"``). These are spikes:
+    events in 1 ms steps, at most one per cell, polarity and millisecond, with ``p``
+    renumbered 1/0 whatever values the sensor wrote. ``gain="auto"`` and ``causal=True``
+    are refused: they calibrate on a whole dataset.
 
     Raises :class:`NotFoundError` for a missing folder, :class:`DataError` for a bad
     recording and :class:`ParameterError` for a broken option."""

@@ -24,7 +24,7 @@ from typing import Any, Callable, List, Optional, Tuple, Union
 
 import numpy as np
 
-from . import EVENT_DTYPE, _DEFAULTS, _event_arrays, _native, _stage_options
+from . import EVENT_DTYPE, _event_arrays, _native, _stage_options
 
 __all__ = ["Dataset"]
 
@@ -36,8 +36,10 @@ class Dataset:
     2)``: x, y and the two polarities), ``ordering`` (``"xytp"``), ``dtype``, ``classes``
     (the labels, sorted) and ``targets`` (each recording's class index).
 
-    ``encoding`` chooses the populations: ``"sa"`` gives ON events only, ``"fa"`` OFF
-    only, ``"sa+fa"`` both. Further keywords are the stage options of
+    ``encoding`` chooses the populations: ``"sa+fa"`` (the default) both polarities,
+    ``"sa"`` ON events only (what a dataset without polarities has), ``"fa"`` OFF only.
+    Events are neurotex's spikes: 1 ms steps, at most one per cell, polarity and
+    millisecond, ``p`` renumbered 1/0. Further keywords are the stage options of
     :func:`neurotex.features` (``gain``, ``preset``, ``cutoff``, ...), used to encode a
     sampled dataset; ``gain="auto"`` and ``causal=True`` are refused (they calibrate on a
     whole dataset: pass the gain instead).
@@ -49,7 +51,7 @@ class Dataset:
     ordering = "xytp"
     dtype = EVENT_DTYPE
 
-    def __init__(self, path: Union[str, os.PathLike], encoding: str = _DEFAULTS["encoding"], *,
+    def __init__(self, path: Union[str, os.PathLike], encoding: str = "sa+fa", *,
                  transform: Optional[Callable[[np.ndarray], Any]] = None,
                  target_transform: Optional[Callable[[int], Any]] = None,
                  transforms: Optional[Callable[[np.ndarray, int], Tuple[Any, Any]]] = None,

@@ -147,8 +147,9 @@ pub struct ImportEventsOptions {
     /// The unit of the time stamps: `us` (tonic's), `ms` or `s`.
     #[cfg_attr(feature = "cli", arg(long = "time-unit"))]
     pub time_unit: TimeUnit,
-    /// Metadata from file names, e.g. `{label}_v{speed}_{trial}` (without it the label is
-    /// the file stem).
+    /// Metadata from file names, with the extension, e.g. `{label}_v{speed}_{trial}.csv`
+    /// (`{speed}` in mm/s gives `speed_mm_s`, which reproduce and `compare --per
+    /// speed_mm_s` need; without a pattern the label is the file stem).
     #[cfg_attr(feature = "cli", arg(long = "name-pattern"))]
     pub name_pattern: Option<NamePattern>,
     /// The time column or field.
@@ -162,24 +163,23 @@ pub struct ImportEventsOptions {
     pub y: String,
     /// Instead of --x and --y: a 0-based taxel index column, placed on the grid by
     /// --channel-map (row-major without one).
-    #[cfg_attr(feature = "cli", arg(long))]
+    #[cfg_attr(feature = "cli", arg(long, conflicts_with_all = ["x", "y"]))]
     pub taxel: Option<String>,
-    /// Each taxel index's cell, `row,col;row,col;...` in index order.
-    #[cfg_attr(feature = "cli", arg(long = "channel-map"))]
+    /// With --taxel: each taxel index's cell, `row,col;row,col;...` in index order. Cells
+    /// no taxel maps to are masked out (they are not silent taxels).
+    #[cfg_attr(feature = "cli", arg(long = "channel-map", requires = "taxel"))]
     pub channel_map: Option<ChannelMap>,
-    /// The polarity column or field (a log without it holds ON events only).
-    #[cfg_attr(feature = "cli", arg(long, default_value = "p"))]
-    pub polarity: String,
-    /// The ON and OFF polarity values, `ON,OFF` (booleans read as 1 and 0).
+    /// The polarity column or field [default: p, optional: a log without it holds ON
+    /// events only]. Named here, or with --polarity-values, it must be in every log.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub polarity: Option<String>,
+    /// The ON and OFF polarity values, `ON,OFF` [default: 1,0]; booleans read as 1 and 0,
+    /// so `True`/`False` logs take the default.
     #[cfg_attr(
         feature = "cli",
-        arg(
-            long = "polarity-values",
-            default_value = "1,0",
-            allow_hyphen_values = true
-        )
+        arg(long = "polarity-values", allow_hyphen_values = true)
     )]
-    pub polarity_values: String,
+    pub polarity_values: Option<String>,
     /// Time 0: `zero` (the stamps count from the recording's start) or `first` (the first
     /// event's stamp, for logs stamped with a clock).
     #[cfg_attr(feature = "cli", arg(long, default_value = "zero"))]
@@ -193,8 +193,8 @@ impl ImportEventsOptions {
     /// Polarity values or an origin that do not parse, or a channel map that does not fit
     /// the grid.
     pub fn params(&self) -> Result<EventImportParams> {
-        let values: Vec<i64> = self
-            .polarity_values
+        let given = self.polarity_values.as_deref().unwrap_or("1,0");
+        let values: Vec<i64> = given
             .split(',')
             .map(|v| v.trim().parse::<i64>())
             .collect::<Result<_, _>>()
@@ -203,7 +203,7 @@ impl ImportEventsOptions {
             .ok_or_else(|| {
                 let rule =
                     "polarity values are two different integers, ON,OFF (for example 1,0 or 1,-1)";
-                ParamError::new("polarity-values", rule, &self.polarity_values)
+                ParamError::new("polarity-values", rule, given)
             })?;
         let origin = match self.origin.as_str() {
             "zero" => Origin::Zero,
@@ -218,6 +218,7 @@ impl ImportEventsOptions {
             Some(map) => map.cells().iter().map(|c| c.row * cols + c.col).collect(),
             None => (0..rows * cols).collect(),
         };
+        let mut present = self.grid.present().to_vec();
         if let Some(map) = &self.channel_map {
             if let Some(c) = map.cells().iter().find(|c| c.row >= rows || c.col >= cols) {
                 let rule = "every channel-map cell must lie on the grid";
@@ -225,6 +226,18 @@ impl ImportEventsOptions {
                     ParamError::new("channel-map", rule, format!("{c} on {rows}x{cols}")).into(),
                 );
             }
+            let mut mapped = vec![false; rows * cols];
+            for (i, &t) in taxels.iter().enumerate() {
+                if std::mem::replace(&mut mapped[t], true) {
+                    let rule = "each cell takes one taxel";
+                    let got = format!(
+                        "taxel {i} on {}, a cell an earlier taxel has",
+                        map.cells()[i]
+                    );
+                    return Err(ParamError::new("channel-map", rule, got).into());
+                }
+            }
+            present = mapped;
         }
         Ok(EventImportParams {
             pattern: self.name_pattern.clone(),
@@ -234,16 +247,17 @@ impl ImportEventsOptions {
                 x: self.x.clone(),
                 y: self.y.clone(),
                 taxel: self.taxel.clone(),
-                polarity: self.polarity.clone(),
+                polarity: self.polarity.clone().unwrap_or_else(|| "p".into()),
                 values: [values[0], values[1]],
                 origin,
             },
             grid: EventGrid {
                 rows,
                 cols,
-                present: self.grid.present().to_vec(),
+                present,
                 taxels,
             },
+            require_polarity: self.polarity.is_some() || self.polarity_values.is_some(),
         })
     }
 
@@ -265,14 +279,25 @@ impl ImportEventsOptions {
         }
         let events: usize = imported.iter().map(|f| f.events).sum();
         let merged: usize = imported.iter().map(|f| f.merged).sum();
+        let mut spans: Vec<f64> = imported.iter().map(|f| f.span_s).collect();
+        spans.sort_by(f64::total_cmp);
+        let median = spans.get(spans.len() / 2).copied().unwrap_or(0.0);
         on(Progress::Say(&format!(
-            "{} recordings, {events} events ({merged} in a millisecond already holding an event of their cell and polarity, so one spike) -> {}; {}x{} grid, times in {}",
+            "{} recordings, {events} events ({merged} in a millisecond already holding an event of their cell and polarity, so one spike) -> {}; {}x{} grid, times in {}; a recording spans {median:.3} s (median; from {:.3} to {:.3} s)",
             imported.len(),
             out.display(),
             params.grid.rows,
             params.grid.cols,
-            self.time_unit
+            self.time_unit,
+            spans.first().copied().unwrap_or(0.0),
+            spans.last().copied().unwrap_or(0.0)
         )));
+        if !(0.05..=600.0).contains(&median) {
+            on(Progress::Advice(&format!(
+                "the median recording spans {median:.3} s, read with --time-unit {}: a tactile trial lasts seconds, so the unit is probably wrong",
+                self.time_unit
+            )));
+        }
         Ok(imported)
     }
 }
