@@ -1213,38 +1213,35 @@ pub fn import_events(
             return Err(DataError::invalid(f, why).into());
         }
     }
-    let read: Vec<(crate::recording::Meta, String, ImportedFile)> = files
-        .par_iter()
-        .map(|f| {
-            let meta = meta_from_name(f, p.pattern.as_ref())?;
-            let (text, summary) = sorted_log(f, p)?;
-            on_done();
-            Ok((meta, text, summary))
-        })
-        .collect::<Result<_>>()?;
-    // `read` is in the order of `files`.
-    let with = read.iter().zip(files).find(|(r, _)| r.2.polarity);
-    let without = read.iter().zip(files).find(|(r, _)| !r.2.polarity);
-    if let (Some((_, with)), Some((_, without))) = (with, without) {
-        let why = format!(
-            "has no polarity column `{}`, which {} has: its OFF events would be read as ON",
-            p.format.polarity,
-            with.display()
-        );
-        return Err(DataError::invalid(without, why).into());
-    }
     crate::recording::create_dataset_dir(out, |dir| {
-        let mut metas = Vec::new();
-        let mut summaries = Vec::new();
-        for (meta, text, summary) in read {
-            let path = dir.join(&summary.file);
-            std::fs::write(&path, text).map_err(|e| DataError::write(&path, e))?;
-            metas.push(crate::recording::Meta {
-                file: summary.file.clone(),
-                ..meta
-            });
-            summaries.push(summary);
+        // Each log is written as soon as it is read: an import holds one log per thread.
+        let read: Vec<(crate::recording::Meta, ImportedFile)> = files
+            .par_iter()
+            .map(|f| {
+                let meta = meta_from_name(f, p.pattern.as_ref())?;
+                let (text, summary) = sorted_log(f, p)?;
+                let path = dir.join(&summary.file);
+                std::fs::write(&path, text).map_err(|e| DataError::write(&path, e))?;
+                on_done();
+                let meta = crate::recording::Meta {
+                    file: summary.file.clone(),
+                    ..meta
+                };
+                Ok((meta, summary))
+            })
+            .collect::<Result<_>>()?;
+        // `read` is in the order of `files`.
+        let with = read.iter().zip(files).find(|(r, _)| r.1.polarity);
+        let without = read.iter().zip(files).find(|(r, _)| !r.1.polarity);
+        if let (Some((_, with)), Some((_, without))) = (with, without) {
+            let why = format!(
+                "has no polarity column `{}`, which {} has: its OFF events would be read as ON",
+                p.format.polarity,
+                with.display()
+            );
+            return Err(DataError::invalid(without, why).into());
         }
+        let (metas, summaries): (Vec<_>, Vec<_>) = read.into_iter().unzip();
         crate::recording::write_manifest(dir, &metas)?;
         crate::recording::write_layout(dir, &imported_layout(p))?;
         crate::recording::Dataset::open(dir)?;
