@@ -27,6 +27,24 @@ fn feature_columns(path: &Path) -> Vec<Vec<(String, String)>> {
         .collect()
 }
 
+/// `neurotex features --method METHOD --encoding sa+fa` on `ds`, as [`feature_columns`].
+fn sa_fa_features(dir: &Dir, ds: &Path, method: &str) -> Vec<Vec<(String, String)>> {
+    let name = ds.file_name().unwrap().to_string_lossy();
+    let out = dir.join(&format!("{name}_{method}.csv"));
+    dir.ok(&[
+        "features",
+        "--dataset",
+        s(ds),
+        "--method",
+        method,
+        "--encoding",
+        "sa+fa",
+        "--out",
+        s(&out),
+    ]);
+    feature_columns(&out)
+}
+
 /// The `predicted` column and every share column of a predictions file.
 fn predictions(path: &Path) -> Vec<Vec<String>> {
     let mut reader = csv::Reader::from_path(path).unwrap();
@@ -86,24 +104,7 @@ fn exported_events_give_the_encoded_spikes_results_bit_for_bit() {
     let layout = std::fs::read_to_string(npy.join("layout.toml")).unwrap();
     assert!(layout.contains("time_unit = \"us\""), "{layout}");
     for method in ["glcm3d", "taxel", "spectrum"] {
-        let of = |ds: &Path| {
-            let out = dir.join(&format!(
-                "{}_{method}.csv",
-                ds.file_name().unwrap().to_string_lossy()
-            ));
-            dir.ok(&[
-                "features",
-                "--dataset",
-                s(ds),
-                "--method",
-                method,
-                "--encoding",
-                "sa+fa",
-                "--out",
-                s(&out),
-            ]);
-            feature_columns(&out)
-        };
+        let of = |ds: &Path| sa_fa_features(&dir, ds, method);
         let sampled = of(&sim);
         assert_eq!(sampled.len(), 30);
         assert!(
@@ -507,24 +508,7 @@ fn imported_logs_read_as_the_events_they_hold() {
         run.stderr
     );
     for method in ["glcm3d", "taxel"] {
-        let of = |ds: &Path| {
-            let out = dir.join(&format!(
-                "{}_{method}.csv",
-                ds.file_name().unwrap().to_string_lossy()
-            ));
-            dir.ok(&[
-                "features",
-                "--dataset",
-                s(ds),
-                "--method",
-                method,
-                "--encoding",
-                "sa+fa",
-                "--out",
-                s(&out),
-            ]);
-            feature_columns(&out)
-        };
+        let of = |ds: &Path| sa_fa_features(&dir, ds, method);
         assert_eq!(of(&imported), of(&direct), "{method}");
     }
     // The import's checks, on these logs: each run must fail, naming what is wrong, and

@@ -531,16 +531,26 @@ fn parse_csv(path: &Path, p: &CsvImportParams) -> Result<ParsedCsv> {
 /// # Errors
 /// An input that does not exist or a folder that cannot be read.
 pub fn csv_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    files_with(inputs, &["csv"])
+}
+
+/// The files among `inputs` with one of `extensions` (any case; folders are searched one
+/// level deep, files given by name are taken whatever their extension), sorted.
+///
+/// # Errors
+/// An input that does not exist or a folder that cannot be read.
+fn files_with(inputs: &[PathBuf], extensions: &[&str]) -> Result<Vec<PathBuf>> {
+    let wanted = |p: &Path| {
+        p.extension()
+            .is_some_and(|x| extensions.iter().any(|e| x.eq_ignore_ascii_case(e)))
+    };
     let mut out = Vec::new();
     for input in inputs {
         if input.is_dir() {
             let entries = std::fs::read_dir(input).map_err(|e| DataError::io(input, e))?;
             for e in entries {
                 let path = e.map_err(|e| DataError::io(input, e))?.path();
-                if path
-                    .extension()
-                    .is_some_and(|x| x.eq_ignore_ascii_case("csv"))
-                {
+                if wanted(&path) {
                     out.push(path);
                 }
             }
@@ -1150,29 +1160,8 @@ pub struct EventImportParams {
 ///
 /// # Errors
 /// An input that does not exist or a folder that cannot be read.
-pub fn event_files(inputs: &[std::path::PathBuf]) -> Result<Vec<std::path::PathBuf>> {
-    let mut out = Vec::new();
-    let wanted = |p: &Path| {
-        p.extension()
-            .is_some_and(|x| x.eq_ignore_ascii_case("csv") || x.eq_ignore_ascii_case("npy"))
-    };
-    for input in inputs {
-        if input.is_dir() {
-            let entries = std::fs::read_dir(input).map_err(|e| DataError::io(input, e))?;
-            for e in entries {
-                let path = e.map_err(|e| DataError::io(input, e))?.path();
-                if wanted(&path) {
-                    out.push(path);
-                }
-            }
-        } else if input.is_file() {
-            out.push(input.clone());
-        } else {
-            return Err(DataError::invalid(input, "does not exist").into());
-        }
-    }
-    out.sort();
-    Ok(out)
+pub fn event_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    files_with(inputs, &["csv", "npy"])
 }
 
 /// Imports event logs into a new dataset folder `out`: each file's events sorted into time

@@ -445,9 +445,15 @@ fn parse_descr(descr: &str) -> std::result::Result<(char, usize), String> {
 mod tests {
     use super::*;
 
-    /// A version 1.0 `.npy` with `header` (padded as numpy pads it) and `data` bytes.
+    /// A version 1.0 `.npy` of the simple dtype `descr` with `data` bytes.
     fn npy_bytes(descr: &str, shape: &str, data: &[u8]) -> Vec<u8> {
-        let mut h = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+        npy_of(&format!("'{descr}'"), shape, data)
+    }
+
+    /// A version 1.0 `.npy` whose `descr` is `descr` as written (a quoted dtype or a list
+    /// of fields), its header padded as numpy pads it, then `data` bytes.
+    fn npy_of(descr: &str, shape: &str, data: &[u8]) -> Vec<u8> {
+        let mut h = format!("{{'descr': {descr}, 'fortran_order': False, 'shape': {shape}, }}");
         while (10 + h.len() + 1) % 64 != 0 {
             h.push(' ');
         }
@@ -513,17 +519,10 @@ mod tests {
     fn a_structured_dtype_is_read_field_by_field() {
         // numpy: np.array([(5, 1, 2, True)], dtype=[('t','<i8'),('x','<i2'),('y','<u1'),('p','|b1')])
         let descr = "[('t', '<i8'), ('x', '<i2'), ('y', '|u1'), ('p', '|b1')]";
-        let mut h = format!("{{'descr': {descr}, 'fortran_order': False, 'shape': (1,), }}");
-        while (10 + h.len() + 1) % 64 != 0 {
-            h.push(' ');
-        }
-        h.push('\n');
-        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
-        bytes.extend((h.len() as u16).to_le_bytes());
-        bytes.extend(h.as_bytes());
-        bytes.extend(5i64.to_le_bytes());
-        bytes.extend((-1i16).to_le_bytes());
-        bytes.extend([2u8, 1]);
+        let mut data = 5i64.to_le_bytes().to_vec();
+        data.extend((-1i16).to_le_bytes());
+        data.extend([2u8, 1]);
+        let bytes = npy_of(descr, "(1,)", &data);
         let header = header_of(&bytes).unwrap();
         assert_eq!((header.kind, header.item_bytes), ('V', 12));
         let names: Vec<&str> = header.fields.iter().map(|f| f.name.as_str()).collect();
@@ -537,10 +536,7 @@ mod tests {
         assert_eq!(values, [5, -1, 2, 1]);
         assert!(!header.is_number());
         for bad in ["[('t', '<i8', (2,))]", "[]", "[('t')]"] {
-            let h = format!("{{'descr': {bad}, 'fortran_order': False, 'shape': (0,), }}");
-            let mut b = b"\x93NUMPY\x01\x00".to_vec();
-            b.extend((h.len() as u16).to_le_bytes());
-            b.extend(h.as_bytes());
+            let b = npy_of(bad, "(0,)", &[]);
             assert!(header_of(&b).is_err(), "{bad}");
         }
     }
