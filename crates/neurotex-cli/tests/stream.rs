@@ -715,3 +715,200 @@ fn frames_stamped_on_the_1_ms_grid_stream_as_the_same_frames_unstamped() {
         assert_eq!(streamed(&text), expected, "stamped from {origin} ms");
     }
 }
+
+/// An exported event recording as a stream's text: its lines, then a tick at its duration
+/// (the manifest's `duration_s`, in ms), so the stream's episode is the recording's length.
+fn event_text(events: &Path, file: &str) -> String {
+    let manifest = std::fs::read_to_string(events.join("manifest.csv")).unwrap();
+    let row = manifest
+        .lines()
+        .find(|l| l.starts_with(file))
+        .expect("the recording's row");
+    let duration_s: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
+    let text = std::fs::read_to_string(events.join(file)).unwrap();
+    format!("{text}{}\n", (duration_s * 1000.0).round())
+}
+
+/// The same events as binary records (t in µs); a tick's record has kind 1.
+fn event_records(text: &str) -> Vec<u8> {
+    let mut out = Vec::new();
+    for line in text.lines().skip(1) {
+        let f: Vec<i64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        out.extend_from_slice(&(f[0] * 1000).to_le_bytes());
+        let (x, y, p, kind) = match f.len() {
+            1 => (0, 0, 0, 1u8),
+            _ => (f[1] as u16, f[2] as u16, f[3] as i8, 0),
+        };
+        out.extend_from_slice(&x.to_le_bytes());
+        out.extend_from_slice(&y.to_le_bytes());
+        out.push(p as u8);
+        out.push(kind);
+        out.extend_from_slice(&[0, 0]);
+    }
+    out
+}
+
+#[test]
+fn a_recordings_spikes_as_events_stream_as_its_samples() {
+    // A causal SA+FA model; its spikes exported as events with the same causal pipeline.
+    // Streamed as text lines and as binary records, the events give the lines the samples
+    // give (`predict --causal`, which equals the frames' stream), bit for bit.
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &["--encoding", "sa+fa"]);
+    let events = dir.join("events");
+    dir.ok(&[
+        "export",
+        "events",
+        "--dataset",
+        s(&data),
+        "--out",
+        s(&events),
+        "--causal",
+        "--encoding",
+        "sa+fa",
+    ]);
+    let names: Vec<String> = std::fs::read_dir(&events)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".csv") && n != "manifest.csv")
+        .collect();
+    for (i, row) in slides(&data)
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| [1, 6].contains(i))
+    {
+        let expected = predicted(&dir, &model, &data, &row.0);
+        assert!(expected.len() > 40);
+        let name = names
+            .iter()
+            .find(|n| n.starts_with(&format!("{i:05}_")))
+            .unwrap();
+        let text = event_text(&events, name);
+        let as_text = [
+            "--model",
+            s(&model),
+            "--format",
+            "events",
+            "--time-unit",
+            "ms",
+            "--origin",
+            "zero",
+        ];
+        let (out, err) = stream_stdin(&dir, &as_text, text.as_bytes());
+        assert_eq!(lines(&out), expected, "{name}: {err}");
+        assert!(
+            err.contains("0 bad event(s) skipped, 1 episode(s)"),
+            "{err}"
+        );
+        let records = event_records(&text);
+        let as_records = [
+            "--model",
+            s(&model),
+            "--format",
+            "events-bin",
+            "--origin",
+            "zero",
+        ];
+        let (out, _) = stream_stdin(&dir, &as_records, &records);
+        assert_eq!(lines(&out), expected, "{name} as records");
+        // Bad events are counted, named and skipped; the rest stream as before.
+        let mut bad: Vec<&str> = text.lines().collect();
+        bad.insert(3, "6,9,0,1");
+        bad.insert(5, "6,1,1,7");
+        bad.insert(7, "not,an,event,line");
+        bad.insert(9, "2,1,1,1");
+        let (out, err) = stream_stdin(&dir, &as_text, (bad.join("\n") + "\n").as_bytes());
+        let mut clean = expected.clone();
+        for l in &mut clean {
+            l.as_object_mut().unwrap().remove("bad_frames");
+        }
+        assert_eq!(streamed(&out), clean, "{err}");
+        assert_eq!(lines(&out).last().unwrap()["bad_frames"], 4, "{err}");
+        for said in [
+            "line 4",
+            "outside the 4x4 grid",
+            "line 6",
+            "polarity 7",
+            "line 8",
+            "line 10",
+            "before the previous event",
+        ] {
+            assert!(err.contains(said), "{said}: {err}");
+        }
+    }
+}
+
+#[test]
+fn a_model_trained_on_events_streams_events_and_refuses_frames() {
+    let dir = Dir::new();
+    let (data, causal) = trained(&dir, &[]);
+    let events = dir.join("events");
+    dir.ok(&[
+        "export",
+        "events",
+        "--dataset",
+        s(&data),
+        "--out",
+        s(&events),
+    ]);
+    let model = dir.join("events_model.json");
+    dir.ok(&["train", "--dataset", s(&events), "--out", s(&model)]);
+    let name = "00001_FT1_v10_t01.csv";
+    // The model knows its events' unit and origin: none need saying. With a window longer
+    // than the recording, the episode's end classifies all of it, as `predict` does.
+    let text = event_text(&events, name);
+    let args = [
+        "--model",
+        s(&model),
+        "--format",
+        "events",
+        "--window-s",
+        "60",
+    ];
+    let (out, _) = stream_stdin(&dir, &args, text.as_bytes());
+    let predicted = dir.join("p.csv");
+    dir.ok(&[
+        "predict",
+        "--model",
+        s(&model),
+        "--dataset",
+        s(&events),
+        "--out",
+        s(&predicted),
+    ]);
+    let table = std::fs::read_to_string(&predicted).unwrap();
+    let offline = table.lines().find(|l| l.contains(name)).unwrap();
+    let all = lines(&out);
+    assert!(all.len() > 40, "a line every 200 ms");
+    let label = all.last().unwrap()["label"].as_str().unwrap().to_string();
+    assert!(
+        offline.split(',').any(|f| f == label),
+        "{offline} / {label}"
+    );
+    let frames = dir.join("frames.csv");
+    std::fs::write(&frames, csv_text(&slide_frames(&data, &slides(&data)[1]))).unwrap();
+    let err = dir.fails(&["stream", "--model", s(&model), "--input", s(&frames)]);
+    assert!(err.contains("trained on address events"), "{err}");
+    // A sampled model's text events need their unit.
+    let err = dir.fails(&[
+        "stream",
+        "--model",
+        s(&causal),
+        "--format",
+        "events",
+        "--input",
+        s(&frames),
+    ]);
+    assert!(err.contains("--time-unit"), "{err}");
+    let err = dir.fails(&[
+        "stream",
+        "--model",
+        s(&causal),
+        "--format",
+        "events",
+        "--time-unit",
+        "ms",
+        "--stamped",
+    ]);
+    assert!(err.contains("--stamped"), "{err}");
+}

@@ -74,6 +74,20 @@ fn default_values() -> [i64; 2] {
 }
 
 impl EventsFormat {
+    /// Whether an event of polarity `p` is ON (every event without a polarity is); `Err`
+    /// for a value that is neither ON nor OFF.
+    pub fn is_on(&self, p: Option<i64>) -> Result<bool, String> {
+        let [on, off] = self.values;
+        match p {
+            None => Ok(true),
+            Some(v) if v == on => Ok(true),
+            Some(v) if v == off => Ok(false),
+            Some(v) => Err(format!(
+                "polarity {v} is neither ON ({on}) nor OFF ({off}); `import events --polarity-values ON,OFF` (or layout.toml's `[events] values = [on, off]`) names them"
+            )),
+        }
+    }
+
     /// The format of files written in `unit` with the default column names.
     pub fn new(unit: TimeUnit) -> Self {
         EventsFormat {
@@ -113,6 +127,51 @@ pub struct EventGrid {
     pub taxels: Vec<usize>,
 }
 
+impl EventGrid {
+    /// The cell (row-major index) of an event at `(x, y)`, or of taxel `a` when `taxel`
+    /// (`b` unused), checked against the grid and its mask; `Err` says why there is none.
+    pub fn cell(&self, taxel: bool, (a, b): (i64, i64)) -> Result<usize, String> {
+        let g = self;
+        let (row, col) = match taxel {
+            true => {
+                let cell = usize::try_from(a)
+                    .ok()
+                    .and_then(|i| g.taxels.get(i))
+                    .ok_or_else(|| {
+                        format!(
+                            "taxel {a} is outside the layout's {} taxels (0 to {})",
+                            g.taxels.len(),
+                            g.taxels.len().saturating_sub(1)
+                        )
+                    })?;
+                (cell / g.cols, cell % g.cols)
+            }
+            false => {
+                let inside = |v: i64, n: usize| usize::try_from(v).ok().filter(|&v| v < n);
+                match (inside(b, g.rows), inside(a, g.cols)) {
+                    (Some(r), Some(c)) => (r, c),
+                    _ => {
+                        return Err(format!(
+                            "x = {a}, y = {b} is outside the {}x{} grid (x is the column, 0 to {}; y the row, 0 to {})",
+                            g.rows,
+                            g.cols,
+                            g.cols - 1,
+                            g.rows - 1
+                        ))
+                    }
+                }
+            }
+        };
+        let cell = row * g.cols + col;
+        if !g.present[cell] {
+            return Err(format!(
+                "the event is at row {row}, column {col}, a cell layout.toml's mask leaves out"
+            ));
+        }
+        Ok(cell)
+    }
+}
+
 /// One recording's events as spike trains: per polarity, per cell (row-major), the sorted
 /// 1 ms steps with at least one event.
 #[derive(Debug, Clone, PartialEq)]
@@ -136,11 +195,41 @@ pub struct Events {
     pub merged: usize,
 }
 
-/// One event as read: its time in the file's unit (exact for integers) and its fields.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Stamp {
+/// An event's time stamp as written, in its unit: exact for integers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stamp {
+    /// An integer stamp (tonic's microseconds, a clock's ticks).
     Int(i64),
+    /// A decimal stamp (seconds with a fraction).
     Float(f64),
+}
+
+impl Stamp {
+    /// The stamp as a number.
+    pub fn as_f64(self) -> f64 {
+        as_f64(self)
+    }
+
+    /// Whether the stamp is before `other`.
+    pub fn before(self, other: Stamp) -> bool {
+        match (self, other) {
+            (Stamp::Int(a), Stamp::Int(b)) => a < b,
+            (a, b) => as_f64(a) < as_f64(b),
+        }
+    }
+
+    /// The 1 ms step of the stamp counted from `from`, in `unit`: integer arithmetic for
+    /// integer stamps, and a decimal stamp within a millionth of a millisecond below a
+    /// boundary counted on it. `Err` says why there is none (before `from`, not finite).
+    pub fn step_from(self, from: Stamp, unit: TimeUnit) -> Result<u64, String> {
+        to_step(self, from, unit)
+    }
+}
+
+impl std::fmt::Display for Stamp {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&show(*self))
+    }
 }
 
 /// The columns of one file, as indices into a record's values.
@@ -203,19 +292,12 @@ impl<'a> Gather<'a> {
     ) -> Result<(), String> {
         let step = self.step(t)?;
         let cell = self.cell(cell)?;
-        let trains = match p {
-            None => &mut self.on,
-            Some(v) if v == self.format.values[0] => &mut self.on,
-            Some(v) if v == self.format.values[1] => self
+        let trains = match self.format.is_on(p)? {
+            true => &mut self.on,
+            false => self
                 .off
                 .as_mut()
                 .expect("a polarity column gives OFF trains"),
-            Some(v) => {
-                let [on, off] = self.format.values;
-                return Err(format!(
-                    "polarity {v} is neither ON ({on}) nor OFF ({off}); `import events --polarity-values ON,OFF` (or layout.toml's `[events] values = [on, off]`) names them"
-                ));
-            }
         };
         let train = &mut trains[cell];
         let step = step as u32;
@@ -254,11 +336,7 @@ impl<'a> Gather<'a> {
             }
         }
         if let Some(last) = self.last {
-            let back = match (last, t) {
-                (Stamp::Int(a), Stamp::Int(b)) => b < a,
-                (a, b) => as_f64(b) < as_f64(a),
-            };
-            if back {
+            if t.before(last) {
                 return Err(format!(
                     "time {} comes before the previous event's {}: events must be in time order (`neurotex import events` sorts them)",
                     show(t),
@@ -299,45 +377,8 @@ impl<'a> Gather<'a> {
     }
 
     /// The event's cell (row-major index), checked against the grid and its mask.
-    pub(crate) fn cell(&self, (a, b): (i64, i64)) -> Result<usize, String> {
-        let g = self.grid;
-        let (row, col) = match self.format.taxel {
-            Some(_) => {
-                let cell = usize::try_from(a)
-                    .ok()
-                    .and_then(|i| g.taxels.get(i))
-                    .ok_or_else(|| {
-                        format!(
-                            "taxel {a} is outside the layout's {} taxels (0 to {})",
-                            g.taxels.len(),
-                            g.taxels.len().saturating_sub(1)
-                        )
-                    })?;
-                (cell / g.cols, cell % g.cols)
-            }
-            None => {
-                let inside = |v: i64, n: usize| usize::try_from(v).ok().filter(|&v| v < n);
-                match (inside(b, g.rows), inside(a, g.cols)) {
-                    (Some(r), Some(c)) => (r, c),
-                    _ => {
-                        return Err(format!(
-                            "x = {a}, y = {b} is outside the {}x{} grid (x is the column, 0 to {}; y the row, 0 to {})",
-                            g.rows,
-                            g.cols,
-                            g.cols - 1,
-                            g.rows - 1
-                        ))
-                    }
-                }
-            }
-        };
-        let cell = row * g.cols + col;
-        if !g.present[cell] {
-            return Err(format!(
-                "the event is at row {row}, column {col}, a cell layout.toml's mask leaves out"
-            ));
-        }
-        Ok(cell)
+    pub(crate) fn cell(&self, at: (i64, i64)) -> Result<usize, String> {
+        self.grid.cell(self.format.taxel.is_some(), at)
     }
 
     pub(crate) fn finish(self) -> Events {

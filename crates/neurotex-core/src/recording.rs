@@ -322,6 +322,28 @@ pub struct LayoutFile {
 pub const DEFAULT_MAX_DURATION_S: f64 = 3600.0;
 
 impl LayoutFile {
+    /// How events address the cells of a `rows x cols` grid: the mask's cells, and each
+    /// taxel index's cell (the channel map's, or row-major order without one).
+    pub fn event_grid(&self, rows: usize, cols: usize) -> crate::events::EventGrid {
+        let present: Vec<bool> = match &self.mask {
+            Some(m) => m
+                .iter()
+                .flat_map(|row| row.chars().map(|ch| ch == '1'))
+                .collect(),
+            None => vec![true; rows * cols],
+        };
+        let taxels = match &self.channel_map {
+            Some(map) => map.iter().map(|&[r, c]| r * cols + c).collect(),
+            None => (0..rows * cols).collect(),
+        };
+        crate::events::EventGrid {
+            rows,
+            cols,
+            present,
+            taxels,
+        }
+    }
+
     /// Reads and checks `layout.toml`.
     ///
     /// # Errors
@@ -702,23 +724,7 @@ impl Dataset {
                 }
             },
         };
-        let present: Vec<bool> = match &self.layout.mask {
-            Some(m) => m
-                .iter()
-                .flat_map(|row| row.chars().map(|ch| ch == '1'))
-                .collect(),
-            None => vec![true; rows * cols],
-        };
-        let taxels = match &self.layout.channel_map {
-            Some(map) => map.iter().map(|&[r, c]| r * cols + c).collect(),
-            None => (0..rows * cols).collect(),
-        };
-        let grid = crate::events::EventGrid {
-            rows,
-            cols,
-            present,
-            taxels,
-        };
+        let grid = self.layout.event_grid(rows, cols);
         let max_s = self.layout.max_duration_s.unwrap_or(DEFAULT_MAX_DURATION_S);
         // Spike times are u32 milliseconds: at most 49 days, far past any limit one sets.
         let max_steps = ((max_s * 1000.0) as u64).min(u64::from(u32::MAX));

@@ -10,7 +10,7 @@
 //! A [`DecisionRule`] turns the per-bin classifications into one decision.
 //!
 //! [`episode_decisions`] computes all of this from a whole encoded recording at once;
-//! [`crate::stream::StreamClassifier`] computes it frame by frame. Both run the same
+//! `neurotex_stream::StreamClassifier` computes it frame by frame. Both run the same
 //! conditioning arithmetic, the same neurons and the same feature extractor on the same
 //! windows, so their decisions are identical (tests/stream.rs).
 
@@ -192,7 +192,7 @@ pub fn window_steps(window_ms: usize, bin_ms: usize) -> usize {
     (window_ms / bin_ms).max(1) * bin_ms
 }
 
-/// The offline twin of [`crate::stream::StreamClassifier`]: the decisions at every bin
+/// The offline twin of `neurotex_stream::StreamClassifier`: the decisions at every bin
 /// boundary of one causally encoded recording (the episode: its selected phase), each over
 /// the last `window_ms` (whole bins) or all the episode so far, and the summary.
 ///

@@ -1,7 +1,7 @@
 //! neurotex's pipeline layer: one recording's path from samples to features
 //! ([`pipeline`]), feature tables over a dataset ([`analysis`], [`diagnostics`]), saved
 //! models ([`model`]), the gain calibration ([`calibrate`]), decisions from a window's
-//! beginning ([`causal`]) and live streams ([`stream`]), and the ranking of methods
+//! beginning ([`causal`]), and the ranking of methods
 //! ([`compare`]). Depends on every layer below.
 #![deny(missing_docs)]
 
@@ -18,11 +18,10 @@ pub mod options;
 pub mod pipeline;
 pub mod saved;
 pub mod spiking_model;
-pub mod stream;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
-use neurotex_core::{csvlog, error, events, import, io, progress, recording, values, Error};
+use neurotex_core::{error, events, import, io, progress, recording, values, Error};
 use neurotex_features::features;
 use neurotex_learn::{classify, snn};
 use neurotex_signal::{encode, signal};

@@ -398,13 +398,13 @@ impl Model {
     ///
     /// # Errors
     /// As [`Model::predict_rows`].
-    pub(crate) fn predict_extracted(&self, row: &[f64]) -> Result<Prediction> {
+    pub fn predict_extracted(&self, row: &[f64]) -> Result<Prediction> {
         let row: Vec<f64> = self.columns.iter().map(|&j| row[j]).collect();
         Ok(self.predict_rows(&row)?.remove(0))
     }
 
     /// The feature extractor.
-    pub(crate) fn extractor(&self) -> &FeatureExtractor {
+    pub fn extractor(&self) -> &FeatureExtractor {
         &self.extractor
     }
 

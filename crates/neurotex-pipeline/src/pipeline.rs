@@ -931,7 +931,7 @@ impl FeatureExtractor {
 
     /// The Haralick features of the extractor's set from a GLCM's summed counts
     /// (`levels x levels`).
-    pub(crate) fn haralick_row(&self, counts: &[u64]) -> Vec<f64> {
+    pub fn haralick_row(&self, counts: &[u64]) -> Vec<f64> {
         let l = self.volume.levels;
         match self.features.haralick {
             HaralickSet::Paper => haralick(counts, l).to_array().to_vec(),
@@ -943,12 +943,12 @@ impl FeatureExtractor {
     }
 
     /// The quantisation and binning parameters.
-    pub(crate) fn volume_params(&self) -> &VolumeParams {
+    pub fn volume_params(&self) -> &VolumeParams {
         &self.volume
     }
 
     /// The co-occurrence parameters.
-    pub(crate) fn glcm_params(&self) -> &GlcmParams {
+    pub fn glcm_params(&self) -> &GlcmParams {
         &self.glcm
     }
 }

@@ -31,10 +31,11 @@ pub use neurotex_learn::classify;
 pub use neurotex_learn::snn;
 pub use neurotex_pipeline::{
     analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, nir, options,
-    pipeline, saved, spiking_model, stream,
+    pipeline, saved, spiking_model,
 };
 pub use neurotex_report::report;
 pub use neurotex_signal::{encode, signal};
 pub use neurotex_sim::sim;
+pub use neurotex_stream as stream;
 
 pub mod workflows;

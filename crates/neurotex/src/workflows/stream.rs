@@ -7,8 +7,10 @@ use std::path::PathBuf;
 use crate::causal::DecisionRule;
 use crate::csvlog::{ChannelSelect, Column, CsvFormat, CsvOverrides, Delimiter};
 use crate::error::OptionsError;
+use crate::events::Origin;
 use crate::recording::TimeUnit;
-use crate::saved::Trained;
+use crate::saved::{SavedModel, Trained};
+use crate::stream::events::{EventEncoding, EventSource};
 use crate::stream::frames::FrameFormat as Format;
 use crate::stream::{EpisodeRule, StreamParams};
 use crate::Result;
@@ -64,6 +66,13 @@ pub enum FrameFormat {
     /// Raw little-endian frames: an f64 time stamp in s when `--stamped`, then one f32 per
     /// taxel; a frame whose every value is NaN ends the episode.
     F32le,
+    /// Address events as text lines: `t,x,y,p` (or `t,taxel,p` for a model trained on
+    /// taxel-indexed events), with or without a header; a line holding only a time is a
+    /// tick (time has reached it), `reset` ends the episode.
+    Events,
+    /// Address events as 16-byte little-endian records: t i64, x u16, y u16, p i8, kind u8
+    /// (0 event, 1 tick, 2 end of episode), 2 unused bytes.
+    EventsBin,
 }
 
 /// Options of `neurotex stream`.
@@ -96,7 +105,8 @@ pub struct StreamOptions {
     /// frames are taken at --fs. A column named t_ms/time_ms or t_s/time_s is found alone.
     #[cfg_attr(feature = "cli", arg(long = "time-column"))]
     pub time_column: Option<Column>,
-    /// Unit of the time stamps: `ms` or `s` (default `ms` for CSV; f32le stamps are s).
+    /// Unit of the time stamps: `us`, `ms` or `s` (default `ms` for CSV; f32le stamps are s;
+    /// events: the model's event dataset's unit, required without one; events-bin: `us`).
     #[cfg_attr(feature = "cli", arg(long = "time-unit"))]
     pub time_unit: Option<TimeUnit>,
     /// CSV: the channel columns (names, 0-based indices and ranges such as `2-17`, or a
@@ -113,6 +123,12 @@ pub struct StreamOptions {
     /// f32le: each frame starts with an f64 time stamp in s.
     #[cfg_attr(feature = "cli", arg(long))]
     pub stamped: bool,
+    /// Events: where the first episode's time 0 is, `zero` (the stamps count from the
+    /// recording's start, as an exported recording's) or `first` (its first event; later
+    /// episodes always start at their first event). Default: the model's event dataset's,
+    /// else `first`.
+    #[cfg_attr(feature = "cli", arg(long, value_parser = ["zero", "first"]))]
+    pub origin: Option<String>,
     /// Replay the input at its own pace (its time stamps, or --fs): for demonstrations.
     #[cfg_attr(feature = "cli", arg(long))]
     pub realtime: bool,
@@ -150,6 +166,55 @@ impl StreamOptions {
             max_gap_s: self.max_gap_s,
             speed_mm_s: self.speed,
         })
+    }
+
+    /// For an event stream (`--format events` or `events-bin`), how its events are
+    /// written and address the model's grid; `None` for frames.
+    ///
+    /// # Errors
+    /// An option for frames with events, or a text event stream whose unit is not known.
+    pub fn event_source(&self, model: &SavedModel) -> Result<Option<(EventEncoding, EventSource)>> {
+        let encoding = match self.format {
+            FrameFormat::Events => EventEncoding::Text,
+            FrameFormat::EventsBin => EventEncoding::Binary,
+            FrameFormat::Csv | FrameFormat::F32le => {
+                if self.origin.is_some() {
+                    return Err(OptionsError::NotApplicable {
+                        option: "--origin",
+                        applies_to: "--format events or events-bin",
+                    }
+                    .into());
+                }
+                return Ok(None);
+            }
+        };
+        let frames_only = [
+            ("--stamped", self.stamped),
+            ("--time-column", self.time_column.is_some()),
+            ("--channels", self.channels.is_some()),
+            ("--no-header", self.no_header),
+            ("--delimiter", self.delimiter.is_some()),
+        ];
+        if let Some((option, _)) = frames_only.iter().find(|o| o.1) {
+            return Err(OptionsError::NotApplicable {
+                option,
+                applies_to: "frames (--format csv or f32le); events name their columns in a header or come as t,x,y,p",
+            }
+            .into());
+        }
+        let origin = self.origin.as_deref().map(|o| match o {
+            "zero" => Origin::Zero,
+            _ => Origin::First,
+        });
+        // Binary records' stamps are microseconds unless said: the record's definition, not
+        // the training files' unit.
+        let unit = match (encoding, self.time_unit) {
+            (_, Some(unit)) => Some(unit),
+            (EventEncoding::Binary, None) => Some(TimeUnit::Microseconds),
+            (EventEncoding::Text, None) => None,
+        };
+        let source = EventSource::for_model(model, unit, origin).map_err(OptionsError::Conflict)?;
+        Ok(Some((encoding, source)))
     }
 
     /// The frame format the options describe. CSV: with no option saying where the columns
@@ -195,6 +260,10 @@ impl StreamOptions {
                 stamped: self.stamped,
                 unit: self.time_unit.unwrap_or(TimeUnit::Seconds),
             },
+            FrameFormat::Events | FrameFormat::EventsBin => {
+                let why = "events have no frame format: `StreamOptions::event_source` reads them";
+                return Err(OptionsError::Conflict(why.into()).into());
+            }
         })
     }
 }

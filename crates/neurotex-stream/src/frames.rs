@@ -352,7 +352,7 @@ fn parse_fields(
 /// `limit` bytes of it: a longer line is read to its end and the rest dropped, so a peer
 /// cannot make the stream buffer more. Returns the line's whole length in bytes, `None`
 /// at the end of the input or once `stop()` says so.
-fn read_line(
+pub(crate) fn read_line(
     input: &mut dyn BufRead,
     line: &mut Vec<u8>,
     limit: usize,

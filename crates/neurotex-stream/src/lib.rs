@@ -11,12 +11,22 @@
 //!
 //! Memory is bounded by the window, not the stream: per taxel the filter, neuron and
 //! resampler state (a few f64) and the spike times of the current window (as u32).
+#![deny(missing_docs)]
 
+pub mod events;
 pub mod frames;
 pub mod input;
 mod network;
 mod spike_log;
 mod window_glcm;
+
+// The layers below, under the names their modules had when they were one crate, so that
+// `crate::causal` and the like read the same in every layer.
+use neurotex_core::{csvlog, error, recording, Error};
+use neurotex_features::features;
+use neurotex_learn::snn;
+use neurotex_pipeline::{causal, model, pipeline, saved, spiking_model};
+use neurotex_signal::{encode, signal};
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
@@ -223,6 +233,18 @@ pub enum BadFrame {
         /// The largest gap.
         max_gap_s: f64,
     },
+    /// An event stamped before the previous event.
+    #[error("time stamp {t} s is before the previous event's {previous} s: events must come in time order")]
+    Order {
+        /// The event's stamp.
+        t: f64,
+        /// The previous event's.
+        previous: f64,
+    },
+    /// An event that names no cell of the model's grid, or a polarity that is neither ON
+    /// nor OFF.
+    #[error("{0}")]
+    Address(String),
     /// A time stamp beyond [`MAX_STAMP_S`].
     #[error("time stamp {t} s exceeds the exact range of stamps (within 2^33 s, about 272 years, of zero; beyond, stamps 1 ms apart can be one number)")]
     StampRange {
@@ -270,6 +292,17 @@ struct EpisodeState {
     /// The populations' neurons, in the order of [`Encoded::populations`], each marked
     /// whether it is FA (driven by the rectified rate of change).
     neurons: Vec<(Encoder, bool)>,
+    /// What the window keeps of the spikes.
+    kept: Kept,
+    decider: Decider,
+    bins: usize,
+    /// Since when (s from the origin) the signal has been at rest, for onset episodes.
+    rest_since: Option<f64>,
+}
+
+/// What an episode keeps of its spikes for the classifications at bin boundaries.
+#[derive(Debug, Clone)]
+struct Kept {
     /// The spikes of the current window, per population (none for a spiking network,
     /// which takes them as they come).
     spikes: Vec<SpikeLog>,
@@ -278,10 +311,29 @@ struct EpisodeState {
     /// Per population, the window's co-occurrence counts kept bin by bin, for 3D-GLCM
     /// models (empty for others, which count the window's spike times afresh).
     glcm: Vec<WindowGlcm>,
-    decider: Decider,
-    bins: usize,
-    /// Since when (s from the origin) the signal has been at rest, for onset episodes.
-    rest_since: Option<f64>,
+}
+
+impl Kept {
+    /// Opens the next 1 ms step.
+    fn begin_step(&mut self) {
+        for log in &mut self.spikes {
+            log.begin_step();
+        }
+    }
+
+    /// Takes the open step's spikes of `population` in the cells from `start` on
+    /// (`raster[i]` for cell `start + i`, whose taxel flag is `present[i]`).
+    fn add(&mut self, population: usize, start: usize, raster: &[u8], present: &[bool]) {
+        if let Some(window) = self.glcm.get_mut(population) {
+            window.add_spikes(start, raster);
+        }
+        if let Some(log) = self.spikes.get_mut(population) {
+            log.add_part(start, raster, present);
+        }
+        if let Some(feed) = &mut self.network {
+            feed.add(population, start, raster);
+        }
+    }
 }
 
 /// A causal model classifying a live stream frame by frame.
@@ -322,6 +374,8 @@ pub struct StreamClassifier {
     previous: Vec<f64>,
     drive: Vec<f64>,
     raster: Vec<u8>,
+    /// An event stream's state (`None` for frames).
+    event_input: Option<events::EventState>,
 }
 
 pub use crate::causal::NO_RUNNING_SPECTRUM;
@@ -336,11 +390,23 @@ impl StreamClassifier {
     /// features need a speed when none is given, or broken parameters.
     pub fn new(model: impl Into<SavedModel>, params: StreamParams) -> Result<Self> {
         let model = model.into();
-        params.check()?;
+        if let Some(why) = events::trained_on_events(&model) {
+            return Err(crate::error::OptionsError::Conflict(why).into());
+        }
         let conditioning = match model.streams() {
             Ok(conditioning) => conditioning.clone(),
             Err(why) => return Err(crate::error::OptionsError::Conflict(why.into()).into()),
         };
+        Self::with_conditioning(model, params, conditioning)
+    }
+
+    /// [`StreamClassifier::new`] with the conditioning of frames given (unused by events).
+    fn with_conditioning(
+        model: SavedModel,
+        params: StreamParams,
+        conditioning: CausalConditioning,
+    ) -> Result<Self> {
+        params.check()?;
         if let SavedModel::Features(m) = &model {
             if m.features().method == crate::pipeline::Method::AllTaxelsMm
                 && !params.speed_mm_s.is_some_and(|v| v.is_finite() && v != 0.0)
@@ -402,6 +468,7 @@ impl StreamClassifier {
             previous: buffer.clone(),
             drive: buffer,
             raster: vec![0; cells],
+            event_input: None,
             model,
             params,
         })
@@ -443,7 +510,7 @@ impl StreamClassifier {
     pub fn retained_spikes(&self) -> usize {
         self.episode
             .as_ref()
-            .map_or(0, |e| e.spikes.iter().map(SpikeLog::len).sum())
+            .map_or(0, |e| e.kept.spikes.iter().map(SpikeLog::len).sum())
     }
 
     /// Whether an episode is under way.
@@ -656,7 +723,9 @@ impl StreamClassifier {
     /// this check touch the clock, so a frame refused for its values cannot confirm a jump.
     fn follow(&mut self, t: f64) -> Result<bool, BadFrame> {
         let max_gap_s = self.params.max_gap_s;
-        let follows = |p: f64| t > p && t - p <= max_gap_s;
+        // Events may share a stamp; frames may not.
+        let equal = self.event_input.is_some();
+        let follows = |p: f64| (t > p || (equal && t == p)) && t - p <= max_gap_s;
         let stray = self.stray_stamp.take();
         let Some(previous) = self.previous_stamp else {
             self.previous_stamp = Some(t);
@@ -669,6 +738,7 @@ impl StreamClassifier {
         }
         self.stray_stamp = Some(t);
         Err(match t <= previous {
+            true if equal => BadFrame::Order { t, previous },
             true => BadFrame::Stamp { t, previous },
             false => BadFrame::Jump {
                 t,
@@ -719,11 +789,13 @@ impl StreamClassifier {
             steps: 0,
             filter_state: [vec![0.0; cells], vec![0.0; cells]],
             has_previous: false,
-            spikes,
-            network,
-            glcm: match &self.empty_glcm {
-                Some(empty) => vec![empty.clone(); neurons.len()],
-                None => Vec::new(),
+            kept: Kept {
+                spikes,
+                network,
+                glcm: match &self.empty_glcm {
+                    Some(empty) => vec![empty.clone(); neurons.len()],
+                    None => Vec::new(),
+                },
             },
             neurons,
             decider: Decider::new(self.params.rule),
@@ -763,6 +835,9 @@ impl StreamClassifier {
     /// The episode's last steps, up to its last frame's time, as offline: bracketed by
     /// the last two frames (clamped beyond the last), or the only frame.
     fn flush(&mut self) -> Result<(), StreamError> {
+        if self.event_input.is_some() {
+            return self.flush_events();
+        }
         let episode = self.episode.as_mut().expect("an episode is under way");
         let (ta, tb) = (episode.before_t, episode.last_t);
         let total = match episode.frames {
@@ -804,9 +879,7 @@ impl StreamClassifier {
         let cells = self.rows * self.cols;
         let has_fa = episode.neurons.iter().any(|n| n.1);
         let [z0, z1] = &mut episode.filter_state;
-        for log in &mut episode.spikes {
-            log.begin_step();
-        }
+        episode.kept.begin_step();
         for start in (0..cells).step_by(PART) {
             let part = start..(start + PART).min(cells);
             let conditioning = Conditioning {
@@ -836,27 +909,27 @@ impl StreamClassifier {
                     }
                 };
                 neurons.run_part(part.start, input, raster);
-                if let Some(window) = episode.glcm.get_mut(population) {
-                    window.add_spikes(part.start, raster);
-                }
-                if let Some(log) = episode.spikes.get_mut(population) {
-                    log.add_part(part.start, raster, &self.present[part.clone()]);
-                }
-                if let Some(feed) = &mut episode.network {
-                    feed.add(population, part.start, raster);
-                }
+                let present = &self.present[part.clone()];
+                episode.kept.add(population, part.start, raster, present);
             }
         }
         if has_fa {
             std::mem::swap(&mut self.previous, &mut self.conditioned);
             episode.has_previous = true;
         }
+        self.end_step()
+    }
+
+    /// Ends the episode's current 1 ms step, whose spikes were added: the network's step
+    /// when its time step is complete, and the window's classification at a bin boundary.
+    fn end_step(&mut self) -> Result<(), StreamError> {
+        let episode = self.episode.as_mut().expect("an episode is under way");
         episode.steps += 1;
-        if let (Some(feed), SavedModel::Spiking(m)) = (&mut episode.network, &self.model) {
+        if let (Some(feed), SavedModel::Spiking(m)) = (&mut episode.kept.network, &self.model) {
             feed.end_ms(m.network());
         }
         if episode.steps.is_multiple_of(self.bin) {
-            for window in &mut episode.glcm {
+            for window in &mut episode.kept.glcm {
                 window.close_bin();
             }
             self.boundary()?;
@@ -870,13 +943,13 @@ impl StreamClassifier {
         let end = episode.steps;
         let start = end.saturating_sub(self.window);
         // Later windows start later, and the episode's summary no earlier than this one.
-        for log in &mut episode.spikes {
+        for log in &mut episode.kept.spikes {
             log.drop_before(start);
         }
-        let (class, shares) = match (&self.model, &episode.network) {
+        let (class, shares) = match (&self.model, &episode.kept.network) {
             (SavedModel::Spiking(m), Some(feed)) => decide(&feed.scores(m.network())),
             (SavedModel::Features(m), _) => {
-                let prediction = match episode.glcm.is_empty() {
+                let prediction = match episode.kept.glcm.is_empty() {
                     true => self.classify(m, start, end)?,
                     false => self.classify_window(m)?,
                 };
@@ -903,6 +976,7 @@ impl StreamClassifier {
     fn classify(&self, model: &Model, start: usize, end: usize) -> Result<Prediction, StreamError> {
         let episode = self.episode.as_ref().expect("an episode is under way");
         let trains: Vec<SpikeTrains> = episode
+            .kept
             .spikes
             .iter()
             .map(|log| log.trains(start, end, (self.rows, self.cols), &self.present))
@@ -933,7 +1007,7 @@ impl StreamClassifier {
         let symmetric = extractor.glcm_params().symmetric;
         let mut row = Vec::new();
         let mut counts = Vec::new();
-        for window in &episode.glcm {
+        for window in &episode.kept.glcm {
             window.counts(volume.levels, volume.range, symmetric, &mut counts);
             row.extend(extractor.haralick_row(&counts));
         }
@@ -947,7 +1021,7 @@ impl StreamClassifier {
         let episode = self.episode.as_mut().expect("an episode is under way");
         let n = episode.steps;
         let whole = n.min(self.window);
-        let last = match (&self.model, &mut episode.network) {
+        let last = match (&self.model, &mut episode.kept.network) {
             _ if whole < self.bin => None,
             (SavedModel::Spiking(m), Some(feed)) => {
                 feed.flush(m.network());

@@ -1,0 +1,651 @@
+//! Address events through a stream: an event sensor's events (a time, a cell, a polarity)
+//! are spikes already, so they skip the resampler, the filter and the neurons and go
+//! straight into the window the model classifies, ON events as the SA population and OFF
+//! events as the FA one, in the 1 ms steps of the offline reader
+//! ([`neurotex_core::events`]): an event recording streamed as one episode gives the lines
+//! `predict` would give its bins, and the same lines as the sampled recording whose spikes
+//! the events are.
+//!
+//! Events come as text lines (`t,x,y,p` or `t,taxel,p`, with or without a header naming the
+//! columns) or as 16-byte binary records ([`RECORD_BYTES`]). Besides events, a stream may
+//! send a tick (a time alone: time has reached it, with no event) and `reset` (the episode
+//! ends). A sensor that falls silent should tick: a stamp further than `max_gap_s` after
+//! the previous one is refused as a wild stamp unless the next one follows it, as for
+//! frames ([`StreamClassifier::push`]), so the first event after a long silence costs its
+//! own spike and starts a new episode.
+
+use std::io::{BufRead, ErrorKind};
+
+use neurotex_core::events::{EventGrid, EventsFormat, Origin, Stamp};
+
+use super::{BadFrame, EpisodeEnd, EpisodeRule, Event, StreamClassifier, StreamError};
+use crate::error::{DataError, Result};
+use crate::frames::{Replay, Sink};
+use crate::pipeline::Encoding;
+use crate::recording::TimeUnit;
+use crate::saved::{SavedModel, Trained};
+use crate::signal::CausalConditioning;
+use crate::StreamParams;
+
+/// The bytes of one binary event record, little-endian: `t` i64 (in the stream's unit,
+/// microseconds unless said), `x` u16 (or the taxel index), `y` u16, `p` i8 (the polarity),
+/// `kind` u8 (0 an event, 1 a tick, 2 the episode's end), two bytes unused. NumPy's
+/// `[("t", "<i8"), ("x", "<u2"), ("y", "<u2"), ("p", "i1"), ("kind", "u1"), ("pad", "<u2")]`.
+pub const RECORD_BYTES: usize = 16;
+
+/// How a stream's events address the model's grid and count time.
+#[derive(Debug, Clone)]
+pub struct EventSource {
+    /// The stamps' unit, the polarity values, a taxel column or `x` and `y`, the origin.
+    pub format: EventsFormat,
+    /// The model's grid, its mask and the taxel indices' cells.
+    pub grid: EventGrid,
+}
+
+impl EventSource {
+    /// The events of `model`'s sensor: read as its training dataset's event files were when
+    /// it was trained on events, else as `x` and `y` on its grid with polarities 1 (ON) and
+    /// 0 (OFF). `unit` and `origin` override the dataset's.
+    ///
+    /// # Errors
+    /// No unit: the model was not trained on events and none was given.
+    pub fn for_model(
+        model: &SavedModel,
+        unit: Option<TimeUnit>,
+        origin: Option<Origin>,
+    ) -> std::result::Result<Self, String> {
+        let grid = model.grid();
+        let layout = model.provenance().layout.as_ref();
+        let trained = layout.and_then(|l| l.events.clone());
+        let mut format = match (trained, unit) {
+            (Some(f), _) => f,
+            (None, Some(unit)) => EventsFormat::new(unit),
+            (None, None) => return Err("the model was not trained on events, so the stream's time unit is not known: say it with --time-unit (us, ms or s)".into()),
+        };
+        if let Some(unit) = unit {
+            format.time_unit = unit;
+        }
+        format.origin = origin.unwrap_or(match layout.is_some_and(|l| l.events.is_some()) {
+            true => format.origin,
+            false => Origin::First,
+        });
+        let mut grid = match layout {
+            Some(l) if format.taxel.is_some() => l.event_grid(grid.rows(), grid.cols()),
+            _ => EventGrid {
+                rows: grid.rows(),
+                cols: grid.cols(),
+                present: Vec::new(),
+                taxels: (0..grid.rows() * grid.cols()).collect(),
+            },
+        };
+        grid.present = model.grid().present().to_vec();
+        Ok(EventSource { format, grid })
+    }
+}
+
+/// Why `model` cannot stream frames: it was trained on address events.
+pub fn trained_on_events(model: &SavedModel) -> Option<String> {
+    let layout = model.provenance().layout.as_ref()?;
+    layout.events.as_ref().map(|_| {
+        "the model was trained on address events, which skip the encoder: stream its sensor's events (--format events or events-bin), not sampled frames".to_string()
+    })
+}
+
+/// An event stream's state beside the episode's.
+#[derive(Debug, Clone)]
+pub(crate) struct EventState {
+    source: EventSource,
+    /// The population ON events feed, and OFF events (`None`: the model reads none).
+    on: Option<usize>,
+    off: Option<usize>,
+    /// Per population, the current step's spikes by cell.
+    rasters: Vec<Vec<u8>>,
+    /// Whether the current step holds a spike.
+    pending: bool,
+    /// The episode's time 0.
+    origin: Stamp,
+    /// Episodes started.
+    episodes: u64,
+    /// The step of the episode's last event.
+    last_event: Option<u64>,
+    /// Events that fell in a step already holding a spike of their cell and population.
+    merged: u64,
+}
+
+impl StreamClassifier {
+    /// A stream classifier for address events from `source` with any feature model or
+    /// spiking network (events need no conditioning, so a model trained without `--causal`
+    /// streams them too; a spectrum model still cannot).
+    ///
+    /// # Errors
+    /// As [`StreamClassifier::new`], but for `--causal`.
+    pub fn for_events(
+        model: impl Into<SavedModel>,
+        params: StreamParams,
+        source: EventSource,
+    ) -> Result<Self> {
+        let model = model.into();
+        if let SavedModel::Features(m) = &model {
+            if m.features().method == crate::pipeline::Method::Spectrum {
+                let why = crate::causal::NO_RUNNING_SPECTRUM.into();
+                return Err(crate::error::OptionsError::Conflict(why).into());
+            }
+        }
+        let cells = model.grid().rows() * model.grid().cols();
+        let conditioning = CausalConditioning {
+            offsets: vec![0.0; cells],
+            scale: 1.0,
+        };
+        let (on, off) = match model.params().encoding {
+            Encoding::Sa => (Some(0), None),
+            Encoding::Fa => (None, Some(0)),
+            Encoding::SaFa => (Some(0), Some(1)),
+        };
+        let populations = usize::from(on.is_some()) + usize::from(off.is_some());
+        let mut stream = Self::with_conditioning(model, params, conditioning)?;
+        stream.event_input = Some(EventState {
+            source,
+            on,
+            off,
+            rasters: vec![vec![0; cells]; populations],
+            pending: false,
+            origin: Stamp::Int(0),
+            episodes: 0,
+            last_event: None,
+            merged: 0,
+        });
+        Ok(stream)
+    }
+
+    /// Events that added no spike: their cell already had one from its polarity in that
+    /// millisecond (a train holds at most one spike per 1 ms step, as offline).
+    pub fn merged_events(&self) -> u64 {
+        self.event_input.as_ref().map_or(0, |e| e.merged)
+    }
+
+    /// Takes one event at `stamp` (in the source's unit) of the cell `address` gives (`x`
+    /// and `y`, or the taxel index and an unused value) and its polarity, or a tick when
+    /// `address` is `None`: time has reached `stamp`. Returns what it completed: a
+    /// classification at each bin boundary passed, an episode's end.
+    ///
+    /// An episode's steps count from its origin: the stream's first episode from time 0
+    /// with the `zero` origin, every other from its first event. A tick starts a `whole`
+    /// episode but not an `onset` one; an `onset` episode ends once `rest_ms` pass without
+    /// an event (its level does not apply to events).
+    ///
+    /// # Errors
+    /// [`StreamError::Bad`] for a bad event (a cell off the grid or masked, an unknown
+    /// polarity, a stamp not finite, before the previous or a gap too far ahead): counted and
+    /// skipped. [`StreamError::Classify`] when the model cannot classify a window.
+    ///
+    /// # Panics
+    /// If the classifier was not made for events ([`StreamClassifier::for_events`]).
+    pub fn push_event(
+        &mut self,
+        stamp: Stamp,
+        address: Option<(i64, i64, Option<i64>)>,
+    ) -> std::result::Result<&[Event], StreamError> {
+        self.events.clear();
+        let (target, jumped) = match self.accept_event(stamp, address) {
+            Ok(taken) => taken,
+            Err(bad) => {
+                self.bad_frames += 1;
+                return Err(bad.into());
+            }
+        };
+        self.frames += 1;
+        if jumped && self.episode.is_some() {
+            self.end_episode(EpisodeEnd::Gap)?;
+        }
+        let rest = match self.params.episodes {
+            EpisodeRule::Onset { rest_ms, .. } => Some(rest_ms as u64),
+            EpisodeRule::Whole => None,
+        };
+        let mut step = None;
+        if self.episode.is_some() {
+            let state = self.event_input.as_ref().expect("an event stream");
+            let s = stamp
+                .step_from(state.origin, state.source.format.time_unit)
+                .unwrap_or(u64::MAX);
+            if let (Some(rest), Some(last)) = (rest, state.last_event) {
+                if s > last + rest {
+                    self.advance(last + rest + 1)?;
+                    self.end_episode(EpisodeEnd::Rest)?;
+                }
+            }
+            if s >= super::MAX_EPISODE_STEPS as u64 && self.episode.is_some() {
+                self.end_episode(EpisodeEnd::Gap)?;
+            }
+            step = self.episode.is_some().then_some(s);
+        }
+        let step = match step {
+            Some(s) => s,
+            None if rest.is_some() && target.is_none() => return Ok(&self.events),
+            None => self.start_event_episode(stamp),
+        };
+        self.advance(step)?;
+        let state = self.event_input.as_mut().expect("an event stream");
+        if let Some((cell, population)) = target {
+            state.last_event = Some(step);
+            if let Some(p) = population {
+                let spike = &mut state.rasters[p][cell];
+                state.merged += u64::from(*spike != 0);
+                *spike = 1;
+                state.pending = true;
+            }
+        }
+        Ok(&self.events)
+    }
+
+    /// Checks an event: its cell and population (`None` for a polarity the model does not
+    /// read) unless it is a tick, then its stamp against the previous one.
+    #[allow(clippy::type_complexity)]
+    fn accept_event(
+        &mut self,
+        stamp: Stamp,
+        address: Option<(i64, i64, Option<i64>)>,
+    ) -> std::result::Result<(Option<(usize, Option<usize>)>, bool), BadFrame> {
+        let state = self.event_input.as_ref().expect("an event stream");
+        let format = &state.source.format;
+        let t = format.time_unit.to_seconds(stamp.as_f64());
+        if !t.is_finite() {
+            return Err(BadFrame::NotFinite { index: 0 });
+        }
+        if t.abs() > super::MAX_STAMP_S {
+            return Err(BadFrame::StampRange { t });
+        }
+        let target = match address {
+            None => None,
+            Some((a, b, p)) => {
+                let taxel = format.taxel.is_some();
+                let cell = state.source.grid.cell(taxel, (a, b));
+                let on = format.is_on(p);
+                let (cell, on) = (
+                    cell.map_err(BadFrame::Address)?,
+                    on.map_err(BadFrame::Address)?,
+                );
+                Some((cell, if on { state.on } else { state.off }))
+            }
+        };
+        Ok((target, self.follow(t)?))
+    }
+
+    /// Starts an episode at `stamp`: its first step.
+    fn start_event_episode(&mut self, stamp: Stamp) -> u64 {
+        self.episode = Some(self.new_episode(0.0));
+        let state = self.event_input.as_mut().expect("an event stream");
+        let zero = state.episodes == 0 && state.source.format.origin == Origin::Zero;
+        state.origin = if zero { Stamp::Int(0) } else { stamp };
+        state.episodes += 1;
+        state.last_event = None;
+        let unit = state.source.format.time_unit;
+        match stamp.step_from(state.origin, unit) {
+            Ok(s) if s < super::MAX_EPISODE_STEPS as u64 => s,
+            // Before time 0 or too far past it: the episode counts from this stamp.
+            _ => {
+                state.origin = stamp;
+                0
+            }
+        }
+    }
+
+    /// Completes the episode's steps before `step`.
+    fn advance(&mut self, step: u64) -> std::result::Result<(), StreamError> {
+        while self
+            .episode
+            .as_ref()
+            .is_some_and(|e| (e.steps as u64) < step)
+        {
+            self.complete_step()?;
+        }
+        Ok(())
+    }
+
+    /// Completes the episode's current step with the events it holds.
+    fn complete_step(&mut self) -> std::result::Result<(), StreamError> {
+        let episode = self.episode.as_mut().expect("an episode is under way");
+        let state = self.event_input.as_mut().expect("an event stream");
+        episode.kept.begin_step();
+        for (population, raster) in state.rasters.iter_mut().enumerate() {
+            episode.kept.add(population, 0, raster, &self.present);
+            if state.pending {
+                raster.fill(0);
+            }
+        }
+        state.pending = false;
+        self.end_step()
+    }
+
+    /// The episode's last step when it holds events (the steps before it are complete).
+    pub(crate) fn flush_events(&mut self) -> std::result::Result<(), StreamError> {
+        let pending = self.event_input.as_ref().is_some_and(|s| s.pending);
+        match pending {
+            true => self.complete_step(),
+            false => Ok(()),
+        }
+    }
+}
+
+/// How a stream's events are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventEncoding {
+    /// Text lines, `t,x,y,p` or `t,taxel,p` (the polarity optional), with or without a
+    /// header naming the columns; a line holding only a time is a tick, `reset` ends the
+    /// episode.
+    Text,
+    /// Binary records of [`RECORD_BYTES`].
+    Binary,
+}
+
+/// What the input holds next.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Item {
+    /// An event (`address` the cell's two numbers and the polarity) or a tick (`None`).
+    Event {
+        /// The stamp, in the stream's unit.
+        stamp: Stamp,
+        /// The cell and polarity, `None` for a tick.
+        address: Option<(i64, i64, Option<i64>)>,
+    },
+    /// The sender asked for the episode to end.
+    Reset,
+    /// An event that could not be decoded.
+    Bad {
+        /// Where it was: `line 12`, `record 7`.
+        place: String,
+        /// Why.
+        why: String,
+    },
+}
+
+/// The text columns, planned from the first line.
+#[derive(Debug, Clone)]
+struct TextColumns {
+    delimiter: Option<u8>,
+    time: usize,
+    a: usize,
+    b: Option<usize>,
+    polarity: Option<usize>,
+}
+
+/// Decodes events from `input`, named `source` in messages.
+pub struct EventReader<R> {
+    input: R,
+    source: String,
+    encoding: EventEncoding,
+    format: EventsFormat,
+    columns: Option<TextColumns>,
+    line: Vec<u8>,
+    count: u64,
+}
+
+impl<R: BufRead> EventReader<R> {
+    /// A reader of `encoding` events whose columns `format` names.
+    pub fn new(input: R, source: &str, encoding: EventEncoding, format: &EventsFormat) -> Self {
+        EventReader {
+            input,
+            source: source.to_string(),
+            encoding,
+            format: format.clone(),
+            columns: None,
+            line: Vec::new(),
+            count: 0,
+        }
+    }
+
+    /// Where the last event was (`line 12`, `record 7`).
+    pub fn place(&self) -> String {
+        match self.encoding {
+            EventEncoding::Text => format!("line {}", self.count),
+            EventEncoding::Binary => format!("record {}", self.count),
+        }
+    }
+
+    /// The next item; `None` at the end of the input or once `stop()` says so.
+    ///
+    /// # Errors
+    /// The input cannot be read, or a header names no time column.
+    pub fn next(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Item>> {
+        match self.encoding {
+            EventEncoding::Text => self.next_line(stop),
+            EventEncoding::Binary => self.next_record(stop),
+        }
+    }
+
+    fn next_record(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Item>> {
+        let mut record = [0u8; RECORD_BYTES];
+        let mut got = 0;
+        while got < RECORD_BYTES {
+            let available = match self.input.fill_buf() {
+                Ok(bytes) => bytes,
+                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) => return Err(DataError::io(&self.source, e).into()),
+            };
+            if available.is_empty() || (got == 0 && stop()) {
+                break;
+            }
+            let n = available.len().min(RECORD_BYTES - got);
+            record[got..got + n].copy_from_slice(&available[..n]);
+            self.input.consume(n);
+            got += n;
+        }
+        if got == 0 {
+            return Ok(None);
+        }
+        self.count += 1;
+        if got < RECORD_BYTES {
+            let why = format!("the input ended after {got} of its {RECORD_BYTES} bytes");
+            return Ok(Some(Item::Bad {
+                place: self.place(),
+                why,
+            }));
+        }
+        let t = i64::from_le_bytes(record[..8].try_into().expect("8 bytes"));
+        let x = u16::from_le_bytes([record[8], record[9]]);
+        let y = u16::from_le_bytes([record[10], record[11]]);
+        let p = record[12] as i8;
+        let stamp = Stamp::Int(t);
+        Ok(Some(match record[13] {
+            0 => Item::Event {
+                stamp,
+                address: Some((i64::from(x), i64::from(y), Some(i64::from(p)))),
+            },
+            1 => Item::Event {
+                stamp,
+                address: None,
+            },
+            2 => Item::Reset,
+            kind => Item::Bad {
+                place: self.place(),
+                why: format!("kind {kind} is none of 0 (an event), 1 (a tick), 2 (the end)"),
+            },
+        }))
+    }
+
+    fn next_line(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Item>> {
+        loop {
+            let read = crate::frames::read_line(&mut self.input, &mut self.line, 4096, stop);
+            let Some(length) = read.map_err(|e| DataError::io(&self.source, e))? else {
+                return Ok(None);
+            };
+            self.count += 1;
+            let bad = |why: String| Item::Bad {
+                place: format!("line {}", self.count),
+                why,
+            };
+            if length > 4096 {
+                return Ok(Some(bad(format!("a {length}-byte line is no event"))));
+            }
+            let Ok(text) = std::str::from_utf8(&self.line) else {
+                return Ok(Some(bad("the line is not UTF-8 text".into())));
+            };
+            let text = text.trim();
+            if text.is_empty() || text.starts_with('#') {
+                continue;
+            }
+            if text.eq_ignore_ascii_case("reset") {
+                return Ok(Some(Item::Reset));
+            }
+            if self.columns.is_none() {
+                let (columns, header) = self.plan(text)?;
+                self.columns = Some(columns);
+                if header {
+                    continue;
+                }
+            }
+            let columns = self.columns.as_ref().expect("planned above");
+            return Ok(Some(parse_line(text, columns).unwrap_or_else(bad)));
+        }
+    }
+
+    /// The columns from the first line: a header names them (by the format's names),
+    /// otherwise they are `t`, then `x` and `y` or the taxel, then the polarity.
+    fn plan(&self, text: &str) -> Result<(TextColumns, bool)> {
+        let delimiter = [b',', b';', b'\t']
+            .into_iter()
+            .find(|d| text.as_bytes().contains(d));
+        let (fields, n) = split(text, delimiter);
+        let names = &fields[..n.min(fields.len())];
+        let taxel = self.format.taxel.as_deref();
+        let header = names
+            .first()
+            .is_some_and(|f| f.parse::<f64>().is_err() && !f.is_empty());
+        if !header {
+            let columns = TextColumns {
+                delimiter,
+                time: 0,
+                a: 1,
+                b: taxel.is_none().then_some(2),
+                polarity: Some(if taxel.is_some() { 2 } else { 3 }),
+            };
+            return Ok((columns, false));
+        }
+        let find = |name: &str| names.iter().position(|n| n.eq_ignore_ascii_case(name));
+        let missing = |name: &str| {
+            let why = format!(
+                "line {}: the header {names:?} has no column `{name}`",
+                self.count
+            );
+            crate::Error::from(DataError::invalid(&self.source, why))
+        };
+        let f = &self.format;
+        let time = find(&f.time).ok_or_else(|| missing(&f.time))?;
+        let (a, b) = match taxel {
+            Some(t) => (find(t).ok_or_else(|| missing(t))?, None),
+            None => (
+                find(&f.x).ok_or_else(|| missing(&f.x))?,
+                Some(find(&f.y).ok_or_else(|| missing(&f.y))?),
+            ),
+        };
+        let columns = TextColumns {
+            delimiter,
+            time,
+            a,
+            b,
+            polarity: find(&f.polarity),
+        };
+        Ok((columns, true))
+    }
+}
+
+/// The fields of `text` split at `delimiter` (at runs of spaces without one), trimmed;
+/// the first eight, and how many there are.
+fn split(text: &str, delimiter: Option<u8>) -> ([&str; 8], usize) {
+    let mut fields = [""; 8];
+    let mut n = 0;
+    let cut = |c: char| match delimiter {
+        Some(d) => c == char::from(d),
+        None => c == ' ' || c == '\t',
+    };
+    for field in text.split(cut).map(str::trim) {
+        if delimiter.is_none() && field.is_empty() {
+            continue;
+        }
+        if let Some(slot) = fields.get_mut(n) {
+            *slot = field;
+        }
+        n += 1;
+    }
+    (fields, n)
+}
+
+/// One line's event or tick; `Err` says why it is neither.
+fn parse_line(text: &str, columns: &TextColumns) -> std::result::Result<Item, String> {
+    let (fields, _) = split(text, columns.delimiter);
+    let get = |j: usize| fields.get(j).copied().filter(|f| !f.is_empty());
+    let time = get(columns.time).ok_or("the line has no time")?;
+    let stamp = match time.parse::<i64>() {
+        Ok(t) => Stamp::Int(t),
+        Err(_) => Stamp::Float(
+            time.parse::<f64>()
+                .map_err(|_| format!("time `{time}` is not a number"))?,
+        ),
+    };
+    let number = |j: usize, what: &str| -> std::result::Result<Option<i64>, String> {
+        get(j)
+            .map(|f| {
+                f.parse::<i64>().or_else(|_| match f.parse::<f64>() {
+                    Ok(v) if v.fract() == 0.0 && v.abs() < 9e15 => Ok(v as i64),
+                    _ => Err(format!("{what} `{f}` is not a whole number")),
+                })
+            })
+            .transpose()
+    };
+    let a = number(columns.a, "the cell")?;
+    let b = match columns.b {
+        Some(j) => number(j, "y")?,
+        None => a.map(|_| 0),
+    };
+    let p = match columns.polarity {
+        Some(j) => number(j, "the polarity")?,
+        None => None,
+    };
+    let address = match (a, b) {
+        (Some(a), Some(b)) => Some((a, b, p)),
+        (None, None) => None,
+        _ => return Err("the line has half a cell (x without y, or y without x)".into()),
+    };
+    Ok(Item::Event { stamp, address })
+}
+
+/// Feeds every item of `events` to `stream` until the input ends or `stop()` says so, as
+/// [`crate::frames::feed`] feeds frames: bad events are counted, reported and skipped, and
+/// the stream is not finished.
+///
+/// # Errors
+/// As [`EventReader::next`]; the model could not classify a window; `sink` failed.
+pub fn feed_events<R: BufRead>(
+    events: &mut EventReader<R>,
+    stream: &mut StreamClassifier,
+    mut replay: Option<Replay>,
+    sink: &mut dyn Sink,
+    stop: &dyn Fn() -> bool,
+) -> Result<()> {
+    let unit = events.format.time_unit;
+    loop {
+        let done = match events.next(stop)? {
+            None => return Ok(()),
+            Some(Item::Reset) => stream.reset(),
+            Some(Item::Bad { place, why }) => {
+                stream.skip_bad_frame();
+                sink.bad_frame(&place, &why);
+                continue;
+            }
+            Some(Item::Event { stamp, address }) => {
+                if let Some(r) = replay.as_mut() {
+                    r.wait(unit.to_seconds(stamp.as_f64()));
+                }
+                stream.push_event(stamp, address)
+            }
+        };
+        match done {
+            Ok([]) => {}
+            Ok(done) => {
+                let done = done.to_vec();
+                sink.events(stream, &done)?;
+            }
+            Err(StreamError::Bad(bad)) => sink.bad_frame(&events.place(), &bad.to_string()),
+            Err(StreamError::Classify(e)) => return Err(e),
+        }
+    }
+}
