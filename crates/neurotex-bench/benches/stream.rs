@@ -3,45 +3,22 @@
 //! 100x100 skin, 3D-GLCM + KNN. The model's training rows are made up: the work per frame
 //! and per bin does not depend on them.
 
+mod support;
+
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use neurotex::analysis::{Columns, FeatureTable};
-use neurotex::classify::{ClassifierChoice, KnnParams};
-use neurotex::model::{Model, Provenance};
-use neurotex::pipeline::{Method, PipelineParams};
-use neurotex::recording::{Baseline, Meta};
+use neurotex::model::Model;
+use neurotex::pipeline::PipelineParams;
 use neurotex::signal::CausalConditioning;
 use neurotex::stream::{StreamClassifier, StreamParams};
-use neurotex::Grid;
+use support::made_up_model;
 
 fn model(side: usize) -> Model {
-    let cells = side * side;
     let mut params = PipelineParams::default();
     params.preprocess.causal = Some(CausalConditioning {
-        offsets: vec![0.0; cells],
+        offsets: vec![0.0; side * side],
         scale: 1.0,
     });
-    let table = FeatureTable {
-        method: Method::Glcm3d,
-        grid: Grid::masked(side, side, vec![true; cells]).unwrap(),
-        names: vec!["contrast".into(), "correlation".into(), "asm".into()],
-        metas: (0..10)
-            .map(|i| Meta {
-                label: ["A", "B"][i % 2].into(),
-                ..Meta::default()
-            })
-            .collect(),
-        values: (0..30).map(|i| ((i * 37) % 11) as f64 / 11.0).collect(),
-    };
-    let provenance = Provenance {
-        fingerprint: "made up".into(),
-        baseline: Baseline::None,
-        speeds: None,
-        gain_calibration: None,
-        median_duration_ms: Some(4000),
-        layout: None,
-    };
-    let knn = ClassifierChoice::Knn(KnnParams::default());
-    Model::train(&params, &table, Columns::All, knn, provenance).unwrap()
+    made_up_model(side, &params)
 }
 
 /// 200 frames of a texture moving over the skin, values in [0, 1].

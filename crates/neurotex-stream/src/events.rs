@@ -608,22 +608,83 @@ fn parse_line(text: &str, columns: &TextColumns) -> std::result::Result<Item, St
     Ok(Item::Event { stamp, address })
 }
 
+/// Where events come from: bytes an [`EventReader`] decodes, or an LSL inlet's samples
+/// ([`crate::lsl::LslEvents`]).
+pub trait EventInput {
+    /// The next item; `None` at the end of the input or once `stop()` says so.
+    ///
+    /// # Errors
+    /// The input cannot be read, or no longer fits the model.
+    fn next_item(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Item>>;
+    /// Where the last item was (`line 12`, `record 7`, `sample 9`).
+    fn place(&self) -> String;
+    /// The stamps' unit.
+    fn unit(&self) -> TimeUnit;
+    /// Why the input ended, when a person should hear it (a live stream that went away).
+    fn ended(&self) -> Option<String> {
+        None
+    }
+}
+
+impl<R: BufRead> EventInput for EventReader<R> {
+    fn next_item(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Item>> {
+        self.next(stop)
+    }
+
+    fn place(&self) -> String {
+        EventReader::place(self)
+    }
+
+    fn unit(&self) -> TimeUnit {
+        self.format.time_unit
+    }
+}
+
+/// The event a marker string holds (`x,y,p`, `x,y`, `taxel,p` or `taxel` for a
+/// `taxel`-addressed source), stamped `stamp` s; an empty string is a tick, `reset` the
+/// episode's end.
+pub(crate) fn marker_item(
+    stamp: f64,
+    text: &str,
+    taxel: bool,
+) -> std::result::Result<Item, String> {
+    let text = text.trim();
+    if text.eq_ignore_ascii_case("reset") {
+        return Ok(Item::Reset);
+    }
+    let delimiter = [b',', b';', b'\t']
+        .into_iter()
+        .find(|d| text.as_bytes().contains(d));
+    let line = match delimiter {
+        Some(d) => format!("{stamp}{}{text}", char::from(d)),
+        None => format!("{stamp} {text}"),
+    };
+    let columns = TextColumns {
+        delimiter,
+        time: 0,
+        a: 1,
+        b: (!taxel).then_some(2),
+        polarity: Some(if taxel { 2 } else { 3 }),
+    };
+    parse_line(&line, &columns)
+}
+
 /// Feeds every item of `events` to `stream` until the input ends or `stop()` says so, as
 /// [`crate::frames::feed`] feeds frames: bad events are counted, reported and skipped, and
 /// the stream is not finished.
 ///
 /// # Errors
-/// As [`EventReader::next`]; the model could not classify a window; `sink` failed.
-pub fn feed_events<R: BufRead>(
-    events: &mut EventReader<R>,
+/// As [`EventInput::next_item`]; the model could not classify a window; `sink` failed.
+pub fn feed_events(
+    events: &mut dyn EventInput,
     stream: &mut StreamClassifier,
     mut replay: Option<Replay>,
     sink: &mut dyn Sink,
     stop: &dyn Fn() -> bool,
 ) -> Result<()> {
-    let unit = events.format.time_unit;
+    let unit = events.unit();
     loop {
-        let done = match events.next(stop)? {
+        let done = match events.next_item(stop)? {
             None => return Ok(()),
             Some(Item::Reset) => stream.reset(),
             Some(Item::Bad { place, why }) => {

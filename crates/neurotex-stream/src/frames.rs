@@ -452,6 +452,32 @@ pub fn event_json(stream: &StreamClassifier, event: &Event) -> Value {
     }
 }
 
+/// Where frames come from: bytes a [`FrameReader`] decodes, or an LSL inlet's samples
+/// ([`crate::lsl::LslFrames`]).
+pub trait FrameSource {
+    /// The next frame; `None` at the end of the input or once `stop()` says so.
+    ///
+    /// # Errors
+    /// The input cannot be read, or no longer fits the model.
+    fn next_frame(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Frame<'_>>>;
+    /// Where the last frame was (`line 12`, `frame 7`, `sample 9`).
+    fn place(&self) -> String;
+    /// Why the input ended, when a person should hear it (a live stream that went away).
+    fn ended(&self) -> Option<String> {
+        None
+    }
+}
+
+impl<R: BufRead> FrameSource for FrameReader<R> {
+    fn next_frame(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Frame<'_>>> {
+        self.next(stop)
+    }
+
+    fn place(&self) -> String {
+        FrameReader::place(self)
+    }
+}
+
 /// What [`feed`] reports to its caller as it goes.
 pub trait Sink {
     /// Events the last frame completed (bin decisions, episode ends), in order.
@@ -470,9 +496,9 @@ pub trait Sink {
 /// ([`StreamClassifier::finish`] or [`StreamClassifier::stop`]).
 ///
 /// # Errors
-/// As [`FrameReader::next`]; the model could not classify a window; `sink` failed.
-pub fn feed<R: BufRead>(
-    frames: &mut FrameReader<R>,
+/// As [`FrameSource::next_frame`]; the model could not classify a window; `sink` failed.
+pub fn feed(
+    frames: &mut dyn FrameSource,
     stream: &mut StreamClassifier,
     mut replay: Option<Replay>,
     sink: &mut dyn Sink,
@@ -480,7 +506,7 @@ pub fn feed<R: BufRead>(
 ) -> Result<()> {
     let fs = stream.params().fs;
     loop {
-        let events = match frames.next(stop)? {
+        let events = match frames.next_frame(stop)? {
             None => return Ok(()),
             Some(Frame::Reset) => stream.reset(),
             Some(Frame::Bad { place, why }) => {

@@ -16,6 +16,7 @@
 pub mod events;
 pub mod frames;
 pub mod input;
+pub mod lsl;
 mod network;
 mod spike_log;
 mod window_glcm;

@@ -10,9 +10,12 @@ use crate::error::OptionsError;
 use crate::events::Origin;
 use crate::recording::TimeUnit;
 use crate::saved::{SavedModel, Trained};
-use crate::stream::events::{EventEncoding, EventSource};
+use crate::stream::events::{feed_events, EventEncoding, EventInput, EventReader, EventSource};
 use crate::stream::frames::FrameFormat as Format;
-use crate::stream::{EpisodeRule, StreamParams};
+use crate::stream::frames::{event_json, feed, FrameReader, FrameSource, Replay, Sink};
+use crate::stream::input;
+use crate::stream::lsl::{Lsl, LslEvents, LslFrames, Outlet, Query};
+use crate::stream::{EpisodeRule, Event, StreamClassifier, StreamParams};
 use crate::Result;
 
 /// How the per-bin classifications of an episode become a decision, and over which window:
@@ -90,8 +93,11 @@ pub struct StreamOptions {
     pub like: Option<PathBuf>,
     /// Where frames come from: `-` (standard input), a file, `tcp://HOST:PORT` (listens
     /// there and takes one connection: the sensor's driver connects and sends frames
-    /// until it closes) or `udp://HOST:PORT` (binds there; each datagram holds whole lines
-    /// or frames; an empty datagram ends the input). SIGINT (Ctrl-C), SIGTERM or SIGHUP
+    /// until it closes), `udp://HOST:PORT` (binds there; each datagram holds whole lines
+    /// or frames; an empty datagram ends the input) or `lsl:NAME` / `lsl:PROPERTY=VALUE`
+    /// (a Lab Streaming Layer stream: one number per taxel per sample, or for events `x, y,
+    /// p` numbers or marker strings; stamps from LSL's clock; liblsl from pylsl's wheel or
+    /// the system, PYLSL_LIB naming its file). SIGINT (Ctrl-C), SIGTERM or SIGHUP
     /// ends the stream at its next frame with the episode's summary.
     #[cfg_attr(feature = "cli", arg(long, default_value = "-"))]
     pub input: String,
@@ -147,6 +153,13 @@ pub struct StreamOptions {
     /// The sliding speed in mm/s, for a model with all-taxels-mm features.
     #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub speed: Option<f64>,
+    /// Publish each decision line on a Lab Streaming Layer outlet: `lsl:NAME`, a marker
+    /// stream (type Markers) of one string channel, each sample a JSON line.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub publish: Option<String>,
+    /// With `--input lsl:...`: how long to look for the stream before giving up, s.
+    #[cfg_attr(feature = "cli", arg(long = "lsl-timeout-s", default_value_t = 10.0))]
+    pub lsl_timeout_s: f64,
     /// How an episode is decided.
     #[cfg_attr(feature = "cli", command(flatten))]
     pub decision: DecisionOptions,
@@ -202,13 +215,28 @@ impl StreamOptions {
             }
             .into());
         }
-        let origin = self.origin.as_deref().map(|o| match o {
+        let mut origin = self.origin.as_deref().map(|o| match o {
             "zero" => Origin::Zero,
             _ => Origin::First,
         });
+        // LSL stamps are seconds on the sender's clock, whose zero means nothing.
+        let lsl = self.input.starts_with("lsl:");
+        if lsl {
+            if origin == Some(Origin::Zero)
+                || self.time_unit.is_some_and(|u| u != TimeUnit::Seconds)
+            {
+                return Err(OptionsError::NotApplicable {
+                    option: "--origin zero or --time-unit",
+                    applies_to: "events from a file or socket (LSL stamps are seconds on the sender's clock)",
+                }
+                .into());
+            }
+            origin = Some(Origin::First);
+        }
         // Binary records' stamps are microseconds unless said: the record's definition, not
         // the training files' unit.
         let unit = match (encoding, self.time_unit) {
+            _ if lsl => Some(TimeUnit::Seconds),
             (_, Some(unit)) => Some(unit),
             (EventEncoding::Binary, None) => Some(TimeUnit::Microseconds),
             (EventEncoding::Text, None) => None,
@@ -265,5 +293,220 @@ impl StreamOptions {
                 return Err(OptionsError::Conflict(why.into()).into());
             }
         })
+    }
+}
+
+/// What a stream run hears as it goes.
+pub struct StreamTalk<'a> {
+    /// A JSON line per bin boundary and per episode's end, as it happens.
+    pub out: &'a mut dyn std::io::Write,
+    /// Notes for a person: the address listened on, a bad frame, why the input ended, the
+    /// summary.
+    pub say: &'a dyn Fn(&str),
+    /// Whether a signal asked the stream to stop (checked after each frame).
+    pub stop: &'a dyn Fn() -> bool,
+    /// Called once the input is open (a connection accepted, a stream found): from then on
+    /// a signal ends the input rather than the run.
+    pub opened: &'a dyn Fn(),
+}
+
+/// Runs `neurotex stream`: opens the model and the input, classifies frames or events
+/// until the input ends or `stop()` says so, and says the summary line; the decisions also
+/// go to `--publish`'s LSL outlet.
+///
+/// # Errors
+/// A model that cannot stream, options that do not fit it, an input that cannot be opened
+/// or read, a live stream that came back with other channels. An error after the stream
+/// began comes after the episode's end and the summary.
+pub fn run_stream(args: &StreamOptions, talk: StreamTalk<'_>) -> Result<()> {
+    let model = SavedModel::load(&args.model, args.like.as_deref())?;
+    let events = args.event_source(&model)?;
+    if events.is_none() {
+        frames_model(args, &model)?;
+    }
+    let params = args.params(&model)?;
+    let publish = match &args.publish {
+        Some(target) => Some(publisher(target)?),
+        None => None,
+    };
+    let StreamTalk {
+        out,
+        say,
+        stop,
+        opened,
+    } = talk;
+    let (mut stream, mut input) = open_input(args, model, params, events, say)?;
+    opened();
+    let mut sink = Lines {
+        out,
+        say,
+        publish,
+        episodes: 0,
+    };
+    let replay = args
+        .realtime
+        .then(|| Replay::new(stream.params().max_gap_s));
+    let fed = match &mut input {
+        Input::Frames(frames) => feed(frames.as_mut(), &mut stream, replay, &mut sink, stop),
+        Input::Events(events) => feed_events(events.as_mut(), &mut stream, replay, &mut sink, stop),
+    };
+    let stopped = stop();
+    if stopped {
+        (sink.say)("interrupted: the stream stopped at its next frame");
+    } else if let Some(why) = input.ended() {
+        (sink.say)(&why);
+    }
+    let ended = match stopped {
+        true => stream.stop(),
+        false => stream.finish(),
+    }
+    .map(<[_]>::to_vec);
+    let ended = ended.map_err(|e| match e {
+        crate::stream::StreamError::Classify(e) => e,
+        bad => OptionsError::Conflict(bad.to_string()).into(),
+    })?;
+    sink.events(&stream, &ended)?;
+    (sink.say)(&input.summary(&stream, sink.episodes));
+    fed
+}
+
+/// The stream classifier for `model`, and its input: frames or events, from bytes or LSL.
+fn open_input(
+    args: &StreamOptions,
+    model: SavedModel,
+    params: StreamParams,
+    events: Option<(EventEncoding, EventSource)>,
+    say: &dyn Fn(&str),
+) -> Result<(StreamClassifier, Input)> {
+    let lsl_query = match args.input.strip_prefix("lsl:") {
+        Some(q) => Some(Query::parse(q).map_err(OptionsError::Conflict)?),
+        None => None,
+    };
+    let timeout = args.lsl_timeout_s;
+    Ok(match events {
+        Some((encoding, source)) => {
+            let taxel = source.format.taxel.is_some();
+            let format = source.format.clone();
+            let stream = StreamClassifier::for_events(model, params, source)?;
+            let input = match &lsl_query {
+                Some(q) => Input::Events(Box::new(LslEvents::open(q, taxel, timeout)?)),
+                None => {
+                    let bytes = input::open(&args.input, say)?;
+                    let reader = EventReader::new(bytes, &args.input, encoding, &format);
+                    Input::Events(Box::new(reader))
+                }
+            };
+            (stream, input)
+        }
+        None => {
+            let format = args.frame_format(&model)?;
+            let stream = StreamClassifier::new(model, params)?;
+            let channels = stream.channels();
+            let input = match &lsl_query {
+                Some(q) => Input::Frames(Box::new(LslFrames::open(q, channels, timeout)?)),
+                None => {
+                    let bytes = input::open(&args.input, say)?;
+                    let reader = FrameReader::new(bytes, &args.input, format, channels);
+                    Input::Frames(Box::new(reader))
+                }
+            };
+            (stream, input)
+        }
+    })
+}
+
+/// Checks that `model` streams frames: not trained on events, trained for streams.
+fn frames_model(args: &StreamOptions, model: &SavedModel) -> Result<()> {
+    let from = match &args.like {
+        Some(like) => format!(
+            "{} (its pipeline from {})",
+            args.model.display(),
+            like.display()
+        ),
+        None => args.model.display().to_string(),
+    };
+    let why = match crate::stream::events::trained_on_events(model) {
+        Some(why) => why,
+        None => match model.streams() {
+            Ok(_) => return Ok(()),
+            Err(why) => why.to_string(),
+        },
+    };
+    Err(OptionsError::Conflict(format!("{from}: {why}")).into())
+}
+
+/// The LSL outlet `--publish lsl:NAME` names.
+fn publisher(target: &str) -> Result<Outlet> {
+    let Some(name) = target.strip_prefix("lsl:").filter(|n| !n.trim().is_empty()) else {
+        let why =
+            format!("--publish takes lsl:NAME (a marker stream of the decisions), not `{target}`");
+        return Err(OptionsError::Conflict(why).into());
+    };
+    let lsl =
+        Lsl::load().map_err(|why| OptionsError::Conflict(format!("--publish {target}: {why}")))?;
+    Outlet::new(&lsl, name.trim())
+        .map_err(|why| OptionsError::Conflict(format!("--publish {target}: {why}")).into())
+}
+
+/// Where a stream's frames or events come from.
+enum Input {
+    Frames(Box<dyn FrameSource>),
+    Events(Box<dyn EventInput>),
+}
+
+impl Input {
+    /// The summary line: what the stream took and skipped, and its episodes.
+    fn summary(&self, stream: &StreamClassifier, episodes: usize) -> String {
+        let what = match self {
+            Input::Frames(_) => format!(
+                "{} frames, {} bad frame(s) skipped",
+                stream.frames(),
+                stream.bad_frames()
+            ),
+            Input::Events(_) => format!(
+                "{} events ({} in a millisecond their cell already spiked in), {} bad event(s) skipped",
+                stream.frames(),
+                stream.merged_events(),
+                stream.bad_frames()
+            ),
+        };
+        format!("{what}, {episodes} episode(s)")
+    }
+
+    fn ended(&self) -> Option<String> {
+        match self {
+            Input::Frames(f) => f.ended(),
+            Input::Events(e) => e.ended(),
+        }
+    }
+}
+
+/// The JSON lines, each written and flushed at once (and published on the outlet); bad
+/// frames said.
+struct Lines<'a> {
+    out: &'a mut dyn std::io::Write,
+    say: &'a dyn Fn(&str),
+    publish: Option<Outlet>,
+    /// Episodes ended so far.
+    episodes: usize,
+}
+
+impl Sink for Lines<'_> {
+    fn events(&mut self, stream: &StreamClassifier, events: &[Event]) -> Result<()> {
+        let write = |e| crate::error::DataError::write("standard output", e);
+        for event in events {
+            self.episodes += usize::from(matches!(event, Event::End(_)));
+            let line = event_json(stream, event).to_string();
+            writeln!(self.out, "{line}").map_err(write)?;
+            if let Some(outlet) = &self.publish {
+                outlet.push(&line);
+            }
+        }
+        self.out.flush().map_err(write)?;
+        Ok(())
+    }
+
+    fn bad_frame(&mut self, place: &str, why: &str) {
+        (self.say)(&format!("warning: {place}: bad frame skipped: {why}"));
     }
 }
