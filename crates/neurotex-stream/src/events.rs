@@ -553,18 +553,15 @@ impl<R: BufRead> EventReader<R> {
 fn split(text: &str, delimiter: Option<u8>) -> ([&str; 8], usize) {
     let mut fields = [""; 8];
     let mut n = 0;
-    let cut = |c: char| match delimiter {
-        Some(d) => c == char::from(d),
-        None => c == ' ' || c == '\t',
-    };
-    for field in text.split(cut).map(str::trim) {
-        if delimiter.is_none() && field.is_empty() {
-            continue;
-        }
+    let mut put = |field| {
         if let Some(slot) = fields.get_mut(n) {
             *slot = field;
         }
         n += 1;
+    };
+    match delimiter {
+        Some(d) => text.split(char::from(d)).for_each(|f| put(f.trim_ascii())),
+        None => text.split_ascii_whitespace().for_each(put),
     }
     (fields, n)
 }

@@ -4,7 +4,7 @@
 use neurotex::analysis::{Columns, FeatureTable};
 use neurotex::classify::{ClassifierChoice, KnnParams};
 use neurotex::model::{Model, Provenance};
-use neurotex::pipeline::{Method, PipelineParams};
+use neurotex::pipeline::{Encoding, Method, PipelineParams};
 use neurotex::recording::{Baseline, Meta};
 use neurotex::Grid;
 
@@ -12,13 +12,14 @@ use neurotex::Grid;
 /// Haralick features per population, with a 4 s window.
 pub fn made_up_model(side: usize, params: &PipelineParams) -> Model {
     let cells = side * side;
-    let populations = match params.encoding {
-        neurotex::pipeline::Encoding::SaFa => 2,
-        _ => 1,
+    let features = ["contrast", "correlation", "asm"];
+    let names: Vec<String> = match params.encoding {
+        Encoding::SaFa => ["sa", "fa"]
+            .iter()
+            .flat_map(|p| features.map(|f| format!("{p}_{f}")))
+            .collect(),
+        _ => features.map(String::from).to_vec(),
     };
-    let names: Vec<String> = (0..populations)
-        .flat_map(|p| ["contrast", "correlation", "asm"].map(|f| format!("p{p}_{f}")))
-        .collect();
     let table = FeatureTable {
         method: Method::Glcm3d,
         grid: Grid::masked(side, side, vec![true; cells]).unwrap(),
