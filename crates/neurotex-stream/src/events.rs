@@ -663,7 +663,14 @@ pub(crate) fn marker_item(
         b: (!taxel).then_some(2),
         polarity: Some(if taxel { 2 } else { 3 }),
     };
-    parse_line(&line, &columns)
+    // The stamp as LSL gave it, not as its text reads back (`2` would be an integer).
+    Ok(match parse_line(&line, &columns)? {
+        Item::Event { address, .. } => Item::Event {
+            stamp: Stamp::Float(stamp),
+            address,
+        },
+        other => other,
+    })
 }
 
 /// Feeds every item of `events` to `stream` until the input ends or `stop()` says so, as
@@ -705,5 +712,123 @@ pub fn feed_events(
             Err(StreamError::Bad(bad)) => sink.bad_frame(&events.place(), &bad.to_string()),
             Err(StreamError::Classify(e)) => return Err(e),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn items(text: &str, format: &EventsFormat) -> Vec<Item> {
+        let mut reader = EventReader::new(text.as_bytes(), "test", EventEncoding::Text, format);
+        let mut out = Vec::new();
+        while let Some(item) = reader.next(&|| false).unwrap() {
+            out.push(item);
+        }
+        out
+    }
+
+    fn event(t: i64, x: i64, y: i64, p: Option<i64>) -> Item {
+        Item::Event {
+            stamp: Stamp::Int(t),
+            address: Some((x, y, p)),
+        }
+    }
+
+    #[test]
+    fn lines_with_and_without_a_header_ticks_and_resets() {
+        let format = EventsFormat::new(TimeUnit::Microseconds);
+        let tick = |t| Item::Event {
+            stamp: Stamp::Int(t),
+            address: None,
+        };
+        // A header in another order, a tick written two ways, a comment, a reset.
+        let text = "p;y;t;x\n1;2;10;3\n# note\n;;20;\nreset\n0; 1; 30; 0\n";
+        let got = items(text, &format);
+        let want = [
+            event(10, 3, 2, Some(1)),
+            tick(20),
+            Item::Reset,
+            event(30, 0, 1, Some(0)),
+        ];
+        assert_eq!(got, want);
+        // No header: t, x, y and an optional polarity; a time alone is a tick; decimals.
+        let got = items("5 1 2\n6\n7.5 0 0 1\n", &format);
+        assert_eq!(got[0], event(5, 1, 2, None));
+        assert_eq!(got[1], tick(6));
+        assert_eq!(
+            got[2],
+            Item::Event {
+                stamp: Stamp::Float(7.5),
+                address: Some((0, 0, Some(1)))
+            }
+        );
+        // Taxel-indexed: t, taxel, p.
+        let mut taxels = format.clone();
+        taxels.taxel = Some("taxel".into());
+        assert_eq!(
+            items("t,taxel,p\n9,4,0\n", &taxels),
+            [event(9, 4, 0, Some(0))]
+        );
+    }
+
+    #[test]
+    fn undecodable_lines_and_records_are_bad_and_named() {
+        let format = EventsFormat::new(TimeUnit::Microseconds);
+        let got = items("t,x,y,p\nsoon,1,1,1\n5,1,,1\n6,1.5,1,1\n", &format);
+        let whys: Vec<String> = got
+            .iter()
+            .map(|i| match i {
+                Item::Bad { place, why } => format!("{place}: {why}"),
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert!(whys[0].starts_with("line 2: time `soon`"), "{whys:?}");
+        assert!(whys[1].contains("half a cell"), "{whys:?}");
+        assert!(whys[2].contains("`1.5` is not a whole number"), "{whys:?}");
+        let mut reader = EventReader::new(&b"t,x\n"[..], "test", EventEncoding::Text, &format);
+        let err = reader.next(&|| false).unwrap_err().to_string();
+        assert!(err.contains("no column `y`"), "{err}");
+        // A record cut short, and one of an unknown kind.
+        let mut bytes = vec![0u8; RECORD_BYTES];
+        bytes[13] = 9;
+        bytes.extend_from_slice(&[1, 2, 3]);
+        let mut reader = EventReader::new(&bytes[..], "test", EventEncoding::Binary, &format);
+        let first = reader.next(&|| false).unwrap().unwrap();
+        assert!(matches!(first, Item::Bad { ref why, .. } if why.contains("kind 9")));
+        let second = reader.next(&|| false).unwrap().unwrap();
+        assert!(
+            matches!(second, Item::Bad { ref place, ref why } if place == "record 2" && why.contains("3 of its 16"))
+        );
+        assert_eq!(reader.next(&|| false).unwrap(), None);
+    }
+
+    #[test]
+    fn marker_strings_are_events_ticks_and_resets() {
+        assert_eq!(marker_item(1.5, "reset", false), Ok(Item::Reset));
+        let tick = marker_item(1.5, "", false).unwrap();
+        assert_eq!(
+            tick,
+            Item::Event {
+                stamp: Stamp::Float(1.5),
+                address: None
+            }
+        );
+        let e = marker_item(2.0, "3, 1, 0", false).unwrap();
+        assert_eq!(
+            e,
+            Item::Event {
+                stamp: Stamp::Float(2.0),
+                address: Some((3, 1, Some(0)))
+            }
+        );
+        let t = marker_item(2.0, "7", true).unwrap();
+        assert_eq!(
+            t,
+            Item::Event {
+                stamp: Stamp::Float(2.0),
+                address: Some((7, 0, None))
+            }
+        );
     }
 }
