@@ -2,8 +2,10 @@
 //! every bin, as `neurotex stream` prints them.
 
 use neurotex::causal::DecisionRule;
+use neurotex::events::{Origin, Stamp};
 use neurotex::recording::TimeUnit;
 use neurotex::saved::SavedModel;
+use neurotex::stream::events::EventSource;
 use neurotex::stream::{bin_json, end_json, Event, StreamClassifier, StreamError, StreamParams};
 use pyo3::prelude::*;
 
@@ -18,6 +20,8 @@ pub struct NativeStream {
     inner: StreamClassifier,
     /// The unit of every stamp pushed.
     unit: TimeUnit,
+    /// Whether it takes address events rather than frames.
+    events: bool,
 }
 
 /// The events as dicts, the lines `neurotex stream` prints (without `bad_frames`).
@@ -44,7 +48,7 @@ impl NativeStream {
     /// A stream classifier for `model` (a feature model or a spiking network, trained with
     /// `--causal`).
     #[new]
-    #[pyo3(signature = (model, window_s=None, decide=0.8, decide_bins=3, episode="whole", fs=1000.0, max_gap_s=1.0, speed=None, time_unit="s"))]
+    #[pyo3(signature = (model, window_s=None, decide=0.8, decide_bins=3, episode="whole", fs=1000.0, max_gap_s=1.0, speed=None, time_unit="s", events=false, origin=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         model: &Bound<'_, PyAny>,
@@ -56,6 +60,8 @@ impl NativeStream {
         max_gap_s: f64,
         speed: Option<f64>,
         time_unit: &str,
+        events: bool,
+        origin: Option<&str>,
     ) -> PyResult<Self> {
         let unit: TimeUnit = time_unit.parse().map_err(param)?;
         let model: SavedModel = match (
@@ -81,8 +87,26 @@ impl NativeStream {
         params.fs = fs;
         params.max_gap_s = max_gap_s;
         params.speed_mm_s = speed;
-        let inner = guarded(|| StreamClassifier::new(model, params))?;
-        Ok(NativeStream { inner, unit })
+        if !events {
+            if origin.is_some() {
+                return Err(raise(Kind::Parameter, "origin applies to event streams (events=True)"));
+            }
+            let inner = guarded(|| StreamClassifier::new(model, params))?;
+            return Ok(NativeStream { inner, unit, events });
+        }
+        let origin = match origin {
+            None => None,
+            Some("zero") => Some(Origin::Zero),
+            Some("first") => Some(Origin::First),
+            Some(other) => {
+                let why = format!("origin is \"zero\" or \"first\", not {other:?}");
+                return Err(raise(Kind::Parameter, why));
+            }
+        };
+        let source = EventSource::for_model(&model, Some(unit), origin)
+            .map_err(|why| raise(Kind::Parameter, why))?;
+        let inner = guarded(|| StreamClassifier::for_events(model, params, source))?;
+        Ok(NativeStream { inner, unit, events })
     }
 
     /// Takes one frame (one value per taxel) with its time stamp in the stream's unit, or
@@ -94,9 +118,40 @@ impl NativeStream {
         values: Vec<f64>,
         t: Option<f64>,
     ) -> PyResult<Vec<Py<PyAny>>> {
+        if self.events {
+            return Err(raise(Kind::Parameter, "this stream takes events (push_event), not frames"));
+        }
         let events = self
             .inner
             .push_in(t, self.unit, &values)
+            .map_err(stream_error)?
+            .to_vec();
+        lines(py, &self.inner, &events)
+    }
+
+    /// Takes one event at `t` (in the stream's unit; an int is exact) of the cell `x`, `y`
+    /// (or taxel `x`) with polarity `p`, or a tick when `x` is None; returns the lines it
+    /// completed, as dicts.
+    #[pyo3(signature = (t, x=None, y=None, p=None))]
+    fn push_event(
+        &mut self,
+        py: Python<'_>,
+        t: &Bound<'_, PyAny>,
+        x: Option<i64>,
+        y: Option<i64>,
+        p: Option<i64>,
+    ) -> PyResult<Vec<Py<PyAny>>> {
+        if !self.events {
+            return Err(raise(Kind::Parameter, "this stream takes frames (push); events need StreamClassifier(..., events=True)"));
+        }
+        let stamp = match t.extract::<i64>() {
+            Ok(t) => Stamp::Int(t),
+            Err(_) => Stamp::Float(t.extract::<f64>()?),
+        };
+        let address = x.map(|x| (x, y.unwrap_or(0), p));
+        let events = self
+            .inner
+            .push_event(stamp, address)
             .map_err(stream_error)?
             .to_vec();
         lines(py, &self.inner, &events)

@@ -83,3 +83,39 @@ def test_tonic_transforms_take_the_events(exported):
     assert frames[:, 1].sum() == len(on)
     assert frames[:, 1, on["y"][0], on["x"][0]].sum() == np.sum(
         (on["y"] == on["y"][0]) & (on["x"] == on["x"][0]))
+
+
+def test_a_python_event_stream_decides_as_the_command_line(exported, tmp_path):
+    # A model trained on the exported event dataset; one recording's events streamed from
+    # Python (tonic's array, t in us) and through `neurotex stream --format events-bin`.
+    model = tmp_path / "ev_model.json"
+    run_cli("train", "--dataset", exported, "--encoding", "sa+fa", "--out", model)
+    events = neurotex.events(exported, [5], encoding="sa+fa")[0]
+    with open(exported / "manifest.csv") as f:
+        duration_s = float(list(csv.DictReader(f))[5]["duration_s"])
+    end_us = int(round(duration_s * 1000)) * 1000
+    stream = neurotex.StreamClassifier(str(model), events=True, time_unit="us")
+    lines = (stream.push_events(events) or []) + (stream.push_event(end_us) or [])
+    lines += stream.finish() or []
+    assert len(lines) > 20 and lines[-1]["end"] is True
+    record = np.dtype([("t", "<i8"), ("x", "<u2"), ("y", "<u2"), ("p", "i1"), ("kind", "u1"),
+                       ("pad", "<u2")])
+    records = np.zeros(len(events) + 1, record)
+    for name in ("t", "x", "y", "p"):
+        records[name][:-1] = events[name]
+    records["t"][-1], records["kind"][-1] = end_us, 1
+    path = tmp_path / "events.bin"
+    records.tofile(path)
+    out = run_cli("stream", "--model", model, "--format", "events-bin", "--input", path)
+    import json
+    cli = [json.loads(l) for l in out.stdout.splitlines()]
+    for line in cli:
+        line.pop("bad_frames", None)
+    assert lines == cli
+    # Frames are refused on an event stream, events on a frame stream.
+    with pytest.raises(ParameterError, match="push_event"):
+        stream.push([0.0] * 16)
+    with pytest.raises(ParameterError, match="zero"):
+        neurotex.StreamClassifier(str(model), events=True, origin="start")
+    with pytest.raises(neurotex.DataError, match="outside the 4x4 grid"):
+        stream.push_event(end_us + 1000, 7, 0, 1)

@@ -1183,19 +1183,49 @@ class StreamClassifier:
     stamps in the unit they were logged in. Stamps are taken relative to the episode's first
     in that unit and only then become seconds, so integer ms stamps on the encoder's 1 ms
     grid give the same spikes as the same frames unstamped at 1 kHz; the same stamps as
-    seconds (``0.001 * k``, not exact in binary) can move a near-threshold spike."""
+    seconds (``0.001 * k``, not exact in binary) can move a near-threshold spike.
+
+    With ``events=True`` the stream takes an event sensor's address events instead
+    (``push_event``, ``push_events``), as ``neurotex stream --format events`` does: any model
+    (one trained on an event dataset, or a causal or offline one on samples) classifies
+    them without its encoder, ON events as SA spikes and OFF as FA. ``origin`` is
+    ``"zero"`` (the first episode counts from time 0) or ``"first"`` (from its first event);
+    by default the model's event dataset's, else ``"first"``."""
 
     def __init__(self, model: Union["Model", "SpikingModel", str, os.PathLike], *,
                  window_s: Optional[float] = None,
                  decide: float = 0.8, decide_bins: int = 3, episode: str = "whole",
                  fs: float = 1000.0, max_gap_s: float = 1.0,
-                 speed: Optional[float] = None, time_unit: str = "s") -> None:
+                 speed: Optional[float] = None, time_unit: str = "s",
+                 events: bool = False, origin: Optional[str] = None) -> None:
         if not isinstance(model, (Model, SpikingModel)):
             spiking = _native.is_spiking_model(os.fspath(model))
             model = (SpikingModel if spiking else Model).load(model)
         self.model = model
         self._native = _native.NativeStream(model._native, window_s, decide, decide_bins,
-                                            episode, fs, max_gap_s, speed, time_unit)
+                                            episode, fs, max_gap_s, speed, time_unit,
+                                            events, origin)
+
+    def push_event(self, t: Union[int, float], x: Optional[int] = None,
+                   y: Optional[int] = None, p: Optional[int] = None
+                   ) -> Optional[List[Dict[str, Any]]]:
+        """Takes one event at ``t`` (``time_unit``; an int is exact) of cell ``x``, ``y``
+        (or taxel ``x``) with polarity ``p``, or a tick (time has come, no event) when
+        ``x`` is None. A bad event raises :class:`DataError` and is skipped."""
+        return self._events(self._native.push_event(t, x, y, p))
+
+    def push_events(self, events: Any) -> Optional[List[Dict[str, Any]]]:
+        """Takes a structured array of events with fields ``t``, ``x``, ``y`` and
+        optionally ``p`` (tonic's, :data:`EVENT_DTYPE`), in time order; the lines they
+        completed. Bad events raise :class:`DataError` at the first, the ones before it
+        taken."""
+        names = events.dtype.names or ()
+        p = events["p"].astype(np.int64).tolist() if "p" in names else [None] * len(events)
+        lines: List[Dict[str, Any]] = []
+        for t, x, y, pol in zip(events["t"].tolist(), events["x"].tolist(),
+                                events["y"].tolist(), p):
+            lines.extend(self._native.push_event(t, x, y, pol))
+        return self._events(lines)
 
     @staticmethod
     def _events(lines: List[Dict[str, Any]]) -> Optional[List[Dict[str, Any]]]:
