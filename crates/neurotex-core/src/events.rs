@@ -557,6 +557,12 @@ fn parse_csv(
         .iter()
         .map(|h| std::str::from_utf8(h).unwrap_or(""))
         .collect();
+    if names.iter().all(|n| n.trim().is_empty()) {
+        return Err(bad(format!(
+            "the file is empty or its first line is blank: an event file starts with a header row naming its columns ({}, ...)",
+            format.time
+        )));
+    }
     let cols = columns(&names, format).map_err(bad)?;
     sink(Parsed::Columns {
         polarity: cols.polarity.is_some(),
@@ -570,25 +576,33 @@ fn parse_csv(
             Ok(true) => {}
             Err(e) => return Err(bad(format!("line {}: {e}", line + 1))),
         }
-        line += 1;
+        // The line the record starts on (blank lines and quoted line breaks counted).
+        line = record.position().map_or(line + 1, |p| p.line() as usize);
         let at = |m: String| bad(format!("line {line}: {m}"));
-        let field = |i: usize| std::str::from_utf8(&record[i]).unwrap_or("").trim();
+        let field = |i: usize, what: &str| -> Result<&str> {
+            std::str::from_utf8(&record[i]).map(str::trim).map_err(|e| {
+                at(format!(
+                    "{what} is not UTF-8 text (its byte {} is not)",
+                    e.valid_up_to() + 1
+                ))
+            })
+        };
         let int = |i: usize, what: &str| -> Result<i64> {
-            field(i)
-                .parse::<i64>()
-                .or(match field(i) {
+            let text = field(i, what)?;
+            text.parse::<i64>()
+                .or(match text {
                     "True" | "true" => Ok(1),
                     "False" | "false" => Ok(0),
                     _ => Err(()),
                 })
-                .map_err(|_| at(format!("{what} `{}` is not an integer", field(i))))
+                .map_err(|_| at(format!("{what} `{text}` is not an integer")))
         };
-        let t = match field(cols.time).parse::<i64>() {
+        let time = field(cols.time, "the time")?;
+        let t = match time.parse::<i64>() {
             Ok(v) => Stamp::Int(v),
             Err(_) => Stamp::Float(
-                field(cols.time)
-                    .parse::<f64>()
-                    .map_err(|_| at(format!("time `{}` is not a number", field(cols.time))))?,
+                time.parse::<f64>()
+                    .map_err(|_| at(format!("time `{time}` is not a number")))?,
             ),
         };
         let cell = match cols.cell {

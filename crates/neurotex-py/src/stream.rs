@@ -89,10 +89,17 @@ impl NativeStream {
         params.speed_mm_s = speed;
         if !events {
             if origin.is_some() {
-                return Err(raise(Kind::Parameter, "origin applies to event streams (events=True)"));
+                return Err(raise(
+                    Kind::Parameter,
+                    "origin applies to event streams (events=True)",
+                ));
             }
             let inner = guarded(|| StreamClassifier::new(model, params))?;
-            return Ok(NativeStream { inner, unit, events });
+            return Ok(NativeStream {
+                inner,
+                unit,
+                events,
+            });
         }
         let origin = match origin {
             None => None,
@@ -106,7 +113,11 @@ impl NativeStream {
         let source = EventSource::for_model(&model, Some(unit), origin)
             .map_err(|why| raise(Kind::Parameter, why))?;
         let inner = guarded(|| StreamClassifier::for_events(model, params, source))?;
-        Ok(NativeStream { inner, unit, events })
+        Ok(NativeStream {
+            inner,
+            unit,
+            events,
+        })
     }
 
     /// Takes one frame (one value per taxel) with its time stamp in the stream's unit, or
@@ -119,7 +130,10 @@ impl NativeStream {
         t: Option<f64>,
     ) -> PyResult<Vec<Py<PyAny>>> {
         if self.events {
-            return Err(raise(Kind::Parameter, "this stream takes events (push_event), not frames"));
+            return Err(raise(
+                Kind::Parameter,
+                "this stream takes events (push_event), not frames",
+            ));
         }
         let events = self
             .inner
@@ -142,7 +156,10 @@ impl NativeStream {
         p: Option<i64>,
     ) -> PyResult<Vec<Py<PyAny>>> {
         if !self.events {
-            return Err(raise(Kind::Parameter, "this stream takes frames (push); events need StreamClassifier(..., events=True)"));
+            return Err(raise(
+                Kind::Parameter,
+                "this stream takes frames (push); events need StreamClassifier(..., events=True)",
+            ));
         }
         let stamp = match t.extract::<i64>() {
             Ok(t) => Stamp::Int(t),
