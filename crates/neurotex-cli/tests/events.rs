@@ -562,6 +562,12 @@ fn imported_logs_read_as_the_events_they_hold() {
     // values given without the column's name ask for the default column, `p`
     let err = import(&["--polarity-values", "1,-1"], false);
     assert!(err.contains("no polarity column `p`"), "{err}");
+    // a polarity under another name, left unnamed, would make every OFF event ON
+    let err = import(&[], false);
+    assert!(
+        err.contains("column `pol` is not read") && err.contains("--polarity pol"),
+        "{err}"
+    );
     // one taxel per cell; a taxel past a shorter map is named
     let map = |cells: &'static str| [&polar[..], &["--channel-map", cells]].concat();
     assert!(import(&map("0,0;0,0"), false).contains("each cell takes one taxel"));

@@ -866,7 +866,7 @@ fn a_model_trained_on_events_streams_events_and_refuses_frames() {
         "60",
     ];
     let (out, _) = stream_stdin(&dir, &args, text.as_bytes());
-    let predicted = dir.join("p.csv");
+    let table_path = dir.join("p.csv");
     dir.ok(&[
         "predict",
         "--model",
@@ -874,9 +874,9 @@ fn a_model_trained_on_events_streams_events_and_refuses_frames() {
         "--dataset",
         s(&events),
         "--out",
-        s(&predicted),
+        s(&table_path),
     ]);
-    let table = std::fs::read_to_string(&predicted).unwrap();
+    let table = std::fs::read_to_string(&table_path).unwrap();
     let offline = table.lines().find(|l| l.contains(name)).unwrap();
     let all = lines(&out);
     assert!(all.len() > 40, "a line every 200 ms");
@@ -885,6 +885,10 @@ fn a_model_trained_on_events_streams_events_and_refuses_frames() {
         offline.split(',').any(|f| f == label),
         "{offline} / {label}"
     );
+    // Its offline twin, `predict --causal` on the event dataset: the same lines.
+    let args = ["--model", s(&model), "--format", "events"];
+    let (out, _) = stream_stdin(&dir, &args, text.as_bytes());
+    assert_eq!(lines(&out), predicted(&dir, &model, &events, name));
     let frames = dir.join("frames.csv");
     std::fs::write(&frames, csv_text(&slide_frames(&data, &slides(&data)[1]))).unwrap();
     let err = dir.fails(&["stream", "--model", s(&model), "--input", s(&frames)]);

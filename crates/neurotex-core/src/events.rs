@@ -244,6 +244,24 @@ enum CellColumns {
     Taxel(usize),
 }
 
+impl Columns {
+    /// The names of `names` this plan does not read.
+    fn unread(&self, names: &[&str]) -> Vec<String> {
+        let read = |i: usize| {
+            i == self.time
+                || self.polarity == Some(i)
+                || match self.cell {
+                    CellColumns::Xy(x, y) => i == x || i == y,
+                    CellColumns::Taxel(t) => i == t,
+                }
+        };
+        (0..names.len())
+            .filter(|&i| !read(i))
+            .map(|i| names[i].trim().to_string())
+            .collect()
+    }
+}
+
 /// Gathers events into trains, checking each as it comes.
 pub(crate) struct Gather<'a> {
     format: &'a EventsFormat,
@@ -472,7 +490,7 @@ pub fn read_events(
 ) -> Result<Events> {
     let mut gather: Option<Gather> = None;
     parse(path, format, &mut |event| match event {
-        Parsed::Columns { polarity } => {
+        Parsed::Columns { polarity, .. } => {
             gather = Some(Gather::new(format, grid, polarity, duration_ms, max_steps));
             Ok(())
         }
@@ -490,6 +508,8 @@ pub fn read_events(
 pub(crate) enum Parsed {
     Columns {
         polarity: bool,
+        /// The columns or fields not read.
+        unread: Vec<String>,
     },
     Event {
         t: Stamp,
@@ -566,6 +586,7 @@ fn parse_csv(
     let cols = columns(&names, format).map_err(bad)?;
     sink(Parsed::Columns {
         polarity: cols.polarity.is_some(),
+        unread: cols.unread(&names),
     })
     .map_err(bad)?;
     let mut record = csv::ByteRecord::new();
@@ -661,6 +682,7 @@ fn parse_npy(
     }
     sink(Parsed::Columns {
         polarity: cols.polarity.is_some(),
+        unread: cols.unread(&names),
     })
     .map_err(bad)?;
     let data = read_data(path, &header)?;

@@ -1260,6 +1260,19 @@ fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
     }
 }
 
+/// Column names that say an event's polarity, refused when left unread.
+const POLARITY_NAMES: [&str; 9] = [
+    "p",
+    "pol",
+    "polarity",
+    "sign",
+    "on",
+    "onoff",
+    "on_off",
+    "parity",
+    "ev_polarity",
+];
+
 /// An event as parsed: time, cell fields, polarity, and its line or record.
 type RawEvent = (crate::events::Stamp, (i64, i64), Option<i64>, usize);
 
@@ -1267,9 +1280,13 @@ type RawEvent = (crate::events::Stamp, (i64, i64), Option<i64>, usize);
 fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {
     let mut events: Vec<RawEvent> = Vec::new();
     let mut polarity = false;
+    let mut unread = Vec::new();
     crate::events::parse(path, &p.format, &mut |event| {
         match event {
-            crate::events::Parsed::Columns { polarity: has } => polarity = has,
+            crate::events::Parsed::Columns {
+                polarity: has,
+                unread: other,
+            } => (polarity, unread) = (has, other),
             crate::events::Parsed::Event { t, cell, p, at } => events.push((t, cell, p, at)),
         }
         Ok(())
@@ -1285,6 +1302,16 @@ fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFil
         return Err(bad(
             "holds no events (a header only, or an empty array)".into()
         ));
+    }
+    // A polarity under another name would leave every OFF event ON, silently.
+    let polarity_like = |name: &str| {
+        let n = name.to_ascii_lowercase();
+        POLARITY_NAMES.contains(&n.as_str())
+    };
+    if let Some(name) = unread.iter().find(|n| !polarity && polarity_like(n)) {
+        return Err(bad(format!(
+            "column `{name}` is not read, and its name says polarity: name it with --polarity {name} (and --polarity-values ON,OFF unless they are 1,0), or the log's OFF events would be read as ON"
+        )));
     }
     let key = |t: &crate::events::Stamp| crate::events::as_f64(*t);
     let mut reordered = 0;

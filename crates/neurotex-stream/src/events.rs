@@ -361,6 +361,8 @@ pub enum Item {
 /// The text columns, planned from the first line.
 #[derive(Debug, Clone)]
 struct TextColumns {
+    /// The fields of every line but a tick's (a time alone), when the first line set them.
+    fields: Option<usize>,
     delimiter: Option<u8>,
     time: usize,
     a: usize,
@@ -512,6 +514,7 @@ impl<R: BufRead> EventReader<R> {
             .is_some_and(|f| f.parse::<f64>().is_err() && !f.is_empty());
         if !header {
             let columns = TextColumns {
+                fields: Some(n),
                 delimiter,
                 time: 0,
                 a: 1,
@@ -538,6 +541,7 @@ impl<R: BufRead> EventReader<R> {
             ),
         };
         let columns = TextColumns {
+            fields: Some(n),
             delimiter,
             time,
             a,
@@ -568,7 +572,10 @@ fn split(text: &str, delimiter: Option<u8>) -> ([&str; 8], usize) {
 
 /// One line's event or tick; `Err` says why it is neither.
 fn parse_line(text: &str, columns: &TextColumns) -> std::result::Result<Item, String> {
-    let (fields, _) = split(text, columns.delimiter);
+    let (fields, n) = split(text, columns.delimiter);
+    if let Some(expected) = columns.fields.filter(|&e| n != e && n != 1) {
+        return Err(format!("{n} fields; the stream's lines have {expected}"));
+    }
     let get = |j: usize| fields.get(j).copied().filter(|f| !f.is_empty());
     let time = get(columns.time).ok_or("the line has no time")?;
     let stamp = match time.parse::<i64>() {
@@ -657,6 +664,7 @@ pub(crate) fn marker_item(
         None => format!("{stamp} {text}"),
     };
     let columns = TextColumns {
+        fields: None,
         delimiter,
         time: 0,
         a: 1,
@@ -753,15 +761,19 @@ mod tests {
         ];
         assert_eq!(got, want);
         // No header: t, x, y and an optional polarity; a time alone is a tick; decimals.
-        let got = items("5 1 2\n6\n7.5 0 0 1\n", &format);
+        // Every line has the first one's fields.
+        let got = items("5 1 2\n6\n7.5 0 0\n8 0 0 1\n", &format);
         assert_eq!(got[0], event(5, 1, 2, None));
         assert_eq!(got[1], tick(6));
         assert_eq!(
             got[2],
             Item::Event {
                 stamp: Stamp::Float(7.5),
-                address: Some((0, 0, Some(1)))
+                address: Some((0, 0, None))
             }
+        );
+        assert!(
+            matches!(&got[3], Item::Bad { why, .. } if why == "4 fields; the stream's lines have 3")
         );
         // Taxel-indexed: t, taxel, p.
         let mut taxels = format.clone();

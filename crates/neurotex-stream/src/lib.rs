@@ -223,7 +223,7 @@ pub enum BadFrame {
     },
     /// A time stamp further after the previous frame's than the largest gap.
     #[error(
-        "time stamp {t} s is {} s after the previous frame's {previous} s, more than the largest gap ({max_gap_s} s)",
+        "time stamp {t} s is {:.6} s after the previous stamp, {previous} s: more than the largest gap ({max_gap_s} s)",
         .t - .previous
     )]
     Jump {
@@ -662,6 +662,9 @@ impl StreamClassifier {
     /// # Errors
     /// The model cannot classify the episode's last window.
     pub fn reset(&mut self) -> Result<&[Event], StreamError> {
+        // The next episode's clock may start again: its stamps follow none before.
+        self.previous_stamp = None;
+        self.stray_stamp = None;
         self.end_with(EpisodeEnd::Reset)
     }
 

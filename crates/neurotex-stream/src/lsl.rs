@@ -460,6 +460,20 @@ impl Outlet {
         })
     }
 
+    /// Waits up to `timeout_s` for a first consumer: lines pushed before one connects are
+    /// lost. Whether one connected.
+    pub fn wait_for_consumers(&self, timeout_s: f64) -> bool {
+        let start = std::time::Instant::now();
+        // SAFETY: a live outlet.
+        while unsafe { (self.lsl.api.have_consumers)(self.handle) } == 0 {
+            if start.elapsed().as_secs_f64() >= timeout_s {
+                return false;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        true
+    }
+
     /// Publishes one line.
     pub fn push(&self, line: &str) {
         let Ok(text) = CString::new(line) else {
@@ -486,7 +500,11 @@ impl Drop for Outlet {
 }
 
 /// How long a lost stream is looked for again before the input ends, s.
-const REFIND_S: f64 = 2.0;
+const REFIND_S: f64 = 3.0;
+
+/// How long one search for a lost stream waits: the searches repeat until [`REFIND_S`], as
+/// the first may find the closed outlet still announced, and opening it fails.
+const SEARCH_S: f64 = 0.25;
 
 /// How long one pull waits before looking at `stop()` again, s.
 const PULL_WAIT_S: f64 = 0.1;
@@ -525,18 +543,26 @@ impl Live {
     /// Looks for the lost stream again: `true` when it is back with the same channels.
     fn refind(&mut self) -> Result<bool> {
         let query = self.inlet.query.clone();
-        let Ok(inlet) = Inlet::open(&self.lsl, &query, REFIND_S) else {
-            self.ended = Some(format!(
-                "{query}: the stream is gone (its outlet closed, or its host cannot be reached): the input ended"
-            ));
-            return Ok(false);
+        let start = std::time::Instant::now();
+        let inlet = loop {
+            if let Ok(inlet) = Inlet::open(&self.lsl, &query, SEARCH_S) {
+                break inlet;
+            }
+            if start.elapsed().as_secs_f64() >= REFIND_S {
+                self.ended = Some(format!(
+                    "{query}: the stream is gone (its outlet closed, or its host cannot be reached for {REFIND_S} s): the input ended"
+                ));
+                return Ok(false);
+            }
+            std::thread::sleep(std::time::Duration::from_secs_f64(SEARCH_S / 2.0));
         };
         let (was, now) = (self.inlet.channels, inlet.channels);
         if was != now || self.inlet.text != inlet.text {
+            let kind = |text| if text { "text" } else { "numeric" };
             let why = format!(
-                "the stream came back with {now} {} channel(s); it had {was} {}",
-                if inlet.text { "text" } else { "numeric" },
-                if self.inlet.text { "text" } else { "numeric" },
+                "the stream came back with {now} {} channel(s); it had {was} {} channel(s)",
+                kind(inlet.text),
+                kind(self.inlet.text),
             );
             return Err(DataError::invalid(query.to_string(), why).into());
         }

@@ -103,9 +103,17 @@ impl PredictOptions {
     /// Every recording's per-bin decisions and end, as `stream` decides them.
     ///
     /// # Errors
-    /// A model not trained with `--causal`, or a decision rule out of range.
+    /// A model not trained with `--causal` (for sampled recordings), or a decision rule out
+    /// of range.
     pub fn episodes(&self, model: &SavedModel, encoded: &[Encoded]) -> Result<Vec<Episode>> {
-        if let Err(why) = model.streams() {
+        // Events skip the conditioning a stream of samples needs: only a method without a
+        // running form (the spectrum) is refused for them.
+        let events = !encoded.is_empty() && encoded.iter().all(|e| e.from_events);
+        let refused = match model.streams() {
+            Err(why) if events && why != crate::causal::NO_RUNNING_SPECTRUM => Ok(()),
+            other => other.map(|_| ()),
+        };
+        if let Err(why) = refused {
             let message = format!(
                 "{}: --causal decides as a stream: {why}",
                 self.model.display()

@@ -336,12 +336,19 @@ pub fn run_stream(args: &StreamOptions, talk: StreamTalk<'_>) -> Result<()> {
         opened,
     } = talk;
     let (mut stream, mut input) = open_input(args, model, params, events, say)?;
+    // Lines pushed before a consumer connects are lost; an LSL input buffers meanwhile.
+    if let (Some(outlet), Some(target)) = (&publish, &args.publish) {
+        if !outlet.wait_for_consumers(PUBLISH_WAIT_S) {
+            say(&format!("{target}: no consumer after {PUBLISH_WAIT_S} s; lines published before one connects are lost"));
+        }
+    }
     opened();
     let mut sink = Lines {
         out,
         say,
         publish,
         episodes: 0,
+        events: matches!(input, Input::Events(_)),
     };
     let replay = args
         .realtime
@@ -435,6 +442,9 @@ fn frames_model(args: &StreamOptions, model: &SavedModel) -> Result<()> {
     Err(OptionsError::Conflict(format!("{from}: {why}")).into())
 }
 
+/// How long `--publish` waits for a first consumer before the stream starts, s.
+const PUBLISH_WAIT_S: f64 = 2.0;
+
 /// The LSL outlet `--publish lsl:NAME` names.
 fn publisher(target: &str) -> Result<Outlet> {
     let Some(name) = target.strip_prefix("lsl:").filter(|n| !n.trim().is_empty()) else {
@@ -489,6 +499,8 @@ struct Lines<'a> {
     publish: Option<Outlet>,
     /// Episodes ended so far.
     episodes: usize,
+    /// Whether the input is events (their warnings say so).
+    events: bool,
 }
 
 impl Sink for Lines<'_> {
@@ -507,6 +519,7 @@ impl Sink for Lines<'_> {
     }
 
     fn bad_frame(&mut self, place: &str, why: &str) {
-        (self.say)(&format!("warning: {place}: bad frame skipped: {why}"));
+        let what = if self.events { "event" } else { "frame" };
+        (self.say)(&format!("warning: {place}: bad {what} skipped: {why}"));
     }
 }
