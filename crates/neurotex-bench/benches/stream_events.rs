@@ -74,6 +74,7 @@ fn bench(c: &mut Criterion) {
                     &model,
                     Some(TimeUnit::Microseconds),
                     Some(Origin::Zero),
+                    false,
                 )
                 .unwrap();
                 let params = StreamParams::for_model(&model);

@@ -52,8 +52,10 @@ enum Command {
     /// Run every analysis of the paper (E0-E8), and E5c and E9 beyond it, and write a
     /// report with figures; without --dataset, on the built-in simulated rig.
     Reproduce(reproduce::ReproduceArgs),
-    /// Classify a live taxel stream (standard input, a file, TCP or UDP) frame by frame with
-    /// a model trained with --causal: one JSON line per 200 ms bin, one per episode's end.
+    /// Classify a live taxel stream (standard input, a file, TCP, UDP or the Lab Streaming
+    /// Layer) frame by frame with a model trained with --causal, or an event sensor's events
+    /// (--format events or events-bin) with any model: one JSON line per 200 ms bin, one per
+    /// episode's end (docs/live-rigs.md).
     ///
     /// Bad frames are said on standard error with their line or frame number, counted
     /// (`bad_frames` in the end line) and skipped; the stream goes on. They are: a CSV line

@@ -511,6 +511,33 @@ fn imported_logs_read_as_the_events_they_hold() {
         let of = |ds: &Path| sa_fa_features(&dir, ds, method);
         assert_eq!(of(&imported), of(&direct), "{method}");
     }
+    // The sensor's taxel indices stream live with the import's channel map (`--taxel`), as
+    // the imported file's x and y do.
+    let model = dir.join("model.json");
+    dir.ok(&["train", "--dataset", s(&imported), "--encoding", "sa+fa", "--out", s(&model)]);
+    let file = std::fs::read_dir(&imported)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_string_lossy().contains("silk_1"))
+        .unwrap();
+    let xy = std::fs::read_to_string(&file).unwrap();
+    let mut by_taxel = String::from("t,taxel,p\n");
+    for line in xy.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let taxel = f[2].parse::<usize>().unwrap() * 3 + f[1].parse::<usize>().unwrap();
+        by_taxel.push_str(&format!("{},{taxel},{}\n", f[0], f[3]));
+    }
+    let streamed = |text: &str, extra: &[&str]| {
+        let input = dir.join("live.csv");
+        std::fs::write(&input, text).unwrap();
+        let mut args = vec!["stream", "--model", s(&model), "--format", "events"];
+        args.extend_from_slice(extra);
+        args.extend(["--input", s(&input)]);
+        dir.ok(&args)
+    };
+    let expected = streamed(&xy, &[]);
+    assert!(expected.lines().count() > 4, "{expected}");
+    assert_eq!(streamed(&by_taxel, &["--taxel"]), expected);
     // The import's checks, on these logs: each run must fail, naming what is wrong, and
     // leave nothing behind, unless `ok`.
     let out = dir.join("bad");

@@ -1238,7 +1238,9 @@ pub fn import_events(
     })
 }
 
-/// The layout an import writes: the grid, its mask, and the columns it writes.
+/// The layout an import writes: the grid, its mask, the columns it writes, and for logs
+/// addressed by taxel index the channel map (a stream of the same sensor's taxel indices
+/// reads it, `neurotex stream --taxel`).
 fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
     let g = &p.grid;
     let masked = g.present.iter().any(|&x| !x);
@@ -1249,6 +1251,12 @@ fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
             g.present
                 .chunks(g.cols)
                 .map(|row| row.iter().map(|&x| if x { '1' } else { '0' }).collect())
+                .collect()
+        }),
+        channel_map: p.format.taxel.as_ref().map(|_| {
+            g.taxels
+                .iter()
+                .map(|&cell| [cell / g.cols, cell % g.cols])
                 .collect()
         }),
         events: Some(crate::events::EventsFormat {

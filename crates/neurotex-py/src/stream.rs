@@ -110,7 +110,7 @@ impl NativeStream {
                 return Err(raise(Kind::Parameter, why));
             }
         };
-        let source = EventSource::for_model(&model, Some(unit), origin)
+        let source = EventSource::for_model(&model, Some(unit), origin, false)
             .map_err(|why| raise(Kind::Parameter, why))?;
         let inner = guarded(|| StreamClassifier::for_events(model, params, source))?;
         Ok(NativeStream {

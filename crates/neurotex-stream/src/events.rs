@@ -45,7 +45,9 @@ pub struct EventSource {
 impl EventSource {
     /// The events of `model`'s sensor: read as its training dataset's event files were when
     /// it was trained on events, else as `x` and `y` on its grid with polarities 1 (ON) and
-    /// 0 (OFF). `unit` and `origin` override the dataset's.
+    /// 0 (OFF). `unit` and `origin` override the dataset's. `taxel`: the events name a
+    /// taxel index (`t,taxel,p`), each taxel's cell from the channel map of the model's
+    /// dataset (`import events --channel-map` keeps it), else row-major.
     ///
     /// # Errors
     /// No unit: the model was not trained on events and none was given.
@@ -53,6 +55,7 @@ impl EventSource {
         model: &SavedModel,
         unit: Option<TimeUnit>,
         origin: Option<Origin>,
+        taxel: bool,
     ) -> std::result::Result<Self, String> {
         let grid = model.grid();
         let layout = model.provenance().layout.as_ref();
@@ -64,6 +67,9 @@ impl EventSource {
         };
         if let Some(unit) = unit {
             format.time_unit = unit;
+        }
+        if taxel && format.taxel.is_none() {
+            format.taxel = Some("taxel".into());
         }
         format.origin = origin.unwrap_or(match layout.is_some_and(|l| l.events.is_some()) {
             true => format.origin,

@@ -83,7 +83,8 @@ pub enum FrameFormat {
 #[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct StreamOptions {
     /// A model trained with `--causal` (`neurotex train --causal`, with any classifier:
-    /// a spiking network runs step by step on the spikes as they come).
+    /// a spiking network runs step by step on the spikes as they come); for events, any
+    /// model, such as one trained on an event dataset.
     #[cfg_attr(feature = "cli", arg(long))]
     pub model: PathBuf,
     /// With --model FILE.nir from another tool (no neurotex metadata in the graph): a
@@ -135,6 +136,11 @@ pub struct StreamOptions {
     /// else `first`.
     #[cfg_attr(feature = "cli", arg(long, value_parser = ["zero", "first"]))]
     pub origin: Option<String>,
+    /// Events: each names a taxel index instead of x and y (`t,taxel,p` lines; a record's
+    /// x, or an LSL stream's `taxel[,p]`), mapped to cells by the channel map of the model's
+    /// dataset (`import events --channel-map`), else row-major.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub taxel: bool,
     /// Replay the input at its own pace (its time stamps, or --fs): for demonstrations.
     #[cfg_attr(feature = "cli", arg(long))]
     pub realtime: bool,
@@ -191,9 +197,9 @@ impl StreamOptions {
             FrameFormat::Events => EventEncoding::Text,
             FrameFormat::EventsBin => EventEncoding::Binary,
             FrameFormat::Csv | FrameFormat::F32le => {
-                if self.origin.is_some() {
+                if self.origin.is_some() || self.taxel {
                     return Err(OptionsError::NotApplicable {
-                        option: "--origin",
+                        option: "--origin and --taxel",
                         applies_to: "--format events or events-bin",
                     }
                     .into());
@@ -241,7 +247,8 @@ impl StreamOptions {
             (EventEncoding::Binary, None) => Some(TimeUnit::Microseconds),
             (EventEncoding::Text, None) => None,
         };
-        let source = EventSource::for_model(model, unit, origin).map_err(OptionsError::Conflict)?;
+        let source = EventSource::for_model(model, unit, origin, self.taxel)
+            .map_err(OptionsError::Conflict)?;
         Ok(Some((encoding, source)))
     }
 
