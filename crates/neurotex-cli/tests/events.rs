@@ -514,7 +514,15 @@ fn imported_logs_read_as_the_events_they_hold() {
     // The sensor's taxel indices stream live with the import's channel map (`--taxel`), as
     // the imported file's x and y do.
     let model = dir.join("model.json");
-    dir.ok(&["train", "--dataset", s(&imported), "--encoding", "sa+fa", "--out", s(&model)]);
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&imported),
+        "--encoding",
+        "sa+fa",
+        "--out",
+        s(&model),
+    ]);
     let file = std::fs::read_dir(&imported)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -606,6 +614,33 @@ fn imported_logs_read_as_the_events_they_hold() {
     // a wrong time unit shows in the spans and is said; the dataset is written
     let err = import(&[&polar[..], &["--time-unit", "ms"]].concat(), true);
     assert!(err.contains("the unit is probably wrong"), "{err}");
+    std::fs::remove_dir_all(&out).unwrap();
+    // stamps from a clock read from time 0 make long spans too: the origin is named
+    let clock = dir.join("clock");
+    std::fs::create_dir_all(&clock).unwrap();
+    for name in ["silk_0.csv", "wool_1.csv"] {
+        std::fs::write(clock.join(name), "t,x,y\n1000.5,0,0\n1001.5,1,0\n").unwrap();
+    }
+    let run = dir.run(&[
+        "import",
+        "events",
+        s(&clock),
+        "--out",
+        s(&out),
+        "--grid",
+        "2x3",
+        "--time-unit",
+        "s",
+        "--name-pattern",
+        "{label}_{trial}.csv",
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("stamps from a clock need --origin first"),
+        "{}",
+        run.stderr
+    );
     std::fs::remove_dir_all(&out).unwrap();
     for (extra, says) in [
         (

@@ -1137,6 +1137,8 @@ pub struct ImportedFile {
     pub merged: usize,
     /// The recording's span from its start (by the origin) to its last event, s.
     pub span_s: f64,
+    /// Its first event's time from its start, s (0 with `--origin first`).
+    pub first_s: f64,
     /// Whether the log has a polarity column.
     pub polarity: bool,
 }
@@ -1373,6 +1375,13 @@ fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFil
             reordered,
             merged: done.merged,
             span_s: done.n_steps as f64 / 1000.0,
+            first_s: done
+                .on
+                .iter()
+                .chain(done.off.iter().flatten())
+                .filter_map(|train| train.first())
+                .min()
+                .map_or(0.0, |&step| f64::from(step) / 1000.0),
             polarity,
         },
     ))

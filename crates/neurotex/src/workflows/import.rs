@@ -292,10 +292,17 @@ impl ImportEventsOptions {
             spans.first().copied().unwrap_or(0.0),
             spans.last().copied().unwrap_or(0.0)
         )));
+        let mut firsts: Vec<f64> = imported.iter().map(|f| f.first_s).collect();
+        firsts.sort_by(f64::total_cmp);
+        let first = firsts.get(firsts.len() / 2).copied().unwrap_or(0.0);
         if !(0.05..=600.0).contains(&median) {
+            // Most of the span before the first event: the stamps count from a clock's zero.
+            let why = match first > median / 2.0 && params.format.origin == Origin::Zero {
+                true => format!("the first events come {first:.3} s (median) after time 0: stamps from a clock need --origin first"),
+                false => format!("read with --time-unit {}: a tactile trial lasts seconds, so the unit is probably wrong", self.time_unit),
+            };
             on(Progress::Advice(&format!(
-                "the median recording spans {median:.3} s, read with --time-unit {}: a tactile trial lasts seconds, so the unit is probably wrong",
-                self.time_unit
+                "the median recording spans {median:.3} s; {why}"
             )));
         }
         Ok(imported)
