@@ -199,7 +199,8 @@ impl StreamClassifier {
                 return Err(bad.into());
             }
         };
-        self.frames += 1;
+        // Ticks are not events: the count is of events taken.
+        self.frames += u64::from(address.is_some());
         if jumped && self.episode.is_some() {
             self.end_episode(EpisodeEnd::Gap)?;
         }

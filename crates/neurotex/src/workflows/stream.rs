@@ -356,6 +356,7 @@ pub fn run_stream(args: &StreamOptions, talk: StreamTalk<'_>) -> Result<()> {
         publish,
         episodes: 0,
         events: matches!(input, Input::Events(_)),
+        warned: 0,
     };
     let replay = args
         .realtime
@@ -508,7 +509,13 @@ struct Lines<'a> {
     episodes: usize,
     /// Whether the input is events (their warnings say so).
     events: bool,
+    /// Bad frames said so far.
+    warned: usize,
 }
+
+/// The bad frames or events a stream says one by one; the rest are only counted, so a
+/// wrong option cannot bury the decisions in warnings.
+const MAX_WARNINGS: usize = 100;
 
 impl Sink for Lines<'_> {
     fn events(&mut self, stream: &StreamClassifier, events: &[Event]) -> Result<()> {
@@ -527,6 +534,15 @@ impl Sink for Lines<'_> {
 
     fn bad_frame(&mut self, place: &str, why: &str) {
         let what = if self.events { "event" } else { "frame" };
-        (self.say)(&format!("warning: {place}: bad {what} skipped: {why}"));
+        self.warned += 1;
+        match self.warned.cmp(&MAX_WARNINGS) {
+            std::cmp::Ordering::Less => {
+                (self.say)(&format!("warning: {place}: bad {what} skipped: {why}"))
+            }
+            std::cmp::Ordering::Equal => (self.say)(&format!(
+                "warning: {place}: bad {what} skipped: {why}; further bad {what}s are counted (the summary and each episode's end line) but not said"
+            )),
+            std::cmp::Ordering::Greater => {}
+        }
     }
 }
