@@ -597,40 +597,10 @@ fn parse_csv(
             Ok(true) => {}
             Err(e) => return Err(bad(format!("line {}: {e}", line + 1))),
         }
-        // The line the record starts on (blank lines and quoted line breaks counted).
+        // The line the record starts on, as the CSV reader counts lines.
         line = record.position().map_or(line + 1, |p| p.line() as usize);
         let at = |m: String| bad(format!("line {line}: {m}"));
-        let field = |i: usize, what: &str| -> Result<&str> {
-            std::str::from_utf8(&record[i]).map(str::trim).map_err(|e| {
-                at(format!(
-                    "{what} is not UTF-8 text (its byte {} is not)",
-                    e.valid_up_to() + 1
-                ))
-            })
-        };
-        let int = |i: usize, what: &str| -> Result<i64> {
-            let text = field(i, what)?;
-            text.parse::<i64>()
-                .or(match text {
-                    "True" | "true" => Ok(1),
-                    "False" | "false" => Ok(0),
-                    _ => Err(()),
-                })
-                .map_err(|_| at(format!("{what} `{text}` is not an integer")))
-        };
-        let time = field(cols.time, "the time")?;
-        let t = match time.parse::<i64>() {
-            Ok(v) => Stamp::Int(v),
-            Err(_) => Stamp::Float(
-                time.parse::<f64>()
-                    .map_err(|_| at(format!("time `{time}` is not a number")))?,
-            ),
-        };
-        let cell = match cols.cell {
-            CellColumns::Xy(x, y) => (int(x, "x")?, int(y, "y")?),
-            CellColumns::Taxel(i) => (int(i, "taxel")?, 0),
-        };
-        let p = cols.polarity.map(|i| int(i, "polarity")).transpose()?;
+        let (t, cell, p) = csv_event(&record, &cols).map_err(at)?;
         sink(Parsed::Event {
             t,
             cell,
@@ -640,6 +610,45 @@ fn parse_csv(
         .map_err(at)?;
     }
     Ok(())
+}
+
+/// An event's time, cell fields (`x` and `y`, or the taxel and 0) and polarity.
+type EventFields = (Stamp, (i64, i64), Option<i64>);
+
+/// One CSV record's event: its time, cell fields and polarity; `Err` says why it is none.
+fn csv_event(record: &csv::ByteRecord, cols: &Columns) -> std::result::Result<EventFields, String> {
+    let field = |i: usize, what: &str| -> std::result::Result<&str, String> {
+        std::str::from_utf8(&record[i]).map(str::trim).map_err(|e| {
+            format!(
+                "{what} is not UTF-8 text (its byte {} is not)",
+                e.valid_up_to() + 1
+            )
+        })
+    };
+    let int = |i: usize, what: &str| -> std::result::Result<i64, String> {
+        let text = field(i, what)?;
+        text.parse::<i64>()
+            .or(match text {
+                "True" | "true" => Ok(1),
+                "False" | "false" => Ok(0),
+                _ => Err(()),
+            })
+            .map_err(|_| format!("{what} `{text}` is not an integer"))
+    };
+    let time = field(cols.time, "the time")?;
+    let t = match time.parse::<i64>() {
+        Ok(v) => Stamp::Int(v),
+        Err(_) => Stamp::Float(
+            time.parse::<f64>()
+                .map_err(|_| format!("time `{time}` is not a number"))?,
+        ),
+    };
+    let cell = match cols.cell {
+        CellColumns::Xy(x, y) => (int(x, "x")?, int(y, "y")?),
+        CellColumns::Taxel(i) => (int(i, "taxel")?, 0),
+    };
+    let p = cols.polarity.map(|i| int(i, "polarity")).transpose()?;
+    Ok((t, cell, p))
 }
 
 fn parse_npy(

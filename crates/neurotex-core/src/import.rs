@@ -1286,6 +1286,51 @@ const POLARITY_NAMES: [&str; 9] = [
 /// An event as parsed: time, cell fields, polarity, and its line or record.
 type RawEvent = (crate::events::Stamp, (i64, i64), Option<i64>, usize);
 
+/// Checks that a log's polarity is read when it has one: the column named (or its values
+/// given) is there, and no unread column is named like a polarity, which would leave
+/// every OFF event ON, silently.
+fn polarity_read(
+    p: &EventImportParams,
+    polarity: bool,
+    unread: &[String],
+) -> std::result::Result<(), String> {
+    if p.require_polarity && !polarity {
+        return Err(format!(
+            "no polarity column `{}`, which --polarity or --polarity-values asks for",
+            p.format.polarity
+        ));
+    }
+    let polarity_like = |name: &str| POLARITY_NAMES.contains(&name.to_ascii_lowercase().as_str());
+    match unread.iter().find(|n| !polarity && polarity_like(n)) {
+        Some(name) => Err(format!(
+            "column `{name}` is not read, and its name says polarity: name it with --polarity {name} (and --polarity-values ON,OFF unless they are 1,0), or the log's OFF events would be read as ON"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Sorts `events` into time order, stably (events of one time keep the log's order); the
+/// events that came before an earlier line's time.
+fn sort_stably(events: &mut [RawEvent]) -> usize {
+    let key = |t: &crate::events::Stamp| crate::events::as_f64(*t);
+    let mut reordered = 0;
+    let mut latest = f64::NEG_INFINITY;
+    for (t, ..) in events.iter() {
+        let v = key(t);
+        if v < latest {
+            reordered += 1;
+        }
+        latest = latest.max(v);
+    }
+    if reordered > 0 {
+        events.sort_by(|a, b| match (a.0, b.0) {
+            (crate::events::Stamp::Int(x), crate::events::Stamp::Int(y)) => x.cmp(&y),
+            (x, y) => key(&x).total_cmp(&key(&y)),
+        });
+    }
+    reordered
+}
+
 /// One log's events in time order as the CSV text an import writes, and what was done.
 fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {
     let mut events: Vec<RawEvent> = Vec::new();
@@ -1302,43 +1347,13 @@ fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFil
         Ok(())
     })?;
     let bad = |why: String| -> crate::Error { DataError::invalid(path, why).into() };
-    if p.require_polarity && !polarity {
-        return Err(bad(format!(
-            "no polarity column `{}`, which --polarity or --polarity-values asks for",
-            p.format.polarity
-        )));
-    }
+    polarity_read(p, polarity, &unread).map_err(bad)?;
     if events.is_empty() {
         return Err(bad(
             "holds no events (a header only, or an empty array)".into()
         ));
     }
-    // A polarity under another name would leave every OFF event ON, silently.
-    let polarity_like = |name: &str| {
-        let n = name.to_ascii_lowercase();
-        POLARITY_NAMES.contains(&n.as_str())
-    };
-    if let Some(name) = unread.iter().find(|n| !polarity && polarity_like(n)) {
-        return Err(bad(format!(
-            "column `{name}` is not read, and its name says polarity: name it with --polarity {name} (and --polarity-values ON,OFF unless they are 1,0), or the log's OFF events would be read as ON"
-        )));
-    }
-    let key = |t: &crate::events::Stamp| crate::events::as_f64(*t);
-    let mut reordered = 0;
-    let mut latest = f64::NEG_INFINITY;
-    for (t, ..) in &events {
-        let v = key(t);
-        if v < latest {
-            reordered += 1;
-        }
-        latest = latest.max(v);
-    }
-    if reordered > 0 {
-        events.sort_by(|a, b| match (a.0, b.0) {
-            (crate::events::Stamp::Int(x), crate::events::Stamp::Int(y)) => x.cmp(&y),
-            (x, y) => key(&x).total_cmp(&key(&y)),
-        });
-    }
+    let reordered = sort_stably(&mut events);
     let max_steps = (crate::recording::DEFAULT_MAX_DURATION_S * 1000.0) as u64;
     let mut gather = crate::events::Gather::new(&p.format, &p.grid, polarity, None, max_steps);
     let name = format!(
