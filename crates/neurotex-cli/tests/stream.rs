@@ -889,6 +889,23 @@ fn a_model_trained_on_events_streams_events_and_refuses_frames() {
     let args = ["--model", s(&model), "--format", "events"];
     let (out, _) = stream_stdin(&dir, &args, text.as_bytes());
     assert_eq!(lines(&out), predicted(&dir, &model, &events, name));
+    // So does a spiking network trained on the events, run step by step on them.
+    let snn = dir.join("snn.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&events),
+        "--classifier",
+        "snn",
+        "--out",
+        s(&snn),
+    ]);
+    let (out, _) = stream_stdin(
+        &dir,
+        &["--model", s(&snn), "--format", "events"],
+        text.as_bytes(),
+    );
+    assert_eq!(lines(&out), predicted(&dir, &snn, &events, name));
     let frames = dir.join("frames.csv");
     std::fs::write(&frames, csv_text(&slide_frames(&data, &slides(&data)[1]))).unwrap();
     let err = dir.fails(&["stream", "--model", s(&model), "--input", s(&frames)]);
