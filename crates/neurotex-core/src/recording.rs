@@ -576,7 +576,7 @@ pub struct Dataset {
 }
 
 /// Why a step that reads sampled signals refuses an address-event recording.
-const EVENTS_NOT_SAMPLES: &str = "is an address-event recording (its layout.toml has an [events] table), not sampled signals, and this step needs samples (encode, the signal baselines of compare --encodings none, --gain auto, --causal, stream, and predict on single files); an event dataset goes to features, evaluate, train, compare, reproduce, inspect and predict --dataset, and raw event logs through `neurotex import events` first";
+const EVENTS_NOT_SAMPLES: &str = "is an address-event recording (its layout.toml has an [events] table), not sampled signals, and this step needs samples (encode, the signal baselines of compare --encodings none, --gain auto, --causal, and predict on single files); an event dataset goes to features, evaluate, train, compare, reproduce, inspect and predict --dataset, a live sensor's events to stream --format events, and raw event logs through `neurotex import events` first";
 
 /// The manifest's required columns.
 pub const MANIFEST_COLUMNS: [&str; 2] = ["file", "label"];
