@@ -1,7 +1,7 @@
 //! Address events through the stream classifier, one thread: 10^5 events of a 4x4 sensor
 //! over 12 s (both polarities, about 8 a millisecond, as FabricSlide's encoded spikes), read
 //! as 16-byte binary records and as text lines and classified at every 200 ms bin by a
-//! 3D-GLCM + KNN model of SA (ON) and FA (OFF) spikes. The target: 10^7 events/s.
+//! 3D-GLCM + KNN model of SA (ON) and FA (OFF) spikes. The target is 10^7 events/s.
 
 mod support;
 
