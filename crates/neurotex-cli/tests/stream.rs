@@ -932,4 +932,17 @@ fn a_model_trained_on_events_streams_events_and_refuses_frames() {
         "--stamped",
     ]);
     assert!(err.contains("--stamped"), "{err}");
+    // LSL options are checked before any stream is looked for.
+    let err = dir.fails(&[
+        "stream",
+        "--model",
+        s(&causal),
+        "--input",
+        "lsl:x",
+        "--lsl-timeout-s",
+        "nan",
+    ]);
+    assert!(err.contains("lsl-timeout-s"), "{err}");
+    let err = dir.fails(&["stream", "--model", s(&causal), "--publish", "tcp://x"]);
+    assert!(err.contains("--publish takes lsl:NAME"), "{err}");
 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use crate::causal::DecisionRule;
 use crate::csvlog::{ChannelSelect, Column, CsvFormat, CsvOverrides, Delimiter};
-use crate::error::OptionsError;
+use crate::error::{OptionsError, ParamError};
 use crate::events::Origin;
 use crate::recording::TimeUnit;
 use crate::saved::{SavedModel, Trained};
@@ -398,6 +398,10 @@ fn open_input(
         None => None,
     };
     let timeout = args.lsl_timeout_s;
+    if !(timeout.is_finite() && timeout > 0.0 && timeout <= 3600.0) {
+        let rule = "how long to look for an LSL stream must be in (0, 3600] s";
+        return Err(ParamError::new("lsl-timeout-s", rule, timeout).into());
+    }
     Ok(match events {
         Some((encoding, source)) => {
             let taxel = source.format.taxel.is_some();
