@@ -716,6 +716,22 @@ fn frames_stamped_on_the_1_ms_grid_stream_as_the_same_frames_unstamped() {
     }
 }
 
+/// `data`'s spikes exported as an event dataset (`export events EXTRA...`), in `events`.
+fn exported(dir: &Dir, data: &Path, extra: &[&str]) -> PathBuf {
+    let events = dir.join("events");
+    let mut args = vec![
+        "export",
+        "events",
+        "--dataset",
+        s(data),
+        "--out",
+        s(&events),
+    ];
+    args.extend_from_slice(extra);
+    dir.ok(&args);
+    events
+}
+
 /// An exported event recording as a stream's text: its lines, then a tick at its duration
 /// (the manifest's `duration_s`, in ms), so the stream's episode is the recording's length.
 fn event_text(events: &Path, file: &str) -> String {
@@ -755,18 +771,7 @@ fn a_recordings_spikes_as_events_stream_as_its_samples() {
     // give (`predict --causal`, which equals the frames' stream), bit for bit.
     let dir = Dir::new();
     let (data, model) = trained(&dir, &["--encoding", "sa+fa"]);
-    let events = dir.join("events");
-    dir.ok(&[
-        "export",
-        "events",
-        "--dataset",
-        s(&data),
-        "--out",
-        s(&events),
-        "--causal",
-        "--encoding",
-        "sa+fa",
-    ]);
+    let events = exported(&dir, &data, &["--causal", "--encoding", "sa+fa"]);
     let names: Vec<String> = std::fs::read_dir(&events)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -842,15 +847,7 @@ fn a_recordings_spikes_as_events_stream_as_its_samples() {
 fn a_model_trained_on_events_streams_events_and_refuses_frames() {
     let dir = Dir::new();
     let (data, causal) = trained(&dir, &[]);
-    let events = dir.join("events");
-    dir.ok(&[
-        "export",
-        "events",
-        "--dataset",
-        s(&data),
-        "--out",
-        s(&events),
-    ]);
+    let events = exported(&dir, &data, &[]);
     let model = dir.join("events_model.json");
     dir.ok(&["train", "--dataset", s(&events), "--out", s(&model)]);
     let name = "00001_FT1_v10_t01.csv";

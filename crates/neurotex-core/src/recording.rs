@@ -322,16 +322,21 @@ pub struct LayoutFile {
 pub const DEFAULT_MAX_DURATION_S: f64 = 3600.0;
 
 impl LayoutFile {
-    /// How events address the cells of a `rows x cols` grid: the mask's cells, and each
-    /// taxel index's cell (the channel map's, or row-major order without one).
-    pub fn event_grid(&self, rows: usize, cols: usize) -> crate::events::EventGrid {
-        let present: Vec<bool> = match &self.mask {
+    /// Which of the grid's `cells` hold a taxel, row-major: the mask's `1`s, or all.
+    fn present(&self, cells: usize) -> Vec<bool> {
+        match &self.mask {
             Some(m) => m
                 .iter()
                 .flat_map(|row| row.chars().map(|ch| ch == '1'))
                 .collect(),
-            None => vec![true; rows * cols],
-        };
+            None => vec![true; cells],
+        }
+    }
+
+    /// How events address the cells of a `rows x cols` grid: the mask's cells, and each
+    /// taxel index's cell (the channel map's, or row-major order without one).
+    pub fn event_grid(&self, rows: usize, cols: usize) -> crate::events::EventGrid {
+        let present = self.present(rows * cols);
         let taxels = match &self.channel_map {
             Some(map) => map.iter().map(|&[r, c]| r * cols + c).collect(),
             None => (0..rows * cols).collect(),
@@ -481,13 +486,7 @@ impl LayoutFile {
             (_, _, Shape::Grid(r, c)) => (r, c),
             (_, _, Shape::Channels(n)) => (1, n),
         };
-        let present: Vec<bool> = match &self.mask {
-            Some(m) => m
-                .iter()
-                .flat_map(|row| row.chars().map(|ch| ch == '1'))
-                .collect(),
-            None => vec![true; rows * cols],
-        };
+        let present = self.present(rows * cols);
         let n_channels = match shape {
             Shape::Grid(r, c) => {
                 if (r, c) != (rows, cols) {

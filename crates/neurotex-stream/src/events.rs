@@ -75,16 +75,17 @@ impl EventSource {
             true => format.origin,
             false => Origin::First,
         });
-        let mut grid = match layout {
-            Some(l) if format.taxel.is_some() => l.event_grid(grid.rows(), grid.cols()),
-            _ => EventGrid {
-                rows: grid.rows(),
-                cols: grid.cols(),
-                present: Vec::new(),
-                taxels: (0..grid.rows() * grid.cols()).collect(),
-            },
+        let (rows, cols) = (grid.rows(), grid.cols());
+        let taxels = match layout {
+            Some(l) if format.taxel.is_some() => l.event_grid(rows, cols).taxels,
+            _ => (0..rows * cols).collect(),
         };
-        grid.present = model.grid().present().to_vec();
+        let grid = EventGrid {
+            rows,
+            cols,
+            present: grid.present().to_vec(),
+            taxels,
+        };
         Ok(EventSource { format, grid })
     }
 }
@@ -718,15 +719,8 @@ pub fn feed_events(
                 stream.push_event(stamp, address)
             }
         };
-        match done {
-            Ok([]) => {}
-            Ok(done) => {
-                let done = done.to_vec();
-                sink.events(stream, &done)?;
-            }
-            Err(StreamError::Bad(bad)) => sink.bad_frame(&events.place(), &bad.to_string()),
-            Err(StreamError::Classify(e)) => return Err(e),
-        }
+        let done = done.map(<[_]>::to_vec);
+        crate::frames::pass_on(done, stream, sink, &|| events.place())?;
     }
 }
 

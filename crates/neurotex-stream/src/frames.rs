@@ -526,13 +526,29 @@ pub fn feed(
                 stream.push_in(stamp, unit, values)
             }
         };
-        match events {
-            Ok(events) => {
-                let events = events.to_vec();
-                sink.events(stream, &events)?;
-            }
-            Err(StreamError::Bad(bad)) => sink.bad_frame(&frames.place(), &bad.to_string()),
-            Err(StreamError::Classify(e)) => return Err(e),
+        let events = events.map(<[_]>::to_vec);
+        pass_on(events, stream, sink, &|| frames.place())?;
+    }
+}
+
+/// Passes what one frame or event completed to `sink`: its decisions, or the bad frame it
+/// was (named by `place`).
+///
+/// # Errors
+/// The model could not classify a window; `sink` failed.
+pub(crate) fn pass_on(
+    done: std::result::Result<Vec<Event>, StreamError>,
+    stream: &StreamClassifier,
+    sink: &mut dyn Sink,
+    place: &dyn Fn() -> String,
+) -> Result<()> {
+    match done {
+        Ok(events) if events.is_empty() => Ok(()),
+        Ok(events) => sink.events(stream, &events),
+        Err(StreamError::Bad(bad)) => {
+            sink.bad_frame(&place(), &bad.to_string());
+            Ok(())
         }
+        Err(StreamError::Classify(e)) => Err(e),
     }
 }
