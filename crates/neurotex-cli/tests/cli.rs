@@ -19,6 +19,7 @@ mod raw_logs;
 mod reproduce;
 mod simulate;
 mod stream;
+mod trust;
 mod util;
 
 use util::Dir;

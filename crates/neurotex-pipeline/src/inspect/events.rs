@@ -68,6 +68,19 @@ pub(super) fn inspect_events(
     };
     let mut findings = super::findings::findings(&inspection, &ds.layout, params);
     findings.extend(event_findings(&inspection));
+    let onsets: Vec<(f64, f64)> = ok
+        .iter()
+        .filter_map(|(_, e)| first_step(e).map(|f| (f as f64 / 1000.0, e.n_steps as f64 / 1000.0)))
+        .collect();
+    if let Some(late) = LateOnsets::of(&onsets) {
+        findings.push(finding(
+            Severity::Severe,
+            "events",
+            "late-first-events",
+            late.message(),
+            "set `origin = \"first\"` in layout.toml's [events] table (each recording then starts at its first event), or import the logs again with `neurotex import events --origin first`",
+        ));
+    }
     findings.sort_by_key(|f| std::cmp::Reverse(f.severity));
     inspection.findings = findings;
     Ok(inspection)
@@ -132,6 +145,68 @@ fn lengths(ok: &[(Meta, Events)], unreadable: Vec<Unreadable>, bin_ms: usize) ->
         too_short: name(&|s| s * 1000.0 < bin_ms as f64),
         short: name(&|s| s < duration_s[1] / 4.0),
         channels: Vec::new(),
+    }
+}
+
+/// A recording's first event's 1 ms step; `None` without events.
+fn first_step(e: &Events) -> Option<u32> {
+    let first = |lists: &[Vec<u32>]| lists.iter().filter_map(|l| l.first().copied()).min();
+    let off = e.off.as_deref().and_then(first);
+    match (first(&e.on), off) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// Leading silence, s, that is one rate-volume bin or less: never a finding.
+const ONSET_FLOOR_S: f64 = 0.2;
+/// A median first event later than this share of the median recording's events' span
+/// (first to last event) is a late start.
+const LATE_SHARE: f64 = 0.25;
+/// First events spread over more than this share of the median span differ widely.
+const SPREAD_SHARE: f64 = 0.5;
+
+/// Recordings whose first events come late, or at times that differ widely between them:
+/// stamps from a sensor's clock read with the origin at time 0, which puts seconds of
+/// silence in front of every recording (the rate volume, the GLCM and the time windows
+/// read it as texture; the paper's method loses half its accuracy on such logs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LateOnsets {
+    /// The first event's time, `[min, median, max]`, s from the recording's start.
+    pub first_s: [f64; 3],
+    /// The median span from the first to the last event, s.
+    pub active_s: f64,
+    /// Recordings with events.
+    pub recordings: usize,
+}
+
+impl LateOnsets {
+    /// The rule on `(first event, end)` pairs in s, one per recording with events:
+    /// `Some` when the median first event is later than a quarter of the median span of
+    /// the events, or the first events spread over more than half of it (each also at
+    /// least one 200 ms bin).
+    pub fn of(onsets: &[(f64, f64)]) -> Option<LateOnsets> {
+        if onsets.is_empty() {
+            return None;
+        }
+        let firsts = spread(onsets.iter().map(|&(f, _)| f).collect());
+        let active = spread(onsets.iter().map(|&(f, end)| (end - f).max(0.0)).collect())[1];
+        let late = firsts[1] >= ONSET_FLOOR_S.max(LATE_SHARE * active);
+        let differ = firsts[2] - firsts[0] >= ONSET_FLOOR_S.max(SPREAD_SHARE * active);
+        (late || differ).then_some(LateOnsets {
+            first_s: firsts,
+            active_s: active,
+            recordings: onsets.len(),
+        })
+    }
+
+    /// What was found, in numbers.
+    pub fn message(&self) -> String {
+        let [lo, median, hi] = self.first_s;
+        format!(
+            "the first event comes {median:.3} s after the recording's start (median of {}; from {lo:.3} to {hi:.3} s) while the events span {:.3} s: stamps from a sensor's clock read from time 0 put that silence in front of every recording, where the rate volume, the GLCM and the time windows read it as texture",
+            self.recordings, self.active_s
+        )
     }
 }
 

@@ -295,7 +295,19 @@ impl ImportEventsOptions {
         let mut firsts: Vec<f64> = imported.iter().map(|f| f.first_s).collect();
         firsts.sort_by(f64::total_cmp);
         let first = firsts.get(firsts.len() / 2).copied().unwrap_or(0.0);
-        if !(0.05..=600.0).contains(&median) {
+        let onsets: Vec<(f64, f64)> = imported
+            .iter()
+            .filter(|f| f.events > 0)
+            .map(|f| (f.first_s, f.span_s))
+            .collect();
+        let late = crate::inspect::events::LateOnsets::of(&onsets);
+        if let (Some(late), Origin::Zero) = (late, params.format.origin) {
+            on(Progress::Advice(&format!(
+                "{}; import again with --origin first (each recording then starts at its first event), or set origin = \"first\" in {}",
+                late.message(),
+                out.join("layout.toml").display()
+            )));
+        } else if !(0.05..=600.0).contains(&median) {
             // Most of the span before the first event: the stamps count from a clock's zero.
             let why = match first > median / 2.0 && params.format.origin == Origin::Zero {
                 true => format!("the first events come {first:.3} s (median) after time 0: stamps from a clock need --origin first"),

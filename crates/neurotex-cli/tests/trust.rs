@@ -1,0 +1,89 @@
+//! Inputs that used to give a wrong number without a word: each is now flagged, refused or
+//! handled, through the binary.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::util::{s, xorshift, Dir};
+
+/// Writes event logs `t_us,x,y,p` of two textures x `trials` into `logs`: 2 s of events on
+/// a 2x2 grid (texture A's ON events on the left column, B's on the right), each log's
+/// stamps starting `lead_s(trial)` seconds after the clock's zero.
+fn clock_logs(dir: &Dir, lead_s: &dyn Fn(usize) -> f64, trials: usize) -> PathBuf {
+    let logs = dir.join("logs");
+    std::fs::create_dir_all(&logs).unwrap();
+    for (k, label) in ["A", "B"].iter().enumerate() {
+        for trial in 0..trials {
+            let mut random = xorshift((k * 100 + trial) as u64);
+            let start = (lead_s(trial) * 1e6) as u64;
+            let mut log = String::from("t,x,y,p\n");
+            let mut t = start;
+            while t < start + 2_000_000 {
+                t += 1_000 + random() % 20_000;
+                let (x, y) = (random() % 2, random() % 2);
+                let p = u64::from(x == k as u64);
+                log.push_str(&format!("{t},{x},{y},{p}\n"));
+            }
+            std::fs::write(logs.join(format!("{label}_{trial}.csv")), log).unwrap();
+        }
+    }
+    logs
+}
+
+fn import_events(dir: &Dir, logs: &Path, name: &str, extra: &[&str]) -> (PathBuf, String) {
+    let out = dir.join(name);
+    let mut args = vec![
+        "import",
+        "events",
+        s(logs),
+        "--out",
+        s(&out),
+        "--grid",
+        "2x2",
+        "--time-unit",
+        "us",
+        "--name-pattern",
+        "{label}_{trial}.csv",
+    ];
+    args.extend_from_slice(extra);
+    let run = dir.run(&args);
+    assert!(run.status.success(), "{}", run.stderr);
+    (out, run.stderr)
+}
+
+fn finding_codes(dir: &Dir, dataset: &Path) -> Vec<String> {
+    let json: Value =
+        serde_json::from_str(&dir.ok(&["inspect", s(dataset), "--json"])).expect("JSON");
+    json["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["code"].as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn event_logs_stamped_by_a_sensor_clock_are_flagged_with_the_origin_as_the_fix() {
+    let dir = Dir::new();
+    // Stamps from a clock started 1 to 9 s before each trial.
+    let logs = clock_logs(&dir, &|trial| 1.0 + (trial * 37 % 9) as f64, 6);
+    let (zero, said) = import_events(&dir, &logs, "zero", &[]);
+    assert!(
+        said.contains("the first event comes") && said.contains("--origin first"),
+        "{said}"
+    );
+    assert!(finding_codes(&dir, &zero).contains(&"late-first-events".to_string()));
+    let text = dir.ok(&["inspect", s(&zero)]);
+    assert!(text.contains("origin = \"first\""), "{text}");
+    // The fix the finding names removes it.
+    let (first, said) = import_events(&dir, &logs, "first", &["--origin", "first"]);
+    assert!(!said.contains("the first event comes"), "{said}");
+    assert!(!finding_codes(&dir, &first).contains(&"late-first-events".to_string()));
+    // Logs whose clock starts with the trial are not flagged.
+    let dir = Dir::new();
+    let logs = clock_logs(&dir, &|_| 0.0, 6);
+    let (prompt, said) = import_events(&dir, &logs, "prompt", &[]);
+    assert!(!said.contains("the first event comes"), "{said}");
+    assert!(!finding_codes(&dir, &prompt).contains(&"late-first-events".to_string()));
+}
