@@ -87,3 +87,60 @@ fn event_logs_stamped_by_a_sensor_clock_are_flagged_with_the_origin_as_the_fix()
     assert!(!said.contains("the first event comes"), "{said}");
     assert!(!finding_codes(&dir, &prompt).contains(&"late-first-events".to_string()));
 }
+
+#[test]
+fn raw_event_logs_are_pointed_to_import_events_not_read_as_samples() {
+    let dir = Dir::new();
+    let logs = clock_logs(&dir, &|_| 0.0, 2);
+    for header in ["t,x,y,p", "timestamp,x,y,polarity", "t_us,taxel,pol"] {
+        let log = dir.join("event_log.csv");
+        let fields = header.split(',').count();
+        let mut text = format!("{header}\n");
+        for i in 0..50 {
+            let line: Vec<String> = (0..fields)
+                .map(|f| (i * 17 + f) % 2)
+                .map(|v| v.to_string())
+                .collect();
+            text.push_str(&format!("{},{}\n", i * 1000, line[1..].join(",")));
+        }
+        std::fs::write(&log, text).unwrap();
+        let err = dir.fails(&["inspect", s(&log), "--time-column", "0"]);
+        assert!(err.contains("neurotex import events"), "{header}: {err}");
+        let out = dir.join("imported");
+        let err = dir.fails(&[
+            "import",
+            "csv",
+            s(&log),
+            "--out",
+            s(&out),
+            "--time-column",
+            "0",
+        ]);
+        assert!(err.contains("neurotex import events"), "{header}: {err}");
+        assert!(!out.exists());
+    }
+    let err = dir.fails(&["inspect", s(&logs)]);
+    assert!(err.contains("address event"), "{err}");
+}
+
+#[test]
+fn a_log_without_a_time_column_chosen_is_told_which_column_holds_time() {
+    let dir = Dir::new();
+    let log = dir.join("trial.csv");
+    let mut text = String::from("timestamp,left,right\n");
+    for i in 0..400 {
+        text.push_str(&format!("{},{},{}\n", i * 2, i % 7, i % 5));
+    }
+    std::fs::write(&log, text).unwrap();
+    let err = dir.fails(&["inspect", s(&log)]);
+    assert!(err.contains("--time-column timestamp"), "{err}");
+    assert!(!err.contains("--fs is needed"), "{err}");
+    // And the advice works.
+    dir.ok(&[
+        "inspect",
+        s(&log),
+        "--time-column",
+        "timestamp",
+        "--no-encoder",
+    ]);
+}

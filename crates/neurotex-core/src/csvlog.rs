@@ -561,6 +561,30 @@ fn detect_delimiter(path: &Path) -> Result<Delimiter> {
     Ok(detect_delimiter_in(&lines))
 }
 
+/// The column names of a log's header row, from its first 16 KiB; `None` when the file
+/// cannot be read, has no header row by `format`, or its first line is longer.
+pub fn header_names(path: &Path, format: &CsvFormat) -> Option<Vec<String>> {
+    // Never opened unless a regular file: a FIFO would block the open.
+    if !format.header || !std::fs::metadata(path).ok()?.is_file() {
+        return None;
+    }
+    let mut head = Vec::with_capacity(16 * 1024);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(16 * 1024).read_to_end(&mut head))
+        .ok()?;
+    let text = String::from_utf8_lossy(&head);
+    let first = text.lines().find(|l| !l.trim().is_empty())?;
+    if head.len() == 16 * 1024 && !text.contains('\n') {
+        return None;
+    }
+    let delimiter = format
+        .delimiter
+        .unwrap_or_else(|| detect_delimiter_in(&[first]))
+        .byte() as char;
+    let unquote = |f: &str| f.trim().trim_matches('"').trim().to_string();
+    Some(first.split(delimiter).map(unquote).collect())
+}
+
 /// Guesses the delimiter from the first lines of a log (a file's first ten, or a stream's
 /// first): among `,` `;` and tab, the one found the same non-zero number of times on each
 /// line, the most frequent such one (tab, then `;`, then `,` on a tie: `;` files often

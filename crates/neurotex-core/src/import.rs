@@ -352,6 +352,57 @@ pub struct Logs {
     params: CsvImportParams,
 }
 
+/// The error for logs read with neither a time column nor a rate, saying first what the
+/// first log's header shows: an address event's fields (`import events`), or a column
+/// named like time stamps (`--time-column`).
+fn no_rate(files: &[PathBuf], p: &CsvImportParams) -> crate::Error {
+    let header = files
+        .first()
+        .and_then(|f| Some((f, crate::csvlog::header_names(f, &p.format)?)));
+    if let Some((file, names)) = header {
+        let time = names
+            .iter()
+            .position(|n| crate::csvlog::is_timelike_name(n));
+        let rest: Vec<String> = (names.iter().enumerate())
+            .filter(|&(j, _)| Some(j) != time)
+            .map(|(_, n)| n.clone())
+            .collect();
+        if let Err(e) = refuse_event_log(file, &rest) {
+            return e;
+        }
+        if let Some(j) = time {
+            let why = format!(
+                "no time column was chosen and no rate given, and column `{}` is named like time stamps: `--time-column {}` reads it as time (the rate then comes from its stamps; `--time-unit` if they are not in ms), or --fs gives the rate of logs without stamps",
+                names[j], names[j]
+            );
+            return DataError::invalid(file, why).into();
+        }
+    }
+    let rule = "without --time-column the sampling rate --fs is needed";
+    ParamError::new("fs", rule, "none").into()
+}
+
+/// Refuses a log whose channels are an address event's fields (`x`, `y` or a taxel
+/// index, and perhaps a polarity): read as samples, each event would be a frame and its
+/// coordinates taxel values, at the events' rate.
+fn refuse_event_log(file: &Path, channels: &[String]) -> Result<()> {
+    let lower: Vec<String> = channels.iter().map(|c| c.trim().to_lowercase()).collect();
+    let has = |name: &str| lower.iter().any(|c| c == name);
+    let address = (has("x") && has("y")) || ["taxel", "addr", "address"].iter().any(|n| has(n));
+    let event_field = |c: &String| {
+        ["x", "y", "taxel", "addr", "address"].contains(&c.as_str())
+            || POLARITY_NAMES.contains(&c.as_str())
+    };
+    if address && lower.iter().all(event_field) {
+        let why = format!(
+            "its columns ({}) are an address event's fields, one event per line, not one frame of taxel values per line: `neurotex import events` reads it into an event dataset, which `inspect` and every command then read as events",
+            channels.join(", ")
+        );
+        return Err(DataError::invalid(file, why).into());
+    }
+    Ok(())
+}
+
 impl Logs {
     /// The logs `files` under the import's options `p`: the first log that reads gives the
     /// channels and the layout.
@@ -361,8 +412,7 @@ impl Logs {
     /// that does not fit the channels.
     pub fn open(files: Vec<PathBuf>, p: CsvImportParams) -> Result<Self> {
         if p.format.time_column.is_none() && p.fs.is_none() {
-            let rule = "without --time-column the sampling rate --fs is needed";
-            return Err(ParamError::new("fs", rule, "none").into());
+            return Err(no_rate(&files, &p));
         }
         let mut first_error = None;
         for f in &files {
@@ -374,6 +424,7 @@ impl Logs {
                     };
                     let unit = first.log.times.is_some().then_some(first.log.time_unit);
                     let names = &first.log.channel_names;
+                    refuse_event_log(f, names)?;
                     let layout = csv_layout(&p, names, fs, unit, &first.log.columns)?;
                     return Ok(Logs {
                         files,
@@ -582,8 +633,7 @@ pub fn import_csv(
         return Err(DataError::invalid(out, "no .csv files to import").into());
     }
     if p.format.time_column.is_none() && p.fs.is_none() {
-        let rule = "without --time-column the sampling rate --fs is needed";
-        return Err(ParamError::new("fs", rule, "none").into());
+        return Err(no_rate(files, p));
     }
     reject_duplicate_names(files)?;
     let mut summary = ImportSummary::default();
@@ -599,6 +649,7 @@ pub fn import_csv(
         return Err(DataError::invalid(out, message).into());
     }
     let names = first.log.channel_names.clone();
+    refuse_event_log(Path::new(&first.meta.file), &names)?;
     if let Some(other) = good.iter().find(|c| c.log.channel_names != names) {
         return Err(invalid(
             Path::new(&other.meta.file),
