@@ -15,7 +15,7 @@ use crate::util::{fabricslide, s, Dir};
 
 /// A simulated dataset of FT1, SB and CP x 4 trials at 10 mm/s (hold 5 s, slide 9 s), and a
 /// causal model trained on it with `extra` options.
-fn trained(dir: &Dir, extra: &[&str]) -> (PathBuf, PathBuf) {
+pub(crate) fn trained(dir: &Dir, extra: &[&str]) -> (PathBuf, PathBuf) {
     let data = dir.join("sim");
     dir.ok(&[
         "simulate",
@@ -43,7 +43,7 @@ fn trained(dir: &Dir, extra: &[&str]) -> (PathBuf, PathBuf) {
 }
 
 /// The manifest's rows as `(file, slide_start_s, slide_end_s)`.
-fn slides(data: &Path) -> Vec<(String, f64, f64)> {
+pub(crate) fn slides(data: &Path) -> Vec<(String, f64, f64)> {
     let text = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -63,7 +63,7 @@ fn slides(data: &Path) -> Vec<(String, f64, f64)> {
 
 /// The sliding phase of a simulated recording: `(frames, 16 values)` at 1 kHz, selected as
 /// the pipeline selects it (step `i` at `i / 1000` s, in `[start, end)`).
-fn slide_frames(data: &Path, (file, start, end): &(String, f64, f64)) -> Vec<Vec<f32>> {
+pub(crate) fn slide_frames(data: &Path, (file, start, end): &(String, f64, f64)) -> Vec<Vec<f32>> {
     let x: Array3<f32> = read_npy(data.join(file)).unwrap();
     (0..x.shape()[0])
         .filter(|&i| {
@@ -75,7 +75,7 @@ fn slide_frames(data: &Path, (file, start, end): &(String, f64, f64)) -> Vec<Vec
 }
 
 /// Frames as CSV text: a header of taxel names, then one line per frame.
-fn csv_text(frames: &[Vec<f32>]) -> String {
+pub(crate) fn csv_text(frames: &[Vec<f32>]) -> String {
     let mut text: String = (0..16)
         .map(|i| format!("taxel{i}"))
         .collect::<Vec<_>>()
@@ -90,14 +90,14 @@ fn csv_text(frames: &[Vec<f32>]) -> String {
 }
 
 /// JSON lines, parsed.
-fn lines(text: &str) -> Vec<Value> {
+pub(crate) fn lines(text: &str) -> Vec<Value> {
     text.lines()
         .map(|l| serde_json::from_str(l).expect("a JSON line"))
         .collect()
 }
 
 /// `predict --causal`'s lines for `file`, without the `file` field.
-fn predicted(dir: &Dir, model: &Path, data: &Path, file: &str) -> Vec<Value> {
+pub(crate) fn predicted(dir: &Dir, model: &Path, data: &Path, file: &str) -> Vec<Value> {
     let out = dir.join("causal.jsonl");
     dir.ok(&[
         "predict",

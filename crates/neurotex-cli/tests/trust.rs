@@ -144,3 +144,70 @@ fn a_log_without_a_time_column_chosen_is_told_which_column_holds_time() {
         "--no-encoder",
     ]);
 }
+
+/// Adds to each recording of `data` a resting level of its own, up to `factor` times the
+/// recording's range, and one per taxel: a capacitive skin whose rest drifts between
+/// recordings.
+fn drift_offsets(data: &Path, factor: f32) {
+    use ndarray::Array3;
+    use ndarray_npy::{read_npy, write_npy};
+    let mut random = xorshift(11);
+    let mut unit = move || (random() % 1_000_000) as f32 / 1e6;
+    for (file, _, _) in crate::stream::slides(data) {
+        let path = data.join(&file);
+        let x: Array3<f32> = read_npy(&path).unwrap();
+        let span =
+            x.fold(f32::NEG_INFINITY, |a, &b| a.max(b)) - x.fold(f32::INFINITY, |a, &b| a.min(b));
+        let level = 2.0 + factor * span * unit();
+        let taxel: Vec<f32> = (0..16).map(|_| 0.1 * span * unit()).collect();
+        let y = Array3::from_shape_fn(x.dim(), |(t, r, c)| x[[t, r, c]] + level + taxel[r * 4 + c]);
+        write_npy(&path, &y).unwrap();
+    }
+}
+
+#[test]
+fn a_drift_window_tracks_rest_identically_in_the_stream_and_predict_causal() {
+    let dir = Dir::new();
+    // Trained on the simulator's recordings, whose rest is 0; then every recording's rest
+    // moves by up to 10 times its signal. A 2 s window, shorter than the 9 s slides, so
+    // the window's blocks are replaced as the slide goes on.
+    let (data, model) = crate::stream::trained(&dir, &["--drift-window-s", "2"]);
+    let saved: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(
+        saved["pipeline"]["preprocess"]["drift_window_ms"], 2000,
+        "{saved}"
+    );
+    drift_offsets(&data, 10.0);
+    let all = crate::stream::slides(&data);
+    for row in [&all[0], &all[5]] {
+        let expected = crate::stream::predicted(&dir, &model, &data, &row.0);
+        assert!(expected.len() > 40, "a bin every 200 ms of a 9 s slide");
+        let frames = crate::stream::slide_frames(&data, row);
+        let csv = dir.join("slide.csv");
+        std::fs::write(&csv, crate::stream::csv_text(&frames)).unwrap();
+        let text = dir.ok(&["stream", "--model", s(&model), "--input", s(&csv)]);
+        assert_eq!(crate::stream::lines(&text), expected, "{}", row.0);
+    }
+    // A window without causal conditioning would go unused: refused.
+    let err = dir.fails(&[
+        "evaluate",
+        "--dataset",
+        s(&data),
+        "--method",
+        "glcm3d",
+        "--drift-window-s",
+        "2",
+    ]);
+    assert!(err.contains("needs --causal"), "{err}");
+    let err = dir.fails(&[
+        "evaluate",
+        "--dataset",
+        s(&data),
+        "--method",
+        "glcm3d",
+        "--causal",
+        "--drift-window-s",
+        "0.25",
+    ]);
+    assert!(err.contains("multiple of 0.1 s"), "{err}");
+}

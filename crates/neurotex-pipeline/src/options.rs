@@ -71,6 +71,9 @@ pub struct StageOptions {
     pub gain: GainChoice,
     /// Condition causally, as a live stream can.
     pub causal: bool,
+    /// Under `causal`, the trailing window (s) over which each taxel's resting value is
+    /// tracked as its least input; 0 keeps the resting values fixed at training.
+    pub drift_window_s: f64,
     /// The Izhikevich firing type.
     pub preset: FiringType,
     /// Low-pass cutoff in Hz; 0 turns the filter off.
@@ -113,6 +116,7 @@ impl Default for StageOptions {
         Self {
             gain: GainChoice::default(),
             causal: false,
+            drift_window_s: 0.0,
             preset: FiringType::default(),
             cutoff: pre.cutoff_hz,
             baseline: pre.baseline,
@@ -171,6 +175,7 @@ impl StageOptions {
         p.preprocess.cutoff_hz = self.cutoff;
         p.preprocess.slide_only = !self.whole;
         p.preprocess.baseline = self.baseline;
+        p.preprocess.drift_window_ms = self.drift_window_ms()?;
         p.volume.levels = self.levels;
         p.volume.bin_ms = self.bin_ms;
         p.glcm.distances = self.distances.clone();
@@ -191,6 +196,31 @@ impl StageOptions {
             gain: self.gain,
             causal: self.causal,
         })
+    }
+
+    /// The drift window in ms; `None` for 0.
+    ///
+    /// # Errors
+    /// A window without causal conditioning (it would go unused), or one that is not a
+    /// whole number of 0.1 s from 0.1 to 600 s.
+    fn drift_window_ms(&self) -> Result<Option<u32>, ParamError> {
+        let s = self.drift_window_s;
+        if s == 0.0 {
+            return Ok(None);
+        }
+        let rule = "the drift window must be a multiple of 0.1 s from 0.1 to 600 s";
+        let tenths = s * 10.0;
+        if !(tenths.is_finite()
+            && (tenths - tenths.round()).abs() < 1e-9
+            && (1.0..=6000.0).contains(&tenths.round()))
+        {
+            return Err(ParamError::new("drift-window-s", rule, s));
+        }
+        if !self.causal {
+            let rule = "the drift window tracks the resting values of causal conditioning: it needs --causal";
+            return Err(ParamError::new("drift-window-s", rule, s));
+        }
+        Ok(Some(tenths.round() as u32 * 100))
     }
 
     /// Sets the option `name` (Python's spelling) from text as it is typed.
@@ -379,6 +409,16 @@ pub static STAGE_OPTIONS: &[OptionSpec] = &[
          training recordings (labels unused) instead of the zero-phase filter and each \
          recording's own baseline and maximum, which need the whole recording.",
         get: shown, set: flag),
+    spec!(
+        drift_window_s,
+        Number,
+        "With --causal, track each taxel's resting value as the least of its input over \
+         the last this many seconds (a multiple of 0.1 s; within 0.1 s) instead of fixing \
+         it at training: for sensors whose resting level drifts between or within \
+         recordings by more than their signal (capacitive skins). Longer than a contact, \
+         so that the resting level before it stays in the window; 0 (the default) keeps \
+         the fixed values."
+    ),
 ];
 
 #[cfg(test)]

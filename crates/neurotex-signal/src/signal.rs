@@ -27,6 +27,12 @@ pub struct PreprocessParams {
     /// baseline and maximum. `None` (the paper's offline pipeline) when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub causal: Option<CausalConditioning>,
+    /// Under causal conditioning, each cell's resting value is the least of its input over
+    /// a trailing window of this many ms ([`RestTracker`]) instead of the value fixed at
+    /// training: for sensors whose resting level drifts between or within recordings.
+    /// `None` keeps the fixed values.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drift_window_ms: Option<u32>,
 }
 
 impl Default for PreprocessParams {
@@ -36,6 +42,7 @@ impl Default for PreprocessParams {
             slide_only: true,
             baseline: None,
             causal: None,
+            drift_window_ms: None,
         }
     }
 }
@@ -94,10 +101,106 @@ impl PreprocessParams {
                 c,
             ));
         }
+        if let Some(window) = self.drift_window_ms {
+            if !(DRIFT_BLOCK_MS..=MAX_DRIFT_WINDOW_MS).contains(&window)
+                || window % DRIFT_BLOCK_MS != 0
+            {
+                return Err(ParamError::new(
+                    "drift-window-s",
+                    "the drift window must be a multiple of 0.1 s from 0.1 to 600 s",
+                    window as f64 / 1000.0,
+                ));
+            }
+        }
         match &self.causal {
             Some(causal) => causal.check(),
             None => Ok(()),
         }
+    }
+}
+
+/// The drift window's blocks, in 1 ms steps: [`RestTracker`] keeps one minimum per block.
+pub const DRIFT_BLOCK_MS: u32 = 100;
+/// The longest drift window, ms: ten minutes.
+pub const MAX_DRIFT_WINDOW_MS: u32 = 600_000;
+/// The most block minima a [`RestTracker`] keeps (cells x blocks): 128 MiB.
+pub const MAX_DRIFT_VALUES: usize = 1 << 24;
+
+/// Each cell's resting value as the least of its input over a trailing window: the
+/// current 100 ms block so far and the `window / 100 ms` whole blocks before it (so the
+/// window spans between `window` and `window + 0.1 s`). A causal counterpart of the `min`
+/// baseline that follows a resting level drifting by more than the signal, at a cost of
+/// one comparison per cell and step and one pass over the block minima per block. The
+/// offline causal pipeline and the stream both run it, step by step, on the resampled
+/// input, so they subtract the same values.
+#[derive(Debug, Clone)]
+pub struct RestTracker {
+    cells: usize,
+    blocks: usize,
+    /// The last `blocks` whole blocks' minima, `blocks x cells` (infinite while unfilled).
+    ring: Vec<f64>,
+    /// Per cell, the least of `ring`.
+    earlier: Vec<f64>,
+    /// Per cell, the least of the current block so far.
+    current: Vec<f64>,
+    step: u64,
+}
+
+impl RestTracker {
+    /// A tracker for `cells` cells over a window of `window_ms` (a checked
+    /// [`PreprocessParams::drift_window_ms`]).
+    ///
+    /// # Errors
+    /// A grid too large to keep the window's block minima for ([`MAX_DRIFT_VALUES`]).
+    pub fn new(cells: usize, window_ms: u32) -> Result<Self, ParamError> {
+        let blocks = (window_ms / DRIFT_BLOCK_MS).max(1) as usize;
+        if cells.saturating_mul(blocks) > MAX_DRIFT_VALUES {
+            let rule = "the drift window keeps one minimum per taxel and 0.1 s, at most 16777216 values over the grid";
+            let got = format!(
+                "{} s on {cells} cells (at most {:.1} s on this grid)",
+                window_ms as f64 / 1000.0,
+                (MAX_DRIFT_VALUES / cells.max(1)) as f64 / 10.0
+            );
+            return Err(ParamError::new("drift-window-s", rule, got));
+        }
+        Ok(RestTracker {
+            cells,
+            blocks,
+            ring: vec![f64::INFINITY; cells * blocks],
+            earlier: vec![f64::INFINITY; cells],
+            current: vec![f64::INFINITY; cells],
+            step: 0,
+        })
+    }
+
+    /// Takes one step's input `raw` (one value per cell) and writes each cell's resting
+    /// value into `rest`.
+    ///
+    /// # Panics
+    /// `raw` or `rest` does not hold one value per cell.
+    pub fn push(&mut self, raw: &[f64], rest: &mut [f64]) {
+        let cells = self.cells;
+        assert!(raw.len() == cells && rest.len() == cells);
+        let block_steps = u64::from(DRIFT_BLOCK_MS);
+        if self.step > 0 && self.step.is_multiple_of(block_steps) {
+            let slot = ((self.step / block_steps - 1) % self.blocks as u64) as usize;
+            self.ring[slot * cells..(slot + 1) * cells].copy_from_slice(&self.current);
+            self.earlier.fill(f64::INFINITY);
+            for block in self.ring.chunks_exact(cells) {
+                for (e, &b) in self.earlier.iter_mut().zip(block) {
+                    *e = e.min(b);
+                }
+            }
+            self.current.fill(f64::INFINITY);
+        }
+        for (((c, &x), &e), r) in (self.current.iter_mut().zip(raw))
+            .zip(&self.earlier)
+            .zip(rest.iter_mut())
+        {
+            *c = c.min(x);
+            *r = c.min(e);
+        }
+        self.step += 1;
     }
 }
 
@@ -525,6 +628,28 @@ fn selected_phase(
     Ok(samples)
 }
 
+/// Each frame of `samples` (1 kHz, `cells` values each) less each cell's resting value as
+/// a [`RestTracker`] over `window_ms` follows it; cells not `present` stay 0.
+///
+/// # Errors
+/// A grid too large for the window ([`RestTracker::new`]).
+fn less_tracked_rest(
+    samples: &mut [f64],
+    cells: usize,
+    present: &[bool],
+    window_ms: u32,
+) -> Result<()> {
+    let mut tracker = RestTracker::new(cells, window_ms)?;
+    let mut rest = vec![0.0; cells];
+    for frame in samples.chunks_exact_mut(cells) {
+        tracker.push(frame, &mut rest);
+        for ((s, &r), &p) in frame.iter_mut().zip(&rest).zip(present) {
+            *s = if p { *s - r } else { 0.0 };
+        }
+    }
+    Ok(())
+}
+
 /// The error of a selected phase without a whole 1 ms step.
 fn phase_too_short(rec: &Recording) -> crate::Error {
     let message = "the selected phase is shorter than one 1 ms encoder step";
@@ -676,6 +801,14 @@ impl Preprocessor {
         frames: std::ops::Range<usize>,
     ) -> Result<(Vec<f64>, Option<f64>)> {
         let (cells, present) = (rec.layout.cells(), &rec.layout.present);
+        if let (Some(_), Some(window)) = (&self.params.causal, self.params.drift_window_ms) {
+            let mut samples = selected_phase(rec, times, offsets, frames)?;
+            less_tracked_rest(&mut samples, cells, present, window)?;
+            if let Some(filter) = &self.filter {
+                filter.lfilter_frames(&mut samples, cells);
+            }
+            return Ok((samples, None));
+        }
         let Some(filter) = &self.filter else {
             return Ok((selected_phase(rec, times, offsets, frames)?, None));
         };
@@ -727,6 +860,10 @@ impl Preprocessor {
         let stamps = rec.times_s.as_ref().map(|_| relative_times(rec));
         let times = Times::of(rec, stamps.as_deref());
         let offsets = match &self.params.causal {
+            // The resting values are tracked as the samples come (`less_tracked_rest`).
+            Some(causal) if self.params.drift_window_ms.is_some() => {
+                vec![0.0; fixed_offsets(rec, causal)?.len()]
+            }
             Some(causal) => fixed_offsets(rec, causal)?,
             None => {
                 let baseline = self.params.baseline.unwrap_or(dataset_baseline);
@@ -1065,6 +1202,40 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64 * (hi - lo) + lo
         }
+    }
+
+    /// The tracker's resting value is, at every step, the least input from the start of
+    /// the block `window / 100 ms` blocks back through the current step: checked against
+    /// that minimum taken directly, for windows of one and of several blocks, across many
+    /// replacements of the ring, on a drifting input.
+    #[test]
+    fn the_rest_tracker_is_the_trailing_minimum_by_its_definition() {
+        let mut next = uniform(7, -1.0, 1.0);
+        let cells = 3;
+        let steps = 2_345;
+        let input: Vec<f64> = (0..steps * cells)
+            .map(|i| next() + (i / cells) as f64 * 0.01)
+            .collect();
+        for window_ms in [100, 300, 1_000] {
+            let mut tracker = RestTracker::new(cells, window_ms).unwrap();
+            let mut rest = vec![0.0; cells];
+            let blocks = (window_ms / DRIFT_BLOCK_MS) as usize;
+            for t in 0..steps {
+                tracker.push(&input[t * cells..(t + 1) * cells], &mut rest);
+                let from = (t / 100).saturating_sub(blocks) * 100;
+                for (c, &r) in rest.iter().enumerate() {
+                    let least = (from..=t)
+                        .map(|u| input[u * cells + c])
+                        .fold(f64::INFINITY, f64::min);
+                    assert_eq!(
+                        r.to_bits(),
+                        least.to_bits(),
+                        "window {window_ms} step {t} cell {c}"
+                    );
+                }
+            }
+        }
+        assert!(RestTracker::new(1 << 20, 100_000).is_err());
     }
 
     /// The masked copy less offsets, the maximum and the division equal their one-value-

@@ -41,7 +41,7 @@ use crate::model::{Model, Prediction};
 use crate::pipeline::{Encoded, Encoding};
 use crate::recording::{Meta, TimeUnit};
 use crate::saved::{SavedModel, Trained};
-use crate::signal::{Butterworth2, CausalConditioning, Preprocessor, ENCODER_FS};
+use crate::signal::{Butterworth2, CausalConditioning, Preprocessor, RestTracker, ENCODER_FS};
 use crate::spiking_model::decide;
 use network::NetworkFeed;
 use spike_log::SpikeLog;
@@ -299,6 +299,8 @@ struct EpisodeState {
     bins: usize,
     /// Since when (s from the origin) the signal has been at rest, for onset episodes.
     rest_since: Option<f64>,
+    /// The resting values tracked through the episode under a drift window.
+    tracker: Option<RestTracker>,
 }
 
 /// What an episode keeps of its spikes for the classifications at bin boundaries.
@@ -371,6 +373,8 @@ pub struct StreamClassifier {
     before: Vec<f64>,
     last: Vec<f64>,
     step_in: Vec<f64>,
+    /// The resting values of the current step under a drift window.
+    rest: Vec<f64>,
     conditioned: Vec<f64>,
     previous: Vec<f64>,
     drive: Vec<f64>,
@@ -424,6 +428,9 @@ impl StreamClassifier {
             let rule = "the model's causal resting values must match its grid";
             return Err(ParamError::new("model", rule, conditioning.offsets.len()).into());
         }
+        if let Some(window) = model.params().preprocess.drift_window_ms {
+            RestTracker::new(cells, window)?;
+        }
         let channel_cells = (0..cells).filter(|&c| present[c]).collect();
         let filter = Preprocessor::new(&model.params().preprocess)?
             .filter()
@@ -465,6 +472,7 @@ impl StreamClassifier {
             before: buffer.clone(),
             last: buffer.clone(),
             step_in: buffer.clone(),
+            rest: buffer.clone(),
             conditioned: buffer.clone(),
             previous: buffer.clone(),
             drive: buffer,
@@ -805,6 +813,8 @@ impl StreamClassifier {
             decider: Decider::new(self.params.rule),
             bins: 0,
             rest_since: None,
+            tracker: (p.preprocess.drift_window_ms)
+                .map(|w| RestTracker::new(cells, w).expect("a window checked with the model")),
         }
     }
 
@@ -883,12 +893,19 @@ impl StreamClassifier {
         let cells = self.rows * self.cols;
         let has_fa = episode.neurons.iter().any(|n| n.1);
         let [z0, z1] = &mut episode.filter_state;
+        let offsets = match &mut episode.tracker {
+            Some(tracker) => {
+                tracker.push(&self.step_in, &mut self.rest);
+                &self.rest
+            }
+            None => &self.conditioning.offsets,
+        };
         episode.kept.begin_step();
         for start in (0..cells).step_by(PART) {
             let part = start..(start + PART).min(cells);
             let conditioning = Conditioning {
                 raw: &self.step_in[part.clone()],
-                offsets: &self.conditioning.offsets[part.clone()],
+                offsets: &offsets[part.clone()],
                 present: &self.present[part.clone()],
                 state: [&mut z0[part.clone()], &mut z1[part.clone()]],
                 out: &mut self.conditioned[part.clone()],
