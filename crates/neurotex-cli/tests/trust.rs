@@ -211,3 +211,39 @@ fn a_drift_window_tracks_rest_identically_in_the_stream_and_predict_causal() {
     ]);
     assert!(err.contains("multiple of 0.1 s"), "{err}");
 }
+
+fn small_simulation(dir: &Dir) -> PathBuf {
+    let data = dir.join("sim");
+    let args = ["--trials", "4", "--speeds", "10", "--textures", "FT1,SB,CP"];
+    let mut all = vec!["simulate", "--out", s(&data)];
+    all.extend_from_slice(&args);
+    dir.ok(&all);
+    data
+}
+
+#[test]
+fn resting_levels_that_move_between_recordings_are_found_and_not_blamed_on_the_gain() {
+    let dir = Dir::new();
+    let data = small_simulation(&dir);
+    assert!(!finding_codes(&dir, &data).contains(&"drifting-rest".to_string()));
+    drift_offsets(&data, 10.0);
+    std::fs::write(data.join("layout.toml"), "baseline = { kind = \"min\" }\n").unwrap();
+    assert!(finding_codes(&dir, &data).contains(&"drifting-rest".to_string()));
+    let run = dir.run(&[
+        "evaluate",
+        "--dataset",
+        s(&data),
+        "--method",
+        "glcm3d",
+        "--causal",
+        "--folds",
+        "2",
+        "--k",
+        "1",
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(run.stderr.contains("--drift-window-s"), "{}", run.stderr);
+    // inspect judges the offline conditioning: a causal option there would go unused.
+    let err = dir.fails(&["inspect", s(&data), "--causal"]);
+    assert!(err.contains("drifting-rest"), "{err}");
+}

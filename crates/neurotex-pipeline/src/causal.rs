@@ -315,6 +315,34 @@ pub struct ConditioningCalibration {
     /// The median length of their selected phases at 1 kHz, ms: the default window of a
     /// stream (the classifier was trained on features of slides about this long).
     pub median_duration_ms: usize,
+    /// How far the recordings' own resting values spread around the fixed ones, in units
+    /// of the scale: per taxel the 10th to 90th percentile over the recordings, the median
+    /// taxel. From 1 on, a fixed resting value leaves some recordings silent and others
+    /// at the ceiling ([`PreprocessParams::drift_window_ms`] tracks it instead).
+    ///
+    /// [`PreprocessParams::drift_window_ms`]: crate::signal::PreprocessParams::drift_window_ms
+    #[serde(default)]
+    pub rest_spread: f64,
+}
+
+/// [`ConditioningCalibration::rest_spread`] of the recordings' resting values
+/// `per_recording` (one per cell each, 0 in every recording for a cell without a taxel)
+/// over `scale`.
+fn rest_spread(per_recording: &[Vec<f64>], scale: f64) -> f64 {
+    let cells = per_recording.first().map_or(0, Vec::len);
+    let spreads: Vec<f64> = (0..cells)
+        .filter(|&c| per_recording.iter().any(|o| o[c] != 0.0))
+        .map(|c| {
+            let mut values: Vec<f64> = per_recording.iter().map(|o| o[c]).collect();
+            values.sort_by(f64::total_cmp);
+            let at = |q: f64| values[((values.len() - 1) as f64 * q).round() as usize];
+            at(0.9) - at(0.1)
+        })
+        .collect();
+    match per_recording.len() >= 2 && !spreads.is_empty() {
+        true => median(spreads) / scale,
+        false => 0.0,
+    }
 }
 
 /// Fixes causal conditioning on the training recordings `indices` (loaded by `load`),
@@ -393,11 +421,10 @@ pub fn calibrate_conditioning(
         return Err(ParamError::new("causal", rule, "every recording is flat").into());
     }
     let durations: Vec<f64> = maxima.iter().map(|m| m.1 as f64).collect();
+    let scale = median(positive);
     Ok(ConditioningCalibration {
-        conditioning: CausalConditioning {
-            offsets,
-            scale: median(positive),
-        },
+        rest_spread: rest_spread(&per_recording, scale),
+        conditioning: CausalConditioning { offsets, scale },
         recordings: indices.len(),
         median_duration_ms: median(durations) as usize,
     })

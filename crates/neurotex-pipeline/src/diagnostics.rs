@@ -85,6 +85,19 @@ impl TaxelDiagnostics {
         }
     }
 
+    /// [`TaxelDiagnostics::advice`] for a pipeline with `params`: under causal
+    /// conditioning with resting values fixed at training, a resting level that differs
+    /// between recordings leaves taxels silent or at the ceiling whatever the gain, so that
+    /// is said first.
+    pub fn advice_for(&self, params: &crate::pipeline::PipelineParams) -> Option<String> {
+        let advice = self.advice()?;
+        let p = &params.preprocess;
+        Some(match p.causal.is_some() && p.drift_window_ms.is_none() {
+            true => format!("{advice}. Under --causal each taxel's resting value is fixed at training: if the sensor's resting level differs between recordings (`neurotex inspect` says so: drifting-rest), --drift-window-s tracks it, which no gain replaces"),
+            false => advice,
+        })
+    }
+
     /// Whether taxel `name` (`r{row}c{col}`) responds; unknown names do not.
     pub fn responsive(&self, name: &str) -> bool {
         self.taxels

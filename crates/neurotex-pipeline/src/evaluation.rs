@@ -88,7 +88,8 @@ impl Evaluation {
             }
             _ => None,
         };
-        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?.advice();
+        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?
+            .advice_for(pipeline.params());
         Self::new(
             outcome,
             method.name(),
@@ -131,7 +132,8 @@ impl Evaluation {
         let candidate = candidates(encoded, grid, pipeline.params(), &set, 0.0)?.remove(0);
         let outcome = (candidate.evaluate)(&candidate.table, Columns::All, split)?;
         let metas = candidate.table.metas.clone();
-        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?.advice();
+        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?
+            .advice_for(pipeline.params());
         Self::new(
             outcome,
             method.name(),

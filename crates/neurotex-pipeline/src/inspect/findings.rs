@@ -354,6 +354,11 @@ fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<
         .baseline
         .or(file.baseline)
         .unwrap_or_default();
+    let spreads: Vec<f64> = chans.iter().filter_map(|c| c.resting_spread).collect();
+    let spread = super::median(spreads);
+    if spread >= OFFSET_RATIO {
+        out.push(finding(Warning, "signals", "drifting-rest", format!("each channel's resting level (its least sample) moves between recordings by {spread:.1} times its range (median channel; 10th to 90th percentile of the recordings): offline, each recording's own minimum (--baseline min) absorbs it, but causal conditioning (--causal, `neurotex stream`) subtracts one resting value fixed at training, so recordings resting above it fire throughout and those below stay silent, whatever the gain"), "--causal --drift-window-s 30 (each taxel's resting value tracked as its least input over the last 30 s, longer than a contact); and --baseline min offline"));
+    }
     if baseline == crate::recording::Baseline::None && resting >= OFFSET_RATIO {
         out.push(finding(Severe, "signals", "resting-offset", format!("the channels rest at about {resting:.1} times their range above zero (median channel) and no baseline is removed, so the encoder, dividing by each recording's maximum, sees mostly the resting offset"), "--baseline min (each channel's minimum removed)"));
     }

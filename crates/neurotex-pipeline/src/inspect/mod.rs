@@ -205,6 +205,10 @@ pub struct ChannelSummary {
     pub range: f64,
     /// The median over recordings of how far above zero it rests, in ranges.
     pub resting_ratio: Option<f64>,
+    /// How far its resting level (its least sample) moves between recordings, in ranges:
+    /// the 10th to 90th percentile of its minima over the median range. `None` when it
+    /// does not move or fewer than two recordings read.
+    pub resting_spread: Option<f64>,
     /// Share of recordings in which it is dead (one value throughout).
     pub dead_share: f64,
     /// Share of recordings in which it rises at every frame, as a clock.
@@ -681,6 +685,7 @@ fn channel_summaries(checked: &[Checked], names: &[String]) -> Vec<ChannelSummar
                 name: names[k].clone(),
                 range: median(all.iter().map(|c| c.max - c.min).collect()),
                 resting_ratio: (!ratios.is_empty()).then(|| median(ratios)),
+                resting_spread: resting_spread(&all),
                 dead_share: share(&|c| of(c).is_some_and(|ch| ch.dead)),
                 rising_share: share(&|c| of(c).is_some_and(|ch| ch.rising)),
                 clipped_share: share(&|c| of(c).is_some_and(|ch| ch.full_scale_share >= 0.01)),
@@ -689,6 +694,19 @@ fn channel_summaries(checked: &[Checked], names: &[String]) -> Vec<ChannelSummar
             }
         })
         .collect()
+}
+
+/// [`ChannelSummary::resting_spread`] of one channel's recordings.
+fn resting_spread(all: &[Channel]) -> Option<f64> {
+    let range = median(all.iter().map(|c| c.max - c.min).collect());
+    if all.len() < 2 || !(range > 0.0 && range.is_finite()) {
+        return None;
+    }
+    let mut minima: Vec<f64> = all.iter().map(|c| c.min).collect();
+    minima.sort_by(f64::total_cmp);
+    let at = |q: f64| minima[((minima.len() - 1) as f64 * q).round() as usize];
+    let spread = (at(0.9) - at(0.1)) / range;
+    spread.is_finite().then_some(spread)
 }
 
 /// The most frequent value (the smallest of equally frequent ones).

@@ -42,6 +42,10 @@ impl InspectOptions {
     /// # Errors
     /// Inputs that are neither a dataset folder nor CSV logs, or a parameter out of range.
     pub fn run(&self, stages: &StageOptions, traces: bool, on: OnProgress) -> Result<Inspection> {
+        if stages.causal {
+            let rule = "inspect checks the offline conditioning and the encoder; what causal conditioning meets is its own finding (`drifting-rest`), so --causal and --drift-window-s are for evaluate, train and the others";
+            return Err(crate::error::ParamError::new("causal", rule, "--causal").into());
+        }
         let checked = stages.check()?;
         let params = InspectParams {
             pipeline: checked.params,

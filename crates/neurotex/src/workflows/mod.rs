@@ -334,6 +334,12 @@ pub fn calibrated_pipeline(
             "--causal: forward-only filter; resting values and scale {:.6} fixed on {} training recording(s) (median selected phase {} ms)",
             c.conditioning.scale, c.recordings, c.median_duration_ms
         )));
+        if c.rest_spread >= 1.0 && calibrated.params.preprocess.drift_window_ms.is_none() {
+            on(Progress::Advice(&format!(
+                "the training recordings' resting values differ by {:.1} times the causal scale (median taxel, 10th to 90th percentile): one fixed resting value leaves recordings resting above it at the ceiling and those below it silent, whatever the gain; --drift-window-s tracks each taxel's resting value instead",
+                c.rest_spread
+            )));
+        }
     }
     if let Some(c) = &calibrated.gain {
         on(Progress::Say(&calibration_line(c)));

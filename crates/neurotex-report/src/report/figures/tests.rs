@@ -129,6 +129,7 @@ pub(crate) fn wide() -> Results {
                         },
                         recordings: 69,
                         median_duration_ms: 200 * bins,
+                        rest_spread: 0.0,
                     },
                     n: 69,
                     chance: if s.mm_s() > 0.0 { 0.2 } else { 1.0 / 7.0 },
