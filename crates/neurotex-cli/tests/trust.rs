@@ -247,3 +247,177 @@ fn resting_levels_that_move_between_recordings_are_found_and_not_blamed_on_the_g
     let err = dir.fails(&["inspect", s(&data), "--causal"]);
     assert!(err.contains("drifting-rest"), "{err}");
 }
+
+#[test]
+fn samples_beyond_any_sensor_are_refused_by_readers_and_skipped_by_streams() {
+    use ndarray_npy::{read_npy, write_npy};
+    let dir = Dir::new();
+    let data = dir.dataset("ds", &["A", "B"], &[5.0], 3);
+    // One corrupted word inside a recording: 1e308, and one beyond f32's range as f64.
+    let file = data.join("A_5_0.npy");
+    let mut x: ndarray::Array3<f32> = read_npy(&file).unwrap();
+    x[[700, 1, 2]] = f32::MAX;
+    write_npy(&file, &x).unwrap();
+    let out = dir.join("features.csv");
+    let err = dir.fails(&[
+        "features",
+        "--dataset",
+        s(&data),
+        "--method",
+        "taxel",
+        "--out",
+        s(&out),
+    ]);
+    assert!(
+        err.contains("A_5_0.npy") && err.contains("sample 700 of channel 6"),
+        "{err}"
+    );
+    assert!(err.contains("±1e15"), "{err}");
+    assert!(!out.exists());
+    // The same in a CSV log, in import csv and encode.
+    let log = dir.join("log.csv");
+    let mut text = String::from("t_ms,a,b\n");
+    for i in 0..300 {
+        let b = if i == 150 {
+            "1e308".to_string()
+        } else {
+            format!("{}", i % 9)
+        };
+        text.push_str(&format!("{i},{},{b}\n", i % 7));
+    }
+    std::fs::write(&log, &text).unwrap();
+    let imported = dir.join("imported");
+    let err = dir.fails(&[
+        "import",
+        "csv",
+        s(&log),
+        "--out",
+        s(&imported),
+        "--time-column",
+        "t_ms",
+    ]);
+    assert!(
+        err.contains("line 152, column `b`") && err.contains("±1e15"),
+        "{err}"
+    );
+    assert!(!imported.exists());
+    let spikes = dir.join("spikes.npy");
+    let err = dir.fails(&[
+        "encode",
+        s(&log),
+        "--out",
+        s(&spikes),
+        "--time-column",
+        "t_ms",
+    ]);
+    assert!(err.contains("±1e15"), "{err}");
+    // A stream counts such a frame as bad and goes on.
+    let (sim, model) = crate::stream::trained(&dir, &[]);
+    let row = &crate::stream::slides(&sim)[0];
+    let mut frames = crate::stream::slide_frames(&sim, row);
+    let clean = crate::stream::csv_text(&frames);
+    let clean_lines = dir.ok(&[
+        "stream",
+        "--model",
+        s(&model),
+        "--input",
+        s(&write(&dir, "clean.csv", &clean)),
+    ]);
+    frames.insert(500, vec![1e30; 16]);
+    let glitch = crate::stream::csv_text(&frames);
+    let run = dir.run(&[
+        "stream",
+        "--model",
+        s(&model),
+        "--input",
+        s(&write(&dir, "glitch.csv", &glitch)),
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(run.stderr.contains("beyond ±1e15"), "{}", run.stderr);
+    let last: Value = serde_json::from_str(run.stdout.lines().last().unwrap()).unwrap();
+    assert_eq!(last["bad_frames"], 1, "{last}");
+    let decided = |text: &str| -> Vec<Value> {
+        text.lines()
+            .map(|l| {
+                let mut v: Value = serde_json::from_str(l).unwrap();
+                v.as_object_mut().unwrap().remove("bad_frames");
+                v
+            })
+            .collect()
+    };
+    assert_eq!(decided(&run.stdout), decided(&clean_lines));
+}
+
+fn write(dir: &Dir, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn numeric_labels_never_merge_and_a_grid_the_axes_fix_is_refused() {
+    use ndarray_npy::write_npy;
+    let dir = Dir::new();
+    let x = dir.join("x.npy");
+    write_npy(
+        &x,
+        &ndarray::Array::from_elem(ndarray::IxDyn(&[4, 300, 2, 2]), 1.0f32),
+    )
+    .unwrap();
+    let labels = dir.join("y.npy");
+    let import = |labels: &Path, out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "import",
+            "stacked",
+            "--data",
+            s(&x),
+            "--labels",
+            s(labels),
+            "--axes",
+            "n,t,row,col",
+            "--fs",
+            "1000",
+            "--out",
+            s(out),
+        ];
+        args.extend_from_slice(extra);
+        dir.run(&args)
+    };
+    // Integers beyond 2^53 stay distinct.
+    let big = [u64::MAX, u64::MAX - 1, u64::MAX, u64::MAX - 1];
+    write_npy(&labels, &ndarray::Array1::from(big.to_vec())).unwrap();
+    let out = dir.join("big");
+    let run = import(&labels, &out, &[]);
+    assert!(run.status.success(), "{}", run.stderr);
+    let manifest = std::fs::read_to_string(out.join("manifest.csv")).unwrap();
+    assert!(
+        manifest.contains("18446744073709551615") && manifest.contains("18446744073709551614"),
+        "{manifest}"
+    );
+    // Floats that cannot hold them are refused.
+    write_npy(
+        &labels,
+        &ndarray::Array1::from(vec![1e300, 2e300, 1e300, 2e300]),
+    )
+    .unwrap();
+    let out = dir.join("floats");
+    let run = import(&labels, &out, &[]);
+    assert!(!run.status.success());
+    assert!(
+        run.stderr.contains("label 0 is 1e300") && run.stderr.contains("2^53"),
+        "{}",
+        run.stderr
+    );
+    assert!(!out.exists());
+    // --grid with row and col axes would go unused.
+    write_npy(&labels, &ndarray::Array1::from(vec![0i64, 1, 0, 1])).unwrap();
+    let out = dir.join("grid");
+    let run = import(&labels, &out, &["--grid", "1x4"]);
+    assert!(!run.status.success());
+    assert!(
+        run.stderr.contains("has its grid already"),
+        "{}",
+        run.stderr
+    );
+    assert!(!out.exists());
+}

@@ -1013,6 +1013,12 @@ impl<'a> RowReader<'a> {
         self.row.clear();
         for k in 0..self.columns.channels.len() {
             let v = self.parse(record, line, self.columns.channels[k])?;
+            if !crate::values::sample_in_range(v) {
+                let name = excerpt(&self.columns.names[self.columns.channels[k]]);
+                let rule = crate::values::SAMPLE_RULE;
+                let message = format!("line {line}, column `{name}`: {v} is out of range ({rule})");
+                return Err(invalid(self.path, message));
+            }
             self.row.push(v);
         }
         let Some(j) = self.columns.time else {

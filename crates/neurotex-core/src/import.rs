@@ -939,18 +939,43 @@ fn read_numbers(path: &Path) -> Result<ArrayD<f64>> {
     Err(invalid(path, message))
 }
 
+/// The largest whole number every float up to it holds exactly (2^53): float labels
+/// beyond would turn distinct integers into one.
+const EXACT_FLOAT_INTEGER: f64 = 9_007_199_254_740_992.0;
+
+/// Labels stored as numbers, as text: integers of any width exactly as they are, floats
+/// only when whole and within [`EXACT_FLOAT_INTEGER`], so that two labels never merge.
+fn numeric_labels(path: &Path, descr: &str) -> Result<Vec<String>> {
+    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
+    macro_rules! integers {
+        ($($t:ty),*) => {$(
+            if let Ok(a) = ArrayD::<$t>::read_npy(bytes.as_slice()) {
+                return Ok(a.iter().map(|v| v.to_string()).collect());
+            }
+        )*};
+    }
+    integers!(i64, u64, i32, u32, i16, u16, i8, u8);
+    let floats = ArrayD::<f64>::read_npy(bytes.as_slice())
+        .or_else(|_| ArrayD::<f32>::read_npy(bytes.as_slice()).map(|a| a.mapv(f64::from)));
+    let Ok(a) = floats else {
+        let message = format!("not a readable .npy array of numbers (dtype `{descr}`)");
+        return Err(invalid(path, message));
+    };
+    let whole = |v: f64| v.fract() == 0.0 && v.abs() <= EXACT_FLOAT_INTEGER;
+    if let Some((i, v)) = a.iter().enumerate().find(|(_, &v)| !whole(v)) {
+        let message = format!(
+            "label {i} is {v:?}: float labels must be whole numbers within ±2^53, which a float holds exactly (beyond, distinct labels become one); store labels as integers or strings"
+        );
+        return Err(invalid(path, message));
+    }
+    Ok(a.iter().map(|&v| format!("{}", v as i64)).collect())
+}
+
 /// Reads labels: integers, or fixed-width strings (`<U` or `|S`), one per sample.
 fn read_labels(path: &Path) -> Result<Vec<String>> {
     let header = crate::npy::read_header(path)?;
     if header.is_number() {
-        let a = read_numbers(path)?;
-        if a.iter().any(|v| v.fract() != 0.0) {
-            return Err(invalid(
-                path,
-                "labels must be integers or strings, got non-integer numbers",
-            ));
-        }
-        return Ok(a.iter().map(|v| format!("{}", *v as i64)).collect());
+        return numeric_labels(path, &header.descr);
     }
     let descr = &header.descr;
     let little = !descr.starts_with('>');
@@ -1083,10 +1108,15 @@ fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usiz
         let message = format!("--axes names {named} axes but the data has {has} (shape {shape:?})");
         return Err(invalid(data, message));
     }
-    if let Some(pos) = array.iter().position(|v| !v.is_finite()) {
+    if let Some(pos) = array
+        .iter()
+        .position(|&v| !crate::values::sample_in_range(v))
+    {
+        let value = array.iter().nth(pos).copied().unwrap_or(f64::NAN);
+        let rule = crate::values::SAMPLE_RULE;
         return Err(invalid(
             data,
-            format!("value {pos} (flat index) is not finite"),
+            format!("value {pos} (flat index) is {value} ({rule})"),
         ));
     }
     let find = |a: AxisName| axes.iter().position(|&x| x == a);
@@ -1103,6 +1133,11 @@ fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usiz
         .into_owned();
     let shape = arr.shape().to_vec();
     let grid = if has_grid {
+        if let Some(g) = &p.grid {
+            let rule = "--grid places a channel axis on a grid; data with row and col axes has its grid already";
+            let got = format!("{g} for axes with a {}x{} grid", shape[2], shape[3]);
+            return Err(ParamError::new("grid", rule, got).into());
+        }
         (shape[2], shape[3])
     } else {
         let ch = shape[2];

@@ -246,7 +246,7 @@ fn decode_finite<const N: usize>(
     let mut bad = false;
     for (o, b) in out.iter_mut().zip(items) {
         let v = decode(*b);
-        bad |= !v.is_finite();
+        bad |= !crate::values::sample_in_range(v);
         o.write(v);
     }
     !bad

@@ -1393,16 +1393,17 @@ fn checked_channels(path: &Path, shape: Shape, raw: &[f64], finite: bool) -> Res
         return Err(DataError::invalid(path, message).into());
     }
     if let Some(pos) = (!finite)
-        .then(|| raw.iter().position(|v| !v.is_finite()))
+        .then(|| raw.iter().position(|&v| !crate::values::sample_in_range(v)))
         .flatten()
     {
         return Err(DataError::invalid(
             path,
             format!(
-                "sample {} of channel {} is {} (every sample must be a finite number)",
+                "sample {} of channel {} is {} ({})",
                 pos / n_channels,
                 pos % n_channels,
-                raw[pos]
+                raw[pos],
+                crate::values::SAMPLE_RULE
             ),
         )
         .into());
@@ -1539,12 +1540,13 @@ fn read_npy(path: &Path) -> Result<(Shape, Vec<f64>, bool)> {
 
 widest_or_plain! {
     ["avx2"]
-    /// Whether every sample is a finite number: one pass without early exit, which
-    /// vectorises (the position of a bad one is sought only for the error).
+    /// Whether every sample is in range ([`crate::values::sample_in_range`]): one pass
+    /// without early exit, which vectorises (the position of a bad one is sought only for
+    /// the error).
     fn all_finite(samples: &[f64]) -> bool {
         let mut bad = false;
-        for v in samples {
-            bad |= !v.is_finite();
+        for &v in samples {
+            bad |= !crate::values::sample_in_range(v);
         }
         !bad
     }

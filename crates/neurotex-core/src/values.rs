@@ -9,6 +9,25 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+/// The largest magnitude a sample may have. No sensor reads anywhere near it in any unit
+/// (a 32-bit converter counts to 4e9; 1 N is 1e9 nN), while a value beyond it is a
+/// corrupted word or a placeholder (1e308, `f32::MAX`): taken, it would become the
+/// recording's maximum and silence every other sample, or drive a stream's neurons to
+/// infinite state they never leave. Readers refuse such a sample as they refuse NaN;
+/// streams count its frame as bad.
+pub const MAX_SAMPLE_MAGNITUDE: f64 = 1e15;
+
+/// Whether `v` is a sample neurotex takes: a number within [`MAX_SAMPLE_MAGNITUDE`] of 0
+/// (never NaN or infinite).
+#[inline(always)]
+pub fn sample_in_range(v: f64) -> bool {
+    v.abs() <= MAX_SAMPLE_MAGNITUDE
+}
+
+/// What a reader says of a sample it refuses: "a number within ±1e15".
+pub const SAMPLE_RULE: &str =
+    "every sample must be a number within ±1e15 (beyond, it is no sensor's reading)";
+
 /// Largest number of grid cells accepted from a user (a 1024 x 1024 skin); more is a typo
 /// or a hostile file, and would allocate per-cell state for nothing.
 pub const MAX_CELLS: usize = 1 << 20;

@@ -118,12 +118,16 @@ impl SamplesView<'_> {
             SamplesView::F32(a) => samples.extend(a.iter().map(|&v| f64::from(v))),
         }
         let n_cells = rows * cols;
-        if let Some(pos) = samples.iter().position(|v| !v.is_finite()) {
+        if let Some(pos) = samples
+            .iter()
+            .position(|&v| !neurotex::values::sample_in_range(v))
+        {
             return Err(bad(format!(
-                "sample {} of channel {} is {} (every sample must be a finite number)",
+                "sample {} of channel {} is {} ({})",
                 pos / n_cells,
                 pos % n_cells,
-                samples[pos]
+                samples[pos],
+                neurotex::values::SAMPLE_RULE
             )));
         }
         let mut layout = Layout::grid(rows, cols);

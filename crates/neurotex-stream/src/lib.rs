@@ -23,7 +23,7 @@ mod window_glcm;
 
 // The layers below, under the names their modules had when they were one crate, so that
 // `crate::causal` and the like read the same in every layer.
-use neurotex_core::{csvlog, error, recording, Error};
+use neurotex_core::{csvlog, error, recording, values, Error};
 use neurotex_features::features;
 use neurotex_learn::snn;
 use neurotex_pipeline::{causal, model, pipeline, saved, spiking_model};
@@ -212,6 +212,14 @@ pub enum BadFrame {
     NotFinite {
         /// Which value (the time stamp is value 0 when given).
         index: usize,
+    },
+    /// A value beyond [`crate::values::MAX_SAMPLE_MAGNITUDE`]: no sensor's reading.
+    #[error("value {index} is {value}, beyond ±1e15, which is no sensor's reading")]
+    OutOfRange {
+        /// Which value (the time stamp is value 0 when given).
+        index: usize,
+        /// The value.
+        value: f64,
     },
     /// A time stamp not after the previous frame's.
     #[error("time stamp {t} s is not after the previous frame's {previous} s")]
@@ -720,10 +728,16 @@ impl StreamClassifier {
             }
         }
         // One pass without early exit (it vectorises); the position only for a bad frame.
-        if values.iter().fold(false, |bad, v| bad | !v.is_finite()) {
-            let i = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
-            return Err(BadFrame::NotFinite {
-                index: i + first_value,
+        let in_range = crate::values::sample_in_range;
+        if values.iter().fold(false, |bad, &v| bad | !in_range(v)) {
+            let i = values.iter().position(|&v| !in_range(v)).unwrap_or(0);
+            let index = i + first_value;
+            return Err(match values[i].is_finite() {
+                false => BadFrame::NotFinite { index },
+                true => BadFrame::OutOfRange {
+                    index,
+                    value: values[i],
+                },
             });
         }
         Ok(())
