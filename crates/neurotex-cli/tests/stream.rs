@@ -337,12 +337,13 @@ fn bad_frames_are_warned_about_counted_and_skipped() {
             hostile.push_str(&format!("{}.5,{}\n", i, values[..15].join(","))); // 15 values
             hostile.push_str(&format!("{}.5,NaN,{}\n", i, values[1..].join(",")));
             hostile.push_str(&format!("{}.5,x,{}\n", i, values[1..].join(",")));
+            hostile.push_str(&format!("NaN,{}\n", values.join(",")));
         }
     }
     let args = ["--model", s(&model)];
     let (good, _) = stream_stdin(&dir, &args, clean.as_bytes());
     let (out, err) = stream_stdin(&dir, &args, hostile.as_bytes());
-    let bad = 4 * frames
+    let bad = 5 * frames
         .iter()
         .enumerate()
         .filter(|(i, _)| i % 1000 == 500)
@@ -354,6 +355,10 @@ fn bad_frames_are_warned_about_counted_and_skipped() {
     assert!(err.contains("is not after the previous frame's"), "{err}");
     assert!(err.contains("16 fields, expected 17"), "{err}");
     assert!(err.contains("value 1 is not a finite number"), "{err}");
+    assert!(
+        err.contains("the time stamp NaN is not a finite number"),
+        "{err}"
+    );
     assert!(err.contains("a field is not a number"), "{err}");
 }
 

@@ -258,7 +258,7 @@ impl StreamClassifier {
         let format = &state.source.format;
         let t = format.time_unit.to_seconds(stamp.as_f64());
         if !t.is_finite() {
-            return Err(BadFrame::NotFinite { index: 0 });
+            return Err(BadFrame::StampNotFinite { t: stamp.as_f64() });
         }
         if t.abs() > super::MAX_STAMP_S {
             return Err(BadFrame::StampRange { t });
