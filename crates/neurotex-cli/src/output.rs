@@ -21,6 +21,52 @@ pub fn shown(path: &Path) -> String {
     }
 }
 
+/// Refuses `-` for an output folder (`option` names it): standard output takes one file.
+pub fn check_folder(path: &Path, option: &str) -> Result<()> {
+    if is_stdout(path) {
+        anyhow::bail!(
+            "{option} -: standard output takes one file, and {option} names a folder here; name the folder"
+        );
+    }
+    Ok(())
+}
+
+/// Refuses `-` for `option`'s binary output (`what`) when standard output is a terminal,
+/// where its bytes would only garble the screen.
+pub fn check_binary(path: &Path, option: &str, what: &str) -> Result<()> {
+    use std::io::IsTerminal;
+    if is_stdout(path) && std::io::stdout().is_terminal() {
+        anyhow::bail!(
+            "{option} -: {what} is binary and standard output is a terminal; redirect it (`> FILE`) or name a file"
+        );
+    }
+    Ok(())
+}
+
+/// Writes an output the library writes to a path (a model file, a NIR graph) to `path`, or
+/// for `-` to standard output: into a temporary folder first, then copied, so standard
+/// output gets the whole file or nothing.
+pub fn save_to(
+    path: &Path,
+    what: &str,
+    save: impl FnOnce(&Path) -> neurotex::Result<()>,
+) -> Result<()> {
+    if !is_stdout(path) {
+        return Ok(save(path)?);
+    }
+    let name = format!(".neurotex-stdout.partial-{}", std::process::id());
+    let tmp = neurotex::io::Temporary::new(std::env::temp_dir().join(name));
+    std::fs::create_dir(tmp.path())
+        .with_context(|| format!("creating {}", tmp.path().display()))?;
+    let file = tmp.path().join("output");
+    save(&file)?;
+    let mut out = std::io::stdout().lock();
+    std::fs::File::open(&file)
+        .and_then(|mut f| std::io::copy(&mut f, &mut out))
+        .and_then(|_| out.flush())
+        .with_context(|| format!("writing {what} to standard output"))
+}
+
 /// Writes `what` to `path` through `fill` with the library's [`neurotex::io::write_atomic`]
 /// (a temporary file beside it, renamed into place only when everything succeeded), or
 /// to standard output for `-`.

@@ -15,6 +15,7 @@ mod hostile;
 mod import;
 mod inspect;
 mod model;
+mod outputs;
 mod raw_logs;
 mod reproduce;
 mod simulate;

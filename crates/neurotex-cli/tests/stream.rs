@@ -337,12 +337,13 @@ fn bad_frames_are_warned_about_counted_and_skipped() {
             hostile.push_str(&format!("{}.5,{}\n", i, values[..15].join(","))); // 15 values
             hostile.push_str(&format!("{}.5,NaN,{}\n", i, values[1..].join(",")));
             hostile.push_str(&format!("{}.5,x,{}\n", i, values[1..].join(",")));
+            hostile.push_str(&format!("NaN,{}\n", values.join(",")));
         }
     }
     let args = ["--model", s(&model)];
     let (good, _) = stream_stdin(&dir, &args, clean.as_bytes());
     let (out, err) = stream_stdin(&dir, &args, hostile.as_bytes());
-    let bad = 4 * frames
+    let bad = 5 * frames
         .iter()
         .enumerate()
         .filter(|(i, _)| i % 1000 == 500)
@@ -354,6 +355,10 @@ fn bad_frames_are_warned_about_counted_and_skipped() {
     assert!(err.contains("is not after the previous frame's"), "{err}");
     assert!(err.contains("16 fields, expected 17"), "{err}");
     assert!(err.contains("value 1 is not a finite number"), "{err}");
+    assert!(
+        err.contains("the time stamp NaN is not a finite number"),
+        "{err}"
+    );
     assert!(err.contains("a field is not a number"), "{err}");
 }
 
@@ -584,6 +589,50 @@ fn invalid_utf8_is_a_bad_frame_and_the_stream_goes_on() {
     assert_eq!(lines(&out).last().unwrap()["bad_frames"], 1, "{err}");
     assert!(err.contains("line 702: bad frame skipped"), "{err}");
     assert!(err.contains("not UTF-8"), "{err}");
+}
+
+#[test]
+fn a_stream_joined_mid_line_or_opened_with_garbage_skips_its_first_line() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &[]);
+    let frames = slide_frames(&data, &slides(&data)[2]);
+    let clean = csv_text(&frames);
+    // Garbage before the header (a terminal's escape, bytes that are not text): each line
+    // is a bad frame, and the header after them still names the columns.
+    let mut garbled = b"\x1b[0m,12\n\xff\xfe\x00\n".to_vec();
+    garbled.extend_from_slice(clean.as_bytes());
+    let args = ["--model", s(&model)];
+    let (good, _) = stream_stdin(&dir, &args, clean.as_bytes());
+    let (out, err) = stream_stdin(&dir, &args, &garbled);
+    assert_eq!(streamed(&out), streamed(&good));
+    assert_eq!(lines(&out).last().unwrap()["bad_frames"], 2, "{err}");
+    assert!(err.contains("line 1: bad frame skipped"), "{err}");
+    assert!(err.contains("line 2: bad frame skipped"), "{err}");
+    // Joined mid-line, without a header: the first line is the tail of a frame.
+    let headerless: String = clean.split_inclusive('\n').skip(2).collect();
+    let first_frame = clean.lines().nth(1).unwrap();
+    let tail = &first_frame[first_frame.len() / 2..];
+    let joined = format!("{tail}\n{headerless}");
+    let args = ["--model", s(&model), "--no-header"];
+    let (good, _) = stream_stdin(&dir, &args, headerless.as_bytes());
+    let (out, err) = stream_stdin(&dir, &args, joined.as_bytes());
+    assert_eq!(streamed(&out), streamed(&good));
+    assert_eq!(lines(&out).last().unwrap()["bad_frames"], 1, "{err}");
+    assert!(err.contains("line 1: bad frame skipped"), "{err}");
+    assert!(err.contains("cut short"), "{err}");
+    // A header that does not fit is still an error, and so are frames that fit no
+    // columns, at their second line; an input of nothing but skipped lines too.
+    let header = format!("extra,{}", &clean[..clean.find('\n').unwrap()]);
+    for (input, says) in [
+        (format!("{header}\n"), "line 1: 17 channel columns selected"),
+        (format!("{tail}\n{tail}\n"), "line 2:"),
+        ("\x1b[0m,12\n".to_string(), "the input ended after 1 lines"),
+    ] {
+        let file = dir.join("frames.csv");
+        std::fs::write(&file, &input).unwrap();
+        let err = dir.fails(&["stream", "--model", s(&model), "--input", s(&file)]);
+        assert!(err.contains(says), "{input:?}: {err}");
+    }
 }
 
 #[test]
@@ -841,6 +890,44 @@ fn a_recordings_spikes_as_events_stream_as_its_samples() {
             assert!(err.contains(said), "{said}: {err}");
         }
     }
+}
+
+#[test]
+fn an_event_stream_joined_mid_line_skips_its_first_line() {
+    let dir = Dir::new();
+    let (data, model) = trained(&dir, &["--encoding", "sa+fa"]);
+    let events = exported(&dir, &data, &["--causal", "--encoding", "sa+fa"]);
+    let name = std::fs::read_dir(&events)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .find(|n| n.ends_with(".csv") && n != "manifest.csv")
+        .unwrap();
+    let text = event_text(&events, &name);
+    let body: Vec<&str> = text.lines().skip(1).collect();
+    // The stream as it is after its first event, with a header ...
+    let clean = format!("t,x,y,p\n{}\n", body[1..].join("\n"));
+    // ... and joined mid-line: a garbled line, then the first event without its time
+    // (`x,y,p`, which reads as an event of three fields), then the rest without a header.
+    let cut = &body[0][body[0].find(',').unwrap() + 1..];
+    let joined = format!("\x1b[0m,garbage\n{cut}\n{}\n", body[1..].join("\n"));
+    let args = [
+        "--model",
+        s(&model),
+        "--format",
+        "events",
+        "--time-unit",
+        "ms",
+    ];
+    let (good, _) = stream_stdin(&dir, &args, clean.as_bytes());
+    let (out, err) = stream_stdin(&dir, &args, joined.as_bytes());
+    assert!(lines(&good).len() > 10);
+    assert_eq!(streamed(&out), streamed(&good), "{err}");
+    assert_eq!(lines(&out).last().unwrap()["bad_frames"], 2, "{err}");
+    assert!(
+        err.contains("line 1") && err.contains("neither a header nor an event"),
+        "{err}"
+    );
+    assert!(err.contains("line 2") && err.contains("cut short"), "{err}");
 }
 
 #[test]

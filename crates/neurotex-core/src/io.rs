@@ -411,6 +411,7 @@ pub fn create_dir_atomic<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -
         return Err(DataError::invalid(dir, "output folder exists and is not empty").into());
     }
     let created = create_parents(dir)?;
+    let _claim = claim_folder(dir)?;
     let tmp = Temporary::beside(dir)?;
     std::fs::create_dir(tmp.path()).map_err(|e| DataError::write(dir, e))?;
     let value = fill(tmp.path()).map_err(|e| named_in(e, tmp.path(), dir))?;
@@ -531,12 +532,20 @@ pub struct OutputClaim {
 /// Another running process claims `dir` (its id and the lock file named), the lock file
 /// cannot be created, or as [`check_output_dir`].
 pub fn claim_output_dir(dir: &Path) -> Result<OutputClaim> {
-    let claim = claim(dir)?;
+    let claim = claim_folder(dir)?;
     check_output_dir(dir)?;
     Ok(claim)
 }
 
-fn claim(dir: &Path) -> Result<OutputClaim> {
+/// Claims output folder `dir` for this run ([`OutputClaim`]) without checking what it
+/// holds: for a folder that must be new or empty ([`create_dir_atomic`] says so), claimed
+/// at a command's start so that a second run says so before it does any work. A folder
+/// whose parent does not exist yet is not claimed.
+///
+/// # Errors
+/// Another running process claims `dir` (its id and the lock file named), or the lock file
+/// cannot be created.
+pub fn claim_folder(dir: &Path) -> Result<OutputClaim> {
     let unclaimed = OutputClaim { _lock: None };
     let (Some(name), true) = (dir.file_name(), parent(dir).is_dir()) else {
         return Ok(unclaimed);

@@ -43,6 +43,25 @@ fn stream_error(e: StreamError) -> PyErr {
     }
 }
 
+/// A bad event named by the argument of `push_event` at fault (`t`, or the cell and
+/// polarity `x`, `y`, `p`), as a Python caller passed them.
+fn event_error(e: StreamError, t: &Bound<'_, PyAny>) -> PyErr {
+    use neurotex::stream::BadFrame as B;
+    match e {
+        StreamError::Bad(bad) => {
+            let argument = match &bad {
+                B::Address(_) => "x, y, p".to_string(),
+                _ => format!("t={}", t.repr().map_or("?".into(), |r| r.to_string())),
+            };
+            raise(
+                Kind::Data,
+                format!("push_event({argument}): bad event skipped: {bad}"),
+            )
+        }
+        StreamError::Classify(e) => to_py(e),
+    }
+}
+
 #[pymethods]
 impl NativeStream {
     /// A stream classifier for `model` (a feature model or a spiking network, trained with
@@ -163,13 +182,19 @@ impl NativeStream {
         }
         let stamp = match t.extract::<i64>() {
             Ok(t) => Stamp::Int(t),
-            Err(_) => Stamp::Float(t.extract::<f64>()?),
+            Err(_) => Stamp::Float(t.extract::<f64>().map_err(|_| {
+                let got = t.get_type().name().map_or("?".into(), |n| n.to_string());
+                raise(
+                    Kind::Parameter,
+                    format!("push_event: t, the time stamp, must be a number; got {got}"),
+                )
+            })?),
         };
         let address = x.map(|x| (x, y.unwrap_or(0), p));
         let events = self
             .inner
             .push_event(stamp, address)
-            .map_err(stream_error)?
+            .map_err(|e| event_error(e, t))?
             .to_vec();
         lines(py, &self.inner, &events)
     }

@@ -126,3 +126,18 @@ def test_ms_stamps_on_the_grid_give_the_unstamped_lines(sim_dir, causal_model):
     assert stamped == unstamped and len(unstamped) > 20
     with pytest.raises(ParameterError, match="time_unit"):
         neurotex.StreamClassifier(causal_model, time_unit="minutes")
+
+
+def test_event_errors_name_the_argument_at_fault(causal_model):
+    stream = neurotex.StreamClassifier(causal_model, time_unit="ms", events=True)
+    with pytest.raises(DataError, match=r"push_event\(t=nan\): .*time stamp NaN is not a finite number"):
+        stream.push_event(float("nan"), 1, 1, 1)
+    assert stream.bad_frames == 1
+    with pytest.raises(ParameterError, match="t, the time stamp, must be a number; got str"):
+        stream.push_event("soon", 1, 1, 1)
+    # A plain float array where events are needed names the dtype it needs.
+    with pytest.raises(ParameterError, match=r"fields t, x, y and optionally p .*got dtype float64"):
+        stream.push_events(np.zeros((5, 4)))
+    wrong = np.zeros(3, dtype=[("ts", "<i8"), ("x", "<u2"), ("y", "<u2")])
+    with pytest.raises(ParameterError, match="without field"):
+        stream.push_events(wrong)

@@ -14,6 +14,7 @@
 //! frames ([`StreamClassifier::push`]), so the first event after a long silence costs its
 //! own spike and starts a new episode.
 
+use std::collections::VecDeque;
 use std::io::{BufRead, ErrorKind};
 
 use neurotex_core::events::{EventGrid, EventsFormat, Origin, Stamp};
@@ -257,7 +258,7 @@ impl StreamClassifier {
         let format = &state.source.format;
         let t = format.time_unit.to_seconds(stamp.as_f64());
         if !t.is_finite() {
-            return Err(BadFrame::NotFinite { index: 0 });
+            return Err(BadFrame::StampNotFinite { t: stamp.as_f64() });
         }
         if t.abs() > super::MAX_STAMP_S {
             return Err(BadFrame::StampRange { t });
@@ -387,6 +388,23 @@ pub struct EventReader<R> {
     columns: Option<TextColumns>,
     line: Vec<u8>,
     count: u64,
+    /// The first event of a stream without a header, held until the next line with a cell
+    /// shows whether it was whole, with what came between (ticks, resets, bad lines).
+    held: Option<Held>,
+    /// Items ready to be returned, in order.
+    ready: VecDeque<Item>,
+}
+
+/// A headerless stream's first event, not yet known to be whole: a stream joined mid-line
+/// starts with a line cut short, which may still read as an event of fewer fields.
+#[derive(Debug)]
+struct Held {
+    /// The event, its line's place and fields.
+    item: Item,
+    place: String,
+    fields: usize,
+    /// The lines after it, before the next event.
+    after: Vec<Item>,
 }
 
 impl<R: BufRead> EventReader<R> {
@@ -400,6 +418,8 @@ impl<R: BufRead> EventReader<R> {
             columns: None,
             line: Vec::new(),
             count: 0,
+            held: None,
+            ready: VecDeque::new(),
         }
     }
 
@@ -474,53 +494,129 @@ impl<R: BufRead> EventReader<R> {
 
     fn next_line(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Item>> {
         loop {
+            if let Some(item) = self.ready.pop_front() {
+                return Ok(Some(item));
+            }
             let read = crate::frames::read_line(&mut self.input, &mut self.line, 4096, stop);
             let Some(length) = read.map_err(|e| DataError::io(&self.source, e))? else {
-                return Ok(None);
+                match self.held.take() {
+                    Some(held) => self.release(held, None),
+                    None => return Ok(None),
+                }
+                continue;
             };
             self.count += 1;
+            let place = format!("line {}", self.count);
             let bad = |why: String| Item::Bad {
-                place: format!("line {}", self.count),
+                place: place.clone(),
                 why,
             };
-            if length > 4096 {
-                return Ok(Some(bad(format!("a {length}-byte line is no event"))));
-            }
-            let Ok(text) = std::str::from_utf8(&self.line) else {
-                return Ok(Some(bad("the line is not UTF-8 text".into())));
-            };
-            let text = text.trim();
-            if text.is_empty() || text.starts_with('#') {
-                continue;
-            }
-            if text.eq_ignore_ascii_case("reset") {
-                return Ok(Some(Item::Reset));
-            }
-            if self.columns.is_none() {
-                let (columns, header) = self.plan(text)?;
-                self.columns = Some(columns);
-                if header {
+            let (item, fields) = if length > 4096 {
+                (bad(format!("a {length}-byte line is no event")), 0)
+            } else if let Ok(text) = std::str::from_utf8(&self.line) {
+                let text = text.trim().to_string();
+                if text.is_empty() || text.starts_with('#') {
                     continue;
                 }
+                if text.eq_ignore_ascii_case("reset") {
+                    (Item::Reset, 0)
+                } else if self.columns.is_none() {
+                    match self.plan(&text)? {
+                        Planned::Header(columns) => {
+                            self.columns = Some(columns);
+                            continue;
+                        }
+                        Planned::Skip(why) => (bad(why), 0),
+                        Planned::Tick(tick) => (tick, 1),
+                        Planned::First(columns, item, fields) => {
+                            self.columns = Some(columns);
+                            self.held = Some(Held {
+                                item,
+                                place,
+                                fields,
+                                after: Vec::new(),
+                            });
+                            continue;
+                        }
+                    }
+                } else {
+                    self.read_line_item(&text, &place)
+                }
+            } else {
+                (bad("the line is not UTF-8 text".into()), 0)
+            };
+            match self.held.take() {
+                Some(mut held) if fields < 2 => {
+                    held.after.push(item);
+                    self.held = Some(held);
+                }
+                Some(held) => self.release(held, Some((item, fields))),
+                None => return Ok(Some(item)),
             }
-            let columns = self.columns.as_ref().expect("planned above");
-            return Ok(Some(parse_line(text, columns).unwrap_or_else(bad)));
         }
     }
 
+    /// A line's item once the columns are planned, and its fields.
+    fn read_line_item(&mut self, text: &str, place: &str) -> (Item, usize) {
+        let columns = self.columns.as_mut().expect("planned");
+        let (_, n) = split(text, columns.delimiter);
+        let item = parse_line(text, columns).unwrap_or_else(|why| Item::Bad {
+            place: place.to_string(),
+            why,
+        });
+        // A line with more fields than the held first event, that reads with them: the
+        // first was cut short, and the lines have this one's fields.
+        let longer = self.held.as_ref().is_some_and(|h| n > h.fields);
+        if longer && matches!(item, Item::Bad { .. }) {
+            let mut wider = columns.clone();
+            wider.fields = Some(n);
+            if let Ok(item) = parse_line(text, &wider) {
+                *columns = wider;
+                return (item, n);
+            }
+        }
+        (item, n)
+    }
+
+    /// Makes the held first event and what followed it ready, then `next` (the line with a
+    /// cell that decided, and its fields): the first is a bad line when `next` has more.
+    fn release(&mut self, held: Held, next: Option<(Item, usize)>) {
+        let cut = next
+            .as_ref()
+            .is_some_and(|(item, n)| *n > held.fields && !matches!(item, Item::Bad { .. }));
+        self.ready.push_back(match cut {
+            true => Item::Bad {
+                place: held.place,
+                why: format!(
+                    "{} fields, and the lines after it have {}: a line cut short, as when a stream is joined mid-line",
+                    held.fields,
+                    next.as_ref().map_or(0, |(_, n)| *n)
+                ),
+            },
+            false => held.item,
+        });
+        self.ready.extend(held.after);
+        self.ready.extend(next.map(|(item, _)| item));
+    }
+
     /// The columns from the first line: a header names them (by the format's names),
-    /// otherwise they are `t`, then `x` and `y` or the taxel, then the polarity.
-    fn plan(&self, text: &str) -> Result<(TextColumns, bool)> {
+    /// otherwise they are `t`, then `x` and `y` or the taxel, then the polarity, taken from
+    /// the first line that reads as an event (held until the next shows it whole). A line
+    /// that is neither (names and numbers mixed, an event that does not read) is skipped.
+    ///
+    /// # Errors
+    /// A header without the time or cell columns.
+    fn plan(&self, text: &str) -> Result<Planned> {
         let delimiter = [b',', b';', b'\t']
             .into_iter()
             .find(|d| text.as_bytes().contains(d));
         let (fields, n) = split(text, delimiter);
         let names = &fields[..n.min(fields.len())];
         let taxel = self.format.taxel.as_deref();
-        let header = names
-            .first()
-            .is_some_and(|f| f.parse::<f64>().is_err() && !f.is_empty());
-        if !header {
+        let is_name = |f: &&str| {
+            f.parse::<f64>().is_err() && !f.is_empty() && !f.chars().any(char::is_control)
+        };
+        if !names.iter().all(is_name) {
             let columns = TextColumns {
                 fields: Some(n),
                 delimiter,
@@ -529,7 +625,19 @@ impl<R: BufRead> EventReader<R> {
                 b: taxel.is_none().then_some(2),
                 polarity: Some(if taxel.is_some() { 2 } else { 3 }),
             };
-            return Ok((columns, false));
+            let numbers = !names.iter().any(is_name);
+            return Ok(match parse_line(text, &columns) {
+                Ok(
+                    item @ Item::Event {
+                        address: Some(_), ..
+                    },
+                ) if numbers => Planned::First(columns, item, n),
+                Ok(tick) if numbers => Planned::Tick(tick),
+                Err(why) if numbers => Planned::Skip(format!(
+                    "{why}; a first line cut short, as when a stream is joined mid-line"
+                )),
+                _ => Planned::Skip("neither a header nor an event".into()),
+            });
         }
         let find = |name: &str| names.iter().position(|n| n.eq_ignore_ascii_case(name));
         let missing = |name: &str| {
@@ -548,16 +656,27 @@ impl<R: BufRead> EventReader<R> {
                 Some(find(&f.y).ok_or_else(|| missing(&f.y))?),
             ),
         };
-        let columns = TextColumns {
+        Ok(Planned::Header(TextColumns {
             fields: Some(n),
             delimiter,
             time,
             a,
             b,
             polarity: find(&f.polarity),
-        };
-        Ok((columns, true))
+        }))
     }
+}
+
+/// What a text stream's first lines plan.
+enum Planned {
+    /// A header named the columns.
+    Header(TextColumns),
+    /// An event read by position, its item and fields.
+    First(TextColumns, Item, usize),
+    /// A tick (a time alone), which plans nothing.
+    Tick(Item),
+    /// The line is bad (why), and the columns are still to be planned.
+    Skip(String),
 }
 
 /// The fields of `text` split at `delimiter` (at runs of spaces without one), trimmed;

@@ -6,9 +6,11 @@
 //! read frames alike.
 //!
 //! A frame that cannot be decoded is a bad frame: counted, reported to the caller, and
-//! skipped, as a frame the classifier refuses is. Only what makes the rest of the input
-//! unreadable is an error: the first line (the header, or the frame the columns are
-//! planned from), columns that do not fit the model, a failing read.
+//! skipped, as a frame the classifier refuses is; so is a line before the columns are
+//! planned that is neither a header nor a frame (garbage, or a frame cut short: a stream
+//! joined mid-line). Only what makes the rest of the input unreadable is an error: a
+//! header whose columns do not fit the model, frames that fit no columns (their second
+//! line), an input that ends with nothing planned, a failing read.
 
 use std::io::{BufRead, ErrorKind, Read};
 use std::path::Path;
@@ -85,6 +87,10 @@ pub struct FrameReader<R> {
     values: Vec<f64>,
     /// Lines (CSV) or records (f32le) read so far.
     count: u64,
+    /// Why the first line skipped before the columns were planned was bad, and whether a
+    /// line of numbers was skipped then (one cut short: a stream joined mid-line).
+    skipped: Option<String>,
+    cut_skipped: bool,
 }
 
 impl<R: BufRead> FrameReader<R> {
@@ -102,6 +108,8 @@ impl<R: BufRead> FrameReader<R> {
             fields: Vec::new(),
             values: vec![0.0; channels],
             count: 0,
+            skipped: None,
+            cut_skipped: false,
         }
     }
 
@@ -109,8 +117,8 @@ impl<R: BufRead> FrameReader<R> {
     /// while waiting for bytes, so a line that never ends does not hold the stream).
     ///
     /// # Errors
-    /// The input cannot be read; the first CSV line is not text or its columns do not fit
-    /// the model.
+    /// The input cannot be read; a CSV header's columns do not fit the model, nor do two
+    /// lines of numbers before the columns are planned; the input ends with none planned.
     pub fn next(&mut self, stop: &dyn Fn() -> bool) -> Result<Option<Frame<'_>>> {
         match self.format {
             FrameFormat::Csv(_) => self.next_csv(stop),
@@ -130,7 +138,7 @@ impl<R: BufRead> FrameReader<R> {
         loop {
             let read = read_line(&mut self.input, &mut self.line, limit, stop);
             let Some(length) = read.map_err(|e| self.read_error(e))? else {
-                return Ok(None);
+                return self.ended_unplanned();
             };
             self.count += 1;
             let text = match (length > limit, std::str::from_utf8(&self.line)) {
@@ -144,13 +152,12 @@ impl<R: BufRead> FrameReader<R> {
                 )),
                 (false, Ok(text)) => Ok(text.trim()),
             };
-            let text = match (text, &self.plan) {
-                (Ok(text), _) => text,
-                (Err(why), None) => {
-                    let message = format!("{}: {why}", self.place());
-                    return Err(DataError::invalid(&self.source, message).into());
-                }
-                (Err(why), Some(_)) => {
+            let text = match text {
+                Ok(text) => text,
+                Err(why) => {
+                    if self.plan.is_none() {
+                        self.skipped.get_or_insert_with(|| why.clone());
+                    }
                     let place = self.place();
                     return Ok(Some(Frame::Bad { place, why }));
                 }
@@ -162,7 +169,16 @@ impl<R: BufRead> FrameReader<R> {
                 return Ok(Some(Frame::Reset));
             }
             if self.plan.is_none() {
-                let (header, delimiter, columns) = self.plan_columns(formats, text)?;
+                let (header, delimiter, columns) = match self.plan_columns(formats, text) {
+                    Ok(plan) => plan,
+                    Err(e) => {
+                        let (why, numbers) = self.unplanned(formats, text, e)?;
+                        self.cut_skipped |= numbers;
+                        self.skipped.get_or_insert_with(|| why.clone());
+                        let place = self.place();
+                        return Ok(Some(Frame::Bad { place, why }));
+                    }
+                };
                 let splitter = csv_core::ReaderBuilder::new()
                     .delimiter(delimiter.byte())
                     .build();
@@ -189,6 +205,54 @@ impl<R: BufRead> FrameReader<R> {
                 unit,
                 values: &self.values,
             }));
+        }
+    }
+
+    /// Why a line read before the columns were planned, which plans none, is a bad frame,
+    /// and whether it is a line of numbers: a stream joined mid-line starts with a frame
+    /// cut short, and a sender may start with a garbled line. A line of names (a header
+    /// whose columns do not fit the model) is an error, as is a second line of numbers
+    /// that fits no columns (the frames themselves do not fit).
+    ///
+    /// # Errors
+    /// `planning`'s error, at the line read.
+    fn unplanned(
+        &self,
+        formats: &[CsvFormat],
+        text: &str,
+        planning: crate::Error,
+    ) -> Result<(String, bool)> {
+        let message = match planning {
+            crate::Error::Data(DataError::Invalid { message, .. }) => message,
+            other => other.to_string(),
+        };
+        let kind = line_kind(text);
+        let header = kind == LineKind::Names && formats.iter().any(|f| f.header);
+        if header || (kind == LineKind::Numbers && self.cut_skipped) {
+            let message = format!("{}: {message}", self.place());
+            return Err(DataError::invalid(&self.source, message).into());
+        }
+        let why = match kind {
+            LineKind::Numbers => {
+                format!("a line of numbers no columns fit, taken for a frame cut short ({message})")
+            }
+            _ => format!("neither a header nor a frame ({message})"),
+        };
+        Ok((why, kind == LineKind::Numbers))
+    }
+
+    /// The end of the input: an error when lines were skipped and none planned the
+    /// columns (nothing of the input was read).
+    fn ended_unplanned(&self) -> Result<Option<Frame<'static>>> {
+        match (&self.plan, &self.skipped) {
+            (None, Some(why)) => {
+                let message = format!(
+                    "the input ended after {} lines, none of them a header or frame of the model's columns; the first was skipped as {why}",
+                    self.count
+                );
+                Err(DataError::invalid(&self.source, message).into())
+            }
+            _ => Ok(None),
         }
     }
 
@@ -316,6 +380,43 @@ fn for_each_field(
                 len = 0;
             }
         }
+    }
+}
+
+/// What a line that plans no columns looks like.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LineKind {
+    /// Every field a name: a header.
+    Names,
+    /// Every field a number or empty: a frame, perhaps cut short.
+    Numbers,
+    /// Names and numbers mixed, or control characters: neither.
+    Garbled,
+}
+
+/// The kind of line `text` is, its fields split as a frame's are.
+fn line_kind(text: &str) -> LineKind {
+    if text.chars().any(|c| c.is_control() && c != '\t') {
+        return LineKind::Garbled;
+    }
+    let delimiter = detect_delimiter_in(&[text]);
+    let mut splitter = csv_core::ReaderBuilder::new()
+        .delimiter(delimiter.byte())
+        .build();
+    let (mut names, mut numbers, mut fields) = (0, 0, 0);
+    for_each_field(&mut splitter, text, &mut Vec::new(), |f| {
+        fields += 1;
+        match std::str::from_utf8(f) {
+            Ok(f) if f.is_empty() || f.parse::<f64>().is_ok() => numbers += 1,
+            Ok(_) => names += 1,
+            Err(_) => {}
+        }
+        true
+    });
+    match (names, numbers) {
+        (n, 0) if n == fields => LineKind::Names,
+        (0, n) if n == fields => LineKind::Numbers,
+        _ => LineKind::Garbled,
     }
 }
 

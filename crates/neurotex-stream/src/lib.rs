@@ -207,19 +207,27 @@ pub enum BadFrame {
         /// The frame's values.
         got: usize,
     },
-    /// A value or time stamp that is not a finite number.
+    /// A value that is not a finite number.
     #[error("value {index} is not a finite number")]
     NotFinite {
-        /// Which value (the time stamp is value 0 when given).
+        /// Which value, counted from the line's first field (the time stamp is value 0
+        /// when given).
         index: usize,
     },
     /// A value beyond [`crate::values::MAX_SAMPLE_MAGNITUDE`]: no sensor's reading.
     #[error("value {index} is {value}, beyond ±1e15, which is no sensor's reading")]
     OutOfRange {
-        /// Which value (the time stamp is value 0 when given).
+        /// Which value, counted from the line's first field (the time stamp is value 0
+        /// when given).
         index: usize,
         /// The value.
         value: f64,
+    },
+    /// A time stamp that is not a finite number.
+    #[error("the time stamp {t} is not a finite number")]
+    StampNotFinite {
+        /// The stamp, as given (in its own unit).
+        t: f64,
     },
     /// A time stamp not after the previous frame's.
     #[error("time stamp {t} s is not after the previous frame's {previous} s")]
@@ -721,7 +729,7 @@ impl StreamClassifier {
         let first_value = usize::from(time_s.is_some());
         if let Some(t) = time_s {
             if !t.is_finite() {
-                return Err(BadFrame::NotFinite { index: 0 });
+                return Err(BadFrame::StampNotFinite { t });
             }
             if t.abs() > MAX_STAMP_S {
                 return Err(BadFrame::StampRange { t });

@@ -30,6 +30,9 @@ pub struct CompareArgs {
 /// Runs `neurotex compare`.
 pub fn run(args: CompareArgs) -> Result<()> {
     let o = &args.options;
+    if let Some(dir) = &args.out {
+        crate::output::check_folder(dir, "--out")?;
+    }
     let dataset = o.open.open(&o.dataset)?;
     let _claim = match &args.out {
         Some(dir) => {

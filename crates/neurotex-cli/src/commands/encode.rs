@@ -8,7 +8,7 @@ use clap::Args;
 use neurotex::encode::SpikeTrains;
 use neurotex::workflows::encode::EncodeOptions;
 
-use crate::output::{check_output, stage_file, Shown};
+use crate::output::{check_binary, check_output, is_stdout, shown, stage_file, write_file, Shown};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex encode`.
@@ -31,46 +31,57 @@ pub fn run(args: EncodeArgs) -> Result<()> {
     let o = &args.options;
     let stages = &args.stages.options;
     EncodeOptions::check(stages)?;
-    let shown = Shown::new("encoding");
-    let on = shown.callback();
+    let bar = Shown::new("encoding");
+    let on = bar.callback();
     let input = o.read(&on)?;
     check_output(&args.out, &input.files)?;
+    check_binary(&args.out, "--out", "a spike raster (.npy)")?;
     if let Some(events) = &args.events {
         if events == &args.out || neurotex::io::same_file(events, &args.out) {
             bail!(
                 "--events and --out name the same file, {}",
-                args.out.display()
+                shown(&args.out)
             );
         }
         check_output(events, &input.files)?;
     }
     let encoded = o.encode(&input, stages, &on)?;
-    shown.finish();
+    bar.finish();
     let spikes = &encoded.spikes;
     let raster = ndarray::Array3::from_shape_vec(
         (spikes.n_steps, spikes.rows, spikes.cols),
         spikes.to_raster(),
     )?;
-    // Both files are written before either is put in place: a failure leaves neither.
-    let events = match &args.events {
-        Some(path) => Some(stage_file(path, "address events", |w| {
-            write_events(w, spikes)
-        })?),
-        None => None,
-    };
-    let raster = stage_file(&args.out, "spike raster", |w| {
+    let write_raster = |w: &mut dyn Write| {
         ndarray_npy::WriteNpyExt::write_npy(&raster, w).map_err(std::io::Error::other)
-    })?;
-    raster.commit()?;
-    if let Some(events) = events {
-        events.commit()?;
+    };
+    // Both files are written before either is put in place: a failure leaves neither.
+    // Standard output is written last of all but the renames.
+    let mut staged = Vec::new();
+    let events = args.events.as_deref();
+    if let Some(path) = events.filter(|p| !is_stdout(p)) {
+        staged.push(stage_file(path, "address events", |w| {
+            write_events(w, spikes)
+        })?);
+    }
+    if !is_stdout(&args.out) {
+        staged.push(stage_file(&args.out, "spike raster", write_raster)?);
+    }
+    if let Some(path) = events.filter(|p| is_stdout(p)) {
+        write_file(path, "address events", |w| write_events(w, spikes))?;
+    }
+    if is_stdout(&args.out) {
+        write_file(&args.out, "spike raster", write_raster)?;
+    }
+    for file in staged {
+        file.commit()?;
     }
     eprintln!(
         "{} spikes from {} taxels over {} ms -> {}",
         spikes.total_spikes(),
         spikes.present.iter().filter(|&&p| p).count(),
         spikes.n_steps,
-        args.out.display()
+        shown(&args.out)
     );
     Ok(())
 }

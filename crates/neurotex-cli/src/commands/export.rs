@@ -12,7 +12,7 @@ use neurotex::workflows::export::{
 };
 use neurotex::workflows::OpenOptions;
 
-use crate::output::{check_output, Shown};
+use crate::output::{check_binary, check_folder, check_output, save_to, shown, Shown};
 use crate::stage_args::StageArgs;
 
 /// `neurotex export`: what other tools read.
@@ -95,8 +95,11 @@ pub fn run(command: ExportCommand) -> Result<()> {
     match command {
         ExportCommand::Nir(args) => {
             check_output(&args.out, std::slice::from_ref(&args.model))?;
+            check_binary(&args.out, "--out", "a NIR graph (HDF5)")?;
             let model = load_spiking(&args.model)?;
-            export_nir(&model, &args.out, args.convention)?;
+            save_to(&args.out, "the NIR graph", |p| {
+                export_nir(&model, p, args.convention)
+            })?;
             let net = model.network();
             eprintln!(
                 "NIR graph: {} inputs -> {} CubaLIF -> {} LI outputs ({}), dt {} ms -> {}",
@@ -105,13 +108,14 @@ pub fn run(command: ExportCommand) -> Result<()> {
                 net.classes,
                 model.labels().join(", "),
                 net.dt_ms,
-                args.out.display()
+                shown(&args.out)
             );
         }
         ExportCommand::Inputs(args) => {
+            check_folder(&args.out, "--out")?;
+            let _claim = neurotex::io::claim_output_dir(&args.out)?;
             let model = load_spiking(&args.model)?;
             let dataset = args.open.open(&args.dataset)?;
-            neurotex::io::check_output_dir(&args.out)?;
             let shown = Shown::new("starting");
             let n = export_inputs(&model, &dataset, &args.out, &shown.callback());
             shown.finish();
@@ -124,8 +128,9 @@ pub fn run(command: ExportCommand) -> Result<()> {
             );
         }
         ExportCommand::Events(args) => {
+            check_folder(&args.out, "--out")?;
+            let _claim = neurotex::io::claim_output_dir(&args.out)?;
             let dataset = args.open.open(&args.dataset)?;
-            neurotex::io::check_output_dir(&args.out)?;
             let shown = Shown::new("starting");
             let on = shown.callback();
             let all: Vec<usize> = (0..dataset.entries.len()).collect();

@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::{Args, Subcommand};
 use neurotex::workflows::import::{ImportCsvOptions, ImportEventsOptions, ImportStackedOptions};
 
-use crate::output::Shown;
+use crate::output::{check_folder, Shown};
 
 /// `neurotex import`: bring recordings from other layouts into the dataset format.
 #[derive(Subcommand)]
@@ -59,18 +59,21 @@ pub struct ImportStackedArgs {
 pub fn run(command: ImportCommand) -> Result<()> {
     match command {
         ImportCommand::Csv(args) => {
+            check_folder(&args.out, "--out")?;
             let shown = Shown::new("importing");
             let summary = args.options.run(&args.out, &shown.callback());
             shown.finish();
             summary?;
         }
         ImportCommand::Events(args) => {
+            check_folder(&args.out, "--out")?;
             let shown = Shown::new("importing");
             let imported = args.options.run(&args.out, &shown.callback());
             shown.finish();
             imported?;
         }
         ImportCommand::Stacked(args) => {
+            check_folder(&args.out, "--out")?;
             let n = args.options.run(&args.out)?;
             eprintln!("{n} recordings -> {}", args.out.display());
         }

@@ -38,6 +38,7 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         Some(dir) => Some(o.open.open(dir)?),
         None => None,
     };
+    crate::output::check_folder(&args.out, "--out")?;
     let _claim =
         neurotex::report::check_report_dir(&args.out).context("checking the report folder")?;
     if let Some(path) = &args.predictions {

@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use neurotex::workflows::simulate::SimulateOptions;
 
-use crate::output::Shown;
+use crate::output::{check_folder, Shown};
 
 /// Options of `neurotex simulate`.
 #[derive(Args)]
@@ -20,6 +20,7 @@ pub struct SimulateArgs {
 
 /// Runs `neurotex simulate`.
 pub fn run(args: SimulateArgs) -> Result<()> {
+    check_folder(&args.out, "--out")?;
     let shown = Shown::new("simulating");
     let n = args.options.run(&args.out, &shown.callback());
     shown.finish();

@@ -8,7 +8,7 @@ use anyhow::Result;
 use clap::Args;
 use neurotex::workflows::train::TrainOptions;
 
-use crate::output::{check_output, Shown};
+use crate::output::{check_output, save_to, Shown};
 use crate::stage_args::StageArgs;
 
 /// Options of `neurotex train`.
@@ -35,7 +35,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         shown.finish();
         let trained = trained?;
         let model = &trained.model;
-        model.save(&args.out)?;
+        save_to(&args.out, "the model", |p| model.save(p))?;
         let net = model.network();
         eprintln!(
             "{} on {} recordings of {} classes ({} inputs: taxels x populations; best validation loss {:.3} at epoch {} of {}) on the {} grid -> {}",
@@ -47,14 +47,14 @@ pub fn run(args: TrainArgs) -> Result<()> {
             trained.log.best_epoch,
             trained.log.epochs,
             trained.grid,
-            args.out.display()
+            crate::output::shown(&args.out)
         );
         return Ok(());
     }
     let trained = o.run(&dataset, &args.stages.options, &shown.callback())?;
     shown.finish();
     let model = &trained.model;
-    model.save(&args.out)?;
+    save_to(&args.out, "the model", |p| model.save(p))?;
     eprintln!(
         "{} on {} recordings of {} classes, {} {} features on the {} grid -> {}",
         model.classifier(),
@@ -63,7 +63,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         model.features().columns.len(),
         o.method.name(),
         trained.grid,
-        args.out.display()
+        crate::output::shown(&args.out)
     );
     Ok(())
 }

@@ -1219,7 +1219,15 @@ class StreamClassifier:
         optionally ``p`` (tonic's, :data:`EVENT_DTYPE`), in time order; the lines they
         completed. Bad events raise :class:`DataError` at the first, the ones before it
         taken."""
+        events = np.asarray(events)
         names = events.dtype.names or ()
+        missing = [f for f in ("t", "x", "y") if f not in names]
+        if missing or events.ndim != 1:
+            raise ParameterError(
+                f"push_events(events): a 1-D structured array of events is needed, with "
+                f"fields t, x, y and optionally p (tonic's dtype, neurotex.EVENT_DTYPE = "
+                f"{EVENT_DTYPE}); got dtype {events.dtype} of shape {events.shape}"
+                + (f", without field(s) {', '.join(missing)}" if names else ""))
         p = events["p"].astype(np.int64).tolist() if "p" in names else [None] * len(events)
         lines: List[Dict[str, Any]] = []
         for t, x, y, pol in zip(events["t"].tolist(), events["x"].tolist(),

@@ -65,8 +65,10 @@ impl ImportCsvOptions {
     /// warning and what was written.
     ///
     /// # Errors
-    /// A log that cannot be read (without `--skip-bad`), or a folder that cannot be written.
+    /// A log that cannot be read (without `--skip-bad`), a folder that cannot be written, or one another run is writing.
     pub fn run(&self, out: &Path, on: OnProgress) -> Result<ImportSummary> {
+        // Claimed before the inputs are read: a second run into the folder says so at once.
+        let _claim = crate::io::claim_folder(out)?;
         let params = CsvImportParams {
             // `none` is what a layout without a baseline means; it is not written out
             baseline: self.baseline.filter(|b| *b != Baseline::None),
@@ -116,8 +118,10 @@ impl ImportStackedOptions {
     /// written.
     ///
     /// # Errors
-    /// Arrays that cannot be read or do not match, or a folder that cannot be written.
+    /// Arrays that cannot be read or do not match, a folder that cannot be written, or one another run is writing.
     pub fn run(&self, out: &Path) -> Result<usize> {
+        // Claimed before the inputs are read: a second run into the folder says so at once.
+        let _claim = crate::io::claim_folder(out)?;
         let params = StackedParams {
             axes: self.axes.clone(),
             fs: self.fs.hz(),
@@ -265,8 +269,10 @@ impl ImportEventsOptions {
     /// written.
     ///
     /// # Errors
-    /// A log that cannot be read or breaks a rule, or a folder that cannot be written.
+    /// A log that cannot be read or breaks a rule, a folder that cannot be written, or one another run is writing.
     pub fn run(&self, out: &Path, on: OnProgress) -> Result<Vec<ImportedFile>> {
+        // Claimed before the inputs are read: a second run into the folder says so at once.
+        let _claim = crate::io::claim_folder(out)?;
         let params = self.params()?;
         let files = event_files(&self.inputs)?;
         on(Progress::Stage("importing", files.len()));

@@ -42,8 +42,10 @@ impl SimulateOptions {
     /// Simulates the design into the dataset folder `out`; returns the recordings written.
     ///
     /// # Errors
-    /// A design out of range, or a folder that cannot be written.
+    /// A design out of range, a folder that cannot be written, or one another run is writing.
     pub fn run(&self, out: &Path, on: OnProgress) -> Result<usize> {
+        // Claimed before anything is simulated: a second run into the folder says so at once.
+        let _claim = crate::io::claim_folder(out)?;
         let textures = self
             .textures
             .clone()
