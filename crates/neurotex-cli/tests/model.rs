@@ -597,3 +597,80 @@ fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
     }
     assert!(!dir.partial_left(), "temporary files left behind");
 }
+
+#[test]
+fn every_field_training_guarantees_is_checked_when_a_feature_model_is_read() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let model = dir.join("causal.json");
+    let train = ["train", "--dataset", s(&ds), "--causal", "-k", "1"];
+    dir.ok(&[&train[..], &["--out", s(&model)]].concat());
+    let file = read_json(&model);
+    let labels = vec![Value::from("A"), Value::from("B"), Value::from("Z")];
+    let offsets = file["pipeline"]["preprocess"]["causal"]["offsets"]
+        .as_array()
+        .unwrap()[1..]
+        .to_vec();
+    let cases: Vec<(&str, Value, &str)> = vec![
+        ("/labels", labels.into(), "class `Z` has no training row"),
+        ("/labels/1", "A".into(), "class `A` is listed twice"),
+        (
+            "/pipeline/preprocess/causal/offsets",
+            offsets.into(),
+            "`pipeline.preprocess.causal.offsets` holds 15 resting values for the 16 cells",
+        ),
+        (
+            "/training/dataset/median_duration_ms",
+            0.into(),
+            "median_duration_ms",
+        ),
+        ("/training/dataset/layout/fs", (-1.0).into(), "`fs`"),
+    ];
+    for (pointer, value, expected) in cases {
+        refused_when_tampered(&dir, &file, &ds, &[(pointer, value)], expected);
+    }
+    assert!(!dir.partial_left(), "temporary files left behind");
+}
+
+#[test]
+fn a_model_trained_on_events_refuses_sampled_recordings() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let events = dir.join("ev");
+    dir.ok(&["export", "events", "--dataset", s(&ds), "--out", s(&events)]);
+    let out = dir.join("never.csv");
+    for (name, extra) in [
+        ("ev.json", &[][..]),
+        (
+            "ev_snn.json",
+            &[
+                "--classifier",
+                "snn",
+                "--snn-hidden",
+                "8",
+                "--snn-epochs",
+                "2",
+            ][..],
+        ),
+    ] {
+        let model = dir.join(name);
+        let train = ["train", "--dataset", s(&events), "--out", s(&model)];
+        dir.ok(&[&train[..], extra].concat());
+        // its own kind of recordings is predicted
+        let fine = dir.join("fine.csv");
+        dir.ok(&predict(s(&model), s(&fine), &["--dataset", s(&events)]));
+        for causal in [&[][..], &["--causal"][..]] {
+            let args = [
+                &predict(s(&model), s(&out), &["--dataset", s(&ds)])[..],
+                causal,
+            ]
+            .concat();
+            let err = dir.fails(&args);
+            assert!(
+                err.contains("is a sampled recording, but the model was trained on address events"),
+                "{name} {causal:?}: {err}"
+            );
+            assert!(!out.exists(), "{name} {causal:?}: output written");
+        }
+    }
+}
