@@ -393,7 +393,10 @@ impl Network {
         ] {
             // Training rounds every weight to float32 (what NIR and NumPy files hold); a
             // larger one is damage, and could overflow a readout's sum to infinity.
-            if let Some(pos) = w.iter().position(|v| !(v.abs() <= f64::from(f32::MAX))) {
+            if let Some(pos) = w
+                .iter()
+                .position(|v| !v.is_finite() || v.abs() > f64::from(f32::MAX))
+            {
                 return Err(format!(
                     "the network's {name}[{pos}] is {:?}, not a finite float32 value",
                     w[pos]
