@@ -571,10 +571,7 @@ fn newer_seeds() -> Vec<(&'static str, Vec<u8>)> {
         [&[1u8 | 64][..], b"t,x,y\n0,0,0\n7,1,1\n"].concat(),
     ));
     out.push(("events_npy", [&[0u8][..], &npy].concat()));
-    out.push((
-        "events_npy",
-        [&[0u8 | 32 | 64][..], &event_npy_u16()].concat(),
-    ));
+    out.push(("events_npy", [&[32u8 | 64][..], &event_npy_u16()].concat()));
     let text = b"t,x,y,p\n0,0,0,1\n150000,1,1,0\n400000\nreset\n1000000,1,0,1\n1900000\n".to_vec();
     out.push(("stream_events", [&[0u8][..], &text].concat()));
     out.push((
