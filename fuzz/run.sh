@@ -11,7 +11,8 @@ secs=${1:-60}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(npy csv manifest layout dataset import_csv import_stacked)
+    targets=(npy csv manifest layout dataset import_csv import_stacked events_csv events_npy
+        stream_events snn_model nir)
 fi
 # One build, then the targets' binaries run directly: `cargo fuzz run` would check the build
 # again per target, and neurotex's build script (the git commit) can make that a rebuild.

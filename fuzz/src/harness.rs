@@ -9,15 +9,27 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
 
 use neurotex::csvlog::{Column, CsvFormat, DuplicateStamps};
+use neurotex::events::Origin;
+use neurotex::events::{read_events, write_events, Event, EventFile, EventGrid, EventsFormat};
 use neurotex::import::{import_csv, import_stacked, ChannelSelect, CsvImportParams};
 use neurotex::import::{NamePattern, StackedParams};
+use neurotex::model::Provenance;
+use neurotex::nir::Convention;
+use neurotex::pipeline::{Encoding, PipelineParams};
 use neurotex::recording::{read_manifest, read_recording, Dataset, LayoutFile};
 use neurotex::recording::{Baseline, TimeUnit};
+use neurotex::saved::SavedModel;
+use neurotex::snn::{Network, Readout, SnnParams, SpikeInput};
+use neurotex::spiking_model::{decide, SpikingModel, SpikingTraining};
+use neurotex::stream::events::{EventEncoding, EventReader, EventSource, Item};
+use neurotex::stream::{StreamClassifier, StreamParams};
+use neurotex::Grid;
 
 /// The targets, by name: the names of the fuzz targets and of the corpus folders.
-pub const TARGETS: [&str; 7] = [
+pub const TARGETS: [&str; 12] = [
     "npy",
     "csv",
     "manifest",
@@ -25,6 +37,11 @@ pub const TARGETS: [&str; 7] = [
     "dataset",
     "import_csv",
     "import_stacked",
+    "events_csv",
+    "events_npy",
+    "stream_events",
+    "snn_model",
+    "nir",
 ];
 
 /// Runs target `name` on `data`; whether the input was accepted all the way (read, or
@@ -41,6 +58,11 @@ pub fn run(name: &str, data: &[u8]) -> bool {
         "dataset" => dataset(data),
         "import_csv" => import_csv_files(data),
         "import_stacked" => import_stacked_arrays(data),
+        "events_csv" => events_file(data, "e.csv"),
+        "events_npy" => events_file(data, "e.npy"),
+        "stream_events" => stream_events(data),
+        "snn_model" => snn_model(data),
+        "nir" => nir_graph(data),
         other => panic!("unknown fuzz target {other}"),
     }
 }
@@ -297,6 +319,319 @@ pub fn import_stacked_arrays(data: &[u8]) -> bool {
     import_stacked(&data_path, &labels, speeds.as_deref(), &params, &out).is_ok() && read_back(&out)
 }
 
+/// The longest event recording the readers are run with, ms (an hour).
+const MAX_EVENT_STEPS: u64 = 3_600_000;
+
+/// The format, grid and duration an event file is read with, chosen by the bits of
+/// `flags`: the unit (2 bits), a taxel column instead of `x` and `y`, OFF written as -1,
+/// the first event as time 0, a masked cell, a duration of 50 ms.
+fn event_setup(flags: u8) -> (EventsFormat, EventGrid, Option<u64>) {
+    let units = [
+        TimeUnit::Microseconds,
+        TimeUnit::Milliseconds,
+        TimeUnit::Seconds,
+    ];
+    let mut format = EventsFormat::new(units[usize::from(flags % 4).min(2)]);
+    if flags & 4 != 0 {
+        format.taxel = Some("taxel".into());
+    }
+    if flags & 8 != 0 {
+        format.values = [1, -1];
+    }
+    if flags & 16 != 0 {
+        format.origin = Origin::First;
+    }
+    let present = match flags & 32 {
+        0 => vec![true; 4],
+        _ => vec![true, false, true, true],
+    };
+    let taxels = (0..4).filter(|&c| present[c]).collect();
+    let grid = EventGrid {
+        rows: 2,
+        cols: 2,
+        present,
+        taxels,
+    };
+    (format, grid, (flags & 64 != 0).then_some(50))
+}
+
+/// An event file (CSV or `.npy` by `name`'s extension) read on a 2x2 grid, the first byte
+/// choosing the format ([`event_setup`]), the rest the file.
+pub fn events_file(data: &[u8], name: &str) -> bool {
+    let Some((&flags, rest)) = data.split_first() else {
+        return false;
+    };
+    let (format, grid, duration) = event_setup(flags);
+    let case = Case::new();
+    let path = case.file(name, rest);
+    read_events(&path, &format, &grid, duration, MAX_EVENT_STEPS).is_ok()
+}
+
+/// The model file (as JSON) of a small spiking network on a 2x2 grid's SA and FA inputs,
+/// trained on events; `recurrent` adds the hidden layer's loop.
+fn spiking_file(recurrent: bool) -> serde_json::Value {
+    let (inputs, hidden, classes) = (8, 3, 2);
+    let weights = |n: usize, k: f64| -> Vec<f64> {
+        (0..n)
+            .map(|i| f64::from(((i as f64 * 0.37 + k).sin() * 0.8) as f32))
+            .collect()
+    };
+    let classifier = SnnParams {
+        hidden,
+        dt_ms: 5,
+        epochs: 3,
+        recurrent,
+        ..SnnParams::default()
+    };
+    let network = Network {
+        inputs,
+        hidden,
+        classes,
+        dt_ms: 5,
+        tau_syn_ms: classifier.tau_syn_ms,
+        tau_mem_ms: classifier.tau_mem_ms,
+        tau_out_ms: classifier.tau_out_ms,
+        readout: Readout::Mean,
+        w_in: weights(inputs * hidden, 0.1),
+        b_in: weights(hidden, 0.2),
+        w_out: weights(hidden * classes, 0.3),
+        b_out: weights(classes, 0.4),
+        w_rec: if recurrent {
+            weights(hidden * hidden, 0.5)
+        } else {
+            Vec::new()
+        },
+    };
+    let layout = LayoutFile {
+        rows: Some(2),
+        cols: Some(2),
+        events: Some(EventsFormat::new(TimeUnit::Microseconds)),
+        ..LayoutFile::default()
+    };
+    let training = SpikingTraining {
+        dataset: Provenance {
+            fingerprint: "fuzz".into(),
+            baseline: Baseline::default(),
+            speeds: None,
+            gain_calibration: None,
+            median_duration_ms: Some(600),
+            layout: Some(layout),
+        },
+        recordings: 4,
+        epochs: 2,
+        best_epoch: 1,
+        validation_loss: 0.5,
+    };
+    let pipeline = PipelineParams {
+        encoding: Encoding::SaFa,
+        ..PipelineParams::default()
+    };
+    serde_json::json!({
+        "format": neurotex::spiking_model::FORMAT,
+        "version": neurotex::spiking_model::VERSION,
+        "neurotex_version": "0.0.0",
+        "pipeline": pipeline,
+        "grid": Grid::masked(2, 2, vec![true; 4]).expect("a grid"),
+        "classifier": classifier,
+        "labels": ["a", "b"],
+        "training": training,
+        "network": network,
+    })
+}
+
+/// The model of [`spiking_file`] (feed-forward), read once.
+fn spiking_model() -> &'static SpikingModel {
+    static MODEL: OnceLock<SpikingModel> = OnceLock::new();
+    MODEL.get_or_init(|| {
+        let case = Case::new();
+        let text = spiking_file(false).to_string();
+        SpikingModel::load(&case.file("m.json", text.as_bytes())).expect("the fuzz model reads")
+    })
+}
+
+/// What every model that reads must give: finite shares summing to 1 on a window of
+/// spikes, and a NIR graph.
+///
+/// # Panics
+/// When it does not (the model file's checks let damage through).
+fn runs_as_trained(model: &SpikingModel) {
+    let net = model.network();
+    let events: Vec<(u32, u32)> = (0..40u32)
+        .map(|k| (k / 2, (k * 7) % net.inputs as u32))
+        .collect();
+    let scores = net.scores(&SpikeInput::from_events(net.inputs, 20, &events));
+    let (_, shares) = decide(&scores);
+    let sum: f64 = shares.iter().sum();
+    assert!(
+        shares.iter().all(|s| s.is_finite()) && (sum - 1.0).abs() < 1e-9,
+        "a model that reads gives shares {shares:?}"
+    );
+    model
+        .to_nir(Convention::Physical)
+        .expect("a model that reads exports its graph");
+}
+
+/// A spiking model file (JSON), and when it reads, its network run and exported.
+pub fn snn_model(data: &[u8]) -> bool {
+    let case = Case::new();
+    let Ok(model) = SpikingModel::load(&case.file("m.json", data)) else {
+        return false;
+    };
+    runs_as_trained(&model);
+    true
+}
+
+/// A NIR graph (HDF5), and when it reads, its network run and exported.
+pub fn nir_graph(data: &[u8]) -> bool {
+    let case = Case::new();
+    let Ok(model) = SpikingModel::load(&case.file("g.nir", data)) else {
+        return false;
+    };
+    runs_as_trained(&model);
+    true
+}
+
+/// Items a stream input is read for at most: enough for every path, few enough that
+/// inputs stay fast.
+const MAX_STREAM_ITEMS: usize = 4096;
+
+/// A live stream's events through [`EventReader`] and into a stream classifier of a small
+/// spiking network trained on events. The first byte: binary records (bit 0) or text
+/// lines; text events naming a taxel (bit 1); the text's unit (bits 2-3: the model's
+/// microseconds, ms, s); the first event as time 0 (bit 4). The rest is the stream.
+pub fn stream_events(data: &[u8]) -> bool {
+    let Some((&flags, rest)) = data.split_first() else {
+        return false;
+    };
+    let model = SavedModel::from(spiking_model().clone());
+    let encoding = match flags & 1 {
+        0 => EventEncoding::Text,
+        _ => EventEncoding::Binary,
+    };
+    let unit = [
+        None,
+        Some(TimeUnit::Milliseconds),
+        Some(TimeUnit::Seconds),
+        None,
+    ];
+    let origin = (flags & 16 != 0).then_some(Origin::First);
+    let unit = unit[usize::from((flags >> 2) & 3)];
+    let source = EventSource::for_model(&model, unit, origin, flags & 2 != 0)
+        .expect("the model was trained on events");
+    let mut reader = EventReader::new(rest, "fuzz", encoding, &source.format);
+    let params = StreamParams::for_model(&model);
+    let mut stream = StreamClassifier::for_events(model, params, source).expect("a stream");
+    let mut clean = true;
+    for _ in 0..MAX_STREAM_ITEMS {
+        let taken = match reader.next(&|| false) {
+            Ok(Some(Item::Event { stamp, address })) => stream.push_event(stamp, address).is_ok(),
+            Ok(Some(Item::Reset)) => stream.reset().is_ok(),
+            Ok(Some(Item::Bad { .. })) => {
+                stream.skip_bad_frame();
+                false
+            }
+            Ok(None) => break,
+            Err(_) => return false,
+        };
+        clean &= taken;
+    }
+    stream.finish().is_ok() && clean
+}
+
+/// Event files of `kind` holding a short recording's events on a 2x2 grid.
+fn event_file_bytes(kind: EventFile) -> Vec<u8> {
+    let events: Vec<Event> = (0..12u32)
+        .map(|k| Event {
+            t_ms: k * 3,
+            y: k % 2,
+            x: (k / 2) % 2,
+            p: (k % 3 == 0) as u8,
+        })
+        .collect();
+    let mut out = Vec::new();
+    write_events(&mut out, &events, kind).expect("writing to memory");
+    out
+}
+
+/// Seeds of the event, stream, spiking model and NIR targets.
+fn newer_seeds() -> Vec<(&'static str, Vec<u8>)> {
+    let mut out = Vec::new();
+    let csv = event_file_bytes(EventFile::Csv);
+    let npy = event_file_bytes(EventFile::Npy);
+    // CSV in ms (unit 1), in ms from the first event, masked with a duration; a taxel
+    // column with OFF as -1; tonic's .npy in us
+    out.push(("events_csv", [&[1u8][..], &csv].concat()));
+    out.push(("events_csv", [&[1u8 | 16][..], &csv].concat()));
+    out.push((
+        "events_csv",
+        [&[4u8 | 8 | 1][..], b"t,taxel,p\n0,0,1\n2,3,-1\n2,1,1\n"].concat(),
+    ));
+    out.push((
+        "events_csv",
+        [&[1u8 | 64][..], b"t,x,y\n0,0,0\n7,1,1\n"].concat(),
+    ));
+    out.push(("events_npy", [&[0u8][..], &npy].concat()));
+    out.push(("events_npy", [&[32u8 | 64][..], &event_npy_u16()].concat()));
+    let text = b"t,x,y,p\n0,0,0,1\n150000,1,1,0\n400000\nreset\n1000000,1,0,1\n1900000\n".to_vec();
+    out.push(("stream_events", [&[0u8][..], &text].concat()));
+    out.push((
+        "stream_events",
+        [&[2u8 | 4][..], b"t,taxel,p\n0,0,1\n300,2,0\n700\n"].concat(),
+    ));
+    let mut records = Vec::new();
+    for (t, x, y, p, kind) in [
+        (0i64, 0u16, 0u16, 1i8, 0u8),
+        (90_000, 1, 1, 0, 0),
+        (500_000, 0, 0, 0, 1),
+        (0, 0, 0, 0, 2),
+        (700_000, 1, 0, 1, 0),
+        (1_500_000, 0, 0, 0, 1),
+    ] {
+        records.extend_from_slice(&t.to_le_bytes());
+        records.extend_from_slice(&x.to_le_bytes());
+        records.extend_from_slice(&y.to_le_bytes());
+        records.push(p as u8);
+        records.push(kind);
+        records.extend_from_slice(&[0, 0]);
+    }
+    out.push(("stream_events", [&[1u8][..], &records].concat()));
+    for recurrent in [false, true] {
+        let file = spiking_file(recurrent);
+        out.push(("snn_model", serde_json::to_vec_pretty(&file).expect("JSON")));
+        let case = Case::new();
+        let model = SpikingModel::load(&case.file("m.json", file.to_string().as_bytes()))
+            .expect("the seed model reads");
+        for convention in [Convention::Physical, Convention::Snntorch] {
+            out.push(("nir", model.to_nir(convention).expect("a graph")));
+        }
+    }
+    out
+}
+
+/// A tonic-like `.npy` of events whose `x` and `y` are `<u2`, `t` `<u4` and `p` a boolean.
+fn event_npy_u16() -> Vec<u8> {
+    let descr = "[('t', '<u4'), ('x', '<u2'), ('y', '<u2'), ('p', '|b1')]";
+    let records: [(u32, u16, u16, u8); 3] = [(0, 0, 0, 1), (1500, 1, 1, 0), (2500, 0, 1, 1)];
+    let mut header = format!(
+        "{{'descr': {descr}, 'fortran_order': False, 'shape': ({},), }}",
+        records.len()
+    );
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    for (t, x, y, p) in records {
+        out.extend_from_slice(&t.to_le_bytes());
+        out.extend_from_slice(&x.to_le_bytes());
+        out.extend_from_slice(&y.to_le_bytes());
+        out.push(p);
+    }
+    out
+}
+
 /// An `.npy` file of `shape` holding `0, 1, 2, ...` as f32.
 fn npy_bytes(shape: &[usize]) -> Vec<u8> {
     let n: usize = shape.iter().product();
@@ -382,5 +717,6 @@ mask = [\"11\", \"11\"]\nbaseline = { kind = \"min\" }\ntime_column = \"t_ms\"\n
         "import_stacked",
         join(&[b"\x0a", &npy_bytes(&[3, 4, 4]), &ints, &speeds]),
     ));
+    out.extend(newer_seeds());
     out
 }

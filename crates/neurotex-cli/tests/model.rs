@@ -514,3 +514,163 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     assert_eq!(index.lines().count(), 25, "{index}");
     assert!(index.starts_with("file,label,array\n"));
 }
+
+/// Writes `file` with each `(JSON pointer, value)` of `edits` set to `damaged.json`;
+/// `predict` with it must fail naming the file and `expected`, and write nothing.
+fn refused_when_tampered(
+    dir: &Dir,
+    file: &Value,
+    dataset: &Path,
+    edits: &[(&str, Value)],
+    expected: &str,
+) {
+    let mut tampered = file.clone();
+    for (pointer, value) in edits {
+        match tampered.pointer_mut(pointer) {
+            Some(at) => *at = value.clone(),
+            None => {
+                // A field the file leaves out: added to its object.
+                let (parent, key) = pointer.rsplit_once('/').expect(pointer);
+                let object = tampered.pointer_mut(parent).and_then(Value::as_object_mut);
+                object.expect(parent).insert(key.into(), value.clone());
+            }
+        }
+    }
+    let damaged = dir.join("damaged.json");
+    std::fs::write(&damaged, serde_json::to_string(&tampered).unwrap()).unwrap();
+    let out = dir.join("never.csv");
+    let err = dir.fails(&predict(s(&damaged), s(&out), &["--dataset", s(dataset)]));
+    assert!(
+        err.contains("damaged.json: damaged or truncated model file") && err.contains(expected),
+        "{edits:?}: expected `{expected}` in {err}"
+    );
+    assert!(!out.exists(), "{edits:?}: predictions written");
+}
+
+#[test]
+fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let model = dir.join("snn.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&ds),
+        "--classifier",
+        "snn",
+        "--snn-hidden",
+        "8",
+        "--snn-epochs",
+        "2",
+        "--out",
+        s(&model),
+    ]);
+    let file = read_json(&model);
+    let both = |field: &str, v: Value| {
+        let net = format!("/network/{field}");
+        let params = format!("/classifier/{field}");
+        vec![(net, v.clone()), (params, v)]
+    };
+    let one = |pointer: &str, v: Value| vec![(pointer.to_string(), v)];
+    let cases: Vec<(Vec<(String, Value)>, &str)> = vec![
+        (both("dt_ms", 5000.into()), "dt_ms is 5000"),
+        (one("/network/dt_ms", 20.into()), "`network.dt_ms` differs"),
+        (both("tau_mem_ms", 1e300.into()), "tau_mem_ms is 1e300"),
+        (one("/network/w_out/0", 1e300.into()), "w_out[0] is 1e300"),
+        (one("/network/b_in/1", (-1e39).into()), "b_in[1] is -1e39"),
+        (one("/labels/1", "A".into()), "class `A` is listed twice"),
+        (
+            one("/classifier/validation", 1.5.into()),
+            "field `classifier`",
+        ),
+        (one("/training/best_epoch", 99.into()), "field `training`"),
+        (
+            one("/training/dataset/median_duration_ms", 0.into()),
+            "median_duration_ms",
+        ),
+        (one("/training/dataset/layout/fs", (-1.0).into()), "`fs`"),
+    ];
+    for (edits, expected) in &cases {
+        let edits: Vec<(&str, Value)> =
+            edits.iter().map(|(p, v)| (p.as_str(), v.clone())).collect();
+        refused_when_tampered(&dir, &file, &ds, &edits, expected);
+    }
+    assert!(!dir.partial_left(), "temporary files left behind");
+}
+
+#[test]
+fn every_field_training_guarantees_is_checked_when_a_feature_model_is_read() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let model = dir.join("causal.json");
+    let train = ["train", "--dataset", s(&ds), "--causal", "-k", "1"];
+    dir.ok(&[&train[..], &["--out", s(&model)]].concat());
+    let file = read_json(&model);
+    let labels = vec![Value::from("A"), Value::from("B"), Value::from("Z")];
+    let offsets = file["pipeline"]["preprocess"]["causal"]["offsets"]
+        .as_array()
+        .unwrap()[1..]
+        .to_vec();
+    let cases: Vec<(&str, Value, &str)> = vec![
+        ("/labels", labels.into(), "class `Z` has no training row"),
+        ("/labels/1", "A".into(), "class `A` is listed twice"),
+        (
+            "/pipeline/preprocess/causal/offsets",
+            offsets.into(),
+            "`pipeline.preprocess.causal.offsets` holds 15 resting values for the 16 cells",
+        ),
+        (
+            "/training/dataset/median_duration_ms",
+            0.into(),
+            "median_duration_ms",
+        ),
+        ("/training/dataset/layout/fs", (-1.0).into(), "`fs`"),
+    ];
+    for (pointer, value, expected) in cases {
+        refused_when_tampered(&dir, &file, &ds, &[(pointer, value)], expected);
+    }
+    assert!(!dir.partial_left(), "temporary files left behind");
+}
+
+#[test]
+fn a_model_trained_on_events_refuses_sampled_recordings() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let events = dir.join("ev");
+    dir.ok(&["export", "events", "--dataset", s(&ds), "--out", s(&events)]);
+    let out = dir.join("never.csv");
+    for (name, extra) in [
+        ("ev.json", &[][..]),
+        (
+            "ev_snn.json",
+            &[
+                "--classifier",
+                "snn",
+                "--snn-hidden",
+                "8",
+                "--snn-epochs",
+                "2",
+            ][..],
+        ),
+    ] {
+        let model = dir.join(name);
+        let train = ["train", "--dataset", s(&events), "--out", s(&model)];
+        dir.ok(&[&train[..], extra].concat());
+        // its own kind of recordings is predicted
+        let fine = dir.join("fine.csv");
+        dir.ok(&predict(s(&model), s(&fine), &["--dataset", s(&events)]));
+        for causal in [&[][..], &["--causal"][..]] {
+            let args = [
+                &predict(s(&model), s(&out), &["--dataset", s(&ds)])[..],
+                causal,
+            ]
+            .concat();
+            let err = dir.fails(&args);
+            assert!(
+                err.contains("is a sampled recording, but the model was trained on address events"),
+                "{name} {causal:?}: {err}"
+            );
+            assert!(!out.exists(), "{name} {causal:?}: output written");
+        }
+    }
+}

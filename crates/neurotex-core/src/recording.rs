@@ -399,7 +399,12 @@ impl LayoutFile {
         }
     }
 
-    fn check(&self, path: &Path) -> Result<()> {
+    /// Checks the rules [`LayoutFile::read`] checks (a layout kept in a model file is
+    /// checked when the model is read), naming `path` in the error.
+    ///
+    /// # Errors
+    /// The first rule broken.
+    pub fn check(&self, path: &Path) -> Result<()> {
         let bad = |m: String| -> Result<()> { Err(DataError::invalid(path, m).into()) };
         if let Err(e) = self.csv_formats(&CsvOverrides::default()) {
             return bad(e.to_string());

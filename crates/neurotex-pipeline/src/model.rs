@@ -270,6 +270,8 @@ impl Model {
                 spec.method.name()
             )));
         }
+        check_trained(&file.labels, &file.pipeline, &grid, &file.training.dataset)
+            .map_err(inconsistent)?;
         let classifier = fit(&file, columns.len())?;
         Ok(Model {
             file,
@@ -370,10 +372,12 @@ impl Model {
     ///
     /// # Errors
     /// [`ModelError::OtherGrid`] naming the first recording on another grid than the
-    /// model's; a recording shorter than one bin.
+    /// model's; a sampled recording for a model trained on events; a recording shorter
+    /// than one bin.
     pub fn predict(&self, encoded: &[Encoded]) -> Result<Vec<Prediction>> {
         for e in encoded {
             self.check_grid(e)?;
+            check_source(self.provenance(), e)?;
         }
         let rows: Vec<Vec<f64>> = encoded
             .par_iter()
@@ -591,11 +595,6 @@ fn fit(file: &ModelFile, dims: usize) -> Result<ChosenModel> {
             )));
         }
     }
-    for (i, label) in file.labels.iter().enumerate() {
-        if file.labels[..i].contains(label) {
-            return Err(inconsistent(format!("class `{label}` is listed twice")));
-        }
-    }
     let y = training
         .labels
         .iter()
@@ -605,8 +604,89 @@ fn fit(file: &ModelFile, dims: usize) -> Result<ChosenModel> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    // Training lists exactly the labels of its rows: a class without a row would leave the
+    // classifier with fewer outputs than the file has labels.
+    if let Some(label) = (0..file.labels.len()).find(|c| !y.contains(c)) {
+        return Err(inconsistent(format!(
+            "field `labels`: class `{}` has no training row",
+            file.labels[label]
+        )));
+    }
     let classifier = file.classifier.check()?;
     Ok(classifier.fit(&training.rows.concat(), dims, &y)?)
+}
+
+/// Checks that a recording is of the kind the model was trained on: a model trained on
+/// address events (its training layout has an `[events]` table) takes events only, as a
+/// stream of frames refuses it, since samples would go through an encoder whose spikes it
+/// never learned. (A model trained on sampled recordings takes events: the spikes of the
+/// encoder, exported as events, give its predictions bit for bit.)
+///
+/// # Errors
+/// [`DataError::Invalid`] naming the recording.
+pub(crate) fn check_source(provenance: &Provenance, e: &Encoded) -> Result<()> {
+    let on_events = provenance
+        .layout
+        .as_ref()
+        .is_some_and(|l| l.events.is_some());
+    if on_events && !e.from_events {
+        let why = "is a sampled recording, but the model was trained on address events, which skip the encoder: give it its sensor's events (an event dataset made by `neurotex import events`, or `neurotex stream --format events`)";
+        return Err(DataError::invalid(&e.meta.file, why).into());
+    }
+    Ok(())
+}
+
+/// Checks what training guarantees of any model's file beyond its pipeline's own rules:
+/// at least two distinct labels, a causal conditioning with one resting value per cell of
+/// `grid`, and a provenance training could have written (a stream's default window of at
+/// least 1 ms, a finite gain calibration, a layout that passes its own checks).
+///
+/// # Errors
+/// The rule broken, as a sentence naming the field.
+pub(crate) fn check_trained(
+    labels: &[String],
+    pipeline: &PipelineParams,
+    grid: &Grid,
+    provenance: &Provenance,
+) -> std::result::Result<(), String> {
+    if labels.len() < 2 {
+        return Err(format!(
+            "field `labels` holds {} class(es); a model is trained on at least two",
+            labels.len()
+        ));
+    }
+    if let Some(i) = (1..labels.len()).find(|&i| labels[..i].contains(&labels[i])) {
+        return Err(format!(
+            "field `labels`: class `{}` is listed twice",
+            labels[i]
+        ));
+    }
+    if let Some(causal) = &pipeline.preprocess.causal {
+        let cells = grid.rows() * grid.cols();
+        if causal.offsets.len() != cells {
+            return Err(format!(
+                "field `pipeline.preprocess.causal.offsets` holds {} resting values for the {cells} cells of the {grid} grid",
+                causal.offsets.len()
+            ));
+        }
+    }
+    if provenance.median_duration_ms == Some(0) {
+        return Err("field `training.dataset.median_duration_ms` is 0; training recordings last at least one bin".into());
+    }
+    if let Some(g) = &provenance.gain_calibration {
+        let numbers = [g.target_hz, g.gain, g.median_hz];
+        if numbers.iter().any(|v| !(v.is_finite() && *v >= 0.0)) || g.gain == 0.0 {
+            return Err(format!(
+                "field `training.dataset.gain_calibration`: target {} Hz, gain {}, median {} Hz; each must be finite and not negative, the gain positive",
+                g.target_hz, g.gain, g.median_hz
+            ));
+        }
+    }
+    if let Some(layout) = &provenance.layout {
+        let at = Path::new("field `training.dataset.layout`");
+        layout.check(at).map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }
 
 /// Scores `predictions` against the true labels `truth` for a model of classes `labels`

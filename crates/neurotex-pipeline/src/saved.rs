@@ -161,10 +161,20 @@ impl SavedModel {
         }
     }
 
+    /// Checks that a recording is of the kind the model was trained on: events for a
+    /// model trained on events (a model trained on sampled recordings takes both).
+    ///
+    /// # Errors
+    /// A sampled recording for a model trained on events, named.
+    pub fn check_source(&self, encoded: &Encoded) -> Result<()> {
+        crate::model::check_source(self.provenance(), encoded)
+    }
+
     /// Predicts each encoded recording's class, in parallel.
     ///
     /// # Errors
-    /// A recording on another grid than the model's, or too short for its features.
+    /// A recording on another grid than the model's or of another kind than its training
+    /// recordings ([`SavedModel::check_source`]), or too short for its features.
     pub fn predict(&self, encoded: &[Encoded]) -> Result<Vec<Prediction>> {
         match self {
             SavedModel::Features(m) => m.predict(encoded),
@@ -185,13 +195,16 @@ impl SavedModel {
     /// [`spiking_episode_decisions`]).
     ///
     /// # Errors
-    /// A rule out of range, a recording on another grid, features that cannot be computed.
+    /// A rule out of range, a recording on another grid or of another kind than the
+    /// training recordings (samples for a model trained on events), features that cannot
+    /// be computed.
     pub fn episode(
         &self,
         encoded: &Encoded,
         window_ms: usize,
         rule: DecisionRule,
     ) -> Result<Episode> {
+        self.check_source(encoded)?;
         match self {
             SavedModel::Features(m) => episode_decisions(m, encoded, window_ms, rule),
             SavedModel::Spiking(m) => spiking_episode_decisions(m, encoded, window_ms, rule),

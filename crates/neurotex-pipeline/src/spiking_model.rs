@@ -98,6 +98,29 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
     (best, shares)
 }
 
+/// Checks that a model file's network is the one its training parameters make: the same
+/// hidden layer, step, readout, recurrence and time constants (to a float's rounding in
+/// JSON). A NIR graph's network is not checked so: one run with `--like` comes from
+/// another tool, whatever the spiking model lending its pipeline was trained with.
+fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+    let fields = [
+        ("hidden", net.hidden == snn.hidden),
+        ("dt_ms", net.dt_ms == snn.dt_ms),
+        ("readout", net.readout == snn.readout),
+        ("w_rec", net.recurrent() == snn.recurrent),
+        ("tau_syn_ms", close(net.tau_syn_ms, snn.tau_syn_ms)),
+        ("tau_mem_ms", close(net.tau_mem_ms, snn.tau_mem_ms)),
+        ("tau_out_ms", close(net.tau_out_ms, snn.tau_out_ms)),
+    ];
+    match fields.iter().find(|(_, same)| !same) {
+        None => Ok(()),
+        Some((name, _)) => Err(format!(
+            "field `network.{name}` differs from the training parameters (`classifier`) that made the network"
+        )),
+    }
+}
+
 impl SpikingModel {
     /// Trains a network with `snn` on the recordings `encoded` (conditioned and encoded
     /// with `params`, all on `grid`).
@@ -166,11 +189,24 @@ impl SpikingModel {
         Ok((SpikingModel::assemble(file)?, log))
     }
 
-    /// Checks a file's content: the network's weights, and that its shape fits the
-    /// pipeline (one input per taxel and population, one readout per label).
+    /// Checks a file's content: the network's weights, that its shape fits the pipeline
+    /// (one input per taxel and population, one readout per label), the training
+    /// parameters' rules and what training guarantees of labels and provenance.
     fn assemble(file: SpikingFile) -> Result<SpikingModel> {
         let inconsistent = |what: String| -> crate::Error { ModelError::Inconsistent(what).into() };
         file.network.check().map_err(inconsistent)?;
+        file.classifier
+            .check()
+            .map_err(|e| inconsistent(format!("field `classifier`: {e}")))?;
+        let t = &file.training;
+        if !(1 <= t.best_epoch && t.best_epoch <= t.epochs && t.epochs <= file.classifier.epochs)
+            || t.recordings < file.labels.len()
+        {
+            return Err(inconsistent(format!(
+                "field `training`: best epoch {} of {} run (at most {}), on {} recordings of {} classes; training keeps an epoch it ran, on at least one recording per class",
+                t.best_epoch, t.epochs, file.classifier.epochs, t.recordings, file.labels.len()
+            )));
+        }
         let grid = Grid::masked(
             file.grid.rows(),
             file.grid.cols(),
@@ -193,6 +229,8 @@ impl SpikingModel {
                 file.labels.len()
             )));
         }
+        crate::model::check_trained(&file.labels, &file.pipeline, &grid, &t.dataset)
+            .map_err(inconsistent)?;
         let mut resolved = file.pipeline.clone();
         let baseline = resolved.preprocess.baseline;
         resolved.preprocess.baseline = Some(baseline.unwrap_or(file.training.dataset.baseline));
@@ -301,6 +339,7 @@ impl SpikingModel {
         crate::model::check_header(path, format, version, (FORMAT, VERSION))?;
         let file: SpikingFile =
             serde_json::from_value(value).map_err(|e| damaged(e.to_string()))?;
+        trained_as_said(&file.network, &file.classifier).map_err(damaged)?;
         SpikingModel::assemble(file).map_err(|e| damaged(e.to_string()))
     }
 
@@ -321,10 +360,12 @@ impl SpikingModel {
     /// Predicts each encoded recording's class, in parallel.
     ///
     /// # Errors
-    /// A recording on another grid than the model's.
+    /// A recording on another grid than the model's, or sampled for a network trained on
+    /// events.
     pub fn predict(&self, encoded: &[Encoded]) -> Result<Vec<Prediction>> {
         for e in encoded {
             self.check_grid(e)?;
+            crate::model::check_source(&self.file.training.dataset, e)?;
         }
         let net = &self.file.network;
         Ok(encoded

@@ -1,5 +1,8 @@
 //! Every reader over the fuzz seed corpus and deterministic mutations of it (bit flips,
-//! truncations, huge numbers in headers): an error is fine, a panic is not. The readers'
+//! truncations, huge numbers in headers and text, extreme binary words in records): an
+//! error is fine, a panic is not. The readers: recordings (NPY, CSV), manifests, layouts,
+//! datasets, both importers, event files (CSV, `.npy`), a live stream's event lines and
+//! records, spiking model files and NIR graphs. The readers'
 //! bodies are the fuzz targets' own (`fuzz/src/harness.rs`), so this stable test and
 //! `cargo +nightly fuzz` exercise the same paths; see `fuzz/README.md` for the long run.
 
@@ -66,8 +69,15 @@ fn sets_unbounded_size(bytes: &[u8], at: usize) -> bool {
     in_npy_header || layout_size
 }
 
-/// The mutations of one seed.
-fn mutants(seed: &[u8]) -> Vec<Mutant> {
+/// Binary words put at aligned places of binary inputs (a stream's 16-byte event records,
+/// an `.npy` event array's records, an HDF5 graph): the extremes of i64 and -1.
+const WORDS: [i64; 3] = [i64::MAX, i64::MIN, -1];
+
+/// The targets whose inputs are binary records, given [`WORDS`] too.
+const BINARY: [&str; 3] = ["stream_events", "events_npy", "nir"];
+
+/// The mutations of one seed of `target`.
+fn mutants(target: &str, seed: &[u8]) -> Vec<Mutant> {
     let mut out = Vec::new();
     let n = seed.len();
     for i in (0..n).step_by((n / 48).max(1)) {
@@ -86,6 +96,21 @@ fn mutants(seed: &[u8]) -> Vec<Mutant> {
             bytes,
             huge: false,
         });
+    }
+    if BINARY.contains(&target) {
+        // After the flags byte, every 8 bytes: a stream record's stamp, then its address,
+        // polarity and kind.
+        for at in (1..n.saturating_sub(8)).step_by(8).take(24) {
+            for word in WORDS {
+                let mut bytes = seed.to_vec();
+                bytes[at..at + 8].copy_from_slice(&word.to_le_bytes());
+                out.push(Mutant {
+                    what: format!("bytes {at}..{} set to {word} (i64, little-endian)", at + 8),
+                    bytes,
+                    huge: false,
+                });
+            }
+        }
     }
     for (start, end) in digit_runs(seed) {
         for huge in HUGE {
@@ -111,7 +136,7 @@ fn run_all(huge: bool) -> (usize, Vec<String>) {
             bytes: seed.clone(),
             huge: false,
         };
-        for m in std::iter::once(seed_itself).chain(mutants(&seed)) {
+        for m in std::iter::once(seed_itself).chain(mutants(target, &seed)) {
             if m.huge != huge {
                 continue;
             }

@@ -339,34 +339,51 @@ impl Network {
         ]
     }
 
-    /// Checks the shapes and that every weight is finite.
+    /// Checks what training guarantees: the shapes, a time step of 1 to 1000 ms, time
+    /// constants whose decays lie strictly between 0 and 1, and weights a float32 holds.
     ///
     /// # Errors
-    /// The rule broken, as a sentence.
+    /// The rule broken, as a sentence naming the field.
     pub fn check(&self) -> Result<(), String> {
         let shapes = [
-            ("w_in", self.w_in.len(), self.inputs * self.hidden),
-            ("b_in", self.b_in.len(), self.hidden),
-            ("w_out", self.w_out.len(), self.hidden * self.classes),
-            ("b_out", self.b_out.len(), self.classes),
+            (
+                "w_in",
+                self.w_in.len(),
+                self.inputs.checked_mul(self.hidden),
+            ),
+            ("b_in", self.b_in.len(), Some(self.hidden)),
+            (
+                "w_out",
+                self.w_out.len(),
+                self.hidden.checked_mul(self.classes),
+            ),
+            ("b_out", self.b_out.len(), Some(self.classes)),
         ];
         for (name, got, want) in shapes {
-            if got != want {
+            if Some(got) != want {
+                let want = want.map_or("more than memory holds".into(), |w| w.to_string());
                 return Err(format!(
                     "the network's {name} holds {got} values, not {want}"
                 ));
             }
         }
-        let square = self.hidden * self.hidden;
+        let square = self.hidden.saturating_mul(self.hidden);
         if self.recurrent() && self.w_rec.len() != square {
             let got = self.w_rec.len();
             return Err(format!(
                 "the network's w_rec holds {got} values, not hidden x hidden = {square} (or none)"
             ));
         }
-        if self.inputs == 0 || self.hidden == 0 || self.classes == 0 || self.dt_ms == 0 {
-            return Err("the network has an empty layer or a zero time step".into());
+        if self.inputs == 0 || self.hidden == 0 || self.classes == 0 {
+            return Err("the network has an empty layer".into());
         }
+        if !(1..=1000).contains(&self.dt_ms) {
+            return Err(format!(
+                "the network's dt_ms is {}; the time step must be 1 to 1000 ms",
+                self.dt_ms
+            ));
+        }
+        self.check_taus()?;
         for (name, w) in [
             ("w_in", &self.w_in),
             ("b_in", &self.b_in),
@@ -374,13 +391,37 @@ impl Network {
             ("b_out", &self.b_out),
             ("w_rec", &self.w_rec),
         ] {
-            if let Some(pos) = w.iter().position(|v| !v.is_finite()) {
-                return Err(format!("the network's {name}[{pos}] is not finite"));
+            // Training rounds every weight to float32 (what NIR and NumPy files hold); a
+            // larger one is damage, and could overflow a readout's sum to infinity.
+            if let Some(pos) = w
+                .iter()
+                .position(|v| !v.is_finite() || v.abs() > f64::from(f32::MAX))
+            {
+                return Err(format!(
+                    "the network's {name}[{pos}] is {:?}, not a finite float32 value",
+                    w[pos]
+                ));
             }
         }
-        let taus = [self.tau_syn_ms, self.tau_mem_ms, self.tau_out_ms];
-        if taus.iter().any(|t| !(*t > 0.0 && t.is_finite())) {
-            return Err("the network's time constants must be positive and finite".into());
+        Ok(())
+    }
+
+    /// Checks that each time constant is positive and finite and gives a decay per step
+    /// strictly between 0 and 1 (a decay of 0 or 1 has no continuous-time constant, so no
+    /// NIR graph).
+    fn check_taus(&self) -> Result<(), String> {
+        let (alpha, beta, kappa) = self.decays();
+        for (name, tau, decay) in [
+            ("tau_syn_ms", self.tau_syn_ms, alpha),
+            ("tau_mem_ms", self.tau_mem_ms, beta),
+            ("tau_out_ms", self.tau_out_ms, kappa),
+        ] {
+            if !(tau > 0.0 && tau.is_finite() && decay > 0.0 && decay < 1.0) {
+                return Err(format!(
+                    "the network's {name} is {tau:?}, which gives the decay {decay} per step of {} ms; a time constant must be positive and finite, its decay strictly between 0 and 1",
+                    self.dt_ms
+                ));
+            }
         }
         Ok(())
     }

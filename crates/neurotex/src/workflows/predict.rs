@@ -79,7 +79,8 @@ impl PredictOptions {
     /// saying where layouts came from and what conditioning noticed.
     ///
     /// # Errors
-    /// A recording that cannot be read, or does not fit the model.
+    /// A recording that cannot be read, or does not fit the model (sampled, for a model
+    /// trained on events).
     pub fn encode(
         &self,
         model: &SavedModel,
@@ -96,6 +97,10 @@ impl PredictOptions {
                 encoded
             }
         };
+        // Refused before anything else is said of them, --causal's needs included.
+        for e in &encoded {
+            model.check_source(e)?;
+        }
         say_conditions(&encoded, on);
         Ok(encoded)
     }
