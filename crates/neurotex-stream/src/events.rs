@@ -25,7 +25,7 @@ use crate::frames::{Replay, Sink};
 use crate::pipeline::Encoding;
 use crate::recording::TimeUnit;
 use crate::saved::{SavedModel, Trained};
-use crate::signal::CausalConditioning;
+use crate::signal::{CausalConditioning, ENCODER_FS};
 use crate::StreamParams;
 
 /// The bytes of one binary event record, little-endian: `t` i64 (in the stream's unit,
@@ -288,8 +288,12 @@ impl StreamClassifier {
         state.episodes += 1;
         state.last_event = None;
         let unit = state.source.format.time_unit;
+        // Time 0 is the stream's first stamp: a first event more than the largest gap
+        // after it is a jump, as between frames, and the episode counts from the event
+        // (which also bounds the silent steps one event completes).
+        let max_gap_steps = (self.params.max_gap_s * ENCODER_FS) as u64;
         match stamp.step_from(state.origin, unit) {
-            Ok(s) if s < super::MAX_EPISODE_STEPS as u64 => s,
+            Ok(s) if s <= max_gap_steps => s,
             // Before time 0 or too far past it: the episode counts from this stamp.
             _ => {
                 state.origin = stamp;
