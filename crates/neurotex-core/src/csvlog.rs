@@ -493,13 +493,16 @@ fn first_line_names(path: &Path, format: &CsvFormat) -> Result<Vec<String>> {
     open_log(path, format).map(|(_, _, names)| names)
 }
 
+/// A log file as its reader reads it: a regular file, a line at a time up to the limit.
+type LogFile = crate::io::LineBounded<std::fs::File>;
+
 /// A reader of the log at `path` as `format` says, past its first line: the reader, the
 /// delimiter (given or detected) and the first line's fields as column names (header
 /// names, or `column{index}` without a header, the first line then still to be read).
 fn open_log(
     path: &Path,
     format: &CsvFormat,
-) -> Result<(csv::Reader<std::fs::File>, Delimiter, Vec<String>)> {
+) -> Result<(csv::Reader<LogFile>, Delimiter, Vec<String>)> {
     let delimiter = match format.delimiter {
         Some(d) => d,
         None => detect_delimiter(path)?,
@@ -508,8 +511,7 @@ fn open_log(
         .delimiter(delimiter.byte())
         .has_headers(format.header)
         .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| csv_error(path, e))?;
+        .from_reader(crate::io::open_text(path)?);
     let first = reader.headers().map_err(|e| csv_error(path, e))?;
     let names = match format.header {
         true => first.iter().map(str::to_string).collect(),
@@ -549,8 +551,9 @@ fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
 /// Guesses a file's delimiter from its first lines ([`detect_delimiter_in`]).
 fn detect_delimiter(path: &Path) -> Result<Delimiter> {
     let mut head = Vec::with_capacity(16 * 1024);
-    std::fs::File::open(path)
-        .and_then(|f| f.take(16 * 1024).read_to_end(&mut head))
+    crate::io::open_input(path)?
+        .take(16 * 1024)
+        .read_to_end(&mut head)
         .map_err(|e| DataError::io(path, e))?;
     let text = String::from_utf8_lossy(&head);
     let mut lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
@@ -1094,7 +1097,7 @@ pub(crate) fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
             let csv::ErrorKind::Io(io) = e.into_kind() else {
                 unreachable!()
             };
-            DataError::io(path, io).into()
+            crate::io::read_error(path, io)
         }
         _ => {
             let line = e

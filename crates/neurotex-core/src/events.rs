@@ -564,15 +564,16 @@ fn parse_csv(
     sink: &mut impl FnMut(Parsed) -> Result<(), String>,
 ) -> Result<()> {
     let bad = |m: String| -> crate::Error { DataError::invalid(path, m).into() };
-    let file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
+    let file = crate::io::open_text(path)?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(false)
         .from_reader(std::io::BufReader::with_capacity(1 << 16, file));
-    let header = reader
-        .byte_headers()
-        .map_err(|e| bad(format!("not a CSV file with a header row: {e}")))?
-        .clone();
+    let header = match reader.byte_headers() {
+        Ok(header) => header.clone(),
+        Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
+        Err(e) => return Err(bad(format!("not a CSV file with a header row: {e}"))),
+    };
     let names: Vec<&str> = header
         .iter()
         .map(|h| std::str::from_utf8(h).unwrap_or(""))
@@ -595,6 +596,7 @@ fn parse_csv(
         match reader.read_byte_record(&mut record) {
             Ok(false) => break,
             Ok(true) => {}
+            Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
             Err(e) => return Err(bad(format!("line {}: {e}", line + 1))),
         }
         // The line the record starts on, as the CSV reader counts lines.

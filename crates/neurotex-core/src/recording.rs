@@ -354,7 +354,7 @@ impl LayoutFile {
     /// # Errors
     /// The file is unreadable, not TOML of this form, or inconsistent.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, e))?;
+        let text = crate::io::read_text(path)?;
         let file: LayoutFile = toml::from_str(&text)
             .map_err(|e| DataError::invalid(path, format!("not a valid layout file: {e}")))?;
         file.check(path)?;
@@ -623,7 +623,17 @@ impl Dataset {
         }
         let (columns, entries) = read_manifest_columns(&manifest_path)?;
         for (i, m) in entries.iter().enumerate() {
-            if !root.join(&m.file).is_file() {
+            let file = root.join(&m.file);
+            if let Some(meta) = std::fs::metadata(&file).ok().filter(|m| !m.is_file()) {
+                let kind = crate::io::kind_name(meta.file_type());
+                let why = format!(
+                    "line {}: file `{}` is {kind}, not a regular file: a dataset's recordings are regular files",
+                    i + 2,
+                    m.file
+                );
+                return Err(DataError::invalid(&manifest_path, why).into());
+            }
+            if !file.is_file() {
                 return Err(DataError::invalid(
                     &manifest_path,
                     format!(
@@ -1000,8 +1010,7 @@ fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Meta>)> {
     // refuse two that differ only by surrounding spaces, which trimming would make one class.
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::Headers)
-        .from_path(path)
-        .map_err(|e| csv_error(path, e))?;
+        .from_reader(crate::io::open_text(path)?);
     let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
     let columns = ManifestColumns::find(path, &headers)?;
     let mut out = Vec::new();
