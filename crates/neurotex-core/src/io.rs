@@ -658,6 +658,11 @@ fn write_record(tmp: &Path, dir: &Path) -> Result<()> {
 /// (the earlier output is then put back).
 pub fn replace_dir<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
     let _claim = claim_output_dir(dir)?;
+    let name = dir.file_name().unwrap_or_default().to_string_lossy();
+    let prefix = format!(".{name}.old-");
+    // A run killed between the two renames below left its earlier output aside, and `dir`
+    // absent: removed whichever way this run writes `dir`.
+    remove_stale(parent(dir), &prefix);
     let is_empty = |d: &Path| std::fs::read_dir(d).is_ok_and(|mut e| e.next().is_none());
     if !dir.exists() || is_empty(dir) {
         return create_dir_atomic(dir, |tmp| {
@@ -670,9 +675,6 @@ pub fn replace_dir<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -> Resu
     std::fs::create_dir(tmp.path()).map_err(|e| DataError::write(dir, e))?;
     let value = fill(tmp.path()).map_err(|e| named_in(e, tmp.path(), dir))?;
     write_record(tmp.path(), dir)?;
-    let name = dir.file_name().unwrap_or_default().to_string_lossy();
-    let prefix = format!(".{name}.old-");
-    remove_stale(parent(dir), &prefix);
     let old = Temporary::new(parent(dir).join(format!("{prefix}{}", std::process::id())));
     std::fs::rename(dir, old.path()).map_err(|e| DataError::write(dir, e))?;
     if let Err(e) = tmp.persist(dir) {
