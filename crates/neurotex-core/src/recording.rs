@@ -737,11 +737,13 @@ impl Dataset {
         let max_s = self.layout.max_duration_s.unwrap_or(DEFAULT_MAX_DURATION_S);
         // Spike times are u32 milliseconds: at most 49 days, far past any limit one sets.
         let max_steps = ((max_s * 1000.0) as u64).min(u64::from(u32::MAX));
-        if let Some(d) = duration.filter(|&d| d > max_steps) {
+        let limit = crate::events::StepLimit::new(max_steps, rows * cols);
+        if let Some(d) = duration.filter(|&d| d > limit.steps) {
             let why = format!(
-                "line {}: duration_s {} s is longer than the longest recording accepted ({max_s} s, layout.toml's max_duration_s)",
+                "line {}: duration_s {} s is longer than {}",
                 index + 2,
-                d as f64 / 1000.0
+                d as f64 / 1000.0,
+                limit.describe()
             );
             return Err(DataError::invalid(manifest(), why).into());
         }
