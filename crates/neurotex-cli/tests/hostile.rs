@@ -691,3 +691,91 @@ fn a_line_longer_than_the_limit_is_refused_naming_it() {
     );
     assert!(!dir.join("f.csv").exists() && !dir.join("ds").exists());
 }
+
+#[test]
+fn a_repeated_column_name_is_refused_in_every_table_read() {
+    let dir = Dir::new();
+    let both = |i: usize, j: usize, name: &str| {
+        format!("columns {i} and {j} of line 1 are both named `{name}`: each column read needs a name of its own")
+    };
+    // an event log, imported
+    let logs = dir.join("logs");
+    std::fs::create_dir(&logs).unwrap();
+    std::fs::write(logs.join("a.csv"), "t,x,y,x,p\n0,0,0,1,1\n300,1,1,0,0\n").unwrap();
+    let err = dir.fails(&[
+        "import",
+        "events",
+        "logs",
+        "--out",
+        "eds",
+        "--grid",
+        "2x2",
+        "--time-unit",
+        "ms",
+    ]);
+    assert!(
+        err.contains("a.csv") && err.contains(&both(2, 4, "x")),
+        "{err}"
+    );
+    // an event dataset's file, and one column named for two roles in its layout
+    let ds = dir.join("events");
+    std::fs::create_dir(&ds).unwrap();
+    std::fs::write(ds.join("a.csv"), "t,x,y,p\n0,0,0,1\n300,1,1,0\n").unwrap();
+    std::fs::write(ds.join("b.csv"), "t,x,y,p,p\n0,0,0,1,0\n300,1,1,0,1\n").unwrap();
+    std::fs::write(ds.join("manifest.csv"), "file,label\na.csv,A\nb.csv,B\n").unwrap();
+    let layout = "rows = 2\ncols = 2\n\n[events]\ntime_unit = \"ms\"\n";
+    std::fs::write(ds.join("layout.toml"), layout).unwrap();
+    let features = |data: &str| {
+        dir.fails(&[
+            "features",
+            "--dataset",
+            data,
+            "--method",
+            "glcm3d",
+            "--out",
+            "f.csv",
+        ])
+    };
+    let err = features("events");
+    assert!(
+        err.contains("b.csv") && err.contains(&both(4, 5, "p")),
+        "{err}"
+    );
+    std::fs::write(ds.join("b.csv"), "t,x,y,p\n0,0,0,1\n300,1,1,0\n").unwrap();
+    std::fs::write(
+        ds.join("layout.toml"),
+        format!("{layout}polarity = \"x\"\n"),
+    )
+    .unwrap();
+    let err = features("events");
+    assert!(
+        err.contains("column `x` is both x and the polarity"),
+        "{err}"
+    );
+    // a manifest
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    for (header, name, at) in [
+        ("session,session", "session", (8, 9)),
+        ("label", "label", (2, 8)),
+    ] {
+        let changed: String = manifest
+            .lines()
+            .enumerate()
+            .map(|(i, line)| match i {
+                0 => format!("{line},{header}\n"),
+                _ => format!(
+                    "{line},{}\n",
+                    if header.contains(',') { "s1,s2" } else { "A" }
+                ),
+            })
+            .collect();
+        std::fs::write(data.join("manifest.csv"), changed).unwrap();
+        let err = features("data");
+        assert!(
+            err.contains("manifest.csv") && err.contains(&both(at.0, at.1, name)),
+            "{err}"
+        );
+    }
+    assert!(!dir.join("f.csv").exists() && !dir.join("eds").exists());
+}

@@ -718,23 +718,38 @@ fn unique_names<'a>(
     names: &[String],
     used: impl Iterator<Item = &'a usize>,
 ) -> Result<()> {
+    let why = "layouts, models and imported datasets find channels by name";
+    match repeated_name(names, used.copied(), why) {
+        Some(message) => Err(invalid(path, message)),
+        None => Ok(()),
+    }
+}
+
+/// The message refusing two of the columns `used` (indices into a header's `names`) that
+/// share one name, `why` saying what finds columns by name; `None` when they are distinct.
+/// Every table neurotex reads by column name refuses a repeated name with it: a reader
+/// finds the first column of a name, and the other's values would be silently unread.
+pub(crate) fn repeated_name<S: AsRef<str>>(
+    names: &[S],
+    used: impl Iterator<Item = usize>,
+    why: &str,
+) -> Option<String> {
     let mut first: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
-    for &j in used {
-        if let Some(&i) = first.get(names[j].as_str()) {
+    for j in used {
+        let name = names[j].as_ref();
+        if let Some(&i) = first.get(name) {
             let (i, j) = (i.min(j), i.max(j));
-            let message = format!(
+            return Some(format!(
                 "columns {} and {} of line 1 are both named `{}`: each column read needs a \
-                 name of its own (layouts, models and imported datasets find channels by \
-                 name), so rename them in the header row",
+                 name of its own ({why}), so rename them in the header row",
                 i + 1,
                 j + 1,
-                excerpt(&names[j])
-            );
-            return Err(invalid(path, message));
+                excerpt(name)
+            ));
         }
-        first.insert(&names[j], j);
+        first.insert(name, j);
     }
-    Ok(())
+    None
 }
 
 /// `text`, cut to its first 60 characters (with `...`) so that an error never echoes a

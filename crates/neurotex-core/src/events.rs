@@ -587,15 +587,36 @@ fn columns(names: &[&str], format: &EventsFormat) -> Result<Columns, String> {
             )
         })
     };
+    let named = (0..names.len()).filter(|&j| !names[j].trim().is_empty());
+    let trimmed: Vec<&str> = names.iter().map(|n| n.trim()).collect();
+    let why = "an event log's time, cell and polarity are found by name";
+    if let Some(message) = crate::csvlog::repeated_name(&trimmed, named, why) {
+        return Err(message);
+    }
     let cell = match &format.taxel {
         Some(taxel) => CellColumns::Taxel(need(taxel)?),
         None => CellColumns::Xy(need(&format.x)?, need(&format.y)?),
     };
-    Ok(Columns {
+    let columns = Columns {
         time: need(&format.time)?,
         cell,
         polarity: find(&format.polarity),
-    })
+    };
+    let mut roles = vec![("the time", columns.time)];
+    match columns.cell {
+        CellColumns::Xy(x, y) => roles.extend([("x", x), ("y", y)]),
+        CellColumns::Taxel(t) => roles.push(("the taxel", t)),
+    }
+    roles.extend(columns.polarity.map(|p| ("the polarity", p)));
+    for (k, &(what, j)) in roles.iter().enumerate() {
+        if let Some(&(other, _)) = roles[..k].iter().find(|&&(_, i)| i == j) {
+            return Err(format!(
+                "column `{}` is both {other} and {what}: each needs a column of its own (layout.toml's [events] table or `import events` options name them)",
+                names[j].trim()
+            ));
+        }
+    }
+    Ok(columns)
 }
 
 fn parse_csv(

@@ -1081,6 +1081,11 @@ struct ManifestColumns {
 
 impl ManifestColumns {
     fn find(path: &Path, headers: &csv::StringRecord) -> Result<Self> {
+        let names: Vec<&str> = headers.iter().collect();
+        let why = "a manifest's fields are found by column name";
+        if let Some(message) = crate::csvlog::repeated_name(&names, 0..names.len(), why) {
+            return Err(DataError::invalid(path, message).into());
+        }
         let col = |name: &str| headers.iter().position(|h| h == name);
         let mut required = [0usize; 2];
         for (slot, name) in required.iter_mut().zip(MANIFEST_COLUMNS) {
