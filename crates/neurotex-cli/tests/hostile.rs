@@ -779,3 +779,64 @@ fn a_repeated_column_name_is_refused_in_every_table_read() {
     }
     assert!(!dir.join("f.csv").exists() && !dir.join("eds").exists());
 }
+
+#[test]
+fn layout_values_an_import_would_refuse_are_refused_on_reading() {
+    let dir = Dir::new();
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let grid = "rows = 4\ncols = 4\n";
+    let row_major: Vec<String> = (0..16).map(|k| format!("[{}, {}]", k / 4, k % 4)).collect();
+    let map = format!("channel_map = [{}]\n", row_major.join(", "));
+    let cases = [
+        (
+            format!("{grid}mask = [\"0000\", \"0000\", \"0000\", \"0000\"]\n"),
+            "field `mask` must leave at least one taxel",
+        ),
+        (
+            format!("{grid}mask = [\"1110\", \"1111\", \"1111\", \"1111\"]\n{map}"),
+            "field `channel_map`: channel 3 maps to [0, 3], a cell the mask marks empty",
+        ),
+        (
+            format!("{grid}channels = [\"a\", \"b\", \"c\"]\n"),
+            "field `channels` names 3 channels, but the 4x4 grid has 16 taxel cells",
+        ),
+        (
+            format!("{grid}channels = [\"a\", \"b\"]\n{map}"),
+            "field `channel_map` has 16 cells for the 2 channels of `channels`",
+        ),
+        (
+            "channels = [\"a\", \"b\", \"a\"]\n".to_string(),
+            "field `channels` names `a` twice (entries 1 and 3)",
+        ),
+        (
+            format!("{grid}\n[events]\ntime_unit = \"ms\"\nvalues = [1, 1]\n"),
+            "the ON and OFF polarity values must be two different integers",
+        ),
+    ];
+    for (layout, says) in cases {
+        std::fs::write(data.join("layout.toml"), &layout).unwrap();
+        let err = dir.fails(&[
+            "features",
+            "--dataset",
+            "data",
+            "--method",
+            "glcm3d",
+            "--out",
+            "f.csv",
+        ]);
+        assert!(
+            err.contains("layout.toml") && err.contains(says),
+            "{layout}: {err}"
+        );
+        let err = dir.fails(&[
+            "encode",
+            "data/A_5_0.npy",
+            "--layout",
+            "data/layout.toml",
+            "--out",
+            "s.npy",
+        ]);
+        assert!(err.contains(says), "{layout}: {err}");
+    }
+    assert!(!dir.join("f.csv").exists() && !dir.join("s.npy").exists());
+}

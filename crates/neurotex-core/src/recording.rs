@@ -399,29 +399,22 @@ impl LayoutFile {
         }
     }
 
+    /// Checks every field against the rules the importers apply to the same values, so a
+    /// layout written by hand is refused where an import's options would have been.
     fn check(&self, path: &Path) -> Result<()> {
         let bad = |m: String| -> Result<()> { Err(DataError::invalid(path, m).into()) };
         if let Err(e) = self.csv_formats(&CsvOverrides::default()) {
             return bad(e.to_string());
         }
-        if let Some(fs) = self.fs {
-            if !(fs.is_finite() && fs > 0.0) {
+        let positive = [
+            ("fs", self.fs, "Hz"),
+            ("max_gap_s", self.max_gap_s, "s"),
+            ("max_duration_s", self.max_duration_s, "s"),
+        ];
+        for (field, value, unit) in positive {
+            if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
                 return bad(format!(
-                    "field `fs` must be a positive number of Hz, got {fs}"
-                ));
-            }
-        }
-        if let Some(gap) = self.max_gap_s {
-            if !(gap.is_finite() && gap > 0.0) {
-                return bad(format!(
-                    "field `max_gap_s` must be a positive number of s, got {gap}"
-                ));
-            }
-        }
-        if let Some(max) = self.max_duration_s {
-            if !(max.is_finite() && max > 0.0) {
-                return bad(format!(
-                    "field `max_duration_s` must be a positive number of s, got {max}"
+                    "field `{field}` must be a positive number of {unit}, got {v}"
                 ));
             }
         }
@@ -429,51 +422,94 @@ impl LayoutFile {
             return bad("fields `rows` and `cols` must be given together".into());
         }
         if let (Some(r), Some(c)) = (self.rows, self.cols) {
-            if r == 0 || c == 0 {
-                return bad(format!("grid must be at least 1x1, got {r}x{c}"));
-            }
-            if let Err(e) = crate::values::check_grid_cells(r, c) {
-                return bad(format!("fields `rows` and `cols`: {e}"));
-            }
-            if let Some(map) = &self.channel_map {
-                let mut seen = vec![false; r * c];
-                for (ch, &[mr, mc]) in map.iter().enumerate() {
-                    if mr >= r || mc >= c {
-                        return bad(format!(
-                            "field `channel_map`: channel {ch} maps to [{mr}, {mc}], outside the {r}x{c} grid"
-                        ));
-                    }
-                    if std::mem::replace(&mut seen[mr * c + mc], true) {
-                        return bad(format!(
-                            "field `channel_map`: cell [{mr}, {mc}] is given twice"
-                        ));
-                    }
-                }
-            }
-            if let Some(mask) = &self.mask {
-                if mask.len() != r || mask.iter().any(|row| row.chars().count() != c) {
-                    return bad(format!(
-                        "field `mask` must have {r} strings of {c} characters"
-                    ));
-                }
-                if mask
-                    .iter()
-                    .any(|row| row.chars().any(|ch| ch != '0' && ch != '1'))
-                {
-                    return bad("field `mask` may hold only `0` and `1`".into());
-                }
-            }
+            self.check_grid(r, c).or_else(bad)?;
         } else if self.channel_map.is_some() || self.mask.is_some() {
             return bad("fields `channel_map` and `mask` need `rows` and `cols`".into());
         }
-        if self.events.is_some() && self.rows.is_none() {
-            return bad("an [events] table needs the grid: give `rows` and `cols`".into());
+        if let Some(channels) = &self.channels {
+            // A column named twice would be read twice, as two taxels of one signal.
+            let mut seen = std::collections::HashMap::new();
+            for (j, name) in channels.iter().enumerate() {
+                if let Some(i) = seen.insert(name.as_str(), j) {
+                    return bad(format!(
+                        "field `channels` names `{}` twice (entries {} and {}): each channel is a column of its own",
+                        crate::csvlog::excerpt(name),
+                        i + 1,
+                        j + 1
+                    ));
+                }
+            }
+        }
+        if let Some(events) = &self.events {
+            if self.rows.is_none() {
+                return bad("an [events] table needs the grid: give `rows` and `cols`".into());
+            }
+            let [on, off] = events.values;
+            if on == off {
+                return bad(format!("[events] `values`: the ON and OFF polarity values must be two different integers, got [{on}, {off}]"));
+            }
         }
         if let Some(Baseline::Mean { start_s, end_s }) = self.baseline {
             if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
                 return bad(format!(
                     "field `baseline`: mean interval must satisfy 0 <= start_s < end_s, got [{start_s}, {end_s}]"
                 ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The grid's fields on a `r x c` grid: its size, the mask (its shape, at least one
+    /// taxel), and the channel map (one cell per channel, each on the grid, none twice,
+    /// none masked, as many as `channels`); `Err` says which rule is broken.
+    fn check_grid(&self, r: usize, c: usize) -> std::result::Result<(), String> {
+        if r == 0 || c == 0 {
+            return Err(format!("grid must be at least 1x1, got {r}x{c}"));
+        }
+        crate::values::check_grid_cells(r, c)
+            .map_err(|e| format!("fields `rows` and `cols`: {e}"))?;
+        if let Some(mask) = &self.mask {
+            if mask.len() != r || mask.iter().any(|row| row.chars().count() != c) {
+                return Err(format!(
+                    "field `mask` must have {r} strings of {c} characters"
+                ));
+            }
+            if mask
+                .iter()
+                .any(|row| row.chars().any(|ch| ch != '0' && ch != '1'))
+            {
+                return Err("field `mask` may hold only `0` and `1`".into());
+            }
+            if mask.iter().all(|row| !row.contains('1')) {
+                return Err("field `mask` must leave at least one taxel (a `1`)".into());
+            }
+        }
+        let present = self.present(r * c);
+        let channels = self.channels.as_ref().map(Vec::len);
+        let Some(map) = &self.channel_map else {
+            let taxels = present.iter().filter(|&&p| p).count();
+            return match channels.filter(|&n| n != taxels) {
+                Some(n) => Err(format!("field `channels` names {n} channels, but the {r}x{c} grid has {taxels} taxel cells and no `channel_map` places them")),
+                None => Ok(()),
+            };
+        };
+        if let Some(n) = channels.filter(|&n| n != map.len()) {
+            return Err(format!("field `channel_map` has {} cells for the {n} channels of `channels`: the map needs one cell per channel", map.len()));
+        }
+        let mut seen = vec![false; r * c];
+        for (ch, &[mr, mc]) in map.iter().enumerate() {
+            if mr >= r || mc >= c {
+                return Err(format!(
+                    "field `channel_map`: channel {ch} maps to [{mr}, {mc}], outside the {r}x{c} grid"
+                ));
+            }
+            if std::mem::replace(&mut seen[mr * c + mc], true) {
+                return Err(format!(
+                    "field `channel_map`: cell [{mr}, {mc}] is given twice"
+                ));
+            }
+            if !present[mr * c + mc] {
+                return Err(format!("field `channel_map`: channel {ch} maps to [{mr}, {mc}], a cell the mask marks empty"));
             }
         }
         Ok(())
