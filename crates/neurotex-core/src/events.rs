@@ -264,7 +264,7 @@ impl Columns {
 
 /// The longest an event recording may last, in 1 ms steps: the layout's `max_duration_s`,
 /// and the bound sampled recordings keep on what a recording becomes on its grid at 1 kHz
-/// (at most `max_duration_s` x [`crate::recording::VALUES_PER_LIMIT_S`] values). Feature
+/// (at most `max_duration_s` x [`crate::values::VALUES_PER_LIMIT_S`] values). Feature
 /// methods plan a value per cell and millisecond (rasters, rate volumes), so a handful of
 /// events on a huge grid would otherwise ask for gigabytes; a larger grid may last
 /// proportionally less.
@@ -281,7 +281,7 @@ pub struct StepLimit {
 impl StepLimit {
     /// The limit on a grid of `cells` cells under a span limit of `span_steps` ms.
     pub fn new(span_steps: u64, cells: usize) -> Self {
-        let per_ms = crate::recording::VALUES_PER_LIMIT_S / 1000.0;
+        let per_ms = crate::values::VALUES_PER_LIMIT_S / 1000.0;
         let on_grid = (span_steps as f64 * per_ms / cells.max(1) as f64).floor() as u64;
         StepLimit {
             steps: span_steps.min(on_grid),

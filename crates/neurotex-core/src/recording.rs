@@ -1481,10 +1481,7 @@ fn onto_cells(raw: Vec<f64>, n_channels: usize, lay: &Layout) -> Vec<f64> {
     out
 }
 
-/// Samples per second of `max_duration_s` that one recording may hold once placed on its
-/// grid and resampled to 1 kHz: the paper's 16 taxels. With the default hour that is 57.6
-/// million values, 460 MB as f64; a larger grid may span proportionally less.
-pub const VALUES_PER_LIMIT_S: f64 = 16_000.0;
+pub use crate::values::VALUES_PER_LIMIT_S;
 
 /// A recording's time span must stay within the layout's `max_duration_s` (default
 /// [`DEFAULT_MAX_DURATION_S`]), and so must what it becomes in memory: resampling allocates
