@@ -322,3 +322,32 @@ fn temporaries_of_a_killed_run_are_removed_by_the_next() {
         ]
     );
 }
+
+#[test]
+fn an_earlier_output_set_aside_by_a_killed_run_is_removed_by_the_next() {
+    let dir = Dir::new();
+    dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let inspect = |out: &str| dir.ok(&["inspect", "data", "--no-encoder", "--out", out]);
+    inspect("fresh");
+    // What `kill -9` between replace's two renames leaves: the earlier output moved aside
+    // as `.rep.old-PID` and the new one still `.rep.partial-PID`, of a process that is gone
+    // (no process has a PID this large), and no `rep`.
+    let old = dir.join(".rep.old-4194999");
+    std::fs::create_dir(&old).unwrap();
+    std::fs::write(old.join("inspect.md"), "the earlier report").unwrap();
+    let partial = dir.join(".rep.partial-4194999");
+    std::fs::create_dir(&partial).unwrap();
+    std::fs::write(partial.join("inspect.md"), "the new report").unwrap();
+    inspect("rep");
+    assert_eq!(names(dir.path()), ["data", "fresh", "rep"]);
+    assert_eq!(names(&dir.join("rep")), names(&dir.join("fresh")));
+    let report = std::fs::read_to_string(dir.join("rep/inspect.md")).unwrap();
+    assert_eq!(
+        report,
+        std::fs::read_to_string(dir.join("fresh/inspect.md")).unwrap()
+    );
+    // and when the earlier output is still in place beside such a leftover
+    std::fs::create_dir(&old).unwrap();
+    inspect("rep");
+    assert_eq!(names(dir.path()), ["data", "fresh", "rep"]);
+}

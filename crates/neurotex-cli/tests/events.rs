@@ -654,3 +654,80 @@ fn imported_logs_read_as_the_events_they_hold() {
         assert!(err.contains(says), "{extra:?}: {err}");
     }
 }
+
+#[test]
+fn event_recordings_keep_the_bound_on_values_on_the_grid_that_sampled_ones_keep() {
+    let dir = Dir::new();
+    let out = dir.join("f.csv");
+    // max_duration_s = 1 allows 16 000 values on the grid: 62 ms of a 16x16 grid.
+    let ds = dir.join("big");
+    std::fs::create_dir(&ds).unwrap();
+    let events = "t,x,y,p\n0,0,0,1\n30,5,5,0\n500,15,15,1\n";
+    for file in ["a.csv", "b.csv"] {
+        std::fs::write(ds.join(file), events).unwrap();
+    }
+    let layout = "rows = 16\ncols = 16\nmax_duration_s = 1\n\n[events]\ntime_unit = \"ms\"\n";
+    std::fs::write(ds.join("layout.toml"), layout).unwrap();
+    std::fs::write(ds.join("manifest.csv"), "file,label\na.csv,A\nb.csv,B\n").unwrap();
+    let features = [
+        "features",
+        "--dataset",
+        s(&ds),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ];
+    let err = dir.fails(&features);
+    let bound = "the 62 ms a recording on 256 grid cells may last";
+    assert!(
+        err.contains("a.csv")
+            && err.contains("line 4: time 500 is at 500 ms, past")
+            && err.contains(bound),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // a duration in the manifest is checked before the file is read
+    let manifest = "file,label,duration_s\na.csv,A,0.5\nb.csv,B,0.05\n";
+    std::fs::write(ds.join("manifest.csv"), manifest).unwrap();
+    let err = dir.fails(&features);
+    assert!(
+        err.contains("manifest.csv: line 2: duration_s 0.5 s is longer than")
+            && err.contains(bound),
+        "{err}"
+    );
+    // within the bound (62 steps, the last at 61 ms) it reads
+    std::fs::write(ds.join("a.csv"), "t,x,y,p\n0,0,0,1\n61,5,5,0\n").unwrap();
+    std::fs::write(ds.join("b.csv"), "t,x,y,p\n0,0,0,1\n61,5,5,0\n").unwrap();
+    std::fs::write(ds.join("manifest.csv"), "file,label\na.csv,A\nb.csv,B\n").unwrap();
+    dir.ok(&[&features[..], &["--bin-ms", "20"]].concat());
+    std::fs::write(ds.join("b.csv"), "t,x,y,p\n0,0,0,1\n62,5,5,0\n").unwrap();
+    let err = dir.fails(&[&features[..], &["--bin-ms", "20"]].concat());
+    assert!(err.contains("b.csv") && err.contains(bound), "{err}");
+    // an import onto a 1024x1024 grid: an hour allows 54 ms
+    let logs = dir.join("logs");
+    std::fs::create_dir(&logs).unwrap();
+    for i in 0..6 {
+        let text: String = (0..100)
+            .map(|k| format!("{},{},{},1\n", k * 10, (k * 37 + i) % 1024, (k * 91) % 1024))
+            .collect();
+        std::fs::write(logs.join(format!("l{i}.csv")), format!("t,x,y,p\n{text}")).unwrap();
+    }
+    let imported = dir.join("imported");
+    let err = dir.fails(&[
+        "import",
+        "events",
+        s(&logs),
+        "--out",
+        s(&imported),
+        "--grid",
+        "1024x1024",
+        "--time-unit",
+        "ms",
+    ]);
+    assert!(
+        err.contains("the 54 ms a recording on 1048576 grid cells may last"),
+        "{err}"
+    );
+    assert!(!imported.exists());
+}

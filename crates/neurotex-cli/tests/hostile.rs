@@ -466,3 +466,377 @@ fn glcm_counts_beyond_u32_are_counted_in_u64() {
         );
     }
 }
+
+/// Runs `neurotex args...` in `dir`, killing it and failing the test when it has not ended
+/// within a minute (a reader blocked on a pipe never would); returns its exit code and
+/// standard error.
+#[cfg(unix)]
+fn run_or_hang(dir: &Dir, args: &[&str]) -> (Option<i32>, String) {
+    use std::io::Read;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_neurotex"))
+        .args(args)
+        .current_dir(dir.path())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("neurotex {args:?} did not end within a minute");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    (status.code(), err)
+}
+
+/// A FIFO at `path`.
+#[cfg(unix)]
+fn fifo(path: &Path) {
+    let made = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .unwrap();
+    assert!(made.success());
+}
+
+#[cfg(unix)]
+#[test]
+fn what_is_not_a_regular_file_is_left_out_of_folders_and_refused_by_name() {
+    let dir = Dir::new();
+    let logs = dir.join("logs");
+    std::fs::create_dir(&logs).unwrap();
+    let rows: String = (0..400).map(|i| format!("{i},{},1\n", i % 7)).collect();
+    std::fs::write(logs.join("a_1.csv"), format!("t_ms,c0,c1\n{rows}")).unwrap();
+    std::fs::write(logs.join("b_1.csv"), format!("t_ms,c0,c1\n{rows}")).unwrap();
+    fifo(&logs.join("pipe.csv"));
+    std::os::unix::fs::symlink("/dev/zero", logs.join("zero.csv")).unwrap();
+    let read = ["--time-column", "t_ms"];
+    // In a folder: left out, with a warning naming each.
+    let (code, err) = run_or_hang(
+        &dir,
+        &[&["import", "csv", "logs", "--out", "ds"], &read[..]].concat(),
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("pipe.csv: is a pipe (FIFO), not a regular file"),
+        "{err}"
+    );
+    assert!(
+        err.contains("zero.csv: is a character device, not a regular file"),
+        "{err}"
+    );
+    let (code, err) = run_or_hang(
+        &dir,
+        &[&["inspect", "logs", "--no-encoder"], &read[..]].concat(),
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("pipe.csv: is a pipe (FIFO)"), "{err}");
+    // Named: refused.
+    for name in ["logs/pipe.csv", "logs/zero.csv"] {
+        for args in [
+            vec!["inspect", name, "--no-encoder"],
+            vec!["import", "csv", name, "--out", "ds2"],
+            vec!["encode", name, "--out", "spikes.npy"],
+        ] {
+            let (code, err) = run_or_hang(&dir, &[&args[..], &read[..]].concat());
+            assert_eq!(code, Some(1), "{args:?}: {err}");
+            assert!(err.contains("not a regular file"), "{args:?}: {err}");
+        }
+    }
+    // Event logs alike.
+    let events = dir.join("events");
+    std::fs::create_dir(&events).unwrap();
+    std::fs::write(events.join("a.csv"), "t,x,y,p\n0,0,0,1\n300,1,1,0\n").unwrap();
+    fifo(&events.join("pipe.csv"));
+    fifo(&events.join("pipe.npy"));
+    let import = [
+        "import",
+        "events",
+        "--grid",
+        "2x2",
+        "--time-unit",
+        "ms",
+        "--out",
+    ];
+    let (code, err) = run_or_hang(&dir, &[&import[..], &["eds", "events"]].concat());
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("pipe.npy: is a pipe (FIFO)"), "{err}");
+    let (code, err) = run_or_hang(&dir, &[&import[..], &["eds2", "events/pipe.csv"]].concat());
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+    // A dataset's recording, manifest or layout.
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let features = [
+        "features",
+        "--dataset",
+        "data",
+        "--method",
+        "glcm3d",
+        "--out",
+        "f.csv",
+    ];
+    std::fs::remove_file(data.join("A_5_0.npy")).unwrap();
+    fifo(&data.join("A_5_0.npy"));
+    let (code, err) = run_or_hang(&dir, &features);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("`A_5_0.npy` is a pipe (FIFO), not a regular file"),
+        "{err}"
+    );
+    std::fs::remove_file(data.join("A_5_0.npy")).unwrap();
+    fifo(&data.join("layout.toml"));
+    let (code, err) = run_or_hang(&dir, &features);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("layout.toml: is a pipe (FIFO)"), "{err}");
+    std::fs::remove_file(data.join("layout.toml")).unwrap();
+    std::fs::remove_file(data.join("manifest.csv")).unwrap();
+    fifo(&data.join("manifest.csv"));
+    let (code, err) = run_or_hang(&dir, &features);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("manifest.csv: is a pipe (FIFO)"), "{err}");
+    assert!(!dir.join("f.csv").exists());
+}
+
+#[test]
+fn a_line_longer_than_the_limit_is_refused_naming_it() {
+    let dir = Dir::new();
+    // 64 MiB and one byte without a line break
+    let long = vec![b'7'; (64 << 20) + 1];
+    let logs = dir.join("logs");
+    std::fs::create_dir(&logs).unwrap();
+    std::fs::write(logs.join("long.csv"), &long).unwrap();
+    let says = "line 1 is longer than 67108864 bytes";
+    for args in [
+        vec![
+            "inspect",
+            "logs/long.csv",
+            "--no-encoder",
+            "--time-column",
+            "t_ms",
+        ],
+        vec![
+            "import",
+            "csv",
+            "logs",
+            "--out",
+            "ds",
+            "--time-column",
+            "t_ms",
+        ],
+        vec![
+            "import",
+            "events",
+            "logs",
+            "--out",
+            "ds",
+            "--grid",
+            "2x2",
+            "--time-unit",
+            "ms",
+        ],
+        vec![
+            "encode",
+            "logs/long.csv",
+            "--out",
+            "spikes.npy",
+            "--delimiter",
+            ",",
+        ],
+    ] {
+        let err = dir.fails(&args);
+        assert!(
+            err.contains("long.csv") && err.contains(says),
+            "{args:?}: {err}"
+        );
+    }
+    // a dataset's manifest, and a layout larger than the limit
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let features = [
+        "features",
+        "--dataset",
+        "data",
+        "--method",
+        "glcm3d",
+        "--out",
+        "f.csv",
+    ];
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    std::fs::write(data.join("manifest.csv"), &long).unwrap();
+    let err = dir.fails(&features);
+    assert!(err.contains("manifest.csv") && err.contains(says), "{err}");
+    std::fs::write(data.join("manifest.csv"), manifest).unwrap();
+    let mut layout = b"# ".to_vec();
+    layout.extend(&long);
+    std::fs::write(data.join("layout.toml"), layout).unwrap();
+    let err = dir.fails(&features);
+    assert!(
+        err.contains("layout.toml: is longer than 67108864 bytes"),
+        "{err}"
+    );
+    assert!(!dir.join("f.csv").exists() && !dir.join("ds").exists());
+}
+
+#[test]
+fn a_repeated_column_name_is_refused_in_every_table_read() {
+    let dir = Dir::new();
+    let both = |i: usize, j: usize, name: &str| {
+        format!("columns {i} and {j} of line 1 are both named `{name}`: each column read needs a name of its own")
+    };
+    // an event log, imported
+    let logs = dir.join("logs");
+    std::fs::create_dir(&logs).unwrap();
+    std::fs::write(logs.join("a.csv"), "t,x,y,x,p\n0,0,0,1,1\n300,1,1,0,0\n").unwrap();
+    let err = dir.fails(&[
+        "import",
+        "events",
+        "logs",
+        "--out",
+        "eds",
+        "--grid",
+        "2x2",
+        "--time-unit",
+        "ms",
+    ]);
+    assert!(
+        err.contains("a.csv") && err.contains(&both(2, 4, "x")),
+        "{err}"
+    );
+    // an event dataset's file, and one column named for two roles in its layout
+    let ds = dir.join("events");
+    std::fs::create_dir(&ds).unwrap();
+    std::fs::write(ds.join("a.csv"), "t,x,y,p\n0,0,0,1\n300,1,1,0\n").unwrap();
+    std::fs::write(ds.join("b.csv"), "t,x,y,p,p\n0,0,0,1,0\n300,1,1,0,1\n").unwrap();
+    std::fs::write(ds.join("manifest.csv"), "file,label\na.csv,A\nb.csv,B\n").unwrap();
+    let layout = "rows = 2\ncols = 2\n\n[events]\ntime_unit = \"ms\"\n";
+    std::fs::write(ds.join("layout.toml"), layout).unwrap();
+    let features = |data: &str| {
+        dir.fails(&[
+            "features",
+            "--dataset",
+            data,
+            "--method",
+            "glcm3d",
+            "--out",
+            "f.csv",
+        ])
+    };
+    let err = features("events");
+    assert!(
+        err.contains("b.csv") && err.contains(&both(4, 5, "p")),
+        "{err}"
+    );
+    std::fs::write(ds.join("b.csv"), "t,x,y,p\n0,0,0,1\n300,1,1,0\n").unwrap();
+    std::fs::write(
+        ds.join("layout.toml"),
+        format!("{layout}polarity = \"x\"\n"),
+    )
+    .unwrap();
+    let err = features("events");
+    assert!(
+        err.contains("column `x` is both x and the polarity"),
+        "{err}"
+    );
+    // a manifest
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    for (header, name, at) in [
+        ("session,session", "session", (8, 9)),
+        ("label", "label", (2, 8)),
+    ] {
+        let changed: String = manifest
+            .lines()
+            .enumerate()
+            .map(|(i, line)| match i {
+                0 => format!("{line},{header}\n"),
+                _ => format!(
+                    "{line},{}\n",
+                    if header.contains(',') { "s1,s2" } else { "A" }
+                ),
+            })
+            .collect();
+        std::fs::write(data.join("manifest.csv"), changed).unwrap();
+        let err = features("data");
+        assert!(
+            err.contains("manifest.csv") && err.contains(&both(at.0, at.1, name)),
+            "{err}"
+        );
+    }
+    assert!(!dir.join("f.csv").exists() && !dir.join("eds").exists());
+}
+
+#[test]
+fn layout_values_an_import_would_refuse_are_refused_on_reading() {
+    let dir = Dir::new();
+    let data = dir.dataset("data", &["A", "B"], &[5.0], 5);
+    let grid = "rows = 4\ncols = 4\n";
+    let row_major: Vec<String> = (0..16).map(|k| format!("[{}, {}]", k / 4, k % 4)).collect();
+    let map = format!("channel_map = [{}]\n", row_major.join(", "));
+    let cases = [
+        (
+            format!("{grid}mask = [\"0000\", \"0000\", \"0000\", \"0000\"]\n"),
+            "field `mask` must leave at least one taxel",
+        ),
+        (
+            format!("{grid}mask = [\"1110\", \"1111\", \"1111\", \"1111\"]\n{map}"),
+            "field `channel_map`: channel 3 maps to [0, 3], a cell the mask marks empty",
+        ),
+        (
+            format!("{grid}channels = [\"a\", \"b\", \"c\"]\n"),
+            "field `channels` names 3 channels, but the 4x4 grid has 16 taxel cells",
+        ),
+        (
+            format!("{grid}channels = [\"a\", \"b\"]\n{map}"),
+            "field `channel_map` has 16 cells for the 2 channels of `channels`",
+        ),
+        (
+            "channels = [\"a\", \"b\", \"a\"]\n".to_string(),
+            "field `channels` names `a` twice (entries 1 and 3)",
+        ),
+        (
+            format!("{grid}\n[events]\ntime_unit = \"ms\"\nvalues = [1, 1]\n"),
+            "the ON and OFF polarity values must be two different integers",
+        ),
+    ];
+    for (layout, says) in cases {
+        std::fs::write(data.join("layout.toml"), &layout).unwrap();
+        let err = dir.fails(&[
+            "features",
+            "--dataset",
+            "data",
+            "--method",
+            "glcm3d",
+            "--out",
+            "f.csv",
+        ]);
+        assert!(
+            err.contains("layout.toml") && err.contains(says),
+            "{layout}: {err}"
+        );
+        let err = dir.fails(&[
+            "encode",
+            "data/A_5_0.npy",
+            "--layout",
+            "data/layout.toml",
+            "--out",
+            "s.npy",
+        ]);
+        assert!(err.contains(says), "{layout}: {err}");
+    }
+    assert!(!dir.join("f.csv").exists() && !dir.join("s.npy").exists());
+}

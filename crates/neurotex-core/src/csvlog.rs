@@ -493,13 +493,16 @@ fn first_line_names(path: &Path, format: &CsvFormat) -> Result<Vec<String>> {
     open_log(path, format).map(|(_, _, names)| names)
 }
 
+/// A log file as its reader reads it: a regular file, a line at a time up to the limit.
+type LogFile = crate::io::LineBounded<std::fs::File>;
+
 /// A reader of the log at `path` as `format` says, past its first line: the reader, the
 /// delimiter (given or detected) and the first line's fields as column names (header
 /// names, or `column{index}` without a header, the first line then still to be read).
 fn open_log(
     path: &Path,
     format: &CsvFormat,
-) -> Result<(csv::Reader<std::fs::File>, Delimiter, Vec<String>)> {
+) -> Result<(csv::Reader<LogFile>, Delimiter, Vec<String>)> {
     let delimiter = match format.delimiter {
         Some(d) => d,
         None => detect_delimiter(path)?,
@@ -508,8 +511,7 @@ fn open_log(
         .delimiter(delimiter.byte())
         .has_headers(format.header)
         .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| csv_error(path, e))?;
+        .from_reader(crate::io::open_text(path)?);
     let first = reader.headers().map_err(|e| csv_error(path, e))?;
     let names = match format.header {
         true => first.iter().map(str::to_string).collect(),
@@ -549,8 +551,9 @@ fn invalid(path: &Path, message: impl Into<String>) -> crate::Error {
 /// Guesses a file's delimiter from its first lines ([`detect_delimiter_in`]).
 fn detect_delimiter(path: &Path) -> Result<Delimiter> {
     let mut head = Vec::with_capacity(16 * 1024);
-    std::fs::File::open(path)
-        .and_then(|f| f.take(16 * 1024).read_to_end(&mut head))
+    crate::io::open_input(path)?
+        .take(16 * 1024)
+        .read_to_end(&mut head)
         .map_err(|e| DataError::io(path, e))?;
     let text = String::from_utf8_lossy(&head);
     let mut lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
@@ -739,23 +742,38 @@ fn unique_names<'a>(
     names: &[String],
     used: impl Iterator<Item = &'a usize>,
 ) -> Result<()> {
+    let why = "layouts, models and imported datasets find channels by name";
+    match repeated_name(names, used.copied(), why) {
+        Some(message) => Err(invalid(path, message)),
+        None => Ok(()),
+    }
+}
+
+/// The message refusing two of the columns `used` (indices into a header's `names`) that
+/// share one name, `why` saying what finds columns by name; `None` when they are distinct.
+/// Every table neurotex reads by column name refuses a repeated name with it: a reader
+/// finds the first column of a name, and the other's values would be silently unread.
+pub(crate) fn repeated_name<S: AsRef<str>>(
+    names: &[S],
+    used: impl Iterator<Item = usize>,
+    why: &str,
+) -> Option<String> {
     let mut first: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
-    for &j in used {
-        if let Some(&i) = first.get(names[j].as_str()) {
+    for j in used {
+        let name = names[j].as_ref();
+        if let Some(&i) = first.get(name) {
             let (i, j) = (i.min(j), i.max(j));
-            let message = format!(
+            return Some(format!(
                 "columns {} and {} of line 1 are both named `{}`: each column read needs a \
-                 name of its own (layouts, models and imported datasets find channels by \
-                 name), so rename them in the header row",
+                 name of its own ({why}), so rename them in the header row",
                 i + 1,
                 j + 1,
-                excerpt(&names[j])
-            );
-            return Err(invalid(path, message));
+                excerpt(name)
+            ));
         }
-        first.insert(&names[j], j);
+        first.insert(name, j);
     }
-    Ok(())
+    None
 }
 
 /// `text`, cut to its first 60 characters (with `...`) so that an error never echoes a
@@ -1124,7 +1142,7 @@ pub(crate) fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
             let csv::ErrorKind::Io(io) = e.into_kind() else {
                 unreachable!()
             };
-            DataError::io(path, io).into()
+            crate::io::read_error(path, io)
         }
         _ => {
             let line = e

@@ -262,11 +262,52 @@ impl Columns {
     }
 }
 
+/// The longest an event recording may last, in 1 ms steps: the layout's `max_duration_s`,
+/// and the bound sampled recordings keep on what a recording becomes on its grid at 1 kHz
+/// (at most `max_duration_s` x [`crate::values::VALUES_PER_LIMIT_S`] values). Feature
+/// methods plan a value per cell and millisecond (rasters, rate volumes), so a handful of
+/// events on a huge grid would otherwise ask for gigabytes; a larger grid may last
+/// proportionally less.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepLimit {
+    /// The steps a recording may last.
+    pub steps: u64,
+    /// The span limit, in steps (`max_duration_s` in ms).
+    pub span_steps: u64,
+    /// The grid's cells.
+    pub cells: usize,
+}
+
+impl StepLimit {
+    /// The limit on a grid of `cells` cells under a span limit of `span_steps` ms.
+    pub fn new(span_steps: u64, cells: usize) -> Self {
+        let per_ms = crate::values::VALUES_PER_LIMIT_S / 1000.0;
+        let on_grid = (span_steps as f64 * per_ms / cells.max(1) as f64).floor() as u64;
+        StepLimit {
+            steps: span_steps.min(on_grid),
+            span_steps,
+            cells,
+        }
+    }
+
+    /// The limit as messages say it, with what to do about it.
+    pub fn describe(&self) -> String {
+        let max_s = self.span_steps as f64 / 1000.0;
+        match self.steps < self.span_steps {
+            false => format!("the longest recording accepted ({max_s} s, layout.toml's max_duration_s)"),
+            true => format!(
+                "the {} ms a recording on {} grid cells may last (its spikes on the grid at 1 kHz may hold at most max_duration_s x 16 000 values, {max_s} s of a 16-taxel grid; a wrong grid or time unit is the usual cause, else raise max_duration_s in layout.toml)",
+                self.steps, self.cells
+            ),
+        }
+    }
+}
+
 /// Gathers events into trains, checking each as it comes.
 pub(crate) struct Gather<'a> {
     format: &'a EventsFormat,
     grid: &'a EventGrid,
-    max_steps: u64,
+    limit: StepLimit,
     duration: Option<u64>,
     first: Option<Stamp>,
     last_step: Option<u64>,
@@ -289,7 +330,7 @@ impl<'a> Gather<'a> {
         Gather {
             format,
             grid,
-            max_steps,
+            limit: StepLimit::new(max_steps, cells),
             duration,
             first: None,
             last_step: None,
@@ -346,7 +387,7 @@ impl<'a> Gather<'a> {
                     TimeUnit::Milliseconds => d,
                     TimeUnit::Seconds => d.saturating_mul(1000),
                 } as u64;
-                if ms < self.duration.unwrap_or(self.max_steps) {
+                if ms < self.duration.unwrap_or(self.limit.steps) {
                     self.last = Some(Stamp::Int(t));
                     self.last_step = Some(self.last_step.map_or(ms, |s| s.max(ms)));
                     return Ok(ms);
@@ -369,8 +410,9 @@ impl<'a> Gather<'a> {
             Origin::First => first,
         };
         let step = to_step(t, from, self.format.time_unit)?;
-        let limit = self.duration.unwrap_or(self.max_steps);
+        let limit = self.duration.unwrap_or(self.limit.steps);
         if step >= limit {
+            let past = self.limit.describe();
             return Err(match self.duration {
                 Some(d) => format!(
                     "time {} is at {step} ms, past the recording's duration_s ({d} ms) in the manifest",
@@ -378,14 +420,12 @@ impl<'a> Gather<'a> {
                 ),
                 None => match self.format.origin {
                     Origin::Zero => format!(
-                        "time {} is at {step} ms, past the longest recording accepted ({} s, layout.toml's max_duration_s): a clock's stamps need `--origin first` (`origin = \"first\"` in layout.toml), or the time unit is wrong",
+                        "time {} is at {step} ms, past {past}: a clock's stamps need `--origin first` (`origin = \"first\"` in layout.toml), or the time unit is wrong",
                         show(t),
-                        self.max_steps / 1000
                     ),
                     Origin::First => format!(
-                        "time {} is {step} ms after the first event, past the longest recording accepted ({} s, layout.toml's max_duration_s): is the time unit right?",
+                        "time {} is {step} ms after the first event, past {past}: is the time unit right?",
                         show(t),
-                        self.max_steps / 1000
                     ),
                 },
             });
@@ -547,15 +587,36 @@ fn columns(names: &[&str], format: &EventsFormat) -> Result<Columns, String> {
             )
         })
     };
+    let named = (0..names.len()).filter(|&j| !names[j].trim().is_empty());
+    let trimmed: Vec<&str> = names.iter().map(|n| n.trim()).collect();
+    let why = "an event log's time, cell and polarity are found by name";
+    if let Some(message) = crate::csvlog::repeated_name(&trimmed, named, why) {
+        return Err(message);
+    }
     let cell = match &format.taxel {
         Some(taxel) => CellColumns::Taxel(need(taxel)?),
         None => CellColumns::Xy(need(&format.x)?, need(&format.y)?),
     };
-    Ok(Columns {
+    let columns = Columns {
         time: need(&format.time)?,
         cell,
         polarity: find(&format.polarity),
-    })
+    };
+    let mut roles = vec![("the time", columns.time)];
+    match columns.cell {
+        CellColumns::Xy(x, y) => roles.extend([("x", x), ("y", y)]),
+        CellColumns::Taxel(t) => roles.push(("the taxel", t)),
+    }
+    roles.extend(columns.polarity.map(|p| ("the polarity", p)));
+    for (k, &(what, j)) in roles.iter().enumerate() {
+        if let Some(&(other, _)) = roles[..k].iter().find(|&&(_, i)| i == j) {
+            return Err(format!(
+                "column `{}` is both {other} and {what}: each needs a column of its own (layout.toml's [events] table or `import events` options name them)",
+                names[j].trim()
+            ));
+        }
+    }
+    Ok(columns)
 }
 
 fn parse_csv(
@@ -564,15 +625,16 @@ fn parse_csv(
     sink: &mut impl FnMut(Parsed) -> Result<(), String>,
 ) -> Result<()> {
     let bad = |m: String| -> crate::Error { DataError::invalid(path, m).into() };
-    let file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
+    let file = crate::io::open_text(path)?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(false)
         .from_reader(std::io::BufReader::with_capacity(1 << 16, file));
-    let header = reader
-        .byte_headers()
-        .map_err(|e| bad(format!("not a CSV file with a header row: {e}")))?
-        .clone();
+    let header = match reader.byte_headers() {
+        Ok(header) => header.clone(),
+        Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
+        Err(e) => return Err(bad(format!("not a CSV file with a header row: {e}"))),
+    };
     let names: Vec<&str> = header
         .iter()
         .map(|h| std::str::from_utf8(h).unwrap_or(""))
@@ -595,6 +657,7 @@ fn parse_csv(
         match reader.read_byte_record(&mut record) {
             Ok(false) => break,
             Ok(true) => {}
+            Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
             Err(e) => return Err(bad(format!("line {}: {e}", line + 1))),
         }
         // The line the record starts on, as the CSV reader counts lines.

@@ -577,42 +577,71 @@ fn parse_csv(path: &Path, p: &CsvImportParams) -> Result<ParsedCsv> {
     Ok(ParsedCsv { meta, log })
 }
 
-/// The `.csv` files among `inputs` (folders are searched one level deep), sorted.
+/// The `.csv` files among `inputs` (folders are searched one level deep), sorted; what a
+/// folder holds that is not a regular file is left out ([`find_csv`] says which).
 ///
 /// # Errors
-/// An input that does not exist or a folder that cannot be read.
+/// As [`find_csv`].
 pub fn csv_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    find_csv(inputs).map(|found| found.files)
+}
+
+/// The `.csv` files among `inputs` (folders are searched one level deep), sorted, and
+/// those a folder holds that are not regular files, left out.
+///
+/// # Errors
+/// An input that does not exist or is not a regular file or folder, or a folder that
+/// cannot be read.
+pub fn find_csv(inputs: &[PathBuf]) -> Result<Found> {
     files_with(inputs, &["csv"])
+}
+
+/// The files a scan of a command's inputs found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Found {
+    /// The files to read, sorted.
+    pub files: Vec<PathBuf>,
+    /// Entries of the folders searched, named like the files wanted, that are not regular
+    /// files (a pipe, a device, a link to one or to nothing), with the reason: reading a
+    /// pipe blocks until something writes it, and a device may never end.
+    pub left_out: Vec<(PathBuf, String)>,
 }
 
 /// The files among `inputs` with one of `extensions` (any case; folders are searched one
 /// level deep, files given by name are taken whatever their extension), sorted.
 ///
 /// # Errors
-/// An input that does not exist or a folder that cannot be read.
-fn files_with(inputs: &[PathBuf], extensions: &[&str]) -> Result<Vec<PathBuf>> {
+/// An input that does not exist or is not a regular file or folder, or a folder that
+/// cannot be read.
+fn files_with(inputs: &[PathBuf], extensions: &[&str]) -> Result<Found> {
     let wanted = |p: &Path| {
         p.extension()
             .is_some_and(|x| extensions.iter().any(|e| x.eq_ignore_ascii_case(e)))
     };
-    let mut out = Vec::new();
+    let mut found = Found::default();
     for input in inputs {
         if input.is_dir() {
             let entries = std::fs::read_dir(input).map_err(|e| DataError::io(input, e))?;
             for e in entries {
                 let path = e.map_err(|e| DataError::io(input, e))?.path();
-                if wanted(&path) {
-                    out.push(path);
+                if !wanted(&path) {
+                    continue;
+                }
+                match crate::io::check_input(&path) {
+                    Ok(()) => found.files.push(path),
+                    Err(why) => found.left_out.push((path, why.to_string())),
                 }
             }
-        } else if input.is_file() {
-            out.push(input.clone());
+        } else if std::fs::symlink_metadata(input).is_ok() {
+            crate::io::check_input(input)?;
+            found.files.push(input.clone());
         } else {
             return Err(invalid(input, "does not exist"));
         }
     }
-    out.sort();
-    Ok(out)
+    found.files.sort();
+    found.left_out.sort();
+    Ok(found)
 }
 
 /// Imports CSV logs into a new dataset folder `out`: one CSV per recording with a `t_ms`
@@ -1244,11 +1273,11 @@ pub struct EventImportParams {
 }
 
 /// The `.csv` and `.npy` files among `inputs` (folders are searched one level deep),
-/// sorted.
+/// sorted, and those a folder holds that are not regular files, left out.
 ///
 /// # Errors
-/// An input that does not exist or a folder that cannot be read.
-pub fn event_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+/// As [`find_csv`].
+pub fn event_files(inputs: &[PathBuf]) -> Result<Found> {
     files_with(inputs, &["csv", "npy"])
 }
 

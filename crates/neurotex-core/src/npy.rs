@@ -112,7 +112,7 @@ impl NpyHeader {
 /// and what the header claims.
 pub(crate) fn read_header(path: &Path) -> Result<NpyHeader> {
     let bad = |message: String| -> crate::Error { DataError::invalid(path, message).into() };
-    let mut file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
+    let mut file = crate::io::open_input(path)?;
     let file_len = file.metadata().map_err(|e| DataError::io(path, e))?.len();
     let mut prefix = [0u8; 12];
     let got = read_up_to(&mut file, &mut prefix).map_err(|e| DataError::io(path, e))?;
@@ -185,7 +185,7 @@ pub(crate) fn read_le_floats(path: &Path, header: &NpyHeader) -> Result<Option<F
         return Ok(None);
     }
     let io = |e| DataError::io(path, e);
-    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut file = crate::io::open_input(path)?;
     file.seek(SeekFrom::Start(header.data_offset as u64))
         .map_err(io)?;
     BYTES.with_borrow_mut(|bytes| {
@@ -383,7 +383,7 @@ fn parse_fields(text: &str) -> std::result::Result<Vec<NpyField>, String> {
 pub(crate) fn read_data(path: &Path, header: &NpyHeader) -> Result<Vec<u8>> {
     use std::io::{Seek, SeekFrom};
     let io = |e| DataError::io(path, e);
-    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut file = crate::io::open_input(path)?;
     file.seek(SeekFrom::Start(header.data_offset as u64))
         .map_err(io)?;
     let mut bytes = vec![0u8; header.elements * header.item_bytes];

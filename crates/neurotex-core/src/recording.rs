@@ -354,7 +354,7 @@ impl LayoutFile {
     /// # Errors
     /// The file is unreadable, not TOML of this form, or inconsistent.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, e))?;
+        let text = crate::io::read_text(path)?;
         let file: LayoutFile = toml::from_str(&text)
             .map_err(|e| DataError::invalid(path, format!("not a valid layout file: {e}")))?;
         file.check(path)?;
@@ -399,8 +399,10 @@ impl LayoutFile {
         }
     }
 
-    /// Checks the rules [`LayoutFile::read`] checks (a layout kept in a model file is
-    /// checked when the model is read), naming `path` in the error.
+    /// Checks every field against the rules the importers apply to the same values, so a
+    /// layout written by hand is refused where an import's options would have been (a
+    /// layout kept in a model file is checked when the model is read), naming `path` in the
+    /// error.
     ///
     /// # Errors
     /// The first rule broken.
@@ -409,24 +411,15 @@ impl LayoutFile {
         if let Err(e) = self.csv_formats(&CsvOverrides::default()) {
             return bad(e.to_string());
         }
-        if let Some(fs) = self.fs {
-            if !(fs.is_finite() && fs > 0.0) {
+        let positive = [
+            ("fs", self.fs, "Hz"),
+            ("max_gap_s", self.max_gap_s, "s"),
+            ("max_duration_s", self.max_duration_s, "s"),
+        ];
+        for (field, value, unit) in positive {
+            if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
                 return bad(format!(
-                    "field `fs` must be a positive number of Hz, got {fs}"
-                ));
-            }
-        }
-        if let Some(gap) = self.max_gap_s {
-            if !(gap.is_finite() && gap > 0.0) {
-                return bad(format!(
-                    "field `max_gap_s` must be a positive number of s, got {gap}"
-                ));
-            }
-        }
-        if let Some(max) = self.max_duration_s {
-            if !(max.is_finite() && max > 0.0) {
-                return bad(format!(
-                    "field `max_duration_s` must be a positive number of s, got {max}"
+                    "field `{field}` must be a positive number of {unit}, got {v}"
                 ));
             }
         }
@@ -434,51 +427,94 @@ impl LayoutFile {
             return bad("fields `rows` and `cols` must be given together".into());
         }
         if let (Some(r), Some(c)) = (self.rows, self.cols) {
-            if r == 0 || c == 0 {
-                return bad(format!("grid must be at least 1x1, got {r}x{c}"));
-            }
-            if let Err(e) = crate::values::check_grid_cells(r, c) {
-                return bad(format!("fields `rows` and `cols`: {e}"));
-            }
-            if let Some(map) = &self.channel_map {
-                let mut seen = vec![false; r * c];
-                for (ch, &[mr, mc]) in map.iter().enumerate() {
-                    if mr >= r || mc >= c {
-                        return bad(format!(
-                            "field `channel_map`: channel {ch} maps to [{mr}, {mc}], outside the {r}x{c} grid"
-                        ));
-                    }
-                    if std::mem::replace(&mut seen[mr * c + mc], true) {
-                        return bad(format!(
-                            "field `channel_map`: cell [{mr}, {mc}] is given twice"
-                        ));
-                    }
-                }
-            }
-            if let Some(mask) = &self.mask {
-                if mask.len() != r || mask.iter().any(|row| row.chars().count() != c) {
-                    return bad(format!(
-                        "field `mask` must have {r} strings of {c} characters"
-                    ));
-                }
-                if mask
-                    .iter()
-                    .any(|row| row.chars().any(|ch| ch != '0' && ch != '1'))
-                {
-                    return bad("field `mask` may hold only `0` and `1`".into());
-                }
-            }
+            self.check_grid(r, c).or_else(bad)?;
         } else if self.channel_map.is_some() || self.mask.is_some() {
             return bad("fields `channel_map` and `mask` need `rows` and `cols`".into());
         }
-        if self.events.is_some() && self.rows.is_none() {
-            return bad("an [events] table needs the grid: give `rows` and `cols`".into());
+        if let Some(channels) = &self.channels {
+            // A column named twice would be read twice, as two taxels of one signal.
+            let mut seen = std::collections::HashMap::new();
+            for (j, name) in channels.iter().enumerate() {
+                if let Some(i) = seen.insert(name.as_str(), j) {
+                    return bad(format!(
+                        "field `channels` names `{}` twice (entries {} and {}): each channel is a column of its own",
+                        crate::csvlog::excerpt(name),
+                        i + 1,
+                        j + 1
+                    ));
+                }
+            }
+        }
+        if let Some(events) = &self.events {
+            if self.rows.is_none() {
+                return bad("an [events] table needs the grid: give `rows` and `cols`".into());
+            }
+            let [on, off] = events.values;
+            if on == off {
+                return bad(format!("[events] `values`: the ON and OFF polarity values must be two different integers, got [{on}, {off}]"));
+            }
         }
         if let Some(Baseline::Mean { start_s, end_s }) = self.baseline {
             if !(start_s.is_finite() && end_s.is_finite() && start_s >= 0.0 && end_s > start_s) {
                 return bad(format!(
                     "field `baseline`: mean interval must satisfy 0 <= start_s < end_s, got [{start_s}, {end_s}]"
                 ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The grid's fields on a `r x c` grid: its size, the mask (its shape, at least one
+    /// taxel), and the channel map (one cell per channel, each on the grid, none twice,
+    /// none masked, as many as `channels`); `Err` says which rule is broken.
+    fn check_grid(&self, r: usize, c: usize) -> std::result::Result<(), String> {
+        if r == 0 || c == 0 {
+            return Err(format!("grid must be at least 1x1, got {r}x{c}"));
+        }
+        crate::values::check_grid_cells(r, c)
+            .map_err(|e| format!("fields `rows` and `cols`: {e}"))?;
+        if let Some(mask) = &self.mask {
+            if mask.len() != r || mask.iter().any(|row| row.chars().count() != c) {
+                return Err(format!(
+                    "field `mask` must have {r} strings of {c} characters"
+                ));
+            }
+            if mask
+                .iter()
+                .any(|row| row.chars().any(|ch| ch != '0' && ch != '1'))
+            {
+                return Err("field `mask` may hold only `0` and `1`".into());
+            }
+            if mask.iter().all(|row| !row.contains('1')) {
+                return Err("field `mask` must leave at least one taxel (a `1`)".into());
+            }
+        }
+        let present = self.present(r * c);
+        let channels = self.channels.as_ref().map(Vec::len);
+        let Some(map) = &self.channel_map else {
+            let taxels = present.iter().filter(|&&p| p).count();
+            return match channels.filter(|&n| n != taxels) {
+                Some(n) => Err(format!("field `channels` names {n} channels, but the {r}x{c} grid has {taxels} taxel cells and no `channel_map` places them")),
+                None => Ok(()),
+            };
+        };
+        if let Some(n) = channels.filter(|&n| n != map.len()) {
+            return Err(format!("field `channel_map` has {} cells for the {n} channels of `channels`: the map needs one cell per channel", map.len()));
+        }
+        let mut seen = vec![false; r * c];
+        for (ch, &[mr, mc]) in map.iter().enumerate() {
+            if mr >= r || mc >= c {
+                return Err(format!(
+                    "field `channel_map`: channel {ch} maps to [{mr}, {mc}], outside the {r}x{c} grid"
+                ));
+            }
+            if std::mem::replace(&mut seen[mr * c + mc], true) {
+                return Err(format!(
+                    "field `channel_map`: cell [{mr}, {mc}] is given twice"
+                ));
+            }
+            if !present[mr * c + mc] {
+                return Err(format!("field `channel_map`: channel {ch} maps to [{mr}, {mc}], a cell the mask marks empty"));
             }
         }
         Ok(())
@@ -628,7 +664,17 @@ impl Dataset {
         }
         let (columns, entries) = read_manifest_columns(&manifest_path)?;
         for (i, m) in entries.iter().enumerate() {
-            if !root.join(&m.file).is_file() {
+            let file = root.join(&m.file);
+            if let Some(meta) = std::fs::metadata(&file).ok().filter(|m| !m.is_file()) {
+                let kind = crate::io::kind_name(meta.file_type());
+                let why = format!(
+                    "line {}: file `{}` is {kind}, not a regular file: a dataset's recordings are regular files",
+                    i + 2,
+                    m.file
+                );
+                return Err(DataError::invalid(&manifest_path, why).into());
+            }
+            if !file.is_file() {
                 return Err(DataError::invalid(
                     &manifest_path,
                     format!(
@@ -732,11 +778,13 @@ impl Dataset {
         let max_s = self.layout.max_duration_s.unwrap_or(DEFAULT_MAX_DURATION_S);
         // Spike times are u32 milliseconds: at most 49 days, far past any limit one sets.
         let max_steps = ((max_s * 1000.0) as u64).min(u64::from(u32::MAX));
-        if let Some(d) = duration.filter(|&d| d > max_steps) {
+        let limit = crate::events::StepLimit::new(max_steps, rows * cols);
+        if let Some(d) = duration.filter(|&d| d > limit.steps) {
             let why = format!(
-                "line {}: duration_s {} s is longer than the longest recording accepted ({max_s} s, layout.toml's max_duration_s)",
+                "line {}: duration_s {} s is longer than {}",
                 index + 2,
-                d as f64 / 1000.0
+                d as f64 / 1000.0,
+                limit.describe()
             );
             return Err(DataError::invalid(manifest(), why).into());
         }
@@ -1005,8 +1053,7 @@ fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Meta>)> {
     // refuse two that differ only by surrounding spaces, which trimming would make one class.
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::Headers)
-        .from_path(path)
-        .map_err(|e| csv_error(path, e))?;
+        .from_reader(crate::io::open_text(path)?);
     let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
     let columns = ManifestColumns::find(path, &headers)?;
     let mut out = Vec::new();
@@ -1075,6 +1122,11 @@ struct ManifestColumns {
 
 impl ManifestColumns {
     fn find(path: &Path, headers: &csv::StringRecord) -> Result<Self> {
+        let names: Vec<&str> = headers.iter().collect();
+        let why = "a manifest's fields are found by column name";
+        if let Some(message) = crate::csvlog::repeated_name(&names, 0..names.len(), why) {
+            return Err(DataError::invalid(path, message).into());
+        }
         let col = |name: &str| headers.iter().position(|h| h == name);
         let mut required = [0usize; 2];
         for (slot, name) in required.iter_mut().zip(MANIFEST_COLUMNS) {
@@ -1435,10 +1487,7 @@ fn onto_cells(raw: Vec<f64>, n_channels: usize, lay: &Layout) -> Vec<f64> {
     out
 }
 
-/// Samples per second of `max_duration_s` that one recording may hold once placed on its
-/// grid and resampled to 1 kHz: the paper's 16 taxels. With the default hour that is 57.6
-/// million values, 460 MB as f64; a larger grid may span proportionally less.
-pub const VALUES_PER_LIMIT_S: f64 = 16_000.0;
+pub use crate::values::VALUES_PER_LIMIT_S;
 
 /// A recording's time span must stay within the layout's `max_duration_s` (default
 /// [`DEFAULT_MAX_DURATION_S`]), and so must what it becomes in memory: resampling allocates

@@ -32,6 +32,12 @@ pub const SAMPLE_RULE: &str =
 /// or a hostile file, and would allocate per-cell state for nothing.
 pub const MAX_CELLS: usize = 1 << 20;
 
+/// Samples per second of `max_duration_s` that one recording may hold once placed on its
+/// grid and resampled to 1 kHz: the paper's 16 taxels. With the default hour that is 57.6
+/// million values, 460 MB as f64; a larger grid may span proportionally less. Sampled
+/// recordings and event recordings alike keep it.
+pub const VALUES_PER_LIMIT_S: f64 = 16_000.0;
+
 /// A `rows x cols` taxel grid and which of its cells hold a taxel.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Grid {

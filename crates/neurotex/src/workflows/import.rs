@@ -7,10 +7,10 @@ use super::{LogOptions, OnProgress};
 use crate::error::ParamError;
 use crate::events::{EventGrid, EventsFormat, Origin};
 use crate::import::NamePattern;
+use crate::import::{event_files, import_events, EventImportParams, Found, ImportedFile};
 use crate::import::{
-    csv_files, import_csv, import_stacked, Axes, CsvImportParams, ImportSummary, StackedParams,
+    find_csv, import_csv, import_stacked, Axes, CsvImportParams, ImportSummary, StackedParams,
 };
-use crate::import::{event_files, import_events, EventImportParams, ImportedFile};
 use crate::progress::Progress;
 use crate::recording::{Baseline, ChannelMap};
 use crate::values::TimeUnit;
@@ -75,7 +75,9 @@ impl ImportCsvOptions {
             skip_bad: self.skip_bad,
             ..self.logs.params()
         };
-        let files = csv_files(&self.inputs)?;
+        let found = find_csv(&self.inputs)?;
+        say_left_out(&found, on);
+        let files = found.files;
         on(Progress::Stage("importing", files.len()));
         let summary = import_csv(&files, &params, out, &|| on(Progress::Tick))?;
         for (_, why) in &summary.skipped {
@@ -86,6 +88,13 @@ impl ImportCsvOptions {
         }
         say_summary(&summary, out, on);
         Ok(summary)
+    }
+}
+
+/// Says each entry of the folders searched that is left out: not a regular file.
+fn say_left_out(found: &Found, on: OnProgress) {
+    for (_, why) in &found.left_out {
+        on(Progress::Advice(&format!("left out {why}")));
     }
 }
 
@@ -274,7 +283,9 @@ impl ImportEventsOptions {
         // Claimed before the inputs are read: a second run into the folder says so at once.
         let _claim = crate::io::claim_folder(out)?;
         let params = self.params()?;
-        let files = event_files(&self.inputs)?;
+        let found = event_files(&self.inputs)?;
+        say_left_out(&found, on);
+        let files = found.files;
         on(Progress::Stage("importing", files.len()));
         let imported = import_events(&files, &params, out, &|| on(Progress::Tick))?;
         for f in imported.iter().filter(|f| f.reordered > 0) {

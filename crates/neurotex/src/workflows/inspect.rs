@@ -61,6 +61,12 @@ impl InspectOptions {
             self.logs.any(),
             self.open.allow_outside_paths,
         )?;
+        if let Opened::Logs(_) = opened {
+            // Raw logs' folders may hold what is not a regular file, which is left out.
+            for (_, why) in crate::import::find_csv(&self.inputs)?.left_out {
+                on(Progress::Advice(&format!("left out {why}")));
+            }
+        }
         on(Progress::Stage("inspecting", opened.len()));
         inspect(opened.source(), &params, &|| on(Progress::Tick))
     }
