@@ -421,3 +421,77 @@ fn numeric_labels_never_merge_and_a_grid_the_axes_fix_is_refused() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn a_broken_layout_or_model_file_is_told_in_its_own_words() {
+    let dir = Dir::new();
+    let data = dir.dataset("ds", &["A", "B"], &[5.0], 3);
+    std::fs::write(data.join("layout.toml"), "rows = 4\nbaseline = \"min\"\n").unwrap();
+    let err = dir.fails(&[
+        "features",
+        "--dataset",
+        s(&data),
+        "--method",
+        "taxel",
+        "--out",
+        "f.csv",
+    ]);
+    assert!(err.contains("line 2 (`baseline = \"min\"`)"), "{err}");
+    assert!(
+        !err.contains("TOML parse error") && !err.contains("internally tagged"),
+        "{err}"
+    );
+    std::fs::remove_file(data.join("layout.toml")).unwrap();
+    let model = dir.join("model.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&data),
+        "--method",
+        "taxel",
+        "--out",
+        s(&model),
+    ]);
+    let text = std::fs::read_to_string(&model).unwrap();
+    let broken = text.replacen("\"labels\": [", "\"labels\": {", 1);
+    assert_ne!(broken, text);
+    std::fs::write(&model, broken).unwrap();
+    let err = dir.fails(&[
+        "predict",
+        "--model",
+        s(&model),
+        "--dataset",
+        s(&data),
+        "--out",
+        "p.csv",
+    ]);
+    assert!(
+        err.contains(", column ") && err.contains(": line "),
+        "{err}"
+    );
+    assert!(!err.contains(" at line "), "{err}");
+}
+
+#[test]
+fn a_headerless_stream_keeps_its_first_frame_even_at_rest() {
+    let dir = Dir::new();
+    let (sim, model) = crate::stream::trained(&dir, &[]);
+    let row = &crate::stream::slides(&sim)[0];
+    let mut frames = crate::stream::slide_frames(&sim, row);
+    frames[0] = vec![0.0; 16];
+    let text = crate::stream::csv_text(&frames);
+    let body = text.split_once('\n').unwrap().1;
+    let input = write(&dir, "headerless.csv", body);
+    let read = dir.ok(&["stream", "--model", s(&model), "--input", s(&input)]);
+    let told = dir.ok(&[
+        "stream",
+        "--model",
+        s(&model),
+        "--input",
+        s(&input),
+        "--no-header",
+    ]);
+    assert_eq!(read, told);
+    let last: Value = serde_json::from_str(read.lines().last().unwrap()).unwrap();
+    assert_eq!(last["bad_frames"], 0, "{last}");
+}

@@ -157,6 +157,62 @@ pub enum DataError {
     },
 }
 
+/// A serde parser's message in a user's words: its type names and jargon turned into
+/// what the file was expected to hold ("invalid type: string \"min\", expected internally
+/// tagged enum Baseline" becomes "a string \"min\" where a Baseline table was expected").
+pub fn parser_words(message: &str) -> String {
+    let message = message.trim().trim_end_matches('.');
+    let (found, expected) = match message.strip_prefix("invalid type: ") {
+        Some(rest) => match rest.split_once(", expected ") {
+            Some((found, expected)) => (Some(found), expected),
+            None => (None, rest),
+        },
+        None => (None, message),
+    };
+    let expected = expected
+        .replace("internally tagged enum ", "")
+        .replace("struct ", "")
+        .replace("enum ", "")
+        .replace("a sequence", "a list")
+        .replace("a map", "a table");
+    match found {
+        Some(found) => {
+            let found = found
+                .replace("map", "a table")
+                .replace("sequence", "a list");
+            format!("{found} where {expected} was expected")
+        }
+        None => expected,
+    }
+}
+
+/// A TOML file's error: where it is, the line as written, and what was wrong in
+/// [`parser_words`], never the parser's own layout of it.
+pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
+    let Some(span) = e.span() else {
+        return parser_words(e.message());
+    };
+    let start = span.start.min(text.len());
+    let line = text[..start].matches('\n').count() + 1;
+    let line_text = text.lines().nth(line - 1).unwrap_or("").trim();
+    let shown: String = line_text.chars().take(80).collect();
+    format!("line {line} (`{shown}`): {}", parser_words(e.message()))
+}
+
+/// A JSON file's error: its line and column and what was wrong in [`parser_words`].
+pub fn json_error(e: &serde_json::Error) -> String {
+    let text = e.to_string();
+    let message = text.split(" at line ").next().unwrap_or(&text);
+    match e.line() {
+        0 => parser_words(message),
+        line => format!(
+            "line {line}, column {}: {}",
+            e.column(),
+            parser_words(message)
+        ),
+    }
+}
+
 /// An empty vector with room for `len` values, reserved fallibly: where the input decides
 /// a buffer's size, a request the machine cannot meet is a [`DataError::OutOfMemory`]
 /// naming `what`, not an abort.

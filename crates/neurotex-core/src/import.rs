@@ -363,11 +363,7 @@ fn no_rate(files: &[PathBuf], p: &CsvImportParams) -> crate::Error {
         let time = names
             .iter()
             .position(|n| crate::csvlog::is_timelike_name(n));
-        let rest: Vec<String> = (names.iter().enumerate())
-            .filter(|&(j, _)| Some(j) != time)
-            .map(|(_, n)| n.clone())
-            .collect();
-        if let Err(e) = refuse_event_log(file, &rest) {
+        if let Err(e) = refuse_event_header(file, &names) {
             return e;
         }
         if let Some(j) = time {
@@ -380,6 +376,18 @@ fn no_rate(files: &[PathBuf], p: &CsvImportParams) -> crate::Error {
     }
     let rule = "without --time-column the sampling rate --fs is needed";
     ParamError::new("fs", rule, "none").into()
+}
+
+/// [`refuse_event_log`] on a header's names less the one named like time stamps.
+fn refuse_event_header(file: &Path, names: &[String]) -> Result<()> {
+    let time = names
+        .iter()
+        .position(|n| crate::csvlog::is_timelike_name(n));
+    let rest: Vec<String> = (names.iter().enumerate())
+        .filter(|&(j, _)| Some(j) != time)
+        .map(|(_, n)| n.clone())
+        .collect();
+    refuse_event_log(file, &rest)
 }
 
 /// Refuses a log whose channels are an address event's fields (`x`, `y` or a taxel
@@ -413,6 +421,13 @@ impl Logs {
     pub fn open(files: Vec<PathBuf>, p: CsvImportParams) -> Result<Self> {
         if p.format.time_column.is_none() && p.fs.is_none() {
             return Err(no_rate(&files, &p));
+        }
+        // An event log is named as one before its stamps are judged as a sampled log's.
+        let first = files.first();
+        if let Some((f, names)) =
+            first.and_then(|f| Some((f, crate::csvlog::header_names(f, &p.format)?)))
+        {
+            refuse_event_header(f, &names)?;
         }
         let mut first_error = None;
         for f in &files {

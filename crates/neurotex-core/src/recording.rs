@@ -355,8 +355,10 @@ impl LayoutFile {
     /// The file is unreadable, not TOML of this form, or inconsistent.
     pub fn read(path: &Path) -> Result<Self> {
         let text = crate::io::read_text(path)?;
-        let file: LayoutFile = toml::from_str(&text)
-            .map_err(|e| DataError::invalid(path, format!("not a valid layout file: {e}")))?;
+        let file: LayoutFile = toml::from_str(&text).map_err(|e| {
+            let why = crate::error::toml_error(&text, &e);
+            DataError::invalid(path, format!("not a valid layout file: {why}"))
+        })?;
         file.check(path)?;
         Ok(file)
     }

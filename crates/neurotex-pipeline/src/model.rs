@@ -320,11 +320,12 @@ impl Model {
                 found: "missing (the file is not a JSON object)".into(),
             }
             .into(),
-            _ => damaged(e.to_string()),
+            _ => damaged(crate::error::json_error(&e)),
         })?;
         let (format, version) = (header.format.as_ref(), header.version.as_ref());
         check_header(path, format, version, (FORMAT, VERSION))?;
-        let file: ModelFile = serde_json::from_slice(&bytes).map_err(|e| damaged(e.to_string()))?;
+        let file: ModelFile =
+            serde_json::from_slice(&bytes).map_err(|e| damaged(crate::error::json_error(&e)))?;
         Model::assemble(file).map_err(|e| damaged(e.to_string()))
     }
 

@@ -286,7 +286,7 @@ impl SpikingModel {
             (Some(like), None) => like.file.clone(),
             (None, Some(json)) => {
                 let mut value: serde_json::Value = serde_json::from_str(json).map_err(|e| damaged(format!("its neurotex_model metadata: {e}")))?;
-                value["network"] = serde_json::to_value(&graph.network).map_err(|e| damaged(e.to_string()))?;
+                value["network"] = serde_json::to_value(&graph.network).map_err(|e| damaged(crate::error::json_error(&e)))?;
                 serde_json::from_value::<SpikingFile>(value).map_err(|e| damaged(format!("its neurotex_model metadata: {e}")))?
             }
             (None, None) => {
@@ -334,11 +334,11 @@ impl SpikingModel {
             .into()
         };
         let value: serde_json::Value =
-            serde_json::from_slice(&bytes).map_err(|e| damaged(e.to_string()))?;
+            serde_json::from_slice(&bytes).map_err(|e| damaged(crate::error::json_error(&e)))?;
         let (format, version) = (value.get("format"), value.get("version"));
         crate::model::check_header(path, format, version, (FORMAT, VERSION))?;
         let file: SpikingFile =
-            serde_json::from_value(value).map_err(|e| damaged(e.to_string()))?;
+            serde_json::from_value(value).map_err(|e| damaged(crate::error::json_error(&e)))?;
         trained_as_said(&file.network, &file.classifier).map_err(damaged)?;
         SpikingModel::assemble(file).map_err(|e| damaged(e.to_string()))
     }

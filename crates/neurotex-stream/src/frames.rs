@@ -298,6 +298,27 @@ impl<R: BufRead> FrameReader<R> {
                 )),
             }
         };
+        // A first line of numbers is a frame, not a header (a sensor at rest sends zeros),
+        // unless it is the column indices 0, 1, 2, ... that pandas writes as a header.
+        let numeric_frame = {
+            let fields = names(&formats[0]).unwrap_or_default();
+            let numbers: Vec<Option<f64>> = fields.iter().map(|f| f.trim().parse().ok()).collect();
+            let indices = (0..numbers.len()).all(|j| numbers[j] == Some(j as f64));
+            numbers.iter().all(Option::is_some) && !indices
+        };
+        let headerless: Vec<CsvFormat>;
+        let formats = match numeric_frame && formats.iter().any(|f| f.header) {
+            true => {
+                headerless = (formats.iter())
+                    .map(|f| CsvFormat {
+                        header: false,
+                        ..f.clone()
+                    })
+                    .collect();
+                &headerless[..]
+            }
+            false => formats,
+        };
         let path = Path::new(&self.source);
         let (i, columns) = choose_columns(path, formats, &names, &fits)?;
         Ok((formats[i].header, delimiter(&formats[i]), columns))

@@ -359,8 +359,17 @@ impl Inspection {
 /// As [`inspect`].
 pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<Vec<Finding>> {
     if dataset.is_events() {
-        // Address events carry no signal to check; their reader checks every event.
-        return Ok(Vec::new());
+        // Address events carry no signal to check, but their timing can mislead (a
+        // sensor's clock read from time 0): the events' own findings.
+        let params = InspectParams {
+            pipeline: pipeline.clone(),
+            encoder: false,
+            traces: false,
+            ..InspectParams::default()
+        };
+        let i = events::inspect_events(dataset, &params, &|| {})?;
+        let severe = i.at_least(Severity::Severe).filter(|f| f.area == "events");
+        return Ok(severe.cloned().collect());
     }
     let params = InspectParams {
         pipeline: pipeline.clone(),

@@ -112,8 +112,9 @@ pub struct CompareOptions {
     /// Cross-validation folds.
     #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().folds))]
     pub folds: usize,
-    /// Cross-validation repeats (every candidate gets the same folds in each).
-    #[cfg_attr(feature = "cli", arg(long, default_value_t = 2))]
+    /// Cross-validation repeats (every candidate gets the same folds in each); the
+    /// default is `evaluate`'s, so a candidate scores here as `evaluate` scores it.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().repeats))]
     pub repeats: usize,
     /// Seed of the folds, the bootstrap and the sign-flip test.
     #[cfg_attr(feature = "cli", arg(long, default_value_t = 0))]
