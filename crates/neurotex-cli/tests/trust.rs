@@ -495,3 +495,35 @@ fn a_headerless_stream_keeps_its_first_frame_even_at_rest() {
     let last: Value = serde_json::from_str(read.lines().last().unwrap()).unwrap();
     assert_eq!(last["bad_frames"], 0, "{last}");
 }
+
+#[test]
+fn labels_never_reach_the_terminal_raw_and_inspect_refuses_what_it_cannot_honour() {
+    let dir = Dir::new();
+    let data = dir.dataset("ds", &["A", "B"], &[5.0], 3);
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    std::fs::write(
+        data.join("manifest.csv"),
+        manifest.replace(",B,", ",\"B\u{1b}[31m\u{7}\","),
+    )
+    .unwrap();
+    let out = dir.ok(&[
+        "evaluate",
+        "--dataset",
+        s(&data),
+        "--method",
+        "taxel",
+        "--folds",
+        "2",
+        "--k",
+        "1",
+    ]);
+    assert!(!out.contains('\u{1b}') && !out.contains('\u{7}'), "{out:?}");
+    assert!(out.contains("B\\u{1b}[31m\\u{7}"), "{out}");
+    let err = dir.fails(&["inspect", s(&data), "--out", "-"]);
+    assert!(err.contains("standard output takes one file"), "{err}");
+    assert!(!dir.join("-").exists());
+    let err = dir.fails(&["inspect", s(&data), "--folds", "0"]);
+    assert!(err.contains("at least 2 folds"), "{err}");
+    let err = dir.fails(&["inspect", s(&data), "--k", "0"]);
+    assert!(err.contains("at least 1 neighbour"), "{err}");
+}

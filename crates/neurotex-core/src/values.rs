@@ -28,6 +28,22 @@ pub fn sample_in_range(v: f64) -> bool {
 pub const SAMPLE_RULE: &str =
     "every sample must be a number within ±1e15 (beyond, it is no sensor's reading)";
 
+/// A label (or any name from a user's data) as a terminal line shows it: control
+/// characters (a newline, a tab, the bell, an escape sequence's start) written as escapes,
+/// so that a label cannot break a table's layout or reach the terminal as a command.
+pub fn shown_label(label: &str) -> String {
+    match label.chars().any(char::is_control) {
+        false => label.to_string(),
+        true => label
+            .chars()
+            .map(|c| match c.is_control() {
+                true => c.escape_default().to_string(),
+                false => c.to_string(),
+            })
+            .collect(),
+    }
+}
+
 /// Largest number of grid cells accepted from a user (a 1024 x 1024 skin); more is a typo
 /// or a hostile file, and would allocate per-cell state for nothing.
 pub const MAX_CELLS: usize = 1 << 20;

@@ -4,6 +4,7 @@
 //! scored one by one, the result as JSON and as text, and each recording's out-of-fold
 //! prediction as CSV.
 
+use crate::values::shown_label;
 use std::fmt::Write as _;
 use std::io::Write;
 
@@ -361,19 +362,19 @@ fn confusion_text(out: &mut String, outcome: &Outcome) {
         None => "",
     };
     let _ = writeln!(out, "confusion (rows = true, columns = predicted{summed}):");
-    let width = outcome
-        .labels
+    let labels: Vec<String> = outcome.labels.iter().map(|l| shown_label(l)).collect();
+    let width = labels
         .iter()
-        .map(|l| l.len())
+        .map(|l| l.chars().count())
         .max()
         .unwrap_or(1)
         .max(5);
     let _ = write!(out, "{:width$}", "");
-    for l in &outcome.labels {
+    for l in &labels {
         let _ = write!(out, " {l:>width$}");
     }
     out.push('\n');
-    for (l, row) in outcome.labels.iter().zip(outcome.confusion.rows()) {
+    for (l, row) in labels.iter().zip(outcome.confusion.rows()) {
         let _ = write!(out, "{l:width$}");
         for v in row {
             let _ = write!(out, " {v:>width$}");

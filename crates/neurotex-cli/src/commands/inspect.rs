@@ -35,6 +35,7 @@ pub fn run(args: InspectArgs) -> Result<bool> {
     let o = &args.options;
     let _claim = match &args.out {
         Some(dir) => {
+            crate::output::check_folder(dir, "--out")?;
             Some(neurotex::io::claim_output_dir(dir).context("checking the output folder")?)
         }
         None => None,

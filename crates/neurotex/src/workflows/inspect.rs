@@ -46,6 +46,14 @@ impl InspectOptions {
             let rule = "inspect checks the offline conditioning and the encoder; what causal conditioning meets is its own finding (`drifting-rest`), so --causal and --drift-window-s are for evaluate, train and the others";
             return Err(crate::error::ParamError::new("causal", rule, "--causal").into());
         }
+        if self.folds < 2 {
+            let rule = "the design is judged for at least 2 folds";
+            return Err(crate::error::ParamError::new("folds", rule, self.folds).into());
+        }
+        if self.k < 1 {
+            let rule = "the design is judged for at least 1 neighbour";
+            return Err(crate::error::ParamError::new("k", rule, self.k).into());
+        }
         let checked = stages.check()?;
         let params = InspectParams {
             pipeline: checked.params,
