@@ -1034,7 +1034,8 @@ impl<'a> RowReader<'a> {
             if !crate::values::sample_in_range(v) {
                 let name = excerpt(&self.columns.names[self.columns.channels[k]]);
                 let rule = crate::values::SAMPLE_RULE;
-                let message = format!("line {line}, column `{name}`: {v} is out of range ({rule})");
+                let message =
+                    format!("line {line}, column `{name}`: {v:?} is out of range ({rule})");
                 return Err(invalid(self.path, message));
             }
             self.row.push(v);

@@ -1160,7 +1160,7 @@ fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usiz
         let rule = crate::values::SAMPLE_RULE;
         return Err(invalid(
             data,
-            format!("value {pos} (flat index) is {value} ({rule})"),
+            format!("value {pos} (flat index) is {value:?} ({rule})"),
         ));
     }
     let find = |a: AxisName| axes.iter().position(|&x| x == a);

@@ -1458,7 +1458,7 @@ fn checked_channels(path: &Path, shape: Shape, raw: &[f64], finite: bool) -> Res
         return Err(DataError::invalid(
             path,
             format!(
-                "sample {} of channel {} is {} ({})",
+                "sample {} of channel {} is {:?} ({})",
                 pos / n_channels,
                 pos % n_channels,
                 raw[pos],

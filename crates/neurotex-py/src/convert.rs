@@ -123,7 +123,7 @@ impl SamplesView<'_> {
             .position(|&v| !neurotex::values::sample_in_range(v))
         {
             return Err(bad(format!(
-                "sample {} of channel {} is {} ({})",
+                "sample {} of channel {} is {:?} ({})",
                 pos / n_cells,
                 pos % n_cells,
                 samples[pos],

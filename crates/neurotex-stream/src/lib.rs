@@ -215,7 +215,7 @@ pub enum BadFrame {
         index: usize,
     },
     /// A value beyond [`crate::values::MAX_SAMPLE_MAGNITUDE`]: no sensor's reading.
-    #[error("value {index} is {value}, beyond ±1e15, which is no sensor's reading")]
+    #[error("value {index} is {value:?}, beyond ±1e15, which is no sensor's reading")]
     OutOfRange {
         /// Which value, counted from the line's first field (the time stamp is value 0
         /// when given).

@@ -189,3 +189,20 @@ fn every_seed_is_accepted_all_the_way() {
         );
     }
 }
+
+/// The stream's fuzz regressions: a first stamp (or tick) far past time 0 once made one
+/// event complete every 1 ms step up to it, minutes of work for 65 bytes. A first event
+/// more than the largest gap after time 0 now starts the episode, so each runs at once.
+#[test]
+fn a_far_first_stamp_costs_a_stream_no_silent_steps() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/stream_events");
+    for name in ["far-first-stamp.bin", "far-tick-in-seconds.bin"] {
+        let bytes = std::fs::read(dir.join(name)).unwrap();
+        let start = std::time::Instant::now();
+        let ran = catch_unwind(AssertUnwindSafe(|| harness::stream_events(&bytes)));
+        assert!(ran.is_ok(), "{name} panicked");
+        let took = start.elapsed().as_secs_f64();
+        assert!(took < 10.0, "{name} took {took:.1} s");
+    }
+}

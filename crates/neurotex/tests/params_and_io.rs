@@ -231,13 +231,17 @@ fn a_non_finite_npy_sample_is_named_in_float32_and_float64() {
             }
         }
     }
-    // The largest finite values are read.
-    let x = Array2::<f32>::from_shape_fn(
-        (37, 3),
-        |(t, _)| if t % 2 == 0 { f32::MAX } else { f32::MIN },
-    );
+    // Values up to ±1e15 are read; larger ones (f32::MAX, a placeholder) are no
+    // sensor's reading and refused.
+    let x = Array2::<f32>::from_shape_fn((37, 3), |(t, _)| if t % 2 == 0 { 1e15 } else { -1e15 });
     write_npy(&path, &x).unwrap();
-    assert_eq!(read().unwrap().samples[3], f64::from(f32::MIN));
+    assert_eq!(read().unwrap().samples[3], f64::from(-1e15f32));
+    let x = Array2::<f32>::from_shape_fn((37, 3), |(t, _)| if t == 5 { f32::MAX } else { 0.0 });
+    write_npy(&path, &x).unwrap();
+    assert!(read()
+        .unwrap_err()
+        .to_string()
+        .contains("sample 5 of channel 0"));
 }
 
 #[test]
@@ -279,7 +283,7 @@ fn bad_recordings_are_named_errors() {
     let msg = read_recording(&dir.path().join("inf.npy"), &LayoutFile::default())
         .unwrap_err()
         .to_string();
-    assert!(msg.contains("finite"), "{msg}");
+    assert!(msg.contains("±1e15"), "{msg}");
     let layout = LayoutFile {
         rows: Some(4),
         cols: Some(4),
