@@ -527,3 +527,123 @@ fn labels_never_reach_the_terminal_raw_and_inspect_refuses_what_it_cannot_honour
     let err = dir.fails(&["inspect", s(&data), "--k", "0"]);
     assert!(err.contains("at least 1 neighbour"), "{err}");
 }
+
+/// Logs `t_ms,c0..c15` of a 4x4 grid whose channel `c5` (cell 1,1) holds one value: the
+/// other channels carry a wave whose phase follows the cell, so a taxel's place shows.
+fn logs_with_a_dead_taxel(dir: &Dir) -> PathBuf {
+    let logs = dir.join("dead-logs");
+    std::fs::create_dir_all(&logs).unwrap();
+    for (label, hz) in [("silk", 3.0), ("felt", 9.0)] {
+        for trial in 0..2 {
+            let head: Vec<String> = (0..16).map(|i| format!("c{i}")).collect();
+            let mut log = format!("t_ms,{}\n", head.join(","));
+            for k in 0..400 {
+                let t = f64::from(k) / 1000.0;
+                let row: Vec<String> = (0..16)
+                    .map(|i| match i {
+                        5 => "512".to_string(),
+                        _ => format!("{:.3}", 500.0 + 90.0 * (hz * t + f64::from(i) * 0.1).sin()),
+                    })
+                    .collect();
+                log.push_str(&format!("{k},{}\n", row.join(",")));
+            }
+            std::fs::write(logs.join(format!("{label}_{trial}.csv")), log).unwrap();
+        }
+    }
+    logs
+}
+
+#[test]
+fn a_dead_taxel_of_a_full_grid_is_dropped_with_its_cell_masked_by_one_option() {
+    let dir = Dir::new();
+    let logs = logs_with_a_dead_taxel(&dir);
+    let read = [
+        "--time-column",
+        "t_ms",
+        "--name-pattern",
+        "{label}_{trial}.csv",
+    ];
+    let mut inspect = vec!["inspect", s(&logs), "--grid", "4x4"];
+    inspect.extend_from_slice(&read);
+    let said = dir.run(&inspect);
+    assert!(
+        said.stdout.contains("--drop-channels c5"),
+        "the dead-channel finding names the option: {}",
+        said.stdout
+    );
+    let out = dir.join("ds");
+    let mut import = vec!["import", "csv", s(&logs), "--out", s(&out), "--grid", "4x4"];
+    import.extend_from_slice(&read);
+    import.extend_from_slice(&["--drop-channels", "c5"]);
+    let run = dir.run(&import);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(!run.stderr.contains("fill it row by row"), "{}", run.stderr);
+    let layout = std::fs::read_to_string(out.join("layout.toml")).unwrap();
+    let line = |key: &str| {
+        layout
+            .lines()
+            .find(|l| l.starts_with(key))
+            .unwrap_or_default()
+            .to_string()
+    };
+    assert_eq!(line("mask"), r#"mask = ["1111", "1011", "1111", "1111"]"#);
+    // c6, the fifth channel kept, stays in its own cell (1,2), not in c5's (1,1).
+    assert!(
+        line("channel_map").starts_with(
+            "channel_map = [[0, 0], [0, 1], [0, 2], [0, 3], [1, 0], [1, 2], [1, 3], [2, 0]"
+        ),
+        "{layout}"
+    );
+    assert!(!line("channels").contains("\"c5\""), "{layout}");
+    assert!(
+        run.stderr
+            .contains("15 channels on a 4x4 grid (1 cell masked)"),
+        "{}",
+        run.stderr
+    );
+    // The dataset reads: a feature run over it goes through.
+    let features = dir.join("features.csv");
+    dir.ok(&[
+        "features",
+        "--dataset",
+        s(&out),
+        "--method",
+        "glcm2d",
+        "--out",
+        s(&features),
+    ]);
+    // Column indices count as --channels counts them (t_ms is column 0, c5 column 6).
+    let by_index = dir.join("ds-index");
+    let mut import = vec![
+        "import",
+        "csv",
+        s(&logs),
+        "--out",
+        s(&by_index),
+        "--grid",
+        "4x4",
+    ];
+    import.extend_from_slice(&read);
+    import.extend_from_slice(&["--drop-channels", "6"]);
+    dir.ok(&import);
+    let again = std::fs::read_to_string(by_index.join("layout.toml")).unwrap();
+    assert!(again.contains(&line("mask")), "{again}");
+    // A name that is not a channel, or every channel, is refused by name.
+    let no = dir.join("no");
+    for (drop, says) in [
+        ("t_ms", "the channels are"),
+        ("c99", "`c99`"),
+        ("^c", "at least one"),
+    ] {
+        let mut import = vec!["import", "csv", s(&logs), "--out", s(&no), "--grid", "4x4"];
+        import.extend_from_slice(&read);
+        import.extend_from_slice(&["--drop-channels", drop]);
+        let run = dir.run(&import);
+        assert!(
+            !run.status.success() && run.stderr.contains(says),
+            "{drop}: {}",
+            run.stderr
+        );
+        assert!(!no.exists());
+    }
+}

@@ -22,6 +22,8 @@ use crate::recording::{
 };
 use crate::values::{Grid, Speed};
 
+mod dropped;
+
 /// A file-name pattern such as `{label}_F{force}_V{speed}mmps_{trial}.csv`: literal text and
 /// `{field}`s. `label`, `speed` (mm/s), `force` (N) and `trial` fill the manifest's columns;
 /// any other field becomes an extra manifest column. Text outside the fields is matched
@@ -171,6 +173,9 @@ pub struct CsvImportParams {
     pub grid: Option<Grid>,
     /// Each channel's cell; default row-major.
     pub channel_map: Option<ChannelMap>,
+    /// Channels left out after they are placed on the grid: their cells are masked, so a
+    /// dead taxel of a full grid leaves the others where they are.
+    pub drop_channels: Option<ChannelSelect>,
     /// Nominal sampling rate in Hz (required without a time column; else estimated).
     pub fs: Option<f64>,
     /// Baseline removal recorded in `layout.toml`.
@@ -422,6 +427,7 @@ impl Logs {
         if p.format.time_column.is_none() && p.fs.is_none() {
             return Err(no_rate(&files, &p));
         }
+        let p = p.without_dropped(&files)?;
         // An event log is named as one before its stamps are judged as a sampled log's.
         let first = files.first();
         if let Some((f, names)) =
@@ -680,6 +686,7 @@ pub fn import_csv(
         return Err(no_rate(files, p));
     }
     reject_duplicate_names(files)?;
+    let p = &p.without_dropped(files)?;
     let mut summary = ImportSummary::default();
     let good = parse_all(files, p, on_done, &mut summary.skipped)?;
     let Some(first) = good.first() else {

@@ -53,6 +53,7 @@ fn log_params(reading: &Bound<'_, PyDict>) -> PyResult<CsvImportParams> {
         format: overrides.apply(Default::default()),
         grid: parse("grid", text("grid")?)?,
         channel_map: parse("channel_map", text("channel_map")?)?,
+        drop_channels: parse("drop_channels", text("drop_channels")?)?,
         fs: parse::<f64>("fs", text("fs")?)?,
         baseline: None,
         skip_bad: false,

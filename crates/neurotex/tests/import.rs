@@ -26,6 +26,7 @@ fn params() -> CsvImportParams {
         },
         grid: None,
         channel_map: None,
+        drop_channels: None,
         fs: None,
         baseline: None,
         skip_bad: false,

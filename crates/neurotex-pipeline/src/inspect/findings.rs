@@ -216,12 +216,13 @@ fn layout(i: &Inspection, out: &mut Vec<Finding>) {
             rows: l.rows,
             cols: l.cols,
         };
+        let fix = format!("{}; if the sensor is the full grid with taxels left out, give every channel and --drop-channels the missing ones, which keeps the others in their cells", grid_advice(n));
         out.push(finding(
             Warning,
             "layout",
             "grid-not-filled",
             w.to_string(),
-            grid_advice(n),
+            fix,
         ));
     }
 }
@@ -336,7 +337,12 @@ fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<
     }
     let dead = list(&|c| most(c.dead_share));
     if !dead.is_empty() {
-        out.push(finding(Warning, "signals", "dead-channel", format!("channel(s) {} hold one value throughout most recordings: unconnected or stuck, they carry nothing of the texture (silent taxels, or steady firing when no baseline is removed)", names(&dead)), "--channels listing only the live channels"));
+        let listed = dead.join(",");
+        let how = match logs {
+            true => format!("--drop-channels {listed} (the other taxels keep their cells; these cells are masked)"),
+            false => format!("re-import with --drop-channels {listed} (the other taxels keep their cells; these cells are masked)"),
+        };
+        out.push(finding(Warning, "signals", "dead-channel", format!("channel(s) {} hold one value throughout most recordings: unconnected or stuck, they carry nothing of the texture (silent taxels, or steady firing when no baseline is removed)", names(&dead)), how));
     }
     for c in chans.iter().filter(|c| most(c.copy_share)) {
         let of = c.copy_of.as_deref().unwrap_or("another channel");

@@ -1128,6 +1128,7 @@ def inspect(
     channels: Optional[str] = None,
     grid: Optional[str] = None,
     channel_map: Optional[str] = None,
+    drop_channels: Optional[str] = None,
     fs: Optional[float] = None,
     header: Optional[bool] = None,
     delimiter: Optional[str] = None,
@@ -1144,7 +1145,8 @@ def inspect(
     writes ``inspect.md``, ``inspect.json`` and ``figures/`` there.
 
     The reading options (``name_pattern``, ``time_column``, ``channels``, ``grid`` such as
-    ``"3x3"``, ``channel_map``, ``fs``, ``header``, ``delimiter``, ...) are the import's and
+    ``"3x3"``, ``channel_map``, ``drop_channels`` (channels left out after placing every
+    channel on the grid, their cells masked), ``fs``, ``header``, ``delimiter``, ...) are the import's and
     apply to raw logs only; ``stage_options`` are :func:`features`' (``gain``, ``baseline``,
     ``bin_ms``, ...).
 
@@ -1154,7 +1156,8 @@ def inspect(
         paths = [paths]
     reading = {"name_pattern": name_pattern, "time_column": time_column,
                "time_unit": time_unit, "channels": channels, "grid": grid,
-               "channel_map": channel_map, "fs": fs, "header": header,
+               "channel_map": channel_map, "drop_channels": drop_channels,
+               "fs": fs, "header": header,
                "delimiter": delimiter, "duplicate_stamps": duplicate_stamps,
                "max_gap_s": max_gap_s}
     found, text = _native.inspect(

@@ -109,8 +109,16 @@ fn say_summary(summary: &ImportSummary, out: &Path, on: OnProgress) {
     let merged: usize = summary.merged.iter().map(|m| m.merged_rows).sum();
     let duplicates: usize = summary.merged.iter().map(|m| m.duplicate_rows).sum();
     let layout = &summary.layout;
+    let masked = (layout.mask.iter().flatten())
+        .map(|row| row.chars().filter(|&c| c == '0').count())
+        .sum::<usize>();
+    let masked = match masked {
+        0 => String::new(),
+        1 => " (1 cell masked)".to_string(),
+        n => format!(" ({n} cells masked)"),
+    };
     on(Progress::Say(&format!(
-        "{} recordings ({} left out; {merged} rows merged and {duplicates} exact duplicates dropped in {} files) -> {}; {} channels on a {}x{} grid at {:.2} Hz nominal",
+        "{} recordings ({} left out; {merged} rows merged and {duplicates} exact duplicates dropped in {} files) -> {}; {} channels on a {}x{} grid{masked} at {:.2} Hz nominal",
         summary.written,
         summary.skipped.len(),
         summary.merged.len(),

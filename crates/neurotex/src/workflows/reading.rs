@@ -163,6 +163,12 @@ pub struct LogOptions {
     /// Each channel's cell as `row,col;row,col;...` (needs --grid).
     #[cfg_attr(feature = "cli", arg(long = "channel-map", requires = "grid"))]
     pub channel_map: Option<ChannelMap>,
+    /// Channels to leave out after placing every channel on the grid (row-major or by
+    /// --channel-map): names, 0-based column indices such as `5,17`, or a regular
+    /// expression. Their cells are masked, so a dead taxel of a full grid leaves the others
+    /// where they are.
+    #[cfg_attr(feature = "cli", arg(long = "drop-channels"))]
+    pub drop_channels: Option<ChannelSelect>,
     /// Nominal sampling rate in Hz (needed without a time column; else the median interval).
     #[cfg_attr(feature = "cli", arg(long, allow_negative_numbers = true))]
     pub fs: Option<SampleRate>,
@@ -176,6 +182,7 @@ impl LogOptions {
             format: self.csv.overrides().apply(CsvFormat::default()),
             grid: self.grid.clone(),
             channel_map: self.channel_map.clone(),
+            drop_channels: self.drop_channels.clone(),
             fs: self.fs.map(SampleRate::hz),
             baseline: None,
             skip_bad: false,
@@ -188,6 +195,7 @@ impl LogOptions {
         self.name_pattern.is_some()
             || self.grid.is_some()
             || self.channel_map.is_some()
+            || self.drop_channels.is_some()
             || self.fs.is_some()
             || c.overrides().place_columns()
             || c.no_header
