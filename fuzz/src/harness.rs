@@ -241,7 +241,8 @@ fn csv_params(flags: u8, pattern: Option<NamePattern>) -> CsvImportParams {
         channels: match (flags >> 2) & 3 {
             0 => ChannelSelect::All,
             1 => ChannelSelect::parse("a,b").expect("a list"),
-            _ => ChannelSelect::parse("^[a-z]$").expect("a regex"),
+            2 => ChannelSelect::parse("^[a-z]$").expect("a regex"),
+            _ => ChannelSelect::All,
         },
         duplicate_stamps: if flags & 128 != 0 {
             DuplicateStamps::Error
@@ -255,6 +256,8 @@ fn csv_params(flags: u8, pattern: Option<NamePattern>) -> CsvImportParams {
         format,
         grid: (flags & 16 != 0).then(|| "1x2".parse().expect("a grid")),
         channel_map: None,
+        // Every channel read, then `b` left out with its cell masked.
+        drop_channels: ((flags >> 2) & 3 == 3).then(|| ChannelSelect::parse("b").expect("a name")),
         fs: (flags & 32 != 0).then_some(100.0),
         baseline: None,
         skip_bad: flags & 64 != 0,
