@@ -647,3 +647,39 @@ fn a_dead_taxel_of_a_full_grid_is_dropped_with_its_cell_masked_by_one_option() {
         assert!(!no.exists());
     }
 }
+
+#[test]
+fn the_check_at_a_workflows_start_reads_a_bounded_sample_and_says_so() {
+    let dir = Dir::new();
+    let data = dir.join("sim");
+    let args = [
+        "--trials",
+        "12",
+        "--speeds",
+        "10",
+        "--textures",
+        "FT1,SB,CP",
+    ];
+    let mut all = vec!["simulate", "--out", s(&data)];
+    all.extend_from_slice(&args);
+    dir.ok(&all);
+    drift_offsets(&data, 10.0);
+    std::fs::write(data.join("layout.toml"), "").unwrap();
+    let out = dir.join("features.csv");
+    let run = dir.run(&[
+        "features",
+        "--dataset",
+        s(&data),
+        "--method",
+        "glcm3d",
+        "--out",
+        s(&out),
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("resting offset")
+            && run.stderr.contains("checked on 32 of the 36 recordings"),
+        "{}",
+        run.stderr
+    );
+}

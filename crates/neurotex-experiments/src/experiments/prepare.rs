@@ -431,8 +431,8 @@ fn say_severe_findings(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<()> {
     if let Source::Dataset(ds) = source {
-        for finding in severe_findings(ds, params.pipeline().params())? {
-            progress(Progress::Advice(&finding.line()));
+        for line in severe_findings(ds, params.pipeline().params())?.lines() {
+            progress(Progress::Advice(&line));
         }
     }
     Ok(())

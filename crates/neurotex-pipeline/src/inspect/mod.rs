@@ -351,35 +351,74 @@ impl Inspection {
     }
 }
 
+/// The most recordings the check at a workflow's start reads ([`severe_findings`]): what
+/// it looks for (a clock read as a channel, resting offsets, a layout the channels do not
+/// fit, event stamps from a sensor's clock) holds in most recordings when it holds at all,
+/// so a sample spread over the manifest finds it at a bounded cost.
+pub const CHECK_SAMPLE: usize = 32;
+
+/// What the check at a workflow's start found, and on how many recordings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SevereFindings {
+    /// The severe findings on the signals and layout (or the events' timing).
+    pub findings: Vec<Finding>,
+    /// Recordings read.
+    pub checked: usize,
+    /// Recordings in the dataset.
+    pub total: usize,
+}
+
+impl SevereFindings {
+    /// Each finding as a line of advice, saying what was read when not every recording.
+    pub fn lines(&self) -> Vec<String> {
+        let read = match self.checked < self.total {
+            true => format!(
+                "checked on {} of the {} recordings, spread over the manifest; neurotex inspect reads them all",
+                self.checked, self.total
+            ),
+            false => "neurotex inspect says more".to_string(),
+        };
+        (self.findings.iter())
+            .map(|f| format!("{} ({read})", f.line()))
+            .collect()
+    }
+}
+
 /// The severe findings on a dataset's signals and layout, for a workflow to say at its start
-/// (its design and its taxels' responses it judges itself): reads every recording once,
-/// without encoding.
+/// (its design and its taxels' responses it judges itself): reads at most [`CHECK_SAMPLE`]
+/// recordings, evenly spaced in manifest order, without encoding.
 ///
 /// # Errors
 /// As [`inspect`].
-pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<Vec<Finding>> {
-    if dataset.is_events() {
-        // Address events carry no signal to check, but their timing can mislead (a
-        // sensor's clock read from time 0): the events' own findings.
-        let params = InspectParams {
-            pipeline: pipeline.clone(),
-            encoder: false,
-            traces: false,
-            ..InspectParams::default()
-        };
-        let i = events::inspect_events(dataset, &params, &|| {})?;
-        let severe = i.at_least(Severity::Severe).filter(|f| f.area == "events");
-        return Ok(severe.cloned().collect());
-    }
+pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<SevereFindings> {
+    let total = dataset.entries.len();
+    let checked = total.min(CHECK_SAMPLE);
+    let mut sample = dataset.clone();
+    sample.entries = (0..checked)
+        .map(|j| dataset.entries[j * total / checked].clone())
+        .collect();
     let params = InspectParams {
         pipeline: pipeline.clone(),
         encoder: false,
         traces: false,
         ..InspectParams::default()
     };
-    let i = inspect(Source::Dataset(dataset), &params, &|| {})?;
-    let severe = i.at_least(Severity::Severe).filter(|f| f.area != "design");
-    Ok(severe.cloned().collect())
+    let findings = if sample.is_events() {
+        // Address events carry no signal to check, but their timing can mislead (a
+        // sensor's clock read from time 0): the events' own findings.
+        let i = events::inspect_events(&sample, &params, &|| {})?;
+        let severe = i.at_least(Severity::Severe).filter(|f| f.area == "events");
+        severe.cloned().collect()
+    } else {
+        let i = inspect(Source::Dataset(&sample), &params, &|| {})?;
+        let severe = i.at_least(Severity::Severe).filter(|f| f.area != "design");
+        severe.cloned().collect()
+    };
+    Ok(SevereFindings {
+        findings,
+        checked,
+        total,
+    })
 }
 
 /// One recording, reduced.

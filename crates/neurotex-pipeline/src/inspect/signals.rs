@@ -6,7 +6,6 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
-use crate::import::clock_like;
 use crate::recording::Recording;
 
 /// An interval this many times the median interval, or longer, is a gap in the stamps.
@@ -68,54 +67,102 @@ pub fn channel_series(rec: &Recording, c: usize) -> impl Iterator<Item = f64> + 
     rec.samples.iter().skip(cell).step_by(cells).copied()
 }
 
-/// The statistics of `rec`.
+/// The statistics of `rec`, in one pass over its frames (each channel's extremes, steps
+/// and a hash of its values), then a look back only at the channels that need one: those
+/// held at a converter's full scale, and those whose hashes match another's.
 pub fn signal_stats(rec: &Recording) -> SignalStats {
     let n = rec.layout.channel_map.len();
-    let channels: Vec<Channel> = (0..n).map(|c| channel(channel_series(rec, c))).collect();
+    let cells = rec.layout.cells().max(1);
+    let map = &rec.layout.channel_map;
+    let mut pass = vec![Pass::default(); n];
+    for row in rec.samples.chunks_exact(cells) {
+        for (p, &cell) in pass.iter_mut().zip(map) {
+            p.add(row[cell]);
+        }
+    }
+    let channels: Vec<Channel> = (pass.iter().enumerate())
+        .map(|(c, p)| p.channel(|| channel_series(rec, c)))
+        .collect();
     SignalStats {
         frames: rec.len(),
         duration_s: rec.duration_s(),
         stamps: rec.times_s.as_deref().and_then(stamps),
-        copies: copies(rec, &channels),
+        copies: copies(rec, &channels, &pass),
         channels,
     }
 }
 
-fn channel(values: impl Iterator<Item = f64> + Clone) -> Channel {
-    let (mut lo, mut hi, mut frames) = (f64::INFINITY, f64::NEG_INFINITY, 0usize);
-    for v in values.clone() {
-        lo = lo.min(v);
-        hi = hi.max(v);
-        frames += 1;
+/// One channel's running statistics over the frames seen so far.
+#[derive(Debug, Clone, Copy)]
+struct Pass {
+    lo: f64,
+    hi: f64,
+    frames: usize,
+    prev: f64,
+    rises: usize,
+    falls: usize,
+    /// FNV-1a over the values' bits.
+    hash: u64,
+}
+
+impl Default for Pass {
+    fn default() -> Self {
+        Pass {
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+            frames: 0,
+            prev: f64::NAN,
+            rises: 0,
+            falls: 0,
+            hash: 0xcbf2_9ce4_8422_2325,
+        }
     }
-    let full_scale = if FULL_SCALES.contains(&hi) && hi > lo {
-        values.clone().filter(|&v| v == hi).count() as f64 / frames.max(1) as f64
-    } else {
-        0.0
-    };
-    Channel {
-        min: lo,
-        max: hi,
-        resting_ratio: (hi > lo && lo > 0.0).then(|| lo / (hi - lo)),
-        full_scale_share: full_scale,
-        dead: frames > 0 && hi == lo,
-        rising: clock_like(values),
+}
+
+impl Pass {
+    fn add(&mut self, v: f64) {
+        self.lo = self.lo.min(v);
+        self.hi = self.hi.max(v);
+        self.frames += 1;
+        // Comparisons with the first frame's NaN `prev` are false: no step before it.
+        self.rises += usize::from(v > self.prev);
+        self.falls += usize::from(v < self.prev);
+        self.prev = v;
+        self.hash = (self.hash ^ v.to_bits()).wrapping_mul(0x0100_0000_01b3);
+    }
+
+    /// The channel; `values` gives its samples again when it is held at a full scale.
+    fn channel<I: Iterator<Item = f64>>(&self, values: impl Fn() -> I) -> Channel {
+        let (lo, hi, frames) = (self.lo, self.hi, self.frames);
+        let full_scale = if FULL_SCALES.contains(&hi) && hi > lo {
+            values().filter(|&v| v == hi).count() as f64 / frames.max(1) as f64
+        } else {
+            0.0
+        };
+        // As `clock_like`: at least two steps, none falling, at least 99 % rising.
+        let steps = frames.saturating_sub(1);
+        Channel {
+            min: lo,
+            max: hi,
+            resting_ratio: (hi > lo && lo > 0.0).then(|| lo / (hi - lo)),
+            full_scale_share: full_scale,
+            dead: frames > 0 && hi == lo,
+            rising: steps >= 2 && self.falls == 0 && self.rises as f64 >= 0.99 * steps as f64,
+        }
     }
 }
 
 /// Pairs of channels equal at every frame (dead channels left out: every flat channel
-/// equals every other flat one at the same level, which says nothing).
-fn copies(rec: &Recording, channels: &[Channel]) -> Vec<(usize, usize)> {
+/// equals every other flat one at the same level, which says nothing); only channels of
+/// equal hashes are compared.
+fn copies(rec: &Recording, channels: &[Channel], pass: &[Pass]) -> Vec<(usize, usize)> {
     let mut seen: HashMap<u64, Vec<usize>> = HashMap::new();
     let mut out = Vec::new();
     for (c, ch) in channels.iter().enumerate() {
         if ch.dead {
             continue;
         }
-        let hash = channel_series(rec, c).fold(0xcbf2_9ce4_8422_2325u64, |h, v| {
-            (h ^ v.to_bits()).wrapping_mul(0x0100_0000_01b3)
-        });
-        let same = seen.entry(hash).or_default();
+        let same = seen.entry(pass[c].hash).or_default();
         let original = same
             .iter()
             .copied()

@@ -319,11 +319,8 @@ pub fn calibrated_pipeline(
         ))
         .into());
     }
-    for finding in crate::inspect::severe_findings(dataset, &params)? {
-        on(Progress::Advice(&format!(
-            "{} (neurotex inspect says more)",
-            finding.line()
-        )));
+    for line in crate::inspect::severe_findings(dataset, &params)?.lines() {
+        on(Progress::Advice(&line));
     }
     let baseline = dataset.layout.baseline.unwrap_or_default();
     let load = |i: usize| dataset.load(i);
