@@ -30,10 +30,14 @@
 
 use std::path::Path;
 
-use hdf5_pure::{DType, File, FileBuilder, GroupBuilder};
+use hdf5_pure::{DType, File};
 
 use crate::error::{DataError, ModelError, Result};
 use crate::snn::{Network, Readout};
+
+mod write;
+
+pub use write::{to_bytes, NEVER_FIRES, SNNTORCH_DT_S};
 
 /// The nodes of the graph, in order along its one path.
 pub const NODES: [(&str, &str); 6] = [
@@ -45,19 +49,36 @@ pub const NODES: [(&str, &str); 6] = [
     ("output", "Output"),
 ];
 
-/// How the exported time constants are scaled for the importer that will read them.
+/// The importer a graph is written for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Convention {
-    /// Physical time: `dt` in the metadata and the constants in seconds (Norse, Rockpool,
-    /// and NIR's own equations).
+    /// NIR's equations by forward Euler in physical time (`dt` in the metadata, constants
+    /// in seconds), the readout a CubaLIF that never fires: Norse (`from_nir(g, dt=dt)`),
+    /// neurotex, and any reader of NIR 1.0 (`v_reset` is left out, as it is 0).
     Physical,
     /// snnTorch's importer, which steps every graph at `dt = 1e-4` s whatever its metadata:
-    /// the constants are scaled by `1e-4 / dt` so that its decays are neurotex's.
+    /// the same graph with its constants scaled by `1e-4 / dt`, so that its decays are
+    /// neurotex's. Norse and neurotex read it too.
     Snntorch,
+    /// sinabs 3.1's importer: time in steps, exact decays, the synapse an LI node, neurons
+    /// that subtract the threshold on a spike.
+    Sinabs,
+    /// Rockpool 3.1's importer: time in steps, exact decays, the input before the decay,
+    /// neurons that subtract the threshold on a spike.
+    Rockpool,
 }
 
-/// snnTorch's fixed import step, s.
-pub const SNNTORCH_DT_S: f64 = 1e-4;
+impl Convention {
+    /// The name written in the graph's metadata (`neurotex_for`) and typed after `--for`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Convention::Physical => "nir",
+            Convention::Snntorch => "snntorch",
+            Convention::Sinabs => "sinabs",
+            Convention::Rockpool => "rockpool",
+        }
+    }
+}
 
 /// A network and what the graph's metadata says about it.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,156 +91,6 @@ pub struct NirNetwork {
     /// The neurotex model file without its weights, when the graph was written by
     /// neurotex (`neurotex_model` in the metadata).
     pub neurotex_model: Option<String>,
-}
-
-/// The graph's bytes (HDF5) for `net`, with `model_json` (the model file without its
-/// network) in the metadata.
-///
-/// # Errors
-/// The HDF5 writer fails (it should not for these shapes).
-pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Result<Vec<u8>> {
-    let dt = f64::from(net.dt_ms) / 1000.0;
-    let scale = match convention {
-        Convention::Physical => 1.0,
-        Convention::Snntorch => SNNTORCH_DT_S / dt,
-    };
-    let mut fb = FileBuilder::new();
-    fb.create_dataset("version")
-        .with_vlen_strings(&["1.0.0"])
-        .with_shape(&[]);
-    let mut node = fb.create_group("node");
-    put_str(&mut node, "type", "NIRGraph");
-    let mut edges: Vec<&str> = NODES.windows(2).flat_map(|w| [w[0].0, w[1].0]).collect();
-    if net.recurrent() {
-        edges.extend(["lif1", "rec", "rec", "lif1"]);
-    }
-    node.create_dataset("edges")
-        .with_vlen_strings(&edges)
-        .with_shape(&[edges.len() as u64 / 2, 2]);
-    let mut meta = node.create_group("metadata");
-    meta.create_dataset("dt")
-        .with_f64_data(&[dt * scale])
-        .with_shape(&[]);
-    if convention == Convention::Snntorch {
-        // The network's own step, beside snnTorch's: neurotex reads its own export back.
-        meta.create_dataset("neurotex_dt")
-            .with_f64_data(&[dt])
-            .with_shape(&[]);
-    }
-    put_str(&mut meta, "readout", net.readout.name());
-    put_str(&mut meta, "neurotex_model", model_json);
-    node.add_group(meta.finish());
-    let mut nodes = node.create_group("nodes");
-    layers(&mut nodes, net, dt, scale);
-    node.add_group(nodes.finish());
-    fb.add_group(node.finish());
-    fb.finish()
-        .map_err(|e| ModelError::Inconsistent(format!("writing the NIR graph: {e}")).into())
-}
-
-/// The six nodes of `net`'s graph (see the module's mapping).
-fn layers(nodes: &mut GroupBuilder, net: &Network, dt: f64, scale: f64) {
-    let (alpha, beta, kappa) = net.decays();
-    let (tau_syn, tau_mem, tau_out) = (dt / (1.0 - alpha), dt / (1.0 - beta), dt / (1.0 - kappa));
-    let (h, c, n) = (net.hidden, net.classes, net.inputs);
-    let io = |nodes: &mut GroupBuilder, name: &str, kind: &str, width: usize| {
-        let mut g = nodes.create_group(name);
-        put_str(&mut g, "type", kind);
-        g.create_dataset("shape")
-            .with_i64_data(&[width as i64])
-            .with_shape(&[1]);
-        nodes.add_group(g.finish());
-    };
-    let transposed = |w: &[f64], rows: usize, cols: usize| -> Vec<f32> {
-        // neurotex keeps weights source-major; NIR's Affine is (out, in).
-        (0..cols)
-            .flat_map(|o| (0..rows).map(move |i| w[i * cols + o] as f32))
-            .collect()
-    };
-    io(nodes, "input", "Input", n);
-    affine(
-        nodes,
-        "fc1",
-        &transposed(&net.w_in, n, h),
-        &net.b_in,
-        (h, n),
-    );
-    let lif = [
-        ("tau_syn", tau_syn * scale),
-        ("tau_mem", tau_mem * scale),
-        ("r", tau_mem / dt),
-        ("v_leak", 0.0),
-        ("v_threshold", 1.0),
-        ("v_reset", 0.0),
-        ("w_in", tau_syn / dt),
-    ];
-    neurons(nodes, "lif1", "CubaLIF", &lif, h);
-    if net.recurrent() {
-        let mut g = nodes.create_group("rec");
-        put_str(&mut g, "type", "Linear");
-        put_f32(
-            &mut g,
-            "weight",
-            &transposed(&net.w_rec, h, h),
-            &[h as u64, h as u64],
-        );
-        nodes.add_group(g.finish());
-    }
-    affine(
-        nodes,
-        "fc2",
-        &transposed(&net.w_out, h, c),
-        &net.b_out,
-        (c, h),
-    );
-    let li = [
-        ("tau", tau_out * scale),
-        ("r", tau_out / dt),
-        ("v_leak", 0.0),
-    ];
-    neurons(nodes, "li", "LI", &li, c);
-    io(nodes, "output", "Output", c);
-}
-
-/// A node of `len` neurons whose fields each hold one value for all. The constants are
-/// written in float64, so that reading them back gives the decays to the last bit (the
-/// weights are float32 values already).
-fn neurons(nodes: &mut GroupBuilder, name: &str, kind: &str, fields: &[(&str, f64)], len: usize) {
-    let mut g = nodes.create_group(name);
-    put_str(&mut g, "type", kind);
-    for &(field, v) in fields {
-        g.create_dataset(field)
-            .with_f64_data(&vec![v; len])
-            .with_shape(&[len as u64]);
-    }
-    nodes.add_group(g.finish());
-}
-
-fn put_str(g: &mut GroupBuilder, name: &str, value: &str) {
-    g.create_dataset(name)
-        .with_vlen_strings(&[value])
-        .with_shape(&[]);
-}
-
-fn put_f32(g: &mut GroupBuilder, name: &str, values: &[f32], shape: &[u64]) {
-    g.create_dataset(name)
-        .with_f32_data(values)
-        .with_shape(shape);
-}
-
-fn affine(
-    nodes: &mut GroupBuilder,
-    name: &str,
-    weight: &[f32],
-    bias: &[f64],
-    (out, inp): (usize, usize),
-) {
-    let mut g = nodes.create_group(name);
-    put_str(&mut g, "type", "Affine");
-    put_f32(&mut g, "weight", weight, &[out as u64, inp as u64]);
-    let bias: Vec<f32> = bias.iter().map(|&b| b as f32).collect();
-    put_f32(&mut g, "bias", &bias, &[out as u64]);
-    nodes.add_group(g.finish());
 }
 
 /// Writes `net`'s graph to `path`, whole or not at all.
@@ -321,6 +192,15 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
     if kind.first().map(String::as_str) != Some("NIRGraph") {
         return Err(format!("/node is a {kind:?}, not a NIRGraph"));
     }
+    if let Some(tool) = reader
+        .group(&["node", "metadata"])
+        .ok()
+        .and_then(|m| read_string(&m, "neurotex_for", "/node/metadata").ok())
+        .and_then(|v| v.into_iter().next())
+        .filter(|t| t == "sinabs" || t == "rockpool")
+    {
+        return Err(format!("the graph was written for {tool}'s importer (time in steps, the synapse split or the input before the decay), which neurotex does not read back: give the model file it was exported from, or a graph written with --for nir"));
+    }
     let (names, rec) = path_of_nodes(&reader)?;
     let meta = reader.group(&["node", "metadata"]).map_err(|_| {
         "the graph has no metadata, so no `dt` (its time step in seconds)".to_string()
@@ -368,15 +248,18 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
 /// The nodes along the graph's one path from its Input to its Output, checked to be the
 /// six neurotex runs, in order, and the Linear (or Affine) node of a recurrent loop on the
 /// CubaLIF node (`lif → rec → lif`), if there is one.
-fn path_of_nodes(reader: &Reader) -> Result<(Vec<String>, Option<String>), String> {
+fn path_of_nodes(reader: &Reader) -> Result<(Vec<String>, Option<Vec<String>>), String> {
     let nodes = reader.group(&["node", "nodes"])?;
     let names = nodes.groups().map_err(|e| format!("/node/nodes: {e}"))?;
     let mut kinds = Vec::new();
     for name in &names {
         let g = nodes.group(name).map_err(|e| format!("node {name}: {e}"))?;
         let kind = read_string(&g, "type", &format!("node {name}"))?.concat();
+        if kind == "NIRGraph" {
+            return Err(format!("node {name} is a graph of its own (how snnTorch and Rockpool write a recurrent layer); neurotex reads a recurrent layer as a loop of Linear nodes on its CubaLIF node, in one flat graph"));
+        }
         if !NODES.iter().any(|(_, k)| *k == kind) && kind != "Linear" {
-            return Err(format!("node {name} is a {kind}; neurotex runs Input → Affine/Linear → CubaLIF → Affine/Linear → LI → Output"));
+            return Err(format!("node {name} is a {kind}; neurotex runs Input → Affine/Linear → CubaLIF → Affine/Linear → LI (or a CubaLIF that never fires) → Output"));
         }
         kinds.push((name.clone(), kind));
     }
@@ -434,7 +317,9 @@ fn path_of_nodes(reader: &Reader) -> Result<(Vec<String>, Option<String>), Strin
         .collect();
     let want = ["Input", "Affine", "CubaLIF", "Affine", "LI", "Output"];
     for (i, (got, want)) in order.iter().zip(want).enumerate() {
-        let fits = *got == want || (want == "Affine" && *got == "Linear");
+        let fits = *got == want
+            || (want == "Affine" && *got == "Linear")
+            || (want == "LI" && *got == "CubaLIF");
         if !fits {
             return Err(format!("node {} is a {got} where neurotex runs a {want} (Input → Affine → CubaLIF → Affine → LI → Output)", path[i]));
         }
@@ -445,22 +330,41 @@ fn path_of_nodes(reader: &Reader) -> Result<(Vec<String>, Option<String>), Strin
     Ok((path, rec))
 }
 
-/// Reads the recurrent loop's weights (node `rec` on the CubaLIF node `lif`) into `net`,
-/// with the CubaLIF's gain per neuron as for its feed-forward input; a bias on the loop is
-/// a constant current, added to the hidden biases.
+/// Reads the recurrent loop's weights (the Linear or Affine nodes `rec`, in order from the
+/// CubaLIF node `lif` back to it: their product is the loop's weight) into `net`, with the
+/// CubaLIF's gain per neuron as for its feed-forward input; a bias on the loop is a
+/// constant current, added to the hidden biases.
 fn recurrent_of(
     reader: &Reader,
-    rec: &str,
+    rec: &[String],
     lif: &str,
     dt_s: f64,
     net: &mut Network,
 ) -> Result<(), String> {
     let h = net.hidden;
-    let (w, bias, out, inp) = read_affine(reader, rec)?;
-    if (out, inp) != (h, h) {
-        return Err(format!(
-            "node {rec}: the recurrent weight is ({out}, {inp}), not ({h}, {h}) for the {h} neurons of {lif}"
-        ));
+    // The loop as one (out, in) matrix and bias: each node's applied to the last's output.
+    let mut w: Vec<f64> = (0..h * h)
+        .map(|k| f64::from(u8::from(k / h == k % h)))
+        .collect();
+    let mut bias = vec![0.0; h];
+    for node in rec {
+        let (wn, bn, out, inp) = read_affine(reader, node)?;
+        if (out, inp) != (h, h) {
+            return Err(format!(
+                "node {node}: the recurrent weight is ({out}, {inp}), not ({h}, {h}) for the {h} neurons of {lif}"
+            ));
+        }
+        let row = |o: usize| &wn[o * h..(o + 1) * h];
+        w = (0..h * h)
+            .map(|k| {
+                (row(k / h).iter().enumerate())
+                    .map(|(j, x)| x * w[j * h + k % h])
+                    .sum()
+            })
+            .collect();
+        bias = (0..h)
+            .map(|o| bn[o] + row(o).iter().zip(&bias).map(|(x, b)| x * b).sum::<f64>())
+            .collect();
     }
     let (_, _, gain) = lif_of(reader, lif, dt_s, h)?;
     net.w_rec = (0..h * h)
@@ -472,31 +376,41 @@ fn recurrent_of(
     Ok(())
 }
 
-/// Takes the one recurrent loop `CubaLIF → Linear/Affine → CubaLIF` (the Linear node with
-/// no other edge) out of the node list and edges, and returns its Linear node's name.
+/// Takes the one recurrent loop on a CubaLIF node (through one Linear/Affine node, or two
+/// in a row as snnTorch's importer needs, each with no other edge) out of the node list
+/// and edges, and returns the loop's nodes in order from the CubaLIF.
 fn take_loop(
     kinds: &mut Vec<(String, String)>,
     edges: &mut Vec<(&str, &str)>,
-) -> Result<Option<String>, String> {
+) -> Result<Option<Vec<String>>, String> {
     let kind_of = |n: &str| kinds.iter().find(|(m, _)| m == n).map(|(_, k)| k.clone());
-    let loops: Vec<(String, String)> = edges
-        .iter()
-        .filter(|(a, b)| {
-            kind_of(a).as_deref() == Some("CubaLIF")
-                && matches!(kind_of(b).as_deref(), Some("Linear" | "Affine"))
-                && edges.contains(&(*b, *a))
-                && edges.iter().filter(|e| e.0 == *b || e.1 == *b).count() == 2
-        })
-        .map(|(a, b)| (a.to_string(), b.to_string()))
-        .collect();
+    let dense = |n: &str| {
+        matches!(kind_of(n).as_deref(), Some("Linear" | "Affine"))
+            && edges.iter().filter(|e| e.0 == n || e.1 == n).count() == 2
+    };
+    let next = |n: &str| edges.iter().find(|e| e.0 == n).map(|e| e.1);
+    let mut loops: Vec<(String, Vec<String>)> = Vec::new();
+    for &(lif, a) in edges.iter() {
+        if kind_of(lif).as_deref() != Some("CubaLIF") || !dense(a) {
+            continue;
+        }
+        let mut path = vec![a.to_string()];
+        let mut at = next(a);
+        if let Some(b) = at.filter(|&b| b != lif && dense(b)) {
+            path.push(b.to_string());
+            at = next(b);
+        }
+        if at == Some(lif) {
+            loops.push((lif.to_string(), path));
+        }
+    }
     Ok(match loops.as_slice() {
         [] => None,
-        [(lif, rec)] => {
-            edges.retain(|e| {
-                *e != (lif.as_str(), rec.as_str()) && *e != (rec.as_str(), lif.as_str())
-            });
-            kinds.retain(|(n, _)| n != rec);
-            Some(rec.clone())
+        [(lif, path)] => {
+            let on_loop = |n: &str| n == lif || path.iter().any(|p| p == n);
+            edges.retain(|e| !(on_loop(e.0) && on_loop(e.1)));
+            kinds.retain(|(n, _)| !path.contains(n));
+            Some(path.clone())
         }
         _ => return Err(
             "the graph has more than one recurrent loop; neurotex runs one, on its CubaLIF layer"
@@ -570,8 +484,12 @@ fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<(f64, f64, V
         field("r")?,
         field("w_in")?,
     );
-    let (v_leak, v_threshold, v_reset) =
-        (field("v_leak")?, field("v_threshold")?, field("v_reset")?);
+    // `v_reset` may be left out (nir 1.0.4 has no such field; later versions default to 0).
+    let v_reset = match lif.dataset("v_reset") {
+        Ok(_) => field("v_reset")?,
+        Err(_) => vec![0.0; h],
+    };
+    let (v_leak, v_threshold) = (field("v_leak")?, field("v_threshold")?);
     let alpha = one_decay(&tau_syn, dt_s, lif_at, "tau_syn")?;
     let beta = one_decay(&tau_mem, dt_s, lif_at, "tau_mem")?;
     if v_leak.iter().chain(&v_reset).any(|v| *v != 0.0) {
@@ -586,6 +504,44 @@ fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<(f64, f64, V
         .map(|j| (dt_s / tau_mem[j]) * r[j] * (dt_s / tau_syn[j]) * w_in[j] / v_threshold[j])
         .collect();
     Ok((alpha, beta, gain))
+}
+
+/// The readout node's decay, and per class the gain each step gives its input and the
+/// constant its leak adds: an LI node (`τ dv/dt = v_leak - v + r a`), or a CubaLIF that
+/// never fires whose current is the step's input (`tau_syn = dt`; a threshold of at least
+/// 1e20), the readout snnTorch and Norse map.
+fn readout_of(
+    reader: &Reader,
+    at: &str,
+    dt_s: f64,
+    c: usize,
+) -> Result<(f64, Vec<f64>, Vec<f64>), String> {
+    let g = reader.group(&["node", "nodes", at])?;
+    let field = |f: &str| per_neuron(&g, f, at, c);
+    let kind = read_string(&g, "type", &format!("node {at}"))?.concat();
+    let (tau, r, leak, input_gain) = if kind == "CubaLIF" {
+        let tau_syn = field("tau_syn")?;
+        if let Some(t) = tau_syn.iter().find(|t| ((*t - dt_s) / dt_s).abs() > 1e-6) {
+            return Err(format!("node {at}: a CubaLIF readout needs tau_syn = dt ({dt_s} s), so that its current is the step's input; got {t} s"));
+        }
+        if let Some(v) = field("v_threshold")?.iter().find(|v| **v < 1e20) {
+            return Err(format!(
+                "node {at}: a CubaLIF readout must never fire (v_threshold at least 1e20); got {v}"
+            ));
+        }
+        let w_in = field("w_in")?;
+        let gain = (0..c).map(|k| (dt_s / tau_syn[k]) * w_in[k]).collect();
+        (field("tau_mem")?, field("r")?, field("v_leak")?, gain)
+    } else {
+        (field("tau")?, field("r")?, field("v_leak")?, vec![1.0; c])
+    };
+    let field_name = if kind == "CubaLIF" { "tau_mem" } else { "tau" };
+    let kappa = one_decay(&tau, dt_s, at, field_name)?;
+    let gain = (0..c)
+        .map(|k| (dt_s / tau[k]) * r[k] * input_gain[k])
+        .collect();
+    let leak = (0..c).map(|k| (dt_s / tau[k]) * leak[k]).collect();
+    Ok((kappa, gain, leak))
 }
 
 fn network_of(
@@ -621,15 +577,7 @@ fn network_of(
         ));
     }
     let (alpha, beta, gain) = lif_of(reader, &names[2], dt_s, h)?;
-    let li_at = names[4].as_str();
-    let li = reader.group(&["node", "nodes", li_at])?;
-    let (tau, r_out, leak) = (
-        per_neuron(&li, "tau", li_at, c)?,
-        per_neuron(&li, "r", li_at, c)?,
-        per_neuron(&li, "v_leak", li_at, c)?,
-    );
-    let kappa = one_decay(&tau, dt_s, li_at, "tau")?;
-    let out_gain: Vec<f64> = (0..c).map(|k| (dt_s / tau[k]) * r_out[k]).collect();
+    let (kappa, out_gain, out_leak) = readout_of(reader, &names[4], dt_s, c)?;
     let tau_ms = |decay: f64| -f64::from(dt_ms) / decay.ln();
     Ok(Network {
         inputs: n,
@@ -647,16 +595,16 @@ fn network_of(
         w_out: (0..h * c)
             .map(|k| out_gain[k % c] * w2[(k % c) * h + k / c])
             .collect(),
-        b_out: (0..c)
-            .map(|k| out_gain[k] * b2[k] + (dt_s / tau[k]) * leak[k])
-            .collect(),
+        b_out: (0..c).map(|k| out_gain[k] * b2[k] + out_leak[k]).collect(),
         w_rec: Vec::new(),
     })
 }
 
 #[cfg(test)]
 mod tests {
+    use super::write::put_str;
     use super::*;
+    use hdf5_pure::FileBuilder;
 
     /// A node as the tests edit it: name, type, and each field's values and shape.
     type Node = (String, String, Vec<(String, Vec<f64>, Vec<u64>)>);
@@ -754,9 +702,13 @@ mod tests {
         n.2.iter().find(|x| x.0 == f).unwrap().1.clone()
     }
 
+    /// Sets field `f` of `node` to `v` (added, shaped as `v`, when the node has none).
     fn set(nodes: &mut [Node], node: &str, f: &str, v: Vec<f64>) {
         let n = nodes.iter_mut().find(|n| n.0 == node).unwrap();
-        n.2.iter_mut().find(|x| x.0 == f).unwrap().1 = v;
+        match n.2.iter_mut().find(|x| x.0 == f) {
+            Some(field) => field.1 = v,
+            None => n.2.push((f.to_string(), v.clone(), vec![v.len() as u64])),
+        }
     }
 
     #[test]
@@ -852,6 +804,57 @@ mod tests {
         );
         let err = from_bytes(two).unwrap_err();
         assert!(err.contains("more than one recurrent loop"), "{err}");
+    }
+
+    /// The graph neurotex wrote before its readout became a CubaLIF (an LI readout, a
+    /// `v_reset` of zeros, a two-node loop) still reads as the same network.
+    #[test]
+    fn an_li_readout_and_an_explicit_v_reset_read_as_before() {
+        let older = graph(
+            |nodes, _| {
+                let tau = field(nodes, "li", "tau_mem");
+                let r = field(nodes, "li", "r");
+                let li = nodes.iter_mut().find(|n| n.0 == "li").unwrap();
+                li.1 = "LI".into();
+                li.2 = vec![
+                    ("tau".into(), tau, vec![2]),
+                    ("r".into(), r, vec![2]),
+                    ("v_leak".into(), vec![0.0; 2], vec![2]),
+                ];
+                set(nodes, "lif1", "v_reset", vec![0.0; 4]);
+            },
+            Some(0.01),
+        );
+        let back = from_bytes(older).unwrap().network;
+        let x = crate::snn::SpikeInput::from_events(3, 20, &[(0, 1), (2, 0), (5, 2), (9, 0)]);
+        for (a, b) in net().scores(&x).iter().zip(back.scores(&x)) {
+            assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+        }
+    }
+
+    /// What the written graphs hold: no `v_reset` (nir 1.0.4 has no such field), a readout
+    /// that never fires, and the conventions in steps refused on reading back.
+    #[test]
+    fn the_graphs_load_in_older_readers_and_say_what_they_were_written_for() {
+        let bytes = to_bytes(&net(), "{}", Convention::Physical).unwrap();
+        let file = File::from_bytes(bytes).unwrap();
+        let nodes = file.root().group("node").unwrap().group("nodes").unwrap();
+        let lif = nodes.group("lif1").unwrap();
+        assert!(lif.dataset("v_reset").is_err());
+        let li = nodes.group("li").unwrap();
+        let kind = li.dataset("type").unwrap().read_string().unwrap().concat();
+        let threshold = li.dataset("v_threshold").unwrap().read_f64().unwrap();
+        assert_eq!((kind.as_str(), threshold[0]), ("CubaLIF", NEVER_FIRES));
+        for convention in [Convention::Sinabs, Convention::Rockpool] {
+            let err = from_bytes(to_bytes(&net(), "{}", convention).unwrap()).unwrap_err();
+            assert!(
+                err.contains(convention.name()) && err.contains("--for nir"),
+                "{err}"
+            );
+        }
+        let firing = graph(|n, _| set(n, "li", "v_threshold", vec![1.0; 2]), Some(0.01));
+        let err = from_bytes(firing).unwrap_err();
+        assert!(err.contains("must never fire"), "{err}");
     }
 
     #[test]

@@ -49,18 +49,23 @@ impl NativeSpikingModel {
         py.detach(|| guarded(|| self.inner.save(&path)))
     }
 
-    /// Writes the network as a NIR graph (`convention`: `physical` or `snntorch`).
+    /// Writes the network as a NIR graph for the importer `convention` names (`nir`,
+    /// `snntorch`, `norse`, `sinabs`, `rockpool`).
     fn write_nir(&self, py: Python<'_>, path: PathBuf, convention: &str) -> PyResult<()> {
-        let convention = match convention {
-            "physical" => NirConvention::Physical,
-            "snntorch" => NirConvention::Snntorch,
-            other => {
-                return Err(raise(
+        let convention =
+            match convention {
+                "nir" | "physical" => NirConvention::Nir,
+                "snntorch" => NirConvention::Snntorch,
+                "norse" => NirConvention::Norse,
+                "sinabs" => NirConvention::Sinabs,
+                "rockpool" => NirConvention::Rockpool,
+                other => return Err(raise(
                     Kind::Parameter,
-                    format!("convention must be physical or snntorch, got {other:?}"),
-                ))
-            }
-        };
+                    format!(
+                        "for_tool must be nir, snntorch, norse, sinabs or rockpool, got {other:?}"
+                    ),
+                )),
+            };
         py.detach(|| guarded(|| export_nir(&self.inner, &path, convention)))
     }
 

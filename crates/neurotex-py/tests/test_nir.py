@@ -17,13 +17,20 @@ def run_graph(graph, x):
     (`lif → Linear → lif`) feeds a step's spikes into the next step's input."""
     dt = float(np.asarray(graph.metadata["dt"]))
     edges = [tuple(e) for e in graph.edges]
-    loops = {src: dst for src, dst in edges
-             if (dst, src) in edges and isinstance(graph.nodes[dst], nir.Linear)}
-    follow = {src: dst for src, dst in edges
-              if src not in loops.values() and dst not in loops.values()}
+    linear = {n for n, node in graph.nodes.items() if isinstance(node, nir.Linear)}
+    loops = {}  # CubaLIF -> the Linear nodes of its loop, in order
+    for src, dst in edges:
+        path = [dst]
+        while path[-1] in linear and len(path) < 3:
+            path.append(next(d for s, d in edges if s == path[-1]))
+        if isinstance(graph.nodes[src], nir.CubaLIF) and path[-1] == src and len(path) > 1:
+            loops[src] = path[:-1]
+    on_loop = {n for path in loops.values() for n in path}
+    follow = {src: dst for src, dst in edges if src not in on_loop and dst not in on_loop}
     order = [name for name, node in graph.nodes.items() if isinstance(node, nir.Input)]
     while order[-1] in follow:
         order.append(follow[order[-1]])
+    readout = order[-2]
     state = {}
     trace = []
     for t in range(x.shape[0]):
@@ -35,15 +42,20 @@ def run_graph(graph, x):
             elif isinstance(node, nir.CubaLIF):
                 i, v = state.get(name, (np.zeros_like(node.tau_syn), np.zeros_like(node.tau_mem)))
                 if name in loops:
-                    fired = state.get(name + "/spikes", np.zeros_like(node.tau_mem))
-                    a = a + graph.nodes[loops[name]].weight.astype(np.float64) @ fired
+                    fed = state.get(name + "/spikes", np.zeros_like(node.tau_mem))
+                    for linear_node in loops[name]:
+                        fed = graph.nodes[linear_node].weight.astype(np.float64) @ fed
+                    a = a + fed
                 i = i + dt / node.tau_syn * (-i + node.w_in * a)
                 v = v + dt / node.tau_mem * (node.v_leak - v + node.r * i)
                 spikes = v >= node.v_threshold
-                v = np.where(spikes, node.v_reset, v)
+                v_reset = getattr(node, "v_reset", None)
+                v = np.where(spikes, 0.0 if v_reset is None else v_reset, v)
                 state[name] = (i, v)
                 a = spikes.astype(np.float64)
                 state[name + "/spikes"] = a
+                if name == readout:
+                    a = v  # a readout that never fires is read by its membrane
             elif isinstance(node, nir.LI):
                 v = state.get(name, np.zeros_like(node.tau))
                 v = v + dt / node.tau * (node.v_leak - v + node.r * a)
@@ -74,7 +86,7 @@ def test_exported_graph_runs_in_nirs_equations_as_in_neurotex(cli, sim_dir, tmp_
 
     graph = nir.read(str(graph_file))
     assert [type(graph.nodes[n]).__name__ for n in ("input", "fc1", "lif1", "fc2", "li", "output")] == [
-        "Input", "Affine", "CubaLIF", "Affine", "LI", "Output"]
+        "Input", "Affine", "CubaLIF", "Affine", "CubaLIF", "Output"]
     assert ("rec" in graph.nodes) == recurrent
     labels = [c[len("share_"):] for c in next(csv.reader(open(predicted)))[3:]]
     rows = list(csv.DictReader(open(predicted)))
@@ -109,7 +121,7 @@ def test_a_graph_written_by_the_nir_package_runs_with_a_pipeline_given_by_like(c
     for name, node in graph.nodes.items():
         if isinstance(node, nir.CubaLIF):
             node = nir.CubaLIF(**{k: np.asarray(getattr(node, k), dtype=np.float32) for k in (
-                "tau_syn", "tau_mem", "r", "v_leak", "v_threshold", "v_reset", "w_in")})
+                "tau_syn", "tau_mem", "r", "v_leak", "v_threshold", "w_in")})
         elif isinstance(node, nir.LI):
             node = nir.LI(tau=node.tau.astype(np.float32), r=node.r.astype(np.float32),
                           v_leak=node.v_leak.astype(np.float32))

@@ -66,10 +66,12 @@ pub struct ExportNirArgs {
     /// The NIR file to write.
     #[arg(long)]
     pub out: PathBuf,
-    /// The importer the time constants are written for: `physical` (seconds, with `dt` in
-    /// the metadata: Norse, Rockpool, NIR's equations) or `snntorch` (whose importer steps
-    /// every graph at 0.1 ms: the constants are scaled to give the network's decays there).
-    #[arg(long, value_enum, default_value_t = NirConvention::Physical)]
+    /// The importer the graph is written for, each loading it unchanged with the network's
+    /// decisions and scores: `nir` (NIR's equations by forward Euler, seconds, `dt` in the
+    /// metadata: Norse, neurotex, any NIR reader), `snntorch` (its importer steps at 0.1 ms:
+    /// the constants are scaled to it), `norse` (the `nir` graph), `sinabs` or `rockpool`
+    /// (time in steps, exact decays; for networks trained with `--snn-reset subtract`).
+    #[arg(long = "for", alias = "convention", value_enum, default_value_t = NirConvention::Nir)]
     pub convention: NirConvention,
 }
 
@@ -101,8 +103,10 @@ pub fn run(command: ExportCommand) -> Result<()> {
                 export_nir(&model, p, args.convention)
             })?;
             let net = model.network();
+            let recurrent = if net.recurrent() { " recurrent" } else { "" };
             eprintln!(
-                "NIR graph: {} inputs -> {} CubaLIF -> {} LI outputs ({}), dt {} ms -> {}",
+                "NIR graph for {}: {} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms -> {}",
+                neurotex::nir::Convention::from(args.convention).name(),
                 net.inputs,
                 net.hidden,
                 net.classes,

@@ -927,23 +927,26 @@ class SpikingModel(_Predicting):
         """Writes the model file (whole or not at all)."""
         self._native.save(os.fspath(path))
 
-    def to_nir(self, convention: str = "physical") -> Any:
-        """The network as a ``nir.NIRGraph`` (needs the ``nir`` package): Input, Affine,
-        CubaLIF, Affine, LI, Output, with ``dt`` (seconds) and the pipeline in its
-        metadata. ``convention="snntorch"`` scales the time constants for snnTorch's
-        importer, which steps every graph at 0.1 ms."""
+    def to_nir(self, for_tool: str = "nir") -> Any:
+        """The network as a ``nir.NIRGraph`` (needs the ``nir`` package) written for
+        ``for_tool``, as ``neurotex export nir --for``: ``"nir"`` (Input, Affine, CubaLIF,
+        Affine, a CubaLIF readout that never fires, Output; NIR's equations by forward
+        Euler with ``dt`` in seconds, and the pipeline, in its metadata; Norse reads it),
+        ``"snntorch"`` (the same, its constants scaled to snnTorch's 0.1 ms step),
+        ``"norse"``, or ``"sinabs"`` / ``"rockpool"`` (networks trained with
+        ``snn_reset="subtract"``)."""
         import tempfile
 
         nir = _nir()
 
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "model.nir")
-            self._native.write_nir(path, convention)
+            self._native.write_nir(path, for_tool)
             return nir.read(path)
 
-    def save_nir(self, path: Union[str, os.PathLike], convention: str = "physical") -> None:
-        """Writes the network as a NIR file (as ``neurotex export nir``)."""
-        self._native.write_nir(os.fspath(path), convention)
+    def save_nir(self, path: Union[str, os.PathLike], for_tool: str = "nir") -> None:
+        """Writes the network as a NIR file (as ``neurotex export nir --for FOR_TOOL``)."""
+        self._native.write_nir(os.fspath(path), for_tool)
 
     @classmethod
     def from_nir(cls, graph: Any, like: Optional["SpikingModel"] = None) -> "SpikingModel":

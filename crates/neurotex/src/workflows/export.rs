@@ -19,24 +19,35 @@ use crate::recording::{
 use crate::spiking_model::{spike_input, SpikingModel};
 use crate::Result;
 
-/// Which importer the exported time constants are meant for.
+/// Which importer a NIR graph is written for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum NirConvention {
-    /// Physical time: `dt` in the metadata, time constants in seconds (Norse, Rockpool,
-    /// NIR's equations).
+    /// NIR's equations by forward Euler in physical time (`dt` in the metadata, constants in
+    /// seconds), the readout a CubaLIF that never fires: Norse, neurotex, any NIR reader.
     #[default]
-    Physical,
-    /// snnTorch's importer, which steps every graph at dt = 0.1 ms: the time constants are
-    /// scaled so that its decays per step are the network's.
+    #[cfg_attr(feature = "cli", value(alias = "physical"))]
+    Nir,
+    /// snnTorch's importer, which steps every graph at dt = 0.1 ms: the same graph with its
+    /// constants scaled so that its decays per step are the network's (Norse reads it too).
     Snntorch,
+    /// Norse's `from_nir(graph, dt=graph.metadata["dt"])`: the `nir` graph.
+    Norse,
+    /// sinabs's `from_nir`: time in steps and exact decays, for a network trained with
+    /// `--snn-reset subtract` (sinabs's neurons subtract the threshold on a spike).
+    Sinabs,
+    /// Rockpool's `from_nir`: time in steps and exact decays, for a network trained with
+    /// `--snn-reset subtract` (Rockpool's neurons subtract the threshold on a spike).
+    Rockpool,
 }
 
 impl From<NirConvention> for Convention {
     fn from(c: NirConvention) -> Self {
         match c {
-            NirConvention::Physical => Convention::Physical,
+            NirConvention::Nir | NirConvention::Norse => Convention::Physical,
             NirConvention::Snntorch => Convention::Snntorch,
+            NirConvention::Sinabs => Convention::Sinabs,
+            NirConvention::Rockpool => Convention::Rockpool,
         }
     }
 }
