@@ -23,6 +23,12 @@
 //! (dividing by the threshold, adding the leak to the readout's bias), while the decays must
 //! be one per layer, as neurotex's network has.
 //!
+//! **Subtractive reset** (`--snn-reset subtract`): NIR 1.0's CubaLIF resets to `v_reset`
+//! and says nothing of several spikes in a step, so the graph keeps the same nodes and
+//! says `reset = subtract` in its metadata (absent for a reset to zero); neurotex reads it
+//! back, and an importer must be given the neuron by hand (sinabs' `MultiSpike` with
+//! `MembraneSubtract`, Rockpool's `LIFTorch`).
+//!
 //! **Recurrent networks** (`--snn-recurrent`) add a `rec` node (Linear, `(hidden, hidden)`)
 //! on the edges `lif1 → rec → lif1`, the form snnTorch's and Norse's importers read as a
 //! recurrent layer. NIR's equations leave the loop's delay to the simulator; neurotex's
@@ -33,7 +39,7 @@ use std::path::Path;
 use hdf5_pure::{DType, File, FileBuilder, GroupBuilder};
 
 use crate::error::{DataError, ModelError, Result};
-use crate::snn::{Network, Readout};
+use crate::snn::{Network, Readout, Reset};
 
 /// The nodes of the graph, in order along its one path.
 pub const NODES: [(&str, &str); 6] = [
@@ -107,6 +113,9 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
             .with_shape(&[]);
     }
     put_str(&mut meta, "readout", net.readout.name());
+    if !net.reset.is_zero() {
+        put_str(&mut meta, "reset", net.reset.name());
+    }
     put_str(&mut meta, "neurotex_model", model_json);
     node.add_group(meta.finish());
     let mut nodes = node.create_group("nodes");
@@ -350,10 +359,18 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
         })?,
         Err(_) => Readout::Mean,
     };
+    let reset = match read_string(&meta, "reset", "/node/metadata") {
+        Ok(r) => r.first().map_or(Ok(Reset::Zero), |r| {
+            r.parse()
+                .map_err(|e: crate::error::ParamError| e.rule.to_string())
+        })?,
+        Err(_) => Reset::Zero,
+    };
     let neurotex_model = read_string(&meta, "neurotex_model", "/node/metadata")
         .ok()
         .and_then(|v| v.into_iter().next());
     let mut network = network_of(&reader, &names, dt_s, dt_ms.round() as u32, readout)?;
+    network.reset = reset;
     if let Some(rec) = rec {
         recurrent_of(&reader, &rec, &names[2], dt_s, &mut network)?;
     }
@@ -640,6 +657,7 @@ fn network_of(
         tau_mem_ms: tau_ms(beta),
         tau_out_ms: tau_ms(kappa),
         readout,
+        reset: Reset::Zero,
         w_in: (0..n * h)
             .map(|k| gain[k % h] * w1[(k % h) * n + k / h])
             .collect(),
@@ -677,6 +695,7 @@ mod tests {
             tau_mem_ms: 40.0,
             tau_out_ms: 30.0,
             readout: Readout::Max,
+            reset: Reset::Zero,
             w_in: w(n * h, 0.1),
             b_in: w(h, 0.2),
             w_out: w(h * c, 0.3),
