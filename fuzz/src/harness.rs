@@ -22,7 +22,7 @@ use neurotex::pipeline::{Encoding, PipelineParams};
 use neurotex::recording::{read_manifest, read_recording, Dataset, LayoutFile};
 use neurotex::recording::{Baseline, TimeUnit};
 use neurotex::saved::SavedModel;
-use neurotex::snn::{Network, Readout, SnnParams, SpikeInput};
+use neurotex::snn::{Network, Readout, Reset, SnnParams, SpikeInput};
 use neurotex::spiking_model::{decide, SpikingModel, SpikingTraining};
 use neurotex::stream::events::{EventEncoding, EventReader, EventSource, Item};
 use neurotex::stream::{StreamClassifier, StreamParams};
@@ -395,6 +395,7 @@ fn spiking_file(recurrent: bool) -> serde_json::Value {
         tau_mem_ms: classifier.tau_mem_ms,
         tau_out_ms: classifier.tau_out_ms,
         readout: Readout::Mean,
+        reset: Reset::Zero,
         w_in: weights(inputs * hidden, 0.1),
         b_in: weights(hidden, 0.2),
         w_out: weights(hidden * classes, 0.3),

@@ -6,7 +6,7 @@
 //! for validation) with one epoch, so every iteration is one whole epoch.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use neurotex::snn::{fit, Network, Readout, SnnParams, SpikeInput};
+use neurotex::snn::{fit, Network, Readout, Reset, SnnParams, SpikeInput};
 
 fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
     move || {
@@ -29,6 +29,7 @@ fn network(inputs: usize, hidden: usize, classes: usize) -> Network {
         tau_mem_ms: 10.0,
         tau_out_ms: 10.0,
         readout: Readout::Mean,
+        reset: Reset::Zero,
         w_in: w(inputs * hidden, 1.0),
         b_in: w(hidden, 0.2),
         w_out: w(hidden * classes, 1.0),

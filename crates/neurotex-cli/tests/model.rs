@@ -515,6 +515,66 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     assert!(index.starts_with("file,label,array\n"));
 }
 
+/// `--snn-reset subtract` is written in the model file (network and training parameters),
+/// predicts, and travels through a NIR graph; a zero-reset model file has no `reset` key
+/// and is the same, byte for byte, with `--snn-reset zero` or without the option.
+#[test]
+fn a_subtractive_reset_is_written_and_a_zero_reset_left_out() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let train = |out: &Path, reset: &[&str]| {
+        let mut args = vec!["train", "--dataset", s(&ds), "--classifier", "snn"];
+        args.extend(["--snn-hidden", "8", "--snn-epochs", "2", "--out", s(out)]);
+        args.extend(reset);
+        dir.ok(&args);
+    };
+    let (plain, zero, subtract) = (
+        dir.join("plain.json"),
+        dir.join("zero.json"),
+        dir.join("subtract.json"),
+    );
+    train(&plain, &[]);
+    train(&zero, &["--snn-reset", "zero"]);
+    train(&subtract, &["--snn-reset", "subtract"]);
+    let text = std::fs::read_to_string(&plain).unwrap();
+    assert!(!text.contains("\"reset\""), "{text}");
+    assert_eq!(text, std::fs::read_to_string(&zero).unwrap());
+    let file = read_json(&subtract);
+    assert_eq!(file["network"]["reset"], "subtract");
+    assert_eq!(file["classifier"]["reset"], "subtract");
+    let predict = |model: &Path, out: &Path| {
+        let text = dir.ok(&[
+            "predict",
+            "--model",
+            s(model),
+            "--dataset",
+            s(&ds),
+            "--out",
+            s(out),
+            "--json",
+        ]);
+        let score: Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(score["n"], 8, "{score}");
+        std::fs::read_to_string(out).unwrap()
+    };
+    let from_file = predict(&subtract, &dir.join("file.csv"));
+    let graph = dir.join("subtract.nir");
+    dir.ok(&["export", "nir", "--model", s(&subtract), "--out", s(&graph)]);
+    assert_eq!(predict(&graph, &dir.join("graph.csv")), from_file);
+    let err = dir.fails(&[
+        "train",
+        "--dataset",
+        s(&ds),
+        "--classifier",
+        "snn",
+        "--snn-reset",
+        "half",
+        "--out",
+        s(&dir.join("never.json")),
+    ]);
+    assert!(err.contains("snn-reset"), "{err}");
+}
+
 /// Writes `file` with each `(JSON pointer, value)` of `edits` set to `damaged.json`;
 /// `predict` with it must fail naming the file and `expected`, and write nothing.
 fn refused_when_tampered(
@@ -589,6 +649,14 @@ fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
             "median_duration_ms",
         ),
         (one("/training/dataset/layout/fs", (-1.0).into()), "`fs`"),
+        (
+            one("/network/reset", "subtract".into()),
+            "`network.reset` differs",
+        ),
+        (
+            both("reset", "sideways".into()),
+            "unknown variant `sideways`",
+        ),
     ];
     for (edits, expected) in &cases {
         let edits: Vec<(&str, Value)> =

@@ -33,7 +33,7 @@ use std::path::Path;
 use hdf5_pure::{DType, File};
 
 use crate::error::{DataError, ModelError, Result};
-use crate::snn::{Network, Readout};
+use crate::snn::{Network, Readout, Reset};
 
 mod write;
 
@@ -78,6 +78,24 @@ impl Convention {
             Convention::Rockpool => "rockpool",
         }
     }
+}
+
+/// Whether `convention`'s importer runs `net`'s neurons: sinabs's and Rockpool's subtract
+/// the threshold on a spike (several spikes a step), snnTorch's and Norse's reset to zero.
+/// NIR's own graph takes both (a subtracting network says so in its metadata, which only
+/// neurotex reads).
+///
+/// # Errors
+/// A network whose reset the importer does not have, naming the training option.
+pub fn check_reset(net: &Network, convention: Convention) -> Result<()> {
+    let subtracts = !net.reset.is_zero();
+    let tool = convention.name();
+    let why = match convention {
+        Convention::Sinabs | Convention::Rockpool if !subtracts => format!("{tool}'s neurons subtract the threshold on a spike (several spikes a step), and this network resets to zero: train it with --snn-reset subtract for {tool}, or export it --for nir"),
+        Convention::Snntorch if subtracts => format!("this network's neurons subtract the threshold (--snn-reset subtract), and a graph for {tool} resets to zero: export it --for sinabs or --for rockpool, or --for nir for neurotex"),
+        _ => return Ok(()),
+    };
+    Err(crate::error::OptionsError::Conflict(why).into())
 }
 
 /// A network and what the graph's metadata says about it.
@@ -230,6 +248,13 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
         })?,
         Err(_) => Readout::Mean,
     };
+    let reset = match read_string(&meta, "reset", "/node/metadata") {
+        Ok(r) => r.first().map_or(Ok(Reset::Zero), |r| {
+            r.parse()
+                .map_err(|e: crate::error::ParamError| e.rule.to_string())
+        })?,
+        Err(_) => Reset::Zero,
+    };
     let neurotex_model = read_string(&meta, "neurotex_model", "/node/metadata")
         .ok()
         .and_then(|v| v.into_iter().next());
@@ -237,6 +262,7 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
     if let Some(rec) = rec {
         recurrent_of(&reader, &rec, &names[2], dt_s, &mut network)?;
     }
+    network.reset = reset;
     network.check()?;
     Ok(NirNetwork {
         network,
@@ -597,6 +623,7 @@ fn network_of(
             .collect(),
         b_out: (0..c).map(|k| out_gain[k] * b2[k] + out_leak[k]).collect(),
         w_rec: Vec::new(),
+        reset: Reset::Zero,
     })
 }
 
@@ -630,6 +657,7 @@ mod tests {
             w_out: w(h * c, 0.3),
             b_out: w(c, 0.4),
             w_rec: Vec::new(),
+            reset: Reset::Zero,
         }
     }
 

@@ -99,7 +99,7 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
 }
 
 /// Checks that a model file's network is the one its training parameters make: the same
-/// hidden layer, step, readout, recurrence and time constants (to a float's rounding in
+/// hidden layer, step, readout, reset, recurrence and time constants (to a float's rounding in
 /// JSON). A NIR graph's network is not checked so: one run with `--like` comes from
 /// another tool, whatever the spiking model lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
@@ -108,6 +108,7 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
         ("hidden", net.hidden == snn.hidden),
         ("dt_ms", net.dt_ms == snn.dt_ms),
         ("readout", net.readout == snn.readout),
+        ("reset", net.reset == snn.reset),
         ("w_rec", net.recurrent() == snn.recurrent),
         ("tau_syn_ms", close(net.tau_syn_ms, snn.tau_syn_ms)),
         ("tau_mem_ms", close(net.tau_mem_ms, snn.tau_mem_ms)),
@@ -255,6 +256,7 @@ impl SpikingModel {
     /// # Errors
     /// The graph cannot be written.
     pub fn to_nir(&self, convention: Convention) -> Result<Vec<u8>> {
+        crate::nir::check_reset(&self.file.network, convention)?;
         let mut value = serde_json::to_value(&self.file)
             .map_err(|e| ModelError::Inconsistent(e.to_string()))?;
         if let Some(map) = value.as_object_mut() {

@@ -191,7 +191,15 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             "forest_seed",
         ],
         ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
-        ClassifierChoice::Snn(_) => &["hidden", "dt_ms", "epochs", "readout", "seed", "recurrent"],
+        ClassifierChoice::Snn(_) => &[
+            "hidden",
+            "dt_ms",
+            "epochs",
+            "readout",
+            "seed",
+            "recurrent",
+            "reset",
+        ],
     };
     only_known(
         options,
@@ -225,8 +233,8 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
     Ok(choice)
 }
 
-/// The spiking network's training knobs (`hidden`, `dt_ms`, `epochs`, `readout`, `seed`)
-/// over `d`, unchecked.
+/// The spiking network's training knobs (`hidden`, `dt_ms`, `epochs`, `readout`, `seed`,
+/// `recurrent`, `reset`) over `d`, unchecked.
 fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> {
     Ok(SnnParams {
         hidden: get(options, "hidden")?.unwrap_or(d.hidden),
@@ -238,6 +246,10 @@ fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> 
         },
         seed: get(options, "seed")?.unwrap_or(d.seed),
         recurrent: get(options, "recurrent")?.unwrap_or(d.recurrent),
+        reset: match get::<String>(options, "reset")? {
+            Some(r) => r.parse().map_err(param)?,
+            None => d.reset,
+        },
         ..d
     })
 }
@@ -254,6 +266,7 @@ pub fn snn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("readout", d.readout.name())?;
     out.set_item("seed", d.seed)?;
     out.set_item("recurrent", d.recurrent)?;
+    out.set_item("reset", d.reset.name())?;
     Ok(out)
 }
 
@@ -261,7 +274,15 @@ pub fn snn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 pub fn snn(options: &Bound<'_, PyDict>) -> PyResult<SnnParams> {
     only_known(
         options,
-        &["hidden", "dt_ms", "epochs", "readout", "seed", "recurrent"],
+        &[
+            "hidden",
+            "dt_ms",
+            "epochs",
+            "readout",
+            "seed",
+            "recurrent",
+            "reset",
+        ],
         " for the spiking network; its options are",
     )?;
     snn_params(options, SnnParams::default())?

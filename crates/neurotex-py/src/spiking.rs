@@ -52,20 +52,21 @@ impl NativeSpikingModel {
     /// Writes the network as a NIR graph for the importer `convention` names (`nir`,
     /// `snntorch`, `norse`, `sinabs`, `rockpool`).
     fn write_nir(&self, py: Python<'_>, path: PathBuf, convention: &str) -> PyResult<()> {
-        let convention =
-            match convention {
-                "nir" | "physical" => NirConvention::Nir,
-                "snntorch" => NirConvention::Snntorch,
-                "norse" => NirConvention::Norse,
-                "sinabs" => NirConvention::Sinabs,
-                "rockpool" => NirConvention::Rockpool,
-                other => return Err(raise(
+        let convention = match convention {
+            "nir" | "physical" => NirConvention::Nir,
+            "snntorch" => NirConvention::Snntorch,
+            "norse" => NirConvention::Norse,
+            "sinabs" => NirConvention::Sinabs,
+            "rockpool" => NirConvention::Rockpool,
+            other => {
+                return Err(raise(
                     Kind::Parameter,
                     format!(
                         "for_tool must be nir, snntorch, norse, sinabs or rockpool, got {other:?}"
                     ),
-                )),
-            };
+                ))
+            }
+        };
         py.detach(|| guarded(|| export_nir(&self.inner, &path, convention)))
     }
 

@@ -103,6 +103,9 @@ pub fn run(command: ExportCommand) -> Result<()> {
                 export_nir(&model, p, args.convention)
             })?;
             let net = model.network();
+            if !net.reset.is_zero() && args.convention == NirConvention::Nir {
+                eprintln!("note: the network's neurons subtract the threshold on a spike; NIR's reset to zero, so the graph says `reset = subtract` in its metadata, which neurotex reads and other tools ignore (--for sinabs or --for rockpool write it for theirs)");
+            }
             let recurrent = if net.recurrent() { " recurrent" } else { "" };
             eprintln!(
                 "NIR graph for {}: {} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms -> {}",

@@ -15,8 +15,16 @@
 //! ∂L/∂W_in += gI[t] x[t]ᵀ, ∂L/∂b_in += gI[t], ∂L/∂W_out += S[t] gO[t]ᵀ, ∂L/∂b_out += gO[t]
 //! ∂L/∂W_rec += S[t-1] gI[t]ᵀ                      (recurrent networks)
 //! ```
+//!
+//! With the subtractive reset (`V[t] = P[t] - S[t]`, `S[t]` a count), the spike's
+//! derivative is the same surrogate and the membrane line becomes
+//!
+//! ```text
+//! gP[t] = gV[t] + gS[t] H'(P[t] - 1)                 reset detached
+//! gP[t] = gV[t] (1 - H'(P[t] - 1)) + gS[t] H'(P[t] - 1)  reset in the graph
+//! ```
 
-use super::{softmax, Network, Readout, SpikeInput};
+use super::{softmax, Network, Readout, Reset, SpikeInput};
 
 /// The spike nonlinearity of the forward pass and the derivative the backward pass uses.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -143,10 +151,32 @@ pub fn forward(
     act: Activation,
     tr: &mut Trajectory,
 ) -> Vec<f64> {
-    // One copy of the loop per nonlinearity, so that each inlines and vectorises.
-    match act {
-        Activation::Spike { .. } => forward_with(net, input, tr, |x| f64::from(u8::from(x >= 0.0))),
-        Activation::Smooth { .. } => forward_with(net, input, tr, |x| act.value(x)),
+    // One copy of the loop per nonlinearity and reset, so that each inlines and
+    // vectorises. `spike` maps the membrane to the step's spikes, `reset` the membrane and
+    // its spikes to what is kept.
+    let zero = |p: f64, s: f64| p * (1.0 - s);
+    let subtract = |p: f64, s: f64| p - s;
+    match (act, net.reset) {
+        (Activation::Spike { .. }, Reset::Zero) => forward_with(
+            net,
+            input,
+            tr,
+            |p| f64::from(u8::from(p - 1.0 >= 0.0)),
+            zero,
+        ),
+        (Activation::Spike { .. }, Reset::Subtract) => forward_with(
+            net,
+            input,
+            tr,
+            |p| if p >= 1.0 { p.floor() } else { 0.0 },
+            subtract,
+        ),
+        (Activation::Smooth { .. }, Reset::Zero) => {
+            forward_with(net, input, tr, |p| act.value(p - 1.0), zero)
+        }
+        (Activation::Smooth { .. }, Reset::Subtract) => {
+            forward_with(net, input, tr, |p| act.value(p - 1.0), subtract)
+        }
     }
 }
 
@@ -154,7 +184,8 @@ fn forward_with(
     net: &Network,
     input: &SpikeInput,
     tr: &mut Trajectory,
-    value: impl Fn(f64) -> f64,
+    spike: impl Fn(f64) -> f64,
+    reset: impl Fn(f64, f64) -> f64,
 ) -> Vec<f64> {
     let (alpha, beta, kappa) = net.decays();
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
@@ -200,8 +231,8 @@ fn forward_with(
             .zip(&current)
         {
             *p = beta * *m + c;
-            *s = value(*p - 1.0);
-            *m = *p * (1.0 - *s);
+            *s = spike(*p);
+            *m = reset(*p, *s);
         }
         for (h, &s) in spikes.iter().enumerate() {
             if s != 0.0 {
@@ -298,6 +329,7 @@ fn backward_with(
     }
     let mean_share = 1.0 / steps.max(1) as f64;
     let recurrent = net.recurrent();
+    let subtract = net.reset == Reset::Subtract;
     for t in (0..steps).rev() {
         for c in 0..c_n {
             let direct = match &argmax {
@@ -322,14 +354,9 @@ fn backward_with(
             // S[t] drives I[t+1]: g_i still holds step t+1's.
             add_recurrent_spike_gradient(net, &g_i, &mut g_s);
         }
-        let reset = f64::from(u8::from(!detach_reset));
-        let neurons = g_s.iter().zip(pre).zip(spikes).zip(&mut g_v).zip(&mut g_i);
-        for ((((&g_s, &p), &s), g_v), g_i) in neurons {
-            let g_sh = g_s - reset * p * *g_v;
-            let g_p = *g_v * (1.0 - s) + g_sh * derivative(p - 1.0);
-            *g_i = g_p + alpha * *g_i;
-            *g_v = beta * g_p;
-        }
+        let decays = (alpha, beta, f64::from(u8::from(!detach_reset)));
+        let step = (g_s.as_slice(), pre, spikes);
+        step_back(step, &mut g_v, &mut g_i, decays, subtract, &derivative);
         for (b, g) in grad.b_in.iter_mut().zip(&g_i) {
             *b += g;
         }
@@ -342,6 +369,37 @@ fn backward_with(
         if recurrent && t > 0 {
             let before = &tr.spikes[(t - 1) * h_n..t * h_n];
             add_outer(&mut grad.w_rec, before, &g_i);
+        }
+    }
+}
+
+/// One step of the hidden layer backwards (see the module's equations): from the step's
+/// spike gradient, membranes and spikes `(gS, P, S)`, turns the next step's membrane and
+/// current gradients `g_v`, `g_i` into this step's; `decays` are `(α, β, 1 if the reset is
+/// in the graph else 0)`.
+#[inline]
+fn step_back(
+    (g_s, pre, spikes): (&[f64], &[f64], &[f64]),
+    g_v: &mut [f64],
+    g_i: &mut [f64],
+    (alpha, beta, reset): (f64, f64, f64),
+    subtract: bool,
+    derivative: &impl Fn(f64) -> f64,
+) {
+    let neurons = g_s.iter().zip(pre).zip(spikes).zip(g_v).zip(g_i);
+    if subtract {
+        // V = P - S: the reset passes gV to P whole, and (in the graph) as -gV to S.
+        for ((((&g_s, &p), _), g_v), g_i) in neurons {
+            let g_p = *g_v + (g_s - reset * *g_v) * derivative(p - 1.0);
+            *g_i = g_p + alpha * *g_i;
+            *g_v = beta * g_p;
+        }
+    } else {
+        for ((((&g_s, &p), &s), g_v), g_i) in neurons {
+            let g_sh = g_s - reset * p * *g_v;
+            let g_p = *g_v * (1.0 - s) + g_sh * derivative(p - 1.0);
+            *g_i = g_p + alpha * *g_i;
+            *g_v = beta * g_p;
         }
     }
 }
@@ -403,6 +461,7 @@ mod tests {
             tau_mem_ms: 20.0,
             tau_out_ms: 15.0,
             readout,
+            reset: Reset::Zero,
             w_in: w(inputs * hidden, 1.5),
             b_in: w(hidden, 0.2),
             w_out: w(hidden * classes, 1.0),
@@ -480,21 +539,122 @@ mod tests {
         }
     }
 
+    /// An evidently correct forward pass of the smooth network, neuron by neuron, for
+    /// either reset, returning the loss (class 1) and every step's spikes. With `frozen`
+    /// (the spikes of an earlier run) the reset subtracts those instead of this run's:
+    /// held fixed, they are what a detached reset keeps out of the gradient, so finite
+    /// differences of this loss check the detached backward pass.
+    fn reference_loss(
+        net: &Network,
+        input: &SpikeInput,
+        k: f64,
+        frozen: Option<&[f64]>,
+    ) -> (f64, Vec<f64>) {
+        let (alpha, beta, kappa) = net.decays();
+        let (n, h_n, c_n) = (net.inputs, net.hidden, net.classes);
+        let sigma = |x: f64| 1.0 / (1.0 + (-k * x).exp());
+        let x = input.dense();
+        let (mut current, mut v) = (vec![0.0; h_n], vec![0.0; h_n]);
+        let (mut out, mut last) = (vec![0.0; c_n], vec![0.0; h_n]);
+        let (mut spikes, mut trace) = (Vec::new(), Vec::new());
+        for t in 0..input.steps() {
+            let loops = if net.recurrent() { h_n } else { 0 };
+            for (h, current) in current.iter_mut().enumerate() {
+                let mut drive = net.b_in[h];
+                for i in 0..n {
+                    drive += f64::from(x[t * n + i]) * net.w_in[i * h_n + h];
+                }
+                for (j, &s) in last.iter().enumerate().take(loops) {
+                    drive += s * net.w_rec[j * h_n + h];
+                }
+                *current = alpha * *current + drive;
+            }
+            for h in 0..h_n {
+                let p = beta * v[h] + current[h];
+                last[h] = sigma(p - 1.0);
+                let r = frozen.map_or(last[h], |f| f[t * h_n + h]);
+                v[h] = match net.reset {
+                    Reset::Zero => p * (1.0 - r),
+                    Reset::Subtract => p - r,
+                };
+            }
+            for (c, out) in out.iter_mut().enumerate() {
+                let drive: f64 = (0..h_n).map(|h| last[h] * net.w_out[h * c_n + c]).sum();
+                *out = kappa * *out + net.b_out[c] + drive;
+            }
+            spikes.extend_from_slice(&last);
+            trace.extend_from_slice(&out);
+        }
+        let scores = net.reduce(trace.chunks_exact(c_n));
+        (-softmax(&scores)[1].ln(), spikes)
+    }
+
+    /// The backward pass against central finite differences of the reference's loss, for
+    /// both resets, feed-forward and recurrent, the reset detached (the reference's
+    /// spikes in the reset held) and in the graph.
+    #[test]
+    fn gradient_matches_finite_differences_for_each_reset() {
+        let k = 4.0;
+        let act = Activation::Smooth { k };
+        let mut seed = 10;
+        for reset in [Reset::Subtract, Reset::Zero] {
+            for recurrent in [false, true] {
+                for detach_reset in [true, false] {
+                    seed += 1;
+                    let (mut net, input) = random_net_of(Readout::Mean, seed, recurrent);
+                    net.reset = reset;
+                    let (loss_at, spikes) = reference_loss(&net, &input, k, None);
+                    let want = loss(&net, &input, act);
+                    assert!((loss_at - want).abs() <= 1e-9, "{loss_at} vs {want}");
+                    let mut grad = Gradient::zeros(&net);
+                    let rule = Backprop { act, detach_reset };
+                    let mut tr = Trajectory::default();
+                    loss_and_gradient(&net, &input, 1, rule, 1.0, &mut tr, &mut grad);
+                    let frozen = detach_reset.then_some(spikes.as_slice());
+                    let eps = 1e-6;
+                    for part in 0..5 {
+                        for j in 0..grad.parts()[part].len() {
+                            let bump = |d: f64| {
+                                let mut n = net.clone();
+                                n.params_mut()[part][j] += d;
+                                reference_loss(&n, &input, k, frozen).0
+                            };
+                            let numeric = (bump(eps) - bump(-eps)) / (2.0 * eps);
+                            let analytic = grad.parts()[part][j];
+                            let tol = 1e-6 + 1e-4 * numeric.abs().max(analytic.abs());
+                            assert!(
+                                (numeric - analytic).abs() <= tol,
+                                "{reset:?} recurrent {recurrent} detached {detach_reset} part {part} [{j}]: numeric {numeric}, backward {analytic}"
+                            );
+                        }
+                    }
+                    assert!(grad.w_in.iter().any(|g| g.abs() > 1e-4));
+                    assert!(!recurrent || grad.w_rec.iter().any(|g| g.abs() > 1e-4));
+                }
+            }
+        }
+    }
+
     /// The training forward pass with the spike nonlinearity gives the scores prediction's
-    /// step-by-step runner gives, bit for bit.
+    /// step-by-step runner gives, bit for bit, for either reset.
     #[test]
     fn training_forward_equals_the_runner() {
-        for (readout, recurrent) in [
-            (Readout::Mean, false),
-            (Readout::Max, false),
-            (Readout::Mean, true),
+        for (readout, recurrent, reset) in [
+            (Readout::Mean, false, Reset::Zero),
+            (Readout::Max, false, Reset::Zero),
+            (Readout::Mean, true, Reset::Zero),
+            (Readout::Mean, false, Reset::Subtract),
+            (Readout::Max, true, Reset::Subtract),
         ] {
-            let (net, input) = random_net_of(readout, 3, recurrent);
+            let (mut net, input) = random_net_of(readout, 3, recurrent);
+            net.reset = reset;
             let act = Activation::Spike { slope: 10.0 };
             let mut tr = Trajectory::default();
             let trained = forward(&net, &input, act, &mut tr);
             assert_eq!(trained, net.scores(&input));
             assert!(tr.spikes.contains(&1.0) && tr.spikes.contains(&0.0));
+            let most = tr.spikes.iter().copied().fold(0.0, f64::max);
+            assert_eq!(most >= 2.0, reset == Reset::Subtract, "{reset:?}: {most}");
         }
     }
 

@@ -15,6 +15,11 @@
 //! O[t] = κ O[t-1] + W_out S[t] + b_out       leaky readout, one per class
 //! ```
 //!
+//! With [`Reset::Subtract`] a neuron instead emits `S[t] = ⌊P[t]⌋` spikes when `P[t] ≥ 1`
+//! (none below) and keeps the rest, `V[t] = P[t] - S[t]`: the multi-spike neuron with
+//! subtractive reset of sinabs, Rockpool and SynSense's Xylo, so that a network trained
+//! with it runs unchanged there. The readout and a recurrent layer receive the count.
+//!
 //! A class's score is the **mean of its readout over time** ([`Readout::Mean`]): a texture
 //! slid over the skin is a stationary process, so evidence is gathered over the whole
 //! window rather than at the one most confident step ([`Readout::Max`], Zenke & Vogels
@@ -71,6 +76,48 @@ impl std::str::FromStr for Readout {
     }
 }
 
+/// How a hidden neuron resets when its membrane reaches the threshold.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Reset {
+    /// One spike at most per step, the membrane set to zero (the default).
+    #[default]
+    Zero,
+    /// `n = ⌊P⌋` spikes in a step, `n` subtracted from the membrane (sinabs, Rockpool,
+    /// Xylo).
+    Subtract,
+}
+
+impl Reset {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reset::Zero => "zero",
+            Reset::Subtract => "subtract",
+        }
+    }
+
+    /// Whether this is the default reset to zero (which model files leave out).
+    pub fn is_zero(&self) -> bool {
+        *self == Reset::Zero
+    }
+}
+
+impl std::str::FromStr for Reset {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        match s {
+            "zero" => Ok(Reset::Zero),
+            "subtract" => Ok(Reset::Subtract),
+            _ => Err(ParamError::new(
+                "snn-reset",
+                "reset must be zero or subtract",
+                s,
+            )),
+        }
+    }
+}
+
 /// The spiking classifier's parameters (defaults chosen a priori; SPEC 11 and
 /// `docs/spiking-classifier.md` give the reasons).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -108,6 +155,10 @@ pub struct SnnParams {
     /// Recurrent connections within the hidden layer (false: feed-forward): each
     /// neuron's spikes of one step drive every hidden neuron's current at the next.
     pub recurrent: bool,
+    /// How a hidden neuron resets on a spike (zero); left out of model files when zero,
+    /// so that they read as before the option existed.
+    #[serde(skip_serializing_if = "Reset::is_zero")]
+    pub reset: Reset,
 }
 
 impl Default for SnnParams {
@@ -128,6 +179,7 @@ impl Default for SnnParams {
             detach_reset: true,
             seed: 0,
             recurrent: false,
+            reset: Reset::Zero,
         }
     }
 }
@@ -297,6 +349,10 @@ pub struct Network {
     pub tau_out_ms: f64,
     /// How scores are read.
     pub readout: Readout,
+    /// How a hidden neuron resets on a spike; absent (zero) in the files of networks that
+    /// reset to zero.
+    #[serde(default, skip_serializing_if = "Reset::is_zero")]
+    pub reset: Reset,
     /// Input weights, input-major: `w_in[i * hidden + h]` from input `i` to neuron `h`.
     pub w_in: Vec<f64>,
     /// Hidden biases (a constant current each step).
@@ -492,9 +548,9 @@ pub struct State {
     current: Vec<f64>,
     membrane: Vec<f64>,
     out: Vec<f64>,
-    /// The hidden neurons that spiked in the last step, ascending (kept for a recurrent
-    /// network).
-    fired: Vec<u32>,
+    /// The hidden neurons that spiked in the last step, ascending, with their spike
+    /// counts (kept for a recurrent network).
+    fired: Vec<(u32, f64)>,
 }
 
 impl State {
@@ -527,10 +583,10 @@ impl State {
                 *c += w;
             }
         }
-        for &j in &self.fired {
+        for &(j, n) in &self.fired {
             let w = &net.w_rec[j as usize * h_n..(j as usize + 1) * h_n];
             for (c, w) in self.current.iter_mut().zip(w) {
-                *c += w;
+                *c += n * w;
             }
         }
         self.fired.clear();
@@ -538,16 +594,20 @@ impl State {
         for (o, b) in self.out.iter_mut().zip(&net.b_out) {
             *o = kappa * *o + b;
         }
+        let subtract = net.reset == Reset::Subtract;
         for h in 0..h_n {
             let p = beta * self.membrane[h] + self.current[h];
             if p >= 1.0 {
-                self.membrane[h] = 0.0;
+                // One spike and a membrane of zero, or floor(p) spikes and the rest kept
+                // (a count of 1 multiplies the weights exactly).
+                let n = if subtract { p.floor() } else { 1.0 };
+                self.membrane[h] = if subtract { p - n } else { 0.0 };
                 if recurrent {
-                    self.fired.push(h as u32);
+                    self.fired.push((h as u32, n));
                 }
                 let w = &net.w_out[h * net.classes..(h + 1) * net.classes];
                 for (o, w) in self.out.iter_mut().zip(w) {
-                    *o += w;
+                    *o += n * w;
                 }
             } else {
                 self.membrane[h] = p;
@@ -648,4 +708,76 @@ pub fn softmax(scores: &[f64]) -> Vec<f64> {
     let exp: Vec<f64> = scores.iter().map(|s| (s - top).exp()).collect();
     let sum: f64 = exp.iter().sum();
     exp.iter().map(|e| e / sum).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One input, one hidden neuron, one class: an input weight of 2.7 drives the membrane
+    /// to 2.7 in the first step.
+    fn one_neuron(reset: Reset, w_rec: Vec<f64>) -> Network {
+        Network {
+            inputs: 1,
+            hidden: 1,
+            classes: 1,
+            dt_ms: 10,
+            tau_syn_ms: 20.0,
+            tau_mem_ms: 40.0,
+            tau_out_ms: 40.0,
+            readout: Readout::Mean,
+            reset,
+            w_in: vec![2.7],
+            b_in: vec![0.0],
+            w_out: vec![0.25],
+            b_out: vec![0.0],
+            w_rec,
+        }
+    }
+
+    /// A strong input makes a subtracting neuron spike twice in one step and keep 0.7; the
+    /// readout and the recurrent current receive both spikes. Reset to zero, the same
+    /// neuron spikes once and keeps nothing.
+    #[test]
+    fn subtract_emits_several_spikes_in_a_step_and_keeps_the_rest() {
+        for (reset, spikes, kept) in [(Reset::Subtract, 2.0, 2.7 - 2.0), (Reset::Zero, 1.0, 0.0)] {
+            let net = one_neuron(reset, vec![0.5]);
+            let mut state = State::new(&net);
+            state.step(&net, &[0]);
+            assert_eq!(state.membrane, [kept], "{reset:?}");
+            assert_eq!(state.readout(), [spikes * 0.25], "{reset:?}");
+            assert_eq!(state.fired, [(0, spikes)], "{reset:?}");
+            let (alpha, _, _) = net.decays();
+            state.step(&net, &[]);
+            assert_eq!(state.current, [alpha * 2.7 + spikes * 0.5], "{reset:?}");
+        }
+    }
+
+    /// Below the threshold nothing fires and the membrane is kept, whatever the reset.
+    #[test]
+    fn subtract_below_threshold_keeps_the_membrane() {
+        let mut net = one_neuron(Reset::Subtract, Vec::new());
+        net.w_in = vec![0.6];
+        let mut state = State::new(&net);
+        state.step(&net, &[0]);
+        assert_eq!(state.membrane, [0.6]);
+        assert_eq!(state.readout(), [0.0]);
+    }
+
+    /// The reset's names and its file form: `subtract` is written, `zero` left out of a
+    /// network's file, and a file without it reads as zero.
+    #[test]
+    fn reset_parses_and_zero_is_left_out_of_files() {
+        assert_eq!("subtract".parse::<Reset>().unwrap(), Reset::Subtract);
+        assert_eq!("zero".parse::<Reset>().unwrap(), Reset::Zero);
+        assert_eq!("Zero".parse::<Reset>().unwrap_err().name, "snn-reset");
+        let zero = serde_json::to_value(one_neuron(Reset::Zero, Vec::new())).unwrap();
+        assert!(zero.get("reset").is_none());
+        let back: Network = serde_json::from_value(zero).unwrap();
+        assert_eq!(back.reset, Reset::Zero);
+        let sub = serde_json::to_value(one_neuron(Reset::Subtract, Vec::new())).unwrap();
+        assert_eq!(sub["reset"], "subtract");
+        let params = serde_json::to_value(SnnParams::default()).unwrap();
+        assert!(params.get("reset").is_none());
+    }
 }

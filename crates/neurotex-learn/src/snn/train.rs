@@ -165,6 +165,7 @@ fn initial(
         tau_mem_ms: params.tau_mem_ms,
         tau_out_ms: params.tau_out_ms,
         readout: params.readout,
+        reset: params.reset,
         w_in: (0..n * h).map(|_| normal.sample(rng)).collect(),
         b_in: vec![0.0; h],
         w_out: (0..h * classes)

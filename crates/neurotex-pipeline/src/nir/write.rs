@@ -251,6 +251,11 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
     put_f64(&mut meta, "neurotex_dt", f64::from(net.dt_ms) / 1000.0);
     put_str(&mut meta, "neurotex_for", convention.name());
     put_str(&mut meta, "readout", net.readout.name());
+    if !net.reset.is_zero() {
+        // NIR 1.0's neurons reset to `v_reset`: the subtracting neuron is neurotex's word
+        // to itself here (sinabs and Rockpool have it as their own neuron).
+        put_str(&mut meta, "reset", net.reset.name());
+    }
     put_str(&mut meta, "neurotex_model", model_json);
     node.add_group(meta.finish());
     fb.add_group(node.finish());

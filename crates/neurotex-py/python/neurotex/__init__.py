@@ -899,6 +899,7 @@ class SpikingModel(_Predicting):
         readout: str = _SNN_DEFAULTS["readout"],
         seed: int = _SNN_DEFAULTS["seed"],
         recurrent: bool = _SNN_DEFAULTS["recurrent"],
+        reset: str = _SNN_DEFAULTS["reset"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -907,13 +908,16 @@ class SpikingModel(_Predicting):
         ``epochs`` passes with early stopping on 20 % of each class, scores read as the
         readout's ``mean`` or ``max`` over time, weights seeded by ``seed`` (the same on
         any number of threads); ``recurrent=True`` connects the hidden layer to itself
-        (``--snn-recurrent``). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
+        (``--snn-recurrent``); ``reset`` is how a hidden neuron resets on a spike:
+        ``"zero"`` (one spike per step at most) or ``"subtract"`` (n = floor(v) spikes,
+        v - n kept: the neuron of sinabs, Rockpool and Xylo, needed to export to them;
+        ``--snn-reset``). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
         ...) as :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
         opts = _stage_options(**stage_options)
         opts["causal"] = bool(causal)
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
-               "seed": seed, "recurrent": recurrent}
+               "seed": seed, "recurrent": recurrent, "reset": reset}
         native, ran, best, loss = _native.train_spiking_model(arrays, infos, opts, snn, fp,
                                                               baseline)
         return cls(native, {"epochs": ran, "best_epoch": best, "validation_loss": loss})

@@ -57,6 +57,10 @@ impl From<NirConvention> for Convention {
 /// # Errors
 /// The file cannot be written.
 pub fn export_nir(model: &SpikingModel, out: &Path, convention: NirConvention) -> Result<()> {
+    if convention == NirConvention::Norse && !model.network().reset.is_zero() {
+        let why = "this network's neurons subtract the threshold (--snn-reset subtract), and Norse's reset to zero: export it --for sinabs or --for rockpool, or --for nir for neurotex";
+        return Err(crate::error::OptionsError::Conflict(why.into()).into());
+    }
     let bytes = model.to_nir(convention.into())?;
     crate::io::write_atomic(out, |w| w.write_all(&bytes))
 }

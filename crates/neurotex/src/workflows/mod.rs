@@ -127,6 +127,11 @@ pub struct SnnOptions {
     /// spikes drive the next step's currents); default feed-forward.
     #[cfg_attr(feature = "cli", arg(long = "snn-recurrent", id = "snn-recurrent"))]
     pub recurrent: bool,
+    /// With `--classifier snn`: how a hidden neuron resets on a spike: `zero` (the
+    /// default; one spike per step at most) or `subtract` (n = floor(v) spikes, v - n
+    /// kept: the neuron of sinabs, Rockpool and Xylo, needed to export to them).
+    #[cfg_attr(feature = "cli", arg(long = "snn-reset", id = "snn-reset"))]
+    pub reset: Option<neurotex_learn::snn::Reset>,
 }
 
 impl SnnOptions {
@@ -138,6 +143,7 @@ impl SnnOptions {
             || self.readout.is_some()
             || self.seed.is_some()
             || self.recurrent
+            || self.reset.is_some()
     }
 
     /// `defaults` with the options given applied, checked.
@@ -152,6 +158,7 @@ impl SnnOptions {
             readout: self.readout.unwrap_or(defaults.readout),
             seed: self.seed.unwrap_or(defaults.seed),
             recurrent: self.recurrent || defaults.recurrent,
+            reset: self.reset.unwrap_or(defaults.reset),
             ..defaults
         }
         .check()?)
