@@ -24,7 +24,7 @@ pub use crate::error::DatasetError;
 use crate::error::{DataError, ParamError, Result};
 use crate::simd::widest_or_plain;
 pub use crate::values::TimeUnit;
-use crate::values::{Cell, Grid, Speed};
+use crate::values::{Cell, Grid, SampleRate, Speed, FS_RULE};
 
 /// The phase of the protocol a sample belongs to (paper section II-D).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -413,8 +413,10 @@ impl LayoutFile {
         if let Err(e) = self.csv_formats(&CsvOverrides::default()) {
             return bad(e.to_string());
         }
+        if let Some(fs) = self.fs.filter(|&fs| SampleRate::new(fs).is_err()) {
+            return bad(format!("field `fs`: {FS_RULE}, got {fs}"));
+        }
         let positive = [
-            ("fs", self.fs, "Hz"),
             ("max_gap_s", self.max_gap_s, "s"),
             ("max_duration_s", self.max_duration_s, "s"),
         ];
