@@ -117,6 +117,23 @@ impl Meta {
             other => self.extra.get(other).filter(|v| !v.is_empty()).cloned(),
         }
     }
+
+    /// The manifest columns some of `metas` have a value in, in manifest order (the
+    /// standard columns first): what a column-naming option may name.
+    pub fn columns_with_values(metas: &[Meta]) -> Vec<String> {
+        let standard = ["file", "label"].into_iter().chain(NUMERIC_COLUMNS);
+        let extra = metas
+            .iter()
+            .flat_map(|m| m.extra.keys().map(String::as_str));
+        let mut names: Vec<String> = Vec::new();
+        for name in standard.chain(extra) {
+            let valued = metas.iter().any(|m| m.field(name).is_some());
+            if valued && !names.iter().any(|n| n == name) {
+                names.push(name.to_string());
+            }
+        }
+        names
+    }
 }
 
 /// The manifest columns whose values are numbers, compared as numbers.

@@ -322,6 +322,13 @@ fn conditions(metas: &[Meta], column: &str) -> Result<Vec<String>> {
             }
         }
     }
+    if values.is_empty() {
+        let rule = "the protocol's column must be a manifest column with values";
+        let names = Meta::columns_with_values(metas).join(", ");
+        let got =
+            format!("{column}, which no recording has a value in (columns with values: {names})");
+        return Err(ParamError::new("per / hold-out", rule, got).into());
+    }
     if values.len() < 2 {
         let rule = "the protocol's column must have at least two values";
         let got = format!("{column}: {} value(s)", values.len());
