@@ -652,6 +652,13 @@ fn folds_the_design_cannot_give_are_said_with_the_folds_used() {
     assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
     let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
     assert!(json["notes"][0].as_str().unwrap().contains(said), "{json}");
+    // reproduce's analyses at each speed, said before any is run.
+    let report = dir.join("report");
+    let mut all = vec!["reproduce", "--dataset", s(&data), "--out", s(&report)];
+    all.extend_from_slice(&["--quick", "--group-by", "trial", "--folds", "5", "--k", "1"]);
+    let run = dir.run(&all);
+    let said = "--folds 5 with --group-by trial: 4 `trial` group(s) at 5 mm/s, so 4 folds";
+    assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
     // Nested selection's inner folds, fewer where a class of an outer training set is
     // smaller than the folds.
     let data = dir.dataset("six", &["A", "B"], &[5.0], 6);
