@@ -77,8 +77,23 @@ enum Command {
     Export(export::ExportCommand),
 }
 
+/// Ends on an argument the parser refused, a number's error in words rather than the
+/// standard library's ("invalid digit found in string" for `--folds -1`).
+fn parse_failed(e: clap::Error) -> ! {
+    use clap::error::ErrorKind;
+    if !matches!(
+        e.kind(),
+        ErrorKind::ValueValidation | ErrorKind::InvalidValue
+    ) {
+        e.exit()
+    }
+    let text = e.render().to_string();
+    eprint!("{}", neurotex::error::number_words(&text));
+    std::process::exit(e.exit_code())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| parse_failed(e));
     interrupt::install();
     if let Ok(value) = std::env::var("NEUROTEX_SIMD") {
         if !matches!(value.as_str(), "native" | "avx2" | "portable") {

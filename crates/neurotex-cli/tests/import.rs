@@ -205,7 +205,7 @@ fn import_bad_input_is_named_through_the_binary() {
             "not a valid regular expression",
         ),
         (csv(&["--name-pattern", FABRIC_PATTERN]), "--fs"),
-        (csv(&["--fs", "-1"]), "positive number of Hz"),
+        (csv(&["--fs", "-1"]), "from 1 to 1e6"),
     ];
     dir.fails_each(&cases, &out);
     // --skip-bad leaves the NaN file out with a warning and imports the rest

@@ -683,3 +683,170 @@ fn the_check_at_a_workflows_start_reads_a_bounded_sample_and_says_so() {
         run.stderr
     );
 }
+
+/// Writes four two-channel CSV logs `{label}_{trial}.csv` (300 ms at 1 kHz) into `logs`.
+fn two_channel_logs(dir: &Dir) -> PathBuf {
+    let logs = dir.join("csv_logs");
+    std::fs::create_dir_all(&logs).unwrap();
+    for name in ["A_0", "A_1", "B_0", "B_1"] {
+        std::fs::write(logs.join(format!("{name}.csv")), text_of_log()).unwrap();
+    }
+    logs
+}
+
+#[test]
+fn a_ragged_line_is_told_by_its_line_and_field_counts() {
+    let dir = Dir::new();
+    let logs = two_channel_logs(&dir);
+    let ragged = logs.join("A_1.csv");
+    let text = std::fs::read_to_string(&ragged).unwrap();
+    std::fs::write(&ragged, text.replacen("\n5,5,0\n", "\n5,5\n", 1)).unwrap();
+    let out = dir.join("ds");
+    let pattern = [
+        "--name-pattern",
+        "{label}_{trial}.csv",
+        "--time-column",
+        "t_ms",
+    ];
+    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
+    args.extend_from_slice(&pattern);
+    let err = dir.fails(&args);
+    assert!(
+        err.contains("A_1.csv: line 7 has 2 field(s) where the header has 3"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("previous record") && !err.contains("byte"),
+        "{err}"
+    );
+    // An event log's ragged line in the same words.
+    let events = clock_logs(&dir, &|_| 0.0, 2);
+    let log = events.join("B_1.csv");
+    let mut text = std::fs::read_to_string(&log).unwrap();
+    text.push_str("99999999,1,1\n");
+    let line = text.lines().count();
+    std::fs::write(&log, text).unwrap();
+    let mut args = vec![
+        "import",
+        "events",
+        s(&events),
+        "--out",
+        "ev",
+        "--grid",
+        "2x2",
+    ];
+    args.extend_from_slice(&["--time-unit", "us", "--name-pattern", "{label}_{trial}.csv"]);
+    let err = dir.fails(&args);
+    let said = format!("line {line} has 3 field(s) where the header has 4");
+    assert!(err.contains(&said), "{err}");
+}
+
+#[test]
+fn a_bad_count_an_absurd_rate_or_a_missing_column_is_told_plainly() {
+    let dir = Dir::new();
+    let logs = two_channel_logs(&dir);
+    let out = dir.join("ds");
+    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
+    args.extend_from_slice(&[
+        "--name-pattern",
+        "{label}_{trial}.csv",
+        "--time-column",
+        "t_ms",
+    ]);
+    dir.ok(&args);
+    // A count given as a negative number, as an option and in a layout file.
+    let data = s(&out);
+    let err = dir.fails(&["evaluate", "--dataset", data, "--folds=-1"]);
+    assert!(
+        err.contains("'-1' for '--folds") && err.contains("whole number"),
+        "{err}"
+    );
+    assert!(!err.contains("invalid digit"), "{err}");
+    let layout = std::fs::read_to_string(out.join("layout.toml")).unwrap();
+    let broken = layout.replacen("rows = 1", "rows = -1", 1);
+    assert_ne!(broken, layout);
+    std::fs::write(out.join("layout.toml"), &broken).unwrap();
+    let err = dir.fails(&["inspect", data]);
+    assert!(
+        err.contains("`-1` where a whole number, 0 or more was expected"),
+        "{err}"
+    );
+    assert!(!err.contains("usize"), "{err}");
+    // A rate no sensor has, refused where it is given, with the range.
+    let fs = layout.replacen("fs = ", "fs = 1e12 # ", 1);
+    std::fs::write(out.join("layout.toml"), fs).unwrap();
+    let err = dir.fails(&["inspect", data]);
+    assert!(
+        err.contains("layout.toml: field `fs`") && err.contains("from 1 to 1e6"),
+        "{err}"
+    );
+    let npy = dir.dataset("npy", &["A", "B"], &[5.0], 3);
+    let one = npy.join("A_5_0.npy");
+    let err = dir.fails(&["encode", s(&one), "--fs", "1e-9", "--out", "x.npy"]);
+    assert!(
+        err.contains("from 1 to 1e6") && err.contains("--fs"),
+        "{err}"
+    );
+    // A protocol's column the manifest lacks, with the columns it has.
+    let mut args = vec!["compare", "--dataset", s(&npy), "--per", "session"];
+    args.extend_from_slice(&["--methods", "glcm3d", "--classifiers", "knn", "--k", "1"]);
+    let err = dir.fails(&args);
+    assert!(
+        err.contains("session, which no recording has a value in (columns with values: file, label, speed_mm_s"),
+        "{err}"
+    );
+}
+
+/// A clean two-channel log: `t_ms,a,b`, 300 rows.
+fn text_of_log() -> String {
+    let mut text = String::from("t_ms,a,b\n");
+    for t in 0..300 {
+        text.push_str(&format!("{t},{},{}\n", t % 7, t % 5));
+    }
+    text
+}
+
+#[test]
+fn folds_the_design_cannot_give_are_said_with_the_folds_used() {
+    let dir = Dir::new();
+    let data = dir.dataset("ds", &["A", "B"], &[5.0], 4);
+    let args = ["--group-by", "trial", "--folds", "5", "--k", "1", "--json"];
+    let mut all = vec!["evaluate", "--dataset", s(&data), "--method", "glcm3d"];
+    all.extend_from_slice(&args);
+    let run = dir.run(&all);
+    assert!(run.status.success(), "{}", run.stderr);
+    let said = "--folds 5 with --group-by trial: 4 `trial` groups, so 4 folds are used";
+    assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
+    let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
+    assert!(json["notes"][0].as_str().unwrap().contains(said), "{json}");
+    // reproduce's analyses at each speed, said before any is run.
+    let report = dir.join("report");
+    let mut all = vec!["reproduce", "--dataset", s(&data), "--out", s(&report)];
+    all.extend_from_slice(&["--quick", "--group-by", "trial", "--folds", "5", "--k", "1"]);
+    let run = dir.run(&all);
+    let said = "--folds 5 with --group-by trial: 4 `trial` group(s) at 5 mm/s, so 4 folds";
+    assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
+    // Nested selection's inner folds, fewer where a class of an outer training set is
+    // smaller than the folds.
+    let data = dir.dataset("six", &["A", "B"], &[5.0], 6);
+    let run = dir.run(&[
+        "compare",
+        "--dataset",
+        s(&data),
+        "--nested",
+        "--folds",
+        "5",
+        "--k",
+        "1",
+        "--methods",
+        "glcm3d",
+        "--classifiers",
+        "knn",
+        "--json",
+    ]);
+    assert!(run.status.success(), "{}", run.stderr);
+    let said = "--folds 5: nested selection's inner cross-validation uses 4 folds";
+    assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
+    let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
+    assert!(json["notes"][0].as_str().unwrap().contains(said), "{json}");
+}

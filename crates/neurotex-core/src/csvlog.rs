@@ -958,7 +958,14 @@ pub fn read_csv_log(path: &Path, format: &CsvFormat) -> Result<CsvLog> {
         match reader.read_byte_record(&mut record) {
             Ok(false) => break,
             Ok(true) => rows.push(&record)?,
-            Err(e) => return Err(csv_error(path, e)),
+            Err(e) => {
+                let first = if format.header {
+                    "the header"
+                } else {
+                    "line 1"
+                };
+                return Err(csv_error_after(path, e, first));
+            }
         }
     }
     let log = rows.finish(delimiter, format);
@@ -1136,8 +1143,14 @@ impl<'a> RowReader<'a> {
     }
 }
 
-/// A CSV reading error under the file's name, with its line when the reader knows it.
+/// A CSV reading error under the file's name, with its line when the reader knows it,
+/// the first line counted as the header.
 pub(crate) fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
+    csv_error_after(path, e, "the header")
+}
+
+/// As [`csv_error`], `first` naming the file's first line (`the header`, `line 1`).
+fn csv_error_after(path: &Path, e: csv::Error, first: &str) -> crate::Error {
     match e.kind() {
         csv::ErrorKind::Io(_) => {
             let csv::ErrorKind::Io(io) = e.into_kind() else {
@@ -1145,12 +1158,31 @@ pub(crate) fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
             };
             crate::io::read_error(path, io)
         }
+        _ => DataError::invalid(path, csv_words(&e, first)).into(),
+    }
+}
+
+/// A CSV reader's error (not an I/O one) in neurotex's words: the line, what it holds
+/// and what was expected, never the reader's record and byte counts.
+pub(crate) fn csv_words(e: &csv::Error, first: &str) -> String {
+    let line = e.position().map(|p| p.line());
+    let at = line.map(|l| format!("line {l}")).unwrap_or("a line".into());
+    match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!(
+            "{at} has {len} field(s) where {first} has {expected_len}: every line needs one \
+             field per column (a field holding the delimiter goes in double quotes)"
+        ),
+        csv::ErrorKind::Utf8 { err, .. } => format!(
+            "{at}: field {} is not UTF-8 text (save the file as UTF-8)",
+            err.field() + 1
+        ),
         _ => {
-            let line = e
-                .position()
-                .map(|p| format!("line {}: ", p.line()))
-                .unwrap_or_default();
-            DataError::invalid(path, format!("{line}malformed CSV: {e}")).into()
+            let text = e.to_string();
+            // The reader's own wording after its position, if any.
+            let what = text.rsplit("): ").next().unwrap_or(&text);
+            format!("{at}: {}", crate::error::parser_words(what))
         }
     }
 }

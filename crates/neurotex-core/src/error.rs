@@ -162,7 +162,10 @@ pub enum DataError {
 /// tagged enum Baseline" becomes "a string \"min\" where a Baseline table was expected").
 pub fn parser_words(message: &str) -> String {
     let message = message.trim().trim_end_matches('.');
-    let (found, expected) = match message.strip_prefix("invalid type: ") {
+    let stated = message
+        .strip_prefix("invalid type: ")
+        .or_else(|| message.strip_prefix("invalid value: "));
+    let (found, expected) = match stated {
         Some(rest) => match rest.split_once(", expected ") {
             Some((found, expected)) => (Some(found), expected),
             None => (None, rest),
@@ -175,6 +178,13 @@ pub fn parser_words(message: &str) -> String {
         .replace("enum ", "")
         .replace("a sequence", "a list")
         .replace("a map", "a table");
+    // Rust's number types, as the value each may hold.
+    let expected = match expected.as_str() {
+        "usize" | "u64" | "u32" | "u16" | "u8" => "a whole number, 0 or more".to_string(),
+        "isize" | "i64" | "i32" | "i16" | "i8" => "a whole number".to_string(),
+        "f64" | "f32" => "a number".to_string(),
+        _ => expected,
+    };
     match found {
         Some(found) => {
             let found = found
@@ -184,6 +194,25 @@ pub fn parser_words(message: &str) -> String {
         }
         None => expected,
     }
+}
+
+/// The standard library's number parse errors ("invalid digit found in string") in a
+/// user's words, what was expected; other text unchanged.
+pub fn number_words(message: &str) -> String {
+    message
+        .replace(
+            "invalid digit found in string",
+            "expected a whole number such as 0, 1, 2 (no sign, point or letters)",
+        )
+        .replace(
+            "cannot parse integer from empty string",
+            "empty where a whole number was expected",
+        )
+        .replace(
+            "number too large to fit in target type",
+            "a whole number too large",
+        )
+        .replace("invalid float literal", "not a number")
 }
 
 /// A TOML file's error: where it is, the line as written, and what was wrong in

@@ -633,7 +633,10 @@ fn parse_csv(
     let header = match reader.byte_headers() {
         Ok(header) => header.clone(),
         Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
-        Err(e) => return Err(bad(format!("not a CSV file with a header row: {e}"))),
+        Err(e) => {
+            let why = crate::csvlog::csv_words(&e, "the header");
+            return Err(bad(format!("not a CSV file with a header row: {why}")));
+        }
     };
     let names: Vec<&str> = header
         .iter()
@@ -658,7 +661,7 @@ fn parse_csv(
             Ok(false) => break,
             Ok(true) => {}
             Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
-            Err(e) => return Err(bad(format!("line {}: {e}", line + 1))),
+            Err(e) => return Err(bad(crate::csvlog::csv_words(&e, "the header"))),
         }
         // The line the record starts on, as the CSV reader counts lines.
         line = record.position().map_or(line + 1, |p| p.line() as usize);

@@ -1095,9 +1095,7 @@ pub fn import_stacked(
     p: &StackedParams,
     out: &Path,
 ) -> Result<usize> {
-    if !(p.fs.is_finite() && p.fs > 0.0) {
-        return Err(ParamError::new("fs", "sampling rate must be positive", p.fs).into());
-    }
+    crate::values::SampleRate::new(p.fs)?;
     let (arr, (rows, cols)) = stacked_samples(data, p)?;
     let (n, t) = (arr.shape()[0], arr.shape()[1]);
     let metas = stacked_metas(data, labels, speeds, n)?;

@@ -17,4 +17,4 @@ pub mod simd;
 pub mod values;
 
 pub use error::{Error, Result};
-pub use values::{BySpeed, Cell, Grid, SampleRate, Speed};
+pub use values::{BySpeed, Cell, Grid, SampleRate, Speed, FS_RANGE, FS_RULE};

@@ -24,7 +24,7 @@ pub use crate::error::DatasetError;
 use crate::error::{DataError, ParamError, Result};
 use crate::simd::widest_or_plain;
 pub use crate::values::TimeUnit;
-use crate::values::{Cell, Grid, Speed};
+use crate::values::{Cell, Grid, SampleRate, Speed, FS_RULE};
 
 /// The phase of the protocol a sample belongs to (paper section II-D).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -116,6 +116,23 @@ impl Meta {
             "slide_end_s" => number(self.slide_end_s),
             other => self.extra.get(other).filter(|v| !v.is_empty()).cloned(),
         }
+    }
+
+    /// The manifest columns some of `metas` have a value in, in manifest order (the
+    /// standard columns first): what a column-naming option may name.
+    pub fn columns_with_values(metas: &[Meta]) -> Vec<String> {
+        let standard = ["file", "label"].into_iter().chain(NUMERIC_COLUMNS);
+        let extra = metas
+            .iter()
+            .flat_map(|m| m.extra.keys().map(String::as_str));
+        let mut names: Vec<String> = Vec::new();
+        for name in standard.chain(extra) {
+            let valued = metas.iter().any(|m| m.field(name).is_some());
+            if valued && !names.iter().any(|n| n == name) {
+                names.push(name.to_string());
+            }
+        }
+        names
     }
 }
 
@@ -413,8 +430,10 @@ impl LayoutFile {
         if let Err(e) = self.csv_formats(&CsvOverrides::default()) {
             return bad(e.to_string());
         }
+        if let Some(fs) = self.fs.filter(|&fs| SampleRate::new(fs).is_err()) {
+            return bad(format!("field `fs`: {FS_RULE}, got {fs}"));
+        }
         let positive = [
-            ("fs", self.fs, "Hz"),
             ("max_gap_s", self.max_gap_s, "s"),
             ("max_duration_s", self.max_duration_s, "s"),
         ];

@@ -368,7 +368,15 @@ impl<'de> Deserialize<'de> for Speed {
     }
 }
 
-/// A sampling rate in Hz: a positive, finite number.
+/// The sampling rates a recording may be read at, in Hz: outside them a rate is a typo or
+/// a unit slip (ms for s), whose recordings would otherwise be refused later as too long
+/// or too short for some stage, with the rate not named.
+pub const FS_RANGE: (f64, f64) = (1.0, 1e6);
+
+/// The rule of [`FS_RANGE`], as said to the user.
+pub const FS_RULE: &str = "a sampling rate must be a number of Hz from 1 to 1e6 (1 MHz)";
+
+/// A sampling rate in Hz: a number within [`FS_RANGE`].
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
 pub struct SampleRate(f64);
 
@@ -376,16 +384,12 @@ impl SampleRate {
     /// A rate of `hz` Hz.
     ///
     /// # Errors
-    /// A rate that is not a positive, finite number.
+    /// A rate outside [`FS_RANGE`] (or not a number).
     pub fn new(hz: f64) -> Result<Self, ParamError> {
-        if hz.is_finite() && hz > 0.0 {
+        if (FS_RANGE.0..=FS_RANGE.1).contains(&hz) {
             Ok(SampleRate(hz))
         } else {
-            Err(ParamError::new(
-                "fs",
-                "a sampling rate must be a positive number of Hz",
-                hz,
-            ))
+            Err(ParamError::new("fs", FS_RULE, hz))
         }
     }
 

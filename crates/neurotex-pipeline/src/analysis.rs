@@ -322,6 +322,19 @@ fn classes(table: &FeatureTable, rows: &[usize]) -> (Vec<String>, Vec<usize>) {
     (labels, y)
 }
 
+/// The number of groups of manifest column `column` among `rows` (recordings without a
+/// value there one group), as grouped cross-validation counts them.
+pub fn group_count(metas: &[Meta], rows: &[usize], column: &str) -> usize {
+    let mut seen: Vec<String> = Vec::new();
+    for &r in rows {
+        let value = metas[r].field(column).unwrap_or_default();
+        if !seen.contains(&value) {
+            seen.push(value);
+        }
+    }
+    seen.len()
+}
+
 /// Each row's group under the manifest column `column`, as indices from 0.
 ///
 /// # Errors
@@ -337,7 +350,10 @@ fn group_indices(table: &FeatureTable, rows: &[usize], column: &str) -> Result<V
             None if table.metas.iter().any(|m| m.field(column).is_some()) => String::new(),
             None => {
                 let rule = "--group-by must name a manifest column with values";
-                let got = format!("{column} (not in {})", meta.file);
+                let names = Meta::columns_with_values(&table.metas).join(", ");
+                let got = format!(
+                    "{column} (no recording has a value there; columns with values: {names})"
+                );
                 return Err(ParamError::new("group-by", rule, got).into());
             }
         };

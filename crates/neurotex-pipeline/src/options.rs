@@ -251,7 +251,7 @@ where
 {
     text.trim().parse().map_err(|e: T::Err| {
         // A number's error ("invalid digit found in string") does not show the value.
-        let e = e.to_string();
+        let e = crate::error::number_words(&e.to_string());
         match e.contains(text.trim()) {
             true => e,
             false => format!("`{text}`: {e}"),

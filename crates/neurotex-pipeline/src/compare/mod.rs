@@ -201,6 +201,10 @@ pub struct Comparison {
     pub nested: Option<Nested>,
     /// What the ranking does not say.
     pub caveat: String,
+    /// Options the design could not honour as given (fewer folds than asked), each as
+    /// said on standard error when the comparison ran.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// The caveat every comparison carries.
@@ -253,6 +257,10 @@ pub fn compare_with_progress(
         true => Some(check_nested(metas, params)?),
         false => None,
     };
+    let notes = fewer_folds(metas, params, outer.as_deref());
+    for note in &notes {
+        progress(Progress::Advice(note));
+    }
     progress(Progress::Stage("candidates", candidates.len()));
     let scored: Vec<Scored> = candidates
         .par_iter()
@@ -292,7 +300,60 @@ pub fn compare_with_progress(
         results,
         nested,
         caveat: CAVEAT.into(),
+        notes,
     })
+}
+
+/// What the design makes of `--folds` where it cannot honour it: fewer groups than folds
+/// (each group then held out in turn) and nested selection's inner folds, which a class
+/// smaller than the folds reduces; each said once, with the value given and the one used.
+fn fewer_folds(
+    metas: &[Meta],
+    params: &CompareParams,
+    outer: Option<&[OuterSplit]>,
+) -> Vec<String> {
+    let folds = params.cv.folds;
+    let mut notes = Vec::new();
+    if let Some(column) = &params.group_by {
+        let all: Vec<usize> = (0..metas.len()).collect();
+        let sets: Vec<(String, Vec<usize>)> = match &params.protocol {
+            Protocol::Pooled => vec![(String::new(), all)],
+            Protocol::Per(per) => conditions(metas, per)
+                .unwrap_or_default()
+                .into_iter()
+                .map(|v| (format!(" at {per} = {v}"), rows_with(metas, per, &v)))
+                .collect(),
+            Protocol::HoldOut(_) | Protocol::Where { .. } => Vec::new(),
+        };
+        let fewest = sets
+            .iter()
+            .map(|(at, rows)| (crate::analysis::group_count(metas, rows, column), at))
+            .min_by_key(|(n, _)| *n);
+        if let Some((groups, at)) = fewest.filter(|(n, _)| *n < folds) {
+            notes.push(format!(
+                "--folds {folds} with --group-by {column}: {groups} `{column}` group(s){at}, so {groups} folds are used there (each group held out in turn)"
+            ));
+        }
+    }
+    let inner = outer
+        .unwrap_or_default()
+        .iter()
+        .map(|split| inner_folds(folds, smallest_class(metas, &split.train)))
+        .filter(|&used| used < folds);
+    if let Some(used) = inner.clone().min() {
+        notes.push(format!(
+            "--folds {folds}: nested selection's inner cross-validation uses {used} folds in {} of {} outer training sets (their smallest class has fewer than {folds} recordings)",
+            inner.count(),
+            outer.map_or(0, <[_]>::len)
+        ));
+    }
+    notes
+}
+
+/// The folds of nested selection's inner cross-validation: `folds`, fewer when a class of
+/// the outer training set has fewer recordings (`smallest`), never under 2.
+fn inner_folds(folds: usize, smallest: usize) -> usize {
+    folds.min(smallest).max(2)
 }
 
 /// The number of classes among the evaluated rows and the largest class's share.
@@ -321,6 +382,13 @@ fn conditions(metas: &[Meta], column: &str) -> Result<Vec<String>> {
                 values.push(v);
             }
         }
+    }
+    if values.is_empty() {
+        let rule = "the protocol's column must be a manifest column with values";
+        let names = Meta::columns_with_values(metas).join(", ");
+        let got =
+            format!("{column}, which no recording has a value in (columns with values: {names})");
+        return Err(ParamError::new("per / hold-out", rule, got).into());
     }
     if values.len() < 2 {
         let rule = "the protocol's column must have at least two values";
@@ -737,7 +805,7 @@ fn outer(
     let inner = CompareParams {
         cv: crate::classify::CvParams {
             repeats: 1,
-            folds: params.cv.folds.min(smallest).max(2),
+            folds: inner_folds(params.cv.folds, smallest),
             ..*params.cv
         }
         .check()?,

@@ -14,6 +14,7 @@ use crate::error::OptionsError;
 use crate::evaluation::{Evaluation, Spikes};
 use crate::options::StageOptions;
 use crate::pipeline::{Method, Pipeline};
+use crate::progress::Progress;
 use crate::recording::{Dataset, Selection};
 use crate::{Cell, Result, Speed};
 
@@ -196,6 +197,23 @@ impl EvaluateOptions {
         super::calibration_rows(split.as_ref().map(|s| &s.0), dataset, all, stages, on)
     }
 
+    /// What `--group-by` makes of `--folds` when the recordings `indices` hold fewer
+    /// groups than folds (each group is then held out in turn): said once, with the folds
+    /// given and used.
+    fn fewer_groups(&self, dataset: &Dataset, indices: &[usize]) -> Vec<String> {
+        let (Some(column), None) = (&self.group_by, self.selections()) else {
+            return Vec::new();
+        };
+        let groups = crate::analysis::group_count(&dataset.entries, indices, column);
+        if groups >= self.folds || groups < 2 {
+            return Vec::new();
+        }
+        vec![format!(
+            "--folds {} with --group-by {column}: {groups} `{column}` groups, so {groups} folds are used (each group held out in turn)",
+            self.folds
+        )]
+    }
+
     /// The feature columns to classify with.
     ///
     /// # Errors
@@ -268,6 +286,8 @@ impl EvaluateOptions {
             .into());
         }
         let indices = self.indices(dataset)?;
+        let notes = self.fewer_groups(dataset, &indices);
+        notes.iter().for_each(|note| on(Progress::Advice(note)));
         let calibration = self.calibration_indices(dataset, &indices, stages, on)?;
         let calibrated = calibrated_pipeline(stages, dataset, &calibration, on)?;
         let pipeline = Pipeline::new(calibrated.params.clone())?;
@@ -298,6 +318,7 @@ impl EvaluateOptions {
         Ok(Evaluated {
             evaluation,
             calibrated,
+            notes,
         })
     }
 }
@@ -309,6 +330,9 @@ pub struct Evaluated {
     pub evaluation: Evaluation,
     /// The pipeline as run, with what `--causal` and `--gain auto` fixed.
     pub calibrated: CalibratedParams,
+    /// Options the design could not honour as given (fewer folds than asked), each as
+    /// said on standard error.
+    pub notes: Vec<String>,
 }
 
 impl Evaluated {
@@ -324,6 +348,9 @@ impl Evaluated {
         }
         if let Some(c) = &self.calibrated.gain {
             value["gain_calibration"] = serde_json::to_value(c)?;
+        }
+        if !self.notes.is_empty() {
+            value["notes"] = serde_json::to_value(&self.notes)?;
         }
         Ok(value)
     }

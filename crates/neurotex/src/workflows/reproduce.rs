@@ -119,6 +119,9 @@ impl ReproduceOptions {
             Some(_) => (0, Vec::new()),
             None => simulated_design(self.quick, self.trials, self.seeds, self.seed)?,
         };
+        if let Some(note) = dataset.and_then(|ds| fewer_groups(ds, &params)) {
+            on(Progress::Advice(&note));
+        }
         let data = match dataset {
             Some(ds) => Data::Folder(ds),
             None => Data::Simulated {
@@ -134,4 +137,30 @@ impl ReproduceOptions {
         };
         reproduce(out, data, params, &run)
     }
+}
+
+/// What `--group-by` makes of `--folds` at the speed with the fewest groups, when fewer
+/// than the folds (each group is then held out in turn there), said once.
+fn fewer_groups(dataset: &Dataset, params: &ReproduceParams) -> Option<String> {
+    let column = params.group_by.as_deref()?;
+    let folds = params.cv.folds;
+    let entries = &dataset.entries;
+    let mut speeds: Vec<String> = entries
+        .iter()
+        .filter_map(|m| m.field("speed_mm_s"))
+        .collect();
+    speeds.sort();
+    speeds.dedup();
+    let (groups, speed) = speeds
+        .iter()
+        .map(|speed| {
+            let rows: Vec<usize> = (0..entries.len())
+                .filter(|&i| entries[i].field("speed_mm_s").as_ref() == Some(speed))
+                .collect();
+            (crate::analysis::group_count(entries, &rows, column), speed)
+        })
+        .min()?;
+    (groups < folds).then(|| format!(
+        "--folds {folds} with --group-by {column}: {groups} `{column}` group(s) at {speed} mm/s, so {groups} folds are used there (each group held out in turn)"
+    ))
 }

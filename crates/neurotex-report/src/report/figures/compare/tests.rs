@@ -86,6 +86,7 @@ fn comparison(n: usize, nested: bool, conditions: usize) -> Comparison {
             outer_splits: 5,
         }),
         caveat: crate::compare::CAVEAT.into(),
+        notes: Vec::new(),
     }
 }
 
