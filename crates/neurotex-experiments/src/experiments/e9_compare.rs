@@ -18,8 +18,9 @@ use crate::classify::ClassifierChoice;
 use crate::classify::CvParams;
 use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::compare::signal::baseline_candidates;
-use crate::compare::{compare, CompareParams, Comparison, Protocol};
+use crate::compare::{compare_with_progress, CompareParams, Comparison, Protocol};
 use crate::pipeline::{Encoding, Method};
+use crate::progress::Progress;
 use crate::snn::SnnParams;
 
 /// E9's two comparisons.
@@ -86,7 +87,16 @@ pub enum Baselines {
 ///
 /// # Errors
 /// Skipped with one speed; fails when a candidate cannot be evaluated.
-pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<E9, Stop> {
+pub fn e9_compare(
+    prepared: &Prepared,
+    params: &ValidReproduceParams,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<E9, Stop> {
+    let said = Said::new(progress);
+    let compare = |list: &[crate::compare::Candidate], p: &CompareParams, what: &str| {
+        said.begin(what);
+        compare_with_progress(list, p, &|e| said.on(e))
+    };
     if prepared.speeds.len() < 2 {
         return Err(Stop::Skipped(Skip::OneSpeedE9));
     }
@@ -127,8 +137,16 @@ pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<
                 0.0,
             )?;
             Baselines::Compared {
-                per_speed: Box::new(compare(&list, &with(per(), false))?),
-                held_out: Box::new(compare(&list, &with(held(), false))?),
+                per_speed: Box::new(compare(
+                    &list,
+                    &with(per(), false),
+                    "signal baselines within each speed",
+                )?),
+                held_out: Box::new(compare(
+                    &list,
+                    &with(held(), false),
+                    "signal baselines, each speed held out",
+                )?),
             }
         }
         Err(why) => Baselines::Skipped(why),
@@ -137,17 +155,28 @@ pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<
         true => Some(spiking(
             prepared,
             params,
-            &with(per(), false),
-            &with(held(), false),
+            [&with(per(), false), &with(held(), false)],
+            &compare,
         )?),
         false => None,
     };
     Ok(E9 {
         // A pilot too small for folds inside each speed's training folds is ranked
         // without the nested estimate (the held-out comparison trains on other speeds).
-        per_speed: compare(&list, &with(per(), true))
-            .or_else(|_| compare(&list, &with(per(), false)))?,
-        held_out: compare(&list, &with(held(), true))?,
+        per_speed: compare(&list, &with(per(), true), "candidates within each speed").or_else(
+            |_| {
+                compare(
+                    &list,
+                    &with(per(), false),
+                    "candidates within each speed, not nested",
+                )
+            },
+        )?,
+        held_out: compare(
+            &list,
+            &with(held(), true),
+            "candidates, each speed held out",
+        )?,
         baselines: Some(baselines),
         spiking,
     })
@@ -158,8 +187,12 @@ pub fn e9_compare(prepared: &Prepared, params: &ValidReproduceParams) -> Result<
 fn spiking(
     prepared: &Prepared,
     params: &ValidReproduceParams,
-    per: &CompareParams,
-    held: &CompareParams,
+    [per, held]: [&CompareParams; 2],
+    compare: &dyn Fn(
+        &[crate::compare::Candidate],
+        &CompareParams,
+        &str,
+    ) -> crate::Result<Comparison>,
 ) -> Result<Spiking, Stop> {
     let pipeline = params.pipeline().params().clone();
     let set = |encoding, method, classifier| CandidateSet {
@@ -187,7 +220,67 @@ fn spiking(
         0.0,
     )?);
     Ok(Spiking {
-        per_speed: compare(&list, per)?,
-        held_out: compare(&list, held)?,
+        per_speed: compare(&list, per, "the spiking network within each speed")?,
+        held_out: compare(&list, held, "the spiking network, each speed held out")?,
     })
+}
+
+/// How often E9 says how far its comparisons are: it runs beside the other analyses,
+/// which hold the progress bar, so it speaks in lines.
+const SAY_EVERY_S: f64 = 15.0;
+
+/// E9's progress as lines: each comparison's start, then its stage and steps done at most
+/// every [`SAY_EVERY_S`] seconds (`compare`'s steps: candidates scored, then nested
+/// selection's splits).
+struct Said<'a> {
+    progress: &'a (dyn Fn(Progress) + Sync),
+    state: std::sync::Mutex<SaidState>,
+}
+
+struct SaidState {
+    what: String,
+    stage: String,
+    done: usize,
+    total: usize,
+    last: std::time::Instant,
+}
+
+impl<'a> Said<'a> {
+    fn new(progress: &'a (dyn Fn(Progress) + Sync)) -> Self {
+        let state = SaidState {
+            what: String::new(),
+            stage: String::new(),
+            done: 0,
+            total: 0,
+            last: std::time::Instant::now(),
+        };
+        Said {
+            progress,
+            state: std::sync::Mutex::new(state),
+        }
+    }
+
+    fn begin(&self, what: &str) {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        s.what = what.to_string();
+        s.last = std::time::Instant::now();
+        (self.progress)(Progress::Say(&format!("E9: {what}")));
+    }
+
+    fn on(&self, event: Progress) {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        match event {
+            Progress::Stage(stage, total) => {
+                (s.stage, s.total, s.done) = (stage.to_string(), total, 0);
+            }
+            Progress::Tick | Progress::Done(..) | Progress::Skipped(..) => s.done += 1,
+            other => return (self.progress)(other),
+        }
+        let due = s.last.elapsed().as_secs_f64() >= SAY_EVERY_S;
+        if due || (s.done == s.total && s.total > 0 && s.stage == "nested selection") {
+            s.last = std::time::Instant::now();
+            let line = format!("E9: {}: {} {}/{}", s.what, s.stage, s.done, s.total);
+            (self.progress)(Progress::Say(&line));
+        }
+    }
 }

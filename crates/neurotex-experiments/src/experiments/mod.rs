@@ -383,12 +383,12 @@ pub fn run_all(
                 analysis: "e9",
                 reason: reason.clone(),
             })),
-            (None, true) => e9_compare(prepared, params).map(Some).map_err(|stop| {
-                match stop.design_skipped("e9") {
+            (None, true) => e9_compare(prepared, params, progress)
+                .map(Some)
+                .map_err(|stop| match stop.design_skipped("e9") {
                     Stop::Failed(e) => Stop::Failed(e.in_analysis(format!("E9 ({asks})"))),
                     skipped => skipped,
-                }
-            }),
+                }),
         };
         match &e9 {
             Err(Stop::Skipped(skip)) => progress(Progress::Skipped("e9", asks, &skip.to_string())),
