@@ -188,11 +188,7 @@ fn spiking(
     prepared: &Prepared,
     params: &ValidReproduceParams,
     [per, held]: [&CompareParams; 2],
-    compare: &dyn Fn(
-        &[crate::compare::Candidate],
-        &CompareParams,
-        &str,
-    ) -> crate::Result<Comparison>,
+    compare: &CompareFn,
 ) -> Result<Spiking, Stop> {
     let pipeline = params.pipeline().params().clone();
     let set = |encoding, method, classifier| CandidateSet {
@@ -224,6 +220,10 @@ fn spiking(
         held_out: compare(&list, held, "the spiking network, each speed held out")?,
     })
 }
+
+/// One of E9's comparisons, said as it runs: the candidates, the protocol, what to call it.
+type CompareFn<'a> =
+    dyn Fn(&[crate::compare::Candidate], &CompareParams, &str) -> crate::Result<Comparison> + 'a;
 
 /// How often E9 says how far its comparisons are: it runs beside the other analyses,
 /// which hold the progress bar, so it speaks in lines.
