@@ -191,15 +191,7 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             "forest_seed",
         ],
         ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
-        ClassifierChoice::Snn(_) => &[
-            "hidden",
-            "dt_ms",
-            "epochs",
-            "readout",
-            "seed",
-            "recurrent",
-            "reset",
-        ],
+        ClassifierChoice::Snn(_) => SNN_OPTIONS,
     };
     only_known(
         options,
@@ -270,19 +262,22 @@ pub fn snn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     Ok(out)
 }
 
+/// The spiking network's options, by their Python names.
+const SNN_OPTIONS: &[&str] = &[
+    "hidden",
+    "dt_ms",
+    "epochs",
+    "readout",
+    "seed",
+    "recurrent",
+    "reset",
+];
+
 /// The spiking network's training knobs, checked.
 pub fn snn(options: &Bound<'_, PyDict>) -> PyResult<SnnParams> {
     only_known(
         options,
-        &[
-            "hidden",
-            "dt_ms",
-            "epochs",
-            "readout",
-            "seed",
-            "recurrent",
-            "reset",
-        ],
+        SNN_OPTIONS,
         " for the spiking network; its options are",
     )?;
     snn_params(options, SnnParams::default())?

@@ -53,7 +53,7 @@ impl CsvImportParams {
             .channels
             .clone()
             .unwrap_or_else(|| names.clone());
-        let dropped = dropped_flags(file, select, &self.format, log)?;
+        let dropped = dropped_flags(file, select, &self.format, log, &columns)?;
         let n = names.len();
         if dropped.iter().all(|&d| d) {
             let rule = "leave at least one channel";
@@ -103,13 +103,9 @@ fn dropped_flags(
     select: &ChannelSelect,
     format: &crate::csvlog::CsvFormat,
     log: &CsvLog,
+    columns: &[String],
 ) -> Result<Vec<bool>> {
     let names = &log.channel_names;
-    let columns = log
-        .columns
-        .channels
-        .clone()
-        .unwrap_or_else(|| names.clone());
     let mut dropped = vec![false; names.len()];
     let not_a_channel = |what: String| -> crate::Error {
         let rule = "name channels of the log (not its time column)";
