@@ -53,7 +53,10 @@ make_venv() { # dir, pip requirements...
     echo "creating $dir (torch is large: minutes)" >&2
     rm -rf "$dir"; python3 -m venv "$dir"
     "$dir/bin/pip" install -q --upgrade pip
-    "$dir/bin/pip" install -q --index-url https://download.pytorch.org/whl/cpu torch
+    # The CPU-only wheels when their index is reachable; else PyPI's (CUDA libraries
+    # included, about 5 GB, and they run on a CPU too).
+    "$dir/bin/pip" install -q --index-url https://download.pytorch.org/whl/cpu torch ||
+        "$dir/bin/pip" install -q torch
     "$dir/bin/pip" install -q "$@"
     touch "$dir/.installed"
 }
