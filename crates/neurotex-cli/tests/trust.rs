@@ -597,7 +597,10 @@ fn a_dead_taxel_of_a_full_grid_is_dropped_with_its_cell_masked_by_one_option() {
     assert!(!line("channels").contains("\"c5\""), "{layout}");
     assert!(
         run.stderr
-            .contains("15 channels on a 4x4 grid (1 cell masked)"),
+            .contains("15 channels on a 4x4 grid (1 cell masked)")
+            && run
+                .stderr
+                .contains("dropped channel(s) c5: their cells are masked"),
         "{}",
         run.stderr
     );

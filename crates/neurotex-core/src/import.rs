@@ -198,6 +198,8 @@ pub struct ImportSummary {
     /// What the import did that is probably not what was meant (the dataset is written all
     /// the same).
     pub warnings: Vec<ImportWarning>,
+    /// The channels `drop_channels` left out (their cells masked).
+    pub dropped: Vec<String>,
 }
 
 /// A choice of the import that is probably a mistake, found on the logs it read.
@@ -427,7 +429,7 @@ impl Logs {
         if p.format.time_column.is_none() && p.fs.is_none() {
             return Err(no_rate(&files, &p));
         }
-        let p = p.without_dropped(&files)?;
+        let (p, _) = p.without_dropped(&files)?;
         // An event log is named as one before its stamps are judged as a sampled log's.
         let first = files.first();
         if let Some((f, names)) =
@@ -686,8 +688,12 @@ pub fn import_csv(
         return Err(no_rate(files, p));
     }
     reject_duplicate_names(files)?;
-    let p = &p.without_dropped(files)?;
-    let mut summary = ImportSummary::default();
+    let (p, dropped) = p.without_dropped(files)?;
+    let p = &p;
+    let mut summary = ImportSummary {
+        dropped,
+        ..ImportSummary::default()
+    };
     let good = parse_all(files, p, on_done, &mut summary.skipped)?;
     let Some(first) = good.first() else {
         return Err(DataError::invalid(out, "every file was left out").into());

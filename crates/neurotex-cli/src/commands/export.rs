@@ -19,10 +19,11 @@ use crate::stage_args::StageArgs;
 #[derive(Subcommand)]
 pub enum ExportCommand {
     /// A spiking model's network (`train --classifier snn`) as a NIR graph (HDF5, NIR 1.0:
-    /// Input → Affine → CubaLIF → Affine → LI → Output), the time step as `dt` (seconds)
-    /// and the model's pipeline, grid and labels in the graph's metadata. snnTorch, Norse,
-    /// Rockpool and the neuromorphic toolchains read it; `neurotex predict --model
-    /// FILE.nir` runs it again.
+    /// Input → Affine → CubaLIF → Affine → CubaLIF readout that never fires → Output, for
+    /// `--for nir`), the time step as `dt` (seconds) and the model's pipeline, grid and
+    /// labels in the graph's metadata. `--for` writes it for snnTorch, Norse, sinabs or
+    /// Rockpool, each loading it unchanged; `neurotex predict --model FILE.nir` runs the
+    /// `nir`, `norse` and `snntorch` graphs again.
     Nir(ExportNirArgs),
     /// The spike tensors a spiking model's input node receives: one `(steps, inputs)`
     /// float32 NPY per recording of a dataset (spike counts per time step; inputs are the
@@ -104,12 +105,12 @@ pub fn run(command: ExportCommand) -> Result<()> {
             })?;
             let net = model.network();
             if !net.reset.is_zero() && args.convention == NirConvention::Nir {
-                eprintln!("note: the network's neurons subtract the threshold on a spike; NIR's reset to zero, so the graph says `reset = subtract` in its metadata, which neurotex reads and other tools ignore (--for sinabs or --for rockpool write it for theirs)");
+                eprintln!("note: the network's neurons subtract the threshold on a spike and NIR's neurons reset to zero, so the graph says `reset = subtract` in its metadata, which neurotex reads and other tools ignore (--for sinabs or --for rockpool write it for theirs)");
             }
             let recurrent = if net.recurrent() { " recurrent" } else { "" };
             eprintln!(
                 "NIR graph for {}: {} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms -> {}",
-                neurotex::nir::Convention::from(args.convention).name(),
+                args.convention.name(),
                 net.inputs,
                 net.hidden,
                 net.classes,

@@ -49,6 +49,12 @@ pub fn run(args: TrainArgs) -> Result<()> {
             trained.grid,
             crate::output::shown(&args.out)
         );
+        if trained.log.best_epoch == trained.log.epochs {
+            eprintln!(
+                "note: the validation loss was still falling at the last of the {} epochs: training stopped at the cap, not by early stopping; a larger --snn-epochs may do better",
+                trained.log.epochs
+            );
+        }
         return Ok(());
     }
     let trained = o.run(&dataset, &args.stages.options, &shown.callback())?;

@@ -13,14 +13,15 @@ impl CsvImportParams {
     /// These options with `drop_channels` resolved on the first of `files` that reads:
     /// every channel is placed on the grid (row-major or by the channel map), the dropped
     /// ones are left out of the channel list and of the map, so their cells are masked.
-    /// Without `drop_channels`, a copy of these options.
+    /// Without `drop_channels`, a copy of these options. Also returns the names of the
+    /// channels dropped.
     ///
     /// # Errors
     /// No file reads; a dropped channel that is not a channel; every channel dropped; a
     /// grid without a cell for every channel.
-    pub fn without_dropped(&self, files: &[PathBuf]) -> Result<CsvImportParams> {
+    pub fn without_dropped(&self, files: &[PathBuf]) -> Result<(CsvImportParams, Vec<String>)> {
         let Some(select) = &self.drop_channels else {
-            return Ok(self.clone());
+            return Ok((self.clone(), Vec::new()));
         };
         let all = CsvImportParams {
             drop_channels: None,
@@ -46,7 +47,7 @@ impl CsvImportParams {
         file: &Path,
         select: &ChannelSelect,
         log: &CsvLog,
-    ) -> Result<CsvImportParams> {
+    ) -> Result<(CsvImportParams, Vec<String>)> {
         let names = &log.channel_names;
         let columns = log
             .columns
@@ -86,13 +87,15 @@ impl CsvImportParams {
                 ChannelSelect::Indices(kept_columns.iter().filter_map(|c| c.parse().ok()).collect())
             }
         };
+        let gone = (0..n).filter(|&k| dropped[k]).map(|k| names[k].clone());
+        let gone: Vec<String> = gone.collect();
         let mut out = self.clone();
         out.format.channels = channels;
         out.grid = Some(grid);
         out.channel_map = Some(ChannelMap::new(
             (0..n).filter(keep).map(|k| cells[k]).collect(),
         ));
-        Ok(out)
+        Ok((out, gone))
     }
 }
 

@@ -399,7 +399,13 @@ fn encoder(i: &Inspection, p: &InspectParams, out: &mut Vec<Finding>) {
             auto.clone(),
         ));
     } else {
-        let silent: Vec<String> = diagnostics.silent().iter().map(|s| s.to_string()).collect();
+        // A dead channel is silent at any gain: the dead-channel finding says what to do.
+        let dead =
+            |name: &str| (i.signals.channels.iter()).any(|c| c.name == name && c.dead_share > 0.5);
+        let silent: Vec<String> = (diagnostics.silent().iter())
+            .filter(|s| !dead(s))
+            .map(|s| s.to_string())
+            .collect();
         if !silent.is_empty() {
             out.push(finding(
                 Warning,

@@ -41,6 +41,16 @@ pub enum NirConvention {
     Rockpool,
 }
 
+impl NirConvention {
+    /// The name typed after `--for`.
+    pub fn name(self) -> &'static str {
+        match self {
+            NirConvention::Norse => "norse",
+            other => Convention::from(other).name(),
+        }
+    }
+}
+
 impl From<NirConvention> for Convention {
     fn from(c: NirConvention) -> Self {
         match c {

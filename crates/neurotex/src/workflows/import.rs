@@ -117,6 +117,15 @@ fn say_summary(summary: &ImportSummary, out: &Path, on: OnProgress) {
         1 => " (1 cell masked)".to_string(),
         n => format!(" ({n} cells masked)"),
     };
+    if !summary.dropped.is_empty() {
+        on(Progress::Say(&format!(
+            "dropped channel(s) {}: their cells are masked",
+            (summary.dropped.iter())
+                .map(|n| crate::values::shown_label(n))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
     on(Progress::Say(&format!(
         "{} recordings ({} left out; {merged} rows merged and {duplicates} exact duplicates dropped in {} files) -> {}; {} channels on a {}x{} grid{masked} at {:.2} Hz nominal",
         summary.written,
