@@ -122,35 +122,13 @@ pub fn e9_compare(
     let column = "speed_mm_s".to_string();
     let per = || Protocol::Per(column.clone());
     let held = || Protocol::HoldOut(column.clone());
-    let baselines = match prepared
-        .signal
-        .iter()
-        .cloned()
-        .collect::<Result<Vec<_>, _>>()
-    {
-        Ok(rows) => {
-            let list = baseline_candidates(
-                &rows,
-                &prepared.grid,
-                &pipeline.features,
-                &set.classifiers,
-                0.0,
-            )?;
-            Baselines::Compared {
-                per_speed: Box::new(compare(
-                    &list,
-                    &with(per(), false),
-                    "signal baselines within each speed",
-                )?),
-                held_out: Box::new(compare(
-                    &list,
-                    &with(held(), false),
-                    "signal baselines, each speed held out",
-                )?),
-            }
-        }
-        Err(why) => Baselines::Skipped(why),
-    };
+    let baselines = baselines(
+        prepared,
+        &set,
+        &pipeline,
+        [&with(per(), false), &with(held(), false)],
+        &compare,
+    )?;
     let spiking = match params.e9_snn {
         true => Some(spiking(
             prepared,
@@ -179,6 +157,41 @@ pub fn e9_compare(
         )?,
         baselines: Some(baselines),
         spiking,
+    })
+}
+
+/// The signal baselines (no spikes) compared under `per` and `held`, or why they were not
+/// run.
+fn baselines(
+    prepared: &Prepared,
+    set: &CandidateSet,
+    pipeline: &crate::pipeline::PipelineParams,
+    [per, held]: [&CompareParams; 2],
+    compare: &CompareFn,
+) -> Result<Baselines, Stop> {
+    let rows = match prepared
+        .signal
+        .iter()
+        .cloned()
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(rows) => rows,
+        Err(why) => return Ok(Baselines::Skipped(why)),
+    };
+    let list = baseline_candidates(
+        &rows,
+        &prepared.grid,
+        &pipeline.features,
+        &set.classifiers,
+        0.0,
+    )?;
+    Ok(Baselines::Compared {
+        per_speed: Box::new(compare(&list, per, "signal baselines within each speed")?),
+        held_out: Box::new(compare(
+            &list,
+            held,
+            "signal baselines, each speed held out",
+        )?),
     })
 }
 
