@@ -649,6 +649,13 @@ fn a_dead_taxel_of_a_full_grid_is_dropped_with_its_cell_masked_by_one_option() {
         );
         assert!(!no.exists());
     }
+    // A channel map must place every channel, the dropped ones too.
+    let mut import = vec!["import", "csv", s(&logs), "--out", s(&no), "--grid", "4x4"];
+    import.extend_from_slice(&read);
+    import.extend_from_slice(&["--channel-map", "0,0;0,1", "--drop-channels", "c5"]);
+    let err = dir.fails(&import);
+    assert!(err.contains("2 cells for 16 channels"), "{err}");
+    assert!(!no.exists());
 }
 
 #[test]

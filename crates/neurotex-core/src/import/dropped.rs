@@ -66,6 +66,11 @@ impl CsvImportParams {
             None => Grid::full(1, n)?,
         };
         let cells: Vec<Cell> = match &self.channel_map {
+            Some(map) if map.cells().len() != n => {
+                let rule = "the map needs one cell per channel, dropped ones included";
+                let got = format!("{} cells for {n} channels", map.cells().len());
+                return Err(ParamError::new("channel-map", rule, got).into());
+            }
             Some(map) => map.cells().to_vec(),
             None if grid.cells() < n => {
                 let rule = "the grid must have a cell for every channel, dropped ones included (their cells are masked)";
