@@ -405,6 +405,7 @@ fn spiking_file(recurrent: bool) -> serde_json::Value {
         } else {
             Vec::new()
         },
+        target: Default::default(),
     };
     let layout = LayoutFile {
         rows: Some(2),

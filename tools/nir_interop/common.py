@@ -65,6 +65,12 @@ def load(inputs_dir, predictions_csv):
     return labels, items
 
 
+def truth(predictions_csv):
+    """(file, true label) of each recording of a `neurotex predict` CSV."""
+    with open(predictions_csv) as f:
+        return [(r["file"], r["label"]) for r in csv.DictReader(f)]
+
+
 def centred(s):
     s = np.asarray(s, dtype=np.float64)
     return s - s.mean()

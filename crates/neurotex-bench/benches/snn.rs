@@ -35,6 +35,7 @@ fn network(inputs: usize, hidden: usize, classes: usize) -> Network {
         w_out: w(hidden * classes, 1.0),
         b_out: w(classes, 0.1),
         w_rec: Vec::new(),
+        target: Default::default(),
     }
 }
 

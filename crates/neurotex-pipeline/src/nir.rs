@@ -624,6 +624,7 @@ fn network_of(
         b_out: (0..c).map(|k| out_gain[k] * b2[k] + out_leak[k]).collect(),
         w_rec: Vec::new(),
         reset: Reset::Zero,
+        target: Default::default(),
     })
 }
 
@@ -658,6 +659,7 @@ mod tests {
             b_out: w(c, 0.4),
             w_rec: Vec::new(),
             reset: Reset::Zero,
+            target: Default::default(),
         }
     }
 

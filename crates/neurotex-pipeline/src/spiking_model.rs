@@ -109,6 +109,7 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
         ("dt_ms", net.dt_ms == snn.dt_ms),
         ("readout", net.readout == snn.readout),
         ("reset", net.reset == snn.reset),
+        ("target", net.target == snn.target),
         ("w_rec", net.recurrent() == snn.recurrent),
         ("tau_syn_ms", close(net.tau_syn_ms, snn.tau_syn_ms)),
         ("tau_mem_ms", close(net.tau_mem_ms, snn.tau_mem_ms)),

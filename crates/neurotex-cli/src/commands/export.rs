@@ -8,7 +8,7 @@ use clap::{Args, Subcommand};
 use neurotex::pipeline::Pipeline;
 use neurotex::workflows::calibrated_pipeline;
 use neurotex::workflows::export::{
-    export_events, export_inputs, export_nir, load_spiking, EventFormat, NirConvention,
+    export_events, export_inputs, export_nir, export_xylo, load_spiking, EventFormat, NirConvention,
 };
 use neurotex::workflows::OpenOptions;
 
@@ -25,6 +25,14 @@ pub enum ExportCommand {
     /// Rockpool, each loading it unchanged; `neurotex predict --model FILE.nir` runs the
     /// `nir`, `norse` and `snntorch` graphs again.
     Nir(ExportNirArgs),
+    /// A spiking model trained for SynSense's Xylo Audio 2 (`train --classifier snn
+    /// --snn-target xylo`) in the chip's integers (JSON): under `specification` the keyword
+    /// arguments of Rockpool's `XyloSim.from_specification` (its bit-accurate simulator)
+    /// and `config_from_specification` (a board's configuration), beside them the readouts'
+    /// labels, `readout` and `score_scale`. XyloSim run with `output_mode="Vmem"` on
+    /// `export inputs` gives neurotex's scores: the readout's membrane, its mean over the
+    /// window divided by `score_scale`.
+    Xylo(ExportXyloArgs),
     /// The spike tensors a spiking model's input node receives: one `(steps, inputs)`
     /// float32 NPY per recording of a dataset (spike counts per time step; inputs are the
     /// SA then the FA taxels in row-major order) and `index.csv` (`file,label,array`), so
@@ -76,6 +84,17 @@ pub struct ExportNirArgs {
     pub convention: NirConvention,
 }
 
+/// Options of `neurotex export xylo`.
+#[derive(Args)]
+pub struct ExportXyloArgs {
+    /// The spiking model file, trained with `--snn-target xylo`.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// The configuration file to write (JSON).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
 /// Options of `neurotex export inputs`.
 #[derive(Args)]
 pub struct ExportInputsArgs {
@@ -111,6 +130,23 @@ pub fn run(command: ExportCommand) -> Result<()> {
             eprintln!(
                 "NIR graph for {}: {} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms -> {}",
                 args.convention.name(),
+                net.inputs,
+                net.hidden,
+                net.classes,
+                model.labels().join(", "),
+                net.dt_ms,
+                shown(&args.out)
+            );
+        }
+        ExportCommand::Xylo(args) => {
+            check_output(&args.out, std::slice::from_ref(&args.model))?;
+            let model = load_spiking(&args.model)?;
+            save_to(&args.out, "the Xylo configuration", |p| {
+                export_xylo(&model, p)
+            })?;
+            let net = model.network();
+            eprintln!(
+                "Xylo Audio 2 configuration: {} inputs -> {} hidden neurons -> {} readout neurons ({}), dt {} ms, 8-bit weights -> {}",
                 net.inputs,
                 net.hidden,
                 net.classes,

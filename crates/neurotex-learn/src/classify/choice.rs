@@ -100,15 +100,25 @@ impl fmt::Display for ClassifierChoice {
                 write!(f, "random forest ({} trees, seed {})", p.trees, p.seed)
             }
             ClassifierChoice::Linear(p) => write!(f, "logistic regression (C = {})", p.c),
-            ClassifierChoice::Snn(p) => write!(
-                f,
-                "spiking network ({} {}LIF neurons, {} ms steps, {} readout, seed {})",
-                p.hidden,
-                if p.recurrent { "recurrent " } else { "" },
-                p.dt_ms,
-                p.readout.name(),
-                p.seed
-            ),
+            ClassifierChoice::Snn(p) => {
+                write!(
+                    f,
+                    "spiking network ({} {}LIF neurons, {} ms steps, {} readout, seed {}",
+                    p.hidden,
+                    if p.recurrent { "recurrent " } else { "" },
+                    p.dt_ms,
+                    p.readout.name(),
+                    p.seed
+                )?;
+                if p.target == crate::snn::Target::Xylo {
+                    write!(
+                        f,
+                        "; Xylo profile: 8-bit weights, subtractive reset, tau_syn {:.2} ms, tau_mem {:.2} ms, tau_out {:.2} ms",
+                        p.tau_syn_ms, p.tau_mem_ms, p.tau_out_ms
+                    )?;
+                }
+                write!(f, ")")
+            }
         }
     }
 }

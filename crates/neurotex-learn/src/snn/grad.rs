@@ -470,6 +470,7 @@ mod tests {
                 true => w(hidden * hidden, 0.8),
                 false => Vec::new(),
             },
+            target: Default::default(),
         };
         let mut events = Vec::new();
         for t in 0..steps as u32 {

@@ -33,6 +33,7 @@
 
 pub mod grad;
 pub mod train;
+pub mod xylo;
 
 use serde::{Deserialize, Serialize};
 
@@ -40,6 +41,7 @@ use crate::encode::SpikeTrains;
 use crate::error::ParamError;
 
 pub use train::fit;
+pub use xylo::Target;
 
 /// How a class's score is read from its readout trace.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -159,6 +161,11 @@ pub struct SnnParams {
     /// so that they read as before the option existed.
     #[serde(skip_serializing_if = "Reset::is_zero")]
     pub reset: Reset,
+    /// Where the network runs (float); with [`Target::Xylo`] it is trained within the
+    /// chip's limits and predicts as the chip computes ([`xylo`]). Left out of model files
+    /// when float.
+    #[serde(skip_serializing_if = "Target::is_float")]
+    pub target: Target,
 }
 
 impl Default for SnnParams {
@@ -180,6 +187,7 @@ impl Default for SnnParams {
             seed: 0,
             recurrent: false,
             reset: Reset::Zero,
+            target: Target::Float,
         }
     }
 }
@@ -229,6 +237,31 @@ impl SnnParams {
         if !(self.validation > 0.0 && self.validation < 1.0) {
             let rule = "the validation share must lie strictly between 0 and 1";
             return Err(ParamError::new("snn-validation", rule, self.validation));
+        }
+        match self.target {
+            Target::Float => Ok(self),
+            Target::Xylo => self.on_xylo(),
+        }
+    }
+
+    /// The parameters under the Xylo profile: its limits checked, each time constant moved
+    /// to the nearest whose decay per step the chip has (`1 - 2^-d`).
+    fn on_xylo(mut self) -> Result<SnnParams, ParamError> {
+        let rules = [
+            ("snn-hidden", self.hidden > xylo::MAX_HIDDEN, "the Xylo profile holds at most 1000 hidden neurons", self.hidden.to_string()),
+            ("snn-dt-ms", self.dt_ms > xylo::MAX_DT_MS, "the Xylo profile steps at most 15 ms (an input carries at most 15 events a step)", self.dt_ms.to_string()),
+            ("snn-reset", self.reset != Reset::Subtract, "the Xylo profile's neurons subtract the threshold on a spike: --snn-reset subtract", self.reset.name().to_string()),
+            ("snn-recurrent", self.recurrent, "the Xylo profile runs feed-forward networks", "--snn-recurrent".to_string()),
+        ];
+        if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
+            return Err(ParamError::new(name, rule, got));
+        }
+        for tau in [
+            &mut self.tau_syn_ms,
+            &mut self.tau_mem_ms,
+            &mut self.tau_out_ms,
+        ] {
+            *tau = xylo::tau_of(xylo::dash_of(*tau, self.dt_ms), self.dt_ms);
         }
         Ok(self)
     }
@@ -365,6 +398,9 @@ pub struct Network {
     /// one step to neuron `h`'s current at the next; empty for a feed-forward network.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub w_rec: Vec<f64>,
+    /// Where the network runs; absent (float) in the files of float networks.
+    #[serde(default, skip_serializing_if = "Target::is_float")]
+    pub target: Target,
 }
 
 impl Network {
@@ -440,6 +476,9 @@ impl Network {
             ));
         }
         self.check_taus()?;
+        if self.target == Target::Xylo {
+            xylo::check(self)?;
+        }
         for (name, w) in [
             ("w_in", &self.w_in),
             ("b_in", &self.b_in),
@@ -551,17 +590,30 @@ pub struct State {
     /// The hidden neurons that spiked in the last step, ascending, with their spike
     /// counts (kept for a recurrent network).
     fired: Vec<(u32, f64)>,
+    /// A Xylo-profile network's integers and the chip's state, which then step in place
+    /// of the float state.
+    chip: Option<Box<(xylo::XyloNetwork, xylo::XyloState)>>,
 }
 
 impl State {
     /// The network at rest.
+    ///
+    /// # Panics
+    /// If `net` is a Xylo-profile network that breaks the profile's rules (a network is
+    /// checked when trained or read, so a caller bug).
     pub fn new(net: &Network) -> Self {
+        let chip = (net.target == Target::Xylo).then(|| {
+            let chip = xylo::XyloNetwork::quantise(net).expect("a checked Xylo-profile network");
+            let state = xylo::XyloState::new(&chip);
+            Box::new((chip, state))
+        });
         State {
             decays: net.decays(),
             current: vec![0.0; net.hidden],
             membrane: vec![0.0; net.hidden],
             out: vec![0.0; net.classes],
             fired: Vec::new(),
+            chip,
         }
     }
 
@@ -572,6 +624,12 @@ impl State {
     /// # Panics
     /// If an input index is out of range (a caller bug).
     pub fn step(&mut self, net: &Network, spiked: &[u32]) {
+        if let Some(chip) = self.chip.as_deref_mut() {
+            let (xnet, state) = (&chip.0, &mut chip.1);
+            state.step(xnet, spiked);
+            self.out = state.readout(xnet);
+            return;
+        }
         let (alpha, beta, kappa) = self.decays;
         let h_n = net.hidden;
         for (c, b) in self.current.iter_mut().zip(&net.b_in) {
@@ -732,6 +790,7 @@ mod tests {
             w_out: vec![0.25],
             b_out: vec![0.0],
             w_rec,
+            target: Target::Float,
         }
     }
 

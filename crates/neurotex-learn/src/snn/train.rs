@@ -36,6 +36,10 @@ pub fn fit(
     classes: usize,
 ) -> Result<(Network, TrainingLog), ClassifyError> {
     check_inputs(inputs, y)?;
+    if params.target == super::Target::Xylo {
+        let shape = super::xylo::check_shape(inputs[0].inputs, params.hidden, classes);
+        shape.map_err(ClassifyError::BadFeatures)?;
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let (train, valid) = validation_split(y, classes, params.validation, &mut rng)?;
     let mut net = initial(params, inputs, &train, classes, &mut rng)?;
@@ -166,6 +170,7 @@ fn initial(
         tau_out_ms: params.tau_out_ms,
         readout: params.readout,
         reset: params.reset,
+        target: params.target,
         w_in: (0..n * h).map(|_| normal.sample(rng)).collect(),
         b_in: vec![0.0; h],
         w_out: (0..h * classes)

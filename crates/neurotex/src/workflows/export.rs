@@ -16,6 +16,8 @@ use crate::progress::Progress;
 use crate::recording::{
     create_dataset_dir, write_layout, write_manifest, Dataset, LayoutFile, Meta,
 };
+use crate::snn::xylo::XyloNetwork;
+use crate::snn::Target;
 use crate::spiking_model::{spike_input, SpikingModel};
 use crate::Result;
 
@@ -71,8 +73,43 @@ pub fn export_nir(model: &SpikingModel, out: &Path, convention: NirConvention) -
         let why = "this network's neurons subtract the threshold (--snn-reset subtract), and Norse's reset to zero: export it --for sinabs or --for rockpool, or --for nir for neurotex";
         return Err(crate::error::OptionsError::Conflict(why.into()).into());
     }
+    if model.network().target == Target::Xylo {
+        let why = "this network was trained for Xylo (--snn-target xylo), and predicts in the chip's integers, which a NIR graph does not hold: export it with `export xylo`";
+        return Err(crate::error::OptionsError::Conflict(why.into()).into());
+    }
     let bytes = model.to_nir(convention.into())?;
     crate::io::write_atomic(out, |w| w.write_all(&bytes))
+}
+
+/// The format name of a Xylo configuration file.
+pub const XYLO_FORMAT: &str = "neurotex-xylo";
+
+/// Writes `model`'s network in the Xylo chip's integers to `out` (JSON), whole or not at
+/// all: under `specification` the keyword arguments of Rockpool's
+/// `XyloSim.from_specification` (and of `config_from_specification` for a board), beside
+/// them the labels of the readouts in order, how scores are read and the readout's scale.
+///
+/// # Errors
+/// A network not trained for Xylo (`--snn-target xylo`), or the file cannot be written.
+pub fn export_xylo(model: &SpikingModel, out: &Path) -> Result<()> {
+    let net = model.network();
+    if net.target != Target::Xylo {
+        let why = "this network was trained for neurotex's float network; a Xylo configuration needs a network trained within the chip's limits: train it with --classifier snn --snn-target xylo";
+        return Err(crate::error::OptionsError::Conflict(why.into()).into());
+    }
+    let chip = XyloNetwork::quantise(net).map_err(crate::error::ModelError::Inconsistent)?;
+    let file = serde_json::json!({
+        "format": XYLO_FORMAT,
+        "version": 1,
+        "labels": model.labels(),
+        "readout": chip.readout.name(),
+        "score_scale": chip.score_scale,
+        "dt_ms": chip.dt_ms,
+        "output_mode": "Vmem",
+        "specification": chip.specification(),
+    });
+    let text = serde_json::to_string(&file).expect("JSON of numbers and strings");
+    crate::io::write_atomic(out, |w| w.write_all(text.as_bytes()))
 }
 
 /// Loads the spiking model at `path` (a model file or a NIR graph written by neurotex):

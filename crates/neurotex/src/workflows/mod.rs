@@ -30,7 +30,7 @@ use crate::options::StageOptions;
 use crate::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{one_grid, Dataset, Meta};
-use crate::snn::SnnParams;
+use crate::snn::{Reset, SnnParams, Target};
 use crate::{Grid, Result};
 
 pub use reading::{CsvOptions, LogOptions, OpenOptions, ReadOptions};
@@ -132,6 +132,23 @@ pub struct SnnOptions {
     /// kept: the neuron of sinabs, Rockpool and Xylo, needed to export to them).
     #[cfg_attr(feature = "cli", arg(long = "snn-reset", id = "snn-reset"))]
     pub reset: Option<neurotex_learn::snn::Reset>,
+    /// With `--classifier snn`: the hidden neurons' synaptic time constant, ms [default:
+    /// 20].
+    #[cfg_attr(feature = "cli", arg(long = "snn-tau-syn-ms", id = "snn-tau-syn-ms"))]
+    pub tau_syn_ms: Option<f64>,
+    /// With `--classifier snn`: the hidden neurons' membrane time constant, ms [default:
+    /// 40].
+    #[cfg_attr(feature = "cli", arg(long = "snn-tau-mem-ms", id = "snn-tau-mem-ms"))]
+    pub tau_mem_ms: Option<f64>,
+    /// With `--classifier snn`: the readout's time constant, ms [default: 40].
+    #[cfg_attr(feature = "cli", arg(long = "snn-tau-out-ms", id = "snn-tau-out-ms"))]
+    pub tau_out_ms: Option<f64>,
+    /// With `--classifier snn`: where the network runs: `float` (the default) or `xylo`
+    /// (SynSense's Xylo Audio 2: trained within the chip's limits, its time constants
+    /// moved to the chip's bitshift decays, subtractive reset, and predicting in the
+    /// chip's integers as its simulator does; `export xylo` writes its configuration).
+    #[cfg_attr(feature = "cli", arg(long = "snn-target", id = "snn-target"))]
+    pub target: Option<neurotex_learn::snn::Target>,
 }
 
 impl SnnOptions {
@@ -144,6 +161,10 @@ impl SnnOptions {
             || self.seed.is_some()
             || self.recurrent
             || self.reset.is_some()
+            || self.target.is_some()
+            || self.tau_syn_ms.is_some()
+            || self.tau_mem_ms.is_some()
+            || self.tau_out_ms.is_some()
     }
 
     /// `defaults` with the options given applied, checked.
@@ -158,7 +179,15 @@ impl SnnOptions {
             readout: self.readout.unwrap_or(defaults.readout),
             seed: self.seed.unwrap_or(defaults.seed),
             recurrent: self.recurrent || defaults.recurrent,
-            reset: self.reset.unwrap_or(defaults.reset),
+            reset: self.reset.unwrap_or(match self.target {
+                // The chip's neurons subtract; its profile asks for no other option.
+                Some(Target::Xylo) => Reset::Subtract,
+                _ => defaults.reset,
+            }),
+            target: self.target.unwrap_or(defaults.target),
+            tau_syn_ms: self.tau_syn_ms.unwrap_or(defaults.tau_syn_ms),
+            tau_mem_ms: self.tau_mem_ms.unwrap_or(defaults.tau_mem_ms),
+            tau_out_ms: self.tau_out_ms.unwrap_or(defaults.tau_out_ms),
             ..defaults
         }
         .check()?)
