@@ -47,19 +47,7 @@ name=${name:-$(basename "$src")}
 mkdir -p "$work"; work=$(realpath "$work")
 
 # --- the tools, one venv per set of compatible pins (sinabs and Rockpool pin nir <= 1.0.4)
-make_venv() { # dir, pip requirements...
-    local dir=$1; shift
-    [ -e "$dir/.installed" ] && return
-    echo "creating $dir (torch is large: minutes)" >&2
-    rm -rf "$dir"; python3 -m venv "$dir"
-    "$dir/bin/pip" install -q --upgrade pip
-    # The CPU-only wheels when their index is reachable; else PyPI's (CUDA libraries
-    # included, about 5 GB, and they run on a CPU too).
-    "$dir/bin/pip" install -q --index-url https://download.pytorch.org/whl/cpu torch ||
-        "$dir/bin/pip" install -q torch
-    "$dir/bin/pip" install -q "$@"
-    touch "$dir/.installed"
-}
+. "$here/lib.sh"
 if [ -z "$venvs" ]; then
     venvs=$work/venvs
     make_venv "$venvs/snntorch-norse" snntorch==1.0.0 norse==1.1.0 nir==1.0.8 nirtorch==2.6
@@ -72,22 +60,8 @@ py_a=$venvs/snntorch-norse/bin/python py_b=$venvs/sinabs/bin/python py_c=$venvs/
 run=$work/runs/$name
 case "$src/" in "$run/"*) echo "the dataset is inside $run, which a run replaces" >&2; exit 2 ;; esac
 rm -rf "$run"; mkdir -p "$run/logs"; cd "$run"
-subset() { # folder, awk condition on t (trial) and v (speed): hard links where possible
-    mkdir -p "$1"
-    [ -f "$src/layout.toml" ] && cp "$src/layout.toml" "$1/"
-    head -1 "$src/manifest.csv" > "$1/manifest.csv"
-    local cols; cols=$(head -1 "$src/manifest.csv" | tr -d '\r' | tr ',' '\n')
-    local tc vc
-    tc=$(echo "$cols" | grep -n '^trial$' | cut -d: -f1)
-    vc=$(echo "$cols" | grep -n '^speed_mm_s$' | cut -d: -f1)
-    tail -n +2 "$src/manifest.csv" | awk -F, -v tc="$tc" -v vc="$vc" \
-        "{ t = \$tc + 0; v = \$vc + 0; if ($2) print }" >> "$1/manifest.csv"
-    tail -n +2 "$1/manifest.csv" | cut -d, -f1 | while read -r f; do
-        mkdir -p "$1/$(dirname "$f")"; ln "$src/$f" "$1/$f" 2>/dev/null || cp "$src/$f" "$1/$f"
-    done
-}
 if [ -n "$train_if" ]; then
-    subset train "$train_if"; subset heldout "$heldout_if"
+    subset "$src" train "$train_if"; subset "$src" heldout "$heldout_if"
     train=$run/train heldout=$run/heldout
     split="trained on $(basename "$src") where $train_if, held out where $heldout_if"
 elif [ -n "$heldout" ]; then

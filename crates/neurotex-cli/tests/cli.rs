@@ -22,6 +22,7 @@ mod simulate;
 mod stream;
 mod trust;
 mod util;
+mod xylo;
 
 use util::Dir;
 

@@ -24,7 +24,7 @@ pub struct EvaluateArgs {
     /// output, the evaluation then said on standard error):
     /// `file,label,predicted,fold,repeat`, one row per recording and CV repeat (folds and
     /// repeats count from 0; `fold` is `test` with a train/test split). Needs one
-    /// classifier: a GLCM method, or --method taxel with --taxel.
+    /// classifier: any method but --method taxel without --taxel.
     #[arg(long)]
     pub predictions: Option<PathBuf>,
     #[command(flatten)]

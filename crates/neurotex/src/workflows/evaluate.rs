@@ -228,18 +228,11 @@ impl EvaluateOptions {
     }
 
     /// Checks that the options name one classifier, whose out-of-fold predictions can be
-    /// written: a GLCM method, or `taxel` with `--taxel`.
+    /// written: any method but `taxel` without `--taxel`.
     ///
     /// # Errors
-    /// One classifier per taxel, or spike-train distances.
+    /// One classifier per taxel.
     pub fn one_classifier(&self) -> Result<()> {
-        if !matches!(self.method, MethodChoice::Features(_)) {
-            return Err(OptionsError::NotApplicable {
-                option: "--predictions",
-                applies_to: "feature methods, not --method van-rossum or spikes",
-            }
-            .into());
-        }
         if self.columns()? == Columns::EachTaxel {
             return Err(OptionsError::Conflict(
                 "--predictions needs one classifier, not one per taxel: add --taxel ROW,COL".into(),
