@@ -8,7 +8,7 @@ use neurotex::classify::{
 use neurotex::options::{CheckedStages, OptionKind, OptionSpec, StageOptions, STAGE_OPTIONS};
 use neurotex::pipeline::Method;
 use neurotex::recording::Baseline;
-use neurotex::snn::SnnParams;
+use neurotex::snn::{Reset, SnnParams, Target};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -226,8 +226,13 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
 }
 
 /// The spiking network's training knobs (`hidden`, `dt_ms`, `epochs`, `readout`, `seed`,
-/// `recurrent`, `reset`) over `d`, unchecked.
+/// `recurrent`, `reset`, `target`) over `d`, unchecked; without `reset`, the target's
+/// (subtract for Xylo).
 fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> {
+    let target = match get::<String>(options, "target")? {
+        Some(t) => t.parse().map_err(param)?,
+        None => d.target,
+    };
     Ok(SnnParams {
         hidden: get(options, "hidden")?.unwrap_or(d.hidden),
         dt_ms: get(options, "dt_ms")?.unwrap_or(d.dt_ms),
@@ -238,10 +243,13 @@ fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> 
         },
         seed: get(options, "seed")?.unwrap_or(d.seed),
         recurrent: get(options, "recurrent")?.unwrap_or(d.recurrent),
-        reset: match get::<String>(options, "reset")? {
-            Some(r) => r.parse().map_err(param)?,
-            None => d.reset,
+        reset: match (get::<String>(options, "reset")?, target) {
+            (Some(r), _) => r.parse().map_err(param)?,
+            // The chip's neurons subtract; its profile asks for no other option.
+            (None, Target::Xylo) => Reset::Subtract,
+            (None, Target::Float) => d.reset,
         },
+        target,
         ..d
     })
 }
@@ -259,6 +267,7 @@ pub fn snn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("seed", d.seed)?;
     out.set_item("recurrent", d.recurrent)?;
     out.set_item("reset", d.reset.name())?;
+    out.set_item("target", d.target.name())?;
     Ok(out)
 }
 
@@ -271,6 +280,7 @@ const SNN_OPTIONS: &[&str] = &[
     "seed",
     "recurrent",
     "reset",
+    "target",
 ];
 
 /// The spiking network's training knobs, checked.

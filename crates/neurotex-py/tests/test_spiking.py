@@ -93,3 +93,18 @@ def test_the_sklearn_estimator_fits_predicts_clones_and_pickles(sim):
     np.testing.assert_array_equal(again.predict_proba(sim.recordings), proba)
     scores = cross_val_score(SpikingClassifier(hidden=16, epochs=3), sim.recordings, labels, cv=2)
     assert scores.shape == (2,) and np.all((0 <= scores) & (scores <= 1))
+
+
+def test_python_trains_the_xylo_network_the_cli_trains(sim, sim_dir, tmp_path):
+    """`target="xylo"` is `--snn-target xylo`: the same network file (subtractive reset
+    implied, the chip's time constants); a reset to zero is refused by name."""
+    opts = {"hidden": 12, "epochs": 2}
+    neurotex.SpikingModel.train(sim, target="xylo", **opts).save(tmp_path / "py.json")
+    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-target", "xylo",
+            "--snn-hidden", "12", "--snn-epochs", "2", "--out", tmp_path / "cli.json")
+    py = json.loads((tmp_path / "py.json").read_text())
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    assert py["network"] == cli["network"]
+    assert py["network"]["target"] == "xylo" and py["network"]["reset"] == "subtract"
+    with pytest.raises(neurotex.errors.ParameterError, match="snn.reset"):
+        neurotex.SpikingModel.train(sim, target="xylo", reset="zero", **opts)

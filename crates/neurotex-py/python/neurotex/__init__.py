@@ -899,7 +899,8 @@ class SpikingModel(_Predicting):
         readout: str = _SNN_DEFAULTS["readout"],
         seed: int = _SNN_DEFAULTS["seed"],
         recurrent: bool = _SNN_DEFAULTS["recurrent"],
-        reset: str = _SNN_DEFAULTS["reset"],
+        reset: Optional[str] = None,
+        target: str = _SNN_DEFAULTS["target"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -911,13 +912,17 @@ class SpikingModel(_Predicting):
         (``--snn-recurrent``); ``reset`` is how a hidden neuron resets on a spike:
         ``"zero"`` (one spike per step at most) or ``"subtract"`` (n = floor(v) spikes,
         v - n kept: the neuron of sinabs, Rockpool and Xylo, needed to export to them;
-        ``--snn-reset``). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
+        ``--snn-reset``; default ``"zero"``, ``"subtract"`` with Xylo); ``target`` is where
+        the network runs: ``"float"`` or ``"xylo"`` (trained within Xylo Audio 2's limits,
+        predicting in the chip's integers; ``--snn-target``). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
         ...) as :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
         opts = _stage_options(**stage_options)
         opts["causal"] = bool(causal)
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
-               "seed": seed, "recurrent": recurrent, "reset": reset}
+               "seed": seed, "recurrent": recurrent, "target": target}
+        if reset is not None:
+            snn["reset"] = reset
         native, ran, best, loss = _native.train_spiking_model(arrays, infos, opts, snn, fp,
                                                               baseline)
         return cls(native, {"epochs": ran, "best_epoch": best, "validation_loss": loss})

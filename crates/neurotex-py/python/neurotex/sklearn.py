@@ -274,7 +274,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     ``baseline=dataset.baseline``) and trains
     ``hidden`` LIF neurons with time steps of ``dt_ms`` for at most ``epochs`` passes, early
     stopping on 20 % of each class of ``X``, seeded by ``seed``; ``recurrent`` and
-    ``reset`` (``"zero"`` or ``"subtract"``) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
+    ``reset`` (``"zero"`` or ``"subtract"``) and ``target`` (``"float"`` or ``"xylo"``) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
     it to NIR)."""
 
@@ -286,7 +286,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         readout: str = _SNN_DEFAULTS["readout"],
         seed: int = _SNN_DEFAULTS["seed"],
         recurrent: bool = _SNN_DEFAULTS["recurrent"],
-        reset: str = _SNN_DEFAULTS["reset"],
+        reset: Optional[str] = None,
+        target: str = _SNN_DEFAULTS["target"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
@@ -300,6 +301,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.seed = seed
         self.recurrent = recurrent
         self.reset = reset
+        self.target = target
         self.encoding = encoding
         self.gain = gain
         self.baseline = baseline
@@ -320,7 +322,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.model_ = SpikingModel.train(
             X, [str(label) for label in y], fs=self.fs, hidden=self.hidden,
             dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
-            recurrent=self.recurrent, reset=self.reset, causal=self.causal, encoding=self.encoding, gain=self.gain,
+            recurrent=self.recurrent, reset=self.reset, target=self.target, causal=self.causal, encoding=self.encoding, gain=self.gain,
             baseline=self.baseline,
         )
         # the network's outputs (labels as text) -> columns in classes_ order
