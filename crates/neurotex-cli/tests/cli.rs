@@ -11,6 +11,7 @@ mod evaluate;
 mod events;
 mod extensions;
 mod features;
+mod foreign_nir;
 mod hostile;
 mod import;
 mod inspect;

@@ -27,6 +27,17 @@
 //! on the edges `lif1 → rec → lif1`, the form snnTorch's and Norse's importers read as a
 //! recurrent layer. NIR's equations leave the loop's delay to the simulator; neurotex's
 //! network, like theirs, feeds a step's spikes into the next step's current.
+//!
+//! **Graphs written by other tools** ([`read_as`], [`NirFrom`]). A LIF hidden node is a
+//! layer without synaptic current (`α = 0`: the current is the step's input), as snnTorch's
+//! `Leaky` and Norse's `LIFBoxCell` step. snnTorch's `export_to_nir` writes no `dt`, its
+//! constants for a step of 1e-4 s whatever the network's, and a recurrent layer as a graph
+//! nested in the graph (`Input → LIF → Output` with the loop `LIF → w_rec → LIF`), which is
+//! read as the loop on a flat graph's hidden layer; its readout is a `Leaky`, a LIF node
+//! whose membrane is read without reset. Norse's `to_nir` writes no `dt` and every time
+//! constant multiplied by `dt`. Neither file says the step, which comes from the model
+//! lending the pipeline; every formula above holds `dt/τ`, so each convention is NIR's read
+//! at another time: 1e-4 s for snnTorch, `dt²` for Norse.
 
 use std::path::Path;
 
@@ -98,6 +109,50 @@ pub fn check_reset(net: &Network, convention: Convention) -> Result<()> {
     Err(crate::error::OptionsError::Conflict(why).into())
 }
 
+/// The tool that wrote a graph: how to read what its file does not say (`--nir-from`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum NirFrom {
+    /// NIR's equations in physical time, `dt` in the metadata (else the time step of the
+    /// model lending the pipeline); a readout must never fire.
+    #[default]
+    Nir,
+    /// snnTorch's `export_to_nir`: constants written for its fixed step of 1e-4 s
+    /// (`τ = 1e-4/(1-β)`), no `dt`, the network stepping at the `--like` model's `dt_ms`;
+    /// a LIF readout is its `Leaky` output layer, whose membrane is the score and is read
+    /// without reset (snnTorch's `reset_mechanism="none"`).
+    Snntorch,
+    /// Norse's `to_nir(net, x, dt)`: every time constant written multiplied by `dt`
+    /// (`τ dt`), no `dt` in the file, the network stepping at the `--like` model's `dt_ms`.
+    Norse,
+}
+
+impl NirFrom {
+    /// The name typed after `--nir-from`.
+    pub fn name(self) -> &'static str {
+        match self {
+            NirFrom::Nir => "nir",
+            NirFrom::Snntorch => "snntorch",
+            NirFrom::Norse => "norse",
+        }
+    }
+}
+
+impl std::str::FromStr for NirFrom {
+    type Err = crate::error::ParamError;
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s {
+            "nir" => Ok(NirFrom::Nir),
+            "snntorch" => Ok(NirFrom::Snntorch),
+            "norse" => Ok(NirFrom::Norse),
+            _ => Err(crate::error::ParamError::new(
+                "nir-from",
+                "the tool that wrote the graph must be nir, snntorch or norse",
+                s,
+            )),
+        }
+    }
+}
+
 /// A network and what the graph's metadata says about it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NirNetwork {
@@ -128,6 +183,16 @@ pub fn write(path: &Path, net: &Network, model_json: &str, convention: Conventio
 /// the weights, per-neuron decays, a missing or non-whole-millisecond `dt`, or a
 /// non-finite weight, each naming the node.
 pub fn read(path: &Path) -> Result<NirNetwork> {
+    read_as(path, NirFrom::Nir, None)
+}
+
+/// Reads a NIR graph written by `from` (see [`NirFrom`]); `step_s`, the time step of the
+/// model lending the pipeline, is the network's step when the graph has none.
+///
+/// # Errors
+/// As [`read`]; also a graph without a time step and no `step_s`, or a readout that fires
+/// where `from` has none.
+pub fn read_as(path: &Path, from: NirFrom, step_s: Option<f64>) -> Result<NirNetwork> {
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     let damaged = |reason: String| -> crate::Error {
         ModelError::Nir {
@@ -138,7 +203,7 @@ pub fn read(path: &Path) -> Result<NirNetwork> {
     };
     // The parser is a young crate: whatever a damaged file makes it do, neurotex reports
     // an error rather than stopping.
-    let parsed = std::panic::catch_unwind(|| from_bytes(bytes));
+    let parsed = std::panic::catch_unwind(|| from_bytes_as(bytes, from, step_s));
     match parsed {
         Ok(result) => result.map_err(damaged),
         Err(_) => Err(damaged("not a readable HDF5 file".into())),
@@ -162,6 +227,15 @@ impl Reader {
                 .map_err(|_| format!("the graph has no group {at}"))?;
         }
         Ok(g)
+    }
+
+    /// The group of node `name`; `outer/inner` names a node of the subgraph `outer`.
+    fn node(&self, name: &str) -> Result<hdf5_pure::Group, String> {
+        let mut path = vec!["node"];
+        for part in name.split('/') {
+            path.extend(["nodes", part]);
+        }
+        self.group(&path)
     }
 }
 
@@ -197,7 +271,16 @@ fn read_array(g: &hdf5_pure::Group, name: &str, at: &str) -> Result<(Vec<f64>, V
     Ok((values, shape))
 }
 
+#[cfg(test)]
 fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
+    from_bytes_as(bytes, NirFrom::Nir, None)
+}
+
+fn from_bytes_as(
+    bytes: Vec<u8>,
+    from: NirFrom,
+    fallback_step_s: Option<f64>,
+) -> Result<NirNetwork, String> {
     if !bytes.starts_with(b"\x89HDF\r\n\x1a\n") {
         return Err(
             "not an HDF5 file (a NIR graph is HDF5, which starts with its signature)".into(),
@@ -210,93 +293,123 @@ fn from_bytes(bytes: Vec<u8>) -> Result<NirNetwork, String> {
     if kind.first().map(String::as_str) != Some("NIRGraph") {
         return Err(format!("/node is a {kind:?}, not a NIRGraph"));
     }
-    if let Some(tool) = reader
-        .group(&["node", "metadata"])
-        .ok()
-        .and_then(|m| read_string(&m, "neurotex_for", "/node/metadata").ok())
-        .and_then(|v| v.into_iter().next())
-        .filter(|t| t == "sinabs" || t == "rockpool")
-    {
+    let meta = reader.group(&["node", "metadata"]).ok();
+    let meta_str = |field: &str| {
+        meta.as_ref()
+            .and_then(|m| read_string(m, field, "/node/metadata").ok())
+            .and_then(|v| v.into_iter().next())
+    };
+    if let Some(tool) = meta_str("neurotex_for").filter(|t| t == "sinabs" || t == "rockpool") {
         return Err(format!("the graph was written for {tool}'s importer (time in steps, the synapse split or the input before the decay), which neurotex does not read back: give the model file it was exported from, or a graph written with --for nir"));
     }
     let (names, rec) = path_of_nodes(&reader)?;
-    let meta = reader.group(&["node", "metadata"]).map_err(|_| {
-        "the graph has no metadata, so no `dt` (its time step in seconds)".to_string()
-    })?;
-    let dt = match meta.dataset("dt") {
-        Err(_) => return Err("the graph's metadata has no `dt` (its time step in seconds)".into()),
-        Ok(d) => d.read_f64().map_err(|_| {
-            "the graph's metadata `dt` is not a number (its time step in seconds)".to_string()
-        })?,
-    };
-    let dt_s = *dt.first().ok_or("the graph's `dt` is empty")?;
-    // A graph written for snnTorch's importer (its constants scaled to `dt` = 0.1 ms) keeps
-    // the network's own step as `neurotex_dt`; the decays follow from `dt`, the spikes'
-    // binning from the network's step.
-    let step_s = match meta.dataset("neurotex_dt").and_then(|d| d.read_f64()) {
-        Ok(v) => *v.first().ok_or("the graph's `neurotex_dt` is empty")?,
-        Err(_) => dt_s,
-    };
+    let (scale_s, step_s) = time_of(meta.as_ref(), from, fallback_step_s)?;
     let dt_ms = step_s * 1000.0;
     if !((1.0..=1000.0).contains(&dt_ms) && (dt_ms - dt_ms.round()).abs() < 1e-6) {
         return Err(format!("the graph's dt is {step_s} s; neurotex's networks step a whole number of ms (1 to 1000) on the encoder's 1 ms spikes"));
     }
-    let readout = match read_string(&meta, "readout", "/node/metadata") {
-        Ok(r) => r.first().map_or(Ok(Readout::Mean), |r| {
-            r.parse()
-                .map_err(|e: crate::error::ParamError| e.rule.to_string())
-        })?,
-        Err(_) => Readout::Mean,
+    let readout = meta_str("readout").map_or(Ok(Readout::Mean), |r| {
+        r.parse()
+            .map_err(|e: crate::error::ParamError| e.rule.to_string())
+    })?;
+    let reset = meta_str("reset").map_or(Ok(Reset::Zero), |r| {
+        r.parse()
+            .map_err(|e: crate::error::ParamError| e.rule.to_string())
+    })?;
+    let at = Layers {
+        names: &names,
+        scale_s,
+        dt_ms: dt_ms.round() as u32,
+        from,
     };
-    let reset = match read_string(&meta, "reset", "/node/metadata") {
-        Ok(r) => r.first().map_or(Ok(Reset::Zero), |r| {
-            r.parse()
-                .map_err(|e: crate::error::ParamError| e.rule.to_string())
-        })?,
-        Err(_) => Reset::Zero,
-    };
-    let neurotex_model = read_string(&meta, "neurotex_model", "/node/metadata")
-        .ok()
-        .and_then(|v| v.into_iter().next());
-    let mut network = network_of(&reader, &names, dt_s, dt_ms.round() as u32, readout)?;
+    let mut network = network_of(&reader, &at, readout)?;
     if let Some(rec) = rec {
-        recurrent_of(&reader, &rec, &names[2], dt_s, &mut network)?;
+        recurrent_of(&reader, &rec, &names[2], scale_s, &mut network)?;
     }
     network.reset = reset;
     network.check()?;
     Ok(NirNetwork {
         network,
         dt_s: step_s,
-        neurotex_model,
+        neurotex_model: meta_str("neurotex_model"),
     })
+}
+
+/// A number in the graph's metadata, if it has the field.
+fn meta_number(meta: Option<&hdf5_pure::Group>, field: &str) -> Result<Option<f64>, String> {
+    let Some(d) = meta.and_then(|m| m.dataset(field).ok()) else {
+        return Ok(None);
+    };
+    let v = d.read_f64().map_err(|_| {
+        format!("the graph's metadata `{field}` is not a number (a time step in seconds)")
+    })?;
+    match v.first() {
+        Some(&x) if x > 0.0 && x.is_finite() => Ok(Some(x)),
+        Some(x) => Err(format!(
+            "the graph's metadata `{field}` is {x}; a time step must be positive"
+        )),
+        None => Err(format!("the graph's metadata `{field}` is empty")),
+    }
+}
+
+/// The time against which the graph's constants are read (every formula has `dt/τ`) and
+/// the network's step, both in seconds. NIR's graphs say `dt`; neurotex's graphs for
+/// snnTorch keep the network's own step as `neurotex_dt` beside snnTorch's `dt`; snnTorch
+/// writes its constants for 1e-4 s and Norse its time constants multiplied by the step,
+/// and neither says the step, which then is the `--like` model's.
+fn time_of(
+    meta: Option<&hdf5_pure::Group>,
+    from: NirFrom,
+    fallback_step_s: Option<f64>,
+) -> Result<(f64, f64), String> {
+    let dt = meta_number(meta, "dt")?;
+    let own_step = meta_number(meta, "neurotex_dt")?;
+    let no_step = |tool: &str| {
+        format!("the graph's metadata has no `dt` (its time step in seconds), as {tool} writes none: give the neurotex spiking model whose pipeline makes its input spikes (--like MODEL.json), whose dt_ms is the step")
+    };
+    match from {
+        NirFrom::Nir => {
+            let dt = dt.or(fallback_step_s).ok_or_else(|| {
+                "the graph's metadata has no `dt` (its time step in seconds)".to_string()
+            })?;
+            Ok((dt, own_step.unwrap_or(dt)))
+        }
+        NirFrom::Snntorch => {
+            let step = own_step
+                .or(fallback_step_s)
+                .ok_or_else(|| no_step("snnTorch"))?;
+            Ok((SNNTORCH_DT_S, step))
+        }
+        NirFrom::Norse => {
+            let step = dt.or(fallback_step_s).ok_or_else(|| no_step("Norse"))?;
+            Ok((step * step, step))
+        }
+    }
+}
+
+/// The graph's layers: the nodes along its path and how to read their constants.
+struct Layers<'a> {
+    names: &'a [String],
+    /// The time against which `dt/τ` is read, s.
+    scale_s: f64,
+    /// The network's step, ms.
+    dt_ms: u32,
+    from: NirFrom,
 }
 
 /// The nodes along the graph's one path from its Input to its Output, checked to be the
 /// six neurotex runs, in order, and the Linear (or Affine) node of a recurrent loop on the
 /// CubaLIF node (`lif → rec → lif`), if there is one.
 fn path_of_nodes(reader: &Reader) -> Result<(Vec<String>, Option<Vec<String>>), String> {
-    let nodes = reader.group(&["node", "nodes"])?;
-    let names = nodes.groups().map_err(|e| format!("/node/nodes: {e}"))?;
-    let mut kinds = Vec::new();
-    for name in &names {
-        let g = nodes.group(name).map_err(|e| format!("node {name}: {e}"))?;
-        let kind = read_string(&g, "type", &format!("node {name}"))?.concat();
-        if kind == "NIRGraph" {
-            return Err(format!("node {name} is a graph of its own (how snnTorch and Rockpool write a recurrent layer); neurotex reads a recurrent layer as a loop of Linear nodes on its CubaLIF node, in one flat graph"));
+    let (mut kinds, owned) = nodes_and_edges(reader)?;
+    for (name, kind) in &kinds {
+        if !NODES.iter().any(|(_, k)| *k == kind) && kind != "Linear" && kind != "LIF" {
+            return Err(format!("node {name} is a {kind}; neurotex runs Input → Affine/Linear → CubaLIF or LIF → Affine/Linear → LI (or a LIF or CubaLIF that never fires) → Output, with at most one recurrent loop of Linear/Affine nodes on the hidden layer"));
         }
-        if !NODES.iter().any(|(_, k)| *k == kind) && kind != "Linear" {
-            return Err(format!("node {name} is a {kind}; neurotex runs Input → Affine/Linear → CubaLIF → Affine/Linear → LI (or a CubaLIF that never fires) → Output"));
-        }
-        kinds.push((name.clone(), kind));
     }
-    let node = reader.group(&["node"])?;
-    let flat = read_string(&node, "edges", "/node")?;
-    if flat.len() % 2 != 0 {
-        return Err("the graph's edges are not pairs".into());
-    }
-    let mut edges: Vec<(&str, &str)> = flat
-        .chunks(2)
-        .map(|e| (e[0].as_str(), e[1].as_str()))
+    let mut edges: Vec<(&str, &str)> = owned
+        .iter()
+        .map(|(a, b)| (a.as_str(), b.as_str()))
         .collect();
     let rec = take_loop(&mut kinds, &mut edges)?;
     let start = kinds
@@ -345,9 +458,10 @@ fn path_of_nodes(reader: &Reader) -> Result<(Vec<String>, Option<Vec<String>>), 
     for (i, (got, want)) in order.iter().zip(want).enumerate() {
         let fits = *got == want
             || (want == "Affine" && *got == "Linear")
-            || (want == "LI" && *got == "CubaLIF");
+            || (want == "CubaLIF" && *got == "LIF")
+            || (want == "LI" && (*got == "CubaLIF" || *got == "LIF"));
         if !fits {
-            return Err(format!("node {} is a {got} where neurotex runs a {want} (Input → Affine → CubaLIF → Affine → LI → Output)", path[i]));
+            return Err(format!("node {} is a {got} where neurotex runs a {want} (Input → Affine → CubaLIF or LIF → Affine → LI → Output)", path[i]));
         }
     }
     if order.len() != want.len() {
@@ -402,6 +516,82 @@ fn recurrent_of(
     Ok(())
 }
 
+/// A graph's nodes `(name, type)` and edges, with a nested graph's nodes in place of its
+/// node (named `outer/inner`): snnTorch writes a recurrent layer (`RLeaky`, `RSynaptic`)
+/// as a graph `Input → LIF → Output` with a loop `LIF → w_rec → LIF`, which then reads as
+/// the loop on a flat graph's hidden layer.
+type NodesAndEdges = (Vec<(String, String)>, Vec<(String, String)>);
+
+fn nodes_and_edges(reader: &Reader) -> Result<NodesAndEdges, String> {
+    let (kinds, mut edges) = graph_level(reader, &["node"], "")?;
+    let mut flat = Vec::new();
+    for (name, kind) in kinds {
+        if kind != "NIRGraph" {
+            flat.push((name, kind));
+            continue;
+        }
+        let (inner, inner_edges) =
+            graph_level(reader, &["node", "nodes", &name], &format!("{name}/"))?;
+        if let Some((n, _)) = inner.iter().find(|(_, k)| k == "NIRGraph") {
+            return Err(format!("node {n} is a graph inside the graph {name}; neurotex reads one level of nesting (snnTorch's recurrent layer)"));
+        }
+        let is = |n: &str, want: &str| inner.iter().any(|(m, k)| m == n && k == want);
+        let entries: Vec<&String> = (inner_edges.iter().filter(|(a, _)| is(a, "Input")))
+            .map(|(_, b)| b)
+            .collect();
+        let exits: Vec<&String> = (inner_edges.iter().filter(|(_, b)| is(b, "Output")))
+            .map(|(a, _)| a)
+            .collect();
+        let mut rewired = Vec::new();
+        for (a, b) in edges {
+            if b == name {
+                rewired.extend(entries.iter().map(|e| (a.clone(), (*e).clone())));
+            } else if a == name {
+                rewired.extend(exits.iter().map(|x| ((*x).clone(), b.clone())));
+            } else {
+                rewired.push((a, b));
+            }
+        }
+        rewired.extend(
+            (inner_edges.iter())
+                .filter(|(a, b)| !is(a, "Input") && !is(b, "Output"))
+                .cloned(),
+        );
+        edges = rewired;
+        flat.extend(
+            (inner.iter())
+                .filter(|(_, k)| k != "Input" && k != "Output")
+                .cloned(),
+        );
+    }
+    Ok((flat, edges))
+}
+
+/// The nodes and edges of the graph at `path`, their names prefixed with `prefix`.
+fn graph_level(reader: &Reader, path: &[&str], prefix: &str) -> Result<NodesAndEdges, String> {
+    let at = format!("/{}", path.join("/"));
+    let group = reader.group(path)?;
+    let nodes = group
+        .group("nodes")
+        .map_err(|_| format!("{at} has no nodes"))?;
+    let names = nodes.groups().map_err(|e| format!("{at}/nodes: {e}"))?;
+    let mut kinds = Vec::new();
+    for name in &names {
+        let full = format!("{prefix}{name}");
+        let g = nodes.group(name).map_err(|e| format!("node {full}: {e}"))?;
+        let kind = read_string(&g, "type", &format!("node {full}"))?.concat();
+        kinds.push((full, kind));
+    }
+    let flat = read_string(&group, "edges", &at)?;
+    if flat.len() % 2 != 0 {
+        return Err(format!("the edges of {at} are not pairs"));
+    }
+    let edges = (flat.chunks(2))
+        .map(|e| (format!("{prefix}{}", e[0]), format!("{prefix}{}", e[1])))
+        .collect();
+    Ok((kinds, edges))
+}
+
 /// Takes the one recurrent loop on a CubaLIF node (through one Linear/Affine node, or two
 /// in a row as snnTorch's importer needs, each with no other edge) out of the node list
 /// and edges, and returns the loop's nodes in order from the CubaLIF.
@@ -417,7 +607,7 @@ fn take_loop(
     let next = |n: &str| edges.iter().find(|e| e.0 == n).map(|e| e.1);
     let mut loops: Vec<(String, Vec<String>)> = Vec::new();
     for &(lif, a) in edges.iter() {
-        if kind_of(lif).as_deref() != Some("CubaLIF") || !dense(a) {
+        if !matches!(kind_of(lif).as_deref(), Some("CubaLIF" | "LIF")) || !dense(a) {
             continue;
         }
         let mut path = vec![a.to_string()];
@@ -459,7 +649,7 @@ fn per_neuron(g: &hdf5_pure::Group, field: &str, at: &str, len: usize) -> Result
 
 /// An Affine's (or Linear's) weight, `(out, in)` row-major, and bias.
 fn read_affine(reader: &Reader, name: &str) -> Result<(Vec<f64>, Vec<f64>, usize, usize), String> {
-    let g = reader.group(&["node", "nodes", name])?;
+    let g = reader.node(name)?;
     let (weight, shape) = read_array(&g, "weight", name)?;
     let [out, inp] = shape.as_slice() else {
         return Err(format!(
@@ -501,33 +691,37 @@ fn one_decay(taus: &[f64], dt_s: f64, at: &str, field: &str) -> Result<f64, Stri
 /// The CubaLIF node's decays and, per neuron, the gain each step gives its input on the
 /// membrane scaled to a threshold of 1: `(dt/τ_mem) r (dt/τ_syn) w_in / v_threshold`.
 fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<(f64, f64, Vec<f64>), String> {
-    let lif_at = at;
-    let lif = reader.group(&["node", "nodes", lif_at])?;
-    let field = |f: &str| per_neuron(&lif, f, lif_at, h);
-    let (tau_syn, tau_mem, r, w_in) = (
-        field("tau_syn")?,
-        field("tau_mem")?,
-        field("r")?,
-        field("w_in")?,
-    );
+    let lif = reader.node(at)?;
+    let field = |f: &str| per_neuron(&lif, f, at, h);
+    let kind = read_string(&lif, "type", &format!("node {at}"))?.concat();
+    // A LIF node has no synapse: its current is the step's input (α = 0, gain 1), as
+    // snnTorch's `Leaky` and Norse's `LIFBoxCell` step.
+    let (alpha, synapse_gain, tau_mem, tau_field) = if kind == "LIF" {
+        (0.0, vec![1.0; h], field("tau")?, "tau")
+    } else {
+        let (tau_syn, w_in) = (field("tau_syn")?, field("w_in")?);
+        let alpha = one_decay(&tau_syn, dt_s, at, "tau_syn")?;
+        let gain = (0..h).map(|j| (dt_s / tau_syn[j]) * w_in[j]).collect();
+        (alpha, gain, field("tau_mem")?, "tau_mem")
+    };
+    let r = field("r")?;
     // `v_reset` may be left out (nir 1.0.4 has no such field; later versions default to 0).
     let v_reset = match lif.dataset("v_reset") {
         Ok(_) => field("v_reset")?,
         Err(_) => vec![0.0; h],
     };
     let (v_leak, v_threshold) = (field("v_leak")?, field("v_threshold")?);
-    let alpha = one_decay(&tau_syn, dt_s, lif_at, "tau_syn")?;
-    let beta = one_decay(&tau_mem, dt_s, lif_at, "tau_mem")?;
+    let beta = one_decay(&tau_mem, dt_s, at, tau_field)?;
     if v_leak.iter().chain(&v_reset).any(|v| *v != 0.0) {
         return Err(format!(
-            "node {lif_at}: v_leak and v_reset must be 0 (neurotex's neurons rest and reset at 0)"
+            "node {at}: v_leak and v_reset must be 0 (neurotex's neurons rest and reset at 0)"
         ));
     }
     if v_threshold.iter().any(|v| *v <= 0.0) {
-        return Err(format!("node {lif_at}: v_threshold must be positive"));
+        return Err(format!("node {at}: v_threshold must be positive"));
     }
     let gain: Vec<f64> = (0..h)
-        .map(|j| (dt_s / tau_mem[j]) * r[j] * (dt_s / tau_syn[j]) * w_in[j] / v_threshold[j])
+        .map(|j| (dt_s / tau_mem[j]) * r[j] * synapse_gain[j] / v_threshold[j])
         .collect();
     Ok((alpha, beta, gain))
 }
@@ -535,14 +729,17 @@ fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<(f64, f64, V
 /// The readout node's decay, and per class the gain each step gives its input and the
 /// constant its leak adds: an LI node (`τ dv/dt = v_leak - v + r a`), or a CubaLIF that
 /// never fires whose current is the step's input (`tau_syn = dt`; a threshold of at least
-/// 1e20), the readout snnTorch and Norse map.
+/// 1e20), the readout snnTorch and Norse map, or a LIF node that never fires (with
+/// [`NirFrom::Snntorch`], snnTorch's `Leaky` output layer: its membrane, read without
+/// reset).
 fn readout_of(
     reader: &Reader,
     at: &str,
     dt_s: f64,
     c: usize,
+    from: NirFrom,
 ) -> Result<(f64, Vec<f64>, Vec<f64>), String> {
-    let g = reader.group(&["node", "nodes", at])?;
+    let g = reader.node(at)?;
     let field = |f: &str| per_neuron(&g, f, at, c);
     let kind = read_string(&g, "type", &format!("node {at}"))?.concat();
     let (tau, r, leak, input_gain) = if kind == "CubaLIF" {
@@ -559,6 +756,13 @@ fn readout_of(
         let gain = (0..c).map(|k| (dt_s / tau_syn[k]) * w_in[k]).collect();
         (field("tau_mem")?, field("r")?, field("v_leak")?, gain)
     } else {
+        let fires = (kind == "LIF" && from != NirFrom::Snntorch)
+            .then(|| field("v_threshold"))
+            .transpose()?
+            .and_then(|v| v.into_iter().find(|v| *v < 1e20));
+        if let Some(v) = fires {
+            return Err(format!("node {at}: a LIF readout that fires (v_threshold {v}); neurotex scores a readout's membrane, which a spike would reset, so a LIF readout must never fire (v_threshold at least 1e20); snnTorch's Leaky output layer reads with --nir-from snntorch, as a membrane without reset"));
+        }
         (field("tau")?, field("r")?, field("v_leak")?, vec![1.0; c])
     };
     let field_name = if kind == "CubaLIF" { "tau_mem" } else { "tau" };
@@ -570,17 +774,12 @@ fn readout_of(
     Ok((kappa, gain, leak))
 }
 
-fn network_of(
-    reader: &Reader,
-    names: &[String],
-    dt_s: f64,
-    dt_ms: u32,
-    readout: Readout,
-) -> Result<Network, String> {
+fn network_of(reader: &Reader, at: &Layers<'_>, readout: Readout) -> Result<Network, String> {
+    let (names, dt_s, dt_ms) = (at.names, at.scale_s, at.dt_ms);
     let (w1, b1, h, n) = read_affine(reader, &names[1])?;
     let (w2, b2, c, h2) = read_affine(reader, &names[3])?;
     let io_width = |name: &str| -> Result<usize, String> {
-        let g = reader.group(&["node", "nodes", name])?;
+        let g = reader.node(name)?;
         let (shape, _) = read_array(&g, "shape", name)?;
         Ok(shape.iter().product::<f64>() as usize)
     };
@@ -603,7 +802,7 @@ fn network_of(
         ));
     }
     let (alpha, beta, gain) = lif_of(reader, &names[2], dt_s, h)?;
-    let (kappa, out_gain, out_leak) = readout_of(reader, &names[4], dt_s, c)?;
+    let (kappa, out_gain, out_leak) = readout_of(reader, &names[4], dt_s, c, at.from)?;
     let tau_ms = |decay: f64| -f64::from(dt_ms) / decay.ln();
     Ok(Network {
         inputs: n,
@@ -885,6 +1084,87 @@ mod tests {
         let firing = graph(|n, _| set(n, "li", "v_threshold", vec![1.0; 2]), Some(0.01));
         let err = from_bytes(firing).unwrap_err();
         assert!(err.contains("must never fire"), "{err}");
+    }
+
+    /// Scores of two networks on one input, to within `tol`.
+    fn same_scores(a: &Network, b: &Network, tol: f64) {
+        let x = crate::snn::SpikeInput::from_events(3, 30, &[(0, 1), (1, 0), (2, 2), (3, 1)]);
+        for (a, b) in a.scores(&x).iter().zip(b.scores(&x)) {
+            assert!((a - b).abs() < tol, "{a} vs {b}");
+        }
+    }
+
+    /// A LIF hidden node (snnTorch's `Leaky`, Norse's `LIFBoxCell`) has no synapse: it
+    /// reads as a network whose current is the step's input (`tau_syn_ms` 0).
+    #[test]
+    fn a_lif_hidden_node_reads_without_synaptic_memory() {
+        let lif = graph(
+            |nodes, _| {
+                let (tau, r) = (field(nodes, "lif1", "tau_mem"), field(nodes, "lif1", "r"));
+                let node = nodes.iter_mut().find(|n| n.0 == "lif1").unwrap();
+                node.1 = "LIF".into();
+                node.2
+                    .retain(|f| !matches!(f.0.as_str(), "tau_syn" | "tau_mem" | "w_in" | "r"));
+                node.2.push(("tau".into(), tau, vec![4]));
+                node.2.push(("r".into(), r, vec![4]));
+            },
+            Some(0.01),
+        );
+        let back = from_bytes(lif).unwrap().network;
+        assert_eq!(back.tau_syn_ms, 0.0);
+        let mut want = net();
+        want.tau_syn_ms = 0.0;
+        same_scores(&want, &back, 1e-9);
+        let x = crate::snn::SpikeInput::from_events(3, 30, &[(0, 1), (1, 0), (2, 2), (3, 1)]);
+        assert_ne!(back.scores(&x), net().scores(&x), "the synapse matters");
+    }
+
+    /// Norse writes every time constant multiplied by `dt` and no `dt`: read with the step
+    /// given, it is the network; read as NIR's seconds, it is refused.
+    #[test]
+    fn norse_time_constants_read_with_the_step_given() {
+        let dt = 0.01;
+        let norse = graph(
+            |nodes, _| {
+                for (node, f) in [
+                    ("lif1", "tau_syn"),
+                    ("lif1", "tau_mem"),
+                    ("li", "tau_syn"),
+                    ("li", "tau_mem"),
+                ] {
+                    let v = field(nodes, node, f).iter().map(|t| t * dt).collect();
+                    set(nodes, node, f, v);
+                }
+            },
+            None,
+        );
+        let back = from_bytes_as(norse.clone(), NirFrom::Norse, Some(dt)).unwrap();
+        assert_eq!((back.dt_s, back.network.dt_ms), (dt, 10));
+        same_scores(&net(), &back.network, 1e-9);
+        let err = from_bytes_as(norse.clone(), NirFrom::Nir, Some(dt)).unwrap_err();
+        assert!(err.contains("node lif1: `tau_syn`"), "{err}");
+        let err = from_bytes_as(norse, NirFrom::Norse, None).unwrap_err();
+        assert!(
+            err.contains("Norse writes none") && err.contains("--like"),
+            "{err}"
+        );
+    }
+
+    /// The time step: the graph's `dt`, else the one given; none, or one not positive, is
+    /// refused by name.
+    #[test]
+    fn a_graph_without_a_positive_time_step_is_refused() {
+        let back = from_bytes_as(graph(|_, _| {}, None), NirFrom::Nir, Some(0.01)).unwrap();
+        same_scores(&net(), &back.network, 1e-9);
+        let err = from_bytes(graph(|_, _| {}, Some(-0.01))).unwrap_err();
+        assert!(
+            err.contains("`dt` is -0.01; a time step must be positive"),
+            "{err}"
+        );
+        let err = from_bytes_as(graph(|_, _| {}, None), NirFrom::Snntorch, None).unwrap_err();
+        assert!(err.contains("snnTorch writes none"), "{err}");
+        assert!("keras".parse::<NirFrom>().is_err());
+        assert_eq!("norse".parse::<NirFrom>().unwrap().name(), "norse");
     }
 
     #[test]

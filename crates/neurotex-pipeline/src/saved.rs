@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use crate::causal::{episode_decisions, spiking_episode_decisions, DecisionRule, Episode};
 use crate::error::{ModelError, Result};
 use crate::model::{Model, Prediction, Provenance, Score};
+use crate::nir::NirFrom;
 use crate::pipeline::{Encoded, Method, Pipeline, PipelineParams};
 use crate::recording::{Baseline, FileReading, LayoutFrom};
 use crate::signal::CausalConditioning;
@@ -71,16 +72,36 @@ impl SavedModel {
     /// What [`Model::load`] and [`SpikingModel::load`] refuse; `like` given for a file that
     /// is not a NIR graph.
     pub fn load(path: &Path, like: Option<&Path>) -> Result<SavedModel> {
+        SavedModel::load_as(path, like, NirFrom::Nir)
+    }
+
+    /// As [`SavedModel::load`], a NIR graph read as written by `from` (see [`NirFrom`]).
+    ///
+    /// # Errors
+    /// As [`SavedModel::load`]; `from` other than NIR for a file that is not a NIR graph.
+    pub fn load_as(path: &Path, like: Option<&Path>, from: NirFrom) -> Result<SavedModel> {
+        let graph_named = (path.extension()).is_some_and(|e| e.eq_ignore_ascii_case("nir"));
+        if from != NirFrom::Nir && path.is_file() && !is_hdf5(path) && !graph_named {
+            return Err(ModelError::Inconsistent(format!(
+                "{}: --nir-from {} applies to a NIR graph, not to a model file",
+                path.display(),
+                from.name()
+            ))
+            .into());
+        }
         match (like, SpikingModel::is_spiking(path)) {
             (Some(like), true) if is_hdf5(path) => {
                 let like = SpikingModel::load(like)?;
-                Ok(SpikingModel::from_nir(path, Some(&like))?.into())
+                Ok(SpikingModel::from_nir_as(path, Some(&like), from)?.into())
             }
             (Some(_), _) => Err(ModelError::Inconsistent(format!(
                 "{}: a pipeline to run with (--like) applies to a NIR graph, not to a model file",
                 path.display()
             ))
             .into()),
+            (None, true) if is_hdf5(path) => {
+                Ok(SpikingModel::from_nir_as(path, None, from)?.into())
+            }
             (None, true) => Ok(SpikingModel::load(path)?.into()),
             (None, false) => Ok(Model::load(path)?.into()),
         }

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{ClassifyError, DataError, ModelError, Result};
 use crate::model::{Prediction, Provenance, Score};
-use crate::nir::Convention;
+use crate::nir::{Convention, NirFrom};
 use crate::pipeline::{taxel_cells, Encoded, Pipeline, PipelineParams};
 use crate::recording::{Baseline, FileReading, LayoutFrom};
 use crate::snn::{softmax, train::TrainingLog, Network, SnnParams, SpikeInput};
@@ -274,7 +274,22 @@ impl SpikingModel {
     /// A graph of another shape (see [`crate::nir::read`]), a graph without neurotex's
     /// metadata and no `like`, or a network that does not fit the pipeline, naming the file.
     pub fn from_nir(path: &Path, like: Option<&SpikingModel>) -> Result<SpikingModel> {
-        let graph = crate::nir::read(path)?;
+        SpikingModel::from_nir_as(path, like, NirFrom::Nir)
+    }
+
+    /// As [`SpikingModel::from_nir`], for a graph written by `from` (snnTorch's and Norse's
+    /// exporters leave out the time step, which is then `like`'s, and write their
+    /// constants in conventions of their own: [`NirFrom`]).
+    ///
+    /// # Errors
+    /// As [`SpikingModel::from_nir`], and what [`crate::nir::read_as`] refuses.
+    pub fn from_nir_as(
+        path: &Path,
+        like: Option<&SpikingModel>,
+        from: NirFrom,
+    ) -> Result<SpikingModel> {
+        let step_s = like.map(|l| f64::from(l.file.network.dt_ms) / 1000.0);
+        let graph = crate::nir::read_as(path, from, step_s)?;
         let damaged = |reason: String| -> crate::Error {
             ModelError::Nir {
                 path: path.to_path_buf(),

@@ -29,6 +29,14 @@ pub struct PredictArgs {
     /// graph's network runs with (the network must have its inputs and outputs).
     #[arg(long)]
     pub like: Option<PathBuf>,
+    /// The tool that wrote the graph given as --model, for what its file does not say:
+    /// `nir` (NIR's equations, `dt` in the metadata or else --like's time step),
+    /// `snntorch` (snnTorch's `export_to_nir`: constants for its fixed 0.1 ms step, a
+    /// `Leaky` readout's membrane read without reset) or `norse` (Norse's `to_nir`: time
+    /// constants multiplied by `dt`); snnTorch and Norse write no time step, so the network
+    /// steps at --like's `dt_ms`, which must be the `dt` the tool ran at.
+    #[arg(long, value_name = "TOOL", default_value = "nir")]
+    pub nir_from: neurotex::nir::NirFrom,
     /// Also print `{"accuracy", "n", "labels", "confusion"}` (rows = true label) as JSON;
     /// needs --dataset, and every label there must be a class of the model.
     #[arg(long)]
@@ -49,7 +57,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
     }
     let dataset = o.dataset()?;
     check_output(&args.out, &o.inputs(dataset.as_ref()))?;
-    let model = SavedModel::load(&o.model, args.like.as_deref())?;
+    let model = SavedModel::load_as(&o.model, args.like.as_deref(), args.nir_from)?;
     let progress = Shown::new("starting");
     let encoded = o.encode(&model, dataset.as_ref(), &progress.callback());
     progress.finish();

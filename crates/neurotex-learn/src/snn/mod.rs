@@ -503,7 +503,9 @@ impl Network {
 
     /// Checks that each time constant is positive and finite and gives a decay per step
     /// strictly between 0 and 1 (a decay of 0 or 1 has no continuous-time constant, so no
-    /// NIR graph).
+    /// NIR graph). The one exception is `tau_syn_ms` 0, a hidden layer without synaptic
+    /// memory (`α = 0`: the current is the step's input), which is how a NIR graph's LIF
+    /// hidden node (snnTorch's `Leaky`, Norse's `LIFBoxCell`) reads.
     fn check_taus(&self) -> Result<(), String> {
         let (alpha, beta, kappa) = self.decays();
         for (name, tau, decay) in [
@@ -511,7 +513,9 @@ impl Network {
             ("tau_mem_ms", self.tau_mem_ms, beta),
             ("tau_out_ms", self.tau_out_ms, kappa),
         ] {
-            if !(tau > 0.0 && tau.is_finite() && decay > 0.0 && decay < 1.0) {
+            let memoryless = name == "tau_syn_ms" && tau == 0.0;
+            let decays = tau > 0.0 && tau.is_finite() && decay > 0.0 && decay < 1.0;
+            if !(memoryless || decays) {
                 return Err(format!(
                     "the network's {name} is {tau:?}, which gives the decay {decay} per step of {} ms; a time constant must be positive and finite, its decay strictly between 0 and 1",
                     self.dt_ms

@@ -92,6 +92,10 @@ pub struct StreamOptions {
     /// graph's network runs with.
     #[cfg_attr(feature = "cli", arg(long))]
     pub like: Option<PathBuf>,
+    /// The tool that wrote the graph given as --model (`nir`, `snntorch` or `norse`), for
+    /// what its file does not say: as for `neurotex predict --nir-from`.
+    #[cfg_attr(feature = "cli", arg(long, value_name = "TOOL", default_value = "nir"))]
+    pub nir_from: crate::nir::NirFrom,
     /// Where frames come from: `-` (standard input), a file, `tcp://HOST:PORT` (listens
     /// there and takes one connection: the sensor's driver connects and sends frames
     /// until it closes), `udp://HOST:PORT` (binds there; each datagram holds whole lines
@@ -326,7 +330,7 @@ pub struct StreamTalk<'a> {
 /// or read, a live stream that came back with other channels. An error after the stream
 /// began comes after the episode's end and the summary.
 pub fn run_stream(args: &StreamOptions, talk: StreamTalk<'_>) -> Result<()> {
-    let model = SavedModel::load(&args.model, args.like.as_deref())?;
+    let model = SavedModel::load_as(&args.model, args.like.as_deref(), args.nir_from)?;
     let events = args.event_source(&model)?;
     if events.is_none() {
         frames_model(args, &model)?;
