@@ -7,7 +7,9 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::encode::{encode, encode_fa, encode_sa_fa, FaParams, IzhikevichParams, SpikeTrains};
+use crate::encode::{
+    encode, encode_drives, encode_fa, encode_sa_fa, Drive, FaParams, IzhikevichParams, SpikeTrains,
+};
 use crate::error::{DataError, ParamError, Result};
 use crate::events::Events;
 use crate::features::glcm::GlcmKind;
@@ -451,6 +453,60 @@ impl Pipeline {
                 (sa, Some(fa))
             }
         })
+    }
+
+    /// Encodes several inputs of one recording (conditioned signals of its grid and of one
+    /// length, such as the perturbed draws of the encoder's sensitivity) with the
+    /// populations of the pipeline's encoding, all in one call: the same trains, bit for
+    /// bit, as [`Pipeline::encode_populations`] of each input alone, in the order of
+    /// `inputs`.
+    ///
+    /// Each population of each input is a bank of neurons of its own, and the banks run
+    /// side by side ([`encode_drives`]): a neuron's state depends on its own input only, so
+    /// the vector lanes hold several inputs' neurons at once without changing a bit.
+    ///
+    /// # Errors
+    /// A broken encoder rule.
+    ///
+    /// # Panics
+    /// If the inputs differ in length (a caller bug).
+    pub fn encode_populations_side_by_side(
+        &self,
+        rec: &Recording,
+        inputs: &[&[f64]],
+    ) -> Result<Vec<(SpikeTrains, Option<SpikeTrains>)>> {
+        let (l, p) = (&rec.layout, &self.params);
+        let encoding = p.encoding;
+        if encoding != Encoding::Sa {
+            p.fa.check()?;
+        }
+        let mut drives = Vec::new();
+        let mut gains = Vec::new();
+        for &input in inputs {
+            if encoding != Encoding::Fa {
+                drives.push(Drive::Signal(input));
+                gains.push(p.encoder.gain);
+            }
+            if encoding != Encoding::Sa {
+                drives.push(Drive::RectifiedRate(input));
+                gains.push(p.fa.gain);
+            }
+        }
+        // FA alone runs the SA firing type at the FA gain, as `encode_fa` does.
+        let neuron = match encoding {
+            Encoding::Fa => p.encoder.with_gain(p.fa.gain),
+            Encoding::Sa | Encoding::SaFa => p.encoder,
+        };
+        let trains = encode_drives(&mut drives, &gains, l.rows, l.cols, &l.present, neuron)?;
+        let mut trains = trains.into_iter();
+        let mut next = || trains.next().expect("one bank per population and input");
+        Ok(inputs
+            .iter()
+            .map(|_| match encoding {
+                Encoding::Sa | Encoding::Fa => (next(), None),
+                Encoding::SaFa => (next(), Some(next())),
+            })
+            .collect())
     }
 
     /// Encodes a conditioned recording with the pipeline's SA neurons and its FA

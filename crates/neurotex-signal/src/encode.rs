@@ -728,17 +728,15 @@ pub fn encode(
 
 /// Encodes several conditioned `n_steps x cells` signals of one grid and length, signal
 /// `k` by neurons of input gain `gains[k]` and `params`' other parameters, into one set of
-/// spike trains each: the same trains as [`encode`] of each signal alone.
-///
-/// The signals run as one bank of neurons, their frames side by side: where the processor
-/// has AVX-512, two banks of 16 taxels run in little more time than one (see [`BLOCK`]).
-/// The callers pair the encodings one recording needs (SA and FA, the gains of a sweep).
+/// spike trains each: the same trains as [`encode`] of each signal alone
+/// ([`encode_drives`] with every drive a [`Drive::Signal`]).
 ///
 /// # Errors
 /// A broken parameter rule, for `params` or with one of the gains.
 ///
 /// # Panics
-/// If the signals and gains differ in number, or the signals in length (a caller bug).
+/// If the signals and gains differ in number, or the signals in length, or are not whole
+/// frames (a caller bug).
 pub fn encode_banks(
     signals: &[&[f64]],
     gains: &[f64],
@@ -747,77 +745,223 @@ pub fn encode_banks(
     present: &[bool],
     params: IzhikevichParams,
 ) -> Result<Vec<SpikeTrains>, ParamError> {
-    const BLOCK_STEPS: usize = 1024;
-    assert_eq!(signals.len(), gains.len(), "one gain per signal");
-    let len = signals.first().map_or(0, |s| s.len());
+    let mut drives: Vec<Drive<'_>> = signals.iter().map(|&s| Drive::Signal(s)).collect();
+    encode_drives(&mut drives, gains, rows, cols, present, params)
+}
+
+/// What drives a bank of neurons: a conditioned `n_steps x cells` signal itself, its
+/// rectified rate of change, or values made as the bank runs.
+pub enum Drive<'a> {
+    /// The signal (the SA population).
+    Signal(&'a [f64]),
+    /// [`rectified_rate`] of the signal (the FA-I population, see [`FaParams`]), made a
+    /// block of steps at a time as the bank runs.
+    RectifiedRate(&'a [f64]),
+    /// Values made a block of steps at a time as the bank runs.
+    Made(&'a mut dyn MadeDrive),
+}
+
+/// A drive whose values are made a block of steps at a time as its bank runs
+/// ([`Drive::Made`]), rather than read from a whole signal in memory: a signal computed
+/// from another (a perturbed copy) then needs no memory of its own, and its values go
+/// straight into the bank's place in the frames the neurons read.
+pub trait MadeDrive: Send {
+    /// The number of values, `n_steps x cells`.
+    fn values(&self) -> usize;
+
+    /// Writes the values of the steps from `first` on into `rows`, one row of `cells`
+    /// values per step; called for consecutive blocks of steps, from step 0 on.
+    fn fill(&mut self, first: usize, rows: BankRows<'_>);
+}
+
+/// One bank's place in a block of frames of several banks side by side: a row of `cells`
+/// values per step.
+pub struct BankRows<'a> {
+    frames: &'a mut [f64],
+    width: usize,
+    bank: std::ops::Range<usize>,
+}
+
+impl BankRows<'_> {
+    /// The number of steps (rows).
+    pub fn steps(&self) -> usize {
+        self.frames.len() / self.width
+    }
+
+    /// The rows in order, each the bank's `cells` values of one step.
+    pub fn rows(&mut self) -> impl Iterator<Item = &mut [f64]> {
+        let bank = self.bank.clone();
+        self.frames
+            .chunks_exact_mut(self.width)
+            .map(move |frame| &mut frame[bank.clone()])
+    }
+}
+
+impl Drive<'_> {
+    /// The number of values, `n_steps x cells`.
+    fn values(&self) -> usize {
+        match self {
+            Drive::Signal(signal) | Drive::RectifiedRate(signal) => signal.len(),
+            Drive::Made(made) => made.values(),
+        }
+    }
+}
+
+/// Steps per block of [`encode_drives`] for a bank of `width` neurons: the block's frames
+/// (`8 width` bytes a step) stay within a few hundred kilobytes, so that every block of
+/// neurons the kernel runs finds them in cache; never more than 1024 steps.
+fn block_steps(width: usize) -> usize {
+    const VALUES: usize = 32 * 1024;
+    (VALUES / width.max(1)).clamp(1, 1024)
+}
+
+/// Encodes several drives of one grid and length, drive `k` by neurons of input gain
+/// `gains[k]` and `params`' other parameters, into one set of spike trains each: the same
+/// trains as [`encode`] of each drive's values alone (for a [`Drive::RectifiedRate`], as
+/// [`encode_fa`]).
+///
+/// The drives run as one bank of neurons, their frames side by side, a block of steps at
+/// a time through a small raster that stays in cache; each block's spikes are appended to
+/// per-cell lists, so no whole-recording raster or drive is ever allocated. A neuron's
+/// state depends on its own input only and every lane computes what [`step`] computes,
+/// so where a neuron sits in the bank changes no bit. Where the processor has AVX-512,
+/// two banks of 16 taxels run in little more time than one (see [`BLOCK`]); the callers
+/// put together the encodings one recording needs (SA and FA, the gains of a sweep, the
+/// perturbed draws of the encoder's sensitivity).
+///
+/// # Errors
+/// A broken parameter rule, for `params` or with one of the gains.
+///
+/// # Panics
+/// If the drives and gains differ in number, or the drives in length, or are not whole
+/// frames (a caller bug).
+pub fn encode_drives(
+    drives: &mut [Drive<'_>],
+    gains: &[f64],
+    rows: usize,
+    cols: usize,
+    present: &[bool],
+    params: IzhikevichParams,
+) -> Result<Vec<SpikeTrains>, ParamError> {
+    assert_eq!(drives.len(), gains.len(), "one gain per drive");
+    let len = drives.first().map_or(0, Drive::values);
     assert!(
-        signals.iter().all(|s| s.len() == len),
-        "signals of one length"
+        drives.iter().all(|d| d.values() == len),
+        "drives of one length"
     );
-    let (cells, banks) = (rows * cols, signals.len());
+    let (cells, banks) = (rows * cols, drives.len());
+    assert!(cells == 0 || len.is_multiple_of(cells), "whole frames");
     let width = cells * banks;
     let bank_gains = gains.iter().flat_map(|&g| std::iter::repeat_n(g, cells));
     let mut encoder = Encoder::with_gains(params, bank_gains.collect())?;
-    let mut raster = vec![0u8; BLOCK_STEPS * width];
-    // The banks' frames side by side, for more than one bank.
-    let mut frames = vec![0.0; if banks > 1 { BLOCK_STEPS * width } else { 0 }];
+    let block = block_steps(width);
+    let mut raster = vec![0u8; block * width];
+    // The banks' frames side by side, unless one signal is its own frames.
+    let direct = matches!(drives, [Drive::Signal(_)]);
+    let mut frames = vec![0.0; if direct { 0 } else { block * width }];
     let mut lists: Vec<Vec<u32>> = vec![Vec::new(); width];
     let neuron_present: Vec<bool> = (0..width).map(|neuron| present[neuron % cells]).collect();
     // A grid without cells has no frames and no trains to fill.
-    let blocks = if cells == 0 {
-        0
-    } else {
-        len.div_ceil(BLOCK_STEPS * cells)
-    };
-    for k in 0..blocks {
-        let part = k * BLOCK_STEPS * cells..((k + 1) * BLOCK_STEPS * cells).min(len);
-        let steps = part.len() / cells;
-        let input = if banks == 1 {
-            &signals[0][part]
-        } else {
-            let frames = &mut frames[..steps * width];
-            for (b, signal) in signals.iter().enumerate() {
-                let rows = signal[part.clone()].chunks_exact(cells);
-                for (row, frame) in rows.zip(frames.chunks_exact_mut(width)) {
-                    copy_short(row, &mut frame[b * cells..(b + 1) * cells]);
-                }
+    let n_steps = len.checked_div(cells).unwrap_or(0);
+    for first in (0..n_steps).step_by(block) {
+        let steps = block.min(n_steps - first);
+        let input = match drives {
+            [Drive::Signal(signal)] => &signal[first * cells..(first + steps) * cells],
+            _ => {
+                let frames = &mut frames[..steps * width];
+                fill_frames(drives, cells, first, frames);
+                &*frames
             }
-            &*frames
         };
         let raster = &mut raster[..input.len()];
         encoder.run(input, raster);
-        // Spikes are sparse: a step's entries (each 0 or 1) are read eight at a time as
-        // one word, and only its set bytes visited, in order. Step and neuron come from
-        // the loop, not from dividing a spike's place in the raster.
-        for (s, row) in raster.chunks_exact(width).enumerate() {
-            let t = (k * BLOCK_STEPS + s) as u32;
-            let words = row.chunks_exact(8);
-            let tail = words.remainder();
-            for (w, word) in words.enumerate() {
-                let mut bits = u64::from_le_bytes(word.try_into().expect("8 bytes"));
-                while bits != 0 {
-                    let neuron = w * 8 + bits.trailing_zeros() as usize / 8;
-                    if neuron_present[neuron] {
-                        lists[neuron].push(t);
-                    }
-                    bits &= bits - 1;
-                }
-            }
-            let base = width - tail.len();
-            for (neuron, _) in (base..).zip(tail).filter(|&(_, &spike)| spike != 0) {
-                if neuron_present[neuron] {
-                    lists[neuron].push(t);
-                }
-            }
-        }
+        collect_spikes(raster, width, first as u32, &neuron_present, &mut lists);
     }
-    let n_steps = len.checked_div(cells).unwrap_or(0);
     Ok((0..banks)
         .map(|b| {
             let lists = &lists[b * cells..(b + 1) * cells];
             SpikeTrains::from_lists(lists, rows, cols, present, n_steps)
         })
         .collect())
+}
+
+/// Writes the steps from `first` on of every drive into `frames` (whole frames of all
+/// banks side by side, `cells` values per bank).
+fn fill_frames(drives: &mut [Drive<'_>], cells: usize, first: usize, frames: &mut [f64]) {
+    let width = cells * drives.len();
+    let steps = frames.len() / width;
+    for (b, drive) in drives.iter_mut().enumerate() {
+        let bank = b * cells..(b + 1) * cells;
+        match drive {
+            Drive::Signal(signal) => {
+                let rows = signal[first * cells..(first + steps) * cells].chunks_exact(cells);
+                for (row, frame) in rows.zip(frames.chunks_exact_mut(width)) {
+                    copy_short(row, &mut frame[bank.clone()]);
+                }
+            }
+            Drive::RectifiedRate(signal) => {
+                for (t, frame) in (first..).zip(frames.chunks_exact_mut(width)) {
+                    let out = &mut frame[bank.clone()];
+                    // The first step has no previous sample, as in `rectified_rate`.
+                    if t == 0 {
+                        out.fill(0.0);
+                        continue;
+                    }
+                    let before = &signal[(t - 1) * cells..(t + 1) * cells];
+                    let (before, now) = before.split_at(cells);
+                    for ((o, &x), &x0) in out.iter_mut().zip(now).zip(before) {
+                        *o = (x - x0).abs();
+                    }
+                }
+            }
+            Drive::Made(made) => {
+                let frames = &mut *frames;
+                made.fill(
+                    first,
+                    BankRows {
+                        frames,
+                        width,
+                        bank,
+                    },
+                );
+            }
+        }
+    }
+}
+
+/// Appends the spikes of a raster of `width` neurons a step, whose first step is `first`,
+/// to the present neurons' lists.
+///
+/// Spikes are sparse: a step's entries (each 0 or 1) are read eight at a time as one word,
+/// and only its set bytes visited, in order. Step and neuron come from the loop, not from
+/// dividing a spike's place in the raster.
+fn collect_spikes(
+    raster: &[u8],
+    width: usize,
+    first: u32,
+    neuron_present: &[bool],
+    lists: &mut [Vec<u32>],
+) {
+    for (t, row) in (first..).zip(raster.chunks_exact(width)) {
+        let words = row.chunks_exact(8);
+        let tail = words.remainder();
+        for (w, word) in words.enumerate() {
+            let mut bits = u64::from_le_bytes(word.try_into().expect("8 bytes"));
+            while bits != 0 {
+                let neuron = w * 8 + bits.trailing_zeros() as usize / 8;
+                if neuron_present[neuron] {
+                    lists[neuron].push(t);
+                }
+                bits &= bits - 1;
+            }
+        }
+        let base = width - tail.len();
+        for (neuron, _) in (base..).zip(tail).filter(|&(_, &spike)| spike != 0) {
+            if neuron_present[neuron] {
+                lists[neuron].push(t);
+            }
+        }
+    }
 }
 
 /// Copies a frame's few values eight at a time: `copy_from_slice` calls `memcpy` for
@@ -921,12 +1065,14 @@ pub fn encode_fa(
     fa: FaParams,
 ) -> Result<SpikeTrains, ParamError> {
     fa.check()?;
-    let drive = rectified_rate(samples, (rows * cols).max(1));
-    encode(&drive, rows, cols, present, neuron.with_gain(fa.gain))
+    let mut drive = [Drive::RectifiedRate(samples)];
+    let neuron = neuron.with_gain(fa.gain);
+    let mut trains = encode_drives(&mut drive, &[fa.gain], rows, cols, present, neuron)?;
+    Ok(trains.pop().expect("one bank"))
 }
 
 /// The SA trains of a conditioned signal ([`encode`] with `neuron`) and its FA-I trains
-/// ([`encode_fa`]), encoded side by side as two banks ([`encode_banks`]).
+/// ([`encode_fa`]), encoded side by side as two banks ([`encode_drives`]).
 ///
 /// # Errors
 /// A broken parameter rule.
@@ -940,11 +1086,90 @@ pub fn encode_sa_fa(
 ) -> Result<(SpikeTrains, SpikeTrains), ParamError> {
     neuron.check()?;
     fa.check()?;
-    let drive = rectified_rate(samples, (rows * cols).max(1));
-    let signals = [samples, drive.as_slice()];
+    let mut drives = [Drive::Signal(samples), Drive::RectifiedRate(samples)];
     let gains = [neuron.gain, fa.gain];
-    let [sa, fa]: [SpikeTrains; 2] = encode_banks(&signals, &gains, rows, cols, present, neuron)?
-        .try_into()
-        .expect("two banks");
+    let [sa, fa]: [SpikeTrains; 2] =
+        encode_drives(&mut drives, &gains, rows, cols, present, neuron)?
+            .try_into()
+            .expect("two banks");
     Ok((sa, fa))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A drive made as the banks ask for it: `signal` times `factor`.
+    struct Scaled<'a> {
+        signal: &'a [f64],
+        cells: usize,
+        factor: f64,
+    }
+
+    impl MadeDrive for Scaled<'_> {
+        fn values(&self) -> usize {
+            self.signal.len()
+        }
+
+        fn fill(&mut self, first: usize, mut rows: BankRows<'_>) {
+            let signal = &self.signal[first * self.cells..][..rows.steps() * self.cells];
+            for (row, x) in rows.rows().zip(signal.chunks_exact(self.cells)) {
+                for (out, &x) in row.iter_mut().zip(x) {
+                    *out = x * self.factor;
+                }
+            }
+        }
+    }
+
+    /// Many drives of every kind side by side on a grid whose banks straddle the vector
+    /// registers (9 cells), over several blocks of steps and a part block: each bank's
+    /// trains are those of its values encoded alone, whole.
+    #[test]
+    fn drives_side_by_side_give_each_drives_own_trains() {
+        let (rows, cols, steps, banks) = (3, 3, 2_500, 13);
+        let cells = rows * cols;
+        let present: Vec<bool> = (0..cells).map(|c| c != 4).collect();
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let signals: Vec<Vec<f64>> = (0..banks)
+            .map(|_| (0..cells * steps).map(|_| next()).collect())
+            .collect();
+        let gains: Vec<f64> = (0..banks).map(|b| 12.0 + 2.0 * b as f64).collect();
+        let factors: Vec<f64> = (0..banks).map(|b| 1.0 + b as f64 / 7.0).collect();
+        let mut made: Vec<Scaled> = (0..banks)
+            .map(|b| Scaled {
+                signal: &signals[b],
+                cells,
+                factor: factors[b],
+            })
+            .collect();
+        let mut drives: Vec<Drive> = made
+            .iter_mut()
+            .enumerate()
+            .map(|(b, made)| match b % 3 {
+                0 => Drive::Signal(&signals[b]),
+                1 => Drive::RectifiedRate(&signals[b]),
+                _ => Drive::Made(made),
+            })
+            .collect();
+        assert!(block_steps(cells * banks) < steps / 4, "several blocks");
+        let p = IzhikevichParams::default();
+        let together = encode_drives(&mut drives, &gains, rows, cols, &present, p).unwrap();
+        assert_eq!(together.len(), banks);
+        for (b, trains) in together.iter().enumerate() {
+            let values: Vec<f64> = match b % 3 {
+                0 => signals[b].clone(),
+                1 => rectified_rate(&signals[b], cells),
+                _ => signals[b].iter().map(|x| x * factors[b]).collect(),
+            };
+            let alone = encode(&values, rows, cols, &present, p.with_gain(gains[b])).unwrap();
+            assert!(alone.total_spikes() > 100, "bank {b} nearly silent");
+            assert_eq!(trains, &alone, "bank {b}");
+        }
+    }
 }
