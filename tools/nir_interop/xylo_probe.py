@@ -47,4 +47,10 @@ if __name__ == "__main__":
     x3[0] = 15
     case("order", [[127], [127], [-127]], [[1]], x3, weight_shift_in=4, dash_syn=[15])
     case("negative_saturation", [[-128]], [[1]], [[15], [15], [15]], threshold=[10], weight_shift_in=7)
+    # One input event into one synapse, then its decay alone, for the dashes and weights
+    # of decay_follows_the_chip_to_the_last_unit.
+    for d, w in [(1, 10), (1, -10), (2, 10), (2, -100), (4, -100), (15, 100)]:
+        x = np.zeros((12, 1), int)
+        x[0, 0] = 1
+        case(f"decay_d{d}_w{w}", [[w]], [[1]], x, dash_syn=[d])
     case("readout_fires", [[100]], [[10]], [[1], [0], [0], [0], [0]], threshold=[20], threshold_out=[5])

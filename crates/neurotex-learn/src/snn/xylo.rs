@@ -2,7 +2,7 @@
 //! it, in integers, step for step as its bit-accurate simulator `XyloSim` (the `xylosim`
 //! package, through Rockpool's `XyloSim.from_specification`).
 //!
-//! **The chip's neuron**, measured on `xylosim` 0.1.3 (`tools/nir_interop/xylo.py` runs the
+//! **The chip's neuron**, measured on `xylosim` 0.1.3 (`tools/nir_interop/xylo.sh` runs the
 //! comparison): states are 16-bit signed integers that saturate, and a decay by the
 //! bitshift `dash` d is `D(v) = v - max(v >> d, 1)` for `v > 0` and `v - (v >> d)` (an
 //! arithmetic shift, so at least 1) for `v < 0`, `1 - 2^-d` per step. Each step, with input
@@ -488,31 +488,39 @@ mod tests {
     use super::*;
 
     /// Traces recorded from `xylosim` 0.1.3 (`XyloSim.from_specification(...,
-    /// output_mode="Vmem")`, `record=True`; the probe is `tools/nir_interop/xylo.py
-    /// --probe`): one synaptic current after one input event of weight `w` with dash `d`.
+    /// output_mode="Vmem")`, `record=True`, by `tools/nir_interop/xylo_probe.py`, cases
+    /// `decay_d*`): one synaptic current after one input event of weight `w` with dash `d`.
     #[test]
     fn decay_follows_the_chip_to_the_last_unit() {
-        let traces: [(u8, i32, &[i32]); 6] = [
-            (1, 10, &[5, 3, 2, 1, 0, 0]),
-            (1, -10, &[-5, -2, -1, 0, 0]),
-            (2, 10, &[8, 6, 5, 4, 3, 2, 1, 0]),
-            (
-                2,
-                -100,
-                &[-75, -56, -42, -31, -23, -17, -12, -9, -6, -4, -3, -2],
-            ),
-            (4, -100, &[-93, -87, -81, -75, -70, -65]),
-            (15, 100, &[99, 98, 97, 96]),
-        ];
-        for (d, w, want) in traces {
+        let mut checked = 0;
+        for line in recorded() {
+            let Some(name) = line["case"]
+                .as_str()
+                .and_then(|c| c.strip_prefix("decay_d"))
+            else {
+                continue;
+            };
+            let (d, w) = name.split_once("_w").unwrap();
+            let (d, w): (u8, i32) = (d.parse().unwrap(), w.parse().unwrap());
+            let want: Vec<i64> = serde_json::from_value(line["Isyn"][0].clone()).unwrap();
             let mut v = decay(w, d);
-            let mut got = vec![v];
+            let mut got = vec![i64::from(v)];
             while got.len() < want.len() {
                 v = decay(v, d);
-                got.push(v);
+                got.push(i64::from(v));
             }
             assert_eq!(got, want, "dash {d}, weight {w}");
+            checked += 1;
         }
+        assert_eq!(checked, 6);
+    }
+
+    /// The probe's recorded cases, one JSON object each.
+    fn recorded() -> Vec<serde_json::Value> {
+        include_str!("testdata/xylosim_traces.jsonl")
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
     }
 
     /// A network of `inputs x hidden x classes` with the defaults of the probe
@@ -584,10 +592,7 @@ mod tests {
     /// input at 16 bits.
     #[test]
     fn the_network_steps_as_the_simulator_recorded() {
-        let recorded: Vec<serde_json::Value> = include_str!("testdata/xylosim_traces.jsonl")
-            .lines()
-            .map(|l| serde_json::from_str(l).unwrap())
-            .collect();
+        let recorded = recorded();
         let small_x: [&[u32]; 8] = [
             &[1, 0],
             &[0, 3],
