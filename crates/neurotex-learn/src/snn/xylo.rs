@@ -138,7 +138,7 @@ pub fn check_shape(inputs: usize, hidden: usize, classes: usize) -> Result<(), S
             "inputs",
             inputs,
             MAX_INPUTS,
-            "use --encoding sa or fa on a grid of at most 16 taxels, or leave taxels out (import csv --drop-channels)",
+            "use --encoding sa or fa on a grid of at most 16 taxels (compare: --encodings sa,fa), or leave taxels out (import csv --drop-channels)",
         ),
         (
             "hidden neurons",
