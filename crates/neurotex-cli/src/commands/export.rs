@@ -112,6 +112,21 @@ pub struct ExportInputsArgs {
     pub open: OpenOptions,
 }
 
+/// A spiking model's network in words: inputs, hidden neurons, readouts with their labels,
+/// and the time step.
+fn shape(model: &neurotex::spiking_model::SpikingModel) -> String {
+    let net = model.network();
+    let recurrent = if net.recurrent() { " recurrent" } else { "" };
+    format!(
+        "{} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms",
+        net.inputs,
+        net.hidden,
+        net.classes,
+        model.labels().join(", "),
+        net.dt_ms
+    )
+}
+
 /// Runs `neurotex export nir`, `inputs` or `events`.
 pub fn run(command: ExportCommand) -> Result<()> {
     match command {
@@ -126,15 +141,10 @@ pub fn run(command: ExportCommand) -> Result<()> {
             if !net.reset.is_zero() && args.convention == NirConvention::Nir {
                 eprintln!("note: the network's neurons subtract the threshold on a spike and NIR's neurons reset to zero, so the graph says `reset = subtract` in its metadata, which neurotex reads and other tools ignore (--for sinabs or --for rockpool write it for theirs)");
             }
-            let recurrent = if net.recurrent() { " recurrent" } else { "" };
             eprintln!(
-                "NIR graph for {}: {} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms -> {}",
+                "NIR graph for {}: {} -> {}",
                 args.convention.name(),
-                net.inputs,
-                net.hidden,
-                net.classes,
-                model.labels().join(", "),
-                net.dt_ms,
+                shape(&model),
                 shown(&args.out)
             );
         }
@@ -144,14 +154,9 @@ pub fn run(command: ExportCommand) -> Result<()> {
             save_to(&args.out, "the Xylo configuration", |p| {
                 export_xylo(&model, p)
             })?;
-            let net = model.network();
             eprintln!(
-                "Xylo Audio 2 configuration: {} inputs -> {} hidden neurons -> {} readout neurons ({}), dt {} ms, 8-bit weights -> {}",
-                net.inputs,
-                net.hidden,
-                net.classes,
-                model.labels().join(", "),
-                net.dt_ms,
+                "Xylo Audio 2 configuration: {}, 8-bit weights -> {}",
+                shape(&model),
                 shown(&args.out)
             );
         }
