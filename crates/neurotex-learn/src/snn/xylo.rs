@@ -468,11 +468,6 @@ impl XyloState {
         }
     }
 
-    /// The readout membranes after the last step, in the chip's integers.
-    pub fn readout_raw(&self) -> &[i32] {
-        &self.vmem_out
-    }
-
     /// The readout membranes after the last step, in the float network's units.
     pub fn readout(&self, net: &XyloNetwork) -> Vec<f64> {
         let scale = net.score_scale;
