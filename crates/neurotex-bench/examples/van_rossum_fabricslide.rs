@@ -6,10 +6,9 @@
 //! cargo run --release -p neurotex-bench --example van_rossum_fabricslide -- /tmp/fsc 10
 //! ```
 
-use std::sync::Arc;
 use std::time::Instant;
 
-use neurotex::classify::{cross_validate, CvParams, SpikeDistanceKnn, VanRossumParams};
+use neurotex::classify::{cross_validate_on, CvParams, SpikeDistanceKnn, VanRossumParams};
 use neurotex::pipeline::{Pipeline, PipelineParams};
 use neurotex::recording::Dataset;
 use neurotex::values::Speed;
@@ -54,8 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let full = metric.matrix(&spikes)?;
         let full_s = started.elapsed().as_secs_f64();
         let subset: Vec<_> = at_speed.iter().map(|&i| spikes[i].clone()).collect();
-        let knn = SpikeDistanceKnn::new(Arc::new(metric.matrix(&subset)?), 5)?;
-        let eval = cross_validate(&knn, &knn.samples(), 1, &y, &labels, cv)?;
+        let (matrix, knn) = (metric.matrix(&subset)?, SpikeDistanceKnn::new(5)?);
+        let all: Vec<usize> = (0..y.len()).collect();
+        let eval = cross_validate_on(&knn, &matrix, (&all, &y), &labels, cv, None)?.remove(0);
         println!(
             "tau {tau:>5} ms: full {n}x{n} matrix {full_s:.2} s; {speed} mm/s: {} recordings, \
              {} classes, 5-fold accuracy {:.3}",

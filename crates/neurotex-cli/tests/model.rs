@@ -742,3 +742,54 @@ fn a_model_trained_on_events_refuses_sampled_recordings() {
         }
     }
 }
+
+/// `train` and `evaluate` choose the spiking network the same way: `--classifier snn`
+/// reads the spike trains and `--method spikes` is read by the network, so either one
+/// alone chooses it and both give the same model; a pairing that does not run is refused
+/// by name in both commands.
+#[test]
+fn train_and_evaluate_choose_the_network_alike() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let snn = ["--snn-hidden", "8", "--snn-epochs", "2"];
+    let (by_classifier, by_method) = (dir.join("c.json"), dir.join("m.json"));
+    for (choice, out) in [
+        (["--classifier", "snn"], &by_classifier),
+        (["--method", "spikes"], &by_method),
+    ] {
+        let mut args = vec!["train", "--dataset", s(&ds), "--out", s(out)];
+        args.extend(choice);
+        args.extend(snn);
+        dir.ok(&args);
+    }
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap();
+    assert!(read(&by_classifier).contains("neurotex-snn-model"));
+    assert_eq!(read(&by_classifier), read(&by_method));
+    let evaluate = |choice: &[&str]| {
+        let mut args = vec!["evaluate", "--dataset", s(&ds), "--folds", "2", "--json"];
+        args.extend(choice);
+        args.extend(snn);
+        let out: Value = serde_json::from_str(&dir.ok(&args)).unwrap();
+        assert_eq!(out["method"], "spikes", "{out}");
+        out["accuracy"].clone()
+    };
+    assert_eq!(
+        evaluate(&["--classifier", "snn"]),
+        evaluate(&["--method", "spikes"])
+    );
+    for command in ["train", "evaluate"] {
+        let mut args = vec![command, "--dataset", s(&ds), "--out", s(&by_method)];
+        if command == "evaluate" {
+            args.truncate(3);
+        }
+        args.extend(["--method", "spikes", "--classifier", "forest"]);
+        let err = dir.fails(&args);
+        assert!(
+            err.contains("classifier") && err.contains("spikes with snn"),
+            "{err}"
+        );
+    }
+    let args = ["train", "--dataset", s(&ds), "--method", "van-rossum"];
+    let err = dir.fails(&[&args[..], &["--out", s(&dir.join("never.json"))]].concat());
+    assert!(err.contains("evaluated, not trained"), "{err}");
+}

@@ -6,8 +6,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::classify::{
-    bootstrap_mean_share, bootstrap_over_encodings, cross_validate_sweep, train_test_sweep,
-    BootstrapParams, Classifier, ConfusionMatrix, Evaluation, Interval, Sweep, ValidCv,
+    bootstrap_mean_share, bootstrap_over_encodings, cross_validate_on, train_test_on,
+    BootstrapParams, Classifier, ConfusionMatrix, Evaluation, Interval, Learner, Rows, Samples,
+    Sweep, ValidCv,
 };
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Method};
@@ -79,9 +80,7 @@ impl FeatureTable {
 
     /// The indices of the rows recorded at one of `speeds`.
     pub fn rows_at(&self, speeds: &[Speed]) -> Vec<usize> {
-        (0..self.metas.len())
-            .filter(|&i| self.metas[i].speed().is_some_and(|s| speeds.contains(&s)))
-            .collect()
+        rows_at(&self.metas, speeds)
     }
 
     /// The table of rows `rows` alone, in that order.
@@ -101,6 +100,13 @@ impl FeatureTable {
             .flat_map(|&i| columns.iter().map(move |&j| self.row(i)[j]))
             .collect()
     }
+}
+
+/// The indices of the recordings of `metas` made at one of `speeds`.
+fn rows_at(metas: &[Meta], speeds: &[Speed]) -> Vec<usize> {
+    (0..metas.len())
+        .filter(|&i| metas[i].speed().is_some_and(|s| speeds.contains(&s)))
+        .collect()
 }
 
 /// How to split recordings for evaluation.
@@ -307,12 +313,12 @@ pub(crate) fn column_groups(
 }
 
 /// The class names in order of first appearance over `rows`, and each row's class index.
-fn classes(table: &FeatureTable, rows: &[usize]) -> (Vec<String>, Vec<usize>) {
+fn classes(metas: &[Meta], rows: &[usize]) -> (Vec<String>, Vec<usize>) {
     let mut labels: Vec<String> = Vec::new();
     let y = rows
         .iter()
         .map(|&i| {
-            let label = &table.metas[i].label;
+            let label = &metas[i].label;
             labels.iter().position(|l| l == label).unwrap_or_else(|| {
                 labels.push(label.clone());
                 labels.len() - 1
@@ -339,18 +345,18 @@ pub fn group_count(metas: &[Meta], rows: &[usize], column: &str) -> usize {
 ///
 /// # Errors
 /// A column the manifest does not have, or a single group (nothing to test on).
-fn group_indices(table: &FeatureTable, rows: &[usize], column: &str) -> Result<Vec<usize>> {
+fn group_indices(metas: &[Meta], rows: &[usize], column: &str) -> Result<Vec<usize>> {
     let mut names: Vec<String> = Vec::new();
     let mut out = Vec::with_capacity(rows.len());
     for &i in rows {
-        let meta = &table.metas[i];
+        let meta = &metas[i];
         let value = match meta.field(column) {
             Some(value) => value,
             // A recording without a value (an empty field) groups with the others like it.
-            None if table.metas.iter().any(|m| m.field(column).is_some()) => String::new(),
+            None if metas.iter().any(|m| m.field(column).is_some()) => String::new(),
             None => {
                 let rule = "--group-by must name a manifest column with values";
-                let names = Meta::columns_with_values(&table.metas).join(", ");
+                let names = Meta::columns_with_values(metas).join(", ");
                 let got = format!(
                     "{column} (no recording has a value there; columns with values: {names})"
                 );
@@ -405,59 +411,129 @@ pub fn evaluate_sweep<C: Sweep>(
     sweep: &C,
 ) -> Result<Vec<Outcome>> {
     let groups = column_groups(&table.grid, table.dims(), columns)?;
-    let (train_rows, test_rows) = split_rows(table, split)?;
-    if train_rows.is_empty() {
-        return Err(ClassifyError::Empty {
-            what: "evaluate: no recordings at the selected speeds",
-        }
-        .into());
-    }
-    let all_rows: Vec<usize> = train_rows.iter().chain(&test_rows).copied().collect();
-    let (labels, y) = classes(table, &all_rows);
-    let (y_train, y_test) = y.split_at(train_rows.len());
-    let row_groups = match split {
-        Split::CrossValidation {
-            group_by: Some(column),
-            ..
-        } => Some(group_indices(table, &train_rows, column)?),
-        _ => None,
-    };
+    let all: Vec<usize> = (0..table.metas.len()).collect();
+    let design = Design::of(&table.metas, &all, split)?;
     // Per column group, each setting's evaluation.
     let results: Vec<Vec<Evaluation>> = groups
         .par_iter()
         .map(|(_, cols)| -> Result<Vec<Evaluation>> {
-            let x_train = table.select(&train_rows, cols);
-            let d = cols.len();
-            Ok(match split {
-                Split::CrossValidation { cv, .. } => {
-                    let groups = row_groups.as_deref();
-                    cross_validate_sweep(sweep, (&x_train, d), y_train, &labels, *cv, groups)?
-                }
-                Split::Where { .. } | Split::Rows { .. } => {
-                    let x_test = table.select(&test_rows, cols);
-                    let (train, test) = ((&x_train[..], y_train), (&x_test[..], y_test));
-                    train_test_sweep(sweep, train, test, d, &labels)?
-                }
-            })
+            let values = match cols.len() == table.dims() {
+                true => std::borrow::Cow::Borrowed(&table.values[..]),
+                false => std::borrow::Cow::Owned(table.select(&all, cols)),
+            };
+            design.run(&Rows::new(&values, cols.len())?, split, sweep)
         })
         .collect::<Result<_>>()?;
-    let evaluated = match split {
-        Split::CrossValidation { .. } => &train_rows,
-        _ => &test_rows,
-    };
-    let truth = match split {
-        Split::CrossValidation { .. } => y_train,
-        _ => y_test,
-    };
-    let each_taxel = columns == Columns::EachTaxel;
-    Ok(by_setting(
-        results,
-        &groups,
-        &labels,
-        (evaluated, truth),
-        each_taxel,
-        &table.grid,
-    ))
+    let each_taxel = (columns == Columns::EachTaxel).then_some(&table.grid);
+    Ok(design.outcomes(results, &groups, each_taxel))
+}
+
+/// Evaluates `learner` on the samples of the recordings `within` (sample `i` is recording
+/// `metas[i]`) under `split`, whose rows are positions in `within`: one outcome per
+/// setting, its recordings numbered by those positions. This is how the methods whose
+/// samples are not feature rows are evaluated: the spiking network on the recordings'
+/// spike inputs, KNN on their van Rossum distances.
+///
+/// # Errors
+/// As [`evaluate`].
+pub fn evaluate_samples<S: Samples + ?Sized, L: Learner<S>>(
+    metas: &[Meta],
+    within: &[usize],
+    samples: &S,
+    split: &Split,
+    learner: &L,
+) -> Result<Vec<Outcome>> {
+    let design = Design::of(metas, within, split)?;
+    let results = vec![design.run(samples, split, learner)?];
+    Ok(design.outcomes(results, &[(None, Vec::new())], None))
+}
+
+/// What a split makes of the recordings it is given: the rows it trains (or
+/// cross-validates) on and tests on, their classes and their groups.
+struct Design {
+    /// Positions among the evaluated recordings: trained on, then tested on.
+    train: Vec<usize>,
+    test: Vec<usize>,
+    /// The same as sample indices.
+    train_samples: Vec<usize>,
+    test_samples: Vec<usize>,
+    labels: Vec<String>,
+    /// Each training, then each test row's class.
+    y: Vec<usize>,
+    /// Each training row's group under `--group-by`.
+    groups: Option<Vec<usize>>,
+}
+
+impl Design {
+    /// The design of `split` over the recordings `within` of `metas`.
+    ///
+    /// # Errors
+    /// No recordings selected, a selection that selects nothing, a recording in both sets.
+    fn of(metas: &[Meta], within: &[usize], split: &Split) -> Result<Self> {
+        let sub: Vec<Meta> = within.iter().map(|&i| metas[i].clone()).collect();
+        let (train, test) = split_rows(&sub, split)?;
+        if train.is_empty() {
+            return Err(ClassifyError::Empty {
+                what: "evaluate: no recordings at the selected speeds",
+            }
+            .into());
+        }
+        let all_rows: Vec<usize> = train.iter().chain(&test).copied().collect();
+        let (labels, y) = classes(&sub, &all_rows);
+        let groups = match split {
+            Split::CrossValidation {
+                group_by: Some(column),
+                ..
+            } => Some(group_indices(&sub, &train, column)?),
+            _ => None,
+        };
+        Ok(Design {
+            train_samples: train.iter().map(|&r| within[r]).collect(),
+            test_samples: test.iter().map(|&r| within[r]).collect(),
+            train,
+            test,
+            labels,
+            y,
+            groups,
+        })
+    }
+
+    /// Each setting's evaluation of `learner` on `samples`.
+    fn run<S: Samples + ?Sized, L: Learner<S>>(
+        &self,
+        samples: &S,
+        split: &Split,
+        learner: &L,
+    ) -> Result<Vec<Evaluation>> {
+        let (y_train, y_test) = self.y.split_at(self.train.len());
+        let train = (&self.train_samples[..], y_train);
+        Ok(match split {
+            Split::CrossValidation { cv, .. } => {
+                let groups = self.groups.as_deref();
+                cross_validate_on(learner, samples, train, &self.labels, *cv, groups)?
+            }
+            Split::Where { .. } | Split::Rows { .. } => {
+                let test = (&self.test_samples[..], y_test);
+                train_test_on(learner, samples, train, test, &self.labels)?
+            }
+        })
+    }
+
+    /// One outcome per setting from each column group's evaluations; `each_taxel` is the
+    /// grid when every taxel was evaluated alone.
+    fn outcomes(
+        &self,
+        results: Vec<Vec<Evaluation>>,
+        groups: &[(Option<usize>, Vec<usize>)],
+        each_taxel: Option<&Grid>,
+    ) -> Vec<Outcome> {
+        let (y_train, y_test) = self.y.split_at(self.train.len());
+        let evaluated = match self.test.is_empty() {
+            true => (&self.train[..], y_train),
+            false => (&self.test[..], y_test),
+        };
+        by_setting(results, groups, &self.labels, evaluated, each_taxel)
+    }
 }
 
 /// One [`Outcome`] per setting of a sweep from each column group's evaluations (`results`,
@@ -467,8 +543,7 @@ fn by_setting(
     groups: &[(Option<usize>, Vec<usize>)],
     labels: &[String],
     (evaluated, truth): (&[usize], &[usize]),
-    each_taxel: bool,
-    grid: &Grid,
+    each_taxel: Option<&Grid>,
 ) -> Vec<Outcome> {
     let settings = results.first().map_or(0, Vec::len);
     let mut by_group: Vec<_> = results.into_iter().map(Vec::into_iter).collect();
@@ -492,7 +567,7 @@ fn by_setting(
         Outcome {
             predictions,
             correct_shares,
-            ..combine(results, labels.to_vec(), each_taxel, grid)
+            ..combine(results, labels.to_vec(), each_taxel)
         }
     });
     outcomes.collect()
@@ -502,15 +577,15 @@ fn by_setting(
 ///
 /// # Errors
 /// A selection that selects nothing, or a recording in both sets.
-fn split_rows(table: &FeatureTable, split: &Split) -> Result<(Vec<usize>, Vec<usize>)> {
+fn split_rows(metas: &[Meta], split: &Split) -> Result<(Vec<usize>, Vec<usize>)> {
     Ok(match split {
-        Split::CrossValidation { speeds: None, .. } => ((0..table.metas.len()).collect(), vec![]),
+        Split::CrossValidation { speeds: None, .. } => ((0..metas.len()).collect(), vec![]),
         Split::CrossValidation {
             speeds: Some(s), ..
-        } => (table.rows_at(s), vec![]),
-        Split::Where { train, test } => disjoint(table, train, test)?,
+        } => (rows_at(metas, s), vec![]),
+        Split::Where { train, test } => disjoint(metas, train, test)?,
         Split::Rows { train, test } => {
-            let n = table.metas.len();
+            let n = metas.len();
             if let Some(&i) = train.iter().chain(test).find(|&&i| i >= n) {
                 let message = format!("row {i} of a table of {n} rows");
                 return Err(ClassifyError::BadFeatures(message).into());
@@ -529,14 +604,14 @@ fn split_rows(table: &FeatureTable, split: &Split) -> Result<(Vec<usize>, Vec<us
 /// # Errors
 /// A selection that selects nothing ([`Selection::rows`]), or a recording in both.
 fn disjoint(
-    table: &FeatureTable,
+    metas: &[Meta],
     train: &Selection,
     test: &Selection,
 ) -> Result<(Vec<usize>, Vec<usize>)> {
-    let (train_rows, test_rows) = (train.rows(&table.metas)?, test.rows(&table.metas)?);
+    let (train_rows, test_rows) = (train.rows(metas)?, test.rows(metas)?);
     if let Some(&i) = test_rows.iter().find(|i| train_rows.contains(i)) {
         return Err(DatasetError::InBothSets {
-            file: table.metas[i].file.clone(),
+            file: metas[i].file.clone(),
             train: train.to_string(),
             test: test.to_string(),
         }
@@ -567,7 +642,7 @@ fn correct_shares(results: &[GroupResult], rows: &[usize], truth: &[usize]) -> V
 
 /// One outcome from the groups' results: mean accuracy and spread, summed confusion, and
 /// per-taxel accuracies with the best when every taxel was evaluated.
-fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Grid) -> Outcome {
+fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: Option<&Grid>) -> Outcome {
     let n_groups = results.len() as f64;
     let mut confusion = ConfusionMatrix::zeros(labels.len());
     for r in &results {
@@ -579,7 +654,7 @@ fn combine(results: Vec<GroupResult>, labels: Vec<String>, each: bool, grid: &Gr
         .map(|r| r.evaluation.accuracy_std)
         .sum::<f64>()
         / n_groups;
-    let per_taxel: Option<Vec<TaxelAccuracy>> = each.then(|| {
+    let per_taxel: Option<Vec<TaxelAccuracy>> = each.map(|grid| {
         results
             .iter()
             .map(|r| {

@@ -12,12 +12,16 @@ use serde_json::Value;
 
 use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split, TaxelAccuracy};
 use crate::classify::{ChosenClassifier, ClassifierChoice, Interval, Metrics};
-use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
+use crate::error::ParamError;
 use crate::pipeline::{Encoded, Method, Pipeline};
 use crate::recording::{Meta, Selection};
+use crate::samples::{
+    evaluator, population_view, spike_inputs, MethodChoice, MethodSamples, PopulationMatrices,
+};
 use crate::values::{Grid, Speed};
 use neurotex_core::Result;
+use std::sync::Arc;
 
 /// A dataset's recordings as encoded: what every evaluation starts from.
 #[derive(Debug, Clone, Copy)]
@@ -123,16 +127,27 @@ impl Evaluation {
             grid,
             pipeline,
         } = spikes;
-        let set = CandidateSet {
-            encodings: vec![pipeline.params().encoding],
-            methods: vec![method],
-            classifiers: vec![classifier],
-            tau_ms,
-            baselines: false,
+        let encoding = pipeline.params().encoding;
+        let view = population_view(encoded, encoding);
+        let metas: Vec<Meta> = encoded.iter().map(|e| e.meta.clone()).collect();
+        let shared = Arc::new(metas.clone());
+        let samples = match (method, classifier) {
+            (MethodChoice::Spikes, ClassifierChoice::Snn(p)) => {
+                let inputs = spike_inputs(&view, encoding, p.dt_ms)?;
+                MethodSamples::Spikes(shared, Arc::from(inputs))
+            }
+            (MethodChoice::VanRossum, _) => {
+                let matrix = PopulationMatrices::new(tau_ms)?.matrix(&view, encoding)?;
+                MethodSamples::Distances(shared, matrix)
+            }
+            (method, classifier) => {
+                method.check_pairing(&classifier)?;
+                let rule = "a method whose samples are spikes: van-rossum or spikes";
+                return Err(ParamError::new("method", rule, method.name()).into());
+            }
         };
-        let candidate = candidates(encoded, grid, pipeline.params(), &set, 0.0)?.remove(0);
-        let outcome = (candidate.evaluate)(&candidate.table, Columns::All, split)?;
-        let metas = candidate.table.metas.clone();
+        let all: Vec<usize> = (0..metas.len()).collect();
+        let outcome = evaluator(classifier, samples)?(&all, split)?;
         let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?
             .advice_for(pipeline.params());
         Self::new(

@@ -16,6 +16,7 @@ pub mod model;
 pub mod nir;
 pub mod options;
 pub mod pipeline;
+pub mod samples;
 pub mod saved;
 pub mod spiking_model;
 

@@ -31,7 +31,7 @@ pub use neurotex_learn::classify;
 pub use neurotex_learn::snn;
 pub use neurotex_pipeline::{
     analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, nir, options,
-    pipeline, saved, spiking_model,
+    pipeline, samples, saved, spiking_model,
 };
 pub use neurotex_report::report;
 pub use neurotex_signal::{encode, signal};

@@ -2,11 +2,9 @@
 //! references (double sums, numerical integration, brute-force neighbours), hand cases and
 //! Elephant's values.
 
-use std::sync::Arc;
-
 use neurotex::classify::{
-    cross_validate, van_rossum, van_rossum_squared, Classifier, CvParams, DistanceMatrix,
-    KnnParams, Predict, SpikeDistanceKnn, VanRossumParams,
+    cross_validate, cross_validate_on, van_rossum, van_rossum_squared, CvParams, Decide,
+    DistanceMatrix, KnnParams, Learner, SpikeDistanceKnn, VanRossumParams,
 };
 use neurotex::encode::SpikeTrains;
 use neurotex::error::ClassifyError;
@@ -252,16 +250,14 @@ fn knn_on_the_matrix_predicts_as_brute_force() {
     let (recs, y) = recordings(6, 3, 1_500, 11);
     for (tau, k) in [(2.0, 1), (10.0, 3), (100.0, 5)] {
         let metric = VanRossumParams { tau_ms: tau }.check().unwrap();
-        let matrix = Arc::new(metric.matrix(&recs).unwrap());
-        let knn = SpikeDistanceKnn::new(Arc::clone(&matrix), k).unwrap();
+        let matrix = metric.matrix(&recs).unwrap();
+        let knn = SpikeDistanceKnn::new(k).unwrap();
         // train on every third recording's complement, test on the rest
         let train: Vec<usize> = (0..recs.len()).filter(|i| i % 3 != 1).collect();
         let test: Vec<usize> = (0..recs.len()).filter(|i| i % 3 == 1).collect();
         let labels: Vec<usize> = train.iter().map(|&i| y[i]).collect();
-        let x_train: Vec<f64> = train.iter().map(|&i| i as f64).collect();
-        let model = knn.fit(&x_train, 1, &labels).unwrap();
-        let x_test: Vec<f64> = test.iter().map(|&i| i as f64).collect();
-        let got = model.predict(&x_test);
+        let model = knn.learn(&matrix, &train, &labels).unwrap();
+        let got = model.decide(&matrix, &test).unwrap().remove(0);
         let want: Vec<usize> = test
             .iter()
             .map(|&q| brute_force_predict(&recs, &train, &labels, q, k, tau))
@@ -307,7 +303,7 @@ fn cross_validation_over_the_matrix_equals_knn_on_the_points_ties_included() {
     let mut compared = 0;
     for seed in 1..6 {
         let (points, y, matrix) = lattice(40, seed);
-        let knn = SpikeDistanceKnn::new(Arc::new(matrix), 5).unwrap();
+        let knn = SpikeDistanceKnn::new(5).unwrap();
         let cv = CvParams {
             folds: 4,
             seed,
@@ -315,12 +311,14 @@ fn cross_validation_over_the_matrix_equals_knn_on_the_points_ties_included() {
         }
         .check()
         .unwrap();
-        let (Ok(on_matrix), Ok(on_points)) = (
-            cross_validate(&knn, &knn.samples(), 1, &y, &names, cv),
+        let all: Vec<usize> = (0..y.len()).collect();
+        let (Ok(mut on_matrix), Ok(on_points)) = (
+            cross_validate_on(&knn, &matrix, (&all, &y), &names, cv, None),
             cross_validate(&plain, &points, 2, &y, &names, cv),
         ) else {
             continue; // a class too small for 4 folds under this seed
         };
+        let on_matrix = on_matrix.remove(0);
         assert_eq!(on_matrix.predictions, on_points.predictions, "seed {seed}");
         compared += 1;
     }
@@ -331,10 +329,14 @@ fn cross_validation_over_the_matrix_equals_knn_on_the_points_ties_included() {
 fn cross_validation_separates_classes_that_differ_in_timing() {
     let (recs, y) = recordings(10, 3, 2_000, 5);
     let metric = VanRossumParams { tau_ms: 10.0 }.check().unwrap();
-    let knn = SpikeDistanceKnn::new(Arc::new(metric.matrix(&recs).unwrap()), 3).unwrap();
+    let matrix = metric.matrix(&recs).unwrap();
+    let knn = SpikeDistanceKnn::new(3).unwrap();
     let names: Vec<String> = (0..3).map(|c| format!("T{c}")).collect();
     let cv = CvParams::default().check().unwrap();
-    let eval = cross_validate(&knn, &knn.samples(), 1, &y, &names, cv).unwrap();
+    let all: Vec<usize> = (0..y.len()).collect();
+    let eval = cross_validate_on(&knn, &matrix, (&all, &y), &names, cv, None)
+        .unwrap()
+        .remove(0);
     assert_eq!(eval.n, 30);
     assert!(eval.accuracy > 0.9, "{}", eval.accuracy);
 }
@@ -373,26 +375,25 @@ fn bad_input_is_an_error_naming_the_rule() {
         metric.cross_distances(&mixed[1..], &recs),
         Err(ClassifyError::BadFeatures(_))
     ));
-    let matrix = Arc::new(metric.matrix(&recs).unwrap());
-    assert_eq!(
-        SpikeDistanceKnn::new(Arc::clone(&matrix), 0)
-            .unwrap_err()
-            .name,
-        "k"
-    );
-    let knn = SpikeDistanceKnn::new(matrix, 3).unwrap();
-    let bad_rows = [0.0, 1.5, 2.0, 3.0];
+    let matrix = metric.matrix(&recs).unwrap();
+    assert_eq!(SpikeDistanceKnn::new(0).unwrap_err().name, "k");
+    let knn = SpikeDistanceKnn::new(3).unwrap();
     assert!(matches!(
-        knn.fit(&bad_rows, 1, &y),
+        knn.learn(&matrix, &[0, 1, 2], &y),
         Err(ClassifyError::BadFeatures(_))
     ));
     assert!(matches!(
-        knn.fit(&[0.0, 1.0, 2.0, 4.0], 1, &y),
+        knn.learn(&matrix, &[0, 1, 2, 4], &y),
         Err(ClassifyError::BadFeatures(_))
     ));
     assert!(matches!(
-        knn.fit(&[0.0, 1.0], 1, &y[..2]),
+        knn.learn(&matrix, &[0, 1], &y[..2]),
         Err(ClassifyError::KTooLarge { .. })
+    ));
+    let model = knn.learn(&matrix, &[0, 1, 2], &y[..3]).unwrap();
+    assert!(matches!(
+        model.decide(&matrix, &[4]),
+        Err(ClassifyError::BadFeatures(_))
     ));
     assert!(DistanceMatrix::from_values(2, vec![0.0, 1.0, 2.0, 0.0]).is_err());
 }

@@ -67,7 +67,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         model.n_training(),
         model.labels().len(),
         model.features().columns.len(),
-        o.method.name(),
+        o.method().name(),
         trained.grid,
         crate::output::shown(&args.out)
     );

@@ -6,7 +6,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{Classifier, ConfusionMatrix, Sweep, SweepModel};
+use super::samples::{Decide, Learner, Rows, Samples};
+use super::{Classifier, ConfusionMatrix, Sweep};
 use crate::error::{ClassifyError, ParamError};
 
 /// Largest number of repeats (CV shuffles, E3 draws) accepted; beyond it a run would take
@@ -199,42 +200,57 @@ pub fn predict_out_of_fold<C: Classifier>(
     fold_of: &[usize],
     folds: usize,
 ) -> Result<Vec<usize>, ClassifyError> {
-    let mut each = out_of_fold_sweep(classifier, (x, dims), y, fold_of, folds)?;
+    let rows = rows_of(x, dims, y.len())?;
+    let all: Vec<usize> = (0..y.len()).collect();
+    let mut each = out_of_fold(classifier, &rows, (&all, y), fold_of, folds)?;
     // No fold tested anything (fold numbers past `folds`): every prediction stays 0.
     Ok(each.pop().unwrap_or_else(|| vec![0; y.len()]))
 }
 
-/// Out-of-fold predictions of every setting of `sweep` under a given fold assignment, one
-/// fit per fold.
-fn out_of_fold_sweep<C: Sweep>(
-    sweep: &C,
-    (x, dims): (&[f64], usize),
-    y: &[usize],
+/// `x` as feature rows of `n` samples.
+///
+/// # Errors
+/// Values that are not `n` rows of `dims` features.
+fn rows_of(x: &[f64], dims: usize, n: usize) -> Result<Rows<'_>, ClassifyError> {
+    if x.len() != n * dims {
+        return Err(ClassifyError::BadFeatures(format!(
+            "{} feature values for {n} samples of {dims} features",
+            x.len()
+        )));
+    }
+    Ok(Rows { values: x, dims })
+}
+
+/// Out-of-fold predictions of every setting of `learner` under a given fold assignment of
+/// the samples `rows` (classes `y`), one fit per fold.
+fn out_of_fold<S: Samples + ?Sized, L: Learner<S>>(
+    learner: &L,
+    samples: &S,
+    (rows, y): (&[usize], &[usize]),
     fold_of: &[usize],
     folds: usize,
 ) -> Result<Vec<Vec<usize>>, ClassifyError> {
     let mut predicted: Vec<Vec<usize>> = Vec::new();
-    let (mut xtr, mut ytr, mut xte, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut train, mut ytr, mut test, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for fold in 0..folds {
-        xtr.clear();
+        train.clear();
         ytr.clear();
-        xte.clear();
+        test.clear();
         idx.clear();
         for (i, &f) in fold_of.iter().enumerate() {
-            let row = &x[i * dims..(i + 1) * dims];
             if f == fold {
-                xte.extend_from_slice(row);
+                test.push(rows[i]);
                 idx.push(i);
             } else {
-                xtr.extend_from_slice(row);
+                train.push(rows[i]);
                 ytr.push(y[i]);
             }
         }
         if idx.is_empty() {
             continue;
         }
-        let model = sweep.fit_sweep(&xtr, dims, &ytr)?;
-        for (s, setting) in model.predict_sweep(&xte).into_iter().enumerate() {
+        let model = learner.learn(samples, &train, &ytr)?;
+        for (s, setting) in model.decide(samples, &test)?.into_iter().enumerate() {
             if s == predicted.len() {
                 predicted.push(vec![0usize; y.len()]);
             }
@@ -341,8 +357,32 @@ pub fn cross_validate_sweep<C: Sweep>(
     cv: ValidCv,
     groups: Option<&[usize]>,
 ) -> Result<Vec<Evaluation>, ClassifyError> {
+    let samples = rows_of(x, dims, y.len())?;
+    let all: Vec<usize> = (0..y.len()).collect();
+    cross_validate_on(sweep, &samples, (&all, y), class_names, cv, groups)
+}
+
+/// Cross-validation of every setting of `learner` over the samples `rows` of `samples`
+/// (classes `y`, one per row), grouped by `groups` (one per row) as
+/// [`cross_validate_grouped`] when given; each fold is fitted once. The evaluations' sample
+/// order is that of `rows`.
+///
+/// # Errors
+/// As [`cross_validate_grouped`].
+pub fn cross_validate_on<S: Samples + ?Sized, L: Learner<S>>(
+    learner: &L,
+    samples: &S,
+    (rows, y): (&[usize], &[usize]),
+    class_names: &[String],
+    cv: ValidCv,
+    groups: Option<&[usize]>,
+) -> Result<Vec<Evaluation>, ClassifyError> {
     if let Some(groups) = groups.filter(|g| g.len() != y.len()) {
         let message = format!("{} groups for {} samples", groups.len(), y.len());
+        return Err(ClassifyError::BadFeatures(message));
+    }
+    if rows.len() != y.len() {
+        let message = format!("{} samples for {} classes", rows.len(), y.len());
         return Err(ClassifyError::BadFeatures(message));
     }
     if y.is_empty() {
@@ -362,7 +402,7 @@ pub fn cross_validate_sweep<C: Sweep>(
                 cv.folds,
             ),
         };
-        let each = out_of_fold_sweep(sweep, (x, dims), y, &fold_of, folds)
+        let each = out_of_fold(learner, samples, (rows, y), &fold_of, folds)
             .map_err(|e| e.with_class_names(class_names))?;
         for (s, predicted) in each.into_iter().enumerate() {
             if s == settings.len() {
@@ -434,6 +474,36 @@ pub fn train_test_sweep<C: Sweep>(
     class_names: &[String],
 ) -> Result<Vec<Evaluation>, ClassifyError> {
     let ((x_train, y_train), (x_test, y_test)) = (train, test);
+    if x_test.len() != y_test.len() * dims {
+        let message = "test features are ragged or not finite";
+        return Err(ClassifyError::BadFeatures(message.into()));
+    }
+    rows_of(x_train, dims, y_train.len())?;
+    let values = [x_train, x_test].concat();
+    let samples = Rows {
+        values: &values,
+        dims,
+    };
+    let n = y_train.len();
+    let (train_rows, test_rows): (Vec<usize>, Vec<usize>) =
+        ((0..n).collect(), (n..n + y_test.len()).collect());
+    let (train, test) = ((&train_rows[..], y_train), (&test_rows[..], y_test));
+    train_test_on(sweep, &samples, train, test, class_names)
+}
+
+/// [`train_test`] of every setting of `learner` (one evaluation each, in its order),
+/// fitted once on the samples `train.0` (classes `train.1`) of `samples` and tested on
+/// the samples `test.0` (classes `test.1`).
+///
+/// # Errors
+/// As [`train_test`].
+pub fn train_test_on<S: Samples + ?Sized, L: Learner<S>>(
+    learner: &L,
+    samples: &S,
+    (train_rows, y_train): (&[usize], &[usize]),
+    (test_rows, y_test): (&[usize], &[usize]),
+    class_names: &[String],
+) -> Result<Vec<Evaluation>, ClassifyError> {
     if y_test.is_empty() {
         return Err(ClassifyError::Empty { what: "test" });
     }
@@ -443,19 +513,15 @@ pub fn train_test_sweep<C: Sweep>(
             label: class_names.get(c).cloned().unwrap_or_else(|| c.to_string()),
         });
     }
-    let model = sweep
-        .fit_sweep(x_train, dims, y_train)
+    let model = learner
+        .learn(samples, train_rows, y_train)
         .map_err(|e| e.with_class_names(class_names))?;
-    if x_test.len() != y_test.len() * dims || x_test.iter().any(|v| !v.is_finite()) {
-        return Err(ClassifyError::BadFeatures(
-            "test features are ragged or not finite".into(),
-        ));
-    }
+    samples.check_test(test_rows)?;
     let n_classes = class_names
         .len()
         .max(1 + *y_train.iter().chain(y_test).max().unwrap_or(&0));
     Ok(model
-        .predict_sweep(x_test)
+        .decide(samples, test_rows)?
         .into_iter()
         .map(|predicted| {
             let mut one = Repeats::new(n_classes, 1);

@@ -13,6 +13,7 @@ pub mod forest;
 pub mod knn;
 pub mod linear;
 pub mod metrics;
+pub mod samples;
 pub mod spike_distance;
 pub mod spiking;
 pub mod stats;
@@ -20,8 +21,9 @@ pub mod stats;
 pub use choice::{ChosenClassifier, ChosenModel, ClassifierChoice};
 pub use confusion::ConfusionMatrix;
 pub use cv::{
-    cross_validate, cross_validate_grouped, cross_validate_sweep, group_folds, stratified_folds,
-    train_test, train_test_sweep, CvParams, Evaluation, RepeatPredictions, ValidCv,
+    cross_validate, cross_validate_grouped, cross_validate_on, cross_validate_sweep, group_folds,
+    stratified_folds, train_test, train_test_on, train_test_sweep, CvParams, Evaluation,
+    RepeatPredictions, ValidCv,
 };
 pub use forest::{Forest, ForestModel, ForestParams};
 pub use knn::{Knn, KnnModel, KnnParams, KnnSweep, KnnSweepModel};
@@ -32,6 +34,7 @@ pub use metrics::{
     BootstrapParams, ClassMetrics, Interval, IntervalMethod, Metrics, PairedTest, PairedVerdict,
     Side, ValidBootstrap,
 };
+pub use samples::{Decide, Learner, Rows, Samples};
 pub use spike_distance::{
     van_rossum, van_rossum_squared, DistanceMatrix, SpikeDistanceKnn, SpikeDistanceKnnModel,
     VanRossum, VanRossumParams,

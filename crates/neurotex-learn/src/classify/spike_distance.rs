@@ -33,12 +33,10 @@
 //! 1 ms grid (`taxels x steps` values, 2.3 MB for 16 taxels x 18 000 ms); beyond
 //! [`MAX_TRACE_VALUES`] it falls back to the exact pairwise merge.
 
-use std::sync::Arc;
-
 use rayon::prelude::*;
 
 use super::knn::{insert, majority};
-use super::{Classifier, Predict};
+use super::samples::{Decide, Learner, Samples};
 use crate::encode::SpikeTrains;
 use crate::error::{ClassifyError, ParamError};
 
@@ -458,80 +456,75 @@ impl VanRossum {
     }
 }
 
-/// K-nearest neighbours over a precomputed [`DistanceMatrix`] of recordings.
-///
-/// Its samples are not features: each sample is one value, the recording's row index
-/// into the matrix (as `f64`; [`SpikeDistanceKnn::samples`] builds the table), with
-/// `dims = 1`. Fitting stores the training indices and labels; prediction looks up each
-/// query's distances to the training recordings in the matrix. Cloning shares the matrix.
-#[derive(Debug, Clone)]
+impl Samples for DistanceMatrix {
+    fn count(&self) -> usize {
+        self.n()
+    }
+}
+
+/// K-nearest neighbours over a precomputed [`DistanceMatrix`] of recordings: a
+/// [`Learner`] whose samples are the matrix's recordings. Fitting stores the training
+/// recordings' indices and labels; prediction looks up each query's distances to them in
+/// the matrix.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpikeDistanceKnn {
     k: usize,
-    matrix: Arc<DistanceMatrix>,
 }
 
 impl SpikeDistanceKnn {
-    /// A classifier with `k` neighbours over `matrix`.
+    /// A classifier with `k` neighbours.
     ///
     /// # Errors
     /// `k` of 0.
-    pub fn new(matrix: Arc<DistanceMatrix>, k: usize) -> Result<Self, ParamError> {
+    pub fn new(k: usize) -> Result<Self, ParamError> {
         if k == 0 {
             return Err(ParamError::new("k", "k must be at least 1", k));
         }
-        Ok(SpikeDistanceKnn { k, matrix })
+        Ok(SpikeDistanceKnn { k })
     }
 
     /// Neighbours.
     pub fn k(&self) -> usize {
         self.k
     }
+}
 
-    /// The shared distance matrix.
-    pub fn matrix(&self) -> &Arc<DistanceMatrix> {
-        &self.matrix
-    }
-
-    /// The sample table of every recording in the matrix, in order: `0.0, 1.0, ..`, one
-    /// value per sample (`dims = 1`), to hand to [`super::cross_validate`].
-    pub fn samples(&self) -> Vec<f64> {
-        (0..self.matrix.n()).map(|i| i as f64).collect()
+/// Checks that `rows` are recordings of `matrix`.
+///
+/// # Errors
+/// The first index past the matrix's last recording.
+fn check_rows(matrix: &DistanceMatrix, rows: &[usize], role: &str) -> Result<(), ClassifyError> {
+    let n = matrix.n();
+    match rows.iter().position(|&i| i >= n) {
+        None => Ok(()),
+        Some(pos) => Err(ClassifyError::BadFeatures(format!(
+            "{role} sample {pos} is {}, not a row index of the {n} x {n} distance matrix",
+            rows[pos]
+        ))),
     }
 }
 
-/// Reads row indices from a sample table: whole numbers below `n`.
-fn row_indices(x: &[f64], n: usize, role: &str) -> Result<Vec<usize>, ClassifyError> {
-    x.iter()
-        .enumerate()
-        .map(|(pos, &v)| {
-            if v >= 0.0 && v.fract() == 0.0 && v < n as f64 {
-                Ok(v as usize)
-            } else {
-                Err(ClassifyError::BadFeatures(format!(
-                    "{role} sample {pos} is {v}, not a row index of the {n} x {n} distance matrix"
-                )))
-            }
-        })
-        .collect()
-}
-
-impl Classifier for SpikeDistanceKnn {
-    type Model = SpikeDistanceKnnModel;
+impl Learner<DistanceMatrix> for SpikeDistanceKnn {
+    type Fitted = SpikeDistanceKnnModel;
 
     /// Stores the training recordings' row indices and labels.
     ///
     /// # Errors
-    /// Empty input, `dims` other than 1, a value that is not a row index of the matrix,
-    /// `k` larger than the training set.
-    fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<Self::Model, ClassifyError> {
+    /// No training recording, labels of another length than `rows`, an index past the
+    /// matrix, `k` larger than the training set.
+    fn learn(
+        &self,
+        matrix: &DistanceMatrix,
+        rows: &[usize],
+        y: &[usize],
+    ) -> Result<SpikeDistanceKnnModel, ClassifyError> {
         if y.is_empty() {
             return Err(ClassifyError::Empty { what: "train on" });
         }
-        if dims != 1 || x.len() != y.len() {
+        if rows.len() != y.len() {
             return Err(ClassifyError::BadFeatures(format!(
-                "a spike-distance KNN takes one row index per sample, got {} values of {dims} \
-                 features for {} samples",
-                x.len(),
+                "{} training recordings for {} labels",
+                rows.len(),
                 y.len()
             )));
         }
@@ -541,10 +534,10 @@ impl Classifier for SpikeDistanceKnn {
                 n_train: y.len(),
             });
         }
+        check_rows(matrix, rows, "training")?;
         Ok(SpikeDistanceKnnModel {
             k: self.k,
-            matrix: Arc::clone(&self.matrix),
-            train: row_indices(x, self.matrix.n(), "training")?,
+            train: rows.to_vec(),
             labels: y.to_vec(),
             n_classes: y.iter().max().map_or(0, |&m| m + 1),
         })
@@ -552,10 +545,9 @@ impl Classifier for SpikeDistanceKnn {
 }
 
 /// A fitted [`SpikeDistanceKnn`]: the training recordings' row indices and labels.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct SpikeDistanceKnnModel {
     k: usize,
-    matrix: Arc<DistanceMatrix>,
     train: Vec<usize>,
     labels: Vec<usize>,
     n_classes: usize,
@@ -570,6 +562,11 @@ impl SpikeDistanceKnnModel {
     /// The training labels, in training order.
     pub fn labels(&self) -> &[usize] {
         &self.labels
+    }
+
+    /// The classes the votes cover: the largest training class index, plus one.
+    pub fn n_classes(&self) -> usize {
+        self.n_classes
     }
 
     /// Predicts recordings given by their distances to the training recordings: row-major,
@@ -593,6 +590,35 @@ impl SpikeDistanceKnnModel {
             .map(|row| vote(self.k, row, &self.labels, &mut best, &mut votes))
             .collect()
     }
+
+    /// The predicted class of each of the recordings `rows` of `matrix`, with every
+    /// class's votes among the `k` nearest training recordings divided by `k`.
+    ///
+    /// # Errors
+    /// An index past the matrix's last recording, or a matrix smaller than the one the
+    /// model was fitted on.
+    pub fn predict_with_shares(
+        &self,
+        matrix: &DistanceMatrix,
+        rows: &[usize],
+    ) -> Result<Vec<(usize, Vec<f64>)>, ClassifyError> {
+        check_rows(matrix, rows, "query")?;
+        check_rows(matrix, &self.train, "training")?;
+        let k = self.k as f64;
+        let mut votes = vec![0usize; self.n_classes];
+        let mut best = Vec::with_capacity(self.k);
+        let mut row = vec![0.0; self.train.len()];
+        let mut out = Vec::with_capacity(rows.len());
+        for &q in rows {
+            let all = matrix.row(q);
+            for (d, &t) in row.iter_mut().zip(&self.train) {
+                *d = all[t];
+            }
+            let predicted = vote(self.k, &row, &self.labels, &mut best, &mut votes);
+            out.push((predicted, votes.iter().map(|&v| v as f64 / k).collect()));
+        }
+        Ok(out)
+    }
 }
 
 /// The majority class among the `k` training samples nearest under the order (distance,
@@ -611,53 +637,14 @@ fn vote(
     majority(best, labels, votes)
 }
 
-impl SpikeDistanceKnnModel {
-    /// Calls `on_row` with each query's predicted class and the votes of every class.
-    ///
-    /// # Panics
-    /// If a sample is not a row index of the matrix (see [`Predict::predict`]).
-    fn classify(&self, x: &[f64], mut on_row: impl FnMut(usize, &[usize])) {
-        let queries = row_indices(x, self.matrix.n(), "query").unwrap_or_else(|e| panic!("{e}"));
-        let mut votes = vec![0usize; self.n_classes];
-        let mut best = Vec::with_capacity(self.k);
-        let mut row = vec![0.0; self.train.len()];
-        for q in queries {
-            let all = self.matrix.row(q);
-            for (d, &t) in row.iter_mut().zip(&self.train) {
-                *d = all[t];
-            }
-            let predicted = vote(self.k, &row, &self.labels, &mut best, &mut votes);
-            on_row(predicted, &votes);
-        }
-    }
-}
-
-impl Predict for SpikeDistanceKnnModel {
-    fn dims(&self) -> usize {
-        1
-    }
-
-    /// # Panics
-    /// If a sample is not a row index of the matrix (a caller bug: the table must come
-    /// from [`SpikeDistanceKnn::samples`] or its rows).
-    fn predict(&self, x: &[f64]) -> Vec<usize> {
-        let mut out = Vec::with_capacity(x.len());
-        self.classify(x, |predicted, _| out.push(predicted));
-        out
-    }
-
-    fn n_classes(&self) -> usize {
-        self.n_classes
-    }
-
-    /// The votes of each class among the `k` nearest recordings, divided by `k`.
-    fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
-        let k = self.k as f64;
-        let mut out = Vec::with_capacity(x.len());
-        self.classify(x, |predicted, votes| {
-            out.push((predicted, votes.iter().map(|&v| v as f64 / k).collect()));
-        });
-        out
+impl Decide<DistanceMatrix> for SpikeDistanceKnnModel {
+    fn decide(
+        &self,
+        matrix: &DistanceMatrix,
+        rows: &[usize],
+    ) -> Result<Vec<Vec<usize>>, ClassifyError> {
+        let shares = self.predict_with_shares(matrix, rows)?;
+        Ok(vec![shares.into_iter().map(|p| p.0).collect()])
     }
 }
 

@@ -1,107 +1,105 @@
-//! The spiking classifier ([`crate::snn`]) under the [`Classifier`] machinery (cross-validation,
-//! train/test). Its input is spike trains, not a feature row, so, as with
-//! [`crate::classify::SpikeDistanceKnn`], every recording's [`SpikeInput`] is built once
-//! and shared, and the table the classifier is given holds, as its single "feature", each
-//! sample's **index** into that list.
+//! The spiking classifier ([`crate::snn`]) as a [`Learner`] over the recordings' binned
+//! spikes (`[SpikeInput]`): cross-validation and train/test pick its training and test
+//! recordings by index, and every recording's input is built once and shared by the folds.
 
-use std::sync::Arc;
+use rayon::prelude::*;
 
-use super::{Classifier, Predict};
+use super::samples::{Decide, Learner, Samples};
 use crate::error::ClassifyError;
 use crate::snn::{fit, softmax, Network, SnnParams, SpikeInput};
 
-/// An unfitted spiking classifier over a shared list of recordings' inputs.
-#[derive(Debug, Clone)]
+impl Samples for [SpikeInput] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+}
+
+/// An unfitted spiking classifier with checked parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SnnClassifier {
     params: SnnParams,
-    inputs: Arc<Vec<SpikeInput>>,
 }
 
 impl SnnClassifier {
-    /// The classifier with checked `params` over `inputs` (a sample's "feature" is its
-    /// index into this list).
-    pub fn new(params: SnnParams, inputs: Arc<Vec<SpikeInput>>) -> Self {
-        SnnClassifier { params, inputs }
-    }
-
-    /// The recordings' inputs.
-    pub fn inputs(&self) -> &Arc<Vec<SpikeInput>> {
-        &self.inputs
-    }
-
-    fn lookup(&self, x: &[f64]) -> Result<Vec<&SpikeInput>, ClassifyError> {
-        x.iter()
-            .map(|&v| {
-                let i = v as usize;
-                match v >= 0.0 && v.fract() == 0.0 && i < self.inputs.len() {
-                    true => Ok(&self.inputs[i]),
-                    false => Err(ClassifyError::BadFeatures(format!(
-                        "{v} is not an index into the {} recordings' spike inputs",
-                        self.inputs.len()
-                    ))),
-                }
-            })
-            .collect()
-    }
-}
-
-impl Classifier for SnnClassifier {
-    type Model = SnnModel;
-
-    fn fit(&self, x: &[f64], dims: usize, y: &[usize]) -> Result<SnnModel, ClassifyError> {
-        if dims != 1 {
-            return Err(ClassifyError::BadFeatures(format!(
-                "the spiking classifier reads one index per sample, got {dims} columns"
-            )));
-        }
-        let inputs = self.lookup(x)?;
-        let classes = y.iter().max().map_or(0, |m| m + 1);
-        let (network, _) = fit(&self.params, &inputs, y, classes)?;
-        Ok(SnnModel {
-            network,
-            inputs: Arc::clone(&self.inputs),
+    /// The classifier with `params`, checked.
+    ///
+    /// # Errors
+    /// The rule `params` break.
+    pub fn new(params: SnnParams) -> Result<Self, crate::error::ParamError> {
+        Ok(SnnClassifier {
+            params: params.check()?,
         })
     }
+
+    /// The checked parameters.
+    pub fn params(&self) -> &SnnParams {
+        &self.params
+    }
 }
 
-/// A trained network over the shared list of inputs.
-#[derive(Debug, Clone)]
+/// The inputs `rows` of `samples`.
+///
+/// # Errors
+/// An index past the last recording.
+fn pick<'a>(
+    samples: &'a [SpikeInput],
+    rows: &[usize],
+) -> Result<Vec<&'a SpikeInput>, ClassifyError> {
+    rows.iter()
+        .map(|&i| {
+            samples.get(i).ok_or_else(|| {
+                let message = format!("recording {i} of {} spike inputs", samples.len());
+                ClassifyError::BadFeatures(message)
+            })
+        })
+        .collect()
+}
+
+impl Learner<[SpikeInput]> for SnnClassifier {
+    type Fitted = SnnModel;
+
+    fn learn(
+        &self,
+        samples: &[SpikeInput],
+        rows: &[usize],
+        y: &[usize],
+    ) -> Result<SnnModel, ClassifyError> {
+        let inputs = pick(samples, rows)?;
+        let classes = y.iter().max().map_or(0, |m| m + 1);
+        let (network, _) = fit(&self.params, &inputs, y, classes)?;
+        Ok(SnnModel { network })
+    }
+}
+
+/// A trained network.
+#[derive(Debug, Clone, PartialEq)]
 pub struct SnnModel {
     /// The network.
     pub network: Network,
-    inputs: Arc<Vec<SpikeInput>>,
 }
 
-impl PartialEq for SnnModel {
-    fn eq(&self, other: &Self) -> bool {
-        self.network == other.network
-    }
-}
-
-impl Predict for SnnModel {
-    fn dims(&self) -> usize {
-        1
-    }
-
-    fn n_classes(&self) -> usize {
-        self.network.classes
-    }
-
-    fn predict(&self, x: &[f64]) -> Vec<usize> {
-        self.predict_with_shares(x)
-            .into_iter()
-            .map(|p| p.0)
-            .collect()
-    }
-
-    fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
-        use rayon::prelude::*;
-        x.par_iter()
-            .map(|&v| {
-                let scores = self.network.scores(&self.inputs[v as usize]);
-                let shares = softmax(&scores);
+impl SnnModel {
+    /// The predicted class of each of `inputs` with every class's share (the softmax of
+    /// the network's scores).
+    pub fn predict_with_shares(&self, inputs: &[&SpikeInput]) -> Vec<(usize, Vec<f64>)> {
+        inputs
+            .par_iter()
+            .map(|input| {
+                let shares = softmax(&self.network.scores(input));
                 (super::first_max(&shares), shares)
             })
             .collect()
+    }
+}
+
+impl Decide<[SpikeInput]> for SnnModel {
+    fn decide(
+        &self,
+        samples: &[SpikeInput],
+        rows: &[usize],
+    ) -> Result<Vec<Vec<usize>>, ClassifyError> {
+        let inputs = pick(samples, rows)?;
+        let predicted = self.predict_with_shares(&inputs).into_iter().map(|p| p.0);
+        Ok(vec![predicted.collect()])
     }
 }

@@ -6,60 +6,14 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::Candidate;
-use crate::analysis::{evaluate, Columns, FeatureTable};
-use crate::classify::SnnClassifier;
-use crate::classify::{
-    ClassifierChoice, DistanceMatrix, ForestParams, KnnParams, SpikeDistanceKnn, VanRossum,
-    VanRossumParams,
-};
-use crate::encode::SpikeTrains;
-use crate::error::{ParamError, Result};
+use crate::analysis::{Columns, FeatureTable};
+use crate::classify::{ClassifierChoice, ForestParams, KnnParams};
+use crate::error::Result;
 use crate::pipeline::{Encoded, Encoding, FeatureExtractor, Method, PipelineParams};
-use crate::snn::{SnnParams, SpikeInput};
+use crate::samples::{evaluator, population_view, spike_inputs, MethodSamples, PopulationMatrices};
+pub use crate::samples::{MethodChoice, SPIKES, STANDARD_TAU_MS, VAN_ROSSUM};
+use crate::snn::SnnParams;
 use crate::values::Grid;
-
-/// The spike-timing method's name.
-pub const VAN_ROSSUM: &str = "van-rossum";
-/// The spike trains themselves, the spiking classifier's input.
-pub const SPIKES: &str = "spikes";
-
-/// A feature method, or the spike-timing method.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum MethodChoice {
-    /// Feature rows of a [`Method`].
-    Features(Method),
-    /// KNN over van Rossum distances between the recordings' spike trains.
-    VanRossum,
-    /// The spike trains as they are, for the spiking classifier (`snn`).
-    Spikes,
-}
-
-impl MethodChoice {
-    /// The command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            MethodChoice::Features(m) => m.name(),
-            MethodChoice::VanRossum => VAN_ROSSUM,
-            MethodChoice::Spikes => SPIKES,
-        }
-    }
-}
-
-impl std::str::FromStr for MethodChoice {
-    type Err = ParamError;
-    fn from_str(s: &str) -> Result<Self, ParamError> {
-        if s == VAN_ROSSUM {
-            return Ok(MethodChoice::VanRossum);
-        }
-        if s == SPIKES {
-            return Ok(MethodChoice::Spikes);
-        }
-        s.parse().map(MethodChoice::Features).map_err(|_| {
-            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi, spectrum, van-rossum or spikes";
-            ParamError::new("methods", rule, s)
-        })
-    }
-}
 
 /// What to compare: every encoding x method x classifier, except that the paper's
 /// single-taxel method (each taxel alone, mean over taxels) and the spike-timing method
@@ -87,9 +41,6 @@ pub const STANDARD_METHODS: &str =
     "taxel,all-taxels,glcm2d,glcm3d,glcm3d-multi,spectrum,van-rossum";
 /// The classifiers compared by default.
 pub const STANDARD_CLASSIFIERS: &str = "knn,forest,linear";
-/// The van Rossum time constant by default: the rate volume's 200 ms bin, the time
-/// resolution the paper's rate code keeps (chosen a priori, not on any data).
-pub const STANDARD_TAU_MS: f64 = 200.0;
 
 impl CandidateSet {
     /// The standard set ([`STANDARD_ENCODINGS`] x [`STANDARD_METHODS`] x
@@ -213,27 +164,17 @@ pub fn candidates(
         let share = encode_s / (set.encodings.len() * methods.len()).max(1) as f64;
         for method in methods {
             let start = Instant::now();
-            let table = Arc::new(match method {
-                MethodChoice::Features(m) => FeatureTable::build(&view, &extractor, m)?,
-                MethodChoice::VanRossum | MethodChoice::Spikes => index_table(&view, grid),
-            });
-            let shared = match method {
-                MethodChoice::VanRossum => Shared::Distances(van_rossum.matrix(&view, encoding)?),
-                MethodChoice::Spikes => Shared::Spikes(spike_inputs(&view, encoding, &pairs)?),
-                MethodChoice::Features(_) => Shared::None,
-            };
+            let made = (&view[..], encoding, &extractor);
+            let samples = method_samples(made, method, &pairs, &mut van_rossum)?;
             let prepare_s = share + start.elapsed().as_secs_f64();
+            let metas = Arc::new(samples.metas().to_vec());
             for &(_, classifier) in pairs.iter().filter(|p| p.0 == method) {
                 out.push(Candidate {
                     encoding: encoding.name().to_string(),
                     method: method.name().to_string(),
                     classifier: classifier.name().to_string(),
-                    table: Arc::clone(&table),
-                    columns: match method {
-                        MethodChoice::Features(Method::Taxel) => Columns::EachTaxel,
-                        _ => Columns::All,
-                    },
-                    evaluate: evaluator(classifier, shared.clone())?,
+                    metas: Arc::clone(&metas),
+                    evaluate: evaluator(classifier, samples.clone())?,
                     prepare_s,
                 });
             }
@@ -242,164 +183,40 @@ pub fn candidates(
     Ok(out)
 }
 
-/// What a method's classifier shares across folds besides its table.
-#[derive(Clone)]
-pub(crate) enum Shared {
-    /// Nothing: feature rows.
-    None,
-    /// Van Rossum distances between every two recordings.
-    Distances(Arc<DistanceMatrix>),
-    /// Every recording's spikes as the spiking network's input.
-    Spikes(Arc<Vec<SpikeInput>>),
-}
-
-/// The classifier as a [`Candidate::evaluate`]; with a distance matrix, KNN over it; with
-/// spike inputs, the spiking network.
-pub(crate) fn evaluator(
-    classifier: ClassifierChoice,
-    shared: Shared,
-) -> Result<Arc<super::EvaluateFn>> {
-    Ok(match (shared, classifier) {
-        (Shared::Distances(matrix), ClassifierChoice::Knn(p)) => {
-            let knn = SpikeDistanceKnn::new(matrix, p.k)?;
-            Arc::new(move |t, c, s| evaluate(t, c, s, &knn))
+/// The samples `method` makes of the recordings `view` (one encoding's view): its feature
+/// table, the van Rossum matrix, or the spike inputs at the spiking network's step (that
+/// of the `spikes` method's pair in `pairs`).
+///
+/// # Errors
+/// A feature method the recordings cannot support, or populations an encoding lacks.
+fn method_samples(
+    (view, encoding, extractor): (&[Encoded], Encoding, &FeatureExtractor),
+    method: MethodChoice,
+    pairs: &[(MethodChoice, ClassifierChoice)],
+    van_rossum: &mut PopulationMatrices,
+) -> Result<MethodSamples> {
+    let metas = || Arc::new(view.iter().map(|e| e.meta.clone()).collect::<Vec<_>>());
+    Ok(match method {
+        MethodChoice::Features(m) => {
+            let columns = match m {
+                Method::Taxel => Columns::EachTaxel,
+                _ => Columns::All,
+            };
+            MethodSamples::Table(Arc::new(FeatureTable::build(view, extractor, m)?), columns)
         }
-        (Shared::Distances(_), other) => {
-            let rule = "the van-rossum method classifies with KNN only";
-            return Err(ParamError::new("classifiers", rule, other.name()).into());
+        MethodChoice::VanRossum => {
+            MethodSamples::Distances(metas(), van_rossum.matrix(view, encoding)?)
         }
-        (Shared::Spikes(inputs), ClassifierChoice::Snn(p)) => {
-            let snn = SnnClassifier::new(p.check()?, inputs);
-            Arc::new(move |t, c, s| evaluate(t, c, s, &snn))
-        }
-        (Shared::Spikes(_), other) => {
-            let rule = "the spikes method classifies with the spiking network (snn) only";
-            return Err(ParamError::new("classifiers", rule, other.name()).into());
-        }
-        (Shared::None, classifier) => {
-            let chosen = classifier.check()?;
-            Arc::new(move |t, c, s| evaluate(t, c, s, &chosen))
+        MethodChoice::Spikes => {
+            let dt_ms = pairs
+                .iter()
+                .find_map(|p| match p {
+                    (MethodChoice::Spikes, ClassifierChoice::Snn(s)) => Some(s.dt_ms),
+                    _ => None,
+                })
+                .unwrap_or(SnnParams::default().dt_ms);
+            let inputs = spike_inputs(view, encoding, dt_ms)?;
+            MethodSamples::Spikes(metas(), Arc::from(inputs))
         }
     })
-}
-
-/// Every recording's spikes under `encoding` binned to the spiking network's time step
-/// (that of the `spikes` method's pair in `pairs`).
-fn spike_inputs(
-    view: &[Encoded],
-    encoding: Encoding,
-    pairs: &[(MethodChoice, ClassifierChoice)],
-) -> Result<Arc<Vec<SpikeInput>>> {
-    let dt_ms = pairs
-        .iter()
-        .find_map(|p| match p {
-            (MethodChoice::Spikes, ClassifierChoice::Snn(s)) => Some(s.dt_ms),
-            _ => None,
-        })
-        .unwrap_or(SnnParams::default().dt_ms);
-    let inputs = view
-        .iter()
-        .map(|e| {
-            let pops: Vec<&SpikeTrains> = match encoding {
-                Encoding::SaFa => e.populations().collect(),
-                _ => vec![&e.spikes],
-            };
-            if encoding == Encoding::SaFa && pops.len() < 2 {
-                let rule = "the sa+fa encoding needs both populations of every recording";
-                return Err(ParamError::new("encodings", rule, "one population"));
-            }
-            Ok(SpikeInput::from_trains(&pops, dt_ms))
-        })
-        .collect::<Result<Vec<_>, ParamError>>()?;
-    Ok(Arc::new(inputs))
-}
-
-/// The recordings as `encoding` sees them: for `fa` alone, the fast-adapting population
-/// as the first (and only) one.
-fn population_view(encoded: &[Encoded], encoding: Encoding) -> Vec<Encoded> {
-    encoded
-        .iter()
-        .map(|e| match (encoding, &e.fa) {
-            (Encoding::Fa, Some(fa)) => Encoded {
-                spikes: fa.clone(),
-                fa: None,
-                ..e.clone()
-            },
-            _ => e.clone(),
-        })
-        .collect()
-}
-
-/// The table of the spike-timing method: each recording's row index into the distance
-/// matrix, the "feature" [`SpikeDistanceKnn`] looks up.
-fn index_table(encoded: &[Encoded], grid: &Grid) -> FeatureTable {
-    FeatureTable {
-        // Not a feature method: the field is not read for a table of row indices.
-        method: Method::Glcm3d,
-        grid: grid.clone(),
-        names: vec!["row".into()],
-        metas: encoded.iter().map(|e| e.meta.clone()).collect(),
-        values: (0..encoded.len()).map(|i| i as f64).collect(),
-    }
-}
-
-/// The van Rossum distances between every two recordings of each population, computed
-/// once and shared by the encodings that use it: `sa` and `sa+fa` read the same SA matrix.
-struct PopulationMatrices {
-    metric: VanRossum,
-    /// The first population's matrix (the SA neurons, or the FA neurons of `fa` alone).
-    first: Option<Arc<DistanceMatrix>>,
-    /// The FA population's matrix, as `sa+fa` adds it.
-    fa: Option<Arc<DistanceMatrix>>,
-}
-
-impl PopulationMatrices {
-    fn new(tau_ms: f64) -> Result<Self> {
-        Ok(PopulationMatrices {
-            metric: VanRossumParams { tau_ms }.check()?,
-            first: None,
-            fa: None,
-        })
-    }
-
-    /// The distances over `encoding`'s populations of `view` (the recordings as
-    /// [`population_view`] gives them): with `sa+fa` the squared distances of the two
-    /// populations add, as those of the taxels do.
-    fn matrix(&mut self, view: &[Encoded], encoding: Encoding) -> Result<Arc<DistanceMatrix>> {
-        let trains = |pick: fn(&Encoded) -> Option<&SpikeTrains>| -> Vec<SpikeTrains> {
-            view.iter().filter_map(|e| pick(e).cloned()).collect()
-        };
-        if encoding == Encoding::Fa {
-            // The view's first population is then the FA one: a matrix of its own.
-            return Ok(Arc::new(self.metric.matrix(&trains(|e| Some(&e.spikes)))?));
-        }
-        let sa = match &self.first {
-            Some(m) => Arc::clone(m),
-            None => {
-                let m = Arc::new(self.metric.matrix(&trains(|e| Some(&e.spikes)))?);
-                self.first.insert(m).clone()
-            }
-        };
-        if encoding != Encoding::SaFa {
-            return Ok(sa);
-        }
-        let fa = match &self.fa {
-            Some(m) => Arc::clone(m),
-            None => {
-                let fa = trains(|e| e.fa.as_ref());
-                if fa.len() != view.len() {
-                    let rule = "the sa+fa encoding needs both populations of every recording";
-                    return Err(ParamError::new("encodings", rule, "one population").into());
-                }
-                self.fa.insert(Arc::new(self.metric.matrix(&fa)?)).clone()
-            }
-        };
-        let values = sa
-            .values()
-            .iter()
-            .zip(fa.values())
-            .map(|(a, b)| (a * a + b * b).sqrt())
-            .collect();
-        Ok(Arc::new(DistanceMatrix::from_values(sa.n(), values)?))
-    }
 }

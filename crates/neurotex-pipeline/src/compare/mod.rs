@@ -25,7 +25,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::{Columns, FeatureTable, Outcome, Split};
+use crate::analysis::{Outcome, Split};
 use crate::classify::draws::for_each_resample;
 use crate::classify::metrics::sign_flip_p;
 use crate::classify::stats::percentile;
@@ -34,8 +34,7 @@ use crate::error::{ClassifyError, ParamError, Result};
 use crate::progress::Progress;
 use crate::recording::{Meta, Selection};
 
-/// Evaluates a candidate's table (or a subset of it) under a split.
-pub type EvaluateFn = dyn Fn(&FeatureTable, Columns, &Split) -> Result<Outcome> + Send + Sync;
+pub use crate::samples::EvaluateFn;
 
 /// One encoding x feature method x classifier, with its features computed.
 #[derive(Clone)]
@@ -46,14 +45,12 @@ pub struct Candidate {
     pub method: String,
     /// The classifier's name.
     pub classifier: String,
-    /// The features of every compared recording, rows in the same order for every candidate.
-    pub table: Arc<FeatureTable>,
-    /// The columns classified (every taxel in turn for the paper's single-taxel method).
-    pub columns: Columns,
-    /// The classifier applied to a table under a split.
+    /// Every compared recording, in the same order for every candidate.
+    pub metas: Arc<Vec<Meta>>,
+    /// The classifier applied to the method's samples of some recordings under a split.
     pub evaluate: Arc<EvaluateFn>,
-    /// Seconds spent making the table (encoding shared among the methods of one encoding
-    /// is split evenly among them).
+    /// Seconds spent making the samples (encoding shared among the methods of one
+    /// encoding is split evenly among them).
     pub prepare_s: f64,
 }
 
@@ -61,6 +58,15 @@ impl Candidate {
     /// `encoding / method / classifier`.
     pub fn name(&self) -> String {
         format!("{} / {} / {}", self.encoding, self.method, self.classifier)
+    }
+
+    /// Evaluates the candidate on all its recordings under `split`.
+    ///
+    /// # Errors
+    /// As the candidate's classifier.
+    pub fn evaluate_all(&self, split: &Split) -> Result<Outcome> {
+        let all: Vec<usize> = (0..self.metas.len()).collect();
+        (self.evaluate)(&all, split)
     }
 
     /// Whether this is the paper's method: the SA encoding, 3D-GLCM and KNN.
@@ -244,8 +250,8 @@ pub fn compare_with_progress(
     let first = candidates.first().ok_or(ClassifyError::Empty {
         what: "compare: no candidates",
     })?;
-    let metas = &first.table.metas;
-    if let Some(c) = candidates.iter().find(|c| c.table.metas != *metas) {
+    let metas = &first.metas;
+    if let Some(c) = candidates.iter().find(|c| c.metas != *metas) {
         let message = format!("{} has other recordings than {}", c.name(), first.name());
         return Err(ClassifyError::BadFeatures(message).into());
     }
@@ -423,20 +429,19 @@ fn cv_split(params: &CompareParams) -> Split {
 /// Evaluates one candidate under the protocol, timing it.
 fn score(c: &Candidate, params: &CompareParams) -> Result<Scored> {
     let start = Instant::now();
-    let table = &c.table;
+    let metas = &c.metas;
     let mut per_condition = Vec::new();
     let mut shares = Vec::new();
     let accuracy = match &params.protocol {
         Protocol::Pooled => {
-            let outcome = (c.evaluate)(table, c.columns, &cv_split(params))?;
+            let outcome = c.evaluate_all(&cv_split(params))?;
             shares = outcome.correct_shares;
             outcome.accuracy
         }
         Protocol::Per(column) => {
-            for value in conditions(&table.metas, column)? {
-                let rows = rows_with(&table.metas, column, &value);
-                let sub = table.subset(&rows);
-                let outcome = (c.evaluate)(&sub, c.columns, &cv_split(params))
+            for value in conditions(metas, column)? {
+                let rows = rows_with(metas, column, &value);
+                let outcome = (c.evaluate)(&rows, &cv_split(params))
                     .map_err(|e| in_condition(e, column, &value))?;
                 shares.extend(outcome.correct_shares.iter().map(|&(r, s)| (rows[r], s)));
                 per_condition.push(ConditionAccuracy {
@@ -447,10 +452,10 @@ fn score(c: &Candidate, params: &CompareParams) -> Result<Scored> {
             mean(per_condition.iter().map(|p| p.accuracy))
         }
         Protocol::HoldOut(column) => {
-            let values = conditions(&table.metas, column)?;
+            let values = conditions(metas, column)?;
             for value in &values {
                 let split = hold_out(column, &values, value);
-                let outcome = (c.evaluate)(table, c.columns, &split)?;
+                let outcome = c.evaluate_all(&split)?;
                 shares.extend(outcome.correct_shares);
                 per_condition.push(ConditionAccuracy {
                     condition: value.clone(),
@@ -464,7 +469,7 @@ fn score(c: &Candidate, params: &CompareParams) -> Result<Scored> {
                 train: train.clone(),
                 test: test.clone(),
             };
-            let outcome = (c.evaluate)(table, c.columns, &split)?;
+            let outcome = c.evaluate_all(&split)?;
             shares = outcome.correct_shares;
             outcome.accuracy
         }
@@ -813,10 +818,7 @@ fn outer(
     };
     let accuracies: Vec<f64> = candidates
         .par_iter()
-        .map(|c| {
-            let sub = c.table.subset(&split.train);
-            Ok((c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy)
-        })
+        .map(|c| Ok((c.evaluate)(&split.train, &cv_split(&inner))?.accuracy))
         .collect::<Result<_>>()?;
     // The first candidate of the highest accuracy.
     let mut best = (f64::NEG_INFINITY, 0);
@@ -830,7 +832,7 @@ fn outer(
         train: split.train.clone(),
         test: split.test.clone(),
     };
-    let outcome = (c.evaluate)(&c.table, c.columns, &rows)?;
+    let outcome = c.evaluate_all(&rows)?;
     Ok(OuterResult {
         condition: split.condition.clone(),
         chosen: best.1,
@@ -848,7 +850,7 @@ fn nested(
     units: &Units,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Nested> {
-    let metas = &candidates[0].table.metas;
+    let metas = &candidates[0].metas;
     progress(Progress::Stage("nested selection", splits.len()));
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
@@ -895,6 +897,7 @@ fn nested(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::{Columns, FeatureTable};
     use crate::classify::{CvParams, KnnParams};
     use crate::pipeline::Method;
     use crate::values::Grid;
@@ -940,13 +943,13 @@ mod tests {
 
     fn candidate(method: &str, separable: bool) -> Candidate {
         let knn = KnnParams::default().check().unwrap();
+        let table = table(separable);
         Candidate {
             encoding: "sa".into(),
             method: method.into(),
             classifier: "knn".into(),
-            table: Arc::new(table(separable)),
-            columns: Columns::All,
-            evaluate: Arc::new(move |t, c, s| crate::analysis::evaluate(t, c, s, &knn)),
+            metas: Arc::new(table.metas.clone()),
+            evaluate: crate::samples::on_table(Arc::new(table), Columns::All, knn),
             prepare_s: 0.0,
         }
     }

@@ -19,7 +19,6 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use super::candidates::evaluator;
 use super::Candidate;
 use crate::analysis::{Columns, FeatureTable};
 use crate::classify::ClassifierChoice;
@@ -29,6 +28,7 @@ use crate::pipeline::{
     spectrum_names, spectrum_span, taxel_cells, FeatureParams, Method, Pipeline,
 };
 use crate::recording::{Dataset, Meta, Recording};
+use crate::samples::{evaluator, MethodSamples};
 use crate::signal::Conditioned;
 use crate::values::Grid;
 
@@ -139,6 +139,7 @@ pub fn baseline_candidates(
         Arc::new(table(spectrum_names, |r| &r.spectrum)),
         Arc::new(table(stats_names, |r| &r.stats)),
     ];
+    let metas = Arc::new(metas);
     let mut out = Vec::new();
     for (method, table) in SIGNAL_METHODS.iter().zip(tables) {
         // The spiking network reads spikes: it has no baseline without them.
@@ -150,9 +151,11 @@ pub fn baseline_candidates(
                 encoding: NO_ENCODING.to_string(),
                 method: method.to_string(),
                 classifier: classifier.name().to_string(),
-                table: Arc::clone(&table),
-                columns: Columns::All,
-                evaluate: evaluator(classifier, super::candidates::Shared::None)?,
+                metas: Arc::clone(&metas),
+                evaluate: evaluator(
+                    classifier,
+                    MethodSamples::Table(Arc::clone(&table), Columns::All),
+                )?,
                 prepare_s,
             });
         }

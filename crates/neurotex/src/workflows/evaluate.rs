@@ -8,15 +8,19 @@ use super::{
 };
 use crate::analysis::{Columns, Split};
 use crate::calibrate::CalibratedParams;
-use crate::classify::{ClassifierChoice, CvParams};
-use crate::compare::candidates::MethodChoice;
+use crate::classify::CvParams;
 use crate::error::OptionsError;
 use crate::evaluation::{Evaluation, Spikes};
 use crate::options::StageOptions;
 use crate::pipeline::{Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{Dataset, Selection};
+use crate::samples::MethodChoice;
 use crate::{Cell, Result, Speed};
+
+/// The method evaluated when neither `--method` nor a classifier that implies one is
+/// given: the paper's 3D-GLCM.
+pub const DEFAULT_METHOD: MethodChoice = MethodChoice::Features(Method::Glcm3d);
 
 /// Options of `neurotex evaluate`.
 #[derive(Debug, Clone)]
@@ -31,12 +35,13 @@ pub struct EvaluateOptions {
     /// taxel's spike counts along the slide in bands of spatial frequency), `van-rossum`
     /// (KNN over van Rossum distances between the recordings' spike trains) or `spikes`
     /// (the spike trains themselves, classified by the spiking network, `--classifier snn`,
-    /// which `--method spikes` chooses when no other classifier is given).
+    /// which `--method spikes` chooses when no other classifier is given). [default:
+    /// glcm3d, the paper's method; spikes with `--classifier snn`]
     #[cfg_attr(feature = "cli", arg(long))]
-    pub method: MethodChoice,
+    pub method: Option<MethodChoice>,
     /// With `--method van-rossum`: the kernel's time constant in ms (default: the rate
     /// volume's 200 ms bin).
-    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = crate::compare::candidates::STANDARD_TAU_MS))]
+    #[cfg_attr(feature = "cli", arg(long = "tau-ms", default_value_t = crate::samples::STANDARD_TAU_MS))]
     pub tau_ms: f64,
     /// With `--method taxel`: the taxel to use, as `ROW,COL`. Without it every taxel is
     /// evaluated and the mean over taxels is reported, with the best beside it.
@@ -219,12 +224,17 @@ impl EvaluateOptions {
     /// # Errors
     /// `--taxel` with another method than `taxel`.
     pub fn columns(&self) -> Result<Columns> {
-        Ok(match (self.method, self.taxel) {
+        Ok(match (self.method(), self.taxel) {
             (MethodChoice::Features(Method::Taxel), Some(cell)) => Columns::Taxel(cell),
             (MethodChoice::Features(Method::Taxel), None) => Columns::EachTaxel,
             (_, Some(_)) => return Err(super::taxel_not_applicable()),
             (_, None) => Columns::All,
         })
+    }
+
+    /// The method evaluated: `--method`, or what `--classifier` reads.
+    pub fn method(&self) -> MethodChoice {
+        self.classifier.kinds(self.method, DEFAULT_METHOD).0
     }
 
     /// Checks that the options name one classifier, whose out-of-fold predictions can be
@@ -253,31 +263,11 @@ impl EvaluateOptions {
         stages: &StageOptions,
         on: OnProgress,
     ) -> Result<Evaluated> {
-        let classifier = self.classifier.choice(self.knn.params()?)?;
+        let (method, classifier) =
+            self.classifier
+                .with_method(self.method, DEFAULT_METHOD, self.knn.params()?)?;
         let split = self.split()?;
         let columns = self.columns()?;
-        // `--method spikes` runs the spiking network: KNN, the default, is replaced by it.
-        let classifier = match (self.method, classifier) {
-            (MethodChoice::Spikes, ClassifierChoice::Knn(_)) => ClassifierChoice::Snn(
-                self.classifier
-                    .snn
-                    .params(crate::snn::SnnParams::default())?,
-            ),
-            (_, c) => c,
-        };
-        let fits = match (self.method, classifier) {
-            (MethodChoice::VanRossum, c) => matches!(c, ClassifierChoice::Knn(_)),
-            (MethodChoice::Spikes, c) => matches!(c, ClassifierChoice::Snn(_)),
-            (MethodChoice::Features(_), c) => !matches!(c, ClassifierChoice::Snn(_)),
-        };
-        if !fits {
-            return Err(OptionsError::Conflict(format!(
-                "--method {} does not run with --classifier {}: van-rossum classifies with knn, spikes with snn (the spiking network), and the feature methods with knn, forest or linear",
-                self.method.name(),
-                classifier.name()
-            ))
-            .into());
-        }
         let indices = self.indices(dataset)?;
         let notes = self.fewer_groups(dataset, &indices);
         notes.iter().for_each(|note| on(Progress::Advice(note)));
@@ -290,7 +280,7 @@ impl EvaluateOptions {
             grid: &grid,
             pipeline: &pipeline,
         };
-        let evaluation = match self.method {
+        let evaluation = match method {
             MethodChoice::Features(method) => Evaluation::of_features(
                 spikes,
                 method,

@@ -30,6 +30,7 @@ use crate::options::StageOptions;
 use crate::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{one_grid, Dataset, Meta};
+use crate::samples::MethodChoice;
 use crate::snn::{Reset, SnnParams, Target};
 use crate::{Grid, Result};
 
@@ -80,12 +81,12 @@ impl KnnOptions {
 pub struct ClassifierOptions {
     /// Classifier: `knn` (the paper's), `forest` (random forest of CART trees, √d features
     /// tried per split), `linear` (multinomial logistic regression, L2 penalty) or `snn` (a
-    /// spiking network that reads the spike trains themselves, not features: `evaluate
-    /// --method spikes`; in `train` the feature method is then not read). The regression
-    /// always z-scores features with training statistics and the forest needs no scaling:
-    /// --no-standardize applies to KNN only.
-    #[cfg_attr(feature = "cli", arg(long, default_value = "knn"))]
-    pub classifier: ClassifierChoice,
+    /// spiking network that reads the spike trains themselves, not features: it implies
+    /// `--method spikes`, and `--method spikes` implies it). The regression always z-scores
+    /// features with training statistics and the forest needs no scaling: --no-standardize
+    /// applies to KNN only. [default: knn]
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub classifier: Option<ClassifierChoice>,
     /// With `--classifier forest`: trees in the forest [default: 200].
     #[cfg_attr(feature = "cli", arg(long))]
     pub trees: Option<usize>,
@@ -201,7 +202,47 @@ impl ClassifierOptions {
     /// # Errors
     /// An option of another classifier, or a parameter out of its range.
     pub fn choice(&self, knn: KnnParams) -> Result<ClassifierChoice> {
-        let choice = match self.classifier {
+        self.choice_of(self.classifier.unwrap_or_default(), knn)
+    }
+
+    /// The method and the classifier that reads it: `--classifier snn` reads the spike
+    /// trains and `--method spikes` is read by the spiking network, so either implies the
+    /// other; without either, `method` given or `default`, and KNN. A pairing that does not
+    /// run is refused here, naming the pairings that do.
+    ///
+    /// # Errors
+    /// As [`ClassifierOptions::choice`], and a method the classifier does not read.
+    pub fn with_method(
+        &self,
+        method: Option<MethodChoice>,
+        default: MethodChoice,
+        knn: KnnParams,
+    ) -> Result<(MethodChoice, ClassifierChoice)> {
+        let (method, kind) = self.kinds(method, default);
+        let classifier = self.choice_of(kind, knn)?;
+        method.check_pairing(&classifier)?;
+        Ok((method, classifier))
+    }
+
+    /// The method and the classifier's kind (its default parameters) the options name.
+    pub fn kinds(
+        &self,
+        method: Option<MethodChoice>,
+        default: MethodChoice,
+    ) -> (MethodChoice, ClassifierChoice) {
+        let spikes = ClassifierChoice::Snn(SnnParams::default());
+        let kind = match (self.classifier, method) {
+            (Some(kind), _) => kind,
+            (None, Some(MethodChoice::Spikes)) => spikes,
+            (None, _) => ClassifierChoice::default(),
+        };
+        let method = method.unwrap_or_else(|| MethodChoice::for_classifier(&kind, default));
+        (method, kind)
+    }
+
+    /// The classifier of kind `kind` with its options applied, checked.
+    fn choice_of(&self, kind: ClassifierChoice, knn: KnnParams) -> Result<ClassifierChoice> {
+        let choice = match kind {
             ClassifierChoice::Knn(_) => ClassifierChoice::Knn(knn),
             ClassifierChoice::Forest(defaults) => ClassifierChoice::Forest(ForestParams {
                 trees: self.trees.unwrap_or(defaults.trees),

@@ -9,13 +9,16 @@ use super::{
 use super::{OnProgress, OpenOptions};
 use crate::analysis::Columns;
 use crate::classify::ClassifierChoice;
+use crate::error::ParamError;
 use crate::model::{Model, Provenance};
 use crate::options::StageOptions;
 use crate::pipeline::{Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::Dataset;
+use crate::samples::MethodChoice;
 use crate::snn::train::TrainingLog;
 use crate::spiking_model::SpikingModel;
+use crate::workflows::evaluate::DEFAULT_METHOD;
 use crate::{Cell, Grid, Result, Speed};
 
 /// Options of `train`.
@@ -33,10 +36,12 @@ pub struct TrainOptions {
     pub speeds: Option<Vec<Speed>>,
     /// Feature set: `taxel`, `glcm2d`, `glcm3d` (the paper's spatio-temporal approach),
     /// `all-taxels`, `all-taxels-mm`, `glcm3d-multi` or `spectrum` (spike counts along the
-    /// slide in bands of spatial frequency; not with `--causal`). Not read by
-    /// `--classifier snn`, whose network reads the spike trains themselves.
-    #[cfg_attr(feature = "cli", arg(long, default_value = "glcm3d"))]
-    pub method: Method,
+    /// slide in bands of spatial frequency; not with `--causal`), or `spikes` (the spike
+    /// trains themselves, read by the spiking network: `--method spikes` and
+    /// `--classifier snn` each imply the other). [default: glcm3d; spikes with
+    /// `--classifier snn`]
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub method: Option<MethodChoice>,
     /// With `--method taxel`: classify with this one taxel's statistics, as `ROW,COL`.
     /// Without it, every taxel's three statistics together form one feature row.
     #[cfg_attr(feature = "cli", arg(long))]
@@ -68,7 +73,12 @@ impl TrainOptions {
     /// Options out of range or that do not go together, recordings that cannot be read,
     /// or too few recordings for the classifier.
     pub fn run(&self, dataset: &Dataset, stages: &StageOptions, on: OnProgress) -> Result<Trained> {
-        if stages.causal && self.method == Method::Spectrum {
+        let (method, classifier) = self.method_and_classifier()?;
+        let MethodChoice::Features(method) = method else {
+            let message = "a spiking network is trained with TrainOptions::run_spiking";
+            return Err(crate::error::OptionsError::Conflict(message.into()).into());
+        };
+        if stages.causal && method == Method::Spectrum {
             let why = crate::stream::NO_RUNNING_SPECTRUM;
             let message = format!("--causal trains a model for streams: {why}");
             return Err(crate::error::OptionsError::Conflict(message).into());
@@ -77,17 +87,12 @@ impl TrainOptions {
         let calibrated = calibrated_pipeline(stages, dataset, &indices, on)?;
         let params = calibrated.params;
         let pipeline = Pipeline::new(params.clone())?;
-        let classifier = self.classifier.choice(self.knn.params()?)?;
-        if matches!(classifier, ClassifierChoice::Snn(_)) {
-            let message = "a spiking network is trained with TrainOptions::run_spiking";
-            return Err(crate::error::OptionsError::Conflict(message.into()).into());
-        }
-        let columns = match (self.method, self.taxel) {
+        let columns = match (method, self.taxel) {
             (Method::Taxel, Some(cell)) => Columns::Taxel(cell),
             (_, Some(_)) => return Err(super::taxel_not_applicable()),
             (_, None) => Columns::All,
         };
-        let (table, grid) = feature_table(dataset, &pipeline, &indices, self.method, on)?;
+        let (table, grid) = feature_table(dataset, &pipeline, &indices, method, on)?;
         if let Some(cell) = self.taxel {
             grid.locate(cell)?;
         }
@@ -113,9 +118,33 @@ pub struct TrainedSpiking {
 }
 
 impl TrainOptions {
-    /// Whether the options train the spiking network (`--classifier snn`).
+    /// Whether the options train the spiking network (`--classifier snn` or `--method
+    /// spikes`).
     pub fn spiking(&self) -> bool {
-        matches!(self.classifier.classifier, ClassifierChoice::Snn(_))
+        self.method() == MethodChoice::Spikes
+    }
+
+    /// The method trained on: `--method`, or what `--classifier` reads.
+    pub fn method(&self) -> MethodChoice {
+        self.classifier.kinds(self.method, DEFAULT_METHOD).0
+    }
+
+    /// The method and the classifier, checked: a model reads feature rows or spike
+    /// inputs, so `van-rossum`, which compares recordings with each other, is evaluated,
+    /// not trained.
+    ///
+    /// # Errors
+    /// A pairing that does not run, `van-rossum`, or a broken parameter.
+    pub fn method_and_classifier(&self) -> Result<(MethodChoice, ClassifierChoice)> {
+        let knn = self.knn.params()?;
+        let (method, classifier) = self
+            .classifier
+            .with_method(self.method, DEFAULT_METHOD, knn)?;
+        if method == MethodChoice::VanRossum {
+            let rule = "a model is trained on feature rows or on the spike trains (spikes); van-rossum is evaluated, not trained";
+            return Err(ParamError::new("method", rule, method.name()).into());
+        }
+        Ok((method, classifier))
     }
 
     /// Trains the spiking network (`--classifier snn`) on the spike trains of `dataset`'s
@@ -130,7 +159,7 @@ impl TrainOptions {
         stages: &StageOptions,
         on: OnProgress,
     ) -> Result<TrainedSpiking> {
-        let ClassifierChoice::Snn(snn) = self.classifier.choice(self.knn.params()?)? else {
+        let (_, ClassifierChoice::Snn(snn)) = self.method_and_classifier()? else {
             let message = "run_spiking trains --classifier snn";
             return Err(crate::error::OptionsError::Conflict(message.into()).into());
         };

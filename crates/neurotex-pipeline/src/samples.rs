@@ -1,0 +1,291 @@
+//! Each method's samples and the classifiers that read them. A feature method makes a
+//! [`FeatureTable`] (feature rows: KNN, the forest, logistic regression); the `spikes`
+//! method makes every recording's [`SpikeInput`] (the spiking network); `van-rossum` makes
+//! the [`DistanceMatrix`] between the recordings (KNN over it). [`evaluator`] pairs a
+//! method with a classifier once, where the options are checked, and returns one
+//! [`EvaluateFn`] that evaluation, `compare` and nested selection call alike.
+
+use std::sync::Arc;
+
+use crate::analysis::{evaluate, evaluate_samples, Columns, FeatureTable, Outcome, Split};
+use crate::classify::{
+    Classifier, ClassifierChoice, DistanceMatrix, Learner, Samples, SnnClassifier,
+    SpikeDistanceKnn, VanRossum, VanRossumParams,
+};
+use crate::encode::SpikeTrains;
+use crate::error::{ClassifyError, ParamError, Result};
+use crate::pipeline::{Encoded, Encoding, Method};
+use crate::recording::Meta;
+use crate::snn::SpikeInput;
+
+/// The spike-timing method's name.
+pub const VAN_ROSSUM: &str = "van-rossum";
+/// The spike trains themselves, the spiking classifier's input.
+pub const SPIKES: &str = "spikes";
+/// The van Rossum time constant by default: the rate volume's 200 ms bin, the time
+/// resolution the paper's rate code keeps (chosen a priori, not on any data).
+pub const STANDARD_TAU_MS: f64 = 200.0;
+
+/// A feature method, or a method whose samples are the spikes themselves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MethodChoice {
+    /// Feature rows of a [`Method`].
+    Features(Method),
+    /// KNN over van Rossum distances between the recordings' spike trains.
+    VanRossum,
+    /// The spike trains as they are, for the spiking classifier (`snn`).
+    Spikes,
+}
+
+impl MethodChoice {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodChoice::Features(m) => m.name(),
+            MethodChoice::VanRossum => VAN_ROSSUM,
+            MethodChoice::Spikes => SPIKES,
+        }
+    }
+
+    /// The method a classifier reads when none is named: the spike trains for the spiking
+    /// network, `default` for the others.
+    pub fn for_classifier(classifier: &ClassifierChoice, default: MethodChoice) -> MethodChoice {
+        match classifier {
+            ClassifierChoice::Snn(_) => MethodChoice::Spikes,
+            _ => default,
+        }
+    }
+
+    /// Checks that `classifier` reads this method's samples: feature rows for KNN, the
+    /// forest and logistic regression; van Rossum distances for KNN; spike inputs for the
+    /// spiking network.
+    ///
+    /// # Errors
+    /// A pairing that does not run, naming the ones that do.
+    pub fn check_pairing(self, classifier: &ClassifierChoice) -> Result<(), ParamError> {
+        let fits = match self {
+            MethodChoice::VanRossum => matches!(classifier, ClassifierChoice::Knn(_)),
+            MethodChoice::Spikes => matches!(classifier, ClassifierChoice::Snn(_)),
+            MethodChoice::Features(_) => !matches!(classifier, ClassifierChoice::Snn(_)),
+        };
+        match fits {
+            true => Ok(()),
+            false => Err(ParamError::new(
+                "classifier",
+                "van-rossum classifies with knn, spikes with snn (the spiking network), and the feature methods with knn, forest or linear",
+                format!("{} with the {} method", classifier.name(), self.name()),
+            )),
+        }
+    }
+}
+
+impl std::str::FromStr for MethodChoice {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        if s == VAN_ROSSUM {
+            return Ok(MethodChoice::VanRossum);
+        }
+        if s == SPIKES {
+            return Ok(MethodChoice::Spikes);
+        }
+        s.parse().map(MethodChoice::Features).map_err(|_| {
+            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi, spectrum, van-rossum or spikes";
+            ParamError::new("methods", rule, s)
+        })
+    }
+}
+
+/// A classifier applied to its samples: evaluates the recordings `within` (indices into
+/// the samples' recordings) under a split whose rows are positions in `within`.
+pub type EvaluateFn = dyn Fn(&[usize], &Split) -> Result<Outcome> + Send + Sync;
+
+/// `classifier` on `columns` of `table`'s rows.
+pub fn on_table<C: Classifier + Send + 'static>(
+    table: Arc<FeatureTable>,
+    columns: Columns,
+    classifier: C,
+) -> Arc<EvaluateFn> {
+    Arc::new(move |within, split| {
+        let whole =
+            within.len() == table.metas.len() && within.iter().enumerate().all(|(i, &r)| i == r);
+        match whole {
+            true => evaluate(&table, columns, split, &classifier),
+            false => evaluate(&table.subset(within), columns, split, &classifier),
+        }
+    })
+}
+
+/// `learner` on `samples`, sample `i` being the recording `metas[i]`.
+pub fn on_samples<S, L>(metas: Arc<Vec<Meta>>, samples: Arc<S>, learner: L) -> Arc<EvaluateFn>
+where
+    S: Samples + Send + ?Sized + 'static,
+    L: Learner<S> + Send + 'static,
+{
+    Arc::new(move |within, split| {
+        let mut each = evaluate_samples(&metas, within, &*samples, split, &learner)?;
+        each.pop().ok_or_else(|| {
+            ClassifyError::Empty {
+                what: "evaluate: no classifier setting",
+            }
+            .into()
+        })
+    })
+}
+
+/// What a method's classifier reads, made once and shared by every fold and candidate.
+#[derive(Clone)]
+pub enum MethodSamples {
+    /// Feature rows, with the columns classified.
+    Table(Arc<FeatureTable>, Columns),
+    /// Van Rossum distances between every two recordings.
+    Distances(Arc<Vec<Meta>>, Arc<DistanceMatrix>),
+    /// Every recording's spikes as the spiking network's input.
+    Spikes(Arc<Vec<Meta>>, Arc<[SpikeInput]>),
+}
+
+impl MethodSamples {
+    /// The recordings the samples stand for, in sample order.
+    pub fn metas(&self) -> &[Meta] {
+        match self {
+            MethodSamples::Table(table, _) => &table.metas,
+            MethodSamples::Distances(metas, _) | MethodSamples::Spikes(metas, _) => metas,
+        }
+    }
+}
+
+/// `classifier` on `samples`: KNN over a distance matrix, the spiking network over spike
+/// inputs, any feature classifier over feature rows.
+///
+/// # Errors
+/// A classifier that does not read these samples, or its broken parameter.
+pub fn evaluator(classifier: ClassifierChoice, samples: MethodSamples) -> Result<Arc<EvaluateFn>> {
+    Ok(match (samples, classifier) {
+        (MethodSamples::Distances(metas, matrix), ClassifierChoice::Knn(p)) => {
+            on_samples(metas, matrix, SpikeDistanceKnn::new(p.k)?)
+        }
+        (MethodSamples::Spikes(metas, inputs), ClassifierChoice::Snn(p)) => {
+            on_samples(metas, inputs, SnnClassifier::new(p)?)
+        }
+        (MethodSamples::Table(table, columns), classifier) => {
+            MethodChoice::Features(table.method).check_pairing(&classifier)?;
+            on_table(table, columns, classifier.check()?)
+        }
+        (MethodSamples::Distances(..), other) => {
+            return Err(MethodChoice::VanRossum
+                .check_pairing(&other)
+                .unwrap_err()
+                .into())
+        }
+        (MethodSamples::Spikes(..), other) => {
+            return Err(MethodChoice::Spikes
+                .check_pairing(&other)
+                .unwrap_err()
+                .into())
+        }
+    })
+}
+
+/// Every recording's spikes under `encoding` binned to `dt_ms` steps, the spiking
+/// network's input.
+///
+/// # Errors
+/// `sa+fa` on recordings encoded with one population.
+pub fn spike_inputs(view: &[Encoded], encoding: Encoding, dt_ms: u32) -> Result<Vec<SpikeInput>> {
+    view.iter()
+        .map(|e| {
+            let pops: Vec<&SpikeTrains> = match encoding {
+                Encoding::SaFa => e.populations().collect(),
+                _ => vec![&e.spikes],
+            };
+            if encoding == Encoding::SaFa && pops.len() < 2 {
+                let rule = "the sa+fa encoding needs both populations of every recording";
+                return Err(ParamError::new("encodings", rule, "one population").into());
+            }
+            Ok(SpikeInput::from_trains(&pops, dt_ms))
+        })
+        .collect()
+}
+
+/// The recordings as `encoding` sees them: for `fa` alone, the fast-adapting population
+/// as the first (and only) one.
+pub fn population_view(encoded: &[Encoded], encoding: Encoding) -> Vec<Encoded> {
+    encoded
+        .iter()
+        .map(|e| match (encoding, &e.fa) {
+            (Encoding::Fa, Some(fa)) => Encoded {
+                spikes: fa.clone(),
+                fa: None,
+                ..e.clone()
+            },
+            _ => e.clone(),
+        })
+        .collect()
+}
+
+/// The van Rossum distances between every two recordings of each population, computed
+/// once and shared by the encodings that use it: `sa` and `sa+fa` read the same SA matrix.
+pub struct PopulationMatrices {
+    metric: VanRossum,
+    /// The first population's matrix (the SA neurons, or the FA neurons of `fa` alone).
+    first: Option<Arc<DistanceMatrix>>,
+    /// The FA population's matrix, as `sa+fa` adds it.
+    fa: Option<Arc<DistanceMatrix>>,
+}
+
+impl PopulationMatrices {
+    /// No matrix yet, for the kernel's time constant `tau_ms`.
+    ///
+    /// # Errors
+    /// A time constant that is not positive and finite.
+    pub fn new(tau_ms: f64) -> Result<Self> {
+        Ok(PopulationMatrices {
+            metric: VanRossumParams { tau_ms }.check()?,
+            first: None,
+            fa: None,
+        })
+    }
+
+    /// The distances over `encoding`'s populations of `view` (the recordings as
+    /// [`population_view`] gives them): with `sa+fa` the squared distances of the two
+    /// populations add, as those of the taxels do.
+    ///
+    /// # Errors
+    /// Recordings of different grids, or `sa+fa` without both populations.
+    pub fn matrix(&mut self, view: &[Encoded], encoding: Encoding) -> Result<Arc<DistanceMatrix>> {
+        let trains = |pick: fn(&Encoded) -> Option<&SpikeTrains>| -> Vec<SpikeTrains> {
+            view.iter().filter_map(|e| pick(e).cloned()).collect()
+        };
+        if encoding == Encoding::Fa {
+            // The view's first population is then the FA one: a matrix of its own.
+            return Ok(Arc::new(self.metric.matrix(&trains(|e| Some(&e.spikes)))?));
+        }
+        let sa = match &self.first {
+            Some(m) => Arc::clone(m),
+            None => {
+                let m = Arc::new(self.metric.matrix(&trains(|e| Some(&e.spikes)))?);
+                self.first.insert(m).clone()
+            }
+        };
+        if encoding != Encoding::SaFa {
+            return Ok(sa);
+        }
+        let fa = match &self.fa {
+            Some(m) => Arc::clone(m),
+            None => {
+                let fa = trains(|e| e.fa.as_ref());
+                if fa.len() != view.len() {
+                    let rule = "the sa+fa encoding needs both populations of every recording";
+                    return Err(ParamError::new("encodings", rule, "one population").into());
+                }
+                self.fa.insert(Arc::new(self.metric.matrix(&fa)?)).clone()
+            }
+        };
+        let values = sa
+            .values()
+            .iter()
+            .zip(fa.values())
+            .map(|(a, b)| (a * a + b * b).sqrt())
+            .collect();
+        Ok(Arc::new(DistanceMatrix::from_values(sa.n(), values)?))
+    }
+}
