@@ -39,12 +39,33 @@ def test_python_trains_the_network_the_cli_trains(trained):
     assert py["network"] == cli["network"]
     assert py["pipeline"] == cli["pipeline"]
     assert set(model.training) == {"epochs", "best_epoch", "validation_loss"}
-    # Either kind of model file, given where the other is needed, is named as such.
+    # Model.load reads every classifier's file: a spiking model file or graph gives a
+    # SpikingModel, itself a Model.
     model.save_nir(d / "py.nir")
     for path in (d / "py.json", d / "py.nir"):
-        with pytest.raises(neurotex.ModelError, match="a spiking model"):
-            neurotex.Model.load(path)
+        back = neurotex.Model.load(path)
+        assert isinstance(back, neurotex.SpikingModel) and isinstance(back, neurotex.Model)
+        assert back.classes_ == model.classes_ and back.method == "spikes"
     assert 1 <= model.training["best_epoch"] <= model.training["epochs"] <= 4
+
+
+def test_model_train_chooses_the_network_as_the_cli_does(sim, sim_dir, tmp_path):
+    """`Model.train(classifier="snn")` and `Model.train(method="spikes")` train the network
+    `neurotex train --method spikes` trains; a pairing that does not run is refused."""
+    knobs = {"hidden": 8, "epochs": 2}
+    by_classifier = neurotex.Model.train(sim, classifier="snn", classifier_options=knobs)
+    by_method = neurotex.Model.train(sim, method="spikes", classifier_options=knobs)
+    assert isinstance(by_classifier, neurotex.SpikingModel)
+    by_classifier.save(tmp_path / "c.json")
+    by_method.save(tmp_path / "m.json")
+    run_cli("train", "--dataset", sim_dir, "--method", "spikes", "--snn-hidden", "8",
+            "--snn-epochs", "2", "--out", tmp_path / "cli.json")
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    for path in ("c.json", "m.json"):
+        py = json.loads((tmp_path / path).read_text())
+        assert py["network"] == cli["network"] and py["pipeline"] == cli["pipeline"]
+    with pytest.raises(neurotex.ParameterError, match="spikes with snn"):
+        neurotex.Model.train(sim, method="spikes", classifier="forest")
 
 
 def test_a_spiking_stream_gives_the_lines_of_the_cli(trained, sim_dir, tmp_path):

@@ -763,14 +763,20 @@ def _training_set(recordings: Any, labels: Optional[Sequence[Any]], fs: float, m
 
 class Model(_Predicting):
     """A trained classifier with its pipeline: the model file of ``neurotex train``
-    (read with :meth:`load`, written with :meth:`save`, which the CLI reads back)."""
+    (read with :meth:`load`, written with :meth:`save`, which the CLI reads back). Every
+    classifier's model is a :class:`Model`: a spiking network's is the subclass
+    :class:`SpikingModel`, which :meth:`train` and :meth:`load` return for it."""
 
     def __init__(self, native: Any) -> None:
         self._native = native
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "Model":
-        """Reads a model file. Raises :class:`NotFoundError` or :class:`ModelError`."""
+        """Reads a model file of any classifier (a spiking network's model file or NIR
+        graph gives a :class:`SpikingModel`). Raises :class:`NotFoundError` or
+        :class:`ModelError`."""
+        if cls is Model and _native.is_spiking_model(os.fspath(path)):
+            return SpikingModel.load(path)
         return cls(_native.NativeModel.load(os.fspath(path)))
 
     def save(self, path: Union[str, os.PathLike]) -> None:
@@ -782,8 +788,8 @@ class Model(_Predicting):
         cls,
         recordings: Any,
         labels: Optional[Sequence[Any]] = None,
-        method: str = "glcm3d",
-        classifier: str = "knn",
+        method: Optional[str] = None,
+        classifier: Optional[str] = None,
         *,
         fs: float = 1000.0,
         mask: Any = None,
@@ -793,11 +799,14 @@ class Model(_Predicting):
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "Model":
-        """Trains ``classifier`` (``knn``, ``forest``, ``linear``; knobs in
-        ``classifier_options``, e.g. ``{"k": 5}``) on ``method``'s features of the
-        recordings, as ``neurotex train`` does. ``labels`` default to the recordings' own
-        (a :class:`Dataset`'s). ``stage_options`` are :func:`features`' (gain, cutoff,
-        levels, ...).
+        """Trains ``classifier`` (``knn``, the default, ``forest``, ``linear`` or ``snn``;
+        knobs in ``classifier_options``, e.g. ``{"k": 5}``, or the keywords of
+        :meth:`SpikingModel.train` for ``snn``) on ``method``'s features of the recordings
+        (``glcm3d`` by default), as ``neurotex train`` does. As there, ``classifier="snn"``
+        reads the spike trains (``method="spikes"``) and ``method="spikes"`` is read by the
+        spiking network: either one trains it and returns a :class:`SpikingModel`.
+        ``labels`` default to the recordings' own (a :class:`Dataset`'s). ``stage_options``
+        are :func:`features`' (gain, cutoff, levels, ...).
 
         ``causal=True`` trains a causal model (``neurotex train --causal``): a forward-only
         low-pass, and each taxel's resting value and one normalisation scale fixed on
@@ -805,9 +814,21 @@ class Model(_Predicting):
         :class:`StreamClassifier` can classify a live stream with it. ``gain="auto"``
         calibrates the gain on these recordings (after the causal conditioning, when
         both); the model keeps the calibration (:attr:`gain_calibration`)."""
-        if classifier == "snn":
-            raise ParameterError("a spiking network classifies spike trains, not features: "
-                                 "train it with SpikingModel.train")
+        if classifier is None:
+            classifier = "snn" if method == "spikes" else "knn"
+        if method is None:
+            method = "spikes" if classifier == "snn" else "glcm3d"
+        if (method == "spikes") != (classifier == "snn"):
+            raise ParameterError(
+                "invalid parameter `classifier`: van-rossum classifies with knn, spikes with "
+                "snn (the spiking network), and the feature methods with knn, forest or "
+                f"linear, got {classifier} with the {method} method")
+        if method == "spikes":
+            if taxel is not None:
+                raise ParameterError("taxel applies to method='taxel' only")
+            return SpikingModel.train(recordings, labels, fs=fs, mask=mask, speeds=speeds,
+                                      causal=causal, **dict(classifier_options or {}),
+                                      **stage_options)
         arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
         opts = _stage_options(**stage_options)
         opts["causal"] = bool(causal)
@@ -872,14 +893,14 @@ def _nir() -> Any:
     return nir
 
 
-class SpikingModel(_Predicting):
+class SpikingModel(Model):
     """A trained spiking network with its pipeline: the model file of ``neurotex train
-    --classifier snn``, or a NIR graph (:meth:`to_nir`, :meth:`from_nir`; see
+    --classifier snn`` (``Model.train(..., classifier="snn")``), or a NIR graph (:meth:`to_nir`, :meth:`from_nir`; see
     docs/spiking-classifier.md). Its input is the recordings' spikes, encoded with the
     model's own pipeline; its shares are the softmax of the readout's scores."""
 
     def __init__(self, native: Any, training: Optional[Dict[str, Any]] = None) -> None:
-        self._native = native
+        super().__init__(native)
         #: How training went (``epochs``, ``best_epoch``, ``validation_loss``) for a model
         #: trained by :meth:`train`; ``None`` for one read from a file.
         self.training = training
@@ -931,6 +952,18 @@ class SpikingModel(_Predicting):
     def load(cls, path: Union[str, os.PathLike]) -> "SpikingModel":
         """Reads a spiking model file, or a NIR graph written by neurotex."""
         return cls(_native.NativeSpikingModel.load(os.fspath(path)))
+
+    @property
+    def method(self) -> str:
+        """``spikes``: the network reads the spike trains themselves."""
+        return "spikes"
+
+    @property
+    def columns(self) -> List[str]:
+        """No feature column: the network reads spike inputs (one per taxel and
+        population)."""
+        return []
+
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the model file (whole or not at all)."""
