@@ -17,6 +17,7 @@ mod params;
 mod reproduce;
 mod spiking;
 mod stream;
+mod workflow;
 
 use ndarray::{Array2, Array3};
 use neurotex::encode::SpikeTrains;
@@ -407,5 +408,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     spiking::register(m)?;
     estimator::register(m)?;
     stream::register(m)?;
+    workflow::register(m)?;
     Ok(())
 }

@@ -49,6 +49,17 @@ impl NativeModel {
         predict_recordings(py, &recordings, infos, model, predict)
     }
 
+    /// Predicts every recording of a dataset folder (sampled or address events) as
+    /// `neurotex predict --dataset` does: `(labels, shares (n, classes), what was said)`.
+    fn predict_dataset<'py>(
+        &self,
+        py: Python<'py>,
+        path: PathBuf,
+    ) -> PyResult<crate::workflow::FolderPredictions<'py>> {
+        let model = neurotex::saved::SavedModel::from(self.inner.clone());
+        crate::workflow::predict_dataset(py, model, path)
+    }
+
     /// The classes, in the order of the shares' columns.
     #[getter]
     fn labels(&self) -> Vec<String> {
@@ -225,7 +236,7 @@ pub(crate) fn predict_recordings<'py>(
 }
 
 /// Predictions as `(labels, shares (n, classes))`.
-fn labels_and_shares(
+pub(crate) fn labels_and_shares(
     py: Python<'_>,
     predictions: Vec<Prediction>,
     classes: usize,

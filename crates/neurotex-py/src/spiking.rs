@@ -84,6 +84,17 @@ impl NativeSpikingModel {
     }
 
     /// The classes, in the order of the network's outputs.
+    /// Predicts every recording of a dataset folder (sampled or address events) as
+    /// `neurotex predict --dataset` does: `(labels, shares (n, classes), what was said)`.
+    fn predict_dataset<'py>(
+        &self,
+        py: Python<'py>,
+        path: PathBuf,
+    ) -> PyResult<crate::workflow::FolderPredictions<'py>> {
+        let model = neurotex::saved::SavedModel::from(self.inner.clone());
+        crate::workflow::predict_dataset(py, model, path)
+    }
+
     #[getter]
     fn labels(&self) -> Vec<String> {
         self.inner.labels().to_vec()

@@ -119,3 +119,41 @@ def test_a_python_event_stream_decides_as_the_command_line(exported, tmp_path):
         neurotex.StreamClassifier(str(model), events=True, origin="start")
     with pytest.raises(neurotex.DataError, match="outside the 4x4 grid"):
         stream.push_event(end_us + 1000, 7, 0, 1)
+
+
+def test_an_event_dataset_trains_and_predicts_as_the_cli_does(exported, tmp_path):
+    """A dataset folder of address events, given to Model.train and predict, runs the
+    CLI's own train and predict workflows: the same model file, byte for byte, and the
+    same predictions, for the spiking network and a feature classifier alike."""
+    for name, kind, knobs, flags in [
+        ("snn", "snn", {"hidden": 8, "epochs": 2}, ["--snn-hidden", "8", "--snn-epochs", "2"]),
+        ("knn", "knn", {"k": 3}, ["-k", "3"]),
+    ]:
+        model = neurotex.Model.train(exported, classifier=kind, classifier_options=knobs,
+                                     encoding="sa+fa")
+        assert isinstance(model, neurotex.SpikingModel) == (kind == "snn")
+        model.save(tmp_path / f"py-{name}.json")
+        run_cli("train", "--dataset", exported, "--classifier", kind, "--encoding", "sa+fa",
+                *flags, "--out", tmp_path / f"cli-{name}.json")
+        assert (tmp_path / f"py-{name}.json").read_bytes() == \
+            (tmp_path / f"cli-{name}.json").read_bytes()
+        labels = model.predict(exported)
+        shares = model.predict_proba(exported)
+        run_cli("predict", "--model", tmp_path / f"cli-{name}.json", "--dataset", exported,
+                "--out", tmp_path / f"cli-{name}.csv")
+        with open(tmp_path / f"cli-{name}.csv") as f:
+            rows = list(csv.DictReader(f))
+        assert list(labels) == [r["predicted"] for r in rows]
+        cli_shares = [[float(r[f"share_{c}"]) for c in model.classes_] for r in rows]
+        assert np.array_equal(shares, np.array(cli_shares))
+
+
+def test_a_sampled_folder_trains_the_cli_model_and_a_bad_path_is_named(sim_dir, tmp_path):
+    model = neurotex.Model.train(sim_dir, method="glcm3d", speeds=[5])
+    model.save(tmp_path / "py.json")
+    run_cli("train", "--dataset", sim_dir, "--speeds", "5", "--out", tmp_path / "cli.json")
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    with pytest.raises(neurotex.NotFoundError, match="no such dataset folder"):
+        model.predict(str(tmp_path / "missing"))
+    with pytest.raises(ParameterError, match="manifest"):
+        neurotex.Model.train(sim_dir, ["a"] * 30)

@@ -735,6 +735,12 @@ class _Predicting:
         return self._predict(recordings, fs, mask)[1]
 
     def _predict(self, recordings: Any, fs: float, mask: Any) -> Tuple[np.ndarray, np.ndarray]:
+        folder = _folder(recordings)
+        if folder is not None:
+            labels, shares, said = self._native.predict_dataset(folder)
+            for line in said:
+                _log.info("%s", line)
+            return np.array(labels, dtype=object), shares
         items = _recording_list(recordings)
         arrays, infos = _prepare(items, fs, mask)
         labels, shares = self._native.predict(arrays, infos)
@@ -744,6 +750,15 @@ class _Predicting:
     def classes_(self) -> List[str]:
         """The classes, in the order of :meth:`predict_proba`'s columns."""
         return list(self._native.labels)
+
+
+def _folder(recordings: Any) -> Optional[str]:
+    """The dataset folder ``recordings`` names (a path to a folder), or ``None``."""
+    if isinstance(recordings, (str, os.PathLike)) and os.path.isdir(recordings):
+        return os.fspath(recordings)
+    if isinstance(recordings, (str, os.PathLike)):
+        raise NotFoundError(f"{os.fspath(recordings)}: no such dataset folder")
+    return None
 
 
 def _training_set(recordings: Any, labels: Optional[Sequence[Any]], fs: float, mask: Any,
@@ -808,6 +823,11 @@ class Model(_Predicting):
         ``labels`` default to the recordings' own (a :class:`Dataset`'s). ``stage_options``
         are :func:`features`' (gain, cutoff, levels, ...).
 
+        ``recordings`` may be a dataset folder's path, sampled or of address events: the
+        model is then trained by ``neurotex train --dataset``'s own workflow (the CLI's
+        model file, byte for byte), with ``speeds`` the speeds to train on (``--speeds``;
+        all when ``None``) and the labels the manifest's.
+
         ``causal=True`` trains a causal model (``neurotex train --causal``): a forward-only
         low-pass, and each taxel's resting value and one normalisation scale fixed on
         these recordings (labels unused) and stored in the model, so that
@@ -823,6 +843,10 @@ class Model(_Predicting):
                 "invalid parameter `classifier`: van-rossum classifies with knn, spikes with "
                 "snn (the spiking network), and the feature methods with knn, forest or "
                 f"linear, got {classifier} with the {method} method")
+        folder = _folder(recordings)
+        if folder is not None:
+            return _train_folder(folder, labels, method, classifier, classifier_options,
+                                 taxel, speeds, causal, stage_options)
         if method == "spikes":
             if taxel is not None:
                 raise ParameterError("taxel applies to method='taxel' only")
@@ -883,6 +907,27 @@ class Model(_Predicting):
 
 
 
+def _train_folder(folder: str, labels: Any, method: Optional[str], classifier: Optional[str],
+                  classifier_options: Any, taxel: Optional[str], speeds: Any, causal: bool,
+                  stage_options: Dict[str, Any]) -> "Model":
+    """A model trained on a dataset folder by ``neurotex train``'s own workflow: the CLI's
+    model file, byte for byte, for sampled recordings and address events alike."""
+    if labels is not None:
+        raise ParameterError("labels: a dataset folder's labels are its manifest's")
+    opts = _stage_options(**stage_options)
+    opts["causal"] = bool(causal)
+    only = None if speeds is None else [float(v) for v in np.atleast_1d(speeds)]
+    native, log, said = _native.train_dataset(folder, method, classifier,
+                                              dict(classifier_options or {}), opts, only,
+                                              taxel)
+    for line in said:
+        _log.info("%s", line)
+    if log is None:
+        return Model(native)
+    ran, best, loss = log
+    return SpikingModel(native, {"epochs": ran, "best_epoch": best, "validation_loss": loss})
+
+
 def _nir() -> Any:
     """The ``nir`` package, or an error that says how to get it."""
     try:
@@ -937,13 +982,19 @@ class SpikingModel(Model):
         the network runs: ``"float"`` or ``"xylo"`` (trained within Xylo Audio 2's limits,
         predicting in the chip's integers; ``--snn-target``). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
         ...) as :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
-        arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
-        opts = _stage_options(**stage_options)
-        opts["causal"] = bool(causal)
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
                "seed": seed, "recurrent": recurrent, "target": target}
         if reset is not None:
             snn["reset"] = reset
+        folder = _folder(recordings)
+        if folder is not None:
+            model = _train_folder(folder, labels, "spikes", "snn", snn, None, speeds, causal,
+                                  stage_options)
+            assert isinstance(model, SpikingModel)
+            return model
+        arrays, infos, fp, baseline = _training_set(recordings, labels, fs, mask, speeds)
+        opts = _stage_options(**stage_options)
+        opts["causal"] = bool(causal)
         native, ran, best, loss = _native.train_spiking_model(arrays, infos, opts, snn, fp,
                                                               baseline)
         return cls(native, {"epochs": ran, "best_epoch": best, "validation_loss": loss})

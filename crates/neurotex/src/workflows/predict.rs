@@ -87,22 +87,14 @@ impl PredictOptions {
         dataset: Option<&Dataset>,
         on: OnProgress,
     ) -> Result<Vec<Encoded>> {
-        let encoded = match dataset {
-            Some(dataset) => encode_dataset(model.pipeline(), model.baseline(), dataset, on)?,
-            None => {
-                let (encoded, from) = model.encode_files(&self.files, &self.read.reading()?)?;
-                for note in ReadOptions::layout_notes(&from) {
-                    on(Progress::Say(&note));
-                }
-                encoded
-            }
-        };
-        // Refused before anything else is said of them, --causal's needs included.
-        for e in &encoded {
-            model.check_source(e)?;
+        if let Some(dataset) = dataset {
+            return encode_for(model, dataset, on);
         }
-        say_conditions(&encoded, on);
-        Ok(encoded)
+        let (encoded, from) = model.encode_files(&self.files, &self.read.reading()?)?;
+        for note in ReadOptions::layout_notes(&from) {
+            on(Progress::Say(&note));
+        }
+        checked(model, encoded, on)
     }
 
     /// Every recording's per-bin decisions and end, as `stream` decides them.
@@ -135,6 +127,27 @@ impl PredictOptions {
 }
 
 /// Encodes every recording of `dataset` with a model's pipeline and baseline.
+/// Every recording of `dataset` (sampled or address events) encoded with `model`'s own
+/// pipeline, as `predict --dataset` encodes them, and checked against what the model was
+/// trained on (grid, populations, stamps).
+///
+/// # Errors
+/// A recording that cannot be read or encoded, or one the model cannot take.
+pub fn encode_for(model: &SavedModel, dataset: &Dataset, on: OnProgress) -> Result<Vec<Encoded>> {
+    let encoded = encode_dataset(model.pipeline(), model.baseline(), dataset, on)?;
+    checked(model, encoded, on)
+}
+
+/// `encoded` once every recording passed the model's checks, the conditions said.
+fn checked(model: &SavedModel, encoded: Vec<Encoded>, on: OnProgress) -> Result<Vec<Encoded>> {
+    // Refused before anything else is said of them, --causal's needs included.
+    for e in &encoded {
+        model.check_source(e)?;
+    }
+    say_conditions(&encoded, on);
+    Ok(encoded)
+}
+
 fn encode_dataset(
     pipeline: &Pipeline,
     baseline: Baseline,
