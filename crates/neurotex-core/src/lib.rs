@@ -14,6 +14,7 @@ pub mod progress;
 pub mod recording;
 #[doc(hidden)]
 pub mod simd;
+pub mod spikes;
 pub mod values;
 
 pub use error::{Error, Result};

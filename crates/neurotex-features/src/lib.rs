@@ -8,4 +8,4 @@ pub mod features;
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
 use neurotex_core::error;
-use neurotex_signal::encode;
+use neurotex_core::spikes;

@@ -47,6 +47,13 @@ fn load_dataset<'py>(
     indices: Option<Vec<usize>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let dataset = open(&dir)?;
+    if dataset.is_events() {
+        let message = format!(
+            "{}: an address-event dataset (its layout.toml has an [events] table), not sampled signals: its events are neurotex.events(path) or neurotex.tonic.Dataset(path), and Model.train(path) and model.predict(path) train and predict on the folder itself",
+            dir.display()
+        );
+        return Err(raise(Kind::Data, message));
+    }
     let n = dataset.entries.len();
     let indices = indices.unwrap_or_else(|| (0..n).collect());
     if let Some(&bad) = indices.iter().find(|&&i| i >= n) {

@@ -157,3 +157,8 @@ def test_a_sampled_folder_trains_the_cli_model_and_a_bad_path_is_named(sim_dir, 
         model.predict(str(tmp_path / "missing"))
     with pytest.raises(ParameterError, match="manifest"):
         neurotex.Model.train(sim_dir, ["a"] * 30)
+
+
+def test_load_dataset_of_an_event_folder_says_where_its_events_go(exported):
+    with pytest.raises(neurotex.DataError, match=r"neurotex.events\(path\)"):
+        neurotex.load_dataset(exported)

@@ -6,8 +6,8 @@ use std::cmp::Ordering;
 use serde::{Deserialize, Serialize};
 
 use super::exact::{f64_parts, sign_of_sum};
-use crate::encode::SpikeTrains;
 use crate::error::ParamError;
+use crate::spikes::SpikeTrains;
 
 /// Binning and quantisation parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -600,7 +600,7 @@ fn bisect(mut low: u64, mut high: u64, high_side: impl Fn(u64) -> bool) -> (u64,
 #[cfg(test)]
 mod tests {
     use super::{count_levels, CountVolume, FastDivide};
-    use crate::encode::SpikeTrains;
+    use crate::spikes::SpikeTrains;
     use proptest::prelude::*;
 
     /// A fraction `num / den`, `den > 0`, for levels straight from SPEC 3.9's formula.

@@ -37,8 +37,8 @@ use rayon::prelude::*;
 
 use super::knn::{insert, majority};
 use super::samples::{Decide, Learner, Samples};
-use crate::encode::SpikeTrains;
 use crate::error::{ClassifyError, ParamError};
+use crate::spikes::SpikeTrains;
 
 /// Largest `taxels x steps` trace table the fast matrix path builds per worker (32 MB of
 /// `f64`); longer recordings use the exact pairwise merge, slower but without the table.

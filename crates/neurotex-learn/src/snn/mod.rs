@@ -37,8 +37,8 @@ pub mod xylo;
 
 use serde::{Deserialize, Serialize};
 
-use crate::encode::SpikeTrains;
 use crate::error::ParamError;
+use crate::spikes::SpikeTrains;
 
 pub use train::fit;
 pub use xylo::Target;
