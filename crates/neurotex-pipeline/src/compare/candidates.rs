@@ -5,12 +5,11 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::evaluator::{evaluator, Shared};
 use super::Candidate;
-use crate::analysis::{evaluate, Columns, FeatureTable};
-use crate::classify::SnnClassifier;
+use crate::analysis::{Columns, FeatureTable};
 use crate::classify::{
-    ClassifierChoice, DistanceMatrix, ForestParams, KnnParams, SpikeDistanceKnn, VanRossum,
-    VanRossumParams,
+    ClassifierChoice, DistanceMatrix, ForestParams, KnnParams, VanRossum, VanRossumParams,
 };
 use crate::encode::SpikeTrains;
 use crate::error::{ParamError, Result};
@@ -240,47 +239,6 @@ pub fn candidates(
         }
     }
     Ok(out)
-}
-
-/// What a method's classifier shares across folds besides its table.
-#[derive(Clone)]
-pub(crate) enum Shared {
-    /// Nothing: feature rows.
-    None,
-    /// Van Rossum distances between every two recordings.
-    Distances(Arc<DistanceMatrix>),
-    /// Every recording's spikes as the spiking network's input.
-    Spikes(Arc<Vec<SpikeInput>>),
-}
-
-/// The classifier as a [`Candidate::evaluate`]; with a distance matrix, KNN over it; with
-/// spike inputs, the spiking network.
-pub(crate) fn evaluator(
-    classifier: ClassifierChoice,
-    shared: Shared,
-) -> Result<Arc<super::EvaluateFn>> {
-    Ok(match (shared, classifier) {
-        (Shared::Distances(matrix), ClassifierChoice::Knn(p)) => {
-            let knn = SpikeDistanceKnn::new(matrix, p.k)?;
-            Arc::new(move |t, c, s| evaluate(t, c, s, &knn))
-        }
-        (Shared::Distances(_), other) => {
-            let rule = "the van-rossum method classifies with KNN only";
-            return Err(ParamError::new("classifiers", rule, other.name()).into());
-        }
-        (Shared::Spikes(inputs), ClassifierChoice::Snn(p)) => {
-            let snn = SnnClassifier::new(p.check()?, inputs);
-            Arc::new(move |t, c, s| evaluate(t, c, s, &snn))
-        }
-        (Shared::Spikes(_), other) => {
-            let rule = "the spikes method classifies with the spiking network (snn) only";
-            return Err(ParamError::new("classifiers", rule, other.name()).into());
-        }
-        (Shared::None, classifier) => {
-            let chosen = classifier.check()?;
-            Arc::new(move |t, c, s| evaluate(t, c, s, &chosen))
-        }
-    })
 }
 
 /// Every recording's spikes under `encoding` binned to the spiking network's time step

@@ -17,6 +17,7 @@
 //! its training recordings only, and the chosen one is scored on its test recordings.
 
 pub mod candidates;
+mod evaluator;
 pub mod signal;
 
 use std::sync::Arc;

@@ -19,7 +19,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use super::candidates::evaluator;
+use super::evaluator::{evaluator, Shared};
 use super::Candidate;
 use crate::analysis::{Columns, FeatureTable};
 use crate::classify::ClassifierChoice;
@@ -152,7 +152,7 @@ pub fn baseline_candidates(
                 classifier: classifier.name().to_string(),
                 table: Arc::clone(&table),
                 columns: Columns::All,
-                evaluate: evaluator(classifier, super::candidates::Shared::None)?,
+                evaluate: evaluator(classifier, Shared::None)?,
                 prepare_s,
             });
         }
