@@ -1,4 +1,4 @@
-//! The paper's analyses E0-E8 (SPEC section 4), one file and one function each, from
+//! The paper's analyses E0-E8 (docs/analyses.md), one file and one function each, from
 //! prepared recordings, their feature tables and validated parameters to a result struct.
 //!
 //! [`prepare`] makes one pass over the recordings (simulated or a dataset folder),
