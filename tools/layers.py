@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """The house in layers, checked: each crate's lines and the crates it depends on, and any
 import circle between the files of a crate. Exits 1 when a circle is found, when a library
-crate is over 12 000 lines or the CLI over 1 500, or when a function outside tests and SIMD
-kernels is over 80 lines.
+crate is over 12 000 lines or the CLI over 1 500, when a function outside tests and SIMD
+kernels is over 80 lines, or when ARCHITECTURE.md names in backticks a path (`tools/x.py`)
+or a module path (`recording::read_recording`, `Dataset::open`, a bold **`module`**) that
+is not in the tree.
 
     python3 tools/layers.py              # from the repository root
     python3 tools/layers.py --self-test  # the circle finder on a small tree of its own
@@ -71,12 +73,17 @@ USE = re.compile(r"^\s*(pub(?:\([^)]*\))?\s+)?use\s+([^;]*);", re.M)
 PATH = re.compile(r"\b((?:crate|super|self)(?:\s*::\s*[A-Za-z_][A-Za-z_0-9]*)+)")
 
 
+LEXEME = re.compile(r"""//[^\n]*|/\*.*?\*/|r(\#*)"[\s\S]*?"\1|"(?:[^"\\]|\\.)*"|'(?:[^'\\\n]|\\[^\n]{1,9})'""",
+                    re.S)
+
+
 def code_of(path):
-    """A file's text without its tests, comments and string literals' contents."""
-    text = without_tests(open(path).read())
-    text = re.sub(r"//[^\n]*", "", text)
-    text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
-    return re.sub(r'"(?:[^"\\]|\\.)*"', '""', text)
+    """A file's text without its tests and comments, and with its string and character
+    literals emptied (one pass, so that `"//"` is a string and `'"'` a character)."""
+    def blank(m):
+        token = m.group(0)
+        return "" if token.startswith("/") else ("' '" if token.startswith("'") else '""')
+    return LEXEME.sub(blank, without_tests(open(path).read()))
 
 
 def use_paths(tree):
@@ -325,6 +332,66 @@ def self_test():
     return 0
 
 
+# Crates the facade re-exports under another name (`neurotex::stream` is `neurotex-stream`).
+ALIASES = {"stream": ("neurotex-stream", ())}
+
+
+def module_index():
+    """(crate, module path) -> file, over every crate's sources."""
+    index = {}
+    for c in sorted(os.listdir(CRATES)):
+        src = os.path.join(CRATES, c, "src")
+        if os.path.isdir(src):
+            index.update({(c, m): f for m, f in crate_files(src).items()})
+    return index
+
+
+def names_module_path(segs, index):
+    """Whether `a::b::f` names a module of some crate and an item of it (a name its file
+    defines or re-exports), or `Type::item` a type with that item in an `impl` of it."""
+    segs = [s for s in segs if not s.startswith("neurotex")]
+    if not segs or segs[0] in ("crate", "self", "super", "std"):
+        return True
+    if segs[0][0].isupper():
+        impl = re.compile(r"impl\b[^{;]*\b" + segs[0] + r"\b")
+        item = re.compile(r"\b(?:fn|const|type)\s+" + segs[1] + r"\b")
+        return any(impl.search(t) and item.search(t) for t in map(code_of, index.values()))
+    starts = [(c, m) for c, m in index if m and m[-1] == segs[0]]
+    starts += [ALIASES[segs[0]]] if segs[0] in ALIASES else []
+    for crate, module in starts:
+        found = True
+        for seg in segs[1:]:
+            if (crate, module + (seg,)) in index:
+                module += (seg,)
+                continue
+            # An item of this module (what comes after it, `Type::method`, is not checked).
+            found = re.search(r"\b" + seg + r"\b", code_of(index[(crate, module)])) is not None
+            break
+        if found:
+            return True
+    return False
+
+
+def document_names(path):
+    """What `path` (a Markdown file) names in backticks that does not exist: a path with a
+    `/` (from the repository's root, a crate's folder or its `src/`) or a module path
+    (`recording::read_recording`, and each bold **`module`** of the code map)."""
+    text = open(path).read()
+    index = module_index()
+    missing = []
+    for name in sorted(set(re.findall(r"`([^`\s]*/[^`\s]*)`", text))):
+        bases = [ROOT] + [os.path.join(CRATES, c, sub) for c in os.listdir(CRATES)
+                          for sub in ("", "src")]
+        if not any(os.path.exists(os.path.join(b, name)) for b in bases):
+            missing.append(name)
+    paths = re.findall(r"`([A-Za-z_][A-Za-z_0-9]*(?:::[A-Za-z_][A-Za-z_0-9]*)+)`", text)
+    paths += re.findall(r"\*\*`([a-z_][a-z_0-9]*)`\*\*", text)
+    for name in sorted(set(paths)):
+        if not names_module_path(name.split("::"), index):
+            missing.append(name)
+    return missing
+
+
 def main():
     if sys.argv[1:] == ["--self-test"]:
         return self_test()
@@ -349,6 +416,9 @@ def main():
             for name, line, length in long_functions(f):
                 print(f"  {os.path.relpath(f, ROOT)}:{line}: fn {name} is {length} lines")
                 failed = True
+    for name in document_names(os.path.join(ROOT, "ARCHITECTURE.md")):
+        print(f"  ARCHITECTURE.md names `{name}`, which is not in the tree")
+        failed = True
     return 1 if failed else 0
 
 
