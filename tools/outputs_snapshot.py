@@ -16,8 +16,8 @@ step's standard output and error), `files/` (every file the commands wrote) and
 `MANIFEST.sha256` (a sha256 per file). Text is normalised before it is stored and hashed,
 so that two runs of one binary give identical snapshots; what is normalised, and why, is
 listed at `NORMALISE`. The recordings of the simulated and imported datasets, and any file
-over `COPY_LIMIT` bytes, are hashed but not copied. Nothing is normalised in binary files: they must be equal as they
-are.
+over `COPY_LIMIT` bytes, are hashed but not copied. Nothing is normalised in binary files:
+they must be equal as they are.
 """
 import difflib
 import hashlib
@@ -246,6 +246,7 @@ def run_steps(binary, work, out, steps):
     log = []
     for i, (name, args) in enumerate(steps, 1):
         stem = f"{i:02d}-{name}"
+        # `stream` reads text frames: one simulated recording written as CSV, by this script.
         if name == "stream-sim-csv":
             npy_to_csv(os.path.join(work, "sim", "FT1_v5_t00.npy"),
                        os.path.join(work, "out", "sim-frames.csv"))
