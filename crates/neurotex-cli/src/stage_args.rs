@@ -7,7 +7,8 @@ use clap::error::ErrorKind;
 use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
 use neurotex::options::{OptionKind, OptionSpec, StageOptions, STAGE_OPTIONS};
 
-/// Stage parameters; defaults are the paper's values (or SPEC's choice where it gives none).
+/// Stage parameters; defaults are the paper's values (or, where it gives none, a choice
+/// whose reasons docs/decisions/ gives).
 #[derive(Debug, Clone, Default)]
 pub struct StageArgs {
     /// The stage options as given, unchecked.

@@ -1,5 +1,6 @@
-//! Outputs whole or not at all (SPEC 8): a failed or interrupted run leaves no
-//! output file or folder and no temporary one.
+//! Outputs whole or not at all
+//! (docs/decisions/0012-outputs-whole-and-never-over-what-is-not-theirs.md): a failed or
+//! interrupted run leaves no output file or folder and no temporary one.
 
 use std::path::Path;
 use std::process::{Command, Stdio};

@@ -1,7 +1,8 @@
-//! Hostile and extreme input (SPEC 8, limits): headers that claim more than the file
-//! holds, time spans and grids beyond the documented limits, huge counts, manifest paths
-//! leaving the dataset, and inputs that would overwrite one another. Each must fail with a
-//! message naming the file or option and the limit, exit 1 or 2, and leave no output.
+//! Hostile and extreme input (the limits of docs/your-data.md): headers that claim more
+//! than the file holds, time spans and grids beyond the documented limits, huge counts,
+//! manifest paths leaving the dataset, and inputs that would overwrite one another. Each
+//! must fail with a message naming the file or option and the limit, exit 1 or 2, and leave
+//! no output.
 
 use std::path::Path;
 

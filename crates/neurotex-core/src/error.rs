@@ -125,8 +125,8 @@ pub enum DataError {
         /// The bin, ms.
         bin_ms: usize,
     },
-    /// A size beyond one of neurotex's limits (SPEC 8), in data that has no file of its
-    /// own (the recording is named by [`Error::in_recording`]).
+    /// A size beyond one of neurotex's limits on input (docs/your-data.md), in data that
+    /// has no file of its own (the recording is named by [`Error::in_recording`]).
     #[error("{what} is {got}, beyond the limit of {limit}: {hint}")]
     TooLarge {
         /// What is too large.

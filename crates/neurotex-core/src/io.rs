@@ -1,6 +1,8 @@
-//! Writing outputs whole or not at all (SPEC 8): every file neurotex writes goes through
-//! [`write_atomic`] (or [`stage`] and [`Staged::commit`] when several files must appear
-//! together), and every folder through a [`Temporary`] folder renamed into place.
+//! Writing outputs whole or not at all (why:
+//! docs/decisions/0012-outputs-whole-and-never-over-what-is-not-theirs.md): every file
+//! neurotex writes goes through [`write_atomic`] (or [`stage`] and [`Staged::commit`] when
+//! several files must appear together), and every folder through a [`Temporary`] folder
+//! renamed into place.
 //!
 //! Each temporary file or folder is listed in a process-wide registry from before it is
 //! created until it is renamed into place or removed, so that a signal handler in the

@@ -1,5 +1,6 @@
 //! The header of a `.npy` file, read and checked against the file's size before any array
-//! is allocated (SPEC 8: no allocation larger than the input can hold).
+//! is allocated: no allocation larger than the input can hold
+//! (docs/decisions/0017-npy-header-checked-before-reading.md).
 //!
 //! ndarray-npy 0.9 keeps its header parser private (`mod npy` is not public) and allocates
 //! the array the header describes before it finds the data missing, so a 192-byte file

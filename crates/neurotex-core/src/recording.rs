@@ -1,4 +1,4 @@
-//! The data model (SPEC section 2): recordings, layouts, dataset folders and their I/O.
+//! The data model: recordings, layouts, dataset folders and their I/O (docs/your-data.md).
 //!
 //! A dataset is a folder with `manifest.csv` naming recordings (`.npy` or `.csv`) and an
 //! optional `layout.toml`. Recordings are loaded one at a time ([`Dataset::load`]) so a
@@ -183,7 +183,7 @@ impl Recording {
     }
 }
 
-/// How to remove a taxel's resting value before encoding (SPEC 3.3).
+/// How to remove a taxel's resting value before encoding.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", tag = "kind")]
 pub enum Baseline {

@@ -1,6 +1,6 @@
-//! Causal classification (SPEC 10; the paper's own drawback: "its reliance on whole spike
-//! trains making it inherently non real-time"): a decision at every rate-volume bin from
-//! what has been sensed so far, and the offline twin of [`crate::stream`].
+//! Causal classification (the paper's own drawback: "its reliance on whole spike trains
+//! making it inherently non real-time"): a decision at every rate-volume bin from what has
+//! been sensed so far, and the offline twin of [`crate::stream`].
 //!
 //! A causal model conditions with a forward-only filter and a resting value and scale
 //! fixed at training ([`CausalConditioning`], set by [`calibrate_conditioning`]), so a

@@ -1,7 +1,8 @@
-//! Saved models (SPEC 10): a classifier trained on one dataset, with everything needed to
-//! apply it to new recordings, in one self-describing, versioned JSON file: the validated
-//! pipeline, the feature method and columns, the taxel grid, the classifier's parameters
-//! and training set, the class labels, and the training data's fingerprint.
+//! Saved models (docs/models-and-streaming.md): a classifier trained on one dataset, with
+//! everything needed to apply it to new recordings, in one self-describing, versioned JSON
+//! file: the validated pipeline, the feature method and columns, the taxel grid, the
+//! classifier's parameters and training set, the class labels, and the training data's
+//! fingerprint.
 //!
 //! The fitted classifier (KNN, random forest or logistic regression, a [`ClassifierChoice`]
 //! tagged by `kind`) is kept in the file as its parameters and its training feature rows

@@ -109,7 +109,8 @@ pub struct StageOptions {
 }
 
 impl Default for StageOptions {
-    /// The library's defaults: the paper's values, or SPEC's choice where it gives none.
+    /// The library's defaults: the paper's values, or where it gives none a choice whose
+    /// reasons docs/decisions/ gives.
     fn default() -> Self {
         let (pre, volume) = (PreprocessParams::default(), VolumeParams::default());
         let features = FeatureParams::default();

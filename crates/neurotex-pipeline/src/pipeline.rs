@@ -274,9 +274,9 @@ impl FeatureParams {
     }
 }
 
-/// All stage parameters, each with the paper's value (or SPEC's choice) as default. The
-/// fields after `glcm` default when absent, so model files written before them load with
-/// the paper's SA encoding.
+/// All stage parameters, each with the paper's value as default (or, where the paper gives
+/// none, a choice whose reasons docs/decisions/ gives). The fields after `glcm` default
+/// when absent, so model files written before them load with the paper's SA encoding.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct PipelineParams {
     /// Conditioning.

@@ -6,9 +6,10 @@ against a numpy/scipy implementation of the same pipeline
     python bench/bench_features.py [--cli PATH] [--repeats 5] [--data DIR]
 
 Prints the median of each timing. The numpy peer is the straightforward vectorised
-version a Python user would write: scipy's filtfilt per recording, the Izhikevich
-encoder batched over every neuron of every trial (the peer of SPEC section 7), rate
-volumes by reshaping, 52 co-occurrence offsets by np.bincount, Haralick features in numpy.
+version a Python user would write (as the peers of docs/performance.md): scipy's
+filtfilt per recording, the Izhikevich encoder batched over every neuron of every trial,
+rate volumes by reshaping, 52 co-occurrence offsets by np.bincount, Haralick features in
+numpy.
 """
 
 from __future__ import annotations

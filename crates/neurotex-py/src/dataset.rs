@@ -11,6 +11,7 @@ use neurotex::recording::{
 };
 use neurotex::sim::{check_design, design, write_dataset, RigParams, Texture, ALL_TEXTURES};
 use neurotex::workflows::export::encoded_events;
+use neurotex::workflows::simulate::texture;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -333,16 +334,7 @@ fn simulate(
         None => ALL_TEXTURES.to_vec(),
         Some(names) => names
             .iter()
-            .map(|n| {
-                Texture::from_name(n.trim()).ok_or_else(|| {
-                    raise(
-                        Kind::Parameter,
-                        format!(
-                            "unknown texture `{n}`: expected FT1, FT2, FT3, RT, TRug, SB, CP or STF"
-                        ),
-                    )
-                })
-            })
+            .map(|n| texture(n).map_err(|why| raise(Kind::Parameter, why)))
             .collect::<PyResult<_>>()?,
     };
     for &s in &speeds {

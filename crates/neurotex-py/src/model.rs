@@ -55,9 +55,9 @@ impl NativeModel {
         &self,
         py: Python<'py>,
         path: PathBuf,
-    ) -> PyResult<crate::workflow::FolderPredictions<'py>> {
+    ) -> PyResult<FolderPredictions<'py>> {
         let model = neurotex::saved::SavedModel::from(self.inner.clone());
-        crate::workflow::predict_dataset(py, model, path)
+        predict_dataset(py, model, path)
     }
 
     /// The classes, in the order of the shares' columns.
@@ -233,6 +233,53 @@ pub(crate) fn predict_recordings<'py>(
         })
     })?;
     labels_and_shares(py, predictions, classes)
+}
+
+/// A folder's predictions: the labels, each class's share `(n, classes)`, and what the
+/// workflow said.
+pub(crate) type FolderPredictions<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>, Vec<String>);
+
+/// A model applied to every recording of the dataset folder `path` (sampled or address
+/// events) as `neurotex predict --dataset PATH` applies it: `(predicted labels, shares
+/// (n, classes), what was said)`.
+pub(crate) fn predict_dataset<'py>(
+    py: Python<'py>,
+    model: neurotex::saved::SavedModel,
+    path: PathBuf,
+) -> PyResult<FolderPredictions<'py>> {
+    let dataset = crate::convert::open(&path)?;
+    let said = Said::default();
+    let on = |p: neurotex::progress::Progress| said.hear(p);
+    let predictions = py.detach(|| {
+        guarded(|| {
+            let encoded = neurotex::workflows::predict::encode_for(&model, &dataset, &on)?;
+            model.predict(&encoded)
+        })
+    })?;
+    let (labels, shares) = labels_and_shares(py, predictions, model.labels().len())?;
+    Ok((labels, shares, said.lines()))
+}
+
+/// What a workflow said on its way (advice, calibrations), for Python's log.
+#[derive(Default)]
+pub(crate) struct Said(std::sync::Mutex<Vec<String>>);
+
+impl Said {
+    pub(crate) fn hear(&self, progress: neurotex::progress::Progress) {
+        let line = match progress {
+            neurotex::progress::Progress::Say(s) | neurotex::progress::Progress::Advice(s) => {
+                s.to_string()
+            }
+            _ => return,
+        };
+        if let Ok(mut lines) = self.0.lock() {
+            lines.push(line);
+        }
+    }
+
+    pub(crate) fn lines(self) -> Vec<String> {
+        self.0.into_inner().unwrap_or_default()
+    }
 }
 
 /// Predictions as `(labels, shares (n, classes))`.

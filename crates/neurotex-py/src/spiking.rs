@@ -90,9 +90,9 @@ impl NativeSpikingModel {
         &self,
         py: Python<'py>,
         path: PathBuf,
-    ) -> PyResult<crate::workflow::FolderPredictions<'py>> {
+    ) -> PyResult<crate::model::FolderPredictions<'py>> {
         let model = neurotex::saved::SavedModel::from(self.inner.clone());
-        crate::workflow::predict_dataset(py, model, path)
+        crate::model::predict_dataset(py, model, path)
     }
 
     #[getter]

@@ -5,52 +5,24 @@
 //! conversion of its keywords into the workflow's options.
 
 use std::path::PathBuf;
-use std::sync::Mutex;
 
 use neurotex::classify::ClassifierChoice;
 use neurotex::progress::Progress;
 use neurotex::samples::MethodChoice;
-use neurotex::saved::SavedModel;
-use neurotex::workflows::predict::encode_for;
 use neurotex::workflows::train::TrainOptions;
 use neurotex::workflows::{ClassifierOptions, KnnOptions, OpenOptions};
 use neurotex::{Cell, Speed};
-use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::open;
 use crate::errors::{guarded, param};
-use crate::model::{labels_and_shares, NativeModel};
+use crate::model::{NativeModel, Said};
 use crate::params;
 use crate::spiking::NativeSpikingModel;
 
-/// A folder's predictions: the labels, each class's share `(n, classes)`, and what the
-/// workflow said.
-pub(crate) type FolderPredictions<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>, Vec<String>);
-
 /// How a spiking network's training went: epochs run, the best epoch, its validation loss.
 type TrainingLog = (usize, usize, f64);
-
-/// What a workflow said on its way (advice, calibrations), for Python's log.
-#[derive(Default)]
-struct Said(Mutex<Vec<String>>);
-
-impl Said {
-    fn hear(&self, progress: Progress) {
-        let line = match progress {
-            Progress::Say(s) | Progress::Advice(s) => s.to_string(),
-            _ => return,
-        };
-        if let Ok(mut lines) = self.0.lock() {
-            lines.push(line);
-        }
-    }
-
-    fn lines(self) -> Vec<String> {
-        self.0.into_inner().unwrap_or_default()
-    }
-}
 
 /// The classifier `kind` (`None`: what `method` implies) with Python's knobs
 /// `options`, as `train`'s options take it.
@@ -141,27 +113,6 @@ fn train_dataset(
         inner: trained.model,
     };
     Ok((Py::new(py, model)?.into_any(), None, said.lines()))
-}
-
-/// A model applied to every recording of the dataset folder `path` (sampled or address
-/// events) as `neurotex predict --dataset PATH` applies it: `(predicted labels, shares
-/// (n, classes), what was said)`.
-pub(crate) fn predict_dataset<'py>(
-    py: Python<'py>,
-    model: SavedModel,
-    path: PathBuf,
-) -> PyResult<crate::workflow::FolderPredictions<'py>> {
-    let dataset = open(&path)?;
-    let said = Said::default();
-    let on = |p: Progress| said.hear(p);
-    let predictions = py.detach(|| {
-        guarded(|| {
-            let encoded = encode_for(&model, &dataset, &on)?;
-            model.predict(&encoded)
-        })
-    })?;
-    let (labels, shares) = labels_and_shares(py, predictions, model.labels().len())?;
-    Ok((labels, shares, said.lines()))
 }
 
 /// Registers the workflows.

@@ -21,9 +21,10 @@ def expected_failures(estimator):
     """Checks that test a convention the library deliberately does otherwise."""
     if isinstance(estimator, KNNClassifier):
         return {
-            # SPEC 3.12: a tie in votes goes to the tied class with the nearest member, so
+            # KNN's tie rule (docs/decisions/0005-knn-k5-stratified-5-fold-cv.md): a tie in
+            # votes goes to the tied class with the nearest member, so
             # predict may differ from argmax(predict_proba) (argmax takes the first class).
-            "check_classifiers_train": "KNN vote ties go to the nearest class (SPEC 3.12)",
+            "check_classifiers_train": "KNN vote ties go to the nearest class",
             # The library refuses k > n_samples with its own message ("k = 5 neighbours
             # needs at least 5 training samples, got 1"), not scikit-learn's wording.
             "check_fit2d_1sample": "the library's message names k, not 'n_samples=1'",

@@ -1,6 +1,6 @@
-//! Signal conditioning before encoding (SPEC 3.1-3.5): sliding-phase selection,
-//! baseline removal, resampling to the encoder's 1 kHz, zero-phase Butterworth low-pass
-//! and global-max normalisation.
+//! Signal conditioning before encoding: sliding-phase selection, baseline removal,
+//! resampling to the encoder's 1 kHz, zero-phase Butterworth low-pass and global-max
+//! normalisation.
 
 use std::mem::MaybeUninit;
 
@@ -48,12 +48,13 @@ impl Default for PreprocessParams {
 }
 
 /// What causal conditioning fixes at training so that a sample can be conditioned the
-/// moment it arrives (SPEC 10): the offline pipeline's zero-phase filter needs the future,
-/// its `min` baseline and its division by the recording's maximum need the whole
-/// recording. Here the low-pass runs forward only (the same Butterworth biquad, started in
-/// its steady state for the first sample, as `scipy.signal.lfilter` with
-/// `lfilter_zi * x[0]`), each cell's resting value is subtracted as fixed `offsets`, and
-/// every sample is divided by one fixed `scale`
+/// moment it arrives, as a live stream needs
+/// (docs/decisions/0013-causal-conditioning-with-a-scale-fixed-at-training.md): the offline
+/// pipeline's zero-phase filter needs the future, its `min` baseline and its division by
+/// the recording's maximum need the whole recording. Here the low-pass runs forward only
+/// (the same Butterworth biquad, started in its steady state for the first sample, as
+/// `scipy.signal.lfilter` with `lfilter_zi * x[0]`), each cell's resting value is
+/// subtracted as fixed `offsets`, and every sample is divided by one fixed `scale`
 /// ([`crate::causal::calibrate_conditioning`] sets both from the training recordings).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CausalConditioning {

@@ -1,7 +1,7 @@
-//! A live taxel stream classified frame by frame with a causal model (SPEC 10): online
-//! resampling to 1 kHz, the causal filter, the fixed resting values and scale, Izhikevich
-//! state across frames, and at every bin boundary the model's classification of the
-//! current window with the decision rule of [`crate::causal`].
+//! A live taxel stream classified frame by frame with a causal model (docs/live-rigs.md):
+//! online resampling to 1 kHz, the causal filter, the fixed resting values and scale,
+//! Izhikevich state across frames, and at every bin boundary the model's classification of
+//! the current window with the decision rule of [`crate::causal`].
 //!
 //! Every stage keeps its state between frames and computes each 1 ms step with the same
 //! arithmetic as the offline causal pipeline ([`crate::signal::Preprocessor`] with

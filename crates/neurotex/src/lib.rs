@@ -9,12 +9,13 @@
 //!
 //! | layer | crate | modules |
 //! |---|---|---|
-//! | values, errors, recordings, readers, import, outputs | `neurotex-core` | [`values`], [`error`], [`recording`], [`csvlog`], [`import`], [`io`] |
+//! | values, errors, recordings, event files, readers, import, outputs, progress | `neurotex-core` | [`values`], [`error`], [`recording`], [`events`], [`csvlog`], [`import`], [`io`], [`progress`] |
 //! | conditioning and spike encoding | `neurotex-signal` | [`signal`], [`encode`] |
 //! | spike statistics and GLCM features | `neurotex-features` | [`features`] |
-//! | classifiers, cross-validation, statistics | `neurotex-learn` | [`classify`] |
+//! | classifiers, the spiking network, cross-validation, statistics | `neurotex-learn` | [`classify`], [`snn`] |
 //! | simulated recordings | `neurotex-sim` | [`sim`] |
-//! | stage options, pipeline, feature tables, models, streams, compare | `neurotex-pipeline` | [`pipeline`], [`analysis`], [`diagnostics`], [`model`], [`options`], [`calibrate`], [`causal`], [`stream`], [`compare`] |
+//! | stage options, pipeline, feature tables, evaluation, inspection, models, NIR, compare | `neurotex-pipeline` | [`pipeline`], [`options`], [`analysis`], [`evaluation`], [`diagnostics`], [`inspect`], [`calibrate`], [`causal`], [`model`], [`spiking_model`], [`nir`], [`saved`], [`compare`] |
+//! | live streams: frames, events, the Lab Streaming Layer | `neurotex-stream` | [`stream`] |
 //! | the paper's analyses | `neurotex-experiments` | [`experiments`] |
 //! | report and figures | `neurotex-report` | [`report`] |
 //! | the commands' options and workflows, shared by the command line and Python | `neurotex` | [`workflows`] |

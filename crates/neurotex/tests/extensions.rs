@@ -9,7 +9,9 @@ use neurotex::pipeline::{
 use neurotex::recording::Meta;
 use neurotex::values::Grid;
 
-/// The SPEC's scheme for one neuron, step by step, with a per-step input current.
+/// Izhikevich's own scheme for one neuron
+/// (docs/decisions/0001-izhikevich-rs-neurons-dt-1ms.md), step by step, with a per-step
+/// input current.
 fn slow_izhikevich(p: IzhikevichParams, current: &[f64]) -> Vec<u32> {
     let (mut v, mut u) = (p.c, p.b * p.c);
     let mut spikes = Vec::new();

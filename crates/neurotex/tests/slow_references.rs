@@ -386,8 +386,8 @@ proptest! {
     }
 
     /// Count volumes from spike trains, 3D (bins of `bin` ms) and 2D (one bin spanning the
-    /// train), against SPEC 3.9's formula in fractions, over counts on level boundaries
-    /// (the span of the counts a multiple of L) and anywhere.
+    /// train), against the quantisation's formula in fractions, over counts on level
+    /// boundaries (the span of the counts a multiple of L) and anywhere.
     #[test]
     fn count_volume_levels_are_the_formula_in_fractions(
         bin in prop_oneof![Just(201usize), Just(300), Just(7 * 31), 110usize..400],
@@ -472,7 +472,7 @@ proptest! {
 }
 
 /// A fraction `num / den` with `den > 0`, kept in lowest terms: the slow exact arithmetic
-/// of SPEC 3.9's levels.
+/// of the quantisation's levels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Frac(i128, i128);
 
@@ -512,8 +512,9 @@ fn level_value(x: Frac, lo: Frac, hi: Frac, levels: usize) -> Option<Frac> {
     (span.0 > 0).then(|| x.sub(lo).div(span).times(levels as i128))
 }
 
-/// SPEC 3.9: `min(L-1, floor((x - lo) / (hi - lo) * L))`, clamped at 0; 0 for a constant
-/// volume (`hi <= lo`).
+/// The quantisation's level, `min(L-1, floor((x - lo) / (hi - lo) * L))`, clamped at 0; 0
+/// for a constant volume (`hi <= lo`)
+/// (docs/decisions/0004-sixteen-gray-levels-over-the-volumes-own-range.md).
 fn level_by_definition(x: Frac, lo: Frac, hi: Frac, levels: usize) -> u8 {
     level_value(x, lo, hi, levels).map_or(0, |v| {
         v.0.div_euclid(v.1).clamp(0, levels as i128 - 1) as u8

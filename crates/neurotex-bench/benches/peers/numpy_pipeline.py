@@ -1,6 +1,6 @@
 """The paper's 3D-GLCM feature pipeline written the straightforward vectorised way a Python
 user would: scipy's filtfilt per recording, the Izhikevich encoder batched over every neuron
-of every trial (the encoder peer of SPEC section 7), rate volumes by reshaping, the 52
+of every trial (the encoder's peer in docs/performance.md), rate volumes by reshaping, the 52
 co-occurrence offsets by np.bincount, Haralick features in numpy. The peer of
 `neurotex features --method glcm3d` for `peers.py` and the Python package's
 `bench/bench_features.py`.

@@ -3,7 +3,7 @@ criterion benches (run both back to back on one host: these machines are noisy).
 
     python -m venv /tmp/peers && /tmp/peers/bin/pip install numpy scikit-learn \
         six pykwalify pywavelets simpleitk setuptools wheel versioneer
-    # pyradiomics 3.0.1 from its sdist, as SPEC section 7 describes
+    # pyradiomics 3.0.1 from its sdist, as docs/correctness.md shows
     /tmp/peers/bin/python crates/neurotex-bench/benches/peers/peers.py [--data DIR] [--cli PATH]
 
 Prints one line per stage with the median time and the work size. With `--data` (a folder

@@ -8,7 +8,8 @@ use clap::{Args, Subcommand};
 use neurotex::pipeline::Pipeline;
 use neurotex::workflows::calibrated_pipeline;
 use neurotex::workflows::export::{
-    export_events, export_inputs, export_nir, export_xylo, load_spiking, EventFormat, NirConvention,
+    export_events, export_inputs, export_nir, export_xylo, load_spiking, network_shape,
+    EventFormat, ExportInputsOptions, ExportNirOptions, ExportXyloOptions, NirConvention,
 };
 use neurotex::workflows::OpenOptions;
 
@@ -24,7 +25,7 @@ pub enum ExportCommand {
     /// labels in the graph's metadata. `--for` writes it for snnTorch, Norse, sinabs or
     /// Rockpool, each loading it unchanged; `neurotex predict --model FILE.nir` runs the
     /// `nir`, `norse` and `snntorch` graphs again.
-    Nir(ExportNirArgs),
+    Nir(ExportNirOptions),
     /// A spiking model trained for SynSense's Xylo Audio 2 (`train --classifier snn
     /// --snn-target xylo`) in the chip's integers (JSON): under `specification` the keyword
     /// arguments of Rockpool's `XyloSim.from_specification` (its bit-accurate simulator)
@@ -32,12 +33,12 @@ pub enum ExportCommand {
     /// labels, `readout` and `score_scale`. XyloSim run with `output_mode="Vmem"` on
     /// `export inputs` gives neurotex's scores: the readout's membrane, its mean over the
     /// window divided by `score_scale`.
-    Xylo(ExportXyloArgs),
+    Xylo(ExportXyloOptions),
     /// The spike tensors a spiking model's input node receives: one `(steps, inputs)`
     /// float32 NPY per recording of a dataset (spike counts per time step; inputs are the
     /// SA then the FA taxels in row-major order) and `index.csv` (`file,label,array`), so
     /// that the same network can be run or trained elsewhere on exactly neurotex's spikes.
-    Inputs(ExportInputsArgs),
+    Inputs(ExportInputsOptions),
     /// A dataset's recordings encoded into spikes, written as a new address-event dataset:
     /// one event file per recording (`t,x,y,p` CSV in ms, or tonic's structured `.npy` in
     /// microseconds), ON (`p` 1) for the SA population and OFF (`p` 0) for the FA one,
@@ -66,67 +67,6 @@ pub struct ExportEventsArgs {
     pub stages: StageArgs,
 }
 
-/// Options of `neurotex export nir`.
-#[derive(Args)]
-pub struct ExportNirArgs {
-    /// The spiking model file (`train --classifier snn`).
-    #[arg(long)]
-    pub model: PathBuf,
-    /// The NIR file to write.
-    #[arg(long)]
-    pub out: PathBuf,
-    /// The importer the graph is written for, each loading it unchanged with the network's
-    /// decisions and scores: `nir` (NIR's equations by forward Euler, seconds, `dt` in the
-    /// metadata: Norse, neurotex, any NIR reader), `snntorch` (its importer steps at 0.1 ms:
-    /// the constants are scaled to it), `norse` (the `nir` graph), `sinabs` or `rockpool`
-    /// (time in steps, exact decays; for networks trained with `--snn-reset subtract`).
-    #[arg(long = "for", alias = "convention", value_enum, default_value_t = NirConvention::Nir)]
-    pub convention: NirConvention,
-}
-
-/// Options of `neurotex export xylo`.
-#[derive(Args)]
-pub struct ExportXyloArgs {
-    /// The spiking model file, trained with `--snn-target xylo`.
-    #[arg(long)]
-    pub model: PathBuf,
-    /// The configuration file to write (JSON).
-    #[arg(long)]
-    pub out: PathBuf,
-}
-
-/// Options of `neurotex export inputs`.
-#[derive(Args)]
-pub struct ExportInputsArgs {
-    /// The spiking model whose pipeline and time step make the tensors.
-    #[arg(long)]
-    pub model: PathBuf,
-    /// The dataset folder whose recordings are exported.
-    #[arg(long)]
-    pub dataset: PathBuf,
-    /// The folder to write (new, empty, or an earlier export, which is replaced).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// How the dataset folder is opened.
-    #[command(flatten)]
-    pub open: OpenOptions,
-}
-
-/// A spiking model's network in words: inputs, hidden neurons, readouts with their labels,
-/// and the time step.
-fn shape(model: &neurotex::spiking_model::SpikingModel) -> String {
-    let net = model.network();
-    let recurrent = if net.recurrent() { " recurrent" } else { "" };
-    format!(
-        "{} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms",
-        net.inputs,
-        net.hidden,
-        net.classes,
-        model.labels().join(", "),
-        net.dt_ms
-    )
-}
-
 /// Runs `neurotex export nir`, `inputs` or `events`.
 pub fn run(command: ExportCommand) -> Result<()> {
     match command {
@@ -144,7 +84,7 @@ pub fn run(command: ExportCommand) -> Result<()> {
             eprintln!(
                 "NIR graph for {}: {} -> {}",
                 args.convention.name(),
-                shape(&model),
+                network_shape(&model),
                 shown(&args.out)
             );
         }
@@ -156,7 +96,7 @@ pub fn run(command: ExportCommand) -> Result<()> {
             })?;
             eprintln!(
                 "Xylo Audio 2 configuration: {}, 8-bit weights -> {}",
-                shape(&model),
+                network_shape(&model),
                 shown(&args.out)
             );
         }

@@ -36,24 +36,13 @@ pub fn run(args: TrainArgs) -> Result<()> {
         let trained = trained?;
         let model = &trained.model;
         save_to(&args.out, "the model", |p| model.save(p))?;
-        let net = model.network();
         eprintln!(
-            "{} on {} recordings of {} classes ({} inputs: taxels x populations; best validation loss {:.3} at epoch {} of {}) on the {} grid -> {}",
-            neurotex::classify::ClassifierChoice::Snn(model.params()),
-            model.training().recordings,
-            model.labels().len(),
-            net.inputs,
-            trained.log.validation_loss,
-            trained.log.best_epoch,
-            trained.log.epochs,
-            trained.grid,
+            "{} -> {}",
+            trained.summary(),
             crate::output::shown(&args.out)
         );
-        if trained.log.best_epoch == trained.log.epochs {
-            eprintln!(
-                "note: the validation loss was still falling at the last of the {} epochs: training stopped at the cap, not by early stopping; a larger --snn-epochs may do better",
-                trained.log.epochs
-            );
+        if let Some(note) = trained.at_the_cap() {
+            eprintln!("note: {note}");
         }
         return Ok(());
     }
@@ -62,13 +51,8 @@ pub fn run(args: TrainArgs) -> Result<()> {
     let model = &trained.model;
     save_to(&args.out, "the model", |p| model.save(p))?;
     eprintln!(
-        "{} on {} recordings of {} classes, {} {} features on the {} grid -> {}",
-        model.classifier(),
-        model.n_training(),
-        model.labels().len(),
-        model.features().columns.len(),
-        o.method().name(),
-        trained.grid,
+        "{} -> {}",
+        trained.summary(),
         crate::output::shown(&args.out)
     );
     Ok(())

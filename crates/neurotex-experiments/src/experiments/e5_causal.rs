@@ -1,7 +1,7 @@
-//! E5c (beyond the paper; SPEC 10): online time to recognition. The paper's 3D-GLCM + KNN
-//! with causal conditioning, classifying at every bin boundary from the slide so far, as
-//! `neurotex stream` does; beside the offline E5, and the accuracy the causal pipeline
-//! costs against the paper's zero-phase one on the same folds.
+//! E5c (beyond the paper; docs/analyses.md): online time to recognition. The paper's
+//! 3D-GLCM + KNN with causal conditioning, classifying at every bin boundary from the slide
+//! so far, as `neurotex stream` does; beside the offline E5, and the accuracy the causal
+//! pipeline costs against the paper's zero-phase one on the same folds.
 //!
 //! Each speed's causal conditioning (forward-only low-pass, resting values and scale) is
 //! fixed on all of that speed's recordings, labels unused ([`super::prepare`]): every one

@@ -1,4 +1,4 @@
-//! The paper's analyses E0-E8 (SPEC section 4), one file and one function each, from
+//! The paper's analyses E0-E8 (docs/analyses.md), one file and one function each, from
 //! prepared recordings, their feature tables and validated parameters to a result struct.
 //!
 //! [`prepare`] makes one pass over the recordings (simulated or a dataset folder),
@@ -26,6 +26,7 @@ mod prepare;
 mod provenance;
 mod seeds;
 mod skip;
+mod source;
 mod tables;
 #[cfg(test)]
 mod testing;
@@ -53,10 +54,11 @@ pub use encodings::{encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, Ove
 pub use params::{
     ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS, MAX_REPEATS,
 };
-pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, Source, WITHIN_SPEED};
+pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, WITHIN_SPEED};
 pub use provenance::Provenance;
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
 pub use skip::{Skip, Stop};
+pub use source::Source;
 pub use tables::{EncodingTables, Headline, Tables};
 
 /// One encoding: what results files written before the encodings were counted were over.

@@ -16,7 +16,8 @@ pub const DEFAULT_ENCODER_DRAWS: usize = 8;
 /// Most encodings per recording one run accepts.
 pub const MAX_ENCODER_DRAWS: usize = 100;
 
-/// Parameters of a reproduction run; defaults are the paper's values and SPEC's choices.
+/// Parameters of a reproduction run; defaults are the paper's values, and where the paper
+/// gives none, choices whose reasons docs/decisions/ gives.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReproduceParams {
     /// The pipeline (gain 8, 200 ms bins, 16 levels, distances 1, 2, 4, 8, ...).

@@ -1,5 +1,5 @@
-//! Features from spike trains (SPEC 3.7-3.11): single-taxel spike statistics, the rate
-//! volume and its quantisation, gray-level co-occurrence matrices and Haralick features.
+//! Features from spike trains: single-taxel spike statistics, the rate volume and its
+//! quantisation, gray-level co-occurrence matrices and Haralick features.
 
 mod exact;
 pub mod glcm;

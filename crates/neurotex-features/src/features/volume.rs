@@ -97,8 +97,9 @@ impl RateVolume {
 
 /// Spike counts per bin, the rate volume before scaling to Hz. Its quantisation is exact:
 /// rates are counts over one bin width, so levels are computed from the counts in integer
-/// arithmetic (SPEC 3.9), never from rates rounded to f64. It is also cheaper: a volume
-/// holds few distinct counts, so each count's level is computed once.
+/// arithmetic (docs/decisions/0004-sixteen-gray-levels-over-the-volumes-own-range.md),
+/// never from rates rounded to f64. It is also cheaper: a volume holds few distinct counts,
+/// so each count's level is computed once.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CountVolume {
     /// Grid rows.
@@ -242,7 +243,7 @@ pub fn count_levels(
 /// Counts are u32: every count is below this.
 const COUNTS_END: u64 = 1 << 32;
 
-/// How counts become levels (SPEC 3.9), exactly.
+/// How counts become levels, exactly.
 enum CountLevels {
     /// All level 0: a constant volume, or a range that is not finite with `lo < hi`.
     Constant,
@@ -421,9 +422,9 @@ fn is_constant(lo: f64, hi: f64) -> bool {
 /// so it is within about 4 * 2^-53 |v| of the real value; 2^-48 leaves a wide margin.
 const NEAR_BOUNDARY: f64 = 1.0 / (1u64 << 48) as f64;
 
-/// SPEC 3.9's level of a rate for `lo < hi` in f64, and whether the real level may differ
-/// (the f64 value lies within [`NEAR_BOUNDARY`] of a boundary `1..L-1`; elsewhere its floor
-/// is the real one). Without branches so that loops over it vectorise.
+/// The quantisation's level of a rate for `lo < hi` in f64, and whether the real level may
+/// differ (the f64 value lies within [`NEAR_BOUNDARY`] of a boundary `1..L-1`; elsewhere
+/// its floor is the real one). Without branches so that loops over it vectorise.
 #[inline(always)]
 fn level_in(x: f64, lo: f64, hi: f64, levels: usize) -> (u8, bool) {
     // Clamped into [0, L-1] first, where truncation equals floor. `max` and `min` return
@@ -494,10 +495,11 @@ impl ExactRateLevels {
     }
 }
 
-/// Quantises the volume to `levels` gray levels (SPEC 3.9):
+/// Quantises the volume to `levels` gray levels:
 /// `min(L-1, floor((x - lo) / (hi - lo) * L))`, with `lo`, `hi` the present cells' own min
 /// and max unless `range` fixes them (values outside it are clamped). A constant volume is
-/// all level 0. Masked cells get level 0 and are never paired by the GLCM.
+/// all level 0. Masked cells get level 0 and are never paired by the GLCM. Why the volume's
+/// own range: docs/decisions/0004-sixteen-gray-levels-over-the-volumes-own-range.md.
 ///
 /// The formula is evaluated exactly for the f64 values given: a rate on a boundary lands
 /// on it. Rates that came from spike counts were rounded when divided by the bin width,
@@ -603,7 +605,8 @@ mod tests {
     use crate::spikes::SpikeTrains;
     use proptest::prelude::*;
 
-    /// A fraction `num / den`, `den > 0`, for levels straight from SPEC 3.9's formula.
+    /// A fraction `num / den`, `den > 0`, for levels straight from the quantisation's
+    /// formula.
     #[derive(Debug, Clone, Copy)]
     struct Frac(i128, i128);
 

@@ -95,7 +95,7 @@ pub struct Evaluation {
     /// Samples evaluated per repeat.
     pub n: usize,
     /// Each repeat's prediction of every evaluated sample, so that results can be traced
-    /// back to recordings (SPEC 9).
+    /// back to recordings.
     pub predictions: Vec<RepeatPredictions>,
 }
 

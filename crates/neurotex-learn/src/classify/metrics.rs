@@ -1,5 +1,5 @@
-//! What an accuracy means (SPEC section 9): the summary of a confusion matrix beside its
-//! chance levels ([`Metrics`]), 95 % intervals for an accuracy ([`wilson_interval`],
+//! What an accuracy means: the summary of a confusion matrix beside its chance levels
+//! ([`Metrics`]), 95 % intervals for an accuracy ([`wilson_interval`],
 //! [`bootstrap_accuracy`], [`t_interval_over_repeats`]), and a paired test of two methods
 //! on the same recordings ([`mcnemar_exact`]) with the verdict it allows ([`PairedVerdict`]).
 //!

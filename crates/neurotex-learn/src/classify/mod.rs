@@ -1,9 +1,10 @@
-//! Classification (SPEC 3.12-3.13): a [`Classifier`] trait (fit, then predict), k-nearest
-//! neighbours with training-fold z-scoring, a random forest ([`forest`]) and multinomial
-//! logistic regression ([`linear`]) beside it, one [`ClassifierChoice`] over the three, stratified shuffled k-fold cross-validation and
-//! train/test evaluation over any classifier, and the [`ConfusionMatrix`] they fill; then
-//! what the results mean (SPEC 9): [`Metrics`] with chance levels, 95 % intervals for an
-//! accuracy, and McNemar's paired test of two methods ([`metrics`], on [`stats`]).
+//! Classification: a [`Classifier`] trait (fit, then predict), k-nearest neighbours with
+//! training-fold z-scoring, a random forest ([`forest`]) and multinomial logistic
+//! regression ([`linear`]) beside it, one [`ClassifierChoice`] over the three, stratified
+//! shuffled k-fold cross-validation and train/test evaluation over any classifier, and the
+//! [`ConfusionMatrix`] they fill; then what the results mean: [`Metrics`] with chance
+//! levels, 95 % intervals for an accuracy, and McNemar's paired test of two methods
+//! ([`metrics`], on [`stats`]).
 
 pub mod choice;
 pub mod confusion;

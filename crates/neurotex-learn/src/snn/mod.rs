@@ -120,8 +120,8 @@ impl std::str::FromStr for Reset {
     }
 }
 
-/// The spiking classifier's parameters (defaults chosen a priori; SPEC 11 and
-/// `docs/spiking-classifier.md` give the reasons).
+/// The spiking classifier's parameters (defaults chosen a priori;
+/// `docs/spiking-classifier.md` gives the reasons).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SnnParams {

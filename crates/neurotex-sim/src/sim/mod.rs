@@ -1,4 +1,5 @@
-//! The paper's rig as a physical model (SPEC section 5): the built-in default dataset.
+//! The paper's rig as a physical model, the built-in default dataset
+//! (docs/decisions/0015-a-physical-simulator-never-tuned-to-the-paper.md).
 //!
 //! A 4x4 array of 2x2 mm piezoresistive taxels on a 13x13 mm pad, under a soft cover, is
 //! pressed onto one of eight procedural textures with 1 N under force control, held 5 s,

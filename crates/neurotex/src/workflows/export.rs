@@ -3,11 +3,11 @@
 //! as an address-event dataset.
 use ndarray::Array2;
 use ndarray_npy::write_npy;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use super::OnProgress;
+use super::{OnProgress, OpenOptions};
 use crate::error::DataError;
 use crate::events::{write_events, Event, EventFile, EventsFormat};
 use crate::nir::Convention;
@@ -20,6 +20,70 @@ use crate::snn::xylo::XyloNetwork;
 use crate::snn::Target;
 use crate::spiking_model::{spike_input, SpikingModel};
 use crate::Result;
+
+/// Options of `neurotex export nir`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct ExportNirOptions {
+    /// The spiking model file (`train --classifier snn`).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub model: PathBuf,
+    /// The NIR file to write.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub out: PathBuf,
+    /// The importer the graph is written for, each loading it unchanged with the network's
+    /// decisions and scores: `nir` (NIR's equations by forward Euler, seconds, `dt` in the
+    /// metadata: Norse, neurotex, any NIR reader), `snntorch` (its importer steps at 0.1 ms:
+    /// the constants are scaled to it), `norse` (the `nir` graph), `sinabs` or `rockpool`
+    /// (time in steps, exact decays; for networks trained with `--snn-reset subtract`).
+    #[cfg_attr(feature = "cli", arg(long = "for", alias = "convention", value_enum, default_value_t = NirConvention::Nir))]
+    pub convention: NirConvention,
+}
+
+/// Options of `neurotex export xylo`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct ExportXyloOptions {
+    /// The spiking model file, trained with `--snn-target xylo`.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub model: PathBuf,
+    /// The configuration file to write (JSON).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub out: PathBuf,
+}
+
+/// Options of `neurotex export inputs`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct ExportInputsOptions {
+    /// The spiking model whose pipeline and time step make the tensors.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub model: PathBuf,
+    /// The dataset folder whose recordings are exported.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub dataset: PathBuf,
+    /// The folder to write (new, empty, or an earlier export, which is replaced).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub out: PathBuf,
+    /// How the dataset folder is opened.
+    #[cfg_attr(feature = "cli", command(flatten))]
+    pub open: OpenOptions,
+}
+
+/// A spiking model's network in words: inputs, hidden neurons, readouts with their labels,
+/// and the time step.
+pub fn network_shape(model: &SpikingModel) -> String {
+    let net = model.network();
+    let recurrent = if net.recurrent() { " recurrent" } else { "" };
+    format!(
+        "{} inputs -> {}{recurrent} hidden neurons -> {} readout neurons ({}), dt {} ms",
+        net.inputs,
+        net.hidden,
+        net.classes,
+        model.labels().join(", "),
+        net.dt_ms
+    )
+}
 
 /// Which importer a NIR graph is written for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

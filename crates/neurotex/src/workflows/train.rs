@@ -106,6 +106,22 @@ impl TrainOptions {
     }
 }
 
+impl Trained {
+    /// The model in one line: classifier, training set, features, grid.
+    pub fn summary(&self) -> String {
+        let model = &self.model;
+        format!(
+            "{} on {} recordings of {} classes, {} {} features on the {} grid",
+            model.classifier(),
+            model.n_training(),
+            model.labels().len(),
+            model.features().columns.len(),
+            model.features().method.name(),
+            self.grid
+        )
+    }
+}
+
 /// A spiking network, how its training went, and the grid of its training recordings.
 #[derive(Debug)]
 pub struct TrainedSpiking {
@@ -115,6 +131,33 @@ pub struct TrainedSpiking {
     pub log: TrainingLog,
     /// The training recordings' grid.
     pub grid: Grid,
+}
+
+impl TrainedSpiking {
+    /// The network in one line: its parameters, training set, inputs, how training went.
+    pub fn summary(&self) -> String {
+        let (model, log) = (&self.model, &self.log);
+        format!(
+            "{} on {} recordings of {} classes ({} inputs: taxels x populations; best validation loss {:.3} at epoch {} of {}) on the {} grid",
+            ClassifierChoice::Snn(model.params()),
+            model.training().recordings,
+            model.labels().len(),
+            model.network().inputs,
+            log.validation_loss,
+            log.best_epoch,
+            log.epochs,
+            self.grid
+        )
+    }
+
+    /// When training stopped at the epoch cap with the validation loss still falling, what
+    /// to say of it.
+    pub fn at_the_cap(&self) -> Option<String> {
+        (self.log.best_epoch == self.log.epochs).then(|| format!(
+            "the validation loss was still falling at the last of the {} epochs: training stopped at the cap, not by early stopping; a larger --snn-epochs may do better",
+            self.log.epochs
+        ))
+    }
 }
 
 impl TrainOptions {

@@ -6,7 +6,7 @@ scikit-learn and pyradiomics 3.0.1 at the versions printed into the file. Re-run
 
     python -m venv /tmp/ref && /tmp/ref/bin/pip install numpy scipy scikit-learn scikit-image \
         six pykwalify pywavelets simpleitk setuptools wheel versioneer
-    # pyradiomics 3.0.1 from its sdist, as SPEC section 7 describes
+    # pyradiomics 3.0.1 from its sdist, as docs/correctness.md shows
     /tmp/ref/bin/python crates/neurotex/tests/reference/make_reference.py
 
 The inputs are generated here from fixed seeds and stored beside the outputs, so the Rust

@@ -21,7 +21,6 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use skrifa::instance::{LocationRef, Size};
 use skrifa::{FontRef, MetadataProvider};
 
-use super::raster::FONT_DATA;
 use super::FigureError;
 
 /// The drawing surface of one figure.
@@ -35,6 +34,9 @@ pub(crate) type Chart<'a, 'b> =
 /// The SVG's pixels to the inch: CSS pixels, so that a browser prints the SVG at its
 /// paper width.
 pub(crate) const DPI: f64 = 96.0;
+/// The font every figure is set in, as TrueType data: text is measured here and drawn
+/// with it in the PNGs ([`super::raster`]).
+pub(crate) const FONT_DATA: &[u8] = ttf_noto_sans::REGULAR;
 
 /// The paper width a figure is laid out for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

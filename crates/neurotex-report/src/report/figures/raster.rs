@@ -16,12 +16,10 @@ use std::sync::{Arc, OnceLock};
 use resvg::tiny_skia::{Pixmap, Transform};
 use resvg::usvg::{self, fontdb, Node, Tree};
 
-use super::plot::DPI;
+use super::plot::{DPI, FONT_DATA};
 use super::FigureError;
 
-/// The font every figure is set in, as TrueType data.
-pub(crate) const FONT_DATA: &[u8] = ttf_noto_sans::REGULAR;
-/// Its family name, as the font names itself.
+/// The family name of the font every figure is set in ([`FONT_DATA`]), as it names itself.
 const FONT_FAMILY: &str = "Noto Sans";
 /// The PNG's resolution: 300 dpi at the figure's paper width.
 pub(crate) const PNG_DPI: f64 = 300.0;
