@@ -391,6 +391,7 @@ fn library_version() -> &'static str {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(params::stage_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(params::snn_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(params::classifier_knobs, m)?)?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(features, m)?)?;
     m.add_function(wrap_pyfunction!(spike_stats, m)?)?;

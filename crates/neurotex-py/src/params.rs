@@ -179,20 +179,7 @@ pub fn chosen_classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Ch
 pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<ClassifierChoice> {
     // The kind by the library's name, with its defaults.
     let defaults: ClassifierChoice = kind.parse().map_err(param)?;
-    let known: &[&str] = match defaults {
-        ClassifierChoice::Knn(_) => &["k", "standardize"],
-        ClassifierChoice::Forest(_) => &[
-            "trees",
-            "max_depth",
-            "min_samples_leaf",
-            "max_features",
-            "bootstrap",
-            "seed",
-            "forest_seed",
-        ],
-        ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
-        ClassifierChoice::Snn(_) => SNN_OPTIONS,
-    };
+    let known = knobs(&defaults);
     only_known(
         options,
         known,
@@ -225,6 +212,32 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
     Ok(choice)
 }
 
+/// A classifier's knobs by their Python names.
+fn knobs(kind: &ClassifierChoice) -> &'static [&'static str] {
+    match kind {
+        ClassifierChoice::Knn(_) => &["k", "standardize"],
+        ClassifierChoice::Forest(_) => &[
+            "trees",
+            "max_depth",
+            "min_samples_leaf",
+            "max_features",
+            "bootstrap",
+            "seed",
+            "forest_seed",
+        ],
+        ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
+        ClassifierChoice::Snn(_) => SNN_OPTIONS,
+    }
+}
+
+/// The knobs `classifier_options` takes for the classifier `kind` (`knn`, `forest`,
+/// `linear`, `snn`), by their Python names: what the tests hold against the CLI's flags.
+#[pyfunction]
+pub fn classifier_knobs(kind: &str) -> PyResult<Vec<&'static str>> {
+    let kind: ClassifierChoice = kind.parse().map_err(param)?;
+    Ok(knobs(&kind).to_vec())
+}
+
 /// The spiking network's training knobs (`hidden`, `dt_ms`, `epochs`, `readout`, `seed`,
 /// `recurrent`, `reset`, `target`) over `d`, unchecked; without `reset`, the target's
 /// (subtract for Xylo).
@@ -250,6 +263,9 @@ fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> 
             (None, Target::Float) => d.reset,
         },
         target,
+        tau_syn_ms: get(options, "tau_syn_ms")?.unwrap_or(d.tau_syn_ms),
+        tau_mem_ms: get(options, "tau_mem_ms")?.unwrap_or(d.tau_mem_ms),
+        tau_out_ms: get(options, "tau_out_ms")?.unwrap_or(d.tau_out_ms),
         ..d
     })
 }
@@ -268,6 +284,9 @@ pub fn snn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("recurrent", d.recurrent)?;
     out.set_item("reset", d.reset.name())?;
     out.set_item("target", d.target.name())?;
+    out.set_item("tau_syn_ms", d.tau_syn_ms)?;
+    out.set_item("tau_mem_ms", d.tau_mem_ms)?;
+    out.set_item("tau_out_ms", d.tau_out_ms)?;
     Ok(out)
 }
 
@@ -281,6 +300,9 @@ const SNN_OPTIONS: &[&str] = &[
     "recurrent",
     "reset",
     "target",
+    "tau_syn_ms",
+    "tau_mem_ms",
+    "tau_out_ms",
 ];
 
 /// The spiking network's training knobs, checked.

@@ -592,13 +592,6 @@ impl Predict for ForestModel {
         self.n_classes
     }
 
-    fn predict(&self, x: &[f64]) -> Vec<usize> {
-        self.predict_with_shares(x)
-            .into_iter()
-            .map(|(c, _)| c)
-            .collect()
-    }
-
     /// Rows are predicted in parallel; each row's shares are summed in tree order.
     fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
         assert_eq!(

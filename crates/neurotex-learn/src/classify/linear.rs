@@ -774,13 +774,6 @@ impl Predict for LinearModel {
         self.n_classes
     }
 
-    fn predict(&self, x: &[f64]) -> Vec<usize> {
-        self.predict_with_shares(x)
-            .into_iter()
-            .map(|(c, _)| c)
-            .collect()
-    }
-
     fn predict_with_shares(&self, x: &[f64]) -> Vec<(usize, Vec<f64>)> {
         assert_eq!(
             x.len() % self.dims,

@@ -106,7 +106,10 @@ pub trait Predict {
     ///
     /// # Panics
     /// If `x` is not whole rows of the training dimension (a caller bug).
-    fn predict(&self, x: &[f64]) -> Vec<usize>;
+    fn predict(&self, x: &[f64]) -> Vec<usize> {
+        let shares = self.predict_with_shares(x);
+        shares.into_iter().map(|(c, _)| c).collect()
+    }
 
     /// The classes the shares of [`Predict::predict_with_shares`] cover: the largest class
     /// index seen in training, plus one.

@@ -967,6 +967,9 @@ class SpikingModel(Model):
         recurrent: bool = _SNN_DEFAULTS["recurrent"],
         reset: Optional[str] = None,
         target: str = _SNN_DEFAULTS["target"],
+        tau_syn_ms: float = _SNN_DEFAULTS["tau_syn_ms"],
+        tau_mem_ms: float = _SNN_DEFAULTS["tau_mem_ms"],
+        tau_out_ms: float = _SNN_DEFAULTS["tau_out_ms"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -980,10 +983,14 @@ class SpikingModel(Model):
         v - n kept: the neuron of sinabs, Rockpool and Xylo, needed to export to them;
         ``--snn-reset``; default ``"zero"``, ``"subtract"`` with Xylo); ``target`` is where
         the network runs: ``"float"`` or ``"xylo"`` (trained within Xylo Audio 2's limits,
-        predicting in the chip's integers; ``--snn-target``). ``labels`` and ``stage_options`` (``encoding``, ``gain``,
-        ...) as :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
+        predicting in the chip's integers; ``--snn-target``); ``tau_syn_ms``, ``tau_mem_ms``
+        and ``tau_out_ms`` are the hidden neurons' synaptic and membrane time constants and
+        the readout's (``--snn-tau-*-ms``; moved to the chip's decays with Xylo).
+        ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
+        :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
-               "seed": seed, "recurrent": recurrent, "target": target}
+               "seed": seed, "recurrent": recurrent, "target": target,
+               "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms}
         if reset is not None:
             snn["reset"] = reset
         folder = _folder(recordings)

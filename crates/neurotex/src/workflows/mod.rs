@@ -93,9 +93,30 @@ pub struct ClassifierOptions {
     /// With `--classifier forest`: seed of the trees' random streams [default: 0].
     #[cfg_attr(feature = "cli", arg(long = "forest-seed"))]
     pub forest_seed: Option<u64>,
+    /// With `--classifier forest`: deepest level of a tree, the root at 0 [default: grown
+    /// until leaves are pure or too small to split].
+    #[cfg_attr(feature = "cli", arg(long = "max-depth"))]
+    pub max_depth: Option<usize>,
+    /// With `--classifier forest`: fewest training recordings in a leaf [default: 1].
+    #[cfg_attr(feature = "cli", arg(long = "min-samples-leaf"))]
+    pub min_samples_leaf: Option<usize>,
+    /// With `--classifier forest`: features tried at each split [default: ⌊√d⌋].
+    #[cfg_attr(feature = "cli", arg(long = "max-features"))]
+    pub max_features: Option<usize>,
+    /// With `--classifier forest`: grow each tree on a bootstrap sample (`true`) or on the
+    /// whole training set (`false`) [default: true].
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub bootstrap: Option<bool>,
     /// With `--classifier linear`: inverse penalty strength, scikit-learn's C [default: 1].
     #[cfg_attr(feature = "cli", arg(long = "c"))]
     pub c: Option<f64>,
+    /// With `--classifier linear`: most L-BFGS iterations [default: 1000].
+    #[cfg_attr(feature = "cli", arg(long = "max-iter"))]
+    pub max_iter: Option<usize>,
+    /// With `--classifier linear`: stop when no gradient component exceeds this [default:
+    /// 1e-8].
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub tol: Option<f64>,
     /// The spiking network's options (`--classifier snn`).
     #[cfg_attr(feature = "cli", command(flatten))]
     pub snn: SnnOptions,
@@ -247,14 +268,32 @@ impl ClassifierOptions {
             ClassifierChoice::Forest(defaults) => ClassifierChoice::Forest(ForestParams {
                 trees: self.trees.unwrap_or(defaults.trees),
                 seed: self.forest_seed.unwrap_or(defaults.seed),
-                ..defaults
+                max_depth: self.max_depth.or(defaults.max_depth),
+                min_samples_leaf: self.min_samples_leaf.unwrap_or(defaults.min_samples_leaf),
+                max_features: self.max_features.or(defaults.max_features),
+                bootstrap: self.bootstrap.unwrap_or(defaults.bootstrap),
             }),
             ClassifierChoice::Linear(defaults) => ClassifierChoice::Linear(LinearParams {
                 c: self.c.unwrap_or(defaults.c),
-                ..defaults
+                max_iter: self.max_iter.unwrap_or(defaults.max_iter),
+                tol: self.tol.unwrap_or(defaults.tol),
             }),
             ClassifierChoice::Snn(defaults) => ClassifierChoice::Snn(self.snn.params(defaults)?),
         };
+        self.only_its_own(&choice)?;
+        if !matches!(choice, ClassifierChoice::Snn(_)) {
+            choice.check()?;
+        }
+        Ok(choice)
+    }
+}
+
+impl ClassifierOptions {
+    /// Refuses an option of another classifier than `choice`.
+    ///
+    /// # Errors
+    /// The first option given that `choice` does not take.
+    fn only_its_own(&self, choice: &ClassifierChoice) -> Result<()> {
         if !matches!(choice, ClassifierChoice::Snn(_)) && self.snn.any() {
             return Err(OptionsError::NotApplicable {
                 option: "--snn-*",
@@ -269,17 +308,27 @@ impl ClassifierOptions {
             )
             .into());
         }
-        if !matches!(choice, ClassifierChoice::Linear(_)) && self.c.is_some() {
-            return Err(OptionsError::NotApplicable {
-                option: "--c",
-                applies_to: "--classifier linear",
+        let forest_knobs = [
+            ("--max-depth", self.max_depth.is_some()),
+            ("--min-samples-leaf", self.min_samples_leaf.is_some()),
+            ("--max-features", self.max_features.is_some()),
+            ("--bootstrap", self.bootstrap.is_some()),
+        ];
+        let linear_knobs = [
+            ("--c", self.c.is_some()),
+            ("--max-iter", self.max_iter.is_some()),
+            ("--tol", self.tol.is_some()),
+        ];
+        let linear = matches!(choice, ClassifierChoice::Linear(_));
+        for (knobs, own, applies_to) in [
+            (&forest_knobs[..], forest, "--classifier forest"),
+            (&linear_knobs[..], linear, "--classifier linear"),
+        ] {
+            if let Some((option, _)) = knobs.iter().find(|k| k.1 && !own) {
+                return Err(OptionsError::NotApplicable { option, applies_to }.into());
             }
-            .into());
         }
-        if !matches!(choice, ClassifierChoice::Snn(_)) {
-            choice.check()?;
-        }
-        Ok(choice)
+        Ok(())
     }
 }
 
