@@ -90,12 +90,24 @@ pub fn to_py(error: neurotex::Error) -> PyErr {
     let text = match &error {
         // The workflows name options as the command line spells them.
         neurotex::Error::Options(_) => keywords(&error.to_string()),
+        neurotex::Error::Param(p) => {
+            let (name, rule, got) = (keyword(p.name), p.rule, &p.got);
+            format!("invalid parameter `{name}`: {rule}, got {got}")
+        }
         _ => error.to_string(),
     };
     match hint {
         Some(hint) => raise(kind_of(&error), format!("{text}\nhint: {hint}")),
         None => raise(kind_of(&error), text),
     }
+}
+
+/// A parameter's name as Python's keyword spells it: `bin_ms` for the command line's
+/// `bin-ms`, and the spiking network's knobs without the CLI's `snn-` prefix (`hidden`
+/// for `snn-hidden`), as `classifier_options` and `SpikingModel.train` take them.
+fn keyword(name: &str) -> String {
+    let knob = name.strip_prefix("snn-").filter(|rest| !rest.is_empty());
+    knob.unwrap_or(name).replace('-', "_")
 }
 
 /// `text` with each command-line option (`--forest-seed`) spelled as Python's keyword
@@ -109,7 +121,7 @@ fn keywords(text: &str) -> String {
         let end = name
             .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
             .unwrap_or(name.len());
-        out.push_str(&name[..end].replace('-', "_"));
+        out.push_str(&keyword(&name[..end]));
         rest = &name[end..];
     }
     out.push_str(rest);
@@ -142,7 +154,7 @@ pub fn param(error: ParamError) -> PyErr {
         Kind::Parameter,
         format!(
             "invalid parameter `{}`: {}, got {}",
-            error.name.replace('-', "_"),
+            keyword(error.name),
             error.rule,
             error.got
         ),

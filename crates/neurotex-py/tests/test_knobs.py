@@ -52,3 +52,10 @@ def test_the_network_knobs_reach_training_with_the_cli_defaults():
         text = help_text.split(flag("snn", knob), 1)[1].split("\n  -", 1)[0]
         shown = re.search(r"\[default: ([0-9.]+)", text).group(1)
         assert float(shown) == float(defaults[knob]), knob
+
+
+def test_a_broken_knob_is_named_as_python_spells_it(sim):
+    with pytest.raises(neurotex.ParameterError, match=r"invalid parameter `hidden`"):
+        neurotex.Model.train(sim, classifier="snn", classifier_options={"hidden": 0})
+    with pytest.raises(neurotex.ParameterError, match=r"invalid parameter `tau_mem_ms`"):
+        neurotex.SpikingModel.train(sim, tau_mem_ms=-1.0)
