@@ -232,7 +232,7 @@ pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Compa
 }
 
 /// [`compare`], saying its progress: a step per candidate scored, then with nested
-/// selection a step per outer split.
+/// selection a step per candidate cross-validated inside each outer split.
 ///
 /// # Errors
 /// As [`compare`].
@@ -798,6 +798,7 @@ fn outer(
     split: &OuterSplit,
     params: &CompareParams,
     metas: &[Meta],
+    progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<OuterResult> {
     // One repeat; fewer folds when a class of the training set is smaller than
     // the folds (an outer training set is a part of one condition's recordings).
@@ -815,7 +816,9 @@ fn outer(
         .par_iter()
         .map(|c| {
             let sub = c.table.subset(&split.train);
-            Ok((c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy)
+            let accuracy = (c.evaluate)(&sub, c.columns, &cv_split(&inner))?.accuracy;
+            progress(Progress::Tick);
+            Ok(accuracy)
         })
         .collect::<Result<_>>()?;
     // The first candidate of the highest accuracy.
@@ -849,14 +852,11 @@ fn nested(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Nested> {
     let metas = &candidates[0].table.metas;
-    progress(Progress::Stage("nested selection", splits.len()));
+    let steps = splits.len() * candidates.len();
+    progress(Progress::Stage("nested selection", steps));
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
-        .map(|split| {
-            let outcome = outer(candidates, split, params, metas);
-            progress(Progress::Tick);
-            outcome
-        })
+        .map(|split| outer(candidates, split, params, metas, progress))
         .collect::<Result<_>>()?;
     let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();
     shares.sort_by_key(|&(row, _)| row);
