@@ -1,7 +1,7 @@
 //! `inspect`'s per-recording statistics (range, resting offset, full scale, dead, clock,
 //! copies, stamps) on a FabricSlide-sized log (16 channels, 420 frames at 35.7 Hz) and on
 //! a 10 s recording of 16 channels at 1 kHz. The whole command on FabricSlide is timed in
-//! docs/your-data.md.
+//! docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use neurotex::inspect::signals::signal_stats;

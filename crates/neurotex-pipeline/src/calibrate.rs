@@ -198,7 +198,17 @@ pub fn calibrate_gain(
         let rule = "--gain auto needs a taxel with some signal in the training recordings";
         return Err(ParamError::new("gain", rule, "every taxel is flat").into());
     }
-    let median = |gain: f64| median_rate(pipeline, &samples, gain);
+    // Each gain's median is computed once: the search ends on a gain it has tried.
+    let tried: std::cell::RefCell<Vec<(f64, f64)>> = std::cell::RefCell::new(Vec::new());
+    let median = |gain: f64| -> Result<f64> {
+        let known = tried.borrow().iter().find(|t| t.0 == gain).map(|t| t.1);
+        if let Some(m) = known {
+            return Ok(m);
+        }
+        let m = median_rate(pipeline, &samples, gain)?;
+        tried.borrow_mut().push((gain, m));
+        Ok(m)
+    };
     let (lo, hi) = GAIN_RANGE;
     let (gain, clamped) = if median(hi)? < target_hz {
         (hi, true)

@@ -321,9 +321,16 @@ impl Butterworth2 {
     /// place and the right pad in turn (and back), its state carried from one to the next,
     /// the same steps in the same order as over one padded copy.
     pub fn filtfilt_frames(&self, x: &mut [f64], cells: usize) {
+        self.filtfilt_frames_top(x, cells);
+    }
+
+    /// [`Butterworth2::filtfilt_frames`], returning the largest filtered value (-inf for
+    /// none), found by the backward pass where a pass of its own would read every sample
+    /// again.
+    fn filtfilt_frames_top(&self, x: &mut [f64], cells: usize) -> f64 {
         let n = x.len() / cells.max(1);
         if n < 2 {
-            return;
+            return largest(x);
         }
         let pad = 9.min(n - 1);
         let frame = |i: usize| &x[i * cells..(i + 1) * cells];
@@ -341,8 +348,9 @@ impl Butterworth2 {
         run_frames(self, x, cells, &mut state, false, false);
         run_frames(self, &mut right, cells, &mut state, false, false);
         run_frames(self, &mut right, cells, &mut state, true, true);
-        run_frames(self, x, cells, &mut state, true, false);
+        let top = run_frames(self, x, cells, &mut state, true, false);
         run_frames(self, &mut left, cells, &mut state, true, false);
+        top
     }
 
     /// [`Butterworth2::filtfilt_frames`] of the frames of `from` less each cell's resting
@@ -600,7 +608,7 @@ fn selected_phase(
     let present = &rec.layout.present;
     let (lo, hi) = (frames.start, frames.end);
     let uniform_1k = uniform_1k(rec);
-    let mut samples = if uniform_1k {
+    let samples = if uniform_1k {
         less_offsets(&rec.samples[lo * cells..hi * cells], offsets, present)
     } else {
         let span = times.at(hi - 1) - times.at(lo);
@@ -609,22 +617,16 @@ fn selected_phase(
                 format!("a {span} s span resampled to 1 kHz is more samples than memory can hold");
             return Err(DataError::invalid(file, message).into());
         }
-        resample_linear(
+        resample_less(
             &rec.samples[lo * cells..hi * cells],
             cells,
             &times.span(lo..hi),
             ENCODER_FS,
+            Some((offsets, present)),
         )
     };
     if samples.is_empty() {
         return Err(phase_too_short(rec));
-    }
-    if !uniform_1k {
-        for frame in samples.chunks_exact_mut(cells) {
-            for ((s, &o), &p) in frame.iter_mut().zip(offsets).zip(present) {
-                *s = if p { *s - o } else { 0.0 };
-            }
-        }
     }
     Ok(samples)
 }
@@ -829,10 +831,15 @@ impl Preprocessor {
         } else {
             let mut samples = selected_phase(rec, times, offsets, frames)?;
             match self.params.causal {
-                Some(_) => filter.lfilter_frames(&mut samples, cells),
-                None => filter.filtfilt_frames(&mut samples, cells),
+                Some(_) => {
+                    filter.lfilter_frames(&mut samples, cells);
+                    (samples, None)
+                }
+                None => {
+                    let top = filter.filtfilt_frames_top(&mut samples, cells);
+                    (samples, Some(top))
+                }
             }
-            (samples, None)
         };
         // A masked cell's filtered zeros are +0 or -0 (the sign of a coefficient), so the
         // largest value found before they are set to +0 is the largest after.
@@ -1071,38 +1078,99 @@ pub fn resampled_len(span_s: f64, fs: f64, cells: usize) -> Option<usize> {
 /// If `times` does not have one entry per frame, or the result would not fit in memory
 /// ([`resampled_len`] is `None`): caller bugs, as readers bound a recording's span.
 pub fn resample_linear(frames: &[f64], cells: usize, times: &[f64], fs: f64) -> Vec<f64> {
+    resample_less(frames, cells, times, fs, None)
+}
+
+/// [`resample_linear`], each value then less its cell's resting value in the same pass when
+/// `rest` gives them (`(offsets, present)`: a cell not present is 0), as a pass of its own
+/// after the resampling would make it.
+///
+/// # Panics
+/// As [`resample_linear`].
+fn resample_less(
+    frames: &[f64],
+    cells: usize,
+    times: &[f64],
+    fs: f64,
+    rest: Option<(&[f64], &[bool])>,
+) -> Vec<f64> {
     assert_eq!(
         frames.len(),
         times.len() * cells,
         "one time stamp per frame"
     );
-    if times.is_empty() {
+    if times.is_empty() || cells == 0 {
         return Vec::new();
     }
-    let t0 = times[0];
-    let span = times[times.len() - 1] - t0;
+    let span = times[times.len() - 1] - times[0];
     let total = resampled_len(span, fs, cells).expect("a resampled length that fits in memory");
-    let steps = total / cells.max(1);
     let mut out = Vec::with_capacity(total);
-    let mut k = 0usize;
-    for s in 0..steps {
-        let t = t0 + s as f64 / fs;
-        while k + 1 < times.len() - 1 && times[k + 1] <= t {
-            k += 1;
-        }
-        if times.len() == 1 {
-            out.extend_from_slice(&frames[..cells]);
-            continue;
-        }
-        let (ta, tb) = (times[k], times[k + 1]);
-        let w = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
-        let (fa, fb) = (
-            &frames[k * cells..(k + 1) * cells],
-            &frames[(k + 1) * cells..(k + 2) * cells],
-        );
-        out.extend(fa.iter().zip(fb).map(|(&a, &b)| a + (b - a) * w));
-    }
+    resample_into(
+        frames,
+        times,
+        fs,
+        rest,
+        &mut out.spare_capacity_mut()[..total],
+    );
+    // SAFETY: the pass wrote every one of the `total` values.
+    unsafe { out.set_len(total) };
     out
+}
+
+widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// The steps of [`resample_less`] into `out` (`frames.len() / times.len()` cells a
+    /// step): each value `a + (b - a) * w` of its bracketing frames, then less its resting
+    /// value, lane by lane, so the width changes no bit.
+    fn resample_into(
+        frames: &[f64],
+        times: &[f64],
+        fs: f64,
+        rest: Option<(&[f64], &[bool])>,
+        out: &mut [MaybeUninit<f64>],
+    ) {
+        let cells = frames.len() / times.len();
+        let t0 = times[0];
+        let mut k = 0usize;
+        for (s, step) in out.chunks_exact_mut(cells).enumerate() {
+            if times.len() == 1 {
+                for (x, &a) in step.iter_mut().zip(&frames[..cells]) {
+                    x.write(a);
+                }
+            } else {
+                let t = t0 + s as f64 / fs;
+                while k + 1 < times.len() - 1 && times[k + 1] <= t {
+                    k += 1;
+                }
+                let (ta, tb) = (times[k], times[k + 1]);
+                let w = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
+                let fa = &frames[k * cells..(k + 1) * cells];
+                let fb = &frames[(k + 1) * cells..(k + 2) * cells];
+                match rest {
+                    Some((offsets, present)) => {
+                        let cell = fa.iter().zip(fb).zip(offsets).zip(present);
+                        for (x, (((&a, &b), &o), &p)) in step.iter_mut().zip(cell) {
+                            let v = a + (b - a) * w;
+                            x.write(if p { v - o } else { 0.0 });
+                        }
+                    }
+                    None => {
+                        for ((x, &a), &b) in step.iter_mut().zip(fa).zip(fb) {
+                            x.write(a + (b - a) * w);
+                        }
+                    }
+                }
+                continue;
+            }
+            if let Some((offsets, present)) = rest {
+                for ((x, &o), &p) in step.iter_mut().zip(offsets).zip(present) {
+                    // SAFETY: written from the frame just above.
+                    let v = unsafe { x.assume_init() };
+                    x.write(if p { v - o } else { 0.0 });
+                }
+            }
+        }
+    }
 }
 
 /// The sample range `[lo, hi)` of the sliding phase: labelled phases first, then the
@@ -1202,6 +1270,45 @@ mod tests {
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64 * (hi - lo) + lo
+        }
+    }
+
+    /// The resampling with the resting values taken off in the same pass gives the bits of
+    /// the resampling followed by a pass of its own, at every width the processor has, on
+    /// irregular stamps (a repeated stamp and a long gap among them) and a masked cell.
+    #[test]
+    fn resampling_less_rest_is_the_two_passes_bit_for_bit() {
+        let mut next = uniform(11, -50.0, 4000.0);
+        let mut step = uniform(12, 0.002, 0.04);
+        for cells in [1, 3, 16, 17] {
+            let mut times = vec![0.0];
+            for k in 1..300 {
+                let dt = match k {
+                    40 => 0.0,
+                    90 => 0.3,
+                    _ => step(),
+                };
+                times.push(times[k - 1] + dt);
+            }
+            let frames: Vec<f64> = (0..times.len() * cells).map(|_| next()).collect();
+            let offsets: Vec<f64> = (0..cells).map(|_| next()).collect();
+            let present: Vec<bool> = (0..cells).map(|c| c % 5 != 2).collect();
+            let mut expected = resample_linear(&frames, cells, &times, ENCODER_FS);
+            for frame in expected.chunks_exact_mut(cells) {
+                for ((x, &o), &p) in frame.iter_mut().zip(&offsets).zip(&present) {
+                    *x = if p { *x - o } else { 0.0 };
+                }
+            }
+            let rest = Some((&offsets[..], &present[..]));
+            let got = resample_less(&frames, cells, &times, ENCODER_FS, rest);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&expected), "{cells} cells");
+            let one = resample_less(&frames[..cells], cells, &times[..1], ENCODER_FS, rest);
+            assert_eq!(
+                bits(&one),
+                bits(&expected[..cells]),
+                "{cells} cells, one stamp"
+            );
         }
     }
 

@@ -243,8 +243,8 @@ type CompareFn<'a> =
 const SAY_EVERY_S: f64 = 15.0;
 
 /// E9's progress as lines: each comparison's start, then its stage and steps done at most
-/// every [`SAY_EVERY_S`] seconds (`compare`'s steps: candidates scored, then nested
-/// selection's splits).
+/// every [`SAY_EVERY_S`] seconds (`compare`'s steps: candidates scored, then each
+/// candidate cross-validated inside each of nested selection's splits).
 struct Said<'a> {
     progress: &'a (dyn Fn(Progress) + Sync),
     state: std::sync::Mutex<SaidState>,

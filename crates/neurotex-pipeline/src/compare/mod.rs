@@ -238,7 +238,7 @@ pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Compa
 }
 
 /// [`compare`], saying its progress: a step per candidate scored, then with nested
-/// selection a step per outer split.
+/// selection a step per candidate cross-validated inside each outer split.
 ///
 /// # Errors
 /// As [`compare`].
@@ -803,6 +803,7 @@ fn outer(
     split: &OuterSplit,
     params: &CompareParams,
     metas: &[Meta],
+    progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<OuterResult> {
     // One repeat; fewer folds when a class of the training set is smaller than
     // the folds (an outer training set is a part of one condition's recordings).
@@ -818,7 +819,11 @@ fn outer(
     };
     let accuracies: Vec<f64> = candidates
         .par_iter()
-        .map(|c| Ok((c.evaluate)(&split.train, &cv_split(&inner))?.accuracy))
+        .map(|c| {
+            let accuracy = (c.evaluate)(&split.train, &cv_split(&inner))?.accuracy;
+            progress(Progress::Tick);
+            Ok(accuracy)
+        })
         .collect::<Result<_>>()?;
     // The first candidate of the highest accuracy.
     let mut best = (f64::NEG_INFINITY, 0);
@@ -851,14 +856,11 @@ fn nested(
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Nested> {
     let metas = &candidates[0].metas;
-    progress(Progress::Stage("nested selection", splits.len()));
+    let steps = splits.len() * candidates.len();
+    progress(Progress::Stage("nested selection", steps));
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
-        .map(|split| {
-            let outcome = outer(candidates, split, params, metas);
-            progress(Progress::Tick);
-            outcome
-        })
+        .map(|split| outer(candidates, split, params, metas, progress))
         .collect::<Result<_>>()?;
     let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();
     shares.sort_by_key(|&(row, _)| row);

@@ -27,7 +27,7 @@ use crate::error::{DataError, ParamError};
 use crate::import::{csv_files, CsvImportParams, Logs, MergedRows};
 use crate::model::GainCalibration;
 use crate::pipeline::{Pipeline, PipelineParams};
-use crate::recording::{Baseline, Dataset, LayoutFile, Meta, Recording};
+use crate::recording::{Baseline, Dataset, Layout, LayoutFile, Meta, Recording};
 pub use design::{Condition, Design, GroupColumn, Support};
 pub use findings::{Finding, Severity};
 pub use signals::{Channel, SignalStats, Stamps};
@@ -426,6 +426,9 @@ struct Checked {
     /// The recording's index in the source.
     index: usize,
     meta: Meta,
+    /// The recording's layout and rate (the summary's layout is the first readable one's).
+    layout: Layout,
+    fs: f64,
     stats: SignalStats,
     merged: usize,
     /// Spikes per second of each channel's taxel; `None` when not encoded.
@@ -580,6 +583,8 @@ fn check_one(
     Ok(Checked {
         index: i,
         meta: rec.meta,
+        layout: rec.layout,
+        fs: rec.fs,
         stats,
         merged,
         rates,
@@ -599,8 +604,7 @@ fn layout_summary(source: Source<'_>, checked: &[Checked], baseline: Baseline) -
     let file = source.layout();
     // The grid as the first readable recording has it (a dataset of grid-shaped arrays
     // may give no grid in its layout).
-    let first = checked.first().and_then(|c| source.load(c.index).ok());
-    let Some((rec, _)) = first else {
+    let Some(first) = checked.first() else {
         return LayoutSummary {
             rows: file.rows.unwrap_or(1),
             cols: file.cols.unwrap_or(0),
@@ -613,7 +617,7 @@ fn layout_summary(source: Source<'_>, checked: &[Checked], baseline: Baseline) -
             fs_hz: file.fs.unwrap_or(1000.0),
         };
     };
-    let l = &rec.layout;
+    let l = &first.layout;
     let cells: Vec<[usize; 2]> = (l.channel_map.iter())
         .map(|&c| [c / l.cols, c % l.cols])
         .collect();
@@ -643,7 +647,7 @@ fn layout_summary(source: Source<'_>, checked: &[Checked], baseline: Baseline) -
         cells,
         neighbour_pairs: pairs,
         baseline: baseline.to_string(),
-        fs_hz: rec.fs,
+        fs_hz: first.fs,
     }
 }
 
