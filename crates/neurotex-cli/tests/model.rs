@@ -771,6 +771,8 @@ fn train_and_evaluate_choose_the_network_alike() {
         args.extend(snn);
         let out: Value = serde_json::from_str(&dir.ok(&args)).unwrap();
         assert_eq!(out["method"], "spikes", "{out}");
+        let classifier = out["classifier"].as_str().unwrap_or_default();
+        assert!(classifier.starts_with("spiking network (8 LIF"), "{out}");
         out["accuracy"].clone()
     };
     assert_eq!(
@@ -789,6 +791,12 @@ fn train_and_evaluate_choose_the_network_alike() {
             "{err}"
         );
     }
+    let forest = ["--classifier", "forest", "--snn-epochs", "2"];
+    let err = dir.fails(&[&["evaluate", "--dataset", s(&ds)][..], &forest].concat());
+    assert!(
+        err.contains("--snn-epochs applies only to --classifier snn"),
+        "{err}"
+    );
     let args = ["train", "--dataset", s(&ds), "--method", "van-rossum"];
     let err = dir.fails(&[&args[..], &["--out", s(&dir.join("never.json"))]].concat());
     assert!(err.contains("evaluated, not trained"), "{err}");

@@ -470,7 +470,11 @@ impl Design {
     /// # Errors
     /// No recordings selected, a selection that selects nothing, a recording in both sets.
     fn of(metas: &[Meta], within: &[usize], split: &Split) -> Result<Self> {
-        let sub: Vec<Meta> = within.iter().map(|&i| metas[i].clone()).collect();
+        let whole = within.len() == metas.len() && within.iter().enumerate().all(|(i, &r)| i == r);
+        let sub: std::borrow::Cow<[Meta]> = match whole {
+            true => std::borrow::Cow::Borrowed(metas),
+            false => within.iter().map(|&i| metas[i].clone()).collect(),
+        };
         let (train, test) = split_rows(&sub, split)?;
         if train.is_empty() {
             return Err(ClassifyError::Empty {

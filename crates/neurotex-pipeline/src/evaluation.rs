@@ -54,6 +54,9 @@ pub struct Evaluation {
     /// What to change when most taxels are silent or at the encoder's ceiling
     /// ([`TaxelDiagnostics::advice`]), whatever the method.
     pub advice: Option<String>,
+    /// The classifier and its main parameters as run (`KNN (k = 5)`), when the caller
+    /// names it: said in the text's first line and under `classifier` in JSON.
+    pub classifier: Option<String>,
     /// The grid's columns, to print per-taxel accuracies in place.
     pub cols: usize,
     /// Each table row's recording, for the out-of-fold predictions.
@@ -184,6 +187,7 @@ impl Evaluation {
             split: split.clone(),
             taxels,
             advice: None,
+            classifier: None,
             cols: grid.cols(),
             metas,
         })
@@ -199,6 +203,9 @@ impl Evaluation {
     pub fn json(&self) -> serde_json::Result<Value> {
         let mut value = serde_json::to_value(&self.outcome)?;
         value["method"] = self.method.into();
+        if let Some(classifier) = &self.classifier {
+            value["classifier"] = classifier.as_str().into();
+        }
         if let Some(tau) = self.tau_ms {
             value["tau_ms"] = tau.into();
         }
@@ -227,7 +234,13 @@ impl Evaluation {
         let (outcome, metrics, interval) = (&self.outcome, &self.metrics, &self.interval);
         let how = split_text(&self.split);
         // Writing to a String cannot fail.
-        let _ = writeln!(out, "method {}: {} samples, {how}", self.method, outcome.n);
+        let by = self.classifier.as_ref().map(|c| format!(", {c}"));
+        let by = by.unwrap_or_default();
+        let _ = writeln!(
+            out,
+            "method {}{by}: {} samples, {how}",
+            self.method, outcome.n
+        );
         accuracy_text(&mut out, outcome, self.cols);
         // No accuracy without its uncertainty and the level a guess reaches.
         let _ = writeln!(

@@ -59,3 +59,8 @@ def test_a_broken_knob_is_named_as_python_spells_it(sim):
         neurotex.Model.train(sim, classifier="snn", classifier_options={"hidden": 0})
     with pytest.raises(neurotex.ParameterError, match=r"invalid parameter `tau_mem_ms`"):
         neurotex.SpikingModel.train(sim, tau_mem_ms=-1.0)
+
+
+def test_a_knob_the_network_does_not_take_is_named_with_the_networks_knobs(sim):
+    with pytest.raises(neurotex.ParameterError, match=r"`trees` for the spiking network; its options are hidden"):
+        neurotex.Model.train(sim, classifier="snn", classifier_options={"trees": 3})

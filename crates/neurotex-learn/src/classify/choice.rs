@@ -97,9 +97,34 @@ impl fmt::Display for ClassifierChoice {
         match self {
             ClassifierChoice::Knn(p) => write!(f, "KNN (k = {})", p.k),
             ClassifierChoice::Forest(p) => {
-                write!(f, "random forest ({} trees, seed {})", p.trees, p.seed)
+                write!(f, "random forest ({} trees, seed {}", p.trees, p.seed)?;
+                let d = ForestParams::default();
+                if let Some(depth) = p.max_depth {
+                    write!(f, ", depth at most {depth}")?;
+                }
+                if p.min_samples_leaf != d.min_samples_leaf {
+                    write!(f, ", at least {} per leaf", p.min_samples_leaf)?;
+                }
+                if let Some(tried) = p.max_features {
+                    write!(f, ", {tried} features tried per split")?;
+                }
+                if !p.bootstrap {
+                    write!(f, ", no bootstrap")?;
+                }
+                write!(f, ")")
             }
-            ClassifierChoice::Linear(p) => write!(f, "logistic regression (C = {})", p.c),
+            ClassifierChoice::Linear(p) => {
+                write!(f, "logistic regression (C = {}", p.c)?;
+                let d = LinearParams::default();
+                if p.max_iter != d.max_iter || p.tol != d.tol {
+                    write!(
+                        f,
+                        ", at most {} iterations, tolerance {:e}",
+                        p.max_iter, p.tol
+                    )?;
+                }
+                write!(f, ")")
+            }
             ClassifierChoice::Snn(p) => {
                 write!(
                     f,

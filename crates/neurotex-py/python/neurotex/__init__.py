@@ -850,6 +850,12 @@ class Model(_Predicting):
         if method == "spikes":
             if taxel is not None:
                 raise ParameterError("taxel applies to method='taxel' only")
+            knobs = _native.classifier_knobs("snn")
+            for name in classifier_options or {}:
+                if name not in knobs:
+                    raise ParameterError(
+                        f"unknown option `{name}` for the spiking network; its options are "
+                        + ", ".join(knobs))
             return SpikingModel.train(recordings, labels, fs=fs, mask=mask, speeds=speeds,
                                       causal=causal, **dict(classifier_options or {}),
                                       **stage_options)

@@ -298,6 +298,10 @@ impl EvaluateOptions {
                 self.seed,
             )?,
         };
+        let evaluation = Evaluation {
+            classifier: Some(classifier.to_string()),
+            ..evaluation
+        };
         Ok(Evaluated {
             evaluation,
             calibrated,

@@ -174,6 +174,24 @@ pub struct SnnOptions {
 }
 
 impl SnnOptions {
+    /// The first option given, as the command line spells it.
+    pub fn given(&self) -> Option<&'static str> {
+        let given = [
+            ("--snn-hidden", self.hidden.is_some()),
+            ("--snn-dt-ms", self.dt_ms.is_some()),
+            ("--snn-epochs", self.epochs.is_some()),
+            ("--snn-readout", self.readout.is_some()),
+            ("--snn-seed", self.seed.is_some()),
+            ("--snn-recurrent", self.recurrent),
+            ("--snn-reset", self.reset.is_some()),
+            ("--snn-target", self.target.is_some()),
+            ("--snn-tau-syn-ms", self.tau_syn_ms.is_some()),
+            ("--snn-tau-mem-ms", self.tau_mem_ms.is_some()),
+            ("--snn-tau-out-ms", self.tau_out_ms.is_some()),
+        ];
+        given.into_iter().find(|g| g.1).map(|g| g.0)
+    }
+
     /// Whether any option was given.
     pub fn any(&self) -> bool {
         self.hidden.is_some()
@@ -294,12 +312,11 @@ impl ClassifierOptions {
     /// # Errors
     /// The first option given that `choice` does not take.
     fn only_its_own(&self, choice: &ClassifierChoice) -> Result<()> {
-        if !matches!(choice, ClassifierChoice::Snn(_)) && self.snn.any() {
-            return Err(OptionsError::NotApplicable {
-                option: "--snn-*",
-                applies_to: "--classifier snn",
+        if let Some(option) = self.snn.given() {
+            if !matches!(choice, ClassifierChoice::Snn(_)) {
+                let applies_to = "--classifier snn";
+                return Err(OptionsError::NotApplicable { option, applies_to }.into());
             }
-            .into());
         }
         let forest = matches!(choice, ClassifierChoice::Forest(_));
         if !forest && (self.trees.is_some() || self.forest_seed.is_some()) {
