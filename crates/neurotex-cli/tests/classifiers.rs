@@ -122,7 +122,7 @@ fn options_of_another_classifier_are_refused() {
         ),
         (
             train(&["--trees", "10"]),
-            "apply only to --classifier forest",
+            "--trees applies only to --classifier forest",
         ),
         (
             train(&["--classifier", "forest", "--c", "2"]),
@@ -135,6 +135,14 @@ fn options_of_another_classifier_are_refused() {
         (
             train(&["--classifier", "linear", "--c", "0"]),
             "C must be positive",
+        ),
+        (
+            train(&["--classifier", "snn", "--bootstrap", "false"]),
+            "--bootstrap applies only to --classifier forest",
+        ),
+        (
+            train(&["--classifier", "forest", "--bootstrap", "maybe"]),
+            "expected true or false, got `maybe`",
         ),
     ];
     dir.fails_each(&cases, &out);

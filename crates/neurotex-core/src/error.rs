@@ -612,4 +612,12 @@ pub enum OptionsError {
     /// and what to do instead.
     #[error("{0}")]
     Conflict(String),
+    /// A value an option does not take.
+    #[error("invalid value for {option}: {reason}")]
+    Invalid {
+        /// The option given.
+        option: &'static str,
+        /// What was expected, and what came.
+        reason: String,
+    },
 }

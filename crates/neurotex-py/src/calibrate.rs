@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use neurotex::calibrate::{calibrate_pipeline, GainCalibration};
+use neurotex::calibrate::GainCalibration;
 use neurotex::causal::ConditioningCalibration;
 use neurotex::pipeline::Pipeline;
 use neurotex::recording::{Baseline, Recording};
@@ -57,8 +57,7 @@ pub fn calibrated(
     indices: &[usize],
     baseline: Baseline,
 ) -> neurotex::Result<Calibrated> {
-    let params = stages.params.clone();
-    let c = calibrate_pipeline(params, stages.causal, stages.gain, load, indices, baseline)?;
+    let c = stages.calibrate(load, indices, baseline)?;
     Ok(Calibrated {
         pipeline: Pipeline::new(c.params)?,
         gain: c.gain,

@@ -180,20 +180,20 @@ fn dataset_events<'py>(
     Option<(usize, usize)>,
 )> {
     let stages = params::stages(options)?;
-    if stages.causal || stages.gain.target_hz().is_some() {
+    let Some(params) = stages.fixed().cloned() else {
         let why = "gain='auto' and causal=True calibrate on a whole dataset; pass the gain (neurotex.calibrate_gain chooses one) and leave causal off";
         return Err(raise(Kind::Parameter, why.to_string()));
-    }
+    };
     let dataset = open(&dir)?;
     let n = dataset.entries.len();
     if let Some(&bad) = indices.iter().find(|&&i| i >= n) {
         let why = format!("row {bad} is beyond the manifest's {n} recordings");
         return Err(raise(Kind::Parameter, why));
     }
-    let encoding = stages.params.encoding;
+    let encoding = params.encoding;
     let (events, grid) = py.detach(|| {
         guarded(|| {
-            let pipeline = Pipeline::new(stages.params.clone())?;
+            let pipeline = Pipeline::new(params.clone())?;
             let encoded = pipeline.encode_dataset(&dataset, &indices, &|| ())?;
             let grid = encoded.first().map(|e| (e.spikes.rows, e.spikes.cols));
             let events: Vec<Vec<Event>> = encoded

@@ -82,7 +82,7 @@ fn inspect(
         neurotex::calibrate::GainChoice::Fixed(_) => None,
     };
     let params = InspectParams {
-        pipeline: stages.params.clone(),
+        pipeline: stages.to_calibrate().clone(),
         encoder,
         folds,
         k,

@@ -390,7 +390,7 @@ fn library_version() -> &'static str {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(params::stage_defaults, m)?)?;
-    m.add_function(wrap_pyfunction!(params::snn_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(params::classifier_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(params::classifier_knobs, m)?)?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(features, m)?)?;

@@ -2,31 +2,17 @@
 //! are: the one place where the Python layer parses options (the pipeline's, the
 //! classifiers', the feature method).
 
-use neurotex::classify::{
-    ChosenClassifier, ClassifierChoice, ForestParams, KnnParams, LinearParams,
+use neurotex::classify::{ChosenClassifier, ClassifierChoice};
+use neurotex::options::{
+    classifier_with, knobs_of, CheckedStages, OptionKind, StageOptions, STAGE_OPTIONS,
 };
-use neurotex::options::{CheckedStages, OptionKind, OptionSpec, StageOptions, STAGE_OPTIONS};
 use neurotex::pipeline::Method;
 use neurotex::recording::Baseline;
-use neurotex::snn::{Reset, SnnParams, Target};
+use neurotex::snn::SnnParams;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{param, raise, Kind};
-
-/// Reads `key` from `options`, or `None` when absent or `None`.
-fn get<'py, T: FromPyObjectOwned<'py>>(
-    options: &Bound<'py, PyDict>,
-    key: &str,
-) -> PyResult<Option<T>> {
-    match options.get_item(key)? {
-        Some(v) if !v.is_none() => v.extract::<T>().map(Some).map_err(|e| {
-            let e: PyErr = e.into();
-            invalid(key, e)
-        }),
-        _ => Ok(None),
-    }
-}
 
 /// A `ParameterError` for option `key`.
 fn invalid(key: &str, reason: impl std::fmt::Display) -> PyErr {
@@ -57,9 +43,9 @@ pub type Stages = CheckedStages;
 
 /// A Python value as the text the library's option parser reads: `True` as `true`, a
 /// sequence of counts as `1,2`, a number or a name as it is written.
-fn option_text(spec: &OptionSpec, value: &Bound<'_, PyAny>) -> PyResult<String> {
-    let text = match spec.kind {
-        OptionKind::Flag => value.extract::<bool>().map(|b| b.to_string()),
+fn option_text(name: &str, kind: OptionKind, value: &Bound<'_, PyAny>) -> PyResult<String> {
+    let text = match kind {
+        OptionKind::Flag | OptionKind::Bool => value.extract::<bool>().map(|b| b.to_string()),
         OptionKind::Count => value.extract::<usize>().map(|n| n.to_string()),
         OptionKind::Counts => value.extract::<Vec<usize>>().map(|v| {
             let v: Vec<String> = v.iter().map(usize::to_string).collect();
@@ -78,17 +64,17 @@ fn option_text(spec: &OptionSpec, value: &Bound<'_, PyAny>) -> PyResult<String> 
     };
     text.map_err(|e| {
         // A negative whole number is a value out of range, not a type to convert.
-        let negative = match spec.kind {
+        let negative = match kind {
             OptionKind::Count => value.extract::<i64>().ok().map(|i| i.to_string()),
             OptionKind::Counts => value.extract::<Vec<i64>>().ok().map(|v| format!("{v:?}")),
             _ => None,
         };
         match negative {
             Some(got) => invalid(
-                spec.name,
+                name,
                 format!("expected whole numbers of at least 0, got {got}"),
             ),
-            None => invalid(spec.name, e),
+            None => invalid(name, e),
         }
     })
 }
@@ -107,7 +93,7 @@ pub fn stage_options(options: &Bound<'_, PyDict>) -> PyResult<StageOptions> {
     for spec in STAGE_OPTIONS {
         match options.get_item(spec.name)? {
             Some(v) if !v.is_none() => {
-                let text = option_text(spec, &v)?;
+                let text = option_text(spec.name, spec.kind, &v)?;
                 (spec.set)(&mut chosen, &text).map_err(|e| invalid(spec.name, e))?;
             }
             _ => {}
@@ -128,29 +114,43 @@ pub fn stage_defaults<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
             out.set_item(key, py.None())?;
             continue;
         };
-        let bad = |e: String| raise(Kind::Internal, format!("default of `{key}`: {e}"));
-        match spec.kind {
-            OptionKind::Flag => out.set_item(key, text == "true")?,
-            OptionKind::Count => {
-                out.set_item(key, text.parse::<usize>().map_err(|e| bad(e.to_string()))?)?
-            }
-            OptionKind::Counts => {
-                let v: Result<Vec<usize>, _> = text.split(',').map(str::parse).collect();
-                out.set_item(
-                    key,
-                    pyo3::types::PyTuple::new(py, v.map_err(|e| bad(e.to_string()))?)?,
-                )?
-            }
-            OptionKind::Number => {
-                out.set_item(key, text.parse::<f64>().map_err(|e| bad(e.to_string()))?)?
-            }
-            OptionKind::Text => match text.parse::<f64>() {
-                Ok(x) => out.set_item(key, x)?,
-                Err(_) => out.set_item(key, text)?,
-            },
-        }
+        out.set_item(key, py_value(py, key, spec.kind, &text)?)?;
     }
     Ok(out)
+}
+
+/// A default as the Python value a keyword argument takes: `True`, `200`, `(1, 2)`, `8.0`,
+/// `"RS"`.
+fn py_value<'py>(
+    py: Python<'py>,
+    key: &str,
+    kind: OptionKind,
+    text: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let bad = |e: String| raise(Kind::Internal, format!("default of `{key}`: {e}"));
+    Ok(match kind {
+        OptionKind::Flag | OptionKind::Bool => {
+            (text == "true").into_pyobject(py)?.to_owned().into_any()
+        }
+        OptionKind::Count => text
+            .parse::<usize>()
+            .map_err(|e| bad(e.to_string()))?
+            .into_pyobject(py)?
+            .into_any(),
+        OptionKind::Counts => {
+            let v: Result<Vec<usize>, _> = text.split(',').map(str::parse).collect();
+            pyo3::types::PyTuple::new(py, v.map_err(|e| bad(e.to_string()))?)?.into_any()
+        }
+        OptionKind::Number => text
+            .parse::<f64>()
+            .map_err(|e| bad(e.to_string()))?
+            .into_pyobject(py)?
+            .into_any(),
+        OptionKind::Text => match text.parse::<f64>() {
+            Ok(x) => x.into_pyobject(py)?.into_any(),
+            Err(_) => text.into_pyobject(py)?.into_any(),
+        },
+    })
 }
 
 /// The baseline of the recordings' dataset (its layout's, as the Python layer passes it
@@ -173,61 +173,36 @@ pub fn chosen_classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Ch
     classifier(kind, options)?.check().map_err(param)
 }
 
-/// A classifier by name with its knobs: `k`, `standardize` (KNN); `trees`, `max_depth`,
-/// `min_samples_leaf`, `max_features`, `bootstrap`, `seed` or `forest_seed` (forest); `c`,
-/// `max_iter`, `tol` (linear). Checked (a model file stores this form).
+/// A classifier by name with its knobs ([`neurotex::options::CLASSIFIER_OPTIONS`] by their Python
+/// names;
+/// the forest's `seed` also as `forest_seed`), checked (a model file stores this form).
 pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<ClassifierChoice> {
     // The kind by the library's name, with its defaults.
     let defaults: ClassifierChoice = kind.parse().map_err(param)?;
-    let known = knobs(&defaults);
-    only_known(
-        options,
-        known,
-        &format!(" for classifier {kind}; its options are"),
-    )?;
-    let choice = match defaults {
-        ClassifierChoice::Knn(d) => ClassifierChoice::Knn(KnnParams {
-            k: get(options, "k")?.unwrap_or(d.k),
-            standardize: get(options, "standardize")?.unwrap_or(d.standardize),
-        }),
-        ClassifierChoice::Forest(d) => ClassifierChoice::Forest(ForestParams {
-            trees: get(options, "trees")?.unwrap_or(d.trees),
-            max_depth: get(options, "max_depth")?.or(d.max_depth),
-            min_samples_leaf: get(options, "min_samples_leaf")?.unwrap_or(d.min_samples_leaf),
-            max_features: get(options, "max_features")?.or(d.max_features),
-            bootstrap: get(options, "bootstrap")?.unwrap_or(d.bootstrap),
-            seed: match get(options, "forest_seed")? {
-                Some(seed) => seed,
-                None => get(options, "seed")?.unwrap_or(d.seed),
-            },
-        }),
-        ClassifierChoice::Linear(d) => ClassifierChoice::Linear(LinearParams {
-            c: get(options, "c")?.unwrap_or(d.c),
-            max_iter: get(options, "max_iter")?.unwrap_or(d.max_iter),
-            tol: get(options, "tol")?.unwrap_or(d.tol),
-        }),
-        ClassifierChoice::Snn(d) => ClassifierChoice::Snn(snn_params(options, d)?),
-    };
-    choice.check().map_err(param)?;
-    Ok(choice)
-}
-
-/// A classifier's knobs by their Python names.
-fn knobs(kind: &ClassifierChoice) -> &'static [&'static str] {
-    match kind {
-        ClassifierChoice::Knn(_) => &["k", "standardize"],
-        ClassifierChoice::Forest(_) => &[
-            "trees",
-            "max_depth",
-            "min_samples_leaf",
-            "max_features",
-            "bootstrap",
-            "seed",
-            "forest_seed",
-        ],
-        ClassifierChoice::Linear(_) => &["c", "max_iter", "tol"],
-        ClassifierChoice::Snn(_) => SNN_OPTIONS,
+    let name = defaults.name();
+    let mut known: Vec<&str> = knobs_of(name).map(|k| k.name).collect();
+    if name == "forest" {
+        known.push("forest_seed");
     }
+    let what = match name {
+        "snn" => " for the spiking network; its options are".to_string(),
+        _ => format!(" for classifier {kind}; its options are"),
+    };
+    only_known(options, &known, &what)?;
+    let mut given = Vec::new();
+    for spec in knobs_of(name) {
+        let alias = (spec.name == "seed" && name == "forest").then_some("forest_seed");
+        let value = match alias.map(|a| options.get_item(a)).transpose()?.flatten() {
+            Some(v) if !v.is_none() => Some(v),
+            _ => options.get_item(spec.name)?.filter(|v| !v.is_none()),
+        };
+        if let Some(value) = value {
+            let text = option_text(spec.name, spec.kind, &value)?;
+            (spec.set)(&mut { defaults }, &text).map_err(|e| invalid(spec.name, e))?;
+            given.push((spec, text));
+        }
+    }
+    classifier_with(defaults, &given).map_err(crate::errors::to_py)
 }
 
 /// The knobs `classifier_options` takes for the classifier `kind` (`knn`, `forest`,
@@ -235,84 +210,29 @@ fn knobs(kind: &ClassifierChoice) -> &'static [&'static str] {
 #[pyfunction]
 pub fn classifier_knobs(kind: &str) -> PyResult<Vec<&'static str>> {
     let kind: ClassifierChoice = kind.parse().map_err(param)?;
-    Ok(knobs(&kind).to_vec())
+    Ok(knobs_of(kind.name()).map(|k| k.name).collect())
 }
 
-/// The spiking network's training knobs (`hidden`, `dt_ms`, `epochs`, `readout`, `seed`,
-/// `recurrent`, `reset`, `target`) over `d`, unchecked; without `reset`, the target's
-/// (subtract for Xylo).
-fn snn_params(options: &Bound<'_, PyDict>, d: SnnParams) -> PyResult<SnnParams> {
-    let target = match get::<String>(options, "target")? {
-        Some(t) => t.parse().map_err(param)?,
-        None => d.target,
-    };
-    Ok(SnnParams {
-        hidden: get(options, "hidden")?.unwrap_or(d.hidden),
-        dt_ms: get(options, "dt_ms")?.unwrap_or(d.dt_ms),
-        epochs: get(options, "epochs")?.unwrap_or(d.epochs),
-        readout: match get::<String>(options, "readout")? {
-            Some(r) => r.parse().map_err(param)?,
-            None => d.readout,
-        },
-        seed: get(options, "seed")?.unwrap_or(d.seed),
-        recurrent: get(options, "recurrent")?.unwrap_or(d.recurrent),
-        reset: match (get::<String>(options, "reset")?, target) {
-            (Some(r), _) => r.parse().map_err(param)?,
-            // The chip's neurons subtract; its profile asks for no other option.
-            (None, Target::Xylo) => Reset::Subtract,
-            (None, Target::Float) => d.reset,
-        },
-        target,
-        tau_syn_ms: get(options, "tau_syn_ms")?.unwrap_or(d.tau_syn_ms),
-        tau_mem_ms: get(options, "tau_mem_ms")?.unwrap_or(d.tau_mem_ms),
-        tau_out_ms: get(options, "tau_out_ms")?.unwrap_or(d.tau_out_ms),
-        ..d
-    })
-}
-
-/// The spiking network's knobs Python takes, with their defaults: the one source of
-/// `SpikingModel.train`'s and `SpikingClassifier`'s keyword defaults.
+/// The knobs of the classifier `kind` with their defaults (`None` for a knob without
+/// one, as the forest's `max_depth`): the one source of the Python estimators' and
+/// `SpikingModel.train`'s keyword defaults.
 #[pyfunction]
-pub fn snn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    let d = SnnParams::default();
+pub fn classifier_defaults<'py>(py: Python<'py>, kind: &str) -> PyResult<Bound<'py, PyDict>> {
+    let kind: ClassifierChoice = kind.parse().map_err(param)?;
     let out = PyDict::new(py);
-    out.set_item("hidden", d.hidden)?;
-    out.set_item("dt_ms", d.dt_ms)?;
-    out.set_item("epochs", d.epochs)?;
-    out.set_item("readout", d.readout.name())?;
-    out.set_item("seed", d.seed)?;
-    out.set_item("recurrent", d.recurrent)?;
-    out.set_item("reset", d.reset.name())?;
-    out.set_item("target", d.target.name())?;
-    out.set_item("tau_syn_ms", d.tau_syn_ms)?;
-    out.set_item("tau_mem_ms", d.tau_mem_ms)?;
-    out.set_item("tau_out_ms", d.tau_out_ms)?;
+    for spec in knobs_of(kind.name()) {
+        match spec.default_text() {
+            Some(text) => out.set_item(spec.name, py_value(py, spec.name, spec.kind, &text)?)?,
+            None => out.set_item(spec.name, py.None())?,
+        }
+    }
     Ok(out)
 }
 
-/// The spiking network's options, by their Python names.
-const SNN_OPTIONS: &[&str] = &[
-    "hidden",
-    "dt_ms",
-    "epochs",
-    "readout",
-    "seed",
-    "recurrent",
-    "reset",
-    "target",
-    "tau_syn_ms",
-    "tau_mem_ms",
-    "tau_out_ms",
-];
-
 /// The spiking network's training knobs, checked.
 pub fn snn(options: &Bound<'_, PyDict>) -> PyResult<SnnParams> {
-    only_known(
-        options,
-        SNN_OPTIONS,
-        " for the spiking network; its options are",
-    )?;
-    snn_params(options, SnnParams::default())?
-        .check()
-        .map_err(param)
+    match classifier("snn", options)? {
+        ClassifierChoice::Snn(p) => Ok(p),
+        other => unreachable!("the network's knobs made a {}", other.name()),
+    }
 }

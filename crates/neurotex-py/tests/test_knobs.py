@@ -44,14 +44,33 @@ def test_python_and_the_cli_take_the_same_classifier_knobs(kind):
         assert cli_knobs(help_text)[kind] <= python, kind
 
 
-def test_the_network_knobs_reach_training_with_the_cli_defaults():
-    defaults = _native.snn_defaults()
-    assert set(defaults) == set(_native.classifier_knobs("snn"))
+@pytest.mark.parametrize("kind", ["forest", "linear", "snn"])
+def test_the_knobs_defaults_are_the_clis(kind):
+    defaults = _native.classifier_defaults(kind)
+    assert set(defaults) == set(_native.classifier_knobs(kind))
     help_text = run_cli("train", "--help").stdout
-    for knob in ("hidden", "tau_syn_ms", "tau_mem_ms", "tau_out_ms"):
-        text = help_text.split(flag("snn", knob), 1)[1].split("\n  -", 1)[0]
-        shown = re.search(r"\[default: ([0-9.]+)", text).group(1)
-        assert float(shown) == float(defaults[knob]), knob
+    for knob, value in defaults.items():
+        text = help_text.split(flag(kind, knob) + " ", 1)[1].split("\n  -", 1)[0]
+        shown = re.search(r"\[default: ([^\]]+)\]", text)
+        if value is None or isinstance(value, bool) and kind == "snn":
+            continue  # a rule in words, or a flag without a value
+        assert shown, f"{kind}: {knob}"
+        if isinstance(value, bool):
+            assert shown.group(1) == str(value).lower(), knob
+        elif isinstance(value, str):
+            assert shown.group(1) == value, knob
+        else:
+            assert float(shown.group(1)) == float(value), knob
+
+
+def test_the_estimators_defaults_are_the_librarys():
+    from neurotex import sklearn as nsk
+    import inspect
+    for cls, kind in ((nsk.KNNClassifier, "knn"), (nsk.RandomForestClassifier, "forest"),
+                      (nsk.LogisticRegression, "linear")):
+        params = inspect.signature(cls.__init__).parameters
+        for knob, value in _native.classifier_defaults(kind).items():
+            assert params[knob].default == value, (kind, knob)
 
 
 def test_a_broken_knob_is_named_as_python_spells_it(sim):

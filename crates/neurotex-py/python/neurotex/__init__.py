@@ -40,7 +40,7 @@ __version__ = _native.library_version()
 # Every stage option's default, from the library's one definition of the options.
 _DEFAULTS: Dict[str, Any] = _native.stage_defaults()
 # The spiking network's defaults (SpikingModel.train), from the library's.
-_SNN_DEFAULTS: Dict[str, Any] = _native.snn_defaults()
+_SNN_DEFAULTS: Dict[str, Any] = _native.classifier_defaults("snn")
 
 HARALICK_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(False))
 """Names of the paper's Haralick features, in the order :func:`haralick` returns them."""

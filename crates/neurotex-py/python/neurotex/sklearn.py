@@ -24,8 +24,11 @@ from . import _native, features as _features
 
 # Every stage option's default, from the library's one definition of the options.
 _DEFAULTS: Dict[str, Any] = _native.stage_defaults()
-# The spiking network's defaults, from the library's.
-_SNN_DEFAULTS: Dict[str, Any] = _native.snn_defaults()
+# Each classifier's defaults, from the library's one definition of its knobs.
+_KNN = _native.classifier_defaults("knn")
+_FOREST = _native.classifier_defaults("forest")
+_LINEAR = _native.classifier_defaults("linear")
+_SNN_DEFAULTS: Dict[str, Any] = _native.classifier_defaults("snn")
 
 __all__ = [
     "SpikeFeatures", "KNNClassifier", "RandomForestClassifier", "LogisticRegression",
@@ -219,7 +222,7 @@ class KNNClassifier(_LibraryClassifier):
 
     _kind = "knn"
 
-    def __init__(self, k: int = 5, standardize: bool = True) -> None:
+    def __init__(self, k: int = _KNN["k"], standardize: bool = _KNN["standardize"]) -> None:
         self.k = k
         self.standardize = standardize
 
@@ -231,12 +234,12 @@ class RandomForestClassifier(_LibraryClassifier):
 
     def __init__(
         self,
-        trees: int = 200,
-        max_depth: Optional[int] = None,
-        min_samples_leaf: int = 1,
-        max_features: Optional[int] = None,
-        bootstrap: bool = True,
-        seed: int = 0,
+        trees: int = _FOREST["trees"],
+        max_depth: Optional[int] = _FOREST["max_depth"],
+        min_samples_leaf: int = _FOREST["min_samples_leaf"],
+        max_features: Optional[int] = _FOREST["max_features"],
+        bootstrap: bool = _FOREST["bootstrap"],
+        seed: int = _FOREST["seed"],
     ) -> None:
         self.trees = trees
         self.max_depth = max_depth
@@ -252,7 +255,12 @@ class LogisticRegression(_LibraryClassifier):
 
     _kind = "linear"
 
-    def __init__(self, c: float = 1.0, max_iter: int = 1000, tol: float = 1e-8) -> None:
+    def __init__(
+        self,
+        c: float = _LINEAR["c"],
+        max_iter: int = _LINEAR["max_iter"],
+        tol: float = _LINEAR["tol"],
+    ) -> None:
         self.c = c
         self.max_iter = max_iter
         self.tol = tol

@@ -47,7 +47,7 @@ impl EncodeOptions {
         if stages.causal {
             return Err(OptionsError::Conflict("--causal fixes resting values and a scale on training recordings: use it with train, evaluate, features or compare (then predict or stream with the model)".into()).into());
         }
-        Ok(Pipeline::new(stages.check()?.params)?)
+        Ok(Pipeline::new(stages.check()?.to_calibrate().clone())?)
     }
 
     /// Reads the recording with its layout, saying where the layout came from.

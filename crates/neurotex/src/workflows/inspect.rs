@@ -56,7 +56,7 @@ impl InspectOptions {
         }
         let checked = stages.check()?;
         let params = InspectParams {
-            pipeline: checked.params,
+            pipeline: checked.to_calibrate().clone(),
             encoder: !self.no_encoder,
             folds: self.folds,
             k: self.k,

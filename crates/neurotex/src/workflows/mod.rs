@@ -23,15 +23,15 @@ pub mod train;
 use rayon::prelude::*;
 
 use crate::analysis::FeatureTable;
-use crate::calibrate::{calibrate_pipeline, CalibratedParams, GainCalibration};
-use crate::classify::{ClassifierChoice, ForestParams, KnnParams, LinearParams};
+use crate::calibrate::{CalibratedParams, GainCalibration};
+use crate::classify::{ClassifierChoice, KnnParams};
 use crate::error::OptionsError;
-use crate::options::StageOptions;
+use crate::options::{classifier_with, KnobSpec, StageOptions};
 use crate::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{one_grid, Dataset, Meta};
 use crate::samples::MethodChoice;
-use crate::snn::{Reset, SnnParams, Target};
+use crate::snn::SnnParams;
 use crate::{Grid, Result};
 
 pub use reading::{CsvOptions, LogOptions, OpenOptions, ReadOptions};
@@ -75,162 +75,34 @@ impl KnnOptions {
     }
 }
 
-/// Options choosing the classifier (KNN's own are [`KnnOptions`]).
+/// Options choosing the classifier and its knobs, each defined once in
+/// [`CLASSIFIER_OPTIONS`](crate::options::CLASSIFIER_OPTIONS) (KNN's own are [`KnnOptions`], shared with the commands that run
+/// the paper's KNN alone).
 #[derive(Debug, Clone, Default)]
-#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct ClassifierOptions {
-    /// Classifier: `knn` (the paper's), `forest` (random forest of CART trees, √d features
-    /// tried per split), `linear` (multinomial logistic regression, L2 penalty) or `snn` (a
-    /// spiking network that reads the spike trains themselves, not features: it implies
-    /// `--method spikes`, and `--method spikes` implies it). The regression always z-scores
-    /// features with training statistics and the forest needs no scaling: --no-standardize
-    /// applies to KNN only. [default: knn]
-    #[cfg_attr(feature = "cli", arg(long))]
+    /// The classifier; `None`: the one the method implies, else KNN.
     pub classifier: Option<ClassifierChoice>,
-    /// With `--classifier forest`: trees in the forest [default: 200].
-    #[cfg_attr(feature = "cli", arg(long))]
-    pub trees: Option<usize>,
-    /// With `--classifier forest`: seed of the trees' random streams [default: 0].
-    #[cfg_attr(feature = "cli", arg(long = "forest-seed"))]
-    pub forest_seed: Option<u64>,
-    /// With `--classifier forest`: deepest level of a tree, the root at 0 [default: grown
-    /// until leaves are pure or too small to split].
-    #[cfg_attr(feature = "cli", arg(long = "max-depth"))]
-    pub max_depth: Option<usize>,
-    /// With `--classifier forest`: fewest training recordings in a leaf [default: 1].
-    #[cfg_attr(feature = "cli", arg(long = "min-samples-leaf"))]
-    pub min_samples_leaf: Option<usize>,
-    /// With `--classifier forest`: features tried at each split [default: ⌊√d⌋].
-    #[cfg_attr(feature = "cli", arg(long = "max-features"))]
-    pub max_features: Option<usize>,
-    /// With `--classifier forest`: grow each tree on a bootstrap sample (`true`) or on the
-    /// whole training set (`false`) [default: true].
-    #[cfg_attr(feature = "cli", arg(long))]
-    pub bootstrap: Option<bool>,
-    /// With `--classifier linear`: inverse penalty strength, scikit-learn's C [default: 1].
-    #[cfg_attr(feature = "cli", arg(long = "c"))]
-    pub c: Option<f64>,
-    /// With `--classifier linear`: most L-BFGS iterations [default: 1000].
-    #[cfg_attr(feature = "cli", arg(long = "max-iter"))]
-    pub max_iter: Option<usize>,
-    /// With `--classifier linear`: stop when no gradient component exceeds this [default:
-    /// 1e-8].
-    #[cfg_attr(feature = "cli", arg(long))]
-    pub tol: Option<f64>,
-    /// The spiking network's options (`--classifier snn`).
-    #[cfg_attr(feature = "cli", command(flatten))]
-    pub snn: SnnOptions,
+    /// The knobs given, each with its value as typed.
+    pub knobs: Vec<(&'static KnobSpec, String)>,
 }
 
-/// Options of the spiking classifier (`--classifier snn`, `docs/spiking-classifier.md`).
+/// The spiking network's knobs alone (`compare`'s network candidate).
 #[derive(Debug, Clone, Default)]
-#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct SnnOptions {
-    /// With `--classifier snn`: hidden LIF neurons [default: 128].
-    #[cfg_attr(feature = "cli", arg(long = "snn-hidden", id = "snn-hidden"))]
-    pub hidden: Option<usize>,
-    /// With `--classifier snn`: the network's time step in ms; the encoder's 1 ms spikes
-    /// are counted in bins this wide [default: 10].
-    #[cfg_attr(feature = "cli", arg(long = "snn-dt-ms", id = "snn-dt-ms"))]
-    pub dt_ms: Option<u32>,
-    /// With `--classifier snn`: most training epochs; early stopping on a validation split
-    /// of the training recordings may end sooner [default: 60].
-    #[cfg_attr(feature = "cli", arg(long = "snn-epochs", id = "snn-epochs"))]
-    pub epochs: Option<usize>,
-    /// With `--classifier snn`: class scores are the readout's `mean` over time or its
-    /// `max` [default: mean].
-    #[cfg_attr(feature = "cli", arg(long = "snn-readout", id = "snn-readout"))]
-    pub readout: Option<neurotex_learn::snn::Readout>,
-    /// With `--classifier snn`: seed of the initial weights, validation split and batch
-    /// order [default: 0].
-    #[cfg_attr(feature = "cli", arg(long = "snn-seed", id = "snn-seed"))]
-    pub seed: Option<u64>,
-    /// With `--classifier snn`: recurrent connections within the hidden layer (each step's
-    /// spikes drive the next step's currents); default feed-forward.
-    #[cfg_attr(feature = "cli", arg(long = "snn-recurrent", id = "snn-recurrent"))]
-    pub recurrent: bool,
-    /// With `--classifier snn`: how a hidden neuron resets on a spike: `zero` (the
-    /// default; one spike per step at most) or `subtract` (n = floor(v) spikes, v - n
-    /// kept: the neuron of sinabs, Rockpool and Xylo, needed to export to them).
-    #[cfg_attr(feature = "cli", arg(long = "snn-reset", id = "snn-reset"))]
-    pub reset: Option<neurotex_learn::snn::Reset>,
-    /// With `--classifier snn`: the hidden neurons' synaptic time constant, ms [default:
-    /// 20].
-    #[cfg_attr(feature = "cli", arg(long = "snn-tau-syn-ms", id = "snn-tau-syn-ms"))]
-    pub tau_syn_ms: Option<f64>,
-    /// With `--classifier snn`: the hidden neurons' membrane time constant, ms [default:
-    /// 40].
-    #[cfg_attr(feature = "cli", arg(long = "snn-tau-mem-ms", id = "snn-tau-mem-ms"))]
-    pub tau_mem_ms: Option<f64>,
-    /// With `--classifier snn`: the readout's time constant, ms [default: 40].
-    #[cfg_attr(feature = "cli", arg(long = "snn-tau-out-ms", id = "snn-tau-out-ms"))]
-    pub tau_out_ms: Option<f64>,
-    /// With `--classifier snn`: where the network runs: `float` (the default) or `xylo`
-    /// (SynSense's Xylo Audio 2: trained within the chip's limits, its time constants
-    /// moved to the chip's bitshift decays, subtractive reset, and predicting in the
-    /// chip's integers as its simulator does; `export xylo` writes its configuration).
-    #[cfg_attr(feature = "cli", arg(long = "snn-target", id = "snn-target"))]
-    pub target: Option<neurotex_learn::snn::Target>,
+    /// The knobs given, each with its value as typed.
+    pub knobs: Vec<(&'static KnobSpec, String)>,
 }
 
 impl SnnOptions {
-    /// The first option given, as the command line spells it.
-    pub fn given(&self) -> Option<&'static str> {
-        let given = [
-            ("--snn-hidden", self.hidden.is_some()),
-            ("--snn-dt-ms", self.dt_ms.is_some()),
-            ("--snn-epochs", self.epochs.is_some()),
-            ("--snn-readout", self.readout.is_some()),
-            ("--snn-seed", self.seed.is_some()),
-            ("--snn-recurrent", self.recurrent),
-            ("--snn-reset", self.reset.is_some()),
-            ("--snn-target", self.target.is_some()),
-            ("--snn-tau-syn-ms", self.tau_syn_ms.is_some()),
-            ("--snn-tau-mem-ms", self.tau_mem_ms.is_some()),
-            ("--snn-tau-out-ms", self.tau_out_ms.is_some()),
-        ];
-        given.into_iter().find(|g| g.1).map(|g| g.0)
-    }
-
-    /// Whether any option was given.
-    pub fn any(&self) -> bool {
-        self.hidden.is_some()
-            || self.dt_ms.is_some()
-            || self.epochs.is_some()
-            || self.readout.is_some()
-            || self.seed.is_some()
-            || self.recurrent
-            || self.reset.is_some()
-            || self.target.is_some()
-            || self.tau_syn_ms.is_some()
-            || self.tau_mem_ms.is_some()
-            || self.tau_out_ms.is_some()
-    }
-
-    /// `defaults` with the options given applied, checked.
+    /// `defaults` with the knobs given applied, checked.
     ///
     /// # Errors
-    /// A parameter out of its range.
+    /// A value a knob does not take, or a parameter out of its range.
     pub fn params(&self, defaults: SnnParams) -> Result<SnnParams> {
-        Ok(SnnParams {
-            hidden: self.hidden.unwrap_or(defaults.hidden),
-            dt_ms: self.dt_ms.unwrap_or(defaults.dt_ms),
-            epochs: self.epochs.unwrap_or(defaults.epochs),
-            readout: self.readout.unwrap_or(defaults.readout),
-            seed: self.seed.unwrap_or(defaults.seed),
-            recurrent: self.recurrent || defaults.recurrent,
-            reset: self.reset.unwrap_or(match self.target {
-                // The chip's neurons subtract; its profile asks for no other option.
-                Some(Target::Xylo) => Reset::Subtract,
-                _ => defaults.reset,
-            }),
-            target: self.target.unwrap_or(defaults.target),
-            tau_syn_ms: self.tau_syn_ms.unwrap_or(defaults.tau_syn_ms),
-            tau_mem_ms: self.tau_mem_ms.unwrap_or(defaults.tau_mem_ms),
-            tau_out_ms: self.tau_out_ms.unwrap_or(defaults.tau_out_ms),
-            ..defaults
+        match classifier_with(ClassifierChoice::Snn(defaults), &self.knobs)? {
+            ClassifierChoice::Snn(p) => Ok(p),
+            other => unreachable!("the network's knobs made a {}", other.name()),
         }
-        .check()?)
     }
 }
 
@@ -270,8 +142,8 @@ impl ClassifierOptions {
         default: MethodChoice,
     ) -> (MethodChoice, ClassifierChoice) {
         let spikes = ClassifierChoice::Snn(SnnParams::default());
-        let kind = match (self.classifier, method) {
-            (Some(kind), _) => kind,
+        let kind = match (&self.classifier, method) {
+            (Some(kind), _) => *kind,
             (None, Some(MethodChoice::Spikes)) => spikes,
             (None, _) => ClassifierChoice::default(),
         };
@@ -279,73 +151,124 @@ impl ClassifierOptions {
         (method, kind)
     }
 
-    /// The classifier of kind `kind` with its options applied, checked.
+    /// The classifier of kind `kind` with its knobs applied, checked; KNN as `knn` says.
     fn choice_of(&self, kind: ClassifierChoice, knn: KnnParams) -> Result<ClassifierChoice> {
-        let choice = match kind {
+        let kind = match kind {
             ClassifierChoice::Knn(_) => ClassifierChoice::Knn(knn),
-            ClassifierChoice::Forest(defaults) => ClassifierChoice::Forest(ForestParams {
-                trees: self.trees.unwrap_or(defaults.trees),
-                seed: self.forest_seed.unwrap_or(defaults.seed),
-                max_depth: self.max_depth.or(defaults.max_depth),
-                min_samples_leaf: self.min_samples_leaf.unwrap_or(defaults.min_samples_leaf),
-                max_features: self.max_features.or(defaults.max_features),
-                bootstrap: self.bootstrap.unwrap_or(defaults.bootstrap),
-            }),
-            ClassifierChoice::Linear(defaults) => ClassifierChoice::Linear(LinearParams {
-                c: self.c.unwrap_or(defaults.c),
-                max_iter: self.max_iter.unwrap_or(defaults.max_iter),
-                tol: self.tol.unwrap_or(defaults.tol),
-            }),
-            ClassifierChoice::Snn(defaults) => ClassifierChoice::Snn(self.snn.params(defaults)?),
+            other => other,
         };
-        self.only_its_own(&choice)?;
-        if !matches!(choice, ClassifierChoice::Snn(_)) {
-            choice.check()?;
-        }
-        Ok(choice)
+        classifier_with(kind, &self.knobs)
     }
 }
 
-impl ClassifierOptions {
-    /// Refuses an option of another classifier than `choice`.
-    ///
-    /// # Errors
-    /// The first option given that `choice` does not take.
-    fn only_its_own(&self, choice: &ClassifierChoice) -> Result<()> {
-        if let Some(option) = self.snn.given() {
-            if !matches!(choice, ClassifierChoice::Snn(_)) {
-                let applies_to = "--classifier snn";
-                return Err(OptionsError::NotApplicable { option, applies_to }.into());
+#[cfg(feature = "cli")]
+mod knob_flags {
+    //! The classifiers' knobs as flags, built from [`CLASSIFIER_OPTIONS`].
+
+    use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
+
+    use super::{ClassifierOptions, KnobSpec, SnnOptions};
+    use crate::classify::ClassifierChoice;
+    use crate::options::{OptionKind, CLASSIFIER_OPTIONS};
+
+    /// The knobs of every classifier but KNN (whose `-k` and `--no-standardize` are
+    /// [`super::KnnOptions`]'), or of the network alone.
+    fn offered(snn_only: bool) -> impl Iterator<Item = &'static KnobSpec> {
+        CLASSIFIER_OPTIONS
+            .iter()
+            .filter(move |k| k.classifier != "knn" && (!snn_only || k.classifier == "snn"))
+    }
+
+    /// The flag of one knob, its value checked as it is parsed.
+    fn flag(spec: &'static KnobSpec) -> Arg {
+        let long = &spec.flag[2..];
+        let arg = Arg::new(long).long(long).help(spec.help_with_default());
+        if spec.kind == OptionKind::Flag {
+            return arg.action(ArgAction::SetTrue);
+        }
+        arg.value_name(long.replace('-', "_").to_uppercase())
+            .action(ArgAction::Set)
+            .allow_negative_numbers(true)
+            .value_parser(move |text: &str| {
+                let mut defaults: ClassifierChoice = spec.classifier.parse().unwrap_or_default();
+                (spec.set)(&mut defaults, text).map(|()| text.to_string())
+            })
+    }
+
+    /// The knobs given on the command line, each with its text.
+    fn given(matches: &ArgMatches, snn_only: bool) -> Vec<(&'static KnobSpec, String)> {
+        offered(snn_only)
+            .filter_map(|spec| {
+                let id = &spec.flag[2..];
+                let text = match spec.kind {
+                    OptionKind::Flag => matches.get_flag(id).then(|| "true".to_string()),
+                    _ => matches.get_one::<String>(id).cloned(),
+                };
+                text.map(|t| (spec, t))
+            })
+            .collect()
+    }
+
+    /// `--classifier`'s help.
+    const CLASSIFIER_HELP: &str = "Classifier: `knn` (the paper's), `forest` (random forest \
+        of CART trees, √d features tried per split), `linear` (multinomial logistic \
+        regression, L2 penalty) or `snn` (a spiking network that reads the spike trains \
+        themselves, not features: it implies `--method spikes`, and `--method spikes` \
+        implies it). The regression always z-scores features with training statistics and \
+        the forest needs no scaling: --no-standardize applies to KNN only. [default: knn]";
+
+    impl Args for ClassifierOptions {
+        fn augment_args(cmd: Command) -> Command {
+            let classifier = Arg::new("classifier")
+                .long("classifier")
+                .value_name("CLASSIFIER")
+                .help(CLASSIFIER_HELP)
+                .value_parser(|text: &str| text.parse::<ClassifierChoice>());
+            offered(false).fold(cmd.arg(classifier), |cmd, spec| cmd.arg(flag(spec)))
+        }
+
+        fn augment_args_for_update(cmd: Command) -> Command {
+            Self::augment_args(cmd)
+        }
+    }
+
+    impl FromArgMatches for ClassifierOptions {
+        fn from_arg_matches(matches: &ArgMatches) -> Result<Self, clap::Error> {
+            let mut options = Self::default();
+            options.update_from_arg_matches(matches)?;
+            Ok(options)
+        }
+
+        fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+            if let Some(choice) = matches.get_one::<ClassifierChoice>("classifier") {
+                self.classifier = Some(*choice);
             }
+            self.knobs = given(matches, false);
+            Ok(())
         }
-        let forest = matches!(choice, ClassifierChoice::Forest(_));
-        if !forest && (self.trees.is_some() || self.forest_seed.is_some()) {
-            return Err(OptionsError::Conflict(
-                "--trees and --forest-seed apply only to --classifier forest".into(),
-            )
-            .into());
+    }
+
+    impl Args for SnnOptions {
+        fn augment_args(cmd: Command) -> Command {
+            offered(true).fold(cmd, |cmd, spec| cmd.arg(flag(spec)))
         }
-        let forest_knobs = [
-            ("--max-depth", self.max_depth.is_some()),
-            ("--min-samples-leaf", self.min_samples_leaf.is_some()),
-            ("--max-features", self.max_features.is_some()),
-            ("--bootstrap", self.bootstrap.is_some()),
-        ];
-        let linear_knobs = [
-            ("--c", self.c.is_some()),
-            ("--max-iter", self.max_iter.is_some()),
-            ("--tol", self.tol.is_some()),
-        ];
-        let linear = matches!(choice, ClassifierChoice::Linear(_));
-        for (knobs, own, applies_to) in [
-            (&forest_knobs[..], forest, "--classifier forest"),
-            (&linear_knobs[..], linear, "--classifier linear"),
-        ] {
-            if let Some((option, _)) = knobs.iter().find(|k| k.1 && !own) {
-                return Err(OptionsError::NotApplicable { option, applies_to }.into());
-            }
+
+        fn augment_args_for_update(cmd: Command) -> Command {
+            Self::augment_args(cmd)
         }
-        Ok(())
+    }
+
+    impl FromArgMatches for SnnOptions {
+        fn from_arg_matches(matches: &ArgMatches) -> Result<Self, clap::Error> {
+            let mut options = Self::default();
+            options.update_from_arg_matches(matches)?;
+            Ok(options)
+        }
+
+        fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+            self.knobs = given(matches, true);
+            Ok(())
+        }
     }
 }
 
@@ -454,7 +377,7 @@ pub fn calibrated_pipeline(
     indices: &[usize],
     on: OnProgress,
 ) -> Result<CalibratedParams> {
-    let params = stages.check()?.params;
+    let checked = stages.check()?;
     if dataset.is_events() && (stages.causal || stages.gain.target_hz().is_some()) {
         return Err(OptionsError::Conflict(format!(
             "{} holds address events, which skip the encoder: --gain auto and --causal condition and encode a sampled signal",
@@ -462,13 +385,12 @@ pub fn calibrated_pipeline(
         ))
         .into());
     }
-    for line in crate::inspect::severe_findings(dataset, &params)?.lines() {
+    for line in crate::inspect::severe_findings(dataset, checked.to_calibrate())?.lines() {
         on(Progress::Advice(&line));
     }
     let baseline = dataset.layout.baseline.unwrap_or_default();
     let load = |i: usize| dataset.load(i);
-    let calibrated =
-        calibrate_pipeline(params, stages.causal, stages.gain, &load, indices, baseline)?;
+    let calibrated = checked.calibrate(&load, indices, baseline)?;
     if let Some(c) = &calibrated.causal {
         on(Progress::Say(&format!(
             "--causal: forward-only filter; resting values and scale {:.6} fixed on {} training recording(s) (median selected phase {} ms)",

@@ -85,7 +85,7 @@ impl ReproduceOptions {
         if stages.causal {
             return Err(OptionsError::Conflict("reproduce runs the causal pipeline itself (its causal E5 beside the paper's offline E5); --causal is for train, evaluate, features and compare".into()).into());
         }
-        params.pipeline = stages.check()?.params;
+        params.pipeline = stages.check()?.to_calibrate().clone();
         params.knn = self.knn.params()?;
         params.seed = self.seed;
         params.cv.seed = self.seed;

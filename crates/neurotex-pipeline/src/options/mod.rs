@@ -3,6 +3,7 @@
 //! pipeline's validated parameters ([`StageOptions::check`]). The CLI builds its flags
 //! from [`STAGE_OPTIONS`] (`bin_ms` is `--bin-ms`), the Python package its keyword
 //! arguments and their defaults (`bin_ms=200`), so a default or a rule is written here only.
+//! The classifiers' knobs are defined in the same way in [`classifiers`].
 
 use crate::calibrate::GainChoice;
 use crate::encode::{FaParams, FiringType};
@@ -11,6 +12,10 @@ use crate::pipeline::{Encoding, FeatureParams, HaralickSet, PipelineParams};
 use crate::recording::Baseline;
 use crate::signal::PreprocessParams;
 use crate::values::ParamError;
+
+pub mod classifiers;
+
+pub use classifiers::{classifier_with, knobs_of, KnobSpec, CLASSIFIER_OPTIONS};
 
 /// What kind of value an option takes, for the front ends' parsers and types.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,6 +28,9 @@ pub enum OptionKind {
     Counts,
     /// On or off: a flag on the command line, a `bool` in Python.
     Flag,
+    /// `true` or `false` given as a value (`--bootstrap false`), for a switch that is on
+    /// by default; a `bool` in Python.
+    Bool,
     /// A name from a fixed set, or (the gain) a number or a name.
     Text,
 }
@@ -139,12 +147,17 @@ impl Default for StageOptions {
 }
 
 /// The stage options checked: the pipeline's parameters and what is still to be
-/// calibrated on the training recordings before they apply.
+/// calibrated on the training recordings before they apply. The parameters are reached
+/// in one of two ways, so that none is used with a gain or a conditioning that is still
+/// to be chosen: [`CheckedStages::fixed`] when nothing is left to calibrate, and
+/// [`CheckedStages::calibrate`] (or, for an analysis that calibrates inside its own
+/// loops, [`CheckedStages::to_calibrate`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CheckedStages {
-    /// The pipeline parameters, checked; under `auto` gain the gain is a placeholder
-    /// (the encoder's default) replaced by the calibrated one before anything is encoded.
-    pub params: PipelineParams,
+    /// The pipeline parameters, checked; under `auto` gain the encoder's gain is the
+    /// firing type's until calibration chooses it, and under `causal` the conditioning
+    /// has no resting values yet.
+    params: PipelineParams,
     /// The gain as chosen: a number, or `auto` with its target rate.
     pub gain: GainChoice,
     /// Causal conditioning: resting values and a scale fixed on training recordings.
@@ -155,6 +168,41 @@ impl CheckedStages {
     /// The target rate of an `auto` gain, or `None` for a gain given as a number.
     pub fn gain_target(&self) -> Option<f64> {
         self.gain.target_hz()
+    }
+
+    /// The pipeline's parameters when nothing is left to calibrate (a gain given as a
+    /// number, conditioning recording by recording); `None` under `auto` gain or `causal`.
+    pub fn fixed(&self) -> Option<&PipelineParams> {
+        (self.gain_target().is_none() && !self.causal).then_some(&self.params)
+    }
+
+    /// The parameters before calibration, for a caller that calibrates them itself (each
+    /// analysis's training set its own gain, or one recording's): under `auto` gain the
+    /// encoder's gain is the firing type's until then.
+    pub fn to_calibrate(&self) -> &PipelineParams {
+        &self.params
+    }
+
+    /// The parameters with the gain and the causal conditioning chosen on the recordings
+    /// `indices` (loaded by `load`; labels are not read).
+    ///
+    /// # Errors
+    /// As [`crate::calibrate::calibrate_pipeline`].
+    pub fn calibrate(
+        &self,
+        load: &(dyn Fn(usize) -> crate::error::Result<crate::recording::Recording> + Sync),
+        indices: &[usize],
+        baseline: Baseline,
+    ) -> crate::error::Result<crate::calibrate::CalibratedParams> {
+        let params = self.params.clone();
+        crate::calibrate::calibrate_pipeline(
+            params,
+            self.causal,
+            self.gain,
+            load,
+            indices,
+            baseline,
+        )
     }
 }
 
@@ -435,7 +483,7 @@ mod tests {
             }
         }
         assert_eq!(o, StageOptions::default());
-        assert_eq!(o.check().unwrap().params, PipelineParams::default());
+        assert_eq!(o.check().unwrap().fixed(), Some(&PipelineParams::default()));
     }
 
     #[test]
@@ -454,16 +502,15 @@ mod tests {
         }
         let c = o.check().unwrap();
         assert_eq!(c.gain_target(), Some(15.0));
-        assert_eq!(c.params.volume.bin_ms, 100);
-        assert_eq!(c.params.glcm.distances, [1, 2]);
-        assert!(c.params.glcm.symmetric);
-        assert_eq!(c.params.encoding, Encoding::SaFa);
-        assert_eq!(c.params.preprocess.baseline, Some(Baseline::Min));
-        assert_eq!(c.params.preprocess.cutoff_hz, 20.5);
-        assert_eq!(
-            c.params.encoder.gain,
-            PipelineParams::default().encoder.gain
-        );
+        assert_eq!(c.fixed(), None, "the gain is still to be chosen");
+        let p = c.to_calibrate();
+        assert_eq!(p.volume.bin_ms, 100);
+        assert_eq!(p.glcm.distances, [1, 2]);
+        assert!(p.glcm.symmetric);
+        assert_eq!(p.encoding, Encoding::SaFa);
+        assert_eq!(p.preprocess.baseline, Some(Baseline::Min));
+        assert_eq!(p.preprocess.cutoff_hz, 20.5);
+        assert_eq!(p.encoder.gain, PipelineParams::default().encoder.gain);
     }
 
     #[test]
