@@ -50,10 +50,12 @@ def test_the_knobs_defaults_are_the_clis(kind):
     assert set(defaults) == set(_native.classifier_knobs(kind))
     help_text = run_cli("train", "--help").stdout
     for knob, value in defaults.items():
-        text = help_text.split(flag(kind, knob) + " ", 1)[1].split("\n  -", 1)[0]
-        shown = re.search(r"\[default: ([^\]]+)\]", text)
         if value is None or isinstance(value, bool) and kind == "snn":
             continue  # a rule in words, or a flag without a value
+        entry = re.search(rf"^\s+{re.escape(flag(kind, knob))} <\w+>\n(.*?)(?=\n\s+-|\Z)",
+                          help_text, re.M | re.S)
+        assert entry, f"{kind}: {knob}"
+        shown = re.search(r"\[default: ([^\]]+)\]", entry.group(1))
         assert shown, f"{kind}: {knob}"
         if isinstance(value, bool):
             assert shown.group(1) == str(value).lower(), knob
