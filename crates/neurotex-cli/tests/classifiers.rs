@@ -141,6 +141,10 @@ fn options_of_another_classifier_are_refused() {
             "--bootstrap applies only to --classifier forest",
         ),
         (
+            train(&["--classifier", "linear", "-k", "3"]),
+            "-k applies only to --classifier knn",
+        ),
+        (
             train(&["--classifier", "forest", "--bootstrap", "maybe"]),
             "expected true or false, got `maybe`",
         ),

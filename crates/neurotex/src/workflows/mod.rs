@@ -122,7 +122,8 @@ impl ClassifierOptions {
     /// run is refused here, naming the pairings that do.
     ///
     /// # Errors
-    /// As [`ClassifierOptions::choice`], and a method the classifier does not read.
+    /// As [`ClassifierOptions::choice`], a method the classifier does not read, and KNN's
+    /// `k` or z-scoring changed for another classifier.
     pub fn with_method(
         &self,
         method: Option<MethodChoice>,
@@ -132,6 +133,19 @@ impl ClassifierOptions {
         let (method, kind) = self.kinds(method, default);
         let classifier = self.choice_of(kind, knn)?;
         method.check_pairing(&classifier)?;
+        let defaults = KnnParams::default();
+        if !matches!(classifier, ClassifierChoice::Knn(_)) {
+            // A `k` or z-scoring other than the default would otherwise go unused.
+            let option = match (knn.k != defaults.k, knn.standardize != defaults.standardize) {
+                (true, _) => Some("-k"),
+                (_, true) => Some("--no-standardize"),
+                _ => None,
+            };
+            if let Some(option) = option {
+                let applies_to = "--classifier knn";
+                return Err(OptionsError::NotApplicable { option, applies_to }.into());
+            }
+        }
         Ok((method, classifier))
     }
 
