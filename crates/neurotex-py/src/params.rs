@@ -4,7 +4,7 @@
 
 use neurotex::classify::{ChosenClassifier, ClassifierChoice};
 use neurotex::options::{
-    classifier_with, knobs_of, CheckedStages, OptionKind, StageOptions, STAGE_OPTIONS,
+    classifier_with, knobs_of, CheckedStages, KnobSpec, OptionKind, StageOptions, STAGE_OPTIONS,
 };
 use neurotex::pipeline::Method;
 use neurotex::recording::Baseline;
@@ -189,6 +189,22 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
         _ => format!(" for classifier {kind}; its options are"),
     };
     only_known(options, &known, &what)?;
+    let given = knobs_given(name, options)?;
+    classifier_with(defaults, &given).map_err(crate::errors::to_py)
+}
+
+/// The knobs of the classifier `name` among `options`, each with its value as the
+/// library's parser reads it (checked one by one, not yet together); keys of other
+/// classifiers are left to the caller.
+pub fn knobs_given(
+    name: &str,
+    options: &Bound<'_, PyDict>,
+) -> PyResult<Vec<(&'static KnobSpec, String)>> {
+    let defaults: ClassifierChoice = name.parse().map_err(param)?;
+    if name == "snn" {
+        let known: Vec<&str> = knobs_of(name).map(|k| k.name).collect();
+        only_known(options, &known, " for the spiking network; its options are")?;
+    }
     let mut given = Vec::new();
     for spec in knobs_of(name) {
         let alias = (spec.name == "seed" && name == "forest").then_some("forest_seed");
@@ -202,7 +218,7 @@ pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Classifie
             given.push((spec, text));
         }
     }
-    classifier_with(defaults, &given).map_err(crate::errors::to_py)
+    Ok(given)
 }
 
 /// The knobs `classifier_options` takes for the classifier `kind` (`knn`, `forest`,

@@ -1,5 +1,5 @@
-//! The command line's workflows on a dataset folder, called from Python: `train` and
-//! `predict --dataset` run here exactly as the CLI runs them (sampled recordings or
+//! The command line's workflows on a dataset folder, called from Python: `train`,
+//! `evaluate`, `compare` and `predict --dataset` run here exactly as the CLI runs them (sampled recordings or
 //! address events, the spiking network or a feature classifier), so a model trained on a
 //! folder from Python is the CLI's model file, byte for byte. Python keeps only the
 //! conversion of its keywords into the workflow's options.
@@ -8,9 +8,12 @@ use std::path::PathBuf;
 
 use neurotex::classify::ClassifierChoice;
 use neurotex::progress::Progress;
+use neurotex::recording::Selection;
 use neurotex::samples::MethodChoice;
+use neurotex::workflows::compare::CompareOptions;
+use neurotex::workflows::evaluate::EvaluateOptions;
 use neurotex::workflows::train::TrainOptions;
-use neurotex::workflows::{ClassifierOptions, KnnOptions, OpenOptions};
+use neurotex::workflows::{ClassifierOptions, KnnOptions, OpenOptions, SnnOptions};
 use neurotex::{Cell, Speed};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -80,13 +83,8 @@ fn train_dataset(
         .map(|m| m.parse::<MethodChoice>().map_err(param))
         .transpose()?;
     let (knn, classifier) = front_end_classifier(classifier, method, classifier_options)?;
-    let speeds = speeds
-        .map(|v| v.into_iter().map(Speed::new).collect::<Result<Vec<_>, _>>())
-        .transpose()
-        .map_err(param)?;
-    let taxel = taxel
-        .map(|t| t.parse::<Cell>().map_err(param))
-        .transpose()?;
+    let speeds = speeds_of(speeds)?;
+    let taxel = parsed::<Cell>(taxel)?;
     let train = TrainOptions {
         dataset: path.clone(),
         speeds,
@@ -115,7 +113,186 @@ fn train_dataset(
     Ok((Py::new(py, model)?.into_any(), None, said.lines()))
 }
 
+/// Speeds in mm/s as the library's, checked.
+fn speeds_of(speeds: Option<Vec<f64>>) -> PyResult<Option<Vec<Speed>>> {
+    speeds
+        .map(|v| v.into_iter().map(Speed::new).collect::<Result<Vec<_>, _>>())
+        .transpose()
+        .map_err(param)
+}
+
+/// A value as the command line types it (`"2,3"` for a taxel, `"trial=0,1"` for a
+/// selection), parsed by the library's own parser.
+fn parsed<T: std::str::FromStr<Err = neurotex::error::ParamError>>(
+    text: Option<&str>,
+) -> PyResult<Option<T>> {
+    text.map(|t| t.parse::<T>().map_err(param)).transpose()
+}
+
+/// Evaluates on the dataset folder `path` as `neurotex evaluate --dataset PATH --json`
+/// does, through its workflow: the method and classifier as `train_dataset` takes them,
+/// the cross-validation's `folds`, `repeats` and `seed` (`None`: the CLI's defaults), or a
+/// train/test split by speeds or by manifest column (`train_where="trial=0,1"`), and
+/// `group_by`. Returns the evaluation as the CLI's JSON object and what the workflow said.
+#[pyfunction]
+#[pyo3(signature = (path, method, classifier, classifier_options, options, folds=None,
+    repeats=None, seed=0, speeds=None, train_speeds=None, test_speeds=None, train_where=None,
+    test_where=None, group_by=None, taxel=None, tau_ms=None))]
+#[allow(clippy::too_many_arguments)]
+fn evaluate_dataset(
+    py: Python<'_>,
+    path: PathBuf,
+    method: Option<&str>,
+    classifier: Option<&str>,
+    classifier_options: &Bound<'_, PyDict>,
+    options: &Bound<'_, PyDict>,
+    folds: Option<usize>,
+    repeats: Option<usize>,
+    seed: u64,
+    speeds: Option<Vec<f64>>,
+    train_speeds: Option<Vec<f64>>,
+    test_speeds: Option<Vec<f64>>,
+    train_where: Option<&str>,
+    test_where: Option<&str>,
+    group_by: Option<String>,
+    taxel: Option<&str>,
+    tau_ms: Option<f64>,
+) -> PyResult<(Py<PyAny>, Vec<String>)> {
+    let stages = params::stage_options(options)?;
+    let method = method
+        .map(|m| m.parse::<MethodChoice>().map_err(param))
+        .transpose()?;
+    let (knn, classifier) = front_end_classifier(classifier, method, classifier_options)?;
+    if train_speeds.is_some() != test_speeds.is_some()
+        || train_where.is_some() != test_where.is_some()
+    {
+        let why = "a train/test split needs both sets: train_speeds with test_speeds, train_where with test_where";
+        return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
+    }
+    let cv = neurotex::classify::CvParams::default();
+    let evaluate = EvaluateOptions {
+        dataset: path.clone(),
+        method,
+        tau_ms: tau_ms.unwrap_or(neurotex::samples::STANDARD_TAU_MS),
+        taxel: parsed::<Cell>(taxel)?,
+        knn,
+        folds: folds.unwrap_or(cv.folds),
+        seed,
+        repeats: repeats.unwrap_or(cv.repeats),
+        speeds: speeds_of(speeds)?,
+        train_speeds: speeds_of(train_speeds)?,
+        test_speeds: speeds_of(test_speeds)?,
+        train_where: parsed::<Selection>(train_where)?,
+        test_where: parsed::<Selection>(test_where)?,
+        group_by,
+        classifier,
+        open: OpenOptions::default(),
+    };
+    let dataset = open(&path)?;
+    let said = Said::default();
+    let on = |p: Progress| said.hear(p);
+    let evaluated = py.detach(|| guarded(|| evaluate.run(&dataset, &stages, &on)))?;
+    let json = evaluated
+        .json()
+        .map_err(|e| crate::errors::raise(crate::errors::Kind::Internal, e.to_string()))?;
+    Ok((crate::convert::to_object(py, &json)?, said.lines()))
+}
+
+/// A comma-separated list as the command line takes it, or `standard` when `None`.
+fn listed(names: Option<Vec<String>>, standard: &str) -> Vec<String> {
+    names.unwrap_or_else(|| standard.split(',').map(str::to_string).collect())
+}
+
+/// Compares candidates on the dataset folder `path` as `neurotex compare --dataset PATH
+/// --json` does, through its workflow: `encodings`, `methods` and `classifiers` (`None`:
+/// the CLI's standard sets), the protocol (`per`, `hold_out`, or `train_where` with
+/// `test_where`; pooled without), `group_by`, the cross-validation's `folds`, `repeats`
+/// and `seed` (`None`: the CLI's), `nested` selection, KNN's `knn` knobs and the
+/// network's `snn` knobs. With `out`, also writes compare.json, compare.md and the
+/// figures there, as `--out`. Returns the comparison as the CLI's JSON object and what
+/// the workflow said.
+#[pyfunction]
+#[pyo3(signature = (path, options, knn, snn, encodings=None, methods=None, classifiers=None,
+    speeds=None, per=None, hold_out=None, train_where=None, test_where=None, group_by=None,
+    folds=None, repeats=None, seed=0, nested=false, tau_ms=None, out=None))]
+#[allow(clippy::too_many_arguments)]
+fn compare_dataset(
+    py: Python<'_>,
+    path: PathBuf,
+    options: &Bound<'_, PyDict>,
+    knn: &Bound<'_, PyDict>,
+    snn: &Bound<'_, PyDict>,
+    encodings: Option<Vec<String>>,
+    methods: Option<Vec<String>>,
+    classifiers: Option<Vec<String>>,
+    speeds: Option<Vec<f64>>,
+    per: Option<String>,
+    hold_out: Option<String>,
+    train_where: Option<&str>,
+    test_where: Option<&str>,
+    group_by: Option<String>,
+    folds: Option<usize>,
+    repeats: Option<usize>,
+    seed: u64,
+    nested: bool,
+    tau_ms: Option<f64>,
+    out: Option<PathBuf>,
+) -> PyResult<(Py<PyAny>, Vec<String>)> {
+    use neurotex::compare::candidates as standard;
+    let stages = params::stage_options(options)?;
+    let (knn, _) = front_end_classifier(Some("knn"), None, knn)?;
+    let snn_knobs = params::knobs_given("snn", snn)?;
+    let chosen = [per.is_some(), hold_out.is_some(), train_where.is_some()];
+    if chosen.iter().filter(|&&c| c).count() > 1 || train_where.is_some() != test_where.is_some() {
+        let why = "one protocol at a time: per, hold_out, or train_where with test_where";
+        return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
+    }
+    let cv = neurotex::classify::CvParams::default();
+    let compare = CompareOptions {
+        dataset: path.clone(),
+        speeds: speeds_of(speeds)?,
+        per,
+        hold_out,
+        train_where: parsed::<Selection>(train_where)?,
+        test_where: parsed::<Selection>(test_where)?,
+        group_by,
+        encodings: listed(encodings, standard::STANDARD_ENCODINGS),
+        methods: listed(methods, standard::STANDARD_METHODS),
+        classifiers: listed(classifiers, standard::STANDARD_CLASSIFIERS),
+        tau_ms: tau_ms.unwrap_or(standard::STANDARD_TAU_MS),
+        knn,
+        snn: SnnOptions { knobs: snn_knobs },
+        folds: folds.unwrap_or(cv.folds),
+        repeats: repeats.unwrap_or(cv.repeats),
+        seed,
+        nested,
+        open: OpenOptions::default(),
+    };
+    if let Some(dir) = &out {
+        if dir.exists() && std::fs::read_dir(dir).map_or(true, |mut d| d.next().is_some()) {
+            let why = format!("out: {} exists and is not an empty folder", dir.display());
+            return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
+        }
+    }
+    let dataset = open(&path)?;
+    let said = Said::default();
+    let on = |p: Progress| said.hear(p);
+    let comparison = py.detach(|| {
+        guarded(|| {
+            let comparison = compare.run(&dataset, &stages, &on)?;
+            if let Some(dir) = &out {
+                let _claim = neurotex::io::claim_output_dir(dir)?;
+                neurotex::report::comparison::write_comparison(dir, &comparison, &path)?;
+            }
+            Ok(comparison)
+        })
+    })?;
+    Ok((crate::convert::to_object(py, &comparison)?, said.lines()))
+}
+
 /// Registers the workflows.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(train_dataset, m)?)
+    m.add_function(wrap_pyfunction!(train_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(compare_dataset, m)?)
 }

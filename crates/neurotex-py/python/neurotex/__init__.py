@@ -587,6 +587,117 @@ def cross_validate(
                                   int(folds), int(seed), int(repeats))
 
 
+def evaluate(
+    path: Union[str, os.PathLike],
+    *,
+    method: Optional[str] = None,
+    classifier: Optional[str] = None,
+    classifier_options: Optional[Dict[str, Any]] = None,
+    folds: Optional[int] = None,
+    repeats: Optional[int] = None,
+    seed: int = 0,
+    speeds: Any = None,
+    train_speeds: Any = None,
+    test_speeds: Any = None,
+    train_where: Optional[str] = None,
+    test_where: Optional[str] = None,
+    group_by: Optional[str] = None,
+    taxel: Optional[str] = None,
+    tau_ms: Optional[float] = None,
+    causal: bool = False,
+    **stage_options: Any,
+) -> Dict[str, Any]:
+    """Evaluates a method and a classifier on the dataset folder ``path`` (sampled
+    recordings or address events) by ``neurotex evaluate``'s own workflow: the same
+    numbers as ``neurotex evaluate --dataset PATH --json``, as a dict (``accuracy``,
+    ``accuracy_interval`` with its 95 % bounds, ``metrics`` with the chance levels,
+    ``confusion``, ``classifier``, ...).
+
+    ``method`` and ``classifier`` are the CLI's (``None``: glcm3d with KNN; the spiking
+    network with ``classifier="snn"`` or ``method="spikes"``), ``classifier_options`` the
+    classifier's knobs (``{"k": 3}``, ``{"trees": 500}``, ``{"hidden": 64}``); ``folds``,
+    ``repeats`` and ``seed`` the cross-validation's (``None``: the CLI's defaults);
+    ``speeds`` keeps only those speeds; ``train_speeds`` with ``test_speeds``, or
+    ``train_where`` with ``test_where`` (``"trial=0,1"``), train on one set and test on the
+    other instead; ``group_by`` keeps a manifest column's groups within one fold;
+    ``taxel`` (``"2,3"``) one taxel for ``method="taxel"``; ``tau_ms`` the van Rossum
+    kernel's. Stage options (``gain="auto"``, ``encoding``, ``bin_ms``, ...) are the
+    CLI's; what the workflow says goes to the ``neurotex`` logger."""
+    opts = _stage_options(**stage_options)
+    opts["causal"] = bool(causal)
+
+    def listed(v: Any) -> Optional[List[float]]:
+        return None if v is None else [float(x) for x in np.atleast_1d(v)]
+
+    result, said = _native.evaluate_dataset(
+        os.fspath(path), method, classifier, dict(classifier_options or {}), opts,
+        folds, repeats, int(seed), listed(speeds), listed(train_speeds), listed(test_speeds),
+        train_where, test_where, group_by, taxel, tau_ms)
+    for line in said:
+        _log.info("%s", line)
+    return result
+
+
+def compare(
+    path: Union[str, os.PathLike],
+    *,
+    encodings: Optional[Sequence[str]] = None,
+    methods: Optional[Sequence[str]] = None,
+    classifiers: Optional[Sequence[str]] = None,
+    speeds: Any = None,
+    per: Optional[str] = None,
+    hold_out: Optional[str] = None,
+    train_where: Optional[str] = None,
+    test_where: Optional[str] = None,
+    group_by: Optional[str] = None,
+    folds: Optional[int] = None,
+    repeats: Optional[int] = None,
+    seed: int = 0,
+    nested: bool = False,
+    tau_ms: Optional[float] = None,
+    knn_options: Optional[Dict[str, Any]] = None,
+    snn_options: Optional[Dict[str, Any]] = None,
+    out: Optional[Union[str, os.PathLike]] = None,
+    causal: bool = False,
+    **stage_options: Any,
+) -> Dict[str, Any]:
+    """Compares encodings x feature methods x classifiers on the dataset folder ``path``
+    by ``neurotex compare``'s own workflow: the same object as ``neurotex compare
+    --dataset PATH --json``, as a dict (each candidate's accuracy with its 95 % interval
+    and paired test against the paper's method, chance, and with ``nested=True`` the
+    accuracy of choosing the best inside each training set).
+
+    ``encodings``, ``methods`` and ``classifiers`` are lists of the CLI's names (``None``:
+    its standard sets); ``per="speed_mm_s"`` cross-validates within each speed,
+    ``hold_out="speed_mm_s"`` holds each speed out in turn, ``train_where`` with
+    ``test_where`` (``"trial=0,1"``) trains on one set and tests on the other (pooled
+    recordings without any); ``group_by``, ``folds``, ``repeats``, ``seed`` and ``tau_ms``
+    are the CLI's. ``knn_options`` (``{"k": 3}``) and ``snn_options`` (``{"hidden":
+    64}``) are the knobs of the KNN and spiking-network candidates. With ``out``, the
+    folder (new or empty) also gets compare.json, compare.md and the figures. Stage
+    options (``gain="auto"``, ``bin_ms``, ...) are the CLI's."""
+    opts = _stage_options(**stage_options)
+    opts["causal"] = bool(causal)
+
+    def names(v: Optional[Sequence[str]], what: str) -> Optional[List[str]]:
+        if v is None:
+            return None
+        if isinstance(v, str):
+            raise ParameterError(f"{what} must be a list of names, got the string {v!r}")
+        return [str(x) for x in v]
+
+    only = None if speeds is None else [float(x) for x in np.atleast_1d(speeds)]
+    result, said = _native.compare_dataset(
+        os.fspath(path), opts, dict(knn_options or {}), dict(snn_options or {}),
+        names(encodings, "encodings"), names(methods, "methods"),
+        names(classifiers, "classifiers"), only, per, hold_out, train_where, test_where,
+        group_by, folds, repeats, int(seed), bool(nested), tau_ms,
+        None if out is None else os.fspath(out))
+    for line in said:
+        _log.info("%s", line)
+    return result
+
+
 def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = None) -> Dataset:
     """Reads a dataset folder (``manifest.csv``, recordings, optional ``layout.toml``) as
     the library reads it: every recording as float64 ``(T, rows, cols)`` on its grid,
@@ -1371,7 +1482,7 @@ class StreamClassifier:
 
 __all__ = [
     "encode", "features", "spike_stats", "rate_volume", "glcm3d", "glcm2d", "haralick",
-    "cross_validate", "load_dataset", "save_dataset", "simulate", "events", "EVENT_DTYPE", "Model", "SpikingModel", "Recording",
+    "cross_validate", "evaluate", "compare", "load_dataset", "save_dataset", "simulate", "events", "EVENT_DTYPE", "Model", "SpikingModel", "Recording",
     "StreamClassifier", "reproduce", "Reproduction", "calibrate_gain", "GainCalibration",
     "CausalConditioning", "FeatureTable", "inspect", "Inspection",
     "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",

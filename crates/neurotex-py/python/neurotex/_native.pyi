@@ -184,6 +184,45 @@ def train_dataset(
     speeds: Optional[List[float]] = ...,
     taxel: Optional[str] = ...,
 ) -> Tuple[Union[NativeModel, NativeSpikingModel], Optional[Tuple[int, int, float]], List[str]]: ...
+def evaluate_dataset(
+    path: str,
+    method: Optional[str],
+    classifier: Optional[str],
+    classifier_options: Dict[str, Any],
+    options: Dict[str, Any],
+    folds: Optional[int] = ...,
+    repeats: Optional[int] = ...,
+    seed: int = ...,
+    speeds: Optional[List[float]] = ...,
+    train_speeds: Optional[List[float]] = ...,
+    test_speeds: Optional[List[float]] = ...,
+    train_where: Optional[str] = ...,
+    test_where: Optional[str] = ...,
+    group_by: Optional[str] = ...,
+    taxel: Optional[str] = ...,
+    tau_ms: Optional[float] = ...,
+) -> Tuple[Dict[str, Any], List[str]]: ...
+def compare_dataset(
+    path: str,
+    options: Dict[str, Any],
+    knn: Dict[str, Any],
+    snn: Dict[str, Any],
+    encodings: Optional[List[str]] = ...,
+    methods: Optional[List[str]] = ...,
+    classifiers: Optional[List[str]] = ...,
+    speeds: Optional[List[float]] = ...,
+    per: Optional[str] = ...,
+    hold_out: Optional[str] = ...,
+    train_where: Optional[str] = ...,
+    test_where: Optional[str] = ...,
+    group_by: Optional[str] = ...,
+    folds: Optional[int] = ...,
+    repeats: Optional[int] = ...,
+    seed: int = ...,
+    nested: bool = ...,
+    tau_ms: Optional[float] = ...,
+    out: Optional[str] = ...,
+) -> Tuple[Dict[str, Any], List[str]]: ...
 
 class NativeModel:
     @staticmethod

@@ -1,0 +1,77 @@
+"""`neurotex.evaluate` on a dataset folder runs the CLI's own `evaluate` workflow: the
+same JSON object as `neurotex evaluate --json`, for cross-validation and for a train/test
+split, for a feature classifier and the spiking network; broken options are named as
+Python spells them."""
+
+import json
+
+import pytest
+
+import neurotex
+from neurotex.errors import ParameterError
+
+from conftest import run_cli
+
+
+def cli_json(*args):
+    return json.loads(run_cli("evaluate", *args, "--json").stdout)
+
+
+@pytest.mark.parametrize("py_args, cli_args", [
+    ({}, []),
+    ({"classifier": "forest", "classifier_options": {"trees": 20}, "folds": 3, "seed": 4},
+     ["--classifier", "forest", "--trees", "20", "--folds", "3", "--seed", "4"]),
+    ({"method": "all-taxels", "classifier_options": {"k": 3}, "train_speeds": [5],
+      "test_speeds": [10]},
+     ["--method", "all-taxels", "-k", "3", "--train-speeds", "5", "--test-speeds", "10"]),
+    ({"method": "taxel", "taxel": "1,2", "train_where": "trial=0,1,2",
+      "test_where": "trial=3,4", "bin_ms": 100},
+     ["--method", "taxel", "--taxel", "1,2", "--train-where", "trial=0,1,2",
+      "--test-where", "trial=3,4", "--bin-ms", "100"]),
+    ({"classifier": "snn", "classifier_options": {"hidden": 8, "epochs": 2}, "folds": 2,
+      "speeds": [5]},
+     ["--classifier", "snn", "--snn-hidden", "8", "--snn-epochs", "2", "--folds", "2",
+      "--speeds", "5"]),
+])
+def test_evaluate_on_a_folder_is_the_clis_json(sim_dir, py_args, cli_args):
+    ours = neurotex.evaluate(sim_dir, **py_args)
+    assert ours == cli_json("--dataset", sim_dir, *cli_args)
+    assert 0.0 <= ours["accuracy"] <= 1.0
+
+
+def test_gain_auto_is_calibrated_and_said(sim_dir):
+    ours = neurotex.evaluate(sim_dir, gain="auto", folds=2)
+    assert ours == cli_json("--dataset", sim_dir, "--gain", "auto", "--folds", "2")
+    assert "gain_calibration" in ours
+
+
+def test_broken_options_are_named_as_python_spells_them(sim_dir):
+    with pytest.raises(ParameterError, match="`hidden`"):
+        neurotex.evaluate(sim_dir, classifier="snn", classifier_options={"hidden": 0})
+    with pytest.raises(ParameterError, match="test_speeds"):
+        neurotex.evaluate(sim_dir, train_speeds=[5])
+    with pytest.raises(ParameterError, match="bin_ms"):
+        neurotex.evaluate(sim_dir, bin_ms=0)
+    with pytest.raises(ParameterError, match="unknown option `trees` for classifier knn"):
+        neurotex.evaluate(sim_dir, classifier_options={"trees": 3})
+
+
+def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
+    """`neurotex.compare` runs `neurotex compare`'s workflow: the same JSON object, and
+    with `out` the same compare.json."""
+    ours = neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d", "all-taxels"],
+                            classifiers=["knn", "linear"], per="speed_mm_s", folds=3,
+                            knn_options={"k": 3}, nested=True, out=tmp_path / "py")
+    cli = json.loads(run_cli("compare", "--dataset", sim_dir, "--encodings", "sa",
+                             "--methods", "glcm3d,all-taxels", "--classifiers", "knn,linear",
+                             "--per", "speed_mm_s", "--folds", "3", "-k", "3", "--nested",
+                             "--json", "--out", tmp_path / "cli").stdout)
+    assert ours == cli
+    assert (tmp_path / "py" / "compare.json").read_bytes() == \
+        (tmp_path / "cli" / "compare.json").read_bytes()
+    with pytest.raises(ParameterError, match="one protocol at a time"):
+        neurotex.compare(sim_dir, per="speed_mm_s", hold_out="speed_mm_s")
+    with pytest.raises(ParameterError, match="must be a list"):
+        neurotex.compare(sim_dir, methods="glcm3d")
+    with pytest.raises(ParameterError, match="for the spiking network"):
+        neurotex.compare(sim_dir, snn_options={"trees": 3})
