@@ -284,6 +284,62 @@ impl DataError {
     }
 }
 
+/// What is wrong with one event of an event recording, before the file and the line are
+/// named (a reader reports it in a [`DataError::Invalid`], a live stream as a bad frame).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EventError {
+    /// A polarity that is neither the ON value nor the OFF value.
+    #[error("polarity {value} is neither ON ({on}) nor OFF ({off}); `import events --polarity-values ON,OFF` (or layout.toml's `[events] values = [on, off]`) names them")]
+    Polarity {
+        /// The polarity read.
+        value: i64,
+        /// The ON value.
+        on: i64,
+        /// The OFF value.
+        off: i64,
+    },
+    /// A taxel index the layout does not have.
+    #[error("taxel {taxel} is outside the layout's {taxels} taxels (0 to {})", .taxels.saturating_sub(1))]
+    TaxelOutside {
+        /// The index read.
+        taxel: i64,
+        /// The layout's taxels.
+        taxels: usize,
+    },
+    /// An `(x, y)` outside the grid.
+    #[error("x = {x}, y = {y} is outside the {rows}x{cols} grid (x is the column, 0 to {}; y the row, 0 to {})", .cols - 1, .rows - 1)]
+    OutsideGrid {
+        /// The column read.
+        x: i64,
+        /// The row read.
+        y: i64,
+        /// The grid's rows.
+        rows: usize,
+        /// The grid's columns.
+        cols: usize,
+    },
+    /// A cell the layout's mask leaves out.
+    #[error("the event is at row {row}, column {col}, a cell layout.toml's mask leaves out")]
+    Masked {
+        /// Its row.
+        row: usize,
+        /// Its column.
+        col: usize,
+    },
+    /// A time before the recording's start.
+    #[error("time {time} is before the recording's start: stamps from a clock need `--origin first` (`origin = \"first\"` in layout.toml's [events])")]
+    BeforeStart {
+        /// The time stamp, as written.
+        time: String,
+    },
+    /// A time that is not a finite number.
+    #[error("time {time} is not a finite number")]
+    NotFinite {
+        /// The time stamp, as written.
+        time: String,
+    },
+}
+
 /// Classification problems that come from the data given, not from a bug.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ClassifyError {

@@ -261,7 +261,7 @@ pub enum BadFrame {
     /// An event that names no cell of the model's grid, or a polarity that is neither ON
     /// nor OFF.
     #[error("{0}")]
-    Address(String),
+    Address(crate::error::EventError),
     /// A time stamp beyond [`MAX_STAMP_S`].
     #[error("time stamp {t} s exceeds the exact range of stamps (within 2^33 s, about 272 years, of zero; beyond, stamps 1 ms apart can be one number)")]
     StampRange {
