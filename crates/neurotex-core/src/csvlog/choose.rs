@@ -208,7 +208,7 @@ pub fn choose_columns(
 }
 
 /// An error's message without the file's name, which the caller adds once.
-pub(super) fn reason_of(path: &Path, e: crate::Error) -> String {
+fn reason_of(path: &Path, e: crate::Error) -> String {
     match e {
         crate::Error::Data(DataError::Invalid { path: p, message }) if p == path => message,
         other => other.to_string(),
@@ -217,6 +217,6 @@ pub(super) fn reason_of(path: &Path, e: crate::Error) -> String {
 
 /// The first line's fields as `format` splits them: header names, or `column{index}`
 /// without a header.
-pub(super) fn first_line_names(path: &Path, format: &CsvFormat) -> Result<Vec<String>> {
+fn first_line_names(path: &Path, format: &CsvFormat) -> Result<Vec<String>> {
     open_log(path, format).map(|(_, _, names)| names)
 }

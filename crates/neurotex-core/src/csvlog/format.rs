@@ -124,7 +124,7 @@ impl ChannelSelect {
 
 /// The most channel columns a selection may name (a bound on what a typo such as `0-99999999`
 /// may allocate).
-pub(super) const MAX_COLUMNS: usize = 65_536;
+const MAX_COLUMNS: usize = 65_536;
 
 impl FromStr for ChannelSelect {
     type Err = ParamError;

@@ -85,7 +85,7 @@ pub struct Columns {
 }
 
 /// Where column `col` is among `names`; `what` says which role it plays in errors.
-pub(super) fn resolve_column(
+fn resolve_column(
     path: &Path,
     what: &str,
     col: &Column,
@@ -199,7 +199,7 @@ impl Columns {
 
 /// The columns used must have distinct names: a layout, a model and the import's map
 /// find channels by name, and a repeated name would send them all to its first column.
-pub(super) fn unique_names<'a>(
+fn unique_names<'a>(
     path: &Path,
     names: &[String],
     used: impl Iterator<Item = &'a usize>,
@@ -240,7 +240,7 @@ pub(crate) fn repeated_name<S: AsRef<str>>(
 
 /// The unit a time column's name ends in: `_ms`, `_s`, `_us` (or `-`, a space, `(ms)`,
 /// `[s]`), in any case.
-pub(super) fn unit_in_name(name: &str) -> Option<TimeUnit> {
+fn unit_in_name(name: &str) -> Option<TimeUnit> {
     let name = name.trim().to_lowercase();
     let name = name.trim_end_matches([')', ']']);
     [
@@ -272,7 +272,7 @@ pub fn is_timelike_name(name: &str) -> bool {
 pub(super) const EPOCH_LIKE: f64 = 1e9;
 
 /// A column named `t_ms` or `time_ms` (in ms), else `t_s` or `time_s` (in s).
-pub(super) fn detect_time_column(names: &[String]) -> (Option<usize>, TimeUnit) {
+fn detect_time_column(names: &[String]) -> (Option<usize>, TimeUnit) {
     let find = |wanted: &[&str]| names.iter().position(|h| wanted.contains(&h.as_str()));
     match (find(&["t_ms", "time_ms"]), find(&["t_s", "time_s"])) {
         (Some(j), _) => (Some(j), TimeUnit::Milliseconds),

@@ -17,7 +17,7 @@ pub const PLAUSIBLE_HZ: (f64, f64) = (0.1, 20_000.0);
 
 /// Refuses stamps whose unit was only assumed when their median step implies a rate
 /// outside [`PLAUSIBLE_HZ`].
-pub(super) fn check_plausible_rate(path: &Path, columns: &Columns, times: &[f64]) -> Result<()> {
+fn check_plausible_rate(path: &Path, columns: &Columns, times: &[f64]) -> Result<()> {
     let (Some(t), false) = (columns.time, columns.unit_known) else {
         return Ok(());
     };
@@ -45,7 +45,7 @@ pub(super) fn check_plausible_rate(path: &Path, columns: &Columns, times: &[f64]
 }
 
 /// Refuses a gap between consecutive time stamps longer than `max_gap_s`.
-pub(super) fn check_gaps(path: &Path, log: &CsvLog, max_gap_s: f64) -> Result<()> {
+fn check_gaps(path: &Path, log: &CsvLog, max_gap_s: f64) -> Result<()> {
     let Some(times) = &log.times else {
         return Ok(());
     };
@@ -73,7 +73,7 @@ pub(super) fn check_gaps(path: &Path, log: &CsvLog, max_gap_s: f64) -> Result<()
 /// Refuses a log read without a time column whose first channel is named like a time
 /// column (`t`, `time...`, `...stamp...`) and rises on every row: it is its stamps, and
 /// read as one more taxel it would put a ramp on a cell and leave the rate unknown.
-pub(super) fn check_no_stamps_among_channels(
+fn check_no_stamps_among_channels(
     path: &Path,
     format: &CsvFormat,
     columns: &Columns,
@@ -163,7 +163,7 @@ pub fn read_csv_log(path: &Path, format: &CsvFormat) -> Result<CsvLog> {
 
 /// Folds rows into frames: the rows of one time stamp are kept (exact duplicates left out)
 /// until the stamp changes, then become one frame.
-pub(super) struct RowReader<'a> {
+struct RowReader<'a> {
     path: &'a Path,
     columns: &'a Columns,
     policy: DuplicateStamps,

@@ -16,7 +16,7 @@ pub(super) struct Columns {
     polarity: Option<usize>,
 }
 
-pub(super) enum CellColumns {
+enum CellColumns {
     Xy(usize, usize),
     Taxel(usize),
 }
@@ -363,10 +363,10 @@ pub(super) fn parse_csv(
 }
 
 /// An event's time, cell fields (`x` and `y`, or the taxel and 0) and polarity.
-pub(super) type EventFields = (Stamp, (i64, i64), Option<i64>);
+type EventFields = (Stamp, (i64, i64), Option<i64>);
 
 /// One CSV record's event: its time, cell fields and polarity; `Err` says why it is none.
-pub(super) fn csv_event(
+fn csv_event(
     record: &csv::ByteRecord,
     cols: &Columns,
 ) -> std::result::Result<EventFields, String> {
@@ -404,7 +404,7 @@ pub(super) fn csv_event(
     Ok((t, cell, p))
 }
 
-pub(super) fn parse_npy(
+fn parse_npy(
     path: &Path,
     format: &EventsFormat,
     sink: &mut impl FnMut(Parsed) -> Result<(), String>,

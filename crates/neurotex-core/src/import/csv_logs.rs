@@ -77,7 +77,7 @@ pub struct Logs {
 /// The error for logs read with neither a time column nor a rate, saying first what the
 /// first log's header shows: an address event's fields (`import events`), or a column
 /// named like time stamps (`--time-column`).
-pub(super) fn no_rate(files: &[PathBuf], p: &CsvImportParams) -> crate::Error {
+fn no_rate(files: &[PathBuf], p: &CsvImportParams) -> crate::Error {
     let header = files
         .first()
         .and_then(|f| Some((f, crate::csvlog::header_names(f, &p.format)?)));
@@ -101,7 +101,7 @@ pub(super) fn no_rate(files: &[PathBuf], p: &CsvImportParams) -> crate::Error {
 }
 
 /// [`refuse_event_log`] on a header's names less the one named like time stamps.
-pub(super) fn refuse_event_header(file: &Path, names: &[String]) -> Result<()> {
+fn refuse_event_header(file: &Path, names: &[String]) -> Result<()> {
     let time = names
         .iter()
         .position(|n| crate::csvlog::is_timelike_name(n));
@@ -115,7 +115,7 @@ pub(super) fn refuse_event_header(file: &Path, names: &[String]) -> Result<()> {
 /// Refuses a log whose channels are an address event's fields (`x`, `y` or a taxel
 /// index, and perhaps a polarity): read as samples, each event would be a frame and its
 /// coordinates taxel values, at the events' rate.
-pub(super) fn refuse_event_log(file: &Path, channels: &[String]) -> Result<()> {
+fn refuse_event_log(file: &Path, channels: &[String]) -> Result<()> {
     let lower: Vec<String> = channels.iter().map(|c| c.trim().to_lowercase()).collect();
     let has = |name: &str| lower.iter().any(|c| c == name);
     let address = (has("x") && has("y")) || ["taxel", "addr", "address"].iter().any(|n| has(n));
@@ -339,7 +339,7 @@ pub fn import_csv(
 
 /// Each input is written under its file name, so two inputs of one name (`a/x.csv` and
 /// `b/x.csv`) would become one file with two manifest rows: refused, naming both.
-pub(super) fn reject_duplicate_names(files: &[PathBuf]) -> Result<()> {
+fn reject_duplicate_names(files: &[PathBuf]) -> Result<()> {
     let mut seen: BTreeMap<&std::ffi::OsStr, &Path> = BTreeMap::new();
     for f in files {
         let Some(name) = f.file_name() else { continue };
@@ -358,7 +358,7 @@ pub(super) fn reject_duplicate_names(files: &[PathBuf]) -> Result<()> {
 
 /// Parses every file in parallel; a bad file is an error, or with `skip_bad` is listed in
 /// `skipped` with its reason.
-pub(super) fn parse_all(
+fn parse_all(
     files: &[PathBuf],
     p: &CsvImportParams,
     on_done: &(dyn Fn() + Sync),
@@ -384,7 +384,7 @@ pub(super) fn parse_all(
 }
 
 /// The nominal sampling rate: one over the median interval of all files' time stamps.
-pub(super) fn nominal_fs(good: &[ParsedCsv], out: &Path) -> Result<f64> {
+fn nominal_fs(good: &[ParsedCsv], out: &Path) -> Result<f64> {
     let mut dts: Vec<f64> = good
         .iter()
         .filter_map(|c| Some((c.log.times.as_ref()?, c.log.time_unit.seconds())))
@@ -402,7 +402,7 @@ pub(super) fn nominal_fs(good: &[ParsedCsv], out: &Path) -> Result<f64> {
 /// The layout of the imported dataset: channels fill the grid row-major unless mapped, and
 /// cells no channel reaches are masked; `unit` is the logs' time unit when they have stamps,
 /// `source` how they were read.
-pub(super) fn csv_layout(
+fn csv_layout(
     p: &CsvImportParams,
     names: &[String],
     fs: f64,
@@ -465,7 +465,7 @@ pub(super) fn time_column(unit: TimeUnit) -> String {
 /// their own unit (when it has time stamps; [`time_column`]), then the channels. The stamps
 /// are subtracted in their unit and written in the shortest form that reads back to the
 /// same double, so the imported copy gives the times the raw log gives, to the bit.
-pub(super) fn write_imported(dir: &Path, parsed: &ParsedCsv, names: &[String]) -> Result<Meta> {
+fn write_imported(dir: &Path, parsed: &ParsedCsv, names: &[String]) -> Result<Meta> {
     let path = dir.join(&parsed.meta.file);
     let c = &parsed.log;
     let mut text = String::with_capacity(c.samples.len() * 8);

@@ -127,7 +127,7 @@ pub fn import_events(
 /// The layout an import writes: the grid, its mask, the columns it writes, and for logs
 /// addressed by taxel index the channel map (a stream of the same sensor's taxel indices
 /// reads it, `neurotex stream --taxel`).
-pub(super) fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
+fn imported_layout(p: &EventImportParams) -> crate::recording::LayoutFile {
     let g = &p.grid;
     let masked = g.present.iter().any(|&x| !x);
     crate::recording::LayoutFile {
@@ -168,12 +168,12 @@ pub(super) const POLARITY_NAMES: [&str; 9] = [
 ];
 
 /// An event as parsed: time, cell fields, polarity, and its line or record.
-pub(super) type RawEvent = (crate::events::Stamp, (i64, i64), Option<i64>, usize);
+type RawEvent = (crate::events::Stamp, (i64, i64), Option<i64>, usize);
 
 /// Checks that a log's polarity is read when it has one: the column named (or its values
 /// given) is there, and no unread column is named like a polarity, which would leave
 /// every OFF event ON, silently.
-pub(super) fn polarity_read(
+fn polarity_read(
     p: &EventImportParams,
     polarity: bool,
     unread: &[String],
@@ -195,7 +195,7 @@ pub(super) fn polarity_read(
 
 /// Sorts `events` into time order, stably (events of one time keep the log's order); the
 /// events that came before an earlier line's time.
-pub(super) fn sort_stably(events: &mut [RawEvent]) -> usize {
+fn sort_stably(events: &mut [RawEvent]) -> usize {
     let key = |t: &crate::events::Stamp| crate::events::as_f64(*t);
     let mut reordered = 0;
     let mut latest = f64::NEG_INFINITY;
@@ -216,7 +216,7 @@ pub(super) fn sort_stably(events: &mut [RawEvent]) -> usize {
 }
 
 /// One log's events in time order as the CSV text an import writes, and what was done.
-pub(super) fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {
+fn sorted_log(path: &Path, p: &EventImportParams) -> Result<(String, ImportedFile)> {
     let mut events: Vec<RawEvent> = Vec::new();
     let mut polarity = false;
     let mut unread = Vec::new();

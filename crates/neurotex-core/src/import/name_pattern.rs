@@ -31,14 +31,14 @@ impl PartialEq for NamePattern {
 }
 
 #[derive(Debug, Clone, PartialEq)]
-pub(super) enum Part {
+enum Part {
     Literal(String),
     Field(String),
 }
 
 /// What a field's value looks like: `speed` and `force` are numbers, `trial` an integer,
 /// anything else at least one character, as few as possible.
-pub(super) fn field_regex(field: &str) -> &'static str {
+fn field_regex(field: &str) -> &'static str {
     match field {
         "speed" | "force" => r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)",
         "trial" => r"([+-]?[0-9]+)",
@@ -108,7 +108,7 @@ impl NamePattern {
 }
 
 /// A pattern's literal text and `{field}`s, in order.
-pub(super) fn split_pattern(pattern: &str) -> Result<Vec<Part>, ParamError> {
+fn split_pattern(pattern: &str) -> Result<Vec<Part>, ParamError> {
     let bad = |rule| ParamError::new("name-pattern", rule, pattern);
     let mut parts = Vec::new();
     let mut rest = pattern;

@@ -20,7 +20,7 @@ use super::invalid;
 
 /// The axes of a stacked array.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum AxisName {
+enum AxisName {
     N,
     T,
     Row,
@@ -62,7 +62,7 @@ impl fmt::Display for Axes {
 }
 
 /// Parses axes such as `n,row,col,t` or `n,t,channel`.
-pub(super) fn parse_axes(text: &str) -> Result<Vec<AxisName>, ParamError> {
+fn parse_axes(text: &str) -> Result<Vec<AxisName>, ParamError> {
     let axes: Vec<AxisName> = text
         .split(',')
         .map(|a| match a.trim() {
@@ -95,7 +95,7 @@ pub(super) fn parse_axes(text: &str) -> Result<Vec<AxisName>, ParamError> {
 
 /// Reads a `.npy` of numbers as f64 (f64, f32, or any integer type). The header is checked
 /// against the file's size first, so nothing larger than the file is allocated.
-pub(super) fn read_numbers(path: &Path) -> Result<ArrayD<f64>> {
+fn read_numbers(path: &Path) -> Result<ArrayD<f64>> {
     let header = crate::npy::read_header(path)?;
     let descr = &header.descr;
     if !header.is_number() {
@@ -117,11 +117,11 @@ pub(super) fn read_numbers(path: &Path) -> Result<ArrayD<f64>> {
 
 /// The largest whole number every float up to it holds exactly (2^53): float labels
 /// beyond would turn distinct integers into one.
-pub(super) const EXACT_FLOAT_INTEGER: f64 = 9_007_199_254_740_992.0;
+const EXACT_FLOAT_INTEGER: f64 = 9_007_199_254_740_992.0;
 
 /// Labels stored as numbers, as text: integers of any width exactly as they are, floats
 /// only when whole and within [`EXACT_FLOAT_INTEGER`], so that two labels never merge.
-pub(super) fn numeric_labels(path: &Path, descr: &str) -> Result<Vec<String>> {
+fn numeric_labels(path: &Path, descr: &str) -> Result<Vec<String>> {
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
     macro_rules! integers {
         ($($t:ty),*) => {$(
@@ -148,7 +148,7 @@ pub(super) fn numeric_labels(path: &Path, descr: &str) -> Result<Vec<String>> {
 }
 
 /// Reads labels: integers, or fixed-width strings (`<U` or `|S`), one per sample.
-pub(super) fn read_labels(path: &Path) -> Result<Vec<String>> {
+fn read_labels(path: &Path) -> Result<Vec<String>> {
     let header = crate::npy::read_header(path)?;
     if header.is_number() {
         return numeric_labels(path, &header.descr);
@@ -274,7 +274,7 @@ pub(super) fn read_back(dir: &Path) -> Result<()> {
 
 /// The stacked array read and checked, its axes put in the order `n, t, cells...`, and the
 /// grid each sample is laid out on.
-pub(super) fn stacked_samples(
+fn stacked_samples(
     data: &Path,
     p: &StackedParams,
 ) -> Result<(ArrayD<f64>, (usize, usize))> {
@@ -339,7 +339,7 @@ pub(super) fn stacked_samples(
 
 /// One manifest row per stacked sample: its label, its speed (none without a speeds file),
 /// and a trial number counting the samples of each label and speed.
-pub(super) fn stacked_metas(
+fn stacked_metas(
     data: &Path,
     labels_path: &Path,
     speeds: Option<&Path>,

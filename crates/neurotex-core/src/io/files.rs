@@ -78,7 +78,7 @@ pub fn stage(
 
 /// Writes `fill` straight into an existing character device or pipe, which has no content
 /// to lose and cannot be renamed over.
-pub(super) fn write_through(
+fn write_through(
     target: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
@@ -158,24 +158,24 @@ pub fn destination(path: &Path) -> Result<Destination> {
 }
 
 #[cfg(unix)]
-pub(super) fn hard_links(meta: &std::fs::Metadata) -> u64 {
+fn hard_links(meta: &std::fs::Metadata) -> u64 {
     use std::os::unix::fs::MetadataExt;
     meta.nlink()
 }
 
 #[cfg(not(unix))]
-pub(super) fn hard_links(_: &std::fs::Metadata) -> u64 {
+fn hard_links(_: &std::fs::Metadata) -> u64 {
     1
 }
 
 #[cfg(unix)]
-pub(super) fn is_char_device_or_pipe(kind: &std::fs::FileType) -> bool {
+fn is_char_device_or_pipe(kind: &std::fs::FileType) -> bool {
     use std::os::unix::fs::FileTypeExt;
     kind.is_char_device() || kind.is_fifo()
 }
 
 #[cfg(not(unix))]
-pub(super) fn is_char_device_or_pipe(_: &std::fs::FileType) -> bool {
+fn is_char_device_or_pipe(_: &std::fs::FileType) -> bool {
     false
 }
 

@@ -43,7 +43,7 @@ pub fn create_dir_atomic<T>(dir: &Path, fill: impl FnOnce(&Path) -> Result<T>) -
 
 /// `error` with a path inside the temporary folder `tmp` named as it will be inside `dir`:
 /// the user never sees the hidden temporary's name.
-pub(super) fn named_in(error: crate::Error, tmp: &Path, dir: &Path) -> crate::Error {
+fn named_in(error: crate::Error, tmp: &Path, dir: &Path) -> crate::Error {
     let rename = |path: PathBuf| match path.strip_prefix(tmp) {
         Ok(rest) => dir.join(rest),
         Err(_) => path,
@@ -219,7 +219,7 @@ pub fn claim_folder(dir: &Path) -> Result<OutputClaim> {
 
 /// Every file under `dir/rel` (depth first, links not followed) with its SHA-256 in hex,
 /// as paths relative to `dir`.
-pub(super) fn list_files(dir: &Path, rel: &Path, out: &mut Vec<(PathBuf, String)>) -> Result<()> {
+fn list_files(dir: &Path, rel: &Path, out: &mut Vec<(PathBuf, String)>) -> Result<()> {
     let here = dir.join(rel);
     let entries = std::fs::read_dir(&here).map_err(|e| DataError::io(&here, e))?;
     for entry in entries {
@@ -241,7 +241,7 @@ pub(super) fn list_files(dir: &Path, rel: &Path, out: &mut Vec<(PathBuf, String)
 }
 
 /// The SHA-256 of a file's content, in hex.
-pub(super) fn sha256_file(path: &Path) -> Result<String> {
+fn sha256_file(path: &Path) -> Result<String> {
     use sha2::{Digest, Sha256};
     let mut file = std::fs::File::open(path).map_err(|e| DataError::io(path, e))?;
     let mut hasher = Sha256::new();

@@ -264,7 +264,7 @@ impl Dataset {
 /// Whether manifest entry `file` stays inside dataset folder `root`: a relative path
 /// without `..` that, once symbolic links are resolved, still lies under the folder.
 /// Returns why not.
-pub(super) fn check_inside(root: &Path, file: &str) -> std::result::Result<(), String> {
+fn check_inside(root: &Path, file: &str) -> std::result::Result<(), String> {
     use std::path::Component;
     let outside = "lies outside the dataset folder; manifest paths must stay inside it (--allow-outside-paths lets them out)";
     let relative = Path::new(file)

@@ -108,7 +108,7 @@ pub(crate) fn labels_merged_by_trimming(labels: &[(String, String)]) -> Option<S
 
 /// Where a manifest's columns are: the required ones in [`MANIFEST_COLUMNS`] order, the
 /// optional conditions in [`CONDITION_COLUMNS`] order, and the optional sliding interval.
-pub(super) struct ManifestColumns {
+struct ManifestColumns {
     required: [usize; 2],
     conditions: [Option<usize>; 3],
     start: Option<usize>,

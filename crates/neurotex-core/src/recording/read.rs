@@ -200,7 +200,7 @@ pub fn recording_from_channels(
 ///
 /// # Errors
 /// Another extension, or a file its reader refuses.
-pub(super) fn read_samples(path: &Path, format: &CsvFormat) -> Result<RawSamples> {
+fn read_samples(path: &Path, format: &CsvFormat) -> Result<RawSamples> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -225,14 +225,14 @@ pub(super) fn read_samples(path: &Path, format: &CsvFormat) -> Result<RawSamples
 }
 
 /// A file's shape, samples, time stamps in seconds and whether every sample is finite.
-pub(super) type RawSamples = (Shape, Vec<f64>, Option<Vec<f64>>, bool);
+type RawSamples = (Shape, Vec<f64>, Option<Vec<f64>>, bool);
 
 /// The number of channels of `shape`, checked: at least one, at most the cell limit, and
 /// every sample finite (`finite`; the first bad one is named from `raw`).
 ///
 /// # Errors
 /// The rule broken.
-pub(super) fn checked_channels(
+fn checked_channels(
     path: &Path,
     shape: Shape,
     raw: &[f64],
@@ -271,7 +271,7 @@ pub(super) fn checked_channels(
 
 /// The frames of `raw` (`n_channels` values each) placed on the layout's cells by its
 /// channel map; unmapped cells 0. `raw` itself when the map is the identity.
-pub(super) fn onto_cells(raw: Vec<f64>, n_channels: usize, lay: &Layout) -> Vec<f64> {
+fn onto_cells(raw: Vec<f64>, n_channels: usize, lay: &Layout) -> Vec<f64> {
     if lay.channel_map.iter().copied().eq(0..lay.cells()) {
         return raw;
     }
@@ -295,7 +295,7 @@ pub(super) fn onto_cells(raw: Vec<f64>, n_channels: usize, lay: &Layout) -> Vec<
 /// values (a few channels on a huge grid, or a wide file whose stamps span an hour, would
 /// otherwise ask for far more memory than the file holds). `raw_values` (already in memory)
 /// is always allowed.
-pub(super) fn check_duration(
+fn check_duration(
     path: &Path,
     layout: &LayoutFile,
     frames: usize,
@@ -413,7 +413,7 @@ widest_or_plain! {
 /// ([`TimeUnit::to_seconds`]): a raw log stamped from an epoch and its imported copy
 /// stamped from 0 give the same times to the bit, and a stamp on the encoder's grid gives
 /// its sample exactly.
-pub(super) fn read_csv_samples(
+fn read_csv_samples(
     path: &Path,
     format: &CsvFormat,
 ) -> Result<(Shape, Vec<f64>, Option<Vec<f64>>)> {
