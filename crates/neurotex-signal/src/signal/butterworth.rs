@@ -229,7 +229,7 @@ widest_or_plain! {
     /// four lanes, where the processor has them (no multiply and add is fused: the same
     /// bits). Returns the largest value written (-inf for none), found off the filter's
     /// chain of dependent steps, where a pass of its own would read every sample again.
-    pub(super) fn run_frames(
+    fn run_frames(
         f: &Butterworth2,
         x: &mut [f64],
         cells: usize,
@@ -271,7 +271,7 @@ widest_or_plain! {
     /// [`run_frames`] forward over the frames of `from` less each cell's resting value
     /// (masked), written to `out`: the copy of the selected phase made by the filter's
     /// first pass over it.
-    pub(super) fn run_frames_less(
+    fn run_frames_less(
         f: &Butterworth2,
         from: &[f64],
         less: &LessOffsets,
@@ -307,7 +307,7 @@ widest_or_plain! {
 /// at run time it is stored and loaded back every frame, on the chain each frame
 /// waits for.
 #[inline(always)]
-pub(super) fn run_width<const W: usize>(
+fn run_width<const W: usize>(
     f: &Butterworth2,
     x: &mut [f64],
     [z0, z1]: [&mut Vec<f64>; 2],
@@ -340,7 +340,7 @@ pub(super) fn run_width<const W: usize>(
 /// [`run_frames_less`] for frames of exactly `W` cells, the state in registers as in
 /// [`run_width`].
 #[inline(always)]
-pub(super) fn run_width_less<const W: usize>(
+fn run_width_less<const W: usize>(
     f: &Butterworth2,
     from: &[f64],
     less: &LessOffsets,
@@ -370,7 +370,7 @@ pub(super) fn run_width_less<const W: usize>(
 
 /// Each of `top`'s running maxima raised to its value of `frame` where that is larger.
 #[inline(always)]
-pub(super) fn keep_largest(top: &mut [f64], frame: &[f64]) {
+fn keep_largest(top: &mut [f64], frame: &[f64]) {
     for (m, &v) in top.iter_mut().zip(frame) {
         *m = if v > *m { v } else { *m };
     }
@@ -379,7 +379,7 @@ pub(super) fn keep_largest(top: &mut [f64], frame: &[f64]) {
 /// One frame through each channel's filter, its state in `z0` and `z1`; `first`
 /// starts each channel in its steady state for its value.
 #[inline(always)]
-pub(super) fn step_frame(
+fn step_frame(
     f: &Butterworth2,
     frame: &mut [f64],
     z0: &mut [f64],

@@ -13,7 +13,7 @@ use super::rest::RestTracker;
 use super::{LessOffsets, PreprocessParams, ENCODER_FS};
 
 /// Whether the recording is sampled uniformly at the encoder's 1 kHz (no resampling).
-pub(super) fn uniform_1k(rec: &Recording) -> bool {
+fn uniform_1k(rec: &Recording) -> bool {
     rec.times_s.is_none() && (rec.fs - ENCODER_FS).abs() < 1e-9
 }
 
@@ -23,7 +23,7 @@ pub(super) fn uniform_1k(rec: &Recording) -> bool {
 ///
 /// # Errors
 /// A span whose resampling would not fit in memory, or a phase shorter than one step.
-pub(super) fn selected_phase(
+fn selected_phase(
     rec: &Recording,
     times: Times,
     offsets: &[f64],
@@ -61,7 +61,7 @@ pub(super) fn selected_phase(
 ///
 /// # Errors
 /// A grid too large for the window ([`RestTracker::new`]).
-pub(super) fn less_tracked_rest(
+fn less_tracked_rest(
     samples: &mut [f64],
     cells: usize,
     present: &[bool],
@@ -79,7 +79,7 @@ pub(super) fn less_tracked_rest(
 }
 
 /// The error of a selected phase without a whole 1 ms step.
-pub(super) fn phase_too_short(rec: &Recording) -> crate::Error {
+fn phase_too_short(rec: &Recording) -> crate::Error {
     let message = "the selected phase is shorter than one 1 ms encoder step";
     DataError::invalid(&rec.meta.file, message).into()
 }

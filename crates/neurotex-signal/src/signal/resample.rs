@@ -162,7 +162,7 @@ widest_or_plain! {
     /// The steps of [`resample_less`] into `out` (`frames.len() / times.len()` cells a
     /// step): each value `a + (b - a) * w` of its bracketing frames, then less its resting
     /// value, lane by lane, so the width changes no bit.
-    pub(super) fn resample_into(
+    fn resample_into(
         frames: &[f64],
         times: &[f64],
         fs: f64,
