@@ -12,8 +12,7 @@ use super::format::{
     ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps, DEFAULT_MAX_GAP_S,
 };
 use super::header::Columns;
-use super::invalid;
-use super::open_log;
+use super::{invalid, open_log};
 
 /// How a CSV log's columns are written down in `layout.toml` and in model files: the
 /// reading options as text, `time_column` and `channels` by header name, or by 0-based

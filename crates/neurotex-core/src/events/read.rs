@@ -366,10 +366,7 @@ pub(super) fn parse_csv(
 type EventFields = (Stamp, (i64, i64), Option<i64>);
 
 /// One CSV record's event: its time, cell fields and polarity; `Err` says why it is none.
-fn csv_event(
-    record: &csv::ByteRecord,
-    cols: &Columns,
-) -> std::result::Result<EventFields, String> {
+fn csv_event(record: &csv::ByteRecord, cols: &Columns) -> std::result::Result<EventFields, String> {
     let field = |i: usize, what: &str| -> std::result::Result<&str, String> {
         std::str::from_utf8(&record[i]).map(str::trim).map_err(|e| {
             format!(

@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use crate::csvlog::ChannelSelect;
-use crate::csvlog::{read_csv_log, CsvFormat, LogColumns};
+use crate::csvlog::{read_csv_log, ChannelSelect, CsvFormat, LogColumns};
 use crate::error::{DataError, ParamError, Result};
 use crate::recording::{
     create_dataset_dir, labels_merged_by_trimming, recording_from_channels, write_layout,

@@ -274,10 +274,7 @@ pub(super) fn read_back(dir: &Path) -> Result<()> {
 
 /// The stacked array read and checked, its axes put in the order `n, t, cells...`, and the
 /// grid each sample is laid out on.
-fn stacked_samples(
-    data: &Path,
-    p: &StackedParams,
-) -> Result<(ArrayD<f64>, (usize, usize))> {
+fn stacked_samples(data: &Path, p: &StackedParams) -> Result<(ArrayD<f64>, (usize, usize))> {
     let axes = &p.axes.0;
     let array = read_numbers(data)?;
     if array.ndim() != axes.len() {

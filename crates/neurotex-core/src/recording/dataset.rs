@@ -3,8 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::DatasetError;
-use crate::error::{DataError, Result};
+use crate::error::{DataError, DatasetError, Result};
 use crate::values::{Grid, Speed};
 
 use super::layout_file::{LayoutFile, DEFAULT_MAX_DURATION_S};

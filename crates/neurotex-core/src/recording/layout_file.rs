@@ -7,8 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::csvlog::{CsvFormat, CsvOverrides, Delimiter, DuplicateStamps, LogColumns};
 use crate::error::{DataError, ParamError, Result};
-use crate::values::TimeUnit;
-use crate::values::{SampleRate, FS_RULE};
+use crate::values::{SampleRate, TimeUnit, FS_RULE};
 
 use super::{Baseline, Layout, Shape};
 

@@ -232,12 +232,7 @@ type RawSamples = (Shape, Vec<f64>, Option<Vec<f64>>, bool);
 ///
 /// # Errors
 /// The rule broken.
-fn checked_channels(
-    path: &Path,
-    shape: Shape,
-    raw: &[f64],
-    finite: bool,
-) -> Result<usize> {
+fn checked_channels(path: &Path, shape: Shape, raw: &[f64], finite: bool) -> Result<usize> {
     let n_channels = match shape {
         Shape::Grid(r, c) => r * c,
         Shape::Channels(n) => n,

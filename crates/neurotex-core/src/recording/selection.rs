@@ -3,8 +3,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use crate::error::DatasetError;
-use crate::error::{ParamError, Result};
+use crate::error::{DatasetError, ParamError, Result};
 use crate::values::Speed;
 
 use super::{Meta, MANIFEST_COLUMNS, NUMERIC_COLUMNS};

@@ -379,13 +379,7 @@ fn keep_largest(top: &mut [f64], frame: &[f64]) {
 /// One frame through each channel's filter, its state in `z0` and `z1`; `first`
 /// starts each channel in its steady state for its value.
 #[inline(always)]
-fn step_frame(
-    f: &Butterworth2,
-    frame: &mut [f64],
-    z0: &mut [f64],
-    z1: &mut [f64],
-    first: bool,
-) {
+fn step_frame(f: &Butterworth2, frame: &mut [f64], z0: &mut [f64], z1: &mut [f64], first: bool) {
     if first {
         for ((&v, a), b) in frame.iter().zip(z0.iter_mut()).zip(z1.iter_mut()) {
             [*a, *b] = f.steady_state(v);
