@@ -124,7 +124,7 @@ pub(crate) fn csv_words(e: &csv::Error, first: &str) -> String {
             let text = e.to_string();
             // The reader's own wording after its position, if any.
             let what = text.rsplit("): ").next().unwrap_or(&text);
-            format!("{at}: {}", crate::error::parser_words(what))
+            format!("{at}: {}", crate::words::parser_words(what))
         }
     }
 }

@@ -104,7 +104,7 @@ impl LayoutFile {
     pub fn read(path: &Path) -> Result<Self> {
         let text = crate::io::read_text(path)?;
         let file: LayoutFile = toml::from_str(&text).map_err(|e| {
-            let why = crate::error::toml_error(&text, &e);
+            let why = crate::words::toml_error(&text, &e);
             DataError::invalid(path, format!("not a valid layout file: {why}"))
         })?;
         file.check(path)?;
