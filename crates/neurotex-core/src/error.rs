@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 pub use crate::model_format::{MODEL_FORMAT, MODEL_VERSION, SNN_MODEL_FORMAT};
 pub use crate::values::ParamError;
-pub use crate::words::{json_error, number_words, parser_words, toml_error};
 use crate::values::{Grid, Speed};
+pub use crate::words::{json_error, number_words, parser_words, toml_error};
 
 /// Everything that can go wrong in neurotex, by stage.
 #[derive(Debug, thiserror::Error)]
