@@ -2,8 +2,10 @@
 
 use std::path::PathBuf;
 
+pub use crate::model_format::{MODEL_FORMAT, MODEL_VERSION, SNN_MODEL_FORMAT};
 pub use crate::values::ParamError;
 use crate::values::{Grid, Speed};
+pub use crate::words::{json_error, number_words, parser_words, toml_error};
 
 /// Everything that can go wrong in neurotex, by stage.
 #[derive(Debug, thiserror::Error)]
@@ -157,91 +159,6 @@ pub enum DataError {
     },
 }
 
-/// A serde parser's message in a user's words: its type names and jargon turned into
-/// what the file was expected to hold ("invalid type: string \"min\", expected internally
-/// tagged enum Baseline" becomes "a string \"min\" where a Baseline table was expected").
-pub fn parser_words(message: &str) -> String {
-    let message = message.trim().trim_end_matches('.');
-    let stated = message
-        .strip_prefix("invalid type: ")
-        .or_else(|| message.strip_prefix("invalid value: "));
-    let (found, expected) = match stated {
-        Some(rest) => match rest.split_once(", expected ") {
-            Some((found, expected)) => (Some(found), expected),
-            None => (None, rest),
-        },
-        None => (None, message),
-    };
-    let expected = expected
-        .replace("internally tagged enum ", "")
-        .replace("struct ", "")
-        .replace("enum ", "")
-        .replace("a sequence", "a list")
-        .replace("a map", "a table");
-    // Rust's number types, as the value each may hold.
-    let expected = match expected.as_str() {
-        "usize" | "u64" | "u32" | "u16" | "u8" => "a whole number, 0 or more".to_string(),
-        "isize" | "i64" | "i32" | "i16" | "i8" => "a whole number".to_string(),
-        "f64" | "f32" => "a number".to_string(),
-        _ => expected,
-    };
-    match found {
-        Some(found) => {
-            let found = found
-                .replace("map", "a table")
-                .replace("sequence", "a list");
-            format!("{found} where {expected} was expected")
-        }
-        None => expected,
-    }
-}
-
-/// The standard library's number parse errors ("invalid digit found in string") in a
-/// user's words, what was expected; other text unchanged.
-pub fn number_words(message: &str) -> String {
-    message
-        .replace(
-            "invalid digit found in string",
-            "expected a whole number such as 0, 1, 2 (no sign, point or letters)",
-        )
-        .replace(
-            "cannot parse integer from empty string",
-            "empty where a whole number was expected",
-        )
-        .replace(
-            "number too large to fit in target type",
-            "a whole number too large",
-        )
-        .replace("invalid float literal", "not a number")
-}
-
-/// A TOML file's error: where it is, the line as written, and what was wrong in
-/// [`parser_words`], never the parser's own layout of it.
-pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
-    let Some(span) = e.span() else {
-        return parser_words(e.message());
-    };
-    let start = span.start.min(text.len());
-    let line = text[..start].matches('\n').count() + 1;
-    let line_text = text.lines().nth(line - 1).unwrap_or("").trim();
-    let shown: String = line_text.chars().take(80).collect();
-    format!("line {line} (`{shown}`): {}", parser_words(e.message()))
-}
-
-/// A JSON file's error: its line and column and what was wrong in [`parser_words`].
-pub fn json_error(e: &serde_json::Error) -> String {
-    let text = e.to_string();
-    let message = text.split(" at line ").next().unwrap_or(&text);
-    match e.line() {
-        0 => parser_words(message),
-        line => format!(
-            "line {line}, column {}: {}",
-            e.column(),
-            parser_words(message)
-        ),
-    }
-}
-
 /// An empty vector with room for `len` values, reserved fallibly: where the input decides
 /// a buffer's size, a request the machine cannot meet is a [`DataError::OutOfMemory`]
 /// naming `what`, not an abort.
@@ -282,6 +199,62 @@ impl DataError {
             reason: source,
         }
     }
+}
+
+/// What is wrong with one event of an event recording, before the file and the line are
+/// named (a reader reports it in a [`DataError::Invalid`], a live stream as a bad frame).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EventError {
+    /// A polarity that is neither the ON value nor the OFF value.
+    #[error("polarity {value} is neither ON ({on}) nor OFF ({off}); `import events --polarity-values ON,OFF` (or layout.toml's `[events] values = [on, off]`) names them")]
+    Polarity {
+        /// The polarity read.
+        value: i64,
+        /// The ON value.
+        on: i64,
+        /// The OFF value.
+        off: i64,
+    },
+    /// A taxel index the layout does not have.
+    #[error("taxel {taxel} is outside the layout's {taxels} taxels (0 to {})", .taxels.saturating_sub(1))]
+    TaxelOutside {
+        /// The index read.
+        taxel: i64,
+        /// The layout's taxels.
+        taxels: usize,
+    },
+    /// An `(x, y)` outside the grid.
+    #[error("x = {x}, y = {y} is outside the {rows}x{cols} grid (x is the column, 0 to {}; y the row, 0 to {})", .cols - 1, .rows - 1)]
+    OutsideGrid {
+        /// The column read.
+        x: i64,
+        /// The row read.
+        y: i64,
+        /// The grid's rows.
+        rows: usize,
+        /// The grid's columns.
+        cols: usize,
+    },
+    /// A cell the layout's mask leaves out.
+    #[error("the event is at row {row}, column {col}, a cell layout.toml's mask leaves out")]
+    Masked {
+        /// Its row.
+        row: usize,
+        /// Its column.
+        col: usize,
+    },
+    /// A time before the recording's start.
+    #[error("time {time} is before the recording's start: stamps from a clock need `--origin first` (`origin = \"first\"` in layout.toml's [events])")]
+    BeforeStart {
+        /// The time stamp, as written.
+        time: String,
+    },
+    /// A time that is not a finite number.
+    #[error("time {time} is not a finite number")]
+    NotFinite {
+        /// The time stamp, as written.
+        time: String,
+    },
 }
 
 /// Classification problems that come from the data given, not from a bug.
@@ -516,15 +489,6 @@ pub enum StatsError {
     #[error("Student's t needs at least 1 degree of freedom, got 0")]
     ZeroDegreesOfFreedom,
 }
-
-/// The `format` field of every model file.
-pub const MODEL_FORMAT: &str = "neurotex-model";
-
-/// The `format` field of a spiking model file (`train --classifier snn`).
-pub const SNN_MODEL_FORMAT: &str = "neurotex-snn-model";
-
-/// The version of the model file format this neurotex writes and reads.
-pub const MODEL_VERSION: u64 = 1;
 
 /// A model file that cannot be used, or recordings a model cannot take.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -148,6 +148,25 @@ impl Lsl {
     }
 }
 
+/// What the LSL names a stream or an outlet by cannot do.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum LslError {
+    /// `lsl:TEXT` whose text names no stream (an empty name or value, or a NUL byte).
+    #[error(
+        "`lsl:{0}` names no stream: `lsl:NAME` or `lsl:PROPERTY=VALUE` (such as lsl:type=Tactile)"
+    )]
+    NoStream(String),
+    /// An outlet's name holding a NUL byte.
+    #[error("`{0}` holds a NUL byte")]
+    NulByte(String),
+    /// liblsl could not describe the outlet's stream.
+    #[error("liblsl could not describe the stream `{0}`")]
+    Describe(String),
+    /// liblsl could not open the outlet.
+    #[error("liblsl could not open the outlet `{0}`")]
+    Open(String),
+}
+
 /// Which stream to read: `NAME`, or `PROPERTY=VALUE` (`type=Tactile`, `source_id=...`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Query {
@@ -162,15 +181,13 @@ impl Query {
     ///
     /// # Errors
     /// An empty name or value, or a NUL byte.
-    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+    pub fn parse(text: &str) -> std::result::Result<Self, LslError> {
         let (property, value) = match text.split_once('=') {
             Some((p, v)) => (p.trim(), v.trim()),
             None => ("name", text.trim()),
         };
         if property.is_empty() || value.is_empty() || text.contains('\0') {
-            return Err(format!(
-                "`lsl:{text}` names no stream: `lsl:NAME` or `lsl:PROPERTY=VALUE` (such as lsl:type=Tactile)"
-            ));
+            return Err(LslError::NoStream(text.to_string()));
         }
         Ok(Query {
             property: property.into(),
@@ -435,9 +452,9 @@ impl Outlet {
     ///
     /// # Errors
     /// liblsl could not make it.
-    pub fn new(lsl: &Arc<Lsl>, name: &str) -> std::result::Result<Self, String> {
+    pub fn new(lsl: &Arc<Lsl>, name: &str) -> std::result::Result<Self, LslError> {
         let api = &lsl.api;
-        let c = |s: &str| CString::new(s).map_err(|_| format!("`{name}` holds a NUL byte"));
+        let c = |s: &str| CString::new(s).map_err(|_| LslError::NulByte(name.to_string()));
         let (n, kind, id) = (c(name)?, c("Markers")?, c(&format!("neurotex-{name}"))?);
         // SAFETY: NUL-terminated strings that outlive the calls; the info is copied by the
         // outlet and destroyed once.
@@ -445,14 +462,14 @@ impl Outlet {
             let info =
                 (api.create_streaminfo)(n.as_ptr(), kind.as_ptr(), 1, 0.0, CF_STRING, id.as_ptr());
             if info.is_null() {
-                return Err(format!("liblsl could not describe the stream `{name}`"));
+                return Err(LslError::Describe(name.to_string()));
             }
             let handle = (api.create_outlet)(info, 0, 360);
             (api.destroy_streaminfo)(info);
             handle
         };
         if handle.is_null() {
-            return Err(format!("liblsl could not open the outlet `{name}`"));
+            return Err(LslError::Open(name.to_string()));
         }
         Ok(Outlet {
             lsl: Arc::clone(lsl),

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{parse_csv, CsvImportParams};
+use super::csv_logs::{parse_csv, CsvImportParams};
 use crate::csvlog::{header_names, ChannelSelect, CsvLog};
 use crate::error::{ParamError, Result};
 use crate::recording::ChannelMap;

@@ -398,7 +398,7 @@ fn open_input(
     say: &dyn Fn(&str),
 ) -> Result<(StreamClassifier, Input)> {
     let lsl_query = match args.input.strip_prefix("lsl:") {
-        Some(q) => Some(Query::parse(q).map_err(OptionsError::Conflict)?),
+        Some(q) => Some(Query::parse(q).map_err(|e| OptionsError::Conflict(e.to_string()))?),
         None => None,
     };
     let timeout = args.lsl_timeout_s;
