@@ -44,39 +44,48 @@ pub type Stages = CheckedStages;
 /// A Python value as the text the library's option parser reads: `True` as `true`, a
 /// sequence of counts as `1,2`, a number or a name as it is written.
 fn option_text(name: &str, kind: OptionKind, value: &Bound<'_, PyAny>) -> PyResult<String> {
-    let text = match kind {
-        OptionKind::Flag | OptionKind::Bool => value.extract::<bool>().map(|b| b.to_string()),
-        OptionKind::Count => value.extract::<usize>().map(|n| n.to_string()),
-        OptionKind::Counts => value.extract::<Vec<usize>>().map(|v| {
-            let v: Vec<String> = v.iter().map(usize::to_string).collect();
-            v.join(",")
-        }),
-        OptionKind::Number => value.extract::<f64>().map(|x| x.to_string()),
+    // Python's `True` is an `int` too: a switch given where a count or a number is
+    // expected is refused, not read as 1.
+    let is_bool = value.is_instance_of::<pyo3::types::PyBool>();
+    let expected = |what: &str| -> PyResult<String> {
+        let got = value
+            .repr()
+            .map(|r| r.to_string())
+            .unwrap_or_else(|_| "?".into());
+        Err(invalid(name, format!("expected {what}, got {got}")))
+    };
+    match kind {
+        OptionKind::Flag | OptionKind::Bool => match value.extract::<bool>() {
+            Ok(b) => Ok(b.to_string()),
+            Err(_) => expected("True or False"),
+        },
+        OptionKind::Count if is_bool => expected("a whole number of at least 0"),
+        OptionKind::Count => match value.extract::<usize>() {
+            Ok(n) => Ok(n.to_string()),
+            Err(_) => expected("a whole number of at least 0"),
+        },
+        OptionKind::Counts => match value.extract::<Vec<usize>>() {
+            Ok(v) if !value.is_instance_of::<pyo3::types::PyString>() => {
+                let v: Vec<String> = v.iter().map(usize::to_string).collect();
+                Ok(v.join(","))
+            }
+            _ => expected("a list of whole numbers of at least 0"),
+        },
+        OptionKind::Number if is_bool => expected("a number"),
+        OptionKind::Number => match value.extract::<f64>() {
+            Ok(x) => Ok(x.to_string()),
+            Err(_) => expected("a number"),
+        },
         // A number (the gain) or a name; anything else as Python prints it, for the
         // option's own parser to say what it expects.
         OptionKind::Text => match value.extract::<f64>() {
-            Ok(x) => Ok(x.to_string()),
-            Err(_) => match value.extract::<String>() {
+            Ok(x) if !is_bool => Ok(x.to_string()),
+            _ => match value.extract::<String>() {
                 Ok(text) => Ok(text),
                 Err(_) => Ok(value.str()?.to_string()),
             },
         },
-    };
-    text.map_err(|e| {
-        // A negative whole number is a value out of range, not a type to convert.
-        let negative = match kind {
-            OptionKind::Count => value.extract::<i64>().ok().map(|i| i.to_string()),
-            OptionKind::Counts => value.extract::<Vec<i64>>().ok().map(|v| format!("{v:?}")),
-            _ => None,
-        };
-        match negative {
-            Some(got) => invalid(
-                name,
-                format!("expected whole numbers of at least 0, got {got}"),
-            ),
-            None => invalid(name, e),
-        }
-    })
+    }
 }
 
 /// The stage options of [`STAGE_OPTIONS`] by their names (the paper's defaults for the

@@ -54,6 +54,11 @@ def test_broken_options_are_named_as_python_spells_them(sim_dir):
         neurotex.evaluate(sim_dir, bin_ms=0)
     with pytest.raises(ParameterError, match="unknown option `trees` for classifier knn"):
         neurotex.evaluate(sim_dir, classifier_options={"trees": 3})
+    # A switch is not a count, nor text a switch.
+    with pytest.raises(ParameterError, match="`trees`: expected a whole number of at least 0, got True"):
+        neurotex.evaluate(sim_dir, classifier="forest", classifier_options={"trees": True})
+    with pytest.raises(ParameterError, match="`bootstrap`: expected True or False, got 'maybe'"):
+        neurotex.evaluate(sim_dir, classifier="forest", classifier_options={"bootstrap": "maybe"})
 
 
 def untimed(value):

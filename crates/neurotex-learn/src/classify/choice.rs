@@ -97,7 +97,8 @@ impl fmt::Display for ClassifierChoice {
         match self {
             ClassifierChoice::Knn(p) => write!(f, "KNN (k = {})", p.k),
             ClassifierChoice::Forest(p) => {
-                write!(f, "random forest ({} trees, seed {}", p.trees, p.seed)?;
+                let trees = if p.trees == 1 { "tree" } else { "trees" };
+                write!(f, "random forest ({} {trees}, seed {}", p.trees, p.seed)?;
                 let d = ForestParams::default();
                 if let Some(depth) = p.max_depth {
                     write!(f, ", depth at most {depth}")?;

@@ -228,7 +228,13 @@ class KNNClassifier(_LibraryClassifier):
 
 
 class RandomForestClassifier(_LibraryClassifier):
-    """The library's random forest (``--classifier forest``), seeded."""
+    """The library's random forest (``--classifier forest``): ``trees`` CART trees, each
+    grown on a bootstrap sample (``bootstrap=False``: the whole training set) to
+    ``max_depth`` (``None``: until leaves are pure or smaller than ``min_samples_leaf``),
+    trying ``max_features`` features at each split (``None``: ⌊√d⌋, scikit-learn's
+    ``"sqrt"``, not its ``None``, which tries all), seeded by ``seed`` (scikit-learn's
+    ``random_state``). The names are the CLI's (``--trees`` is scikit-learn's
+    ``n_estimators``); the defaults are the library's, as ``neurotex train`` uses them."""
 
     _kind = "forest"
 
@@ -251,7 +257,9 @@ class RandomForestClassifier(_LibraryClassifier):
 
 class LogisticRegression(_LibraryClassifier):
     """The library's multinomial logistic regression (``--classifier linear``), L2
-    penalty with scikit-learn's ``C``, fitted by L-BFGS."""
+    penalty of inverse strength ``c`` (scikit-learn's ``C``, spelled as the CLI's
+    ``--c``), fitted by L-BFGS for at most ``max_iter`` iterations until no gradient
+    component exceeds ``tol``; features are z-scored with training statistics."""
 
     _kind = "linear"
 
