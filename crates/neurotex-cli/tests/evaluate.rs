@@ -73,8 +73,13 @@ fn features_and_evaluate_on_a_dataset() {
         interval["upper"].as_f64().unwrap(),
     );
     assert!(lower <= acc && acc <= upper && (0.0..=1.0).contains(&lower) && upper <= 1.0);
+    // the protocol that gave the accuracy, in words and as numbers
+    assert!(v["protocol"].as_str().unwrap().contains("stratified CV"));
+    assert_eq!(v["cv"]["folds"].as_u64(), Some(5));
+    assert_eq!(v["cv"]["repeats"].as_u64(), Some(1));
 
     let v = json("taxel", &["--repeats", "2"]);
+    assert_eq!(v["cv"]["repeats"].as_u64(), Some(2));
     assert_eq!(v["per_taxel"].as_array().unwrap().len(), 16);
     let mean = v["per_taxel"]
         .as_array()

@@ -211,6 +211,16 @@ impl Evaluation {
         }
         value["metrics"] = serde_json::to_value(&self.metrics)?;
         value["accuracy_interval"] = serde_json::to_value(&self.interval)?;
+        // How the accuracy was obtained, in words and, for cross-validation, as numbers.
+        value["protocol"] = split_text(&self.split).into();
+        if let Split::CrossValidation { cv, group_by, .. } = &self.split {
+            value["cv"] = serde_json::json!({
+                "folds": cv.folds,
+                "seed": cv.seed,
+                "repeats": cv.repeats,
+                "group_by": group_by,
+            });
+        }
         if let Some(advice) = &self.advice {
             value["warning"] = advice.as_str().into();
         }
