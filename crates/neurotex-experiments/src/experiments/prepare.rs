@@ -591,18 +591,19 @@ impl<'a> Perturbed<'a> {
         }
     }
 
-    /// Writes the next samples of the stream, perturbed, into `out`.
-    fn perturb(&mut self, samples: &[f64], out: &mut [f64]) {
-        for (out, &x) in out.iter_mut().zip(samples) {
+    /// Writes the next samples of the stream, perturbed, into `out`: as many at a time as
+    /// the words read hold.
+    fn perturb(&mut self, mut samples: &[f64], mut out: &mut [f64]) {
+        while !samples.is_empty() && !out.is_empty() {
             if self.next == Self::WORDS {
                 self.rng.fill(&mut self.words[..]);
                 self.next = 0;
             }
-            let word = self.words[self.next];
-            self.next += 1;
-            let one_to_two = f64::from_bits(word >> 12 | 1.0f64.to_bits());
-            let u = (one_to_two - 1.0) * 2.0 + -1.0;
-            *out = x * (1.0 + self.eps * u);
+            let n = (Self::WORDS - self.next).min(samples.len()).min(out.len());
+            let words = &self.words[self.next..self.next + n];
+            perturb_with(words, self.eps, &samples[..n], &mut out[..n]);
+            self.next += n;
+            (samples, out) = (&samples[n..], &mut out[n..]);
         }
     }
 
@@ -611,6 +612,21 @@ impl<'a> Perturbed<'a> {
         let mut out = vec![0.0; self.samples.len()];
         self.perturb(self.samples, &mut out);
         out
+    }
+}
+
+neurotex_core::widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// `x * (1 + eps u)` for each sample `x` and word of the stream, `u` in [-1, 1) as
+    /// `gen_range(-1.0..1.0)` makes it of the word: element by element, so any vector
+    /// width gives the same bits.
+    fn perturb_with(words: &[u64], eps: f64, samples: &[f64], out: &mut [f64]) {
+        let n = words.len().min(samples.len()).min(out.len());
+        for i in 0..n {
+            let one_to_two = f64::from_bits(words[i] >> 12 | 1.0f64.to_bits());
+            let u = (one_to_two - 1.0) * 2.0 + -1.0;
+            out[i] = samples[i] * (1.0 + eps * u);
+        }
     }
 }
 
