@@ -3,11 +3,10 @@
 
 use std::time::Instant;
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::keystream::Keystream;
 use super::{
     taxel_diagnostics, Progress, Provenance, Source, TaxelDiagnostics, ValidReproduceParams,
 };
@@ -558,7 +557,7 @@ struct Perturbed<'a> {
     samples: &'a [f64],
     cells: usize,
     eps: f64,
-    rng: ChaCha8Rng,
+    stream: Keystream,
     /// Words read from the stream, used from `next` on.
     words: Vec<u64>,
     next: usize,
@@ -585,7 +584,7 @@ impl<'a> Perturbed<'a> {
             samples,
             cells,
             eps: params.perturbation,
-            rng: ChaCha8Rng::from_seed(key),
+            stream: Keystream::new(key),
             words: vec![0; Self::WORDS],
             next: Self::WORDS,
         }
@@ -596,7 +595,7 @@ impl<'a> Perturbed<'a> {
     fn perturb(&mut self, mut samples: &[f64], mut out: &mut [f64]) {
         while !samples.is_empty() && !out.is_empty() {
             if self.next == Self::WORDS {
-                self.rng.fill(&mut self.words[..]);
+                self.stream.fill(&mut self.words);
                 self.next = 0;
             }
             let n = (Self::WORDS - self.next).min(samples.len()).min(out.len());
@@ -646,10 +645,10 @@ impl MadeDrive for Perturbed<'_> {
     }
 }
 
-/// `samples` perturbed for further encoding `encoding` of recording `recording`
-/// ([`Perturbed`]), whole.
-#[cfg(test)]
-fn perturbed_input(
+/// `samples` perturbed for further encoding `encoding` of recording `recording`, whole:
+/// the input the encoder's sensitivity encodes (`reproduce` makes it a block of steps at a
+/// time as the encoder runs, with the same values).
+pub fn perturbed_input(
     samples: &[f64],
     params: &ValidReproduceParams,
     encoding: usize,
@@ -694,6 +693,8 @@ mod tests {
     use crate::experiments::ReproduceParams;
     use crate::recording::Baseline;
     use crate::sim::{design, simulate_trial, RigParams, ALL_TEXTURES};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     /// The perturbation one `gen_range` call per sample, as the stream is meant to be read.
     fn perturbed_input_one_by_one(
