@@ -354,100 +354,124 @@ fn gradient_portable(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
     }
 }
 
-/// The AVX2 kernels: four f64 lanes, a multiply then an add (no FMA), so each lane's
-/// rounding is the scalar loop's.
+/// The vector kernels of one width, as functions of the enclosing module: `blocks` (the
+/// logits of a group of [`ROWS`] rows, `$lanes` classes a register, for padded classes a
+/// multiple of `$lanes`), `gradient_two` (`4 x $lanes` features of two classes' gradients
+/// held in registers while the group's rows are added in order; returns the first feature
+/// left) and `gradient` (every pair of classes so, the rest of each class and the last of
+/// an odd number of classes by the AVX2 `tail`). A multiply then an add (no FMA), so each
+/// lane's rounding is the scalar loop's.
+#[cfg(target_arch = "x86_64")]
+macro_rules! wide_kernels {
+    ($feature:literal, $lanes:expr, $zero:ident, $set1:ident, $load:ident, $store:ident,
+     $add:ident, $mul:ident) => {
+        /// The logits of a group of rows, a block of classes at a time.
+        #[target_feature(enable = $feature)]
+        unsafe fn blocks(z: &[f64], by_feature: &[f64], d: usize, out: &mut [f64]) {
+            let padded = by_feature.len() / d;
+            for block in (0..padded).step_by($lanes) {
+                let mut acc = [$set1(-0.0); ROWS];
+                for (j, w) in by_feature.chunks_exact(padded).enumerate() {
+                    let w = $load(w[block..block + $lanes].as_ptr());
+                    for (r, a) in acc.iter_mut().enumerate() {
+                        let x = $set1(z[r * d + j]);
+                        *a = $add(*a, $mul(w, x));
+                    }
+                }
+                for (r, a) in acc.iter().enumerate() {
+                    let o = &mut out[r * padded + block..r * padded + block + $lanes];
+                    $store(o.as_mut_ptr(), *a);
+                }
+            }
+        }
+
+        /// [`super::Kernels::gradient`], two classes at a time.
+        #[target_feature(enable = $feature)]
+        pub(super) unsafe fn gradient(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
+            let d = gw.len() / k;
+            let rows = residuals.len() / k;
+            let mut pairs = gw.chunks_exact_mut(2 * d);
+            let mut c = 0;
+            for pair in pairs.by_ref() {
+                let (ga, gb) = pair.split_at_mut(d);
+                let j = gradient_two(z, residuals, (k, c, rows), ga, gb);
+                super::avx2::tail(z, residuals, k, c, rows, j, ga);
+                super::avx2::tail(z, residuals, k, c + 1, rows, j, gb);
+                c += 2;
+            }
+            let last = pairs.into_remainder();
+            if !last.is_empty() {
+                super::avx2::tail(z, residuals, k, c, rows, 0, last);
+            }
+        }
+
+        /// Classes `c` and `c + 1`'s gradients `ga` and `gb`, `4 x $lanes` features at a
+        /// time; the first feature left.
+        #[target_feature(enable = $feature)]
+        unsafe fn gradient_two(
+            z: &[f64],
+            residuals: &[f64],
+            (k, c, rows): (usize, usize, usize),
+            ga: &mut [f64],
+            gb: &mut [f64],
+        ) -> usize {
+            let d = ga.len();
+            let mut j = 0;
+            while j + 4 * $lanes <= d {
+                let mut a = [$zero(); 4];
+                let mut b = [$zero(); 4];
+                for q in 0..4 {
+                    a[q] = $load(ga[j + q * $lanes..][..$lanes].as_ptr());
+                    b[q] = $load(gb[j + q * $lanes..][..$lanes].as_ptr());
+                }
+                for r in 0..rows {
+                    let res = &residuals[r * k + c..r * k + c + 2];
+                    let (ra, rb) = ($set1(res[0]), $set1(res[1]));
+                    let row = &z[r * d + j..r * d + j + 4 * $lanes];
+                    for q in 0..4 {
+                        let x = $load(row[q * $lanes..][..$lanes].as_ptr());
+                        a[q] = $add(a[q], $mul(ra, x));
+                        b[q] = $add(b[q], $mul(rb, x));
+                    }
+                }
+                for q in 0..4 {
+                    $store(ga[j + q * $lanes..][..$lanes].as_mut_ptr(), a[q]);
+                    $store(gb[j + q * $lanes..][..$lanes].as_mut_ptr(), b[q]);
+                }
+                j += 4 * $lanes;
+            }
+            j
+        }
+    };
+}
+
+/// The AVX2 kernels: four f64 lanes.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use std::arch::x86_64::*;
 
     use super::{LANES, ROWS};
 
+    wide_kernels!(
+        "avx2",
+        LANES,
+        _mm256_setzero_pd,
+        _mm256_set1_pd,
+        _mm256_loadu_pd,
+        _mm256_storeu_pd,
+        _mm256_add_pd,
+        _mm256_mul_pd
+    );
+
     /// [`super::Kernels::logits`]: for each block of four classes, the group's rows' sums
     /// in eight registers, one multiply and add per row and feature.
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn logits(z: &[f64], by_feature: &[f64], d: usize, out: &mut [f64]) {
-        let padded = by_feature.len() / d;
-        let rows = z.len() / d;
-        if rows < ROWS {
+        if z.len() / d < ROWS {
             super::logits_portable(z, by_feature, d, out);
             return;
         }
-        for block in (0..padded).step_by(LANES) {
-            let mut acc = [_mm256_set1_pd(-0.0); ROWS];
-            for (j, w) in by_feature.chunks_exact(padded).enumerate() {
-                let w = _mm256_loadu_pd(w[block..block + LANES].as_ptr());
-                for (r, a) in acc.iter_mut().enumerate() {
-                    let x = _mm256_set1_pd(z[r * d + j]);
-                    *a = _mm256_add_pd(*a, _mm256_mul_pd(w, x));
-                }
-            }
-            for (r, a) in acc.iter().enumerate() {
-                let o = &mut out[r * padded + block..r * padded + block + LANES];
-                _mm256_storeu_pd(o.as_mut_ptr(), *a);
-            }
-        }
-    }
-
-    /// [`super::Kernels::gradient`]: sixteen (then four, then one) features of two classes'
-    /// gradients held in registers while the group's rows are added in order; the two
-    /// classes share each load of a row's features. The last of an odd number of classes
-    /// goes four features at a time.
-    #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn gradient(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
-        let d = gw.len() / k;
-        let rows = residuals.len() / k;
-        let mut pairs = gw.chunks_exact_mut(2 * d);
-        let mut c = 0;
-        for pair in pairs.by_ref() {
-            let (ga, gb) = pair.split_at_mut(d);
-            gradient_two(z, residuals, k, c, rows, ga, gb);
-            c += 2;
-        }
-        // The last of an odd number of classes: four features, then one, at a time.
-        let last = pairs.into_remainder();
-        if !last.is_empty() {
-            tail(z, residuals, k, c, rows, 0, last);
-        }
-    }
-
-    /// Classes `c` and `c + 1`'s gradients, `ga` and `gb`.
-    #[target_feature(enable = "avx2")]
-    unsafe fn gradient_two(
-        z: &[f64],
-        residuals: &[f64],
-        k: usize,
-        c: usize,
-        rows: usize,
-        ga: &mut [f64],
-        gb: &mut [f64],
-    ) {
-        let d = ga.len();
-        let mut j = 0;
-        while j + 4 * LANES <= d {
-            let mut a = [_mm256_setzero_pd(); 4];
-            let mut b = [_mm256_setzero_pd(); 4];
-            for q in 0..4 {
-                a[q] = _mm256_loadu_pd(ga[j + q * LANES..][..LANES].as_ptr());
-                b[q] = _mm256_loadu_pd(gb[j + q * LANES..][..LANES].as_ptr());
-            }
-            for r in 0..rows {
-                let res = &residuals[r * k + c..r * k + c + 2];
-                let (ra, rb) = (_mm256_set1_pd(res[0]), _mm256_set1_pd(res[1]));
-                let row = &z[r * d + j..r * d + j + 4 * LANES];
-                for q in 0..4 {
-                    let x = _mm256_loadu_pd(row[q * LANES..][..LANES].as_ptr());
-                    a[q] = _mm256_add_pd(a[q], _mm256_mul_pd(ra, x));
-                    b[q] = _mm256_add_pd(b[q], _mm256_mul_pd(rb, x));
-                }
-            }
-            for q in 0..4 {
-                _mm256_storeu_pd(ga[j + q * LANES..][..LANES].as_mut_ptr(), a[q]);
-                _mm256_storeu_pd(gb[j + q * LANES..][..LANES].as_mut_ptr(), b[q]);
-            }
-            j += 4 * LANES;
-        }
-        tail(z, residuals, k, c, rows, j, ga);
-        tail(z, residuals, k, c + 1, rows, j, gb);
+        blocks(z, by_feature, d, out);
     }
 
     /// Features `j..` of class `c`'s gradient `g`: four, then one at a time.
@@ -480,9 +504,8 @@ mod avx2 {
     }
 }
 
-/// The AVX-512 kernels: the AVX2 kernels' sums eight lanes at a time (a multiply then an
-/// add, no FMA), each lane's rounding the scalar loop's; what is left of a row goes to the
-/// AVX2 kernels.
+/// The AVX-512 kernels: eight f64 lanes; logits whose padded classes are not a multiple of
+/// eight, and groups of fewer rows, go to the AVX2 kernel.
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
     use std::arch::x86_64::*;
@@ -492,90 +515,26 @@ mod avx512 {
     /// Classes per block of the logits.
     const WIDE: usize = 8;
 
-    /// [`super::Kernels::logits`]: for each block of eight classes, the group's rows' sums
-    /// in eight registers.
+    wide_kernels!(
+        "avx512f,avx2",
+        WIDE,
+        _mm512_setzero_pd,
+        _mm512_set1_pd,
+        _mm512_loadu_pd,
+        _mm512_storeu_pd,
+        _mm512_add_pd,
+        _mm512_mul_pd
+    );
+
+    /// [`super::Kernels::logits`] eight classes a register.
     #[target_feature(enable = "avx512f,avx2")]
     pub(super) unsafe fn logits(z: &[f64], by_feature: &[f64], d: usize, out: &mut [f64]) {
         let padded = by_feature.len() / d;
-        let rows = z.len() / d;
-        if rows < ROWS || !padded.is_multiple_of(WIDE) {
+        if z.len() / d < ROWS || !padded.is_multiple_of(WIDE) {
             super::avx2::logits(z, by_feature, d, out);
             return;
         }
-        for block in (0..padded).step_by(WIDE) {
-            let mut acc = [_mm512_set1_pd(-0.0); ROWS];
-            for (j, w) in by_feature.chunks_exact(padded).enumerate() {
-                let w = _mm512_loadu_pd(w[block..block + WIDE].as_ptr());
-                for (r, a) in acc.iter_mut().enumerate() {
-                    let x = _mm512_set1_pd(z[r * d + j]);
-                    *a = _mm512_add_pd(*a, _mm512_mul_pd(w, x));
-                }
-            }
-            for (r, a) in acc.iter().enumerate() {
-                let o = &mut out[r * padded + block..r * padded + block + WIDE];
-                _mm512_storeu_pd(o.as_mut_ptr(), *a);
-            }
-        }
-    }
-
-    /// [`super::Kernels::gradient`]: thirty-two features of two classes' gradients held in
-    /// registers while the group's rows are added in order, the rest of each class by the
-    /// AVX2 kernel's tail; the last of an odd number of classes by that tail alone.
-    #[target_feature(enable = "avx512f,avx2")]
-    pub(super) unsafe fn gradient(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
-        let d = gw.len() / k;
-        let rows = residuals.len() / k;
-        let mut pairs = gw.chunks_exact_mut(2 * d);
-        let mut c = 0;
-        for pair in pairs.by_ref() {
-            let (ga, gb) = pair.split_at_mut(d);
-            let j = gradient_two(z, residuals, (k, c, rows), ga, gb);
-            super::avx2::tail(z, residuals, k, c, rows, j, ga);
-            super::avx2::tail(z, residuals, k, c + 1, rows, j, gb);
-            c += 2;
-        }
-        let last = pairs.into_remainder();
-        if !last.is_empty() {
-            super::avx2::tail(z, residuals, k, c, rows, 0, last);
-        }
-    }
-
-    /// Classes `c` and `c + 1`'s gradients `ga` and `gb`, thirty-two features at a time;
-    /// the first feature left.
-    #[target_feature(enable = "avx512f,avx2")]
-    unsafe fn gradient_two(
-        z: &[f64],
-        residuals: &[f64],
-        (k, c, rows): (usize, usize, usize),
-        ga: &mut [f64],
-        gb: &mut [f64],
-    ) -> usize {
-        let d = ga.len();
-        let mut j = 0;
-        while j + 4 * WIDE <= d {
-            let mut a = [_mm512_setzero_pd(); 4];
-            let mut b = [_mm512_setzero_pd(); 4];
-            for q in 0..4 {
-                a[q] = _mm512_loadu_pd(ga[j + q * WIDE..][..WIDE].as_ptr());
-                b[q] = _mm512_loadu_pd(gb[j + q * WIDE..][..WIDE].as_ptr());
-            }
-            for r in 0..rows {
-                let res = &residuals[r * k + c..r * k + c + 2];
-                let (ra, rb) = (_mm512_set1_pd(res[0]), _mm512_set1_pd(res[1]));
-                let row = &z[r * d + j..r * d + j + 4 * WIDE];
-                for q in 0..4 {
-                    let x = _mm512_loadu_pd(row[q * WIDE..][..WIDE].as_ptr());
-                    a[q] = _mm512_add_pd(a[q], _mm512_mul_pd(ra, x));
-                    b[q] = _mm512_add_pd(b[q], _mm512_mul_pd(rb, x));
-                }
-            }
-            for q in 0..4 {
-                _mm512_storeu_pd(ga[j + q * WIDE..][..WIDE].as_mut_ptr(), a[q]);
-                _mm512_storeu_pd(gb[j + q * WIDE..][..WIDE].as_mut_ptr(), b[q]);
-            }
-            j += 4 * WIDE;
-        }
-        j
+        blocks(z, by_feature, d, out);
     }
 }
 
