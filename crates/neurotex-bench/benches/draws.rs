@@ -3,12 +3,15 @@
 //! (`Pipeline::encode_populations`) against all in one call, each draw's populations banks
 //! side by side (`Pipeline::encode_populations_side_by_side`), for the `sa` and `sa+fa`
 //! encodings; and for `sa`, the draws made a block of steps at a time as the banks run
-//! (`Drive::Made`, as `reproduce` makes its perturbed inputs). The recording is the
+//! (`Drive::Made`, as `reproduce` makes its perturbed inputs). `perturbed_inputs` times
+//! the 7 perturbed inputs themselves (their ChaCha8 stream and the products) as
+//! `reproduce` makes them. The recording is the
 //! simulator's 90 mm slide at 5 mm/s on the 4x4 rig (18 s), the longest of the paper's
 //! design.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use neurotex::encode::{encode_drives, BankRows, Drive, MadeDrive};
+use neurotex::experiments::{perturbed_input, ReproduceParams};
 use neurotex::pipeline::{Encoding, Pipeline, PipelineParams};
 use neurotex::recording::Baseline;
 use neurotex::signal::Conditioned;
@@ -105,6 +108,15 @@ fn bench(c: &mut Criterion) {
             })
         });
         if encoding == Encoding::Sa {
+            let reproduce = ReproduceParams::default().check().unwrap();
+            let inputs = format!("{cells}x{steps}ms_{}draws", DRAWS - 1);
+            group.bench_function(BenchmarkId::new("perturbed_inputs", inputs), |b| {
+                b.iter(|| {
+                    (1..DRAWS)
+                        .map(|draw| perturbed_input(&cond.samples, &reproduce, draw, 0)[0])
+                        .sum::<f64>()
+                })
+            });
             let neuron = pipeline.params().encoder;
             let l = &rec.layout;
             group.bench_function(BenchmarkId::new("made_side_by_side", &size), |b| {

@@ -21,6 +21,7 @@ mod e7_gain;
 mod e8_neighbours;
 mod e9_compare;
 mod encodings;
+mod keystream;
 mod params;
 mod prepare;
 mod provenance;
@@ -54,7 +55,7 @@ pub use encodings::{encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, Ove
 pub use params::{
     ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS, MAX_REPEATS,
 };
-pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, WITHIN_SPEED};
+pub use prepare::{perturbed_input, prepare, CausalPrepared, IsiSweep, Prepared, WITHIN_SPEED};
 pub use provenance::Provenance;
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
 pub use skip::{Skip, Stop};

@@ -3,11 +3,10 @@
 
 use std::time::Instant;
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::keystream::Keystream;
 use super::{
     taxel_diagnostics, Progress, Provenance, Source, TaxelDiagnostics, ValidReproduceParams,
 };
@@ -558,7 +557,7 @@ struct Perturbed<'a> {
     samples: &'a [f64],
     cells: usize,
     eps: f64,
-    rng: ChaCha8Rng,
+    stream: Keystream,
     /// Words read from the stream, used from `next` on.
     words: Vec<u64>,
     next: usize,
@@ -585,24 +584,25 @@ impl<'a> Perturbed<'a> {
             samples,
             cells,
             eps: params.perturbation,
-            rng: ChaCha8Rng::from_seed(key),
+            stream: Keystream::new(key),
             words: vec![0; Self::WORDS],
             next: Self::WORDS,
         }
     }
 
-    /// Writes the next samples of the stream, perturbed, into `out`.
-    fn perturb(&mut self, samples: &[f64], out: &mut [f64]) {
-        for (out, &x) in out.iter_mut().zip(samples) {
+    /// Writes the next samples of the stream, perturbed, into `out`: as many at a time as
+    /// the words read hold.
+    fn perturb(&mut self, mut samples: &[f64], mut out: &mut [f64]) {
+        while !samples.is_empty() && !out.is_empty() {
             if self.next == Self::WORDS {
-                self.rng.fill(&mut self.words[..]);
+                self.stream.fill(&mut self.words);
                 self.next = 0;
             }
-            let word = self.words[self.next];
-            self.next += 1;
-            let one_to_two = f64::from_bits(word >> 12 | 1.0f64.to_bits());
-            let u = (one_to_two - 1.0) * 2.0 + -1.0;
-            *out = x * (1.0 + self.eps * u);
+            let n = (Self::WORDS - self.next).min(samples.len()).min(out.len());
+            let words = &self.words[self.next..self.next + n];
+            perturb_with(words, self.eps, &samples[..n], &mut out[..n]);
+            self.next += n;
+            (samples, out) = (&samples[n..], &mut out[n..]);
         }
     }
 
@@ -611,6 +611,21 @@ impl<'a> Perturbed<'a> {
         let mut out = vec![0.0; self.samples.len()];
         self.perturb(self.samples, &mut out);
         out
+    }
+}
+
+neurotex_core::widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// `x * (1 + eps u)` for each sample `x` and word of the stream, `u` in [-1, 1) as
+    /// `gen_range(-1.0..1.0)` makes it of the word: element by element, so any vector
+    /// width gives the same bits.
+    fn perturb_with(words: &[u64], eps: f64, samples: &[f64], out: &mut [f64]) {
+        let n = words.len().min(samples.len()).min(out.len());
+        for i in 0..n {
+            let one_to_two = f64::from_bits(words[i] >> 12 | 1.0f64.to_bits());
+            let u = (one_to_two - 1.0) * 2.0 + -1.0;
+            out[i] = samples[i] * (1.0 + eps * u);
+        }
     }
 }
 
@@ -630,10 +645,10 @@ impl MadeDrive for Perturbed<'_> {
     }
 }
 
-/// `samples` perturbed for further encoding `encoding` of recording `recording`
-/// ([`Perturbed`]), whole.
-#[cfg(test)]
-fn perturbed_input(
+/// `samples` perturbed for further encoding `encoding` of recording `recording`, whole:
+/// the input the encoder's sensitivity encodes (`reproduce` makes it a block of steps at a
+/// time as the encoder runs, with the same values).
+pub fn perturbed_input(
     samples: &[f64],
     params: &ValidReproduceParams,
     encoding: usize,
@@ -678,6 +693,8 @@ mod tests {
     use crate::experiments::ReproduceParams;
     use crate::recording::Baseline;
     use crate::sim::{design, simulate_trial, RigParams, ALL_TEXTURES};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     /// The perturbation one `gen_range` call per sample, as the stream is meant to be read.
     fn perturbed_input_one_by_one(

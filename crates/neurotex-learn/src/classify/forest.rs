@@ -350,12 +350,15 @@ impl<'a> Grower<'a> {
         }
         let starts = &mut self.rank_starts;
         starts.clear();
-        starts.resize(distinct + 1, 0);
+        starts.resize(distinct, 0);
         for &s in samples {
-            starts[ranks[s as usize] as usize + 1] += 1;
+            starts[ranks[s as usize] as usize] += 1;
         }
-        for r in 1..=distinct {
-            starts[r] += starts[r - 1];
+        // Each rank's first slot: the counts before it, summed in a register (a sum
+        // carried through memory waits on a store and a load per rank).
+        let mut slot = 0u32;
+        for start in starts.iter_mut() {
+            (*start, slot) = (slot, slot + *start);
         }
         self.keys.resize(samples.len(), 0);
         for &s in samples {
@@ -415,47 +418,55 @@ impl<'a> Grower<'a> {
     }
 
     /// [`Grower::scan`]'s walk, the proxies compared in `T`; the feature's best position.
+    /// Only the best proxy and its position are kept while walking (the proxy in `T` is
+    /// the exact value the candidate holds in 128 bits).
     #[inline(always)]
     fn scan_in<T>(&mut self, feature: usize, total: u64) -> Option<Candidate>
     where
-        T: Copy + Ord + From<u64> + std::ops::Mul<Output = T> + std::ops::Add<Output = T>,
+        T: Copy
+            + Ord
+            + From<u64>
+            + Into<u128>
+            + std::ops::Mul<Output = T>
+            + std::ops::Add<Output = T>,
     {
         let min_leaf = self.growth.min_leaf;
         let m = self.keys.len();
-        self.left.fill(0);
+        let (keys, y, weight) = (&self.keys[..], self.data.y, &self.weight[..]);
+        let (counts, left) = (&self.counts[..], &mut self.left[..]);
+        left.fill(0);
         let mut sq_left = 0u64;
-        let mut sq_right: u64 = self.counts.iter().map(|&c| c * c).sum();
+        let mut sq_right: u64 = counts.iter().map(|&c| c * c).sum();
         let mut w_left = 0u64;
-        // The best proxy so far: its numerator and denominator in `T`, and the position
-        // with its sums (`sq_left`, `sq_right`, `w_left`).
-        let mut top: Option<(T, T, usize, [u64; 3])> = None;
+        // The best proxy so far, `num / den` at position `at` (none while `at == m`).
+        let (mut top_num, mut top_den, mut at) = (T::from(0), T::from(1), m);
         for p in 0..m - min_leaf {
-            let s = (self.keys[p] & 0xffff_ffff) as usize;
-            let (c, w) = (self.data.y[s], self.weight[s]);
-            let right_c = self.counts[c] - self.left[c];
-            sq_left += (2 * self.left[c] + w) * w;
+            let s = (keys[p] & 0xffff_ffff) as usize;
+            let (c, w) = (y[s], weight[s]);
+            let right_c = counts[c] - left[c];
+            sq_left += (2 * left[c] + w) * w;
             sq_right -= (2 * right_c - w) * w;
-            self.left[c] += w;
+            left[c] += w;
             w_left += w;
-            if p + 1 < min_leaf || self.keys[p] >> 32 == self.keys[p + 1] >> 32 {
+            if p + 1 < min_leaf || keys[p] >> 32 == keys[p + 1] >> 32 {
                 continue;
             }
             let w_right = total - w_left;
             let num = T::from(sq_left) * T::from(w_right) + T::from(sq_right) * T::from(w_left);
             let den = T::from(w_left) * T::from(w_right);
-            if top.is_none_or(|(n, d, _, _)| num * d > n * den) {
-                top = Some((num, den, p, [sq_left, sq_right, w_left]));
+            if at == m || num * top_den > top_num * den {
+                (top_num, top_den, at) = (num, den, p);
             }
         }
-        let (_, _, p, [sq_left, sq_right, w_left]) = top?;
-        let w_right = total - w_left;
+        if at == m {
+            return None;
+        }
         Some(Candidate {
-            num: u128::from(sq_left) * u128::from(w_right)
-                + u128::from(sq_right) * u128::from(w_left),
-            den: u128::from(w_left) * u128::from(w_right),
+            num: top_num.into(),
+            den: top_den.into(),
             feature,
-            n_left: p + 1,
-            rank: (self.keys[p] >> 32) as u32,
+            n_left: at + 1,
+            rank: (keys[at] >> 32) as u32,
         })
     }
 

@@ -165,22 +165,44 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// `a · b` summed in eight running sums (the solver's long vectors: independent sums fill
-/// the vector units where one running sum waits on each addition).
+/// the vector units where one running sum waits on each addition). The sums are lanes, so
+/// AVX-512 gives the plain code's bits.
+#[inline(always)]
 fn dot8(a: &[f64], b: &[f64]) -> f64 {
-    let mut sums = [0.0; 8];
-    let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
-    let tail: f64 = ac
-        .remainder()
+    let n = a.len().min(b.len());
+    let whole = n - n % 8;
+    let tail: f64 = a[whole..n]
         .iter()
-        .zip(bc.remainder())
+        .zip(&b[whole..n])
         .map(|(x, y)| x * y)
         .sum();
-    for (x, y) in ac.zip(bc) {
+    let mut sums = [0.0; 8];
+    for (x, y) in a[..whole].chunks_exact(8).zip(b[..whole].chunks_exact(8)) {
         for i in 0..8 {
             sums[i] += x[i] * y[i];
         }
     }
     sums.iter().sum::<f64>() + tail
+}
+
+/// `q[i] += a * v[i]`, element by element.
+#[inline(always)]
+fn add_scaled(q: &mut [f64], a: f64, v: &[f64]) {
+    let n = q.len().min(v.len());
+    let (q, v) = (&mut q[..n], &v[..n]);
+    for i in 0..n {
+        q[i] += a * v[i];
+    }
+}
+
+/// `q[i] -= a * v[i]`, element by element.
+#[inline(always)]
+fn sub_scaled(q: &mut [f64], a: f64, v: &[f64]) {
+    let n = q.len().min(v.len());
+    let (q, v) = (&mut q[..n], &v[..n]);
+    for i in 0..n {
+        q[i] -= a * v[i];
+    }
 }
 
 /// Softmax of `logits`, shifted by their maximum.
@@ -288,6 +310,14 @@ impl Kernels {
     fn fastest() -> Self {
         #[cfg(target_arch = "x86_64")]
         {
+            if neurotex_core::has_feature!("avx512f") && neurotex_core::has_feature!("avx2") {
+                return Kernels {
+                    // SAFETY (both): the CPU supports AVX-512F and AVX2, the features they
+                    // enable.
+                    logits: |z, w, d, out| unsafe { avx512::logits(z, w, d, out) },
+                    gradient: |z, res, k, gw| unsafe { avx512::gradient(z, res, k, gw) },
+                };
+            }
             if neurotex_core::has_feature!("avx2") {
                 return Kernels {
                     // SAFETY (both): the CPU supports AVX2, the only feature they enable.
@@ -324,105 +354,129 @@ fn gradient_portable(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
     }
 }
 
-/// The AVX2 kernels: four f64 lanes, a multiply then an add (no FMA), so each lane's
-/// rounding is the scalar loop's.
+/// The vector kernels of one width, as functions of the enclosing module: `blocks` (the
+/// logits of a group of [`ROWS`] rows, `$lanes` classes a register, for padded classes a
+/// multiple of `$lanes`), `gradient_two` (`4 x $lanes` features of two classes' gradients
+/// held in registers while the group's rows are added in order; returns the first feature
+/// left) and `gradient` (every pair of classes so, the rest of each class and the last of
+/// an odd number of classes by the AVX2 `tail`). A multiply then an add (no FMA), so each
+/// lane's rounding is the scalar loop's.
+#[cfg(target_arch = "x86_64")]
+macro_rules! wide_kernels {
+    ($feature:literal, $lanes:expr, $zero:ident, $set1:ident, $load:ident, $store:ident,
+     $add:ident, $mul:ident) => {
+        /// The logits of a group of rows, a block of classes at a time.
+        #[target_feature(enable = $feature)]
+        unsafe fn blocks(z: &[f64], by_feature: &[f64], d: usize, out: &mut [f64]) {
+            let padded = by_feature.len() / d;
+            for block in (0..padded).step_by($lanes) {
+                let mut acc = [$set1(-0.0); ROWS];
+                for (j, w) in by_feature.chunks_exact(padded).enumerate() {
+                    let w = $load(w[block..block + $lanes].as_ptr());
+                    for (r, a) in acc.iter_mut().enumerate() {
+                        let x = $set1(z[r * d + j]);
+                        *a = $add(*a, $mul(w, x));
+                    }
+                }
+                for (r, a) in acc.iter().enumerate() {
+                    let o = &mut out[r * padded + block..r * padded + block + $lanes];
+                    $store(o.as_mut_ptr(), *a);
+                }
+            }
+        }
+
+        /// [`super::Kernels::gradient`], two classes at a time.
+        #[target_feature(enable = $feature)]
+        pub(super) unsafe fn gradient(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
+            let d = gw.len() / k;
+            let rows = residuals.len() / k;
+            let mut pairs = gw.chunks_exact_mut(2 * d);
+            let mut c = 0;
+            for pair in pairs.by_ref() {
+                let (ga, gb) = pair.split_at_mut(d);
+                let j = gradient_two(z, residuals, (k, c, rows), ga, gb);
+                super::avx2::tail(z, residuals, k, c, rows, j, ga);
+                super::avx2::tail(z, residuals, k, c + 1, rows, j, gb);
+                c += 2;
+            }
+            let last = pairs.into_remainder();
+            if !last.is_empty() {
+                super::avx2::tail(z, residuals, k, c, rows, 0, last);
+            }
+        }
+
+        /// Classes `c` and `c + 1`'s gradients `ga` and `gb`, `4 x $lanes` features at a
+        /// time; the first feature left.
+        #[target_feature(enable = $feature)]
+        unsafe fn gradient_two(
+            z: &[f64],
+            residuals: &[f64],
+            (k, c, rows): (usize, usize, usize),
+            ga: &mut [f64],
+            gb: &mut [f64],
+        ) -> usize {
+            let d = ga.len();
+            let mut j = 0;
+            while j + 4 * $lanes <= d {
+                let mut a = [$zero(); 4];
+                let mut b = [$zero(); 4];
+                for q in 0..4 {
+                    a[q] = $load(ga[j + q * $lanes..][..$lanes].as_ptr());
+                    b[q] = $load(gb[j + q * $lanes..][..$lanes].as_ptr());
+                }
+                for r in 0..rows {
+                    let res = &residuals[r * k + c..r * k + c + 2];
+                    let (ra, rb) = ($set1(res[0]), $set1(res[1]));
+                    let row = &z[r * d + j..r * d + j + 4 * $lanes];
+                    for q in 0..4 {
+                        let x = $load(row[q * $lanes..][..$lanes].as_ptr());
+                        a[q] = $add(a[q], $mul(ra, x));
+                        b[q] = $add(b[q], $mul(rb, x));
+                    }
+                }
+                for q in 0..4 {
+                    $store(ga[j + q * $lanes..][..$lanes].as_mut_ptr(), a[q]);
+                    $store(gb[j + q * $lanes..][..$lanes].as_mut_ptr(), b[q]);
+                }
+                j += 4 * $lanes;
+            }
+            j
+        }
+    };
+}
+
+/// The AVX2 kernels: four f64 lanes.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use std::arch::x86_64::*;
 
     use super::{LANES, ROWS};
 
+    wide_kernels!(
+        "avx2",
+        LANES,
+        _mm256_setzero_pd,
+        _mm256_set1_pd,
+        _mm256_loadu_pd,
+        _mm256_storeu_pd,
+        _mm256_add_pd,
+        _mm256_mul_pd
+    );
+
     /// [`super::Kernels::logits`]: for each block of four classes, the group's rows' sums
     /// in eight registers, one multiply and add per row and feature.
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn logits(z: &[f64], by_feature: &[f64], d: usize, out: &mut [f64]) {
-        let padded = by_feature.len() / d;
-        let rows = z.len() / d;
-        if rows < ROWS {
+        if z.len() / d < ROWS {
             super::logits_portable(z, by_feature, d, out);
             return;
         }
-        for block in (0..padded).step_by(LANES) {
-            let mut acc = [_mm256_set1_pd(-0.0); ROWS];
-            for (j, w) in by_feature.chunks_exact(padded).enumerate() {
-                let w = _mm256_loadu_pd(w[block..block + LANES].as_ptr());
-                for (r, a) in acc.iter_mut().enumerate() {
-                    let x = _mm256_set1_pd(z[r * d + j]);
-                    *a = _mm256_add_pd(*a, _mm256_mul_pd(w, x));
-                }
-            }
-            for (r, a) in acc.iter().enumerate() {
-                let o = &mut out[r * padded + block..r * padded + block + LANES];
-                _mm256_storeu_pd(o.as_mut_ptr(), *a);
-            }
-        }
-    }
-
-    /// [`super::Kernels::gradient`]: sixteen (then four, then one) features of two classes'
-    /// gradients held in registers while the group's rows are added in order; the two
-    /// classes share each load of a row's features. The last of an odd number of classes
-    /// goes four features at a time.
-    #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn gradient(z: &[f64], residuals: &[f64], k: usize, gw: &mut [f64]) {
-        let d = gw.len() / k;
-        let rows = residuals.len() / k;
-        let mut pairs = gw.chunks_exact_mut(2 * d);
-        let mut c = 0;
-        for pair in pairs.by_ref() {
-            let (ga, gb) = pair.split_at_mut(d);
-            gradient_two(z, residuals, k, c, rows, ga, gb);
-            c += 2;
-        }
-        // The last of an odd number of classes: four features, then one, at a time.
-        let last = pairs.into_remainder();
-        if !last.is_empty() {
-            tail(z, residuals, k, c, rows, 0, last);
-        }
-    }
-
-    /// Classes `c` and `c + 1`'s gradients, `ga` and `gb`.
-    #[target_feature(enable = "avx2")]
-    unsafe fn gradient_two(
-        z: &[f64],
-        residuals: &[f64],
-        k: usize,
-        c: usize,
-        rows: usize,
-        ga: &mut [f64],
-        gb: &mut [f64],
-    ) {
-        let d = ga.len();
-        let mut j = 0;
-        while j + 4 * LANES <= d {
-            let mut a = [_mm256_setzero_pd(); 4];
-            let mut b = [_mm256_setzero_pd(); 4];
-            for q in 0..4 {
-                a[q] = _mm256_loadu_pd(ga[j + q * LANES..][..LANES].as_ptr());
-                b[q] = _mm256_loadu_pd(gb[j + q * LANES..][..LANES].as_ptr());
-            }
-            for r in 0..rows {
-                let res = &residuals[r * k + c..r * k + c + 2];
-                let (ra, rb) = (_mm256_set1_pd(res[0]), _mm256_set1_pd(res[1]));
-                let row = &z[r * d + j..r * d + j + 4 * LANES];
-                for q in 0..4 {
-                    let x = _mm256_loadu_pd(row[q * LANES..][..LANES].as_ptr());
-                    a[q] = _mm256_add_pd(a[q], _mm256_mul_pd(ra, x));
-                    b[q] = _mm256_add_pd(b[q], _mm256_mul_pd(rb, x));
-                }
-            }
-            for q in 0..4 {
-                _mm256_storeu_pd(ga[j + q * LANES..][..LANES].as_mut_ptr(), a[q]);
-                _mm256_storeu_pd(gb[j + q * LANES..][..LANES].as_mut_ptr(), b[q]);
-            }
-            j += 4 * LANES;
-        }
-        tail(z, residuals, k, c, rows, j, ga);
-        tail(z, residuals, k, c + 1, rows, j, gb);
+        blocks(z, by_feature, d, out);
     }
 
     /// Features `j..` of class `c`'s gradient `g`: four, then one at a time.
     #[target_feature(enable = "avx2")]
-    unsafe fn tail(
+    pub(super) unsafe fn tail(
         z: &[f64],
         residuals: &[f64],
         k: usize,
@@ -450,6 +504,40 @@ mod avx2 {
     }
 }
 
+/// The AVX-512 kernels: eight f64 lanes; logits whose padded classes are not a multiple of
+/// eight, and groups of fewer rows, go to the AVX2 kernel.
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use super::ROWS;
+
+    /// Classes per block of the logits.
+    const WIDE: usize = 8;
+
+    wide_kernels!(
+        "avx512f,avx2",
+        WIDE,
+        _mm512_setzero_pd,
+        _mm512_set1_pd,
+        _mm512_loadu_pd,
+        _mm512_storeu_pd,
+        _mm512_add_pd,
+        _mm512_mul_pd
+    );
+
+    /// [`super::Kernels::logits`] eight classes a register.
+    #[target_feature(enable = "avx512f,avx2")]
+    pub(super) unsafe fn logits(z: &[f64], by_feature: &[f64], d: usize, out: &mut [f64]) {
+        let padded = by_feature.len() / d;
+        if z.len() / d < ROWS || !padded.is_multiple_of(WIDE) {
+            super::avx2::logits(z, by_feature, d, out);
+            return;
+        }
+        blocks(z, by_feature, d, out);
+    }
+}
+
 /// The end of an L-BFGS run.
 struct Solution {
     theta: Vec<f64>,
@@ -459,37 +547,55 @@ struct Solution {
 
 /// L-BFGS's search direction `-H g` by the two-loop recursion over the stored pairs
 /// `(s, y, 1/(s·y))`, the initial Hessian the preconditioner's (else the identity), scaled
-/// by the newest pair.
+/// by the newest pair. Every step is element by element or a sum in lanes
+/// ([`dot8`]), so it is compiled for the widest vectors too with the same bits.
 fn direction(
     grad: &[f64],
     pairs: &VecDeque<(Vec<f64>, Vec<f64>, f64)>,
     pre: Option<&Preconditioner>,
 ) -> Vec<f64> {
-    let mut q = grad.to_vec();
-    let mut alpha = Vec::with_capacity(pairs.len());
-    for (s, y, rho) in pairs.iter().rev() {
-        let a = rho * dot8(s, &q);
-        q.iter_mut().zip(y).for_each(|(qi, yi)| *qi -= a * yi);
-        alpha.push(a);
-    }
-    let solve = |v: &mut [f64]| {
-        if let Some(pre) = pre {
-            pre.solve(v);
+    let pre = pre.map(|p| (&p.inverse[..], p.dims, p.curvature));
+    direction_wide(grad, pairs, pre)
+}
+
+neurotex_core::widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// [`direction`], the preconditioner as its inverse, dimension and curvature.
+    fn direction_wide(
+        grad: &[f64],
+        pairs: &VecDeque<(Vec<f64>, Vec<f64>, f64)>,
+        pre: Option<(&[f64], usize, f64)>,
+    ) -> Vec<f64> {
+        let mut q = grad.to_vec();
+        let mut alpha = Vec::with_capacity(pairs.len());
+        for (s, y, rho) in pairs.iter().rev() {
+            let a = rho * dot8(s, &q);
+            sub_scaled(&mut q, a, y);
+            alpha.push(a);
         }
-    };
-    solve(&mut q);
-    if let Some((s, y, _)) = pairs.back() {
-        let mut my = y.clone();
-        solve(&mut my);
-        let gamma = dot8(s, y) / dot8(y, &my);
-        q.iter_mut().for_each(|qi| *qi *= gamma);
+        let mut scratch = Vec::new();
+        if let Some((inverse, d, curvature)) = pre {
+            solve(inverse, d, curvature, &mut q, &mut scratch);
+        }
+        if let Some((s, y, _)) = pairs.back() {
+            let mut my = y.clone();
+            if let Some((inverse, d, curvature)) = pre {
+                solve(inverse, d, curvature, &mut my, &mut scratch);
+            }
+            let gamma = dot8(s, y) / dot8(y, &my);
+            for qi in q.iter_mut() {
+                *qi *= gamma;
+            }
+        }
+        for ((s, y, rho), a) in pairs.iter().zip(alpha.iter().rev()) {
+            let b = rho * dot8(y, &q);
+            add_scaled(&mut q, a - b, s);
+        }
+        for qi in q.iter_mut() {
+            *qi = -*qi;
+        }
+        q
     }
-    for ((s, y, rho), a) in pairs.iter().zip(alpha.iter().rev()) {
-        let b = rho * dot8(y, &q);
-        q.iter_mut().zip(s).for_each(|(qi, si)| *qi += (a - b) * si);
-    }
-    q.iter_mut().for_each(|qi| *qi = -*qi);
-    q
 }
 
 /// L-BFGS's initial inverse Hessian, the inverse of `a Σ + λ I` for each class's weights
@@ -551,21 +657,31 @@ impl Preconditioner {
             inverse: inverse(m, d),
         })
     }
+}
 
-    /// `v` (`k` rows of weights, then `k` intercepts) times the matrix's inverse.
-    fn solve(&self, v: &mut [f64]) {
-        let d = self.dims;
-        let k = v.len() / (d + 1);
-        let (w, b) = v.split_at_mut(k * d);
-        let mut out = vec![0.0; d];
-        for wc in w.chunks_exact_mut(d) {
-            out.iter_mut().for_each(|o| *o = 0.0);
-            for (&g, row) in wc.iter().zip(self.inverse.chunks_exact(d)) {
-                out.iter_mut().zip(row).for_each(|(o, &m)| *o += g * m);
+/// `v` (`k` rows of weights, then `k` intercepts) times the preconditioner's inverse
+/// (`d x d`) and its intercepts divided by `curvature`, `out` scratch space. Each class's
+/// entry `j` is `Σ_i v_i inverse_ij` added from 0 in the order of `i`; the classes go side
+/// by side, so each row of the inverse is read once per call.
+#[inline(always)]
+fn solve(inverse: &[f64], d: usize, curvature: f64, v: &mut [f64], out: &mut Vec<f64>) {
+    let k = v.len() / (d + 1);
+    let (w, b) = v.split_at_mut(k * d);
+    out.clear();
+    out.resize(k * d, 0.0);
+    for i in 0..d {
+        let row = &inverse[i * d..(i + 1) * d];
+        for c in 0..k {
+            let g = w[c * d + i];
+            let o = &mut out[c * d..(c + 1) * d];
+            for j in 0..d {
+                o[j] += g * row[j];
             }
-            wc.copy_from_slice(&out);
         }
-        b.iter_mut().for_each(|b| *b /= self.curvature);
+    }
+    w.copy_from_slice(out);
+    for bc in b.iter_mut() {
+        *bc /= curvature;
     }
 }
 
@@ -870,7 +986,7 @@ mod tests {
         #[test]
         fn value_grad_is_the_row_by_row_loop(
             n in 1usize..40,
-            d in 1usize..40,
+            d in 1usize..72,
             k in 2usize..11,
             seed in proptest::prelude::any::<u64>(),
             zeros in proptest::prelude::any::<bool>(),
@@ -904,6 +1020,32 @@ mod tests {
                 proptest::prop_assert_eq!(bits(&grad), bits(&expected_grad));
             }
         }
+    }
+
+    #[test]
+    fn the_preconditioner_solves_each_class_as_one_at_a_time() {
+        let mut state = 7u64;
+        let (d, k) = (37, 5);
+        let inverse: Vec<f64> = (0..d * d).map(|_| uniform(&mut state) - 0.5).collect();
+        let v: Vec<f64> = (0..k * (d + 1))
+            .map(|_| uniform(&mut state) - 0.5)
+            .collect();
+        // Class by class: each entry summed from 0 over the inverse's rows in order.
+        let mut expected = v.clone();
+        for c in 0..k {
+            let mut out = vec![0.0; d];
+            for (i, row) in inverse.chunks_exact(d).enumerate() {
+                out.iter_mut()
+                    .zip(row)
+                    .for_each(|(o, &m)| *o += v[c * d + i] * m);
+            }
+            expected[c * d..(c + 1) * d].copy_from_slice(&out);
+        }
+        expected[k * d..].iter_mut().for_each(|b| *b /= 0.3);
+        let mut got = v.clone();
+        solve(&inverse, d, 0.3, &mut got, &mut Vec::new());
+        let bits = |g: &[f64]| g.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&expected));
     }
 
     #[test]
