@@ -2,7 +2,11 @@
 //! AVX-512: the words `ChaCha8Rng::from_seed(seed)` fills a `[u64]` with (stream 0, the
 //! 64-bit block counter from 0, each word two 32-bit words of a block, low first), so the
 //! draws, and every number made from them, are those of `rand_chacha`. Without AVX-512 the
-//! stream is `rand_chacha`'s own.
+//! stream is `rand_chacha`'s own. Written here because `rand_chacha`'s vector backend
+//! makes at most four blocks per call (AVX2 width), and the sensitivity's draws spent
+//! about a tenth of `reproduce`'s CPU in it; with sixteen blocks per AVX-512 call (and the
+//! words turned into numbers in one pass) the draws' share fell from about 17 % to 7 %
+//! (docs/performance.md). A test holds the words equal to `rand_chacha`'s.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
