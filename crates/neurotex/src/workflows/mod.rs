@@ -444,7 +444,7 @@ pub fn calibration_rows(
         }
         None => {
             if stages.gain.target_hz().is_some() || stages.causal {
-                on(Progress::Say("note: under cross-validation --gain auto and --causal calibrate on every recording evaluated (labels unused), test folds included; a train/test split calibrates on the training set only"));
+                on(Progress::Say(&format!("note: under cross-validation --gain auto and --causal calibrate on the recordings evaluated (labels unused; the gain on at most {} of them, spread evenly), test folds included; a train/test split calibrates on the training set only", crate::calibrate::MAX_CALIBRATION_RECORDINGS)));
             }
             Ok(all.to_vec())
         }
