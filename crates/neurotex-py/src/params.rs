@@ -4,7 +4,8 @@
 
 use neurotex::classify::{ChosenClassifier, ClassifierChoice};
 use neurotex::options::{
-    classifier_with, knobs_of, CheckedStages, KnobSpec, OptionKind, StageOptions, STAGE_OPTIONS,
+    classifier_with, knobs_of, snn_with, CheckedStages, KnobSpec, OptionKind, StageOptions,
+    STAGE_OPTIONS,
 };
 use neurotex::pipeline::Method;
 use neurotex::recording::Baseline;
@@ -65,7 +66,7 @@ fn option_text(name: &str, kind: OptionKind, value: &Bound<'_, PyAny>) -> PyResu
             Err(_) => expected("a whole number of at least 0"),
         },
         OptionKind::Counts => match value.extract::<Vec<usize>>() {
-            Ok(v) if !value.is_instance_of::<pyo3::types::PyString>() => {
+            Ok(v) => {
                 let v: Vec<String> = v.iter().map(usize::to_string).collect();
                 Ok(v.join(","))
             }
@@ -182,38 +183,32 @@ pub fn chosen_classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<Ch
     classifier(kind, options)?.check().map_err(param)
 }
 
-/// A classifier by name with its knobs ([`neurotex::options::CLASSIFIER_OPTIONS`] by their Python
-/// names;
-/// the forest's `seed` also as `forest_seed`), checked (a model file stores this form).
+/// A classifier by name with its knobs ([`neurotex::options::CLASSIFIER_OPTIONS`] by
+/// their Python names; the forest's `seed` also as `forest_seed`), checked (a model file
+/// stores this form).
 pub fn classifier(kind: &str, options: &Bound<'_, PyDict>) -> PyResult<ClassifierChoice> {
     // The kind by the library's name, with its defaults.
     let defaults: ClassifierChoice = kind.parse().map_err(param)?;
-    let name = defaults.name();
+    let given = knobs_given(defaults.name(), options)?;
+    classifier_with(defaults, &given).map_err(crate::errors::to_py)
+}
+
+/// The knobs of the classifier `name` in `options`, each with its value as the library's
+/// parser reads it (checked one by one, not yet together); a key the classifier does not
+/// take is refused, naming the ones it does.
+pub fn knobs_given(
+    name: &str,
+    options: &Bound<'_, PyDict>,
+) -> PyResult<Vec<(&'static KnobSpec, String)>> {
     let mut known: Vec<&str> = knobs_of(name).map(|k| k.name).collect();
     if name == "forest" {
         known.push("forest_seed");
     }
     let what = match name {
         "snn" => " for the spiking network; its options are".to_string(),
-        _ => format!(" for classifier {kind}; its options are"),
+        _ => format!(" for classifier {name}; its options are"),
     };
     only_known(options, &known, &what)?;
-    let given = knobs_given(name, options)?;
-    classifier_with(defaults, &given).map_err(crate::errors::to_py)
-}
-
-/// The knobs of the classifier `name` among `options`, each with its value as the
-/// library's parser reads it (checked one by one, not yet together); keys of other
-/// classifiers are left to the caller.
-pub fn knobs_given(
-    name: &str,
-    options: &Bound<'_, PyDict>,
-) -> PyResult<Vec<(&'static KnobSpec, String)>> {
-    let defaults: ClassifierChoice = name.parse().map_err(param)?;
-    if name == "snn" {
-        let known: Vec<&str> = knobs_of(name).map(|k| k.name).collect();
-        only_known(options, &known, " for the spiking network; its options are")?;
-    }
     let mut given = Vec::new();
     for spec in knobs_of(name) {
         let alias = (spec.name == "seed" && name == "forest").then_some("forest_seed");
@@ -223,7 +218,7 @@ pub fn knobs_given(
         };
         if let Some(value) = value {
             let text = option_text(spec.name, spec.kind, &value)?;
-            (spec.set)(&mut { defaults }, &text).map_err(|e| invalid(spec.name, e))?;
+            spec.read(&text).map_err(|e| invalid(spec.name, e))?;
             given.push((spec, text));
         }
     }
@@ -256,8 +251,6 @@ pub fn classifier_defaults<'py>(py: Python<'py>, kind: &str) -> PyResult<Bound<'
 
 /// The spiking network's training knobs, checked.
 pub fn snn(options: &Bound<'_, PyDict>) -> PyResult<SnnParams> {
-    match classifier("snn", options)? {
-        ClassifierChoice::Snn(p) => Ok(p),
-        other => unreachable!("the network's knobs made a {}", other.name()),
-    }
+    let given = knobs_given("snn", options)?;
+    snn_with(SnnParams::default(), &given).map_err(crate::errors::to_py)
 }

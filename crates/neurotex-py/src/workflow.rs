@@ -79,9 +79,7 @@ fn train_dataset(
     taxel: Option<&str>,
 ) -> PyResult<(Py<PyAny>, Option<TrainingLog>, Vec<String>)> {
     let stages = params::stage_options(options)?;
-    let method = method
-        .map(|m| m.parse::<MethodChoice>().map_err(param))
-        .transpose()?;
+    let method = parsed::<MethodChoice>(method)?;
     let (knn, classifier) = front_end_classifier(classifier, method, classifier_options)?;
     let speeds = speeds_of(speeds)?;
     let taxel = parsed::<Cell>(taxel)?;
@@ -159,9 +157,7 @@ fn evaluate_dataset(
     tau_ms: Option<f64>,
 ) -> PyResult<(Py<PyAny>, Vec<String>)> {
     let stages = params::stage_options(options)?;
-    let method = method
-        .map(|m| m.parse::<MethodChoice>().map_err(param))
-        .transpose()?;
+    let method = parsed::<MethodChoice>(method)?;
     let (knn, classifier) = front_end_classifier(classifier, method, classifier_options)?;
     if train_speeds.is_some() != test_speeds.is_some()
         || train_where.is_some() != test_where.is_some()

@@ -7,7 +7,7 @@
 
 use crate::classify::ClassifierChoice;
 use crate::error::{Error, OptionsError};
-use crate::snn::{Reset, Target};
+use crate::snn::{Reset, SnnParams, Target};
 
 use super::{choice, flag, parse, shown, OptionKind};
 
@@ -35,6 +35,15 @@ impl KnobSpec {
     /// Its default as text, `None` when it has none.
     pub fn default_text(&self) -> Option<String> {
         (self.get)(&defaults_of(self.classifier))
+    }
+
+    /// Reads `text` as this knob takes it (on its classifier's defaults), without keeping
+    /// it: the check each front end runs as a value is typed.
+    ///
+    /// # Errors
+    /// What was expected, and what came.
+    pub fn read(&self, text: &str) -> Result<(), String> {
+        (self.set)(&mut defaults_of(self.classifier), text)
     }
 
     /// The help as the command line shows it: the classifier it applies to, what it does
@@ -127,6 +136,21 @@ fn applies_to(name: &str) -> &'static str {
         "forest" => "--classifier forest",
         "linear" => "--classifier linear",
         _ => "--classifier snn",
+    }
+}
+
+/// The spiking network's parameters `defaults` with the knobs `given` applied, checked
+/// ([`classifier_with`] for the network alone).
+///
+/// # Errors
+/// As [`classifier_with`].
+pub fn snn_with(
+    defaults: SnnParams,
+    given: &[(&'static KnobSpec, String)],
+) -> Result<SnnParams, Error> {
+    match classifier_with(ClassifierChoice::Snn(defaults), given)? {
+        ClassifierChoice::Snn(p) => Ok(p),
+        other => unreachable!("the network's knobs made a {}", other.name()),
     }
 }
 

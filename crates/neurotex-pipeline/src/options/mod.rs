@@ -15,7 +15,7 @@ use crate::values::ParamError;
 
 pub mod classifiers;
 
-pub use classifiers::{classifier_with, knobs_of, KnobSpec, CLASSIFIER_OPTIONS};
+pub use classifiers::{classifier_with, knobs_of, snn_with, KnobSpec, CLASSIFIER_OPTIONS};
 
 /// What kind of value an option takes, for the front ends' parsers and types.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -26,7 +26,7 @@ use crate::analysis::FeatureTable;
 use crate::calibrate::{CalibratedParams, GainCalibration};
 use crate::classify::{ClassifierChoice, KnnParams};
 use crate::error::OptionsError;
-use crate::options::{classifier_with, KnobSpec, StageOptions};
+use crate::options::{classifier_with, snn_with, KnobSpec, StageOptions};
 use crate::pipeline::{shared_grid, Encoded, Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{one_grid, Dataset, Meta};
@@ -99,10 +99,7 @@ impl SnnOptions {
     /// # Errors
     /// A value a knob does not take, or a parameter out of its range.
     pub fn params(&self, defaults: SnnParams) -> Result<SnnParams> {
-        match classifier_with(ClassifierChoice::Snn(defaults), &self.knobs)? {
-            ClassifierChoice::Snn(p) => Ok(p),
-            other => unreachable!("the network's knobs made a {}", other.name()),
-        }
+        snn_with(defaults, &self.knobs)
     }
 }
 
@@ -203,10 +200,7 @@ mod knob_flags {
         arg.value_name(long.replace('-', "_").to_uppercase())
             .action(ArgAction::Set)
             .allow_negative_numbers(true)
-            .value_parser(move |text: &str| {
-                let mut defaults: ClassifierChoice = spec.classifier.parse().unwrap_or_default();
-                (spec.set)(&mut defaults, text).map(|()| text.to_string())
-            })
+            .value_parser(move |text: &str| spec.read(text).map(|()| text.to_string()))
     }
 
     /// The knobs given on the command line, each with its text.
