@@ -1,113 +1,30 @@
-//! Feature tables over many recordings and their evaluation: cross-validation on a set of
+//! Every method's samples evaluated over many recordings: cross-validation on a set of
 //! conditions, or training on some conditions and testing on others; per taxel for the
-//! single-taxel method.
+//! single-taxel method. A feature method's samples are a [`FeatureTable`] (KNN, the forest,
+//! logistic regression), the `spikes` method's every recording's [`SpikeInput`] (the
+//! spiking network), `van-rossum`'s the [`DistanceMatrix`] between the recordings (KNN over
+//! it): [`MethodSamples`] holds any of them. [`evaluator`] pairs them with a classifier
+//! once, where the options are checked, and returns one [`EvaluateFn`] that `evaluate`,
+//! `compare` and nested selection call alike.
+
+use std::sync::Arc;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::classify::{
     bootstrap_mean_share, bootstrap_over_encodings, cross_validate_on, train_test_on,
-    BootstrapParams, Classifier, ConfusionMatrix, Evaluation, Interval, Learner, Rows, Samples,
-    Sweep, ValidCv,
+    BootstrapParams, Classifier, ClassifierChoice, ConfusionMatrix, DistanceMatrix, Evaluation,
+    Interval, Learner, Rows, Samples, SnnClassifier, SpikeDistanceKnn, Sweep, ValidCv,
 };
 use crate::error::{ClassifyError, ParamError, Result};
-use crate::pipeline::{Encoded, FeatureExtractor, Method};
+use crate::pipeline::{Encoded, Encoding, FeatureExtractor};
 use crate::recording::{DatasetError, Meta, Selection};
+use crate::samples::{spike_inputs, MethodChoice};
+use crate::snn::SpikeInput;
+use crate::table::rows_at;
+pub use crate::table::FeatureTable;
 use crate::values::{Cell, Grid, Speed};
-
-/// Feature rows of many recordings, one per recording.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FeatureTable {
-    /// The method that made the features.
-    pub method: Method,
-    /// The taxel grid of every recording (the single-taxel columns follow its taxels).
-    pub grid: Grid,
-    /// Column names.
-    pub names: Vec<String>,
-    /// Each row's recording.
-    pub metas: Vec<Meta>,
-    /// Row-major values, `metas.len() * names.len()`.
-    pub values: Vec<f64>,
-}
-
-impl FeatureTable {
-    /// Extracts `method`'s features from every encoded recording, in parallel.
-    ///
-    /// # Errors
-    /// A recording too short for one bin (named by its file).
-    pub fn build(
-        encoded: &[Encoded],
-        extractor: &FeatureExtractor,
-        method: Method,
-    ) -> Result<Self> {
-        let rows: Vec<Vec<f64>> = encoded
-            .par_iter()
-            .map(|e| {
-                extractor
-                    .row(e, method)
-                    .map_err(|err| err.in_recording(&e.meta.file))
-            })
-            .collect::<Result<_>>()?;
-        let metas = encoded.iter().map(|e| e.meta.clone()).collect();
-        Ok(Self::from_rows(extractor, method, metas, &rows))
-    }
-
-    /// The table of `rows`, `method`'s features by `extractor` of the recordings `metas`.
-    pub fn from_rows(
-        extractor: &FeatureExtractor,
-        method: Method,
-        metas: Vec<Meta>,
-        rows: &[Vec<f64>],
-    ) -> Self {
-        FeatureTable {
-            method,
-            grid: extractor.grid().clone(),
-            names: extractor.names(method),
-            metas,
-            values: rows.concat(),
-        }
-    }
-
-    /// Features per row.
-    pub fn dims(&self) -> usize {
-        self.names.len()
-    }
-
-    /// One row's values.
-    pub fn row(&self, i: usize) -> &[f64] {
-        &self.values[i * self.dims()..(i + 1) * self.dims()]
-    }
-
-    /// The indices of the rows recorded at one of `speeds`.
-    pub fn rows_at(&self, speeds: &[Speed]) -> Vec<usize> {
-        rows_at(&self.metas, speeds)
-    }
-
-    /// The table of rows `rows` alone, in that order.
-    pub fn subset(&self, rows: &[usize]) -> FeatureTable {
-        FeatureTable {
-            method: self.method,
-            grid: self.grid.clone(),
-            names: self.names.clone(),
-            metas: rows.iter().map(|&i| self.metas[i].clone()).collect(),
-            values: rows.iter().flat_map(|&i| self.row(i)).copied().collect(),
-        }
-    }
-
-    /// The values of rows `rows` and columns `columns`, row-major.
-    pub(crate) fn select(&self, rows: &[usize], columns: &[usize]) -> Vec<f64> {
-        rows.iter()
-            .flat_map(|&i| columns.iter().map(move |&j| self.row(i)[j]))
-            .collect()
-    }
-}
-
-/// The indices of the recordings of `metas` made at one of `speeds`.
-fn rows_at(metas: &[Meta], speeds: &[Speed]) -> Vec<usize> {
-    (0..metas.len())
-        .filter(|&i| metas[i].speed().is_some_and(|s| speeds.contains(&s)))
-        .collect()
-}
 
 /// How to split recordings for evaluation.
 #[derive(Debug, Clone, PartialEq)]
@@ -693,6 +610,123 @@ pub fn best_taxel(per: &[TaxelAccuracy]) -> Option<TaxelAccuracy> {
             Some(b) if b.accuracy >= t.accuracy => Some(b),
             _ => Some(t),
         })
+}
+
+/// A classifier applied to its samples: evaluates the recordings `within` (indices into
+/// the samples' recordings) under a split whose rows are positions in `within`.
+pub type EvaluateFn = dyn Fn(&[usize], &Split) -> Result<Outcome> + Send + Sync;
+
+/// `classifier` on `columns` of `table`'s rows.
+pub fn on_table<C: Classifier + Send + 'static>(
+    table: Arc<FeatureTable>,
+    columns: Columns,
+    classifier: C,
+) -> Arc<EvaluateFn> {
+    Arc::new(move |within, split| {
+        let whole =
+            within.len() == table.metas.len() && within.iter().enumerate().all(|(i, &r)| i == r);
+        match whole {
+            true => evaluate(&table, columns, split, &classifier),
+            false => evaluate(&table.subset(within), columns, split, &classifier),
+        }
+    })
+}
+
+/// `learner` on `samples`, sample `i` being the recording `metas[i]`.
+pub fn on_samples<S, L>(metas: Arc<Vec<Meta>>, samples: Arc<S>, learner: L) -> Arc<EvaluateFn>
+where
+    S: Samples + Send + ?Sized + 'static,
+    L: Learner<S> + Send + 'static,
+{
+    Arc::new(move |within, split| {
+        let mut each = evaluate_samples(&metas, within, &*samples, split, &learner)?;
+        each.pop().ok_or_else(|| {
+            ClassifyError::Empty {
+                what: "evaluate: no classifier setting",
+            }
+            .into()
+        })
+    })
+}
+
+/// What a method's classifier reads, made once and shared by every fold and candidate.
+#[derive(Clone)]
+pub enum MethodSamples {
+    /// Feature rows, with the columns classified.
+    Table(Arc<FeatureTable>, Columns),
+    /// Van Rossum distances between every two recordings.
+    Distances(Arc<Vec<Meta>>, Arc<DistanceMatrix>),
+    /// Every recording's spikes as the spiking network's input.
+    Spikes(Arc<Vec<Meta>>, Arc<[SpikeInput]>),
+}
+
+impl MethodSamples {
+    /// The recordings the samples stand for, in sample order.
+    pub fn metas(&self) -> &[Meta] {
+        match self {
+            MethodSamples::Table(table, _) => &table.metas,
+            MethodSamples::Distances(metas, _) | MethodSamples::Spikes(metas, _) => metas,
+        }
+    }
+}
+
+/// `classifier` on `samples`: KNN over a distance matrix, the spiking network over spike
+/// inputs, any feature classifier over feature rows.
+///
+/// # Errors
+/// A classifier that does not read these samples, or its broken parameter.
+pub fn evaluator(classifier: ClassifierChoice, samples: MethodSamples) -> Result<Arc<EvaluateFn>> {
+    Ok(match (samples, classifier) {
+        (MethodSamples::Distances(metas, matrix), ClassifierChoice::Knn(p)) => {
+            on_samples(metas, matrix, SpikeDistanceKnn::new(p.k)?)
+        }
+        (MethodSamples::Spikes(metas, inputs), ClassifierChoice::Snn(p)) => {
+            on_samples(metas, inputs, SnnClassifier::new(p)?)
+        }
+        (MethodSamples::Table(table, columns), classifier) => {
+            MethodChoice::Features(table.method).check_pairing(&classifier)?;
+            on_table(table, columns, classifier.check()?)
+        }
+        (MethodSamples::Distances(..), other) => {
+            return Err(MethodChoice::VanRossum
+                .check_pairing(&other)
+                .unwrap_err()
+                .into())
+        }
+        (MethodSamples::Spikes(..), other) => {
+            return Err(MethodChoice::Spikes
+                .check_pairing(&other)
+                .unwrap_err()
+                .into())
+        }
+    })
+}
+
+impl MethodSamples {
+    /// What `method` makes of the recordings `view` under `encoding`: `extractor`'s feature
+    /// table with the columns `columns`, the spike inputs at `dt_ms` steps, or the van
+    /// Rossum distances, computed by `distances` only when asked for.
+    ///
+    /// # Errors
+    /// A feature method the recordings cannot support, or populations an encoding lacks.
+    pub fn of(
+        (view, encoding, extractor): (&[Encoded], Encoding, &FeatureExtractor),
+        method: MethodChoice,
+        columns: Columns,
+        dt_ms: u32,
+        distances: impl FnOnce() -> Result<Arc<DistanceMatrix>>,
+    ) -> Result<Self> {
+        let metas = || Arc::new(view.iter().map(|e| e.meta.clone()).collect::<Vec<_>>());
+        Ok(match method {
+            MethodChoice::Features(m) => {
+                MethodSamples::Table(Arc::new(FeatureTable::build(view, extractor, m)?), columns)
+            }
+            MethodChoice::VanRossum => MethodSamples::Distances(metas(), distances()?),
+            MethodChoice::Spikes => {
+                MethodSamples::Spikes(metas(), Arc::from(spike_inputs(view, encoding, dt_ms)?))
+            }
+        })
+    }
 }
 
 #[cfg(test)]

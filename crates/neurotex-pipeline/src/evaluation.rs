@@ -1,8 +1,8 @@
-//! `evaluate`'s workflow on encoded recordings: a feature method's table (or the van Rossum
-//! distances between spike trains) classified by cross-validation or a train/test split,
-//! with the accuracy's interval and chance levels, which taxels respond when taxels are
-//! scored one by one, the result as JSON and as text, and each recording's out-of-fold
-//! prediction as CSV.
+//! `evaluate` on encoded recordings: the samples a method makes of them
+//! ([`Spikes::samples`], which [`crate::analysis::evaluator`] classifies by
+//! cross-validation or a train/test split), and the result ([`Evaluation`]) with the
+//! accuracy's interval and chance levels, which taxels respond when taxels are scored one
+//! by one, as JSON and as text, and each recording's out-of-fold prediction as CSV.
 
 use crate::values::shown_label;
 use std::fmt::Write as _;
@@ -10,18 +10,15 @@ use std::io::Write;
 
 use serde_json::Value;
 
-use crate::analysis::{evaluate, Columns, FeatureTable, Outcome, Split, TaxelAccuracy};
-use crate::classify::{ChosenClassifier, ClassifierChoice, Interval, Metrics};
+use crate::analysis::{Columns, MethodSamples, Outcome, Split, TaxelAccuracy};
+use crate::classify::{ClassifierChoice, Interval, Metrics};
 use crate::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
-use crate::error::ParamError;
-use crate::pipeline::{Encoded, Method, Pipeline};
+use crate::pipeline::{Encoded, Pipeline};
 use crate::recording::{Meta, Selection};
-use crate::samples::{
-    evaluator, population_view, spike_inputs, MethodChoice, MethodSamples, PopulationMatrices,
-};
+use crate::samples::{MethodChoice, PopulationMatrices};
+use crate::snn::SnnParams;
 use crate::values::{Grid, Speed};
 use neurotex_core::Result;
-use std::sync::Arc;
 
 /// A dataset's recordings as encoded: what every evaluation starts from.
 #[derive(Debug, Clone, Copy)]
@@ -63,66 +60,52 @@ pub struct Evaluation {
     pub metas: Vec<Meta>,
 }
 
-impl Evaluation {
-    /// Classifies `method`'s features of the encoded recordings with
-    /// `classifier` under `split`; `seed` draws the interval's bootstrap.
+impl Spikes<'_> {
+    /// What `method` makes of the encoded recordings for `classifier`: the feature table
+    /// with the columns `columns`, the van Rossum distances (time constant `tau_ms`), or
+    /// the spike inputs at the spiking network's step.
     ///
     /// # Errors
-    /// A taxel outside the grid, a split the recordings cannot support, a classifier that
-    /// cannot fit.
-    pub fn of_features(
-        spikes: Spikes<'_>,
-        method: Method,
-        columns: Columns,
-        split: &Split,
-        classifier: &ChosenClassifier,
-        seed: u64,
-    ) -> Result<Self> {
-        let Spikes {
-            encoded,
-            grid,
-            pipeline,
-        } = spikes;
-        if let Columns::Taxel(cell) = columns {
-            grid.locate(cell)?;
-        }
-        let extractor = pipeline.extractor(grid)?;
-        let table = FeatureTable::build(encoded, &extractor, method)?;
-        let outcome = evaluate(&table, columns, split, classifier)?;
-        // Silent and saturated taxels matter where taxels are scored one by one.
-        let taxels = match columns {
-            Columns::EachTaxel => {
-                Some(taxel_diagnostics(encoded, grid, pipeline.params().encoder)?)
-            }
-            _ => None,
-        };
-        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?
-            .advice_for(pipeline.params());
-        Self::new(
-            outcome,
-            method.name(),
-            None,
-            split,
-            grid,
-            taxels,
-            table.metas,
-            seed,
-        )
-        .map(|e| Self { advice, ..e })
-    }
-    /// The evaluation of a method that reads spike trains rather than feature rows: KNN
-    /// over van Rossum distances (`van-rossum`, time constant `tau_ms`) or the spiking
-    /// network (`spikes` with [`ClassifierChoice::Snn`]).
-    ///
-    /// # Errors
-    /// A classifier the method does not run with, a broken parameter, or a design too
-    /// small for the split.
-    pub fn of_spike_method(
-        spikes: Spikes<'_>,
+    /// A taxel outside the grid, a broken time constant, a feature method the recordings
+    /// cannot support, or populations the encoding lacks.
+    pub fn samples(
+        &self,
         method: MethodChoice,
-        classifier: ClassifierChoice,
+        columns: Columns,
+        classifier: &ClassifierChoice,
         tau_ms: f64,
+    ) -> Result<MethodSamples> {
+        if let Columns::Taxel(cell) = columns {
+            self.grid.locate(cell)?;
+        }
+        let encoding = self.pipeline.params().encoding;
+        let extractor = self.pipeline.extractor(self.grid)?;
+        let dt_ms = match classifier {
+            ClassifierChoice::Snn(p) => p.dt_ms,
+            _ => SnnParams::default().dt_ms,
+        };
+        // The recordings were encoded with the pipeline's encoding: as that encoding sees
+        // them already.
+        let view = self.encoded;
+        MethodSamples::of((view, encoding, &extractor), method, columns, dt_ms, || {
+            PopulationMatrices::new(tau_ms)?.matrix(view, encoding)
+        })
+    }
+}
+
+impl Evaluation {
+    /// The evaluation of `method` whose samples of the recordings `spikes`, in the columns
+    /// `columns`, gave `outcome` under `split`; `seed` draws the interval's bootstrap.
+    /// Which taxels stay silent or saturate is kept when every taxel was scored alone.
+    ///
+    /// # Errors
+    /// An outcome without per-recording results.
+    pub fn of(
+        spikes: Spikes<'_>,
+        (method, columns): (MethodChoice, Columns),
+        outcome: Outcome,
         split: &Split,
+        tau_ms: f64,
         seed: u64,
     ) -> Result<Self> {
         let Spikes {
@@ -130,51 +113,25 @@ impl Evaluation {
             grid,
             pipeline,
         } = spikes;
-        let encoding = pipeline.params().encoding;
-        let view = population_view(encoded, encoding);
-        let metas: Vec<Meta> = encoded.iter().map(|e| e.meta.clone()).collect();
-        let shared = Arc::new(metas.clone());
-        let samples = match (method, classifier) {
-            (MethodChoice::Spikes, ClassifierChoice::Snn(p)) => {
-                let inputs = spike_inputs(&view, encoding, p.dt_ms)?;
-                MethodSamples::Spikes(shared, Arc::from(inputs))
-            }
-            (MethodChoice::VanRossum, _) => {
-                let matrix = PopulationMatrices::new(tau_ms)?.matrix(&view, encoding)?;
-                MethodSamples::Distances(shared, matrix)
-            }
-            (method, classifier) => {
-                method.check_pairing(&classifier)?;
-                let rule = "a method whose samples are spikes: van-rossum or spikes";
-                return Err(ParamError::new("method", rule, method.name()).into());
-            }
-        };
-        let all: Vec<usize> = (0..metas.len()).collect();
-        let outcome = evaluator(classifier, samples)?(&all, split)?;
-        let advice = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?
-            .advice_for(pipeline.params());
-        Self::new(
-            outcome,
-            method.name(),
-            (method == MethodChoice::VanRossum).then_some(tau_ms),
-            split,
-            grid,
-            None,
-            metas,
-            seed,
-        )
-        .map(|e| Self { advice, ..e })
+        let diagnostics = taxel_diagnostics(encoded, grid, pipeline.params().encoder)?;
+        let advice = diagnostics.advice_for(pipeline.params());
+        let metas = encoded.iter().map(|e| e.meta.clone()).collect();
+        let tau_ms = (method == MethodChoice::VanRossum).then_some(tau_ms);
+        let evaluation = Self::new(outcome, method.name(), tau_ms, split, grid, metas, seed)?;
+        Ok(Self {
+            advice,
+            taxels: (columns == Columns::EachTaxel).then_some(diagnostics),
+            ..evaluation
+        })
     }
 
     /// The evaluation of `outcome`, its metrics and interval computed.
-    #[allow(clippy::too_many_arguments)]
     fn new(
         outcome: Outcome,
         method: &'static str,
         tau_ms: Option<f64>,
         split: &Split,
         grid: &Grid,
-        taxels: Option<TaxelDiagnostics>,
         metas: Vec<Meta>,
         seed: u64,
     ) -> Result<Self> {
@@ -185,7 +142,7 @@ impl Evaluation {
             method,
             tau_ms,
             split: split.clone(),
-            taxels,
+            taxels: None,
             advice: None,
             classifier: None,
             cols: grid.cols(),

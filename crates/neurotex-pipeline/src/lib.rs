@@ -19,6 +19,7 @@ pub mod pipeline;
 pub mod samples;
 pub mod saved;
 pub mod spiking_model;
+mod table;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.

@@ -1,21 +1,16 @@
-//! Each method's samples and the classifiers that read them. A feature method makes a
-//! [`FeatureTable`] (feature rows: KNN, the forest, logistic regression); the `spikes`
-//! method makes every recording's [`SpikeInput`] (the spiking network); `van-rossum` makes
-//! the [`DistanceMatrix`] between the recordings (KNN over it). [`evaluator`] pairs a
-//! method with a classifier once, where the options are checked, and returns one
-//! [`EvaluateFn`] that evaluation, `compare` and nested selection call alike.
+//! The methods and what the spike methods read: [`MethodChoice`] names a feature method,
+//! `van-rossum` or `spikes`, and checks its pairing with a classifier; the `spikes` method
+//! gives every recording's [`SpikeInput`] at the spiking network's step
+//! ([`spike_inputs`]), `van-rossum` the distances between the recordings
+//! ([`PopulationMatrices`]). [`crate::analysis::MethodSamples`] gathers them with the
+//! feature tables.
 
 use std::sync::Arc;
 
-use crate::analysis::{evaluate, evaluate_samples, Columns, FeatureTable, Outcome, Split};
-use crate::classify::{
-    Classifier, ClassifierChoice, DistanceMatrix, Learner, Samples, SnnClassifier,
-    SpikeDistanceKnn, VanRossum, VanRossumParams,
-};
+use crate::classify::{ClassifierChoice, DistanceMatrix, VanRossum, VanRossumParams};
 use crate::encode::SpikeTrains;
-use crate::error::{ClassifyError, ParamError, Result};
+use crate::error::{ParamError, Result};
 use crate::pipeline::{Encoded, Encoding, Method};
-use crate::recording::Meta;
 use crate::snn::SpikeInput;
 
 /// The spike-timing method's name.
@@ -93,96 +88,6 @@ impl std::str::FromStr for MethodChoice {
             ParamError::new("methods", rule, s)
         })
     }
-}
-
-/// A classifier applied to its samples: evaluates the recordings `within` (indices into
-/// the samples' recordings) under a split whose rows are positions in `within`.
-pub type EvaluateFn = dyn Fn(&[usize], &Split) -> Result<Outcome> + Send + Sync;
-
-/// `classifier` on `columns` of `table`'s rows.
-pub fn on_table<C: Classifier + Send + 'static>(
-    table: Arc<FeatureTable>,
-    columns: Columns,
-    classifier: C,
-) -> Arc<EvaluateFn> {
-    Arc::new(move |within, split| {
-        let whole =
-            within.len() == table.metas.len() && within.iter().enumerate().all(|(i, &r)| i == r);
-        match whole {
-            true => evaluate(&table, columns, split, &classifier),
-            false => evaluate(&table.subset(within), columns, split, &classifier),
-        }
-    })
-}
-
-/// `learner` on `samples`, sample `i` being the recording `metas[i]`.
-pub fn on_samples<S, L>(metas: Arc<Vec<Meta>>, samples: Arc<S>, learner: L) -> Arc<EvaluateFn>
-where
-    S: Samples + Send + ?Sized + 'static,
-    L: Learner<S> + Send + 'static,
-{
-    Arc::new(move |within, split| {
-        let mut each = evaluate_samples(&metas, within, &*samples, split, &learner)?;
-        each.pop().ok_or_else(|| {
-            ClassifyError::Empty {
-                what: "evaluate: no classifier setting",
-            }
-            .into()
-        })
-    })
-}
-
-/// What a method's classifier reads, made once and shared by every fold and candidate.
-#[derive(Clone)]
-pub enum MethodSamples {
-    /// Feature rows, with the columns classified.
-    Table(Arc<FeatureTable>, Columns),
-    /// Van Rossum distances between every two recordings.
-    Distances(Arc<Vec<Meta>>, Arc<DistanceMatrix>),
-    /// Every recording's spikes as the spiking network's input.
-    Spikes(Arc<Vec<Meta>>, Arc<[SpikeInput]>),
-}
-
-impl MethodSamples {
-    /// The recordings the samples stand for, in sample order.
-    pub fn metas(&self) -> &[Meta] {
-        match self {
-            MethodSamples::Table(table, _) => &table.metas,
-            MethodSamples::Distances(metas, _) | MethodSamples::Spikes(metas, _) => metas,
-        }
-    }
-}
-
-/// `classifier` on `samples`: KNN over a distance matrix, the spiking network over spike
-/// inputs, any feature classifier over feature rows.
-///
-/// # Errors
-/// A classifier that does not read these samples, or its broken parameter.
-pub fn evaluator(classifier: ClassifierChoice, samples: MethodSamples) -> Result<Arc<EvaluateFn>> {
-    Ok(match (samples, classifier) {
-        (MethodSamples::Distances(metas, matrix), ClassifierChoice::Knn(p)) => {
-            on_samples(metas, matrix, SpikeDistanceKnn::new(p.k)?)
-        }
-        (MethodSamples::Spikes(metas, inputs), ClassifierChoice::Snn(p)) => {
-            on_samples(metas, inputs, SnnClassifier::new(p)?)
-        }
-        (MethodSamples::Table(table, columns), classifier) => {
-            MethodChoice::Features(table.method).check_pairing(&classifier)?;
-            on_table(table, columns, classifier.check()?)
-        }
-        (MethodSamples::Distances(..), other) => {
-            return Err(MethodChoice::VanRossum
-                .check_pairing(&other)
-                .unwrap_err()
-                .into())
-        }
-        (MethodSamples::Spikes(..), other) => {
-            return Err(MethodChoice::Spikes
-                .check_pairing(&other)
-                .unwrap_err()
-                .into())
-        }
-    })
 }
 
 /// Every recording's spikes under `encoding` binned to `dt_ms` steps, the spiking

@@ -6,11 +6,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::Candidate;
-use crate::analysis::{Columns, FeatureTable};
+use crate::analysis::{evaluator, Columns, MethodSamples};
 use crate::classify::{ClassifierChoice, ForestParams, KnnParams};
 use crate::error::Result;
 use crate::pipeline::{Encoded, Encoding, FeatureExtractor, Method, PipelineParams};
-use crate::samples::{evaluator, population_view, spike_inputs, MethodSamples, PopulationMatrices};
+use crate::samples::{population_view, PopulationMatrices};
 pub use crate::samples::{MethodChoice, SPIKES, STANDARD_TAU_MS, VAN_ROSSUM};
 use crate::snn::SnnParams;
 use crate::values::Grid;
@@ -184,8 +184,9 @@ pub fn candidates(
 }
 
 /// The samples `method` makes of the recordings `view` (one encoding's view): its feature
-/// table, the van Rossum matrix, or the spike inputs at the spiking network's step (that
-/// of the `spikes` method's pair in `pairs`).
+/// table (every taxel alone for the single-taxel method), the van Rossum matrix, or the
+/// spike inputs at the spiking network's step (that of the `spikes` method's pair in
+/// `pairs`).
 ///
 /// # Errors
 /// A feature method the recordings cannot support, or populations an encoding lacks.
@@ -195,28 +196,19 @@ fn method_samples(
     pairs: &[(MethodChoice, ClassifierChoice)],
     van_rossum: &mut PopulationMatrices,
 ) -> Result<MethodSamples> {
-    let metas = || Arc::new(view.iter().map(|e| e.meta.clone()).collect::<Vec<_>>());
-    Ok(match method {
-        MethodChoice::Features(m) => {
-            let columns = match m {
-                Method::Taxel => Columns::EachTaxel,
-                _ => Columns::All,
-            };
-            MethodSamples::Table(Arc::new(FeatureTable::build(view, extractor, m)?), columns)
-        }
-        MethodChoice::VanRossum => {
-            MethodSamples::Distances(metas(), van_rossum.matrix(view, encoding)?)
-        }
-        MethodChoice::Spikes => {
-            let dt_ms = pairs
-                .iter()
-                .find_map(|p| match p {
-                    (MethodChoice::Spikes, ClassifierChoice::Snn(s)) => Some(s.dt_ms),
-                    _ => None,
-                })
-                .unwrap_or(SnnParams::default().dt_ms);
-            let inputs = spike_inputs(view, encoding, dt_ms)?;
-            MethodSamples::Spikes(metas(), Arc::from(inputs))
-        }
+    let columns = match method {
+        MethodChoice::Features(Method::Taxel) => Columns::EachTaxel,
+        _ => Columns::All,
+    };
+    let dt_ms = pairs
+        .iter()
+        .find_map(|p| match p {
+            (MethodChoice::Spikes, ClassifierChoice::Snn(s)) => Some(s.dt_ms),
+            _ => None,
+        })
+        .unwrap_or(SnnParams::default().dt_ms);
+    let made = (view, encoding, extractor);
+    MethodSamples::of(made, method, columns, dt_ms, || {
+        van_rossum.matrix(view, encoding)
     })
 }

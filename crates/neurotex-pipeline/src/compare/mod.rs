@@ -34,7 +34,7 @@ use crate::error::{ClassifyError, ParamError, Result};
 use crate::progress::Progress;
 use crate::recording::{Meta, Selection};
 
-pub use crate::samples::EvaluateFn;
+pub use crate::analysis::EvaluateFn;
 
 /// One encoding x feature method x classifier, with its features computed.
 #[derive(Clone)]
@@ -951,7 +951,7 @@ mod tests {
             method: method.into(),
             classifier: "knn".into(),
             metas: Arc::new(table.metas.clone()),
-            evaluate: crate::samples::on_table(Arc::new(table), Columns::All, knn),
+            evaluate: crate::analysis::on_table(Arc::new(table), Columns::All, knn),
             prepare_s: 0.0,
         }
     }

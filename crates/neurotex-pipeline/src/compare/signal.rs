@@ -20,7 +20,7 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::Candidate;
-use crate::analysis::{Columns, FeatureTable};
+use crate::analysis::{evaluator, Columns, FeatureTable, MethodSamples};
 use crate::classify::ClassifierChoice;
 use crate::error::{DataError, Result};
 use crate::features::{signal_stats, Spectrum, SIGNAL_STAT_NAMES};
@@ -28,7 +28,6 @@ use crate::pipeline::{
     spectrum_names, spectrum_span, taxel_cells, FeatureParams, Method, Pipeline,
 };
 use crate::recording::{Dataset, Meta, Recording};
-use crate::samples::{evaluator, MethodSamples};
 use crate::signal::Conditioned;
 use crate::values::Grid;
 

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use super::{
     calibrated_pipeline, encode_all, ClassifierOptions, KnnOptions, OnProgress, OpenOptions,
 };
-use crate::analysis::{Columns, Split};
+use crate::analysis::{evaluator, Columns, Split};
 use crate::calibrate::CalibratedParams;
 use crate::classify::CvParams;
 use crate::error::OptionsError;
@@ -280,24 +280,13 @@ impl EvaluateOptions {
             grid: &grid,
             pipeline: &pipeline,
         };
-        let evaluation = match method {
-            MethodChoice::Features(method) => Evaluation::of_features(
-                spikes,
-                method,
-                columns,
-                &split,
-                &classifier.check()?,
-                self.seed,
-            )?,
-            spike_method => Evaluation::of_spike_method(
-                spikes,
-                spike_method,
-                classifier,
-                self.tau_ms,
-                &split,
-                self.seed,
-            )?,
-        };
+        // One path for every method, as `compare` takes: the method's samples, the
+        // classifier over them under the split, the result summarised.
+        let samples = spikes.samples(method, columns, &classifier, self.tau_ms)?;
+        let all: Vec<usize> = (0..samples.metas().len()).collect();
+        let outcome = evaluator(classifier, samples)?(&all, &split)?;
+        let chosen = (method, columns);
+        let evaluation = Evaluation::of(spikes, chosen, outcome, &split, self.tau_ms, self.seed)?;
         let evaluation = Evaluation {
             classifier: Some(classifier.to_string()),
             ..evaluation
