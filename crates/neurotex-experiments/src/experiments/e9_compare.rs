@@ -146,26 +146,8 @@ pub fn e9_compare(
             )
         },
         || {
-            rayon::join(
-                // A pilot too small for folds inside each speed's training folds is ranked
-                // without the nested estimate (the held-out comparison trains on other
-                // speeds).
-                || {
-                    compare(&list, &with(per(), true), "candidates within each speed").or_else(
-                        |_| {
-                            let what = "candidates within each speed, not nested";
-                            compare(&list, &per_plain, what)
-                        },
-                    )
-                },
-                || {
-                    compare(
-                        &list,
-                        &with(held(), true),
-                        "candidates, each speed held out",
-                    )
-                },
-            )
+            let nested = [&with(per(), true), &per_plain, &with(held(), true)];
+            nested_comparisons(&list, nested, &compare)
         },
     );
     let (baselines, spiking) = (baselines?, spiking?);
@@ -175,6 +157,23 @@ pub fn e9_compare(
         baselines: Some(baselines),
         spiking,
     })
+}
+
+/// The candidates compared with nested selection within each speed (`per`; without it,
+/// `per_plain`, when a pilot is too small for folds inside each speed's training folds)
+/// and with each speed held out (`held`, which trains on the other speeds), side by side.
+fn nested_comparisons(
+    list: &[crate::compare::Candidate],
+    [per, per_plain, held]: [&CompareParams; 3],
+    compare: &CompareFn,
+) -> (crate::Result<Comparison>, crate::Result<Comparison>) {
+    rayon::join(
+        || {
+            compare(list, per, "candidates within each speed")
+                .or_else(|_| compare(list, per_plain, "candidates within each speed, not nested"))
+        },
+        || compare(list, held, "candidates, each speed held out"),
+    )
 }
 
 /// The signal baselines (no spikes) compared under `per` and `held`, or why they were not
