@@ -92,10 +92,9 @@ pub fn e9_compare(
     params: &ValidReproduceParams,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<E9, Stop> {
-    let said = Said::new(progress);
     let compare = |list: &[crate::compare::Candidate], p: &CompareParams, what: &str| {
-        said.begin(what);
-        compare_with_progress(list, p, &|e| said.on(e))
+        let meter = Meter::begin(progress, what);
+        compare_with_progress(list, p, &|e| meter.on(e))
     };
     if prepared.speeds.len() < 2 {
         return Err(Stop::Skipped(Skip::OneSpeedE9));
@@ -122,42 +121,59 @@ pub fn e9_compare(
     let column = "speed_mm_s".to_string();
     let per = || Protocol::Per(column.clone());
     let held = || Protocol::HoldOut(column.clone());
-    let baselines = baselines(
-        prepared,
-        &set,
-        &pipeline,
-        [&with(per(), false), &with(held(), false)],
-        &compare,
-    )?;
-    let spiking = match params.e9_snn {
-        true => Some(spiking(
-            prepared,
-            params,
-            [&with(per(), false), &with(held(), false)],
-            &compare,
-        )?),
-        false => None,
-    };
+    let (per_plain, held_plain) = (with(per(), false), with(held(), false));
+    // The comparisons read the same candidates and write nothing the others read: they
+    // run side by side, so that one's last and longest candidates overlap the next one's
+    // work. Each is what it is alone, and a failure is the first in the order below.
+    let ((baselines, spiking), (per_speed, held_out)) = rayon::join(
+        || {
+            rayon::join(
+                || {
+                    baselines(
+                        prepared,
+                        &set,
+                        &pipeline,
+                        [&per_plain, &held_plain],
+                        &compare,
+                    )
+                },
+                || match params.e9_snn {
+                    true => {
+                        spiking(prepared, params, [&per_plain, &held_plain], &compare).map(Some)
+                    }
+                    false => Ok(None),
+                },
+            )
+        },
+        || {
+            let nested = [&with(per(), true), &per_plain, &with(held(), true)];
+            nested_comparisons(&list, nested, &compare)
+        },
+    );
+    let (baselines, spiking) = (baselines?, spiking?);
     Ok(E9 {
-        // A pilot too small for folds inside each speed's training folds is ranked
-        // without the nested estimate (the held-out comparison trains on other speeds).
-        per_speed: compare(&list, &with(per(), true), "candidates within each speed").or_else(
-            |_| {
-                compare(
-                    &list,
-                    &with(per(), false),
-                    "candidates within each speed, not nested",
-                )
-            },
-        )?,
-        held_out: compare(
-            &list,
-            &with(held(), true),
-            "candidates, each speed held out",
-        )?,
+        per_speed: per_speed?,
+        held_out: held_out?,
         baselines: Some(baselines),
         spiking,
     })
+}
+
+/// The candidates compared with nested selection within each speed (`per`; without it,
+/// `per_plain`, when a pilot is too small for folds inside each speed's training folds)
+/// and with each speed held out (`held`, which trains on the other speeds), side by side.
+fn nested_comparisons(
+    list: &[crate::compare::Candidate],
+    [per, per_plain, held]: [&CompareParams; 3],
+    compare: &CompareFn,
+) -> (crate::Result<Comparison>, crate::Result<Comparison>) {
+    rayon::join(
+        || {
+            compare(list, per, "candidates within each speed")
+                .or_else(|_| compare(list, per_plain, "candidates within each speed, not nested"))
+        },
+        || compare(list, held, "candidates, each speed held out"),
+    )
 }
 
 /// The signal baselines (no spikes) compared under `per` and `held`, or why they were not
@@ -185,13 +201,13 @@ fn baselines(
         &set.classifiers,
         0.0,
     )?;
+    let (per_speed, held_out) = rayon::join(
+        || compare(&list, per, "signal baselines within each speed"),
+        || compare(&list, held, "signal baselines, each speed held out"),
+    );
     Ok(Baselines::Compared {
-        per_speed: Box::new(compare(&list, per, "signal baselines within each speed")?),
-        held_out: Box::new(compare(
-            &list,
-            held,
-            "signal baselines, each speed held out",
-        )?),
+        per_speed: Box::new(per_speed?),
+        held_out: Box::new(held_out?),
     })
 }
 
@@ -228,72 +244,149 @@ fn spiking(
         &network,
         0.0,
     )?);
+    let (per_speed, held_out) = rayon::join(
+        || compare(&list, per, "the spiking network within each speed"),
+        || compare(&list, held, "the spiking network, each speed held out"),
+    );
     Ok(Spiking {
-        per_speed: compare(&list, per, "the spiking network within each speed")?,
-        held_out: compare(&list, held, "the spiking network, each speed held out")?,
+        per_speed: per_speed?,
+        held_out: held_out?,
     })
 }
 
 /// One of E9's comparisons, said as it runs: the candidates, the protocol, what to call it.
-type CompareFn<'a> =
-    dyn Fn(&[crate::compare::Candidate], &CompareParams, &str) -> crate::Result<Comparison> + 'a;
+type CompareFn<'a> = dyn Fn(&[crate::compare::Candidate], &CompareParams, &str) -> crate::Result<Comparison>
+    + Sync
+    + 'a;
 
-/// How often E9 says how far its comparisons are: it runs beside the other analyses,
-/// which hold the progress bar, so it speaks in lines.
+/// The longest E9 stays silent while its comparisons make steps: it runs beside the other
+/// analyses, which hold the progress bar, so it speaks in lines.
 const SAY_EVERY_S: f64 = 15.0;
 
-/// E9's progress as lines: each comparison's start, then its stage and steps done at most
-/// every [`SAY_EVERY_S`] seconds (`compare`'s steps: candidates scored, then each
-/// candidate cross-validated inside each of nested selection's splits).
-struct Said<'a> {
+/// How long a comparison's stage runs before its steps are said: a quick one stays quiet.
+const SAY_AFTER_S: f64 = 1.0;
+
+/// One of E9's comparisons, said as lines as it runs: its start, then its stage and the
+/// steps done (`compare`'s steps: each candidate scored on each part of the protocol, then
+/// each candidate cross-validated inside each of nested selection's outer splits) at each
+/// tenth of a stage once it has run [`SAY_AFTER_S`], and at least every [`SAY_EVERY_S`]
+/// while steps are done. The comparisons run side by side, each with its own meter.
+struct Meter<'a> {
     progress: &'a (dyn Fn(Progress) + Sync),
-    state: std::sync::Mutex<SaidState>,
+    what: String,
+    state: std::sync::Mutex<MeterState>,
 }
 
-struct SaidState {
-    what: String,
+struct MeterState {
     stage: String,
     done: usize,
     total: usize,
-    last: std::time::Instant,
+    /// When the stage began.
+    began: std::time::Instant,
+    /// When a line was last said.
+    said: std::time::Instant,
 }
 
-impl<'a> Said<'a> {
-    fn new(progress: &'a (dyn Fn(Progress) + Sync)) -> Self {
-        let state = SaidState {
-            what: String::new(),
+impl<'a> Meter<'a> {
+    /// Says that the comparison `what` begins.
+    fn begin(progress: &'a (dyn Fn(Progress) + Sync), what: &str) -> Self {
+        progress(Progress::Say(&format!("E9: {what}")));
+        let now = std::time::Instant::now();
+        let state = MeterState {
             stage: String::new(),
             done: 0,
             total: 0,
-            last: std::time::Instant::now(),
+            began: now,
+            said: now,
         };
-        Said {
+        Meter {
             progress,
+            what: what.to_string(),
             state: std::sync::Mutex::new(state),
         }
-    }
-
-    fn begin(&self, what: &str) {
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        s.what = what.to_string();
-        s.last = std::time::Instant::now();
-        (self.progress)(Progress::Say(&format!("E9: {what}")));
     }
 
     fn on(&self, event: Progress) {
         let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
         match event {
             Progress::Stage(stage, total) => {
-                (s.stage, s.total, s.done) = (stage.to_string(), total, 0);
+                let now = std::time::Instant::now();
+                (s.stage, s.total, s.done, s.began) = (stage.to_string(), total, 0, now);
+                return;
             }
             Progress::Tick | Progress::Done(..) | Progress::Skipped(..) => s.done += 1,
             other => return (self.progress)(other),
         }
-        let due = s.last.elapsed().as_secs_f64() >= SAY_EVERY_S;
-        if due || (s.done == s.total && s.total > 0 && s.stage == "nested selection") {
-            s.last = std::time::Instant::now();
-            let line = format!("E9: {}: {} {}/{}", s.what, s.stage, s.done, s.total);
+        let (ran, quiet) = (
+            s.began.elapsed().as_secs_f64(),
+            s.said.elapsed().as_secs_f64(),
+        );
+        if say_step(s.done, s.total, ran, quiet) {
+            s.said = std::time::Instant::now();
+            let line = format!(
+                "E9: {}: {} {}/{} ({ran:.1} s)",
+                self.what, s.stage, s.done, s.total
+            );
             (self.progress)(Progress::Say(&line));
         }
+    }
+}
+
+/// Whether step `done` of `total` is said, the stage having run `ran` s and the last line
+/// said `quiet` s ago: at each tenth of the way (every step of a stage of fewer than ten)
+/// once the stage has run [`SAY_AFTER_S`], or when nothing was said for [`SAY_EVERY_S`].
+fn say_step(done: usize, total: usize, ran: f64, quiet: f64) -> bool {
+    let tenth = |d: usize| d * 10 / total.max(1);
+    let new_tenth = done > 0 && (total < 10 || tenth(done) != tenth(done - 1));
+    (ran >= SAY_AFTER_S && new_tenth) || quiet >= SAY_EVERY_S
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn steps_are_said_at_each_tenth_once_the_stage_has_run_a_second() {
+        let said = |ran| (1..=100).filter(|&d| say_step(d, 100, ran, 0.0)).count();
+        assert_eq!(said(0.5), 0, "a quick stage stays quiet");
+        assert_eq!(said(2.0), 10);
+        let every: Vec<usize> = (1..=4).filter(|&d| say_step(d, 4, 2.0, 0.0)).collect();
+        assert_eq!(every, [1, 2, 3, 4], "a short stage says every step");
+        assert!(say_step(7, 100, 0.5, SAY_EVERY_S), "never silent for long");
+    }
+
+    #[test]
+    fn e9_gives_the_same_results_on_one_thread_as_side_by_side() {
+        let run = crate::experiments::testing::small_run();
+        let e9 = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build();
+            let pool = pool.expect("a thread pool");
+            let mut e9 = pool
+                .install(|| e9_compare(&run.prepared, &run.params, &|_| {}))
+                .map_err(|e| format!("{e:?}"))
+                .expect("E9 runs on the small design");
+            for c in comparisons(&mut e9) {
+                c.best.seconds = 0.0;
+                c.results.iter_mut().for_each(|r| r.seconds = 0.0);
+            }
+            e9
+        };
+        assert_eq!(e9(1), e9(3));
+    }
+
+    /// Every comparison of `e9`.
+    fn comparisons(e9: &mut E9) -> Vec<&mut Comparison> {
+        let mut all = vec![&mut e9.per_speed, &mut e9.held_out];
+        if let Some(Baselines::Compared {
+            per_speed,
+            held_out,
+        }) = &mut e9.baselines
+        {
+            all.extend([&mut **per_speed, &mut **held_out]);
+        }
+        if let Some(s) = &mut e9.spiking {
+            all.extend([&mut s.per_speed, &mut s.held_out]);
+        }
+        all
     }
 }

@@ -162,8 +162,9 @@ pub struct Ranked {
     pub difference_vs_paper: Option<f64>,
     /// Accuracy per condition (empty for pooled cross-validation).
     pub per_condition: Vec<ConditionAccuracy>,
-    /// Seconds to make the features and evaluate (wall clock; candidates are evaluated side
-    /// by side, so each one's time includes its share of the others' load).
+    /// Seconds to make the features and evaluate (wall clock, summed over the parts of the
+    /// protocol; candidates and their parts are evaluated side by side, so each one's time
+    /// includes its share of the others' load).
     pub seconds: f64,
     /// Whether this is the paper's method.
     pub paper: bool,
@@ -237,8 +238,10 @@ pub fn compare(candidates: &[Candidate], params: &CompareParams) -> Result<Compa
     compare_with_progress(candidates, params, &crate::progress::silent)
 }
 
-/// [`compare`], saying its progress: a step per candidate scored, then with nested
-/// selection a step per candidate cross-validated inside each outer split.
+/// [`compare`], saying its progress: a step per candidate and part of the protocol scored
+/// (each condition's cross-validation, each held-out value, or the one split of a pooled
+/// or train/test protocol), then with nested selection a step per candidate
+/// cross-validated inside each outer split.
 ///
 /// # Errors
 /// As [`compare`].
@@ -255,9 +258,10 @@ pub fn compare_with_progress(
         let message = format!("{} has other recordings than {}", c.name(), first.name());
         return Err(ClassifyError::BadFeatures(message).into());
     }
-    // Candidates are scored side by side (each is deterministic, so the order of work
+    // Candidates are scored side by side, each part of the protocol (a condition, a
+    // held-out value) on its own (each evaluation is deterministic, so the order of work
     // changes nothing but its clock): one candidate's folds are too few and too unequal
-    // to keep every core busy.
+    // to keep every core busy, and a candidate's parts are its longest pieces of work.
     // Nested selection's outer splits, checked before any candidate is scored.
     let outer = match params.nested {
         true => Some(check_nested(metas, params)?),
@@ -267,15 +271,12 @@ pub fn compare_with_progress(
     for note in &notes {
         progress(Progress::Advice(note));
     }
-    progress(Progress::Stage("candidates", candidates.len()));
-    let scored: Vec<Scored> = candidates
-        .par_iter()
-        .map(|c| {
-            let scored = score(c, params);
-            progress(Progress::Tick);
-            scored
-        })
-        .collect::<Result<_>>()?;
+    let parts = parts(metas, params)?;
+    progress(Progress::Stage(
+        "candidates",
+        candidates.len() * parts.len(),
+    ));
+    let scored = score_all(candidates, &parts, params, progress)?;
     let units = Units::new(metas, &scored[0].shares, params)?;
     let paper = candidates.iter().position(Candidate::is_paper);
     // Each candidate's interval and paired test resample from their own seeded stream,
@@ -426,61 +427,144 @@ fn cv_split(params: &CompareParams) -> Split {
     }
 }
 
-/// Evaluates one candidate under the protocol, timing it.
-fn score(c: &Candidate, params: &CompareParams) -> Result<Scored> {
-    let start = Instant::now();
-    let metas = &c.metas;
-    let mut per_condition = Vec::new();
-    let mut shares = Vec::new();
-    let accuracy = match &params.protocol {
-        Protocol::Pooled => {
-            let outcome = c.evaluate_all(&cv_split(params))?;
-            shares = outcome.correct_shares;
-            outcome.accuracy
-        }
-        Protocol::Per(column) => {
-            for value in conditions(metas, column)? {
-                let rows = rows_with(metas, column, &value);
-                let outcome = (c.evaluate)(&rows, &cv_split(params))
-                    .map_err(|e| in_condition(e, column, &value))?;
-                shares.extend(outcome.correct_shares.iter().map(|&(r, s)| (rows[r], s)));
-                per_condition.push(ConditionAccuracy {
-                    condition: value,
-                    accuracy: outcome.accuracy,
-                });
-            }
-            mean(per_condition.iter().map(|p| p.accuracy))
-        }
+/// One part of the protocol every candidate is evaluated on: one condition's
+/// cross-validation, one held-out value, or the whole protocol's one split.
+struct Part {
+    /// The condition it is of (a value of the protocol's column); `None` for a protocol of
+    /// one split.
+    condition: Option<String>,
+    /// The table rows evaluated (within one condition); `None` for every recording.
+    rows: Option<Vec<usize>>,
+    split: Split,
+}
+
+/// The parts of the protocol, in the order a candidate's results are put together.
+///
+/// # Errors
+/// A protocol column without two values.
+fn parts(metas: &[Meta], params: &CompareParams) -> Result<Vec<Part>> {
+    let whole = |split| {
+        vec![Part {
+            condition: None,
+            rows: None,
+            split,
+        }]
+    };
+    Ok(match &params.protocol {
+        Protocol::Pooled => whole(cv_split(params)),
+        Protocol::Per(column) => (conditions(metas, column)?.into_iter())
+            .map(|value| Part {
+                rows: Some(rows_with(metas, column, &value)),
+                condition: Some(value),
+                split: cv_split(params),
+            })
+            .collect(),
         Protocol::HoldOut(column) => {
             let values = conditions(metas, column)?;
-            for value in &values {
-                let split = hold_out(column, &values, value);
-                let outcome = c.evaluate_all(&split)?;
-                shares.extend(outcome.correct_shares);
-                per_condition.push(ConditionAccuracy {
-                    condition: value.clone(),
-                    accuracy: outcome.accuracy,
-                });
-            }
-            mean(per_condition.iter().map(|p| p.accuracy))
+            (values.iter())
+                .map(|value| Part {
+                    condition: Some(value.clone()),
+                    rows: None,
+                    split: hold_out(column, &values, value),
+                })
+                .collect()
         }
-        Protocol::Where { train, test } => {
-            let split = Split::Where {
-                train: train.clone(),
-                test: test.clone(),
-            };
-            let outcome = c.evaluate_all(&split)?;
-            shares = outcome.correct_shares;
-            outcome.accuracy
+        Protocol::Where { train, test } => whole(Split::Where {
+            train: train.clone(),
+            test: test.clone(),
+        }),
+    })
+}
+
+/// One candidate's result on one part: its accuracy, each evaluated table row's share of
+/// right predictions, and the seconds it took.
+struct PartScore {
+    accuracy: f64,
+    shares: Vec<(usize, f64)>,
+    seconds: f64,
+}
+
+/// Evaluates one candidate on one part of the protocol, timing it.
+fn score_part(c: &Candidate, part: &Part, params: &CompareParams) -> Result<PartScore> {
+    let start = Instant::now();
+    let (accuracy, shares) = match &part.rows {
+        Some(rows) => {
+            let outcome = (c.evaluate)(rows, &part.split).map_err(|e| match &params.protocol {
+                Protocol::Per(column) => {
+                    in_condition(e, column, part.condition.as_deref().unwrap_or_default())
+                }
+                _ => e,
+            })?;
+            let shares = outcome.correct_shares.iter();
+            (
+                outcome.accuracy,
+                shares.map(|&(r, s)| (rows[r], s)).collect(),
+            )
+        }
+        None => {
+            let outcome = c.evaluate_all(&part.split)?;
+            (outcome.accuracy, outcome.correct_shares)
         }
     };
+    Ok(PartScore {
+        accuracy,
+        shares,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Every candidate evaluated on every part of the protocol, each pair a piece of work of
+/// its own run side by side (a step of `progress` each), put together per candidate in
+/// the order of the parts: the same scores as one candidate and part after another.
+///
+/// # Errors
+/// An evaluation that fails.
+fn score_all(
+    candidates: &[Candidate],
+    parts: &[Part],
+    params: &CompareParams,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Vec<Scored>> {
+    let n = parts.len().max(1);
+    let scores: Vec<PartScore> = (0..candidates.len() * parts.len())
+        .into_par_iter()
+        .map(|k| {
+            let scored = score_part(&candidates[k / n], &parts[k % n], params);
+            progress(Progress::Tick);
+            scored
+        })
+        .collect::<Result<_>>()?;
+    Ok(candidates
+        .iter()
+        .zip(scores.chunks(n))
+        .map(|(c, scores)| scored(c, parts, scores, params))
+        .collect())
+}
+
+/// One candidate's scores under the protocol from its parts' (in the order of `parts`).
+fn scored(c: &Candidate, parts: &[Part], scores: &[PartScore], params: &CompareParams) -> Scored {
+    let mut per_condition = Vec::new();
+    let mut shares = Vec::new();
+    for (part, s) in parts.iter().zip(scores) {
+        shares.extend_from_slice(&s.shares);
+        if let Some(condition) = &part.condition {
+            per_condition.push(ConditionAccuracy {
+                condition: condition.clone(),
+                accuracy: s.accuracy,
+            });
+        }
+    }
+    let accuracy = match &params.protocol {
+        Protocol::Per(_) | Protocol::HoldOut(_) => mean(per_condition.iter().map(|p| p.accuracy)),
+        Protocol::Pooled | Protocol::Where { .. } => scores[0].accuracy,
+    };
     shares.sort_by_key(|&(row, _)| row);
-    Ok(Scored {
+    Scored {
         accuracy,
         per_condition,
         shares,
-        seconds: c.prepare_s + start.elapsed().as_secs_f64(),
-    })
+        seconds: c.prepare_s + scores.iter().map(|s| s.seconds).sum::<f64>(),
+    }
 }
 
 /// Trains on every value of `column` but `value`, tests on `value`.
