@@ -41,7 +41,7 @@ mod run;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::ParamError;
+use crate::error::{ModelError, ParamError};
 
 pub use input::SpikeInput;
 pub use params::{SnnParams, MAX_HIDDEN};
@@ -198,8 +198,8 @@ impl Network {
     /// constants whose decays lie strictly between 0 and 1, and weights a float32 holds.
     ///
     /// # Errors
-    /// The rule broken, as a sentence naming the field.
-    pub fn check(&self) -> Result<(), String> {
+    /// [`ModelError::Network`]: the rule broken, as a sentence naming the field.
+    pub fn check(&self) -> Result<(), ModelError> {
         let shapes = [
             (
                 "w_in",
@@ -217,25 +217,36 @@ impl Network {
         for (name, got, want) in shapes {
             if Some(got) != want {
                 let want = want.map_or("more than memory holds".into(), |w| w.to_string());
-                return Err(format!(
-                    "the network's {name} holds {got} values, not {want}"
+                return Err(ModelError::network(
+                    name,
+                    format!("the network's {name} holds {got} values, not {want}"),
                 ));
             }
         }
         let square = self.hidden.saturating_mul(self.hidden);
         if self.recurrent() && self.w_rec.len() != square {
             let got = self.w_rec.len();
-            return Err(format!(
-                "the network's w_rec holds {got} values, not hidden x hidden = {square} (or none)"
+            return Err(ModelError::network(
+                "w_rec",
+                format!("the network's w_rec holds {got} values, not hidden x hidden = {square} (or none)"),
             ));
         }
-        if self.inputs == 0 || self.hidden == 0 || self.classes == 0 {
-            return Err("the network has an empty layer".into());
+        let layers = [
+            ("inputs", self.inputs),
+            ("hidden", self.hidden),
+            ("classes", self.classes),
+        ];
+        if let Some((layer, _)) = layers.iter().find(|(_, n)| *n == 0) {
+            let why = format!("the network has an empty layer: its {layer} is 0");
+            return Err(ModelError::network(layer, why));
         }
         if !(1..=1000).contains(&self.dt_ms) {
-            return Err(format!(
-                "the network's dt_ms is {}; the time step must be 1 to 1000 ms",
-                self.dt_ms
+            return Err(ModelError::network(
+                "dt_ms",
+                format!(
+                    "the network's dt_ms is {}; the time step must be 1 to 1000 ms",
+                    self.dt_ms
+                ),
             ));
         }
         self.check_taus()?;
@@ -255,9 +266,12 @@ impl Network {
                 .iter()
                 .position(|v| !v.is_finite() || v.abs() > f64::from(f32::MAX))
             {
-                return Err(format!(
-                    "the network's {name}[{pos}] is {:?}, not a finite float32 value",
-                    w[pos]
+                return Err(ModelError::network(
+                    name,
+                    format!(
+                        "the network's {name}[{pos}] is {:?}, not a finite float32 value",
+                        w[pos]
+                    ),
                 ));
             }
         }
@@ -269,7 +283,7 @@ impl Network {
     /// NIR graph). The one exception is `tau_syn_ms` 0, a hidden layer without synaptic
     /// memory (`α = 0`: the current is the step's input), which is how a NIR graph's LIF
     /// hidden node (snnTorch's `Leaky`, Norse's `LIFBoxCell`) reads.
-    fn check_taus(&self) -> Result<(), String> {
+    fn check_taus(&self) -> Result<(), ModelError> {
         let (alpha, beta, kappa) = self.decays();
         for (name, tau, decay) in [
             ("tau_syn_ms", self.tau_syn_ms, alpha),
@@ -279,10 +293,10 @@ impl Network {
             let memoryless = name == "tau_syn_ms" && tau == 0.0;
             let decays = tau > 0.0 && tau.is_finite() && decay > 0.0 && decay < 1.0;
             if !(memoryless || decays) {
-                return Err(format!(
+                return Err(ModelError::network(name, format!(
                     "the network's {name} is {tau:?}, which gives the decay {decay} per step of {} ms; a time constant must be positive and finite, its decay strictly between 0 and 1",
                     self.dt_ms
-                ));
+                )));
             }
         }
         Ok(())

@@ -275,7 +275,7 @@ fn from_bytes_as(
         recurrent_of(&reader, &rec, &names[2], scale_s, &mut network)?;
     }
     network.reset = reset;
-    network.check()?;
+    network.check().map_err(|e| e.to_string())?;
     Ok(NirNetwork {
         network,
         dt_s: step_s,
