@@ -540,6 +540,16 @@ pub enum ModelError {
     /// A model's parts disagree with each other (only a damaged file can make them).
     #[error("{0}")]
     Inconsistent(String),
+    /// A spiking network that breaks a rule of its own (a shape, the time step, a time
+    /// constant, a weight) or of the chip it is meant for.
+    #[error("{reason}")]
+    Network {
+        /// The network's field or the chip's limit at fault: `w_in`, `tau_mem_ms`,
+        /// `dt_ms`, `inputs`.
+        parameter: &'static str,
+        /// The rule broken, as a sentence naming the parameter.
+        reason: String,
+    },
     /// A recording on another taxel grid than the model's.
     #[error("{file}: its taxel grid ({}) differs from the model's ({}); a model applies only to recordings of the grid it was trained on", grid_text(.found, .expected), grid_text(.expected, .found))]
     OtherGrid {
@@ -550,6 +560,16 @@ pub enum ModelError {
         /// The recording's grid.
         found: Grid,
     },
+}
+
+impl ModelError {
+    /// A network's broken rule: `parameter` at fault, `reason` the sentence naming it.
+    pub fn network(parameter: &'static str, reason: impl Into<String>) -> Self {
+        ModelError::Network {
+            parameter,
+            reason: reason.into(),
+        }
+    }
 }
 
 /// `4x4, 16 taxels`, saying when the mask is all that differs from `other`.

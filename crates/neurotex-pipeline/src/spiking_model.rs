@@ -196,7 +196,7 @@ impl SpikingModel {
     /// parameters' rules and what training guarantees of labels and provenance.
     fn assemble(file: SpikingFile) -> Result<SpikingModel> {
         let inconsistent = |what: String| -> crate::Error { ModelError::Inconsistent(what).into() };
-        file.network.check().map_err(inconsistent)?;
+        file.network.check()?;
         file.classifier
             .check()
             .map_err(|e| inconsistent(format!("field `classifier`: {e}")))?;

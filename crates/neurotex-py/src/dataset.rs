@@ -334,7 +334,7 @@ fn simulate(
         None => ALL_TEXTURES.to_vec(),
         Some(names) => names
             .iter()
-            .map(|n| texture(n).map_err(|why| raise(Kind::Parameter, why)))
+            .map(|n| texture(n).map_err(param))
             .collect::<PyResult<_>>()?,
     };
     for &s in &speeds {

@@ -38,7 +38,7 @@ pub fn fit(
     check_inputs(inputs, y)?;
     if params.target == super::Target::Xylo {
         let shape = super::xylo::check_shape(inputs[0].inputs, params.hidden, classes);
-        shape.map_err(ClassifyError::BadFeatures)?;
+        shape.map_err(|e| ClassifyError::BadFeatures(e.to_string()))?;
     }
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let (train, valid) = validation_split(y, classes, params.validation, &mut rng)?;

@@ -37,6 +37,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Network, Readout, Reset, SpikeInput};
+use crate::error::ModelError;
 
 /// Where the network runs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -131,16 +132,18 @@ fn exact_dash(tau_ms: f64, dt_ms: u32) -> Option<u8> {
 /// Checks that a network's shape fits the chip: inputs, hidden neurons, classes.
 ///
 /// # Errors
-/// The first limit exceeded, as a sentence naming it.
-pub fn check_shape(inputs: usize, hidden: usize, classes: usize) -> Result<(), String> {
+/// [`ModelError::Network`]: the first limit exceeded, as a sentence naming it.
+pub fn check_shape(inputs: usize, hidden: usize, classes: usize) -> Result<(), ModelError> {
     let limits = [
         (
+            "inputs",
             "inputs",
             inputs,
             MAX_INPUTS,
             "use --encoding sa or fa on a grid of at most 16 taxels (compare: --encodings sa,fa), or leave taxels out (import csv --drop-channels)",
         ),
         (
+            "hidden",
             "hidden neurons",
             hidden,
             MAX_HIDDEN,
@@ -148,15 +151,19 @@ pub fn check_shape(inputs: usize, hidden: usize, classes: usize) -> Result<(), S
         ),
         (
             "classes",
+            "classes",
             classes,
             MAX_CLASSES,
             "train on at most 8 classes",
         ),
     ];
-    for (what, got, most, how) in limits {
+    for (parameter, what, got, most, how) in limits {
         if got > most {
-            return Err(format!(
+            return Err(ModelError::network(
+                parameter,
+                format!(
                 "the Xylo profile holds at most {most} {what}, and this network has {got}: {how}"
+            ),
             ));
         }
     }
@@ -166,17 +173,20 @@ pub fn check_shape(inputs: usize, hidden: usize, classes: usize) -> Result<(), S
 /// Checks every rule of the profile on a trained network.
 ///
 /// # Errors
-/// The first rule broken, as a sentence naming it.
-pub fn check(net: &Network) -> Result<(), String> {
+/// [`ModelError::Network`]: the first rule broken, as a sentence naming it.
+pub fn check(net: &Network) -> Result<(), ModelError> {
     check_shape(net.inputs, net.hidden, net.classes)?;
     if net.dt_ms > MAX_DT_MS {
-        return Err(format!("the Xylo profile steps at most {MAX_DT_MS} ms (so that an input never carries more than {MAX_INPUT_EVENTS} events in a step), and this network steps {} ms", net.dt_ms));
+        return Err(ModelError::network("dt_ms", format!("the Xylo profile steps at most {MAX_DT_MS} ms (so that an input never carries more than {MAX_INPUT_EVENTS} events in a step), and this network steps {} ms", net.dt_ms)));
     }
     if net.reset != Reset::Subtract {
-        return Err("the Xylo profile's neurons subtract the threshold on a spike, and this network resets to zero".into());
+        return Err(ModelError::network("reset", "the Xylo profile's neurons subtract the threshold on a spike, and this network resets to zero"));
     }
     if net.recurrent() {
-        return Err("the Xylo profile runs feed-forward networks; this one is recurrent".into());
+        return Err(ModelError::network(
+            "w_rec",
+            "the Xylo profile runs feed-forward networks; this one is recurrent",
+        ));
     }
     for (name, tau) in [
         ("tau_syn_ms", net.tau_syn_ms),
@@ -184,7 +194,7 @@ pub fn check(net: &Network) -> Result<(), String> {
         ("tau_out_ms", net.tau_out_ms),
     ] {
         if exact_dash(tau, net.dt_ms).is_none() {
-            return Err(format!("the network's {name} is {tau}, whose decay per step of {} ms is not one the chip has (1 - 2^-d)", net.dt_ms));
+            return Err(ModelError::network(name, format!("the network's {name} is {tau}, whose decay per step of {} ms is not one the chip has (1 - 2^-d)", net.dt_ms)));
         }
     }
     Ok(())
@@ -253,8 +263,8 @@ impl XyloNetwork {
     /// The chip's integers for `net` (see the module).
     ///
     /// # Errors
-    /// A network that breaks a rule of the profile ([`check`]).
-    pub fn quantise(net: &Network) -> Result<XyloNetwork, String> {
+    /// [`ModelError::Network`]: a network that breaks a rule of the profile ([`check`]).
+    pub fn quantise(net: &Network) -> Result<XyloNetwork, ModelError> {
         check(net)?;
         let (h_n, c_n) = (net.hidden, net.classes);
         let dash = |tau| exact_dash(tau, net.dt_ms).unwrap_or(1);

@@ -161,7 +161,7 @@ pub fn export_xylo(model: &SpikingModel, out: &Path) -> Result<()> {
         let why = "this network was trained for neurotex's float network; a Xylo configuration needs a network trained within the chip's limits: train it with --classifier snn --snn-target xylo";
         return Err(crate::error::OptionsError::Conflict(why.into()).into());
     }
-    let chip = XyloNetwork::quantise(net).map_err(crate::error::ModelError::Inconsistent)?;
+    let chip = XyloNetwork::quantise(net)?;
     let file = serde_json::json!({
         "format": XYLO_FORMAT,
         "version": 1,

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use super::OnProgress;
+use crate::error::ParamError;
 use crate::progress::Progress;
 use crate::sim::{check_design, design, write_dataset, RigParams, Texture, ALL_TEXTURES};
 use crate::{Result, Speed};
@@ -31,10 +32,14 @@ pub struct SimulateOptions {
 /// A texture by the paper's name, in any case.
 ///
 /// # Errors
-/// A name that is none of the paper's textures.
-pub fn texture(name: &str) -> std::result::Result<Texture, String> {
+/// [`ParamError`] for `textures`: a name that is none of the paper's textures.
+pub fn texture(name: &str) -> std::result::Result<Texture, ParamError> {
     Texture::from_name(name.trim()).ok_or_else(|| {
-        format!("unknown texture `{name}`: expected FT1, FT2, FT3, RT, TRug, SB, CP or STF")
+        ParamError::new(
+            "textures",
+            "a texture is one of the paper's: FT1, FT2, FT3, RT, TRug, SB, CP or STF",
+            name,
+        )
     })
 }
 

@@ -1,0 +1,90 @@
+//! The network's input: spike trains binned to its time step, one input per taxel and
+//! population.
+
+use crate::spikes::SpikeTrains;
+
+/// A recording's spikes as the network's input: for each step of `dt` ms, the inputs that
+/// spiked in it (an input spiking twice in one step is listed twice). Input `p * taxels +
+/// k` is population `p`'s (SA, then FA) `k`-th taxel in row-major grid order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpikeInput {
+    /// Inputs (taxels x populations).
+    pub inputs: usize,
+    /// `offsets[t]..offsets[t + 1]` indexes step `t`'s events in `events`.
+    offsets: Vec<u32>,
+    events: Vec<u32>,
+}
+
+impl SpikeInput {
+    /// Bins `populations` (one or two grids of the same taxels) to steps of `dt_ms`; the
+    /// last step may be partial. The window's steps are `ceil(n_steps / dt_ms)` of the
+    /// first population.
+    ///
+    /// # Panics
+    /// If there is no population or `dt_ms` is 0 (caller bugs).
+    pub fn from_trains(populations: &[&SpikeTrains], dt_ms: u32) -> SpikeInput {
+        assert!(!populations.is_empty() && dt_ms > 0);
+        let dt = dt_ms as usize;
+        let steps = populations[0].n_steps.div_ceil(dt);
+        let mut lists: Vec<(u32, u32)> = Vec::new();
+        let mut input = 0u32;
+        for pop in populations {
+            for cell in (0..pop.cells()).filter(|&c| pop.present[c]) {
+                for &t in pop.train(cell) {
+                    lists.push(((t as usize / dt).min(steps.saturating_sub(1)) as u32, input));
+                }
+                input += 1;
+            }
+        }
+        lists.sort_unstable();
+        SpikeInput::from_events(input as usize, steps, &lists)
+    }
+
+    /// Builds the input from `(step, input)` events sorted by step.
+    ///
+    /// # Panics
+    /// If an event's step or input is out of range or the events are unsorted (caller bugs).
+    pub fn from_events(inputs: usize, steps: usize, events: &[(u32, u32)]) -> SpikeInput {
+        assert!(events.windows(2).all(|w| w[0].0 <= w[1].0));
+        let mut offsets = vec![0u32; steps + 1];
+        for &(t, i) in events {
+            assert!((t as usize) < steps && (i as usize) < inputs);
+            offsets[t as usize + 1] += 1;
+        }
+        for t in 0..steps {
+            offsets[t + 1] += offsets[t];
+        }
+        SpikeInput {
+            inputs,
+            offsets,
+            events: events.iter().map(|e| e.1).collect(),
+        }
+    }
+
+    /// Steps in the window.
+    pub fn steps(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// The inputs that spiked in step `t`.
+    pub fn at(&self, t: usize) -> &[u32] {
+        &self.events[self.offsets[t] as usize..self.offsets[t + 1] as usize]
+    }
+
+    /// Spikes in the window.
+    pub fn total(&self) -> usize {
+        self.events.len()
+    }
+
+    /// The window as a dense `steps x inputs` table of spike counts, row-major (what a
+    /// network's input node receives, step by step).
+    pub fn dense(&self) -> Vec<f32> {
+        let mut out = vec![0f32; self.steps() * self.inputs];
+        for t in 0..self.steps() {
+            for &i in self.at(t) {
+                out[t * self.inputs + i as usize] += 1.0;
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,163 @@
+//! The network's training parameters and their rules, the Xylo profile's among them.
+
+use serde::{Deserialize, Serialize};
+
+use super::{xylo, Readout, Reset, Target};
+use crate::error::ParamError;
+
+/// The spiking classifier's parameters (defaults chosen a priori;
+/// `docs/spiking-classifier.md` gives the reasons).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SnnParams {
+    /// Hidden LIF neurons (128).
+    pub hidden: usize,
+    /// The network's time step in ms (10): the encoder's 1 ms spikes are counted in bins
+    /// of this width.
+    pub dt_ms: u32,
+    /// Synaptic time constant, ms (20).
+    pub tau_syn_ms: f64,
+    /// Membrane time constant, ms (40).
+    pub tau_mem_ms: f64,
+    /// Readout time constant, ms (40).
+    pub tau_out_ms: f64,
+    /// How scores are read from the readout.
+    pub readout: Readout,
+    /// Most passes over the training data (60).
+    pub epochs: usize,
+    /// Recordings per gradient step (8).
+    pub batch: usize,
+    /// Adam's step size (0.005).
+    pub learning_rate: f64,
+    /// Share of each class's training recordings held out for early stopping (0.2).
+    pub validation: f64,
+    /// Epochs without a better validation loss before training stops (15).
+    pub patience: usize,
+    /// Slope of the fast-sigmoid surrogate (10).
+    pub slope: f64,
+    /// Keep the reset out of the gradient (true).
+    pub detach_reset: bool,
+    /// Seed of the initial weights, the validation split and the batch order.
+    pub seed: u64,
+    /// Recurrent connections within the hidden layer (false: feed-forward): each
+    /// neuron's spikes of one step drive every hidden neuron's current at the next.
+    pub recurrent: bool,
+    /// How a hidden neuron resets on a spike (zero); left out of model files when zero,
+    /// so that they read as before the option existed.
+    #[serde(skip_serializing_if = "Reset::is_zero")]
+    pub reset: Reset,
+    /// Where the network runs (float); with [`Target::Xylo`] it is trained within the
+    /// chip's limits and predicts as the chip computes ([`xylo`]). Left out of model files
+    /// when float.
+    #[serde(skip_serializing_if = "Target::is_float")]
+    pub target: Target,
+}
+
+impl Default for SnnParams {
+    fn default() -> Self {
+        SnnParams {
+            hidden: 128,
+            dt_ms: 10,
+            tau_syn_ms: 20.0,
+            tau_mem_ms: 40.0,
+            tau_out_ms: 40.0,
+            readout: Readout::Mean,
+            epochs: 60,
+            batch: 8,
+            learning_rate: 0.005,
+            validation: 0.2,
+            patience: 15,
+            slope: 10.0,
+            detach_reset: true,
+            seed: 0,
+            recurrent: false,
+            reset: Reset::Zero,
+            target: Target::Float,
+        }
+    }
+}
+
+/// Largest hidden layer accepted: beyond it a model file and a training run grow past
+/// what these small tactile datasets can fit.
+pub const MAX_HIDDEN: usize = 4096;
+
+impl SnnParams {
+    /// Checks the rules and returns the parameters.
+    ///
+    /// # Errors
+    /// The first rule broken, named by its command-line option.
+    pub fn check(self) -> Result<SnnParams, ParamError> {
+        let positive = |v: f64| v > 0.0 && v.is_finite();
+        if self.hidden == 0 || self.hidden > MAX_HIDDEN {
+            let rule = "the hidden layer must hold 1 to 4096 neurons";
+            return Err(ParamError::new("snn-hidden", rule, self.hidden));
+        }
+        if self.dt_ms == 0 || self.dt_ms > 1000 {
+            let rule = "the time step must be 1 to 1000 ms";
+            return Err(ParamError::new("snn-dt-ms", rule, self.dt_ms));
+        }
+        for (name, v) in [
+            ("snn-tau-syn-ms", self.tau_syn_ms),
+            ("snn-tau-mem-ms", self.tau_mem_ms),
+            ("snn-tau-out-ms", self.tau_out_ms),
+        ] {
+            if !positive(v) {
+                return Err(ParamError::new(
+                    name,
+                    "a time constant must be positive and finite",
+                    v,
+                ));
+            }
+        }
+        if self.epochs == 0 || self.batch == 0 || self.patience == 0 {
+            let rule = "epochs, batch and patience must be at least 1";
+            let got = format!("{} / {} / {}", self.epochs, self.batch, self.patience);
+            return Err(ParamError::new("snn-epochs", rule, got));
+        }
+        if !positive(self.learning_rate) || !positive(self.slope) {
+            let rule = "the learning rate and the surrogate's slope must be positive and finite";
+            let got = format!("{} / {}", self.learning_rate, self.slope);
+            return Err(ParamError::new("snn-learning-rate", rule, got));
+        }
+        if !(self.validation > 0.0 && self.validation < 1.0) {
+            let rule = "the validation share must lie strictly between 0 and 1";
+            return Err(ParamError::new("snn-validation", rule, self.validation));
+        }
+        match self.target {
+            Target::Float => Ok(self),
+            Target::Xylo => self.on_xylo(),
+        }
+    }
+
+    /// The parameters under the Xylo profile: its limits checked, each time constant moved
+    /// to the nearest whose decay per step the chip has (`1 - 2^-d`).
+    fn on_xylo(mut self) -> Result<SnnParams, ParamError> {
+        let rules = [
+            ("snn-hidden", self.hidden > xylo::MAX_HIDDEN, "the Xylo profile holds at most 1000 hidden neurons", self.hidden.to_string()),
+            ("snn-dt-ms", self.dt_ms > xylo::MAX_DT_MS, "the Xylo profile steps at most 15 ms (an input carries at most 15 events a step)", self.dt_ms.to_string()),
+            ("snn-reset", self.reset != Reset::Subtract, "the Xylo profile's neurons subtract the threshold on a spike: --snn-reset subtract", self.reset.name().to_string()),
+            ("snn-recurrent", self.recurrent, "the Xylo profile runs feed-forward networks", "--snn-recurrent".to_string()),
+        ];
+        if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
+            return Err(ParamError::new(name, rule, got));
+        }
+        for tau in [
+            &mut self.tau_syn_ms,
+            &mut self.tau_mem_ms,
+            &mut self.tau_out_ms,
+        ] {
+            *tau = xylo::tau_of(xylo::dash_of(*tau, self.dt_ms), self.dt_ms);
+        }
+        Ok(self)
+    }
+
+    /// The decay factors `(α, β, κ)` of one step.
+    pub fn decays(&self) -> (f64, f64, f64) {
+        let dt = f64::from(self.dt_ms);
+        (
+            (-dt / self.tau_syn_ms).exp(),
+            (-dt / self.tau_mem_ms).exp(),
+            (-dt / self.tau_out_ms).exp(),
+        )
+    }
+}

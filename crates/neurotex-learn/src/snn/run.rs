@@ -1,0 +1,259 @@
+//! The network run step by step: its state, a runner that gathers the scores as spikes
+//! arrive, and a window that keeps the last steps' readouts.
+
+use super::{xylo, Network, Reset, Target};
+
+/// The network's neuron state, advanced one step at a time; it owns no weights, so it can
+/// live beside the network that drives it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    decays: (f64, f64, f64),
+    current: Vec<f64>,
+    membrane: Vec<f64>,
+    out: Vec<f64>,
+    /// The hidden neurons that spiked in the last step, ascending, with their spike
+    /// counts (kept for a recurrent network).
+    fired: Vec<(u32, f64)>,
+    /// A Xylo-profile network's integers and the chip's state, which then step in place
+    /// of the float state.
+    chip: Option<Box<(xylo::XyloNetwork, xylo::XyloState)>>,
+}
+
+impl State {
+    /// The network at rest.
+    ///
+    /// # Panics
+    /// If `net` is a Xylo-profile network that breaks the profile's rules (a network is
+    /// checked when trained or read, so a caller bug).
+    pub fn new(net: &Network) -> Self {
+        let chip = (net.target == Target::Xylo).then(|| {
+            let chip = xylo::XyloNetwork::quantise(net).expect("a checked Xylo-profile network");
+            let state = xylo::XyloState::new(&chip);
+            Box::new((chip, state))
+        });
+        State {
+            decays: net.decays(),
+            current: vec![0.0; net.hidden],
+            membrane: vec![0.0; net.hidden],
+            out: vec![0.0; net.classes],
+            fired: Vec::new(),
+            chip,
+        }
+    }
+
+    /// Advances one step of `net` (the network this state was made for) with the inputs
+    /// that spiked in it, listed in ascending order for results that do not depend on how
+    /// the spikes arrived.
+    ///
+    /// # Panics
+    /// If an input index is out of range (a caller bug).
+    pub fn step(&mut self, net: &Network, spiked: &[u32]) {
+        if let Some(chip) = self.chip.as_deref_mut() {
+            let (xnet, state) = (&chip.0, &mut chip.1);
+            state.step(xnet, spiked);
+            self.out = state.readout(xnet);
+            return;
+        }
+        let (alpha, beta, kappa) = self.decays;
+        let h_n = net.hidden;
+        for (c, b) in self.current.iter_mut().zip(&net.b_in) {
+            *c = alpha * *c + b;
+        }
+        for &i in spiked {
+            let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
+            for (c, w) in self.current.iter_mut().zip(w) {
+                *c += w;
+            }
+        }
+        for &(j, n) in &self.fired {
+            let w = &net.w_rec[j as usize * h_n..(j as usize + 1) * h_n];
+            for (c, w) in self.current.iter_mut().zip(w) {
+                *c += n * w;
+            }
+        }
+        self.fired.clear();
+        let recurrent = net.recurrent();
+        for (o, b) in self.out.iter_mut().zip(&net.b_out) {
+            *o = kappa * *o + b;
+        }
+        let subtract = net.reset == Reset::Subtract;
+        for h in 0..h_n {
+            let p = beta * self.membrane[h] + self.current[h];
+            if p >= 1.0 {
+                // One spike and a membrane of zero, or floor(p) spikes and the rest kept
+                // (a count of 1 multiplies the weights exactly).
+                let n = if subtract { p.floor() } else { 1.0 };
+                self.membrane[h] = if subtract { p - n } else { 0.0 };
+                if recurrent {
+                    self.fired.push((h as u32, n));
+                }
+                let w = &net.w_out[h * net.classes..(h + 1) * net.classes];
+                for (o, w) in self.out.iter_mut().zip(w) {
+                    *o += n * w;
+                }
+            } else {
+                self.membrane[h] = p;
+            }
+        }
+    }
+
+    /// The readout's values after the last step.
+    pub fn readout(&self) -> &[f64] {
+        &self.out
+    }
+}
+
+/// The network's state, advanced one step at a time, with the scores of every step so far.
+#[derive(Debug, Clone)]
+pub struct Runner<'a> {
+    pub(super) net: &'a Network,
+    pub(super) state: State,
+    /// The readout's sum (mean) or largest value (max) so far.
+    pub(super) acc: Vec<f64>,
+    pub(super) steps: usize,
+}
+
+impl Runner<'_> {
+    /// Advances one step with the inputs that spiked in it (see [`State::step`]).
+    ///
+    /// # Panics
+    /// If an input index is out of range (a caller bug).
+    pub fn step(&mut self, spiked: &[u32]) {
+        self.state.step(self.net, spiked);
+        let readout = self.net.readout;
+        readout.fold(self.steps, &mut self.acc, self.state.readout());
+        self.steps += 1;
+    }
+
+    /// Steps run so far.
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The class scores so far (zeros before the first step).
+    pub fn scores(&self) -> Vec<f64> {
+        self.net.readout.finish(self.steps, self.acc.clone())
+    }
+}
+
+/// A network run on spikes as they come, its scores read over its last `window` steps:
+/// the readout's mean or largest value over those steps (over every step while fewer have
+/// run), while the neurons carry their state from the first step. For a run no longer than
+/// the window, the scores are [`Network::scores`]'s, bit for bit.
+#[derive(Debug, Clone)]
+pub struct Windowed {
+    state: State,
+    window: usize,
+    /// The readout values of the last `window` steps, oldest first.
+    readouts: std::collections::VecDeque<Vec<f64>>,
+    steps: usize,
+}
+
+impl Windowed {
+    /// `net` at rest, its scores read over `window` steps (at least one).
+    pub fn new(net: &Network, window: usize) -> Self {
+        Windowed {
+            state: State::new(net),
+            window: window.max(1),
+            readouts: std::collections::VecDeque::with_capacity(window.clamp(1, 1 << 16)),
+            steps: 0,
+        }
+    }
+
+    /// Advances one step of `net` (see [`State::step`]).
+    pub fn step(&mut self, net: &Network, spiked: &[u32]) {
+        self.state.step(net, spiked);
+        let mut oldest = match self.readouts.len() == self.window {
+            true => self.readouts.pop_front().unwrap_or_default(),
+            false => Vec::with_capacity(net.classes),
+        };
+        oldest.clear();
+        oldest.extend_from_slice(self.state.readout());
+        self.readouts.push_back(oldest);
+        self.steps += 1;
+    }
+
+    /// Steps run so far.
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The class scores over the window (zeros before the first step).
+    pub fn scores(&self, net: &Network) -> Vec<f64> {
+        net.reduce(self.readouts.iter().map(Vec::as_slice))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::snn::{Readout, SnnParams};
+
+    /// One input, one hidden neuron, one class: an input weight of 2.7 drives the membrane
+    /// to 2.7 in the first step.
+    fn one_neuron(reset: Reset, w_rec: Vec<f64>) -> Network {
+        Network {
+            inputs: 1,
+            hidden: 1,
+            classes: 1,
+            dt_ms: 10,
+            tau_syn_ms: 20.0,
+            tau_mem_ms: 40.0,
+            tau_out_ms: 40.0,
+            readout: Readout::Mean,
+            reset,
+            w_in: vec![2.7],
+            b_in: vec![0.0],
+            w_out: vec![0.25],
+            b_out: vec![0.0],
+            w_rec,
+            target: Target::Float,
+        }
+    }
+
+    /// A strong input makes a subtracting neuron spike twice in one step and keep 0.7; the
+    /// readout and the recurrent current receive both spikes. Reset to zero, the same
+    /// neuron spikes once and keeps nothing.
+    #[test]
+    fn subtract_emits_several_spikes_in_a_step_and_keeps_the_rest() {
+        for (reset, spikes, kept) in [(Reset::Subtract, 2.0, 2.7 - 2.0), (Reset::Zero, 1.0, 0.0)] {
+            let net = one_neuron(reset, vec![0.5]);
+            let mut state = State::new(&net);
+            state.step(&net, &[0]);
+            assert_eq!(state.membrane, [kept], "{reset:?}");
+            assert_eq!(state.readout(), [spikes * 0.25], "{reset:?}");
+            assert_eq!(state.fired, [(0, spikes)], "{reset:?}");
+            let (alpha, _, _) = net.decays();
+            state.step(&net, &[]);
+            assert_eq!(state.current, [alpha * 2.7 + spikes * 0.5], "{reset:?}");
+        }
+    }
+
+    /// Below the threshold nothing fires and the membrane is kept, whatever the reset.
+    #[test]
+    fn subtract_below_threshold_keeps_the_membrane() {
+        let mut net = one_neuron(Reset::Subtract, Vec::new());
+        net.w_in = vec![0.6];
+        let mut state = State::new(&net);
+        state.step(&net, &[0]);
+        assert_eq!(state.membrane, [0.6]);
+        assert_eq!(state.readout(), [0.0]);
+    }
+
+    /// The reset's names and its file form: `subtract` is written, `zero` left out of a
+    /// network's file, and a file without it reads as zero.
+    #[test]
+    fn reset_parses_and_zero_is_left_out_of_files() {
+        assert_eq!("subtract".parse::<Reset>().unwrap(), Reset::Subtract);
+        assert_eq!("zero".parse::<Reset>().unwrap(), Reset::Zero);
+        assert_eq!("Zero".parse::<Reset>().unwrap_err().name, "snn-reset");
+        let zero = serde_json::to_value(one_neuron(Reset::Zero, Vec::new())).unwrap();
+        assert!(zero.get("reset").is_none());
+        let back: Network = serde_json::from_value(zero).unwrap();
+        assert_eq!(back.reset, Reset::Zero);
+        let sub = serde_json::to_value(one_neuron(Reset::Subtract, Vec::new())).unwrap();
+        assert_eq!(sub["reset"], "subtract");
+        let params = serde_json::to_value(SnnParams::default()).unwrap();
+        assert!(params.get("reset").is_none());
+    }
+}

@@ -1,0 +1,301 @@
+//! The pipeline's parameters: the feature method, the encoding, the Haralick set, and the
+//! feature and pipeline parameters with their rules.
+
+use serde::{Deserialize, Serialize};
+
+use crate::encode::{FaParams, IzhikevichParams};
+use crate::error::{ParamError, Result};
+use crate::features::{GlcmParams, SpectrumParams, VolumeParams};
+use crate::signal::PreprocessParams;
+
+/// The feature sets: the paper's three and the methods beyond the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Method {
+    /// MSR, CV_ISI and Fano factor of each taxel (approach 1), each taxel classified alone.
+    #[serde(rename = "taxel")]
+    Taxel,
+    /// Contrast, correlation, ASM of the time-collapsed image's GLCM (the paper's control).
+    #[serde(rename = "glcm2d")]
+    Glcm2d,
+    /// Contrast, correlation, ASM of the rate volume's mean 3D GLCM (approach 2).
+    #[serde(rename = "glcm3d")]
+    Glcm3d,
+    /// Every taxel's MSR, CV_ISI and Fano factor in one vector, classified as one (the
+    /// multi-taxel baseline the paper lacks); the columns of [`Method::Taxel`].
+    #[serde(rename = "all-taxels")]
+    AllTaxels,
+    /// [`Method::AllTaxels`] in units of travelled distance (spikes per mm, Fano windows
+    /// of fixed travel; [`crate::features::distance_stats`]), needing each recording's
+    /// speed: a representation meant to be invariant to the sliding speed.
+    #[serde(rename = "all-taxels-mm")]
+    AllTaxelsMm,
+    /// The 3D-GLCM features at each of [`FeatureParams::bin_widths_ms`], concatenated.
+    #[serde(rename = "glcm3d-multi")]
+    Glcm3dMulti,
+    /// Each taxel's spike counts in equal bins of travel, their Fourier magnitudes in
+    /// logarithmic bands of spatial frequency ([`crate::features::spectrum`]): the texture's
+    /// spatial periods, whatever the speed, as Wang et al. (2022) read them from the signal.
+    #[serde(rename = "spectrum")]
+    Spectrum,
+}
+
+impl Method {
+    /// Every method, in the order of the enum.
+    pub const ALL: [Method; 7] = [
+        Method::Taxel,
+        Method::Glcm2d,
+        Method::Glcm3d,
+        Method::AllTaxels,
+        Method::AllTaxelsMm,
+        Method::Glcm3dMulti,
+        Method::Spectrum,
+    ];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Taxel => "taxel",
+            Method::Glcm2d => "glcm2d",
+            Method::Glcm3d => "glcm3d",
+            Method::AllTaxels => "all-taxels",
+            Method::AllTaxelsMm => "all-taxels-mm",
+            Method::Glcm3dMulti => "glcm3d-multi",
+            Method::Spectrum => "spectrum",
+        }
+    }
+
+    /// Whether the columns are three statistics per taxel, taxel by taxel.
+    pub fn per_taxel(self) -> bool {
+        matches!(
+            self,
+            Method::Taxel | Method::AllTaxels | Method::AllTaxelsMm
+        )
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                ParamError::new(
+                    "method",
+                    "method must be taxel, glcm2d, glcm3d, all-taxels, all-taxels-mm, glcm3d-multi or spectrum",
+                    s,
+                )
+            })
+    }
+}
+
+/// Which mechanoreceptor populations encode the signal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum Encoding {
+    /// Slowly adapting (SA-I) neurons driven by the signal, the paper's.
+    #[default]
+    #[serde(rename = "sa")]
+    Sa,
+    /// Fast-adapting (FA-I) neurons driven by its rectified rate of change
+    /// ([`crate::encode::FaParams`]).
+    #[serde(rename = "fa")]
+    Fa,
+    /// Both populations, each with its own features (SA columns, then FA columns).
+    #[serde(rename = "sa+fa")]
+    SaFa,
+}
+
+impl Encoding {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Encoding::Sa => "sa",
+            Encoding::Fa => "fa",
+            Encoding::SaFa => "sa+fa",
+        }
+    }
+
+    /// The column-name prefix of each population, in the order of
+    /// [`Encoded::populations`]: empty for a single population.
+    pub fn prefixes(self) -> &'static [&'static str] {
+        match self {
+            Encoding::Sa | Encoding::Fa => &[""],
+            Encoding::SaFa => &["sa_", "fa_"],
+        }
+    }
+}
+
+impl std::fmt::Display for Encoding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Encoding {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        [Encoding::Sa, Encoding::Fa, Encoding::SaFa]
+            .into_iter()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| ParamError::new("encoding", "encoding must be sa, fa or sa+fa", s))
+    }
+}
+
+/// Which Haralick features the GLCM methods compute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HaralickSet {
+    /// Contrast, correlation and ASM (the paper's eqs. 5-8).
+    #[default]
+    Paper,
+    /// The 13 features of [`crate::features::haralick_full`].
+    Full,
+}
+
+impl std::fmt::Display for HaralickSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            HaralickSet::Paper => "paper",
+            HaralickSet::Full => "full",
+        })
+    }
+}
+
+impl std::str::FromStr for HaralickSet {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        match s {
+            "paper" => Ok(HaralickSet::Paper),
+            "full" => Ok(HaralickSet::Full),
+            _ => Err(ParamError::new(
+                "haralick",
+                "haralick must be paper or full",
+                s,
+            )),
+        }
+    }
+}
+
+/// Parameters of the feature methods beyond the paper's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FeatureParams {
+    /// The Haralick features of the GLCM methods.
+    pub haralick: HaralickSet,
+    /// The rate-volume bin widths of [`Method::Glcm3dMulti`], in ms.
+    pub bin_widths_ms: Vec<usize>,
+    /// The Fano window of [`Method::AllTaxelsMm`] in mm of travel (2 mm: the paper's
+    /// 200 ms window at 10 mm/s).
+    pub window_mm: f64,
+    /// The equal bins [`Method::Spectrum`] counts spikes in (128: at FabricSlide's 590 mm
+    /// slides about 4.6 mm each, near its samples' spacing at 150 mm/s; on the simulated
+    /// rig's 90 mm, 0.7 mm).
+    pub spectrum_bins: usize,
+    /// The logarithmic bands of [`Method::Spectrum`] (16, 14 after merging at 128 bins).
+    pub spectrum_bands: usize,
+    /// The span of [`Method::Spectrum`] in mm of travel from the start of the selected
+    /// phase; 0 (the default) for each recording's whole phase.
+    pub travel_mm: f64,
+}
+
+impl Default for FeatureParams {
+    fn default() -> Self {
+        FeatureParams {
+            haralick: HaralickSet::Paper,
+            bin_widths_ms: vec![50, 100, 200, 400],
+            window_mm: 2.0,
+            spectrum_bins: 128,
+            spectrum_bands: 16,
+            travel_mm: 0.0,
+        }
+    }
+}
+
+impl FeatureParams {
+    /// Checks the rules: at least one bin width, each at least 1 ms; a positive window.
+    ///
+    /// # Errors
+    /// The rule broken.
+    pub fn check(&self) -> Result<(), ParamError> {
+        if self.bin_widths_ms.is_empty() || self.bin_widths_ms.contains(&0) {
+            return Err(ParamError::new(
+                "bin-widths",
+                "bin widths must be at least one width, each at least 1 ms",
+                format!("{:?}", self.bin_widths_ms),
+            ));
+        }
+        if !(self.window_mm.is_finite() && self.window_mm > 0.0) {
+            return Err(ParamError::new(
+                "window-mm",
+                "the travelled-distance window must be a positive number of mm",
+                self.window_mm,
+            ));
+        }
+        if !(8..=crate::features::spectrum::MAX_BINS).contains(&self.spectrum_bins) {
+            return Err(ParamError::new(
+                "spectrum-bins",
+                "the spectrum's bins must be 8 to 4096",
+                self.spectrum_bins,
+            ));
+        }
+        if self.spectrum_bands == 0 {
+            let rule = "the spectrum needs at least one band";
+            return Err(ParamError::new("spectrum-bands", rule, 0));
+        }
+        if !(self.travel_mm.is_finite() && self.travel_mm >= 0.0) {
+            return Err(ParamError::new(
+                "travel-mm",
+                "the spectrum's travel must be 0 (the whole slide) or a positive number of mm",
+                self.travel_mm,
+            ));
+        }
+        Ok(())
+    }
+
+    /// The spectrum's bins and bands.
+    pub fn spectrum(&self) -> SpectrumParams {
+        SpectrumParams {
+            bins: self.spectrum_bins,
+            bands: self.spectrum_bands,
+        }
+    }
+}
+
+/// All stage parameters, each with the paper's value as default (or, where the paper gives
+/// none, a choice whose reasons docs/decisions/ gives). The fields after `glcm` default
+/// when absent, so model files written before them load with the paper's SA encoding.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct PipelineParams {
+    /// Conditioning.
+    pub preprocess: PreprocessParams,
+    /// Neuron model and gain (of the SA population; the FA population uses its firing type).
+    pub encoder: IzhikevichParams,
+    /// Rate volume bins (also the Fano window) and quantisation.
+    pub volume: VolumeParams,
+    /// Co-occurrence offsets.
+    pub glcm: GlcmParams,
+    /// The populations that encode.
+    #[serde(default)]
+    pub encoding: Encoding,
+    /// The FA population's gain.
+    #[serde(default)]
+    pub fa: FaParams,
+    /// Multi-scale widths, Haralick set and travelled-distance window.
+    #[serde(default)]
+    pub features: FeatureParams,
+}
+
+impl PipelineParams {
+    /// Checks every stage's rules.
+    ///
+    /// # Errors
+    /// The first rule broken.
+    pub fn check(&self) -> Result<(), ParamError> {
+        self.preprocess.check()?;
+        self.encoder.check()?;
+        self.volume.check()?;
+        self.glcm.check()?;
+        self.fa.check()?;
+        self.features.check()
+    }
+}
