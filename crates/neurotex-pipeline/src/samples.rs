@@ -84,7 +84,7 @@ impl std::str::FromStr for MethodChoice {
             return Ok(MethodChoice::Spikes);
         }
         s.parse().map(MethodChoice::Features).map_err(|_| {
-            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi, spectrum, van-rossum or spikes";
+            let rule = "method must be taxel, all-taxels, all-taxels-mm, glcm2d, glcm3d, glcm3d-multi, spectrum, rates, van-rossum or spikes";
             ParamError::new("methods", rule, s)
         })
     }

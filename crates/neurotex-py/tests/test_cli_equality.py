@@ -62,6 +62,7 @@ def test_encode_options_equal_cli(sim_dir, cli, tmp_path):
          {"encoding": "sa+fa", "levels": 8, "distances": (1, 3), "symmetric": True,
           "gain": 10.0, "cutoff": 20.0, "bin_ms": 100}),
         ("all-taxels", ["--whole", "--encoding", "fa"], {"whole": True, "encoding": "fa"}),
+        ("rates", ["--encoding", "sa+fa"], {"encoding": "sa+fa"}),
     ],
 )
 def test_features_equal_cli(sim_dir, sim, cli, tmp_path, method, cli_options, py_options):

@@ -63,7 +63,12 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
 
     let spiking = e9.spiking.as_ref().expect("the network ran");
     for (c, paper_column) in [(&spiking.per_speed, &within), (&spiking.held_out, &held)] {
-        assert_eq!(c.results.len(), 2);
+        assert_eq!(c.results.len(), 3);
+        let rates = neurotex::experiments::Spiking::rates(c).expect("the rates baseline ran");
+        assert_eq!(
+            (rates.encoding.as_str(), rates.classifier.as_str()),
+            ("sa+fa", "linear")
+        );
         let (network, paper) = neurotex::experiments::Spiking::pair(c).unwrap();
         assert_eq!(paper.per_condition, paper_column.per_condition);
         assert_eq!(
@@ -99,6 +104,13 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
         100.0 * network.ci[1]
     );
     assert!(text.contains(&mean), "{mean} not in the report");
+    // What the timing adds: the network minus its inputs' rates, within each speed.
+    let rates = neurotex::experiments::Spiking::rates(&spiking.per_speed).unwrap();
+    let adds = format!(
+        "timing of spikes adds {:+.1} points within each speed",
+        100.0 * (network.accuracy - rates.accuracy)
+    );
+    assert!(text.contains(&adds), "{adds} not in the report");
     for figure in ["e9_per_speed.svg", "e9_held_out.svg", "e9_speeds.svg"] {
         assert!(text.contains(figure), "{figure}");
     }

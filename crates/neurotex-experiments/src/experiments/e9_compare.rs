@@ -7,9 +7,10 @@
 //! each training set), whose accuracy is the honest one for "the best method".
 //!
 //! With [`ValidReproduceParams::e9_snn`], the spiking network (`snn` on the SA+FA spikes)
-//! runs beside the paper's method on the same folds. Its hyperparameters are its defaults,
-//! fixed before any data, so it needs no nested selection: its accuracy is honest as it
-//! stands.
+//! runs beside the paper's method and beside its own inputs' spike rates with logistic
+//! regression (`sa+fa / rates / linear`: what the network gains over it is what the timing
+//! of spikes adds) on the same folds. Its hyperparameters are its defaults, fixed before
+//! any data, so it needs no nested selection: its accuracy is honest as it stands.
 
 use serde::{Deserialize, Serialize};
 
@@ -40,8 +41,10 @@ pub struct E9 {
     pub spiking: Option<Spiking>,
 }
 
-/// The spiking network (`sa+fa / spikes / snn`) and the paper's method (`sa / glcm3d /
-/// knn`) on E9's folds; each comparison's non-paper result carries the paired test.
+/// The spiking network (`sa+fa / spikes / snn`), the paper's method (`sa / glcm3d / knn`)
+/// and the network's inputs' spike rates with logistic regression (`sa+fa / rates /
+/// linear`) on E9's folds; each comparison's non-paper results carry the paired test
+/// against the paper's method.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Spiking {
     /// Cross-validation within each speed.
@@ -56,6 +59,13 @@ impl Spiking {
         let network = c.results.iter().find(|r| r.classifier == "snn")?;
         let paper = c.results.iter().find(|r| r.paper)?;
         Some((network, paper))
+    }
+
+    /// The network's inputs' spike rates with logistic regression in `c`, when it ran.
+    pub fn rates(c: &Comparison) -> Option<&crate::compare::Ranked> {
+        c.results
+            .iter()
+            .find(|r| r.method == Method::Rates.name() && r.classifier == "linear")
     }
 }
 
@@ -211,8 +221,8 @@ fn baselines(
     })
 }
 
-/// The spiking network with its default hyperparameters and the paper's method, compared
-/// under `per` and `held`.
+/// The spiking network with its default hyperparameters, the paper's method and the
+/// network's inputs' spike rates with logistic regression, compared under `per` and `held`.
 fn spiking(
     prepared: &Prepared,
     params: &ValidReproduceParams,
@@ -236,14 +246,21 @@ fn spiking(
         MethodChoice::Spikes,
         ClassifierChoice::Snn(SnnParams::default()),
     );
-    let mut list = candidates(&prepared.encoded, &prepared.grid, &pipeline, &paper, 0.0)?;
-    list.extend(candidates(
-        &prepared.encoded,
-        &prepared.grid,
-        &pipeline,
-        &network,
-        0.0,
-    )?);
+    let rates = set(
+        Encoding::SaFa,
+        MethodChoice::Features(Method::Rates),
+        ClassifierChoice::Linear(Default::default()),
+    );
+    let mut list = Vec::new();
+    for set in [&paper, &rates, &network] {
+        list.extend(candidates(
+            &prepared.encoded,
+            &prepared.grid,
+            &pipeline,
+            set,
+            0.0,
+        )?);
+    }
     let (per_speed, held_out) = rayon::join(
         || compare(&list, per, "the spiking network within each speed"),
         || compare(&list, held, "the spiking network, each speed held out"),

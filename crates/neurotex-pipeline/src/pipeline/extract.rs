@@ -83,18 +83,19 @@ impl FeatureExtractor {
             HaralickSet::Paper => vec!["contrast", "correlation", "asm"],
             HaralickSet::Full => FULL_NAMES.to_vec(),
         };
-        let per_taxel = |stats: [&str; 3]| -> Vec<String> {
+        let per_taxel = |stats: &[&str]| -> Vec<String> {
             self.grid
                 .taxels()
                 .flat_map(|cell| {
                     let cell = self.grid.cell(cell);
-                    stats.map(|f| format!("{cell}_{f}"))
+                    stats.iter().map(move |f| format!("{cell}_{f}"))
                 })
                 .collect()
         };
         match method {
-            Method::Taxel | Method::AllTaxels => per_taxel(["msr", "cv_isi", "fano"]),
-            Method::AllTaxelsMm => per_taxel(["spikes_per_mm", "cv_isi", "fano_mm"]),
+            Method::Taxel | Method::AllTaxels => per_taxel(&["msr", "cv_isi", "fano"]),
+            Method::AllTaxelsMm => per_taxel(&["spikes_per_mm", "cv_isi", "fano_mm"]),
+            Method::Rates => per_taxel(&["msr"]),
             Method::Glcm2d | Method::Glcm3d => haralick.iter().map(|h| h.to_string()).collect(),
             Method::Glcm3dMulti => self
                 .features
@@ -255,6 +256,9 @@ impl FeatureExtractor {
         match method {
             Method::Taxel | Method::AllTaxels => Ok(taxel_cells(&spikes.present)
                 .flat_map(|cell| spike_stats(spikes.train(cell), n, bin).to_array())
+                .collect()),
+            Method::Rates => Ok(taxel_cells(&spikes.present)
+                .map(|cell| spike_stats(spikes.train(cell), n, bin).msr)
                 .collect()),
             Method::AllTaxelsMm => {
                 let speed = speed_mm_s
@@ -419,5 +423,46 @@ mod tests {
             onto_empty.swap(0, 4);
             assert!(extractor.glcm3d_moved(&levels, &onto_empty).is_err());
         }
+    }
+
+    /// `rates` is each taxel's spike count over the slide's length in seconds, SA taxels
+    /// then FA taxels, named by cell, with nothing for a cell without a taxel.
+    #[test]
+    fn rates_are_each_taxels_spikes_per_second() {
+        let present = [true, true, true, true, false, true, true, true, true];
+        let n_steps = 2_000;
+        let lists = |base: u32| -> Vec<Vec<u32>> {
+            (0..9u32)
+                .map(|c| (0..c + base).map(|k| k * 7).collect())
+                .collect()
+        };
+        let sa = SpikeTrains::from_lists(&lists(0), 3, 3, &present, n_steps);
+        let fa = SpikeTrains::from_lists(&lists(10), 3, 3, &present, n_steps);
+        let params = PipelineParams {
+            encoding: Encoding::SaFa,
+            ..PipelineParams::default()
+        };
+        let extractor = FeatureExtractor::new(&params, &sa.grid()).unwrap();
+        let encoded = Encoded {
+            meta: Meta::default(),
+            spikes: sa,
+            fa: Some(fa),
+            resampled: false,
+            flat: false,
+            from_events: false,
+        };
+        let row = extractor.row(&encoded, Method::Rates).unwrap();
+        // 2 s of slide: cell c holds c spikes (SA) and c + 10 (FA); cell 4 has no taxel.
+        let taxels = [0.0, 1.0, 2.0, 3.0, 5.0, 6.0, 7.0, 8.0];
+        let want: Vec<f64> = taxels
+            .iter()
+            .map(|c| c / 2.0)
+            .chain(taxels.iter().map(|c| (c + 10.0) / 2.0))
+            .collect();
+        assert_eq!(row, want);
+        let names = extractor.names(Method::Rates);
+        assert_eq!(names.len(), 16);
+        assert_eq!(names[0], "sa_r0c0_msr");
+        assert_eq!(names[15], "fa_r2c2_msr");
     }
 }

@@ -37,11 +37,16 @@ pub enum Method {
     /// spatial periods, whatever the speed, as Wang et al. (2022) read them from the signal.
     #[serde(rename = "spectrum")]
     Spectrum,
+    /// Every taxel's mean spike rate (MSR, spikes/s) in one vector: the spike counts a
+    /// rate code keeps, without their timing. The spiking network reads the same spikes,
+    /// so this method with logistic regression says how much their timing adds.
+    #[serde(rename = "rates")]
+    Rates,
 }
 
 impl Method {
     /// Every method, in the order of the enum.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 8] = [
         Method::Taxel,
         Method::Glcm2d,
         Method::Glcm3d,
@@ -49,6 +54,7 @@ impl Method {
         Method::AllTaxelsMm,
         Method::Glcm3dMulti,
         Method::Spectrum,
+        Method::Rates,
     ];
 
     /// The command-line name.
@@ -61,6 +67,7 @@ impl Method {
             Method::AllTaxelsMm => "all-taxels-mm",
             Method::Glcm3dMulti => "glcm3d-multi",
             Method::Spectrum => "spectrum",
+            Method::Rates => "rates",
         }
     }
 
@@ -82,7 +89,7 @@ impl std::str::FromStr for Method {
             .ok_or_else(|| {
                 ParamError::new(
                     "method",
-                    "method must be taxel, glcm2d, glcm3d, all-taxels, all-taxels-mm, glcm3d-multi or spectrum",
+                    "method must be taxel, glcm2d, glcm3d, all-taxels, all-taxels-mm, glcm3d-multi, spectrum or rates",
                     s,
                 )
             })

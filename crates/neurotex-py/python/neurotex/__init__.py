@@ -51,6 +51,7 @@ _log = logging.getLogger("neurotex")
 
 METHODS = (
     "taxel", "glcm2d", "glcm3d", "all-taxels", "all-taxels-mm", "glcm3d-multi", "spectrum",
+    "rates",
 )
 """Feature methods of :func:`features`, as the CLI's ``--method``."""
 

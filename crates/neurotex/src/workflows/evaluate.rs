@@ -32,7 +32,8 @@ pub struct EvaluateOptions {
     /// Feature set: `taxel` (each taxel alone, the mean reported), `glcm2d`, `glcm3d`,
     /// `all-taxels` (every taxel's statistics in one vector), `all-taxels-mm` (the same per
     /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`), `spectrum` (each
-    /// taxel's spike counts along the slide in bands of spatial frequency), `van-rossum`
+    /// taxel's spike counts along the slide in bands of spatial frequency), `rates` (every
+    /// taxel's mean spike rate, the counts without their timing), `van-rossum`
     /// (KNN over van Rossum distances between the recordings' spike trains) or `spikes`
     /// (the spike trains themselves, classified by the spiking network, `--classifier snn`,
     /// which `--method spikes` chooses when no other classifier is given). [default:

@@ -21,7 +21,8 @@ pub struct FeaturesOptions {
     /// or `glcm3d-multi` (Haralick features, at each of `--bin-widths` for the last), or
     /// `spectrum` (each taxel's spike counts along the slide, their Fourier magnitudes in
     /// logarithmic bands of spatial frequency: `--spectrum-bins`, `--spectrum-bands`,
-    /// `--travel-mm`).
+    /// `--travel-mm`), or `rates` (every taxel's mean spike rate: the counts without their
+    /// timing).
     #[cfg_attr(feature = "cli", arg(long))]
     pub method: Method,
     /// How the dataset folder is opened.

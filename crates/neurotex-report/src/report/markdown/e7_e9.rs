@@ -162,7 +162,8 @@ fn e9_baselines(baselines: Option<&crate::experiments::Baselines>) -> String {
     }
 }
 
-/// The spiking network beside the paper's method on E9's folds (`reproduce --snn`).
+/// The spiking network beside the paper's method and its inputs' spike rates on E9's folds
+/// (`reproduce --snn`).
 fn e9_spiking(spiking: Option<&crate::experiments::Spiking>) -> String {
     use crate::experiments::Spiking;
     let Some(s) = spiking else {
@@ -175,7 +176,7 @@ fn e9_spiking(spiking: Option<&crate::experiments::Spiking>) -> String {
         return String::new();
     };
     let mut out = format!(
-        "\n### The spiking network beside the paper's method\n\n\
+        "\n### The spiking network beside the paper's method and its inputs' spike rates\n\n\
          A spiking network (`--classifier snn`: one hidden layer of current-based leaky integrate-and-fire neurons and a leaky readout, \
          trained with surrogate gradients; see docs/spiking-classifier.md) reads the SA+FA spike trains themselves instead of features. \
          Its hyperparameters are its defaults, fixed before any data, so no selection flatters it; it ran on the same folds and the same encoding (as run) as the paper's method (SA, 3D-GLCM, KNN). \
@@ -184,33 +185,69 @@ fn e9_spiking(spiking: Option<&crate::experiments::Spiking>) -> String {
         pct(within.chance),
         pct(held.chance)
     );
+    let rates = (Spiking::rates(within), Spiking::rates(held));
     let mut t = Table::new(vec![
         "speed (mm/s)",
         "paper, within speed",
+        "rates, within speed",
         "network, within speed",
         "paper, speed held out",
+        "rates, speed held out",
         "network, speed held out",
     ]);
-    let columns = [paper_w, net_w, paper_h, net_h];
+    let columns = [
+        Some(paper_w),
+        rates.0,
+        Some(net_w),
+        Some(paper_h),
+        rates.1,
+        Some(net_h),
+    ];
     for (i, c) in net_w.per_condition.iter().enumerate() {
-        let at = |x: &&crate::compare::Ranked| {
-            x.per_condition
-                .get(i)
+        let at = |x: &Option<&crate::compare::Ranked>| {
+            x.and_then(|x| x.per_condition.get(i))
                 .map_or("-".into(), |p| pct(p.accuracy))
         };
         t.row(std::iter::once(c.condition.clone()).chain(columns.iter().map(at)));
     }
-    let mean = |x: &&crate::compare::Ranked| {
-        format!("{} [{}, {}]", pct(x.accuracy), pct(x.ci[0]), pct(x.ci[1]))
+    let mean = |x: &Option<&crate::compare::Ranked>| match x {
+        Some(x) => format!("{} [{}, {}]", pct(x.accuracy), pct(x.ci[0]), pct(x.ci[1])),
+        None => "-".into(),
     };
     t.row(std::iter::once("mean [95 % CI]".to_string()).chain(columns.iter().map(mean)));
     out += &t.render();
-    out + &format!(
+    out += &format!(
         "\nThe network against the paper's method (paired sign-flip test over {}): within each speed {}, with each speed held out {}. \
          Their training and testing times are under Timing.\n",
         within.units,
         super::super::comparison::versus_paper(net_w),
         super::super::comparison::versus_paper(net_h),
+    );
+    out + &timing_adds(net_w, net_h, rates)
+}
+
+/// What the timing of spikes adds: the network's accuracy minus that of its inputs' spike
+/// rates with logistic regression (`rates`), on the same folds.
+fn timing_adds(
+    net_w: &crate::compare::Ranked,
+    net_h: &crate::compare::Ranked,
+    rates: (
+        Option<&crate::compare::Ranked>,
+        Option<&crate::compare::Ranked>,
+    ),
+) -> String {
+    let (Some(rates_w), Some(rates_h)) = rates else {
+        return String::new();
+    };
+    let points = |net: &crate::compare::Ranked, rates: &crate::compare::Ranked| {
+        format!("{:+.1}", 100.0 * (net.accuracy - rates.accuracy))
+    };
+    format!(
+        "\nThe rates columns are the network's own inputs (SA+FA spike trains) reduced to each taxel's mean spike rate and classified by logistic regression (`sa+fa / rates / linear`). \
+         Reading the timing of spikes adds {} points within each speed and {} points with each speed held out \
+         (the network minus the rates, on the same folds; their intervals are in the table; no paired test is run between the two).\n",
+        points(net_w, rates_w),
+        points(net_h, rates_h),
     )
 }
 
