@@ -6,10 +6,9 @@ pub mod report;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
-use neurotex_core::{error, events, io, recording, values};
+use neurotex_core::{error, events, io, values};
 use neurotex_experiments::experiments;
 use neurotex_learn::classify;
-use neurotex_pipeline::{calibrate, causal, compare, inspect, pipeline};
+use neurotex_pipeline::{causal, compare, inspect};
 #[cfg(test)]
 use neurotex_signal::signal;
-use neurotex_sim::sim;

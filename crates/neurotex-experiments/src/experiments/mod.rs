@@ -23,6 +23,7 @@ mod e9_compare;
 mod encodings;
 mod keystream;
 mod params;
+mod perturb;
 mod prepare;
 mod provenance;
 mod seeds;
@@ -55,7 +56,8 @@ pub use encodings::{encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, Ove
 pub use params::{
     ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS, MAX_REPEATS,
 };
-pub use prepare::{perturbed_input, prepare, CausalPrepared, IsiSweep, Prepared, WITHIN_SPEED};
+pub use perturb::perturbed_input;
+pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, WITHIN_SPEED};
 pub use provenance::Provenance;
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
 pub use skip::{Skip, Stop};

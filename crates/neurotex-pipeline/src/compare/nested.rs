@@ -1,0 +1,301 @@
+//! Nested selection: the candidates ranked inside each outer training set, the chosen one
+//! scored on its test set.
+
+use rayon::prelude::*;
+
+use super::parts::{conditions, cv_split, rows_with};
+use super::units::Units;
+use super::{mean, Candidate, CompareParams, Nested, Protocol};
+use crate::analysis::Split;
+use crate::classify::{group_folds, stratified_folds};
+use crate::error::{ClassifyError, ParamError, Result};
+use crate::progress::Progress;
+use crate::recording::Meta;
+
+/// What the design makes of `--folds` where it cannot honour it: fewer groups than folds
+/// (each group then held out in turn) and nested selection's inner folds, which a class
+/// smaller than the folds reduces; each said once, with the value given and the one used.
+pub(super) fn fewer_folds(
+    metas: &[Meta],
+    params: &CompareParams,
+    outer: Option<&[OuterSplit]>,
+) -> Vec<String> {
+    let folds = params.cv.folds;
+    let mut notes = Vec::new();
+    if let Some(column) = &params.group_by {
+        let all: Vec<usize> = (0..metas.len()).collect();
+        let sets: Vec<(String, Vec<usize>)> = match &params.protocol {
+            Protocol::Pooled => vec![(String::new(), all)],
+            Protocol::Per(per) => conditions(metas, per)
+                .unwrap_or_default()
+                .into_iter()
+                .map(|v| (format!(" at {per} = {v}"), rows_with(metas, per, &v)))
+                .collect(),
+            Protocol::HoldOut(_) | Protocol::Where { .. } => Vec::new(),
+        };
+        let fewest = sets
+            .iter()
+            .map(|(at, rows)| (crate::analysis::group_count(metas, rows, column), at))
+            .min_by_key(|(n, _)| *n);
+        if let Some((groups, at)) = fewest.filter(|(n, _)| *n < folds) {
+            notes.push(format!(
+                "--folds {folds} with --group-by {column}: {groups} `{column}` group(s){at}, so {groups} folds are used there (each group held out in turn)"
+            ));
+        }
+    }
+    let inner = outer
+        .unwrap_or_default()
+        .iter()
+        .map(|split| inner_folds(folds, smallest_class(metas, &split.train)))
+        .filter(|&used| used < folds);
+    if let Some(used) = inner.clone().min() {
+        notes.push(format!(
+            "--folds {folds}: nested selection's inner cross-validation uses {used} folds in {} of {} outer training sets (their smallest class has fewer than {folds} recordings)",
+            inner.count(),
+            outer.map_or(0, <[_]>::len)
+        ));
+    }
+    notes
+}
+
+/// The folds of nested selection's inner cross-validation: `folds`, fewer when a class of
+/// the outer training set has fewer recordings (`smallest`), never under 2.
+fn inner_folds(folds: usize, smallest: usize) -> usize {
+    folds.min(smallest).max(2)
+}
+
+/// One outer split of nested selection.
+pub(super) struct OuterSplit {
+    /// The condition it belongs to (empty for pooled cross-validation).
+    condition: String,
+    /// Training rows.
+    train: Vec<usize>,
+    /// Test rows.
+    test: Vec<usize>,
+}
+
+/// What one outer split chose and how its test rows fared.
+struct OuterResult {
+    condition: String,
+    /// The chosen candidate.
+    chosen: usize,
+    /// Per test row, its share of right predictions.
+    shares: Vec<(usize, f64)>,
+}
+
+/// The outer splits of nested selection, from the first repeat's folds (or the held-out
+/// conditions).
+fn outer_splits(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
+    let folds_of = |rows: Vec<usize>, condition: String| -> Result<Vec<_>> {
+        let fold_of = fold_assignment(metas, &rows, params)?;
+        let n_folds = fold_of.iter().max().map_or(0, |&f| f + 1);
+        Ok((0..n_folds)
+            .map(|f| {
+                let pick = |test: bool| -> Vec<usize> {
+                    let rows = rows.iter().zip(&fold_of);
+                    rows.filter(|(_, &g)| (g == f) == test)
+                        .map(|(&r, _)| r)
+                        .collect()
+                };
+                OuterSplit {
+                    condition: condition.clone(),
+                    train: pick(false),
+                    test: pick(true),
+                }
+            })
+            .collect())
+    };
+    match &params.protocol {
+        Protocol::Pooled => folds_of((0..metas.len()).collect(), String::new()),
+        Protocol::Per(column) => {
+            let mut out = Vec::new();
+            for value in conditions(metas, column)? {
+                out.extend(folds_of(rows_with(metas, column, &value), value)?);
+            }
+            Ok(out)
+        }
+        Protocol::HoldOut(column) => Ok(conditions(metas, column)?
+            .into_iter()
+            .map(|value| {
+                let test = rows_with(metas, column, &value);
+                let train = (0..metas.len()).filter(|i| !test.contains(i)).collect();
+                OuterSplit {
+                    condition: value,
+                    train,
+                    test,
+                }
+            })
+            .collect()),
+        Protocol::Where { train, test } => Ok(vec![OuterSplit {
+            condition: String::new(),
+            train: train.rows(metas)?,
+            test: test.rows(metas)?,
+        }]),
+    }
+}
+
+/// The first repeat's fold of each of `rows`: stratified by label, or by groups.
+fn fold_assignment(metas: &[Meta], rows: &[usize], params: &CompareParams) -> Result<Vec<usize>> {
+    let index = |values: Vec<String>| -> (Vec<usize>, Vec<String>) {
+        let mut names: Vec<String> = Vec::new();
+        let out = values
+            .into_iter()
+            .map(|v| {
+                names.iter().position(|n| *n == v).unwrap_or_else(|| {
+                    names.push(v);
+                    names.len() - 1
+                })
+            })
+            .collect();
+        (out, names)
+    };
+    match &params.group_by {
+        Some(column) => {
+            let values = rows
+                .iter()
+                .map(|&r| metas[r].field(column).unwrap_or_default());
+            let (groups, _) = index(values.collect());
+            Ok(group_folds(&groups, params.cv.folds, params.cv.seed).0)
+        }
+        None => {
+            let labels: Vec<String> = rows.iter().map(|&r| metas[r].label.clone()).collect();
+            let (y, names) = index(labels);
+            let (folds, seed) = (params.cv.folds, params.cv.seed);
+            Ok(stratified_folds(&y, names.len(), folds, seed, &names)?)
+        }
+    }
+}
+
+/// The size of the smallest class among `rows`.
+fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for &r in rows {
+        let label = metas[r].label.as_str();
+        match counts.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((label, 1)),
+        }
+    }
+    counts.iter().map(|c| c.1).min().unwrap_or(0)
+}
+
+/// Nested selection's outer splits, when it can run on them: its inner cross-validation
+/// needs at least 2 folds, so every class at least 2 recordings in each outer training set.
+pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
+    let splits = outer_splits(metas, params)?;
+    for split in &splits {
+        if smallest_class(metas, &split.train) < 2 {
+            let rule = "nested selection cross-validates inside each outer training set: every class needs at least 2 recordings there";
+            let at = match (&params.protocol, split.condition.as_str()) {
+                (_, "") => "an outer training set".to_string(),
+                (Protocol::Per(column) | Protocol::HoldOut(column), c) => {
+                    format!("the outer training set at {column} = {c}")
+                }
+                (_, c) => format!("the outer training set of {c}"),
+            };
+            let got = format!("1 recording or none of some class in {at} (more recordings per class and condition run it)");
+            return Err(ParamError::new("nested", rule, got).into());
+        }
+    }
+    Ok(splits)
+}
+
+/// One outer split of nested selection: every candidate cross-validated on its training
+/// rows (one repeat), the best trained on all of them and tested on its test rows.
+fn outer(
+    candidates: &[Candidate],
+    split: &OuterSplit,
+    params: &CompareParams,
+    metas: &[Meta],
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<OuterResult> {
+    // One repeat; fewer folds when a class of the training set is smaller than
+    // the folds (an outer training set is a part of one condition's recordings).
+    let smallest = smallest_class(metas, &split.train);
+    let inner = CompareParams {
+        cv: crate::classify::CvParams {
+            repeats: 1,
+            folds: inner_folds(params.cv.folds, smallest),
+            ..*params.cv
+        }
+        .check()?,
+        ..params.clone()
+    };
+    let accuracies: Vec<f64> = candidates
+        .par_iter()
+        .map(|c| {
+            let accuracy = (c.evaluate)(&split.train, &cv_split(&inner))?.accuracy;
+            progress(Progress::Tick);
+            Ok(accuracy)
+        })
+        .collect::<Result<_>>()?;
+    // The first candidate of the highest accuracy.
+    let mut best = (f64::NEG_INFINITY, 0);
+    for (k, &accuracy) in accuracies.iter().enumerate() {
+        if accuracy > best.0 {
+            best = (accuracy, k);
+        }
+    }
+    let c = &candidates[best.1];
+    let rows = Split::Rows {
+        train: split.train.clone(),
+        test: split.test.clone(),
+    };
+    let outcome = c.evaluate_all(&rows)?;
+    Ok(OuterResult {
+        condition: split.condition.clone(),
+        chosen: best.1,
+        shares: outcome.correct_shares,
+    })
+}
+
+/// Nested selection: inside each outer split's training rows every candidate is
+/// cross-validated (one repeat), the best is trained on all of them and tested on the
+/// split's test rows.
+pub(super) fn nested(
+    candidates: &[Candidate],
+    splits: &[OuterSplit],
+    params: &CompareParams,
+    units: &Units,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Nested> {
+    let metas = &candidates[0].metas;
+    let steps = splits.len() * candidates.len();
+    progress(Progress::Stage("nested selection", steps));
+    let outcomes: Vec<OuterResult> = splits
+        .par_iter()
+        .map(|split| outer(candidates, split, params, metas, progress))
+        .collect::<Result<_>>()?;
+    let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();
+    shares.sort_by_key(|&(row, _)| row);
+    let mut chosen: Vec<(String, usize)> = Vec::new();
+    for o in &outcomes {
+        let name = candidates[o.chosen].name();
+        match chosen.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, times)) => *times += 1,
+            None => chosen.push((name, 1)),
+        }
+    }
+    chosen.sort_by_key(|c| std::cmp::Reverse(c.1));
+    // Mean over conditions of each condition's share of right test predictions.
+    let mut per: Vec<(String, f64, usize)> = Vec::new();
+    for o in &outcomes {
+        let right: f64 = o.shares.iter().map(|x| x.1).sum();
+        match per.iter_mut().find(|(c, _, _)| *c == o.condition) {
+            Some((_, r, n)) => (*r, *n) = (*r + right, *n + o.shares.len()),
+            None => per.push((o.condition.clone(), right, o.shares.len())),
+        }
+    }
+    // The outer test sets cover the rows every candidate was scored on, once each, so the
+    // units are the same.
+    if shares.len() != units.unit_of.len() {
+        let (first, second) = ("nested selection".to_string(), "the candidates".to_string());
+        return Err(ClassifyError::Unpaired { first, second }.into());
+    }
+    Ok(Nested {
+        accuracy: mean(per.iter().map(|(_, r, n)| r / (*n).max(1) as f64)),
+        ci: units.interval(&shares),
+        chosen,
+        outer_splits: splits.len(),
+    })
+}
