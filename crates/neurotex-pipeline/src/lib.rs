@@ -10,7 +10,6 @@ pub mod calibrate;
 pub mod causal;
 pub mod compare;
 pub mod diagnostics;
-pub mod evaluation;
 pub mod inspect;
 pub mod model;
 pub mod nir;

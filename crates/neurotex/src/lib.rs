@@ -14,7 +14,7 @@
 //! | spike statistics and GLCM features | `neurotex-features` | [`features`] |
 //! | classifiers, the spiking network, cross-validation, statistics | `neurotex-learn` | [`classify`], [`snn`] |
 //! | simulated recordings | `neurotex-sim` | [`sim`] |
-//! | stage options, pipeline, feature tables, evaluation, inspection, models, NIR, compare | `neurotex-pipeline` | [`pipeline`], [`options`], [`analysis`], [`evaluation`], [`diagnostics`], [`inspect`], [`calibrate`], [`causal`], [`model`], [`spiking_model`], [`nir`], [`saved`], [`compare`] |
+//! | stage options, pipeline, feature tables and their evaluation, inspection, models, NIR, compare | `neurotex-pipeline` | [`pipeline`], [`options`], [`analysis`], [`diagnostics`], [`inspect`], [`calibrate`], [`causal`], [`model`], [`spiking_model`], [`nir`], [`saved`], [`compare`] |
 //! | live streams: frames, events, the Lab Streaming Layer | `neurotex-stream` | [`stream`] |
 //! | the paper's analyses | `neurotex-experiments` | [`experiments`] |
 //! | report and figures | `neurotex-report` | [`report`] |
@@ -31,8 +31,8 @@ pub use neurotex_features::features;
 pub use neurotex_learn::classify;
 pub use neurotex_learn::snn;
 pub use neurotex_pipeline::{
-    analysis, calibrate, causal, compare, diagnostics, evaluation, inspect, model, nir, options,
-    pipeline, samples, saved, spiking_model,
+    analysis, calibrate, causal, compare, diagnostics, inspect, model, nir, options, pipeline,
+    samples, saved, spiking_model,
 };
 pub use neurotex_report::report;
 pub use neurotex_signal::{encode, signal};

@@ -18,7 +18,7 @@ use crate::recording::{Meta, Selection};
 use crate::samples::{MethodChoice, PopulationMatrices};
 use crate::snn::SnnParams;
 use crate::values::{Grid, Speed};
-use neurotex_core::Result;
+use crate::Result;
 
 /// A dataset's recordings as encoded: what every evaluation starts from.
 #[derive(Debug, Clone, Copy)]

@@ -10,13 +10,15 @@ use crate::analysis::{evaluator, Columns, Split};
 use crate::calibrate::CalibratedParams;
 use crate::classify::CvParams;
 use crate::error::OptionsError;
-use crate::evaluation::{Evaluation, Spikes};
+pub mod evaluation;
+
 use crate::options::StageOptions;
 use crate::pipeline::{Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{Dataset, Selection};
 use crate::samples::MethodChoice;
 use crate::{Cell, Result, Speed};
+use evaluation::{Evaluation, Spikes};
 
 /// The method evaluated when neither `--method` nor a classifier that implies one is
 /// given: the paper's 3D-GLCM.
