@@ -19,6 +19,7 @@ use crate::classify::{
 };
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, Encoding, FeatureExtractor};
+use crate::progress::Progress;
 use crate::recording::{DatasetError, Meta, Selection};
 use crate::samples::{spike_inputs, MethodChoice};
 use crate::snn::SpikeInput;
@@ -613,8 +614,11 @@ pub fn best_taxel(per: &[TaxelAccuracy]) -> Option<TaxelAccuracy> {
 }
 
 /// A classifier applied to its samples: evaluates the recordings `within` (indices into
-/// the samples' recordings) under a split whose rows are positions in `within`.
-pub type EvaluateFn = dyn Fn(&[usize], &Split) -> Result<Outcome> + Send + Sync;
+/// the samples' recordings) under a split whose rows are positions in `within`. A
+/// classifier whose fits are long (the spiking network) says [`Progress::Tick`] after
+/// each fit to the callback; the others say nothing.
+pub type EvaluateFn =
+    dyn Fn(&[usize], &Split, &(dyn Fn(Progress) + Sync)) -> Result<Outcome> + Send + Sync;
 
 /// `classifier` on `columns` of `table`'s rows.
 pub fn on_table<C: Classifier + Send + 'static>(
@@ -622,7 +626,7 @@ pub fn on_table<C: Classifier + Send + 'static>(
     columns: Columns,
     classifier: C,
 ) -> Arc<EvaluateFn> {
-    Arc::new(move |within, split| {
+    Arc::new(move |within, split, _| {
         let whole =
             within.len() == table.metas.len() && within.iter().enumerate().all(|(i, &r)| i == r);
         match whole {
@@ -638,7 +642,11 @@ where
     S: Samples + Send + ?Sized + 'static,
     L: Learner<S> + Send + 'static,
 {
-    Arc::new(move |within, split| {
+    Arc::new(move |within, split, on| {
+        let learner = Ticking {
+            learner: &learner,
+            on,
+        };
         let mut each = evaluate_samples(&metas, within, &*samples, split, &learner)?;
         each.pop().ok_or_else(|| {
             ClassifyError::Empty {
@@ -647,6 +655,27 @@ where
             .into()
         })
     })
+}
+
+/// A learner that says [`Progress::Tick`] after each fit.
+struct Ticking<'a, L> {
+    learner: &'a L,
+    on: &'a (dyn Fn(Progress) + Sync),
+}
+
+impl<S: ?Sized, L: Learner<S>> Learner<S> for Ticking<'_, L> {
+    type Fitted = L::Fitted;
+
+    fn learn(
+        &self,
+        samples: &S,
+        rows: &[usize],
+        y: &[usize],
+    ) -> std::result::Result<Self::Fitted, ClassifyError> {
+        let fitted = self.learner.learn(samples, rows, y)?;
+        (self.on)(Progress::Tick);
+        Ok(fitted)
+    }
 }
 
 /// What a method's classifier reads, made once and shared by every fold and candidate.

@@ -107,7 +107,7 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
     // What the timing adds: the network minus its inputs' rates, within each speed.
     let rates = neurotex::experiments::Spiking::rates(&spiking.per_speed).unwrap();
     let adds = format!(
-        "timing of spikes adds {:+.1} points within each speed",
+        "The network is {:+.1} points from them within each speed",
         100.0 * (network.accuracy - rates.accuracy)
     );
     assert!(text.contains(&adds), "{adds} not in the report");

@@ -8,9 +8,10 @@
 //!
 //! With [`ValidReproduceParams::e9_snn`], the spiking network (`snn` on the SA+FA spikes)
 //! runs beside the paper's method and beside its own inputs' spike rates with logistic
-//! regression (`sa+fa / rates / linear`: what the network gains over it is what the timing
-//! of spikes adds) on the same folds. Its hyperparameters are its defaults, fixed before
-//! any data, so it needs no nested selection: its accuracy is honest as it stands.
+//! regression (`sa+fa / rates / linear`: what the network gains over it, it draws from the
+//! spikes' timing and its own nonlinearity) on the same folds. Its hyperparameters are its
+//! defaults, fixed before any data, so it needs no nested selection: its accuracy is honest
+//! as it stands.
 
 use serde::{Deserialize, Serialize};
 

@@ -68,7 +68,7 @@ impl Candidate {
     /// As the candidate's classifier.
     pub fn evaluate_all(&self, split: &Split) -> Result<Outcome> {
         let all: Vec<usize> = (0..self.metas.len()).collect();
-        (self.evaluate)(&all, split)
+        (self.evaluate)(&all, split, &crate::progress::silent)
     }
 
     /// Whether this is the paper's method: the SA encoding, 3D-GLCM and KNN.

@@ -9,7 +9,7 @@ use super::{mean, Candidate, CompareParams, Nested, Protocol};
 use crate::analysis::Split;
 use crate::classify::{group_folds, stratified_folds};
 use crate::error::{ClassifyError, ParamError, Result};
-use crate::progress::Progress;
+use crate::progress::{silent, Progress};
 use crate::recording::Meta;
 
 /// What the design makes of `--folds` where it cannot honour it: fewer groups than folds
@@ -224,7 +224,7 @@ fn outer(
     let accuracies: Vec<f64> = candidates
         .par_iter()
         .map(|c| {
-            let accuracy = (c.evaluate)(&split.train, &cv_split(&inner))?.accuracy;
+            let accuracy = (c.evaluate)(&split.train, &cv_split(&inner), &silent)?.accuracy;
             progress(Progress::Tick);
             Ok(accuracy)
         })

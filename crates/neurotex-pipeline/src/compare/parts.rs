@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::{mean, Candidate, CompareParams, ConditionAccuracy, Protocol, Scored};
 use crate::analysis::Split;
 use crate::error::{ParamError, Result};
-use crate::progress::Progress;
+use crate::progress::{silent, Progress};
 use crate::recording::{Meta, Selection};
 
 /// The distinct values of `column` over `metas`, numerically ordered when all are numbers.
@@ -122,12 +122,13 @@ fn score_part(c: &Candidate, part: &Part, params: &CompareParams) -> Result<Part
     let start = Instant::now();
     let (accuracy, shares) = match &part.rows {
         Some(rows) => {
-            let outcome = (c.evaluate)(rows, &part.split).map_err(|e| match &params.protocol {
-                Protocol::Per(column) => {
-                    in_condition(e, column, part.condition.as_deref().unwrap_or_default())
-                }
-                _ => e,
-            })?;
+            let outcome =
+                (c.evaluate)(rows, &part.split, &silent).map_err(|e| match &params.protocol {
+                    Protocol::Per(column) => {
+                        in_condition(e, column, part.condition.as_deref().unwrap_or_default())
+                    }
+                    _ => e,
+                })?;
             let shares = outcome.correct_shares.iter();
             (
                 outcome.accuracy,

@@ -349,9 +349,10 @@ fn timing(r: &Results) -> String {
         ]
     }) {
         for x in &c.results {
-            let who = match x.paper {
-                true => "the paper's method",
-                false => "the spiking network",
+            let who = match (x.paper, x.classifier.as_str()) {
+                (true, _) => "the paper's method",
+                (false, "snn") => "the spiking network",
+                (false, _) => "its inputs' rates (logistic regression)",
             };
             lines += &format!("- e9, {who} {protocol}: {:.3}\n", x.seconds);
         }

@@ -90,10 +90,11 @@ pub struct CompareOptions {
     /// spike-train distances (KNN only).
     /// `all-taxels-mm` (statistics per mm travelled) needs the manifest's speeds.
     /// `spectrum`: each taxel's spike counts along the slide, their Fourier magnitudes in
-    /// logarithmic bands of spatial frequency. `rates`: every taxel's mean spike rate, the
-    /// counts without their timing (with `linear`, the baseline the spiking network must
-    /// beat to show that it reads timing). `spikes`: the spike trains themselves,
-    /// classified by the spiking network (`snn`, its options --snn-*).
+    /// logarithmic bands of spatial frequency. `rates`: every taxel's mean spike rate in
+    /// spikes/s, the counts without their timing (with `linear`, the spiking network's
+    /// baseline: what the network gains over it, it draws from the spikes' timing and its
+    /// own nonlinearity). `spikes`: the spike trains themselves, classified by the spiking
+    /// network (`snn`, its options --snn-*).
     #[cfg_attr(feature = "cli", arg(long, value_delimiter = ',', default_value = crate::compare::candidates::STANDARD_METHODS))]
     pub methods: Vec<String>,
     /// Classifiers to compare, comma-separated: knn, forest, linear, snn (the spiking

@@ -18,11 +18,11 @@ pub struct FeaturesOptions {
     pub dataset: PathBuf,
     /// Feature set: `taxel` or `all-taxels` (MSR, CV_ISI, Fano of every taxel),
     /// `all-taxels-mm` (spikes per mm, CV_ISI, Fano over fixed travel), `glcm2d`, `glcm3d`
-    /// or `glcm3d-multi` (Haralick features, at each of `--bin-widths` for the last), or
+    /// or `glcm3d-multi` (Haralick features, at each of `--bin-widths` for the last),
     /// `spectrum` (each taxel's spike counts along the slide, their Fourier magnitudes in
     /// logarithmic bands of spatial frequency: `--spectrum-bins`, `--spectrum-bands`,
-    /// `--travel-mm`), or `rates` (every taxel's mean spike rate: the counts without their
-    /// timing).
+    /// `--travel-mm`), or `rates` (every taxel's mean spike rate in spikes/s: the counts
+    /// without their timing).
     #[cfg_attr(feature = "cli", arg(long))]
     pub method: Method,
     /// How the dataset folder is opened.

@@ -190,10 +190,17 @@ mod knob_flags {
             .filter(move |k| k.classifier != "knn" && (!snn_only || k.classifier == "snn"))
     }
 
-    /// The flag of one knob, its value checked as it is parsed.
-    fn flag(spec: &'static KnobSpec) -> Arg {
+    /// The flag of one knob, its value checked as it is parsed; `compare` names its
+    /// classifiers in `--classifiers`.
+    fn flag(spec: &'static KnobSpec, in_list: bool) -> Arg {
         let long = &spec.flag[2..];
-        let arg = Arg::new(long).long(long).help(spec.help_with_default());
+        let mut help = spec.help_with_default();
+        if in_list {
+            let one = format!("With `--classifier {}`", spec.classifier);
+            let many = format!("With `{}` in `--classifiers`", spec.classifier);
+            help = help.replacen(&one, &many, 1);
+        }
+        let arg = Arg::new(long).long(long).help(help);
         if spec.kind == OptionKind::Flag {
             return arg.action(ArgAction::SetTrue);
         }
@@ -232,7 +239,7 @@ mod knob_flags {
                 .value_name("CLASSIFIER")
                 .help(CLASSIFIER_HELP)
                 .value_parser(|text: &str| text.parse::<ClassifierChoice>());
-            offered(false).fold(cmd.arg(classifier), |cmd, spec| cmd.arg(flag(spec)))
+            offered(false).fold(cmd.arg(classifier), |cmd, spec| cmd.arg(flag(spec, false)))
         }
 
         fn augment_args_for_update(cmd: Command) -> Command {
@@ -258,7 +265,7 @@ mod knob_flags {
 
     impl Args for SnnOptions {
         fn augment_args(cmd: Command) -> Command {
-            offered(true).fold(cmd, |cmd, spec| cmd.arg(flag(spec)))
+            offered(true).fold(cmd, |cmd, spec| cmd.arg(flag(spec, true)))
         }
 
         fn augment_args_for_update(cmd: Command) -> Command {

@@ -69,10 +69,12 @@ pub struct ReproduceOptions {
           value_parser = clap::value_parser!(u64).range(1..=crate::experiments::MAX_ENCODER_DRAWS as u64)))]
     pub encoder_draws: u64,
     /// E9 also runs the spiking network (`--classifier snn` on the SA+FA spikes, its
-    /// default hyperparameters, no selection) beside the paper's method on the same folds,
-    /// within each speed and with each speed held out, with intervals, chance and the paired
-    /// test. It trains one network per fold, on the first dataset only: on two cores the
-    /// paper-scale simulated default takes about 2.5 min instead of 40 s.
+    /// default hyperparameters, no selection) beside the paper's method and beside its
+    /// inputs' spike rates with logistic regression (`--method rates --classifier linear`)
+    /// on the same folds, within each speed and with each speed held out, with intervals,
+    /// chance and the paired test against the paper's method. It trains one network per
+    /// fold, on the first dataset only: on two cores the paper-scale simulated default
+    /// takes about 3 min instead of 40 s.
     #[cfg_attr(feature = "cli", arg(long))]
     pub snn: bool,
     /// How the dataset folder is opened.

@@ -37,7 +37,7 @@ pub struct TrainOptions {
     /// Feature set: `taxel`, `glcm2d`, `glcm3d` (the paper's spatio-temporal approach),
     /// `all-taxels`, `all-taxels-mm`, `glcm3d-multi` or `spectrum` (spike counts along the
     /// slide in bands of spatial frequency; not with `--causal`), `rates` (every taxel's
-    /// mean spike rate, the counts without their timing), or `spikes` (the spike
+    /// mean spike rate in spikes/s, the counts without their timing), or `spikes` (the spike
     /// trains themselves, read by the spiking network: `--method spikes` and
     /// `--classifier snn` each imply the other). [default: glcm3d; spikes with
     /// `--classifier snn`]

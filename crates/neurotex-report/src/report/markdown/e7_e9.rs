@@ -226,7 +226,7 @@ fn e9_spiking(spiking: Option<&crate::experiments::Spiking>) -> String {
     out + &timing_adds(net_w, net_h, rates)
 }
 
-/// What the timing of spikes adds: the network's accuracy minus that of its inputs' spike
+/// What the network draws beyond its inputs' spike counts: its accuracy minus that of their
 /// rates with logistic regression (`rates`), on the same folds.
 fn timing_adds(
     net_w: &crate::compare::Ranked,
@@ -243,9 +243,11 @@ fn timing_adds(
         format!("{:+.1}", 100.0 * (net.accuracy - rates.accuracy))
     };
     format!(
-        "\nThe rates columns are the network's own inputs (SA+FA spike trains) reduced to each taxel's mean spike rate and classified by logistic regression (`sa+fa / rates / linear`). \
-         Reading the timing of spikes adds {} points within each speed and {} points with each speed held out \
-         (the network minus the rates, on the same folds; their intervals are in the table; no paired test is run between the two).\n",
+        "\nThe rates columns are the network's own inputs (SA+FA spike trains) reduced to each taxel's mean spike rate (spikes/s) and classified by logistic regression (`sa+fa / rates / linear`). \
+         The network is {} points from them within each speed and {} points with each speed held out \
+         (the network minus the rates, from the unrounded accuracies, on the same folds; their intervals are in the table; no paired test is run between the two). \
+         That difference is what the network draws beyond its inputs' spike counts: the timing of the spikes together with its own nonlinearity and training, \
+         so a gain near zero says the network reads rates, and a gain is not the timing's alone (a nonlinear classifier on the rates, `compare --methods rates`, separates the two).\n",
         points(net_w, rates_w),
         points(net_h, rates_h),
     )

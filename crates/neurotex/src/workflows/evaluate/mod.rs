@@ -8,7 +8,7 @@ use super::{
 };
 use crate::analysis::{evaluator, Columns, Split};
 use crate::calibrate::CalibratedParams;
-use crate::classify::CvParams;
+use crate::classify::{ClassifierChoice, CvParams};
 use crate::error::OptionsError;
 pub mod evaluation;
 
@@ -35,7 +35,7 @@ pub struct EvaluateOptions {
     /// `all-taxels` (every taxel's statistics in one vector), `all-taxels-mm` (the same per
     /// mm of travel), `glcm3d-multi` (3D-GLCM at each of `--bin-widths`), `spectrum` (each
     /// taxel's spike counts along the slide in bands of spatial frequency), `rates` (every
-    /// taxel's mean spike rate, the counts without their timing), `van-rossum`
+    /// taxel's mean spike rate in spikes/s, the counts without their timing), `van-rossum`
     /// (KNN over van Rossum distances between the recordings' spike trains) or `spikes`
     /// (the spike trains themselves, classified by the spiking network, `--classifier snn`,
     /// which `--method spikes` chooses when no other classifier is given). [default:
@@ -222,6 +222,22 @@ impl EvaluateOptions {
         )]
     }
 
+    /// The classifier's fits on the recordings `indices`: one per fold and repeat, with as
+    /// many folds as groups when `--group-by` finds fewer; one for a train/test split.
+    fn fits(&self, dataset: &Dataset, indices: &[usize]) -> usize {
+        if self.selections().is_some() {
+            return 1;
+        }
+        let folds = match &self.group_by {
+            Some(column) => {
+                let groups = crate::analysis::group_count(&dataset.entries, indices, column);
+                self.folds.min(groups)
+            }
+            None => self.folds,
+        };
+        self.repeats * folds
+    }
+
     /// The feature columns to classify with.
     ///
     /// # Errors
@@ -287,7 +303,14 @@ impl EvaluateOptions {
         // classifier over them under the split, the result summarised.
         let samples = spikes.samples(method, columns, &classifier, self.tau_ms)?;
         let all: Vec<usize> = (0..samples.metas().len()).collect();
-        let outcome = evaluator(classifier, samples)?(&all, &split)?;
+        if let ClassifierChoice::Snn(_) = classifier {
+            // Minutes on long slides: one step per fit.
+            on(Progress::Stage(
+                "training the spiking network",
+                self.fits(dataset, &indices),
+            ));
+        }
+        let outcome = evaluator(classifier, samples)?(&all, &split, on)?;
         let chosen = (method, columns);
         let evaluation = Evaluation::of(spikes, chosen, outcome, &split, self.tau_ms, self.seed)?;
         let evaluation = Evaluation {
