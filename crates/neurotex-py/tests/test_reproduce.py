@@ -59,7 +59,9 @@ def test_quick_run_on_a_folder_equals_the_cli(sim_dir, tmp_path):
                              encoder_draws=3, snn=True)
     same_report(tmp_path / "py", tmp_path / "cli")
     spiking = run.results["e9"]["spiking"]["per_speed"]["results"]
-    assert sorted(r["classifier"] for r in spiking) == ["knn", "snn"]
+    # the paper's method, the inputs' rates with logistic regression, the network
+    assert sorted((r["method"], r["classifier"]) for r in spiking) == [
+        ("glcm3d", "knn"), ("rates", "linear"), ("spikes", "snn")]
     assert "### The spiking network beside the paper's method" in open(run.report).read()
     assert run.report == str(tmp_path / "py" / "report.md")
     assert run.results == json.loads((tmp_path / "py" / "results.json").read_text())
