@@ -352,7 +352,7 @@ fn timing(r: &Results) -> String {
             let who = match (x.paper, x.classifier.as_str()) {
                 (true, _) => "the paper's method",
                 (false, "snn") => "the spiking network",
-                (false, _) => "its inputs' rates (logistic regression)",
+                (false, _) => "the network's inputs' rates (logistic regression)",
             };
             lines += &format!("- e9, {who} {protocol}: {:.3}\n", x.seconds);
         }
