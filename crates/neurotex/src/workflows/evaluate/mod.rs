@@ -1,6 +1,8 @@
 //! `evaluate`: a classifier on a dataset's features, by cross-validation or by training on
 //! some conditions (speeds, trials, sessions: any manifest column) and testing on others.
 
+pub mod evaluation;
+
 use std::path::PathBuf;
 
 use super::{
@@ -10,8 +12,6 @@ use crate::analysis::{evaluator, Columns, Split};
 use crate::calibrate::CalibratedParams;
 use crate::classify::{ClassifierChoice, CvParams};
 use crate::error::OptionsError;
-pub mod evaluation;
-
 use crate::options::StageOptions;
 use crate::pipeline::{Method, Pipeline};
 use crate::progress::Progress;
