@@ -697,6 +697,31 @@ impl MethodSamples {
             MethodSamples::Distances(metas, _) | MethodSamples::Spikes(metas, _) => metas,
         }
     }
+
+    /// What `method` makes of the recordings `view` under `encoding`: `extractor`'s feature
+    /// table with the columns `columns`, the spike inputs at `dt_ms` steps, or the van
+    /// Rossum distances, computed by `distances` only when asked for.
+    ///
+    /// # Errors
+    /// A feature method the recordings cannot support, or populations an encoding lacks.
+    pub fn of(
+        (view, encoding, extractor): (&[Encoded], Encoding, &FeatureExtractor),
+        method: MethodChoice,
+        columns: Columns,
+        dt_ms: u32,
+        distances: impl FnOnce() -> Result<Arc<DistanceMatrix>>,
+    ) -> Result<Self> {
+        let metas = || Arc::new(view.iter().map(|e| e.meta.clone()).collect::<Vec<_>>());
+        Ok(match method {
+            MethodChoice::Features(m) => {
+                MethodSamples::Table(Arc::new(FeatureTable::build(view, extractor, m)?), columns)
+            }
+            MethodChoice::VanRossum => MethodSamples::Distances(metas(), distances()?),
+            MethodChoice::Spikes => {
+                MethodSamples::Spikes(metas(), Arc::from(spike_inputs(view, encoding, dt_ms)?))
+            }
+        })
+    }
 }
 
 /// `classifier` on `samples`: KNN over a distance matrix, the spiking network over spike
@@ -729,33 +754,6 @@ pub fn evaluator(classifier: ClassifierChoice, samples: MethodSamples) -> Result
                 .into())
         }
     })
-}
-
-impl MethodSamples {
-    /// What `method` makes of the recordings `view` under `encoding`: `extractor`'s feature
-    /// table with the columns `columns`, the spike inputs at `dt_ms` steps, or the van
-    /// Rossum distances, computed by `distances` only when asked for.
-    ///
-    /// # Errors
-    /// A feature method the recordings cannot support, or populations an encoding lacks.
-    pub fn of(
-        (view, encoding, extractor): (&[Encoded], Encoding, &FeatureExtractor),
-        method: MethodChoice,
-        columns: Columns,
-        dt_ms: u32,
-        distances: impl FnOnce() -> Result<Arc<DistanceMatrix>>,
-    ) -> Result<Self> {
-        let metas = || Arc::new(view.iter().map(|e| e.meta.clone()).collect::<Vec<_>>());
-        Ok(match method {
-            MethodChoice::Features(m) => {
-                MethodSamples::Table(Arc::new(FeatureTable::build(view, extractor, m)?), columns)
-            }
-            MethodChoice::VanRossum => MethodSamples::Distances(metas(), distances()?),
-            MethodChoice::Spikes => {
-                MethodSamples::Spikes(metas(), Arc::from(spike_inputs(view, encoding, dt_ms)?))
-            }
-        })
-    }
 }
 
 #[cfg(test)]
