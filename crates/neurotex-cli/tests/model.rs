@@ -801,3 +801,41 @@ fn train_and_evaluate_choose_the_network_alike() {
     let err = dir.fails(&[&args[..], &["--out", s(&dir.join("never.json"))]].concat());
     assert!(err.contains("evaluated, not trained"), "{err}");
 }
+
+/// `--snn-window-ms` trains on windows: the model file records it (a file trained on whole
+/// recordings has no such key, as before the option existed), the trained network differs
+/// from the whole-recording one, and a window shorter than the network's step is refused
+/// by its flag before anything is written.
+#[test]
+fn the_network_trains_on_windows_when_asked() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let train = |extra: &[&str], out: &Path| {
+        let mut args = vec!["train", "--dataset", s(&ds), "--classifier", "snn"];
+        args.extend(["--snn-hidden", "8", "--snn-epochs", "2", "--out", s(out)]);
+        args.extend(extra);
+        dir.ok(&args);
+        serde_json::from_str::<Value>(&std::fs::read_to_string(out).unwrap()).unwrap()
+    };
+    let whole = train(&[], &dir.join("whole.json"));
+    let windowed = train(&["--snn-window-ms", "300"], &dir.join("windowed.json"));
+    assert!(!whole.to_string().contains("window_ms"), "{whole}");
+    assert!(
+        windowed.to_string().contains("\"window_ms\":300"),
+        "{windowed}"
+    );
+    assert_ne!(whole["network"], windowed["network"]);
+    let never = dir.join("never.json");
+    let args = [
+        "train",
+        "--dataset",
+        s(&ds),
+        "--classifier",
+        "snn",
+        "--out",
+        s(&never),
+    ];
+    let err = dir.fails(&[&args[..], &["--snn-window-ms", "5"]].concat());
+    assert!(err.contains("`snn-window-ms`"), "{err}");
+    assert!(!never.exists());
+}

@@ -129,3 +129,18 @@ def test_python_trains_the_xylo_network_the_cli_trains(sim, sim_dir, tmp_path):
     assert py["network"]["target"] == "xylo" and py["network"]["reset"] == "subtract"
     with pytest.raises(neurotex.errors.ParameterError, match="snn.reset"):
         neurotex.SpikingModel.train(sim, target="xylo", reset="zero", **opts)
+
+
+def test_training_on_windows_gives_the_network_of_the_cli(sim, sim_dir, tmp_path):
+    """`window_ms` trains the network `--snn-window-ms` trains, and records it in the file."""
+    model = neurotex.SpikingModel.train(sim, hidden=8, epochs=2, window_ms=500)
+    model.save(tmp_path / "py.json")
+    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-hidden", "8",
+            "--snn-epochs", "2", "--snn-window-ms", "500", "--out", tmp_path / "cli.json")
+    py = json.loads((tmp_path / "py.json").read_text())
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    assert py["network"] == cli["network"]
+    assert "window_ms" in json.dumps(cli) and "500" in json.dumps(cli)
+    whole = neurotex.SpikingModel.train(sim, hidden=8, epochs=2)
+    whole.save(tmp_path / "whole.json")
+    assert json.loads((tmp_path / "whole.json").read_text())["network"] != py["network"]

@@ -71,6 +71,21 @@ impl SpikeInput {
         &self.events[self.offsets[t] as usize..self.offsets[t + 1] as usize]
     }
 
+    /// Steps `start..start + len` as an input of their own: a training window cut from a
+    /// long slide.
+    ///
+    /// # Panics
+    /// If the steps run past the window (a caller bug).
+    pub fn window(&self, start: usize, len: usize) -> SpikeInput {
+        let offsets = &self.offsets[start..=start + len];
+        let (first, last) = (offsets[0], offsets[len]);
+        SpikeInput {
+            inputs: self.inputs,
+            offsets: offsets.iter().map(|&o| o - first).collect(),
+            events: self.events[first as usize..last as usize].to_vec(),
+        }
+    }
+
     /// Spikes in the window.
     pub fn total(&self) -> usize {
         self.events.len()
@@ -86,5 +101,24 @@ impl SpikeInput {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A window holds the steps it was cut from, and its dense table is those rows.
+    #[test]
+    fn a_window_is_its_steps() {
+        let events = [(0, 1), (1, 0), (1, 2), (3, 1), (3, 1), (4, 2), (6, 0)];
+        let x = SpikeInput::from_events(3, 7, &events);
+        let w = x.window(1, 4);
+        assert_eq!((w.inputs, w.steps(), w.total()), (3, 4, 5));
+        for t in 0..4 {
+            assert_eq!(w.at(t), x.at(1 + t));
+        }
+        assert_eq!(w.dense(), x.dense()[3..15].to_vec());
+        assert_eq!(x.window(0, 7), x);
     }
 }

@@ -51,6 +51,12 @@ pub struct SnnParams {
     /// when float.
     #[serde(skip_serializing_if = "Target::is_float")]
     pub target: Target,
+    /// Train on windows of this many ms, each recording's window drawn anew at each epoch
+    /// from anywhere in it (a recording no longer than the window is taken whole); `None`
+    /// trains on whole recordings. Validation and prediction read whole recordings. Left
+    /// out of model files when absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub window_ms: Option<usize>,
 }
 
 impl Default for SnnParams {
@@ -73,6 +79,7 @@ impl Default for SnnParams {
             recurrent: false,
             reset: Reset::Zero,
             target: Target::Float,
+            window_ms: None,
         }
     }
 }
@@ -123,6 +130,12 @@ impl SnnParams {
             let rule = "the validation share must lie strictly between 0 and 1";
             return Err(ParamError::new("snn-validation", rule, self.validation));
         }
+        if let Some(window) = self.window_ms {
+            if window < self.dt_ms as usize {
+                let rule = "a training window must hold at least one of the network's time steps";
+                return Err(ParamError::new("snn-window-ms", rule, window));
+            }
+        }
         match self.target {
             Target::Float => Ok(self),
             Target::Xylo => self.on_xylo(),
@@ -149,6 +162,11 @@ impl SnnParams {
             *tau = xylo::tau_of(xylo::dash_of(*tau, self.dt_ms), self.dt_ms);
         }
         Ok(self)
+    }
+
+    /// The steps of a training window, when training on windows.
+    pub fn window_steps(&self) -> Option<usize> {
+        self.window_ms.map(|w| w / self.dt_ms as usize)
     }
 
     /// The decay factors `(α, β, κ)` of one step.

@@ -3,6 +3,8 @@
 //! ChaCha stream, and a batch's gradients are summed in recording order whatever thread
 //! computed them, so a seed gives the same network on any number of threads.
 
+use std::borrow::Cow;
+
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -57,7 +59,8 @@ pub fn fit(
         epochs = epoch;
         order.shuffle(&mut rng);
         for batch in order.chunks(params.batch) {
-            let grad = batch_gradient(&net, inputs, y, batch, rule);
+            let seen = seen_inputs(params, inputs, batch, &mut rng);
+            let grad = batch_gradient(&net, &seen, y, batch, rule);
             adam.step(&mut net, &grad);
         }
         let loss = mean_loss(&net, inputs, y, &valid);
@@ -201,20 +204,40 @@ fn kernel_energy(alpha: f64, beta: f64) -> f64 {
     energy
 }
 
-/// The batch's mean gradient: each recording's on some thread, summed in batch order.
+/// What the network is trained on for each recording of `batch`, in batch order: the
+/// recording whole, or with [`SnnParams::window_ms`] a window of that length starting at
+/// a step drawn uniformly (in batch order, from the one stream) among those that fit.
+fn seen_inputs<'a>(
+    params: &SnnParams,
+    inputs: &[&'a SpikeInput],
+    batch: &[usize],
+    rng: &mut ChaCha8Rng,
+) -> Vec<Cow<'a, SpikeInput>> {
+    let cut = |x: &'a SpikeInput, rng: &mut ChaCha8Rng| match params.window_steps() {
+        Some(len) if len > 0 && len < x.steps() => {
+            Cow::Owned(x.window(rng.gen_range(0..=x.steps() - len), len))
+        }
+        _ => Cow::Borrowed(x),
+    };
+    batch.iter().map(|&i| cut(inputs[i], rng)).collect()
+}
+
+/// The batch's mean gradient over `seen` (the batch's inputs, in batch order): each
+/// recording's on some thread, summed in batch order.
 fn batch_gradient(
     net: &Network,
-    inputs: &[&SpikeInput],
+    seen: &[Cow<'_, SpikeInput>],
     y: &[usize],
     batch: &[usize],
     rule: Backprop,
 ) -> Gradient {
     let weight = 1.0 / batch.len() as f64;
-    let parts: Vec<Gradient> = batch
+    let parts: Vec<Gradient> = seen
         .par_iter()
-        .map_init(Trajectory::default, |tr, &i| {
+        .zip(batch)
+        .map_init(Trajectory::default, |tr, (x, &i)| {
             let mut g = Gradient::zeros(net);
-            loss_and_gradient(net, inputs[i], y[i], rule, weight, tr, &mut g);
+            loss_and_gradient(net, x, y[i], rule, weight, tr, &mut g);
             g
         })
         .collect();
@@ -297,15 +320,16 @@ mod tests {
 
     /// Two classes told apart by which input fires: the network learns them, and the same
     /// seed gives the same network on one thread and on several.
-    #[test]
-    fn learns_a_separable_task_deterministically() {
+    /// `n` recordings of `steps` steps, two classes told apart by which two of four inputs
+    /// fire more.
+    fn two_class_task(n: usize, steps: u32) -> (Vec<SpikeInput>, Vec<usize>) {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let mut data = Vec::new();
         let mut y = Vec::new();
-        for k in 0..40 {
+        for k in 0..n {
             let class = k % 2;
             let mut events = Vec::new();
-            for t in 0..50u32 {
+            for t in 0..steps {
                 for i in 0..4u32 {
                     let rate = if (i < 2) == (class == 0) { 0.3 } else { 0.05 };
                     if rng.gen_bool(rate) {
@@ -313,19 +337,23 @@ mod tests {
                     }
                 }
             }
-            data.push(SpikeInput::from_events(4, 50, &events));
+            data.push(SpikeInput::from_events(4, steps as usize, &events));
             y.push(class);
         }
-        let refs: Vec<&SpikeInput> = data.iter().collect();
-        let params = SnnParams {
-            hidden: 16,
-            epochs: 30,
-            ..SnnParams::default()
-        };
-        let (net, log) = fit(&params, &refs, &y, 2).unwrap();
+        (data, y)
+    }
+
+    /// `net`, trained with `params`, tells at least 36 of the 40 recordings of
+    /// [`two_class_task`] apart, and training on one thread gives it bit for bit.
+    fn learned_alike_on_one_thread(
+        params: &SnnParams,
+        refs: &[&SpikeInput],
+        y: &[usize],
+        (net, log): (&Network, TrainingLog),
+    ) {
         let correct = refs
             .iter()
-            .zip(&y)
+            .zip(y)
             .filter(|(x, &c)| {
                 let s = net.scores(x);
                 (s[1] > s[0]) == (c == 1)
@@ -336,9 +364,61 @@ mod tests {
             .num_threads(1)
             .build()
             .unwrap();
-        let (again, _) = one.install(|| fit(&params, &refs, &y, 2)).unwrap();
-        assert_eq!(again, net);
+        let (again, _) = one.install(|| fit(params, refs, y, 2)).unwrap();
+        assert_eq!(&again, net);
+    }
+
+    #[test]
+    fn learns_a_separable_task_deterministically() {
+        let (data, y) = two_class_task(40, 50);
+        let refs: Vec<&SpikeInput> = data.iter().collect();
+        let params = SnnParams {
+            hidden: 16,
+            epochs: 30,
+            ..SnnParams::default()
+        };
+        let (net, log) = fit(&params, &refs, &y, 2).unwrap();
+        learned_alike_on_one_thread(&params, &refs, &y, (&net, log));
         assert!(log.best_epoch >= 1 && log.epochs <= 30);
+    }
+
+    /// Training on windows: a window no shorter than every recording trains on them whole
+    /// (the same network bit for bit), short windows still learn the task, and a seed
+    /// gives one network on any number of threads.
+    #[test]
+    fn windows_train_on_parts_of_each_recording() {
+        let (data, y) = two_class_task(40, 50);
+        let refs: Vec<&SpikeInput> = data.iter().collect();
+        let whole = SnnParams {
+            hidden: 16,
+            epochs: 30,
+            ..SnnParams::default()
+        };
+        let long = SnnParams {
+            window_ms: Some(50 * whole.dt_ms as usize),
+            ..whole
+        };
+        assert_eq!(
+            fit(&whole, &refs, &y, 2).unwrap(),
+            fit(&long, &refs, &y, 2).unwrap()
+        );
+        let short = SnnParams {
+            window_ms: Some(10 * whole.dt_ms as usize),
+            ..whole
+        };
+        let (net, log) = fit(&short, &refs, &y, 2).unwrap();
+        assert_ne!(net, fit(&whole, &refs, &y, 2).unwrap().0);
+        learned_alike_on_one_thread(&short, &refs, &y, (&net, log));
+    }
+
+    #[test]
+    fn a_window_shorter_than_a_step_is_refused() {
+        let p = SnnParams {
+            window_ms: Some(5),
+            ..SnnParams::default()
+        };
+        let err = p.check().unwrap_err().to_string();
+        assert!(err.contains("snn-window-ms"), "{err}");
     }
 
     #[test]

@@ -1088,6 +1088,7 @@ class SpikingModel(Model):
         tau_syn_ms: float = _SNN_DEFAULTS["tau_syn_ms"],
         tau_mem_ms: float = _SNN_DEFAULTS["tau_mem_ms"],
         tau_out_ms: float = _SNN_DEFAULTS["tau_out_ms"],
+        window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -1103,12 +1104,15 @@ class SpikingModel(Model):
         the network runs: ``"float"`` or ``"xylo"`` (trained within Xylo Audio 2's limits,
         predicting in the chip's integers; ``--snn-target``); ``tau_syn_ms``, ``tau_mem_ms``
         and ``tau_out_ms`` are the hidden neurons' synaptic and membrane time constants and
-        the readout's (``--snn-tau-*-ms``; moved to the chip's decays with Xylo).
+        the readout's (``--snn-tau-*-ms``; moved to the chip's decays with Xylo);
+        ``window_ms`` trains on windows of that many ms drawn anew at each epoch from
+        anywhere in each recording (``--snn-window-ms``; ``None``: whole recordings).
         ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
         :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
                "seed": seed, "recurrent": recurrent, "target": target,
-               "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms}
+               "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms,
+               "window_ms": window_ms}
         if reset is not None:
             snn["reset"] = reset
         folder = _folder(recordings)
