@@ -318,8 +318,6 @@ mod tests {
         assert!((kernel_energy(a, b) - direct).abs() < 1e-9 * direct);
     }
 
-    /// Two classes told apart by which input fires: the network learns them, and the same
-    /// seed gives the same network on one thread and on several.
     /// `n` recordings of `steps` steps, two classes told apart by which two of four inputs
     /// fire more.
     fn two_class_task(n: usize, steps: u32) -> (Vec<SpikeInput>, Vec<usize>) {
@@ -368,6 +366,8 @@ mod tests {
         assert_eq!(&again, net);
     }
 
+    /// Two classes told apart by which input fires: the network learns them, and the same
+    /// seed gives the same network on one thread and on several.
     #[test]
     fn learns_a_separable_task_deterministically() {
         let (data, y) = two_class_task(40, 50);
