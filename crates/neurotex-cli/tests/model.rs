@@ -804,8 +804,8 @@ fn train_and_evaluate_choose_the_network_alike() {
 
 /// `--snn-window-ms` trains on windows: the model file records it (a file trained on whole
 /// recordings has no such key, as before the option existed), the trained network differs
-/// from the whole-recording one, and a window shorter than the network's step is refused
-/// by its flag before anything is written.
+/// from the whole-recording one, `evaluate` says it, and a window shorter than the
+/// network's step is refused by its flag, with the step, before anything is written.
 #[test]
 fn the_network_trains_on_windows_when_asked() {
     let dir = Dir::new();
@@ -837,5 +837,25 @@ fn the_network_trains_on_windows_when_asked() {
     ];
     let err = dir.fails(&[&args[..], &["--snn-window-ms", "5"]].concat());
     assert!(err.contains("`snn-window-ms`"), "{err}");
+    assert!(err.contains("under one step of 10 ms"), "{err}");
     assert!(!never.exists());
+    let evaluate = [
+        "evaluate",
+        "--dataset",
+        s(&ds),
+        "--classifier",
+        "snn",
+        "--folds",
+        "2",
+    ];
+    let knobs = [
+        "--snn-hidden",
+        "8",
+        "--snn-epochs",
+        "2",
+        "--snn-window-ms",
+        "300",
+    ];
+    let said = dir.ok(&[&evaluate[..], &knobs].concat());
+    assert!(said.contains("trained on 300 ms windows"), "{said}");
 }

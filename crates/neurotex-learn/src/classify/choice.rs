@@ -136,6 +136,9 @@ impl fmt::Display for ClassifierChoice {
                     p.readout.name(),
                     p.seed
                 )?;
+                if let Some(window) = p.window_ms {
+                    write!(f, ", trained on {window} ms windows")?;
+                }
                 if p.target == crate::snn::Target::Xylo {
                     write!(
                         f,

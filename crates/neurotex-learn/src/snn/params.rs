@@ -133,7 +133,8 @@ impl SnnParams {
         if let Some(window) = self.window_ms {
             if window < self.dt_ms as usize {
                 let rule = "a training window must hold at least one of the network's time steps";
-                return Err(ParamError::new("snn-window-ms", rule, window));
+                let got = format!("{window} ms, under one step of {} ms", self.dt_ms);
+                return Err(ParamError::new("snn-window-ms", rule, got));
             }
         }
         match self.target {

@@ -270,6 +270,13 @@ impl CompareOptions {
             indices.len(),
             params.protocol
         )));
+        let snn = set
+            .classifiers
+            .iter()
+            .find(|c| matches!(c, ClassifierChoice::Snn(_)));
+        if let Some(snn) = snn.filter(|_| set.methods.contains(&MethodChoice::Spikes)) {
+            on(Progress::Say(&format!("snn: {snn}")));
+        }
         let comparison = compare_with_progress(&candidates, &params, on)?;
         if !params.nested {
             on(Progress::Say(
