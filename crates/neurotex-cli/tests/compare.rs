@@ -7,7 +7,7 @@ use crate::util::{s, Dir};
 
 /// `{"results": [{"encoding", "method", "classifier", "accuracy", "ci": [lo, hi],
 /// "p_vs_paper"}, ...], "best": {...}}`, ranked, each accuracy inside its interval.
-fn has_the_issues_shape(v: &Value) {
+fn has_the_documented_shape(v: &Value) {
     let results = v["results"].as_array().unwrap();
     for r in results {
         for key in [
@@ -56,7 +56,7 @@ fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
     // 2 encodings x (the paper's taxel method with KNN, 5 feature methods x 3 classifiers,
     // van Rossum with KNN)
     assert_eq!(results.len(), 34);
-    has_the_issues_shape(&v);
+    has_the_documented_shape(&v);
     // The paper's method at each speed is exactly what `evaluate` gives with the same folds.
     let paper = results.iter().find(|r| r["paper"] == true).unwrap();
     assert_eq!(paper["p_vs_paper"], Value::Null);
@@ -166,7 +166,7 @@ fn baselines_without_spikes_join_the_ranking_on_the_same_folds() {
         "--json",
     ]);
     let v: Value = serde_json::from_str(&text).unwrap();
-    has_the_issues_shape(&v);
+    has_the_documented_shape(&v);
     let mut names: Vec<String> = v["results"]
         .as_array()
         .unwrap()
@@ -412,4 +412,33 @@ fn the_spiking_network_options_are_checked() {
         ],
         &out,
     );
+}
+
+/// Pooled cross-validation over several speeds says so and names the per-speed and
+/// held-out protocols; within each speed it says nothing of the kind.
+#[test]
+fn pooling_speeds_is_said_with_the_protocols_that_separate_them() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0, 20.0], 4);
+    let args = [
+        "compare",
+        "--dataset",
+        s(&ds),
+        "--methods",
+        "rates",
+        "--classifiers",
+    ];
+    let args = [&args[..], &["linear", "--encodings", "sa", "--folds", "2"]].concat();
+    let pooled = dir.run(&args);
+    assert!(pooled.status.success(), "{}", pooled.stderr);
+    let note = "recordings at 2 speeds are cross-validated together";
+    assert!(pooled.stderr.contains(note), "{}", pooled.stderr);
+    assert!(
+        pooled.stderr.contains("--per speed_mm_s"),
+        "{}",
+        pooled.stderr
+    );
+    let per = dir.run(&[&args[..], &["--per", "speed_mm_s"]].concat());
+    assert!(per.status.success(), "{}", per.stderr);
+    assert!(!per.stderr.contains(note), "{}", per.stderr);
 }

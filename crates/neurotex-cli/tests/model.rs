@@ -859,3 +859,18 @@ fn the_network_trains_on_windows_when_asked() {
     let said = dir.ok(&[&evaluate[..], &knobs].concat());
     assert!(said.contains("trained on 300 ms windows"), "{said}");
 }
+
+/// A folder given to `predict` where recordings are expected is named as a folder, with
+/// the two ways to give it.
+#[test]
+fn predict_on_a_folder_says_how_to_give_it() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 3);
+    let model = dir.join("m.json");
+    dir.ok(&["train", "--dataset", s(&ds), "--out", s(&model)]);
+    let out = dir.join("p.csv");
+    let err = dir.fails(&["predict", "--model", s(&model), s(&ds), "--out", s(&out)]);
+    assert!(err.contains("a folder, not a recording"), "{err}");
+    assert!(err.contains("--dataset"), "{err}");
+    assert!(!out.exists());
+}

@@ -216,6 +216,11 @@ fn read_samples(path: &Path, format: &CsvFormat) -> Result<RawSamples> {
             let finite = all_finite(&raw);
             Ok((shape, raw, times_s, finite))
         }
+        _ if path.is_dir() => Err(DataError::invalid(
+            path,
+            "a folder, not a recording: give its recordings (FOLDER/*.csv, FOLDER/*.npy), or a dataset folder with --dataset",
+        )
+        .into()),
         _ => Err(DataError::invalid(
             path,
             "unsupported recording format: expected a .npy or .csv file",

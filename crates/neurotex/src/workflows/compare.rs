@@ -277,6 +277,13 @@ impl CompareOptions {
         if let Some(snn) = snn.filter(|_| set.methods.contains(&MethodChoice::Spikes)) {
             on(Progress::Say(&format!("snn: {snn}")));
         }
+        let speeds = Speed::distinct(indices.iter().filter_map(|&i| dataset.entries[i].speed()));
+        if matches!(params.protocol, Protocol::Pooled) && speeds.len() > 1 {
+            on(Progress::Say(&format!(
+                "note: recordings at {} speeds are cross-validated together, so each texture's features vary with speed as well; --per speed_mm_s compares within each speed (as the paper does), --hold-out speed_mm_s on speeds not trained on",
+                speeds.len()
+            )));
+        }
         let comparison = compare_with_progress(&candidates, &params, on)?;
         if !params.nested {
             on(Progress::Say(
