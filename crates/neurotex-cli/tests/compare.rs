@@ -442,3 +442,29 @@ fn pooling_speeds_is_said_with_the_protocols_that_separate_them() {
     assert!(per.status.success(), "{}", per.stderr);
     assert!(!per.stderr.contains(note), "{}", per.stderr);
 }
+
+/// The text ranking names its columns, says why a difference from the paper's method is
+/// missing, and with nested selection its caveat points at the estimate it gave.
+#[test]
+fn the_text_ranking_names_its_columns_and_its_caveat_fits_the_protocol() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 6);
+    let args = ["compare", "--dataset", s(&ds), "--methods", "rates"];
+    let args = [&args[..], &["--classifiers", "linear", "--encodings", "sa"]].concat();
+    let nested = dir.ok(&[&args[..], &["--folds", "2", "--nested"]].concat());
+    assert!(
+        nested.contains("accuracy [95% CI]") && nested.contains("vs paper (paired test)"),
+        "{nested}"
+    );
+    assert!(nested.contains("not among the candidates"), "{nested}");
+    assert!(nested.contains("nested selection: "), "{nested}");
+    assert!(
+        !nested.contains("when nested selection is asked for"),
+        "{nested}"
+    );
+    let plain = dir.ok(&[&args[..], &["--folds", "2"]].concat());
+    assert!(
+        plain.contains("when nested selection is asked for"),
+        "{plain}"
+    );
+}

@@ -216,11 +216,17 @@ pub struct Comparison {
     pub notes: Vec<String>,
 }
 
-/// The caveat every comparison carries.
+/// The caveat every comparison without nested selection carries.
 pub const CAVEAT: &str = "the best of several candidates chosen on the same recordings \
     scores higher than it will on new recordings of the same kind; the nested estimate \
     (selection inside each training set, computed when nested selection is asked for) is the \
     one to quote for the chosen procedure";
+
+/// The caveat of a comparison with nested selection.
+pub const CAVEAT_NESTED: &str = "the best of several candidates chosen on the same \
+    recordings scores higher than it will on new recordings of the same kind; the nested \
+    estimate (selection inside each training set) is the one to quote for the chosen \
+    procedure";
 
 /// One candidate's scores under the protocol.
 struct Scored {
@@ -307,8 +313,11 @@ pub fn compare_with_progress(
         majority,
         best: results[0].clone(),
         results,
+        caveat: match nested {
+            Some(_) => CAVEAT_NESTED.into(),
+            None => CAVEAT.into(),
+        },
         nested,
-        caveat: CAVEAT.into(),
         notes,
     })
 }

@@ -56,11 +56,17 @@ pub fn markdown(c: &Comparison) -> String {
         out.push_str(BASELINES_NOTE);
     }
     if !c.results.iter().any(|r| r.paper) {
-        out.push_str("\nThe paper's method (sa / glcm3d / knn) is not among the candidates, so no difference from it is given.\n");
+        out.push_str(&format!("\n{NO_PAPER}\n"));
     }
     out.push_str(&format!("\nCaveat: {}.\n", c.caveat));
     out
 }
+
+/// The heading of the candidates' column.
+const CANDIDATE: &str = "encoding / method / classifier";
+
+/// Why the ranking has no difference from the paper's method.
+const NO_PAPER: &str = "The paper's method (sa / glcm3d / knn) is not among the candidates, so no difference from it is given (-).";
 
 /// What the encoding `none` means, under a ranking that holds it.
 const BASELINES_NOTE: &str = "\nEncoding `none`: baselines without spikes, computed from the conditioned signal the encoder receives (resampled to 1 kHz, baseline removed, low-pass filtered, divided by the recording's maximum): `spectrum` is the same transform and bands as the spike method's applied to each taxel's signal, `signal-stats` each taxel's moments, quantiles and turns per second. They tell what the spikes cost or gain against the signal.\n";
@@ -79,8 +85,13 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
         .results
         .iter()
         .map(|r| r.encoding.len() + r.method.len() + r.classifier.len() + 6)
+        .chain([CANDIDATE.len()])
         .max()
         .unwrap_or(0);
+    lines.push(format!(
+        "{:>3}  {:<width$}  {:<24} {:<28} {:>9}",
+        "", CANDIDATE, "accuracy [95% CI]", "vs paper (paired test)", "time"
+    ));
     for (i, r) in c.results.iter().enumerate() {
         let name = format!("{} / {} / {}", r.encoding, r.method, r.classifier);
         lines.push(format!(
@@ -93,6 +104,9 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
     }
     if let Some(n) = &c.nested {
         lines.push(format!("nested selection: {}", nested_text(n)));
+    }
+    if !c.results.iter().any(|r| r.paper) {
+        lines.push(NO_PAPER.to_string());
     }
     lines.push(format!("caveat: {}", c.caveat));
     lines
