@@ -144,3 +144,13 @@ def test_training_on_windows_gives_the_network_of_the_cli(sim, sim_dir, tmp_path
     whole = neurotex.SpikingModel.train(sim, hidden=8, epochs=2)
     whole.save(tmp_path / "whole.json")
     assert json.loads((tmp_path / "whole.json").read_text())["network"] != py["network"]
+    from neurotex.sklearn import SpikingClassifier
+
+    est = SpikingClassifier(hidden=8, epochs=2, window_ms=500).fit(sim.recordings, sim.labels)
+    arrays = neurotex.SpikingModel.train(sim.recordings, sim.labels, hidden=8, epochs=2,
+                                         window_ms=500)
+    est.model_.save(tmp_path / "est.json")
+    arrays.save(tmp_path / "arrays.json")
+    est_file = json.loads((tmp_path / "est.json").read_text())
+    assert est_file["network"] == json.loads((tmp_path / "arrays.json").read_text())["network"]
+    assert "window_ms" in json.dumps(est_file)

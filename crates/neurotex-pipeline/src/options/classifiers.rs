@@ -247,10 +247,11 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         "The hidden neurons' membrane time constant, ms."),
     knob!(Snn "snn", tau_out_ms, "--snn-tau-out-ms", Number, "The readout's time constant, ms."),
     knob!(Snn "snn", window_ms, "--snn-window-ms", Count,
-        "Train on windows of this many ms cut from the training recordings, each drawn \
-         anew at every epoch from anywhere in its recording: an epoch's cost no longer \
-         grows with the slides' length, and the network learns from every part of a slide \
-         [default: whole recordings]. Validation and prediction read whole recordings.",
+        "Train on windows of this many ms (rounded down to whole network steps) cut from \
+         the training recordings, each drawn anew at every epoch from anywhere in its \
+         recording: an epoch's cost no longer grows with the slides' length, and the network \
+         learns from every part of a slide [default: whole recordings]. Validation and \
+         prediction read whole recordings.",
         get: shown_some, set: some_count),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \

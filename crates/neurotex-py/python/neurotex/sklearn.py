@@ -290,7 +290,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     ``baseline=dataset.baseline``) and trains
     ``hidden`` LIF neurons with time steps of ``dt_ms`` for at most ``epochs`` passes, early
     stopping on 20 % of each class of ``X``, seeded by ``seed``; ``recurrent`` and
-    ``reset`` (``"zero"`` or ``"subtract"``) and ``target`` (``"float"`` or ``"xylo"``) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
+    ``reset`` (``"zero"`` or ``"subtract"``), ``target`` (``"float"`` or ``"xylo"``) and
+    ``window_ms`` (train on windows of that many ms) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
     it to NIR)."""
 
@@ -304,6 +305,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         recurrent: bool = _SNN_DEFAULTS["recurrent"],
         reset: Optional[str] = None,
         target: str = _SNN_DEFAULTS["target"],
+        window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
@@ -318,6 +320,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.recurrent = recurrent
         self.reset = reset
         self.target = target
+        self.window_ms = window_ms
         self.encoding = encoding
         self.gain = gain
         self.baseline = baseline
@@ -338,7 +341,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.model_ = SpikingModel.train(
             X, [str(label) for label in y], fs=self.fs, hidden=self.hidden,
             dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
-            recurrent=self.recurrent, reset=self.reset, target=self.target, causal=self.causal, encoding=self.encoding, gain=self.gain,
+            recurrent=self.recurrent, reset=self.reset, target=self.target,
+            window_ms=self.window_ms, causal=self.causal, encoding=self.encoding, gain=self.gain,
             baseline=self.baseline,
         )
         # the network's outputs (labels as text) -> columns in classes_ order
