@@ -804,8 +804,9 @@ fn train_and_evaluate_choose_the_network_alike() {
 
 /// `--snn-window-ms` trains on windows: the model file records it (a file trained on whole
 /// recordings has no such key, as before the option existed), the trained network differs
-/// from the whole-recording one, `evaluate` says it, and a window shorter than the
-/// network's step is refused by its flag, with the step, before anything is written.
+/// from the whole-recording one, `evaluate` says it (and that a window under five membrane
+/// time constants is mostly the neurons' start-up), and a window shorter than the network's
+/// step is refused by its flag, with the step, before anything is written.
 #[test]
 fn the_network_trains_on_windows_when_asked() {
     let dir = Dir::new();
@@ -854,10 +855,18 @@ fn the_network_trains_on_windows_when_asked() {
         "--snn-epochs",
         "2",
         "--snn-window-ms",
-        "300",
+        "150",
     ];
-    let said = dir.ok(&[&evaluate[..], &knobs].concat());
-    assert!(said.contains("trained on 300 ms windows"), "{said}");
+    let run = dir.run(&[&evaluate[..], &knobs].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stdout.contains("trained on 150 ms windows"),
+        "{}",
+        run.stdout
+    );
+    // 150 ms is under five membrane time constants of 40 ms.
+    let note = "under five membrane time constants (200 ms)";
+    assert!(run.stderr.contains(note), "{}", run.stderr);
 }
 
 /// A folder given to `predict` where recordings are expected is named as a folder, with

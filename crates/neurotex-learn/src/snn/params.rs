@@ -170,6 +170,16 @@ impl SnnParams {
         self.window_ms.map(|w| w / self.dt_ms as usize)
     }
 
+    /// What to say of training windows under five membrane time constants: each window
+    /// starts from rest, so the neurons' start-up fills much of it.
+    pub fn short_window(&self) -> Option<String> {
+        let window = self.window_ms? as f64;
+        let floor = 5.0 * self.tau_mem_ms;
+        (window < floor).then(|| format!(
+            "note: training windows of {window} ms are under five membrane time constants ({floor} ms): each window starts from rest, so much of it is the neurons' start-up rather than the texture; windows of a second or more keep the start-up a small part"
+        ))
+    }
+
     /// The decay factors `(α, β, κ)` of one step.
     pub fn decays(&self) -> (f64, f64, f64) {
         let dt = f64::from(self.dt_ms);

@@ -220,6 +220,9 @@ impl TrainOptions {
             median_duration_ms: calibrated.causal.map(|c| c.median_duration_ms),
             ..Provenance::of(dataset, self.speeds.clone())?
         };
+        if let Some(note) = snn.short_window() {
+            on(Progress::Say(&note));
+        }
         on(Progress::Say(&format!(
             "training a {} on {} recordings; {:.0} % of each class held out for early stopping",
             ClassifierChoice::Snn(snn),

@@ -303,7 +303,10 @@ impl EvaluateOptions {
         // classifier over them under the split, the result summarised.
         let samples = spikes.samples(method, columns, &classifier, self.tau_ms)?;
         let all: Vec<usize> = (0..samples.metas().len()).collect();
-        if let ClassifierChoice::Snn(_) = classifier {
+        if let ClassifierChoice::Snn(snn) = classifier {
+            if let Some(note) = snn.short_window() {
+                on(Progress::Say(&note));
+            }
             // Minutes on long slides: one step per fit.
             on(Progress::Stage(
                 "training the spiking network",
