@@ -458,14 +458,7 @@ fn encode_one(
     let signal = params.e9.then(|| {
         SignalRows::of(&rec, &cond, &pipeline.params().features).map_err(|e| e.to_string())
     });
-    let encoded = Encoded {
-        meta: rec.meta.clone(),
-        spikes,
-        fa,
-        resampled: cond.resampled,
-        flat: cond.flat,
-        from_events: false,
-    };
+    let encoded = Encoded::of(&rec, &cond, (spikes, fa));
     let perturbed = perturbed_draws(&rec, &cond, params, i)?
         .into_iter()
         .map(|(spikes, fa)| Encoded {

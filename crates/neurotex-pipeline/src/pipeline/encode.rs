@@ -191,15 +191,8 @@ impl Pipeline {
     /// # Errors
     /// A broken encoder rule.
     fn encode_recording(&self, rec: &Recording, cond: &Conditioned) -> Result<Encoded> {
-        let (spikes, fa) = self.encode_populations(rec, cond)?;
-        Ok(Encoded {
-            meta: rec.meta.clone(),
-            spikes,
-            fa,
-            resampled: cond.resampled,
-            flat: cond.flat,
-            from_events: false,
-        })
+        let populations = self.encode_populations(rec, cond)?;
+        Ok(Encoded::of(rec, cond, populations))
     }
 
     /// Loads and encodes the dataset's recordings `indices` in parallel, calling
@@ -316,4 +309,22 @@ pub fn events_encoded(
         flat: false,
         from_events: true,
     })
+}
+
+impl Encoded {
+    /// The encoder's populations `(first, fa)` of `rec`, conditioned as `cond`.
+    pub fn of(
+        rec: &Recording,
+        cond: &Conditioned,
+        (spikes, fa): (SpikeTrains, Option<SpikeTrains>),
+    ) -> Encoded {
+        Encoded {
+            meta: rec.meta.clone(),
+            spikes,
+            fa,
+            resampled: cond.resampled,
+            flat: cond.flat,
+            from_events: false,
+        }
+    }
 }

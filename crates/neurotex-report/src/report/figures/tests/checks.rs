@@ -91,13 +91,7 @@ pub(crate) fn assert_no_overprint(name: &str, svg: &str) {
         .skip(1)
         .filter_map(|part| {
             let close = part.find('>')?;
-            let content = part[close + 1..part.find("</text>")?]
-                .trim()
-                .replace("&apos;", "'")
-                .replace("&quot;", "\"")
-                .replace("&lt;", "<")
-                .replace("&gt;", ">")
-                .replace("&amp;", "&");
+            let content = unescape(part[close + 1..part.find("</text>")?].trim());
             text_box(&part[..close], &content).map(|b| (content, b))
         })
         .collect();
@@ -121,13 +115,7 @@ pub(crate) fn assert_inside(name: &str, svg: &str) {
         let (Some(close), Some(end)) = (part.find('>'), part.find("</text>")) else {
             continue;
         };
-        let content = part[close + 1..end]
-            .trim()
-            .replace("&apos;", "'")
-            .replace("&quot;", "\"")
-            .replace("&lt;", "<")
-            .replace("&gt;", ">")
-            .replace("&amp;", "&");
+        let content = unescape(part[close + 1..end].trim());
         if let Some((x0, y0, x1, y1)) = text_box(&part[..close], &content) {
             assert!(
                 x0 >= 0.0 && y0 >= 0.0 && x1 <= width && y1 <= height,
@@ -159,4 +147,14 @@ pub(crate) fn assert_png_of(name: &str, svg: &str, png: &[u8]) {
     // the title's band: 6 px margin and a 10 pt line, at 300 dpi
     let title = dark_pixels(&image, (0, image.0), (15, 60));
     assert!(title > 200, "{name}: {title} dark pixels in the title");
+}
+
+/// An SVG text's content with its XML escapes read back (`&amp;` last, so that an escaped
+/// escape stays as written).
+fn unescape(text: &str) -> String {
+    text.replace("&apos;", "'")
+        .replace("&quot;", "\"")
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&amp;", "&")
 }
