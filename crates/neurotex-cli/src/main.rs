@@ -11,8 +11,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use commands::{
-    compare, encode, evaluate, export, features, import, inspect, predict, reproduce, simulate,
-    stream, train,
+    compare, datasets, encode, evaluate, export, features, import, inspect, predict, reproduce,
+    simulate, stream, train,
 };
 
 /// Neuromorphic tactile texture classification: taxel recordings → Izhikevich spikes →
@@ -68,6 +68,13 @@ enum Command {
     /// ("ended_by":"gap") and a new one starts at that next frame. So one wrong stamp (a bit
     /// flip far ahead) costs its own frame, and a jump that stays costs one frame.
     Stream(neurotex::workflows::stream::StreamOptions),
+    /// The public datasets neurotex has recipes for: list, check, fetch from a local copy
+    /// (checksums verified, imported once), their folder in the cache.
+    #[command(subcommand)]
+    Datasets(neurotex::workflows::datasets::DatasetsCommand),
+    /// The public datasets' leaderboard: under each protocol of each recipe, a fixed
+    /// candidate set compared with nested selection, the published results beside it.
+    Benchmark(neurotex::workflows::benchmark::BenchmarkOptions),
     /// Import CSV logs or stacked arrays into a dataset folder.
     #[command(subcommand)]
     Import(import::ImportCommand),
@@ -115,6 +122,8 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => reproduce::run(args),
         Command::Stream(args) => stream::run(args),
         Command::Import(command) => import::run(command),
+        Command::Datasets(command) => datasets::run(command),
+        Command::Benchmark(options) => datasets::benchmark(options),
         Command::Export(command) => export::run(command),
     };
     match result {

@@ -40,3 +40,5 @@ pub use neurotex_sim::sim;
 pub use neurotex_stream as stream;
 
 pub mod workflows;
+
+pub use workflows::datasets;

@@ -4,6 +4,7 @@
 
 mod calibration;
 mod classifiers;
+mod datasets;
 mod docs_numbers;
 mod e9;
 mod extensions;

@@ -3,6 +3,7 @@
 //! a progress bar, and writes or prints the result.
 
 pub mod compare;
+pub mod datasets;
 pub mod encode;
 pub mod evaluate;
 pub mod export;

@@ -6,7 +6,9 @@
 //! [`Progress`] callback, which the command line shows on standard error and Python turns
 //! into warnings.
 
+pub mod benchmark;
 pub mod compare;
+pub mod datasets;
 pub mod encode;
 pub mod evaluate;
 pub mod export;

@@ -1,0 +1,236 @@
+//! `benchmark`: the public datasets' leaderboards. Each dataset is fetched by its recipe,
+//! and under each protocol the recipe names a fixed, versioned candidate set is compared
+//! with nested selection, exactly as `compare --nested` compares it; the leaderboard sets
+//! the published results beside ours. A finished dataset x protocol is kept, and a rerun
+//! with the same settings reuses it.
+
+mod leaderboard;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::compare::CompareOptions;
+use super::{KnnOptions, OnProgress, OpenOptions, SnnOptions};
+use crate::compare::candidates::{
+    STANDARD_CLASSIFIERS, STANDARD_ENCODINGS, STANDARD_METHODS, STANDARD_TAU_MS,
+};
+use crate::compare::Comparison;
+use crate::datasets::{self, Published, Recipe};
+use crate::error::DataError;
+use crate::io::write_atomic;
+use crate::options::StageOptions;
+use crate::progress::Progress;
+use crate::Result;
+
+pub use leaderboard::{markdown, Board, Leaderboard};
+
+/// The version of the candidate set below: raised whenever it changes, so that a kept result
+/// of another set is never reused or compared as if it were the same.
+pub const CANDIDATE_SET_VERSION: u32 = 1;
+
+/// The candidate set, written down: `compare`'s standard encodings and the baselines
+/// without spikes (`none`), its standard methods and the spike counts (`rates`), its
+/// standard classifiers; `--snn` adds the spiking network on the spike trains.
+pub fn candidate_set(snn: bool) -> (String, String, String) {
+    let methods = match snn {
+        true => format!("{STANDARD_METHODS},rates,spikes"),
+        false => format!("{STANDARD_METHODS},rates"),
+    };
+    let classifiers = match snn {
+        true => format!("{STANDARD_CLASSIFIERS},snn"),
+        false => STANDARD_CLASSIFIERS.to_string(),
+    };
+    (format!("{STANDARD_ENCODINGS},none"), methods, classifiers)
+}
+
+/// Options of `neurotex benchmark`.
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
+pub struct BenchmarkOptions {
+    /// Datasets: built-in recipes by name (`neurotex datasets list`) or recipe files.
+    #[cfg_attr(feature = "cli", arg(required = true))]
+    pub datasets: Vec<String>,
+    /// The folder to write leaderboard.md, leaderboard.json and, per dataset and protocol,
+    /// the comparison (compare.json, compare.md, figures). A rerun into it keeps what is
+    /// finished.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub out: PathBuf,
+    /// The cache of fetched datasets (default: $NEUROTEX_CACHE, else
+    /// $XDG_CACHE_HOME/neurotex, else ~/.cache/neurotex).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub cache: Option<PathBuf>,
+    /// A local copy of the sources of a dataset not yet in the cache (one dataset only): a
+    /// folder of the downloaded files, or the unpacked folder a recipe's tree digest checks.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub from: Option<PathBuf>,
+    /// Also the spiking network with its defaults (method `spikes`; slow on long slides).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub snn: bool,
+    /// Cross-validation folds.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().folds))]
+    pub folds: usize,
+    /// Cross-validation repeats.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().repeats))]
+    pub repeats: usize,
+    /// Seed of the folds, the bootstrap and the tests.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = 0))]
+    pub seed: u64,
+}
+
+/// What decides one dataset x protocol's result: a kept result is reused only under the
+/// same key.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Key {
+    recipe: String,
+    import_digest: String,
+    protocol: String,
+    candidate_set: u32,
+    snn: bool,
+    folds: usize,
+    repeats: usize,
+    seed: u64,
+    neurotex: String,
+}
+
+impl BenchmarkOptions {
+    /// Fetches every dataset (checking every recipe first), compares under each protocol,
+    /// writes the leaderboard into `--out` and returns it.
+    ///
+    /// # Errors
+    /// A recipe that is not valid, `--from` with several datasets, a dataset that cannot be
+    /// fetched, a comparison that cannot run, or an output that cannot be written.
+    pub fn run(&self, on: OnProgress) -> Result<Leaderboard> {
+        let recipes: Vec<Recipe> = (self.datasets.iter())
+            .map(|d| datasets::resolve(d))
+            .collect::<Result<_>>()?;
+        if self.from.is_some() && recipes.len() > 1 {
+            let why = "--from is the copy of one dataset's sources: benchmark one dataset with it, or fetch each first (`neurotex datasets fetch`)";
+            return Err(crate::error::OptionsError::Conflict(why.into()).into());
+        }
+        let root = datasets::cache_root(self.cache.as_deref())?;
+        let mut boards = Vec::new();
+        for recipe in &recipes {
+            let dataset = datasets::fetch(recipe, &root, self.from.as_deref(), on)?;
+            for (i, protocol) in recipe.protocols.iter().enumerate() {
+                on(Progress::Say(&format!(
+                    "{}: {} ({} of {})",
+                    recipe.name,
+                    protocol.describe(),
+                    i + 1,
+                    recipe.protocols.len()
+                )));
+                let comparison = self.protocol(recipe, &dataset, i, on)?;
+                let published: Vec<Published> = (recipe.published.iter())
+                    .filter(|p| p.beside == protocol.id)
+                    .cloned()
+                    .collect();
+                boards.push(Board::of(recipe, protocol, comparison, published));
+            }
+        }
+        let board = Leaderboard {
+            candidate_set: CANDIDATE_SET_VERSION,
+            seed: self.seed,
+            boards,
+        };
+        board.write(&self.out)?;
+        Ok(board)
+    }
+
+    /// The comparison of `recipe`'s protocol `i` on `dataset`: the kept one under the same
+    /// key, else compared anew and kept.
+    fn protocol(
+        &self,
+        recipe: &Recipe,
+        dataset: &Path,
+        i: usize,
+        on: OnProgress,
+    ) -> Result<Comparison> {
+        let protocol = &recipe.protocols[i];
+        let key = Key {
+            recipe: recipe.name.clone(),
+            import_digest: recipe.import_digest(),
+            protocol: serde_json::to_string(protocol).unwrap_or_default(),
+            candidate_set: CANDIDATE_SET_VERSION,
+            snn: self.snn,
+            folds: self.folds,
+            repeats: self.repeats,
+            seed: self.seed,
+            neurotex: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        let dir = self.out.join(&recipe.name).join(&protocol.id);
+        let key_file = self
+            .out
+            .join(&recipe.name)
+            .join(format!("{}.key.json", protocol.id));
+        if let Some(kept) = kept(&key_file, &dir, &key) {
+            on(Progress::Say(
+                "  kept from an earlier run with the same settings",
+            ));
+            return Ok(kept);
+        }
+        let (encodings, methods, classifiers) = candidate_set(self.snn);
+        let list = |s: String| s.split(',').map(String::from).collect();
+        let options = CompareOptions {
+            dataset: dataset.to_path_buf(),
+            speeds: None,
+            per: protocol.per.clone(),
+            hold_out: protocol.hold_out.clone(),
+            train_where: None,
+            test_where: None,
+            group_by: None,
+            encodings: list(encodings),
+            methods: list(methods),
+            classifiers: list(classifiers),
+            tau_ms: STANDARD_TAU_MS,
+            knn: KnnOptions::default(),
+            snn: SnnOptions::default(),
+            folds: self.folds,
+            repeats: self.repeats,
+            seed: self.seed,
+            nested: true,
+            open: OpenOptions::default(),
+        };
+        let opened = options.open.open(dataset)?;
+        let comparison = options
+            .run(&opened, &StageOptions::default(), on)
+            .map_err(|e| crate::Error::InAnalysis {
+                what: format!("{}, {}", recipe.name, protocol.describe()),
+                source: Box::new(e),
+            })?;
+        // The figures name the dataset by its recipe, not by the cache's folder.
+        let named = Path::new(&recipe.name);
+        crate::report::comparison::write_comparison(&dir, &comparison, named)?;
+        let text = serde_json::to_string_pretty(&key).unwrap_or_default();
+        write_atomic(&key_file, |w| w.write_all(text.as_bytes()))?;
+        Ok(comparison)
+    }
+}
+
+/// The comparison kept in `dir` when its key file holds `key`.
+fn kept(key_file: &Path, dir: &Path, key: &Key) -> Option<Comparison> {
+    let text = std::fs::read_to_string(key_file).ok()?;
+    let found: Key = serde_json::from_str(&text).ok()?;
+    if &found != key {
+        return None;
+    }
+    let json = std::fs::read_to_string(dir.join("compare.json")).ok()?;
+    serde_json::from_str(&json).ok()
+}
+
+impl Leaderboard {
+    /// Writes leaderboard.json and leaderboard.md into `out`.
+    ///
+    /// # Errors
+    /// A file cannot be written.
+    pub fn write(&self, out: &Path) -> Result<()> {
+        std::fs::create_dir_all(out).map_err(|e| DataError::write(out, e))?;
+        let json = serde_json::to_string_pretty(self)
+            .map_err(|e| DataError::invalid(out.join("leaderboard.json"), e.to_string()))?;
+        write_atomic(&out.join("leaderboard.json"), |w| {
+            w.write_all((json + "\n").as_bytes())
+        })?;
+        let md = markdown(self);
+        write_atomic(&out.join("leaderboard.md"), |w| w.write_all(md.as_bytes()))
+    }
+}

@@ -1,0 +1,202 @@
+//! The leaderboard: per dataset and protocol, the nested estimate, the ranked candidates
+//! with their intervals, chance, the paired test against the paper's method, and the
+//! published results beside ours.
+
+use serde::{Deserialize, Serialize};
+
+use super::candidate_set;
+use crate::compare::{Comparison, Ranked};
+use crate::datasets::recipe::ProtocolSpec;
+use crate::datasets::{Published, Recipe};
+
+/// Candidates listed in full per board; the paper's method, the spike counts with logistic
+/// regression and the best baseline without spikes are listed below them when lower.
+const TOP: usize = 10;
+
+/// Every dataset x protocol of one run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Leaderboard {
+    /// The version of the candidate set.
+    pub candidate_set: u32,
+    /// The seed of folds, bootstrap and tests.
+    pub seed: u64,
+    /// One board per dataset and protocol, in the order run.
+    pub boards: Vec<Board>,
+}
+
+/// One dataset under one protocol.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Board {
+    /// The recipe's name.
+    pub dataset: String,
+    /// The recipe's title.
+    pub title: String,
+    /// The data's citation.
+    pub citation: String,
+    /// The data's licence.
+    pub licence: String,
+    /// The protocol's id.
+    pub protocol_id: String,
+    /// The protocol in words.
+    pub protocol: String,
+    /// The comparison, as `compare --nested` gives it.
+    pub comparison: Comparison,
+    /// Results published on the data, shown beside this protocol.
+    pub published: Vec<Published>,
+}
+
+impl Board {
+    /// The board of `recipe` under `protocol`.
+    pub fn of(
+        recipe: &Recipe,
+        protocol: &ProtocolSpec,
+        comparison: Comparison,
+        published: Vec<Published>,
+    ) -> Board {
+        Board {
+            dataset: recipe.name.clone(),
+            title: recipe.title.clone(),
+            citation: recipe.citation.clone(),
+            licence: recipe.licence.clone(),
+            protocol_id: protocol.id.clone(),
+            protocol: protocol.describe(),
+            comparison,
+            published,
+        }
+    }
+}
+
+impl Leaderboard {
+    /// One line per board: the nested estimate, the best candidate and chance.
+    pub fn summary(&self) -> Vec<String> {
+        let line = |b: &Board| {
+            let c = &b.comparison;
+            let nested = c.nested.as_ref().map_or(String::new(), |n| {
+                format!(
+                    "nested {} % [{}, {}]; ",
+                    pct(n.accuracy),
+                    pct(n.ci[0]),
+                    pct(n.ci[1])
+                )
+            });
+            format!(
+                "{} / {}: {nested}best {} {} %; chance {} %",
+                b.dataset,
+                b.protocol_id,
+                name(&c.best),
+                pct(c.best.accuracy),
+                pct(c.chance)
+            )
+        };
+        self.boards.iter().map(line).collect()
+    }
+}
+
+/// A share as a percentage with one decimal.
+fn pct(x: f64) -> String {
+    format!("{:.1}", 100.0 * x)
+}
+
+/// A candidate's name as `compare` writes it, with what it stands for.
+fn name(r: &Ranked) -> String {
+    let role = if r.paper {
+        " (the paper's method)"
+    } else if r.method == "rates" && r.classifier == "linear" {
+        " (spike counts, logistic regression)"
+    } else if r.encoding == "none" {
+        " (no spikes)"
+    } else {
+        ""
+    };
+    format!("{} / {} / {}{role}", r.encoding, r.method, r.classifier)
+}
+
+/// One table row of a ranked candidate.
+fn row(rank: usize, r: &Ranked) -> String {
+    let vs = match (r.difference_vs_paper, r.p_vs_paper) {
+        (Some(d), Some(p)) if p < 0.001 => format!("{:+.1} | < 0.001", 100.0 * d),
+        (Some(d), Some(p)) => format!("{:+.1} | {p:.3}", 100.0 * d),
+        _ => "— | —".to_string(),
+    };
+    format!(
+        "| {rank} | {} | {} | {}–{} | {vs} |",
+        name(r),
+        pct(r.accuracy),
+        pct(r.ci[0]),
+        pct(r.ci[1])
+    )
+}
+
+/// The leaderboard as Markdown.
+pub fn markdown(board: &Leaderboard) -> String {
+    let (encodings, methods, classifiers) = candidate_set(false);
+    let mut s = format!(
+        "# Leaderboard\n\nCandidate set {}: encodings {encodings} (`none`: the baselines without spikes, from the signal the encoder would receive), methods {methods}, classifiers {classifiers} (the spiking network too when run with `--snn`), every pairing `neurotex compare` runs. Each protocol is `neurotex compare --nested` on the recipe's dataset: accuracies are means over the protocol's conditions, with 95 % bootstrap intervals over recordings; Δ and p are against the paper's method (SA, 3D-GLCM, KNN), by the paired sign-flip test. The top candidate of a ranking is chosen on the recordings it is scored on and is biased upwards; the nested estimate (the best chosen inside each training set) is the one to quote. Seed {}.\n",
+        board.candidate_set, board.seed
+    );
+    for b in &board.boards {
+        s.push_str(&section(b));
+    }
+    s
+}
+
+/// One board's section.
+fn section(b: &Board) -> String {
+    let c = &b.comparison;
+    let mut s = format!(
+        "\n## {}: {}\n\n{} ({}; licence {}).\n\n{} recordings, {} classes; chance {} %, majority class {} %.\n\n",
+        b.dataset,
+        b.protocol,
+        b.title,
+        b.citation,
+        b.licence,
+        c.n_recordings,
+        c.classes,
+        pct(c.chance),
+        pct(c.majority)
+    );
+    if let Some(n) = &c.nested {
+        let chosen = n.chosen.first().map_or(String::new(), |(name, times)| {
+            format!(
+                "; chosen most often: {name} ({times} of {} splits)",
+                n.outer_splits
+            )
+        });
+        s.push_str(&format!(
+            "**Nested selection: {} % (95 % interval {}–{} %)**{chosen}.\n\n",
+            pct(n.accuracy),
+            pct(n.ci[0]),
+            pct(n.ci[1])
+        ));
+    }
+    s.push_str("| rank | candidate | accuracy, % | 95 % interval | Δ vs paper, points | p |\n|---|---|---|---|---|---|\n");
+    for (i, r) in c.results.iter().enumerate() {
+        let marked = r.paper
+            || (r.method == "rates" && r.classifier == "linear")
+            || c.results.iter().position(|x| x.encoding == "none") == Some(i);
+        if i < TOP || marked {
+            s.push_str(&row(i + 1, r));
+            s.push('\n');
+        }
+    }
+    if !b.published.is_empty() {
+        s.push_str("\nPublished on these data:\n\n| accuracy, % | who | their method and protocol | the same protocol as above |\n|---|---|---|---|\n");
+        for p in &b.published {
+            let same = match p.same_protocol {
+                true => "yes",
+                false => "no: other splits or conditions, not comparable point for point",
+            };
+            s.push_str(&format!(
+                "| {} | {} | {} | {same} |\n",
+                pct(p.accuracy),
+                p.citation,
+                p.protocol
+            ));
+        }
+    }
+    let dir = format!("{}/{}", b.dataset, b.protocol_id);
+    s.push_str(&format!(
+        "\nEvery candidate, the figures and the notes: [{dir}/compare.md]({dir}/compare.md), ![ranking]({dir}/ranking.png)\n"
+    ));
+    s
+}

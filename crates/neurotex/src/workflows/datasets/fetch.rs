@@ -1,0 +1,322 @@
+//! Fetching a recipe's dataset into the cache: every source found, its checksum verified,
+//! unpacked (no entry outside its folder), imported once, and the whole entry renamed into
+//! place only when all of it succeeded, so that a failure leaves the cache as it was.
+
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use sha2::{Digest, Sha256};
+
+use super::recipe::{hex, Import, Recipe, Source, SourceKind};
+use crate::error::DataError;
+use crate::io::create_dir_atomic;
+use crate::progress::Progress;
+use crate::recording::Dataset;
+use crate::workflows::OnProgress;
+use crate::{Error, Result};
+
+/// The cache folder: `dir` when given, else `$NEUROTEX_CACHE`, else
+/// `$XDG_CACHE_HOME/neurotex`, else `~/.cache/neurotex`.
+///
+/// # Errors
+/// None of them is set.
+pub fn cache_root(dir: Option<&Path>) -> Result<PathBuf> {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
+    if let Some(dir) = dir {
+        return Ok(dir.to_path_buf());
+    }
+    if let Some(dir) = var("NEUROTEX_CACHE") {
+        return Ok(PathBuf::from(dir));
+    }
+    if let Some(xdg) = var("XDG_CACHE_HOME") {
+        return Ok(PathBuf::from(xdg).join("neurotex"));
+    }
+    match var("HOME") {
+        Some(home) => Ok(PathBuf::from(home).join(".cache").join("neurotex")),
+        None => Err(DataError::invalid(
+            "~/.cache",
+            "no cache folder: set NEUROTEX_CACHE or give --cache",
+        )
+        .into()),
+    }
+}
+
+/// The cache entry of `recipe` under `root`: its name and a digest of its sources and
+/// import, so that an edited recipe imports anew.
+pub fn entry(root: &Path, recipe: &Recipe) -> PathBuf {
+    root.join(format!("{}-{}", recipe.name, &recipe.import_digest()[..12]))
+}
+
+/// The imported dataset folder of `recipe` in the cache under `root`, when it was fetched.
+pub fn fetched(root: &Path, recipe: &Recipe) -> Option<PathBuf> {
+    let dir = entry(root, recipe);
+    dir.join(FETCHED).is_file().then(|| dir.join("dataset"))
+}
+
+/// The record of a finished fetch in its cache entry.
+const FETCHED: &str = "fetched.json";
+
+/// Fetches `recipe`'s dataset into the cache under `root` from the local copy `from` (a
+/// folder holding the sources' files by their URLs' names, or unpacked folders checked by
+/// their tree digest; or, for a one-source recipe, the file itself), and returns the
+/// imported dataset folder. A dataset fetched before is reused.
+///
+/// # Errors
+/// No local copy given (neurotex does not download), a source not found in it, a checksum
+/// that does not match, an archive entry outside its folder or a link, an import that fails,
+/// or conditions the data does not have: each naming the recipe and the file.
+pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) -> Result<PathBuf> {
+    if let Some(dataset) = fetched(root, recipe) {
+        on(Progress::Say(&format!(
+            "{}: fetched before, in {}",
+            recipe.name,
+            dataset.display()
+        )));
+        return Ok(dataset);
+    }
+    let Some(from) = from else {
+        let urls: Vec<&str> = recipe.sources.iter().map(|s| s.url.as_str()).collect();
+        return Err(in_recipe(
+            recipe,
+            DataError::invalid(
+                root,
+                format!(
+                    "{} is not in the cache, and neurotex does not download: fetch {} yourself and give the folder with --from",
+                    recipe.name,
+                    urls.join(", ")
+                ),
+            )
+            .into(),
+        ));
+    };
+    let dir = entry(root, recipe);
+    std::fs::create_dir_all(root).map_err(|e| DataError::write(root, e))?;
+    create_dir_atomic(&dir, |tmp| fill(recipe, from, tmp, on)).map_err(|e| in_recipe(recipe, e))?;
+    Ok(dir.join("dataset"))
+}
+
+/// `error` named with the recipe it came from.
+fn in_recipe(recipe: &Recipe, error: Error) -> Error {
+    Error::InAnalysis {
+        what: format!("recipe {}", recipe.name),
+        source: Box::new(error),
+    }
+}
+
+/// Fills the cache entry `tmp`: the sources into `files/`, their import into `dataset/`,
+/// the conditions checked, the record written; `files/` is then removed (the dataset holds
+/// what it needs).
+fn fill(recipe: &Recipe, from: &Path, tmp: &Path, on: OnProgress) -> Result<()> {
+    let files = tmp.join("files");
+    std::fs::create_dir(&files).map_err(|e| DataError::write(&files, e))?;
+    for (i, source) in recipe.sources.iter().enumerate() {
+        on(Progress::Say(&format!(
+            "{}: source {}",
+            recipe.name, source.url
+        )));
+        let work = tmp.join(format!("unpack-{i}"));
+        std::fs::create_dir(&work).map_err(|e| DataError::write(&work, e))?;
+        let used = place(source, recipe.sources.len(), from, &work)?;
+        if let Some(want) = &source.tree_sha256 {
+            let got = tree_digest(&used)?;
+            if &got != want {
+                let why = format!("tree digest {got}, the recipe's tree-sha256 is {want}: not the files the recipe describes");
+                return Err(DataError::invalid(&used, why).into());
+            }
+        }
+        move_into(&used, &files)?;
+        std::fs::remove_dir_all(&work).map_err(|e| DataError::write(&work, e))?;
+    }
+    let dataset = tmp.join("dataset");
+    let import = recipe
+        .import_in(&files)
+        .map_err(|e| DataError::invalid("[import]", e))?;
+    match import {
+        Import::Csv(options) => options.run(&dataset, on).map(|_| ())?,
+        Import::Stacked(options) => options.run(&dataset).map(|_| ())?,
+    }
+    check_conditions(recipe, &Dataset::open(&dataset)?)?;
+    std::fs::remove_dir_all(&files).map_err(|e| DataError::write(&files, e))?;
+    let record = serde_json::json!({
+        "recipe": recipe.name,
+        "import_digest": recipe.import_digest(),
+        "from": from.display().to_string(),
+    });
+    let path = tmp.join(FETCHED);
+    std::fs::write(&path, record.to_string()).map_err(|e| DataError::write(&path, e))?;
+    Ok(())
+}
+
+/// Finds `source` in `from`, verifies it and puts its files under `work`; returns the folder
+/// of the files it contributes (its `folder` inside an archive).
+fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<PathBuf> {
+    let name = source.url.rsplit('/').next().unwrap_or_default();
+    let file = if from.is_file() && n_sources == 1 {
+        Some(from.to_path_buf())
+    } else {
+        Some(from.join(name)).filter(|p| p.is_file())
+    };
+    let Some(file) = file else {
+        if source.tree_sha256.is_some() && from.is_dir() {
+            // An unpacked copy: the folder itself, or the source's folder inside it.
+            let inner = source.folder.as_deref().map(|f| from.join(f));
+            let dir = inner.filter(|d| d.is_dir()).unwrap_or(from.to_path_buf());
+            copy_tree(&dir, work)?;
+            return Ok(work.to_path_buf());
+        }
+        let why = format!("{name} (from {}) is not there", source.url);
+        return Err(DataError::invalid(from, why).into());
+    };
+    if let (Some(size), Some(want)) = (source.size, &source.sha256) {
+        let got_size = std::fs::metadata(&file)
+            .map_err(|reason| DataError::Io {
+                path: file.clone(),
+                reason,
+            })?
+            .len();
+        let got = file_digest(&file)?;
+        if got_size != size || &got != want {
+            let why = format!("{got_size} bytes with SHA-256 {got}; the recipe says {size} bytes with {want}: a different or damaged file");
+            return Err(DataError::invalid(&file, why).into());
+        }
+    }
+    match source.kind {
+        SourceKind::File => {
+            let dest = work.join(name);
+            std::fs::copy(&file, &dest).map_err(|e| DataError::write(&dest, e))?;
+        }
+        SourceKind::Zip | SourceKind::GitArchive => super::unpack::unzip(&file, work)?,
+        SourceKind::TarGz => super::unpack::untar_gz(&file, work)?,
+    }
+    match &source.folder {
+        Some(folder) => {
+            let dir = work.join(folder);
+            if !dir.is_dir() {
+                let why = format!("the archive has no folder {folder}");
+                return Err(DataError::invalid(&file, why).into());
+            }
+            Ok(dir)
+        }
+        None => Ok(work.to_path_buf()),
+    }
+}
+
+/// The SHA-256 of `path`'s content, in hex.
+pub fn file_digest(path: &Path) -> Result<String> {
+    let io = |reason| DataError::Io {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let mut file = File::open(path).map_err(io)?;
+    let mut hasher = Sha256::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = file.read(&mut buf).map_err(io)?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    Ok(hex(&hasher.finalize()))
+}
+
+/// The tree digest of folder `dir`: the SHA-256 of `sha256sum`'s lines (`HASH  PATH`) for
+/// every regular file under it, paths relative to `dir` with `/`, sorted bytewise; the
+/// same as `(cd DIR && find . -type f | sed 's|^\./||' | LC_ALL=C sort | xargs -d '\n'
+/// sha256sum) | sha256sum`.
+///
+/// # Errors
+/// A file cannot be read, or the folder holds a link (a tree is plain files and folders).
+pub fn tree_digest(dir: &Path) -> Result<String> {
+    let mut paths = Vec::new();
+    walk(dir, "", &mut paths)?;
+    paths.sort();
+    let mut lines = String::new();
+    for rel in &paths {
+        lines.push_str(&format!("{}  {rel}\n", file_digest(&dir.join(rel))?));
+    }
+    Ok(hex(&Sha256::digest(lines.as_bytes())))
+}
+
+/// Collects the relative paths of the regular files under `dir/rel`.
+fn walk(dir: &Path, rel: &str, out: &mut Vec<String>) -> Result<()> {
+    let here = dir.join(rel);
+    let io = |reason| DataError::Io {
+        path: here.clone(),
+        reason,
+    };
+    for item in std::fs::read_dir(&here).map_err(io)? {
+        let item = item.map_err(io)?;
+        let name = item.file_name().to_string_lossy().into_owned();
+        let path = if rel.is_empty() {
+            name
+        } else {
+            format!("{rel}/{name}")
+        };
+        let kind = item.file_type().map_err(io)?;
+        if kind.is_dir() {
+            walk(dir, &path, out)?;
+        } else if kind.is_file() {
+            out.push(path);
+        } else {
+            let why = "a link or special file: a dataset's tree holds plain files and folders";
+            return Err(DataError::invalid(dir.join(&path), why).into());
+        }
+    }
+    Ok(())
+}
+
+/// Copies the plain files and folders under `from` into `to`.
+fn copy_tree(from: &Path, to: &Path) -> Result<()> {
+    let mut paths = Vec::new();
+    walk(from, "", &mut paths)?;
+    for rel in paths {
+        let dest = to.join(&rel);
+        if let Some(parent) = dest.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| DataError::write(parent, e))?;
+        }
+        std::fs::copy(from.join(&rel), &dest).map_err(|e| DataError::write(&dest, e))?;
+    }
+    Ok(())
+}
+
+/// Moves what `from` holds into the folder `to`; two sources giving the same name is an
+/// error, never one file replacing another.
+fn move_into(from: &Path, to: &Path) -> Result<()> {
+    let io = |reason| DataError::Io {
+        path: from.to_path_buf(),
+        reason,
+    };
+    for item in std::fs::read_dir(from).map_err(io)? {
+        let item = item.map_err(io)?;
+        let dest = to.join(item.file_name());
+        if dest.symlink_metadata().is_ok() {
+            let why = "two sources hold this name";
+            return Err(DataError::invalid(&dest, why).into());
+        }
+        std::fs::rename(item.path(), &dest).map_err(|e| DataError::write(&dest, e))?;
+    }
+    Ok(())
+}
+
+/// Every value the recipe's `[conditions]` lists is in the dataset's manifest column.
+fn check_conditions(recipe: &Recipe, dataset: &Dataset) -> Result<()> {
+    for (column, values) in &recipe.conditions {
+        let have: Vec<String> = (dataset.entries.iter())
+            .filter_map(|m| m.field(column))
+            .collect();
+        for value in values {
+            if !have.iter().any(|h| h == value || same_number(h, value)) {
+                let why = format!("[conditions] {column} = {value}: no recording has it (the recipe's conditions must be in the data)");
+                return Err(DataError::invalid(&dataset.root, why).into());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether two values are the same number (`10` and `10.0`).
+fn same_number(a: &str, b: &str) -> bool {
+    matches!((a.parse::<f64>(), b.parse::<f64>()), (Ok(x), Ok(y)) if x == y)
+}

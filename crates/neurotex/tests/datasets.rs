@@ -1,0 +1,508 @@
+//! Dataset recipes, fetching into the cache, and the benchmark: recipes refused with their
+//! key named; fabricated archives (headerless CSV logs in a zip, a stacked array in a
+//! tar.gz) fetched, verified and imported; a damaged or hostile archive refused with the
+//! cache left as it was; the tree digest against coreutils' `sha256sum`; and the
+//! leaderboard equal to `compare --nested` on the same folds.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use neurotex::datasets::{self, fetch, tree_digest, Recipe};
+use neurotex::options::StageOptions;
+use neurotex::progress::silent;
+use neurotex::workflows::benchmark::BenchmarkOptions;
+use neurotex::workflows::compare::CompareOptions;
+use neurotex::workflows::{KnnOptions, OpenOptions, SnnOptions};
+use sha2::{Digest, Sha256};
+
+use crate::support::XorShift;
+
+/// The textures, speeds and trials of the fabricated logs.
+const TEXTURES: [&str; 3] = ["silk", "denim", "cork"];
+const SPEEDS: [u32; 2] = [10, 30];
+const TRIALS: usize = 6;
+
+/// One headerless log: 8 channels first, the time in ms last, 100 Hz for 3 s; each texture
+/// a ridge spacing the slide turns into a frequency, with noise.
+fn log(texture: usize, speed: u32, trial: usize) -> String {
+    let mut rng = XorShift::new((texture * 1000 + speed as usize * 10 + trial) as u64 + 7);
+    let spacing_mm = [0.8, 1.6, 3.2][texture];
+    let mut out = String::new();
+    for i in 0..300 {
+        let t = i as f64 / 100.0;
+        for c in 0..8 {
+            let phase = 2.0 * std::f64::consts::PI * (speed as f64 * t / spacing_mm) + c as f64;
+            let v = 500.0
+                + 200.0 * (1.0 + phase.sin()) * (1.0 + 0.2 * c as f64)
+                + 40.0 * rng.fraction(1000);
+            out.push_str(&format!("{v:.1},"));
+        }
+        out.push_str(&format!("{}\n", i * 10));
+    }
+    out
+}
+
+/// A zip of the fabricated logs under `folder/` (and `extra` entries), its bytes.
+fn logs_zip(folder: &str, extra: &[(&str, &str)]) -> Vec<u8> {
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default();
+    for (k, name) in TEXTURES.iter().enumerate() {
+        for &speed in &SPEEDS {
+            for trial in 0..TRIALS {
+                zip.start_file(format!("{folder}/{name}_v{speed}_{trial}.csv"), options)
+                    .unwrap();
+                zip.write_all(log(k, speed, trial).as_bytes()).unwrap();
+            }
+        }
+    }
+    for (name, text) in extra {
+        zip.start_file(*name, options).unwrap();
+        zip.write_all(text.as_bytes()).unwrap();
+    }
+    zip.finish().unwrap().into_inner()
+}
+
+/// SHA-256 in hex, by the `sha2` crate directly.
+fn sha256(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// The recipe of the headerless logs in `archive` (`logs.zip`), with `conditions` as the
+/// speed values it lists.
+fn headerless_recipe(archive: &[u8], conditions: &str) -> String {
+    format!(
+        r#"
+name = "ridges"
+title = "Three fabricated ridged textures, 8 taxels, headerless logs"
+citation = "neurotex's tests"
+licence = "MIT"
+
+[[source]]
+url = "https://example.org/data/logs.zip"
+kind = "zip"
+sha256 = "{}"
+size = {}
+folder = "logs"
+
+[import]
+kind = "csv"
+no-header = true
+time-column = "8"
+channels = "0-7"
+grid = "2x4"
+name-pattern = "{{label}}_v{{speed}}_{{trial}}.csv"
+
+[conditions]
+speed_mm_s = [{conditions}]
+
+[[protocol]]
+id = "within-speed"
+per = "speed_mm_s"
+
+[[protocol]]
+id = "speed-held-out"
+hold-out = "speed_mm_s"
+
+[[published]]
+accuracy = 0.9
+protocol = "a method of another paper"
+citation = "Someone 2024"
+beside = "within-speed"
+same-protocol = false
+"#,
+        sha256(archive),
+        archive.len()
+    )
+}
+
+/// A fresh folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("neurotex-datasets-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// What `dir` holds, as sorted relative paths.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Ok(items) = std::fs::read_dir(dir) {
+        for item in items.flatten() {
+            out.push(item.file_name().to_string_lossy().into_owned());
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn the_built_in_recipes_parse_and_fabricslide_names_its_two_protocols() {
+    let recipes = datasets::built_in();
+    let fs = recipes.iter().find(|r| r.name == "fabricslide").unwrap();
+    let ids: Vec<&str> = fs.protocols.iter().map(|p| p.id.as_str()).collect();
+    assert_eq!(ids, ["within-velocity", "velocity-held-out"]);
+    assert_eq!(fs.published[0].accuracy, 0.96);
+    assert!(!fs.published[0].same_protocol);
+}
+
+#[test]
+fn recipes_breaking_a_rule_are_refused_naming_the_key() {
+    let good = headerless_recipe(b"x", r#""10", "30""#);
+    let cases = [
+        (
+            good.replace("licence = \"MIT\"", "licence = \"MIT\"\ncolour = \"red\""),
+            "colour",
+        ),
+        (good.replace("sha256 = ", "# sha256 = "), "missing checksum"),
+        (good.replace("grid = \"2x4\"", "grid = \"2by4\""), "grid"),
+        (
+            good.replace("per = \"speed_mm_s\"", "per = \"force_n\""),
+            "force_n",
+        ),
+        (
+            good.replace("beside = \"within-speed\"", "beside = \"pooled\""),
+            "pooled",
+        ),
+        (
+            good.replace("accuracy = 0.9", "accuracy = 90"),
+            "accuracy = 90",
+        ),
+        (good.replace("kind = \"zip\"", "kind = \"rar\""), "rar"),
+        (
+            good.replace("name = \"ridges\"", "name = \"Ridges!\""),
+            "Ridges!",
+        ),
+        (
+            good.replace(
+                "time-column = \"8\"",
+                "time-column = \"8\"\ntime-colum = \"8\"",
+            ),
+            "time-colum",
+        ),
+    ];
+    for (text, named) in cases {
+        let err = Recipe::parse(&text, Path::new("r.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(named) && err.contains("r.toml"),
+            "{named}: {err}"
+        );
+    }
+    Recipe::parse(&good, Path::new("r.toml")).unwrap();
+}
+
+#[test]
+fn the_tree_digest_is_that_of_sha256sum_over_the_sorted_files() {
+    let dir = scratch("tree");
+    std::fs::create_dir_all(dir.join("b/c")).unwrap();
+    std::fs::write(dir.join("a.csv"), "1,2\n").unwrap();
+    std::fs::write(dir.join("b/c/d.csv"), "3,4\n").unwrap();
+    std::fs::write(dir.join("B.csv"), "").unwrap();
+    let script =
+        "find . -type f | sed 's|^\\./||' | LC_ALL=C sort | xargs -d '\\n' sha256sum | sha256sum";
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .current_dir(&dir)
+        .output();
+    let Some(out) = out.ok().filter(|o| o.status.success()) else {
+        eprintln!("skipped: no sh, find or sha256sum here");
+        return;
+    };
+    let want = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(
+        tree_digest(&dir).unwrap(),
+        want.split_whitespace().next().unwrap()
+    );
+}
+
+#[test]
+fn a_zip_of_headerless_logs_is_verified_imported_once_and_reused() {
+    let dir = scratch("zip");
+    let archive = logs_zip("logs", &[]);
+    std::fs::create_dir_all(dir.join("copy")).unwrap();
+    std::fs::write(dir.join("copy/logs.zip"), &archive).unwrap();
+    let recipe = Recipe::parse(
+        &headerless_recipe(&archive, r#""10", "30""#),
+        Path::new("r.toml"),
+    )
+    .unwrap();
+    let cache = dir.join("cache");
+    let dataset = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent).unwrap();
+    let opened = neurotex::recording::Dataset::open(&dataset).unwrap();
+    assert_eq!(opened.entries.len(), TEXTURES.len() * SPEEDS.len() * TRIALS);
+    assert_eq!(
+        opened.entries[0]
+            .field("speed_mm_s")
+            .as_deref()
+            .map(|s| s == "10" || s == "30"),
+        Some(true)
+    );
+    // Fetched before: reused without the copy.
+    assert_eq!(fetch(&recipe, &cache, None, &silent).unwrap(), dataset);
+    assert_eq!(datasets::fetched(&cache, &recipe), Some(dataset));
+}
+
+#[test]
+fn a_damaged_archive_a_zip_slip_or_a_missing_condition_leaves_the_cache_as_it_was() {
+    let dir = scratch("refused");
+    std::fs::create_dir_all(dir.join("copy")).unwrap();
+    let cache = dir.join("cache");
+    let good = logs_zip("logs", &[]);
+    let text = headerless_recipe(&good, r#""10", "30""#);
+    // One byte changed.
+    let mut damaged = good.clone();
+    let last = damaged.len() - 30;
+    damaged[last] ^= 1;
+    std::fs::write(dir.join("copy/logs.zip"), &damaged).unwrap();
+    let recipe = Recipe::parse(&text, Path::new("r.toml")).unwrap();
+    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("recipe ridges") && err.contains("logs.zip") && err.contains("SHA-256"),
+        "{err}"
+    );
+    assert!(listing(&cache).is_empty(), "{:?}", listing(&cache));
+    // An entry that would land outside its folder.
+    let hostile = logs_zip("logs", &[("logs/../../escaped.csv", "1,2\n")]);
+    std::fs::write(dir.join("copy/logs.zip"), &hostile).unwrap();
+    let recipe = Recipe::parse(
+        &headerless_recipe(&hostile, r#""10", "30""#),
+        Path::new("r.toml"),
+    )
+    .unwrap();
+    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("escaped.csv") && err.contains("outside"),
+        "{err}"
+    );
+    assert!(listing(&cache).is_empty() && !dir.join("escaped.csv").exists());
+    // A condition the data does not have.
+    std::fs::write(dir.join("copy/logs.zip"), &good).unwrap();
+    let recipe = Recipe::parse(
+        &headerless_recipe(&good, r#""10", "20""#),
+        Path::new("r.toml"),
+    )
+    .unwrap();
+    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("speed_mm_s = 20"), "{err}");
+    assert!(listing(&cache).is_empty());
+    // No copy given: nothing is downloaded, and the message names the source.
+    let err = fetch(&recipe, &cache, None, &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("https://example.org/data/logs.zip") && err.contains("--from"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_stacked_array_in_a_tar_gz_is_imported_with_its_speeds() {
+    use ndarray::{Array1, Array4};
+    let dir = scratch("stacked");
+    let (n, rows, cols, t) = (24usize, 2usize, 2usize, 400usize);
+    let mut rng = XorShift::new(3);
+    let labels = Array1::from_shape_fn(n, |i| (i % 3) as i64);
+    let speeds = Array1::from_shape_fn(n, |i| if i < n / 2 { 10.0 } else { 20.0 });
+    let data = Array4::from_shape_fn((n, rows, cols, t), |(i, r, c, k)| {
+        let f = 1.0 + (i % 3) as f64;
+        (1.0 + (f * k as f64 / 50.0 + (r + c) as f64).sin()) * 100.0 + rng.fraction(100)
+    });
+    let files = dir.join("files");
+    std::fs::create_dir_all(files.join("skin")).unwrap();
+    ndarray_npy::write_npy(files.join("skin/data.npy"), &data).unwrap();
+    ndarray_npy::write_npy(files.join("skin/labels.npy"), &labels).unwrap();
+    ndarray_npy::write_npy(files.join("skin/speeds.npy"), &speeds).unwrap();
+    let mut tar = tar::Builder::new(flate2::write::GzEncoder::new(
+        Vec::new(),
+        flate2::Compression::default(),
+    ));
+    tar.append_dir_all("skin", files.join("skin")).unwrap();
+    let bytes = tar.into_inner().unwrap().finish().unwrap();
+    std::fs::create_dir_all(dir.join("copy")).unwrap();
+    std::fs::write(dir.join("copy/skin.tar.gz"), &bytes).unwrap();
+    let text = format!(
+        r#"
+name = "skin"
+title = "A fabricated stacked skin"
+citation = "neurotex's tests"
+licence = "CC-BY-4.0"
+[[source]]
+url = "https://example.org/skin.tar.gz"
+kind = "tar.gz"
+sha256 = "{}"
+size = {}
+[import]
+kind = "stacked"
+data = "skin/data.npy"
+labels = "skin/labels.npy"
+speeds = "skin/speeds.npy"
+axes = "n,row,col,t"
+fs = 1000
+[conditions]
+speed_mm_s = ["10", "20"]
+[[protocol]]
+id = "within-speed"
+per = "speed_mm_s"
+"#,
+        sha256(&bytes),
+        bytes.len()
+    );
+    let recipe = Recipe::parse(&text, Path::new("skin.toml")).unwrap();
+    let dataset = fetch(
+        &recipe,
+        &dir.join("cache"),
+        Some(&dir.join("copy/skin.tar.gz")),
+        &silent,
+    )
+    .unwrap();
+    let opened = neurotex::recording::Dataset::open(&dataset).unwrap();
+    assert_eq!(opened.entries.len(), n);
+    let at = |i: usize| {
+        opened.entries[i]
+            .field("speed_mm_s")
+            .unwrap()
+            .parse::<f64>()
+            .unwrap()
+    };
+    assert_eq!((at(0), at(n - 1)), (10.0, 20.0));
+}
+
+#[test]
+fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
+    let dir = scratch("bench");
+    let archive = logs_zip("logs", &[]);
+    std::fs::create_dir_all(dir.join("copy")).unwrap();
+    std::fs::write(dir.join("copy/logs.zip"), &archive).unwrap();
+    let recipe_path = dir.join("ridges.toml");
+    std::fs::write(&recipe_path, headerless_recipe(&archive, r#""10", "30""#)).unwrap();
+    let options = BenchmarkOptions {
+        datasets: vec![recipe_path.display().to_string()],
+        out: dir.join("out"),
+        cache: Some(dir.join("cache")),
+        from: Some(dir.join("copy")),
+        snn: false,
+        folds: 3,
+        repeats: 1,
+        seed: 5,
+    };
+    let board = options.run(&silent).unwrap();
+    assert_eq!(board.boards.len(), 2);
+    let recipe = Recipe::read(&recipe_path).unwrap();
+    let dataset = datasets::fetched(&dir.join("cache"), &recipe).unwrap();
+    let (encodings, methods, classifiers) = neurotex::workflows::benchmark::candidate_set(false);
+    let list = |s: String| s.split(',').map(String::from).collect::<Vec<_>>();
+    // `neurotex compare --per speed_mm_s --nested --encodings ... --folds 3 --repeats 1 --seed 5`.
+    let compare = CompareOptions {
+        dataset: dataset.clone(),
+        speeds: None,
+        per: Some("speed_mm_s".into()),
+        hold_out: None,
+        train_where: None,
+        test_where: None,
+        group_by: None,
+        encodings: list(encodings),
+        methods: list(methods),
+        classifiers: list(classifiers),
+        tau_ms: neurotex::compare::candidates::STANDARD_TAU_MS,
+        knn: KnnOptions::default(),
+        snn: SnnOptions::default(),
+        folds: 3,
+        repeats: 1,
+        seed: 5,
+        nested: true,
+        open: OpenOptions::default(),
+    };
+    let opened = compare.open.open(&dataset).unwrap();
+    let direct = compare
+        .run(&opened, &StageOptions::default(), &silent)
+        .unwrap();
+    let mut from_board = board.boards[0].comparison.clone();
+    let mut direct = direct;
+    // Times differ from run to run; everything else is the same.
+    for r in from_board
+        .results
+        .iter_mut()
+        .chain(direct.results.iter_mut())
+    {
+        r.seconds = 0.0;
+    }
+    from_board.best.seconds = 0.0;
+    direct.best.seconds = 0.0;
+    assert_eq!(from_board, direct);
+    let md = std::fs::read_to_string(dir.join("out/leaderboard.md")).unwrap();
+    assert!(
+        md.contains("Someone 2024") && md.contains("Nested selection"),
+        "{md}"
+    );
+    assert!(dir.join("out/ridges/within-speed/ranking.png").is_file());
+    // A rerun keeps both comparisons: same leaderboard, times included; another seed is
+    // compared anew.
+    let said = std::sync::Mutex::new(Vec::<String>::new());
+    let on = |p: neurotex::progress::Progress| {
+        if let neurotex::progress::Progress::Say(s) = p {
+            said.lock().unwrap().push(s.to_string());
+        }
+    };
+    let kept = |said: &std::sync::Mutex<Vec<String>>| {
+        let said = said.lock().unwrap();
+        said.iter()
+            .filter(|s| s.contains("kept from an earlier run"))
+            .count()
+    };
+    let again = BenchmarkOptions {
+        from: None,
+        ..options.clone()
+    }
+    .run(&on)
+    .unwrap();
+    assert_eq!(again, board);
+    assert_eq!(kept(&said), 2);
+    BenchmarkOptions {
+        from: None,
+        seed: 6,
+        ..options
+    }
+    .run(&on)
+    .unwrap();
+    assert_eq!(kept(&said), 2);
+}
+
+#[test]
+#[ignore = "FabricSlide from ../shared: about 40 s"]
+fn fabricslide_benchmark_from_the_shared_copy() {
+    let copy =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/fabricslide/fabric");
+    let dir = scratch("fabricslide");
+    let options = BenchmarkOptions {
+        datasets: vec!["fabricslide".into()],
+        out: dir.join("out"),
+        cache: Some(dir.join("cache")),
+        from: Some(copy),
+        snn: false,
+        folds: 5,
+        repeats: 1,
+        seed: 0,
+    };
+    let board = options.run(&silent).unwrap();
+    assert_eq!(board.boards.len(), 2);
+    for b in &board.boards {
+        let nested = b.comparison.nested.as_ref().unwrap();
+        assert!(
+            nested.accuracy > b.comparison.chance + 0.2,
+            "{}: {}",
+            b.protocol_id,
+            nested.accuracy
+        );
+    }
+}
