@@ -6,6 +6,7 @@ mod atomic;
 mod classifiers;
 mod compare;
 mod conditions;
+mod datasets;
 mod encode;
 mod evaluate;
 mod events;
