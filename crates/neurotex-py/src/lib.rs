@@ -9,6 +9,7 @@
 mod calibrate;
 mod convert;
 mod dataset;
+mod datasets;
 mod errors;
 mod estimator;
 mod inspect;
@@ -403,6 +404,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check_options, m)?)?;
     calibrate::register(m)?;
     dataset::register(m)?;
+    datasets::register(m)?;
     reproduce::register(m)?;
     inspect::register(m)?;
     model::register(m)?;

@@ -244,7 +244,15 @@ fn a_zip_of_headerless_logs_is_verified_imported_once_and_reused() {
     );
     // Fetched before: reused without the copy.
     assert_eq!(fetch(&recipe, &cache, None, &silent).unwrap(), dataset);
-    assert_eq!(datasets::fetched(&cache, &recipe), Some(dataset));
+    assert_eq!(datasets::fetched(&cache, &recipe), Some(dataset.clone()));
+    // The same sources and import with a condition the data lacks: refused on reuse too.
+    let edited = headerless_recipe(&archive, r#""10", "20", "30""#);
+    let edited = Recipe::parse(&edited, Path::new("r.toml")).unwrap();
+    let err = fetch(&edited, &cache, None, &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("speed_mm_s = 20"), "{err}");
+    assert!(dataset.is_dir());
 }
 
 #[test]
@@ -391,6 +399,7 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
         out: dir.join("out"),
         cache: Some(dir.join("cache")),
         from: Some(dir.join("copy")),
+        protocols: Vec::new(),
         snn: false,
         folds: 3,
         repeats: 1,
@@ -479,7 +488,7 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
 }
 
 #[test]
-#[ignore = "FabricSlide from ../shared: about 40 s"]
+#[ignore = "FabricSlide from ../shared: about 80 s"]
 fn fabricslide_benchmark_from_the_shared_copy() {
     let copy =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/fabricslide/fabric");
@@ -489,6 +498,7 @@ fn fabricslide_benchmark_from_the_shared_copy() {
         out: dir.join("out"),
         cache: Some(dir.join("cache")),
         from: Some(copy),
+        protocols: Vec::new(),
         snn: false,
         folds: 5,
         repeats: 1,

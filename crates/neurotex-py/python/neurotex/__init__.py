@@ -1492,5 +1492,8 @@ __all__ = [
     "CausalConditioning", "FeatureTable", "inspect", "Inspection",
     "Dataset", "HARALICK_NAMES", "HARALICK_FULL_NAMES", "METHODS", "Error",
     "ParameterError", "DataError", "NotFoundError", "ReadWriteError", "ModelError",
-    "ClassifyError", "InternalError",
+    "ClassifyError", "InternalError", "benchmark", "datasets",
 ]
+
+from . import datasets  # noqa: E402  (it imports load_dataset from here)
+from .datasets import benchmark  # noqa: E402

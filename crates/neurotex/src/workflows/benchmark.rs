@@ -64,6 +64,9 @@ pub struct BenchmarkOptions {
     /// folder of the downloaded files, or the unpacked folder a recipe's tree digest checks.
     #[cfg_attr(feature = "cli", arg(long))]
     pub from: Option<PathBuf>,
+    /// Only these protocols (their ids in the recipes, comma-separated); default all.
+    #[cfg_attr(feature = "cli", arg(long, value_delimiter = ','))]
+    pub protocols: Vec<String>,
     /// Also the spiking network with its defaults (method `spikes`; slow on long slides).
     #[cfg_attr(feature = "cli", arg(long))]
     pub snn: bool,
@@ -108,11 +111,15 @@ impl BenchmarkOptions {
             let why = "--from is the copy of one dataset's sources: benchmark one dataset with it, or fetch each first (`neurotex datasets fetch`)";
             return Err(crate::error::OptionsError::Conflict(why.into()).into());
         }
+        self.check_protocols(&recipes)?;
         let root = datasets::cache_root(self.cache.as_deref())?;
         let mut boards = Vec::new();
         for recipe in &recipes {
             let dataset = datasets::fetch(recipe, &root, self.from.as_deref(), on)?;
             for (i, protocol) in recipe.protocols.iter().enumerate() {
+                if !self.protocols.is_empty() && !self.protocols.contains(&protocol.id) {
+                    continue;
+                }
                 on(Progress::Say(&format!(
                     "{}: {} ({} of {})",
                     recipe.name,
@@ -131,10 +138,30 @@ impl BenchmarkOptions {
         let board = Leaderboard {
             candidate_set: CANDIDATE_SET_VERSION,
             seed: self.seed,
+            folds: self.folds,
+            repeats: self.repeats,
+            snn: self.snn,
+            neurotex: env!("CARGO_PKG_VERSION").to_string(),
             boards,
         };
         board.write(&self.out)?;
         Ok(board)
+    }
+
+    /// Every id of `--protocols` is a protocol of some recipe.
+    fn check_protocols(&self, recipes: &[Recipe]) -> Result<()> {
+        let ids: Vec<&str> = (recipes.iter())
+            .flat_map(|r| r.protocols.iter().map(|p| p.id.as_str()))
+            .collect();
+        match self.protocols.iter().find(|p| !ids.contains(&p.as_str())) {
+            Some(unknown) => Err(crate::error::ParamError::new(
+                "protocols",
+                "each must be a protocol id of the recipes",
+                format!("{unknown} (the recipes have {})", ids.join(", ")),
+            )
+            .into()),
+            None => Ok(()),
+        }
     }
 
     /// The comparison of `recipe`'s protocol `i` on `dataset`: the kept one under the same

@@ -20,6 +20,14 @@ pub struct Leaderboard {
     pub candidate_set: u32,
     /// The seed of folds, bootstrap and tests.
     pub seed: u64,
+    /// Cross-validation folds.
+    pub folds: usize,
+    /// Cross-validation repeats.
+    pub repeats: usize,
+    /// Whether the spiking network was among the candidates.
+    pub snn: bool,
+    /// The version of neurotex that made it.
+    pub neurotex: String,
     /// One board per dataset and protocol, in the order run.
     pub boards: Vec<Board>,
 }
@@ -129,10 +137,10 @@ fn row(rank: usize, r: &Ranked) -> String {
 
 /// The leaderboard as Markdown.
 pub fn markdown(board: &Leaderboard) -> String {
-    let (encodings, methods, classifiers) = candidate_set(false);
+    let (encodings, methods, classifiers) = candidate_set(board.snn);
     let mut s = format!(
-        "# Leaderboard\n\nCandidate set {}: encodings {encodings} (`none`: the baselines without spikes, from the signal the encoder would receive), methods {methods}, classifiers {classifiers} (the spiking network too when run with `--snn`), every pairing `neurotex compare` runs. Each protocol is `neurotex compare --nested` on the recipe's dataset: accuracies are means over the protocol's conditions, with 95 % bootstrap intervals over recordings; Δ and p are against the paper's method (SA, 3D-GLCM, KNN), by the paired sign-flip test. The top candidate of a ranking is chosen on the recordings it is scored on and is biased upwards; the nested estimate (the best chosen inside each training set) is the one to quote. Seed {}.\n",
-        board.candidate_set, board.seed
+        "# Leaderboard\n\nCandidate set {}: encodings {encodings} (`none`: the baselines without spikes, from the signal the encoder would receive), methods {methods}, classifiers {classifiers}, every pairing `neurotex compare` runs. Each protocol is `neurotex compare --nested` on the recipe's dataset: accuracies are means over the protocol's conditions, with 95 % bootstrap intervals over recordings; Δ and p are against the paper's method (SA, 3D-GLCM, KNN), by the paired sign-flip test. The top candidate of a ranking is chosen on the recordings it is scored on and is biased upwards; the nested estimate (the best chosen inside each training set) is the one to quote. {} folds, {} repeat(s), seed {}; neurotex {}.\n",
+        board.candidate_set, board.folds, board.repeats, board.seed, board.neurotex
     );
     for b in &board.boards {
         s.push_str(&section(b));
@@ -170,14 +178,34 @@ fn section(b: &Board) -> String {
         ));
     }
     s.push_str("| rank | candidate | accuracy, % | 95 % interval | Δ vs paper, points | p |\n|---|---|---|---|---|---|\n");
+    let mut shown = 0;
     for (i, r) in c.results.iter().enumerate() {
         let marked = r.paper
             || (r.method == "rates" && r.classifier == "linear")
             || c.results.iter().position(|x| x.encoding == "none") == Some(i);
         if i < TOP || marked {
+            if i > shown {
+                s.push_str(&format!(
+                    "| … | ranks {}–{} in compare.md | | | | |\n",
+                    shown + 1,
+                    i
+                ));
+            }
             s.push_str(&row(i + 1, r));
             s.push('\n');
+            shown = i + 1;
         }
+    }
+    let tied = c
+        .results
+        .iter()
+        .take_while(|r| r.accuracy == c.best.accuracy)
+        .count();
+    if tied > 1 {
+        s.push_str(&format!(
+            "\nThe first {tied} candidates tie at {} %: the order among them is the order they were listed in, not a ranking.\n",
+            pct(c.best.accuracy)
+        ));
     }
     if !b.published.is_empty() {
         s.push_str("\nPublished on these data:\n\n| accuracy, % | who | their method and protocol | the same protocol as above |\n|---|---|---|---|\n");

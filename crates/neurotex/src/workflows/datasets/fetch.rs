@@ -68,6 +68,8 @@ const FETCHED: &str = "fetched.json";
 /// or conditions the data does not have: each naming the recipe and the file.
 pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) -> Result<PathBuf> {
     if let Some(dataset) = fetched(root, recipe) {
+        // The conditions are not part of the entry's name: an edited list is checked here.
+        check_conditions(recipe, &Dataset::open(&dataset)?).map_err(|e| in_recipe(recipe, e))?;
         on(Progress::Say(&format!(
             "{}: fetched before, in {}",
             recipe.name,
@@ -92,7 +94,17 @@ pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) 
     };
     let dir = entry(root, recipe);
     std::fs::create_dir_all(root).map_err(|e| DataError::write(root, e))?;
-    create_dir_atomic(&dir, |tmp| fill(recipe, from, tmp, on)).map_err(|e| in_recipe(recipe, e))?;
+    create_dir_atomic(&dir, |tmp| {
+        // What the import says names the entry as it will be, not its hidden temporary.
+        let (hidden, shown) = (tmp.display().to_string(), dir.display().to_string());
+        let renamed = |p: Progress| match p {
+            Progress::Say(s) => on(Progress::Say(&s.replace(&hidden, &shown))),
+            Progress::Advice(s) => on(Progress::Advice(&s.replace(&hidden, &shown))),
+            other => on(other),
+        };
+        fill(recipe, from, tmp, &renamed)
+    })
+    .map_err(|e| in_recipe(recipe, e))?;
     Ok(dir.join("dataset"))
 }
 
@@ -121,8 +133,14 @@ fn fill(recipe: &Recipe, from: &Path, tmp: &Path, on: OnProgress) -> Result<()> 
         if let Some(want) = &source.tree_sha256 {
             let got = tree_digest(&used)?;
             if &got != want {
-                let why = format!("tree digest {got}, the recipe's tree-sha256 is {want}: not the files the recipe describes");
-                return Err(DataError::invalid(&used, why).into());
+                let hint = match (&source.folder, source.url.rsplit('/').next()) {
+                    (Some(folder), Some(file)) => format!(
+                        " (give the unpacked folder {folder} itself, or a folder holding {file})"
+                    ),
+                    _ => String::new(),
+                };
+                let why = format!("tree digest {got}, the recipe's tree-sha256 is {want}: not the files the recipe describes{hint}");
+                return Err(DataError::invalid(from, why).into());
             }
         }
         move_into(&used, &files)?;
@@ -231,6 +249,10 @@ pub fn file_digest(path: &Path) -> Result<String> {
 pub fn tree_digest(dir: &Path) -> Result<String> {
     let mut paths = Vec::new();
     walk(dir, "", &mut paths)?;
+    if paths.is_empty() {
+        let why = "no files: a tree digest is of a folder's files";
+        return Err(DataError::invalid(dir, why).into());
+    }
     paths.sort();
     let mut lines = String::new();
     for rel in &paths {

@@ -1,0 +1,115 @@
+"""Public tactile datasets by recipe, as ``neurotex datasets`` and ``neurotex benchmark``
+serve them (docs/benchmark.md): the same recipes, cache and leaderboard as the command
+line::
+
+    import neurotex
+    from neurotex import datasets
+
+    datasets.fetch("fabricslide", source="shared/data/fabricslide/fabric")
+    data = datasets.load("fabricslide")                  # a neurotex.Dataset
+    events = datasets.tonic("fabricslide", encoding="sa+fa")   # tonic's dataset interface
+    board = neurotex.benchmark(["fabricslide"], "bench/")      # the leaderboard, as a dict
+
+``cache`` is the cache folder everywhere (default: ``$NEUROTEX_CACHE``, else
+``$XDG_CACHE_HOME/neurotex``, else ``~/.cache/neurotex``); ``source`` is a local copy of a
+dataset's sources (the command line's ``--from``): neurotex does not download.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+from . import _native, load_dataset
+
+__all__ = ["list_recipes", "check", "fetch", "path", "load", "tonic", "benchmark"]
+
+_log = logging.getLogger("neurotex")
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _opt(p: Optional[PathLike]) -> Optional[str]:
+    return None if p is None else os.path.abspath(os.fspath(p))
+
+
+def list_recipes(cache: Optional[PathLike] = None) -> List[Dict[str, Any]]:
+    """The built-in recipes: each ``{"recipe": {...}, "fetched": folder or None}``."""
+    return _native.datasets_list(_opt(cache))
+
+
+def check(recipe: Union[str, PathLike]) -> Dict[str, Any]:
+    """The recipe (a built-in name or a recipe file), checked, as a dict. Raises
+    :class:`neurotex.DataError` naming the key of a rule it breaks."""
+    return _native.datasets_check(os.fspath(recipe))
+
+
+def fetch(name: Union[str, PathLike], source: Optional[PathLike] = None,
+          cache: Optional[PathLike] = None) -> str:
+    """Fetches a dataset into the cache from the local copy ``source`` (every checksum
+    verified, imported once; reused when fetched before) and returns its dataset folder."""
+    folder, said = _native.datasets_fetch(os.fspath(name), _opt(source), _opt(cache))
+    for line in said:
+        _log.info("%s", line)
+    return folder
+
+
+def path(name: Union[str, PathLike], cache: Optional[PathLike] = None) -> str:
+    """The dataset folder of a fetched dataset; :class:`neurotex.DataError` when it is not
+    in the cache."""
+    return _native.datasets_path(os.fspath(name), _opt(cache))
+
+
+def load(name: Union[str, PathLike], source: Optional[PathLike] = None,
+         cache: Optional[PathLike] = None, rows: Optional[Sequence[int]] = None) -> Any:
+    """The dataset as :func:`neurotex.load_dataset` reads it, fetched first when needed."""
+    return load_dataset(fetch(name, source, cache), rows)
+
+
+def tonic(name: Union[str, PathLike], encoding: str = "sa+fa", *,
+          source: Optional[PathLike] = None, cache: Optional[PathLike] = None,
+          **kwargs: Any) -> Any:
+    """The dataset with tonic's dataset interface (:class:`neurotex.tonic.Dataset`:
+    ``(events, target)`` items, ``transform``...), fetched first when needed."""
+    from .tonic import Dataset
+
+    return Dataset(fetch(name, source, cache), encoding, **kwargs)
+
+
+def _one(task: Sequence[Any]) -> None:
+    """One dataset x protocol of :func:`benchmark`, as a Dask task: compared and kept in
+    ``out`` (the leaderboard is written after, from what the tasks kept)."""
+    name, protocol, out, cache, snn, folds, repeats, seed = task
+    _native.benchmark([name], out, cache, None, [protocol], snn, folds, repeats, seed)
+
+
+def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
+              cache: Optional[PathLike] = None, source: Optional[PathLike] = None,
+              protocols: Optional[Sequence[str]] = None, snn: bool = False, folds: int = 5,
+              repeats: int = 1, seed: int = 0, client: Any = None) -> Dict[str, Any]:
+    """``neurotex benchmark``: under each protocol of each dataset's recipe, the fixed
+    candidate set compared with nested selection, written into ``out`` (leaderboard.md,
+    leaderboard.json, each comparison's folder); returns the leaderboard as a dict.
+
+    With a Dask ``client``, each dataset x protocol is one task on the cluster; the workers
+    must see ``out`` and ``cache`` (a shared file system, or a local cluster). Every dataset
+    is fetched here first, the tasks keep their comparisons in ``out``, and the leaderboard
+    is then made from them: the same as without a client."""
+    names = [os.fspath(d) for d in datasets]
+    out_s, cache_s = _opt(out), _opt(cache)
+    wanted = list(protocols or [])
+    if client is not None:
+        if source is not None and len(names) > 1:
+            raise ValueError("source is the copy of one dataset's sources: one dataset with it")
+        tasks = []
+        for name in names:
+            fetch(name, source, cache)
+            for p in check(name)["protocol"]:
+                if not wanted or p["id"] in wanted:
+                    tasks.append((name, p["id"], out_s, cache_s, snn, folds, repeats, seed))
+        client.gather(client.map(_one, tasks, pure=False))
+    board, said = _native.benchmark(names, out_s, cache_s, _opt(source), wanted, snn, folds,
+                                    repeats, seed)
+    for line in said:
+        _log.info("%s", line)
+    return board

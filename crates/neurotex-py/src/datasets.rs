@@ -1,0 +1,109 @@
+//! `neurotex datasets` and `neurotex benchmark` called from Python: the same recipes, cache
+//! and leaderboard as the command line (`neurotex.datasets`, `neurotex.benchmark`).
+
+use std::path::PathBuf;
+
+use neurotex::datasets::{self, DatasetsCommand};
+use neurotex::workflows::benchmark::BenchmarkOptions;
+use pyo3::prelude::*;
+
+use crate::errors::guarded;
+use crate::model::Said;
+
+/// Runs one `neurotex datasets` command; returns the lines it prints and what it said.
+fn run(py: Python<'_>, command: DatasetsCommand) -> PyResult<(Vec<String>, Vec<String>)> {
+    let said = Said::default();
+    let on = |p: neurotex::progress::Progress| said.hear(p);
+    let lines = py.detach(|| guarded(|| command.run(&on)))?;
+    Ok((lines, said.lines()))
+}
+
+/// The built-in recipes as dicts (name, title, citation, licence, protocols, published,
+/// and the imported folder when fetched into `cache`).
+#[pyfunction]
+#[pyo3(signature = (cache=None))]
+fn datasets_list(py: Python<'_>, cache: Option<PathBuf>) -> PyResult<Vec<Py<PyAny>>> {
+    let root = guarded(|| datasets::cache_root(cache.as_deref()))?;
+    datasets::built_in()
+        .iter()
+        .map(|r| {
+            let fetched = datasets::fetched(&root, r).map(|p| p.display().to_string());
+            let value = serde_json::json!({"recipe": r, "fetched": fetched});
+            crate::convert::to_object(py, &value)
+        })
+        .collect()
+}
+
+/// The recipe `name_or_path`, checked, as a dict.
+#[pyfunction]
+fn datasets_check(py: Python<'_>, name_or_path: &str) -> PyResult<Py<PyAny>> {
+    let recipe = guarded(|| datasets::resolve(name_or_path))?;
+    crate::convert::to_object(py, &recipe)
+}
+
+/// Fetches a dataset into the cache; `(folder, said)`.
+#[pyfunction]
+#[pyo3(signature = (name, source=None, cache=None))]
+fn datasets_fetch(
+    py: Python<'_>,
+    name: String,
+    source: Option<PathBuf>,
+    cache: Option<PathBuf>,
+) -> PyResult<(String, Vec<String>)> {
+    let command = DatasetsCommand::Fetch {
+        name,
+        from: source,
+        cache,
+    };
+    let (lines, said) = run(py, command)?;
+    Ok((lines.concat(), said))
+}
+
+/// The imported folder of a fetched dataset.
+#[pyfunction]
+#[pyo3(signature = (name, cache=None))]
+fn datasets_path(py: Python<'_>, name: String, cache: Option<PathBuf>) -> PyResult<String> {
+    Ok(run(py, DatasetsCommand::Path { name, cache })?.0.concat())
+}
+
+/// Runs `neurotex benchmark`; `(leaderboard, said)`.
+#[pyfunction]
+#[pyo3(signature = (datasets, out, cache=None, source=None, protocols=Vec::new(), snn=false, folds=5, repeats=1, seed=0))]
+#[allow(clippy::too_many_arguments)]
+fn benchmark(
+    py: Python<'_>,
+    datasets: Vec<String>,
+    out: PathBuf,
+    cache: Option<PathBuf>,
+    source: Option<PathBuf>,
+    protocols: Vec<String>,
+    snn: bool,
+    folds: usize,
+    repeats: usize,
+    seed: u64,
+) -> PyResult<(Py<PyAny>, Vec<String>)> {
+    let options = BenchmarkOptions {
+        datasets,
+        out,
+        cache,
+        from: source,
+        protocols,
+        snn,
+        folds,
+        repeats,
+        seed,
+    };
+    let said = Said::default();
+    let on = |p: neurotex::progress::Progress| said.hear(p);
+    let board = py.detach(|| guarded(|| options.run(&on)))?;
+    Ok((crate::convert::to_object(py, &board)?, said.lines()))
+}
+
+/// Registers the functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(datasets_list, m)?)?;
+    m.add_function(wrap_pyfunction!(datasets_check, m)?)?;
+    m.add_function(wrap_pyfunction!(datasets_fetch, m)?)?;
+    m.add_function(wrap_pyfunction!(datasets_path, m)?)?;
+    m.add_function(wrap_pyfunction!(benchmark, m)?)
+}
