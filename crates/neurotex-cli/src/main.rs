@@ -68,8 +68,8 @@ enum Command {
     /// ("ended_by":"gap") and a new one starts at that next frame. So one wrong stamp (a bit
     /// flip far ahead) costs its own frame, and a jump that stays costs one frame.
     Stream(neurotex::workflows::stream::StreamOptions),
-    /// The public datasets neurotex has recipes for: list, check, fetch from a local copy
-    /// (checksums verified, imported once), their folder in the cache.
+    /// The public datasets neurotex has recipes for: list, check, fetch (downloaded or from
+    /// a local copy; checksums verified, imported once), their folder in the cache.
     #[command(subcommand)]
     Datasets(neurotex::workflows::datasets::DatasetsCommand),
     /// The public datasets' leaderboard: under each protocol of each recipe, a fixed

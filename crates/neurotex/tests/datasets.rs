@@ -304,12 +304,114 @@ fn a_damaged_archive_a_zip_slip_or_a_missing_condition_leaves_the_cache_as_it_wa
         .to_string();
     assert!(err.contains("speed_mm_s = 20"), "{err}");
     assert!(listing(&cache).is_empty());
-    // No copy given: nothing is downloaded, and the message names the source.
+    // No copy given and no such file to download: the message names the source, and the
+    // cache is left as it was.
+    let err = fetch(&recipe, &cache, None, &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("https://example.org/data/logs.zip"), "{err}");
+    assert!(listing(&cache).is_empty(), "{:?}", listing(&cache));
+}
+
+/// A local HTTP server for one file: `GET /data/logs.zip` gets `bytes` (from the offset a
+/// `Range: bytes=N-` header asks, with 206), any other path 404. The first `cut` answers
+/// stop after half the bytes they promised. Returns its address and the Range headers seen.
+fn serve(bytes: Vec<u8>, cut: usize) -> (String, std::sync::Arc<std::sync::Mutex<Vec<String>>>) {
+    use std::io::{BufRead, BufReader};
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let address = format!("http://{}", listener.local_addr().unwrap());
+    let ranges = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let seen = ranges.clone();
+    std::thread::spawn(move || {
+        for (i, stream) in listener.incoming().enumerate() {
+            let Ok(mut stream) = stream else { continue };
+            let mut reader = BufReader::new(stream.try_clone().unwrap());
+            let (mut first, mut from) = (String::new(), 0usize);
+            reader.read_line(&mut first).unwrap();
+            loop {
+                let mut line = String::new();
+                if reader.read_line(&mut line).unwrap() == 0 || line == "\r\n" {
+                    break;
+                }
+                if let Some(r) = line.to_ascii_lowercase().strip_prefix("range: bytes=") {
+                    seen.lock().unwrap().push(r.trim().to_string());
+                    from = r.trim().trim_end_matches('-').parse().unwrap();
+                }
+            }
+            if !first.starts_with("GET /data/logs.zip ") {
+                let _ = stream.write_all(
+                    b"HTTP/1.1 404 Not Found\r\ncontent-length: 0\r\nconnection: close\r\n\r\n",
+                );
+                continue;
+            }
+            let body = &bytes[from..];
+            let status = if from > 0 {
+                "206 Partial Content"
+            } else {
+                "200 OK"
+            };
+            let head = format!(
+                "HTTP/1.1 {status}\r\ncontent-length: {}\r\nconnection: close\r\n\r\n",
+                body.len()
+            );
+            let _ = stream.write_all(head.as_bytes());
+            let end = if i < cut { body.len() / 2 } else { body.len() };
+            let _ = stream.write_all(&body[..end]);
+        }
+    });
+    (address, ranges)
+}
+
+#[test]
+fn sources_are_downloaded_and_an_interrupted_download_resumes() {
+    let dir = scratch("download");
+    let cache = dir.join("cache");
+    let archive = logs_zip("logs", &[]);
+    let (address, ranges) = serve(archive.clone(), 1);
+    let text =
+        headerless_recipe(&archive, r#""10", "30""#).replace("https://example.org", &address);
+    let recipe = Recipe::parse(&text, Path::new("r.toml")).unwrap();
+    // The first answer stops halfway: an error, the part kept, no cache entry.
     let err = fetch(&recipe, &cache, None, &silent)
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("https://example.org/data/logs.zip") && err.contains("--from"),
+        err.contains("run again to resume") && err.contains(&address),
+        "{err}"
+    );
+    let entry = datasets::fetch::entry(&cache, &recipe);
+    assert!(!entry.exists());
+    // Run again: the rest is asked for from where the part stops, and the fetch succeeds.
+    let dataset = fetch(&recipe, &cache, None, &silent).unwrap();
+    assert_eq!(*ranges.lock().unwrap(), [format!("{}-", archive.len() / 2)]);
+    assert!(dataset.join("manifest.csv").is_file());
+    assert!(!cache
+        .join("downloads")
+        .join(entry.file_name().unwrap())
+        .exists());
+    // A file that is not the recipe's: refused, removed, no entry.
+    let other = scratch("download-other").join("cache");
+    let (address, _) = serve(logs_zip("logs", &[("logs/extra.txt", "x")]), 0);
+    let text =
+        headerless_recipe(&archive, r#""10", "30""#).replace("https://example.org", &address);
+    let recipe = Recipe::parse(&text, Path::new("r.toml")).unwrap();
+    let err = fetch(&recipe, &other, None, &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("SHA-256"), "{err}");
+    let downloads = other
+        .join("downloads")
+        .join(datasets::fetch::entry(&other, &recipe).file_name().unwrap());
+    assert!(listing(&downloads).is_empty(), "{:?}", listing(&downloads));
+    // A missing file: the status, named with the URL.
+    let text = headerless_recipe(&archive, r#""10", "30""#)
+        .replace("https://example.org/data", &format!("{address}/gone"));
+    let recipe = Recipe::parse(&text, Path::new("r.toml")).unwrap();
+    let err = fetch(&recipe, &other, None, &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("HTTP 404") && err.contains("/gone/logs.zip"),
         "{err}"
     );
 }

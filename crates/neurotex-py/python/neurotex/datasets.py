@@ -12,7 +12,8 @@ line::
 
 ``cache`` is the cache folder everywhere (default: ``$NEUROTEX_CACHE``, else
 ``$XDG_CACHE_HOME/neurotex``, else ``~/.cache/neurotex``); ``source`` is a local copy of a
-dataset's sources (the command line's ``--from``): neurotex does not download.
+dataset's sources (the command line's ``--from``); without one, the sources are downloaded
+(an interrupted download resumes on the next call).
 """
 
 from __future__ import annotations
@@ -46,8 +47,9 @@ def check(recipe: Union[str, PathLike]) -> Dict[str, Any]:
 
 def fetch(name: Union[str, PathLike], source: Optional[PathLike] = None,
           cache: Optional[PathLike] = None) -> str:
-    """Fetches a dataset into the cache from the local copy ``source`` (every checksum
-    verified, imported once; reused when fetched before) and returns its dataset folder."""
+    """Fetches a dataset into the cache, downloaded or from the local copy ``source`` (every
+    checksum verified, imported once; reused when fetched before), and returns its dataset
+    folder."""
     folder, said = _native.datasets_fetch(os.fspath(name), _opt(source), _opt(cache))
     for line in said:
         _log.info("%s", line)

@@ -60,8 +60,9 @@ pub struct BenchmarkOptions {
     /// $XDG_CACHE_HOME/neurotex, else ~/.cache/neurotex).
     #[cfg_attr(feature = "cli", arg(long))]
     pub cache: Option<PathBuf>,
-    /// A local copy of the sources of a dataset not yet in the cache (one dataset only): a
-    /// folder of the downloaded files, or the unpacked folder a recipe's tree digest checks.
+    /// A local copy of the sources of a dataset not yet in the cache (one dataset only),
+    /// instead of downloading them: a folder of the downloaded files, a one-source recipe's
+    /// file itself, or the unpacked folder a recipe's tree digest checks.
     #[cfg_attr(feature = "cli", arg(long))]
     pub from: Option<PathBuf>,
     /// Only these protocols (their ids in the recipes, comma-separated); default all.

@@ -1,14 +1,12 @@
-//! Fetching a recipe's dataset into the cache: every source found, its checksum verified,
+//! Fetching a recipe's dataset into the cache: every source downloaded or found in a local
+//! copy, its checksum verified,
 //! unpacked (no entry outside its folder), imported once, and the whole entry renamed into
 //! place only when all of it succeeded, so that a failure leaves the cache as it was.
 
-use std::fs::File;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use sha2::{Digest, Sha256};
-
-use super::recipe::{hex, Import, Recipe, Source, SourceKind};
+use super::digest::{copy_tree, tree_digest};
+use super::recipe::{Import, Recipe, Source, SourceKind};
 use crate::error::DataError;
 use crate::io::create_dir_atomic;
 use crate::progress::Progress;
@@ -59,11 +57,12 @@ const FETCHED: &str = "fetched.json";
 
 /// Fetches `recipe`'s dataset into the cache under `root` from the local copy `from` (a
 /// folder holding the sources' files by their URLs' names, or unpacked folders checked by
-/// their tree digest; or, for a one-source recipe, the file itself), and returns the
-/// imported dataset folder. A dataset fetched before is reused.
+/// their tree digest; or, for a one-source recipe, the file itself), or without one by
+/// downloading the sources, and returns the imported dataset folder. A dataset fetched
+/// before is reused.
 ///
 /// # Errors
-/// No local copy given (neurotex does not download), a source not found in it, a checksum
+/// A source that cannot be downloaded, a source not found in the copy, a checksum
 /// that does not match, an archive entry outside its folder or a link, an import that fails,
 /// or conditions the data does not have: each naming the recipe and the file.
 pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) -> Result<PathBuf> {
@@ -77,23 +76,26 @@ pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) 
         )));
         return Ok(dataset);
     }
+    std::fs::create_dir_all(root).map_err(|e| DataError::write(root, e))?;
     let Some(from) = from else {
-        let urls: Vec<&str> = recipe.sources.iter().map(|s| s.url.as_str()).collect();
-        return Err(in_recipe(
-            recipe,
-            DataError::invalid(
-                root,
-                format!(
-                    "{} is not in the cache, and neurotex does not download: fetch {} yourself and give the folder with --from",
-                    recipe.name,
-                    urls.join(", ")
-                ),
-            )
-            .into(),
-        ));
+        // Downloaded into the cache, kept until the fetch succeeds (or resumed next time).
+        let dir = root
+            .join("downloads")
+            .join(entry(root, recipe).file_name().unwrap_or_default());
+        if let Err(e) = super::download::download_all(recipe, &dir, on) {
+            // Folders left empty go; a partial download stays, to be resumed.
+            let _ = std::fs::remove_dir(&dir);
+            let _ = std::fs::remove_dir(root.join("downloads"));
+            return Err(in_recipe(recipe, e));
+        }
+        let fetched = fetch(recipe, root, Some(&dir), on);
+        match &fetched {
+            Ok(_) => std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?,
+            Err(_) => super::download::drop_damaged(recipe, &dir),
+        }
+        return fetched;
     };
     let dir = entry(root, recipe);
-    std::fs::create_dir_all(root).map_err(|e| DataError::write(root, e))?;
     create_dir_atomic(&dir, |tmp| {
         // What the import says names the entry as it will be, not its hidden temporary.
         let (hidden, shown) = (tmp.display().to_string(), dir.display().to_string());
@@ -169,7 +171,8 @@ fn fill(recipe: &Recipe, from: &Path, tmp: &Path, on: OnProgress) -> Result<()> 
 /// Finds `source` in `from`, verifies it and puts its files under `work`; returns the folder
 /// of the files it contributes (its `folder` inside an archive).
 fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<PathBuf> {
-    let name = source.url.rsplit('/').next().unwrap_or_default();
+    let name = super::download::file_name(source);
+    let name = name.as_str();
     let file = if from.is_file() && n_sources == 1 {
         Some(from.to_path_buf())
     } else {
@@ -193,7 +196,7 @@ fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<
                 reason,
             })?
             .len();
-        let got = file_digest(&file)?;
+        let got = super::digest::file_digest(&file)?;
         if got_size != size || &got != want {
             let why = format!("{got_size} bytes with SHA-256 {got}; the recipe says {size} bytes with {want}: a different or damaged file");
             return Err(DataError::invalid(&file, why).into());
@@ -218,89 +221,6 @@ fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<
         }
         None => Ok(work.to_path_buf()),
     }
-}
-
-/// The SHA-256 of `path`'s content, in hex.
-pub fn file_digest(path: &Path) -> Result<String> {
-    let io = |reason| DataError::Io {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let mut file = File::open(path).map_err(io)?;
-    let mut hasher = Sha256::new();
-    let mut buf = vec![0u8; 1 << 16];
-    loop {
-        let n = file.read(&mut buf).map_err(io)?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&buf[..n]);
-    }
-    Ok(hex(&hasher.finalize()))
-}
-
-/// The tree digest of folder `dir`: the SHA-256 of `sha256sum`'s lines (`HASH  PATH`) for
-/// every regular file under it, paths relative to `dir` with `/`, sorted bytewise; the
-/// same as `(cd DIR && find . -type f | sed 's|^\./||' | LC_ALL=C sort | xargs -d '\n'
-/// sha256sum) | sha256sum`.
-///
-/// # Errors
-/// A file cannot be read, or the folder holds a link (a tree is plain files and folders).
-pub fn tree_digest(dir: &Path) -> Result<String> {
-    let mut paths = Vec::new();
-    walk(dir, "", &mut paths)?;
-    if paths.is_empty() {
-        let why = "no files: a tree digest is of a folder's files";
-        return Err(DataError::invalid(dir, why).into());
-    }
-    paths.sort();
-    let mut lines = String::new();
-    for rel in &paths {
-        lines.push_str(&format!("{}  {rel}\n", file_digest(&dir.join(rel))?));
-    }
-    Ok(hex(&Sha256::digest(lines.as_bytes())))
-}
-
-/// Collects the relative paths of the regular files under `dir/rel`.
-fn walk(dir: &Path, rel: &str, out: &mut Vec<String>) -> Result<()> {
-    let here = dir.join(rel);
-    let io = |reason| DataError::Io {
-        path: here.clone(),
-        reason,
-    };
-    for item in std::fs::read_dir(&here).map_err(io)? {
-        let item = item.map_err(io)?;
-        let name = item.file_name().to_string_lossy().into_owned();
-        let path = if rel.is_empty() {
-            name
-        } else {
-            format!("{rel}/{name}")
-        };
-        let kind = item.file_type().map_err(io)?;
-        if kind.is_dir() {
-            walk(dir, &path, out)?;
-        } else if kind.is_file() {
-            out.push(path);
-        } else {
-            let why = "a link or special file: a dataset's tree holds plain files and folders";
-            return Err(DataError::invalid(dir.join(&path), why).into());
-        }
-    }
-    Ok(())
-}
-
-/// Copies the plain files and folders under `from` into `to`.
-fn copy_tree(from: &Path, to: &Path) -> Result<()> {
-    let mut paths = Vec::new();
-    walk(from, "", &mut paths)?;
-    for rel in paths {
-        let dest = to.join(&rel);
-        if let Some(parent) = dest.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| DataError::write(parent, e))?;
-        }
-        std::fs::copy(from.join(&rel), &dest).map_err(|e| DataError::write(&dest, e))?;
-    }
-    Ok(())
 }
 
 /// Moves what `from` holds into the folder `to`; two sources giving the same name is an

@@ -3,6 +3,8 @@
 //! protocols use and the results published on it (docs/benchmark.md). The recipes of the
 //! datasets neurotex knows are built in; a user's own is read from its file.
 
+mod digest;
+mod download;
 pub mod fetch;
 pub mod recipe;
 mod unpack;
@@ -12,7 +14,8 @@ use std::path::{Path, PathBuf};
 use super::OnProgress;
 use crate::error::DataError;
 
-pub use fetch::{cache_root, fetch, fetched, file_digest, tree_digest};
+pub use digest::{file_digest, tree_digest};
+pub use fetch::{cache_root, fetch, fetched};
 pub use recipe::{Published, Recipe, Source, SourceKind};
 
 use crate::Result;
@@ -76,13 +79,15 @@ pub enum DatasetsCommand {
         /// The recipe.
         recipe: String,
     },
-    /// Fetch a dataset into the cache from a local copy of its sources, verify every
-    /// checksum, import it once, and print the dataset folder.
+    /// Fetch a dataset into the cache: download its sources (an interrupted download
+    /// resumes on the next run) or take them from a local copy, verify every checksum,
+    /// import it once, and print the dataset folder.
     Fetch {
         /// A built-in recipe's name or a recipe file.
         name: String,
-        /// A local copy of the sources: a folder of the downloaded files (or the unpacked
-        /// folder a recipe's tree digest checks), or a one-source recipe's file itself.
+        /// A local copy of the sources instead of downloading them: a folder of the
+        /// downloaded files (or the unpacked folder a recipe's tree digest checks), or a
+        /// one-source recipe's file itself.
         #[cfg_attr(feature = "cli", arg(long))]
         from: Option<PathBuf>,
         /// The cache (default as for `list`).
