@@ -557,6 +557,7 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
         "{md}"
     );
     assert!(dir.join("out/ridges/within-speed/ranking.png").is_file());
+    assert!(dir.join("out/leaderboard.png").is_file() && dir.join("out/leaderboard.svg").is_file());
     // A rerun keeps both comparisons: same leaderboard, times included; another seed is
     // compared anew.
     let said = std::sync::Mutex::new(Vec::<String>::new());

@@ -247,7 +247,7 @@ fn kept(key_file: &Path, dir: &Path, key: &Key) -> Option<Comparison> {
 }
 
 impl Leaderboard {
-    /// Writes leaderboard.json and leaderboard.md into `out`.
+    /// Writes leaderboard.json, leaderboard.md and the figure (SVG and PNG) into `out`.
     ///
     /// # Errors
     /// A file cannot be written.
@@ -258,6 +258,14 @@ impl Leaderboard {
         write_atomic(&out.join("leaderboard.json"), |w| {
             w.write_all((json + "\n").as_bytes())
         })?;
+        let groups: Vec<_> = self.boards.iter().map(Board::figure_group).collect();
+        let svg = crate::report::figures::leaderboard::leaderboard(&groups, "neurotex benchmark")
+            .map_err(|e| DataError::invalid(out.join("leaderboard.svg"), e.to_string()))?;
+        let files = crate::report::figures::svg_and_png("leaderboard.svg", svg)
+            .map_err(|e| DataError::invalid(out.join("leaderboard.svg"), e.to_string()))?;
+        for (name, bytes) in files {
+            write_atomic(&out.join(&name), |w| w.write_all(&bytes))?;
+        }
         let md = markdown(self);
         write_atomic(&out.join("leaderboard.md"), |w| w.write_all(md.as_bytes()))
     }

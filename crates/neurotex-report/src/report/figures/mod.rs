@@ -9,6 +9,7 @@ pub mod compare;
 mod confusion;
 mod gain;
 pub mod inspect;
+pub mod leaderboard;
 mod neighbours;
 mod perturbation;
 mod plot;

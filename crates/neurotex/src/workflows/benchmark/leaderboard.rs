@@ -8,6 +8,7 @@ use super::candidate_set;
 use crate::compare::{Comparison, Ranked};
 use crate::datasets::recipe::ProtocolSpec;
 use crate::datasets::{Published, Recipe};
+use crate::report::figures::leaderboard::{Entry, Group, Kind};
 
 /// Candidates listed in full per board; the paper's method, the spike counts with logistic
 /// regression and the best baseline without spikes are listed below them when lower.
@@ -100,6 +101,54 @@ impl Leaderboard {
     }
 }
 
+impl Board {
+    /// The board's rows in the leaderboard's figure.
+    pub fn figure_group(&self) -> Group {
+        let c = &self.comparison;
+        let mut rows = Vec::new();
+        if let Some(n) = &c.nested {
+            rows.push(Entry {
+                label: "nested selection".into(),
+                accuracy: n.accuracy,
+                ci: Some(n.ci),
+                kind: Kind::Nested,
+            });
+        }
+        let ranked = |kind: Kind, r: Option<&Ranked>| {
+            r.map(|r| Entry {
+                label: format!("{} / {} / {}", r.encoding, r.method, r.classifier),
+                accuracy: r.accuracy,
+                ci: Some(r.ci),
+                kind,
+            })
+        };
+        let spikes = c.results.iter().find(|r| r.encoding != "none");
+        let rates = (c.results.iter())
+            .filter(|r| r.method == "rates" && r.classifier == "linear")
+            .max_by(|a, b| a.accuracy.total_cmp(&b.accuracy));
+        let none = c.results.iter().find(|r| r.encoding == "none");
+        let paper = c.results.iter().find(|r| r.paper);
+        rows.extend(ranked(Kind::Spikes, spikes));
+        rows.extend(ranked(Kind::Rates, rates));
+        rows.extend(ranked(Kind::NoSpikes, none));
+        rows.extend(ranked(Kind::Paper, paper));
+        rows.extend(self.published.iter().map(|p| Entry {
+            label: p.citation.clone(),
+            accuracy: p.accuracy,
+            ci: None,
+            kind: match p.same_protocol {
+                true => Kind::Published,
+                false => Kind::PublishedOther,
+            },
+        }));
+        Group {
+            title: format!("{}: {}", self.dataset, self.protocol),
+            chance: c.chance,
+            rows,
+        }
+    }
+}
+
 /// A share as a percentage with one decimal.
 fn pct(x: f64) -> String {
     format!("{:.1}", 100.0 * x)
@@ -139,7 +188,7 @@ fn row(rank: usize, r: &Ranked) -> String {
 pub fn markdown(board: &Leaderboard) -> String {
     let (encodings, methods, classifiers) = candidate_set(board.snn);
     let mut s = format!(
-        "# Leaderboard\n\nCandidate set {}: encodings {encodings} (`none`: the baselines without spikes, from the signal the encoder would receive), methods {methods}, classifiers {classifiers}, every pairing `neurotex compare` runs. Each protocol is `neurotex compare --nested` on the recipe's dataset: accuracies are means over the protocol's conditions, with 95 % bootstrap intervals over recordings; Δ and p are against the paper's method (SA, 3D-GLCM, KNN), by the paired sign-flip test. The top candidate of a ranking is chosen on the recordings it is scored on and is biased upwards; the nested estimate (the best chosen inside each training set) is the one to quote. {} folds, {} repeat(s), seed {}; neurotex {}.\n",
+        "# Leaderboard\n\n![the leaderboard](leaderboard.png)\n\nCandidate set {}: encodings {encodings} (`none`: the baselines without spikes, from the signal the encoder would receive), methods {methods}, classifiers {classifiers}, every pairing `neurotex compare` runs. Each protocol is `neurotex compare --nested` on the recipe's dataset: accuracies are means over the protocol's conditions, with 95 % bootstrap intervals over recordings; Δ and p are against the paper's method (SA, 3D-GLCM, KNN), by the paired sign-flip test. The top candidate of a ranking is chosen on the recordings it is scored on and is biased upwards; the nested estimate (the best chosen inside each training set) is the one to quote. {} folds, {} repeat(s), seed {}; neurotex {}.\n",
         board.candidate_set, board.folds, board.repeats, board.seed, board.neurotex
     );
     for b in &board.boards {

@@ -106,8 +106,8 @@ fn one(agent: &ureq::Agent, source: &Source, done: &Path, on: OnProgress) -> Res
         .or(source.size);
     let steps = total.map_or(0, |t| t.div_ceil(STEP)) as usize;
     let what = match resumed {
-        true => "downloading (resumed)",
-        false => "downloading",
+        true => "downloading, resumed (MiB)",
+        false => "downloading (MiB)",
     };
     on(Progress::Stage(what, steps));
     let mut reader = response.body_mut().as_reader();
