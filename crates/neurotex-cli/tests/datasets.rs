@@ -26,7 +26,7 @@ fn list_check_digest_and_the_errors_a_user_meets() {
     let err = dir.fails(&["datasets", "check", "bad.toml"]);
     assert!(err.contains("bad.toml") && err.contains("size"), "{err}");
     let err = dir.fails(&["datasets", "path", "fabricslide", "--cache", s(&cache)]);
-    assert!(err.contains("datasets fetch fabricslide"), "{err}");
+    assert!(err.contains("datasets fetch fabricslide`"), "{err}");
     std::fs::create_dir_all(dir.join("tree")).unwrap();
     std::fs::write(dir.join("tree/a.csv"), "1\n").unwrap();
     let digest = dir.ok(&["datasets", "digest", "tree"]);

@@ -558,6 +558,28 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
     );
     assert!(dir.join("out/ridges/within-speed/ranking.png").is_file());
     assert!(dir.join("out/leaderboard.png").is_file() && dir.join("out/leaderboard.svg").is_file());
+    // A nested interval under chance, or across it, is said so.
+    let mut low = board.clone();
+    let c = &mut low.boards[0].comparison;
+    let chance = c.chance;
+    c.nested.as_mut().unwrap().ci = [chance / 3.0, chance / 2.0];
+    let md = neurotex::workflows::benchmark::markdown(&low);
+    assert!(md.contains("**Below chance**"), "{md}");
+    let c = &mut low.boards[0].comparison;
+    c.nested.as_mut().unwrap().ci = [chance / 2.0, 2.0 * chance];
+    let md = neurotex::workflows::benchmark::markdown(&low);
+    assert!(
+        md.contains("includes chance") && !md.contains("Below chance"),
+        "{md}"
+    );
+    // Within each speed the ridges are told apart well above chance: no such line.
+    let mut within = board.clone();
+    within.boards.truncate(1);
+    let md = neurotex::workflows::benchmark::markdown(&within);
+    assert!(
+        !md.contains("Below chance") && !md.contains("includes chance"),
+        "{md}"
+    );
     // A rerun keeps both comparisons: same leaderboard, times included; another seed is
     // compared anew.
     let said = std::sync::Mutex::new(Vec::<String>::new());

@@ -128,6 +128,12 @@ class Dataset:
     def __len__(self) -> int:
         return len(self.recordings)
 
+    def __repr__(self) -> str:
+        labels = sorted({r.label for r in self.recordings})
+        shown = ", ".join(labels[:8]) + (", ..." if len(labels) > 8 else "")
+        return (f"Dataset({len(self.recordings)} recordings, {len(labels)} labels ({shown}), "
+                f"fs={self.fs:.6g} Hz, columns={self.columns}, path={self.path!r})")
+
 
 @dataclass(frozen=True)
 class GainCalibration:

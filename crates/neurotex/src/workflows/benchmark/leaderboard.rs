@@ -81,8 +81,13 @@ impl Leaderboard {
         let line = |b: &Board| {
             let c = &b.comparison;
             let nested = c.nested.as_ref().map_or(String::new(), |n| {
+                let flag = match against_chance(n.ci, c.chance) {
+                    Some(_) if n.ci[1] < c.chance => " (below chance)",
+                    Some(_) => " (not above chance)",
+                    None => "",
+                };
                 format!(
-                    "nested {} % [{}, {}]; ",
+                    "nested {} % [{}, {}]{flag}; ",
                     pct(n.accuracy),
                     pct(n.ci[0]),
                     pct(n.ci[1])
@@ -146,6 +151,23 @@ impl Board {
             chance: c.chance,
             rows,
         }
+    }
+}
+
+/// What a nested interval at or under chance means, when it is.
+fn against_chance(ci: [f64; 2], chance: f64) -> Option<String> {
+    if ci[1] < chance {
+        Some(format!(
+            "**Below chance** ({} %): the whole interval is under it. What is learnt on the training sets does not carry over to the test sets (under a held-out condition, features that change with the condition).",
+            pct(chance)
+        ))
+    } else if ci[0] <= chance {
+        Some(format!(
+            "The interval includes chance ({} %): not shown to classify better than guessing.",
+            pct(chance)
+        ))
+    } else {
+        None
     }
 }
 
@@ -225,6 +247,9 @@ fn section(b: &Board) -> String {
             pct(n.ci[0]),
             pct(n.ci[1])
         ));
+        if let Some(warning) = against_chance(n.ci, c.chance) {
+            s.push_str(&format!("{warning}\n\n"));
+        }
     }
     s.push_str("| rank | candidate | accuracy, % | 95 % interval | Δ vs paper, points | p |\n|---|---|---|---|---|---|\n");
     let mut shown = 0;

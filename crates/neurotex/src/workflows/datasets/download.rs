@@ -106,8 +106,8 @@ fn one(agent: &ureq::Agent, source: &Source, done: &Path, on: OnProgress) -> Res
         .or(source.size);
     let steps = total.map_or(0, |t| t.div_ceil(STEP)) as usize;
     let what = match resumed {
-        true => "downloading, resumed (MiB)",
-        false => "downloading (MiB)",
+        true => "downloading, resumed, MiB",
+        false => "downloading, MiB",
     };
     on(Progress::Stage(what, steps));
     let mut reader = response.body_mut().as_reader();
@@ -144,13 +144,15 @@ fn one(agent: &ureq::Agent, source: &Source, done: &Path, on: OnProgress) -> Res
 }
 
 /// Removes the downloaded files in `dir` whose checksum does not match their source's, so
-/// that the next run downloads them anew.
-pub fn drop_damaged(recipe: &Recipe, dir: &Path) {
+/// that the next run downloads them anew; whether any was.
+pub fn drop_damaged(recipe: &Recipe, dir: &Path) -> bool {
+    let mut removed = false;
     for source in &recipe.sources {
         let file = dir.join(file_name(source));
         let Some(want) = &source.sha256 else { continue };
         if super::digest::file_digest(&file).is_ok_and(|got| &got != want) {
-            let _ = std::fs::remove_file(&file);
+            removed |= std::fs::remove_file(&file).is_ok();
         }
     }
+    removed
 }

@@ -88,13 +88,30 @@ pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) 
             let _ = std::fs::remove_dir(root.join("downloads"));
             return Err(in_recipe(recipe, e));
         }
-        let fetched = fetch(recipe, root, Some(&dir), on);
+        let fetched = fetch_from(recipe, root, &dir, "downloaded", on);
         match &fetched {
             Ok(_) => std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?,
-            Err(_) => super::download::drop_damaged(recipe, &dir),
+            Err(_) => {
+                if super::download::drop_damaged(recipe, &dir) {
+                    on(Progress::Advice("a download that was not the recipe's file was removed: the next run downloads it again"));
+                }
+                let _ = std::fs::remove_dir(&dir);
+                let _ = std::fs::remove_dir(root.join("downloads"));
+            }
         }
         return fetched;
     };
+    fetch_from(recipe, root, from, &from.display().to_string(), on)
+}
+
+/// [`fetch`] from the files in `from`; `origin` says where they came from in the record.
+fn fetch_from(
+    recipe: &Recipe,
+    root: &Path,
+    from: &Path,
+    origin: &str,
+    on: OnProgress,
+) -> Result<PathBuf> {
     let dir = entry(root, recipe);
     create_dir_atomic(&dir, |tmp| {
         // What the import says names the entry as it will be, not its hidden temporary.
@@ -104,7 +121,7 @@ pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) 
             Progress::Advice(s) => on(Progress::Advice(&s.replace(&hidden, &shown))),
             other => on(other),
         };
-        fill(recipe, from, tmp, &renamed)
+        fill(recipe, from, origin, tmp, &renamed)
     })
     .map_err(|e| in_recipe(recipe, e))?;
     Ok(dir.join("dataset"))
@@ -121,7 +138,7 @@ fn in_recipe(recipe: &Recipe, error: Error) -> Error {
 /// Fills the cache entry `tmp`: the sources into `files/`, their import into `dataset/`,
 /// the conditions checked, the record written; `files/` is then removed (the dataset holds
 /// what it needs).
-fn fill(recipe: &Recipe, from: &Path, tmp: &Path, on: OnProgress) -> Result<()> {
+fn fill(recipe: &Recipe, from: &Path, origin: &str, tmp: &Path, on: OnProgress) -> Result<()> {
     let files = tmp.join("files");
     std::fs::create_dir(&files).map_err(|e| DataError::write(&files, e))?;
     for (i, source) in recipe.sources.iter().enumerate() {
@@ -161,7 +178,8 @@ fn fill(recipe: &Recipe, from: &Path, tmp: &Path, on: OnProgress) -> Result<()> 
     let record = serde_json::json!({
         "recipe": recipe.name,
         "import_digest": recipe.import_digest(),
-        "from": from.display().to_string(),
+        "from": origin,
+        "sources": recipe.sources,
     });
     let path = tmp.join(FETCHED);
     std::fs::write(&path, record.to_string()).map_err(|e| DataError::write(&path, e))?;

@@ -147,7 +147,7 @@ impl DatasetsCommand {
                 match fetched(&root, &resolve(name)?) {
                     Some(dir) => Ok(vec![dir.display().to_string()]),
                     None => {
-                        let why = format!("{name} is not in this cache: `neurotex datasets fetch {name} --from COPY` fetches it");
+                        let why = format!("{name} is not in this cache: `neurotex datasets fetch {name}` downloads it (or takes a local copy with --from)");
                         Err(DataError::invalid(&root, why).into())
                     }
                 }
