@@ -883,3 +883,52 @@ fn predict_on_a_folder_says_how_to_give_it() {
     assert!(err.contains("--dataset"), "{err}");
     assert!(!out.exists());
 }
+
+/// `export inputs --speeds` writes the recordings at those speeds only, and names a speed
+/// the dataset lacks.
+#[test]
+fn export_inputs_at_some_speeds() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0, 10.0], 4);
+    let model = dir.join("snn.json");
+    dir.ok(&[
+        "train",
+        "--dataset",
+        s(&ds),
+        "--classifier",
+        "snn",
+        "--snn-hidden",
+        "8",
+        "--snn-epochs",
+        "2",
+        "--out",
+        s(&model),
+    ]);
+    let inputs = dir.join("inputs");
+    let export = |speeds: &'static str| -> Vec<String> {
+        let args = [
+            "export",
+            "inputs",
+            "--model",
+            s(&model),
+            "--dataset",
+            s(&ds),
+        ];
+        let more = ["--speeds", speeds, "--out", s(&inputs)];
+        args.iter().chain(&more).map(|a| a.to_string()).collect()
+    };
+    fn strs(v: &[String]) -> Vec<&str> {
+        v.iter().map(String::as_str).collect()
+    }
+    dir.ok(&strs(&export("10")));
+    let index = std::fs::read_to_string(inputs.join("index.csv")).unwrap();
+    assert_eq!(index.lines().count(), 1 + 2 * 4, "{index}");
+    let manifest = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    for line in index.lines().skip(1) {
+        let file = line.split(',').next().unwrap();
+        let row = manifest.lines().find(|l| l.starts_with(file)).unwrap();
+        assert!(row.contains(",10"), "{row}");
+    }
+    let err = dir.fails(&strs(&export("7")));
+    assert!(err.contains('7'), "{err}");
+}

@@ -106,7 +106,8 @@ pub fn run(command: ExportCommand) -> Result<()> {
             let model = load_spiking(&args.model)?;
             let dataset = args.open.open(&args.dataset)?;
             let shown = Shown::new("starting");
-            let n = export_inputs(&model, &dataset, &args.out, &shown.callback());
+            let (speeds, on) = (args.speeds.as_deref(), shown.callback());
+            let n = export_inputs(&model, &dataset, speeds, &args.out, &on);
             shown.finish();
             let n = n?;
             eprintln!(

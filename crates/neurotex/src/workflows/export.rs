@@ -65,6 +65,12 @@ pub struct ExportInputsOptions {
     /// The folder to write (new, empty, or an earlier export, which is replaced).
     #[cfg_attr(feature = "cli", arg(long))]
     pub out: PathBuf,
+    /// Only the recordings at these speeds (mm/s, comma-separated); default all.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_delimiter = ',', allow_hyphen_values = true)
+    )]
+    pub speeds: Option<Vec<crate::Speed>>,
     /// How the dataset folder is opened.
     #[cfg_attr(feature = "cli", command(flatten))]
     pub open: OpenOptions,
@@ -186,20 +192,25 @@ pub fn load_spiking(path: &Path) -> Result<SpikingModel> {
     SpikingModel::load(path)
 }
 
-/// Writes, into the folder `out` (new, or an earlier export), every recording of `dataset` as the `(steps,
-/// inputs)` float32 spike counts the network's input node receives (`<n>.npy`, row-major),
-/// and `index.csv` (`file,label,array`). Returns the recordings written.
+/// Writes, into the folder `out` (new, or an earlier export), every recording of `dataset`
+/// (those at `speeds` when given) as the `(steps, inputs)` float32 spike counts the
+/// network's input node receives (`<n>.npy`, row-major), and `index.csv`
+/// (`file,label,array`). Returns the recordings written.
 ///
 /// # Errors
-/// A recording that cannot be read or encoded, or `out` holds files neurotex did not write
-/// there (an earlier export is replaced).
+/// A speed the dataset has no recording at, a recording that cannot be read or encoded, or
+/// `out` holds files neurotex did not write there (an earlier export is replaced).
 pub fn export_inputs(
     model: &SpikingModel,
     dataset: &Dataset,
+    speeds: Option<&[crate::Speed]>,
     out: &Path,
     on: OnProgress,
 ) -> Result<usize> {
-    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    let all: Vec<usize> = match speeds {
+        Some(speeds) => dataset.indices_at(speeds)?,
+        None => (0..dataset.entries.len()).collect(),
+    };
     on(Progress::Stage("encoding", all.len()));
     let encoded = model
         .pipeline()
