@@ -7,9 +7,9 @@ use plotters::style::text_anchor::{HPos, VPos};
 
 use super::accuracy::{chart_width, group_labels, plot_height};
 use super::plot::{
-    accuracy_chart, fit, hline, line_height, line_with_markers, mesh, number, percent, text,
-    text_width, vline, Chart, Drawn, Frame, Key, Placement, Swatch, Width, GLCM3D, GREY, LABEL,
-    MARGIN, SERIES, SINGLE, TICK, X_AXIS_H, Y_AXIS_W,
+    accuracy_axis, accuracy_chart, fit, hline, interval, line_height, line_with_markers, percent,
+    text, text_width, vline, Chart, Drawn, Frame, Key, Placement, Swatch, Width, GLCM3D, GREY,
+    LABEL, MARGIN, SERIES, SINGLE, TICK, X_AXIS_H, Y_AXIS_W,
 };
 use super::FigureError;
 use crate::compare::{Comparison, Ranked};
@@ -285,13 +285,7 @@ fn draw_rows(chart: &mut Chart, c: &Comparison, rows: &[Row]) -> Drawn {
         let (lo, hi) = (100.0 * nested.ci[0], 100.0 * nested.ci[1]);
         chart.draw_series([Rectangle::new([(lo, 0.0), (hi, n)], BAND.mix(0.6).filled())])?;
     }
-    mesh(chart)
-        .disable_y_mesh()
-        .y_labels(0)
-        .x_labels(11)
-        .x_label_formatter(&|v| number(*v))
-        .x_desc("accuracy (%)")
-        .draw()?;
+    accuracy_axis(chart)?;
     vline(chart, 100.0 * c.chance, GREY, 9)?;
     if (c.chance - c.majority).abs() >= 1e-9 {
         vline(chart, 100.0 * c.majority, MAJORITY, 5)?;
@@ -303,13 +297,7 @@ fn draw_rows(chart: &mut Chart, c: &Comparison, rows: &[Row]) -> Drawn {
     }
     for (k, row) in rows.iter().enumerate() {
         let y = n - k as f64 - 0.5;
-        let cap = 0.25;
-        let style = row.colour.stroke_width(1);
-        chart.draw_series([
-            PathElement::new(vec![(row.ci[0], y), (row.ci[1], y)], style),
-            PathElement::new(vec![(row.ci[0], y - cap), (row.ci[0], y + cap)], style),
-            PathElement::new(vec![(row.ci[1], y - cap), (row.ci[1], y + cap)], style),
-        ])?;
+        interval(chart, row.ci, y, row.colour)?;
         chart.draw_series([Circle::new((row.accuracy, y), 3, row.colour.filled())])?;
     }
     Ok(())

@@ -7,8 +7,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::plot::{
-    fit, mesh, number, text, text_width, Frame, Key, Swatch, Width, GLCM3D, GREY, MARGIN, SERIES,
-    SINGLE, TICK, X_AXIS_H,
+    accuracy_axis, fit, interval, text, text_width, Frame, Key, Swatch, Width, GLCM3D, GREY,
+    MARGIN, SERIES, SINGLE, TICK, X_AXIS_H,
 };
 use super::FigureError;
 
@@ -118,13 +118,7 @@ pub fn leaderboard(groups: &[Group], source: &str) -> Result<String, FigureError
             .margin_right(16)
             .x_label_area_size(X_AXIS_H)
             .build_cartesian_2d(0.0..100.0, 0.0..n as f64)?;
-        mesh(&mut chart)
-            .disable_y_mesh()
-            .y_labels(0)
-            .x_labels(11)
-            .x_label_formatter(&|v| number(*v))
-            .x_desc("accuracy (%)")
-            .draw()?;
+        accuracy_axis(&mut chart)?;
         let mut k = 0usize;
         for g in groups {
             let y_of = |k: usize| n as f64 - k as f64 - 0.5;
@@ -144,13 +138,7 @@ pub fn leaderboard(groups: &[Group], source: &str) -> Result<String, FigureError
                 k += 1;
                 let (y, colour) = (y_of(k), row.kind.colour());
                 if let Some([lo, hi]) = row.ci {
-                    let style = colour.stroke_width(1);
-                    let (lo, hi) = (100.0 * lo, 100.0 * hi);
-                    chart.draw_series([
-                        PathElement::new(vec![(lo, y), (hi, y)], style),
-                        PathElement::new(vec![(lo, y - 0.25), (lo, y + 0.25)], style),
-                        PathElement::new(vec![(hi, y - 0.25), (hi, y + 0.25)], style),
-                    ])?;
+                    interval(&mut chart, [100.0 * lo, 100.0 * hi], y, colour)?;
                 }
                 let at = (100.0 * row.accuracy, y);
                 match row.kind {

@@ -250,6 +250,29 @@ pub(crate) fn hline(chart: &mut Chart, y: f64, colour: RGBColor, dash: i32) -> D
     Ok(())
 }
 
+/// A horizontal accuracy axis from 0 to 100 % with a tick every 10, and no y labels: the
+/// axis of the rankings.
+pub(crate) fn accuracy_axis(chart: &mut Chart) -> Drawn {
+    mesh(chart)
+        .disable_y_mesh()
+        .y_labels(0)
+        .x_labels(11)
+        .x_label_formatter(&|v| number(*v))
+        .x_desc("accuracy (%)")
+        .draw()
+}
+
+/// An interval from `lo` to `hi` at height `y`, with short caps, in `colour`.
+pub(crate) fn interval(chart: &mut Chart, [lo, hi]: [f64; 2], y: f64, colour: RGBColor) -> Drawn {
+    let (style, cap) = (colour.stroke_width(1), 0.25);
+    chart.draw_series([
+        PathElement::new(vec![(lo, y), (hi, y)], style),
+        PathElement::new(vec![(lo, y - cap), (lo, y + cap)], style),
+        PathElement::new(vec![(hi, y - cap), (hi, y + cap)], style),
+    ])?;
+    Ok(())
+}
+
 /// A vertical dashed line at `x` across the chart.
 pub(crate) fn vline(chart: &mut Chart, x: f64, colour: RGBColor, dash: i32) -> Drawn {
     let y = chart.y_range();
