@@ -121,17 +121,21 @@ def _without_times(value):
     return value
 
 
-def test_benchmark_on_a_dask_cluster_is_the_command_lines(recipe, tmp_path, cli):
+def test_benchmark_on_a_dask_cluster_is_the_command_lines(recipe, tmp_path, cli, caplog):
     distributed = pytest.importorskip("distributed")
     name = str(recipe / "ridges.toml")
     cli("benchmark", name, "--from", recipe / "copy", "--cache", tmp_path / "c1",
         "--out", tmp_path / "cli", "--folds", "3", "--seed", "2")
     expected = json.loads((tmp_path / "cli" / "leaderboard.json").read_text())
+    caplog.set_level("INFO", logger="neurotex")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
         with distributed.Client(cluster) as client:
             board = neurotex.benchmark([name], tmp_path / "py", cache=tmp_path / "c2",
                                        source=recipe / "copy", folds=3, seed=2, client=client)
+    # Both protocols were compared by the cluster's tasks; the last call only gathered them.
+    kept = [r for r in caplog.records if "kept from an earlier run" in r.getMessage()]
+    assert len(kept) == 2
     assert len(board["boards"]) == 2
     assert _without_times(board) == _without_times(expected)
     written = json.loads((tmp_path / "py" / "leaderboard.json").read_text())

@@ -97,7 +97,9 @@ def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
     must see ``out`` and ``cache`` (a shared file system, or a local cluster). Every dataset
     is fetched here first, the tasks keep their comparisons in ``out``, and the leaderboard
     is then made from them: the same as without a client."""
-    names = [os.fspath(d) for d in datasets]
+    # A recipe file by its absolute path, so that a worker elsewhere finds it too.
+    names = [os.path.abspath(os.fspath(d)) if os.fspath(d).endswith(".toml")
+             or os.sep in os.fspath(d) else os.fspath(d) for d in datasets]
     out_s, cache_s = _opt(out), _opt(cache)
     wanted = list(protocols or [])
     if client is not None:

@@ -228,6 +228,11 @@ impl BenchmarkOptions {
             })?;
         // The figures name the dataset by its recipe, not by the cache's folder.
         let named = Path::new(&recipe.name);
+        // The old key goes first: a run stopped between the two writes leaves no key, never
+        // another run's key beside this comparison.
+        if key_file.exists() {
+            std::fs::remove_file(&key_file).map_err(|e| DataError::write(&key_file, e))?;
+        }
         crate::report::comparison::write_comparison(&dir, &comparison, named)?;
         let text = serde_json::to_string_pretty(&key).unwrap_or_default();
         write_atomic(&key_file, |w| w.write_all(text.as_bytes()))?;

@@ -129,7 +129,7 @@ impl Board {
         };
         let spikes = c.results.iter().find(|r| r.encoding != "none");
         let rates = (c.results.iter())
-            .filter(|r| r.method == "rates" && r.classifier == "linear")
+            .filter(|r| is_rates(r))
             .max_by(|a, b| a.accuracy.total_cmp(&b.accuracy));
         let none = c.results.iter().find(|r| r.encoding == "none");
         let paper = c.results.iter().find(|r| r.paper);
@@ -180,7 +180,7 @@ fn pct(x: f64) -> String {
 fn name(r: &Ranked) -> String {
     let role = if r.paper {
         " (the paper's method)"
-    } else if r.method == "rates" && r.classifier == "linear" {
+    } else if is_rates(r) {
         " (spike counts, logistic regression)"
     } else if r.encoding == "none" {
         " (no spikes)"
@@ -219,6 +219,49 @@ pub fn markdown(board: &Leaderboard) -> String {
     s
 }
 
+/// The ranking's table: the first [`TOP`] candidates, then the paper's method, the spike
+/// counts with logistic regression and the best baseline without spikes where lower, the
+/// ranks left out said; and a note when the first candidates tie.
+fn table(c: &Comparison) -> String {
+    let mut s = String::new();
+    s.push_str("| rank | candidate | accuracy, % | 95 % interval | Δ vs paper, points | p |\n|---|---|---|---|---|---|\n");
+    let mut shown = 0;
+    for (i, r) in c.results.iter().enumerate() {
+        let marked = r.paper
+            || is_rates(r)
+            || c.results.iter().position(|x| x.encoding == "none") == Some(i);
+        if i < TOP || marked {
+            if i > shown {
+                s.push_str(&format!(
+                    "| … | ranks {}–{} in compare.md | | | | |\n",
+                    shown + 1,
+                    i
+                ));
+            }
+            s.push_str(&row(i + 1, r));
+            s.push('\n');
+            shown = i + 1;
+        }
+    }
+    let tied = c
+        .results
+        .iter()
+        .take_while(|r| r.accuracy == c.best.accuracy)
+        .count();
+    if tied > 1 {
+        s.push_str(&format!(
+            "\nThe first {tied} candidates tie at {} %: the order among them is the order they were listed in, not a ranking.\n",
+            pct(c.best.accuracy)
+        ));
+    }
+    s
+}
+
+/// Whether `r` is the spike counts with logistic regression.
+fn is_rates(r: &Ranked) -> bool {
+    r.method == "rates" && r.classifier == "linear"
+}
+
 /// One board's section.
 fn section(b: &Board) -> String {
     let c = &b.comparison;
@@ -251,36 +294,7 @@ fn section(b: &Board) -> String {
             s.push_str(&format!("{warning}\n\n"));
         }
     }
-    s.push_str("| rank | candidate | accuracy, % | 95 % interval | Δ vs paper, points | p |\n|---|---|---|---|---|---|\n");
-    let mut shown = 0;
-    for (i, r) in c.results.iter().enumerate() {
-        let marked = r.paper
-            || (r.method == "rates" && r.classifier == "linear")
-            || c.results.iter().position(|x| x.encoding == "none") == Some(i);
-        if i < TOP || marked {
-            if i > shown {
-                s.push_str(&format!(
-                    "| … | ranks {}–{} in compare.md | | | | |\n",
-                    shown + 1,
-                    i
-                ));
-            }
-            s.push_str(&row(i + 1, r));
-            s.push('\n');
-            shown = i + 1;
-        }
-    }
-    let tied = c
-        .results
-        .iter()
-        .take_while(|r| r.accuracy == c.best.accuracy)
-        .count();
-    if tied > 1 {
-        s.push_str(&format!(
-            "\nThe first {tied} candidates tie at {} %: the order among them is the order they were listed in, not a ranking.\n",
-            pct(c.best.accuracy)
-        ));
-    }
+    s.push_str(&table(c));
     if !b.published.is_empty() {
         s.push_str("\nPublished on these data:\n\n| accuracy, % | who | their method and protocol | the same protocol as above |\n|---|---|---|---|\n");
         for p in &b.published {

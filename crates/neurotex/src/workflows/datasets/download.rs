@@ -48,8 +48,19 @@ pub fn download_all(recipe: &Recipe, dir: &Path, on: OnProgress) -> Result<()> {
         let complete = source.size.is_some_and(|size| {
             std::fs::metadata(&done).is_ok_and(|m| m.is_file() && m.len() == size)
         });
-        if complete || (source.size.is_none() && done.is_file()) {
+        if complete {
             continue;
+        }
+        if source.sha256.is_none() {
+            // Nothing checks its bytes before they are unpacked: never a part kept from
+            // an earlier run, always the whole file anew.
+            let partial = dir.join(format!("{name}.partial"));
+            for stale in [&done, &partial] {
+                plain_or_absent(stale)?;
+                if stale.exists() {
+                    std::fs::remove_file(stale).map_err(|e| DataError::write(stale, e))?;
+                }
+            }
         }
         one(&agent, source, &done, on)?;
     }
@@ -83,11 +94,17 @@ fn one(agent: &ureq::Agent, source: &Source, done: &Path, on: OnProgress) -> Res
         .call()
         .map_err(|e| failed(format!("cannot download ({e}): without a network, download it elsewhere and give its folder with --from")))?;
     let status = response.status().as_u16();
+    // A part is resumed only where the server says it sends the rest from there.
+    let from_here = format!("bytes {have}-");
+    let resumes = (response.headers().get("content-range"))
+        .and_then(|v| v.to_str().ok())
+        .is_some_and(|v| v.starts_with(&from_here));
     let resumed = match status {
-        206 if have > 0 => true,
+        206 if have > 0 && resumes => true,
         200 => false,
-        // The partial file is already whole (or longer than the file): start again.
-        416 => {
+        // Not the rest from where the part stops (another range, or the part is already
+        // whole or longer than the file): the part goes and the file starts again.
+        206 | 416 if have > 0 => {
             std::fs::remove_file(&partial).map_err(|e| DataError::write(&partial, e))?;
             return one(agent, source, done, on);
         }
@@ -102,7 +119,7 @@ fn one(agent: &ureq::Agent, source: &Source, done: &Path, on: OnProgress) -> Res
     let total = response
         .body()
         .content_length()
-        .map(|n| n + start)
+        .and_then(|n| n.checked_add(start))
         .or(source.size);
     let steps = total.map_or(0, |t| t.div_ceil(STEP)) as usize;
     let what = match resumed {
@@ -111,25 +128,13 @@ fn one(agent: &ureq::Agent, source: &Source, done: &Path, on: OnProgress) -> Res
     };
     on(Progress::Stage(what, steps));
     let mut reader = response.body_mut().as_reader();
-    let mut buf = vec![0u8; 1 << 16];
-    let (mut written, mut ticked) = (start, start / STEP);
-    loop {
-        let n = reader.read(&mut buf).map_err(|e| {
-            failed(format!(
-                "the download stopped after {written} bytes ({e}); run again to resume it"
-            ))
+    let written =
+        copy_body(&mut reader, &mut file, start, on).map_err(|(at, e, reading)| match reading {
+            true => failed(format!(
+                "the download stopped after {at} bytes ({e}); run again to resume it"
+            )),
+            false => DataError::write(&partial, e).into(),
         })?;
-        if n == 0 {
-            break;
-        }
-        file.write_all(&buf[..n])
-            .map_err(|e| DataError::write(&partial, e))?;
-        written += n as u64;
-        while ticked < written / STEP {
-            ticked += 1;
-            on(Progress::Tick);
-        }
-    }
     file.sync_all().map_err(|e| DataError::write(&partial, e))?;
     if let Some(t) = total.filter(|&t| t != written) {
         let why =
@@ -143,14 +148,44 @@ fn one(agent: &ureq::Agent, source: &Source, done: &Path, on: OnProgress) -> Res
     Ok(())
 }
 
+/// Copies the body from `reader` to `file`, which holds `start` bytes already, ticking a
+/// step per MiB; the bytes the file holds after. On failure, the bytes written, the error
+/// and whether reading (not writing) failed.
+fn copy_body(
+    reader: &mut impl Read,
+    file: &mut File,
+    start: u64,
+    on: OnProgress,
+) -> std::result::Result<u64, (u64, std::io::Error, bool)> {
+    let mut buf = vec![0u8; 1 << 16];
+    let (mut written, mut ticked) = (start, start / STEP);
+    loop {
+        let n = reader.read(&mut buf).map_err(|e| (written, e, true))?;
+        if n == 0 {
+            return Ok(written);
+        }
+        file.write_all(&buf[..n]).map_err(|e| (written, e, false))?;
+        written += n as u64;
+        while ticked < written / STEP {
+            ticked += 1;
+            on(Progress::Tick);
+        }
+    }
+}
+
 /// Removes the downloaded files in `dir` whose checksum does not match their source's, so
 /// that the next run downloads them anew; whether any was.
 pub fn drop_damaged(recipe: &Recipe, dir: &Path) -> bool {
     let mut removed = false;
     for source in &recipe.sources {
         let file = dir.join(file_name(source));
-        let Some(want) = &source.sha256 else { continue };
-        if super::digest::file_digest(&file).is_ok_and(|got| &got != want) {
+        // Without a checksum (a repository's archive, checked only once unpacked) a
+        // failed fetch cannot vouch for the file either.
+        let damaged = match &source.sha256 {
+            Some(want) => super::digest::file_digest(&file).is_ok_and(|got| &got != want),
+            None => file.is_file(),
+        };
+        if damaged {
             removed |= std::fs::remove_file(&file).is_ok();
         }
     }

@@ -149,26 +149,14 @@ fn fill(recipe: &Recipe, from: &Path, origin: &str, tmp: &Path, on: OnProgress) 
         let work = tmp.join(format!("unpack-{i}"));
         std::fs::create_dir(&work).map_err(|e| DataError::write(&work, e))?;
         let used = place(source, recipe.sources.len(), from, &work)?;
-        if let Some(want) = &source.tree_sha256 {
-            let got = tree_digest(&used)?;
-            if &got != want {
-                let hint = match (&source.folder, source.url.rsplit('/').next()) {
-                    (Some(folder), Some(file)) => format!(
-                        " (give the unpacked folder {folder} itself, or a folder holding {file})"
-                    ),
-                    _ => String::new(),
-                };
-                let why = format!("tree digest {got}, the recipe's tree-sha256 is {want}: not the files the recipe describes{hint}");
-                return Err(DataError::invalid(from, why).into());
-            }
-        }
+        check_tree(source, &used, from)?;
         move_into(&used, &files)?;
         std::fs::remove_dir_all(&work).map_err(|e| DataError::write(&work, e))?;
     }
     let dataset = tmp.join("dataset");
     let import = recipe
         .import_in(&files)
-        .map_err(|e| DataError::invalid("[import]", e))?;
+        .map_err(|e| DataError::invalid(&files, e.to_string()))?;
     match import {
         Import::Csv(options) => options.run(&dataset, on).map(|_| ())?,
         Import::Stacked(options) => options.run(&dataset).map(|_| ())?,
@@ -201,6 +189,8 @@ fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<
             // An unpacked copy: the folder itself, or the source's folder inside it.
             let inner = source.folder.as_deref().map(|f| from.join(f));
             let dir = inner.filter(|d| d.is_dir()).unwrap_or(from.to_path_buf());
+            // Checked where it is, before anything of a wrong folder is copied.
+            check_tree(source, &dir, from)?;
             copy_tree(&dir, work)?;
             return Ok(work.to_path_buf());
         }
@@ -239,6 +229,26 @@ fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<
         }
         None => Ok(work.to_path_buf()),
     }
+}
+
+/// `dir` holds the files of `source`'s tree digest, when it has one; `from` (the copy
+/// given) is named when it does not.
+fn check_tree(source: &Source, dir: &Path, from: &Path) -> Result<()> {
+    let Some(want) = &source.tree_sha256 else {
+        return Ok(());
+    };
+    let got = tree_digest(dir)?;
+    if &got == want {
+        return Ok(());
+    }
+    let hint = match (&source.folder, source.url.rsplit('/').next()) {
+        (Some(folder), Some(file)) => {
+            format!(" (give the unpacked folder {folder} itself, or a folder holding {file})")
+        }
+        _ => String::new(),
+    };
+    let why = format!("tree digest {got}, the recipe's tree-sha256 is {want}: not the files the recipe describes{hint}");
+    Err(DataError::invalid(from, why).into())
 }
 
 /// Moves what `from` holds into the folder `to`; two sources giving the same name is an

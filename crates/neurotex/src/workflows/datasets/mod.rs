@@ -5,6 +5,7 @@
 
 mod digest;
 mod download;
+mod error;
 pub mod fetch;
 pub mod recipe;
 mod unpack;
@@ -15,6 +16,7 @@ use super::OnProgress;
 use crate::error::DataError;
 
 pub use digest::{file_digest, tree_digest};
+pub use error::{RecipeError, SourceRule};
 pub use fetch::{cache_root, fetch, fetched};
 pub use recipe::{Published, Recipe, Source, SourceKind};
 

@@ -10,6 +10,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use super::error::{RecipeError, SourceRule};
 use crate::error::DataError;
 use crate::workflows::import::{ImportCsvOptions, ImportStackedOptions};
 use crate::workflows::{CsvOptions, LogOptions};
@@ -258,7 +259,7 @@ impl Recipe {
             toml::from_str(text).map_err(|e| DataError::invalid(path, e.to_string()))?;
         recipe
             .check()
-            .map_err(|message| DataError::invalid(path, message))?;
+            .map_err(|e| DataError::invalid(path, e.to_string()))?;
         Ok(recipe)
     }
 
@@ -268,63 +269,69 @@ impl Recipe {
     /// results beside a protocol of the recipe, with accuracies in 0..1.
     ///
     /// # Errors
-    /// The first rule broken, as text naming the key.
-    pub fn check(&self) -> std::result::Result<(), String> {
+    /// The first rule broken, naming the key.
+    pub fn check(&self) -> std::result::Result<(), RecipeError> {
         if !is_slug(&self.name) {
-            return Err(format!(
-                "name = {:?}: a name is lowercase letters, digits and -, starting with a letter",
-                self.name
-            ));
+            return Err(RecipeError::Name(self.name.clone()));
         }
         if self.sources.is_empty() {
-            return Err("no [[source]]: a recipe needs at least one".into());
+            return Err(RecipeError::NoSources);
         }
+        let mut names: Vec<&str> = Vec::new();
         for (i, s) in self.sources.iter().enumerate() {
-            check_source(s).map_err(|e| format!("[[source]] {} ({}): {e}", i + 1, s.url))?;
+            let name = s.url.split(['?', '#']).next().unwrap_or_default();
+            let name = name.rsplit('/').next().unwrap_or_default();
+            let rule = match check_source(s) {
+                Err(rule) => Some(rule),
+                Ok(()) if names.contains(&name) => Some(SourceRule::SameName(name.into())),
+                Ok(()) => None,
+            };
+            if let Some(rule) = rule {
+                let url = s.url.clone();
+                return Err(RecipeError::Source {
+                    index: i + 1,
+                    url,
+                    rule,
+                });
+            }
+            names.push(name);
         }
-        self.import_in(Path::new("."))
-            .map_err(|e| format!("[import]: {e}"))?;
+        self.import_in(Path::new("."))?;
+        self.check_protocols()
+    }
+
+    /// The protocols' and the published results' rules of [`Recipe::check`].
+    fn check_protocols(&self) -> std::result::Result<(), RecipeError> {
         if self.protocols.is_empty() {
-            return Err("no [[protocol]]: a recipe needs at least one".into());
+            return Err(RecipeError::NoProtocols);
         }
         let mut ids: Vec<&str> = Vec::new();
         for p in &self.protocols {
             if !is_slug(&p.id) || ids.contains(&p.id.as_str()) {
-                return Err(format!(
-                    "[[protocol]] id = {:?}: ids are distinct, lowercase letters, digits and -",
-                    p.id
-                ));
+                return Err(RecipeError::ProtocolId(p.id.clone()));
             }
             ids.push(&p.id);
             if p.per.is_some() == p.hold_out.is_some() {
-                return Err(format!(
-                    "[[protocol]] {}: give exactly one of per and hold-out",
-                    p.id
-                ));
+                return Err(RecipeError::ProtocolKind(p.id.clone()));
             }
-            match self.conditions.get(p.column()) {
-                Some(values) if values.len() >= 2 => {}
-                _ => {
-                    return Err(format!(
-                        "[[protocol]] {}: column {} needs its values (at least 2) in [conditions]",
-                        p.id,
-                        p.column()
-                    ))
-                }
+            if !self
+                .conditions
+                .get(p.column())
+                .is_some_and(|v| v.len() >= 2)
+            {
+                let (id, column) = (p.id.clone(), p.column().to_string());
+                return Err(RecipeError::ProtocolConditions { id, column });
             }
         }
         for p in &self.published {
+            let citation = p.citation.clone();
             if !ids.contains(&p.beside.as_str()) {
-                return Err(format!(
-                    "[[published]] {}: beside = {:?} is not a protocol id of the recipe",
-                    p.citation, p.beside
-                ));
+                let beside = p.beside.clone();
+                return Err(RecipeError::PublishedBeside { citation, beside });
             }
             if !(0.0..=1.0).contains(&p.accuracy) {
-                return Err(format!(
-                    "[[published]] {}: accuracy = {} is not in 0..1",
-                    p.citation, p.accuracy
-                ));
+                let accuracy = p.accuracy;
+                return Err(RecipeError::PublishedAccuracy { citation, accuracy });
             }
         }
         Ok(())
@@ -334,7 +341,7 @@ impl Recipe {
     ///
     /// # Errors
     /// An option that does not parse, named by its key.
-    pub fn import_in(&self, files: &Path) -> std::result::Result<Import, String> {
+    pub fn import_in(&self, files: &Path) -> std::result::Result<Import, RecipeError> {
         match &self.import {
             ImportSpec::Csv(spec) => spec.options(files).map(Import::Csv),
             ImportSpec::Stacked(s) => Ok(Import::Stacked(ImportStackedOptions {
@@ -358,7 +365,7 @@ impl Recipe {
 
 impl CsvSpec {
     /// `import csv`'s options, its inputs under `files`.
-    fn options(&self, files: &Path) -> std::result::Result<ImportCsvOptions, String> {
+    fn options(&self, files: &Path) -> std::result::Result<ImportCsvOptions, RecipeError> {
         let inputs = match self.inputs.is_empty() {
             true => vec![files.to_path_buf()],
             false => (self.inputs.iter())
@@ -392,52 +399,54 @@ impl CsvSpec {
 }
 
 /// `p` under the fetched files' folder `files`: relative, without `..`.
-fn under(files: &Path, p: &str) -> std::result::Result<PathBuf, String> {
+fn under(files: &Path, p: &str) -> std::result::Result<PathBuf, RecipeError> {
     let rel = Path::new(p);
     if rel.is_absolute() || rel.components().any(|c| c.as_os_str() == "..") {
-        return Err(format!(
-            "{p}: paths are relative to the fetched files, without .."
-        ));
+        return Err(RecipeError::Import {
+            key: "a path".into(),
+            value: p.into(),
+            reason: "paths are relative to the fetched files, without ..".into(),
+        });
     }
     Ok(files.join(rel))
 }
 
 /// A source's checksums as its kind needs them.
-fn check_source(s: &Source) -> std::result::Result<(), String> {
+fn check_source(s: &Source) -> std::result::Result<(), SourceRule> {
     if !(s.url.starts_with("https://") || s.url.starts_with("http://")) {
-        return Err("url must start with https:// or http://".into());
+        return Err(SourceRule::Url);
     }
-    if let Some(h) = s.sha256.as_deref().filter(|h| !is_sha256(h)) {
-        return Err(format!("sha256 = {h:?} is not 64 lowercase hex digits"));
-    }
-    if let Some(h) = s.tree_sha256.as_deref().filter(|h| !is_sha256(h)) {
-        return Err(format!(
-            "tree-sha256 = {h:?} is not 64 lowercase hex digits"
-        ));
+    for (key, value) in [("sha256", &s.sha256), ("tree-sha256", &s.tree_sha256)] {
+        if let Some(h) = value.as_deref().filter(|h| !is_sha256(h)) {
+            return Err(SourceRule::Hex {
+                key,
+                value: h.into(),
+            });
+        }
     }
     match s.kind {
-        SourceKind::GitArchive if s.tree_sha256.is_none() => {
-            Err("a git-archive source needs tree-sha256 (its archive's bytes may change)".into())
-        }
+        SourceKind::GitArchive if s.tree_sha256.is_none() => Err(SourceRule::TreeDigest),
         SourceKind::GitArchive => Ok(()),
-        _ if s.sha256.is_none() || s.size.is_none() => {
-            Err("missing checksum: sha256 and size are required".into())
-        }
-        SourceKind::File if s.folder.is_some() => Err("a file source has no folder".into()),
+        _ if s.sha256.is_none() || s.size.is_none() => Err(SourceRule::Checksum),
+        SourceKind::File if s.folder.is_some() => Err(SourceRule::FileFolder),
         _ => Ok(()),
     }
 }
 
 /// `text` parsed as the flag `key` parses it.
-fn parse<T: FromStr>(key: &str, text: &str) -> std::result::Result<T, String>
+fn parse<T: FromStr>(key: &str, text: &str) -> std::result::Result<T, RecipeError>
 where
     T::Err: Display,
 {
-    text.parse().map_err(|e| format!("{key} = {text:?}: {e}"))
+    text.parse().map_err(|e: T::Err| RecipeError::Import {
+        key: key.into(),
+        value: text.into(),
+        reason: e.to_string(),
+    })
 }
 
 /// An optional option parsed as [`parse`] does.
-fn opt<T: FromStr>(key: &str, text: &Option<String>) -> std::result::Result<Option<T>, String>
+fn opt<T: FromStr>(key: &str, text: &Option<String>) -> std::result::Result<Option<T>, RecipeError>
 where
     T::Err: Display,
 {

@@ -33,7 +33,9 @@ pub fn unzip(path: &Path, dest: &Path) -> Result<()> {
             .name()
             .map_err(|e| bad(path, format!("entry {i}'s name: {e}")))?
             .into_owned();
-        let Some(rel) = entry.enclosed_name().filter(|p| stays_inside(p)) else {
+        let raw = Path::new(&name);
+        let inside = stays_inside(raw) && !name.starts_with(['/', '\\']);
+        let Some(rel) = entry.enclosed_name().filter(|p| inside && stays_inside(p)) else {
             return Err(bad(
                 path,
                 format!("entry {name} would be written outside its folder"),
