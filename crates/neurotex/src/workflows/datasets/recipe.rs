@@ -314,11 +314,7 @@ impl Recipe {
             if p.per.is_some() == p.hold_out.is_some() {
                 return Err(RecipeError::ProtocolKind(p.id.clone()));
             }
-            if !self
-                .conditions
-                .get(p.column())
-                .is_some_and(|v| v.len() >= 2)
-            {
+            if self.conditions.get(p.column()).is_none_or(|v| v.len() < 2) {
                 let (id, column) = (p.id.clone(), p.column().to_string());
                 return Err(RecipeError::ProtocolConditions { id, column });
             }
