@@ -34,6 +34,8 @@ pub fn download_all(recipe: &Recipe, dir: &Path, on: OnProgress) -> Result<()> {
     let agent: ureq::Agent = ureq::Agent::config_builder()
         .timeout_connect(Some(Duration::from_secs(30)))
         .timeout_recv_response(Some(Duration::from_secs(60)))
+        // A stalled transfer ends (and is resumed by the next run) rather than hanging.
+        .timeout_recv_body(Some(Duration::from_secs(30 * 60)))
         .http_status_as_error(false)
         .user_agent(format!("neurotex/{}", env!("CARGO_PKG_VERSION")))
         .build()
