@@ -149,7 +149,6 @@ fn fill(recipe: &Recipe, from: &Path, origin: &str, tmp: &Path, on: OnProgress) 
         let work = tmp.join(format!("unpack-{i}"));
         std::fs::create_dir(&work).map_err(|e| DataError::write(&work, e))?;
         let used = place(source, recipe.sources.len(), from, &work)?;
-        check_tree(source, &used, from)?;
         move_into(&used, &files)?;
         std::fs::remove_dir_all(&work).map_err(|e| DataError::write(&work, e))?;
     }
@@ -174,8 +173,9 @@ fn fill(recipe: &Recipe, from: &Path, origin: &str, tmp: &Path, on: OnProgress) 
     Ok(())
 }
 
-/// Finds `source` in `from`, verifies it and puts its files under `work`; returns the folder
-/// of the files it contributes (its `folder` inside an archive).
+/// Finds `source` in `from`, verifies it (its checksum, and its tree digest once, where its
+/// files are) and puts its files under `work`; returns the folder of the files it
+/// contributes (its `folder` inside an archive).
 fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<PathBuf> {
     let name = super::download::file_name(source);
     let name = name.as_str();
@@ -218,17 +218,19 @@ fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<
         SourceKind::Zip | SourceKind::GitArchive => super::unpack::unzip(&file, work)?,
         SourceKind::TarGz => super::unpack::untar_gz(&file, work)?,
     }
-    match &source.folder {
-        Some(folder) => {
-            let dir = work.join(folder);
-            if !dir.is_dir() {
-                let why = format!("the archive has no folder {folder}");
-                return Err(DataError::invalid(&file, why).into());
-            }
-            Ok(dir)
-        }
-        None => Ok(work.to_path_buf()),
+    let used = match &source.folder {
+        Some(folder) => work.join(folder),
+        None => work.to_path_buf(),
+    };
+    if !used.is_dir() {
+        let why = format!(
+            "the archive has no folder {}",
+            source.folder.as_deref().unwrap_or("")
+        );
+        return Err(DataError::invalid(&file, why).into());
     }
+    check_tree(source, &used, from)?;
+    Ok(used)
 }
 
 /// `dir` holds the files of `source`'s tree digest, when it has one; `from` (the copy
