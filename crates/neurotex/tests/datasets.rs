@@ -7,6 +7,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use neurotex::compare::Comparison;
 use neurotex::datasets::{self, fetch, tree_digest, Recipe};
 use neurotex::options::StageOptions;
 use neurotex::progress::silent;
@@ -623,6 +624,46 @@ per = "speed_mm_s"
     assert_eq!((at(0), at(n - 1)), (10.0, 20.0));
 }
 
+/// `neurotex compare DATASET --per speed_mm_s --nested` over the benchmark's candidate set,
+/// with `folds` and `seed` (one repeat): what a leaderboard's board must equal.
+fn compare_nested_per_speed(dataset: &Path, folds: usize, seed: u64) -> Comparison {
+    let (encodings, methods, classifiers) = neurotex::workflows::benchmark::candidate_set(false);
+    let list = |s: String| s.split(',').map(String::from).collect::<Vec<_>>();
+    let compare = CompareOptions {
+        dataset: dataset.to_path_buf(),
+        speeds: None,
+        per: Some("speed_mm_s".into()),
+        hold_out: None,
+        train_where: None,
+        test_where: None,
+        group_by: None,
+        encodings: list(encodings),
+        methods: list(methods),
+        classifiers: list(classifiers),
+        tau_ms: neurotex::compare::candidates::STANDARD_TAU_MS,
+        knn: KnnOptions::default(),
+        snn: SnnOptions::default(),
+        folds,
+        repeats: 1,
+        seed,
+        nested: true,
+        open: OpenOptions::default(),
+    };
+    let opened = compare.open.open(dataset).unwrap();
+    compare
+        .run(&opened, &StageOptions::default(), &silent)
+        .unwrap()
+}
+
+/// `c` with every time set to 0: times differ from run to run, nothing else does.
+fn without_times(mut c: Comparison) -> Comparison {
+    for r in c.results.iter_mut() {
+        r.seconds = 0.0;
+    }
+    c.best.seconds = 0.0;
+    c
+}
+
 #[test]
 fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
     let dir = scratch("bench");
@@ -646,46 +687,10 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
     assert_eq!(board.boards.len(), 2);
     let recipe = Recipe::read(&recipe_path).unwrap();
     let dataset = datasets::fetched(&dir.join("cache"), &recipe).unwrap();
-    let (encodings, methods, classifiers) = neurotex::workflows::benchmark::candidate_set(false);
-    let list = |s: String| s.split(',').map(String::from).collect::<Vec<_>>();
     // `neurotex compare --per speed_mm_s --nested --encodings ... --folds 3 --repeats 1 --seed 5`.
-    let compare = CompareOptions {
-        dataset: dataset.clone(),
-        speeds: None,
-        per: Some("speed_mm_s".into()),
-        hold_out: None,
-        train_where: None,
-        test_where: None,
-        group_by: None,
-        encodings: list(encodings),
-        methods: list(methods),
-        classifiers: list(classifiers),
-        tau_ms: neurotex::compare::candidates::STANDARD_TAU_MS,
-        knn: KnnOptions::default(),
-        snn: SnnOptions::default(),
-        folds: 3,
-        repeats: 1,
-        seed: 5,
-        nested: true,
-        open: OpenOptions::default(),
-    };
-    let opened = compare.open.open(&dataset).unwrap();
-    let direct = compare
-        .run(&opened, &StageOptions::default(), &silent)
-        .unwrap();
-    let mut from_board = board.boards[0].comparison.clone();
-    let mut direct = direct;
-    // Times differ from run to run; everything else is the same.
-    for r in from_board
-        .results
-        .iter_mut()
-        .chain(direct.results.iter_mut())
-    {
-        r.seconds = 0.0;
-    }
-    from_board.best.seconds = 0.0;
-    direct.best.seconds = 0.0;
-    assert_eq!(from_board, direct);
+    let direct = compare_nested_per_speed(&dataset, 3, 5);
+    let from_board = board.boards[0].comparison.clone();
+    assert_eq!(without_times(from_board), without_times(direct));
     let md = std::fs::read_to_string(dir.join("out/leaderboard.md")).unwrap();
     assert!(
         md.contains("Someone 2024") && md.contains("Nested selection"),
@@ -776,42 +781,10 @@ fn fabricslide_leaderboard_is_compare_nested_with_wangs_number_beside() {
         &datasets::resolve("fabricslide").unwrap(),
     )
     .unwrap();
-    let (encodings, methods, classifiers) = neurotex::workflows::benchmark::candidate_set(false);
-    let list = |s: String| s.split(',').map(String::from).collect::<Vec<_>>();
-    let compare = CompareOptions {
-        dataset: dataset.clone(),
-        speeds: None,
-        per: Some("speed_mm_s".into()),
-        hold_out: None,
-        train_where: None,
-        test_where: None,
-        group_by: None,
-        encodings: list(encodings),
-        methods: list(methods),
-        classifiers: list(classifiers),
-        tau_ms: neurotex::compare::candidates::STANDARD_TAU_MS,
-        knn: KnnOptions::default(),
-        snn: SnnOptions::default(),
-        folds: 5,
-        repeats: 1,
-        seed: 0,
-        nested: true,
-        open: OpenOptions::default(),
-    };
-    let opened = compare.open.open(&dataset).unwrap();
-    let mut direct = compare
-        .run(&opened, &StageOptions::default(), &silent)
-        .unwrap();
-    let mut from_board = b.comparison.clone();
-    for r in from_board
-        .results
-        .iter_mut()
-        .chain(direct.results.iter_mut())
-    {
-        r.seconds = 0.0;
-    }
-    from_board.best.seconds = 0.0;
-    direct.best.seconds = 0.0;
-    assert_eq!(from_board, direct);
+    let direct = compare_nested_per_speed(&dataset, 5, 0);
+    assert_eq!(
+        without_times(b.comparison.clone()),
+        without_times(direct.clone())
+    );
     assert!(direct.nested.unwrap().accuracy > direct.chance + 0.5);
 }
