@@ -295,10 +295,10 @@ proptest! {
 
     #[test]
     fn knn_matches_sorted_brute_force(
-        // up to several blocks of distances past the search's 16 seeds
-        n in 5usize..80,
+        // several blocks of distances past the seeds, and k past the selection search's 16
+        n in 5usize..160,
         dims in 1usize..5,
-        k in 1usize..6,
+        k in 1usize..20,
         classes in 2usize..5,
         seed in any::<u64>(),
         standardize in any::<bool>(),

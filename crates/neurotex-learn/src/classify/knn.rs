@@ -69,8 +69,18 @@ fn closer(a: (f64, usize), b: (f64, usize)) -> bool {
     a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
 }
 
-/// Training samples visited in the scattered order before the rest are read in blocks.
+/// Training samples visited in the scattered order to set the bar the nearest are under:
+/// at least this many, and at least `SEEDS_PER_NEIGHBOUR` per neighbour sought.
 const SEEDS: usize = 16;
+const SEEDS_PER_NEIGHBOUR: usize = 3;
+/// The most neighbours [`KnnModel::nearest_by_selection`] seeks (its seeds are kept on the
+/// stack); a larger `k` takes [`KnnModel::nearest_any`].
+const SELECTION_K: usize = 16;
+const SEEDS_MOST: usize = if SEEDS > SEEDS_PER_NEIGHBOUR * SELECTION_K {
+    SEEDS
+} else {
+    SEEDS_PER_NEIGHBOUR * SELECTION_K
+};
 /// Distances compared at a time while the rest are read.
 const LANES: usize = 4;
 
@@ -260,6 +270,10 @@ impl KnnModel {
     fn neighbours_of_rows(&self, x: &[f64], mut on_row: impl FnMut(&[(f64, usize)])) {
         let n = self.labels.len();
         let mut dist = vec![0.0f64; n];
+        let mut scratch = Scratch {
+            index: vec![0; n + 1],
+            near: vec![0; n + 1],
+        };
         let mut best: Vec<(f64, usize)> = Vec::with_capacity(self.k);
         for row in x.chunks_exact(self.dims) {
             dist.fill(0.0);
@@ -269,43 +283,114 @@ impl KnnModel {
                     *d += (t - q) * (t - q);
                 }
             }
-            // The k smallest under the total order (distance, training index): ties in
-            // distance go to the earlier training sample. The result does not depend on
-            // the order the samples are visited in; the order only decides how much work
-            // it takes. A first few, visited in a fixed scattered order (a stride coprime
-            // to n, so that a training set sorted by class, as manifests often are, does
-            // not make each a new nearest), give the k-th distance to beat; the rest are
-            // then read in index order four at a time, and a block with no distance at
-            // most that is passed over whole (one vector comparison), most of them once
-            // the k-th distance has settled. The seeds' distances are set to NaN, which
-            // no comparison passes, so they are not taken twice.
             best.clear();
-            let mut j = 0usize;
-            for _ in 0..n.min(self.k.max(SEEDS)) {
-                insert(&mut best, self.k, (dist[j], j));
-                dist[j] = f64::NAN;
-                j += self.stride;
-                if j >= n {
-                    j -= n;
-                }
-            }
-            if best.len() == self.k {
-                let mut bar = best[self.k - 1].0;
-                for (b, block) in dist.chunks(LANES).enumerate() {
-                    if !block.iter().fold(false, |any, &d| any | (d <= bar)) {
-                        continue;
-                    }
-                    for (o, &d) in block.iter().enumerate() {
-                        if d <= bar {
-                            insert(&mut best, self.k, (d, b * LANES + o));
-                            bar = best[self.k - 1].0;
-                        }
-                    }
-                }
+            let finite = dist.iter().fold(true, |all, d| all & d.is_finite());
+            if self.k <= SELECTION_K && finite {
+                self.nearest_by_selection(&dist, &mut scratch, &mut best);
+            } else {
+                self.nearest_any(&mut dist, &mut best);
             }
             on_row(&best);
         }
     }
+
+    /// The `k` smallest of `dist` (all finite, `k <= SELECTION_K`) under the order
+    /// (distance, training index), nearest first, into `best`.
+    ///
+    /// The k-th smallest distance among a few samples visited in a fixed scattered order (a
+    /// stride coprime to n, so that a training set sorted by class, as manifests often
+    /// are, does not put the nearest last) is a bar the k nearest are all at or under. The
+    /// samples at most that bar are gathered in index order without a branch, the k-th
+    /// smallest distance among them is found by selection, and the nearest are those under
+    /// it, then the earliest at it, sorted by distance (stably, so index order breaks ties).
+    /// Distances are compared as their bits: a sum of squares from +0.0 is never -0.0, and
+    /// the bits of finite non-negative doubles are in the order of their values.
+    #[inline(always)]
+    fn nearest_by_selection(
+        &self,
+        dist: &[f64],
+        scratch: &mut Scratch,
+        best: &mut Vec<(f64, usize)>,
+    ) {
+        let (n, k) = (dist.len(), self.k);
+        let mut seeds = [0u64; SEEDS_MOST];
+        let sampled = n.min(SEEDS.max(SEEDS_PER_NEIGHBOUR * k));
+        let mut j = 0usize;
+        for seed in &mut seeds[..sampled] {
+            *seed = dist[j].to_bits();
+            j += self.stride;
+            if j >= n {
+                j -= n;
+            }
+        }
+        seeds[..sampled].sort_unstable();
+        let bar = seeds[k - 1];
+        let mut found = 0;
+        for (i, &d) in dist.iter().enumerate() {
+            scratch.index[found] = i;
+            scratch.near[found] = d.to_bits();
+            found += usize::from(d.to_bits() <= bar);
+        }
+        let kth = f64::from_bits(*scratch.near[..found].select_nth_unstable(k - 1).1);
+        best.extend(
+            scratch.index[..found]
+                .iter()
+                .map(|&i| (dist[i], i))
+                .filter(|&(d, _)| d < kth),
+        );
+        let under = best.len();
+        best.extend(
+            scratch.index[..found]
+                .iter()
+                .map(|&i| (dist[i], i))
+                .filter(|&(d, _)| d == kth)
+                .take(k - under),
+        );
+        best[..under].sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+
+    /// The `k` smallest of `dist` under the order (distance, training index), nearest
+    /// first, into `best`, for any `k` and distances (a query with a non-finite feature).
+    ///
+    /// A first few samples, visited in the scattered order of [`KnnModel::nearest_by_selection`],
+    /// give the k-th distance to beat; the rest are then read in index order four at a
+    /// time, and a block with no distance at most that is passed over whole, most of them
+    /// once the k-th distance has settled. The seeds' distances are set to NaN, which no
+    /// comparison passes, so they are not taken twice.
+    #[inline(always)]
+    fn nearest_any(&self, dist: &mut [f64], best: &mut Vec<(f64, usize)>) {
+        let n = dist.len();
+        let mut j = 0usize;
+        for _ in 0..n.min(self.k.max(SEEDS)) {
+            insert(best, self.k, (dist[j], j));
+            dist[j] = f64::NAN;
+            j += self.stride;
+            if j >= n {
+                j -= n;
+            }
+        }
+        if best.len() == self.k {
+            let mut bar = best[self.k - 1].0;
+            for (b, block) in dist.chunks(LANES).enumerate() {
+                if !block.iter().fold(false, |any, &d| any | (d <= bar)) {
+                    continue;
+                }
+                for (o, &d) in block.iter().enumerate() {
+                    if d <= bar {
+                        insert(best, self.k, (d, b * LANES + o));
+                        bar = best[self.k - 1].0;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Room for the samples at most a row's bar in [`KnnModel::nearest_by_selection`] (one
+/// slot spare, written and not counted).
+struct Scratch {
+    index: Vec<usize>,
+    near: Vec<u64>,
 }
 
 /// KNN at several k from one neighbour search per sample: the `k` nearest under the order
