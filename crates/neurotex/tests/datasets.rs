@@ -318,7 +318,7 @@ fn a_zip_of_headerless_logs_is_verified_imported_once_and_reused() {
 }
 
 #[test]
-fn a_damaged_archive_a_zip_slip_or_a_missing_condition_leaves_the_cache_as_it_was() {
+fn a_damaged_archive_a_zip_slip_a_zip_bomb_or_a_missing_condition_leaves_the_cache_as_it_was() {
     let dir = scratch("refused");
     std::fs::create_dir_all(dir.join("copy")).unwrap();
     let cache = dir.join("cache");
@@ -354,6 +354,24 @@ fn a_damaged_archive_a_zip_slip_or_a_missing_condition_leaves_the_cache_as_it_wa
         "{err}"
     );
     assert!(listing(&cache).is_empty() && !anywhere(&dir, "escaped.csv"));
+    // A small archive that inflates past what its recipe allows (a "zip bomb").
+    let zeros = "0".repeat(2_000_000);
+    let bomb = logs_zip("logs", &[("logs/zeros.txt", &zeros)]);
+    assert!(bomb.len() < good.len() + 20_000, "{}", bomb.len());
+    std::fs::write(dir.join("copy/logs.zip"), &bomb).unwrap();
+    let text = headerless_recipe(&bomb, r#""10", "30""#).replace(
+        "folder = \"logs\"",
+        "folder = \"logs\"\nunpacked-at-most = 1000000",
+    );
+    let recipe = Recipe::parse(&text, Path::new("r.toml")).unwrap();
+    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("more than 1000000 bytes") && err.contains("zeros.txt"),
+        "{err}"
+    );
+    assert!(listing(&cache).is_empty() && !anywhere(&dir, "zeros.txt"));
     // A condition the data does not have.
     std::fs::write(dir.join("copy/logs.zip"), &good).unwrap();
     let recipe = Recipe::parse(

@@ -210,13 +210,24 @@ fn place(source: &Source, n_sources: usize, from: &Path, work: &Path) -> Result<
             return Err(DataError::invalid(&file, why).into());
         }
     }
+    let budget = || -> Result<u64> {
+        let bytes = std::fs::metadata(&file)
+            .map_err(|reason| DataError::Io {
+                path: file.clone(),
+                reason,
+            })?
+            .len();
+        Ok(source
+            .unpacked_at_most
+            .unwrap_or_else(|| super::unpack::default_budget(bytes)))
+    };
     match source.kind {
         SourceKind::File => {
             let dest = work.join(name);
             std::fs::copy(&file, &dest).map_err(|e| DataError::write(&dest, e))?;
         }
-        SourceKind::Zip | SourceKind::GitArchive => super::unpack::unzip(&file, work)?,
-        SourceKind::TarGz => super::unpack::untar_gz(&file, work)?,
+        SourceKind::Zip | SourceKind::GitArchive => super::unpack::unzip(&file, work, budget()?)?,
+        SourceKind::TarGz => super::unpack::untar_gz(&file, work, budget()?)?,
     }
     let used = match &source.folder {
         Some(folder) => work.join(folder),

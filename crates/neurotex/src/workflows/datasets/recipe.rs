@@ -67,6 +67,10 @@ pub struct Source {
     /// `git-archive`, whose archive bytes a host may change between downloads.
     #[serde(default)]
     pub tree_sha256: Option<String>,
+    /// The most bytes an archive may unpack to (default: a hundred times its size, at
+    /// least 1 GiB); unpacking stops with an error past it.
+    #[serde(default)]
+    pub unpacked_at_most: Option<u64>,
 }
 
 /// The kinds of source.

@@ -1,9 +1,12 @@
 //! Archives unpacked into a folder, entry by entry: an entry whose path leaves the folder
 //! (`../x`, `/etc/x`: "zip slip") or that is a link is refused, naming the archive and the
-//! entry, before anything of it is written. Written by hand over the `zip` and `tar` crates
-//! only for these checks; neither crate refuses links on its own.
+//! entry, before anything of it is written, and unpacking stops at the first byte past the
+//! archive's budget (a few kilobytes that inflate to terabytes, a "zip bomb"). Written by
+//! hand over the `zip` and `tar` crates only for these checks; neither crate refuses links
+//! or bounds what it writes on its own.
 
 use std::fs::File;
+use std::io::Read;
 use std::path::{Component, Path};
 
 use crate::error::DataError;
@@ -14,11 +17,50 @@ fn bad(path: &Path, why: String) -> crate::Error {
     DataError::invalid(path, why).into()
 }
 
-/// Unpacks the zip archive `path` into `dest`.
+/// The most bytes an archive of `archive_bytes` may unpack to when its recipe states no
+/// `unpacked-at-most`: a hundred times its size (sensor logs compress to a fifth or a
+/// tenth), and never less than 1 GiB.
+pub fn default_budget(archive_bytes: u64) -> u64 {
+    archive_bytes.saturating_mul(100).max(1 << 30)
+}
+
+/// The bytes an archive may still unpack to.
+struct Budget<'a> {
+    archive: &'a Path,
+    limit: u64,
+    left: u64,
+}
+
+impl Budget<'_> {
+    /// Copies `entry` (named `name`) into a new file `out`, at most the bytes left.
+    fn copy(&mut self, entry: &mut impl Read, out: &Path, name: &str) -> Result<()> {
+        let mut w = File::create_new(out).map_err(|e| DataError::write(out, e))?;
+        let written = std::io::copy(&mut entry.take(self.left + 1), &mut w)
+            .map_err(|e| bad(self.archive, format!("entry {name}: {e}")))?;
+        if written > self.left {
+            let why = format!(
+                "unpacks to more than {} bytes (at entry {name}); a recipe that expects more \
+                 says so with unpacked-at-most",
+                self.limit
+            );
+            return Err(bad(self.archive, why));
+        }
+        self.left -= written;
+        Ok(())
+    }
+}
+
+/// Unpacks the zip archive `path` into `dest`, writing at most `limit` bytes.
 ///
 /// # Errors
-/// The archive cannot be read, or an entry leaves the folder or is a link.
-pub fn unzip(path: &Path, dest: &Path) -> Result<()> {
+/// The archive cannot be read, an entry leaves the folder or is a link, or the files
+/// would pass `limit`.
+pub fn unzip(path: &Path, dest: &Path, limit: u64) -> Result<()> {
+    let mut budget = Budget {
+        archive: path,
+        limit,
+        left: limit,
+    };
     let file = File::open(path).map_err(|reason| DataError::Io {
         path: path.to_path_buf(),
         reason,
@@ -52,17 +94,23 @@ pub fn unzip(path: &Path, dest: &Path) -> Result<()> {
         if let Some(parent) = out.parent() {
             std::fs::create_dir_all(parent).map_err(|e| DataError::write(parent, e))?;
         }
-        let mut w = File::create_new(&out).map_err(|e| DataError::write(&out, e))?;
-        std::io::copy(&mut entry, &mut w).map_err(|e| bad(path, format!("entry {name}: {e}")))?;
+        budget.copy(&mut entry, &out, &name)?;
     }
     Ok(())
 }
 
-/// Unpacks the gzip-compressed tar archive `path` into `dest`.
+/// Unpacks the gzip-compressed tar archive `path` into `dest`, writing at most `limit`
+/// bytes.
 ///
 /// # Errors
-/// The archive cannot be read, or an entry leaves the folder or is a link or a device.
-pub fn untar_gz(path: &Path, dest: &Path) -> Result<()> {
+/// The archive cannot be read, an entry leaves the folder or is a link or a device, or
+/// the files would pass `limit`.
+pub fn untar_gz(path: &Path, dest: &Path, limit: u64) -> Result<()> {
+    let mut budget = Budget {
+        archive: path,
+        limit,
+        left: limit,
+    };
     let file = File::open(path).map_err(|reason| DataError::Io {
         path: path.to_path_buf(),
         reason,
@@ -92,9 +140,7 @@ pub fn untar_gz(path: &Path, dest: &Path) -> Result<()> {
             if let Some(parent) = out.parent() {
                 std::fs::create_dir_all(parent).map_err(|e| DataError::write(parent, e))?;
             }
-            let mut w = File::create_new(&out).map_err(|e| DataError::write(&out, e))?;
-            std::io::copy(&mut entry, &mut w)
-                .map_err(|e| bad(path, format!("entry {name}: {e}")))?;
+            budget.copy(&mut entry, &out, &name)?;
         } else if !matches!(
             kind,
             tar::EntryType::XGlobalHeader | tar::EntryType::XHeader
