@@ -147,6 +147,13 @@ fn the_built_in_recipes_parse_and_fabricslide_names_its_two_protocols() {
     assert_eq!(ids, ["within-velocity", "velocity-held-out"]);
     assert_eq!(fs.published[0].accuracy, 0.96);
     assert!(!fs.published[0].same_protocol);
+    // The digest naming its cache entry and keying its kept comparisons: a new optional
+    // key of the recipe format must not change it, or every fetched copy is fetched anew.
+    assert!(
+        fs.import_digest().starts_with("65d647c0dafb"),
+        "{}",
+        fs.import_digest()
+    );
 }
 
 #[test]
@@ -768,6 +775,96 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
     .run(&on)
     .unwrap();
     assert_eq!(kept(&said), 2);
+}
+
+/// A progress callback that stops the run (by a panic, as a signal would) at the step after
+/// `n` steps of the comparison's first stage, its candidates' scores.
+fn stop_after(n: usize) -> impl Fn(neurotex::progress::Progress) + Sync {
+    use neurotex::progress::Progress;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    // usize::MAX until the candidates' stage begins.
+    let ticks = AtomicUsize::new(usize::MAX);
+    move |p| match p {
+        Progress::Stage("candidates", _) => ticks.store(0, Ordering::SeqCst),
+        Progress::Tick
+            if ticks.load(Ordering::SeqCst) != usize::MAX
+                && ticks.fetch_add(1, Ordering::SeqCst) == n =>
+        {
+            panic!("stopped part way")
+        }
+        _ => {}
+    }
+}
+
+#[test]
+fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
+    let dir = scratch("resume");
+    let archive = logs_zip("logs", &[]);
+    std::fs::create_dir_all(dir.join("copy")).unwrap();
+    std::fs::write(dir.join("copy/logs.zip"), &archive).unwrap();
+    let recipe_path = dir.join("ridges.toml");
+    std::fs::write(&recipe_path, headerless_recipe(&archive, r#""10", "30""#)).unwrap();
+    let options = |out: &str, seed: u64| BenchmarkOptions {
+        datasets: vec![recipe_path.display().to_string()],
+        out: dir.join(out),
+        cache: Some(dir.join("cache")),
+        from: Some(dir.join("copy")),
+        protocols: vec!["within-speed".into()],
+        snn: false,
+        folds: 3,
+        repeats: 1,
+        seed,
+    };
+    let whole = options("whole", 5).run(&silent).unwrap();
+    // Stopped after 30 candidates' finished scores, as an interrupted run would be.
+    let stopped = std::panic::catch_unwind(|| options("resumed", 5).run(&stop_after(30)));
+    assert!(stopped.is_err());
+    let pieces = dir.join("resumed/ridges/within-speed.pieces");
+    let kept = listing(&pieces)
+        .iter()
+        .filter(|f| f.ends_with(".piece"))
+        .count();
+    assert!(kept >= 30, "{:?}", listing(&pieces));
+    assert!(!dir.join("resumed/ridges/within-speed.key.json").exists());
+    // Run again: the pieces are taken, the rest computed, the same leaderboard results.
+    let said = std::sync::Mutex::new(Vec::<String>::new());
+    let on = |p: neurotex::progress::Progress| {
+        if let neurotex::progress::Progress::Say(s) = p {
+            said.lock().unwrap().push(s.to_string());
+        }
+    };
+    let resumed = options("resumed", 5).run(&on).unwrap();
+    let taken: Vec<String> = said
+        .lock()
+        .unwrap()
+        .iter()
+        .filter(|s| s.contains("finished pieces taken"))
+        .cloned()
+        .collect();
+    assert_eq!(
+        taken,
+        [format!(
+            "  {kept} finished pieces taken from a run stopped part way"
+        )]
+    );
+    let comparison = |b: &neurotex::workflows::benchmark::Leaderboard| {
+        without_times(b.boards[0].comparison.clone())
+    };
+    assert_eq!(comparison(&resumed), comparison(&whole));
+    assert!(!pieces.exists() && dir.join("resumed/ridges/within-speed.key.json").exists());
+    // Pieces of other settings are never taken: stopped under seed 5, run under seed 6.
+    assert!(std::panic::catch_unwind(|| options("other", 5).run(&stop_after(30))).is_err());
+    said.lock().unwrap().clear();
+    let other = options("other", 6).run(&on).unwrap();
+    assert!(said
+        .lock()
+        .unwrap()
+        .iter()
+        .all(|s| !s.contains("pieces taken")));
+    assert_eq!(
+        comparison(&other),
+        comparison(&options("seed6", 6).run(&silent).unwrap())
+    );
 }
 
 #[test]

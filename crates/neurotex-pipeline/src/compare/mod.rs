@@ -258,6 +258,56 @@ pub fn compare_with_progress(
     params: &CompareParams,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Comparison> {
+    compare_keeping(candidates, params, progress, None)
+}
+
+/// Where the finished pieces of one comparison are kept, so that the same comparison run
+/// again after it stopped part way takes them instead of computing them anew: a
+/// candidate's score on one part of the protocol, and its accuracy inside one outer split
+/// of nested selection. Every evaluation is deterministic, so a kept piece is what it
+/// would be computed to (its seconds aside). A keeper is for one comparison: the same
+/// candidates, recordings and parameters; keys are unique within it.
+pub trait Keep: Sync {
+    /// The piece kept under `key` (JSON), if there is one.
+    fn get(&self, key: &str) -> Option<String>;
+    /// Keeps the piece `json` under `key`.
+    ///
+    /// # Errors
+    /// It cannot be kept (a full disk): the comparison stops rather than losing work
+    /// silently.
+    fn put(&self, key: &str, json: &str) -> Result<()>;
+}
+
+/// A kept piece under `key` read back, or `make`'s piece, kept under `key`.
+fn kept_or<T: Serialize + serde::de::DeserializeOwned>(
+    keep: Option<&dyn Keep>,
+    key: &str,
+    make: impl FnOnce() -> Result<T>,
+) -> Result<T> {
+    let Some(keep) = keep else {
+        return make();
+    };
+    if let Some(piece) = keep.get(key).and_then(|j| serde_json::from_str(&j).ok()) {
+        return Ok(piece);
+    }
+    let piece = make()?;
+    let json = serde_json::to_string(&piece).map_err(|e| {
+        ClassifyError::BadFeatures(format!("a comparison's piece {key} as JSON: {e}"))
+    })?;
+    keep.put(key, &json)?;
+    Ok(piece)
+}
+
+/// [`compare_with_progress`], taking the pieces `keep` holds and keeping the others there.
+///
+/// # Errors
+/// As [`compare`], or a piece that cannot be kept.
+pub fn compare_keeping(
+    candidates: &[Candidate],
+    params: &CompareParams,
+    progress: &(dyn Fn(Progress) + Sync),
+    keep: Option<&dyn Keep>,
+) -> Result<Comparison> {
     let first = candidates.first().ok_or(ClassifyError::Empty {
         what: "compare: no candidates",
     })?;
@@ -284,7 +334,7 @@ pub fn compare_with_progress(
         "candidates",
         candidates.len() * parts.len(),
     ));
-    let scored = score_all(candidates, &parts, params, progress)?;
+    let scored = score_all(candidates, &parts, params, progress, keep)?;
     let units = Units::new(metas, &scored[0].shares, params)?;
     let paper = candidates.iter().position(Candidate::is_paper);
     // Each candidate's interval and paired test resample from their own seeded stream,
@@ -296,7 +346,13 @@ pub fn compare_with_progress(
         .collect::<Result<_>>()?;
     results.sort_by(|a, b| b.accuracy.total_cmp(&a.accuracy));
     let nested = match outer {
-        Some(splits) => Some(nested(candidates, &splits, params, &units, progress)?),
+        Some(splits) => Some(nested(
+            candidates,
+            &splits,
+            params,
+            &units,
+            (progress, keep),
+        )?),
         None => None,
     };
     let (classes, majority) = class_shares(metas, &scored[0].shares);

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::parts::{conditions, cv_split, rows_with};
 use super::units::Units;
-use super::{mean, Candidate, CompareParams, Nested, Protocol};
+use super::{kept_or, mean, Candidate, CompareParams, Keep, Nested, Protocol};
 use crate::analysis::Split;
 use crate::classify::{group_folds, stratified_folds};
 use crate::error::{ClassifyError, ParamError, Result};
@@ -63,6 +63,9 @@ pub(super) fn fewer_folds(
 fn inner_folds(folds: usize, smallest: usize) -> usize {
     folds.min(smallest).max(2)
 }
+
+/// What nested selection reports its steps to and keeps its finished pieces in.
+type Around<'a> = (&'a (dyn Fn(Progress) + Sync), Option<&'a dyn Keep>);
 
 /// One outer split of nested selection.
 pub(super) struct OuterSplit {
@@ -204,10 +207,10 @@ pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec
 /// rows (one repeat), the best trained on all of them and tested on its test rows.
 fn outer(
     candidates: &[Candidate],
-    split: &OuterSplit,
+    (s, split): (usize, &OuterSplit),
     params: &CompareParams,
     metas: &[Meta],
-    progress: &(dyn Fn(Progress) + Sync),
+    (progress, keep): Around<'_>,
 ) -> Result<OuterResult> {
     // One repeat; fewer folds when a class of the training set is smaller than
     // the folds (an outer training set is a part of one condition's recordings).
@@ -224,7 +227,10 @@ fn outer(
     let accuracies: Vec<f64> = candidates
         .par_iter()
         .map(|c| {
-            let accuracy = (c.evaluate)(&split.train, &cv_split(&inner), &silent)?.accuracy;
+            let key = format!("inner accuracy of {} in outer split {s}", c.name());
+            let accuracy = kept_or(keep, &key, || {
+                Ok((c.evaluate)(&split.train, &cv_split(&inner), &silent)?.accuracy)
+            })?;
             progress(Progress::Tick);
             Ok(accuracy)
         })
@@ -257,14 +263,15 @@ pub(super) fn nested(
     splits: &[OuterSplit],
     params: &CompareParams,
     units: &Units,
-    progress: &(dyn Fn(Progress) + Sync),
+    (progress, keep): Around<'_>,
 ) -> Result<Nested> {
     let metas = &candidates[0].metas;
     let steps = splits.len() * candidates.len();
     progress(Progress::Stage("nested selection", steps));
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
-        .map(|split| outer(candidates, split, params, metas, progress))
+        .enumerate()
+        .map(|split| outer(candidates, split, params, metas, (progress, keep)))
         .collect::<Result<_>>()?;
     let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();
     shares.sort_by_key(|&(row, _)| row);

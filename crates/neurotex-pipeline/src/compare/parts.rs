@@ -3,8 +3,9 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
-use super::{mean, Candidate, CompareParams, ConditionAccuracy, Protocol, Scored};
+use super::{kept_or, mean, Candidate, CompareParams, ConditionAccuracy, Keep, Protocol, Scored};
 use crate::analysis::Split;
 use crate::error::{ParamError, Result};
 use crate::progress::{silent, Progress};
@@ -111,6 +112,7 @@ pub(super) fn parts(metas: &[Meta], params: &CompareParams) -> Result<Vec<Part>>
 
 /// One candidate's result on one part: its accuracy, each evaluated table row's share of
 /// right predictions, and the seconds it took.
+#[derive(Serialize, Deserialize)]
 struct PartScore {
     accuracy: f64,
     shares: Vec<(usize, f64)>,
@@ -158,12 +160,15 @@ pub(super) fn score_all(
     parts: &[Part],
     params: &CompareParams,
     progress: &(dyn Fn(Progress) + Sync),
+    keep: Option<&dyn Keep>,
 ) -> Result<Vec<Scored>> {
     let n = parts.len().max(1);
     let scores: Vec<PartScore> = (0..candidates.len() * parts.len())
         .into_par_iter()
         .map(|k| {
-            let scored = score_part(&candidates[k / n], &parts[k % n], params);
+            let (c, part) = (&candidates[k / n], &parts[k % n]);
+            let key = format!("score of {} on part {}", c.name(), k % n);
+            let scored = kept_or(keep, &key, || score_part(c, part, params));
             progress(Progress::Tick);
             scored
         })

@@ -2,9 +2,11 @@
 //! and under each protocol the recipe names a fixed, versioned candidate set is compared
 //! with nested selection, exactly as `compare --nested` compares it; the leaderboard sets
 //! the published results beside ours. A finished dataset x protocol is kept, and a rerun
-//! with the same settings reuses it.
+//! with the same settings reuses it; within a protocol, each candidate's finished scores
+//! are kept as they come, so that a run stopped part way resumes where it stopped.
 
 mod leaderboard;
+mod pieces;
 
 use std::path::{Path, PathBuf};
 
@@ -53,7 +55,7 @@ pub struct BenchmarkOptions {
     pub datasets: Vec<String>,
     /// The folder to write leaderboard.md, leaderboard.json and, per dataset and protocol,
     /// the comparison (compare.json, compare.md, figures). A rerun into it keeps what is
-    /// finished.
+    /// finished, down to the candidates' scores of a protocol stopped part way.
     #[cfg_attr(feature = "cli", arg(long))]
     pub out: PathBuf,
     /// The cache of fetched datasets (default: $NEUROTEX_CACHE, else
@@ -220,12 +222,24 @@ impl BenchmarkOptions {
             open: OpenOptions::default(),
         };
         let opened = options.open.open(dataset)?;
+        let key_text = serde_json::to_string_pretty(&key).unwrap_or_default();
+        let pieces_dir = self
+            .out
+            .join(&recipe.name)
+            .join(format!("{}.pieces", protocol.id));
+        let pieces = pieces::Pieces::open(pieces_dir, &key_text)?;
         let comparison = options
-            .run(&opened, &StageOptions::default(), on)
+            .run_keeping(&opened, &StageOptions::default(), on, Some(&pieces))
             .map_err(|e| crate::Error::InAnalysis {
                 what: format!("{}, {}", recipe.name, protocol.describe()),
                 source: Box::new(e),
             })?;
+        if pieces.taken() > 0 {
+            on(Progress::Say(&format!(
+                "  {} finished pieces taken from a run stopped part way",
+                pieces.taken()
+            )));
+        }
         // The figures name the dataset by its recipe, not by the cache's folder.
         let named = Path::new(&recipe.name);
         // The old key goes first: a run stopped between the two writes leaves no key, never
@@ -234,8 +248,8 @@ impl BenchmarkOptions {
             std::fs::remove_file(&key_file).map_err(|e| DataError::write(&key_file, e))?;
         }
         crate::report::comparison::write_comparison(&dir, &comparison, named)?;
-        let text = serde_json::to_string_pretty(&key).unwrap_or_default();
-        write_atomic(&key_file, |w| w.write_all(text.as_bytes()))?;
+        write_atomic(&key_file, |w| w.write_all(key_text.as_bytes()))?;
+        pieces.finish();
         Ok(comparison)
     }
 }

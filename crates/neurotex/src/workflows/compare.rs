@@ -14,7 +14,7 @@ use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::compare::signal::{
     baseline_candidates, signal_rows, SignalRows, NO_ENCODING, SIGNAL_METHODS,
 };
-use crate::compare::{compare_with_progress, Candidate, CompareParams, Comparison, Protocol};
+use crate::compare::{compare_keeping, Candidate, CompareParams, Comparison, Keep, Protocol};
 use crate::error::{OptionsError, ParamError};
 use crate::options::StageOptions;
 use crate::pipeline::{shared_grid, Encoding, Pipeline};
@@ -248,6 +248,21 @@ impl CompareOptions {
         stages: &StageOptions,
         on: OnProgress,
     ) -> Result<Comparison> {
+        self.run_keeping(dataset, stages, on, None)
+    }
+
+    /// [`CompareOptions::run`], taking the finished pieces `keep` holds (from the same
+    /// comparison stopped part way) and keeping the others there.
+    ///
+    /// # Errors
+    /// As [`CompareOptions::run`], or a piece that cannot be kept.
+    pub fn run_keeping(
+        &self,
+        dataset: &Dataset,
+        stages: &StageOptions,
+        on: OnProgress,
+        keep: Option<&dyn Keep>,
+    ) -> Result<Comparison> {
         let params = self.params()?;
         let indices = self.indices(dataset)?;
         let set = self.set()?;
@@ -284,7 +299,7 @@ impl CompareOptions {
                 speeds.len()
             )));
         }
-        let comparison = compare_with_progress(&candidates, &params, on)?;
+        let comparison = compare_keeping(&candidates, &params, on, keep)?;
         if !params.nested {
             on(Progress::Say(
                 "note: --nested computes the nested estimate the caveat below speaks of",

@@ -68,8 +68,9 @@ pub struct Source {
     #[serde(default)]
     pub tree_sha256: Option<String>,
     /// The most bytes an archive may unpack to (default: a hundred times its size, at
-    /// least 1 GiB); unpacking stops with an error past it.
-    #[serde(default)]
+    /// least 1 GiB); unpacking stops with an error past it. Left out of the digest of the
+    /// sources when absent, so that recipes without it keep their cache entries.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unpacked_at_most: Option<u64>,
 }
 

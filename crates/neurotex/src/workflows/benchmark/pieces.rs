@@ -1,0 +1,76 @@
+//! A comparison's finished pieces kept in a folder, so that a benchmark stopped part way
+//! through a protocol takes them up when it is run again with the same settings.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use sha2::{Digest, Sha256};
+
+use crate::compare::Keep;
+use crate::error::DataError;
+use crate::io::write_atomic;
+use crate::Result;
+
+/// The pieces of one comparison: a file each, named by the SHA-256 of its key and holding
+/// the key on its first line and the piece after it; a folder made under another key is
+/// emptied first, so pieces of other settings are never taken.
+pub(super) struct Pieces {
+    dir: PathBuf,
+    taken: AtomicUsize,
+}
+
+impl Pieces {
+    /// The pieces folder `dir` of the comparison under `key` (its JSON text).
+    ///
+    /// # Errors
+    /// The folder cannot be emptied or made.
+    pub(super) fn open(dir: PathBuf, key: &str) -> Result<Pieces> {
+        let key_file = dir.join("key.json");
+        if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key) {
+            if dir.exists() {
+                std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
+            }
+            std::fs::create_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
+            write_atomic(&key_file, |w| w.write_all(key.as_bytes()))?;
+        }
+        Ok(Pieces {
+            dir,
+            taken: AtomicUsize::new(0),
+        })
+    }
+
+    /// How many pieces were taken from the folder.
+    pub(super) fn taken(&self) -> usize {
+        self.taken.load(Ordering::Relaxed)
+    }
+
+    /// The folder, once its comparison is written whole and its pieces are no longer
+    /// needed, removed; a folder that stays is taken by nothing but the same comparison.
+    pub(super) fn finish(self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+
+    fn file(&self, key: &str) -> PathBuf {
+        let digest: String = Sha256::digest(key.as_bytes())
+            .iter()
+            .take(12)
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        self.dir.join(format!("{digest}.piece"))
+    }
+}
+
+impl Keep for Pieces {
+    fn get(&self, key: &str) -> Option<String> {
+        let text = std::fs::read_to_string(self.file(key)).ok()?;
+        let (found, piece) = text.split_once('\n')?;
+        (found == key).then(|| {
+            self.taken.fetch_add(1, Ordering::Relaxed);
+            piece.to_string()
+        })
+    }
+
+    fn put(&self, key: &str, json: &str) -> Result<()> {
+        write_atomic(&self.file(key), |w| write!(w, "{key}\n{json}"))
+    }
+}
