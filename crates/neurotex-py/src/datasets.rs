@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use neurotex::datasets::{self, DatasetsCommand};
-use neurotex::workflows::benchmark::BenchmarkOptions;
+use neurotex::workflows::benchmark::{BenchmarkOptions, Share};
 use pyo3::prelude::*;
 
 use crate::errors::guarded;
@@ -66,6 +66,30 @@ fn datasets_path(py: Python<'_>, name: String, cache: Option<PathBuf>) -> PyResu
     Ok(run(py, DatasetsCommand::Path { name, cache })?.0.concat())
 }
 
+/// `neurotex benchmark`'s options, from the Python arguments.
+#[allow(clippy::too_many_arguments)]
+fn options(
+    datasets: Vec<String>,
+    out: PathBuf,
+    cache: Option<PathBuf>,
+    source: Option<PathBuf>,
+    protocols: Vec<String>,
+    snn: bool,
+    (folds, repeats, seed): (usize, usize, u64),
+) -> BenchmarkOptions {
+    BenchmarkOptions {
+        datasets,
+        out,
+        cache,
+        from: source,
+        protocols,
+        snn,
+        folds,
+        repeats,
+        seed,
+    }
+}
+
 /// Runs `neurotex benchmark`; `(leaderboard, said)`.
 #[pyfunction]
 #[pyo3(signature = (datasets, out, cache=None, source=None, protocols=Vec::new(), snn=false, folds=5, repeats=1, seed=0))]
@@ -82,21 +106,85 @@ fn benchmark(
     repeats: usize,
     seed: u64,
 ) -> PyResult<(Py<PyAny>, Vec<String>)> {
-    let options = BenchmarkOptions {
+    let options = options(
         datasets,
         out,
         cache,
-        from: source,
+        source,
         protocols,
         snn,
-        folds,
-        repeats,
-        seed,
-    };
+        (folds, repeats, seed),
+    );
     let said = Said::default();
     let on = |p: neurotex::progress::Progress| said.hear(p);
     let board = py.detach(|| guarded(|| options.run(&on)))?;
     Ok((crate::convert::to_object(py, &board)?, said.lines()))
+}
+
+/// The shares of a benchmark's work that separate tasks can compute side by side, as
+/// `(dataset, recipe, protocol, encoding)`; fetches every dataset first.
+#[pyfunction]
+#[pyo3(signature = (datasets, out, cache=None, source=None, protocols=Vec::new(), snn=false, folds=5, repeats=1, seed=0))]
+#[allow(clippy::too_many_arguments)]
+fn benchmark_shares(
+    py: Python<'_>,
+    datasets: Vec<String>,
+    out: PathBuf,
+    cache: Option<PathBuf>,
+    source: Option<PathBuf>,
+    protocols: Vec<String>,
+    snn: bool,
+    folds: usize,
+    repeats: usize,
+    seed: u64,
+) -> PyResult<Vec<(String, String, String, String)>> {
+    let options = options(
+        datasets,
+        out,
+        cache,
+        source,
+        protocols,
+        snn,
+        (folds, repeats, seed),
+    );
+    let shares = py.detach(|| guarded(|| options.shares(&neurotex::progress::silent)))?;
+    Ok(shares
+        .into_iter()
+        .map(|s| (s.dataset, s.recipe, s.protocol, s.encoding))
+        .collect())
+}
+
+/// Computes and keeps one share's pieces in `out` (a share of [`benchmark_shares`]).
+#[pyfunction]
+#[pyo3(signature = (share, out, cache=None, snn=false, folds=5, repeats=1, seed=0))]
+#[allow(clippy::too_many_arguments)]
+fn benchmark_share(
+    py: Python<'_>,
+    share: (String, String, String, String),
+    out: PathBuf,
+    cache: Option<PathBuf>,
+    snn: bool,
+    folds: usize,
+    repeats: usize,
+    seed: u64,
+) -> PyResult<()> {
+    let (dataset, recipe, protocol, encoding) = share;
+    let share = Share {
+        dataset,
+        recipe: recipe.clone(),
+        protocol,
+        encoding,
+    };
+    let options = options(
+        vec![recipe],
+        out,
+        cache,
+        None,
+        Vec::new(),
+        snn,
+        (folds, repeats, seed),
+    );
+    py.detach(|| guarded(|| options.run_share(&share, &neurotex::progress::silent)))
 }
 
 /// Registers the functions.
@@ -105,5 +193,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(datasets_check, m)?)?;
     m.add_function(wrap_pyfunction!(datasets_fetch, m)?)?;
     m.add_function(wrap_pyfunction!(datasets_path, m)?)?;
-    m.add_function(wrap_pyfunction!(benchmark, m)?)
+    m.add_function(wrap_pyfunction!(benchmark, m)?)?;
+    m.add_function(wrap_pyfunction!(benchmark_shares, m)?)?;
+    m.add_function(wrap_pyfunction!(benchmark_share, m)?)
 }

@@ -868,6 +868,84 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
 }
 
 #[test]
+fn shares_computed_apart_make_the_leaderboard_of_one_run() {
+    let dir = scratch("shares");
+    let archive = logs_zip("logs", &[]);
+    std::fs::create_dir_all(dir.join("copy")).unwrap();
+    std::fs::write(dir.join("copy/logs.zip"), &archive).unwrap();
+    let recipe_path = dir.join("ridges.toml");
+    std::fs::write(&recipe_path, headerless_recipe(&archive, r#""10", "30""#)).unwrap();
+    let options = |out: &str| BenchmarkOptions {
+        datasets: vec![recipe_path.display().to_string()],
+        out: dir.join(out),
+        cache: Some(dir.join("cache")),
+        from: Some(dir.join("copy")),
+        protocols: Vec::new(),
+        snn: false,
+        folds: 3,
+        repeats: 1,
+        seed: 5,
+    };
+    let whole = options("whole").run(&silent).unwrap();
+    let apart = options("apart");
+    let shares = apart.shares(&silent).unwrap();
+    // Both protocols, each split by the set's three encodings.
+    assert_eq!(shares.len(), 6, "{shares:?}");
+    // A share whose folder was not made for these settings is refused.
+    let other = BenchmarkOptions {
+        seed: 6,
+        ..apart.clone()
+    };
+    let err = other
+        .run_share(&shares[0], &silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("not the pieces folder of these settings"),
+        "{err}"
+    );
+    // The shares in reverse order, as a cluster may finish them.
+    for share in shares.iter().rev() {
+        apart.run_share(share, &silent).unwrap();
+    }
+    // The final run takes every piece its stages count (each candidate's score on each
+    // part, each candidate inside each outer split) and computes none.
+    let said = std::sync::Mutex::new(Vec::<String>::new());
+    let on = |p: neurotex::progress::Progress| match p {
+        neurotex::progress::Progress::Say(s) => said.lock().unwrap().push(s.to_string()),
+        neurotex::progress::Progress::Stage(name, n) => {
+            said.lock().unwrap().push(format!("stage {name} {n}"))
+        }
+        _ => {}
+    };
+    let board = apart.run(&on).unwrap();
+    let said = said.into_inner().unwrap();
+    let mut needed = 0;
+    let mut taken = Vec::new();
+    for line in &said {
+        if let Some(n) = line
+            .strip_prefix("stage candidates ")
+            .or(line.strip_prefix("stage nested selection "))
+        {
+            needed += n.parse::<usize>().unwrap();
+        } else if line.contains("finished pieces taken") {
+            let n = line.split_whitespace().next().unwrap().parse::<usize>();
+            taken.push((std::mem::take(&mut needed), n.unwrap()));
+        }
+    }
+    assert_eq!(taken.len(), 2, "{said:?}");
+    assert!(taken.iter().all(|(needed, n)| needed == n), "{taken:?}");
+    for (a, b) in board.boards.iter().zip(&whole.boards) {
+        assert_eq!(
+            without_times(a.comparison.clone()),
+            without_times(b.comparison.clone())
+        );
+    }
+    // Nothing is left to share once both protocols are kept.
+    assert!(apart.shares(&silent).unwrap().is_empty());
+}
+
+#[test]
 #[ignore = "FabricSlide from ../shared: about 40 s"]
 fn fabricslide_leaderboard_is_compare_nested_with_wangs_number_beside() {
     let copy =

@@ -241,6 +241,26 @@ def benchmark(
     repeats: int = ...,
     seed: int = ...,
 ) -> Tuple[Dict[str, Any], List[str]]: ...
+def benchmark_shares(
+    datasets: List[str],
+    out: str,
+    cache: Optional[str] = ...,
+    source: Optional[str] = ...,
+    protocols: List[str] = ...,
+    snn: bool = ...,
+    folds: int = ...,
+    repeats: int = ...,
+    seed: int = ...,
+) -> List[Tuple[str, str, str, str]]: ...
+def benchmark_share(
+    share: Tuple[str, str, str, str],
+    out: str,
+    cache: Optional[str] = ...,
+    snn: bool = ...,
+    folds: int = ...,
+    repeats: int = ...,
+    seed: int = ...,
+) -> None: ...
 
 class NativeModel:
     @staticmethod

@@ -78,11 +78,11 @@ def tonic(name: Union[str, PathLike], encoding: str = "sa+fa", *,
     return Dataset(fetch(name, source, cache), encoding, **kwargs)
 
 
-def _one(task: Sequence[Any]) -> None:
-    """One dataset x protocol of :func:`benchmark`, as a Dask task: compared and kept in
-    ``out`` (the leaderboard is written after, from what the tasks kept)."""
-    name, protocol, out, cache, snn, folds, repeats, seed = task
-    _native.benchmark([name], out, cache, None, [protocol], snn, folds, repeats, seed)
+def _share(task: Sequence[Any]) -> None:
+    """One share of :func:`benchmark` (a dataset x protocol x encoding), as a Dask task: its
+    candidates' finished pieces kept in ``out`` for the leaderboard's run to take."""
+    share, out, cache, snn, folds, repeats, seed = task
+    _native.benchmark_share(tuple(share), out, cache, snn, folds, repeats, seed)
 
 
 def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
@@ -93,10 +93,11 @@ def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
     candidate set compared with nested selection, written into ``out`` (leaderboard.md,
     leaderboard.json, each comparison's folder); returns the leaderboard as a dict.
 
-    With a Dask ``client``, each dataset x protocol is one task on the cluster; the workers
-    must see ``out`` and ``cache`` (a shared file system, or a local cluster). Every dataset
-    is fetched here first, the tasks keep their comparisons in ``out``, and the leaderboard
-    is then made from them: the same as without a client."""
+    With a Dask ``client``, each dataset x protocol x encoding of the candidate set is one
+    task on the cluster; the workers must see ``out`` and ``cache`` (a shared file system,
+    or a local cluster). Every dataset is fetched here first, the tasks keep their
+    candidates' finished pieces in ``out``, and the leaderboard's run then takes them: the
+    same leaderboard as without a client."""
     # A recipe file by its absolute path, so that a worker elsewhere finds it too.
     names = [os.path.abspath(os.fspath(d)) if os.fspath(d).endswith(".toml")
              or os.sep in os.fspath(d) else os.fspath(d) for d in datasets]
@@ -105,13 +106,10 @@ def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
     if client is not None:
         if source is not None and len(names) > 1:
             raise ValueError("source is the copy of one dataset's sources: one dataset with it")
-        tasks = []
-        for name in names:
-            fetch(name, source, cache)
-            for p in check(name)["protocol"]:
-                if not wanted or p["id"] in wanted:
-                    tasks.append((name, p["id"], out_s, cache_s, snn, folds, repeats, seed))
-        client.gather(client.map(_one, tasks, pure=False))
+        shares = _native.benchmark_shares(names, out_s, cache_s, _opt(source), wanted, snn,
+                                          folds, repeats, seed)
+        tasks = [(share, out_s, cache_s, snn, folds, repeats, seed) for share in shares]
+        client.gather(client.map(_share, tasks, pure=False))
     board, said = _native.benchmark(names, out_s, cache_s, _opt(source), wanted, snn, folds,
                                     repeats, seed)
     for line in said:

@@ -8,6 +8,8 @@
 mod leaderboard;
 mod pieces;
 
+use pieces::Pieces;
+
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -18,7 +20,7 @@ use crate::compare::candidates::{
     STANDARD_CLASSIFIERS, STANDARD_ENCODINGS, STANDARD_METHODS, STANDARD_TAU_MS,
 };
 use crate::compare::Comparison;
-use crate::datasets::{self, Published, Recipe};
+use crate::datasets::{self, ProtocolSpec, Published, Recipe};
 use crate::error::DataError;
 use crate::io::write_atomic;
 use crate::options::StageOptions;
@@ -99,6 +101,13 @@ struct Key {
     neurotex: String,
 }
 
+impl Key {
+    /// As its key file holds it.
+    fn text(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+}
+
 impl BenchmarkOptions {
     /// Fetches every dataset (checking every recipe first), compares under each protocol,
     /// writes the leaderboard into `--out` and returns it.
@@ -107,14 +116,7 @@ impl BenchmarkOptions {
     /// A recipe that is not valid, `--from` with several datasets, a dataset that cannot be
     /// fetched, a comparison that cannot run, or an output that cannot be written.
     pub fn run(&self, on: OnProgress) -> Result<Leaderboard> {
-        let recipes: Vec<Recipe> = (self.datasets.iter())
-            .map(|d| datasets::resolve(d))
-            .collect::<Result<_>>()?;
-        if self.from.is_some() && recipes.len() > 1 {
-            let why = "--from is the copy of one dataset's sources: benchmark one dataset with it, or fetch each first (`neurotex datasets fetch`)";
-            return Err(crate::error::OptionsError::Conflict(why.into()).into());
-        }
-        self.check_protocols(&recipes)?;
+        let recipes = self.recipes()?;
         let root = datasets::cache_root(self.cache.as_deref())?;
         let mut boards = Vec::new();
         for recipe in &recipes {
@@ -167,17 +169,9 @@ impl BenchmarkOptions {
         }
     }
 
-    /// The comparison of `recipe`'s protocol `i` on `dataset`: the kept one under the same
-    /// key, else compared anew and kept.
-    fn protocol(
-        &self,
-        recipe: &Recipe,
-        dataset: &Path,
-        i: usize,
-        on: OnProgress,
-    ) -> Result<Comparison> {
-        let protocol = &recipe.protocols[i];
-        let key = Key {
+    /// The key of `recipe`'s `protocol` under these settings.
+    fn key(&self, recipe: &Recipe, protocol: &ProtocolSpec) -> Key {
+        Key {
             recipe: recipe.name.clone(),
             import_digest: recipe.import_digest(),
             protocol: serde_json::to_string(protocol).unwrap_or_default(),
@@ -187,7 +181,57 @@ impl BenchmarkOptions {
             repeats: self.repeats,
             seed: self.seed,
             neurotex: env!("CARGO_PKG_VERSION").to_string(),
-        };
+        }
+    }
+
+    /// `compare --nested` over the candidate set (of `encodings` only, when given) under
+    /// `protocol` on `dataset`.
+    fn compare(
+        &self,
+        protocol: &ProtocolSpec,
+        dataset: &Path,
+        encodings: Option<&str>,
+    ) -> CompareOptions {
+        let (all, methods, classifiers) = candidate_set(self.snn);
+        let list = |s: &str| s.split(',').map(String::from).collect();
+        CompareOptions {
+            dataset: dataset.to_path_buf(),
+            speeds: None,
+            per: protocol.per.clone(),
+            hold_out: protocol.hold_out.clone(),
+            train_where: None,
+            test_where: None,
+            group_by: None,
+            encodings: list(encodings.unwrap_or(&all)),
+            methods: list(&methods),
+            classifiers: list(&classifiers),
+            tau_ms: STANDARD_TAU_MS,
+            knn: KnnOptions::default(),
+            snn: SnnOptions::default(),
+            folds: self.folds,
+            repeats: self.repeats,
+            seed: self.seed,
+            nested: true,
+            open: OpenOptions::default(),
+        }
+    }
+
+    /// The folder of the kept pieces of `recipe`'s `protocol`.
+    fn pieces_dir(&self, recipe: &Recipe, protocol: &ProtocolSpec) -> PathBuf {
+        (self.out.join(&recipe.name)).join(format!("{}.pieces", protocol.id))
+    }
+
+    /// The comparison of `recipe`'s protocol `i` on `dataset`: the kept one under the same
+    /// key, else compared anew (taking the pieces a run stopped part way kept) and kept.
+    fn protocol(
+        &self,
+        recipe: &Recipe,
+        dataset: &Path,
+        i: usize,
+        on: OnProgress,
+    ) -> Result<Comparison> {
+        let protocol = &recipe.protocols[i];
+        let key = self.key(recipe, protocol);
         let dir = self.out.join(&recipe.name).join(&protocol.id);
         let key_file = self
             .out
@@ -199,35 +243,10 @@ impl BenchmarkOptions {
             ));
             return Ok(kept);
         }
-        let (encodings, methods, classifiers) = candidate_set(self.snn);
-        let list = |s: String| s.split(',').map(String::from).collect();
-        let options = CompareOptions {
-            dataset: dataset.to_path_buf(),
-            speeds: None,
-            per: protocol.per.clone(),
-            hold_out: protocol.hold_out.clone(),
-            train_where: None,
-            test_where: None,
-            group_by: None,
-            encodings: list(encodings),
-            methods: list(methods),
-            classifiers: list(classifiers),
-            tau_ms: STANDARD_TAU_MS,
-            knn: KnnOptions::default(),
-            snn: SnnOptions::default(),
-            folds: self.folds,
-            repeats: self.repeats,
-            seed: self.seed,
-            nested: true,
-            open: OpenOptions::default(),
-        };
+        let options = self.compare(protocol, dataset, None);
         let opened = options.open.open(dataset)?;
-        let key_text = serde_json::to_string_pretty(&key).unwrap_or_default();
-        let pieces_dir = self
-            .out
-            .join(&recipe.name)
-            .join(format!("{}.pieces", protocol.id));
-        let pieces = pieces::Pieces::open(pieces_dir, &key_text)?;
+        let key_text = key.text();
+        let pieces = Pieces::open(self.pieces_dir(recipe, protocol), &key_text)?;
         let comparison = options
             .run_keeping(&opened, &StageOptions::default(), on, Some(&pieces))
             .map_err(|e| crate::Error::InAnalysis {
@@ -252,6 +271,104 @@ impl BenchmarkOptions {
         pieces.finish();
         Ok(comparison)
     }
+
+    /// The shares of the work that separate tasks (on a cluster) can compute side by side:
+    /// each dataset x protocol not yet kept, split by the candidate set's encodings (each
+    /// share encodes its recordings once). Fetches every dataset and makes each protocol's
+    /// pieces folder, so that the shares find it made; [`BenchmarkOptions::run`] then
+    /// takes what they kept.
+    ///
+    /// # Errors
+    /// As [`BenchmarkOptions::run`]'s checks and fetches.
+    pub fn shares(&self, on: OnProgress) -> Result<Vec<Share>> {
+        let recipes = self.recipes()?;
+        let root = datasets::cache_root(self.cache.as_deref())?;
+        let (encodings, _, _) = candidate_set(self.snn);
+        let mut shares = Vec::new();
+        for (named, recipe) in self.datasets.iter().zip(&recipes) {
+            datasets::fetch(recipe, &root, self.from.as_deref(), on)?;
+            for protocol in self.wanted(recipe) {
+                let key = self.key(recipe, protocol);
+                let out = self.out.join(&recipe.name);
+                let key_file = out.join(format!("{}.key.json", protocol.id));
+                if kept(&key_file, &out.join(&protocol.id), &key).is_some() {
+                    continue;
+                }
+                Pieces::open(self.pieces_dir(recipe, protocol), &key.text())?;
+                shares.extend(encodings.split(',').map(|e| Share {
+                    dataset: recipe.name.clone(),
+                    recipe: named.clone(),
+                    protocol: protocol.id.clone(),
+                    encoding: e.to_string(),
+                }));
+            }
+        }
+        Ok(shares)
+    }
+
+    /// Computes and keeps one share's pieces (its candidates' scores and their accuracies
+    /// inside nested selection's outer splits), for [`BenchmarkOptions::run`] to take.
+    ///
+    /// # Errors
+    /// The share's dataset not fetched, its pieces folder not made for these settings (by
+    /// [`BenchmarkOptions::shares`]), or a comparison that cannot run.
+    pub fn run_share(&self, share: &Share, on: OnProgress) -> Result<()> {
+        let recipe = datasets::resolve(&share.recipe)?;
+        let root = datasets::cache_root(self.cache.as_deref())?;
+        let dataset = datasets::fetched(&root, &recipe).ok_or_else(|| {
+            let why = "not fetched: `neurotex datasets fetch` it first".to_string();
+            DataError::invalid(datasets::entry(&root, &recipe), why)
+        })?;
+        let Some(protocol) = recipe.protocols.iter().find(|p| p.id == share.protocol) else {
+            let why = format!("{} has no protocol {}", recipe.name, share.protocol);
+            return Err(crate::error::OptionsError::Conflict(why).into());
+        };
+        let key = self.key(&recipe, protocol);
+        let pieces = Pieces::existing(self.pieces_dir(&recipe, protocol), &key.text())?;
+        let options = self.compare(protocol, &dataset, Some(&share.encoding));
+        let opened = options.open.open(&dataset)?;
+        options
+            .run_keeping(&opened, &StageOptions::default(), on, Some(&pieces))
+            .map_err(|e| crate::Error::InAnalysis {
+                what: format!("{}, {}", recipe.name, protocol.describe()),
+                source: Box::new(e),
+            })?;
+        Ok(())
+    }
+
+    /// The recipes of `--datasets`, checked.
+    fn recipes(&self) -> Result<Vec<Recipe>> {
+        let recipes: Vec<Recipe> = (self.datasets.iter())
+            .map(|d| datasets::resolve(d))
+            .collect::<Result<_>>()?;
+        if self.from.is_some() && recipes.len() > 1 {
+            let why = "--from is the copy of one dataset's sources: benchmark one dataset with it, or fetch each first (`neurotex datasets fetch`)";
+            return Err(crate::error::OptionsError::Conflict(why.into()).into());
+        }
+        self.check_protocols(&recipes)?;
+        Ok(recipes)
+    }
+
+    /// `recipe`'s protocols that `--protocols` asks for.
+    fn wanted<'r>(&self, recipe: &'r Recipe) -> Vec<&'r ProtocolSpec> {
+        (recipe.protocols.iter())
+            .filter(|p| self.protocols.is_empty() || self.protocols.contains(&p.id))
+            .collect()
+    }
+}
+
+/// A share of a benchmark's work ([`BenchmarkOptions::shares`]): one encoding's candidates
+/// under one protocol of one dataset.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Share {
+    /// The recipe's name.
+    pub dataset: String,
+    /// The dataset as `--datasets` named it (a built-in name or a recipe file).
+    pub recipe: String,
+    /// The protocol's id.
+    pub protocol: String,
+    /// The encoding (`sa`, `sa+fa`, `none`).
+    pub encoding: String,
 }
 
 /// The comparison kept in `dir` when its key file holds `key`.

@@ -39,6 +39,23 @@ impl Pieces {
         })
     }
 
+    /// The pieces folder `dir` of the comparison under `key`, made before (by a
+    /// benchmark's shares on a cluster, where another task may be writing into it).
+    ///
+    /// # Errors
+    /// No such folder, or one made under another key.
+    pub(super) fn existing(dir: PathBuf, key: &str) -> Result<Pieces> {
+        let key_file = dir.join("key.json");
+        if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key) {
+            let why = "is not the pieces folder of these settings: make the shares first";
+            return Err(DataError::invalid(&dir, why.to_string()).into());
+        }
+        Ok(Pieces {
+            dir,
+            taken: AtomicUsize::new(0),
+        })
+    }
+
     /// How many pieces were taken from the folder.
     pub(super) fn taken(&self) -> usize {
         self.taken.load(Ordering::Relaxed)

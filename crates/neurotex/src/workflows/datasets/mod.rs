@@ -17,8 +17,8 @@ use crate::error::DataError;
 
 pub use digest::{file_digest, tree_digest};
 pub use error::{RecipeError, SourceRule};
-pub use fetch::{cache_root, fetch, fetched};
-pub use recipe::{Published, Recipe, Source, SourceKind};
+pub use fetch::{cache_root, entry, fetch, fetched};
+pub use recipe::{ProtocolSpec, Published, Recipe, Source, SourceKind};
 
 use crate::Result;
 
