@@ -35,7 +35,7 @@ pub fn install() {
         }
         // Held until exit: no temporary is created or renamed into place after the clean-up.
         let _registry = neurotex::io::remove_temporaries();
-        eprintln!("interrupted: temporary files removed");
+        eprintln!("interrupted: {}", neurotex::io::interrupted_note());
         std::process::exit(INTERRUPTED);
     });
     if let Err(e) = installed {

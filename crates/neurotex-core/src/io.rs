@@ -157,6 +157,37 @@ pub fn remove_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
     list
 }
 
+/// Folders of finished work that running the same command again takes up (a benchmark's
+/// kept pieces): an interrupted run names them, so that its user knows the work is kept.
+static RESUMABLE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn resumable() -> MutexGuard<'static, Vec<PathBuf>> {
+    RESUMABLE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Notes `dir` as finished work a rerun takes up, until [`forget_resumable`].
+pub fn note_resumable(dir: &Path) {
+    resumable().push(dir.to_path_buf());
+}
+
+/// `dir` no longer holds work to resume (its run finished).
+pub fn forget_resumable(dir: &Path) {
+    forget(&mut resumable(), dir);
+}
+
+/// What an interrupted run leaves, for the signal handler's last words: its temporary
+/// files removed, and the folders of finished work that the same command takes up again.
+pub fn interrupted_note() -> String {
+    let mut note = "temporary files removed".to_string();
+    for dir in resumable().iter() {
+        note.push_str(&format!(
+            "; finished work kept in {}: the same command, run again, takes it up",
+            dir.display()
+        ));
+    }
+    note
+}
+
 /// The folder `path` is in (`.` for a bare name).
 fn parent(path: &Path) -> &Path {
     path.parent()

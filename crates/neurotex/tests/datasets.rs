@@ -389,7 +389,13 @@ fn a_damaged_archive_a_zip_slip_a_zip_bomb_or_a_missing_condition_leaves_the_cac
     let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
         .unwrap_err()
         .to_string();
+    // Named by the copy the data came from, not by the cache entry that was rolled back.
     assert!(err.contains("speed_mm_s = 20"), "{err}");
+    assert!(
+        err.contains(&dir.join("copy").display().to_string()),
+        "{err}"
+    );
+    assert!(!err.contains(&cache.display().to_string()), "{err}");
     assert!(listing(&cache).is_empty());
     // No copy given and no such file to download: the message names the source, and the
     // cache is left as it was.
@@ -861,6 +867,12 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
         .unwrap()
         .iter()
         .all(|s| !s.contains("pieces taken")));
+    // ... and their removal is said.
+    let removed = said.lock().unwrap().iter().find_map(|s| {
+        let n = s.strip_suffix(" finished pieces of a stopped run with other settings removed")?;
+        n.trim().parse::<usize>().ok()
+    });
+    assert!(removed.is_some_and(|n| n >= 30), "{said:?}");
     assert_eq!(
         comparison(&other),
         comparison(&options("seed6", 6).run(&silent).unwrap())

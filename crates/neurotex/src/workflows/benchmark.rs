@@ -247,6 +247,12 @@ impl BenchmarkOptions {
         let opened = options.open.open(dataset)?;
         let key_text = key.text();
         let pieces = Pieces::open(self.pieces_dir(recipe, protocol), &key_text)?;
+        if pieces.removed > 0 {
+            on(Progress::Say(&format!(
+                "  {} finished pieces of a stopped run with other settings removed",
+                pieces.removed
+            )));
+        }
         let comparison = options
             .run_keeping(&opened, &StageOptions::default(), on, Some(&pieces))
             .map_err(|e| crate::Error::InAnalysis {

@@ -17,6 +17,8 @@ use crate::Result;
 pub(super) struct Pieces {
     dir: PathBuf,
     taken: AtomicUsize,
+    /// Pieces of other settings removed when the folder was opened.
+    pub(super) removed: usize,
 }
 
 impl Pieces {
@@ -26,16 +28,25 @@ impl Pieces {
     /// The folder cannot be emptied or made.
     pub(super) fn open(dir: PathBuf, key: &str) -> Result<Pieces> {
         let key_file = dir.join("key.json");
+        let mut removed = 0;
         if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key) {
             if dir.exists() {
+                removed = std::fs::read_dir(&dir).map_or(0, |items| {
+                    let names = items.flatten().map(|item| item.file_name());
+                    names
+                        .filter(|n| n.to_string_lossy().ends_with(".piece"))
+                        .count()
+                });
                 std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
             }
             std::fs::create_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
             write_atomic(&key_file, |w| w.write_all(key.as_bytes()))?;
         }
+        crate::io::note_resumable(&dir);
         Ok(Pieces {
             dir,
             taken: AtomicUsize::new(0),
+            removed,
         })
     }
 
@@ -50,9 +61,11 @@ impl Pieces {
             let why = "is not the pieces folder of these settings: make the shares first";
             return Err(DataError::invalid(&dir, why.to_string()).into());
         }
+        crate::io::note_resumable(&dir);
         Ok(Pieces {
             dir,
             taken: AtomicUsize::new(0),
+            removed: 0,
         })
     }
 
@@ -74,6 +87,14 @@ impl Pieces {
             .map(|b| format!("{b:02x}"))
             .collect();
         self.dir.join(format!("{digest}.piece"))
+    }
+}
+
+impl Drop for Pieces {
+    /// The folder is no longer the work of a running comparison (an interrupted run names
+    /// only those).
+    fn drop(&mut self) {
+        crate::io::forget_resumable(&self.dir);
     }
 }
 

@@ -68,7 +68,8 @@ const FETCHED: &str = "fetched.json";
 pub fn fetch(recipe: &Recipe, root: &Path, from: Option<&Path>, on: OnProgress) -> Result<PathBuf> {
     if let Some(dataset) = fetched(root, recipe) {
         // The conditions are not part of the entry's name: an edited list is checked here.
-        check_conditions(recipe, &Dataset::open(&dataset)?).map_err(|e| in_recipe(recipe, e))?;
+        let opened = Dataset::open(&dataset)?;
+        check_conditions(recipe, &opened, &dataset).map_err(|e| in_recipe(recipe, e))?;
         on(Progress::Say(&format!(
             "{}: fetched before, in {}",
             recipe.name,
@@ -160,7 +161,8 @@ fn fill(recipe: &Recipe, from: &Path, origin: &str, tmp: &Path, on: OnProgress) 
         Import::Csv(options) => options.run(&dataset, on).map(|_| ())?,
         Import::Stacked(options) => options.run(&dataset).map(|_| ())?,
     }
-    check_conditions(recipe, &Dataset::open(&dataset)?)?;
+    // Named by where the data came from: the cache entry being filled is rolled back.
+    check_conditions(recipe, &Dataset::open(&dataset)?, from)?;
     std::fs::remove_dir_all(&files).map_err(|e| DataError::write(&files, e))?;
     let record = serde_json::json!({
         "recipe": recipe.name,
@@ -283,8 +285,9 @@ fn move_into(from: &Path, to: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Every value the recipe's `[conditions]` lists is in the dataset's manifest column.
-fn check_conditions(recipe: &Recipe, dataset: &Dataset) -> Result<()> {
+/// Every value the recipe's `[conditions]` lists is in the dataset's manifest column; an
+/// error names the data as `shown`.
+fn check_conditions(recipe: &Recipe, dataset: &Dataset, shown: &Path) -> Result<()> {
     for (column, values) in &recipe.conditions {
         let have: Vec<String> = (dataset.entries.iter())
             .filter_map(|m| m.field(column))
@@ -292,7 +295,7 @@ fn check_conditions(recipe: &Recipe, dataset: &Dataset) -> Result<()> {
         for value in values {
             if !have.iter().any(|h| h == value || same_number(h, value)) {
                 let why = format!("[conditions] {column} = {value}: no recording has it (the recipe's conditions must be in the data)");
-                return Err(DataError::invalid(&dataset.root, why).into());
+                return Err(DataError::invalid(shown, why).into());
             }
         }
     }
