@@ -13,8 +13,10 @@
 //! Picking the best of many candidates on the same data is itself a choice fitted to that
 //! data: the winner's accuracy is biased upwards (the "winner's curse"; Cawley and Talbot
 //! 2010, JMLR 11). [`CompareParams::nested`] adds the honest estimate of the whole
-//! procedure: for each outer split the candidates are ranked by cross-validation inside
-//! its training recordings only, and the chosen one is scored on its test recordings.
+//! procedure: for each outer split the candidates are ranked inside its training recordings
+//! only (by cross-validation, or under a hold-out protocol by holding out each of their
+//! conditions in turn, the outer protocol's question), and the chosen one is scored on its
+//! test recordings.
 
 pub mod candidates;
 mod nested;
@@ -37,6 +39,11 @@ use parts::{parts, score_all};
 use units::Units;
 
 pub use crate::analysis::EvaluateFn;
+
+/// The version of what nested selection computes, raised whenever its rules change, so that
+/// results kept under an older one are computed anew (2: under a hold-out protocol the inner
+/// ranking holds out each condition of the outer training set).
+pub const NESTED_VERSION: u32 = 2;
 
 /// One encoding x feature method x classifier, with its features computed.
 #[derive(Clone)]
@@ -405,9 +412,9 @@ mod tests {
     use crate::pipeline::Method;
     use crate::values::Grid;
 
-    /// 3 classes x 2 speeds x 12 trials; `separable` features put each class far apart,
+    /// 3 classes x `speeds` x 12 trials; `separable` features put each class far apart,
     /// otherwise the features are noise that knows nothing of the class.
-    fn table(separable: bool) -> FeatureTable {
+    fn table_at(speeds: &[f64], separable: bool) -> FeatureTable {
         let mut metas = Vec::new();
         let mut values = Vec::new();
         let mut seed = 0x2545_f491_4f6c_dd1du64;
@@ -418,7 +425,7 @@ mod tests {
             (seed % 1000) as f64 / 1000.0
         };
         for class in 0..3 {
-            for speed in [5.0, 10.0] {
+            for &speed in speeds {
                 for trial in 0..12 {
                     metas.push(Meta {
                         file: format!("c{class}_{speed}_{trial}.npy"),
@@ -444,9 +451,15 @@ mod tests {
         }
     }
 
+    /// A KNN candidate on 2 speeds (see [`table_at`]).
     fn candidate(method: &str, separable: bool) -> Candidate {
+        candidate_at(&[5.0, 10.0], method, separable)
+    }
+
+    /// [`candidate`] at `speeds`.
+    fn candidate_at(speeds: &[f64], method: &str, separable: bool) -> Candidate {
         let knn = KnnParams::default().check().unwrap();
-        let table = table(separable);
+        let table = table_at(speeds, separable);
         Candidate {
             encoding: "sa".into(),
             method: method.into(),
@@ -528,5 +541,68 @@ mod tests {
         let err = compare(&candidates, &params(Protocol::Per("session".into()), false));
         assert!(err.unwrap_err().to_string().contains("session"));
         assert!(compare(&[], &params(Protocol::Pooled, false)).is_err());
+    }
+
+    /// Pieces kept in memory, for a test to read.
+    #[derive(Default)]
+    struct Spy(std::sync::Mutex<std::collections::HashMap<String, String>>);
+
+    impl Keep for Spy {
+        fn get(&self, key: &str) -> Option<String> {
+            self.0.lock().unwrap().get(key).cloned()
+        }
+        fn put(&self, key: &str, json: &str) -> Result<()> {
+            self.0.lock().unwrap().insert(key.into(), json.into());
+            Ok(())
+        }
+    }
+
+    /// Under a hold-out protocol the inner ranking holds out each speed of the outer
+    /// training set: a candidate's inner accuracy is the mean of its accuracies with each
+    /// of them held out. With two speeds one is left to train on, and the comparison says
+    /// that its inner ranking cross-validates within it.
+    #[test]
+    fn hold_out_nested_selection_holds_out_inside_too() {
+        let speeds = [5.0, 10.0, 15.0];
+        let three = [
+            candidate_at(&speeds, "glcm3d", true),
+            candidate_at(&speeds, "noise", false),
+        ];
+        let p = params(Protocol::HoldOut("speed_mm_s".into()), true);
+        let spy = Spy::default();
+        let c = compare_keeping(&three, &p, &crate::progress::silent, Some(&spy)).unwrap();
+        assert!(c.notes.is_empty(), "{:?}", c.notes);
+        let metas = &three[0].metas;
+        let values = parts::conditions(metas, "speed_mm_s").unwrap();
+        assert_eq!(values.len(), 3);
+        for (s, held) in values.iter().enumerate() {
+            let train: Vec<usize> = (0..metas.len())
+                .filter(|&i| metas[i].field("speed_mm_s").as_ref() != Some(held))
+                .collect();
+            let others: Vec<String> = values.iter().filter(|v| *v != held).cloned().collect();
+            for cand in &three {
+                let each = others.iter().map(|v| {
+                    let split = parts::hold_out("speed_mm_s", &others, v);
+                    (cand.evaluate)(&train, &split, &crate::progress::silent)
+                        .unwrap()
+                        .accuracy
+                });
+                let expected = each.sum::<f64>() / others.len() as f64;
+                let key = format!("inner accuracy of {} in outer split {s}", cand.name());
+                let kept: f64 = serde_json::from_str(&spy.get(&key).unwrap()).unwrap();
+                assert_eq!(kept, expected, "{key}");
+            }
+        }
+        // The separable candidate carries to the speed held out; the noise does not.
+        assert_eq!(c.nested.unwrap().chosen[0].0, three[0].name());
+        let two = [candidate("glcm3d", true), candidate("noise", false)];
+        let c = compare(&two, &p).unwrap();
+        assert!(
+            c.notes
+                .iter()
+                .any(|n| n.contains("2 of 2 outer training sets hold one value")),
+            "{:?}",
+            c.notes
+        );
     }
 }

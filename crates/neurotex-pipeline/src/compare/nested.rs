@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::parts::{conditions, cv_split, rows_with};
+use super::parts::{conditions, cv_split, hold_out, rows_with};
 use super::units::Units;
 use super::{kept_or, mean, Candidate, CompareParams, Keep, Nested, Protocol};
 use crate::analysis::Split;
@@ -46,6 +46,7 @@ pub(super) fn fewer_folds(
     let inner = outer
         .unwrap_or_default()
         .iter()
+        .filter(|split| inner_held_out(metas, params, split).is_none())
         .map(|split| inner_folds(folds, smallest_class(metas, &split.train)))
         .filter(|&used| used < folds);
     if let Some(used) = inner.clone().min() {
@@ -55,6 +56,7 @@ pub(super) fn fewer_folds(
             outer.map_or(0, <[_]>::len)
         ));
     }
+    notes.extend(outer.and_then(|outer| inner_within_one_condition(metas, params, outer)));
     notes
 }
 
@@ -66,6 +68,43 @@ fn inner_folds(folds: usize, smallest: usize) -> usize {
 
 /// What nested selection reports its steps to and keeps its finished pieces in.
 type Around<'a> = (&'a (dyn Fn(Progress) + Sync), Option<&'a dyn Keep>);
+
+/// Under a hold-out protocol, the column and its values in `split`'s training set when
+/// there are two or more: the inner ranking then holds out each of them in turn.
+fn inner_held_out<'p>(
+    metas: &[Meta],
+    params: &'p CompareParams,
+    split: &OuterSplit,
+) -> Option<(&'p str, Vec<String>)> {
+    let Protocol::HoldOut(column) = &params.protocol else {
+        return None;
+    };
+    let values = conditions(metas, column).unwrap_or_default();
+    let present: Vec<String> = (values.into_iter())
+        .filter(|v| (split.train.iter()).any(|&r| metas[r].field(column).as_ref() == Some(v)))
+        .collect();
+    (present.len() > 1).then_some((column.as_str(), present))
+}
+
+/// Under a hold-out protocol, the note that some outer training sets hold one condition, so
+/// that their inner ranking can only cross-validate within it.
+fn inner_within_one_condition(
+    metas: &[Meta],
+    params: &CompareParams,
+    outer: &[OuterSplit],
+) -> Option<String> {
+    let Protocol::HoldOut(column) = &params.protocol else {
+        return None;
+    };
+    let within = outer
+        .iter()
+        .filter(|split| inner_held_out(metas, params, split).is_none())
+        .count();
+    (within > 0).then(|| format!(
+        "nested selection with --hold-out {column}: {within} of {} outer training sets hold one value of `{column}`, so their inner ranking cross-validates within it and favours what does best on a condition seen in training, which need not carry to the one held out (more values of `{column}` let it hold one out)",
+        outer.len()
+    ))
+}
 
 /// One outer split of nested selection.
 pub(super) struct OuterSplit {
@@ -203,8 +242,9 @@ pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec
     Ok(splits)
 }
 
-/// One outer split of nested selection: every candidate cross-validated on its training
-/// rows (one repeat), the best trained on all of them and tested on its test rows.
+/// One outer split of nested selection: every candidate ranked on its training rows
+/// (cross-validated, one repeat, or with each of their conditions held out under a
+/// hold-out protocol), the best trained on all of them and tested on its test rows.
 fn outer(
     candidates: &[Candidate],
     (s, split): (usize, &OuterSplit),
@@ -224,13 +264,28 @@ fn outer(
         .check()?,
         ..params.clone()
     };
+    // The inner ranking asks the outer protocol's question: under a hold-out protocol each
+    // condition of the training set is held out in turn (the mean of their accuracies, as
+    // the outer accuracy is), so that the candidate chosen is the one that carries best to
+    // a condition it was not trained on; with one condition there, cross-validation within
+    // it is all there is ([`inner_within_one_condition`] says so).
+    let held_out = inner_held_out(metas, params, split);
+    let inner_accuracy = |c: &Candidate| -> Result<f64> {
+        let Some((column, values)) = &held_out else {
+            return Ok((c.evaluate)(&split.train, &cv_split(&inner), &silent)?.accuracy);
+        };
+        let mut sum = 0.0;
+        for value in values {
+            let held = hold_out(column, values, value);
+            sum += (c.evaluate)(&split.train, &held, &silent)?.accuracy;
+        }
+        Ok(sum / values.len() as f64)
+    };
     let accuracies: Vec<f64> = candidates
         .par_iter()
         .map(|c| {
             let key = format!("inner accuracy of {} in outer split {s}", c.name());
-            let accuracy = kept_or(keep, &key, || {
-                Ok((c.evaluate)(&split.train, &cv_split(&inner), &silent)?.accuracy)
-            })?;
+            let accuracy = kept_or(keep, &key, || inner_accuracy(c))?;
             progress(Progress::Tick);
             Ok(accuracy)
         })

@@ -207,7 +207,7 @@ fn scored(c: &Candidate, parts: &[Part], scores: &[PartScore], params: &CompareP
 }
 
 /// Trains on every value of `column` but `value`, tests on `value`.
-fn hold_out(column: &str, values: &[String], value: &str) -> Split {
+pub(super) fn hold_out(column: &str, values: &[String], value: &str) -> Split {
     let others = values.iter().filter(|v| *v != value).cloned().collect();
     let select = |values| Selection {
         column: column.to_string(),

@@ -52,6 +52,9 @@ pub fn markdown(c: &Comparison) -> String {
     if let Some(n) = &c.nested {
         out.push_str(&format!("\nNested selection: {}\n", nested_text(n)));
     }
+    for note in &c.notes {
+        out.push_str(&format!("\nNote: {note}.\n"));
+    }
     if c.results.iter().any(|r| r.encoding == NO_ENCODING) {
         out.push_str(BASELINES_NOTE);
     }

@@ -94,6 +94,9 @@ struct Key {
     import_digest: String,
     protocol: String,
     candidate_set: u32,
+    /// [`crate::compare::NESTED_VERSION`].
+    #[serde(default)]
+    nested: u32,
     snn: bool,
     folds: usize,
     repeats: usize,
@@ -176,6 +179,7 @@ impl BenchmarkOptions {
             import_digest: recipe.import_digest(),
             protocol: serde_json::to_string(protocol).unwrap_or_default(),
             candidate_set: CANDIDATE_SET_VERSION,
+            nested: crate::compare::NESTED_VERSION,
             snn: self.snn,
             folds: self.folds,
             repeats: self.repeats,

@@ -278,12 +278,24 @@ fn section(b: &Board) -> String {
         pct(c.majority)
     );
     if let Some(n) = &c.nested {
-        let chosen = n.chosen.first().map_or(String::new(), |(name, times)| {
-            format!(
-                "; chosen most often: {name} ({times} of {} splits)",
-                n.outer_splits
-            )
-        });
+        // Every candidate chosen as often as the most chosen one, not the first of a tie.
+        let most = n.chosen.first().map_or(0, |c| c.1);
+        let names: Vec<&str> = (n.chosen.iter())
+            .take_while(|c| c.1 == most)
+            .map(|c| c.0.as_str())
+            .collect();
+        let chosen = match names.len() {
+            0 => String::new(),
+            1 => format!(
+                "; chosen most often: {} ({most} of {} splits)",
+                names[0], n.outer_splits
+            ),
+            _ => format!(
+                "; chosen most often, {most} of {} splits each: {}",
+                n.outer_splits,
+                names.join(", ")
+            ),
+        };
         s.push_str(&format!(
             "**Nested selection: {} % (95 % interval {}–{} %)**{chosen}.\n\n",
             pct(n.accuracy),
@@ -293,6 +305,9 @@ fn section(b: &Board) -> String {
         if let Some(warning) = against_chance(n.ci, c.chance) {
             s.push_str(&format!("{warning}\n\n"));
         }
+    }
+    for note in &c.notes {
+        s.push_str(&format!("Note: {note}.\n\n"));
     }
     s.push_str(&table(c));
     if !b.published.is_empty() {
