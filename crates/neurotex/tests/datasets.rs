@@ -727,6 +727,13 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
         md.contains("Someone 2024") && md.contains("Nested selection"),
         "{md}"
     );
+    // How nested selection ranked inside its training sets, and every rank accounted for:
+    // the table ends at the last rank or says where the rest are.
+    assert!(md.contains("Ranked by 3-fold cross-validation inside each outer training set."));
+    // Two speeds: each outer training set of the held-out protocol holds one.
+    assert!(md.contains("inside each outer training set (each holds one value of speed_mm_s)"));
+    let n = board.boards[0].comparison.results.len();
+    assert!(md.contains(&format!("–{n} in compare.md |")), "{md}");
     assert!(dir.join("out/ridges/within-speed/ranking.png").is_file());
     assert!(dir.join("out/leaderboard.png").is_file() && dir.join("out/leaderboard.svg").is_file());
     // A nested interval under chance, or across it, is said so.

@@ -190,6 +190,10 @@ pub struct Nested {
     pub chosen: Vec<(String, usize)>,
     /// Outer splits.
     pub outer_splits: usize,
+    /// How each outer training set ranked the candidates (empty in results written before
+    /// it was recorded).
+    #[serde(default)]
+    pub inner: String,
 }
 
 /// The comparison of every candidate.
@@ -594,9 +598,18 @@ mod tests {
             }
         }
         // The separable candidate carries to the speed held out; the noise does not.
-        assert_eq!(c.nested.unwrap().chosen[0].0, three[0].name());
+        let nested = c.nested.unwrap();
+        assert_eq!(nested.chosen[0].0, three[0].name());
+        assert_eq!(
+            nested.inner,
+            "each other value of speed_mm_s held out in turn, inside each outer training set"
+        );
         let two = [candidate("glcm3d", true), candidate("noise", false)];
         let c = compare(&two, &p).unwrap();
+        assert_eq!(
+            c.nested.as_ref().unwrap().inner,
+            "4-fold cross-validation inside each outer training set (each holds one value of speed_mm_s)"
+        );
         assert!(
             c.notes
                 .iter()

@@ -86,6 +86,36 @@ fn inner_held_out<'p>(
     (present.len() > 1).then_some((column.as_str(), present))
 }
 
+/// How the outer training sets ranked the candidates, in words.
+fn inner_ranking(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) -> String {
+    let held = splits
+        .iter()
+        .filter(|split| inner_held_out(metas, params, split).is_some())
+        .count();
+    let folds: Vec<usize> = (splits.iter())
+        .filter(|split| inner_held_out(metas, params, split).is_none())
+        .map(|split| inner_folds(params.cv.folds, smallest_class(metas, &split.train)))
+        .collect();
+    let cv = match (folds.iter().min(), folds.iter().max()) {
+        (Some(a), Some(b)) if a == b => format!("{a}-fold cross-validation"),
+        (Some(a), Some(b)) => format!("{a}- to {b}-fold cross-validation"),
+        _ => String::new(),
+    };
+    match (&params.protocol, held) {
+        (Protocol::HoldOut(column), h) if h == splits.len() => {
+            format!("each other value of {column} held out in turn, inside each outer training set")
+        }
+        (Protocol::HoldOut(column), 0) => {
+            format!("{cv} inside each outer training set (each holds one value of {column})")
+        }
+        (Protocol::HoldOut(column), h) => format!(
+            "each other value of {column} held out in turn inside {h} outer training sets, {cv} inside the {} that hold one",
+            splits.len() - h
+        ),
+        _ => format!("{cv} inside each outer training set"),
+    }
+}
+
 /// Under a hold-out protocol, the note that some outer training sets hold one condition, so
 /// that their inner ranking can only cross-validate within it.
 fn inner_within_one_condition(
@@ -359,5 +389,6 @@ pub(super) fn nested(
         ci: units.interval(&shares),
         chosen,
         outer_splits: splits.len(),
+        inner: inner_ranking(metas, params, splits),
     })
 }

@@ -138,8 +138,12 @@ fn nested_text(n: &Nested) -> String {
         .iter()
         .map(|(name, times)| format!("{name} ({times} of {})", n.outer_splits))
         .collect();
+    let inner = match n.inner.is_empty() {
+        true => String::new(),
+        false => format!("; ranked by {}", n.inner),
+    };
     format!(
-        "{} over {} outer splits; chosen: {}",
+        "{} over {} outer splits{inner}; chosen: {}",
         with_interval(n.accuracy, n.ci),
         n.outer_splits,
         chosen.join(", ")

@@ -243,6 +243,13 @@ fn table(c: &Comparison) -> String {
             shown = i + 1;
         }
     }
+    if shown < c.results.len() {
+        s.push_str(&format!(
+            "| … | ranks {}–{} in compare.md | | | | |\n",
+            shown + 1,
+            c.results.len()
+        ));
+    }
     let tied = c
         .results
         .iter()
@@ -296,8 +303,12 @@ fn section(b: &Board) -> String {
                 names.join(", ")
             ),
         };
+        let inner = match n.inner.is_empty() {
+            true => String::new(),
+            false => format!(" Ranked by {}.", n.inner),
+        };
         s.push_str(&format!(
-            "**Nested selection: {} % (95 % interval {}–{} %)**{chosen}.\n\n",
+            "**Nested selection: {} % (95 % interval {}–{} %)**{chosen}.{inner}\n\n",
             pct(n.accuracy),
             pct(n.ci[0]),
             pct(n.ci[1])

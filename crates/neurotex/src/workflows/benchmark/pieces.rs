@@ -2,7 +2,7 @@
 //! through a protocol takes them up when it is run again with the same settings.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use sha2::{Digest, Sha256};
 
@@ -19,6 +19,8 @@ pub(super) struct Pieces {
     taken: AtomicUsize,
     /// Pieces of other settings removed when the folder was opened.
     pub(super) removed: usize,
+    /// Whether the folder holds a piece (an interrupted run names it only then).
+    holds: AtomicBool,
 }
 
 impl Pieces {
@@ -42,12 +44,16 @@ impl Pieces {
             std::fs::create_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
             write_atomic(&key_file, |w| w.write_all(key.as_bytes()))?;
         }
-        crate::io::note_resumable(&dir);
-        Ok(Pieces {
+        let pieces = Pieces {
             dir,
             taken: AtomicUsize::new(0),
             removed,
-        })
+            holds: AtomicBool::new(false),
+        };
+        if removed == 0 && std::fs::read_dir(&pieces.dir).is_ok_and(|d| d.count() > 1) {
+            pieces.noted();
+        }
+        Ok(pieces)
     }
 
     /// The pieces folder `dir` of the comparison under `key`, made before (by a
@@ -61,12 +67,19 @@ impl Pieces {
             let why = "is not the pieces folder of these settings: make the shares first";
             return Err(DataError::invalid(&dir, why.to_string()).into());
         }
-        crate::io::note_resumable(&dir);
         Ok(Pieces {
             dir,
             taken: AtomicUsize::new(0),
             removed: 0,
+            holds: AtomicBool::new(false),
         })
+    }
+
+    /// The folder noted as finished work an interrupted run names, once it holds a piece.
+    fn noted(&self) {
+        if !self.holds.swap(true, Ordering::SeqCst) {
+            crate::io::note_resumable(&self.dir);
+        }
     }
 
     /// How many pieces were taken from the folder.
@@ -94,7 +107,9 @@ impl Drop for Pieces {
     /// The folder is no longer the work of a running comparison (an interrupted run names
     /// only those).
     fn drop(&mut self) {
-        crate::io::forget_resumable(&self.dir);
+        if self.holds.load(Ordering::SeqCst) {
+            crate::io::forget_resumable(&self.dir);
+        }
     }
 }
 
@@ -109,6 +124,8 @@ impl Keep for Pieces {
     }
 
     fn put(&self, key: &str, json: &str) -> Result<()> {
-        write_atomic(&self.file(key), |w| write!(w, "{key}\n{json}"))
+        write_atomic(&self.file(key), |w| write!(w, "{key}\n{json}"))?;
+        self.noted();
+        Ok(())
     }
 }

@@ -84,6 +84,7 @@ fn comparison(n: usize, nested: bool, conditions: usize) -> Comparison {
                 ("fa / glcm2d / knn".into(), 1),
             ],
             outer_splits: 5,
+            inner: "5-fold cross-validation inside each outer training set".into(),
         }),
         caveat: crate::compare::CAVEAT.into(),
         notes: Vec::new(),
