@@ -330,16 +330,18 @@ fn a_damaged_archive_a_zip_slip_a_zip_bomb_or_a_missing_condition_leaves_the_cac
     std::fs::create_dir_all(dir.join("copy")).unwrap();
     let cache = dir.join("cache");
     let good = logs_zip("logs", &[]);
-    let text = headerless_recipe(&good, r#""10", "30""#);
+    // `archive` as the copy's logs.zip, fetched with the recipe `text`: the error.
+    let refused = |archive: &[u8], text: &str| -> String {
+        std::fs::write(dir.join("copy/logs.zip"), archive).unwrap();
+        let recipe = Recipe::parse(text, Path::new("r.toml")).unwrap();
+        let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent).unwrap_err();
+        err.to_string()
+    };
     // One byte changed.
     let mut damaged = good.clone();
     let last = damaged.len() - 30;
     damaged[last] ^= 1;
-    std::fs::write(dir.join("copy/logs.zip"), &damaged).unwrap();
-    let recipe = Recipe::parse(&text, Path::new("r.toml")).unwrap();
-    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
-        .unwrap_err()
-        .to_string();
+    let err = refused(&damaged, &headerless_recipe(&good, r#""10", "30""#));
     assert!(
         err.contains("recipe ridges") && err.contains("logs.zip") && err.contains("SHA-256"),
         "{err}"
@@ -347,15 +349,7 @@ fn a_damaged_archive_a_zip_slip_a_zip_bomb_or_a_missing_condition_leaves_the_cac
     assert!(listing(&cache).is_empty(), "{:?}", listing(&cache));
     // An entry that would land outside its folder.
     let hostile = logs_zip("logs", &[("logs/../../escaped.csv", "1,2\n")]);
-    std::fs::write(dir.join("copy/logs.zip"), &hostile).unwrap();
-    let recipe = Recipe::parse(
-        &headerless_recipe(&hostile, r#""10", "30""#),
-        Path::new("r.toml"),
-    )
-    .unwrap();
-    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
-        .unwrap_err()
-        .to_string();
+    let err = refused(&hostile, &headerless_recipe(&hostile, r#""10", "30""#));
     assert!(
         err.contains("escaped.csv") && err.contains("outside"),
         "{err}"
@@ -365,31 +359,20 @@ fn a_damaged_archive_a_zip_slip_a_zip_bomb_or_a_missing_condition_leaves_the_cac
     let zeros = "0".repeat(2_000_000);
     let bomb = logs_zip("logs", &[("logs/zeros.txt", &zeros)]);
     assert!(bomb.len() < good.len() + 20_000, "{}", bomb.len());
-    std::fs::write(dir.join("copy/logs.zip"), &bomb).unwrap();
     let text = headerless_recipe(&bomb, r#""10", "30""#).replace(
         "folder = \"logs\"",
         "folder = \"logs\"\nunpacked-at-most = 1000000",
     );
-    let recipe = Recipe::parse(&text, Path::new("r.toml")).unwrap();
-    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
-        .unwrap_err()
-        .to_string();
+    let err = refused(&bomb, &text);
     assert!(
         err.contains("more than 1000000 bytes") && err.contains("zeros.txt"),
         "{err}"
     );
     assert!(listing(&cache).is_empty() && !anywhere(&dir, "zeros.txt"));
-    // A condition the data does not have.
-    std::fs::write(dir.join("copy/logs.zip"), &good).unwrap();
-    let recipe = Recipe::parse(
-        &headerless_recipe(&good, r#""10", "20""#),
-        Path::new("r.toml"),
-    )
-    .unwrap();
-    let err = fetch(&recipe, &cache, Some(&dir.join("copy")), &silent)
-        .unwrap_err()
-        .to_string();
-    // Named by the copy the data came from, not by the cache entry that was rolled back.
+    // A condition the data does not have, named by the copy the data came from, not by
+    // the cache entry that was rolled back.
+    let lacking = headerless_recipe(&good, r#""10", "20""#);
+    let err = refused(&good, &lacking);
     assert!(err.contains("speed_mm_s = 20"), "{err}");
     assert!(
         err.contains(&dir.join("copy").display().to_string()),
@@ -397,6 +380,7 @@ fn a_damaged_archive_a_zip_slip_a_zip_bomb_or_a_missing_condition_leaves_the_cac
     );
     assert!(!err.contains(&cache.display().to_string()), "{err}");
     assert!(listing(&cache).is_empty());
+    let recipe = Recipe::parse(&lacking, Path::new("r.toml")).unwrap();
     // No copy given and no such file to download: the message names the source, and the
     // cache is left as it was.
     let err = fetch(&recipe, &cache, None, &silent)
