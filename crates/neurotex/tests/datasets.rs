@@ -679,14 +679,21 @@ fn without_times(mut c: Comparison) -> Comparison {
     c
 }
 
-#[test]
-fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
-    let dir = scratch("bench");
+/// The fabricated logs' archive in `dir/copy/` and their recipe `dir/ridges.toml` (two
+/// speeds), whose path is returned.
+fn ridges_in(dir: &Path) -> PathBuf {
     let archive = logs_zip("logs", &[]);
     std::fs::create_dir_all(dir.join("copy")).unwrap();
     std::fs::write(dir.join("copy/logs.zip"), &archive).unwrap();
     let recipe_path = dir.join("ridges.toml");
     std::fs::write(&recipe_path, headerless_recipe(&archive, r#""10", "30""#)).unwrap();
+    recipe_path
+}
+
+#[test]
+fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
+    let dir = scratch("bench");
+    let recipe_path = ridges_in(&dir);
     let options = BenchmarkOptions {
         datasets: vec![recipe_path.display().to_string()],
         out: dir.join("out"),
@@ -796,11 +803,7 @@ fn stop_after(n: usize) -> impl Fn(neurotex::progress::Progress) + Sync {
 #[test]
 fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
     let dir = scratch("resume");
-    let archive = logs_zip("logs", &[]);
-    std::fs::create_dir_all(dir.join("copy")).unwrap();
-    std::fs::write(dir.join("copy/logs.zip"), &archive).unwrap();
-    let recipe_path = dir.join("ridges.toml");
-    std::fs::write(&recipe_path, headerless_recipe(&archive, r#""10", "30""#)).unwrap();
+    let recipe_path = ridges_in(&dir);
     let options = |out: &str, seed: u64| BenchmarkOptions {
         datasets: vec![recipe_path.display().to_string()],
         out: dir.join(out),
@@ -873,11 +876,7 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
 #[test]
 fn shares_computed_apart_make_the_leaderboard_of_one_run() {
     let dir = scratch("shares");
-    let archive = logs_zip("logs", &[]);
-    std::fs::create_dir_all(dir.join("copy")).unwrap();
-    std::fs::write(dir.join("copy/logs.zip"), &archive).unwrap();
-    let recipe_path = dir.join("ridges.toml");
-    std::fs::write(&recipe_path, headerless_recipe(&archive, r#""10", "30""#)).unwrap();
+    let recipe_path = ridges_in(&dir);
     let options = |out: &str| BenchmarkOptions {
         datasets: vec![recipe_path.display().to_string()],
         out: dir.join(out),
