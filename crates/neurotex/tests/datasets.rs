@@ -867,6 +867,16 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
         n.trim().parse::<usize>().ok()
     });
     assert!(removed.is_some_and(|n| n >= 30), "{said:?}");
+    // A folder of the user's where the pieces would go is never removed.
+    let theirs = dir.join("mine/ridges/within-speed.pieces");
+    std::fs::create_dir_all(&theirs).unwrap();
+    std::fs::write(theirs.join("notes.txt"), "mine").unwrap();
+    let err = options("mine", 5).run(&silent).unwrap_err().to_string();
+    assert!(
+        err.contains("notes.txt") && err.contains("another --out"),
+        "{err}"
+    );
+    assert!(theirs.join("notes.txt").is_file());
     assert_eq!(
         comparison(&other),
         comparison(&options("seed6", 6).run(&silent).unwrap())

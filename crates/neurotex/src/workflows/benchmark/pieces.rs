@@ -1,7 +1,7 @@
 //! A comparison's finished pieces kept in a folder, so that a benchmark stopped part way
 //! through a protocol takes them up when it is run again with the same settings.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use sha2::{Digest, Sha256};
@@ -33,12 +33,7 @@ impl Pieces {
         let mut removed = 0;
         if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key) {
             if dir.exists() {
-                removed = std::fs::read_dir(&dir).map_or(0, |items| {
-                    let names = items.flatten().map(|item| item.file_name());
-                    names
-                        .filter(|n| n.to_string_lossy().ends_with(".piece"))
-                        .count()
-                });
+                removed = pieces_only(&dir)?;
                 std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
             }
             std::fs::create_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
@@ -101,6 +96,32 @@ impl Pieces {
             .collect();
         self.dir.join(format!("{digest}.piece"))
     }
+}
+
+/// How many pieces the folder `dir` holds, when it holds nothing else than pieces, their
+/// key and a write's hidden temporary (left by a process killed outright).
+///
+/// # Errors
+/// Anything else in it: a folder of the user's is never removed.
+fn pieces_only(dir: &Path) -> Result<usize> {
+    let items = std::fs::read_dir(dir).map_err(|reason| DataError::Io {
+        path: dir.to_path_buf(),
+        reason,
+    })?;
+    let mut pieces = 0;
+    for item in items.flatten() {
+        let name = item.file_name().to_string_lossy().into_owned();
+        let file = item.file_type().is_ok_and(|t| t.is_file());
+        match name.ends_with(".piece") {
+            true if file => pieces += 1,
+            _ if file && (name == "key.json" || name.starts_with('.')) => {}
+            _ => {
+                let why = format!("holds {name}, which is not a benchmark's finished piece: move it, or give another --out");
+                return Err(DataError::invalid(dir, why).into());
+            }
+        }
+    }
+    Ok(pieces)
 }
 
 impl Drop for Pieces {
