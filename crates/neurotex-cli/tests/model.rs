@@ -522,12 +522,7 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
 fn a_subtractive_reset_is_written_and_a_zero_reset_left_out() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
-    let train = |out: &Path, reset: &[&str]| {
-        let mut args = vec!["train", "--dataset", s(&ds), "--classifier", "snn"];
-        args.extend(["--snn-hidden", "8", "--snn-epochs", "2", "--out", s(out)]);
-        args.extend(reset);
-        dir.ok(&args);
-    };
+    let train = |out: &Path, reset: &[&str]| dir.train_tiny_snn(&ds, out, reset);
     let (plain, zero, subtract) = (
         dir.join("plain.json"),
         dir.join("zero.json"),
@@ -612,19 +607,7 @@ fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
     let model = dir.join("snn.json");
-    dir.ok(&[
-        "train",
-        "--dataset",
-        s(&ds),
-        "--classifier",
-        "snn",
-        "--snn-hidden",
-        "8",
-        "--snn-epochs",
-        "2",
-        "--out",
-        s(&model),
-    ]);
+    dir.train_tiny_snn(&ds, &model, &[]);
     let file = read_json(&model);
     let both = |field: &str, v: Value| {
         let net = format!("/network/{field}");
@@ -812,10 +795,7 @@ fn the_network_trains_on_windows_when_asked() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
     let train = |extra: &[&str], out: &Path| {
-        let mut args = vec!["train", "--dataset", s(&ds), "--classifier", "snn"];
-        args.extend(["--snn-hidden", "8", "--snn-epochs", "2", "--out", s(out)]);
-        args.extend(extra);
-        dir.ok(&args);
+        dir.train_tiny_snn(&ds, out, extra);
         serde_json::from_str::<Value>(&std::fs::read_to_string(out).unwrap()).unwrap()
     };
     let whole = train(&[], &dir.join("whole.json"));
@@ -891,19 +871,7 @@ fn export_inputs_at_some_speeds() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[5.0, 10.0], 4);
     let model = dir.join("snn.json");
-    dir.ok(&[
-        "train",
-        "--dataset",
-        s(&ds),
-        "--classifier",
-        "snn",
-        "--snn-hidden",
-        "8",
-        "--snn-epochs",
-        "2",
-        "--out",
-        s(&model),
-    ]);
+    dir.train_tiny_snn(&ds, &model, &[]);
     let inputs = dir.join("inputs");
     let export = |speeds: &'static str| -> Vec<String> {
         let args = [

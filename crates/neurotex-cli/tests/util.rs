@@ -67,6 +67,15 @@ impl Dir {
         run.stdout
     }
 
+    /// Trains a tiny spiking network (8 hidden neurons, 2 epochs) on `dataset` into `out`,
+    /// with `extra` flags; the command must succeed.
+    pub fn train_tiny_snn(&self, dataset: &Path, out: &Path, extra: &[&str]) {
+        let mut args = vec!["train", "--dataset", s(dataset), "--classifier", "snn"];
+        args.extend(["--snn-hidden", "8", "--snn-epochs", "2", "--out", s(out)]);
+        args.extend_from_slice(extra);
+        self.ok(&args);
+    }
+
     /// Runs `neurotex evaluate --dataset DATASET --method METHOD EXTRA... --json`, which
     /// must succeed; returns the JSON it prints.
     pub fn evaluate_json(&self, dataset: &Path, method: &str, extra: &[&str]) -> Value {

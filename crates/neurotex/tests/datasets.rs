@@ -690,13 +690,12 @@ fn ridges_in(dir: &Path) -> PathBuf {
     recipe_path
 }
 
-#[test]
-fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
-    let dir = scratch("bench");
-    let recipe_path = ridges_in(&dir);
-    let options = BenchmarkOptions {
-        datasets: vec![recipe_path.display().to_string()],
-        out: dir.join("out"),
+/// `neurotex benchmark DIR/ridges.toml --from DIR/copy --cache DIR/cache --out DIR/OUT
+/// --folds 3 --seed 5` over both protocols of [`ridges_in`]'s recipe.
+fn ridges_bench(dir: &Path, out: &str) -> BenchmarkOptions {
+    BenchmarkOptions {
+        datasets: vec![dir.join("ridges.toml").display().to_string()],
+        out: dir.join(out),
         cache: Some(dir.join("cache")),
         from: Some(dir.join("copy")),
         protocols: Vec::new(),
@@ -704,7 +703,14 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
         folds: 3,
         repeats: 1,
         seed: 5,
-    };
+    }
+}
+
+#[test]
+fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
+    let dir = scratch("bench");
+    let recipe_path = ridges_in(&dir);
+    let options = ridges_bench(&dir, "out");
     let board = options.run(&silent).unwrap();
     assert_eq!(board.boards.len(), 2);
     let recipe = Recipe::read(&recipe_path).unwrap();
@@ -803,17 +809,11 @@ fn stop_after(n: usize) -> impl Fn(neurotex::progress::Progress) + Sync {
 #[test]
 fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
     let dir = scratch("resume");
-    let recipe_path = ridges_in(&dir);
+    ridges_in(&dir);
     let options = |out: &str, seed: u64| BenchmarkOptions {
-        datasets: vec![recipe_path.display().to_string()],
-        out: dir.join(out),
-        cache: Some(dir.join("cache")),
-        from: Some(dir.join("copy")),
         protocols: vec!["within-speed".into()],
-        snn: false,
-        folds: 3,
-        repeats: 1,
         seed,
+        ..ridges_bench(&dir, out)
     };
     let whole = options("whole", 5).run(&silent).unwrap();
     // Stopped after 30 candidates' finished scores, as an interrupted run would be.
@@ -886,18 +886,8 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
 #[test]
 fn shares_computed_apart_make_the_leaderboard_of_one_run() {
     let dir = scratch("shares");
-    let recipe_path = ridges_in(&dir);
-    let options = |out: &str| BenchmarkOptions {
-        datasets: vec![recipe_path.display().to_string()],
-        out: dir.join(out),
-        cache: Some(dir.join("cache")),
-        from: Some(dir.join("copy")),
-        protocols: Vec::new(),
-        snn: false,
-        folds: 3,
-        repeats: 1,
-        seed: 5,
-    };
+    ridges_in(&dir);
+    let options = |out: &str| ridges_bench(&dir, out);
     let whole = options("whole").run(&silent).unwrap();
     let apart = options("apart");
     let shares = apart.shares(&silent).unwrap();

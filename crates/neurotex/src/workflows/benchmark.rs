@@ -225,6 +225,42 @@ impl BenchmarkOptions {
         (self.out.join(&recipe.name)).join(format!("{}.pieces", protocol.id))
     }
 
+    /// The key file of `recipe`'s `protocol`'s comparison, beside its folder.
+    fn key_file(&self, recipe: &Recipe, protocol: &ProtocolSpec) -> PathBuf {
+        (self.out.join(&recipe.name)).join(format!("{}.key.json", protocol.id))
+    }
+
+    /// The comparison of `recipe`'s `protocol` kept under `key`, if there is one.
+    fn kept(&self, recipe: &Recipe, protocol: &ProtocolSpec, key: &Key) -> Option<Comparison> {
+        let text = std::fs::read_to_string(self.key_file(recipe, protocol)).ok()?;
+        let found: Key = serde_json::from_str(&text).ok()?;
+        if &found != key {
+            return None;
+        }
+        let dir = self.out.join(&recipe.name).join(&protocol.id);
+        let json = std::fs::read_to_string(dir.join("compare.json")).ok()?;
+        serde_json::from_str(&json).ok()
+    }
+
+    /// `compare --nested` of the candidate set (of `encodings` only, when given) under
+    /// `recipe`'s `protocol` on `dataset`, taking and keeping its pieces in `pieces`.
+    fn compare_keeping(
+        &self,
+        (recipe, protocol): (&Recipe, &ProtocolSpec),
+        (dataset, encodings): (&Path, Option<&str>),
+        pieces: &Pieces,
+        on: OnProgress,
+    ) -> Result<Comparison> {
+        let options = self.compare(protocol, dataset, encodings);
+        let opened = options.open.open(dataset)?;
+        options
+            .run_keeping(&opened, &StageOptions::default(), on, Some(pieces))
+            .map_err(|e| crate::Error::InAnalysis {
+                what: format!("{}, {}", recipe.name, protocol.describe()),
+                source: Box::new(e),
+            })
+    }
+
     /// The comparison of `recipe`'s protocol `i` on `dataset`: the kept one under the same
     /// key, else compared anew (taking the pieces a run stopped part way kept) and kept.
     fn protocol(
@@ -236,19 +272,12 @@ impl BenchmarkOptions {
     ) -> Result<Comparison> {
         let protocol = &recipe.protocols[i];
         let key = self.key(recipe, protocol);
-        let dir = self.out.join(&recipe.name).join(&protocol.id);
-        let key_file = self
-            .out
-            .join(&recipe.name)
-            .join(format!("{}.key.json", protocol.id));
-        if let Some(kept) = kept(&key_file, &dir, &key) {
+        if let Some(kept) = self.kept(recipe, protocol, &key) {
             on(Progress::Say(
                 "  kept from an earlier run with the same settings",
             ));
             return Ok(kept);
         }
-        let options = self.compare(protocol, dataset, None);
-        let opened = options.open.open(dataset)?;
         let key_text = key.text();
         let pieces = Pieces::open(self.pieces_dir(recipe, protocol), &key_text)?;
         if pieces.removed > 0 {
@@ -257,12 +286,7 @@ impl BenchmarkOptions {
                 pieces.removed
             )));
         }
-        let comparison = options
-            .run_keeping(&opened, &StageOptions::default(), on, Some(&pieces))
-            .map_err(|e| crate::Error::InAnalysis {
-                what: format!("{}, {}", recipe.name, protocol.describe()),
-                source: Box::new(e),
-            })?;
+        let comparison = self.compare_keeping((recipe, protocol), (dataset, None), &pieces, on)?;
         if pieces.taken() > 0 {
             on(Progress::Say(&format!(
                 "  {} finished pieces taken from a run stopped part way",
@@ -273,6 +297,10 @@ impl BenchmarkOptions {
         let named = Path::new(&recipe.name);
         // The old key goes first: a run stopped between the two writes leaves no key, never
         // another run's key beside this comparison.
+        let (dir, key_file) = (
+            self.out.join(&recipe.name).join(&protocol.id),
+            self.key_file(recipe, protocol),
+        );
         if key_file.exists() {
             std::fs::remove_file(&key_file).map_err(|e| DataError::write(&key_file, e))?;
         }
@@ -299,9 +327,7 @@ impl BenchmarkOptions {
             datasets::fetch(recipe, &root, self.from.as_deref(), on)?;
             for protocol in self.wanted(recipe) {
                 let key = self.key(recipe, protocol);
-                let out = self.out.join(&recipe.name);
-                let key_file = out.join(format!("{}.key.json", protocol.id));
-                if kept(&key_file, &out.join(&protocol.id), &key).is_some() {
+                if self.kept(recipe, protocol, &key).is_some() {
                     continue;
                 }
                 Pieces::open(self.pieces_dir(recipe, protocol), &key.text())?;
@@ -335,14 +361,8 @@ impl BenchmarkOptions {
         };
         let key = self.key(&recipe, protocol);
         let pieces = Pieces::existing(self.pieces_dir(&recipe, protocol), &key.text())?;
-        let options = self.compare(protocol, &dataset, Some(&share.encoding));
-        let opened = options.open.open(&dataset)?;
-        options
-            .run_keeping(&opened, &StageOptions::default(), on, Some(&pieces))
-            .map_err(|e| crate::Error::InAnalysis {
-                what: format!("{}, {}", recipe.name, protocol.describe()),
-                source: Box::new(e),
-            })?;
+        let share_of = (dataset.as_path(), Some(share.encoding.as_str()));
+        self.compare_keeping((&recipe, protocol), share_of, &pieces, on)?;
         Ok(())
     }
 
@@ -379,17 +399,6 @@ pub struct Share {
     pub protocol: String,
     /// The encoding (`sa`, `sa+fa`, `none`).
     pub encoding: String,
-}
-
-/// The comparison kept in `dir` when its key file holds `key`.
-fn kept(key_file: &Path, dir: &Path, key: &Key) -> Option<Comparison> {
-    let text = std::fs::read_to_string(key_file).ok()?;
-    let found: Key = serde_json::from_str(&text).ok()?;
-    if &found != key {
-        return None;
-    }
-    let json = std::fs::read_to_string(dir.join("compare.json")).ok()?;
-    serde_json::from_str(&json).ok()
 }
 
 impl Leaderboard {

@@ -31,7 +31,7 @@ impl Pieces {
     pub(super) fn open(dir: PathBuf, key: &str) -> Result<Pieces> {
         let key_file = dir.join("key.json");
         let mut removed = 0;
-        if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key) {
+        if !made_under(&dir, key) {
             if dir.exists() {
                 removed = pieces_only(&dir)?;
                 std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
@@ -57,8 +57,7 @@ impl Pieces {
     /// # Errors
     /// No such folder, or one made under another key.
     pub(super) fn existing(dir: PathBuf, key: &str) -> Result<Pieces> {
-        let key_file = dir.join("key.json");
-        if std::fs::read_to_string(&key_file).ok().as_deref() != Some(key) {
+        if !made_under(&dir, key) {
             let why = "is not the pieces folder of these settings: make the shares first";
             return Err(DataError::invalid(&dir, why.to_string()).into());
         }
@@ -96,6 +95,14 @@ impl Pieces {
             .collect();
         self.dir.join(format!("{digest}.piece"))
     }
+}
+
+/// Whether the pieces folder `dir` was made under `key` (its key file holds it).
+fn made_under(dir: &Path, key: &str) -> bool {
+    std::fs::read_to_string(dir.join("key.json"))
+        .ok()
+        .as_deref()
+        == Some(key)
 }
 
 /// How many pieces the folder `dir` holds, when it holds nothing else than pieces, their
