@@ -121,8 +121,12 @@ fn benchmark(
     Ok((crate::convert::to_object(py, &board)?, said.lines()))
 }
 
+/// A share as Python holds it: dataset, recipe, protocol, encoding and method (`None` for
+/// every method of the encoding).
+type ShareTuple = (String, String, String, String, Option<String>);
+
 /// The shares of a benchmark's work that separate tasks can compute side by side, as
-/// `(dataset, recipe, protocol, encoding)`; fetches every dataset first.
+/// `(dataset, recipe, protocol, encoding, method)`; fetches every dataset first.
 #[pyfunction]
 #[pyo3(signature = (datasets, out, cache=None, source=None, protocols=Vec::new(), snn=false, folds=5, repeats=1, seed=0))]
 #[allow(clippy::too_many_arguments)]
@@ -137,7 +141,7 @@ fn benchmark_shares(
     folds: usize,
     repeats: usize,
     seed: u64,
-) -> PyResult<Vec<(String, String, String, String)>> {
+) -> PyResult<Vec<ShareTuple>> {
     let options = options(
         datasets,
         out,
@@ -150,7 +154,7 @@ fn benchmark_shares(
     let shares = py.detach(|| guarded(|| options.shares(&neurotex::progress::silent)))?;
     Ok(shares
         .into_iter()
-        .map(|s| (s.dataset, s.recipe, s.protocol, s.encoding))
+        .map(|s| (s.dataset, s.recipe, s.protocol, s.encoding, s.method))
         .collect())
 }
 
@@ -160,7 +164,7 @@ fn benchmark_shares(
 #[allow(clippy::too_many_arguments)]
 fn benchmark_share(
     py: Python<'_>,
-    share: (String, String, String, String),
+    share: ShareTuple,
     out: PathBuf,
     cache: Option<PathBuf>,
     snn: bool,
@@ -168,12 +172,13 @@ fn benchmark_share(
     repeats: usize,
     seed: u64,
 ) -> PyResult<()> {
-    let (dataset, recipe, protocol, encoding) = share;
+    let (dataset, recipe, protocol, encoding, method) = share;
     let share = Share {
         dataset,
         recipe: recipe.clone(),
         protocol,
         encoding,
+        method,
     };
     let options = options(
         vec![recipe],

@@ -844,7 +844,7 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
     assert_eq!(
         taken,
         [format!(
-            "  {kept} finished pieces taken from a run stopped part way"
+            "  {kept} finished pieces taken (kept by a run stopped part way, or by shares)"
         )]
     );
     let comparison = |b: &neurotex::workflows::benchmark::Leaderboard| {
@@ -891,8 +891,12 @@ fn shares_computed_apart_make_the_leaderboard_of_one_run() {
     let whole = options("whole").run(&silent).unwrap();
     let apart = options("apart");
     let shares = apart.shares(&silent).unwrap();
-    // Both protocols, each split by the set's three encodings.
-    assert_eq!(shares.len(), 6, "{shares:?}");
+    // Both protocols, each split by the set's two spike encodings and their eight feature
+    // methods, and the baselines without spikes in one share.
+    assert_eq!(shares.len(), 2 * (2 * 8 + 1), "{shares:?}");
+    let baselines = shares.iter().filter(|s| s.encoding == "none");
+    assert!(baselines.clone().all(|s| s.method.is_none()));
+    assert_eq!(baselines.count(), 2);
     // A share whose folder was not made for these settings is refused.
     let other = BenchmarkOptions {
         seed: 6,

@@ -251,9 +251,9 @@ def benchmark_shares(
     folds: int = ...,
     repeats: int = ...,
     seed: int = ...,
-) -> List[Tuple[str, str, str, str]]: ...
+) -> List[Tuple[str, str, str, str, Optional[str]]]: ...
 def benchmark_share(
-    share: Tuple[str, str, str, str],
+    share: Tuple[str, str, str, str, Optional[str]],
     out: str,
     cache: Optional[str] = ...,
     snn: bool = ...,

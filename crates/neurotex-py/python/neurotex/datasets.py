@@ -79,8 +79,9 @@ def tonic(name: Union[str, PathLike], encoding: str = "sa+fa", *,
 
 
 def _share(task: Sequence[Any]) -> None:
-    """One share of :func:`benchmark` (a dataset x protocol x encoding), as a Dask task: its
-    candidates' finished pieces kept in ``out`` for the leaderboard's run to take."""
+    """One share of :func:`benchmark` (a dataset x protocol x encoding x feature method), as
+    a Dask task: its candidates' finished pieces kept in ``out`` for the leaderboard's run
+    to take."""
     share, out, cache, snn, folds, repeats, seed = task
     _native.benchmark_share(tuple(share), out, cache, snn, folds, repeats, seed)
 
@@ -93,8 +94,10 @@ def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
     candidate set compared with nested selection, written into ``out`` (leaderboard.md,
     leaderboard.json, each comparison's folder); returns the leaderboard as a dict.
 
-    With a Dask ``client``, each dataset x protocol x encoding of the candidate set is one
-    task on the cluster; the workers must see ``out`` and ``cache`` (a shared file system,
+    With a Dask ``client``, each dataset x protocol x encoding x feature method of the
+    candidate set (the method's candidates under every classifier; the baselines without
+    spikes together) is one task on the cluster, and each task encodes the dataset for
+    itself; the workers must see ``out`` and ``cache`` (a shared file system,
     or a local cluster). Every dataset is fetched here first, the tasks keep their
     candidates' finished pieces in ``out``, and the leaderboard's run then takes them: the
     same leaderboard as without a client."""

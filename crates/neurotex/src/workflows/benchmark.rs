@@ -19,6 +19,7 @@ use super::{KnnOptions, OnProgress, OpenOptions, SnnOptions};
 use crate::compare::candidates::{
     STANDARD_CLASSIFIERS, STANDARD_ENCODINGS, STANDARD_METHODS, STANDARD_TAU_MS,
 };
+use crate::compare::signal::NO_ENCODING;
 use crate::compare::Comparison;
 use crate::datasets::{self, ProtocolSpec, Published, Recipe};
 use crate::error::DataError;
@@ -45,7 +46,11 @@ pub fn candidate_set(snn: bool) -> (String, String, String) {
         true => format!("{STANDARD_CLASSIFIERS},snn"),
         false => STANDARD_CLASSIFIERS.to_string(),
     };
-    (format!("{STANDARD_ENCODINGS},none"), methods, classifiers)
+    (
+        format!("{STANDARD_ENCODINGS},{NO_ENCODING}"),
+        methods,
+        classifiers,
+    )
 }
 
 /// Options of `neurotex benchmark`.
@@ -194,9 +199,11 @@ impl BenchmarkOptions {
         &self,
         protocol: &ProtocolSpec,
         dataset: &Path,
-        encodings: Option<&str>,
+        share: Option<&Share>,
     ) -> CompareOptions {
-        let (all, methods, classifiers) = candidate_set(self.snn);
+        let (all, all_methods, classifiers) = candidate_set(self.snn);
+        let encodings = share.map(|s| s.encoding.as_str());
+        let methods = share.and_then(|s| s.method.clone()).unwrap_or(all_methods);
         let list = |s: &str| s.split(',').map(String::from).collect();
         CompareOptions {
             dataset: dataset.to_path_buf(),
@@ -247,11 +254,11 @@ impl BenchmarkOptions {
     fn compare_keeping(
         &self,
         (recipe, protocol): (&Recipe, &ProtocolSpec),
-        (dataset, encodings): (&Path, Option<&str>),
+        (dataset, share): (&Path, Option<&Share>),
         pieces: &Pieces,
         on: OnProgress,
     ) -> Result<Comparison> {
-        let options = self.compare(protocol, dataset, encodings);
+        let options = self.compare(protocol, dataset, share);
         let opened = options.open.open(dataset)?;
         options
             .run_keeping(&opened, &StageOptions::default(), on, Some(pieces))
@@ -289,7 +296,7 @@ impl BenchmarkOptions {
         let comparison = self.compare_keeping((recipe, protocol), (dataset, None), &pieces, on)?;
         if pieces.taken() > 0 {
             on(Progress::Say(&format!(
-                "  {} finished pieces taken from a run stopped part way",
+                "  {} finished pieces taken (kept by a run stopped part way, or by shares)",
                 pieces.taken()
             )));
         }
@@ -311,8 +318,10 @@ impl BenchmarkOptions {
     }
 
     /// The shares of the work that separate tasks (on a cluster) can compute side by side:
-    /// each dataset x protocol not yet kept, split by the candidate set's encodings (each
-    /// share encodes its recordings once). Fetches every dataset and makes each protocol's
+    /// each dataset x protocol not yet kept, split by the candidate set's encodings and, for
+    /// each spike encoding, by its feature methods (each share encodes its recordings once,
+    /// so a share's own work is its method's candidates under every classifier; the
+    /// baselines without spikes are one share). Fetches every dataset and makes each protocol's
     /// pieces folder, so that the shares find it made; [`BenchmarkOptions::run`] then
     /// takes what they kept.
     ///
@@ -321,7 +330,7 @@ impl BenchmarkOptions {
     pub fn shares(&self, on: OnProgress) -> Result<Vec<Share>> {
         let recipes = self.recipes()?;
         let root = datasets::cache_root(self.cache.as_deref())?;
-        let (encodings, _, _) = candidate_set(self.snn);
+        let (encodings, methods, _) = candidate_set(self.snn);
         let mut shares = Vec::new();
         for (named, recipe) in self.datasets.iter().zip(&recipes) {
             datasets::fetch(recipe, &root, self.from.as_deref(), on)?;
@@ -331,12 +340,20 @@ impl BenchmarkOptions {
                     continue;
                 }
                 Pieces::open(self.pieces_dir(recipe, protocol), &key.text())?;
-                shares.extend(encodings.split(',').map(|e| Share {
-                    dataset: recipe.name.clone(),
-                    recipe: named.clone(),
-                    protocol: protocol.id.clone(),
-                    encoding: e.to_string(),
-                }));
+                for encoding in encodings.split(',') {
+                    // The baselines without spikes read no spike method: one share.
+                    let each: Vec<Option<String>> = match encoding == NO_ENCODING {
+                        true => vec![None],
+                        false => methods.split(',').map(|m| Some(m.to_string())).collect(),
+                    };
+                    shares.extend(each.into_iter().map(|method| Share {
+                        dataset: recipe.name.clone(),
+                        recipe: named.clone(),
+                        protocol: protocol.id.clone(),
+                        encoding: encoding.to_string(),
+                        method,
+                    }));
+                }
             }
         }
         Ok(shares)
@@ -361,7 +378,7 @@ impl BenchmarkOptions {
         };
         let key = self.key(&recipe, protocol);
         let pieces = Pieces::existing(self.pieces_dir(&recipe, protocol), &key.text())?;
-        let share_of = (dataset.as_path(), Some(share.encoding.as_str()));
+        let share_of = (dataset.as_path(), Some(share));
         self.compare_keeping((&recipe, protocol), share_of, &pieces, on)?;
         Ok(())
     }
@@ -388,7 +405,7 @@ impl BenchmarkOptions {
 }
 
 /// A share of a benchmark's work ([`BenchmarkOptions::shares`]): one encoding's candidates
-/// under one protocol of one dataset.
+/// (of one method, or all) under one protocol of one dataset.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Share {
     /// The recipe's name.
@@ -399,6 +416,9 @@ pub struct Share {
     pub protocol: String,
     /// The encoding (`sa`, `sa+fa`, `none`).
     pub encoding: String,
+    /// The feature method whose candidates the share computes (every classifier's); `None`
+    /// for every method of the encoding (the baselines of `none`).
+    pub method: Option<String>,
 }
 
 impl Leaderboard {

@@ -83,16 +83,27 @@ fn lines(groups: &[Group]) -> usize {
 /// # Errors
 /// The drawing fails.
 pub fn leaderboard(groups: &[Group], source: &str) -> Result<String, FigureError> {
+    // A key for each kind of row the figure draws (published numbers of either protocol
+    // share one), so that no key names what is not there.
+    let drawn =
+        |kinds: &[Kind]| (groups.iter().flat_map(|g| &g.rows)).any(|r| kinds.contains(&r.kind));
     let keys = [
-        (Kind::Nested, "nested selection (the number to quote)"),
-        (Kind::Spikes, "best spike method"),
-        (Kind::Rates, "spike counts, logistic regression"),
-        (Kind::NoSpikes, "best without spikes"),
-        (Kind::Paper, "paper's method (sa / glcm3d / knn)"),
-        (Kind::Published, "published (hollow: another protocol)"),
+        (
+            &[Kind::Nested][..],
+            "nested selection (the number to quote)",
+        ),
+        (&[Kind::Spikes], "best spike method"),
+        (&[Kind::Rates], "spike counts, logistic regression"),
+        (&[Kind::NoSpikes], "best without spikes"),
+        (&[Kind::Paper], "paper's method (sa / glcm3d / knn)"),
+        (
+            &[Kind::Published, Kind::PublishedOther],
+            "published (hollow: another protocol)",
+        ),
     ]
-    .map(|(k, l)| Key::new(l, Swatch::Points(k.colour())))
     .into_iter()
+    .filter(|(kinds, _)| drawn(kinds))
+    .map(|(kinds, l)| Key::new(l, Swatch::Points(kinds[0].colour())))
     .chain([Key::new("chance", Swatch::Dashed(GREY))])
     .collect::<Vec<_>>();
     let frame = Frame {
@@ -158,4 +169,33 @@ pub fn leaderboard(groups: &[Group], source: &str) -> Result<String, FigureError
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn group(kinds: &[Kind]) -> Group {
+        let rows = kinds.iter().enumerate().map(|(i, &kind)| Entry {
+            label: format!("row {i}"),
+            accuracy: 0.5 + 0.1 * i as f64,
+            ci: (kind != Kind::Published).then_some([0.4, 0.6]),
+            kind,
+        });
+        Group {
+            title: "a dataset, one protocol".into(),
+            chance: 0.25,
+            rows: rows.collect(),
+        }
+    }
+
+    #[test]
+    fn the_keys_name_only_the_kinds_of_rows_drawn() {
+        let without = leaderboard(&[group(&[Kind::Nested, Kind::Paper])], "test").unwrap();
+        assert!(without.contains("nested selection") && without.contains("chance"));
+        assert!(!without.contains("published"), "{without}");
+        assert!(!without.contains("best spike method"));
+        let with = leaderboard(&[group(&[Kind::Nested, Kind::PublishedOther])], "test").unwrap();
+        assert!(with.contains("published (hollow: another protocol)"));
+    }
 }
