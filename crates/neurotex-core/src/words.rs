@@ -1,6 +1,17 @@
 //! Parser messages in a user's words: serde's, the standard library's number parsing's,
 //! and TOML's and JSON's errors with their line, each saying what the file was expected to
-//! hold rather than the parser's type names.
+//! hold rather than the parser's type names; and signed differences as reports print them.
+
+/// A difference with its sign and one decimal (`+12.3`, `-0.4`), and `0.0` for one that
+/// rounds to zero, never `-0.0` or `+0.0`: a difference of accuracies in points, as the
+/// reports print them.
+pub fn signed_one_decimal(x: f64) -> String {
+    let text = format!("{x:+.1}");
+    match text.as_str() {
+        "+0.0" | "-0.0" => "0.0".to_string(),
+        _ => text,
+    }
+}
 
 /// A serde parser's message in a user's words: its type names and jargon turned into
 /// what the file was expected to hold ("invalid type: string \"min\", expected internally
@@ -84,5 +95,20 @@ pub fn json_error(e: &serde_json::Error) -> String {
             e.column(),
             parser_words(message)
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::signed_one_decimal;
+
+    #[test]
+    fn a_difference_that_rounds_to_zero_has_no_sign() {
+        assert_eq!(signed_one_decimal(12.34), "+12.3");
+        assert_eq!(signed_one_decimal(-0.44), "-0.4");
+        assert_eq!(signed_one_decimal(-0.04), "0.0");
+        assert_eq!(signed_one_decimal(-0.0), "0.0");
+        assert_eq!(signed_one_decimal(0.0), "0.0");
+        assert_eq!(signed_one_decimal(0.05), "+0.1");
     }
 }

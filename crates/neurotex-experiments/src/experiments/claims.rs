@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{Comparison, Results};
 use crate::classify::PairedVerdict;
+use neurotex_core::words::signed_one_decimal as signed;
 
 /// Whether a claim of the paper holds on these results: by a paired comparison on the same
 /// recordings where the analysis has one, else by point estimates only (and says so).
@@ -94,10 +95,10 @@ impl Claim {
 /// `a - b` with its interval, in points.
 fn difference(c: &Comparison) -> String {
     format!(
-        "{:+.1} points [{:+.1}, {:+.1}]",
-        100.0 * c.difference,
-        100.0 * c.lower,
-        100.0 * c.upper
+        "{} points [{}, {}]",
+        signed(100.0 * c.difference),
+        signed(100.0 * c.lower),
+        signed(100.0 * c.upper)
     )
 }
 
@@ -159,7 +160,7 @@ fn e1_claims(r: &Results) -> Vec<Claim> {
         let numbers = by_magnitude
             .iter()
             .zip(&margins)
-            .map(|((s, _), m)| format!("{s} mm/s: {:+.1}", 100.0 * m))
+            .map(|((s, _), m)| format!("{s} mm/s: {}", signed(100.0 * m)))
             .collect::<Vec<_>>()
             .join(", ")
             + " points";

@@ -11,6 +11,7 @@ use crate::io::replace_dir;
 
 use super::figures::{compare as figures, svg_and_png, FigureError};
 use super::folder_source;
+use neurotex_core::words::signed_one_decimal as signed;
 
 /// `87.5% [85.1, 89.8]`.
 pub fn with_interval(accuracy: f64, ci: [f64; 2]) -> String {
@@ -119,7 +120,7 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
 pub(super) fn versus_paper(r: &Ranked) -> String {
     match (r.paper, r.difference_vs_paper, r.p_vs_paper) {
         (true, ..) => "paper's method".into(),
-        (false, Some(d), Some(p)) => format!("{:+.1} points (p {})", 100.0 * d, p_text(p)),
+        (false, Some(d), Some(p)) => format!("{} points (p {})", signed(100.0 * d), p_text(p)),
         _ => "-".into(),
     }
 }

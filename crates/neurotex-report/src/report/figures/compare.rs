@@ -13,6 +13,7 @@ use super::plot::{
 };
 use super::FigureError;
 use crate::compare::{Comparison, Ranked};
+use neurotex_core::words::signed_one_decimal as signed;
 
 /// Every candidate but the paper's method.
 const CANDIDATE: RGBColor = SINGLE;
@@ -80,7 +81,7 @@ fn rows(c: &Comparison) -> Vec<Row> {
             (true, _, _) => "reference".into(),
             (false, Some(d), Some(p)) => {
                 let star = if p < SIGNIFICANT { " *" } else { "" };
-                format!("{:+.1}, {}{star}", 100.0 * d, p_text(p))
+                format!("{}, {}{star}", signed(100.0 * d), p_text(p))
             }
             _ => String::new(),
         };

@@ -8,6 +8,7 @@ use super::super::figures::{self, file};
 use super::super::paper::{Paper, PAPER};
 use super::super::table::Table;
 use super::{bracket, figure, heading, list, paper_cell, pct, pct_in, skipped_section};
+use neurotex_core::words::signed_one_decimal as signed;
 
 /// The fractions of the slide E5 used at any speed, ascending.
 fn e5_fractions(r: &Results) -> Vec<f64> {
@@ -155,10 +156,10 @@ fn e5c_whole_slide_row(s: Speed, e: &crate::experiments::E5CausalSpeed) -> Vec<S
         pct(e.offline),
         format!("{} {}", pct(e.whole), bracket(&e.whole_interval)),
         format!(
-            "{:+.1} [{:+.1}, {:+.1}], {verdict}",
-            100.0 * c.difference,
-            100.0 * c.lower,
-            100.0 * c.upper
+            "{} [{}, {}], {verdict}",
+            signed(100.0 * c.difference),
+            signed(100.0 * c.lower),
+            signed(100.0 * c.upper)
         ),
         d.quartiles_s.map_or("-".into(), |q| {
             format!("{:.1} [{:.1}, {:.1}]", q[1], q[0], q[2])

@@ -6,6 +6,7 @@ use crate::experiments::Results;
 use super::super::figures::{self, file};
 use super::super::table::Table;
 use super::{figure, heading, pct, pct_in, skipped_section};
+use neurotex_core::words::signed_one_decimal as signed;
 
 pub(super) fn e7(r: &Results) -> String {
     let Some(e7) = &r.e7 else {
@@ -240,7 +241,7 @@ fn timing_adds(
         return String::new();
     };
     let points = |net: &crate::compare::Ranked, rates: &crate::compare::Ranked| {
-        format!("{:+.1}", 100.0 * (net.accuracy - rates.accuracy))
+        signed(100.0 * (net.accuracy - rates.accuracy))
     };
     format!(
         "\nThe rates columns are the network's own inputs (SA+FA spike trains) reduced to each taxel's mean spike rate (spikes/s) and classified by logistic regression (`sa+fa / rates / linear`). \

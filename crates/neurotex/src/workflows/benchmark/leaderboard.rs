@@ -9,6 +9,7 @@ use crate::compare::{Comparison, Ranked};
 use crate::datasets::recipe::ProtocolSpec;
 use crate::datasets::{Published, Recipe};
 use crate::report::figures::leaderboard::{Entry, Group, Kind};
+use neurotex_core::words::signed_one_decimal as signed;
 
 /// Candidates listed in full per board; the paper's method, the spike counts with logistic
 /// regression and the best baseline without spikes are listed below them when lower.
@@ -193,8 +194,8 @@ fn name(r: &Ranked) -> String {
 /// One table row of a ranked candidate.
 fn row(rank: usize, r: &Ranked) -> String {
     let vs = match (r.difference_vs_paper, r.p_vs_paper) {
-        (Some(d), Some(p)) if p < 0.001 => format!("{:+.1} | < 0.001", 100.0 * d),
-        (Some(d), Some(p)) => format!("{:+.1} | {p:.3}", 100.0 * d),
+        (Some(d), Some(p)) if p < 0.001 => format!("{} | < 0.001", signed(100.0 * d)),
+        (Some(d), Some(p)) => format!("{} | {p:.3}", signed(100.0 * d)),
         _ => "— | —".to_string(),
     };
     format!(
