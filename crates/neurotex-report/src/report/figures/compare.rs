@@ -7,9 +7,9 @@ use plotters::style::text_anchor::{HPos, VPos};
 
 use super::accuracy::{chart_width, group_labels, plot_height};
 use super::plot::{
-    accuracy_axis, accuracy_chart, fit, hline, interval, line_height, line_with_markers, percent,
-    text, text_width, vline, Chart, Drawn, Frame, Key, Placement, Swatch, Width, GLCM3D, GREY,
-    LABEL, MARGIN, SERIES, SINGLE, TICK, X_AXIS_H, Y_AXIS_W,
+    accuracy_axis, accuracy_chart, fit, hline, interval, line_height, line_with_markers, markers,
+    percent, text, text_width, vline, Chart, Drawn, Frame, Key, Placement, Swatch, Width, GLCM3D,
+    GREY, LABEL, MARGIN, SERIES, SINGLE, TICK, X_AXIS_H, Y_AXIS_W,
 };
 use super::FigureError;
 use crate::compare::{Comparison, Ranked};
@@ -496,6 +496,9 @@ impl<'a> PerCondition<'a> {
             .map(|p| p.condition.clone())
             .collect();
         let lines = series(c, self.1, &conditions);
+        // A line joins the conditions only when they are numbers (speeds, forces):
+        // sessions or sensors have no order for a line to follow.
+        let ordered = conditions.iter().all(|c| c.trim().parse::<f64>().is_ok());
         // The best drawn last, on top, but named first.
         let mut keys: Vec<Key> = lines.iter().rev().map(|s| s.key.clone()).collect();
         keys.extend(reference_keys(c));
@@ -521,7 +524,10 @@ impl<'a> PerCondition<'a> {
                 let points: Vec<(f64, f64)> = (s.values.iter().enumerate())
                     .filter_map(|(i, v)| v.map(|v| (i as f64 + 0.5, v)))
                     .collect();
-                line_with_markers(&mut chart, &points, s.colour, s.dashed)?;
+                match ordered {
+                    true => line_with_markers(&mut chart, &points, s.colour, s.dashed)?,
+                    false => markers(&mut chart, &points, s.colour)?,
+                }
             }
             group_labels(root, &chart, &conditions, slot)
         })

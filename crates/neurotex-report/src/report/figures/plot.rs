@@ -349,6 +349,12 @@ pub(crate) fn line_with_markers(
     Ok(())
 }
 
+/// Markers at `points`, joined by no line: values at categories that have no order.
+pub(crate) fn markers(chart: &mut Chart, points: &[(f64, f64)], colour: RGBColor) -> Drawn {
+    chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::colour_scale::colour_ticks;

@@ -189,6 +189,31 @@ fn per_condition_only_with_conditions_and_for_1_to_20() {
 }
 
 #[test]
+fn per_condition_joins_numbers_by_lines_and_categories_by_none() {
+    let c = comparison(4, false, 3);
+    let numbers = per_condition(&c).unwrap().draw("test data").unwrap();
+    let mut c = comparison(4, false, 3);
+    for r in c.results.iter_mut().chain([&mut c.best]) {
+        for (p, name) in r.per_condition.iter_mut().zip(["left", "right", "palm"]) {
+            p.condition = name.into();
+        }
+    }
+    c.protocol = Protocol::HoldOut("sensor".into()).to_string();
+    let svg = per_condition(&c).unwrap().draw("test data").unwrap();
+    // The same figure without the candidates' lines (the best's and the paper's, drawn in
+    // dashes): the sensors have no order for a line to follow. Chance is a line still.
+    let lines = |svg: &str| svg.matches("<polyline").count();
+    assert!(
+        lines(&svg) < lines(&numbers),
+        "{} {}",
+        lines(&svg),
+        lines(&numbers)
+    );
+    check("compare_per_condition_categories", &svg);
+    assert_eq!(svg.matches("<circle").count(), 2 * 3 + 2);
+}
+
+#[test]
 fn per_condition_names_the_held_out_column_and_a_paper_best() {
     let mut c = comparison(2, false, 3);
     c.protocol = Protocol::HoldOut("session".into()).to_string();
