@@ -744,7 +744,7 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
     c.nested.as_mut().unwrap().ci = [chance / 2.0, 2.0 * chance];
     let md = neurotex::workflows::benchmark::markdown(&low);
     assert!(
-        md.contains("includes chance") && !md.contains("Below chance"),
+        md.contains("**Not above chance**") && !md.contains("Below chance"),
         "{md}"
     );
     // Within each speed the ridges are told apart well above chance: no such line.
@@ -752,7 +752,7 @@ fn the_leaderboard_is_compare_nested_on_the_same_folds_and_a_rerun_keeps_it() {
     within.boards.truncate(1);
     let md = neurotex::workflows::benchmark::markdown(&within);
     assert!(
-        !md.contains("Below chance") && !md.contains("includes chance"),
+        !md.contains("Below chance") && !md.contains("above chance"),
         "{md}"
     );
     // A rerun keeps both comparisons: same leaderboard, times included; another seed is

@@ -367,6 +367,12 @@ pub fn compare_keeping(
         None => None,
     };
     let (classes, majority) = class_shares(metas, &scored[0].shares);
+    let chance = 1.0 / classes.max(1) as f64;
+    let mut notes = notes;
+    if let Some(note) = nested.as_ref().and_then(|n| nested_note(n, chance)) {
+        progress(Progress::Advice(&note));
+        notes.push(note);
+    }
     Ok(Comparison {
         protocol: params.protocol.to_string(),
         units: match &params.group_by {
@@ -376,7 +382,7 @@ pub fn compare_keeping(
         n_units: units.n_units(),
         n_recordings: scored[0].shares.len(),
         classes,
-        chance: 1.0 / classes.max(1) as f64,
+        chance,
         majority,
         best: results[0].clone(),
         results,
@@ -386,6 +392,44 @@ pub fn compare_keeping(
         },
         nested,
         notes,
+    })
+}
+
+/// Where a 95 % interval stands against chance, when it is not above it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AgainstChance {
+    /// The whole interval is under chance.
+    Below,
+    /// The interval reaches down to chance or under it.
+    Includes,
+}
+
+impl AgainstChance {
+    /// Where `ci` stands against `chance`; `None` when it is wholly above. An edge within
+    /// rounding of chance (a share of the units against one over the classes) is at it.
+    pub fn of(ci: [f64; 2], chance: f64) -> Option<AgainstChance> {
+        const ROUNDING: f64 = 1e-9;
+        if ci[1] < chance - ROUNDING {
+            Some(AgainstChance::Below)
+        } else if ci[0] <= chance + ROUNDING {
+            Some(AgainstChance::Includes)
+        } else {
+            None
+        }
+    }
+}
+
+/// The note for a nested estimate whose interval is not above chance.
+fn nested_note(n: &Nested, chance: f64) -> Option<String> {
+    let interval = format!("[{:.1}, {:.1}] %", 100.0 * n.ci[0], 100.0 * n.ci[1]);
+    let chance_text = format!("chance ({:.1} %)", 100.0 * chance);
+    AgainstChance::of(n.ci, chance).map(|at| match at {
+        AgainstChance::Below => format!(
+            "the nested estimate's interval {interval} is under {chance_text}: what the selection learns on the training sets does not carry over to the test sets (under a held-out condition, features that change with the condition)"
+        ),
+        AgainstChance::Includes => format!(
+            "the nested estimate's interval {interval} includes {chance_text}: the chosen procedure is not shown to classify better than guessing"
+        ),
     })
 }
 
@@ -559,6 +603,34 @@ mod tests {
             self.0.lock().unwrap().insert(key.into(), json.into());
             Ok(())
         }
+    }
+
+    /// A nested estimate of candidates that see only noise is not above chance, and the
+    /// comparison says so (the separable candidates of the other tests get no such note).
+    #[test]
+    fn a_nested_estimate_at_chance_is_said_to_be() {
+        let noise = [candidate("glcm3d", false), candidate("noise", false)];
+        let c = compare(&noise, &params(Protocol::Per("speed_mm_s".into()), true)).unwrap();
+        let n = c.nested.as_ref().unwrap();
+        assert!(AgainstChance::of(n.ci, c.chance).is_some(), "{:?}", n.ci);
+        let said = c.notes.iter().filter(|s| s.contains("chance (33.3 %)"));
+        assert_eq!(said.count(), 1, "{:?}", c.notes);
+        assert_eq!(
+            AgainstChance::of([0.1, 0.2], 0.25),
+            Some(AgainstChance::Below)
+        );
+        assert_eq!(
+            AgainstChance::of([0.2, 0.3], 0.25),
+            Some(AgainstChance::Includes)
+        );
+        assert_eq!(
+            AgainstChance::of([0.25, 0.3], 0.25),
+            Some(AgainstChance::Includes)
+        );
+        assert_eq!(AgainstChance::of([0.26, 0.3], 0.25), None);
+        // An edge at chance but for rounding is at it.
+        let third = AgainstChance::of([0.333_333_333_333_333_37, 0.5], 1.0 / 3.0);
+        assert_eq!(third, Some(AgainstChance::Includes));
     }
 
     /// Under a hold-out protocol the inner ranking holds out each speed of the outer

@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::candidate_set;
-use crate::compare::{Comparison, Ranked};
+use crate::compare::{AgainstChance, Comparison, Ranked};
 use crate::datasets::recipe::ProtocolSpec;
 use crate::datasets::{Published, Recipe};
 use crate::report::figures::leaderboard::{Entry, Group, Kind};
@@ -82,11 +82,7 @@ impl Leaderboard {
         let line = |b: &Board| {
             let c = &b.comparison;
             let nested = c.nested.as_ref().map_or(String::new(), |n| {
-                let flag = match against_chance(n.ci, c.chance) {
-                    Some(_) if n.ci[1] < c.chance => " (below chance)",
-                    Some(_) => " (not above chance)",
-                    None => "",
-                };
+                let flag = chance_flag(n.ci, c.chance).map_or(String::new(), |f| format!(" ({f})"));
                 format!(
                     "nested {} % [{}, {}]{flag}; ",
                     pct(n.accuracy),
@@ -155,21 +151,13 @@ impl Board {
     }
 }
 
-/// What a nested interval at or under chance means, when it is.
-fn against_chance(ci: [f64; 2], chance: f64) -> Option<String> {
-    if ci[1] < chance {
-        Some(format!(
-            "**Below chance** ({} %): the whole interval is under it. What is learnt on the training sets does not carry over to the test sets (under a held-out condition, features that change with the condition).",
-            pct(chance)
-        ))
-    } else if ci[0] <= chance {
-        Some(format!(
-            "The interval includes chance ({} %): not shown to classify better than guessing.",
-            pct(chance)
-        ))
-    } else {
-        None
-    }
+/// The flag of a nested interval at or under chance (`compare`'s note, among the board's
+/// notes, says what it means).
+fn chance_flag(ci: [f64; 2], chance: f64) -> Option<&'static str> {
+    AgainstChance::of(ci, chance).map(|at| match at {
+        AgainstChance::Below => "below chance",
+        AgainstChance::Includes => "not above chance",
+    })
 }
 
 /// A share as a percentage with one decimal.
@@ -314,8 +302,13 @@ fn section(b: &Board) -> String {
             pct(n.ci[0]),
             pct(n.ci[1])
         ));
-        if let Some(warning) = against_chance(n.ci, c.chance) {
-            s.push_str(&format!("{warning}\n\n"));
+        if let Some(flag) = chance_flag(n.ci, c.chance) {
+            s.push_str(&format!(
+                "**{}{}** ({} %).\n\n",
+                flag[..1].to_uppercase(),
+                &flag[1..],
+                pct(c.chance)
+            ));
         }
     }
     for note in &c.notes {
