@@ -266,10 +266,10 @@ pub(crate) struct Said(std::sync::Mutex<Vec<String>>);
 
 impl Said {
     pub(crate) fn hear(&self, progress: neurotex::progress::Progress) {
+        // Advice as the command line prints it, so that Python logs it as a warning.
         let line = match progress {
-            neurotex::progress::Progress::Say(s) | neurotex::progress::Progress::Advice(s) => {
-                s.to_string()
-            }
+            neurotex::progress::Progress::Say(s) => s.to_string(),
+            neurotex::progress::Progress::Advice(s) => format!("warning: {s}"),
             _ => return,
         };
         if let Ok(mut lines) = self.0.lock() {

@@ -90,3 +90,27 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
         neurotex.compare(sim_dir, methods="glcm3d")
     with pytest.raises(ParameterError, match="for the spiking network"):
         neurotex.compare(sim_dir, snn_options={"trees": 3})
+
+
+def test_a_nested_estimate_at_chance_is_a_warning(sim_dir, tmp_path, caplog):
+    """The workflow's warnings reach Python's log at WARNING, which Python shows without
+    any logging set up: here labels that the textures do not carry (each recording's
+    trial, odd or even), whose nested estimate cannot be above chance."""
+    import csv
+    import shutil
+    data = tmp_path / "parity"
+    shutil.copytree(sim_dir, data)
+    rows = list(csv.DictReader(open(data / "manifest.csv")))
+    for r in rows:
+        r["label"] = "odd" if int(r["trial"]) % 2 else "even"
+    with open(data / "manifest.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    with caplog.at_level("WARNING", logger="neurotex"):
+        neurotex.compare(data, encodings=["sa"], methods=["glcm3d", "all-taxels"],
+                         classifiers=["knn"], per="speed_mm_s", folds=3,
+                         knn_options={"k": 3}, nested=True)
+    warned = [r for r in caplog.records if r.levelname == "WARNING"]
+    assert any("nested estimate's interval" in r.getMessage() and "chance (50.0 %)"
+               in r.getMessage() for r in warned), [r.getMessage() for r in caplog.records]

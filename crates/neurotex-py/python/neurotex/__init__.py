@@ -48,6 +48,19 @@ HARALICK_FULL_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(True))
 """Names of the 13 features of ``haralick(..., full=True)``."""
 
 _log = logging.getLogger("neurotex")
+_WARNING = "warning: "
+
+
+def _log_said(said: Sequence[str]) -> None:
+    """What a workflow said, on the ``neurotex`` logger: its warnings (a nested estimate
+    not above chance, folds fewer than asked, ...) at WARNING, which Python shows without
+    any logging set up; its progress and other lines at INFO
+    (``logging.basicConfig(level=logging.INFO)`` shows them)."""
+    for line in said:
+        if line.startswith(_WARNING):
+            _log.warning("%s", line[len(_WARNING):])
+        else:
+            _log.info("%s", line)
 
 METHODS = (
     "taxel", "glcm2d", "glcm3d", "all-taxels", "all-taxels-mm", "glcm3d-multi", "spectrum",
@@ -640,8 +653,7 @@ def evaluate(
         os.fspath(path), method, classifier, dict(classifier_options or {}), opts,
         folds, repeats, int(seed), listed(speeds), listed(train_speeds), listed(test_speeds),
         train_where, test_where, group_by, taxel, tau_ms)
-    for line in said:
-        _log.info("%s", line)
+    _log_said(said)
     return result
 
 
@@ -700,8 +712,7 @@ def compare(
         names(classifiers, "classifiers"), only, per, hold_out, train_where, test_where,
         group_by, folds, repeats, int(seed), bool(nested), tau_ms,
         None if out is None else os.fspath(out))
-    for line in said:
-        _log.info("%s", line)
+    _log_said(said)
     return result
 
 
@@ -856,8 +867,7 @@ class _Predicting:
         folder = _folder(recordings)
         if folder is not None:
             labels, shares, said = self._native.predict_dataset(folder)
-            for line in said:
-                _log.info("%s", line)
+            _log_said(said)
             return np.array(labels, dtype=object), shares
         items = _recording_list(recordings)
         arrays, infos = _prepare(items, fs, mask)
@@ -1044,8 +1054,7 @@ def _train_folder(folder: str, labels: Any, method: Optional[str], classifier: O
     native, log, said = _native.train_dataset(folder, method, classifier,
                                               dict(classifier_options or {}), opts, only,
                                               taxel)
-    for line in said:
-        _log.info("%s", line)
+    _log_said(said)
     if log is None:
         return Model(native)
     ran, best, loss = log

@@ -18,15 +18,13 @@ dataset's sources (the command line's ``--from``); without one, the sources are 
 
 from __future__ import annotations
 
-import logging
 import os
 from typing import Any, Dict, List, Optional, Sequence, Union
 
-from . import _native, load_dataset
+from . import _log_said, _native, load_dataset
 
 __all__ = ["list_recipes", "check", "fetch", "path", "load", "tonic", "benchmark"]
 
-_log = logging.getLogger("neurotex")
 PathLike = Union[str, "os.PathLike[str]"]
 
 
@@ -51,8 +49,7 @@ def fetch(name: Union[str, PathLike], source: Optional[PathLike] = None,
     checksum verified, imported once; reused when fetched before), and returns its dataset
     folder."""
     folder, said = _native.datasets_fetch(os.fspath(name), _opt(source), _opt(cache))
-    for line in said:
-        _log.info("%s", line)
+    _log_said(said)
     return folder
 
 
@@ -115,6 +112,5 @@ def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
         client.gather(client.map(_share, tasks, pure=False))
     board, said = _native.benchmark(names, out_s, cache_s, _opt(source), wanted, snn, folds,
                                     repeats, seed)
-    for line in said:
-        _log.info("%s", line)
+    _log_said(said)
     return board
