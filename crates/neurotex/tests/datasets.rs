@@ -861,9 +861,11 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
         .unwrap()
         .iter()
         .all(|s| !s.contains("pieces taken")));
-    // ... and their removal is said.
+    // ... and their removal is said, with the setting that differed.
     let removed = said.lock().unwrap().iter().find_map(|s| {
-        let n = s.strip_suffix(" finished pieces of a stopped run with other settings removed")?;
+        let n = s.strip_suffix(
+            " finished pieces of a stopped run with other settings (seed: 5 → 6) removed",
+        )?;
         n.trim().parse::<usize>().ok()
     });
     assert!(removed.is_some_and(|n| n >= 30), "{said:?}");

@@ -288,8 +288,12 @@ impl BenchmarkOptions {
         let key_text = key.text();
         let pieces = Pieces::open(self.pieces_dir(recipe, protocol), &key_text)?;
         if pieces.removed > 0 {
+            let differed = match pieces.differed.is_empty() {
+                true => String::new(),
+                false => format!(" ({})", pieces.differed.join(", ")),
+            };
             on(Progress::Say(&format!(
-                "  {} finished pieces of a stopped run with other settings removed",
+                "  {} finished pieces of a stopped run with other settings{differed} removed",
                 pieces.removed
             )));
         }

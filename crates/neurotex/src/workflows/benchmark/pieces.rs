@@ -19,6 +19,8 @@ pub(super) struct Pieces {
     taken: AtomicUsize,
     /// Pieces of other settings removed when the folder was opened.
     pub(super) removed: usize,
+    /// The settings that differed from those of the removed pieces, as `name: then → now`.
+    pub(super) differed: Vec<String>,
     /// Whether the folder holds a piece (an interrupted run names it only then).
     holds: AtomicBool,
 }
@@ -30,10 +32,12 @@ impl Pieces {
     /// The folder cannot be emptied or made.
     pub(super) fn open(dir: PathBuf, key: &str) -> Result<Pieces> {
         let key_file = dir.join("key.json");
-        let mut removed = 0;
+        let (mut removed, mut differed) = (0, Vec::new());
         if !made_under(&dir, key) {
             if dir.exists() {
                 removed = pieces_only(&dir)?;
+                let before = std::fs::read_to_string(&key_file).unwrap_or_default();
+                differed = differences(&before, key);
                 std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
             }
             std::fs::create_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
@@ -43,6 +47,7 @@ impl Pieces {
             dir,
             taken: AtomicUsize::new(0),
             removed,
+            differed,
             holds: AtomicBool::new(false),
         };
         if removed == 0 && std::fs::read_dir(&pieces.dir).is_ok_and(|d| d.count() > 1) {
@@ -65,6 +70,7 @@ impl Pieces {
             dir,
             taken: AtomicUsize::new(0),
             removed: 0,
+            differed: Vec::new(),
             holds: AtomicBool::new(false),
         })
     }
@@ -95,6 +101,22 @@ impl Pieces {
             .collect();
         self.dir.join(format!("{digest}.piece"))
     }
+}
+
+/// The settings of two keys' JSON texts that differ, as `name: then → now` (values as
+/// JSON); empty when the earlier key cannot be read.
+fn differences(before: &str, now: &str) -> Vec<String> {
+    let parse = |t: &str| serde_json::from_str::<serde_json::Map<String, serde_json::Value>>(t);
+    let (Ok(before), Ok(now)) = (parse(before), parse(now)) else {
+        return Vec::new();
+    };
+    let absent = serde_json::Value::Null;
+    (now.iter())
+        .filter_map(|(name, value)| {
+            let then = before.get(name).unwrap_or(&absent);
+            (then != value).then(|| format!("{name}: {then} → {value}"))
+        })
+        .collect()
 }
 
 /// Whether the pieces folder `dir` was made under `key` (its key file holds it).
