@@ -10,12 +10,11 @@ use pyo3::prelude::*;
 use crate::errors::guarded;
 use crate::model::Said;
 
-/// Runs one `neurotex datasets` command; returns the lines it prints and what it said.
-fn run(py: Python<'_>, command: DatasetsCommand) -> PyResult<(Vec<String>, Vec<String>)> {
-    let said = Said::default();
-    let on = |p: neurotex::progress::Progress| said.hear(p);
-    let lines = py.detach(|| guarded(|| command.run(&on)))?;
-    Ok((lines, said.lines()))
+/// Runs one `neurotex datasets` command; returns the lines it prints (what it says on its
+/// way goes to Python's log).
+fn run(py: Python<'_>, command: DatasetsCommand) -> PyResult<Vec<String>> {
+    let on = |p: neurotex::progress::Progress| Said::hear(p);
+    py.detach(|| guarded(|| command.run(&on)))
 }
 
 /// The built-in recipes as dicts (name, title, citation, licence, protocols, published,
@@ -41,7 +40,7 @@ fn datasets_check(py: Python<'_>, name_or_path: &str) -> PyResult<Py<PyAny>> {
     crate::convert::to_object(py, &recipe)
 }
 
-/// Fetches a dataset into the cache; `(folder, said)`.
+/// Fetches a dataset into the cache; its folder.
 #[pyfunction]
 #[pyo3(signature = (name, source=None, cache=None))]
 fn datasets_fetch(
@@ -49,21 +48,20 @@ fn datasets_fetch(
     name: String,
     source: Option<PathBuf>,
     cache: Option<PathBuf>,
-) -> PyResult<(String, Vec<String>)> {
+) -> PyResult<String> {
     let command = DatasetsCommand::Fetch {
         name,
         from: source,
         cache,
     };
-    let (lines, said) = run(py, command)?;
-    Ok((lines.concat(), said))
+    Ok(run(py, command)?.concat())
 }
 
 /// The imported folder of a fetched dataset.
 #[pyfunction]
 #[pyo3(signature = (name, cache=None))]
 fn datasets_path(py: Python<'_>, name: String, cache: Option<PathBuf>) -> PyResult<String> {
-    Ok(run(py, DatasetsCommand::Path { name, cache })?.0.concat())
+    Ok(run(py, DatasetsCommand::Path { name, cache })?.concat())
 }
 
 /// `neurotex benchmark`'s options, from the Python arguments.
@@ -90,7 +88,7 @@ fn options(
     }
 }
 
-/// Runs `neurotex benchmark`; `(leaderboard, said)`.
+/// Runs `neurotex benchmark`; the leaderboard (what it says on its way goes to Python's log).
 #[pyfunction]
 #[pyo3(signature = (datasets, out, cache=None, source=None, protocols=Vec::new(), snn=false, folds=5, repeats=1, seed=0))]
 #[allow(clippy::too_many_arguments)]
@@ -105,7 +103,7 @@ fn benchmark(
     folds: usize,
     repeats: usize,
     seed: u64,
-) -> PyResult<(Py<PyAny>, Vec<String>)> {
+) -> PyResult<Py<PyAny>> {
     let options = options(
         datasets,
         out,
@@ -115,10 +113,9 @@ fn benchmark(
         snn,
         (folds, repeats, seed),
     );
-    let said = Said::default();
-    let on = |p: neurotex::progress::Progress| said.hear(p);
+    let on = |p: neurotex::progress::Progress| Said::hear(p);
     let board = py.detach(|| guarded(|| options.run(&on)))?;
-    Ok((crate::convert::to_object(py, &board)?, said.lines()))
+    crate::convert::to_object(py, &board)
 }
 
 /// A share as Python holds it: dataset, recipe, protocol, encoding and method (`None` for

@@ -50,7 +50,7 @@ impl NativeModel {
     }
 
     /// Predicts every recording of a dataset folder (sampled or address events) as
-    /// `neurotex predict --dataset` does: `(labels, shares (n, classes), what was said)`.
+    /// `neurotex predict --dataset` does: `(labels, shares (n, classes))`.
     fn predict_dataset<'py>(
         &self,
         py: Python<'py>,
@@ -235,50 +235,58 @@ pub(crate) fn predict_recordings<'py>(
     labels_and_shares(py, predictions, classes)
 }
 
-/// A folder's predictions: the labels, each class's share `(n, classes)`, and what the
-/// workflow said.
-pub(crate) type FolderPredictions<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>, Vec<String>);
+/// A folder's predictions: the labels and each class's share `(n, classes)`.
+pub(crate) type FolderPredictions<'py> = (Vec<String>, Bound<'py, PyArray2<f64>>);
 
 /// A model applied to every recording of the dataset folder `path` (sampled or address
 /// events) as `neurotex predict --dataset PATH` applies it: `(predicted labels, shares
-/// (n, classes), what was said)`.
+/// (n, classes))`; what the workflow says goes to Python's log as it is said.
 pub(crate) fn predict_dataset<'py>(
     py: Python<'py>,
     model: neurotex::saved::SavedModel,
     path: PathBuf,
 ) -> PyResult<FolderPredictions<'py>> {
     let dataset = crate::convert::open(&path)?;
-    let said = Said::default();
-    let on = |p: neurotex::progress::Progress| said.hear(p);
+    let on = |p: neurotex::progress::Progress| Said::hear(p);
     let predictions = py.detach(|| {
         guarded(|| {
             let encoded = neurotex::workflows::predict::encode_for(&model, &dataset, &on)?;
             model.predict(&encoded)
         })
     })?;
-    let (labels, shares) = labels_and_shares(py, predictions, model.labels().len())?;
-    Ok((labels, shares, said.lines()))
+    labels_and_shares(py, predictions, model.labels().len())
 }
 
-/// What a workflow said on its way (advice, calibrations), for Python's log.
-#[derive(Default)]
-pub(crate) struct Said(std::sync::Mutex<Vec<String>>);
+/// What a workflow says on its way (advice, calibrations, pieces taken), put on Python's
+/// `neurotex` logger as it is said, by the package's `_log_said` (advice at WARNING, the
+/// rest at INFO), so that a long run speaks while it runs.
+pub(crate) struct Said;
 
 impl Said {
-    pub(crate) fn hear(&self, progress: neurotex::progress::Progress) {
+    /// Logs a workflow's line, if it is one. Called from the threads of a workflow run with
+    /// the GIL released (every caller runs it inside `py.detach`), so taking the GIL here
+    /// waits on no thread of the run.
+    pub(crate) fn hear(progress: neurotex::progress::Progress) {
         // Advice as the command line prints it, so that Python logs it as a warning.
         let line = match progress {
             neurotex::progress::Progress::Say(s) => s.to_string(),
             neurotex::progress::Progress::Advice(s) => format!("warning: {s}"),
             _ => return,
         };
-        if let Ok(mut lines) = self.0.lock() {
-            lines.push(line);
-        }
-    }
-
-    pub(crate) fn lines(self) -> Vec<String> {
-        self.0.into_inner().unwrap_or_default()
+        Python::attach(|py| {
+            let logged = py
+                .import("neurotex")
+                .and_then(|m| m.getattr("_log_said")?.call1((vec![line],)).map(drop));
+            if let Err(e) = logged {
+                if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                    // A Ctrl-C that reached the logging code: raised again once the
+                    // workflow returns, as a Ctrl-C during a run always is.
+                    // SAFETY: `PyErr_SetInterrupt` only sets the interpreter's flag, and
+                    // the GIL is held.
+                    unsafe { pyo3::ffi::PyErr_SetInterrupt() };
+                }
+            }
+        });
     }
 }
 

@@ -85,7 +85,7 @@ impl NativeSpikingModel {
 
     /// The classes, in the order of the network's outputs.
     /// Predicts every recording of a dataset folder (sampled or address events) as
-    /// `neurotex predict --dataset` does: `(labels, shares (n, classes), what was said)`.
+    /// `neurotex predict --dataset` does: `(labels, shares (n, classes))`.
     fn predict_dataset<'py>(
         &self,
         py: Python<'py>,

@@ -63,8 +63,8 @@ fn front_end_classifier(
 /// its workflow: `method` and `classifier` (`None`: the CLI's defaults, each implying the
 /// other for the spiking network), the classifier's `classifier_options`, the stage
 /// `options`, the recordings at `speeds` only (all when `None`), `taxel` as `"row,col"`.
-/// Returns the model, how a spiking network's training went (`None` for a feature
-/// classifier), and what the workflow said.
+/// Returns the model and how a spiking network's training went (`None` for a feature
+/// classifier); what the workflow says goes to Python's log as it is said.
 #[pyfunction]
 #[pyo3(signature = (path, method, classifier, classifier_options, options, speeds=None, taxel=None))]
 #[allow(clippy::too_many_arguments)]
@@ -77,7 +77,7 @@ fn train_dataset(
     options: &Bound<'_, PyDict>,
     speeds: Option<Vec<f64>>,
     taxel: Option<&str>,
-) -> PyResult<(Py<PyAny>, Option<TrainingLog>, Vec<String>)> {
+) -> PyResult<(Py<PyAny>, Option<TrainingLog>)> {
     let stages = params::stage_options(options)?;
     let method = parsed::<MethodChoice>(method)?;
     let (knn, classifier) = front_end_classifier(classifier, method, classifier_options)?;
@@ -93,8 +93,7 @@ fn train_dataset(
         open: OpenOptions::default(),
     };
     let dataset = open(&path)?;
-    let said = Said::default();
-    let on = |p: Progress| said.hear(p);
+    let on = |p: Progress| Said::hear(p);
     if train.spiking() {
         let trained = py.detach(|| guarded(|| train.run_spiking(&dataset, &stages, &on)))?;
         let log = &trained.log;
@@ -102,13 +101,13 @@ fn train_dataset(
         let model = NativeSpikingModel {
             inner: trained.model,
         };
-        return Ok((Py::new(py, model)?.into_any(), Some(log), said.lines()));
+        return Ok((Py::new(py, model)?.into_any(), Some(log)));
     }
     let trained = py.detach(|| guarded(|| train.run(&dataset, &stages, &on)))?;
     let model = NativeModel {
         inner: trained.model,
     };
-    Ok((Py::new(py, model)?.into_any(), None, said.lines()))
+    Ok((Py::new(py, model)?.into_any(), None))
 }
 
 /// Speeds in mm/s as the library's, checked.
@@ -131,7 +130,8 @@ fn parsed<T: std::str::FromStr<Err = neurotex::error::ParamError>>(
 /// does, through its workflow: the method and classifier as `train_dataset` takes them,
 /// the cross-validation's `folds`, `repeats` and `seed` (`None`: the CLI's defaults), or a
 /// train/test split by speeds or by manifest column (`train_where="trial=0,1"`), and
-/// `group_by`. Returns the evaluation as the CLI's JSON object and what the workflow said.
+/// `group_by`. Returns the evaluation as the CLI's JSON object; what the workflow says goes
+/// to Python's log as it is said.
 #[pyfunction]
 #[pyo3(signature = (path, method, classifier, classifier_options, options, folds=None,
     repeats=None, seed=0, speeds=None, train_speeds=None, test_speeds=None, train_where=None,
@@ -155,7 +155,7 @@ fn evaluate_dataset(
     group_by: Option<String>,
     taxel: Option<&str>,
     tau_ms: Option<f64>,
-) -> PyResult<(Py<PyAny>, Vec<String>)> {
+) -> PyResult<Py<PyAny>> {
     let stages = params::stage_options(options)?;
     let method = parsed::<MethodChoice>(method)?;
     let (knn, classifier) = front_end_classifier(classifier, method, classifier_options)?;
@@ -185,13 +185,12 @@ fn evaluate_dataset(
         open: OpenOptions::default(),
     };
     let dataset = open(&path)?;
-    let said = Said::default();
-    let on = |p: Progress| said.hear(p);
+    let on = |p: Progress| Said::hear(p);
     let evaluated = py.detach(|| guarded(|| evaluate.run(&dataset, &stages, &on)))?;
     let json = evaluated
         .json()
         .map_err(|e| crate::errors::raise(crate::errors::Kind::Internal, e.to_string()))?;
-    Ok((crate::convert::to_object(py, &json)?, said.lines()))
+    crate::convert::to_object(py, &json)
 }
 
 /// A comma-separated list as the command line takes it, or `standard` when `None`.
@@ -205,8 +204,8 @@ fn listed(names: Option<Vec<String>>, standard: &str) -> Vec<String> {
 /// `test_where`; pooled without), `group_by`, the cross-validation's `folds`, `repeats`
 /// and `seed` (`None`: the CLI's), `nested` selection, KNN's `knn` knobs and the
 /// network's `snn` knobs. With `out`, also writes compare.json, compare.md and the
-/// figures there, as `--out`. Returns the comparison as the CLI's JSON object and what
-/// the workflow said.
+/// figures there, as `--out`. Returns the comparison as the CLI's JSON object; what the
+/// workflow says goes to Python's log as it is said.
 #[pyfunction]
 #[pyo3(signature = (path, options, knn, snn, encodings=None, methods=None, classifiers=None,
     speeds=None, per=None, hold_out=None, train_where=None, test_where=None, group_by=None,
@@ -233,7 +232,7 @@ fn compare_dataset(
     nested: bool,
     tau_ms: Option<f64>,
     out: Option<PathBuf>,
-) -> PyResult<(Py<PyAny>, Vec<String>)> {
+) -> PyResult<Py<PyAny>> {
     use neurotex::compare::candidates as standard;
     let stages = params::stage_options(options)?;
     let (knn, _) = front_end_classifier(Some("knn"), None, knn)?;
@@ -271,8 +270,7 @@ fn compare_dataset(
         }
     }
     let dataset = open(&path)?;
-    let said = Said::default();
-    let on = |p: Progress| said.hear(p);
+    let on = |p: Progress| Said::hear(p);
     let comparison = py.detach(|| {
         guarded(|| {
             let comparison = compare.run(&dataset, &stages, &on)?;
@@ -283,7 +281,7 @@ fn compare_dataset(
             Ok(comparison)
         })
     })?;
-    Ok((crate::convert::to_object(py, &comparison)?, said.lines()))
+    crate::convert::to_object(py, &comparison)
 }
 
 /// Registers the workflows.

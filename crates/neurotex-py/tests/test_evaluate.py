@@ -114,3 +114,41 @@ def test_a_nested_estimate_at_chance_is_a_warning(sim_dir, tmp_path, caplog):
     warned = [r for r in caplog.records if r.levelname == "WARNING"]
     assert any("nested estimate's interval" in r.getMessage() and "chance (50.0 %)"
                in r.getMessage() for r in warned), [r.getMessage() for r in caplog.records]
+
+
+def test_a_workflow_speaks_while_it_runs(sim_dir, monkeypatch):
+    """What a workflow says reaches the `neurotex` logger as it is said, each line once:
+    every line is heard before the native call returns, not logged after it."""
+    import logging
+    from neurotex import _native
+    native = _native.compare_dataset
+    returned = []
+
+    def compare_dataset(*args):
+        result = native(*args)
+        returned.append(True)
+        return result
+
+    monkeypatch.setattr(_native, "compare_dataset", compare_dataset)
+    heard = []
+
+    class Heard(logging.Handler):
+        def emit(self, record):
+            heard.append((record.getMessage(), bool(returned)))
+
+    logger = logging.getLogger("neurotex")
+    handler = Heard(level=logging.INFO)
+    logger.addHandler(handler)
+    old = logger.level
+    logger.setLevel(logging.INFO)
+    try:
+        neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d", "all-taxels"],
+                         classifiers=["knn"], per="speed_mm_s", folds=3,
+                         knn_options={"k": 3}, nested=True)
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(old)
+    messages = [m for m, _ in heard]
+    assert any(m.startswith("comparing ") for m in messages), messages
+    assert not any(after for _, after in heard), heard
+    assert len(messages) == len(set(messages)), messages

@@ -52,9 +52,10 @@ _WARNING = "warning: "
 
 
 def _log_said(said: Sequence[str]) -> None:
-    """What a workflow said, on the ``neurotex`` logger: its warnings (a nested estimate
-    not above chance, folds fewer than asked, ...) at WARNING, which Python shows without
-    any logging set up; its progress and other lines at INFO
+    """What a workflow says, on the ``neurotex`` logger as it says it (the native
+    workflows call this from their threads): its warnings (a nested estimate not above
+    chance, folds fewer than asked, ...) at WARNING, which Python shows without any logging
+    set up; its progress and other lines at INFO
     (``logging.basicConfig(level=logging.INFO)`` shows them)."""
     for line in said:
         if line.startswith(_WARNING):
@@ -649,12 +650,10 @@ def evaluate(
     def listed(v: Any) -> Optional[List[float]]:
         return None if v is None else [float(x) for x in np.atleast_1d(v)]
 
-    result, said = _native.evaluate_dataset(
+    return _native.evaluate_dataset(
         os.fspath(path), method, classifier, dict(classifier_options or {}), opts,
         folds, repeats, int(seed), listed(speeds), listed(train_speeds), listed(test_speeds),
         train_where, test_where, group_by, taxel, tau_ms)
-    _log_said(said)
-    return result
 
 
 def compare(
@@ -706,14 +705,12 @@ def compare(
         return [str(x) for x in v]
 
     only = None if speeds is None else [float(x) for x in np.atleast_1d(speeds)]
-    result, said = _native.compare_dataset(
+    return _native.compare_dataset(
         os.fspath(path), opts, dict(knn_options or {}), dict(snn_options or {}),
         names(encodings, "encodings"), names(methods, "methods"),
         names(classifiers, "classifiers"), only, per, hold_out, train_where, test_where,
         group_by, folds, repeats, int(seed), bool(nested), tau_ms,
         None if out is None else os.fspath(out))
-    _log_said(said)
-    return result
 
 
 def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = None) -> Dataset:
@@ -866,8 +863,7 @@ class _Predicting:
     def _predict(self, recordings: Any, fs: float, mask: Any) -> Tuple[np.ndarray, np.ndarray]:
         folder = _folder(recordings)
         if folder is not None:
-            labels, shares, said = self._native.predict_dataset(folder)
-            _log_said(said)
+            labels, shares = self._native.predict_dataset(folder)
             return np.array(labels, dtype=object), shares
         items = _recording_list(recordings)
         arrays, infos = _prepare(items, fs, mask)
@@ -1051,10 +1047,8 @@ def _train_folder(folder: str, labels: Any, method: Optional[str], classifier: O
     opts = _stage_options(**stage_options)
     opts["causal"] = bool(causal)
     only = None if speeds is None else [float(v) for v in np.atleast_1d(speeds)]
-    native, log, said = _native.train_dataset(folder, method, classifier,
-                                              dict(classifier_options or {}), opts, only,
-                                              taxel)
-    _log_said(said)
+    native, log = _native.train_dataset(folder, method, classifier,
+                                        dict(classifier_options or {}), opts, only, taxel)
     if log is None:
         return Model(native)
     ran, best, loss = log

@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 from typing import Any, Dict, List, Optional, Sequence, Union
 
-from . import _log_said, _native, load_dataset
+from . import _native, load_dataset
 
 __all__ = ["list_recipes", "check", "fetch", "path", "load", "tonic", "benchmark"]
 
@@ -48,9 +48,7 @@ def fetch(name: Union[str, PathLike], source: Optional[PathLike] = None,
     """Fetches a dataset into the cache, downloaded or from the local copy ``source`` (every
     checksum verified, imported once; reused when fetched before), and returns its dataset
     folder."""
-    folder, said = _native.datasets_fetch(os.fspath(name), _opt(source), _opt(cache))
-    _log_said(said)
-    return folder
+    return _native.datasets_fetch(os.fspath(name), _opt(source), _opt(cache))
 
 
 def path(name: Union[str, PathLike], cache: Optional[PathLike] = None) -> str:
@@ -110,7 +108,5 @@ def benchmark(datasets: Sequence[Union[str, PathLike]], out: PathLike, *,
                                           folds, repeats, seed)
         tasks = [(share, out_s, cache_s, snn, folds, repeats, seed) for share in shares]
         client.gather(client.map(_share, tasks, pure=False))
-    board, said = _native.benchmark(names, out_s, cache_s, _opt(source), wanted, snn, folds,
-                                    repeats, seed)
-    _log_said(said)
-    return board
+    return _native.benchmark(names, out_s, cache_s, _opt(source), wanted, snn, folds,
+                             repeats, seed)
