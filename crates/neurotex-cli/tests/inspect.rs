@@ -158,6 +158,14 @@ fn each_footgun_is_named_with_its_option() {
     );
     let found = findings(&dir, &offset, &grid);
     assert!(suggestion(&found, "resting-offset").contains("--baseline min"));
+    // taxels held at the ceiling by the offset: --gain auto, which would not lower the
+    // gain here, is not the remedy offered
+    let held = suggestion(&found, "taxels-unresponsive");
+    assert!(held.starts_with("--baseline min"), "{held}");
+    assert!(
+        held.contains("so the gain is not what holds them at the ceiling"),
+        "{held}"
+    );
     let found = findings(&dir, &offset, &[&grid[..], &["--baseline", "min"]].concat());
     assert!(found.iter().all(|f| f.0 != "resting-offset"), "{found:?}");
     // most taxels silent at the gain

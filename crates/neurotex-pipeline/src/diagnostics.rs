@@ -74,7 +74,7 @@ impl TaxelDiagnostics {
         let (silent, saturated) = (self.silent().len(), self.saturated().len());
         if 2 * saturated > n {
             Some(format!(
-                "{saturated} of {n} taxels fire at the encoder's ceiling in most recordings, so they carry little of the texture: a signal riding on a large resting offset stays near its maximum throughout; remove the offset (--baseline min, or baseline in layout.toml), or let --gain auto choose a lower gain"
+                "{saturated} of {n} taxels fire at the encoder's ceiling in most recordings, so they carry little of the texture: a signal riding on a large resting offset stays near its maximum throughout; remove the offset (--baseline min, or baseline in layout.toml), or lower the gain"
             ))
         } else if 2 * silent > n {
             Some(format!(

@@ -924,10 +924,26 @@ fn shares_computed_apart_make_the_leaderboard_of_one_run() {
         neurotex::progress::Progress::Stage(name, n) => {
             said.lock().unwrap().push(format!("stage {name} {n}"))
         }
+        neurotex::progress::Progress::Advice(s) => {
+            said.lock().unwrap().push(format!("warning {s}"))
+        }
         _ => {}
     };
     let board = apart.run(&on).unwrap();
     let said = said.into_inner().unwrap();
+    // A warning names the comparison it is about: the held-out protocol's inner ranking,
+    // with one speed left in each outer training set, cross-validates within it.
+    let warned: Vec<&String> = said.iter().filter(|s| s.starts_with("warning ")).collect();
+    assert!(
+        warned
+            .iter()
+            .any(|s| s.starts_with("warning ridges, speed-held-out: ")),
+        "{warned:?}"
+    );
+    assert!(
+        warned.iter().all(|s| s.starts_with("warning ridges, ")),
+        "{warned:?}"
+    );
     let mut needed = 0;
     let mut taken = Vec::new();
     for line in &said {

@@ -260,8 +260,17 @@ impl BenchmarkOptions {
     ) -> Result<Comparison> {
         let options = self.compare(protocol, dataset, share);
         let opened = options.open.open(dataset)?;
+        // A warning names its dataset and protocol: where only warnings are shown (Python's
+        // default logging), nothing else says which comparison it is about.
+        let named = |p: Progress| match p {
+            Progress::Advice(text) => on(Progress::Advice(&format!(
+                "{}, {}: {text}",
+                recipe.name, protocol.id
+            ))),
+            other => on(other),
+        };
         options
-            .run_keeping(&opened, &StageOptions::default(), on, Some(pieces))
+            .run_keeping(&opened, &StageOptions::default(), &named, Some(pieces))
             .map_err(|e| crate::Error::InAnalysis {
                 what: format!("{}, {}", recipe.name, protocol.describe()),
                 source: Box::new(e),

@@ -520,9 +520,15 @@ impl<'a> PerCondition<'a> {
             if (c.chance - c.majority).abs() >= 1e-9 {
                 hline(&mut chart, 100.0 * c.majority, MAJORITY, 4)?;
             }
-            for s in &lines {
+            for (k, s) in lines.iter().enumerate() {
+                // Markers without a line sit side by side within their condition, so
+                // that equal accuracies do not hide one another.
+                let shift = match ordered {
+                    true => 0.0,
+                    false => 0.12 * (k as f64 - (lines.len() - 1) as f64 / 2.0),
+                };
                 let points: Vec<(f64, f64)> = (s.values.iter().enumerate())
-                    .filter_map(|(i, v)| v.map(|v| (i as f64 + 0.5, v)))
+                    .filter_map(|(i, v)| v.map(|v| (i as f64 + 0.5 + shift, v)))
                     .collect();
                 match ordered {
                     true => line_with_markers(&mut chart, &points, s.colour, s.dashed)?,
