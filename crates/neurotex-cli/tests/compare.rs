@@ -247,6 +247,21 @@ fn bad_compare_options_are_clear_errors() {
 }
 
 #[test]
+fn a_misspelt_protocol_column_is_named_before_any_recording_is_encoded() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0, 10.0], 4);
+    let err = dir.fails(&["compare", "--dataset", s(&ds), "--hold-out", "sped_mm_s"]);
+    assert!(
+        err.contains("sped_mm_s") && err.contains("columns with values: "),
+        "{err}"
+    );
+    assert!(
+        !err.contains("encoding") && !err.contains("comparing"),
+        "{err}"
+    );
+}
+
+#[test]
 fn nested_selection_too_small_for_its_inner_folds_stops_before_any_candidate_runs() {
     let dir = Dir::new();
     // Two recordings per class at each speed: 2 folds leave one per class in each outer

@@ -433,6 +433,21 @@ fn nested_note(n: &Nested, chance: f64) -> Option<String> {
     })
 }
 
+/// Checks that the column `protocol` splits by (per or held out) has a value in some of
+/// the recordings `metas`: a workflow calls it before encoding, so that a misspelt column
+/// is named at once rather than after the recordings are encoded.
+///
+/// # Errors
+/// The column has no value in any recording (the error lists the columns that do).
+pub fn check_protocol_column(metas: &[Meta], protocol: &Protocol) -> Result<()> {
+    match protocol {
+        Protocol::Per(column) | Protocol::HoldOut(column) => {
+            parts::conditions(metas, column).map(drop)
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The number of classes among the evaluated rows and the largest class's share.
 fn class_shares(metas: &[Meta], shares: &[(usize, f64)]) -> (usize, f64) {
     let mut counts: Vec<(String, usize)> = Vec::new();

@@ -265,6 +265,11 @@ impl CompareOptions {
     ) -> Result<Comparison> {
         let params = self.params()?;
         let indices = self.indices(dataset)?;
+        let metas: Vec<_> = indices
+            .iter()
+            .map(|&i| dataset.entries[i].clone())
+            .collect();
+        crate::compare::check_protocol_column(&metas, &params.protocol)?;
         let set = self.set()?;
         let n = set.len();
         if n == 0 || n > MAX_CANDIDATES {
