@@ -263,19 +263,18 @@ fn compare_dataset(
         nested,
         open: OpenOptions::default(),
     };
-    if let Some(dir) = &out {
-        if dir.exists() && std::fs::read_dir(dir).map_or(true, |mut d| d.next().is_some()) {
-            let why = format!("out: {} exists and is not an empty folder", dir.display());
-            return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
-        }
-    }
     let dataset = open(&path)?;
     let on = |p: Progress| Said::hear(p);
     let comparison = py.detach(|| {
         guarded(|| {
+            // As `neurotex compare --out`: the folder claimed and checked before the run
+            // (an earlier output of neurotex is replaced whole, anything else refused).
+            let _claim = out
+                .as_deref()
+                .map(neurotex::io::claim_output_dir)
+                .transpose()?;
             let comparison = compare.run(&dataset, &stages, &on)?;
             if let Some(dir) = &out {
-                let _claim = neurotex::io::claim_output_dir(dir)?;
                 neurotex::report::comparison::write_comparison(dir, &comparison, &path)?;
             }
             Ok(comparison)

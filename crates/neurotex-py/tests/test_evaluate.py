@@ -84,6 +84,19 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
     written = [json.loads((tmp_path / side / "compare.json").read_text()) for side in ("py", "cli")]
     assert untimed(written[0]) == untimed(written[1])
     assert (tmp_path / "py" / "compare.md").is_file()
+    # Into the same folder again, and into the command line's, as `--out` writes: an
+    # earlier output is replaced whole; a folder of the user's is refused before any work.
+    for again in ("py", "cli"):
+        neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d"], classifiers=["knn"],
+                         per="speed_mm_s", folds=3, knn_options={"k": 3}, out=tmp_path / again)
+        assert json.loads((tmp_path / again / "compare.json").read_text())["best"]["method"] == "glcm3d"
+    theirs = tmp_path / "theirs"
+    theirs.mkdir()
+    (theirs / "notes.txt").write_text("mine")
+    with pytest.raises(neurotex.Error, match="notes.txt"):
+        neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d"], classifiers=["knn"],
+                         per="speed_mm_s", folds=3, knn_options={"k": 3}, out=theirs)
+    assert (theirs / "notes.txt").read_text() == "mine"
     with pytest.raises(ParameterError, match="one protocol at a time"):
         neurotex.compare(sim_dir, per="speed_mm_s", hold_out="speed_mm_s")
     with pytest.raises(ParameterError, match="must be a list"):

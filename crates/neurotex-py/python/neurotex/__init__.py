@@ -692,8 +692,10 @@ def compare(
     recordings without any); ``group_by``, ``folds``, ``repeats``, ``seed`` and ``tau_ms``
     are the CLI's. ``knn_options`` (``{"k": 3}``) and ``snn_options`` (``{"hidden":
     64}``) are the knobs of the KNN and spiking-network candidates. With ``out``, the
-    folder (new or empty) also gets compare.json, compare.md and the figures. Stage
-    options (``gain="auto"``, ``bin_ms``, ...) are the CLI's."""
+    folder also gets compare.json, compare.md and the figures, as ``--out``: a new or
+    empty folder, or an earlier output of neurotex, which is replaced whole; any other
+    folder is refused before the comparison runs. Stage options (``gain="auto"``,
+    ``bin_ms``, ...) are the CLI's."""
     opts = _stage_options(**stage_options)
     opts["causal"] = bool(causal)
 
