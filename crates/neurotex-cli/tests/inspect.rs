@@ -166,6 +166,15 @@ fn each_footgun_is_named_with_its_option() {
         held.contains("so the gain is not what holds them at the ceiling"),
         "{held}"
     );
+    // the offset removed and a gain too low for any neuron to fire: silent, not at the
+    // ceiling, and a higher gain is what helps
+    let low = [&grid[..], &["--baseline", "min", "--gain", "1"]].concat();
+    let found = findings(&dir, &offset, &low);
+    let silent = suggestion(&found, "taxels-unresponsive");
+    assert!(
+        silent.starts_with("--gain auto (it would choose"),
+        "{silent}"
+    );
     let found = findings(&dir, &offset, &[&grid[..], &["--baseline", "min"]].concat());
     assert!(found.iter().all(|f| f.0 != "resting-offset"), "{found:?}");
     // most taxels silent at the gain

@@ -15,6 +15,13 @@ use crate::values::{Cell, Grid};
 /// rate of a neuron driven by the largest input the normalisation allows.
 pub const SATURATION_SHARE: f64 = 0.9;
 
+/// Whether a taxel firing at `rate_hz` is at the ceiling `ceiling_hz` ([`SATURATION_SHARE`]
+/// of it). A taxel that never fires is silent, never at the ceiling, even where the gain
+/// is too low for the largest input to fire at all (a ceiling of 0 Hz).
+pub fn at_ceiling(rate_hz: f64, ceiling_hz: f64) -> bool {
+    rate_hz > 0.0 && rate_hz >= SATURATION_SHARE * ceiling_hz
+}
+
 /// One taxel's responses over the recordings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TaxelResponse {
@@ -150,7 +157,7 @@ pub fn taxel_diagnostics(
                 let spikes = e.spikes.train(cell).len();
                 let rate = spikes as f64 * 1000.0 / e.spikes.n_steps.max(1) as f64;
                 silent += usize::from(spikes == 0);
-                saturated += usize::from(rate >= SATURATION_SHARE * ceiling_hz);
+                saturated += usize::from(at_ceiling(rate, ceiling_hz));
             }
             TaxelResponse {
                 taxel: grid.cell(cell).to_string(),
@@ -173,6 +180,16 @@ pub fn ceiling_rate(encoder: IzhikevichParams) -> Result<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_silent_taxel_is_never_at_the_ceiling() {
+        // A gain too low for the largest input to fire: the ceiling is 0 Hz, and a taxel
+        // that never fires is silent, not at it.
+        assert!(!at_ceiling(0.0, 0.0));
+        assert!(!at_ceiling(0.0, 16.0));
+        assert!(at_ceiling(15.0, 16.0) && !at_ceiling(14.0, 16.0));
+        assert!(at_ceiling(0.5, 0.0));
+    }
 
     fn response(taxel: &str, silent_share: f64, saturated_share: f64) -> TaxelResponse {
         TaxelResponse {

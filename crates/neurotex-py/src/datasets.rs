@@ -13,7 +13,8 @@ use crate::model::Said;
 /// Runs one `neurotex datasets` command; returns the lines it prints (what it says on its
 /// way goes to Python's log).
 fn run(py: Python<'_>, command: DatasetsCommand) -> PyResult<Vec<String>> {
-    let on = |p: neurotex::progress::Progress| Said::hear(p);
+    let said = Said::default();
+    let on = |p: neurotex::progress::Progress| said.hear(p);
     py.detach(|| guarded(|| command.run(&on)))
 }
 
@@ -113,7 +114,8 @@ fn benchmark(
         snn,
         (folds, repeats, seed),
     );
-    let on = |p: neurotex::progress::Progress| Said::hear(p);
+    let said = Said::default();
+    let on = |p: neurotex::progress::Progress| said.hear(p);
     let board = py.detach(|| guarded(|| options.run(&on)))?;
     crate::convert::to_object(py, &board)
 }

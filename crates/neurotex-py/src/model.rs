@@ -247,7 +247,8 @@ pub(crate) fn predict_dataset<'py>(
     path: PathBuf,
 ) -> PyResult<FolderPredictions<'py>> {
     let dataset = crate::convert::open(&path)?;
-    let on = |p: neurotex::progress::Progress| Said::hear(p);
+    let said = Said::default();
+    let on = |p: neurotex::progress::Progress| said.hear(p);
     let predictions = py.detach(|| {
         guarded(|| {
             let encoded = neurotex::workflows::predict::encode_for(&model, &dataset, &on)?;
@@ -257,37 +258,79 @@ pub(crate) fn predict_dataset<'py>(
     labels_and_shares(py, predictions, model.labels().len())
 }
 
-/// What a workflow says on its way (advice, calibrations, pieces taken), put on Python's
-/// `neurotex` logger as it is said, by the package's `_log_said` (advice at WARNING, the
-/// rest at INFO), so that a long run speaks while it runs.
-pub(crate) struct Said;
+/// What a workflow says on its way (advice, calibrations, pieces taken) and how far its
+/// stages are, put on Python's `neurotex` logger as it happens, by the package's
+/// `_log_said` (advice at WARNING, the rest at INFO), so that a long run speaks while it
+/// runs: each stage's start and each tenth of its steps, as the command line's bar moves.
+#[derive(Default)]
+pub(crate) struct Said(std::sync::Mutex<Stage>);
+
+/// The stage under way: its name, steps and steps done.
+#[derive(Default)]
+pub(crate) struct Stage {
+    name: String,
+    steps: usize,
+    done: usize,
+}
 
 impl Said {
-    /// Logs a workflow's line, if it is one. Called from the threads of a workflow run with
-    /// the GIL released (every caller runs it inside `py.detach`), so taking the GIL here
-    /// waits on no thread of the run.
-    pub(crate) fn hear(progress: neurotex::progress::Progress) {
+    /// Logs a workflow's event, if it is one to log. Called from the threads of a workflow
+    /// run with the GIL released (every caller runs it inside `py.detach`), so taking the
+    /// GIL here waits on no thread of the run.
+    pub(crate) fn hear(&self, progress: neurotex::progress::Progress) {
+        use neurotex::progress::Progress;
         // Advice as the command line prints it, so that Python logs it as a warning.
         let line = match progress {
-            neurotex::progress::Progress::Say(s) => s.to_string(),
-            neurotex::progress::Progress::Advice(s) => format!("warning: {s}"),
-            _ => return,
-        };
-        Python::attach(|py| {
-            let logged = py
-                .import("neurotex")
-                .and_then(|m| m.getattr("_log_said")?.call1((vec![line],)).map(drop));
-            if let Err(e) = logged {
-                if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-                    // A Ctrl-C that reached the logging code: raised again once the
-                    // workflow returns, as a Ctrl-C during a run always is.
-                    // SAFETY: `PyErr_SetInterrupt` only sets the interpreter's flag, and
-                    // the GIL is held.
-                    unsafe { pyo3::ffi::PyErr_SetInterrupt() };
+            Progress::Say(s) => s.to_string(),
+            Progress::Advice(s) => format!("warning: {s}"),
+            Progress::Stage(name, steps) => {
+                if let Ok(mut stage) = self.0.lock() {
+                    *stage = Stage {
+                        name: name.to_string(),
+                        steps,
+                        done: 0,
+                    };
                 }
+                format!("{name} ({steps} steps)")
             }
-        });
+            Progress::Tick | Progress::Done(..) | Progress::Skipped(..) => {
+                let Some(line) = self.0.lock().ok().and_then(|mut s| s.step()) else {
+                    return;
+                };
+                line
+            }
+            Progress::TooSmall(_) => return,
+        };
+        log_now(line);
     }
+}
+
+impl Stage {
+    /// One step done: the line to log when it ends a tenth of the stage.
+    fn step(&mut self) -> Option<String> {
+        self.done += 1;
+        let tenth = |d: usize| d * 10 / self.steps.max(1);
+        (self.done <= self.steps && tenth(self.done) > tenth(self.done - 1))
+            .then(|| format!("{} {}/{}", self.name, self.done, self.steps))
+    }
+}
+
+/// Puts `line` on Python's `neurotex` logger through the package's `_log_said`.
+fn log_now(line: String) {
+    Python::attach(|py| {
+        let logged = py
+            .import("neurotex")
+            .and_then(|m| m.getattr("_log_said")?.call1((vec![line],)).map(drop));
+        if let Err(e) = logged {
+            if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                // A Ctrl-C that reached the logging code: raised again once the workflow
+                // returns, as a Ctrl-C during a run always is.
+                // SAFETY: `PyErr_SetInterrupt` only sets the interpreter's flag, and the
+                // GIL is held.
+                unsafe { pyo3::ffi::PyErr_SetInterrupt() };
+            }
+        }
+    });
 }
 
 /// Predictions as `(labels, shares (n, classes))`.

@@ -93,7 +93,8 @@ fn train_dataset(
         open: OpenOptions::default(),
     };
     let dataset = open(&path)?;
-    let on = |p: Progress| Said::hear(p);
+    let said = Said::default();
+    let on = |p: Progress| said.hear(p);
     if train.spiking() {
         let trained = py.detach(|| guarded(|| train.run_spiking(&dataset, &stages, &on)))?;
         let log = &trained.log;
@@ -185,7 +186,8 @@ fn evaluate_dataset(
         open: OpenOptions::default(),
     };
     let dataset = open(&path)?;
-    let on = |p: Progress| Said::hear(p);
+    let said = Said::default();
+    let on = |p: Progress| said.hear(p);
     let evaluated = py.detach(|| guarded(|| evaluate.run(&dataset, &stages, &on)))?;
     let json = evaluated
         .json()
@@ -264,7 +266,8 @@ fn compare_dataset(
         open: OpenOptions::default(),
     };
     let dataset = open(&path)?;
-    let on = |p: Progress| Said::hear(p);
+    let said = Said::default();
+    let on = |p: Progress| said.hear(p);
     let comparison = py.detach(|| {
         guarded(|| {
             // As `neurotex compare --out`: the folder claimed and checked before the run

@@ -163,5 +163,8 @@ def test_a_workflow_speaks_while_it_runs(sim_dir, monkeypatch):
         logger.setLevel(old)
     messages = [m for m, _ in heard]
     assert any(m.startswith("comparing ") for m in messages), messages
+    # each stage's start and its tenths, as the command line's bar moves
+    n = next(m for m in messages if m.startswith("candidates (")).split("(")[1].split()[0]
+    assert f"candidates {n}/{n}" in messages, messages
     assert not any(after for _, after in heard), heard
     assert len(messages) == len(set(messages)), messages

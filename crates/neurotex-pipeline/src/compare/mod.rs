@@ -369,7 +369,11 @@ pub fn compare_keeping(
     let (classes, majority) = class_shares(metas, &scored[0].shares);
     let chance = 1.0 / classes.max(1) as f64;
     let mut notes = notes;
-    if let Some(note) = nested.as_ref().and_then(|n| nested_note(n, chance)) {
+    let held_out = matches!(params.protocol, Protocol::HoldOut(_));
+    if let Some(note) = nested
+        .as_ref()
+        .and_then(|n| nested_note(n, chance, held_out))
+    {
         progress(Progress::Advice(&note));
         notes.push(note);
     }
@@ -419,13 +423,18 @@ impl AgainstChance {
     }
 }
 
-/// The note for a nested estimate whose interval is not above chance.
-fn nested_note(n: &Nested, chance: f64) -> Option<String> {
+/// The note for a nested estimate whose interval is not above chance; `held_out` when
+/// the protocol holds a condition out.
+fn nested_note(n: &Nested, chance: f64, held_out: bool) -> Option<String> {
     let interval = format!("[{:.1}, {:.1}] %", 100.0 * n.ci[0], 100.0 * n.ci[1]);
     let chance_text = format!("chance ({:.1} %)", 100.0 * chance);
+    let why = match held_out {
+        true => " (features that change with the held-out condition)",
+        false => "",
+    };
     AgainstChance::of(n.ci, chance).map(|at| match at {
         AgainstChance::Below => format!(
-            "the nested estimate's interval {interval} is under {chance_text}: what the selection learns on the training sets does not carry over to the test sets (under a held-out condition, features that change with the condition)"
+            "the nested estimate's interval {interval} is under {chance_text}: what the selection learns on the training sets does not carry over to the test sets{why}"
         ),
         AgainstChance::Includes => format!(
             "the nested estimate's interval {interval} includes {chance_text}: the chosen procedure is not shown to classify better than guessing"

@@ -363,7 +363,7 @@ pub(super) fn encoder_check(
                 name: name.clone(),
                 cell,
                 silent_share: count(&|r| r == 0.0),
-                saturated_share: count(&|r| r >= crate::diagnostics::SATURATION_SHARE * ceiling_hz),
+                saturated_share: count(&|r| crate::diagnostics::at_ceiling(r, ceiling_hz)),
                 median_hz: median(rates),
             }
         })
