@@ -73,13 +73,21 @@ impl TaxelDiagnostics {
         saturated.map(|t| t.taxel.as_str()).collect()
     }
 
+    /// Whether most taxels are at the ceiling in most recordings (what [`advice`] speaks
+    /// of first).
+    ///
+    /// [`advice`]: TaxelDiagnostics::advice
+    pub fn mostly_at_ceiling(&self) -> bool {
+        2 * self.saturated().len() > self.taxels.len()
+    }
+
     /// What to change when most taxels do not respond: silent ones want a higher gain,
     /// ones at the ceiling most often a signal riding on a resting offset (normalised by
     /// its maximum, it stays near 1 throughout) or a lower gain. `None` when most respond.
     pub fn advice(&self) -> Option<String> {
         let n = self.taxels.len();
         let (silent, saturated) = (self.silent().len(), self.saturated().len());
-        if 2 * saturated > n {
+        if self.mostly_at_ceiling() {
             Some(format!(
                 "{saturated} of {n} taxels fire at the encoder's ceiling in most recordings, so they carry little of the texture: a signal riding on a large resting offset stays near its maximum throughout; remove the offset (--baseline min, or baseline in layout.toml), or lower the gain"
             ))

@@ -363,10 +363,10 @@ fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<
     let spreads: Vec<f64> = chans.iter().filter_map(|c| c.resting_spread).collect();
     let spread = super::median(spreads);
     if spread >= OFFSET_RATIO {
-        out.push(finding(Warning, "signals", "drifting-rest", format!("each channel's resting level (its least sample) moves between recordings by {spread:.1} times its range (median channel; 10th to 90th percentile of the recordings): offline, each recording's own minimum (--baseline min) absorbs it, but causal conditioning (--causal, `neurotex stream`) subtracts one resting value fixed at training, so recordings resting above it fire throughout and those below stay silent, whatever the gain"), match baseline {
-            crate::recording::Baseline::None => "--causal --drift-window-s 30 (each taxel's resting value tracked as its least input over the last 30 s, longer than a contact); and --baseline min offline",
-            _ => "--causal --drift-window-s 30 (each taxel's resting value tracked as its least input over the last 30 s, longer than a contact)",
-        }));
+        out.push(finding(Warning, "signals", "drifting-rest", format!("each channel's resting level (its least sample) moves between recordings by {spread:.1} times its range (median channel; 10th to 90th percentile of the recordings): offline, each recording's own minimum (--baseline min) absorbs it, but causal conditioning (--causal, `neurotex stream`) subtracts one resting value fixed at training, so recordings resting above it fire throughout and those below stay silent, whatever the gain"), format!("--causal --drift-window-s 30 (each taxel's resting value tracked as its least input over the last 30 s, longer than a contact){}", match baseline {
+            crate::recording::Baseline::None => "; and --baseline min offline",
+            _ => "",
+        })));
     }
     if baseline == crate::recording::Baseline::None && resting >= OFFSET_RATIO {
         out.push(finding(Severe, "signals", "resting-offset", format!("the channels rest at about {resting:.1} times their range above zero (median channel) and no baseline is removed, so the encoder, dividing by each recording's maximum, sees mostly the resting offset"), "--baseline min (each channel's minimum removed)"));
@@ -387,9 +387,8 @@ fn encoder(i: &Inspection, p: &InspectParams, out: &mut Vec<Finding>) {
             .collect(),
     };
     // At the ceiling, --gain auto is a remedy only where it would lower the gain.
-    let at_ceiling = 2 * diagnostics.saturated().len() > diagnostics.taxels.len();
     let auto = match &e.auto {
-        Some(a) if at_ceiling && a.gain >= e.gain => format!(
+        Some(a) if diagnostics.mostly_at_ceiling() && a.gain >= e.gain => format!(
             "--baseline min (the resting offset removed); --gain auto would choose {} here (a median of {:.1} Hz), no lower than {}, so the gain is not what holds them at the ceiling",
             a.gain, a.median_hz, e.gain
         ),

@@ -232,6 +232,11 @@ impl BenchmarkOptions {
         (self.out.join(&recipe.name)).join(format!("{}.pieces", protocol.id))
     }
 
+    /// The folder of `recipe`'s `protocol`'s comparison (compare.json, compare.md, figures).
+    fn comparison_dir(&self, recipe: &Recipe, protocol: &ProtocolSpec) -> PathBuf {
+        (self.out.join(&recipe.name)).join(&protocol.id)
+    }
+
     /// The key file of `recipe`'s `protocol`'s comparison, beside its folder.
     fn key_file(&self, recipe: &Recipe, protocol: &ProtocolSpec) -> PathBuf {
         (self.out.join(&recipe.name)).join(format!("{}.key.json", protocol.id))
@@ -244,7 +249,7 @@ impl BenchmarkOptions {
         if &found != key {
             return None;
         }
-        let dir = self.out.join(&recipe.name).join(&protocol.id);
+        let dir = self.comparison_dir(recipe, protocol);
         let json = std::fs::read_to_string(dir.join("compare.json")).ok()?;
         serde_json::from_str(&json).ok()
     }
@@ -318,7 +323,7 @@ impl BenchmarkOptions {
         // The old key goes first: a run stopped between the two writes leaves no key, never
         // another run's key beside this comparison.
         let (dir, key_file) = (
-            self.out.join(&recipe.name).join(&protocol.id),
+            self.comparison_dir(recipe, protocol),
             self.key_file(recipe, protocol),
         );
         if key_file.exists() {

@@ -33,11 +33,11 @@ impl Pieces {
     pub(super) fn open(dir: PathBuf, key: &str) -> Result<Pieces> {
         let key_file = dir.join("key.json");
         let (mut removed, mut differed) = (0, Vec::new());
-        if !made_under(&dir, key) {
+        let before = key_of(&dir);
+        if before.as_deref() != Some(key) {
             if dir.exists() {
                 removed = pieces_only(&dir)?;
-                let before = std::fs::read_to_string(&key_file).unwrap_or_default();
-                differed = differences(&before, key);
+                differed = differences(before.as_deref().unwrap_or_default(), key);
                 std::fs::remove_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
             }
             std::fs::create_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
@@ -62,7 +62,7 @@ impl Pieces {
     /// # Errors
     /// No such folder, or one made under another key.
     pub(super) fn existing(dir: PathBuf, key: &str) -> Result<Pieces> {
-        if !made_under(&dir, key) {
+        if key_of(&dir).as_deref() != Some(key) {
             let why = "is not the pieces folder of these settings: make the shares first";
             return Err(DataError::invalid(&dir, why.to_string()).into());
         }
@@ -119,12 +119,9 @@ fn differences(before: &str, now: &str) -> Vec<String> {
         .collect()
 }
 
-/// Whether the pieces folder `dir` was made under `key` (its key file holds it).
-fn made_under(dir: &Path, key: &str) -> bool {
-    std::fs::read_to_string(dir.join("key.json"))
-        .ok()
-        .as_deref()
-        == Some(key)
+/// The key the pieces folder `dir` was made under (its key file's text), if it has one.
+fn key_of(dir: &Path) -> Option<String> {
+    std::fs::read_to_string(dir.join("key.json")).ok()
 }
 
 /// How many pieces the folder `dir` holds, when it holds nothing else than pieces, their
