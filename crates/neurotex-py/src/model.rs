@@ -279,10 +279,10 @@ impl Said {
     /// GIL here waits on no thread of the run.
     pub(crate) fn hear(&self, progress: neurotex::progress::Progress) {
         use neurotex::progress::Progress;
-        // Advice as the command line prints it, so that Python logs it as a warning.
-        let line = match progress {
-            Progress::Say(s) => s.to_string(),
-            Progress::Advice(s) => format!("warning: {s}"),
+        // Advice is logged as a warning, the rest as information.
+        let (line, warning) = match progress {
+            Progress::Say(s) => (s.to_string(), false),
+            Progress::Advice(s) => (s.to_string(), true),
             Progress::Stage(name, steps) => {
                 if let Ok(mut stage) = self.0.lock() {
                     *stage = Stage {
@@ -291,17 +291,17 @@ impl Said {
                         done: 0,
                     };
                 }
-                format!("{name} ({steps} steps)")
+                (format!("{name} ({steps} steps)"), false)
             }
             Progress::Tick | Progress::Done(..) | Progress::Skipped(..) => {
                 let Some(line) = self.0.lock().ok().and_then(|mut s| s.step()) else {
                     return;
                 };
-                line
+                (line, false)
             }
             Progress::TooSmall(_) => return,
         };
-        log_now(line);
+        log_now(line, warning);
     }
 }
 
@@ -315,12 +315,13 @@ impl Stage {
     }
 }
 
-/// Puts `line` on Python's `neurotex` logger through the package's `_log_said`.
-fn log_now(line: String) {
+/// Puts `line` on Python's `neurotex` logger through the package's `_log_said`, at WARNING
+/// when it is a `warning`, else at INFO.
+fn log_now(line: String, warning: bool) {
     Python::attach(|py| {
         let logged = py
             .import("neurotex")
-            .and_then(|m| m.getattr("_log_said")?.call1((vec![line],)).map(drop));
+            .and_then(|m| m.getattr("_log_said")?.call1((line, warning)).map(drop));
         if let Err(e) = logged {
             if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
                 // A Ctrl-C that reached the logging code: raised again once the workflow

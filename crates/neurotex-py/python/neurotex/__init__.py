@@ -48,20 +48,19 @@ HARALICK_FULL_NAMES: Tuple[str, ...] = tuple(_native.haralick_names(True))
 """Names of the 13 features of ``haralick(..., full=True)``."""
 
 _log = logging.getLogger("neurotex")
-_WARNING = "warning: "
 
 
-def _log_said(said: Sequence[str]) -> None:
-    """What a workflow says, on the ``neurotex`` logger as it says it (the native
-    workflows call this from their threads): its warnings (a nested estimate not above
+def _log_said(line: str, warning: bool) -> None:
+    """One line a workflow says, on the ``neurotex`` logger as it says it (the native
+    workflows call this from their threads): a warning (a nested estimate not above
     chance, folds fewer than asked, ...) at WARNING, which Python shows without any logging
     set up; its progress and other lines at INFO
     (``logging.basicConfig(level=logging.INFO)`` shows them)."""
-    for line in said:
-        if line.startswith(_WARNING):
-            _log.warning("%s", line[len(_WARNING):])
-        else:
-            _log.info("%s", line)
+    if warning:
+        _log.warning("%s", line)
+    else:
+        _log.info("%s", line)
+
 
 METHODS = (
     "taxel", "glcm2d", "glcm3d", "all-taxels", "all-taxels-mm", "glcm3d-multi", "spectrum",
