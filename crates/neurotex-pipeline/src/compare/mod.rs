@@ -30,6 +30,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::{Outcome, Split};
+use crate::classify::metrics::AgainstChance;
 use crate::classify::ValidCv;
 use crate::error::{ClassifyError, Result};
 use crate::progress::Progress;
@@ -319,14 +320,7 @@ pub fn compare_keeping(
     progress: &(dyn Fn(Progress) + Sync),
     keep: Option<&dyn Keep>,
 ) -> Result<Comparison> {
-    let first = candidates.first().ok_or(ClassifyError::Empty {
-        what: "compare: no candidates",
-    })?;
-    let metas = &first.metas;
-    if let Some(c) = candidates.iter().find(|c| c.metas != *metas) {
-        let message = format!("{} has other recordings than {}", c.name(), first.name());
-        return Err(ClassifyError::BadFeatures(message).into());
-    }
+    let metas = shared_recordings(candidates)?;
     // Candidates are scored side by side, each part of the protocol (a condition, a
     // held-out value) on its own (each evaluation is deterministic, so the order of work
     // changes nothing but its clock): one candidate's folds are too few and too unequal
@@ -369,14 +363,11 @@ pub fn compare_keeping(
     let (classes, majority) = class_shares(metas, &scored[0].shares);
     let chance = 1.0 / classes.max(1) as f64;
     let mut notes = notes;
-    let held_out = matches!(params.protocol, Protocol::HoldOut(_));
-    if let Some(note) = nested
-        .as_ref()
-        .and_then(|n| nested_note(n, chance, held_out))
-    {
-        progress(Progress::Advice(&note));
-        notes.push(note);
-    }
+    notes.extend(
+        nested
+            .as_ref()
+            .and_then(|n| nested_note(n, chance, params, progress)),
+    );
     Ok(Comparison {
         protocol: params.protocol.to_string(),
         units: match &params.group_by {
@@ -399,47 +390,46 @@ pub fn compare_keeping(
     })
 }
 
-/// Where a 95 % interval stands against chance, when it is not above it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum AgainstChance {
-    /// The whole interval is under chance.
-    Below,
-    /// The interval reaches down to chance or under it.
-    Includes,
-}
-
-impl AgainstChance {
-    /// Where `ci` stands against `chance`; `None` when it is wholly above. An edge within
-    /// rounding of chance (a share of the units against one over the classes) is at it.
-    pub fn of(ci: [f64; 2], chance: f64) -> Option<AgainstChance> {
-        const ROUNDING: f64 = 1e-9;
-        if ci[1] < chance - ROUNDING {
-            Some(AgainstChance::Below)
-        } else if ci[0] <= chance + ROUNDING {
-            Some(AgainstChance::Includes)
-        } else {
-            None
-        }
+/// The recordings every candidate is made of, the same for all.
+///
+/// # Errors
+/// No candidate, or one made of other recordings than the first.
+fn shared_recordings(candidates: &[Candidate]) -> Result<&[Meta]> {
+    let first = candidates.first().ok_or(ClassifyError::Empty {
+        what: "compare: no candidates",
+    })?;
+    if let Some(c) = candidates.iter().find(|c| c.metas != first.metas) {
+        let message = format!("{} has other recordings than {}", c.name(), first.name());
+        return Err(ClassifyError::BadFeatures(message).into());
     }
+    Ok(&first.metas)
 }
 
-/// The note for a nested estimate whose interval is not above chance; `held_out` when
-/// the protocol holds a condition out.
-fn nested_note(n: &Nested, chance: f64, held_out: bool) -> Option<String> {
+/// The note for a nested estimate whose interval is not above chance, said to `progress`
+/// as advice too.
+fn nested_note(
+    n: &Nested,
+    chance: f64,
+    params: &CompareParams,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Option<String> {
+    let held_out = matches!(params.protocol, Protocol::HoldOut(_));
     let interval = format!("[{:.1}, {:.1}] %", 100.0 * n.ci[0], 100.0 * n.ci[1]);
     let chance_text = format!("chance ({:.1} %)", 100.0 * chance);
     let why = match held_out {
         true => " (features that change with the held-out condition)",
         false => "",
     };
-    AgainstChance::of(n.ci, chance).map(|at| match at {
+    let note = AgainstChance::of(n.ci, chance).map(|at| match at {
         AgainstChance::Below => format!(
             "the nested estimate's interval {interval} is under {chance_text}: what the selection learns on the training sets does not carry over to the test sets{why}"
         ),
         AgainstChance::Includes => format!(
             "the nested estimate's interval {interval} includes {chance_text}: the chosen procedure is not shown to classify better than guessing"
         ),
-    })
+    })?;
+    progress(Progress::Advice(&note));
+    Some(note)
 }
 
 /// Checks that the column `protocol` splits by (per or held out) has a value in some of
@@ -639,22 +629,6 @@ mod tests {
         assert!(AgainstChance::of(n.ci, c.chance).is_some(), "{:?}", n.ci);
         let said = c.notes.iter().filter(|s| s.contains("chance (33.3 %)"));
         assert_eq!(said.count(), 1, "{:?}", c.notes);
-        assert_eq!(
-            AgainstChance::of([0.1, 0.2], 0.25),
-            Some(AgainstChance::Below)
-        );
-        assert_eq!(
-            AgainstChance::of([0.2, 0.3], 0.25),
-            Some(AgainstChance::Includes)
-        );
-        assert_eq!(
-            AgainstChance::of([0.25, 0.3], 0.25),
-            Some(AgainstChance::Includes)
-        );
-        assert_eq!(AgainstChance::of([0.26, 0.3], 0.25), None);
-        // An edge at chance but for rounding is at it.
-        let third = AgainstChance::of([0.333_333_333_333_333_37, 0.5], 1.0 / 3.0);
-        assert_eq!(third, Some(AgainstChance::Includes));
     }
 
     /// Under a hold-out protocol the inner ranking holds out each speed of the outer

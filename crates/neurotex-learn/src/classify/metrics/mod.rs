@@ -1,7 +1,8 @@
 //! What an accuracy means: the summary of a confusion matrix beside its chance levels
 //! ([`Metrics`]), 95 % intervals for an accuracy ([`wilson_interval`],
-//! [`bootstrap_accuracy`], [`t_interval_over_repeats`]), and a paired test of two methods
-//! on the same recordings ([`mcnemar_exact`]) with the verdict it allows ([`PairedVerdict`]).
+//! [`bootstrap_accuracy`], [`t_interval_over_repeats`]) and where one stands against chance
+//! ([`AgainstChance`]), and a paired test of two methods on the same recordings
+//! ([`mcnemar_exact`]) with the verdict it allows ([`PairedVerdict`]).
 //!
 //! Everything here is a pure function of counts or per-recording results; the
 //! distributions they rest on are in [`super::stats`].
@@ -27,6 +28,30 @@ pub use paired::{
 
 /// The confidence level of every interval in this module.
 pub const LEVEL: f64 = 0.95;
+
+/// Where a 95 % interval stands against chance, when it is not above it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AgainstChance {
+    /// The whole interval is under chance.
+    Below,
+    /// The interval reaches down to chance or under it.
+    Includes,
+}
+
+impl AgainstChance {
+    /// Where `ci` stands against `chance`; `None` when it is wholly above. An edge within
+    /// rounding of chance (a share of the units against one over the classes) is at it.
+    pub fn of(ci: [f64; 2], chance: f64) -> Option<AgainstChance> {
+        const ROUNDING: f64 = 1e-9;
+        if ci[1] < chance - ROUNDING {
+            Some(AgainstChance::Below)
+        } else if ci[0] <= chance + ROUNDING {
+            Some(AgainstChance::Includes)
+        } else {
+            None
+        }
+    }
+}
 
 /// The significance level at which a paired comparison counts as a result.
 pub const ALPHA: f64 = 0.05;

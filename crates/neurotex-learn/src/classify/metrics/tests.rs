@@ -203,3 +203,19 @@ fn mcnemar_counts_winner_and_verdicts() {
     );
     assert_eq!(Side::First.other(), Side::Second);
 }
+
+#[test]
+fn an_interval_against_chance_by_hand() {
+    use AgainstChance::{Below, Includes};
+    for (ci, at) in [
+        ([0.1, 0.2], Some(Below)),
+        ([0.2, 0.3], Some(Includes)),
+        ([0.25, 0.3], Some(Includes)),
+        ([0.26, 0.3], None),
+    ] {
+        assert_eq!(AgainstChance::of(ci, 0.25), at, "{ci:?}");
+    }
+    // An edge at chance but for rounding is at it.
+    let third = AgainstChance::of([0.333_333_333_333_333_37, 0.5], 1.0 / 3.0);
+    assert_eq!(third, Some(AgainstChance::Includes));
+}

@@ -77,17 +77,12 @@ fn lines(groups: &[Group]) -> usize {
     groups.iter().map(|g| 1 + g.rows.len()).sum()
 }
 
-/// The figure: every group's rows under its title, on one accuracy axis; `source` names
-/// the run.
-///
-/// # Errors
-/// The drawing fails.
-pub fn leaderboard(groups: &[Group], source: &str) -> Result<String, FigureError> {
-    // A key for each kind of row the figure draws (published numbers of either protocol
-    // share one), so that no key names what is not there.
+/// The legend: a key for each kind of row the figure draws (published numbers of either
+/// protocol share one), so that no key names what is not there, and chance.
+fn keys(groups: &[Group]) -> Vec<Key> {
     let drawn =
         |kinds: &[Kind]| (groups.iter().flat_map(|g| &g.rows)).any(|r| kinds.contains(&r.kind));
-    let keys = [
+    [
         (
             &[Kind::Nested][..],
             "nested selection (the number to quote)",
@@ -105,7 +100,16 @@ pub fn leaderboard(groups: &[Group], source: &str) -> Result<String, FigureError
     .filter(|(kinds, _)| drawn(kinds))
     .map(|(kinds, l)| Key::new(l, Swatch::Points(kinds[0].colour())))
     .chain([Key::new("chance", Swatch::Dashed(GREY))])
-    .collect::<Vec<_>>();
+    .collect()
+}
+
+/// The figure: every group's rows under its title, on one accuracy axis; `source` names
+/// the run.
+///
+/// # Errors
+/// The drawing fails.
+pub fn leaderboard(groups: &[Group], source: &str) -> Result<String, FigureError> {
+    let keys = keys(groups);
     let frame = Frame {
         width: Width::Page,
         title: "the leaderboard: accuracy with 95 % intervals, per dataset and protocol",

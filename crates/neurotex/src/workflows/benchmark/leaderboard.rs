@@ -5,7 +5,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::candidate_set;
-use crate::compare::{AgainstChance, Comparison, Ranked};
+use crate::classify::metrics::AgainstChance;
+use crate::compare::{Comparison, Ranked};
 use crate::datasets::recipe::ProtocolSpec;
 use crate::datasets::{Published, Recipe};
 use crate::report::figures::leaderboard::{Entry, Group, Kind};
