@@ -860,3 +860,54 @@ fn folds_the_design_cannot_give_are_said_with_the_folds_used() {
     let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
     assert!(json["notes"][0].as_str().unwrap().contains(said), "{json}");
 }
+
+/// An accuracy whose interval reaches chance is said to be no result, on standard error
+/// and in the JSON's notes; a separable design's accuracy is not.
+#[test]
+fn an_accuracy_not_above_chance_is_a_warning() {
+    let dir = Dir::new();
+    let data = dir.dataset("ds", &["A", "B", "C"], &[5.0], 8);
+    let evaluate = |data: &Path| {
+        let args = [
+            "evaluate",
+            "--dataset",
+            s(data),
+            "--method",
+            "glcm3d",
+            "--json",
+        ];
+        let run = dir.run(&args);
+        assert!(run.status.success(), "{}", run.stderr);
+        let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
+        (run.stderr, json)
+    };
+    let (err, json) = evaluate(&data);
+    let lower = json["accuracy_interval"]["lower"].as_f64().unwrap();
+    assert!(lower > 0.34, "{json}");
+    assert!(!err.contains("chance"), "{err}");
+    assert!(json.get("notes").is_none(), "{json}");
+    // The same recordings labelled by trial parity: nothing in them tells the labels.
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    let mut lines = manifest.lines();
+    let mut relabelled = format!("{}\n", lines.next().unwrap());
+    for line in lines {
+        let mut fields: Vec<&str> = line.split(',').collect();
+        let parity = if fields[4].parse::<usize>().unwrap() % 2 == 0 {
+            "even"
+        } else {
+            "odd"
+        };
+        fields[1] = parity;
+        relabelled.push_str(&format!("{}\n", fields.join(",")));
+    }
+    std::fs::write(data.join("manifest.csv"), relabelled).unwrap();
+    let (err, json) = evaluate(&data);
+    let said = "chance (50.0 %, one over 2 classes)";
+    assert_eq!(err.matches(said).count(), 1, "{err}");
+    assert!(err.contains("warning: the accuracy's interval ["), "{err}");
+    let notes = json["notes"].as_array().expect("notes");
+    assert!(
+        notes.iter().any(|n| n.as_str().unwrap().contains(said)),
+        "{json}"
+    );
+}

@@ -105,10 +105,10 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
         neurotex.compare(sim_dir, snn_options={"trees": 3})
 
 
-def test_a_nested_estimate_at_chance_is_a_warning(sim_dir, tmp_path, caplog):
+def test_an_estimate_at_chance_is_a_warning(sim_dir, tmp_path, caplog):
     """The workflow's warnings reach Python's log at WARNING, which Python shows without
     any logging set up: here labels that the textures do not carry (each recording's
-    trial, odd or even), whose nested estimate cannot be above chance."""
+    trial, odd or even), whose nested estimate and accuracy cannot be above chance."""
     import csv
     import shutil
     data = tmp_path / "parity"
@@ -127,6 +127,14 @@ def test_a_nested_estimate_at_chance_is_a_warning(sim_dir, tmp_path, caplog):
     warned = [r for r in caplog.records if r.levelname == "WARNING"]
     assert any("nested estimate's interval" in r.getMessage() and "chance (50.0 %)"
                in r.getMessage() for r in warned), [r.getMessage() for r in caplog.records]
+    # evaluate says it of its accuracy, and keeps it in the result's notes.
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="neurotex"):
+        result = neurotex.evaluate(data, folds=3, classifier_options={"k": 3})
+    said = "chance (50.0 %, one over 2 classes)"
+    warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert any("accuracy's interval" in m and said in m for m in warned), warned
+    assert any(said in n for n in result["notes"]), result
 
 
 def test_a_workflow_speaks_while_it_runs(sim_dir, monkeypatch):

@@ -288,7 +288,7 @@ impl EvaluateOptions {
         let split = self.split()?;
         let columns = self.columns()?;
         let indices = self.indices(dataset)?;
-        let notes = self.fewer_groups(dataset, &indices);
+        let mut notes = self.fewer_groups(dataset, &indices);
         notes.iter().for_each(|note| on(Progress::Advice(note)));
         let calibration = self.calibration_indices(dataset, &indices, stages, on)?;
         let calibrated = calibrated_pipeline(stages, dataset, &calibration, on)?;
@@ -320,6 +320,10 @@ impl EvaluateOptions {
             classifier: Some(classifier.to_string()),
             ..evaluation
         };
+        if let Some(note) = evaluation.chance_note() {
+            on(Progress::Advice(&note));
+            notes.push(note);
+        }
         Ok(Evaluated {
             evaluation,
             calibrated,
@@ -335,8 +339,9 @@ pub struct Evaluated {
     pub evaluation: Evaluation,
     /// The pipeline as run, with what `--causal` and `--gain auto` fixed.
     pub calibrated: CalibratedParams,
-    /// Options the design could not honour as given (fewer folds than asked), each as
-    /// said on standard error.
+    /// Options the design could not honour as given (fewer folds than asked), and an
+    /// accuracy not shown above chance ([`Evaluation::chance_note`]), each as said on
+    /// standard error.
     pub notes: Vec<String>,
 }
 
