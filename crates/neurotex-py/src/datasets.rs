@@ -15,7 +15,7 @@ use crate::model::Said;
 fn run(py: Python<'_>, command: DatasetsCommand) -> PyResult<Vec<String>> {
     let said = Said::default();
     let on = |p: neurotex::progress::Progress| said.hear(p);
-    py.detach(|| guarded(|| command.run(&on)))
+    crate::interrupt::watched(py, || guarded(|| command.run(&on)))
 }
 
 /// The built-in recipes as dicts (name, title, citation, licence, protocols, published,
@@ -116,7 +116,7 @@ fn benchmark(
     );
     let said = Said::default();
     let on = |p: neurotex::progress::Progress| said.hear(p);
-    let board = py.detach(|| guarded(|| options.run(&on)))?;
+    let board = crate::interrupt::watched(py, || guarded(|| options.run(&on)))?;
     crate::convert::to_object(py, &board)
 }
 

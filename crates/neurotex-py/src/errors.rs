@@ -167,7 +167,7 @@ pub fn guarded<T>(f: impl FnOnce() -> neurotex::Result<T>) -> PyResult<T> {
     match catch_unwind(AssertUnwindSafe(f)) {
         Ok(Ok(value)) => Ok(value),
         Ok(Err(error)) => Err(to_py(error)),
-        Err(panic) => Err(raise(Kind::Internal, panic_message(panic))),
+        Err(panic) => Err(from_panic(panic)),
     }
 }
 
@@ -176,7 +176,16 @@ pub fn guarded<T>(f: impl FnOnce() -> neurotex::Result<T>) -> PyResult<T> {
 pub fn guarded_py<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
     match catch_unwind(AssertUnwindSafe(f)) {
         Ok(result) => result,
-        Err(panic) => Err(raise(Kind::Internal, panic_message(panic))),
+        Err(panic) => Err(from_panic(panic)),
+    }
+}
+
+/// A caught panic as an exception: `KeyboardInterrupt` for a run a Ctrl-C stopped
+/// ([`crate::interrupt`]), else a `neurotex.InternalError`.
+fn from_panic(panic: Box<dyn std::any::Any + Send>) -> PyErr {
+    match panic.downcast::<neurotex::progress::Stopped>() {
+        Ok(stopped) => crate::interrupt::stopped_error(&stopped),
+        Err(panic) => raise(Kind::Internal, panic_message(panic)),
     }
 }
 

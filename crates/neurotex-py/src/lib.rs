@@ -13,6 +13,7 @@ mod datasets;
 mod errors;
 mod estimator;
 mod inspect;
+mod interrupt;
 mod model;
 mod params;
 mod reproduce;
@@ -390,6 +391,7 @@ fn library_version() -> &'static str {
 /// The native half of the `neurotex` package.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    interrupt::quiet_panic_hook();
     m.add_function(wrap_pyfunction!(params::stage_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(params::classifier_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(params::classifier_knobs, m)?)?;

@@ -249,7 +249,7 @@ pub(crate) fn predict_dataset<'py>(
     let dataset = crate::convert::open(&path)?;
     let said = Said::default();
     let on = |p: neurotex::progress::Progress| said.hear(p);
-    let predictions = py.detach(|| {
+    let predictions = crate::interrupt::watched(py, || {
         guarded(|| {
             let encoded = neurotex::workflows::predict::encode_for(&model, &dataset, &on)?;
             model.predict(&encoded)
@@ -279,6 +279,7 @@ impl Said {
     /// GIL here waits on no thread of the run.
     pub(crate) fn hear(&self, progress: neurotex::progress::Progress) {
         use neurotex::progress::Progress;
+        crate::interrupt::stop_if_asked();
         // Advice is logged as a warning, the rest as information.
         let (line, warning) = match progress {
             Progress::Say(s) => (s.to_string(), false),

@@ -81,8 +81,9 @@ fn reproduce(
         open: OpenOptions::default(),
     };
     let dataset = dataset.map(|dir| open(&dir)).transpose()?;
-    let (results, claims, predictions, seconds, warnings) =
-        py.detach(|| guarded(|| run(&out, dataset.as_ref(), &stages, &reproduce, command)))?;
+    let (results, claims, predictions, seconds, warnings) = crate::interrupt::watched(py, || {
+        guarded(|| run(&out, dataset.as_ref(), &stages, &reproduce, command))
+    })?;
     let warn = PyModule::import(py, "warnings")?;
     for text in warnings {
         warn.call_method1("warn", (text,))?;
@@ -108,14 +109,17 @@ fn run(
     let started = Instant::now();
     let warnings = Mutex::new(Vec::new());
     let say = |text: String| warnings.lock().expect("warnings").push(text);
-    let on_progress = |p: Progress| match p {
-        Progress::TooSmall(e) => {
-            say(format!(
-                "{WITHIN_SPEED}, which cannot run: {e}; they are skipped"
-            ));
+    let on_progress = |p: Progress| {
+        crate::interrupt::stop_if_asked();
+        match p {
+            Progress::TooSmall(e) => {
+                say(format!(
+                    "{WITHIN_SPEED}, which cannot run: {e}; they are skipped"
+                ));
+            }
+            Progress::Advice(text) => say(text.to_string()),
+            _ => (),
         }
-        Progress::Advice(text) => say(text.to_string()),
-        _ => (),
     };
     let results = reproduce.run(out, dataset, stages, command, &on_progress)?;
     let json = |what: &str, value: serde_json::Result<serde_json::Value>| {

@@ -20,6 +20,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::open;
 use crate::errors::{guarded, param};
+use crate::interrupt::watched;
 use crate::model::{NativeModel, Said};
 use crate::params;
 use crate::spiking::NativeSpikingModel;
@@ -96,7 +97,7 @@ fn train_dataset(
     let said = Said::default();
     let on = |p: Progress| said.hear(p);
     if train.spiking() {
-        let trained = py.detach(|| guarded(|| train.run_spiking(&dataset, &stages, &on)))?;
+        let trained = watched(py, || guarded(|| train.run_spiking(&dataset, &stages, &on)))?;
         let log = &trained.log;
         let log = (log.epochs, log.best_epoch, log.validation_loss);
         let model = NativeSpikingModel {
@@ -104,7 +105,7 @@ fn train_dataset(
         };
         return Ok((Py::new(py, model)?.into_any(), Some(log)));
     }
-    let trained = py.detach(|| guarded(|| train.run(&dataset, &stages, &on)))?;
+    let trained = watched(py, || guarded(|| train.run(&dataset, &stages, &on)))?;
     let model = NativeModel {
         inner: trained.model,
     };
@@ -188,7 +189,7 @@ fn evaluate_dataset(
     let dataset = open(&path)?;
     let said = Said::default();
     let on = |p: Progress| said.hear(p);
-    let evaluated = py.detach(|| guarded(|| evaluate.run(&dataset, &stages, &on)))?;
+    let evaluated = watched(py, || guarded(|| evaluate.run(&dataset, &stages, &on)))?;
     let json = evaluated
         .json()
         .map_err(|e| crate::errors::raise(crate::errors::Kind::Internal, e.to_string()))?;
@@ -268,7 +269,7 @@ fn compare_dataset(
     let dataset = open(&path)?;
     let said = Said::default();
     let on = |p: Progress| said.hear(p);
-    let comparison = py.detach(|| {
+    let comparison = watched(py, || {
         guarded(|| {
             // As `neurotex compare --out`: the folder claimed and checked before the run
             // (an earlier output of neurotex is replaced whole, anything else refused).

@@ -233,6 +233,7 @@ fn out_of_fold<S: Samples + ?Sized, L: Learner<S>>(
     let mut predicted: Vec<Vec<usize>> = Vec::new();
     let (mut train, mut ytr, mut test, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for fold in 0..folds {
+        neurotex_core::progress::stop_point();
         train.clear();
         ytr.clear();
         test.clear();

@@ -56,6 +56,7 @@ pub fn fit(
     let mut order = train.clone();
     let mut epochs = 0;
     for epoch in 1..=params.epochs {
+        neurotex_core::progress::stop_point();
         epochs = epoch;
         order.shuffle(&mut rng);
         for batch in order.chunks(params.batch) {

@@ -314,6 +314,7 @@ fn outer(
     let accuracies: Vec<f64> = candidates
         .par_iter()
         .map(|c| {
+            crate::progress::stop_point();
             let key = format!("inner accuracy of {} in outer split {s}", c.name());
             let accuracy = kept_or(keep, &key, || inner_accuracy(c))?;
             progress(Progress::Tick);

@@ -166,6 +166,7 @@ pub(super) fn score_all(
     let scores: Vec<PartScore> = (0..candidates.len() * parts.len())
         .into_par_iter()
         .map(|k| {
+            crate::progress::stop_point();
             let (c, part) = (&candidates[k / n], &parts[k % n]);
             let key = format!("score of {} on part {}", c.name(), k % n);
             let scored = kept_or(keep, &key, || score_part(c, part, params));

@@ -211,6 +211,7 @@ impl Pipeline {
             return indices
                 .par_iter()
                 .map(|&i| {
+                    crate::progress::stop_point();
                     let events = dataset.load_events(i)?;
                     let path = dataset.root.join(&dataset.entries[i].file);
                     let encoded = self.from_events(dataset.entries[i].clone(), events, &path)?;
@@ -249,6 +250,7 @@ impl Pipeline {
         indices
             .par_iter()
             .map(|&i| {
+                crate::progress::stop_point();
                 let rec = dataset.load(i)?;
                 let cond = self.condition(&rec, baseline)?;
                 let encoded = self.encode_recording(&rec, &cond)?;
