@@ -861,6 +861,19 @@ fn folds_the_design_cannot_give_are_said_with_the_folds_used() {
     assert!(json["notes"][0].as_str().unwrap().contains(said), "{json}");
 }
 
+/// Labels each recording of a [`Dir::dataset`] folder by its trial number alone.
+fn relabel(data: &Path, label_of: impl Fn(usize) -> &'static str) {
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    let mut lines = manifest.lines();
+    let mut relabelled = format!("{}\n", lines.next().unwrap());
+    for line in lines {
+        let mut fields: Vec<&str> = line.split(',').collect();
+        fields[1] = label_of(fields[4].parse().unwrap());
+        relabelled.push_str(&format!("{}\n", fields.join(",")));
+    }
+    std::fs::write(data.join("manifest.csv"), relabelled).unwrap();
+}
+
 /// An accuracy whose interval reaches chance is said to be no result, on standard error
 /// and in the JSON's notes; a separable design's accuracy is not.
 #[test]
@@ -885,22 +898,9 @@ fn an_accuracy_not_above_chance_is_a_warning() {
     let lower = json["accuracy_interval"]["lower"].as_f64().unwrap();
     assert!(lower > 0.34, "{json}");
     assert!(!err.contains("chance"), "{err}");
-    assert!(json.get("notes").is_none(), "{json}");
+    assert_eq!(json["notes"], serde_json::json!([]), "{json}");
     // The same recordings labelled by trial parity: nothing in them tells the labels.
-    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
-    let mut lines = manifest.lines();
-    let mut relabelled = format!("{}\n", lines.next().unwrap());
-    for line in lines {
-        let mut fields: Vec<&str> = line.split(',').collect();
-        let parity = if fields[4].parse::<usize>().unwrap() % 2 == 0 {
-            "even"
-        } else {
-            "odd"
-        };
-        fields[1] = parity;
-        relabelled.push_str(&format!("{}\n", fields.join(",")));
-    }
-    std::fs::write(data.join("manifest.csv"), relabelled).unwrap();
+    relabel(&data, |trial| if trial % 2 == 0 { "even" } else { "odd" });
     let (err, json) = evaluate(&data);
     let said = "chance (50.0 %, one over 2 classes)";
     assert_eq!(err.matches(said).count(), 1, "{err}");
@@ -910,4 +910,72 @@ fn an_accuracy_not_above_chance_is_a_warning() {
         notes.iter().any(|n| n.as_str().unwrap().contains(said)),
         "{json}"
     );
+    // compare names the same chance, and the candidates whose whole interval is under it.
+    let args = ["compare", "--dataset", s(&data), "--nested", "--json"];
+    let run = dir.run(&args);
+    assert!(run.status.success(), "{}", run.stderr);
+    let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
+    let notes: Vec<&str> = json["notes"]
+        .as_array()
+        .expect("notes")
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("nested estimate's interval") && n.contains(said)),
+        "{notes:?}"
+    );
+    let results = json["results"].as_array().unwrap();
+    let under = results
+        .iter()
+        .filter(|r| r["ci"][1].as_f64().unwrap() < 0.5)
+        .count();
+    assert!(under > 0, "{json}");
+    let counted = format!("{under} of {} candidates score under {said}", results.len());
+    assert!(
+        notes.iter().any(|n| n.starts_with(&counted)),
+        "{counted} in {notes:?}"
+    );
+    assert_eq!(run.stderr.matches(&counted).count(), 1, "{}", run.stderr);
+}
+
+/// A design whose classes differ in size: chance is what always answering the largest
+/// class scores, when that is more than one over the classes.
+#[test]
+fn chance_is_the_largest_class_share_when_it_is_larger() {
+    let dir = Dir::new();
+    let data = dir.dataset("ds", &["A", "B", "C"], &[5.0], 8);
+    // Trials 0-5 one label, 6-7 another: nothing in the recordings tells them apart.
+    relabel(&data, |trial| if trial < 6 { "early" } else { "late" });
+    let said = "chance (75.0 %, always answering the most frequent class)";
+    for command in ["evaluate", "compare"] {
+        let mut args = vec![command, "--dataset", s(&data), "--json"];
+        if command == "compare" {
+            args.push("--nested");
+        }
+        let run = dir.run(&args);
+        assert!(run.status.success(), "{}", run.stderr);
+        let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
+        let ci = match command {
+            "evaluate" => [
+                &json["accuracy_interval"]["lower"],
+                &json["accuracy_interval"]["upper"],
+            ],
+            _ => [&json["nested"]["ci"][0], &json["nested"]["ci"][1]],
+        };
+        let (lower, upper) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        // Not above the largest class's share, though not under one over the classes.
+        assert!(
+            lower <= 0.75 && upper > 0.5,
+            "{command}: [{lower}, {upper}]"
+        );
+        assert_eq!(
+            run.stderr.matches(said).count(),
+            1,
+            "{command}: {}",
+            run.stderr
+        );
+    }
 }

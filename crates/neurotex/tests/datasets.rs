@@ -847,6 +847,9 @@ fn a_benchmark_stopped_part_way_resumes_from_its_finished_pieces() {
             "  {kept} finished pieces taken (kept by a run stopped part way, or by shares)"
         )]
     );
+    // Said before the comparison runs too, with the pieces the folder held.
+    let found = format!("  {kept} finished pieces found, kept by a run stopped part way (or by shares): taken up, not computed again");
+    assert!(said.lock().unwrap().contains(&found), "{found}");
     let comparison = |b: &neurotex::workflows::benchmark::Leaderboard| {
         without_times(b.boards[0].comparison.clone())
     };

@@ -57,6 +57,47 @@ fn name_patterns_take_fields_from_file_names() {
     }
 }
 
+/// A logger's whole-millisecond stamps (here since the epoch) are the encoder's grid: the
+/// recording is read as sampled uniformly, bit for bit what resampling it would give, and
+/// not said to be resampled; one stamp off the grid makes it resampled.
+#[test]
+fn whole_millisecond_stamps_are_not_resampled() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir(&src).unwrap();
+    let csv = |shift_ms: f64| {
+        let mut text = String::from("stamp,a,b\n");
+        for i in 0..400 {
+            let t = 1_700_000_000_000.0 + i as f64 + if i == 200 { shift_ms } else { 0.0 };
+            let a = 500.0 + 20.0 * (i as f64 / 37.0).sin();
+            text.push_str(&format!("{t},{a:.3},{:.3}\n", 480.0 + (i % 7) as f64));
+        }
+        text
+    };
+    write(&src, "X_V5_0.csv", &csv(0.0));
+    write(&src, "Y_V5_0.csv", &csv(0.5));
+    let out = dir.path().join("ds");
+    import_csv(&csv_files(&[src]).unwrap(), &params(), &out, &|| {}).unwrap();
+    let ds = Dataset::open(&out).unwrap();
+    let pre = Preprocessor::new(&PreprocessParams::default()).unwrap();
+    let on_grid = ds.load(0).unwrap();
+    let times = neurotex::signal::relative_times(&on_grid);
+    let cond = pre.apply(&on_grid, Baseline::None).unwrap();
+    assert!(!cond.resampled);
+    // What resampling the stamps would give: every sample as it is.
+    let resampled = neurotex::signal::resample_linear(&on_grid.samples, 2, &times, 1000.0);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&resampled), bits(&on_grid.samples));
+    let uniform = neurotex::recording::Recording {
+        times_s: None,
+        ..on_grid.clone()
+    };
+    let plain = pre.apply(&uniform, Baseline::None).unwrap();
+    assert_eq!(bits(&cond.samples), bits(&plain.samples));
+    let off_grid = ds.load(1).unwrap();
+    assert!(pre.apply(&off_grid, Baseline::None).unwrap().resampled);
+}
+
 #[test]
 fn irregular_stamps_and_gaps_are_kept_then_resampled_to_1_ms() {
     let dir = tempfile::tempdir().unwrap();

@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::{Outcome, Split};
-use crate::classify::metrics::AgainstChance;
+use crate::classify::metrics::{chance_level, AgainstChance};
 use crate::classify::ValidCv;
 use crate::error::{ClassifyError, Result};
 use crate::progress::Progress;
@@ -222,9 +222,10 @@ pub struct Comparison {
     pub nested: Option<Nested>,
     /// What the ranking does not say.
     pub caveat: String,
-    /// Options the design could not honour as given (fewer folds than asked), each as
-    /// said on standard error when the comparison ran.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    /// Options the design could not honour as given (fewer folds than asked), and results
+    /// not above chance, each as said on standard error when the comparison ran; empty
+    /// when nothing was said.
+    #[serde(default)]
     pub notes: Vec<String>,
 }
 
@@ -366,7 +367,7 @@ pub fn compare_keeping(
     notes.extend(
         nested
             .as_ref()
-            .and_then(|n| nested_note(n, chance, params, progress)),
+            .and_then(|n| nested_note(n, (classes, majority), params, progress)),
     );
     Ok(Comparison {
         protocol: params.protocol.to_string(),
@@ -409,13 +410,14 @@ fn shared_recordings(candidates: &[Candidate]) -> Result<&[Meta]> {
 /// as advice too.
 fn nested_note(
     n: &Nested,
-    chance: f64,
+    (classes, majority): (usize, f64),
     params: &CompareParams,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Option<String> {
     let held_out = matches!(params.protocol, Protocol::HoldOut(_));
     let interval = format!("[{:.1}, {:.1}] %", 100.0 * n.ci[0], 100.0 * n.ci[1]);
-    let chance_text = format!("chance ({:.1} %)", 100.0 * chance);
+    let (chance, words) = chance_level(classes, majority);
+    let chance_text = format!("chance ({words})");
     let why = match held_out {
         true => " (features that change with the held-out condition)",
         false => "",
@@ -627,7 +629,10 @@ mod tests {
         let c = compare(&noise, &params(Protocol::Per("speed_mm_s".into()), true)).unwrap();
         let n = c.nested.as_ref().unwrap();
         assert!(AgainstChance::of(n.ci, c.chance).is_some(), "{:?}", n.ci);
-        let said = c.notes.iter().filter(|s| s.contains("chance (33.3 %)"));
+        let said = c
+            .notes
+            .iter()
+            .filter(|s| s.contains("chance (33.3 %, one over 3 classes)"));
         assert_eq!(said.count(), 1, "{:?}", c.notes);
     }
 

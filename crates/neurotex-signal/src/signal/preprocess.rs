@@ -14,7 +14,18 @@ use super::{LessOffsets, PreprocessParams, ENCODER_FS};
 
 /// Whether the recording is sampled uniformly at the encoder's 1 kHz (no resampling).
 fn uniform_1k(rec: &Recording) -> bool {
-    rec.times_s.is_none() && (rec.fs - ENCODER_FS).abs() < 1e-9
+    (rec.fs - ENCODER_FS).abs() < 1e-9 && rec.times_s.as_deref().is_none_or(on_the_1ms_grid)
+}
+
+/// Whether time stamps (s) fall exactly on the encoder's grid from the first: `i / 1000`
+/// after the first, as a logger writing whole milliseconds gives them. Resampling such
+/// stamps linearly reproduces every sample bit for bit (each grid time is a stamp), so
+/// the recording is read as sampled uniformly, and not said to be resampled.
+fn on_the_1ms_grid(t: &[f64]) -> bool {
+    let first = t.first().copied().unwrap_or(0.0);
+    t.iter()
+        .enumerate()
+        .all(|(i, &x)| x - first == i as f64 / ENCODER_FS)
 }
 
 /// The selected phase (`frames`) of a recording at 1 kHz, each sample less its cell's

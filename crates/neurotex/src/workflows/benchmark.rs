@@ -311,6 +311,12 @@ impl BenchmarkOptions {
                 pieces.removed
             )));
         }
+        if pieces.held > 0 {
+            on(Progress::Say(&format!(
+                "  {} finished pieces found, kept by a run stopped part way (or by shares): taken up, not computed again",
+                pieces.held
+            )));
+        }
         let comparison = self.compare_keeping((recipe, protocol), (dataset, None), &pieces, on)?;
         if pieces.taken() > 0 {
             on(Progress::Say(&format!(

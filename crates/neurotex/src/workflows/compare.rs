@@ -9,6 +9,7 @@ use super::{
     calibrated_pipeline, encode_all, say_conditions, KnnOptions, OnProgress, OpenOptions,
     SnnOptions,
 };
+use crate::classify::metrics::{chance_level, AgainstChance};
 use crate::classify::{ClassifierChoice, CvParams, ForestParams};
 use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::compare::signal::{
@@ -304,7 +305,11 @@ impl CompareOptions {
                 speeds.len()
             )));
         }
-        let comparison = compare_keeping(&candidates, &params, on, keep)?;
+        let mut comparison = compare_keeping(&candidates, &params, on, keep)?;
+        if let Some(note) = under_chance_note(&comparison, &params.protocol) {
+            on(Progress::Advice(&note));
+            comparison.notes.push(note);
+        }
         if !params.nested {
             on(Progress::Say(
                 "note: --nested computes the nested estimate the caveat below speaks of",
@@ -312,6 +317,34 @@ impl CompareOptions {
         }
         Ok(comparison)
     }
+}
+
+/// The note for candidates whose whole interval lies under chance, one over the classes:
+/// `None` when there are none. Recordings cannot teach a classifier to be wrong, so such
+/// scores come from the design, and a ranking or a paired test among them says nothing of
+/// the recordings. (Under the largest class's share alone, a classifier may still carry
+/// what the recordings hold: it need not answer by the classes' shares.)
+fn under_chance_note(c: &Comparison, protocol: &Protocol) -> Option<String> {
+    let (level, words) = chance_level(c.classes, 0.0);
+    let below = Some(AgainstChance::Below);
+    let under = c
+        .results
+        .iter()
+        .filter(|r| AgainstChance::of(r.ci, level) == below);
+    let under = under.count();
+    if under == 0 {
+        return None;
+    }
+    let held_out = match protocol {
+        Protocol::HoldOut(_) => {
+            "; with a condition held out, so do features that change with the condition"
+        }
+        _ => "",
+    };
+    Some(format!(
+        "{under} of {} candidates score under chance ({words}) over their whole 95 % interval: such scores come from the design, not from the recordings (labels the recordings do not carry score under chance in cross-validation, each test fold holding more of the classes its training folds hold less of{held_out}), so their ranks and their differences from the paper's method say nothing of the recordings",
+        c.results.len()
+    ))
 }
 
 /// Encodes the recordings once (both populations when an encoding needs the fast-adapting

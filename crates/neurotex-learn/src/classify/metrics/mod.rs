@@ -53,6 +53,27 @@ impl AgainstChance {
     }
 }
 
+/// The chance level a classifier must beat to be shown better than guessing, with its
+/// words for a note: one over the `classes` (`50.0 %, one over 2 classes`), or the largest
+/// class's share `majority` where that is larger, since always answering that class
+/// scores it (`66.7 %, always answering the most frequent class`).
+pub fn chance_level(classes: usize, majority: f64) -> (f64, String) {
+    let uniform = 1.0 / classes.max(1) as f64;
+    match majority > uniform {
+        true => (
+            majority,
+            format!(
+                "{:.1} %, always answering the most frequent class",
+                100.0 * majority
+            ),
+        ),
+        false => (
+            uniform,
+            format!("{:.1} %, one over {classes} classes", 100.0 * uniform),
+        ),
+    }
+}
+
 /// The significance level at which a paired comparison counts as a result.
 pub const ALPHA: f64 = 0.05;
 

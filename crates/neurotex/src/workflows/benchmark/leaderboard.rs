@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::candidate_set;
-use crate::classify::metrics::AgainstChance;
+use crate::classify::metrics::{chance_level, AgainstChance};
 use crate::compare::{Comparison, Ranked};
 use crate::datasets::recipe::ProtocolSpec;
 use crate::datasets::{Published, Recipe};
@@ -82,8 +82,9 @@ impl Leaderboard {
     pub fn summary(&self) -> Vec<String> {
         let line = |b: &Board| {
             let c = &b.comparison;
+            let (level, words) = chance_level(c.classes, c.majority);
             let nested = c.nested.as_ref().map_or(String::new(), |n| {
-                let flag = chance_flag(n.ci, c.chance).map_or(String::new(), |f| format!(" ({f})"));
+                let flag = chance_flag(n.ci, level).map_or(String::new(), |f| format!(" ({f})"));
                 format!(
                     "nested {} % [{}, {}]{flag}; ",
                     pct(n.accuracy),
@@ -92,12 +93,11 @@ impl Leaderboard {
                 )
             });
             format!(
-                "{} / {}: {nested}best {} {} %; chance {} %",
+                "{} / {}: {nested}best {} {} %; chance {words}",
                 b.dataset,
                 b.protocol_id,
                 name(&c.best),
                 pct(c.best.accuracy),
-                pct(c.chance)
             )
         };
         self.boards.iter().map(line).collect()
@@ -146,7 +146,7 @@ impl Board {
         }));
         Group {
             title: format!("{}: {}", self.dataset, self.protocol),
-            chance: c.chance,
+            chance: chance_level(c.classes, c.majority).0,
             rows,
         }
     }
@@ -303,12 +303,12 @@ fn section(b: &Board) -> String {
             pct(n.ci[0]),
             pct(n.ci[1])
         ));
-        if let Some(flag) = chance_flag(n.ci, c.chance) {
+        let (level, words) = chance_level(c.classes, c.majority);
+        if let Some(flag) = chance_flag(n.ci, level) {
             s.push_str(&format!(
-                "**{}{}** ({} %).\n\n",
+                "**{}{}** ({words}).\n\n",
                 flag[..1].to_uppercase(),
                 &flag[1..],
-                pct(c.chance)
             ));
         }
     }

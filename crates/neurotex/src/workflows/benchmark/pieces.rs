@@ -21,6 +21,8 @@ pub(super) struct Pieces {
     pub(super) removed: usize,
     /// The settings that differed from those of the removed pieces, as `name: then → now`.
     pub(super) differed: Vec<String>,
+    /// Pieces of these settings the folder held when it was opened.
+    pub(super) held: usize,
     /// Whether the folder holds a piece (an interrupted run names it only then).
     holds: AtomicBool,
 }
@@ -43,14 +45,16 @@ impl Pieces {
             std::fs::create_dir_all(&dir).map_err(|e| DataError::write(&dir, e))?;
             write_atomic(&key_file, |w| w.write_all(key.as_bytes()))?;
         }
+        let held = pieces_only(&dir)?;
         let pieces = Pieces {
             dir,
             taken: AtomicUsize::new(0),
             removed,
             differed,
+            held,
             holds: AtomicBool::new(false),
         };
-        if removed == 0 && std::fs::read_dir(&pieces.dir).is_ok_and(|d| d.count() > 1) {
+        if pieces.held > 0 {
             pieces.noted();
         }
         Ok(pieces)
@@ -71,6 +75,7 @@ impl Pieces {
             taken: AtomicUsize::new(0),
             removed: 0,
             differed: Vec::new(),
+            held: 0,
             holds: AtomicBool::new(false),
         })
     }

@@ -11,7 +11,7 @@ use std::io::Write;
 use serde_json::Value;
 
 use crate::analysis::{Columns, MethodSamples, Outcome, Split, TaxelAccuracy};
-use crate::classify::metrics::AgainstChance;
+use crate::classify::metrics::{chance_level, AgainstChance};
 use crate::classify::{ClassifierChoice, Interval, Metrics};
 use crate::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
 use crate::pipeline::{Encoded, Pipeline};
@@ -156,18 +156,8 @@ impl Evaluation {
     /// scores); `None` when the interval is wholly above. A workflow says it as a warning:
     /// the accuracy alone, a few points over chance, reads as a result it is not.
     pub fn chance_note(&self) -> Option<String> {
-        let (uniform, majority) = (self.metrics.chance_uniform, self.metrics.chance_majority);
-        let chance = match majority > uniform {
-            true => format!(
-                "{:.1} %, always answering the most frequent class",
-                100.0 * majority
-            ),
-            false => format!(
-                "{:.1} %, one over {} classes",
-                100.0 * uniform,
-                self.metrics.classes_present
-            ),
-        };
+        let (level, chance) =
+            chance_level(self.metrics.classes_present, self.metrics.chance_majority);
         let ci = [self.interval.lower, self.interval.upper];
         let interval = format!("[{:.1}, {:.1}] %", 100.0 * ci[0], 100.0 * ci[1]);
         let apart = !matches!(self.split, Split::CrossValidation { .. });
@@ -175,7 +165,7 @@ impl Evaluation {
             true => " (features that differ between the training and the test recordings)",
             false => "",
         };
-        AgainstChance::of(ci, uniform.max(majority)).map(|at| match at {
+        AgainstChance::of(ci, level).map(|at| match at {
             AgainstChance::Below => format!(
                 "the accuracy's interval {interval} is under chance ({chance}): what the classifier learns on the training recordings does not carry over to the test recordings{why}"
             ),

@@ -359,9 +359,8 @@ impl Evaluated {
         if let Some(c) = &self.calibrated.gain {
             value["gain_calibration"] = serde_json::to_value(c)?;
         }
-        if !self.notes.is_empty() {
-            value["notes"] = serde_json::to_value(&self.notes)?;
-        }
+        // Always there, empty when nothing was said, so that a script can read it.
+        value["notes"] = serde_json::to_value(&self.notes)?;
         Ok(value)
     }
 }
