@@ -111,7 +111,8 @@ mod handler {
     /// Installs [`on_signal`] for SIGINT; `None` when the system refuses.
     pub(super) fn install() -> Option<Installed> {
         // SAFETY: zeroed `sigaction`s are valid values; `on_signal` only stores to an
-        // atomic (`request_stop`), which is async-signal-safe; the previous action is kept to be restored.
+        // atomic (`request_stop`), which is async-signal-safe; the previous action is
+        // kept to be restored.
         unsafe {
             let mut ours: libc::sigaction = std::mem::zeroed();
             ours.sa_sigaction = on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t;
