@@ -97,7 +97,8 @@ fn latency() {
     let knn = ClassifierChoice::Knn(KnnParams::default());
     let model = Model::train(&params, &table, Columns::All, knn, provenance.clone()).unwrap();
     let snn = SnnParams::default();
-    let (network, _) = SpikingModel::train(&params, &encoded, &grid, snn, provenance).unwrap();
+    let (network, _) =
+        SpikingModel::train(&params, &encoded, &grid, (snn, &|| ()), provenance).unwrap();
 
     let rec = &recs[0];
     let phases = rec.phases.as_ref().unwrap();

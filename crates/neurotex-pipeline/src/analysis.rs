@@ -657,7 +657,8 @@ where
     })
 }
 
-/// A learner that says [`Progress::Tick`] after each fit.
+/// A learner that says [`Progress::Tick`] after each fit, or as often as it says
+/// ([`Learner::ticks`]: each epoch of the spiking network).
 struct Ticking<'a, L> {
     learner: &'a L,
     on: &'a (dyn Fn(Progress) + Sync),
@@ -672,9 +673,8 @@ impl<S: ?Sized, L: Learner<S>> Learner<S> for Ticking<'_, L> {
         rows: &[usize],
         y: &[usize],
     ) -> std::result::Result<Self::Fitted, ClassifyError> {
-        let fitted = self.learner.learn(samples, rows, y)?;
-        (self.on)(Progress::Tick);
-        Ok(fitted)
+        let tick = || (self.on)(Progress::Tick);
+        self.learner.learn_ticking(samples, rows, y, &tick)
     }
 }
 

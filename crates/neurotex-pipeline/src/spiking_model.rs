@@ -125,7 +125,7 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
 
 impl SpikingModel {
     /// Trains a network with `snn` on the recordings `encoded` (conditioned and encoded
-    /// with `params`, all on `grid`).
+    /// with `params`, all on `grid`), calling `each_epoch` once per epoch of `snn.epochs`.
     ///
     /// # Errors
     /// Fewer than two classes, a class too small for the validation split, recordings
@@ -134,7 +134,7 @@ impl SpikingModel {
         params: &PipelineParams,
         encoded: &[Encoded],
         grid: &Grid,
-        snn: SnnParams,
+        (snn, each_epoch): (SnnParams, &(dyn Fn() + Sync)),
         dataset: Provenance,
     ) -> Result<(SpikingModel, TrainingLog)> {
         let snn = snn.check()?;
@@ -161,8 +161,8 @@ impl SpikingModel {
             .map(|e| spike_input(e, snn.dt_ms))
             .collect();
         let refs: Vec<&SpikeInput> = inputs.iter().collect();
-        let (network, log) =
-            crate::snn::fit(&snn, &refs, &y, labels.len()).map_err(|e| match e {
+        let (network, log) = crate::snn::fit_with(&snn, &refs, &y, labels.len(), each_epoch)
+            .map_err(|e| match e {
                 ClassifyError::ValidationTooSmall { class, count } => {
                     ClassifyError::ValidationTooSmall {
                         class: class.parse::<usize>().map_or(class, |c| labels[c].clone()),

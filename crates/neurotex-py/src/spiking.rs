@@ -131,7 +131,7 @@ fn train_spiking_model<'py>(
         guarded(|| {
             let t = Training::encode(&stages, &view, baseline, fingerprint)?;
             let params = t.pipeline.params();
-            SpikingModel::train(params, &t.encoded, &t.grid, snn, t.provenance)
+            SpikingModel::train(params, &t.encoded, &t.grid, (snn, &|| ()), t.provenance)
         })
     })?;
     let model = NativeSpikingModel { inner };

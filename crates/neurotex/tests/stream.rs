@@ -572,7 +572,7 @@ fn causal_network(train: &[Recording], dt_ms: u32) -> SpikingModel {
         ..SnnParams::default()
     };
     let grid = train[0].layout_grid();
-    SpikingModel::train(&params, &encoded, &grid, snn, provenance)
+    SpikingModel::train(&params, &encoded, &grid, (snn, &|| ()), provenance)
         .unwrap()
         .0
 }

@@ -47,6 +47,28 @@ pub trait Learner<S: ?Sized>: Sync {
         rows: &[usize],
         y: &[usize],
     ) -> Result<Self::Fitted, ClassifyError>;
+
+    /// [`Learner::learn`], calling `tick` [`Learner::ticks`] times on the way (once when
+    /// it is done, unless the learner says more of its progress).
+    ///
+    /// # Errors
+    /// As [`Learner::learn`].
+    fn learn_ticking(
+        &self,
+        samples: &S,
+        rows: &[usize],
+        y: &[usize],
+        tick: &(dyn Fn() + Sync),
+    ) -> Result<Self::Fitted, ClassifyError> {
+        let fitted = self.learn(samples, rows, y)?;
+        tick();
+        Ok(fitted)
+    }
+
+    /// How many times [`Learner::learn_ticking`] ticks per fit.
+    fn ticks(&self) -> usize {
+        1
+    }
 }
 
 /// A fitted [`Learner`]: each of its settings' decisions on samples of `S` (one setting,

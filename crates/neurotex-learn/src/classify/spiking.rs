@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::samples::{Decide, Learner, Samples};
 use crate::error::ClassifyError;
-use crate::snn::{fit, softmax, Network, SnnParams, SpikeInput};
+use crate::snn::{fit_with, softmax, Network, SnnParams, SpikeInput};
 
 impl Samples for [SpikeInput] {
     fn count(&self) -> usize {
@@ -64,10 +64,26 @@ impl Learner<[SpikeInput]> for SnnClassifier {
         rows: &[usize],
         y: &[usize],
     ) -> Result<SnnModel, ClassifyError> {
+        self.learn_ticking(samples, rows, y, &|| ())
+    }
+
+    /// Ticks once per epoch of the parameters' `epochs` (a fit on long slides takes
+    /// minutes).
+    fn learn_ticking(
+        &self,
+        samples: &[SpikeInput],
+        rows: &[usize],
+        y: &[usize],
+        tick: &(dyn Fn() + Sync),
+    ) -> Result<SnnModel, ClassifyError> {
         let inputs = pick(samples, rows)?;
         let classes = y.iter().max().map_or(0, |m| m + 1);
-        let (network, _) = fit(&self.params, &inputs, y, classes)?;
+        let (network, _) = fit_with(&self.params, &inputs, y, classes, tick)?;
         Ok(SnnModel { network })
+    }
+
+    fn ticks(&self) -> usize {
+        self.params.epochs
     }
 }
 

@@ -46,7 +46,7 @@ use crate::error::{ModelError, ParamError};
 pub use input::SpikeInput;
 pub use params::{SnnParams, MAX_HIDDEN};
 pub use run::{Runner, State, Windowed};
-pub use train::fit;
+pub use train::{fit, fit_with};
 pub use xylo::Target;
 
 /// How a class's score is read from its readout trace.

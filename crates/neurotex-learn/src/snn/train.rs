@@ -37,6 +37,22 @@ pub fn fit(
     y: &[usize],
     classes: usize,
 ) -> Result<(Network, TrainingLog), ClassifyError> {
+    fit_with(params, inputs, y, classes, &|| ())
+}
+
+/// [`fit`], calling `each_epoch` once for each of `params.epochs`: after each epoch run,
+/// and at the end for those early stopping left out, so that a progress bar of
+/// `params.epochs` steps fills whatever happens.
+///
+/// # Errors
+/// As [`fit`].
+pub fn fit_with(
+    params: &SnnParams,
+    inputs: &[&SpikeInput],
+    y: &[usize],
+    classes: usize,
+    each_epoch: &(dyn Fn() + Sync),
+) -> Result<(Network, TrainingLog), ClassifyError> {
     check_inputs(inputs, y)?;
     if params.target == super::Target::Xylo {
         let shape = super::xylo::check_shape(inputs[0].inputs, params.hidden, classes);
@@ -65,12 +81,14 @@ pub fn fit(
             adam.step(&mut net, &grad);
         }
         let loss = mean_loss(&net, inputs, y, &valid);
+        each_epoch();
         if loss < best.0 {
             best = (loss, net.clone(), epoch);
         } else if epoch - best.2 >= params.patience {
             break;
         }
     }
+    (epochs..params.epochs).for_each(|_| each_epoch());
     let (validation_loss, mut net, best_epoch) = best;
     // Weights a float32 file (NIR, NumPy) holds exactly: the model file and its export
     // predict alike.
@@ -381,6 +399,35 @@ mod tests {
         let (net, log) = fit(&params, &refs, &y, 2).unwrap();
         learned_alike_on_one_thread(&params, &refs, &y, (&net, log));
         assert!(log.best_epoch >= 1 && log.epochs <= 30);
+    }
+
+    /// A progress callback hears one tick per epoch of the parameters, whether early
+    /// stopping ends training before them or not, and changes nothing of the network.
+    #[test]
+    fn each_epoch_ticks_once_early_stopping_or_not() {
+        let (data, _) = two_class_task(40, 50);
+        // Labels the inputs do not carry (the task's classes alternate): the validation
+        // loss soon stops falling, so early stopping ends training.
+        let y: Vec<usize> = (0..data.len()).map(|k| (k / 2) % 2).collect();
+        let refs: Vec<&SpikeInput> = data.iter().collect();
+        for patience in [1, 100] {
+            let params = SnnParams {
+                hidden: 16,
+                epochs: 120,
+                patience,
+                ..SnnParams::default()
+            };
+            let ticks = std::sync::atomic::AtomicUsize::new(0);
+            let tick = || {
+                ticks.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            };
+            let (net, log) = fit_with(&params, &refs, &y, 2, &tick).unwrap();
+            assert_eq!(ticks.into_inner(), 120, "patience {patience}");
+            assert_eq!((net, log), fit(&params, &refs, &y, 2).unwrap());
+            if patience == 1 {
+                assert!(log.epochs < 120, "{log:?}");
+            }
+        }
     }
 
     /// Training on windows: a window no shorter than every recording trains on them whole

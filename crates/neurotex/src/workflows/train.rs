@@ -229,7 +229,14 @@ impl TrainOptions {
             encoded.len(),
             snn.validation * 100.0
         )));
-        let (model, log) = SpikingModel::train(&params, &encoded, &grid, snn, provenance)?;
+        // Minutes on long slides: a step per epoch.
+        on(Progress::Stage(
+            "training the spiking network (epochs)",
+            snn.epochs,
+        ));
+        let each_epoch = || on(Progress::Tick);
+        let (model, log) =
+            SpikingModel::train(&params, &encoded, &grid, (snn, &each_epoch), provenance)?;
         Ok(TrainedSpiking { model, log, grid })
     }
 }

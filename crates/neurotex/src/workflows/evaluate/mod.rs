@@ -307,10 +307,10 @@ impl EvaluateOptions {
             if let Some(note) = snn.short_window() {
                 on(Progress::Say(&note));
             }
-            // Minutes on long slides: one step per fit.
+            // Minutes on long slides: one step per epoch of each fit.
             on(Progress::Stage(
-                "training the spiking network",
-                self.fits(dataset, &indices),
+                "training the spiking network (epochs of every fit)",
+                self.fits(dataset, &indices) * snn.epochs,
             ));
         }
         let outcome = evaluator(classifier, samples)?(&all, &split, on)?;
