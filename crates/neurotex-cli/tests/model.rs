@@ -7,7 +7,7 @@ use ndarray::Array3;
 use ndarray_npy::write_npy;
 use serde_json::Value;
 
-use crate::util::{recording, s, Dir};
+use crate::util::{recording, relabel, s, Dir};
 
 /// Simulates `name`: FT1, SB and CP x 6 trials at 5 mm/s with `seed`.
 fn simulated(dir: &Dir, name: &str, seed: &str) -> PathBuf {
@@ -899,4 +899,37 @@ fn export_inputs_at_some_speeds() {
     }
     let err = dir.fails(&strs(&export("7")));
     assert!(err.contains('7'), "{err}");
+}
+
+/// Training counts its epochs, and says where early stopping ended it: the epoch the
+/// model file records, of those asked for.
+#[test]
+fn early_stopping_is_said_with_the_epoch_it_ended_at() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 6);
+    // Labels the recordings do not carry: the validation loss soon stops falling.
+    relabel(&ds, |trial| if trial % 2 == 0 { "even" } else { "odd" });
+    let model = dir.join("snn.json");
+    let args = ["train", "--dataset", s(&ds), "--classifier", "snn"];
+    let mut args = args.to_vec();
+    args.extend([
+        "--snn-hidden",
+        "8",
+        "--snn-epochs",
+        "400",
+        "--out",
+        s(&model),
+    ]);
+    let run = dir.run(&args);
+    assert!(run.status.success(), "{}", run.stderr);
+    let file: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let epochs = file["training"]["epochs"].as_u64().unwrap();
+    assert!(epochs < 400, "no early stop: {epochs}");
+    let said = format!("early stopping: training ended at epoch {epochs} of 400, 15 epochs after the lowest validation loss");
+    assert_eq!(run.stderr.matches(&said).count(), 1, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("training the spiking network (epochs)"),
+        "{}",
+        run.stderr
+    );
 }

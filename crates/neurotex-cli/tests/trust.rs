@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::util::{s, xorshift, Dir};
+use crate::util::{relabel, s, xorshift, Dir};
 
 /// Writes event logs `t_us,x,y,p` of two textures x `trials` into `logs`: 2 s of events on
 /// a 2x2 grid (texture A's ON events on the left column, B's on the right), each log's
@@ -859,19 +859,6 @@ fn folds_the_design_cannot_give_are_said_with_the_folds_used() {
     assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
     let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
     assert!(json["notes"][0].as_str().unwrap().contains(said), "{json}");
-}
-
-/// Labels each recording of a [`Dir::dataset`] folder by its trial number alone.
-fn relabel(data: &Path, label_of: impl Fn(usize) -> &'static str) {
-    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
-    let mut lines = manifest.lines();
-    let mut relabelled = format!("{}\n", lines.next().unwrap());
-    for line in lines {
-        let mut fields: Vec<&str> = line.split(',').collect();
-        fields[1] = label_of(fields[4].parse().unwrap());
-        relabelled.push_str(&format!("{}\n", fields.join(",")));
-    }
-    std::fs::write(data.join("manifest.csv"), relabelled).unwrap();
 }
 
 /// An accuracy whose interval reaches chance is said to be no result, on standard error

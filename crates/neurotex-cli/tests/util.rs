@@ -201,3 +201,16 @@ pub fn fabricslide() -> PathBuf {
     );
     dir
 }
+
+/// Labels each recording of a [`Dir::dataset`] folder by its trial number alone.
+pub fn relabel(data: &Path, label_of: impl Fn(usize) -> &'static str) {
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    let mut lines = manifest.lines();
+    let mut relabelled = format!("{}\n", lines.next().unwrap());
+    for line in lines {
+        let mut fields: Vec<&str> = line.split(',').collect();
+        fields[1] = label_of(fields[4].parse().unwrap());
+        relabelled.push_str(&format!("{}\n", fields.join(",")));
+    }
+    std::fs::write(data.join("manifest.csv"), relabelled).unwrap();
+}

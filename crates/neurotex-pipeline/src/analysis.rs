@@ -673,8 +673,15 @@ impl<S: ?Sized, L: Learner<S>> Learner<S> for Ticking<'_, L> {
         rows: &[usize],
         y: &[usize],
     ) -> std::result::Result<Self::Fitted, ClassifyError> {
-        let tick = || (self.on)(Progress::Tick);
-        self.learner.learn_ticking(samples, rows, y, &tick)
+        let ticked = std::sync::atomic::AtomicUsize::new(0);
+        let tick = || {
+            ticked.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            (self.on)(Progress::Tick);
+        };
+        let fitted = self.learner.learn_ticking(samples, rows, y, &tick)?;
+        // The steps a fit did not take (epochs early stopping left out), as it ends.
+        (ticked.into_inner()..self.learner.ticks()).for_each(|_| (self.on)(Progress::Tick));
+        Ok(fitted)
     }
 }
 

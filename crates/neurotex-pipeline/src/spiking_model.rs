@@ -125,7 +125,7 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
 
 impl SpikingModel {
     /// Trains a network with `snn` on the recordings `encoded` (conditioned and encoded
-    /// with `params`, all on `grid`), calling `each_epoch` once per epoch of `snn.epochs`.
+    /// with `params`, all on `grid`), calling `each_epoch` after each epoch run.
     ///
     /// # Errors
     /// Fewer than two classes, a class too small for the validation split, recordings

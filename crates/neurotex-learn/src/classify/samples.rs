@@ -48,8 +48,8 @@ pub trait Learner<S: ?Sized>: Sync {
         y: &[usize],
     ) -> Result<Self::Fitted, ClassifyError>;
 
-    /// [`Learner::learn`], calling `tick` [`Learner::ticks`] times on the way (once when
-    /// it is done, unless the learner says more of its progress).
+    /// [`Learner::learn`], calling `tick` at most [`Learner::ticks`] times on the way (once
+    /// when it is done, unless the learner says more of its progress).
     ///
     /// # Errors
     /// As [`Learner::learn`].

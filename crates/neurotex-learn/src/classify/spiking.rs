@@ -67,8 +67,8 @@ impl Learner<[SpikeInput]> for SnnClassifier {
         self.learn_ticking(samples, rows, y, &|| ())
     }
 
-    /// Ticks once per epoch of the parameters' `epochs` (a fit on long slides takes
-    /// minutes).
+    /// Ticks once per epoch run, at most the parameters' `epochs` (a fit on long slides
+    /// takes minutes).
     fn learn_ticking(
         &self,
         samples: &[SpikeInput],

@@ -40,9 +40,8 @@ pub fn fit(
     fit_with(params, inputs, y, classes, &|| ())
 }
 
-/// [`fit`], calling `each_epoch` once for each of `params.epochs`: after each epoch run,
-/// and at the end for those early stopping left out, so that a progress bar of
-/// `params.epochs` steps fills whatever happens.
+/// [`fit`], calling `each_epoch` after each epoch run ([`TrainingLog::epochs`] times:
+/// fewer than `params.epochs` when early stopping ends training).
 ///
 /// # Errors
 /// As [`fit`].
@@ -88,7 +87,6 @@ pub fn fit_with(
             break;
         }
     }
-    (epochs..params.epochs).for_each(|_| each_epoch());
     let (validation_loss, mut net, best_epoch) = best;
     // Weights a float32 file (NIR, NumPy) holds exactly: the model file and its export
     // predict alike.
@@ -401,8 +399,8 @@ mod tests {
         assert!(log.best_epoch >= 1 && log.epochs <= 30);
     }
 
-    /// A progress callback hears one tick per epoch of the parameters, whether early
-    /// stopping ends training before them or not, and changes nothing of the network.
+    /// A progress callback hears one tick per epoch run, whether early stopping ends
+    /// training before the parameters' epochs or not, and changes nothing of the network.
     #[test]
     fn each_epoch_ticks_once_early_stopping_or_not() {
         let (data, _) = two_class_task(40, 50);
@@ -422,7 +420,7 @@ mod tests {
                 ticks.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             };
             let (net, log) = fit_with(&params, &refs, &y, 2, &tick).unwrap();
-            assert_eq!(ticks.into_inner(), 120, "patience {patience}");
+            assert_eq!(ticks.into_inner(), log.epochs, "patience {patience}");
             assert_eq!((net, log), fit(&params, &refs, &y, 2).unwrap());
             if patience == 1 {
                 assert!(log.epochs < 120, "{log:?}");

@@ -237,6 +237,13 @@ impl TrainOptions {
         let each_epoch = || on(Progress::Tick);
         let (model, log) =
             SpikingModel::train(&params, &encoded, &grid, (snn, &each_epoch), provenance)?;
+        if log.epochs < snn.epochs {
+            on(Progress::Say(&format!(
+                "early stopping: training ended at epoch {} of {}, {} epochs after the lowest validation loss",
+                log.epochs, snn.epochs, snn.patience
+            )));
+            (log.epochs..snn.epochs).for_each(|_| on(Progress::Tick));
+        }
         Ok(TrainedSpiking { model, log, grid })
     }
 }
