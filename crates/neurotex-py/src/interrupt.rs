@@ -19,7 +19,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use neurotex::progress::{request_stop, stop_point, take_stop, Stopped};
+use neurotex::progress::{request_stop, take_stop, Stopped};
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 
@@ -32,11 +32,6 @@ pub(crate) fn stopped_error(stopped: &Stopped) -> PyErr {
         .0
         .replace("the same command, run again,", "the same call, made again,");
     PyKeyboardInterrupt::new_err(format!("neurotex: the run stopped; {kept}"))
-}
-
-/// Unwinds the run when a Ctrl-C asked it to stop; called at each event it reports.
-pub(crate) fn stop_if_asked() {
-    stop_point();
 }
 
 /// Keeps the report of a [`Stopped`] panic off standard error: the exception says it.

@@ -279,7 +279,8 @@ impl Said {
     /// GIL here waits on no thread of the run.
     pub(crate) fn hear(&self, progress: neurotex::progress::Progress) {
         use neurotex::progress::Progress;
-        crate::interrupt::stop_if_asked();
+        // A Ctrl-C during the call ends the run here ([`crate::interrupt`]).
+        neurotex::progress::stop_point();
         // Advice is logged as a warning, the rest as information.
         let (line, warning) = match progress {
             Progress::Say(s) => (s.to_string(), false),

@@ -110,7 +110,8 @@ fn run(
     let warnings = Mutex::new(Vec::new());
     let say = |text: String| warnings.lock().expect("warnings").push(text);
     let on_progress = |p: Progress| {
-        crate::interrupt::stop_if_asked();
+        // A Ctrl-C during the call ends the run here ([`crate::interrupt`]).
+        neurotex::progress::stop_point();
         match p {
             Progress::TooSmall(e) => {
                 say(format!(

@@ -12,15 +12,17 @@ use super::resample::{
 use super::rest::RestTracker;
 use super::{LessOffsets, PreprocessParams, ENCODER_FS};
 
-/// Whether the recording is sampled uniformly at the encoder's 1 kHz (no resampling).
-fn uniform_1k(rec: &Recording) -> bool {
-    (rec.fs - ENCODER_FS).abs() < 1e-9 && rec.times_s.as_deref().is_none_or(on_the_1ms_grid)
+/// Whether the recording, whose times are `times`, is sampled uniformly at the encoder's
+/// 1 kHz (no resampling).
+fn uniform_1k(rec: &Recording, times: Times) -> bool {
+    matches!(times, Times::Uniform { .. }) && (rec.fs - ENCODER_FS).abs() < 1e-9
 }
 
 /// Whether time stamps (s) fall exactly on the encoder's grid from the first: `i / 1000`
 /// after the first, as a logger writing whole milliseconds gives them. Resampling such
 /// stamps linearly reproduces every sample bit for bit (each grid time is a stamp), so
-/// the recording is read as sampled uniformly, and not said to be resampled.
+/// a recording at 1 kHz with them is read as sampled uniformly, and not said to be
+/// resampled ([`Preprocessor::apply`]).
 fn on_the_1ms_grid(t: &[f64]) -> bool {
     let first = t.first().copied().unwrap_or(0.0);
     t.iter()
@@ -43,8 +45,7 @@ fn selected_phase(
     let (cells, file) = (rec.layout.cells(), &rec.meta.file);
     let present = &rec.layout.present;
     let (lo, hi) = (frames.start, frames.end);
-    let uniform_1k = uniform_1k(rec);
-    let samples = if uniform_1k {
+    let samples = if uniform_1k(rec, times) {
         less_offsets(&rec.samples[lo * cells..hi * cells], offsets, present)
     } else {
         let span = times.at(hi - 1) - times.at(lo);
@@ -183,7 +184,7 @@ impl Preprocessor {
         let Some(filter) = &self.filter else {
             return Ok((selected_phase(rec, times, offsets, frames)?, None));
         };
-        let (mut samples, top) = if uniform_1k(rec) {
+        let (mut samples, top) = if uniform_1k(rec, times) {
             if cells == 0 || frames.is_empty() {
                 return Err(phase_too_short(rec));
             }
@@ -233,7 +234,11 @@ impl Preprocessor {
         if n == 0 {
             return Err(DataError::invalid(file, "recording holds no samples").into());
         }
-        let stamps = rec.times_s.as_ref().map(|_| relative_times(rec));
+        // Stamps on the 1 ms grid at 1 kHz are the times a uniform recording has.
+        let on_grid = (rec.fs - ENCODER_FS).abs() < 1e-9
+            && rec.times_s.as_deref().is_some_and(on_the_1ms_grid);
+        let stamps = rec.times_s.as_ref().filter(|_| !on_grid);
+        let stamps = stamps.map(|_| relative_times(rec));
         let times = Times::of(rec, stamps.as_deref());
         let offsets = match &self.params.causal {
             // The resting values are tracked as the samples come (`less_tracked_rest`).
@@ -262,7 +267,7 @@ impl Preprocessor {
         Ok(Conditioned {
             samples,
             cells,
-            resampled: !uniform_1k(rec),
+            resampled: !uniform_1k(rec, times),
             flat,
         })
     }
