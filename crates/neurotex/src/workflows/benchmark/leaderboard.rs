@@ -82,7 +82,7 @@ impl Leaderboard {
     pub fn summary(&self) -> Vec<String> {
         let line = |b: &Board| {
             let c = &b.comparison;
-            let (level, words) = chance_level(c.classes, c.majority);
+            let (level, _) = chance_level(c.classes, c.majority);
             let nested = c.nested.as_ref().map_or(String::new(), |n| {
                 let flag = chance_flag(n.ci, level).map_or(String::new(), |f| format!(" ({f})"));
                 format!(
@@ -93,11 +93,13 @@ impl Leaderboard {
                 )
             });
             format!(
-                "{} / {}: {nested}best {} {} %; chance {words}",
+                "{} / {}: {nested}best {} {} %; chance {} %, majority class {} %",
                 b.dataset,
                 b.protocol_id,
                 name(&c.best),
                 pct(c.best.accuracy),
+                pct(c.chance),
+                pct(c.majority)
             )
         };
         self.boards.iter().map(line).collect()
@@ -146,7 +148,8 @@ impl Board {
         }));
         Group {
             title: format!("{}: {}", self.dataset, self.protocol),
-            chance: chance_level(c.classes, c.majority).0,
+            // One over the classes, as the tables' chance column.
+            chance: c.chance,
             rows,
         }
     }
