@@ -241,6 +241,11 @@ fn bad_compare_options_are_clear_errors() {
             (with(&["--spectrum-bands", "0"]), "spectrum-bands"),
             (with(&["--per", "session"]), "session"),
             (with(&["--per", "speed_mm_s"]), "at least two values"),
+            (with(&["--inner-folds", "3"]), "--nested"),
+            (
+                with(&["--nested", "--inner-folds", "1"]),
+                "at least 2 folds",
+            ),
         ],
         &out,
     );

@@ -205,14 +205,15 @@ fn listed(names: Option<Vec<String>>, standard: &str) -> Vec<String> {
 /// --json` does, through its workflow: `encodings`, `methods` and `classifiers` (`None`:
 /// the CLI's standard sets), the protocol (`per`, `hold_out`, or `train_where` with
 /// `test_where`; pooled without), `group_by`, the cross-validation's `folds`, `repeats`
-/// and `seed` (`None`: the CLI's), `nested` selection, KNN's `knn` knobs and the
+/// and `seed` (`None`: the CLI's), `nested` selection with its `inner_folds` (`None`: as
+/// `folds`; refused without `nested`, as `--inner-folds` is), KNN's `knn` knobs and the
 /// network's `snn` knobs. With `out`, also writes compare.json, compare.md and the
 /// figures there, as `--out`. Returns the comparison as the CLI's JSON object; what the
 /// workflow says goes to Python's log as it is said.
 #[pyfunction]
 #[pyo3(signature = (path, options, knn, snn, encodings=None, methods=None, classifiers=None,
     speeds=None, per=None, hold_out=None, train_where=None, test_where=None, group_by=None,
-    folds=None, repeats=None, seed=0, nested=false, tau_ms=None, out=None))]
+    folds=None, repeats=None, seed=0, nested=false, inner_folds=None, tau_ms=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 fn compare_dataset(
     py: Python<'_>,
@@ -233,6 +234,7 @@ fn compare_dataset(
     repeats: Option<usize>,
     seed: u64,
     nested: bool,
+    inner_folds: Option<usize>,
     tau_ms: Option<f64>,
     out: Option<PathBuf>,
 ) -> PyResult<Py<PyAny>> {
@@ -243,6 +245,10 @@ fn compare_dataset(
     let chosen = [per.is_some(), hold_out.is_some(), train_where.is_some()];
     if chosen.iter().filter(|&&c| c).count() > 1 || train_where.is_some() != test_where.is_some() {
         let why = "one protocol at a time: per, hold_out, or train_where with test_where";
+        return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
+    }
+    if inner_folds.is_some() && !nested {
+        let why = "inner_folds is nested selection's: give it with nested=True";
         return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
     }
     let cv = neurotex::classify::CvParams::default();
@@ -264,6 +270,7 @@ fn compare_dataset(
         repeats: repeats.unwrap_or(cv.repeats),
         seed,
         nested,
+        inner_folds,
         open: OpenOptions::default(),
     };
     let dataset = open(&path)?;

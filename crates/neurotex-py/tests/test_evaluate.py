@@ -75,12 +75,14 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
     with `out` the same compare.json, but for the seconds each candidate took."""
     ours = neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d", "all-taxels"],
                             classifiers=["knn", "linear"], per="speed_mm_s", folds=3,
-                            knn_options={"k": 3}, nested=True, out=tmp_path / "py")
+                            knn_options={"k": 3}, nested=True, inner_folds=2,
+                            out=tmp_path / "py")
     cli = json.loads(run_cli("compare", "--dataset", sim_dir, "--encodings", "sa",
                              "--methods", "glcm3d,all-taxels", "--classifiers", "knn,linear",
                              "--per", "speed_mm_s", "--folds", "3", "-k", "3", "--nested",
-                             "--json", "--out", tmp_path / "cli").stdout)
+                             "--inner-folds", "2", "--json", "--out", tmp_path / "cli").stdout)
     assert untimed(ours) == untimed(cli)
+    assert ours["nested"]["inner"] == "2-fold cross-validation inside each outer training set"
     written = [json.loads((tmp_path / side / "compare.json").read_text()) for side in ("py", "cli")]
     assert untimed(written[0]) == untimed(written[1])
     assert (tmp_path / "py" / "compare.md").is_file()
@@ -97,6 +99,10 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
         neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d"], classifiers=["knn"],
                          per="speed_mm_s", folds=3, knn_options={"k": 3}, out=theirs)
     assert (theirs / "notes.txt").read_text() == "mine"
+    with pytest.raises(ParameterError, match="with nested=True"):
+        neurotex.compare(sim_dir, per="speed_mm_s", inner_folds=3)
+    with pytest.raises(ParameterError, match="at least 2 folds"):
+        neurotex.compare(sim_dir, per="speed_mm_s", nested=True, inner_folds=1)
     with pytest.raises(ParameterError, match="one protocol at a time"):
         neurotex.compare(sim_dir, per="speed_mm_s", hold_out="speed_mm_s")
     with pytest.raises(ParameterError, match="must be a list"):

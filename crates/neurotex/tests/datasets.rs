@@ -662,6 +662,7 @@ fn compare_nested_per_speed(dataset: &Path, folds: usize, seed: u64) -> Comparis
         repeats: 1,
         seed,
         nested: true,
+        inner_folds: None,
         open: OpenOptions::default(),
     };
     let opened = compare.open.open(dataset).unwrap();

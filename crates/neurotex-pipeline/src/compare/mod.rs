@@ -140,6 +140,10 @@ pub struct CompareParams {
     pub resamples: usize,
     /// Also estimate the accuracy of choosing the best candidate inside each training set.
     pub nested: bool,
+    /// Folds of nested selection's inner cross-validation, at least 2 (front ends give the
+    /// outer folds unless asked otherwise); fewer where a class of an outer training set
+    /// has fewer recordings.
+    pub inner_folds: usize,
 }
 
 /// A candidate's accuracy at one condition.
@@ -547,6 +551,7 @@ mod tests {
             group_by: None,
             resamples: 500,
             nested,
+            inner_folds: 4,
         }
     }
 

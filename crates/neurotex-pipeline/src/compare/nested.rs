@@ -43,15 +43,16 @@ pub(super) fn fewer_folds(
             ));
         }
     }
+    let asked = params.inner_folds;
     let inner = outer
         .unwrap_or_default()
         .iter()
         .filter(|split| inner_held_out(metas, params, split).is_none())
-        .map(|split| inner_folds(folds, smallest_class(metas, &split.train)))
-        .filter(|&used| used < folds);
+        .map(|split| inner_folds(asked, smallest_class(metas, &split.train)))
+        .filter(|&used| used < asked);
     if let Some(used) = inner.clone().min() {
         notes.push(format!(
-            "--folds {folds}: nested selection's inner cross-validation uses {used} folds in {} of {} outer training sets (their smallest class has fewer than {folds} recordings)",
+            "nested selection's inner cross-validation uses {used} folds instead of {asked} in {} of {} outer training sets (their smallest class has fewer than {asked} recordings)",
             inner.count(),
             outer.map_or(0, <[_]>::len)
         ));
@@ -60,8 +61,9 @@ pub(super) fn fewer_folds(
     notes
 }
 
-/// The folds of nested selection's inner cross-validation: `folds`, fewer when a class of
-/// the outer training set has fewer recordings (`smallest`), never under 2.
+/// The folds of nested selection's inner cross-validation: `folds` (the inner folds asked
+/// for), fewer when a class of the outer training set has fewer recordings (`smallest`),
+/// never under 2.
 fn inner_folds(folds: usize, smallest: usize) -> usize {
     folds.min(smallest).max(2)
 }
@@ -94,7 +96,7 @@ fn inner_ranking(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) 
         .count();
     let folds: Vec<usize> = (splits.iter())
         .filter(|split| inner_held_out(metas, params, split).is_none())
-        .map(|split| inner_folds(params.cv.folds, smallest_class(metas, &split.train)))
+        .map(|split| inner_folds(params.inner_folds, smallest_class(metas, &split.train)))
         .collect();
     let cv = match (folds.iter().min(), folds.iter().max()) {
         (Some(a), Some(b)) if a == b => format!("{a}-fold cross-validation"),
@@ -254,6 +256,10 @@ fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
 /// Nested selection's outer splits, when it can run on them: its inner cross-validation
 /// needs at least 2 folds, so every class at least 2 recordings in each outer training set.
 pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
+    if params.inner_folds < 2 {
+        let rule = "nested selection's inner cross-validation needs at least 2 folds";
+        return Err(ParamError::new("inner_folds", rule, params.inner_folds).into());
+    }
     let splits = outer_splits(metas, params)?;
     for split in &splits {
         if smallest_class(metas, &split.train) < 2 {
@@ -288,7 +294,7 @@ fn outer(
     let inner = CompareParams {
         cv: crate::classify::CvParams {
             repeats: 1,
-            folds: inner_folds(params.cv.folds, smallest),
+            folds: inner_folds(params.inner_folds, smallest),
             ..*params.cv
         }
         .check()?,

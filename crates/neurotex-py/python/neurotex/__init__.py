@@ -671,6 +671,7 @@ def compare(
     repeats: Optional[int] = None,
     seed: int = 0,
     nested: bool = False,
+    inner_folds: Optional[int] = None,
     tau_ms: Optional[float] = None,
     knn_options: Optional[Dict[str, Any]] = None,
     snn_options: Optional[Dict[str, Any]] = None,
@@ -688,7 +689,8 @@ def compare(
     its standard sets); ``per="speed_mm_s"`` cross-validates within each speed,
     ``hold_out="speed_mm_s"`` holds each speed out in turn, ``train_where`` with
     ``test_where`` (``"trial=0,1"``) trains on one set and tests on the other (pooled
-    recordings without any); ``group_by``, ``folds``, ``repeats``, ``seed`` and ``tau_ms``
+    recordings without any); ``group_by``, ``folds``, ``repeats``, ``seed``,
+    ``inner_folds`` (with ``nested=True``: the folds of the inner ranking) and ``tau_ms``
     are the CLI's. ``knn_options`` (``{"k": 3}``) and ``snn_options`` (``{"hidden":
     64}``) are the knobs of the KNN and spiking-network candidates. With ``out``, the
     folder also gets compare.json, compare.md and the figures, as ``--out``: a new or
@@ -710,7 +712,7 @@ def compare(
         os.fspath(path), opts, dict(knn_options or {}), dict(snn_options or {}),
         names(encodings, "encodings"), names(methods, "methods"),
         names(classifiers, "classifiers"), only, per, hold_out, train_where, test_where,
-        group_by, folds, repeats, int(seed), bool(nested), tau_ms,
+        group_by, folds, repeats, int(seed), bool(nested), inner_folds, tau_ms,
         None if out is None else os.fspath(out))
 
 

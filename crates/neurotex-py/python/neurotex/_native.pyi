@@ -220,6 +220,7 @@ def compare_dataset(
     repeats: Optional[int] = ...,
     seed: int = ...,
     nested: bool = ...,
+    inner_folds: Optional[int] = ...,
     tau_ms: Optional[float] = ...,
     out: Optional[str] = ...,
 ) -> Dict[str, Any]: ...

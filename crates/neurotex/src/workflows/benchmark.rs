@@ -223,6 +223,7 @@ impl BenchmarkOptions {
             repeats: self.repeats,
             seed: self.seed,
             nested: true,
+            inner_folds: None,
             open: OpenOptions::default(),
         }
     }

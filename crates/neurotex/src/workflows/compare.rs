@@ -127,6 +127,12 @@ pub struct CompareOptions {
     /// (nested selection): the number to quote for "the best method".
     #[cfg_attr(feature = "cli", arg(long))]
     pub nested: bool,
+    /// With --nested: folds of the inner cross-validation that ranks the candidates inside
+    /// each outer training set (fewer where a class there has fewer recordings). Default:
+    /// --folds. Fewer folds rank on smaller training sets: quicker, but the choice can be
+    /// worse, and the nested estimate with it (docs/methods-and-compare.md).
+    #[cfg_attr(feature = "cli", arg(long = "inner-folds", requires = "nested"))]
+    pub inner_folds: Option<usize>,
     /// How the dataset folder is opened.
     #[cfg_attr(feature = "cli", command(flatten))]
     pub open: OpenOptions,
@@ -163,6 +169,7 @@ impl CompareOptions {
             group_by: self.group_by.clone(),
             resamples: 2000,
             nested: self.nested,
+            inner_folds: self.inner_folds.unwrap_or(self.folds),
         })
     }
 
