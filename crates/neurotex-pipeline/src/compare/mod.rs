@@ -140,9 +140,8 @@ pub struct CompareParams {
     pub resamples: usize,
     /// Also estimate the accuracy of choosing the best candidate inside each training set.
     pub nested: bool,
-    /// Folds of nested selection's inner cross-validation, at least 2 (front ends give the
-    /// outer folds unless asked otherwise); fewer where a class of an outer training set
-    /// has fewer recordings.
+    /// Folds of nested selection's inner cross-validation (at least 2; fewer where a class
+    /// of an outer training set has fewer recordings); the front ends' default is `cv`'s.
     pub inner_folds: usize,
 }
 

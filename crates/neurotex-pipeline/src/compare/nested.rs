@@ -242,15 +242,10 @@ fn fold_assignment(metas: &[Meta], rows: &[usize], params: &CompareParams) -> Re
 
 /// The size of the smallest class among `rows`.
 fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for &r in rows {
-        let label = metas[r].label.as_str();
-        match counts.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, n)) => *n += 1,
-            None => counts.push((label, 1)),
-        }
-    }
-    counts.iter().map(|c| c.1).min().unwrap_or(0)
+    let mut labels: Vec<&str> = rows.iter().map(|&r| metas[r].label.as_str()).collect();
+    labels.sort_unstable();
+    let sizes = labels.chunk_by(|a, b| a == b).map(<[_]>::len);
+    sizes.min().unwrap_or(0)
 }
 
 /// Nested selection's outer splits, when it can run on them: its inner cross-validation
@@ -328,21 +323,15 @@ fn outer(
         })
         .collect::<Result<_>>()?;
     // The first candidate of the highest accuracy.
-    let mut best = (f64::NEG_INFINITY, 0);
-    for (k, &accuracy) in accuracies.iter().enumerate() {
-        if accuracy > best.0 {
-            best = (accuracy, k);
-        }
-    }
-    let c = &candidates[best.1];
-    let rows = Split::Rows {
-        train: split.train.clone(),
-        test: split.test.clone(),
-    };
-    let outcome = c.evaluate_all(&rows)?;
+    let best = (0..accuracies.len()).fold(0, |b, k| match accuracies[k] > accuracies[b] {
+        true => k,
+        false => b,
+    });
+    let (train, test) = (split.train.clone(), split.test.clone());
+    let outcome = candidates[best].evaluate_all(&Split::Rows { train, test })?;
     Ok(OuterResult {
         condition: split.condition.clone(),
-        chosen: best.1,
+        chosen: best,
         shares: outcome.correct_shares,
     })
 }
@@ -368,8 +357,7 @@ pub(super) fn nested(
     let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();
     shares.sort_by_key(|&(row, _)| row);
     let mut chosen: Vec<(String, usize)> = Vec::new();
-    for o in &outcomes {
-        let name = candidates[o.chosen].name();
+    for name in outcomes.iter().map(|o| candidates[o.chosen].name()) {
         match chosen.iter_mut().find(|(n, _)| *n == name) {
             Some((_, times)) => *times += 1,
             None => chosen.push((name, 1)),
