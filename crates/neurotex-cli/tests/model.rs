@@ -932,4 +932,18 @@ fn early_stopping_is_said_with_the_epoch_it_ended_at() {
         "{}",
         run.stderr
     );
+    assert!(!run.stderr.contains("stopped at the cap"), "{}", run.stderr);
+    // Ended by the cap instead: said with the epoch of the lowest validation loss.
+    let capped = ["--snn-hidden", "8", "--snn-epochs", "3", "--out", s(&model)];
+    let run = dir.run(&[&args[..5], &capped[..]].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    let file: Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let best = file["training"]["best_epoch"].as_u64().unwrap();
+    let lowest = match best {
+        3 => "still falling at the last of the 3 epochs".to_string(),
+        b => format!("lowest at epoch {b} of 3"),
+    };
+    let said = format!("note: the validation loss was {lowest}: training stopped at the cap");
+    assert_eq!(run.stderr.matches(&said).count(), 1, "{}", run.stderr);
+    assert!(!run.stderr.contains("early stopping:"), "{}", run.stderr);
 }

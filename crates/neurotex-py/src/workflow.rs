@@ -98,6 +98,9 @@ fn train_dataset(
     let on = |p: Progress| said.hear(p);
     if train.spiking() {
         let trained = watched(py, || guarded(|| train.run_spiking(&dataset, &stages, &on)))?;
+        if let Some(note) = trained.at_the_cap() {
+            on(Progress::Advice(&note));
+        }
         let log = &trained.log;
         let log = (log.epochs, log.best_epoch, log.validation_loss);
         let model = NativeSpikingModel {

@@ -68,6 +68,20 @@ def test_model_train_chooses_the_network_as_the_cli_does(sim, sim_dir, tmp_path)
         neurotex.Model.train(sim, method="spikes", classifier="forest")
 
 
+def test_a_network_the_epoch_cap_stopped_is_a_warning(sim_dir, caplog):
+    """Training on a folder that the epoch cap ends, not early stopping, says so at
+    WARNING with the epoch of the lowest validation loss, as `neurotex train` does."""
+    with caplog.at_level("WARNING", logger="neurotex"):
+        model = neurotex.Model.train(sim_dir, classifier="snn",
+                                     classifier_options={"hidden": 8, "epochs": 2})
+    warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    best = model.training["best_epoch"]
+    lowest = ("still falling at the last of the 2 epochs" if best == 2
+              else f"lowest at epoch {best} of 2")
+    assert any(f"validation loss was {lowest}: training stopped at the cap" in w
+               for w in warned), warned
+
+
 def test_a_spiking_stream_gives_the_lines_of_the_cli(trained, sim_dir, tmp_path):
     model, d = trained
     row = manifest(sim_dir)[7]

@@ -151,13 +151,16 @@ impl TrainedSpiking {
         )
     }
 
-    /// When training stopped at the epoch cap with the validation loss still falling, what
-    /// to say of it.
+    /// When the epoch cap, not early stopping, ended training (the validation loss lowest
+    /// within the last `patience` epochs, so perhaps still falling), what to say of it.
     pub fn at_the_cap(&self) -> Option<String> {
-        (self.log.best_epoch == self.log.epochs).then(|| format!(
-            "the validation loss was still falling at the last of the {} epochs: training stopped at the cap, not by early stopping; a larger --snn-epochs may do better",
-            self.log.epochs
-        ))
+        let (log, params) = (&self.log, self.model.params());
+        let capped = log.epochs == params.epochs && log.epochs - log.best_epoch < params.patience;
+        let lowest = match log.best_epoch == log.epochs {
+            true => format!("still falling at the last of the {} epochs", log.epochs),
+            false => format!("lowest at epoch {} of {}", log.best_epoch, log.epochs),
+        };
+        capped.then(|| format!("the validation loss was {lowest}: training stopped at the cap, not by early stopping; a larger --snn-epochs may do better"))
     }
 }
 
