@@ -144,42 +144,48 @@ pub struct Trajectory {
     out: Vec<f64>,
 }
 
-/// Runs `net` over `input`, keeping the trajectory, and returns the class scores.
-pub fn forward(
-    net: &Network,
-    input: &SpikeInput,
-    act: Activation,
-    tr: &mut Trajectory,
-) -> Vec<f64> {
-    // One copy of the loop per nonlinearity and reset, so that each inlines and
-    // vectorises. `spike` maps the membrane to the step's spikes, `reset` the membrane and
-    // its spikes to what is kept.
-    let zero = |p: f64, s: f64| p * (1.0 - s);
-    let subtract = |p: f64, s: f64| p - s;
-    match (act, net.reset) {
-        (Activation::Spike { .. }, Reset::Zero) => forward_with(
-            net,
-            input,
-            tr,
-            |p| f64::from(u8::from(p - 1.0 >= 0.0)),
-            zero,
-        ),
-        (Activation::Spike { .. }, Reset::Subtract) => forward_with(
-            net,
-            input,
-            tr,
-            |p| if p >= 1.0 { p.floor() } else { 0.0 },
-            subtract,
-        ),
-        (Activation::Smooth { .. }, Reset::Zero) => {
-            forward_with(net, input, tr, |p| act.value(p - 1.0), zero)
-        }
-        (Activation::Smooth { .. }, Reset::Subtract) => {
-            forward_with(net, input, tr, |p| act.value(p - 1.0), subtract)
+neurotex_core::widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// Runs `net` over `input`, keeping the trajectory, and returns the class scores
+    /// (compiled for the widest vectors the processor has: each operation is element by
+    /// element, so every width gives the same bits).
+    pub fn forward(
+        net: &Network,
+        input: &SpikeInput,
+        act: Activation,
+        tr: &mut Trajectory,
+    ) -> Vec<f64> {
+        // One copy of the loop per nonlinearity and reset, so that each inlines and
+        // vectorises. `spike` maps the membrane to the step's spikes, `reset` the membrane and
+        // its spikes to what is kept.
+        let zero = |p: f64, s: f64| p * (1.0 - s);
+        let subtract = |p: f64, s: f64| p - s;
+        match (act, net.reset) {
+            (Activation::Spike { .. }, Reset::Zero) => forward_with(
+                net,
+                input,
+                tr,
+                |p| f64::from(u8::from(p - 1.0 >= 0.0)),
+                zero,
+            ),
+            (Activation::Spike { .. }, Reset::Subtract) => forward_with(
+                net,
+                input,
+                tr,
+                |p| if p >= 1.0 { p.floor() } else { 0.0 },
+                subtract,
+            ),
+            (Activation::Smooth { .. }, Reset::Zero) => {
+                forward_with(net, input, tr, |p| act.value(p - 1.0), zero)
+            }
+            (Activation::Smooth { .. }, Reset::Subtract) => {
+                forward_with(net, input, tr, |p| act.value(p - 1.0), subtract)
+            }
         }
     }
 }
 
+#[inline(always)]
 fn forward_with(
     net: &Network,
     input: &SpikeInput,
@@ -189,15 +195,15 @@ fn forward_with(
 ) -> Vec<f64> {
     let (alpha, beta, kappa) = net.decays();
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
-    tr.pre.clear();
+    // Every value is written below, step by step: the buffers keep their last contents
+    // rather than being cleared on every call.
     tr.pre.resize(steps * h_n, 0.0);
-    tr.spikes.clear();
     tr.spikes.resize(steps * h_n, 0.0);
-    tr.out.clear();
     tr.out.resize(steps * c_n, 0.0);
     let mut current = vec![0.0; h_n];
     let mut membrane = vec![0.0; h_n];
     let mut out = vec![0.0; c_n];
+    let mut fired = Vec::with_capacity(h_n);
     for t in 0..steps {
         for (c, b) in current.iter_mut().zip(&net.b_in) {
             *c = alpha * *c + b;
@@ -209,13 +215,11 @@ fn forward_with(
             }
         }
         if net.recurrent() && t > 0 {
-            let (before, _) = tr.spikes.split_at(t * h_n);
-            for (j, &s) in before[(t - 1) * h_n..].iter().enumerate() {
-                if s != 0.0 {
-                    let w = &net.w_rec[j * h_n..(j + 1) * h_n];
-                    for (c, w) in current.iter_mut().zip(w) {
-                        *c += s * w;
-                    }
+            let before = &tr.spikes[(t - 1) * h_n..t * h_n];
+            for &j in super::nonzero(before, &mut fired) {
+                let (s, w) = (before[j as usize], &net.w_rec[j as usize * h_n..][..h_n]);
+                for (c, w) in current.iter_mut().zip(w) {
+                    *c += s * w;
                 }
             }
         }
@@ -234,12 +238,10 @@ fn forward_with(
             *s = spike(*p);
             *m = reset(*p, *s);
         }
-        for (h, &s) in spikes.iter().enumerate() {
-            if s != 0.0 {
-                let w = &net.w_out[h * c_n..(h + 1) * c_n];
-                for (o, w) in out.iter_mut().zip(w) {
-                    *o += s * w;
-                }
+        for &h in super::nonzero(spikes, &mut fired) {
+            let (s, w) = (spikes[h as usize], &net.w_out[h as usize * c_n..][..c_n]);
+            for (o, w) in out.iter_mut().zip(w) {
+                *o += s * w;
             }
         }
         tr.out[t * c_n..(t + 1) * c_n].copy_from_slice(&out);
@@ -279,28 +281,32 @@ pub fn loss_and_gradient(
     loss
 }
 
-/// Backpropagation through time of the score gradient `dscore` (see the module's
-/// equations).
-fn backward(
-    net: &Network,
-    input: &SpikeInput,
-    rule: Backprop,
-    dscore: &[f64],
-    tr: &Trajectory,
-    grad: &mut Gradient,
-) {
-    let detach = rule.detach_reset;
-    match rule.act {
-        Activation::Spike { slope } => backward_with(net, input, detach, dscore, tr, grad, |x| {
-            let d = 1.0 + slope * x.abs();
-            1.0 / (d * d)
-        }),
-        act @ Activation::Smooth { .. } => {
-            backward_with(net, input, detach, dscore, tr, grad, |x| act.derivative(x))
+neurotex_core::widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// Backpropagation through time of the score gradient `dscore` (see the module's
+    /// equations), compiled as [`forward`] is.
+    fn backward(
+        net: &Network,
+        input: &SpikeInput,
+        rule: Backprop,
+        dscore: &[f64],
+        tr: &Trajectory,
+        grad: &mut Gradient,
+    ) {
+        let detach = rule.detach_reset;
+        match rule.act {
+            Activation::Spike { slope } => backward_with(net, input, detach, dscore, tr, grad, |x| {
+                let d = 1.0 + slope * x.abs();
+                1.0 / (d * d)
+            }),
+            act @ Activation::Smooth { .. } => {
+                backward_with(net, input, detach, dscore, tr, grad, |x| act.derivative(x))
+            }
         }
     }
 }
 
+#[inline(always)]
 fn backward_with(
     net: &Network,
     input: &SpikeInput,
@@ -310,16 +316,42 @@ fn backward_with(
     grad: &mut Gradient,
     derivative: impl Fn(f64) -> f64,
 ) {
-    let (alpha, beta, kappa) = net.decays();
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
-    let argmax = match net.readout {
-        Readout::Max => Some(argmax_steps(&tr.out, c_n, steps)),
-        Readout::Mean => None,
-    };
-    let mut g_out = vec![0.0; c_n];
-    let mut g_v = vec![0.0; h_n];
-    let mut g_i = vec![0.0; h_n];
+    let kappa = net.decays().2;
+    let mut hidden = HiddenBack::new(net, detach_reset);
     let mut g_s = vec![0.0; h_n];
+    if net.readout == Readout::Mean {
+        // Every class's readout gradient follows one decay: gO[t] = φ[t] dscore, with
+        // φ[t] = 1/T + κ φ[t+1]. So gS[t] = φ[t] (W_out dscore), and the readout's
+        // gradients are sums over steps of φ[t] (biases) and φ[t] S[t] (weights).
+        let mean_share = 1.0 / steps.max(1) as f64;
+        let direction: Vec<f64> = (net.w_out.chunks_exact(c_n))
+            .map(|w| w.iter().zip(dscore).map(|(w, d)| w * d).sum())
+            .collect();
+        let (mut phi, mut phi_sum) = (0.0, 0.0);
+        let mut weighted = vec![0.0; h_n];
+        for t in (0..steps).rev() {
+            phi = mean_share + kappa * phi;
+            phi_sum += phi;
+            let spikes = &tr.spikes[t * h_n..(t + 1) * h_n];
+            for ((w, &s), (gs, &u)) in weighted
+                .iter_mut()
+                .zip(spikes)
+                .zip(g_s.iter_mut().zip(&direction))
+            {
+                *w += phi * s;
+                *gs = phi * u;
+            }
+            hidden.step(net, input, t, tr, &mut g_s, grad, &derivative);
+        }
+        for (c, &d) in dscore.iter().enumerate() {
+            grad.b_out[c] += d * phi_sum;
+        }
+        add_outer(&mut grad.w_out, &weighted, dscore);
+        return;
+    }
+    let argmax = argmax_steps(&tr.out, c_n, steps);
+    let mut g_out = vec![0.0; c_n];
     // W_out class-major, for gS = W_out gO over contiguous hidden neurons.
     let mut w_out_t = vec![0.0; h_n * c_n];
     for h in 0..h_n {
@@ -327,21 +359,12 @@ fn backward_with(
             w_out_t[c * h_n + h] = net.w_out[h * c_n + c];
         }
     }
-    let mean_share = 1.0 / steps.max(1) as f64;
-    let recurrent = net.recurrent();
-    let subtract = net.reset == Reset::Subtract;
     for t in (0..steps).rev() {
         for c in 0..c_n {
-            let direct = match &argmax {
-                None => dscore[c] * mean_share,
-                Some(at) if at[c] == t => dscore[c],
-                Some(_) => 0.0,
-            };
+            let direct = if argmax[c] == t { dscore[c] } else { 0.0 };
             g_out[c] = direct + kappa * g_out[c];
             grad.b_out[c] += g_out[c];
         }
-        let pre = &tr.pre[t * h_n..(t + 1) * h_n];
-        let spikes = &tr.spikes[t * h_n..(t + 1) * h_n];
         // gS = W_out gO, class by class over the hidden layer (so the loop vectorises).
         g_s.iter_mut().for_each(|g| *g = 0.0);
         for (c, &g) in g_out.iter().enumerate() {
@@ -349,26 +372,74 @@ fn backward_with(
                 *gs += w * g;
             }
         }
-        add_outer(&mut grad.w_out, spikes, &g_out);
-        if recurrent {
-            // S[t] drives I[t+1]: g_i still holds step t+1's.
-            add_recurrent_spike_gradient(net, &g_i, &mut g_s);
+        add_outer(&mut grad.w_out, &tr.spikes[t * h_n..(t + 1) * h_n], &g_out);
+        hidden.step(net, input, t, tr, &mut g_s, grad, &derivative);
+    }
+}
+
+/// The hidden layer's side of the backward pass, step by step from the last: the next
+/// step's membrane and current gradients, and the decays.
+struct HiddenBack {
+    g_v: Vec<f64>,
+    g_i: Vec<f64>,
+    /// `(α, β, 1 if the reset is in the graph else 0)`.
+    decays: (f64, f64, f64),
+    subtract: bool,
+}
+
+impl HiddenBack {
+    fn new(net: &Network, detach_reset: bool) -> Self {
+        let (alpha, beta, _) = net.decays();
+        HiddenBack {
+            g_v: vec![0.0; net.hidden],
+            g_i: vec![0.0; net.hidden],
+            decays: (alpha, beta, f64::from(u8::from(!detach_reset))),
+            subtract: net.reset == Reset::Subtract,
         }
-        let decays = (alpha, beta, f64::from(u8::from(!detach_reset)));
-        let step = (g_s.as_slice(), pre, spikes);
-        step_back(step, &mut g_v, &mut g_i, decays, subtract, &derivative);
-        for (b, g) in grad.b_in.iter_mut().zip(&g_i) {
+    }
+
+    /// Step `t` from its spike gradient `g_s` (to which the recurrent path is added): the
+    /// membrane and current gradients, and the input-side parameters' gradients.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn step(
+        &mut self,
+        net: &Network,
+        input: &SpikeInput,
+        t: usize,
+        tr: &Trajectory,
+        g_s: &mut [f64],
+        grad: &mut Gradient,
+        derivative: &impl Fn(f64) -> f64,
+    ) {
+        let h_n = net.hidden;
+        let pre = &tr.pre[t * h_n..(t + 1) * h_n];
+        let spikes = &tr.spikes[t * h_n..(t + 1) * h_n];
+        if net.recurrent() {
+            // S[t] drives I[t+1]: g_i still holds step t+1's.
+            add_recurrent_spike_gradient(net, &self.g_i, g_s);
+        }
+        let (g_v, g_i) = (&mut self.g_v, &mut self.g_i);
+        step_back(
+            (g_s, pre, spikes),
+            g_v,
+            g_i,
+            self.decays,
+            self.subtract,
+            derivative,
+        );
+        for (b, g) in grad.b_in.iter_mut().zip(g_i.iter()) {
             *b += g;
         }
         for &i in input.at(t) {
             let gw = &mut grad.w_in[i as usize * h_n..(i as usize + 1) * h_n];
-            for (gw, g) in gw.iter_mut().zip(&g_i) {
+            for (gw, g) in gw.iter_mut().zip(g_i.iter()) {
                 *gw += g;
             }
         }
-        if recurrent && t > 0 {
+        if net.recurrent() && t > 0 {
             let before = &tr.spikes[(t - 1) * h_n..t * h_n];
-            add_outer(&mut grad.w_rec, before, &g_i);
+            add_outer(&mut grad.w_rec, before, g_i);
         }
     }
 }
@@ -377,7 +448,7 @@ fn backward_with(
 /// spike gradient, membranes and spikes `(gS, P, S)`, turns the next step's membrane and
 /// current gradients `g_v`, `g_i` into this step's; `decays` are `(α, β, 1 if the reset is
 /// in the graph else 0)`.
-#[inline]
+#[inline(always)]
 fn step_back(
     (g_s, pre, spikes): (&[f64], &[f64], &[f64]),
     g_v: &mut [f64],
@@ -386,26 +457,30 @@ fn step_back(
     subtract: bool,
     derivative: &impl Fn(f64) -> f64,
 ) {
-    let neurons = g_s.iter().zip(pre).zip(spikes).zip(g_v).zip(g_i);
+    // Indexed over slices of one length, so that the loops vectorise (through five zipped
+    // iterators they ran one neuron at a time).
+    let n = g_s.len();
+    let (pre, spikes, g_v, g_i) = (&pre[..n], &spikes[..n], &mut g_v[..n], &mut g_i[..n]);
     if subtract {
         // V = P - S: the reset passes gV to P whole, and (in the graph) as -gV to S.
-        for ((((&g_s, &p), _), g_v), g_i) in neurons {
-            let g_p = *g_v + (g_s - reset * *g_v) * derivative(p - 1.0);
-            *g_i = g_p + alpha * *g_i;
-            *g_v = beta * g_p;
+        for k in 0..n {
+            let g_p = g_v[k] + (g_s[k] - reset * g_v[k]) * derivative(pre[k] - 1.0);
+            g_i[k] = g_p + alpha * g_i[k];
+            g_v[k] = beta * g_p;
         }
     } else {
-        for ((((&g_s, &p), &s), g_v), g_i) in neurons {
-            let g_sh = g_s - reset * p * *g_v;
-            let g_p = *g_v * (1.0 - s) + g_sh * derivative(p - 1.0);
-            *g_i = g_p + alpha * *g_i;
-            *g_v = beta * g_p;
+        for k in 0..n {
+            let g_sh = g_s[k] - reset * pre[k] * g_v[k];
+            let g_p = g_v[k] * (1.0 - spikes[k]) + g_sh * derivative(pre[k] - 1.0);
+            g_i[k] = g_p + alpha * g_i[k];
+            g_v[k] = beta * g_p;
         }
     }
 }
 
 /// `g_s += W_rec g_next`: the spike gradient through the recurrent weights (`g_next` the
 /// next step's current gradient).
+#[inline(always)]
 fn add_recurrent_spike_gradient(net: &Network, g_next: &[f64], g_s: &mut [f64]) {
     let h_n = net.hidden;
     for (j, gs) in g_s.iter_mut().enumerate() {
@@ -416,6 +491,7 @@ fn add_recurrent_spike_gradient(net: &Network, g_next: &[f64], g_s: &mut [f64]) 
 
 /// `grad += s gᵀ` over the rows `j` where `s[j]` is not zero (source-major, `g.len()`
 /// columns).
+#[inline(always)]
 fn add_outer(grad: &mut [f64], s: &[f64], g: &[f64]) {
     let n = g.len();
     for (j, &s) in s.iter().enumerate().filter(|(_, &s)| s != 0.0) {

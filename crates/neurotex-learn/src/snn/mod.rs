@@ -367,3 +367,18 @@ pub fn softmax(scores: &[f64]) -> Vec<f64> {
     let sum: f64 = exp.iter().sum();
     exp.iter().map(|e| e / sum).collect()
 }
+
+/// The positions of `s`'s values that are not zero, in order, put in `at`: found without a
+/// branch per value, since the spikes of a step are irregular and such a branch is often
+/// mispredicted.
+#[inline(always)]
+pub(super) fn nonzero<'a>(s: &[f64], at: &'a mut Vec<u32>) -> &'a [u32] {
+    at.clear();
+    at.resize(s.len(), 0);
+    let mut n = 0;
+    for (j, &x) in s.iter().enumerate() {
+        at[n] = j as u32;
+        n += usize::from(x != 0.0);
+    }
+    &at[..n]
+}

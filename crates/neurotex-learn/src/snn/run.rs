@@ -17,6 +17,9 @@ pub struct State {
     /// A Xylo-profile network's integers and the chip's state, which then step in place
     /// of the float state.
     chip: Option<Box<(xylo::XyloNetwork, xylo::XyloState)>>,
+    /// Scratch of a step: each hidden neuron's spike count, and the neurons that spiked.
+    counts: Vec<f64>,
+    active: Vec<u32>,
 }
 
 impl State {
@@ -38,6 +41,8 @@ impl State {
             out: vec![0.0; net.classes],
             fired: Vec::new(),
             chip,
+            counts: vec![0.0; net.hidden],
+            active: Vec::with_capacity(net.hidden),
         }
     }
 
@@ -54,52 +59,70 @@ impl State {
             self.out = state.readout(xnet);
             return;
         }
-        let (alpha, beta, kappa) = self.decays;
-        let h_n = net.hidden;
-        for (c, b) in self.current.iter_mut().zip(&net.b_in) {
-            *c = alpha * *c + b;
-        }
-        for &i in spiked {
-            let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
-            for (c, w) in self.current.iter_mut().zip(w) {
-                *c += w;
-            }
-        }
-        for &(j, n) in &self.fired {
-            let w = &net.w_rec[j as usize * h_n..(j as usize + 1) * h_n];
-            for (c, w) in self.current.iter_mut().zip(w) {
-                *c += n * w;
-            }
-        }
-        self.fired.clear();
-        let recurrent = net.recurrent();
-        for (o, b) in self.out.iter_mut().zip(&net.b_out) {
-            *o = kappa * *o + b;
-        }
-        let subtract = net.reset == Reset::Subtract;
-        for h in 0..h_n {
-            let p = beta * self.membrane[h] + self.current[h];
-            if p >= 1.0 {
-                // One spike and a membrane of zero, or floor(p) spikes and the rest kept
-                // (a count of 1 multiplies the weights exactly).
-                let n = if subtract { p.floor() } else { 1.0 };
-                self.membrane[h] = if subtract { p - n } else { 0.0 };
-                if recurrent {
-                    self.fired.push((h as u32, n));
-                }
-                let w = &net.w_out[h * net.classes..(h + 1) * net.classes];
-                for (o, w) in self.out.iter_mut().zip(w) {
-                    *o += n * w;
-                }
-            } else {
-                self.membrane[h] = p;
-            }
-        }
+        float_step(self, net, spiked);
     }
 
     /// The readout's values after the last step.
     pub fn readout(&self) -> &[f64] {
         &self.out
+    }
+}
+
+neurotex_core::widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// [`State::step`] of a float network, compiled for the widest vectors the processor
+    /// has (each operation element by element, so every width gives the same bits): the
+    /// membranes and spike counts of every neuron first, then the readout and recurrent
+    /// rows of those that spiked, in neuron order. The same operations in the same order
+    /// as the training's forward pass, so its scores are those of training.
+    fn float_step(state: &mut State, net: &Network, spiked: &[u32]) {
+        let (alpha, beta, kappa) = state.decays;
+        let h_n = net.hidden;
+        let current = &mut state.current[..h_n];
+        for (c, b) in current.iter_mut().zip(&net.b_in) {
+            *c = alpha * *c + b;
+        }
+        for &i in spiked {
+            let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
+            for (c, w) in current.iter_mut().zip(w) {
+                *c += w;
+            }
+        }
+        for &(j, n) in &state.fired {
+            let w = &net.w_rec[j as usize * h_n..(j as usize + 1) * h_n];
+            for (c, w) in current.iter_mut().zip(w) {
+                *c += n * w;
+            }
+        }
+        state.fired.clear();
+        for (o, b) in state.out.iter_mut().zip(&net.b_out) {
+            *o = kappa * *o + b;
+        }
+        // One spike and a membrane of zero, or floor(p) spikes and the rest kept (a count
+        // of 1 multiplies the weights exactly; `p (1 - 0)` and `p - 0` are `p`).
+        let subtract = net.reset == Reset::Subtract;
+        let (membrane, counts) = (&mut state.membrane[..h_n], &mut state.counts[..h_n]);
+        for h in 0..h_n {
+            let p = beta * membrane[h] + current[h];
+            let n = match (p >= 1.0, subtract) {
+                (false, _) => 0.0,
+                (true, true) => p.floor(),
+                (true, false) => 1.0,
+            };
+            counts[h] = n;
+            membrane[h] = if subtract { p - n } else { p * (1.0 - n) };
+        }
+        let recurrent = net.recurrent();
+        for &h in super::nonzero(counts, &mut state.active) {
+            let n = counts[h as usize];
+            if recurrent {
+                state.fired.push((h, n));
+            }
+            let w = &net.w_out[h as usize * net.classes..][..net.classes];
+            for (o, w) in state.out.iter_mut().zip(w) {
+                *o += n * w;
+            }
+        }
     }
 }
 
