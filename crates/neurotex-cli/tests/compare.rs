@@ -242,10 +242,7 @@ fn bad_compare_options_are_clear_errors() {
             (with(&["--per", "session"]), "session"),
             (with(&["--per", "speed_mm_s"]), "at least two values"),
             (with(&["--inner-folds", "3"]), "--nested"),
-            (
-                with(&["--nested", "--inner-folds", "1"]),
-                "at least 2 folds",
-            ),
+            (with(&["--nested", "--inner-folds", "1"]), "2 folds or more"),
         ],
         &out,
     );

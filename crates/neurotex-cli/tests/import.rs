@@ -204,10 +204,25 @@ fn import_bad_input_is_named_through_the_binary() {
             timed(&["--channels", "^(bad"]),
             "not a valid regular expression",
         ),
+        (
+            timed(&["--name-pattern", FABRIC_PATTERN, "--channels", "^ch[0-9]$"]),
+            "no channel columns selected by --channels `^ch[0-9]$` (columns: timestamp, channel",
+        ),
         (csv(&["--name-pattern", FABRIC_PATTERN]), "--fs"),
         (csv(&["--fs", "-1"]), "from 1 to 1e6"),
     ];
     dir.fails_each(&cases, &out);
+    // --skip-bad leaving every file out says why the first was
+    let err = dir.fails(&timed(&[
+        "--name-pattern",
+        "{label}-{trial}.csv",
+        "--skip-bad",
+    ]));
+    assert!(
+        err.contains("with --skip-bad); the first: ") && err.contains("does not match"),
+        "{err}"
+    );
+    assert!(!out.exists());
     // --skip-bad leaves the NaN file out with a warning and imports the rest
     let run = dir.run(&timed(&["--name-pattern", FABRIC_PATTERN, "--skip-bad"]));
     assert!(run.status.success());

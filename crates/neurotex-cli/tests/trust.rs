@@ -857,7 +857,7 @@ fn folds_the_design_cannot_give_are_said_with_the_folds_used() {
         "--json",
     ]);
     assert!(run.status.success(), "{}", run.stderr);
-    let said = "nested selection's inner cross-validation uses 4 folds instead of 5";
+    let said = "nested selection's inner cross-validation uses as few as 4 folds instead of 5";
     assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
     let json: Value = serde_json::from_str(&run.stdout).expect("JSON");
     assert!(json["notes"][0].as_str().unwrap().contains(said), "{json}");

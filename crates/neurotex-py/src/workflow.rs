@@ -251,7 +251,7 @@ fn compare_dataset(
         return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
     }
     if inner_folds.is_some() && !nested {
-        let why = "inner_folds is nested selection's: give it with nested=True";
+        let why = "inner_folds sets nested selection's inner folds: give it only with nested=True";
         return Err(crate::errors::raise(crate::errors::Kind::Parameter, why));
     }
     let cv = neurotex::classify::CvParams::default();

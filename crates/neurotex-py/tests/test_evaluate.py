@@ -99,9 +99,9 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
         neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d"], classifiers=["knn"],
                          per="speed_mm_s", folds=3, knn_options={"k": 3}, out=theirs)
     assert (theirs / "notes.txt").read_text() == "mine"
-    with pytest.raises(ParameterError, match="with nested=True"):
+    with pytest.raises(ParameterError, match="only with nested=True"):
         neurotex.compare(sim_dir, per="speed_mm_s", inner_folds=3)
-    with pytest.raises(ParameterError, match="at least 2 folds"):
+    with pytest.raises(ParameterError, match="2 folds or more"):
         neurotex.compare(sim_dir, per="speed_mm_s", nested=True, inner_folds=1)
     with pytest.raises(ParameterError, match="one protocol at a time"):
         neurotex.compare(sim_dir, per="speed_mm_s", hold_out="speed_mm_s")

@@ -182,7 +182,16 @@ impl Columns {
             return Err(invalid(path, message));
         }
         if channels.is_empty() {
-            return Err(invalid(path, "no channel columns selected"));
+            let asked = match &format.channels {
+                ChannelSelect::Regex(re) => format!(" by --channels `{}`", excerpt(re.as_str())),
+                _ => String::new(),
+            };
+            let columns = names.join(", ");
+            let message = format!(
+                "no channel columns selected{asked} (columns: {})",
+                excerpt(&columns)
+            );
+            return Err(invalid(path, message));
         }
         if format.header {
             unique_names(path, &names, time.iter().chain(&channels))?;

@@ -284,7 +284,14 @@ pub fn import_csv(
     };
     let good = parse_all(files, p, on_done, &mut summary.skipped)?;
     let Some(first) = good.first() else {
-        return Err(DataError::invalid(out, "every file was left out").into());
+        let why = match summary.skipped.first() {
+            Some((_, first)) => format!(
+                "every file was left out ({} with --skip-bad); the first: {first}",
+                summary.skipped.len()
+            ),
+            None => "every file was left out".to_string(),
+        };
+        return Err(DataError::invalid(out, why).into());
     };
     let labels: Vec<(String, String)> = good
         .iter()

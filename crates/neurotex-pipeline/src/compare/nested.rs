@@ -44,21 +44,27 @@ pub(super) fn fewer_folds(
         }
     }
     let asked = params.inner_folds;
-    let inner = outer
-        .unwrap_or_default()
-        .iter()
-        .filter(|split| inner_held_out(metas, params, split).is_none())
-        .map(|split| inner_folds(asked, smallest_class(metas, &split.train)))
-        .filter(|&used| used < asked);
-    if let Some(used) = inner.clone().min() {
+    let fewer: Vec<usize> = (inner_folds_of(metas, params, outer.unwrap_or_default()).into_iter())
+        .filter(|&used| used < asked)
+        .collect();
+    if let Some(low) = fewer.iter().min() {
         notes.push(format!(
-            "nested selection's inner cross-validation uses {used} folds instead of {asked} in {} of {} outer training sets (their smallest class has fewer than {asked} recordings)",
-            inner.count(),
+            "nested selection's inner cross-validation uses as few as {low} folds instead of {asked} in {} of {} outer training sets (their smallest class has fewer than {asked} recordings)",
+            fewer.len(),
             outer.map_or(0, <[_]>::len)
         ));
     }
     notes.extend(outer.and_then(|outer| inner_within_one_condition(metas, params, outer)));
     notes
+}
+
+/// The inner cross-validation's folds in each of `splits` whose inner ranking
+/// cross-validates (rather than holding conditions out).
+fn inner_folds_of(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) -> Vec<usize> {
+    (splits.iter())
+        .filter(|split| inner_held_out(metas, params, split).is_none())
+        .map(|split| inner_folds(params.inner_folds, smallest_class(metas, &split.train)))
+        .collect()
 }
 
 /// The folds of nested selection's inner cross-validation: `folds` (the inner folds asked
@@ -90,17 +96,11 @@ fn inner_held_out<'p>(
 
 /// How the outer training sets ranked the candidates, in words.
 fn inner_ranking(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) -> String {
-    let held = splits
-        .iter()
-        .filter(|split| inner_held_out(metas, params, split).is_some())
-        .count();
-    let folds: Vec<usize> = (splits.iter())
-        .filter(|split| inner_held_out(metas, params, split).is_none())
-        .map(|split| inner_folds(params.inner_folds, smallest_class(metas, &split.train)))
-        .collect();
+    let folds = inner_folds_of(metas, params, splits);
+    let held = splits.len() - folds.len();
     let cv = match (folds.iter().min(), folds.iter().max()) {
-        (Some(a), Some(b)) if a == b => format!("{a}-fold cross-validation"),
-        (Some(a), Some(b)) => format!("{a}- to {b}-fold cross-validation"),
+        (Some(&a), Some(&b)) if a == b => format!("{a}-fold cross-validation"),
+        (Some(&a), Some(&b)) => format!("{a}- to {b}-fold cross-validation"),
         _ => String::new(),
     };
     match (&params.protocol, held) {

@@ -234,7 +234,7 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
     if !s.unreadable.is_empty() {
         let first = &s.unreadable[0];
         let fix = match logs {
-            true => "fix the files (a pause longer than the reader fills is refused: --max-gap-s raises the limit), or leave them out (import csv --skip-bad)",
+            true => "fix the files, or leave them out (import csv --skip-bad)",
             false => "fix the files, or remove their rows from manifest.csv",
         };
         out.push(finding(

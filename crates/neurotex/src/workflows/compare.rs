@@ -163,6 +163,11 @@ impl CompareOptions {
             repeats: self.repeats,
         }
         .check()?;
+        // Before any recording is encoded (the comparison checks it again as it starts).
+        if let Some(folds) = self.inner_folds.filter(|&folds| folds < 2) {
+            let rule = "nested selection's inner cross-validation needs 2 folds or more";
+            return Err(ParamError::new("inner-folds", rule, folds).into());
+        }
         Ok(CompareParams {
             protocol: self.protocol(),
             cv,
