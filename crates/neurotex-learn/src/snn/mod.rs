@@ -373,8 +373,10 @@ pub fn softmax(scores: &[f64]) -> Vec<f64> {
 /// mispredicted.
 #[inline(always)]
 pub(super) fn nonzero<'a>(s: &[f64], at: &'a mut Vec<u32>) -> &'a [u32] {
-    at.clear();
-    at.resize(s.len(), 0);
+    // Every slot up to the last position is written below before it is read.
+    if at.len() < s.len() {
+        at.resize(s.len(), 0);
+    }
     let mut n = 0;
     for (j, &x) in s.iter().enumerate() {
         at[n] = j as u32;
