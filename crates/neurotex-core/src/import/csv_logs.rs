@@ -402,7 +402,20 @@ fn nominal_fs(good: &[ParsedCsv], out: &Path) -> Result<f64> {
     }
     let mid = dts.len() / 2;
     let (_, median, _) = dts.select_nth_unstable_by(mid, f64::total_cmp);
-    Ok(1.0 / *median)
+    Ok(round_nominal(1.0 / *median))
+}
+
+/// `fs`, or the number of six significant digits within a billionth of it: stamps such as
+/// 0.005 s have no exact binary form, which leaves noise in the last digits of a rate such
+/// as 200 Hz (200.0000000001819), and layout.toml should say 200. A rate of no such
+/// number (35.714285714285715 Hz, stamps every 28 ms) is kept whole.
+fn round_nominal(fs: f64) -> f64 {
+    let scale = 10f64.powi(5 - fs.abs().log10().floor() as i32);
+    let nice = (fs * scale).round() / scale;
+    match ((nice - fs) / fs).abs() < 1e-9 {
+        true => nice,
+        false => fs,
+    }
 }
 
 /// The layout of the imported dataset: channels fill the grid row-major unless mapped, and
@@ -540,4 +553,30 @@ fn import_warnings(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_nominal;
+
+    #[test]
+    fn a_rate_off_a_round_number_by_the_stamps_rounding_is_that_number() {
+        // Stamps written in seconds every 5 ms, read back as a logger prints them.
+        let times: Vec<f64> = (0..100)
+            .map(|i| format!("{}", f64::from(i) * 0.005).parse().unwrap())
+            .collect();
+        let dts: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(
+            dts.iter().any(|&dt| 1.0 / dt != 200.0),
+            "the stamps are exact"
+        );
+        for dt in dts {
+            assert_eq!(round_nominal(1.0 / dt), 200.0, "{dt}");
+        }
+        // Rates that no number of six digits comes within a billionth of are kept.
+        assert_eq!(round_nominal(1.0 / 0.028), 1.0 / 0.028);
+        assert_eq!(round_nominal(1.0 / 3.0), 1.0 / 3.0);
+        assert_eq!(round_nominal(1000.0), 1000.0);
+        assert_eq!(round_nominal(33.3), 33.3);
+    }
 }
