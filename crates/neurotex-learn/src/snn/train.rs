@@ -239,6 +239,13 @@ fn seen_inputs<'a>(
     batch.iter().map(|&i| cut(inputs[i], rng)).collect()
 }
 
+thread_local! {
+    /// Each thread's trajectory, kept from one recording and batch to the next: a new one
+    /// for each (megabytes on long slides) cost its pages anew, and the kernel's work on
+    /// them was a quarter of training's CPU time.
+    static TRAJECTORY: std::cell::RefCell<Trajectory> = std::cell::RefCell::new(Trajectory::default());
+}
+
 /// The batch's mean gradient over `seen` (the batch's inputs, in batch order): each
 /// recording's on some thread, summed in batch order.
 fn batch_gradient(
@@ -252,9 +259,12 @@ fn batch_gradient(
     let parts: Vec<Gradient> = seen
         .par_iter()
         .zip(batch)
-        .map_init(Trajectory::default, |tr, (x, &i)| {
+        .map(|(x, &i)| {
             let mut g = Gradient::zeros(net);
-            loss_and_gradient(net, x, y[i], rule, weight, tr, &mut g);
+            // The pass runs no parallel work, so no other recording's pass can borrow the
+            // thread's trajectory while this one holds it.
+            TRAJECTORY
+                .with_borrow_mut(|tr| loss_and_gradient(net, x, y[i], rule, weight, tr, &mut g));
             g
         })
         .collect();
