@@ -10,8 +10,9 @@
 //! runs beside the paper's method and beside its own inputs' spike rates with logistic
 //! regression (`sa+fa / rates / linear`: what the network gains over it, it draws from the
 //! spikes' timing and its own nonlinearity) on the same folds. Its hyperparameters are its
-//! defaults, fixed before any data, so it needs no nested selection: its accuracy is honest
-//! as it stands.
+//! defaults, not searched on these recordings, so it needs no nested selection (all were
+//! fixed before any data but standardised inputs, chosen over raw counts on the simulator
+//! and FabricSlide; docs/spiking-classifier.md).
 
 use serde::{Deserialize, Serialize};
 

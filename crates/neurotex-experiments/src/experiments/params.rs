@@ -185,7 +185,7 @@ impl ReproduceParams {
         .chain((self.e9 && self.e9_snn).then(|| {
             let snn = crate::snn::SnnParams::default();
             format!(
-                "E9, spiking network: `snn` on the SA+FA spikes with its defaults chosen before any data (hidden {}, dt {} ms, at most {} epochs, {} readout over time, seed {}), E9's folds, no selection",
+                "E9, spiking network: `snn` on the SA+FA spikes with its defaults (hidden {}, dt {} ms, at most {} epochs, {} readout over time, seed {}), E9's folds, no selection",
                 snn.hidden, snn.dt_ms, snn.epochs, snn.readout.name(), snn.seed
             )
         }))

@@ -66,6 +66,12 @@ pub fn fit_with(
         },
         detach_reset: params.detach_reset,
     };
+    let scaled = params.standardize.then(|| Standardised::of(inputs, &train));
+    // What the optimiser moves: the network's own weights, or those of its standardised
+    // inputs.
+    let mut trained = scaled
+        .as_ref()
+        .map_or_else(|| net.clone(), |z| z.trained(&net));
     let mut adam = Adam::new(&net, params.learning_rate);
     let mut best = (f64::INFINITY, net.clone(), 0);
     let mut order = train.clone();
@@ -76,8 +82,14 @@ pub fn fit_with(
         order.shuffle(&mut rng);
         for batch in order.chunks(params.batch) {
             let seen = seen_inputs(params, inputs, batch, &mut rng);
-            let grad = batch_gradient(&net, &seen, y, batch, rule);
-            adam.step(&mut net, &grad);
+            let mut grad = batch_gradient(&net, &seen, y, batch, rule);
+            if let Some(z) = &scaled {
+                z.gradient(&mut grad);
+            }
+            adam.step(&mut trained, &grad);
+            net = scaled
+                .as_ref()
+                .map_or_else(|| trained.clone(), |z| z.network(&trained));
         }
         let loss = mean_loss(&net, inputs, y, &valid);
         each_epoch();
@@ -288,6 +300,79 @@ fn mean_loss(net: &Network, inputs: &[&SpikeInput], y: &[usize], which: &[usize]
     losses.iter().sum::<f64>() / which.len().max(1) as f64
 }
 
+/// Training on standardised inputs ([`SnnParams::standardize`]): each input's mean spike
+/// count per step in each training recording, their mean `μ` and spread `σ` across the
+/// recordings (at least a thousandth of a spike per step, so that an input that hardly
+/// varies is not scaled without bound). The optimiser moves `V` and `c` of the current
+/// `Σ_i z_i V_i + c`, `z_i = (x_i - μ_i) / σ_i`; the network runs on the same current
+/// written in its own counts, `W_i = V_i / σ_i`, `b = c - Σ_i μ_i V_i / σ_i`.
+struct Standardised {
+    mean: Vec<f64>,
+    spread: Vec<f64>,
+}
+
+impl Standardised {
+    fn of(inputs: &[&SpikeInput], train: &[usize]) -> Self {
+        let n = inputs[0].inputs;
+        let rates: Vec<Vec<f64>> = (train.iter())
+            .map(|&r| {
+                let mut counts = vec![0.0; n];
+                (0..inputs[r].steps())
+                    .flat_map(|t| inputs[r].at(t))
+                    .for_each(|&i| counts[i as usize] += 1.0);
+                let steps = inputs[r].steps().max(1) as f64;
+                counts.iter().map(|c| c / steps).collect()
+            })
+            .collect();
+        let m = rates.len().max(1) as f64;
+        let mean: Vec<f64> = (0..n)
+            .map(|i| rates.iter().map(|r| r[i]).sum::<f64>() / m)
+            .collect();
+        let spread = (0..n)
+            .map(|i| {
+                let var = rates.iter().map(|r| (r[i] - mean[i]).powi(2)).sum::<f64>() / m;
+                var.sqrt().max(1e-3)
+            })
+            .collect();
+        Standardised { mean, spread }
+    }
+
+    /// The parameters the optimiser moves of the network `net` (the same current).
+    fn trained(&self, net: &Network) -> Network {
+        let (mut t, h_n) = (net.clone(), net.hidden);
+        for (i, (mu, sd)) in self.mean.iter().zip(&self.spread).enumerate() {
+            for h in 0..h_n {
+                t.w_in[i * h_n + h] = net.w_in[i * h_n + h] * sd;
+                t.b_in[h] += mu * net.w_in[i * h_n + h];
+            }
+        }
+        t
+    }
+
+    /// The network of the moved parameters `t`.
+    fn network(&self, t: &Network) -> Network {
+        let (mut net, h_n) = (t.clone(), t.hidden);
+        for (i, (mu, sd)) in self.mean.iter().zip(&self.spread).enumerate() {
+            for h in 0..h_n {
+                net.w_in[i * h_n + h] = t.w_in[i * h_n + h] / sd;
+                net.b_in[h] -= mu * t.w_in[i * h_n + h] / sd;
+            }
+        }
+        net
+    }
+
+    /// The loss's gradient in the moved parameters, from its gradient in the network's:
+    /// `∂L/∂V_i = (∂L/∂W_i - μ_i ∂L/∂b) / σ_i`; `∂L/∂c = ∂L/∂b`.
+    fn gradient(&self, g: &mut Gradient) {
+        let h_n = g.b_in.len();
+        for (i, (mu, sd)) in self.mean.iter().zip(&self.spread).enumerate() {
+            for h in 0..h_n {
+                g.w_in[i * h_n + h] = g.w_in[i * h_n + h] / sd - mu / sd * g.b_in[h];
+            }
+        }
+    }
+}
+
 /// Adam (Kingma & Ba 2015) with its usual constants.
 struct Adam {
     rate: f64,
@@ -343,6 +428,85 @@ mod tests {
             .map(|t| ((a.powi(t + 1) - b.powi(t + 1)) / (a - b)).powi(2))
             .sum();
         assert!((kernel_energy(a, b) - direct).abs() < 1e-9 * direct);
+    }
+
+    /// Training on standardised inputs: the network of the moved parameters is the
+    /// network they were made from, and their gradient, from the network's, is the central
+    /// finite difference of the loss (a smooth spike, so that the loss has a gradient).
+    #[test]
+    fn standardised_parameters_give_the_network_and_the_gradient_of_the_loss() {
+        use super::super::grad::{Activation, Backprop, Trajectory};
+        use super::super::{Readout, Reset};
+        let (inputs, _) = two_class_task(6, 30);
+        let refs: Vec<&SpikeInput> = inputs.iter().collect();
+        let z = Standardised::of(&refs, &[0, 1, 2, 3, 4]);
+        assert!(z.spread.iter().all(|&sd| sd > 2e-3), "{:?}", z.spread);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut w =
+            |k: usize, s: f64| -> Vec<f64> { (0..k).map(|_| rng.gen_range(-s..s)).collect() };
+        let (n, h, c) = (4, 5, 2);
+        let net = Network {
+            inputs: n,
+            hidden: h,
+            classes: c,
+            dt_ms: 5,
+            tau_syn_ms: 10.0,
+            tau_mem_ms: 20.0,
+            tau_out_ms: 15.0,
+            readout: Readout::Mean,
+            reset: Reset::Zero,
+            w_in: w(n * h, 1.5),
+            b_in: w(h, 0.2),
+            w_out: w(h * c, 1.0),
+            b_out: w(c, 0.3),
+            w_rec: Vec::new(),
+            target: Default::default(),
+        };
+        let moved = z.trained(&net);
+        let back = z.network(&moved);
+        for (a, b) in back
+            .w_in
+            .iter()
+            .chain(&back.b_in)
+            .zip(net.w_in.iter().chain(&net.b_in))
+        {
+            assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} against {b}");
+        }
+        let rule = Backprop {
+            act: Activation::Smooth { k: 4.0 },
+            detach_reset: false,
+        };
+        let loss_of = |moved: &Network, grad: &mut Gradient| {
+            let net = z.network(moved);
+            loss_and_gradient(
+                &net,
+                &inputs[5],
+                1,
+                rule,
+                1.0,
+                &mut Trajectory::default(),
+                grad,
+            )
+        };
+        let mut grad = Gradient::zeros(&net);
+        loss_of(&moved, &mut grad);
+        z.gradient(&mut grad);
+        let eps = 1e-6;
+        for part in 0..2 {
+            for j in 0..grad.parts()[part].len() {
+                let bumped = |d: f64| {
+                    let mut m = moved.clone();
+                    m.params_mut()[part][j] += d;
+                    loss_of(&m, &mut Gradient::zeros(&net))
+                };
+                let numeric = (bumped(eps) - bumped(-eps)) / (2.0 * eps);
+                let analytic = grad.parts()[part][j];
+                assert!(
+                    (numeric - analytic).abs() < 1e-6 * (1.0 + numeric.abs()),
+                    "part {part}, {j}: {numeric} against {analytic}"
+                );
+            }
+        }
     }
 
     /// `n` recordings of `steps` steps, two classes told apart by which two of four inputs

@@ -44,9 +44,8 @@ pub(super) fn fewer_folds(
         }
     }
     let asked = params.inner_folds;
-    let fewer: Vec<usize> = (inner_folds_of(metas, params, outer.unwrap_or_default()).into_iter())
-        .filter(|&used| used < asked)
-        .collect();
+    let mut fewer = inner_folds_of(metas, params, outer.unwrap_or_default());
+    fewer.retain(|&used| used < asked);
     if let Some(low) = fewer.iter().min() {
         notes.push(format!(
             "nested selection's inner cross-validation uses as few as {low} folds instead of {asked} in {} of {} outer training sets (their smallest class has fewer than {asked} recordings)",

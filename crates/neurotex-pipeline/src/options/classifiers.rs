@@ -198,8 +198,7 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         "Neighbours in KNN; at most the number of recordings in a training set."),
     knob!(Knn "knn", standardize, "--standardize", Bool,
         "Z-score features with training-fold statistics before KNN (the command line's \
-         --no-standardize turns it off).",
-        get: shown, set: flag),
+         --no-standardize turns it off).", get: shown, set: flag),
     knob!(Forest "forest", trees, "--trees", Count, "Trees in the forest."),
     knob!(Forest "forest", seed, "--forest-seed", Count, "Seed of the trees' random streams."),
     knob!(Forest "forest", max_depth, "--max-depth", Count,
@@ -213,8 +212,7 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         get: shown_some, set: some_count),
     knob!(Forest "forest", bootstrap, "--bootstrap", Bool,
         "Grow each tree on a bootstrap sample (`true`) or on the whole training set \
-         (`false`).",
-        get: shown, set: flag),
+         (`false`).", get: shown, set: flag),
     knob!(Linear "linear", c, "--c", Number,
         "Inverse penalty strength, scikit-learn's C."),
     knob!(Linear "linear", max_iter, "--max-iter", Count, "Most L-BFGS iterations."),
@@ -234,8 +232,7 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         "Seed of the initial weights, validation split and batch order."),
     knob!(Snn "snn", recurrent, "--snn-recurrent", Flag,
         "Recurrent connections within the hidden layer (each step's spikes drive the next \
-         step's currents); feed-forward without it.",
-        get: shown, set: flag),
+         step's currents); feed-forward without it.", get: shown, set: flag),
     knob!(Snn "snn", reset, "--snn-reset", Text,
         "How a hidden neuron resets on a spike: `zero` (one spike per step at most) or \
          `subtract` (n = floor(v) spikes, v - n kept: the neuron of sinabs, Rockpool and \
@@ -253,6 +250,9 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
          learns from every part of a slide [default: whole recordings]. Validation and \
          prediction read whole recordings.",
         get: shown_some, set: some_count),
+    knob!(Snn "snn", standardize, "--snn-standardize", Bool,
+        "Train on inputs standardised as logistic regression's rates are (`true`), or on \
+         the spike counts as they are (`false`).", get: shown, set: flag),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \
          the chip's limits, its time constants moved to the chip's bitshift decays, \
