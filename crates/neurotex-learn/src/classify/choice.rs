@@ -139,6 +139,9 @@ impl fmt::Display for ClassifierChoice {
                 if let Some(window) = p.window_ms {
                     write!(f, ", trained on {window} ms windows")?;
                 }
+                if !p.standardize {
+                    write!(f, ", inputs not standardised")?;
+                }
                 if p.target == crate::snn::Target::Xylo {
                     write!(
                         f,

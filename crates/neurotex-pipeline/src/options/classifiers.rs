@@ -251,8 +251,9 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
          prediction read whole recordings.",
         get: shown_some, set: some_count),
     knob!(Snn "snn", standardize, "--snn-standardize", Bool,
-        "Train on inputs standardised as logistic regression's rates are (`true`), or on \
-         the spike counts as they are (`false`).", get: shown, set: flag),
+        "Train on inputs standardised by their mean and spread over the training recordings \
+         (`true`: measured higher within a condition, lower on a held-out speed of the \
+         simulator), or on the spike counts as they are (`false`).", get: shown, set: flag),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \
          the chip's limits, its time constants moved to the chip's bitshift decays, \

@@ -160,7 +160,7 @@ impl TrainedSpiking {
             true => format!("still falling at the last of the {} epochs", log.epochs),
             false => format!("lowest at epoch {} of {}", log.best_epoch, log.epochs),
         };
-        capped.then(|| format!("the validation loss was {lowest}: training stopped at the cap, not by early stopping; a larger --snn-epochs may do better"))
+        capped.then(|| format!("the validation loss was {lowest}: training stopped at the cap, not by early stopping; more epochs may do better (--snn-epochs; Python: the `epochs` classifier option)"))
     }
 }
 
