@@ -254,7 +254,7 @@ fn seen_inputs<'a>(
 thread_local! {
     /// Each thread's trajectory, kept from one recording and batch to the next: a new one
     /// for each (megabytes on long slides) cost its pages anew, and the kernel's work on
-    /// them was a quarter of training's CPU time.
+    /// them was a fifth of training's CPU time (11 s of system time in 56 s).
     static TRAJECTORY: std::cell::RefCell<Trajectory> = std::cell::RefCell::new(Trajectory::default());
 }
 
