@@ -66,12 +66,10 @@ pub fn fit_with(
         },
         detach_reset: params.detach_reset,
     };
+    // With standardised inputs the optimiser moves their parameters, of which the network
+    // is made after each step; without, the network's own.
     let scaled = params.standardize.then(|| Standardised::of(inputs, &train));
-    // What the optimiser moves: the network's own weights, or those of its standardised
-    // inputs.
-    let mut trained = scaled
-        .as_ref()
-        .map_or_else(|| net.clone(), |z| z.trained(&net));
+    let mut moved = scaled.as_ref().map(|z| (z, z.trained(&net)));
     let mut adam = Adam::new(&net, params.learning_rate);
     let mut best = (f64::INFINITY, net.clone(), 0);
     let mut order = train.clone();
@@ -83,13 +81,14 @@ pub fn fit_with(
         for batch in order.chunks(params.batch) {
             let seen = seen_inputs(params, inputs, batch, &mut rng);
             let mut grad = batch_gradient(&net, &seen, y, batch, rule);
-            if let Some(z) = &scaled {
-                z.gradient(&mut grad);
+            match &mut moved {
+                None => adam.step(&mut net, &grad),
+                Some((z, trained)) => {
+                    z.gradient(&mut grad);
+                    adam.step(trained, &grad);
+                    net = z.network(trained);
+                }
             }
-            adam.step(&mut trained, &grad);
-            net = scaled
-                .as_ref()
-                .map_or_else(|| trained.clone(), |z| z.network(&trained));
         }
         let loss = mean_loss(&net, inputs, y, &valid);
         each_epoch();
