@@ -437,18 +437,18 @@ fn nested_note(
     Some(note)
 }
 
-/// Checks that the column `protocol` splits by (per or held out) has a value in some of
-/// the recordings `metas`: a workflow calls it before encoding, so that a misspelt column
-/// is named at once rather than after the recordings are encoded.
+/// Checks before the recordings `metas` are encoded what `params` asks of them: the
+/// protocol's column (per or held out) has a value in some, and nested selection can run.
 ///
 /// # Errors
-/// The column has no value in any recording (the error lists the columns that do).
-pub fn check_protocol_column(metas: &[Meta], protocol: &Protocol) -> Result<()> {
-    match protocol {
-        Protocol::Per(column) | Protocol::HoldOut(column) => {
-            parts::conditions(metas, column).map(drop)
-        }
-        _ => Ok(()),
+/// A column without values (named with those that have some), or nested selection's.
+pub fn check_design(metas: &[Meta], params: &CompareParams) -> Result<()> {
+    if let Protocol::Per(column) | Protocol::HoldOut(column) = &params.protocol {
+        parts::conditions(metas, column)?;
+    }
+    match params.nested {
+        true => check_nested(metas, params).map(drop),
+        false => Ok(()),
     }
 }
 

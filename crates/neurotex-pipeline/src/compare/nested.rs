@@ -251,7 +251,7 @@ fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
 /// needs at least 2 folds, so every class at least 2 recordings in each outer training set.
 pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
     if params.inner_folds < 2 {
-        let rule = "nested selection's inner cross-validation needs at least 2 folds";
+        let rule = "nested selection's inner cross-validation needs 2 folds or more";
         return Err(ParamError::new("inner_folds", rule, params.inner_folds).into());
     }
     let splits = outer_splits(metas, params)?;

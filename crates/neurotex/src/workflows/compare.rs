@@ -163,11 +163,6 @@ impl CompareOptions {
             repeats: self.repeats,
         }
         .check()?;
-        // Before any recording is encoded (the comparison checks it again as it starts).
-        if let Some(folds) = self.inner_folds.filter(|&folds| folds < 2) {
-            let rule = "nested selection's inner cross-validation needs 2 folds or more";
-            return Err(ParamError::new("inner-folds", rule, folds).into());
-        }
         Ok(CompareParams {
             protocol: self.protocol(),
             cv,
@@ -282,7 +277,7 @@ impl CompareOptions {
             .iter()
             .map(|&i| dataset.entries[i].clone())
             .collect();
-        crate::compare::check_protocol_column(&metas, &params.protocol)?;
+        crate::compare::check_design(&metas, &params)?;
         let set = self.set()?;
         let n = set.len();
         if n == 0 || n > MAX_CANDIDATES {
