@@ -1,9 +1,10 @@
 //! KNN (k = 5) with 5-fold stratified cross-validation on 160 samples x 3 features
 //! (8 classes x 20 trials, one speed of the paper's dataset); fitting a random forest
 //! (200 trees, √d features per split) and a logistic regression (C = 1) on 1000 samples x
-//! 100 features of 8 classes, and on 102 x 96 (E9's nested inner training sets); the resampling statistics every accuracy carries: a 2000-
-//! resample bootstrap interval over 160 recordings (one speed) and a 2000-resample
-//! sign-flip test over 480 paired differences.
+//! 100 features of 8 classes, and on 102 samples (E9's nested inner training sets) of 96,
+//! 6 and 448 features (`all-taxels`, `glcm3d` and `spectrum` of `sa+fa`); the resampling
+//! statistics every accuracy carries: a 2000-resample bootstrap interval over 160
+//! recordings (one speed) and a 2000-resample sign-flip test over 480 paired differences.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use neurotex::classify::metrics::sign_flip_p;
@@ -95,6 +96,15 @@ fn bench_fit(c: &mut Criterion) {
     group.bench_function(format!("linear_fit/{n}x{dims}"), |b| {
         b.iter(|| linear.fit(&x, dims, &y).unwrap())
     });
+    // The same training set's rows of E9's narrowest and widest forest candidates:
+    // `glcm3d` of `sa+fa` (one split feature tried per node) and `spectrum` of `sa+fa`
+    // (21 tried per node).
+    for dims in [6, 448] {
+        let (x, y) = overlapping(n, dims, 8);
+        group.bench_function(format!("forest_fit/200trees/{n}x{dims}"), |b| {
+            b.iter(|| forest.fit(&x, dims, &y).unwrap())
+        });
+    }
     group.finish();
 }
 

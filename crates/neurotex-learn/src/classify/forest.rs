@@ -14,7 +14,8 @@
 //! Splits are searched by sorting: every feature is rank-transformed once per fit (equal
 //! values share a rank), and a node sorts its samples by rank for each feature it tries, as
 //! 64-bit keys (rank, sample): a stable counting sort over the node's samples, which are
-//! kept in ascending order, or a comparison sort for small nodes. A split's quality is the Gini proxy
+//! kept in ascending order, each small node's keys placed by counting the keys below each,
+//! or a comparison sort where a node has far fewer samples than the feature has ranks. A split's quality is the Gini proxy
 //! `Σ_c L_c² / |L| + Σ_c R_c² / |R|` (class counts weighted by bootstrap multiplicity),
 //! compared exactly as a fraction of integers, so equal splits are equal and the choice
 //! among them is fixed: the lowest feature index, then the lowest threshold. A threshold
@@ -250,38 +251,72 @@ struct Grower<'a> {
     left: Vec<u64>,
 }
 
+/// A grower's buffers, handed from one tree to the next a thread grows so that a forest
+/// allocates them once per thread rather than once per tree; what they hold is never read
+/// before it is written.
+#[derive(Default)]
+struct Spare {
+    weight: Vec<u64>,
+    samples: Vec<u32>,
+    keys: Vec<u64>,
+    rank_starts: Vec<u32>,
+    right: Vec<u32>,
+    features: Vec<usize>,
+    counts: Vec<u64>,
+    left: Vec<u64>,
+}
+
 impl<'a> Grower<'a> {
-    fn new(data: &'a Prepared<'a>, growth: Growth, seed: u64, tree: usize) -> Self {
+    fn new(data: &'a Prepared<'a>, growth: Growth, seed: u64, tree: usize, spare: Spare) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(tree as u64);
         let n = data.y.len();
-        let mut weight = vec![u64::from(!growth.bootstrap); n];
+        let Spare {
+            mut weight,
+            mut samples,
+            mut counts,
+            mut left,
+            keys,
+            rank_starts,
+            right,
+            features,
+        } = spare;
+        weight.clear();
+        weight.resize(n, u64::from(!growth.bootstrap));
         if growth.bootstrap {
             for _ in 0..n {
                 weight[rng.gen_range(0..n as u64) as usize] += 1;
             }
         }
-        let samples = (0..n as u32).filter(|&s| weight[s as usize] > 0).collect();
+        samples.clear();
+        samples.extend((0..n as u32).filter(|&s| weight[s as usize] > 0));
+        counts.resize(data.n_classes, 0);
+        left.resize(data.n_classes, 0);
         Grower {
             data,
             growth,
             rng,
             weight,
             samples,
-            keys: Vec::new(),
-            rank_starts: Vec::new(),
-            right: Vec::new(),
-            features: Vec::new(),
-            counts: vec![0; data.n_classes],
-            left: vec![0; data.n_classes],
+            keys,
+            rank_starts,
+            right,
+            features,
+            counts,
+            left,
         }
     }
 
-    /// Grows the tree depth first from the root.
-    fn grow(mut self) -> Tree {
+    /// Grows the tree depth first from the root; returns it and the buffers for the next.
+    fn grow(mut self) -> (Tree, Spare) {
+        // A binary tree has fewer nodes than twice its leaves, which are at most its
+        // samples: room for every node and share at once, never much more than is used.
+        let leaves = self.samples.len();
+        let mut nodes = Vec::with_capacity(2 * leaves);
+        nodes.push(Node::Leaf(0));
         let mut tree = Tree {
-            nodes: vec![Node::Leaf(0)],
-            shares: Vec::new(),
+            nodes,
+            shares: Vec::with_capacity(leaves * self.data.n_classes),
         };
         let mut stack = vec![(0usize, 0usize, self.samples.len(), 0usize)];
         while let Some((node, start, end, depth)) = stack.pop() {
@@ -314,7 +349,17 @@ impl<'a> Grower<'a> {
                 }
             }
         }
-        tree
+        let spare = Spare {
+            weight: self.weight,
+            samples: self.samples,
+            keys: self.keys,
+            rank_starts: self.rank_starts,
+            right: self.right,
+            features: self.features,
+            counts: self.counts,
+            left: self.left,
+        };
+        (tree, spare)
     }
 
     /// Fills `counts` with the node's class counts (weighted by multiplicity).
@@ -334,8 +379,10 @@ impl<'a> Grower<'a> {
     /// Sorts the node's samples by their rank on `feature` into `keys`, as 64-bit keys
     /// (rank, sample). A node's samples are kept in ascending order (the root's are, and
     /// [`Grower::partition`] keeps the order), so a stable counting sort by rank gives the
-    /// keys in order; small nodes, where clearing a count per rank would cost more than
-    /// the sort, are sorted by comparison. The keys are distinct, so both give one order.
+    /// keys in order; nodes of at most [`SMALL`] samples are placed by [`place_small`],
+    /// and nodes with far more ranks than samples, where clearing a count per rank would
+    /// cost more than the sort, are sorted by comparison. The keys are distinct, so every
+    /// way gives one order.
     fn sort_keys(&mut self, start: usize, end: usize, feature: usize) {
         let n = self.data.y.len();
         let ranks = &self.data.ranks[feature * n..(feature + 1) * n];
@@ -343,7 +390,18 @@ impl<'a> Grower<'a> {
         let key = |s: u32| (u64::from(ranks[s as usize]) << 32) | u64::from(s);
         self.keys.clear();
         let distinct = self.data.distinct[feature] as usize;
-        if samples.len() * 12 < distinct || samples.len() < 32 {
+        if samples.len() <= SMALL && distinct <= 1 << (32 - SMALL.trailing_zeros()) {
+            let mut packed = [u32::MAX; SMALL];
+            let mut keys = [0u64; SMALL];
+            for (i, &s) in samples.iter().enumerate() {
+                packed[i] = (ranks[s as usize] << SMALL.trailing_zeros()) | i as u32;
+                keys[i] = key(s);
+            }
+            self.keys.resize(samples.len(), 0);
+            place_small(&packed, &keys, &mut self.keys);
+            return;
+        }
+        if samples.len() * 12 < distinct {
             self.keys.extend(samples.iter().map(|&s| key(s)));
             self.keys.sort_unstable();
             return;
@@ -518,6 +576,25 @@ impl<'a> Grower<'a> {
     }
 }
 
+/// The most samples a node may have for [`place_small`] (a power of two).
+const SMALL: usize = 32;
+
+neurotex_core::widest_or_plain! {
+    ["avx2"]
+    /// Writes `keys[..out.len()]` into `out` in ascending order, where `packed[i]` orders
+    /// `keys[i]` as the keys do and is distinct for each key (`(rank << 5) | i`, where the
+    /// node's samples, and so their keys of equal rank, ascend with `i`), and unused
+    /// entries of `packed` are `u32::MAX`. Each key goes to the place given by the number of
+    /// `packed` values below its own: a fixed count of comparisons that vectorise, where a
+    /// comparison sort of a small node mispredicts about one branch in two.
+    fn place_small(packed: &[u32; SMALL], keys: &[u64; SMALL], out: &mut [u64]) {
+        for (&own, &key) in packed.iter().zip(keys).take(out.len()) {
+            let below: u32 = packed.iter().map(|&p| u32::from(p < own)).sum();
+            out[below as usize] = key;
+        }
+    }
+}
+
 impl Tree {
     /// The class distribution of the leaf `row` falls in.
     fn leaf(&self, row: &[f64], n_classes: usize) -> &[f64] {
@@ -564,7 +641,12 @@ impl Classifier for Forest {
         let data = Prepared::new(x, dims, y);
         let trees = (0..p.trees)
             .into_par_iter()
-            .map(|t| Grower::new(&data, growth, p.seed, t).grow())
+            .map_init(Spare::default, |spare, t| {
+                let grower = Grower::new(&data, growth, p.seed, t, std::mem::take(spare));
+                let tree;
+                (tree, *spare) = grower.grow();
+                tree
+            })
             .collect();
         Ok(ForestModel {
             dims,
@@ -736,6 +818,38 @@ mod tests {
         0xae7a98d51b3beada,
         0xfadec57147b6908a,
     ];
+
+    /// Every count of up to 32 keys, ranks with many ties and without: placed as sorting
+    /// them puts them.
+    #[test]
+    fn small_nodes_are_placed_as_sorted() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for m in 1..=SMALL {
+            for levels in [2u64, 7, 1 << 20] {
+                let mut samples: Vec<u32> = (0..m).map(|_| (next() % 4096) as u32).collect();
+                samples.sort_unstable();
+                samples.dedup();
+                let mut packed = [u32::MAX; SMALL];
+                let mut keys = [0u64; SMALL];
+                for (i, &s) in samples.iter().enumerate() {
+                    let rank = (next() % levels) as u32;
+                    packed[i] = (rank << 5) | i as u32;
+                    keys[i] = (u64::from(rank) << 32) | u64::from(s);
+                }
+                let mut placed = vec![0u64; samples.len()];
+                place_small(&packed, &keys, &mut placed);
+                let mut sorted = keys[..samples.len()].to_vec();
+                sorted.sort_unstable();
+                assert_eq!(placed, sorted, "{m} keys of {levels} ranks");
+            }
+        }
+    }
 
     #[test]
     fn a_stump_splits_between_the_classes() {
