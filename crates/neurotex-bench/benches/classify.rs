@@ -97,12 +97,15 @@ fn bench_fit(c: &mut Criterion) {
         b.iter(|| linear.fit(&x, dims, &y).unwrap())
     });
     // The same training set's rows of E9's narrowest and widest forest candidates:
-    // `glcm3d` of `sa+fa` (one split feature tried per node) and `spectrum` of `sa+fa`
-    // (21 tried per node).
-    for dims in [6, 448] {
+    // `glcm3d` of `sa+fa` (one split feature tried per node), `spectrum` of `sa` (the widest
+    // the regression preconditions) and of `sa+fa` (21 features tried per node).
+    for dims in [6, 224, 448] {
         let (x, y) = overlapping(n, dims, 8);
         group.bench_function(format!("forest_fit/200trees/{n}x{dims}"), |b| {
             b.iter(|| forest.fit(&x, dims, &y).unwrap())
+        });
+        group.bench_function(format!("linear_fit/{n}x{dims}"), |b| {
+            b.iter(|| linear.fit(&x, dims, &y).unwrap())
         });
     }
     group.finish();

@@ -175,12 +175,61 @@ pub(super) fn inverse(mut m: Vec<f64>, d: usize) -> Vec<f64> {
             let sum = dot8(&m[i * d + c..i * d + i], &x[c..i]);
             x[i] = (f64::from(u8::from(i == c)) - sum) / m[i * d + i];
         }
-        for i in (0..d).rev() {
-            let sum: f64 = (i + 1..d).map(|j| m[j * d + i] * x[j]).sum();
-            x[i] = (x[i] - sum) / m[i * d + i];
+    }
+    // Lᵀ's rows (L's columns), read in order by the back substitutions.
+    let mut upper = vec![0.0; d * d];
+    for i in 0..d {
+        for j in 0..=i {
+            upper[j * d + i] = m[i * d + j];
         }
     }
+    for columns in inv.chunks_mut(BACK * d) {
+        back_substitute(&upper, d, columns);
+    }
     inv
+}
+
+/// Columns solved side by side by [`back_substitute`].
+const BACK: usize = 8;
+
+neurotex_core::widest_or_plain! {
+    ["avx512f", "avx2"]
+    /// Solves `Lᵀ x = b` in place for each of up to [`BACK`] rows `b` of `columns` (each
+    /// `d` long), `upper` holding `Lᵀ` row-major. Entry `i` of each is `(b_i - Σ_j
+    /// Lᵀ_ij x_j) / Lᵀ_ii`, the sum over `j > i` added in ascending order from the value
+    /// `f64`'s `Sum` starts from, as one column alone computes it; the columns are
+    /// independent, so side by side they fill vector lanes where one column's sum waits on
+    /// each addition, with the same bits.
+    fn back_substitute(upper: &[f64], d: usize, columns: &mut [f64]) {
+        let width = columns.len() / d;
+        let mut x = vec![0.0; d * BACK];
+        for (l, column) in columns.chunks_exact(d).enumerate() {
+            for (i, &v) in column.iter().enumerate() {
+                x[i * BACK + l] = v;
+            }
+        }
+        let start: f64 = std::iter::empty::<f64>().sum();
+        for i in (0..d).rev() {
+            let mut sum = [start; BACK];
+            for (&u, xj) in upper[i * d + i + 1..(i + 1) * d]
+                .iter()
+                .zip(x[(i + 1) * BACK..].chunks_exact(BACK))
+            {
+                for l in 0..BACK {
+                    sum[l] += u * xj[l];
+                }
+            }
+            let diag = upper[i * d + i];
+            for l in 0..BACK {
+                x[i * BACK + l] = (x[i * BACK + l] - sum[l]) / diag;
+            }
+        }
+        for (l, column) in columns.chunks_exact_mut(d).enumerate().take(width) {
+            for (i, v) in column.iter_mut().enumerate() {
+                *v = x[i * BACK + l];
+            }
+        }
+    }
 }
 
 /// Minimises the problem's objective from zero by L-BFGS.
