@@ -173,15 +173,19 @@ impl<'a> Prepared<'a> {
         let n = y.len();
         let mut ranks = vec![0u32; n * dims];
         let mut distinct = vec![0u32; dims];
-        let mut order: Vec<usize> = (0..n).collect();
+        // Each feature's values beside their samples, sorted in one piece of memory (the
+        // ranks do not depend on the order of equal values).
+        let mut column: Vec<(f64, u32)> = Vec::with_capacity(n);
         for (f, feature_ranks) in ranks.chunks_exact_mut(n).enumerate() {
-            order.sort_unstable_by(|&a, &b| x[a * dims + f].total_cmp(&x[b * dims + f]));
+            column.clear();
+            column.extend((0..n).map(|s| (x[s * dims + f], s as u32)));
+            column.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
             let mut rank = 0u32;
-            for (i, &s) in order.iter().enumerate() {
-                if i > 0 && x[s * dims + f] != x[order[i - 1] * dims + f] {
+            for (i, &(value, s)) in column.iter().enumerate() {
+                if i > 0 && value != column[i - 1].0 {
                     rank += 1;
                 }
-                feature_ranks[s] = rank;
+                feature_ranks[s as usize] = rank;
             }
             distinct[f] = rank + 1;
         }
@@ -390,11 +394,11 @@ impl<'a> Grower<'a> {
         let key = |s: u32| (u64::from(ranks[s as usize]) << 32) | u64::from(s);
         self.keys.clear();
         let distinct = self.data.distinct[feature] as usize;
-        if samples.len() <= SMALL && distinct <= 1 << (32 - SMALL.trailing_zeros()) {
-            let mut packed = [u32::MAX; SMALL];
+        if samples.len() <= SMALL && distinct <= 1 << (31 - SMALL.trailing_zeros()) {
+            let mut packed = [i32::MAX; SMALL];
             let mut keys = [0u64; SMALL];
             for (i, &s) in samples.iter().enumerate() {
-                packed[i] = (ranks[s as usize] << SMALL.trailing_zeros()) | i as u32;
+                packed[i] = ((ranks[s as usize] << SMALL.trailing_zeros()) | i as u32) as i32;
                 keys[i] = key(s);
             }
             self.keys.resize(samples.len(), 0);
@@ -582,14 +586,17 @@ const SMALL: usize = 32;
 neurotex_core::widest_or_plain! {
     ["avx2"]
     /// Writes `keys[..out.len()]` into `out` in ascending order, where `packed[i]` orders
-    /// `keys[i]` as the keys do and is distinct for each key (`(rank << 5) | i`, where the
-    /// node's samples, and so their keys of equal rank, ascend with `i`), and unused
-    /// entries of `packed` are `u32::MAX`. Each key goes to the place given by the number of
-    /// `packed` values below its own: a fixed count of comparisons that vectorise, where a
-    /// comparison sort of a small node mispredicts about one branch in two.
-    fn place_small(packed: &[u32; SMALL], keys: &[u64; SMALL], out: &mut [u64]) {
+    /// `keys[i]` as the keys do and is distinct for each key (`(rank << 5) | i`, at most
+    /// `i32::MAX`, where the node's samples, and so their keys of equal rank, ascend with
+    /// `i`), and unused entries of `packed` are `i32::MAX`. Each key goes to the place
+    /// given by the number of `packed` values below its own, counted over the keys rounded
+    /// up to eight: a fixed count of comparisons that vectorise (signed, one instruction
+    /// each), where a comparison sort of a small node mispredicts about one branch in two.
+    fn place_small(packed: &[i32; SMALL], keys: &[u64; SMALL], out: &mut [u64]) {
+        let lanes = out.len().next_multiple_of(8).min(SMALL);
+        let packed = &packed[..lanes];
         for (&own, &key) in packed.iter().zip(keys).take(out.len()) {
-            let below: u32 = packed.iter().map(|&p| u32::from(p < own)).sum();
+            let below: i32 = packed.iter().map(|&p| i32::from(p < own)).sum();
             out[below as usize] = key;
         }
     }
@@ -835,11 +842,11 @@ mod tests {
                 let mut samples: Vec<u32> = (0..m).map(|_| (next() % 4096) as u32).collect();
                 samples.sort_unstable();
                 samples.dedup();
-                let mut packed = [u32::MAX; SMALL];
+                let mut packed = [i32::MAX; SMALL];
                 let mut keys = [0u64; SMALL];
                 for (i, &s) in samples.iter().enumerate() {
                     let rank = (next() % levels) as u32;
-                    packed[i] = (rank << 5) | i as u32;
+                    packed[i] = ((rank << 5) | i as u32) as i32;
                     keys[i] = (u64::from(rank) << 32) | u64::from(s);
                 }
                 let mut placed = vec![0u64; samples.len()];
