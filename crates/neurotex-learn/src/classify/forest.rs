@@ -15,9 +15,9 @@
 //! values share a rank), and a node sorts its samples by rank for each feature it tries, as
 //! 64-bit keys (rank, sample): a stable counting sort over the node's samples, which are
 //! kept in ascending order, each small node's keys placed by counting the keys below each,
-//! or a comparison sort where a node has far fewer samples than the feature has ranks. A split's quality is the Gini proxy
-//! `Σ_c L_c² / |L| + Σ_c R_c² / |R|` (class counts weighted by bootstrap multiplicity),
-//! compared exactly as a fraction of integers, so equal splits are equal and the choice
+//! or a comparison sort where a node has far fewer samples than the feature has ranks. A
+//! split's quality is the Gini proxy `Σ_c L_c² / |L| + Σ_c R_c² / |R|` (class counts
+//! weighted by bootstrap multiplicity), compared exactly as a fraction of integers, so equal splits are equal and the choice
 //! among them is fixed: the lowest feature index, then the lowest threshold. A threshold
 //! lies midway between two neighbouring distinct values; a sample goes left when its value
 //! is at most the threshold. A node is split while it is impure, above the depth limit and
@@ -255,9 +255,9 @@ struct Grower<'a> {
     left: Vec<u64>,
 }
 
-/// A grower's buffers, handed from one tree to the next a thread grows so that a forest
-/// allocates them once per thread rather than once per tree; what they hold is never read
-/// before it is written.
+/// A grower's buffers, handed from one tree to the next within each piece of work rayon
+/// splits the trees into, so that a forest allocates them a few times rather than once per
+/// tree; what they hold is never read before it is written.
 #[derive(Default)]
 struct Spare {
     weight: Vec<u64>,

@@ -201,7 +201,6 @@ neurotex_core::widest_or_plain! {
     /// independent, so side by side they fill vector lanes where one column's sum waits on
     /// each addition, with the same bits.
     fn back_substitute(upper: &[f64], d: usize, columns: &mut [f64]) {
-        let width = columns.len() / d;
         let mut x = vec![0.0; d * BACK];
         for (l, column) in columns.chunks_exact(d).enumerate() {
             for (i, &v) in column.iter().enumerate() {
@@ -224,7 +223,7 @@ neurotex_core::widest_or_plain! {
                 x[i * BACK + l] = (x[i * BACK + l] - sum[l]) / diag;
             }
         }
-        for (l, column) in columns.chunks_exact_mut(d).enumerate().take(width) {
+        for (l, column) in columns.chunks_exact_mut(d).enumerate() {
             for (i, v) in column.iter_mut().enumerate() {
                 *v = x[i * BACK + l];
             }
