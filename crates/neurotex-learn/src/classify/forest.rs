@@ -241,6 +241,14 @@ struct Grower<'a> {
     data: &'a Prepared<'a>,
     growth: Growth,
     rng: ChaCha8Rng,
+    buffers: Buffers,
+}
+
+/// A grower's samples and scratch space, handed from one tree to the next within each
+/// piece of work rayon splits the trees into, so that a forest allocates them a few times
+/// rather than once per tree; what they hold is never read before it is written.
+#[derive(Default)]
+struct Buffers {
     /// Bootstrap multiplicity of each training sample.
     weight: Vec<u64>,
     /// The in-bag samples; each node owns a contiguous range.
@@ -255,36 +263,19 @@ struct Grower<'a> {
     left: Vec<u64>,
 }
 
-/// A grower's buffers, handed from one tree to the next within each piece of work rayon
-/// splits the trees into, so that a forest allocates them a few times rather than once per
-/// tree; what they hold is never read before it is written.
-#[derive(Default)]
-struct Spare {
-    weight: Vec<u64>,
-    samples: Vec<u32>,
-    keys: Vec<u64>,
-    rank_starts: Vec<u32>,
-    right: Vec<u32>,
-    features: Vec<usize>,
-    counts: Vec<u64>,
-    left: Vec<u64>,
-}
-
 impl<'a> Grower<'a> {
-    fn new(data: &'a Prepared<'a>, growth: Growth, seed: u64, tree: usize, spare: Spare) -> Self {
+    /// The grower of tree `tree`, its buffers `buffers` (any contents).
+    fn new(
+        data: &'a Prepared<'a>,
+        growth: Growth,
+        seed: u64,
+        tree: usize,
+        mut buffers: Buffers,
+    ) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(tree as u64);
         let n = data.y.len();
-        let Spare {
-            mut weight,
-            mut samples,
-            mut counts,
-            mut left,
-            keys,
-            rank_starts,
-            right,
-            features,
-        } = spare;
+        let weight = &mut buffers.weight;
         weight.clear();
         weight.resize(n, u64::from(!growth.bootstrap));
         if growth.bootstrap {
@@ -292,37 +283,31 @@ impl<'a> Grower<'a> {
                 weight[rng.gen_range(0..n as u64) as usize] += 1;
             }
         }
-        samples.clear();
-        samples.extend((0..n as u32).filter(|&s| weight[s as usize] > 0));
-        counts.resize(data.n_classes, 0);
-        left.resize(data.n_classes, 0);
+        buffers.samples.clear();
+        let in_bag = (0..n as u32).filter(|&s| buffers.weight[s as usize] > 0);
+        buffers.samples.extend(in_bag);
+        buffers.counts.resize(data.n_classes, 0);
+        buffers.left.resize(data.n_classes, 0);
         Grower {
             data,
             growth,
             rng,
-            weight,
-            samples,
-            keys,
-            rank_starts,
-            right,
-            features,
-            counts,
-            left,
+            buffers,
         }
     }
 
     /// Grows the tree depth first from the root; returns it and the buffers for the next.
-    fn grow(mut self) -> (Tree, Spare) {
+    fn grow(mut self) -> (Tree, Buffers) {
         // A binary tree has fewer nodes than twice its leaves, which are at most its
         // samples: room for every node and share at once, never much more than is used.
-        let leaves = self.samples.len();
+        let leaves = self.buffers.samples.len();
         let mut nodes = Vec::with_capacity(2 * leaves);
         nodes.push(Node::Leaf(0));
         let mut tree = Tree {
             nodes,
             shares: Vec::with_capacity(leaves * self.data.n_classes),
         };
-        let mut stack = vec![(0usize, 0usize, self.samples.len(), 0usize)];
+        let mut stack = vec![(0usize, 0usize, self.buffers.samples.len(), 0usize)];
         while let Some((node, start, end, depth)) = stack.pop() {
             self.count(start, end);
             let split = if self.splittable(end - start, depth) {
@@ -347,36 +332,26 @@ impl<'a> Grower<'a> {
                 }
                 None => {
                     tree.nodes[node] = Node::Leaf(tree.shares.len());
-                    let total: u64 = self.counts.iter().sum();
-                    let shares = self.counts.iter().map(|&c| c as f64 / total as f64);
+                    let total: u64 = self.buffers.counts.iter().sum();
+                    let shares = self.buffers.counts.iter().map(|&c| c as f64 / total as f64);
                     tree.shares.extend(shares);
                 }
             }
         }
-        let spare = Spare {
-            weight: self.weight,
-            samples: self.samples,
-            keys: self.keys,
-            rank_starts: self.rank_starts,
-            right: self.right,
-            features: self.features,
-            counts: self.counts,
-            left: self.left,
-        };
-        (tree, spare)
+        (tree, self.buffers)
     }
 
     /// Fills `counts` with the node's class counts (weighted by multiplicity).
     fn count(&mut self, start: usize, end: usize) {
-        self.counts.fill(0);
-        for &s in &self.samples[start..end] {
-            self.counts[self.data.y[s as usize]] += self.weight[s as usize];
+        self.buffers.counts.fill(0);
+        for &s in &self.buffers.samples[start..end] {
+            self.buffers.counts[self.data.y[s as usize]] += self.buffers.weight[s as usize];
         }
     }
 
     /// Whether a node of `n` samples at `depth` (with `counts` filled) may be split.
     fn splittable(&self, n: usize, depth: usize) -> bool {
-        let classes = self.counts.iter().filter(|&&c| c > 0).count();
+        let classes = self.buffers.counts.iter().filter(|&&c| c > 0).count();
         classes > 1 && depth < self.growth.max_depth && n >= 2 * self.growth.min_leaf
     }
 
@@ -390,9 +365,9 @@ impl<'a> Grower<'a> {
     fn sort_keys(&mut self, start: usize, end: usize, feature: usize) {
         let n = self.data.y.len();
         let ranks = &self.data.ranks[feature * n..(feature + 1) * n];
-        let samples = &self.samples[start..end];
+        let samples = &self.buffers.samples[start..end];
         let key = |s: u32| (u64::from(ranks[s as usize]) << 32) | u64::from(s);
-        self.keys.clear();
+        self.buffers.keys.clear();
         let distinct = self.data.distinct[feature] as usize;
         if samples.len() <= SMALL && distinct <= 1 << (31 - SMALL.trailing_zeros()) {
             let mut packed = [i32::MAX; SMALL];
@@ -401,16 +376,16 @@ impl<'a> Grower<'a> {
                 packed[i] = ((ranks[s as usize] << SMALL.trailing_zeros()) | i as u32) as i32;
                 keys[i] = key(s);
             }
-            self.keys.resize(samples.len(), 0);
-            place_small(&packed, &keys, &mut self.keys);
+            self.buffers.keys.resize(samples.len(), 0);
+            place_small(&packed, &keys, &mut self.buffers.keys);
             return;
         }
         if samples.len() * 12 < distinct {
-            self.keys.extend(samples.iter().map(|&s| key(s)));
-            self.keys.sort_unstable();
+            self.buffers.keys.extend(samples.iter().map(|&s| key(s)));
+            self.buffers.keys.sort_unstable();
             return;
         }
-        let starts = &mut self.rank_starts;
+        let starts = &mut self.buffers.rank_starts;
         starts.clear();
         starts.resize(distinct, 0);
         for &s in samples {
@@ -422,10 +397,10 @@ impl<'a> Grower<'a> {
         for start in starts.iter_mut() {
             (*start, slot) = (slot, slot + *start);
         }
-        self.keys.resize(samples.len(), 0);
+        self.buffers.keys.resize(samples.len(), 0);
         for &s in samples {
             let slot = &mut starts[ranks[s as usize] as usize];
-            self.keys[*slot as usize] = key(s);
+            self.buffers.keys[*slot as usize] = key(s);
             *slot += 1;
         }
     }
@@ -434,8 +409,8 @@ impl<'a> Grower<'a> {
     /// feature is constant in it or no split leaves `min_samples_leaf` on both sides.
     fn best_split(&mut self, start: usize, end: usize) -> Option<Candidate> {
         let dims = self.data.dims;
-        self.features.clear();
-        self.features.extend(0..dims);
+        self.buffers.features.clear();
+        self.buffers.features.extend(0..dims);
         let mut best = None;
         let mut tried = 0;
         for i in 0..dims {
@@ -443,10 +418,13 @@ impl<'a> Grower<'a> {
                 break;
             }
             let j = self.rng.gen_range(i as u64..dims as u64) as usize;
-            self.features.swap(i, j);
-            let feature = self.features[i];
+            self.buffers.features.swap(i, j);
+            let feature = self.buffers.features[i];
             self.sort_keys(start, end, feature);
-            let (first, last) = (self.keys[0] >> 32, self.keys[self.keys.len() - 1] >> 32);
+            let (first, last) = (
+                self.buffers.keys[0] >> 32,
+                self.buffers.keys[self.buffers.keys.len() - 1] >> 32,
+            );
             if first == last {
                 continue;
             }
@@ -466,7 +444,7 @@ impl<'a> Grower<'a> {
     /// numerator is below `total³` and its denominator below `total²`), else in 128 bits:
     /// exact either way, so the choice is the same.
     fn scan(&mut self, feature: usize, best: &mut Option<Candidate>) {
-        let total: u64 = self.counts.iter().sum();
+        let total: u64 = self.buffers.counts.iter().sum();
         let found = if total < 1 << 12 {
             self.scan_in::<u64>(feature, total)
         } else {
@@ -493,9 +471,13 @@ impl<'a> Grower<'a> {
             + std::ops::Add<Output = T>,
     {
         let min_leaf = self.growth.min_leaf;
-        let m = self.keys.len();
-        let (keys, y, weight) = (&self.keys[..], self.data.y, &self.weight[..]);
-        let (counts, left) = (&self.counts[..], &mut self.left[..]);
+        let m = self.buffers.keys.len();
+        let (keys, y, weight) = (
+            &self.buffers.keys[..],
+            self.data.y,
+            &self.buffers.weight[..],
+        );
+        let (counts, left) = (&self.buffers.counts[..], &mut self.buffers.left[..]);
         left.fill(0);
         let mut sq_left = 0u64;
         let mut sq_right: u64 = counts.iter().map(|&c| c * c).sum();
@@ -539,8 +521,8 @@ impl<'a> Grower<'a> {
     fn partition(&mut self, start: usize, end: usize, best: &Candidate) -> f64 {
         let n = self.data.y.len();
         let ranks = &self.data.ranks[best.feature * n..(best.feature + 1) * n];
-        let node = &mut self.samples[start..end];
-        self.right.clear();
+        let node = &mut self.buffers.samples[start..end];
+        self.buffers.right.clear();
         let mut left = 0;
         let mut above: Option<u32> = None;
         for i in 0..node.len() {
@@ -550,13 +532,13 @@ impl<'a> Grower<'a> {
                 node[left] = s;
                 left += 1;
             } else {
-                self.right.push(s);
+                self.buffers.right.push(s);
                 if above.is_none_or(|a| r < ranks[a as usize]) {
                     above = Some(s);
                 }
             }
         }
-        node[left..].copy_from_slice(&self.right);
+        node[left..].copy_from_slice(&self.buffers.right);
         debug_assert_eq!(
             left, best.n_left,
             "a split's left side is its ranks up to its own"
@@ -648,10 +630,10 @@ impl Classifier for Forest {
         let data = Prepared::new(x, dims, y);
         let trees = (0..p.trees)
             .into_par_iter()
-            .map_init(Spare::default, |spare, t| {
-                let grower = Grower::new(&data, growth, p.seed, t, std::mem::take(spare));
+            .map_init(Buffers::default, |buffers, t| {
+                let grower = Grower::new(&data, growth, p.seed, t, std::mem::take(buffers));
                 let tree;
-                (tree, *spare) = grower.grow();
+                (tree, *buffers) = grower.grow();
                 tree
             })
             .collect();
@@ -775,19 +757,23 @@ mod tests {
         h
     }
 
+    /// A xorshift stream from `state` (not 0), for test data.
+    fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        }
+    }
+
     /// Forests on data with many ties and without, small and larger, with and without
     /// bootstrap, depth and leaf limits: the digests of the trees grown before the split
     /// search stopped sorting each node's samples (sort_unstable of (rank, sample) keys),
     /// so that any change to the trees is seen.
     #[test]
     fn forests_are_the_ones_grown_before() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
         let mut digests = Vec::new();
         for (n, dims, classes, levels) in [(40, 3, 3, 5u64), (200, 12, 8, 1000), (480, 96, 8, 40)] {
             let x: Vec<f64> = (0..n * dims)
@@ -830,13 +816,7 @@ mod tests {
     /// them puts them.
     #[test]
     fn small_nodes_are_placed_as_sorted() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
         for m in 1..=SMALL {
             for levels in [2u64, 7, 1 << 20] {
                 let mut samples: Vec<u32> = (0..m).map(|_| (next() % 4096) as u32).collect();
