@@ -11,3 +11,17 @@ pub mod snn;
 // that `crate::recording` and the like read the same in every layer.
 use neurotex_core::error;
 use neurotex_core::spikes;
+
+/// What the unit tests share.
+#[cfg(test)]
+mod testing {
+    /// A xorshift64 stream from `state` (not 0): reproducible test data.
+    pub(crate) fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        }
+    }
+}

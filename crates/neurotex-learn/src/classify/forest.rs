@@ -757,23 +757,13 @@ mod tests {
         h
     }
 
-    /// A xorshift stream from `state` (not 0), for test data.
-    fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
-        move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        }
-    }
-
     /// Forests on data with many ties and without, small and larger, with and without
     /// bootstrap, depth and leaf limits: the digests of the trees grown before the split
     /// search stopped sorting each node's samples (sort_unstable of (rank, sample) keys),
     /// so that any change to the trees is seen.
     #[test]
     fn forests_are_the_ones_grown_before() {
-        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut next = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
         let mut digests = Vec::new();
         for (n, dims, classes, levels) in [(40, 3, 3, 5u64), (200, 12, 8, 1000), (480, 96, 8, 40)] {
             let x: Vec<f64> = (0..n * dims)
@@ -816,7 +806,7 @@ mod tests {
     /// them puts them.
     #[test]
     fn small_nodes_are_placed_as_sorted() {
-        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
+        let mut next = crate::testing::xorshift(0x2545_f491_4f6c_dd1d);
         for m in 1..=SMALL {
             for levels in [2u64, 7, 1 << 20] {
                 let mut samples: Vec<u32> = (0..m).map(|_| (next() % 4096) as u32).collect();

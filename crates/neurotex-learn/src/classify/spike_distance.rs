@@ -653,18 +653,12 @@ mod tests {
     use super::*;
 
     fn random_recordings(n: usize, steps: u32, seed: u64) -> Vec<SpikeTrains> {
-        let mut state = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = crate::testing::xorshift(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
         let present = [true, false, true, true];
         (0..n)
             .map(|_| {
                 let lists: Vec<Vec<u32>> = (0..4)
-                    .map(|_| (0..steps).filter(|_| next() % 40 == 0).collect())
+                    .map(|_| (0..steps).filter(|_| next().is_multiple_of(40)).collect())
                     .collect();
                 SpikeTrains::from_lists(&lists, 2, 2, &present, steps as usize)
             })

@@ -84,13 +84,8 @@ proptest::proptest! {
         seed in proptest::prelude::any::<u64>(),
         zeros in proptest::prelude::any::<bool>(),
     ) {
-        let mut state = seed | 1;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0
-        };
+        let mut bits = crate::testing::xorshift(seed | 1);
+        let mut next = move || (bits() >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0;
         let z: Vec<f64> = (0..n * d).map(|_| next()).collect();
         let y: Vec<usize> = (0..n).map(|i| i % k).collect();
         let problem = Problem { z, dims: d, y, k, penalty: 0.01 + next().abs() };
