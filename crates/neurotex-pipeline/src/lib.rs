@@ -12,7 +12,6 @@ pub mod compare;
 pub mod diagnostics;
 pub mod inspect;
 pub mod model;
-pub mod nir;
 pub mod options;
 pub mod pipeline;
 pub mod samples;
@@ -24,5 +23,7 @@ mod table;
 // that `crate::recording` and the like read the same in every layer.
 use neurotex_core::{error, events, import, io, progress, recording, values, Error};
 use neurotex_features::features;
+/// NIR graphs of the spiking network (in the learn layer, beside [`snn`]).
+pub use neurotex_learn::nir;
 use neurotex_learn::{classify, snn};
 use neurotex_signal::{encode, signal};

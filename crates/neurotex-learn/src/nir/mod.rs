@@ -203,7 +203,7 @@ pub fn read(path: &Path) -> Result<NirNetwork> {
 /// where `from` has none.
 pub fn read_as(path: &Path, from: NirFrom, step_s: Option<f64>) -> Result<NirNetwork> {
     let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
-    let damaged = |reason: String| -> crate::Error {
+    let damaged = |reason: String| -> neurotex_core::Error {
         ModelError::Nir {
             path: path.to_path_buf(),
             reason,
