@@ -106,6 +106,8 @@ fn compare_ranks_candidates_on_the_splits_evaluate_uses() {
         md.contains("paper's method") && md.contains("Caveat"),
         "{md}"
     );
+    // the folds, repeats and seed the ranking rests on
+    assert!(md.contains(", seed 0; "), "{md}");
 }
 
 #[test]
@@ -128,6 +130,7 @@ fn nested_selection_over_held_out_speeds_names_its_choices() {
         text.contains("nested selection:") && text.contains("of 3)"),
         "{text}"
     );
+    assert!(text.contains("one split per held-out part"), "{text}");
     assert!(
         text.contains("paper's method") && text.contains("caveat"),
         "{text}"

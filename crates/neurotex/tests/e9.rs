@@ -78,6 +78,11 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
         let gap = network.difference_vs_paper.unwrap();
         assert!((gap - (network.accuracy - paper.accuracy)).abs() < 1e-12);
         assert!((0.0..=1.0).contains(&network.p_vs_paper.unwrap()));
+        // and against its inputs' rates, paired on the same folds
+        let adds = network.difference_vs_rates.unwrap();
+        assert_eq!(adds, network.accuracy - rates.accuracy);
+        assert!((0.0..=1.0).contains(&network.p_vs_rates.unwrap()));
+        assert_eq!((rates.p_vs_rates, paper.p_vs_rates), (None, None));
         assert!(network.ci[0] <= network.accuracy && network.accuracy <= network.ci[1]);
         assert!(c.chance > 0.0 && c.chance < 1.0);
     }
@@ -107,7 +112,7 @@ fn e9_ranks_every_standard_candidate_and_agrees_with_e1_and_e6() {
     // What the timing adds: the network minus its inputs' rates, within each speed.
     let rates = neurotex::experiments::Spiking::rates(&spiking.per_speed).unwrap();
     let adds = format!(
-        "The network is {:+.1} points from them within each speed",
+        "The network is {:+.1} points (p ",
         100.0 * (network.accuracy - rates.accuracy)
     );
     assert!(text.contains(&adds), "{adds} not in the report");

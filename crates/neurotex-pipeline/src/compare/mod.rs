@@ -87,6 +87,15 @@ impl Candidate {
             self.classifier.as_str(),
         ) == ("sa", "glcm3d", "knn")
     }
+
+    /// Whether `other` is this spiking network's own inputs reduced to their counts: the
+    /// same encoding's spike rates with logistic regression (`rates / linear`), against
+    /// which a paired test says what the spikes' timing adds.
+    pub fn counts_of(&self, other: &Candidate) -> bool {
+        (self.method.as_str(), self.classifier.as_str()) == ("spikes", "snn")
+            && (other.method.as_str(), other.classifier.as_str()) == ("rates", "linear")
+            && other.encoding == self.encoding
+    }
 }
 
 /// How recordings are split.
@@ -173,6 +182,15 @@ pub struct Ranked {
     pub p_vs_paper: Option<f64>,
     /// Accuracy minus the paper's method's (both means over conditions).
     pub difference_vs_paper: Option<f64>,
+    /// For the spiking network (`spikes / snn`), its accuracy minus that of its own inputs'
+    /// spike rates with logistic regression (`rates / linear`, the same encoding), when that
+    /// is a candidate: what the spikes' timing, with the network's nonlinearity, adds to
+    /// their counts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub difference_vs_rates: Option<f64>,
+    /// The two-sided p-value of the paired sign-flip test of that difference.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p_vs_rates: Option<f64>,
     /// Accuracy per condition (empty for pooled cross-validation).
     pub per_condition: Vec<ConditionAccuracy>,
     /// Seconds to make the features and evaluate (wall clock, summed over the parts of the
@@ -205,6 +223,11 @@ pub struct Nested {
 pub struct Comparison {
     /// The protocol, as text.
     pub protocol: String,
+    /// The design behind it, as text: folds, repeats and seed of the cross-validations,
+    /// the resamples of intervals and tests, nested selection's inner folds (empty in
+    /// results written before it was recorded).
+    #[serde(default)]
+    pub design: String,
     /// What intervals and tests resample: `recordings` or `groups of COLUMN`.
     pub units: String,
     /// Units compared.
@@ -346,12 +369,16 @@ pub fn compare_keeping(
     let scored = score_all(candidates, &parts, params, progress, keep)?;
     let units = Units::new(metas, &scored[0].shares, params)?;
     let paper = candidates.iter().position(Candidate::is_paper);
-    // Each candidate's interval and paired test resample from their own seeded stream,
+    let counts = |c: &Candidate| candidates.iter().position(|o| c.counts_of(o));
+    // Each candidate's interval and paired tests resample from their own seeded stream,
     // thousands of draws per unit: ranked side by side too.
     let mut results: Vec<Ranked> = candidates
         .par_iter()
         .zip(&scored)
-        .map(|(c, s)| units.rank(c, s, paper.map(|p| &scored[p]), params))
+        .map(|(c, s)| {
+            let against = (paper.map(|p| &scored[p]), counts(c).map(|r| &scored[r]));
+            units.rank(c, s, against, params)
+        })
         .collect::<Result<_>>()?;
     results.sort_by(|a, b| b.accuracy.total_cmp(&a.accuracy));
     let nested = match outer {
@@ -374,6 +401,7 @@ pub fn compare_keeping(
     );
     Ok(Comparison {
         protocol: params.protocol.to_string(),
+        design: design(params),
         units: match &params.group_by {
             Some(column) => format!("groups of {column}"),
             None => "recordings".into(),
@@ -392,6 +420,40 @@ pub fn compare_keeping(
         nested,
         notes,
     })
+}
+
+/// `5-fold stratified cross-validation, 3 repeats, seed 0; 2000 resamples for intervals
+/// and tests`, with nested selection's inner folds when it runs.
+fn design(params: &CompareParams) -> String {
+    let cv = &params.cv;
+    let folds = match &params.group_by {
+        Some(column) => format!(
+            "{}-fold cross-validation keeping each `{column}` whole",
+            cv.folds
+        ),
+        None => format!("{}-fold stratified cross-validation", cv.folds),
+    };
+    let repeats = match cv.repeats {
+        1 => "1 repeat".to_string(),
+        n => format!("{n} repeats"),
+    };
+    let splits = match params.protocol {
+        Protocol::Pooled | Protocol::Per(_) => format!("{folds}, {repeats}, seed {}", cv.seed),
+        Protocol::HoldOut(_) | Protocol::Where { .. } => {
+            format!("one split per held-out part, seed {}", cv.seed)
+        }
+    };
+    let nested = match params.nested {
+        true => format!(
+            "; nested selection ranks inside each training set ({} inner folds)",
+            params.inner_folds
+        ),
+        false => String::new(),
+    };
+    format!(
+        "{splits}; {} resamples for intervals and tests{nested}",
+        params.resamples
+    )
 }
 
 /// The recordings every candidate is made of, the same for all.
@@ -601,6 +663,57 @@ mod tests {
         assert_eq!(other.difference_vs_paper, Some(0.0));
         assert_eq!(other.p_vs_paper, Some(1.0));
         assert!(c.nested.is_none());
+    }
+
+    /// A candidate named `encoding / method / classifier`, separable or noise.
+    fn named(encoding: &str, method: &str, classifier: &str, separable: bool) -> Candidate {
+        Candidate {
+            encoding: encoding.into(),
+            classifier: classifier.into(),
+            ..candidate(method, separable)
+        }
+    }
+
+    /// The spiking network is tested against its own encoding's rates with logistic
+    /// regression, and nothing else is.
+    #[test]
+    fn the_network_is_paired_with_its_inputs_rates() {
+        let candidates = [
+            named("sa", "glcm3d", "knn", false),
+            named("sa+fa", "spikes", "snn", true),
+            named("sa+fa", "rates", "linear", false),
+            named("sa", "rates", "linear", true),
+            named("sa", "spikes", "snn", true),
+        ];
+        let c = compare(&candidates, &params(Protocol::Pooled, false)).unwrap();
+        let find = |e: &str, m: &str| {
+            let r = c.results.iter().find(|r| r.encoding == e && r.method == m);
+            r.unwrap()
+        };
+        let (net, rates) = (find("sa+fa", "spikes"), find("sa+fa", "rates"));
+        let gap = net.difference_vs_rates.unwrap();
+        assert_eq!(gap, net.accuracy - rates.accuracy);
+        assert!(gap > 0.4 && net.p_vs_rates.unwrap() < 0.01, "{net:?}");
+        // the same features on the same splits: no difference, p = 1
+        let same = find("sa", "spikes");
+        assert_eq!(
+            (same.difference_vs_rates, same.p_vs_rates),
+            (Some(0.0), Some(1.0))
+        );
+        for r in [rates, find("sa", "rates"), find("sa", "glcm3d")] {
+            assert_eq!((r.difference_vs_rates, r.p_vs_rates), (None, None), "{r:?}");
+        }
+        assert_eq!(
+            c.design,
+            "4-fold stratified cross-validation, 2 repeats, seed 3; 500 resamples for intervals and tests"
+        );
+        let json = serde_json::to_value(&c.results).unwrap();
+        let with_test = json
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|r| r.get("p_vs_rates").is_some());
+        assert_eq!(with_test.count(), 2);
     }
 
     #[test]

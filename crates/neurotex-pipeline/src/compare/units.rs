@@ -122,28 +122,53 @@ impl Units {
             .collect()
     }
 
+    /// The paired sign-flip test of `s` against `other` over units: its p-value and the
+    /// accuracy difference (`s` minus `other`).
+    ///
+    /// # Errors
+    /// The two were not scored on the same rows.
+    fn paired(
+        &self,
+        (name, s): (String, &Scored),
+        (other_name, other): (&str, &Scored),
+        params: &CompareParams,
+    ) -> Result<(f64, f64)> {
+        if other
+            .shares
+            .iter()
+            .map(|x| x.0)
+            .ne(s.shares.iter().map(|x| x.0))
+        {
+            let second = other_name.to_string();
+            return Err(ClassifyError::Unpaired {
+                first: name,
+                second,
+            }
+            .into());
+        }
+        let d = self.differences(&s.shares, &other.shares);
+        let p_value = sign_flip_p(&d, params.resamples, params.cv.seed)?;
+        Ok((p_value, s.accuracy - other.accuracy))
+    }
+
+    /// `c`'s ranking entry, tested against the paper's method and, for the spiking
+    /// network, against its inputs' counts (`against`: their scores, when they ran).
     pub(super) fn rank(
         &self,
         c: &Candidate,
         s: &Scored,
-        paper: Option<&Scored>,
+        (paper, counts): (Option<&Scored>, Option<&Scored>),
         params: &CompareParams,
     ) -> Result<Ranked> {
-        let against = match paper {
+        let versus_paper = match paper {
             Some(p) if !c.is_paper() => {
-                if p.shares
-                    .iter()
-                    .map(|x| x.0)
-                    .ne(s.shares.iter().map(|x| x.0))
-                {
-                    let (first, second) = (c.name(), "the paper's method".to_string());
-                    return Err(ClassifyError::Unpaired { first, second }.into());
-                }
-                let d = self.differences(&s.shares, &p.shares);
-                let p_value = sign_flip_p(&d, params.resamples, params.cv.seed)?;
-                Some((p_value, s.accuracy - p.accuracy))
+                Some(self.paired((c.name(), s), ("the paper's method", p), params)?)
             }
             _ => None,
+        };
+        let versus_counts = match counts {
+            Some(r) => Some(self.paired((c.name(), s), ("its inputs' rates", r), params)?),
+            None => None,
         };
         Ok(Ranked {
             encoding: c.encoding.clone(),
@@ -151,8 +176,10 @@ impl Units {
             classifier: c.classifier.clone(),
             accuracy: s.accuracy,
             ci: self.interval(&s.shares),
-            p_vs_paper: against.map(|a| a.0),
-            difference_vs_paper: against.map(|a| a.1),
+            p_vs_paper: versus_paper.map(|a| a.0),
+            difference_vs_paper: versus_paper.map(|a| a.1),
+            difference_vs_rates: versus_counts.map(|a| a.1),
+            p_vs_rates: versus_counts.map(|a| a.0),
             per_condition: s.per_condition.clone(),
             seconds: s.seconds,
             paper: c.is_paper(),

@@ -25,8 +25,12 @@ pub fn with_interval(accuracy: f64, ci: [f64; 2]) -> String {
 
 /// The ranking as a Markdown document.
 pub fn markdown(c: &Comparison) -> String {
+    let design = match c.design.is_empty() {
+        true => String::new(),
+        false => format!("{}.\n", capitalised(&c.design)),
+    };
     let mut out = format!(
-        "# Comparison\n\n{} recordings ({} units: {}), {} classes; {}.\n\
+        "# Comparison\n\n{} recordings ({} units: {}), {} classes; {}.\n{design}\
          Chance {:.1}%, majority class {:.1}%.\n\n\
          | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) | seconds |\n\
          |---:|---|---|---|---|---|---:|\n",
@@ -49,6 +53,9 @@ pub fn markdown(c: &Comparison) -> String {
             versus_paper(r),
             r.seconds
         ));
+    }
+    for line in versus_rates(c) {
+        out.push_str(&format!("\n{}.\n", capitalised(&line)));
     }
     if let Some(n) = &c.nested {
         out.push_str(&format!("\nNested selection: {}\n", nested_text(n)));
@@ -85,6 +92,9 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
         100.0 * c.chance,
         100.0 * c.majority
     )];
+    if !c.design.is_empty() {
+        lines.push(c.design.clone());
+    }
     let width = c
         .results
         .iter()
@@ -106,6 +116,7 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
             r.seconds
         ));
     }
+    lines.extend(versus_rates(c));
     if let Some(n) = &c.nested {
         lines.push(format!("nested selection: {}", nested_text(n)));
     }
@@ -120,8 +131,43 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
 pub(super) fn versus_paper(r: &Ranked) -> String {
     match (r.paper, r.difference_vs_paper, r.p_vs_paper) {
         (true, ..) => "paper's method".into(),
-        (false, Some(d), Some(p)) => format!("{} points (p {})", signed(100.0 * d), p_text(p)),
+        (false, Some(d), Some(p)) => versus_text(d, p),
         _ => "-".into(),
+    }
+}
+
+/// For each spiking network ranked beside its inputs' spike rates with logistic regression,
+/// the paired test between the two: what the spikes' timing adds to their counts.
+fn versus_rates(c: &Comparison) -> Vec<String> {
+    let rates = |r: &Ranked| format!("{} / rates / linear", r.encoding);
+    c.results
+        .iter()
+        .filter_map(|r| {
+            let (d, p) = (r.difference_vs_rates?, r.p_vs_rates?);
+            Some(format!(
+                "the spiking network ({} / {} / {}) against its inputs' spike rates with logistic regression ({}), paired sign-flip test over {}: {}",
+                r.encoding,
+                r.method,
+                r.classifier,
+                rates(r),
+                c.units,
+                versus_text(d, p)
+            ))
+        })
+        .collect()
+}
+
+/// `+12.3 points (p 0.0004)`.
+pub(super) fn versus_text(difference: f64, p: f64) -> String {
+    format!("{} points (p {})", signed(100.0 * difference), p_text(p))
+}
+
+/// `text` with its first letter a capital.
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(first) => first.to_uppercase().chain(chars).collect(),
+        None => String::new(),
     }
 }
 

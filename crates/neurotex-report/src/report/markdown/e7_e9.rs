@@ -240,13 +240,17 @@ fn timing_adds(
     let (Some(rates_w), Some(rates_h)) = rates else {
         return String::new();
     };
-    let points = |net: &crate::compare::Ranked, rates: &crate::compare::Ranked| {
-        signed(100.0 * (net.accuracy - rates.accuracy))
+    // The paired test where the comparison ran it (both candidates of one encoding), else
+    // the difference alone.
+    let points = |net: &crate::compare::Ranked, rates: &crate::compare::Ranked| match net.p_vs_rates
+    {
+        Some(p) => super::super::comparison::versus_text(net.accuracy - rates.accuracy, p),
+        None => format!("{} points", signed(100.0 * (net.accuracy - rates.accuracy))),
     };
     format!(
         "\nThe rates columns are the network's own inputs (SA+FA spike trains) reduced to each taxel's mean spike rate (spikes/s) and classified by logistic regression (`sa+fa / rates / linear`). \
-         The network is {} points from them within each speed and {} points with each speed held out \
-         (the network minus the rates, from the unrounded accuracies, on the same folds; their intervals are in the table; no paired test is run between the two). \
+         The network is {} from them within each speed and {} with each speed held out \
+         (the network minus the rates, from the unrounded accuracies, on the same folds, with the p-value of the paired sign-flip test over the same units as above; their intervals are in the table). \
          That difference is what the network draws beyond its inputs' spike counts: the timing of the spikes together with its own nonlinearity and training, \
          so a gain near zero says the network reads rates, and a gain is not the timing's alone (a nonlinear classifier on the rates, `compare --methods rates`, separates the two).\n",
         points(net_w, rates_w),

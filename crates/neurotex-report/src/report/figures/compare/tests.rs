@@ -48,6 +48,8 @@ fn comparison(n: usize, nested: bool, conditions: usize) -> Comparison {
                 ci: [(accuracy - 0.06).max(0.0), (accuracy + 0.05).min(1.0)],
                 p_vs_paper: versus.map(|v| v.1),
                 difference_vs_paper: versus.map(|v| v.0),
+                difference_vs_rates: None,
+                p_vs_rates: None,
                 per_condition: speeds
                     .iter()
                     .enumerate()
@@ -68,6 +70,7 @@ fn comparison(n: usize, nested: bool, conditions: usize) -> Comparison {
     };
     Comparison {
         protocol: protocol.to_string(),
+        design: String::new(),
         units: "recordings".into(),
         n_units: 280,
         n_recordings: 280,
