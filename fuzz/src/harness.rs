@@ -406,6 +406,8 @@ fn spiking_file(recurrent: bool) -> serde_json::Value {
             Vec::new()
         },
         target: Default::default(),
+        alpha: Vec::new(),
+        beta: Vec::new(),
     };
     let layout = LayoutFile {
         rows: Some(2),

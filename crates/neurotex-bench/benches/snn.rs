@@ -3,7 +3,8 @@
 //! inputs x hidden, to show the step grows linearly; and one training epoch (forward and
 //! backward through time, Adam) over 55 recordings of 32 inputs x 1200 steps at 10 ms
 //! (12 s slides, about one FabricSlide velocity's training folds; 45 trained, 10 held out
-//! for validation) with one epoch, so every iteration is one whole epoch.
+//! for validation) with one epoch, so every iteration is one whole epoch, with the neurons'
+//! shared decays and with each neuron's own trained.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use neurotex::snn::{fit, Network, Readout, Reset, SnnParams, SpikeInput};
@@ -36,6 +37,8 @@ fn network(inputs: usize, hidden: usize, classes: usize) -> Network {
         b_out: w(classes, 0.1),
         w_rec: Vec::new(),
         target: Default::default(),
+        alpha: Vec::new(),
+        beta: Vec::new(),
     }
 }
 
@@ -98,6 +101,14 @@ fn bench(c: &mut Criterion) {
     };
     c.bench_function("snn/train_epoch/55x32x1200", |b| {
         b.iter(|| fit(&params, &refs, &y, 5).unwrap().1.epochs)
+    });
+    // The same epoch with each hidden neuron's decays trained beside the weights.
+    let decays = SnnParams {
+        train_decays: true,
+        ..params
+    };
+    c.bench_function("snn/train_epoch/55x32x1200/decays", |b| {
+        b.iter(|| fit(&decays, &refs, &y, 5).unwrap().1.epochs)
     });
 }
 

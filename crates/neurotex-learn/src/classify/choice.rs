@@ -142,6 +142,9 @@ impl fmt::Display for ClassifierChoice {
                 if !p.standardize {
                     write!(f, ", inputs not standardised")?;
                 }
+                if p.train_decays {
+                    write!(f, ", each neuron's decays trained")?;
+                }
                 if p.target == crate::snn::Target::Xylo {
                     write!(
                         f,

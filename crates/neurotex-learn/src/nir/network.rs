@@ -74,37 +74,51 @@ fn read_affine(reader: &Reader, name: &str) -> Result<(Vec<f64>, Vec<f64>, usize
     Ok((weight, bias, out, inp))
 }
 
-/// The one decay `1 - dt/τ` of a layer's neurons.
-fn one_decay(taus: &[f64], dt_s: f64, at: &str, field: &str) -> Result<f64, String> {
+/// Each neuron's decay `1 - dt/τ`, each strictly between 0 and 1.
+fn decays_of(taus: &[f64], dt_s: f64, at: &str, field: &str) -> Result<Vec<f64>, String> {
     let decays: Vec<f64> = taus.iter().map(|t| 1.0 - dt_s / t).collect();
-    let first = decays[0];
-    if !(first > 0.0 && first < 1.0) {
-        return Err(format!("node {at}: `{field}` {} s gives the decay {first} per step of {dt_s} s; it must lie between 0 and 1 (tau above dt)", taus[0]));
+    if let Some(j) = decays.iter().position(|d| !(*d > 0.0 && *d < 1.0)) {
+        return Err(format!("node {at}: `{field}` {} s gives the decay {} per step of {dt_s} s; it must lie between 0 and 1 (tau above dt)", taus[j], decays[j]));
     }
-    if decays
-        .iter()
-        .any(|d| (d - first).abs() > 1e-9 * first.max(1e-12) + 1e-12)
-    {
-        return Err(format!(
-            "node {at}: `{field}` differs between neurons; neurotex's network has one per layer"
-        ));
-    }
-    Ok(first)
+    Ok(decays)
 }
 
-/// The CubaLIF node's decays and, per neuron, the gain each step gives its input on the
-/// membrane scaled to a threshold of 1: `(dt/τ_mem) r (dt/τ_syn) w_in / v_threshold`.
-fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<(f64, f64, Vec<f64>), String> {
+/// The one decay of a layer's neurons, when they share it (to a relative 1e-9).
+fn shared(decays: &[f64]) -> Option<f64> {
+    let first = *decays.first()?;
+    let tolerance = 1e-9 * first.max(1e-12) + 1e-12;
+    decays
+        .iter()
+        .all(|d| (d - first).abs() <= tolerance)
+        .then_some(first)
+}
+
+/// The one decay `1 - dt/τ` of a layer's neurons.
+fn one_decay(taus: &[f64], dt_s: f64, at: &str, field: &str) -> Result<f64, String> {
+    let decays = decays_of(taus, dt_s, at, field)?;
+    shared(&decays).ok_or_else(|| {
+        format!(
+            "node {at}: `{field}` differs between neurons; neurotex's readout has one per layer"
+        )
+    })
+}
+
+/// Each neuron's decays in the CubaLIF node, `(α_h, β_h)`, and the gain each step gives
+/// its input on the membrane scaled to a threshold of 1: `(dt/τ_mem) r (dt/τ_syn) w_in /
+/// v_threshold`.
+type Lif = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<Lif, String> {
     let lif = reader.node(at)?;
     let field = |f: &str| per_neuron(&lif, f, at, h);
     let kind = read_string(&lif, "type", &format!("node {at}"))?.concat();
     // A LIF node has no synapse: its current is the step's input (α = 0, gain 1), as
     // snnTorch's `Leaky` and Norse's `LIFBoxCell` step.
     let (alpha, synapse_gain, tau_mem, tau_field) = if kind == "LIF" {
-        (0.0, vec![1.0; h], field("tau")?, "tau")
+        (vec![0.0; h], vec![1.0; h], field("tau")?, "tau")
     } else {
         let (tau_syn, w_in) = (field("tau_syn")?, field("w_in")?);
-        let alpha = one_decay(&tau_syn, dt_s, at, "tau_syn")?;
+        let alpha = decays_of(&tau_syn, dt_s, at, "tau_syn")?;
         let gain = (0..h).map(|j| (dt_s / tau_syn[j]) * w_in[j]).collect();
         (alpha, gain, field("tau_mem")?, "tau_mem")
     };
@@ -115,7 +129,7 @@ fn lif_of(reader: &Reader, at: &str, dt_s: f64, h: usize) -> Result<(f64, f64, V
         Err(_) => vec![0.0; h],
     };
     let (v_leak, v_threshold) = (field("v_leak")?, field("v_threshold")?);
-    let beta = one_decay(&tau_mem, dt_s, at, tau_field)?;
+    let beta = decays_of(&tau_mem, dt_s, at, tau_field)?;
     if v_leak.iter().chain(&v_reset).any(|v| *v != 0.0) {
         return Err(format!(
             "node {at}: v_leak and v_reset must be 0 (neurotex's neurons rest and reset at 0)"
@@ -212,13 +226,25 @@ pub(super) fn network_of(
     let (alpha, beta, gain) = lif_of(reader, &names[2], dt_s, h)?;
     let (kappa, out_gain, out_leak) = readout_of(reader, &names[4], dt_s, c, at.from)?;
     let tau_ms = |decay: f64| -f64::from(dt_ms) / decay.ln();
+    // Neurons that share their decays are a network of shared time constants; others keep
+    // their own, the shared constants then those of the layer's mean decays.
+    let (shared_alpha, shared_beta) = (shared(&alpha), shared(&beta));
+    let mean = |d: &[f64]| d.iter().sum::<f64>() / d.len().max(1) as f64;
+    let (a, b) = (
+        shared_alpha.unwrap_or(mean(&alpha)),
+        shared_beta.unwrap_or(mean(&beta)),
+    );
+    let (alpha, beta) = match (shared_alpha, shared_beta) {
+        (Some(_), Some(_)) => (Vec::new(), Vec::new()),
+        _ => (alpha, beta),
+    };
     Ok(Network {
         inputs: n,
         hidden: h,
         classes: c,
         dt_ms,
-        tau_syn_ms: tau_ms(alpha),
-        tau_mem_ms: tau_ms(beta),
+        tau_syn_ms: tau_ms(a),
+        tau_mem_ms: tau_ms(b),
         tau_out_ms: tau_ms(kappa),
         readout,
         w_in: (0..n * h)
@@ -232,5 +258,7 @@ pub(super) fn network_of(
         w_rec: Vec::new(),
         reset: Reset::Zero,
         target: Default::default(),
+        alpha,
+        beta,
     })
 }

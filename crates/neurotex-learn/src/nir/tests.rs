@@ -28,6 +28,8 @@ fn net() -> Network {
         w_rec: Vec::new(),
         reset: Reset::Zero,
         target: Default::default(),
+        alpha: Vec::new(),
+        beta: Vec::new(),
     }
 }
 
@@ -332,6 +334,51 @@ fn a_graph_without_a_positive_time_step_is_refused() {
     assert_eq!("norse".parse::<NirFrom>().unwrap().name(), "norse");
 }
 
+/// A network whose neurons have decays of their own: written with each neuron's time
+/// constants, read back with them, in NIR's own units and snnTorch's; and a graph written
+/// elsewhere with time constants that differ between neurons reads as such a network.
+#[test]
+fn decays_of_each_neurons_own_round_trip() {
+    let own = Network {
+        alpha: vec![0.3, 0.5, 0.6, 0.9],
+        beta: vec![0.7, 0.75, 0.95, 0.5],
+        ..net()
+    };
+    own.check().unwrap();
+    let x = crate::snn::SpikeInput::from_events(3, 30, &[(0, 1), (2, 0), (2, 2), (5, 1), (9, 0)]);
+    for convention in [Convention::Physical, Convention::Snntorch] {
+        let back = from_bytes(to_bytes(&own, "{}", convention).unwrap())
+            .unwrap()
+            .network;
+        for (a, b) in back
+            .alpha
+            .iter()
+            .chain(&back.beta)
+            .zip(own.alpha.iter().chain(&own.beta))
+        {
+            assert!((a - b).abs() < 1e-12, "{convention:?}: {a} vs {b}");
+        }
+        for (a, b) in own.scores(&x).iter().zip(back.scores(&x)) {
+            assert!((a - b).abs() < 1e-9, "{convention:?}: {a} vs {b}");
+        }
+        assert_ne!(own.scores(&x), net().scores(&x));
+    }
+    // tau_mem 40, 40, 50, 40 ms at dt 10 ms: decays 0.75, 0.75, 0.8, 0.75.
+    let edited = graph(
+        |n, _| set(n, "lif1", "tau_mem", vec![0.04, 0.04, 0.05, 0.04]),
+        Some(0.01),
+    );
+    let read = from_bytes(edited).unwrap().network;
+    let beta: Vec<f64> = read.beta.iter().map(|b| (b * 1e9).round() / 1e9).collect();
+    assert_eq!(beta, [0.75, 0.75, 0.8, 0.75]);
+    assert_eq!(read.alpha.len(), 4);
+    // The shared constants are those of the mean decays; an unedited graph has none of its
+    // neurons' own.
+    assert!((read.tau_mem_ms - (-10.0 / 0.7625f64.ln())).abs() < 1e-9);
+    let plain = from_bytes(graph(|_, _| {}, Some(0.01))).unwrap().network;
+    assert!(plain.alpha.is_empty() && plain.beta.is_empty());
+}
+
 #[test]
 fn graphs_of_another_shape_name_the_node_and_the_rule() {
     let cases: Vec<(Vec<u8>, &str)> = vec![
@@ -361,11 +408,15 @@ fn graphs_of_another_shape_name_the_node_and_the_rule() {
             "node fc2: `bias`[0] is not finite",
         ),
         (
+            graph(|n, _| set(n, "li", "tau_mem", vec![0.04, 0.05]), Some(0.01)),
+            "differs between neurons",
+        ),
+        (
             graph(
-                |n, _| set(n, "lif1", "tau_mem", vec![0.04, 0.04, 0.05, 0.04]),
+                |n, _| set(n, "lif1", "tau_mem", vec![0.04, 0.01, 0.05, 0.04]),
                 Some(0.01),
             ),
-            "differs between neurons",
+            "node lif1: `tau_mem` 0.01 s gives the decay 0",
         ),
         (
             graph(|n, _| set(n, "lif1", "v_reset", vec![0.5; 4]), Some(0.01)),

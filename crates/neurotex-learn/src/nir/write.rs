@@ -58,42 +58,38 @@ impl Graph {
     }
 
     /// An `Affine` (with `bias`) or `Linear` node of a `(out, in)` weight given
-    /// source-major (`w[i * out + o]`, as neurotex keeps weights), each value times
-    /// `scale`.
+    /// source-major (`w[i * out + o]`, as neurotex keeps weights), each output's row and
+    /// bias times its `scale[o]`.
     fn dense(
         &mut self,
         name: &str,
         w: &[f64],
         bias: Option<&[f64]>,
         (out, inp): (usize, usize),
-        scale: f64,
+        scale: &[f64],
     ) {
         let weight: Vec<f32> = (0..out)
-            .flat_map(|o| (0..inp).map(move |i| (scale * w[i * out + o]) as f32))
+            .flat_map(|o| (0..inp).map(move |i| (scale[o] * w[i * out + o]) as f32))
             .collect();
         let kind = if bias.is_some() { "Affine" } else { "Linear" };
         let node = self.node(name, kind);
         let shape = vec![out as u64, inp as u64];
         node.fields.push(("weight", Values::F32(weight), shape));
         if let Some(b) = bias {
-            let b: Vec<f32> = b.iter().map(|&v| (scale * v) as f32).collect();
+            let b: Vec<f32> = (b.iter().zip(scale))
+                .map(|(&v, s)| (s * v) as f32)
+                .collect();
             node.fields.push(("bias", Values::F32(b), vec![out as u64]));
         }
     }
 
-    /// A node of `len` neurons whose fields each hold one value for all, in float64 (so
-    /// that reading them back gives the decays to the last bit).
-    fn neurons(
-        &mut self,
-        name: &str,
-        kind: &'static str,
-        fields: &[(&'static str, f64)],
-        len: usize,
-    ) {
+    /// A node of neurons whose fields each hold one value per neuron, in float64 (so that
+    /// reading them back gives the decays to the last bit).
+    fn neurons(&mut self, name: &str, kind: &'static str, fields: Vec<(&'static str, Vec<f64>)>) {
         let node = self.node(name, kind);
-        for &(field, v) in fields {
-            node.fields
-                .push((field, Values::F64(vec![v; len]), vec![len as u64]));
+        for (field, v) in fields {
+            let len = v.len() as u64;
+            node.fields.push((field, Values::F64(v), vec![len]));
         }
     }
 
@@ -119,44 +115,58 @@ pub(super) fn graph(net: &Network, convention: Convention) -> (Graph, f64) {
     }
 }
 
+/// `v` for each of `len` neurons.
+fn all(len: usize, v: f64) -> Vec<f64> {
+    vec![v; len]
+}
+
+/// `f` of each value.
+fn each(values: &[f64], f: impl Fn(f64) -> f64) -> Vec<f64> {
+    values.iter().map(|&v| f(v)).collect()
+}
+
 /// NIR's equations stepped by forward Euler at `d` seconds (see the module): CubaLIF
-/// hidden neurons, a CubaLIF readout that never fires (its current is the step's input,
-/// `tau_syn = d`), and a recurrent loop `lif1 → rec → rec_id → lif1` through an identity,
-/// which importers run flat with the one-step delay neurotex has.
+/// hidden neurons (each with its own time constants when it has its own decays), a CubaLIF
+/// readout that never fires (its current is the step's input, `tau_syn = d`), and a
+/// recurrent loop `lif1 → rec → rec_id → lif1` through an identity, which importers run
+/// flat with the one-step delay neurotex has.
 fn euler(net: &Network, d: f64) -> Graph {
-    let (alpha, beta, kappa) = net.decays();
-    let (tau_syn, tau_mem, tau_out) = (d / (1.0 - alpha), d / (1.0 - beta), d / (1.0 - kappa));
+    let ((alpha, beta), kappa) = (net.hidden_decays(), net.decays().2);
+    let tau_syn = each(&alpha, |a| d / (1.0 - a));
+    let tau_mem = each(&beta, |b| d / (1.0 - b));
+    let tau_out = d / (1.0 - kappa);
     let (h, c, n) = (net.hidden, net.classes, net.inputs);
     let mut g = Graph::default();
     g.io("input", "Input", n);
-    g.dense("fc1", &net.w_in, Some(&net.b_in), (h, n), 1.0);
-    let lif = [
+    g.dense("fc1", &net.w_in, Some(&net.b_in), (h, n), &all(h, 1.0));
+    let (r, w_in) = (each(&tau_mem, |t| t / d), each(&tau_syn, |t| t / d));
+    let lif = vec![
         ("tau_syn", tau_syn),
         ("tau_mem", tau_mem),
-        ("r", tau_mem / d),
-        ("v_leak", 0.0),
-        ("v_threshold", 1.0),
-        ("w_in", tau_syn / d),
+        ("r", r),
+        ("v_leak", all(h, 0.0)),
+        ("v_threshold", all(h, 1.0)),
+        ("w_in", w_in),
     ];
-    g.neurons("lif1", "CubaLIF", &lif, h);
-    g.dense("fc2", &net.w_out, Some(&net.b_out), (c, h), 1.0);
-    let readout = [
-        ("tau_syn", d),
-        ("tau_mem", tau_out),
-        ("r", tau_out / d),
-        ("v_leak", 0.0),
-        ("v_threshold", NEVER_FIRES),
-        ("w_in", 1.0),
+    g.neurons("lif1", "CubaLIF", lif);
+    g.dense("fc2", &net.w_out, Some(&net.b_out), (c, h), &all(c, 1.0));
+    let readout = vec![
+        ("tau_syn", all(c, d)),
+        ("tau_mem", all(c, tau_out)),
+        ("r", all(c, tau_out / d)),
+        ("v_leak", all(c, 0.0)),
+        ("v_threshold", all(c, NEVER_FIRES)),
+        ("w_in", all(c, 1.0)),
     ];
-    g.neurons("li", "CubaLIF", &readout, c);
+    g.neurons("li", "CubaLIF", readout);
     g.io("output", "Output", c);
     g.chain(&["input", "fc1", "lif1", "fc2", "li", "output"]);
     if net.recurrent() {
-        g.dense("rec", &net.w_rec, None, (h, h), 1.0);
+        g.dense("rec", &net.w_rec, None, (h, h), &all(h, 1.0));
         let identity: Vec<f64> = (0..h * h)
             .map(|k| f64::from(u8::from(k / h == k % h)))
             .collect();
-        g.dense("rec_id", &identity, None, (h, h), 1.0);
+        g.dense("rec_id", &identity, None, (h, h), &all(h, 1.0));
         g.chain(&["lif1", "rec", "rec_id", "lif1"]);
     }
     g
@@ -166,27 +176,34 @@ fn euler(net: &Network, d: f64) -> Graph {
 /// unscaled, no CubaLIF: the synaptic current is an LI node of its own before an LIF
 /// node, and a recurrent loop (an Affine with zero bias: sinabs maps no Linear) joins it.
 fn sinabs(net: &Network) -> Graph {
-    let (alpha, beta, kappa) = net.decays();
+    let ((alpha, beta), kappa) = (net.hidden_decays(), net.decays().2);
     let steps = |decay: f64| -1.0 / decay.ln();
     let (h, c, n) = (net.hidden, net.classes, net.inputs);
     let mut g = Graph::default();
     g.io("input", "Input", n);
-    g.dense("fc1", &net.w_in, Some(&net.b_in), (h, n), 1.0);
-    let li = |tau: f64| [("tau", tau), ("r", 1.0), ("v_leak", 0.0)];
-    g.neurons("syn", "LI", &li(steps(alpha)), h);
-    let lif = [
-        ("tau", steps(beta)),
-        ("r", 1.0),
-        ("v_leak", 0.0),
-        ("v_threshold", 1.0),
+    g.dense("fc1", &net.w_in, Some(&net.b_in), (h, n), &all(h, 1.0));
+    let li = |tau: Vec<f64>| {
+        let len = tau.len();
+        vec![
+            ("tau", tau),
+            ("r", all(len, 1.0)),
+            ("v_leak", all(len, 0.0)),
+        ]
+    };
+    g.neurons("syn", "LI", li(each(&alpha, steps)));
+    let lif = vec![
+        ("tau", each(&beta, steps)),
+        ("r", all(h, 1.0)),
+        ("v_leak", all(h, 0.0)),
+        ("v_threshold", all(h, 1.0)),
     ];
-    g.neurons("lif1", "LIF", &lif, h);
-    g.dense("fc2", &net.w_out, Some(&net.b_out), (c, h), 1.0);
-    g.neurons("li", "LI", &li(steps(kappa)), c);
+    g.neurons("lif1", "LIF", lif);
+    g.dense("fc2", &net.w_out, Some(&net.b_out), (c, h), &all(c, 1.0));
+    g.neurons("li", "LI", li(all(c, steps(kappa))));
     g.io("output", "Output", c);
     g.chain(&["input", "fc1", "syn", "lif1", "fc2", "li", "output"]);
     if net.recurrent() {
-        g.dense("rec", &net.w_rec, Some(&vec![0.0; h]), (h, h), 1.0);
+        g.dense("rec", &net.w_rec, Some(&vec![0.0; h]), (h, h), &all(h, 1.0));
         g.chain(&["lif1", "rec", "syn"]);
     }
     g
@@ -194,39 +211,52 @@ fn sinabs(net: &Network) -> Graph {
 
 /// Rockpool 3.1's `from_nir`: each node's step is `min(tau_mem / (1 + r))` (the metadata
 /// is not read), exact decays, the input added before the synaptic decay (so the weights
-/// into a decaying state are divided by its decay), an LI's `tau` cast to an integer (so
-/// the readout's decay goes into `r` with `tau` 1), and a recurrent layer as a nested
-/// graph `input → lif → w_rec → lif → output`, as Rockpool writes one.
+/// into a decaying state are divided by its decay, neuron by neuron), an LI's `tau` cast
+/// to an integer (so the readout's decay goes into `r` with `tau` 1), and a recurrent layer
+/// as a nested graph `input → lif → w_rec → lif → output`, as Rockpool writes one.
 fn rockpool(net: &Network) -> Graph {
-    let (alpha, beta, kappa) = net.decays();
+    let ((alpha, beta), kappa) = (net.hidden_decays(), net.decays().2);
     let steps = |decay: f64| -1.0 / decay.ln();
     let (h, c, n) = (net.hidden, net.classes, net.inputs);
-    let tau_mem = steps(beta);
-    let lif = [
-        ("tau_syn", steps(alpha)),
-        ("tau_mem", tau_mem),
-        ("r", tau_mem - 1.0),
-        ("v_leak", 0.0),
-        ("v_threshold", 1.0),
-        ("w_in", 1.0),
-    ];
+    let tau_mem = each(&beta, steps);
+    let lif = || {
+        vec![
+            ("tau_syn", each(&alpha, steps)),
+            ("tau_mem", tau_mem.clone()),
+            ("r", each(&tau_mem, |t| t - 1.0)),
+            ("v_leak", all(h, 0.0)),
+            ("v_threshold", all(h, 1.0)),
+            ("w_in", all(h, 1.0)),
+        ]
+    };
+    let into_synapse = each(&alpha, |a| 1.0 / a);
     let mut g = Graph::default();
     g.io("input", "Input", n);
-    g.dense("fc1", &net.w_in, Some(&net.b_in), (h, n), 1.0 / alpha);
+    g.dense("fc1", &net.w_in, Some(&net.b_in), (h, n), &into_synapse);
     if net.recurrent() {
         let mut inner = Graph::default();
         inner.io("input", "Input", h);
-        inner.neurons("lif", "CubaLIF", &lif, h);
-        inner.dense("w_rec", &net.w_rec, None, (h, h), 1.0 / alpha);
+        inner.neurons("lif", "CubaLIF", lif());
+        inner.dense("w_rec", &net.w_rec, None, (h, h), &into_synapse);
         inner.io("output", "Output", h);
         inner.chain(&["input", "lif", "w_rec", "lif", "output"]);
         g.node("lif1", "NIRGraph").graph = Some(inner);
     } else {
-        g.neurons("lif1", "CubaLIF", &lif, h);
+        g.neurons("lif1", "CubaLIF", lif());
     }
-    g.dense("fc2", &net.w_out, Some(&net.b_out), (c, h), 1.0 / kappa);
-    let li = [("tau", 1.0), ("r", steps(kappa) - 1.0), ("v_leak", 0.0)];
-    g.neurons("li", "LI", &li, c);
+    g.dense(
+        "fc2",
+        &net.w_out,
+        Some(&net.b_out),
+        (c, h),
+        &all(c, 1.0 / kappa),
+    );
+    let li = vec![
+        ("tau", all(c, 1.0)),
+        ("r", all(c, steps(kappa) - 1.0)),
+        ("v_leak", all(c, 0.0)),
+    ];
+    g.neurons("li", "LI", li);
     g.io("output", "Output", c);
     g.chain(&["input", "fc1", "lif1", "fc2", "li", "output"]);
     g

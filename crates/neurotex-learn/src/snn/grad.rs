@@ -14,7 +14,11 @@
 //! gV[t-1] = β gP[t]
 //! ∂L/∂W_in += gI[t] x[t]ᵀ, ∂L/∂b_in += gI[t], ∂L/∂W_out += S[t] gO[t]ᵀ, ∂L/∂b_out += gO[t]
 //! ∂L/∂W_rec += S[t-1] gI[t]ᵀ                      (recurrent networks)
+//! ∂L/∂α_h += gI[t]_h I[t-1]_h, ∂L/∂β_h += gP[t]_h V[t-1]_h   (each neuron's own decays)
 //! ```
+//!
+//! `I[t-1]` and `V[t-1]` are not kept: they are made again from the kept membranes and
+//! spikes, `V[t] = P[t] (1 - S[t])` (or `P[t] - S[t]`) and `I[t] = P[t] - β V[t-1]`.
 //!
 //! With the subtractive reset (`V[t] = P[t] - S[t]`, `S[t]` a count), the spike's
 //! derivative is the same surrogate and the membrane line becomes
@@ -89,6 +93,10 @@ pub struct Gradient {
     pub b_out: Vec<f64>,
     /// ∂L/∂W_rec, hidden-major (empty for a feed-forward network).
     pub w_rec: Vec<f64>,
+    /// ∂L/∂α_h (empty when the neurons share their decays).
+    pub alpha: Vec<f64>,
+    /// ∂L/∂β_h (empty when the neurons share their decays).
+    pub beta: Vec<f64>,
 }
 
 impl Gradient {
@@ -100,6 +108,8 @@ impl Gradient {
             w_out: vec![0.0; net.w_out.len()],
             b_out: vec![0.0; net.b_out.len()],
             w_rec: vec![0.0; net.w_rec.len()],
+            alpha: vec![0.0; net.alpha.len()],
+            beta: vec![0.0; net.beta.len()],
         }
     }
 
@@ -112,25 +122,30 @@ impl Gradient {
         }
     }
 
-    /// The parts in the order of [`Network::params_mut`] (w_in, b_in, w_out, b_out, w_rec).
-    pub fn parts(&self) -> [&[f64]; 5] {
+    /// The parts in the order of [`Network::params_mut`] (w_in, b_in, w_out, b_out, w_rec,
+    /// alpha, beta).
+    pub fn parts(&self) -> [&[f64]; 7] {
         [
             &self.w_in,
             &self.b_in,
             &self.w_out,
             &self.b_out,
             &self.w_rec,
+            &self.alpha,
+            &self.beta,
         ]
     }
 
     /// The parts, mutable, in the same order.
-    pub fn parts_mut(&mut self) -> [&mut Vec<f64>; 5] {
+    pub fn parts_mut(&mut self) -> [&mut Vec<f64>; 7] {
         [
             &mut self.w_in,
             &mut self.b_in,
             &mut self.w_out,
             &mut self.b_out,
             &mut self.w_rec,
+            &mut self.alpha,
+            &mut self.beta,
         ]
     }
 }
@@ -193,7 +208,8 @@ fn forward_with(
     spike: impl Fn(f64) -> f64,
     reset: impl Fn(f64, f64) -> f64,
 ) -> Vec<f64> {
-    let (alpha, beta, kappa) = net.decays();
+    let kappa = net.decays().2;
+    let (alpha, beta) = net.hidden_decays();
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
     // Every value is written below, step by step: the buffers keep their last contents
     // rather than being cleared on every call.
@@ -205,8 +221,8 @@ fn forward_with(
     let mut out = vec![0.0; c_n];
     let mut fired = Vec::with_capacity(h_n);
     for t in 0..steps {
-        for (c, b) in current.iter_mut().zip(&net.b_in) {
-            *c = alpha * *c + b;
+        for ((c, b), a) in current.iter_mut().zip(&net.b_in).zip(&alpha) {
+            *c = a * *c + b;
         }
         for &i in input.at(t) {
             let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
@@ -228,13 +244,14 @@ fn forward_with(
         }
         let pre = &mut tr.pre[t * h_n..(t + 1) * h_n];
         let spikes = &mut tr.spikes[t * h_n..(t + 1) * h_n];
-        for (((p, s), m), c) in pre
+        for ((((p, s), m), c), b) in pre
             .iter_mut()
             .zip(spikes.iter_mut())
             .zip(&mut membrane)
             .zip(&current)
+            .zip(&beta)
         {
-            *p = beta * *m + c;
+            *p = b * *m + c;
             *s = spike(*p);
             *m = reset(*p, *s);
         }
@@ -382,19 +399,28 @@ fn backward_with(
 struct HiddenBack {
     g_v: Vec<f64>,
     g_i: Vec<f64>,
-    /// `(α, β, 1 if the reset is in the graph else 0)`.
-    decays: (f64, f64, f64),
+    /// Each neuron's `α_h` and `β_h`.
+    alpha: Vec<f64>,
+    beta: Vec<f64>,
+    /// 1 if the reset is in the graph, else 0.
+    reset: f64,
     subtract: bool,
+    /// The step's membrane gradient `gP[t]`, kept for the gradients of each neuron's own
+    /// decays (empty when the neurons share their decays).
+    g_p: Vec<f64>,
 }
 
 impl HiddenBack {
     fn new(net: &Network, detach_reset: bool) -> Self {
-        let (alpha, beta, _) = net.decays();
+        let (alpha, beta) = net.hidden_decays();
         HiddenBack {
             g_v: vec![0.0; net.hidden],
             g_i: vec![0.0; net.hidden],
-            decays: (alpha, beta, f64::from(u8::from(!detach_reset))),
+            alpha,
+            beta,
+            reset: f64::from(u8::from(!detach_reset)),
             subtract: net.reset == Reset::Subtract,
+            g_p: vec![0.0; if net.own_decays() { net.hidden } else { 0 }],
         }
     }
 
@@ -422,12 +448,20 @@ impl HiddenBack {
         let (g_v, g_i) = (&mut self.g_v, &mut self.g_i);
         step_back(
             (g_s, pre, spikes),
-            g_v,
-            g_i,
-            self.decays,
+            (g_v, g_i, &mut self.g_p),
+            (&self.alpha, &self.beta, self.reset),
             self.subtract,
             derivative,
         );
+        if !self.g_p.is_empty() {
+            add_decay_gradients(
+                (tr, t, h_n),
+                self.subtract,
+                &self.beta,
+                (&self.g_p, g_i),
+                grad,
+            );
+        }
         for (b, g) in grad.b_in.iter_mut().zip(g_i.iter()) {
             *b += g;
         }
@@ -446,14 +480,13 @@ impl HiddenBack {
 
 /// One step of the hidden layer backwards (see the module's equations): from the step's
 /// spike gradient, membranes and spikes `(gS, P, S)`, turns the next step's membrane and
-/// current gradients `g_v`, `g_i` into this step's; `decays` are `(α, β, 1 if the reset is
-/// in the graph else 0)`.
+/// current gradients `g_v`, `g_i` into this step's, and writes `gP` into `g_p` unless it
+/// is empty; the decays are `(α_h, β_h, 1 if the reset is in the graph else 0)`.
 #[inline(always)]
 fn step_back(
     (g_s, pre, spikes): (&[f64], &[f64], &[f64]),
-    g_v: &mut [f64],
-    g_i: &mut [f64],
-    (alpha, beta, reset): (f64, f64, f64),
+    (g_v, g_i, g_p): (&mut [f64], &mut [f64], &mut [f64]),
+    (alpha, beta, reset): (&[f64], &[f64], f64),
     subtract: bool,
     derivative: &impl Fn(f64) -> f64,
 ) {
@@ -461,20 +494,59 @@ fn step_back(
     // iterators they ran one neuron at a time).
     let n = g_s.len();
     let (pre, spikes, g_v, g_i) = (&pre[..n], &spikes[..n], &mut g_v[..n], &mut g_i[..n]);
+    let (alpha, beta) = (&alpha[..n], &beta[..n]);
+    let keep = !g_p.is_empty();
+    let g_p = if keep { &mut g_p[..n] } else { g_p };
     if subtract {
         // V = P - S: the reset passes gV to P whole, and (in the graph) as -gV to S.
         for k in 0..n {
-            let g_p = g_v[k] + (g_s[k] - reset * g_v[k]) * derivative(pre[k] - 1.0);
-            g_i[k] = g_p + alpha * g_i[k];
-            g_v[k] = beta * g_p;
+            let p = g_v[k] + (g_s[k] - reset * g_v[k]) * derivative(pre[k] - 1.0);
+            if keep {
+                g_p[k] = p;
+            }
+            g_i[k] = p + alpha[k] * g_i[k];
+            g_v[k] = beta[k] * p;
         }
     } else {
         for k in 0..n {
             let g_sh = g_s[k] - reset * pre[k] * g_v[k];
-            let g_p = g_v[k] * (1.0 - spikes[k]) + g_sh * derivative(pre[k] - 1.0);
-            g_i[k] = g_p + alpha * g_i[k];
-            g_v[k] = beta * g_p;
+            let p = g_v[k] * (1.0 - spikes[k]) + g_sh * derivative(pre[k] - 1.0);
+            if keep {
+                g_p[k] = p;
+            }
+            g_i[k] = p + alpha[k] * g_i[k];
+            g_v[k] = beta[k] * p;
         }
+    }
+}
+
+/// Step `t`'s share of each neuron's own decays' gradients, `∂L/∂α_h += gI[t] I[t-1]` and
+/// `∂L/∂β_h += gP[t] V[t-1]`, with `V` and `I` made again from the kept membranes and
+/// spikes as the forward pass made them (nothing before step 0).
+#[inline(always)]
+fn add_decay_gradients(
+    (tr, t, h_n): (&Trajectory, usize, usize),
+    subtract: bool,
+    beta: &[f64],
+    (g_p, g_i): (&[f64], &[f64]),
+    grad: &mut Gradient,
+) {
+    if t == 0 {
+        return;
+    }
+    let kept = |u: usize, h: usize| {
+        let (p, s) = (tr.pre[u * h_n + h], tr.spikes[u * h_n + h]);
+        if subtract {
+            p - s
+        } else {
+            p * (1.0 - s)
+        }
+    };
+    for h in 0..h_n {
+        let before = if t >= 2 { kept(t - 2, h) } else { 0.0 };
+        let current = tr.pre[(t - 1) * h_n + h] - beta[h] * before;
+        grad.alpha[h] += g_i[h] * current;
+        grad.beta[h] += g_p[h] * kept(t - 1, h);
     }
 }
 
@@ -547,6 +619,8 @@ mod tests {
                 false => Vec::new(),
             },
             target: Default::default(),
+            alpha: Vec::new(),
+            beta: Vec::new(),
         };
         let mut events = Vec::new();
         for t in 0..steps as u32 {
@@ -563,6 +637,15 @@ mod tests {
         random_net_of(readout, seed, false)
     }
 
+    /// `net` with decays of each neuron's own, drawn from `seed`.
+    fn with_own_decays(mut net: Network, seed: u64) -> Network {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        net.alpha = (0..net.hidden).map(|_| rng.gen_range(0.2..0.95)).collect();
+        net.beta = (0..net.hidden).map(|_| rng.gen_range(0.2..0.95)).collect();
+        net.check().unwrap();
+        net
+    }
+
     fn loss(net: &Network, input: &SpikeInput, act: Activation) -> f64 {
         let scores = forward(net, input, act, &mut Trajectory::default());
         -softmax(&scores)[1].ln()
@@ -573,12 +656,15 @@ mod tests {
     /// kept in the graph, both readouts, feed-forward and recurrent.
     #[test]
     fn gradient_matches_finite_differences() {
-        for (readout, seed, recurrent) in [
-            (Readout::Mean, 1, false),
-            (Readout::Max, 2, false),
-            (Readout::Mean, 5, true),
+        for (readout, seed, recurrent, own) in [
+            (Readout::Mean, 1, false, false),
+            (Readout::Max, 2, false, false),
+            (Readout::Mean, 5, true, false),
+            (Readout::Max, 6, false, true),
+            (Readout::Mean, 7, true, true),
         ] {
             let (net, input) = random_net_of(readout, seed, recurrent);
+            let net = if own { with_own_decays(net, seed) } else { net };
             let act = Activation::Smooth { k: 4.0 };
             let mut grad = Gradient::zeros(&net);
             let mut tr = Trajectory::default();
@@ -589,7 +675,7 @@ mod tests {
             loss_and_gradient(&net, &input, 1, rule, 1.0, &mut tr, &mut grad);
             let eps = 1e-6;
             let mut checked = 0;
-            for part in 0..5 {
+            for part in 0..7 {
                 for j in 0..grad.parts()[part].len() {
                     let bump = |d: f64| {
                         let mut n = net.clone();
@@ -607,12 +693,16 @@ mod tests {
                 }
             }
             let rec = if recurrent { 7 * 7 } else { 0 };
-            assert_eq!(checked, 5 * 7 + 7 + 7 * 3 + 3 + rec);
+            let decays = if own { 2 * 7 } else { 0 };
+            assert_eq!(checked, 5 * 7 + 7 + 7 * 3 + 3 + rec + decays);
             assert!(
                 grad.w_in.iter().any(|g| g.abs() > 1e-4),
                 "a gradient that is all zero checks nothing"
             );
             assert!(!recurrent || grad.w_rec.iter().any(|g| g.abs() > 1e-4));
+            for d in [&grad.alpha, &grad.beta] {
+                assert!(!own || d.iter().any(|g| g.abs() > 1e-4));
+            }
         }
     }
 
@@ -627,7 +717,8 @@ mod tests {
         k: f64,
         frozen: Option<&[f64]>,
     ) -> (f64, Vec<f64>) {
-        let (alpha, beta, kappa) = net.decays();
+        let kappa = net.decays().2;
+        let (alpha, beta) = net.hidden_decays();
         let (n, h_n, c_n) = (net.inputs, net.hidden, net.classes);
         let sigma = |x: f64| 1.0 / (1.0 + (-k * x).exp());
         let x = input.dense();
@@ -644,10 +735,10 @@ mod tests {
                 for (j, &s) in last.iter().enumerate().take(loops) {
                     drive += s * net.w_rec[j * h_n + h];
                 }
-                *current = alpha * *current + drive;
+                *current = alpha[h] * *current + drive;
             }
             for h in 0..h_n {
-                let p = beta * v[h] + current[h];
+                let p = beta[h] * v[h] + current[h];
                 last[h] = sigma(p - 1.0);
                 let r = frozen.map_or(last[h], |f| f[t * h_n + h]);
                 v[h] = match net.reset {
@@ -668,7 +759,8 @@ mod tests {
 
     /// The backward pass against central finite differences of the reference's loss, for
     /// both resets, feed-forward and recurrent, the reset detached (the reference's
-    /// spikes in the reset held) and in the graph.
+    /// spikes in the reset held) and in the graph, every other case with each neuron's
+    /// own decays.
     #[test]
     fn gradient_matches_finite_differences_for_each_reset() {
         let k = 4.0;
@@ -679,6 +771,9 @@ mod tests {
                 for detach_reset in [true, false] {
                     seed += 1;
                     let (mut net, input) = random_net_of(Readout::Mean, seed, recurrent);
+                    if seed % 2 == 0 {
+                        net = with_own_decays(net, seed);
+                    }
                     net.reset = reset;
                     let (loss_at, spikes) = reference_loss(&net, &input, k, None);
                     let want = loss(&net, &input, act);
@@ -689,7 +784,7 @@ mod tests {
                     loss_and_gradient(&net, &input, 1, rule, 1.0, &mut tr, &mut grad);
                     let frozen = detach_reset.then_some(spikes.as_slice());
                     let eps = 1e-6;
-                    for part in 0..5 {
+                    for part in 0..7 {
                         for j in 0..grad.parts()[part].len() {
                             let bump = |d: f64| {
                                 let mut n = net.clone();
@@ -707,6 +802,8 @@ mod tests {
                     }
                     assert!(grad.w_in.iter().any(|g| g.abs() > 1e-4));
                     assert!(!recurrent || grad.w_rec.iter().any(|g| g.abs() > 1e-4));
+                    assert_eq!(grad.beta.len(), if seed % 2 == 0 { 7 } else { 0 });
+                    assert!(grad.beta.iter().all(|g| g.abs() > 0.0));
                 }
             }
         }
@@ -723,7 +820,12 @@ mod tests {
             (Readout::Mean, false, Reset::Subtract),
             (Readout::Max, true, Reset::Subtract),
         ] {
-            let (mut net, input) = random_net_of(readout, 3, recurrent);
+            let (net, input) = random_net_of(readout, 3, recurrent);
+            // Each neuron's own decays, where it runs as the shared ones do.
+            let mut net = match reset {
+                Reset::Subtract => with_own_decays(net, 4),
+                Reset::Zero => net,
+            };
             net.reset = reset;
             let act = Activation::Spike { slope: 10.0 };
             let mut tr = Trajectory::default();

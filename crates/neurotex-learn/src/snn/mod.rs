@@ -164,7 +164,20 @@ pub struct Network {
     /// Where the network runs; absent (float) in the files of float networks.
     #[serde(default, skip_serializing_if = "Target::is_float")]
     pub target: Target,
+    /// Each hidden neuron's synaptic decay per step `α_h`, when the decays were trained
+    /// ([`SnnParams::train_decays`]); empty: every neuron's is `α` of `tau_syn_ms`. Absent
+    /// from the files of networks whose neurons share their decays.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub alpha: Vec<f64>,
+    /// Each hidden neuron's membrane decay per step `β_h`, as [`Network::alpha`]; empty:
+    /// every neuron's is `β` of `tau_mem_ms`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub beta: Vec<f64>,
 }
+
+/// The smallest and largest decay per step trained decays are kept within: time constants
+/// from about a seventh of a step to a thousand steps.
+pub const TRAINED_DECAYS: (f64, f64) = (0.001, 0.999);
 
 impl Network {
     /// The decay factors `(α, β, κ)` of one step.
@@ -182,15 +195,33 @@ impl Network {
         !self.w_rec.is_empty()
     }
 
-    /// Every weight and bias: `w_in`, `b_in`, `w_out`, `b_out`, `w_rec` (empty when
-    /// feed-forward).
-    pub fn params_mut(&mut self) -> [&mut Vec<f64>; 5] {
+    /// Whether each hidden neuron has decays of its own ([`Network::alpha`],
+    /// [`Network::beta`]).
+    pub fn own_decays(&self) -> bool {
+        !self.alpha.is_empty()
+    }
+
+    /// Each hidden neuron's synaptic and membrane decays per step, `(α_h, β_h)`: its own,
+    /// or those of the shared time constants.
+    pub fn hidden_decays(&self) -> (Vec<f64>, Vec<f64>) {
+        if self.own_decays() {
+            return (self.alpha.clone(), self.beta.clone());
+        }
+        let (alpha, beta, _) = self.decays();
+        (vec![alpha; self.hidden], vec![beta; self.hidden])
+    }
+
+    /// Every trained parameter: `w_in`, `b_in`, `w_out`, `b_out`, `w_rec` (empty when
+    /// feed-forward), `alpha` and `beta` (empty when the neurons share their decays).
+    pub fn params_mut(&mut self) -> [&mut Vec<f64>; 7] {
         [
             &mut self.w_in,
             &mut self.b_in,
             &mut self.w_out,
             &mut self.b_out,
             &mut self.w_rec,
+            &mut self.alpha,
+            &mut self.beta,
         ]
     }
 
@@ -250,6 +281,7 @@ impl Network {
             ));
         }
         self.check_taus()?;
+        self.check_own_decays()?;
         if self.target == Target::Xylo {
             xylo::check(self)?;
         }
@@ -296,6 +328,32 @@ impl Network {
                 return Err(ModelError::network(name, format!(
                     "the network's {name} is {tau:?}, which gives the decay {decay} per step of {} ms; a time constant must be positive and finite, its decay strictly between 0 and 1",
                     self.dt_ms
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks each neuron's own decays, when it has them: one per hidden neuron in both
+    /// `alpha` and `beta`, each `β_h` strictly between 0 and 1 and each `α_h` at least 0
+    /// (a synapse without memory, as a NIR graph's LIF node reads) and under 1.
+    fn check_own_decays(&self) -> Result<(), ModelError> {
+        if self.alpha.is_empty() && self.beta.is_empty() {
+            return Ok(());
+        }
+        for (name, d) in [("alpha", &self.alpha), ("beta", &self.beta)] {
+            if d.len() != self.hidden {
+                return Err(ModelError::network(name, format!(
+                    "the network's {name} holds {} decays, not one per hidden neuron ({}); both alpha and beta, or neither",
+                    d.len(),
+                    self.hidden
+                )));
+            }
+            let low_ok = |v: f64| if name == "alpha" { v >= 0.0 } else { v > 0.0 };
+            if let Some(pos) = d.iter().position(|&v| !(low_ok(v) && v < 1.0)) {
+                return Err(ModelError::network(name, format!(
+                    "the network's {name}[{pos}] is {:?}; a decay per step must lie between 0 and 1 (alpha may be 0)",
+                    d[pos]
                 )));
             }
         }

@@ -64,6 +64,12 @@ pub struct SnnParams {
     /// on the counts as they are.
     #[serde(default)]
     pub standardize: bool,
+    /// Train each hidden neuron's synaptic and membrane decays beside the weights
+    /// (false: every neuron keeps those of `tau_syn_ms` and `tau_mem_ms`): the neurons start
+    /// alike and each finds the time scales its inputs' timing is read at (learnable time
+    /// constants, Perez-Nieves et al. 2021). Left out of model files when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub train_decays: bool,
 }
 
 impl Default for SnnParams {
@@ -88,6 +94,7 @@ impl Default for SnnParams {
             target: Target::Float,
             window_ms: None,
             standardize: true,
+            train_decays: false,
         }
     }
 }
@@ -159,6 +166,7 @@ impl SnnParams {
             ("snn-dt-ms", self.dt_ms > xylo::MAX_DT_MS, "the Xylo profile steps at most 15 ms (an input carries at most 15 events a step)", self.dt_ms.to_string()),
             ("snn-reset", self.reset != Reset::Subtract, "the Xylo profile's neurons subtract the threshold on a spike: --snn-reset subtract", self.reset.name().to_string()),
             ("snn-recurrent", self.recurrent, "the Xylo profile runs feed-forward networks", "--snn-recurrent".to_string()),
+            ("snn-train-decays", self.train_decays, "the Xylo profile's neurons share the chip's bitshift decays", "--snn-train-decays".to_string()),
         ];
         if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
             return Err(ParamError::new(name, rule, got));

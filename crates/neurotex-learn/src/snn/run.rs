@@ -7,7 +7,11 @@ use super::{xylo, Network, Reset, Target};
 /// live beside the network that drives it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
-    decays: (f64, f64, f64),
+    /// The readout's decay `κ`.
+    kappa: f64,
+    /// Each hidden neuron's synaptic and membrane decays.
+    alpha: Vec<f64>,
+    beta: Vec<f64>,
     current: Vec<f64>,
     membrane: Vec<f64>,
     out: Vec<f64>,
@@ -34,8 +38,11 @@ impl State {
             let state = xylo::XyloState::new(&chip);
             Box::new((chip, state))
         });
+        let (alpha, beta) = net.hidden_decays();
         State {
-            decays: net.decays(),
+            kappa: net.decays().2,
+            alpha,
+            beta,
             current: vec![0.0; net.hidden],
             membrane: vec![0.0; net.hidden],
             out: vec![0.0; net.classes],
@@ -76,11 +83,12 @@ neurotex_core::widest_or_plain! {
     /// rows of those that spiked, in neuron order. The same operations in the same order
     /// as the training's forward pass, so its scores are those of training.
     fn float_step(state: &mut State, net: &Network, spiked: &[u32]) {
-        let (alpha, beta, kappa) = state.decays;
+        let kappa = state.kappa;
         let h_n = net.hidden;
+        let (alpha, beta) = (&state.alpha[..h_n], &state.beta[..h_n]);
         let current = &mut state.current[..h_n];
-        for (c, b) in current.iter_mut().zip(&net.b_in) {
-            *c = alpha * *c + b;
+        for ((c, b), a) in current.iter_mut().zip(&net.b_in).zip(alpha) {
+            *c = a * *c + b;
         }
         for &i in spiked {
             let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
@@ -103,7 +111,7 @@ neurotex_core::widest_or_plain! {
         let subtract = net.reset == Reset::Subtract;
         let (membrane, counts) = (&mut state.membrane[..h_n], &mut state.counts[..h_n]);
         for h in 0..h_n {
-            let p = beta * membrane[h] + current[h];
+            let p = beta[h] * membrane[h] + current[h];
             let n = match (p >= 1.0, subtract) {
                 (false, _) => 0.0,
                 (true, true) => p.floor(),
@@ -231,6 +239,8 @@ mod tests {
             b_out: vec![0.0],
             w_rec,
             target: Target::Float,
+            alpha: Vec::new(),
+            beta: Vec::new(),
         }
     }
 

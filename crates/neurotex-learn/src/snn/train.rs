@@ -214,7 +214,32 @@ fn initial(
                 .collect(),
             false => Vec::new(),
         },
-    })
+        alpha: Vec::new(),
+        beta: Vec::new(),
+    }
+    .with_own_decays(params, rng))
+}
+
+impl Network {
+    /// With [`SnnParams::train_decays`], each hidden neuron's own decays, drawn from its time
+    /// constants' gamma distributions of shape 3 about the shared ones (Perez-Nieves et al.
+    /// 2021 start heterogeneous neurons so), kept within [`super::TRAINED_DECAYS`].
+    fn with_own_decays(mut self, params: &SnnParams, rng: &mut ChaCha8Rng) -> Network {
+        if !params.train_decays {
+            return self;
+        }
+        let dt = f64::from(params.dt_ms);
+        let (low, high) = super::TRAINED_DECAYS;
+        let mut draw = |tau: f64| -> Vec<f64> {
+            let gamma = rand_distr::Gamma::new(3.0, tau / 3.0).expect("a positive time constant");
+            (0..self.hidden)
+                .map(|_| (-dt / gamma.sample(rng)).exp().clamp(low, high))
+                .collect()
+        };
+        self.alpha = draw(params.tau_syn_ms);
+        self.beta = draw(params.tau_mem_ms);
+        self
+    }
 }
 
 /// `Σ_t k_t²` of the membrane's response to one unit input,
@@ -411,6 +436,11 @@ impl Adam {
                 p[j] -= self.rate * (m[j] / c1) / ((v[j] / c2).sqrt() + EPS);
             }
         }
+        // Each neuron's own decays stay decays (projected gradient descent).
+        let (low, high) = super::TRAINED_DECAYS;
+        for d in net.alpha.iter_mut().chain(net.beta.iter_mut()) {
+            *d = d.clamp(low, high);
+        }
     }
 }
 
@@ -460,6 +490,8 @@ mod tests {
             b_out: w(c, 0.3),
             w_rec: Vec::new(),
             target: Default::default(),
+            alpha: Vec::new(),
+            beta: Vec::new(),
         };
         let moved = z.trained(&net);
         let back = z.network(&moved);

@@ -188,6 +188,12 @@ pub fn check(net: &Network) -> Result<(), ModelError> {
             "the Xylo profile runs feed-forward networks; this one is recurrent",
         ));
     }
+    if net.own_decays() {
+        return Err(ModelError::network(
+            "alpha",
+            "the Xylo profile's neurons share the chip's bitshift decays; this network's neurons have decays of their own",
+        ));
+    }
     for (name, tau) in [
         ("tau_syn_ms", net.tau_syn_ms),
         ("tau_mem_ms", net.tau_mem_ms),

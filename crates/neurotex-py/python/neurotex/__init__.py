@@ -1101,6 +1101,7 @@ class SpikingModel(Model):
         tau_mem_ms: float = _SNN_DEFAULTS["tau_mem_ms"],
         tau_out_ms: float = _SNN_DEFAULTS["tau_out_ms"],
         window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
+        train_decays: bool = _SNN_DEFAULTS["train_decays"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -1118,13 +1119,15 @@ class SpikingModel(Model):
         and ``tau_out_ms`` are the hidden neurons' synaptic and membrane time constants and
         the readout's (``--snn-tau-*-ms``; moved to the chip's decays with Xylo);
         ``window_ms`` trains on windows of that many ms drawn anew at each epoch from
-        anywhere in each recording (``--snn-window-ms``; ``None``: whole recordings).
+        anywhere in each recording (``--snn-window-ms``; ``None``: whole recordings);
+        ``train_decays=True`` trains each hidden neuron's synaptic and membrane decays
+        beside the weights (``--snn-train-decays``).
         ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
         :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
                "seed": seed, "recurrent": recurrent, "target": target,
                "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms,
-               "window_ms": window_ms}
+               "window_ms": window_ms, "train_decays": train_decays}
         if reset is not None:
             snn["reset"] = reset
         folder = _folder(recordings)
