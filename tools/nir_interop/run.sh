@@ -14,6 +14,8 @@
 #   --train-if COND   with --heldout-if: split TRAIN_DATASET by awk conditions on the
 #   --heldout-if COND manifest's trial `t` and speed `v` (e.g. 'v == 50 && t < 2')
 #   --epochs N, --hidden N   of the networks (default 15, 32)
+#   --train-decays    train every network with --snn-train-decays (each hidden neuron's
+#                     own time constants in the graphs)
 #
 # Without HELDOUT_DATASET or a split, the training recordings are predicted (said in the
 # table's title). The neurotex binary is $NEUROTEX, else `neurotex` on the PATH. Exits 1
@@ -23,7 +25,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 neurotex=${NEUROTEX:-neurotex}
 export PYTHONDONTWRITEBYTECODE=1  # no __pycache__ beside the probes in the checkout
 work=${TMPDIR:-/tmp}/neurotex-nir-interop
-venvs="" name="" train_if="" heldout_if="" epochs=15 hidden=32
+venvs="" name="" train_if="" heldout_if="" epochs=15 hidden=32 decays=""
 while [ $# -gt 0 ]; do
     case $1 in
         --work) work=$2; shift 2 ;;
@@ -33,6 +35,7 @@ while [ $# -gt 0 ]; do
         --heldout-if) heldout_if=$2; shift 2 ;;
         --epochs) epochs=$2; shift 2 ;;
         --hidden) hidden=$2; shift 2 ;;
+        --train-decays) decays=--snn-train-decays; shift ;;
         -h | --help) sed -n '2,/^set -e/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
         -*) echo "unknown option $1" >&2; exit 2 ;;
         *) break ;;
@@ -75,6 +78,7 @@ recordings=$(($(wc -l < "$heldout/manifest.csv") - 1))
 nets="ff-zero ff-subtract rec-zero rec-subtract"
 for net in $nets; do
     opts=(--snn-reset "${net#*-}"); [ "${net%-*}" = rec ] && opts+=(--snn-recurrent)
+    [ -n "$decays" ] && opts+=("$decays")
     "$neurotex" train --dataset "$train" --classifier snn --snn-hidden "$hidden" \
         --snn-epochs "$epochs" "${opts[@]}" --out "$net.json" 2> "logs/train-$net.txt"
     "$neurotex" export inputs --model "$net.json" --dataset "$heldout" --out "inputs-$net" 2> "logs/inputs-$net.txt"
@@ -116,7 +120,7 @@ for net in $nets; do
 done
 
 {
-    echo "$name: $split; $recordings held-out recordings; $hidden hidden neurons, $epochs epochs at most"
+    echo "$name: $split; $recordings held-out recordings; $hidden hidden neurons, $epochs epochs at most${decays:+; every hidden neuron with trained decays of its own ($decays)}"
     echo
     echo "| tool | versions | network | graph | recordings | labels agree | max relative score error |"
     echo "|---|---|---|---|---|---|---|"

@@ -99,8 +99,8 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
 }
 
 /// Checks that a model file's network is the one its training parameters make: the same
-/// hidden layer, step, readout, reset, recurrence and time constants (to a float's rounding in
-/// JSON). A NIR graph's network is not checked so: one run with `--like` comes from
+/// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
+/// JSON) and whether each neuron has decays of its own. A NIR graph's network is not checked so: one run with `--like` comes from
 /// another tool, whatever the spiking model lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
@@ -111,6 +111,7 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
         ("reset", net.reset == snn.reset),
         ("target", net.target == snn.target),
         ("w_rec", net.recurrent() == snn.recurrent),
+        ("alpha", net.own_decays() == snn.train_decays),
         ("tau_syn_ms", close(net.tau_syn_ms, snn.tau_syn_ms)),
         ("tau_mem_ms", close(net.tau_mem_ms, snn.tau_mem_ms)),
         ("tau_out_ms", close(net.tau_out_ms, snn.tau_out_ms)),

@@ -168,3 +168,26 @@ def test_training_on_windows_gives_the_network_of_the_cli(sim, sim_dir, tmp_path
     est_file = json.loads((tmp_path / "est.json").read_text())
     assert est_file["network"] == json.loads((tmp_path / "arrays.json").read_text())["network"]
     assert "window_ms" in json.dumps(est_file)
+
+
+def test_trained_decays_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
+    """`train_decays` trains the network `--snn-train-decays` trains: one synaptic and one
+    membrane decay per hidden neuron in the file, which the NIR graph carries."""
+    model = neurotex.SpikingModel.train(sim, hidden=8, epochs=2, train_decays=True)
+    model.save(tmp_path / "py.json")
+    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-hidden", "8",
+            "--snn-epochs", "2", "--snn-train-decays", "--out", tmp_path / "cli.json")
+    py = json.loads((tmp_path / "py.json").read_text())
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    assert py["network"] == cli["network"]
+    alpha, beta = cli["network"]["alpha"], cli["network"]["beta"]
+    assert len(alpha) == len(beta) == 8 and len(set(beta)) > 1
+    assert all(0 < b < 1 for b in beta)
+    shared = neurotex.SpikingModel.train(sim, hidden=8, epochs=2)
+    shared.save(tmp_path / "shared.json")
+    assert "alpha" not in json.loads((tmp_path / "shared.json").read_text())["network"]
+    from neurotex.sklearn import SpikingClassifier
+
+    est = SpikingClassifier(hidden=8, epochs=2, train_decays=True).fit(sim.recordings, sim.labels)
+    est.model_.save(tmp_path / "est.json")
+    assert len(json.loads((tmp_path / "est.json").read_text())["network"]["beta"]) == 8

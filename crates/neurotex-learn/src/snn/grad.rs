@@ -28,7 +28,7 @@
 //! gP[t] = gV[t] (1 - H'(P[t] - 1)) + gS[t] H'(P[t] - 1)  reset in the graph
 //! ```
 
-use super::{softmax, Network, Readout, Reset, SpikeInput};
+use super::{softmax, Network, PerNeuron, Readout, Reset, SpikeInput};
 
 /// The spike nonlinearity of the forward pass and the derivative the backward pass uses.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -209,7 +209,7 @@ fn forward_with(
     reset: impl Fn(f64, f64) -> f64,
 ) -> Vec<f64> {
     let kappa = net.decays().2;
-    let (alpha, beta) = net.hidden_decays();
+    let ((alpha, beta), own) = (net.hidden_decays(), net.own_decays());
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
     // Every value is written below, step by step: the buffers keep their last contents
     // rather than being cleared on every call.
@@ -221,8 +221,9 @@ fn forward_with(
     let mut out = vec![0.0; c_n];
     let mut fired = Vec::with_capacity(h_n);
     for t in 0..steps {
-        for ((c, b), a) in current.iter_mut().zip(&net.b_in).zip(&alpha) {
-            *c = a * *c + b;
+        match own {
+            true => decay_currents(&mut current, &net.b_in, alpha.as_slice()),
+            false => decay_currents(&mut current, &net.b_in, alpha[0]),
         }
         for &i in input.at(t) {
             let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
@@ -244,16 +245,10 @@ fn forward_with(
         }
         let pre = &mut tr.pre[t * h_n..(t + 1) * h_n];
         let spikes = &mut tr.spikes[t * h_n..(t + 1) * h_n];
-        for ((((p, s), m), c), b) in pre
-            .iter_mut()
-            .zip(spikes.iter_mut())
-            .zip(&mut membrane)
-            .zip(&current)
-            .zip(&beta)
-        {
-            *p = b * *m + c;
-            *s = spike(*p);
-            *m = reset(*p, *s);
+        let laws = (&spike, &reset);
+        match own {
+            true => membranes(pre, spikes, &mut membrane, &current, beta.as_slice(), laws),
+            false => membranes(pre, spikes, &mut membrane, &current, beta[0], laws),
         }
         for &h in super::nonzero(spikes, &mut fired) {
             let (s, w) = (spikes[h as usize], &net.w_out[h as usize * c_n..][..c_n]);
@@ -264,6 +259,40 @@ fn forward_with(
         tr.out[t * c_n..(t + 1) * c_n].copy_from_slice(&out);
     }
     read_scores(net.readout, &tr.out, c_n, steps)
+}
+
+/// `I = α I + b` for each hidden neuron, its decay `alpha` one for all or its own.
+#[inline(always)]
+fn decay_currents<D: PerNeuron>(current: &mut [f64], b: &[f64], alpha: D) {
+    // Indexed over slices of one length, so that the loop vectorises; decays of one for
+    // all are one number, as decays read from memory kept it from vectorising.
+    let n = current.len();
+    let (b, alpha) = (&b[..n], alpha.first(n));
+    for k in 0..n {
+        current[k] = alpha.at(k) * current[k] + b[k];
+    }
+}
+
+/// Each hidden neuron's membrane before the spike `P = β V + I`, its spikes, and the
+/// membrane it keeps, `reset(P, S)`.
+/// The slices written are parameters of their own, not a tuple (see [`step_back`]).
+#[inline(always)]
+fn membranes<D: PerNeuron>(
+    pre: &mut [f64],
+    spikes: &mut [f64],
+    membrane: &mut [f64],
+    current: &[f64],
+    beta: D,
+    (spike, reset): (&impl Fn(f64) -> f64, &impl Fn(f64, f64) -> f64),
+) {
+    let n = pre.len();
+    let (spikes, membrane, current) = (&mut spikes[..n], &mut membrane[..n], &current[..n]);
+    let beta = beta.first(n);
+    for k in 0..n {
+        let p = beta.at(k) * membrane[k] + current[k];
+        let s = spike(p);
+        (pre[k], spikes[k], membrane[k]) = (p, s, reset(p, s));
+    }
 }
 
 /// The scores read from a readout trace (`steps x classes`).
@@ -448,7 +477,9 @@ impl HiddenBack {
         let (g_v, g_i) = (&mut self.g_v, &mut self.g_i);
         step_back(
             (g_s, pre, spikes),
-            (g_v, g_i, &mut self.g_p),
+            g_v,
+            g_i,
+            &mut self.g_p,
             (&self.alpha, &self.beta, self.reset),
             self.subtract,
             derivative,
@@ -459,7 +490,8 @@ impl HiddenBack {
                 self.subtract,
                 &self.beta,
                 (&self.g_p, g_i),
-                grad,
+                &mut grad.alpha,
+                &mut grad.beta,
             );
         }
         for (b, g) in grad.b_in.iter_mut().zip(g_i.iter()) {
@@ -482,11 +514,40 @@ impl HiddenBack {
 /// spike gradient, membranes and spikes `(gS, P, S)`, turns the next step's membrane and
 /// current gradients `g_v`, `g_i` into this step's, and writes `gP` into `g_p` unless it
 /// is empty; the decays are `(α_h, β_h, 1 if the reset is in the graph else 0)`.
+///
+/// The gradients written are parameters of their own, not a tuple: a tuple of references is
+/// passed through memory, without the promise that they alias nothing, and the loops then
+/// ran one neuron at a time.
 #[inline(always)]
 fn step_back(
+    parts: (&[f64], &[f64], &[f64]),
+    g_v: &mut [f64],
+    g_i: &mut [f64],
+    g_p: &mut [f64],
+    decays: (&[f64], &[f64], f64),
+    subtract: bool,
+    derivative: &impl Fn(f64) -> f64,
+) {
+    // Neurons that share their decays step with two numbers, as the loops vectorise (with
+    // decays read from memory they ran one neuron at a time); neurons of their own keep
+    // `gP` for their decays' gradients.
+    let (alpha, beta, reset) = decays;
+    match g_p.is_empty() {
+        true => {
+            let shared = (alpha[0], beta[0], reset);
+            step_back_with::<false, f64>(parts, g_v, g_i, g_p, shared, subtract, derivative);
+        }
+        false => step_back_with::<true, &[f64]>(parts, g_v, g_i, g_p, decays, subtract, derivative),
+    }
+}
+
+#[inline(always)]
+fn step_back_with<const KEEP: bool, D: PerNeuron>(
     (g_s, pre, spikes): (&[f64], &[f64], &[f64]),
-    (g_v, g_i, g_p): (&mut [f64], &mut [f64], &mut [f64]),
-    (alpha, beta, reset): (&[f64], &[f64], f64),
+    g_v: &mut [f64],
+    g_i: &mut [f64],
+    g_p: &mut [f64],
+    (alpha, beta, reset): (D, D, f64),
     subtract: bool,
     derivative: &impl Fn(f64) -> f64,
 ) {
@@ -494,59 +555,58 @@ fn step_back(
     // iterators they ran one neuron at a time).
     let n = g_s.len();
     let (pre, spikes, g_v, g_i) = (&pre[..n], &spikes[..n], &mut g_v[..n], &mut g_i[..n]);
-    let (alpha, beta) = (&alpha[..n], &beta[..n]);
-    let keep = !g_p.is_empty();
-    let g_p = if keep { &mut g_p[..n] } else { g_p };
+    let g_p = if KEEP { &mut g_p[..n] } else { g_p };
+    let (alpha, beta) = (alpha.first(n), beta.first(n));
     if subtract {
         // V = P - S: the reset passes gV to P whole, and (in the graph) as -gV to S.
         for k in 0..n {
             let p = g_v[k] + (g_s[k] - reset * g_v[k]) * derivative(pre[k] - 1.0);
-            if keep {
+            if KEEP {
                 g_p[k] = p;
             }
-            g_i[k] = p + alpha[k] * g_i[k];
-            g_v[k] = beta[k] * p;
+            g_i[k] = p + alpha.at(k) * g_i[k];
+            g_v[k] = beta.at(k) * p;
         }
     } else {
         for k in 0..n {
             let g_sh = g_s[k] - reset * pre[k] * g_v[k];
             let p = g_v[k] * (1.0 - spikes[k]) + g_sh * derivative(pre[k] - 1.0);
-            if keep {
+            if KEEP {
                 g_p[k] = p;
             }
-            g_i[k] = p + alpha[k] * g_i[k];
-            g_v[k] = beta[k] * p;
+            g_i[k] = p + alpha.at(k) * g_i[k];
+            g_v[k] = beta.at(k) * p;
         }
     }
 }
 
 /// Step `t`'s share of each neuron's own decays' gradients, `∂L/∂α_h += gI[t] I[t-1]` and
 /// `∂L/∂β_h += gP[t] V[t-1]`, with `V` and `I` made again from the kept membranes and
-/// spikes as the forward pass made them (nothing before step 0).
+/// spikes as the forward pass made them (nothing before step 0). The gradients written are
+/// parameters of their own (see [`step_back`]).
 #[inline(always)]
 fn add_decay_gradients(
     (tr, t, h_n): (&Trajectory, usize, usize),
     subtract: bool,
     beta: &[f64],
     (g_p, g_i): (&[f64], &[f64]),
-    grad: &mut Gradient,
+    g_alpha: &mut [f64],
+    g_beta: &mut [f64],
 ) {
     if t == 0 {
         return;
     }
-    let kept = |u: usize, h: usize| {
-        let (p, s) = (tr.pre[u * h_n + h], tr.spikes[u * h_n + h]);
-        if subtract {
-            p - s
-        } else {
-            p * (1.0 - s)
-        }
-    };
+    // Indexed over slices of one length, so that the loop vectorises.
+    let row = |u: usize| (&tr.pre[u * h_n..][..h_n], &tr.spikes[u * h_n..][..h_n]);
+    let kept = |p: f64, s: f64| if subtract { p - s } else { p * (1.0 - s) };
+    let ((p1, s1), (g_p, g_i, beta)) = (row(t - 1), (&g_p[..h_n], &g_i[..h_n], &beta[..h_n]));
+    let (g_alpha, g_beta) = (&mut g_alpha[..h_n], &mut g_beta[..h_n]);
+    let (p2, s2) = if t >= 2 { row(t - 2) } else { (p1, s1) };
+    let first = t == 1;
     for h in 0..h_n {
-        let before = if t >= 2 { kept(t - 2, h) } else { 0.0 };
-        let current = tr.pre[(t - 1) * h_n + h] - beta[h] * before;
-        grad.alpha[h] += g_i[h] * current;
-        grad.beta[h] += g_p[h] * kept(t - 1, h);
+        let before = if first { 0.0 } else { kept(p2[h], s2[h]) };
+        g_alpha[h] += g_i[h] * (p1[h] - beta[h] * before);
+        g_beta[h] += g_p[h] * kept(p1[h], s1[h]);
     }
 }
 

@@ -165,8 +165,9 @@ pub struct Network {
     #[serde(default, skip_serializing_if = "Target::is_float")]
     pub target: Target,
     /// Each hidden neuron's synaptic decay per step `α_h`, when the decays were trained
-    /// ([`SnnParams::train_decays`]); empty: every neuron's is `α` of `tau_syn_ms`. Absent
-    /// from the files of networks whose neurons share their decays.
+    /// ([`SnnParams::train_decays`]; the shared time constants then say where the neurons
+    /// started from); empty: every neuron's is `α` of `tau_syn_ms`. Absent from the files
+    /// of networks whose neurons share their decays.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub alpha: Vec<f64>,
     /// Each hidden neuron's membrane decay per step `β_h`, as [`Network::alpha`]; empty:
@@ -415,6 +416,37 @@ impl Readout {
             acc.iter_mut().for_each(|a| *a /= n);
         }
         acc
+    }
+}
+
+/// A value per hidden neuron: one for all (`f64`), or each its own (`&[f64]`).
+pub(crate) trait PerNeuron: Copy {
+    /// The first `n` neurons' (indexed below `n` without a bounds check in the loops).
+    fn first(self, n: usize) -> Self;
+    fn at(self, k: usize) -> f64;
+}
+
+impl PerNeuron for f64 {
+    #[inline(always)]
+    fn first(self, _: usize) -> Self {
+        self
+    }
+
+    #[inline(always)]
+    fn at(self, _: usize) -> f64 {
+        self
+    }
+}
+
+impl PerNeuron for &[f64] {
+    #[inline(always)]
+    fn first(self, n: usize) -> Self {
+        &self[..n]
+    }
+
+    #[inline(always)]
+    fn at(self, k: usize) -> f64 {
+        self[k]
     }
 }
 

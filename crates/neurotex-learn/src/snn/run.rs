@@ -1,7 +1,7 @@
 //! The network run step by step: its state, a runner that gathers the scores as spikes
 //! arrive, and a window that keeps the last steps' readouts.
 
-use super::{xylo, Network, Reset, Target};
+use super::{xylo, Network, PerNeuron, Reset, Target};
 
 /// The network's neuron state, advanced one step at a time; it owns no weights, so it can
 /// live beside the network that drives it.
@@ -85,10 +85,13 @@ neurotex_core::widest_or_plain! {
     fn float_step(state: &mut State, net: &Network, spiked: &[u32]) {
         let kappa = state.kappa;
         let h_n = net.hidden;
+        // Neurons that share their decays step with two numbers (see `grad`'s loops).
+        let own = net.own_decays();
         let (alpha, beta) = (&state.alpha[..h_n], &state.beta[..h_n]);
         let current = &mut state.current[..h_n];
-        for ((c, b), a) in current.iter_mut().zip(&net.b_in).zip(alpha) {
-            *c = a * *c + b;
+        match own {
+            true => decay(current, &net.b_in, alpha),
+            false => decay(current, &net.b_in, alpha[0]),
         }
         for &i in spiked {
             let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
@@ -110,15 +113,9 @@ neurotex_core::widest_or_plain! {
         // of 1 multiplies the weights exactly; `p (1 - 0)` and `p - 0` are `p`).
         let subtract = net.reset == Reset::Subtract;
         let (membrane, counts) = (&mut state.membrane[..h_n], &mut state.counts[..h_n]);
-        for h in 0..h_n {
-            let p = beta[h] * membrane[h] + current[h];
-            let n = match (p >= 1.0, subtract) {
-                (false, _) => 0.0,
-                (true, true) => p.floor(),
-                (true, false) => 1.0,
-            };
-            counts[h] = n;
-            membrane[h] = if subtract { p - n } else { p * (1.0 - n) };
+        match own {
+            true => fire(membrane, counts, current, beta, subtract),
+            false => fire(membrane, counts, current, beta[0], subtract),
         }
         let recurrent = net.recurrent();
         for &h in super::nonzero(counts, &mut state.active) {
@@ -131,6 +128,39 @@ neurotex_core::widest_or_plain! {
                 *o += n * w;
             }
         }
+    }
+}
+
+/// `I = α I + b` for each hidden neuron.
+#[inline(always)]
+fn decay(current: &mut [f64], b: &[f64], alpha: impl PerNeuron) {
+    let n = current.len();
+    let (b, alpha) = (&b[..n], alpha.first(n));
+    for h in 0..n {
+        current[h] = alpha.at(h) * current[h] + b[h];
+    }
+}
+
+/// Each hidden neuron's membrane `P = β V + I`, its spike count and the membrane it keeps.
+#[inline(always)]
+fn fire(
+    membrane: &mut [f64],
+    counts: &mut [f64],
+    current: &[f64],
+    beta: impl PerNeuron,
+    subtract: bool,
+) {
+    let n = membrane.len();
+    let (counts, current, beta) = (&mut counts[..n], &current[..n], beta.first(n));
+    for h in 0..n {
+        let p = beta.at(h) * membrane[h] + current[h];
+        let n = match (p >= 1.0, subtract) {
+            (false, _) => 0.0,
+            (true, true) => p.floor(),
+            (true, false) => 1.0,
+        };
+        counts[h] = n;
+        membrane[h] = if subtract { p - n } else { p * (1.0 - n) };
     }
 }
 

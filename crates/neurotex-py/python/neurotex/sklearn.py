@@ -291,7 +291,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     ``hidden`` LIF neurons with time steps of ``dt_ms`` for at most ``epochs`` passes, early
     stopping on 20 % of each class of ``X``, seeded by ``seed``; ``recurrent`` and
     ``reset`` (``"zero"`` or ``"subtract"``), ``target`` (``"float"`` or ``"xylo"``) and
-    ``window_ms`` (train on windows of that many ms) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
+    ``window_ms`` (train on windows of that many ms) and ``train_decays`` (each hidden
+    neuron's decays trained) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
     it to NIR)."""
 
@@ -306,6 +307,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         reset: Optional[str] = None,
         target: str = _SNN_DEFAULTS["target"],
         window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
+        train_decays: bool = _SNN_DEFAULTS["train_decays"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
@@ -321,6 +323,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.reset = reset
         self.target = target
         self.window_ms = window_ms
+        self.train_decays = train_decays
         self.encoding = encoding
         self.gain = gain
         self.baseline = baseline
@@ -342,7 +345,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
             X, [str(label) for label in y], fs=self.fs, hidden=self.hidden,
             dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
             recurrent=self.recurrent, reset=self.reset, target=self.target,
-            window_ms=self.window_ms, causal=self.causal, encoding=self.encoding, gain=self.gain,
+            window_ms=self.window_ms, train_decays=self.train_decays, causal=self.causal,
+            encoding=self.encoding, gain=self.gain,
             baseline=self.baseline,
         )
         # the network's outputs (labels as text) -> columns in classes_ order
