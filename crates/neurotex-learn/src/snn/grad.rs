@@ -265,7 +265,7 @@ fn forward_with(
 #[inline(always)]
 fn decay_currents<D: PerNeuron>(current: &mut [f64], b: &[f64], alpha: D) {
     // Indexed over slices of one length, so that the loop vectorises; decays of one for
-    // all are one number, as decays read from memory kept it from vectorising.
+    // all are one number, not a load per neuron.
     let n = current.len();
     let (b, alpha) = (&b[..n], alpha.first(n));
     for k in 0..n {
@@ -274,8 +274,8 @@ fn decay_currents<D: PerNeuron>(current: &mut [f64], b: &[f64], alpha: D) {
 }
 
 /// Each hidden neuron's membrane before the spike `P = β V + I`, its spikes, and the
-/// membrane it keeps, `reset(P, S)`.
-/// The slices written are parameters of their own, not a tuple (see [`step_back`]).
+/// membrane it keeps, `reset(P, S)`; the slices written are parameters of their own, not a
+/// tuple (see [`step_back`]).
 #[inline(always)]
 fn membranes<D: PerNeuron>(
     pre: &mut [f64],
@@ -528,9 +528,8 @@ fn step_back(
     subtract: bool,
     derivative: &impl Fn(f64) -> f64,
 ) {
-    // Neurons that share their decays step with two numbers, as the loops vectorise (with
-    // decays read from memory they ran one neuron at a time); neurons of their own keep
-    // `gP` for their decays' gradients.
+    // Neurons that share their decays step with two numbers, not a load per neuron;
+    // neurons with decays of their own also keep `gP` for their decays' gradients.
     let (alpha, beta, reset) = decays;
     match g_p.is_empty() {
         true => {
@@ -713,7 +712,8 @@ mod tests {
 
     /// The hand-written backward pass against central finite differences of the loss, on
     /// a network with a smooth spike function (whose loss has a true gradient), the reset
-    /// kept in the graph, both readouts, feed-forward and recurrent.
+    /// kept in the graph, both readouts, feed-forward and recurrent, with shared decays and
+    /// with each neuron's own.
     #[test]
     fn gradient_matches_finite_differences() {
         for (readout, seed, recurrent, own) in [

@@ -15,6 +15,9 @@
 //! O[t] = κ O[t-1] + W_out S[t] + b_out       leaky readout, one per class
 //! ```
 //!
+//! With [`SnnParams::train_decays`] each hidden neuron has decays of its own, `α_h` and
+//! `β_h` ([`Network::alpha`], [`Network::beta`]), trained beside the weights.
+//!
 //! With [`Reset::Subtract`] a neuron instead emits `S[t] = ⌊P[t]⌋` spikes when `P[t] ≥ 1`
 //! (none below) and keeps the rest, `V[t] = P[t] - S[t]`: the multi-spike neuron with
 //! subtractive reset of sinabs, Rockpool and SynSense's Xylo, so that a network trained
