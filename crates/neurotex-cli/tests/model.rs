@@ -443,6 +443,27 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     std::fs::write(&damaged, serde_json::to_string(&nan).unwrap()).unwrap();
     let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(err.contains("damaged.json"), "{err}");
+    // Decays of each neuron's own in a network its training did not give them, named as
+    // such; then of the wrong count, or outside (0, 1).
+    let mut own = file.clone();
+    let hidden = own["network"]["hidden"].as_u64().unwrap() as usize;
+    own["network"]["alpha"] = Value::from(vec![0.5; hidden]);
+    own["network"]["beta"] = Value::from(vec![0.7; hidden]);
+    std::fs::write(&damaged, serde_json::to_string(&own).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        err.contains("`classifier.train_decays` false) do not train each neuron's own decays, and the network has them"),
+        "{err}"
+    );
+    own["classifier"]["train_decays"] = Value::from(true);
+    own["network"]["alpha"].as_array_mut().unwrap().pop();
+    std::fs::write(&damaged, serde_json::to_string(&own).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("not one per hidden neuron"), "{err}");
+    own["network"]["alpha"] = Value::from(vec![1.5; hidden]);
+    std::fs::write(&damaged, serde_json::to_string(&own).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("alpha[0] is 1.5"), "{err}");
     assert!(!never.exists());
     // A graph that is not HDF5, and a feature model where a spiking one is needed.
     let junk = dir.join("junk.nir");

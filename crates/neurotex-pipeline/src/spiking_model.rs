@@ -100,8 +100,9 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
 
 /// Checks that a model file's network is the one its training parameters make: the same
 /// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
-/// JSON) and whether each neuron has decays of its own. A NIR graph's network is not checked so: one run with `--like` comes from
-/// another tool, whatever the spiking model lending its pipeline was trained with.
+/// JSON) and whether each neuron has decays of its own. A NIR graph's network is not
+/// checked so: one run with `--like` comes from another tool, whatever the spiking model
+/// lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
     let fields = [
@@ -118,6 +119,12 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
     ];
     match fields.iter().find(|(_, same)| !same) {
         None => Ok(()),
+        Some(("alpha", _)) => Err(format!(
+            "the training parameters (`classifier.train_decays` {}) {} each neuron's own decays, and the network {} them (`network.alpha`, `network.beta`)",
+            snn.train_decays,
+            if snn.train_decays { "train" } else { "do not train" },
+            if net.own_decays() { "has" } else { "lacks" }
+        )),
         Some((name, _)) => Err(format!(
             "field `network.{name}` differs from the training parameters (`classifier`) that made the network"
         )),

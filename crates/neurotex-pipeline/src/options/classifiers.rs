@@ -256,9 +256,10 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
          simulator), or on the spike counts as they are (`false`).", get: shown, set: flag),
     knob!(Snn "snn", train_decays, "--snn-train-decays", Flag,
         "Train each hidden neuron's synaptic and membrane decays beside the weights \
-         (learnable time constants): the neurons start alike and each finds the time scales \
-         it reads its inputs' timing at; without it they share --snn-tau-syn-ms and \
-         --snn-tau-mem-ms.", get: shown, set: flag),
+         (learnable time constants): each neuron starts from time constants drawn about \
+         --snn-tau-syn-ms and --snn-tau-mem-ms (gamma, shape 3) and finds the time scales it \
+         reads its inputs' timing at; without it the neurons share those two constants.",
+        get: shown, set: flag),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \
          the chip's limits, its time constants moved to the chip's bitshift decays, \

@@ -259,3 +259,34 @@ fn column_names_read_as_words_with_their_units() {
     assert_eq!(column_words("session").1, "session");
     assert_eq!(column_words("force_n").1, "force (N)");
 }
+
+/// The ranking's text says the network's paired test against its inputs' rates with its
+/// verdict, and the design the ranking rests on; a ranking without such a test says none.
+#[test]
+fn the_network_against_its_rates_is_said_with_a_verdict() {
+    use crate::report::comparison::{markdown, text_lines};
+    let mut c = comparison(10, false, 2);
+    c.design = "5-fold stratified cross-validation, 1 repeat, seed 0".into();
+    assert!(!markdown(&c).contains("its inputs' spike rates"));
+    for (p, verdict) in [
+        (
+            0.014,
+            "+10.4 points (p 0.014): ahead of its inputs' rates beyond the folds' noise",
+        ),
+        (
+            0.2,
+            "+10.4 points (p 0.200): not shown to differ from its inputs' rates",
+        ),
+    ] {
+        (c.results[1].difference_vs_rates, c.results[1].p_vs_rates) = (Some(0.104), Some(p));
+        let md = markdown(&c);
+        assert!(md.contains(verdict), "{md}");
+        assert!(
+            md.contains("\n5-fold stratified cross-validation, 1 repeat, seed 0.\n"),
+            "{md}"
+        );
+        assert!(text_lines(&c).iter().any(|l| l.ends_with(verdict)));
+    }
+    (c.results[1].difference_vs_rates, c.results[1].p_vs_rates) = (Some(-0.06), Some(0.002));
+    assert!(markdown(&c).contains("-6.0 points (p 0.002): behind its inputs' rates"));
+}
