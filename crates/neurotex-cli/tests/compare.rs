@@ -130,7 +130,10 @@ fn nested_selection_over_held_out_speeds_names_its_choices() {
         text.contains("nested selection:") && text.contains("of 3)"),
         "{text}"
     );
-    assert!(text.contains("one split per held-out part"), "{text}");
+    assert!(
+        text.contains("one split per held-out value, seed 0; 2000 resamples for intervals and tests; nested selection ranks inside each training set, each of its values held out in turn"),
+        "{text}"
+    );
     assert!(
         text.contains("paper's method") && text.contains("caveat"),
         "{text}"

@@ -439,16 +439,19 @@ fn design(params: &CompareParams) -> String {
     };
     let splits = match params.protocol {
         Protocol::Pooled | Protocol::Per(_) => format!("{folds}, {repeats}, seed {}", cv.seed),
-        Protocol::HoldOut(_) | Protocol::Where { .. } => {
-            format!("one split per held-out part, seed {}", cv.seed)
-        }
+        Protocol::HoldOut(_) => format!("one split per held-out value, seed {}", cv.seed),
+        Protocol::Where { .. } => format!("one train/test split, seed {}", cv.seed),
     };
-    let nested = match params.nested {
-        true => format!(
+    let nested = match (params.nested, &params.protocol) {
+        (false, _) => String::new(),
+        (true, Protocol::HoldOut(_)) => {
+            "; nested selection ranks inside each training set, each of its values held out in turn"
+                .into()
+        }
+        (true, _) => format!(
             "; nested selection ranks inside each training set ({} inner folds)",
             params.inner_folds
         ),
-        false => String::new(),
     };
     format!(
         "{splits}; {} resamples for intervals and tests{nested}",
