@@ -250,11 +250,15 @@ fn timing_adds(
     format!(
         "\nThe rates columns are the network's own inputs (SA+FA spike trains) reduced to each taxel's mean spike rate (spikes/s) and classified by logistic regression (`sa+fa / rates / linear`). \
          The network is {} from them within each speed and {} with each speed held out \
-         (the network minus the rates, from the unrounded accuracies, on the same folds, with the p-value of the paired sign-flip test over the same units as above; their intervals are in the table). \
+         (the network minus the rates, from the unrounded accuracies, on the same folds{}; their intervals are in the table). \
          That difference is what the network draws beyond its inputs' spike counts: the timing of the spikes together with its own nonlinearity and training, \
          so a gain near zero says the network reads rates, and a gain is not the timing's alone (a nonlinear classifier on the rates, `compare --methods rates`, separates the two).\n",
         points(net_w, rates_w),
         points(net_h, rates_h),
+        match net_w.p_vs_rates.is_some() && net_h.p_vs_rates.is_some() {
+            true => ", with the p-value of the paired sign-flip test over the same units as above",
+            false => "; these results were written before the paired test between the two was run",
+        },
     )
 }
 
