@@ -221,10 +221,7 @@ fn forward_with(
     let mut out = vec![0.0; c_n];
     let mut fired = Vec::with_capacity(h_n);
     for t in 0..steps {
-        match own {
-            true => decay_currents(&mut current, &net.b_in, alpha.as_slice()),
-            false => decay_currents(&mut current, &net.b_in, alpha[0]),
-        }
+        super::decay_currents(&mut current, &net.b_in, &alpha, own);
         for &i in input.at(t) {
             let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
             for (c, w) in current.iter_mut().zip(w) {
@@ -259,18 +256,6 @@ fn forward_with(
         tr.out[t * c_n..(t + 1) * c_n].copy_from_slice(&out);
     }
     read_scores(net.readout, &tr.out, c_n, steps)
-}
-
-/// `I = α I + b` for each hidden neuron, its decay `alpha` one for all or its own.
-#[inline(always)]
-fn decay_currents<D: PerNeuron>(current: &mut [f64], b: &[f64], alpha: D) {
-    // Indexed over slices of one length, so that the loop vectorises; decays of one for
-    // all are one number, not a load per neuron.
-    let n = current.len();
-    let (b, alpha) = (&b[..n], alpha.first(n));
-    for k in 0..n {
-        current[k] = alpha.at(k) * current[k] + b[k];
-    }
 }
 
 /// Each hidden neuron's membrane before the spike `P = β V + I`, its spikes, and the

@@ -453,6 +453,27 @@ impl PerNeuron for &[f64] {
     }
 }
 
+/// `I = α I + b` for each hidden neuron, with the decays `alpha` (one per neuron): each
+/// neuron's own when `own`, else the first for all, stepped as one number rather than a load
+/// per neuron. The training pass and the runner both step so, with the same bits.
+#[inline(always)]
+pub(crate) fn decay_currents(current: &mut [f64], b: &[f64], alpha: &[f64], own: bool) {
+    match own {
+        true => decay_currents_by(current, b, alpha),
+        false => decay_currents_by(current, b, alpha[0]),
+    }
+}
+
+#[inline(always)]
+fn decay_currents_by<D: PerNeuron>(current: &mut [f64], b: &[f64], alpha: D) {
+    // Indexed over slices of one length, so that the loop vectorises.
+    let n = current.len();
+    let (b, alpha) = (&b[..n], alpha.first(n));
+    for k in 0..n {
+        current[k] = alpha.at(k) * current[k] + b[k];
+    }
+}
+
 /// Softmax of scores (shifted by their largest value, so nothing overflows).
 pub fn softmax(scores: &[f64]) -> Vec<f64> {
     let top = scores.iter().copied().fold(f64::NEG_INFINITY, f64::max);

@@ -89,10 +89,7 @@ neurotex_core::widest_or_plain! {
         let own = net.own_decays();
         let (alpha, beta) = (&state.alpha[..h_n], &state.beta[..h_n]);
         let current = &mut state.current[..h_n];
-        match own {
-            true => decay(current, &net.b_in, alpha),
-            false => decay(current, &net.b_in, alpha[0]),
-        }
+        super::decay_currents(current, &net.b_in, alpha, own);
         for &i in spiked {
             let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
             for (c, w) in current.iter_mut().zip(w) {
@@ -128,16 +125,6 @@ neurotex_core::widest_or_plain! {
                 *o += n * w;
             }
         }
-    }
-}
-
-/// `I = α I + b` for each hidden neuron.
-#[inline(always)]
-fn decay(current: &mut [f64], b: &[f64], alpha: impl PerNeuron) {
-    let n = current.len();
-    let (b, alpha) = (&b[..n], alpha.first(n));
-    for h in 0..n {
-        current[h] = alpha.at(h) * current[h] + b[h];
     }
 }
 
