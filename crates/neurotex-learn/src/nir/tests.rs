@@ -101,6 +101,12 @@ fn field(nodes: &mut [Node], node: &str, f: &str) -> Vec<f64> {
     n.2.iter().find(|x| x.0 == f).unwrap().1.clone()
 }
 
+/// Multiplies every value of field `f` of `node` by `by`.
+fn scale(nodes: &mut [Node], node: &str, f: &str, by: f64) {
+    let v = field(nodes, node, f).iter().map(|x| x * by).collect();
+    set(nodes, node, f, v);
+}
+
 /// Sets field `f` of `node` to `v` (added, shaped as `v`, when the node has none).
 fn set(nodes: &mut [Node], node: &str, f: &str, v: Vec<f64>) {
     let n = nodes.iter_mut().find(|n| n.0 == node).unwrap();
@@ -135,28 +141,15 @@ fn a_graph_round_trips_and_one_written_in_other_units_reads_the_same() {
     let doubled = graph(
         |nodes, _| {
             set(nodes, "lif1", "v_threshold", vec![2.0; 4]);
-            let w = field(nodes, "fc1", "weight")
-                .iter()
-                .map(|w| 2.0 * w)
-                .collect();
-            set(nodes, "fc1", "weight", w);
-            let b = field(nodes, "fc1", "bias")
-                .iter()
-                .map(|w| 2.0 * w)
-                .collect();
-            set(nodes, "fc1", "bias", b);
-            let r = field(nodes, "li", "r").iter().map(|r| r / 2.0).collect();
-            set(nodes, "li", "r", r);
-            let w = field(nodes, "fc2", "weight")
-                .iter()
-                .map(|w| 2.0 * w)
-                .collect();
-            set(nodes, "fc2", "weight", w);
-            let b = field(nodes, "fc2", "bias")
-                .iter()
-                .map(|w| 2.0 * w)
-                .collect();
-            set(nodes, "fc2", "bias", b);
+            for (node, f, by) in [
+                ("fc1", "weight", 2.0),
+                ("fc1", "bias", 2.0),
+                ("li", "r", 0.5),
+                ("fc2", "weight", 2.0),
+                ("fc2", "bias", 2.0),
+            ] {
+                scale(nodes, node, f, by);
+            }
         },
         Some(0.01),
     );
@@ -299,8 +292,7 @@ fn norse_time_constants_read_with_the_step_given() {
                 ("li", "tau_syn"),
                 ("li", "tau_mem"),
             ] {
-                let v = field(nodes, node, f).iter().map(|t| t * dt).collect();
-                set(nodes, node, f, v);
+                scale(nodes, node, f, dt);
             }
         },
         None,
