@@ -408,6 +408,7 @@ fn spiking_file(recurrent: bool) -> serde_json::Value {
         target: Default::default(),
         alpha: Vec::new(),
         beta: Vec::new(),
+        travel_mm_s: None,
     };
     let layout = LayoutFile {
         rows: Some(2),

@@ -39,6 +39,7 @@ fn network(inputs: usize, hidden: usize, classes: usize) -> Network {
         target: Default::default(),
         alpha: Vec::new(),
         beta: Vec::new(),
+        travel_mm_s: None,
     }
 }
 

@@ -968,3 +968,48 @@ fn early_stopping_is_said_with_the_epoch_it_ended_at() {
     assert_eq!(run.stderr.matches(&said).count(), 1, "{}", run.stderr);
     assert!(!run.stderr.contains("early stopping:"), "{}", run.stderr);
 }
+
+/// `--snn-travel median`: a network trained on two speeds steps in travel at their median
+/// and the model file keeps it; one trained by default (`off`) steps in ms. A recording without a speed is
+/// refused by the first, named, with what to do, and predicted by the second; a model
+/// file whose reference speed is not the one its parameters fix is refused.
+#[test]
+fn a_network_in_travel_keeps_its_reference_speed_and_needs_speeds() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0, 30.0], 4);
+    let (travel, off) = (dir.join("travel.json"), dir.join("off.json"));
+    dir.train_tiny_snn(&ds, &travel, &["--snn-travel", "median"]);
+    dir.train_tiny_snn(&ds, &off, &[]);
+    let file = read_json(&travel);
+    assert_eq!(file["network"]["travel_mm_s"], 20.0, "{}", file["network"]);
+    assert_eq!(file["classifier"]["travel"], "median");
+    let in_ms = read_json(&off);
+    assert!(in_ms["network"].get("travel_mm_s").is_none());
+    assert!(in_ms["classifier"].get("travel").is_none());
+    let manifest = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    let no_speed: String = manifest
+        .lines()
+        .enumerate()
+        .map(|(i, l)| match (i, l.split_once(',')) {
+            (1.., Some((file, rest))) => {
+                let (label, rest) = rest.split_once(',').unwrap();
+                let (_, rest) = rest.split_once(',').unwrap();
+                format!("{file},{label},,{rest}\n")
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(ds.join("manifest.csv"), no_speed).unwrap();
+    let out = dir.join("never.csv");
+    let err = dir.fails(&predict(s(&travel), s(&out), &["--dataset", s(&ds)]));
+    assert!(
+        err.contains("counts time in travel") && err.contains("--snn-travel off"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let in_ms_out = dir.join("in_ms.csv");
+    dir.ok(&predict(s(&off), s(&in_ms_out), &["--dataset", s(&ds)]));
+    std::fs::write(ds.join("manifest.csv"), manifest).unwrap();
+    let at = vec![("/classifier/travel", serde_json::json!({"at": 15.0}))];
+    refused_when_tampered(&dir, &file, &ds, &at, "`network.travel_mm_s` differs");
+}

@@ -1,8 +1,8 @@
 //! Every method's samples evaluated over many recordings: cross-validation on a set of
 //! conditions, or training on some conditions and testing on others; per taxel for the
 //! single-taxel method. A feature method's samples are a [`FeatureTable`] (KNN, the forest,
-//! logistic regression), the `spikes` method's every recording's [`SpikeInput`] (the
-//! spiking network), `van-rossum`'s the [`DistanceMatrix`] between the recordings (KNN over
+//! logistic regression), the `spikes` method's every recording's binned spikes
+//! ([`SpikeSamples`], the spiking network's), `van-rossum`'s the [`DistanceMatrix`] between the recordings (KNN over
 //! it): [`MethodSamples`] holds any of them. [`evaluator`] pairs them with a classifier
 //! once, where the options are checked, and returns one [`EvaluateFn`] that `evaluate`,
 //! `compare` and nested selection call alike.
@@ -15,14 +15,14 @@ use serde::{Deserialize, Serialize};
 use crate::classify::{
     bootstrap_mean_share, bootstrap_over_encodings, cross_validate_on, train_test_on,
     BootstrapParams, Classifier, ClassifierChoice, ConfusionMatrix, DistanceMatrix, Evaluation,
-    Interval, Learner, Rows, Samples, SnnClassifier, SpikeDistanceKnn, Sweep, ValidCv,
+    Interval, Learner, Rows, Samples, SnnClassifier, SpikeDistanceKnn, SpikeSamples, Sweep,
+    ValidCv,
 };
 use crate::error::{ClassifyError, ParamError, Result};
 use crate::pipeline::{Encoded, Encoding, FeatureExtractor};
 use crate::progress::Progress;
 use crate::recording::{DatasetError, Meta, Selection};
 use crate::samples::{spike_inputs, MethodChoice};
-use crate::snn::SpikeInput;
 use crate::table::rows_at;
 pub use crate::table::FeatureTable;
 use crate::values::{Cell, Grid, Speed};
@@ -693,7 +693,7 @@ pub enum MethodSamples {
     /// Van Rossum distances between every two recordings.
     Distances(Arc<Vec<Meta>>, Arc<DistanceMatrix>),
     /// Every recording's spikes as the spiking network's input.
-    Spikes(Arc<Vec<Meta>>, Arc<[SpikeInput]>),
+    Spikes(Arc<Vec<Meta>>, Arc<SpikeSamples>),
 }
 
 impl MethodSamples {
@@ -706,7 +706,7 @@ impl MethodSamples {
     }
 
     /// What `method` makes of the recordings `view` under `encoding`: `extractor`'s feature
-    /// table with the columns `columns`, the spike inputs at `dt_ms` steps, or the van
+    /// table with the columns `columns`, the spike inputs at `step_ms` steps, or the van
     /// Rossum distances, computed by `distances` only when asked for.
     ///
     /// # Errors
@@ -715,7 +715,7 @@ impl MethodSamples {
         (view, encoding, extractor): (&[Encoded], Encoding, &FeatureExtractor),
         method: MethodChoice,
         columns: Columns,
-        dt_ms: u32,
+        step_ms: u32,
         distances: impl FnOnce() -> Result<Arc<DistanceMatrix>>,
     ) -> Result<Self> {
         let metas = || Arc::new(view.iter().map(|e| e.meta.clone()).collect::<Vec<_>>());
@@ -725,7 +725,7 @@ impl MethodSamples {
             }
             MethodChoice::VanRossum => MethodSamples::Distances(metas(), distances()?),
             MethodChoice::Spikes => {
-                MethodSamples::Spikes(metas(), Arc::from(spike_inputs(view, encoding, dt_ms)?))
+                MethodSamples::Spikes(metas(), Arc::new(spike_inputs(view, encoding, step_ms)?))
             }
         })
     }

@@ -262,8 +262,10 @@ pub fn spiking_episode_decisions(
     model.check_grid(encoded)?;
     let bin = model.pipeline_params().volume.bin_ms;
     let net = model.network();
+    // A stream knows no speed: a network counting time in travel steps every `dt_ms`, as
+    // for a slide at its reference speed, here as live.
     let dt = net.dt_ms as usize;
-    let input = spike_input(encoded, net.dt_ms);
+    let input = spike_input(encoded, f64::from(net.dt_ms));
     let mut run = Windowed::new(net, network_window(window_ms, bin, dt));
     let n = encoded.spikes.n_steps;
     let mut decider = Decider::new(rule);

@@ -1,17 +1,17 @@
 //! The methods and what the spike methods read: [`MethodChoice`] names a feature method,
 //! `van-rossum` or `spikes`, and checks its pairing with a classifier; the `spikes` method
-//! gives every recording's [`SpikeInput`] at the spiking network's step
-//! ([`spike_inputs`]), `van-rossum` the distances between the recordings
+//! gives every recording's [`SpikeInput`] at the spiking network's step, or at 1 ms for
+//! networks that rebin them to steps of travel ([`spike_inputs`]), `van-rossum` the distances between the recordings
 //! ([`PopulationMatrices`]). [`crate::analysis::MethodSamples`] gathers them with the
 //! feature tables.
 
 use std::sync::Arc;
 
-use crate::classify::{ClassifierChoice, DistanceMatrix, VanRossum, VanRossumParams};
+use crate::classify::{ClassifierChoice, DistanceMatrix, SpikeSamples, VanRossum, VanRossumParams};
 use crate::encode::SpikeTrains;
 use crate::error::{ParamError, Result};
 use crate::pipeline::{Encoded, Encoding, Method};
-use crate::snn::SpikeInput;
+use crate::snn::{SnnParams, SpikeInput, Travel};
 
 /// The spike-timing method's name.
 pub const VAN_ROSSUM: &str = "van-rossum";
@@ -90,13 +90,31 @@ impl std::str::FromStr for MethodChoice {
     }
 }
 
-/// Every recording's spikes under `encoding` binned to `dt_ms` steps, the spiking
-/// network's input.
+/// The step, ms, the spike inputs of the recordings `view` are binned to for the networks
+/// `snn`: their one `dt_ms` when no fit rebins them (every network counts time in ms, or
+/// at the median speed and every recording slides at the same speed), 1 ms otherwise, to
+/// be rebinned to each fit's steps of travel.
+pub fn input_step_ms(view: &[Encoded], snn: &[SnnParams]) -> u32 {
+    let dt = snn.first().map_or(SnnParams::default().dt_ms, |p| p.dt_ms);
+    let speed = |e: &Encoded| e.meta.speed_mm_s.map(f64::abs);
+    let one_speed = view
+        .iter()
+        .all(|e| speed(e) == view.first().and_then(speed));
+    let in_ms = |p: &SnnParams| p.travel.is_off() || (p.travel == Travel::Median && one_speed);
+    match snn.iter().all(|p| p.dt_ms == dt && in_ms(p)) {
+        true => dt,
+        false => 1,
+    }
+}
+
+/// Every recording's spikes under `encoding` binned to `step_ms` steps ([`input_step_ms`]),
+/// the spiking network's input, with their sliding speeds.
 ///
 /// # Errors
 /// `sa+fa` on recordings encoded with one population.
-pub fn spike_inputs(view: &[Encoded], encoding: Encoding, dt_ms: u32) -> Result<Vec<SpikeInput>> {
-    view.iter()
+pub fn spike_inputs(view: &[Encoded], encoding: Encoding, step_ms: u32) -> Result<SpikeSamples> {
+    let inputs = view
+        .iter()
         .map(|e| {
             let pops: Vec<&SpikeTrains> = match encoding {
                 Encoding::SaFa => e.populations().collect(),
@@ -106,9 +124,14 @@ pub fn spike_inputs(view: &[Encoded], encoding: Encoding, dt_ms: u32) -> Result<
                 let rule = "the sa+fa encoding needs both populations of every recording";
                 return Err(ParamError::new("encodings", rule, "one population").into());
             }
-            Ok(SpikeInput::from_trains(&pops, dt_ms))
+            Ok(SpikeInput::from_trains(&pops, step_ms))
         })
-        .collect()
+        .collect::<Result<Vec<_>>>()?;
+    Ok(SpikeSamples {
+        inputs,
+        speeds: view.iter().map(|e| e.meta.speed_mm_s).collect(),
+        step_ms,
+    })
 }
 
 /// The recordings as `encoding` sees them: for `fa` alone, the fast-adapting population

@@ -16,7 +16,7 @@ use crate::model::{Prediction, Provenance, Score};
 use crate::nir::{Convention, NirFrom};
 use crate::pipeline::{taxel_cells, Encoded, Pipeline, PipelineParams};
 use crate::recording::{Baseline, FileReading, LayoutFrom};
-use crate::snn::{softmax, train::TrainingLog, Network, SnnParams, SpikeInput};
+use crate::snn::{softmax, step_ms, train::TrainingLog, Network, SnnParams, SpikeInput, Travel};
 use crate::values::Grid;
 
 /// The `format` field of a spiking model file.
@@ -84,10 +84,25 @@ fn is_graph(path: &Path) -> bool {
 }
 
 /// A recording's spikes as the network's input: its populations in the pipeline's order
-/// (SA then FA for `sa+fa`), each taxel one input, binned to `dt_ms`.
-pub fn spike_input(encoded: &Encoded, dt_ms: u32) -> SpikeInput {
+/// (SA then FA for `sa+fa`), each taxel one input, binned to steps of `step_ms` (whole or
+/// fractional: a network counting time in travel, [`Network::step_ms`]).
+pub fn spike_input(encoded: &Encoded, step_ms: f64) -> SpikeInput {
     let populations: Vec<_> = encoded.populations().collect();
-    SpikeInput::from_trains(&populations, dt_ms)
+    match step_ms.fract() == 0.0 && step_ms >= 1.0 {
+        true => SpikeInput::from_trains(&populations, step_ms as u32),
+        false => SpikeInput::from_trains(&populations, 1).rebin(step_ms),
+    }
+}
+
+/// The input of a recording to `net`, in its steps for the recording's speed.
+///
+/// # Errors
+/// A network counting time in travel, and a recording without a sliding speed.
+pub fn network_input(net: &Network, encoded: &Encoded) -> Result<SpikeInput> {
+    let step = net
+        .step_ms(encoded.meta.speed_mm_s)
+        .map_err(|why| ClassifyError::BadFeatures(format!("{}: {why}", encoded.meta.file)))?;
+    Ok(spike_input(encoded, step))
 }
 
 /// The class a network's scores choose (the first of the highest) and every class's
@@ -100,7 +115,7 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
 
 /// Checks that a model file's network is the one its training parameters make: the same
 /// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
-/// JSON) and whether each neuron has decays of its own. A NIR graph's network is not
+/// JSON), whether each neuron has decays of its own and whether it counts time in travel. A NIR graph's network is not
 /// checked so: one run with `--like` comes from another tool, whatever the spiking model
 /// lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
@@ -113,6 +128,14 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
         ("target", net.target == snn.target),
         ("w_rec", net.recurrent() == snn.recurrent),
         ("alpha", net.own_decays() == snn.train_decays),
+        (
+            "travel_mm_s",
+            match snn.travel {
+                Travel::Off => net.travel_mm_s.is_none(),
+                Travel::Median => true,
+                Travel::At(v) => net.travel_mm_s == Some(v),
+            },
+        ),
         ("tau_syn_ms", close(net.tau_syn_ms, snn.tau_syn_ms)),
         ("tau_mem_ms", close(net.tau_mem_ms, snn.tau_mem_ms)),
         ("tau_out_ms", close(net.tau_out_ms, snn.tau_out_ms)),
@@ -164,12 +187,19 @@ impl SpikingModel {
             .iter()
             .map(|e| labels.iter().position(|l| *l == e.meta.label).unwrap_or(0))
             .collect();
+        let reference = snn
+            .travel
+            .reference(encoded.iter().map(|e| e.meta.speed_mm_s))?;
         let inputs: Vec<SpikeInput> = encoded
             .par_iter()
-            .map(|e| spike_input(e, snn.dt_ms))
-            .collect();
+            .map(|e| {
+                let step = step_ms(snn.dt_ms, reference, e.meta.speed_mm_s);
+                let why = |why| ClassifyError::BadFeatures(format!("{}: {why}", e.meta.file));
+                step.map(|s| spike_input(e, s)).map_err(why)
+            })
+            .collect::<std::result::Result<_, ClassifyError>>()?;
         let refs: Vec<&SpikeInput> = inputs.iter().collect();
-        let (network, log) = crate::snn::fit_with(&snn, &refs, &y, labels.len(), each_epoch)
+        let (mut network, log) = crate::snn::fit_with(&snn, &refs, &y, labels.len(), each_epoch)
             .map_err(|e| match e {
                 ClassifyError::ValidationTooSmall { class, count } => {
                     ClassifyError::ValidationTooSmall {
@@ -179,6 +209,7 @@ impl SpikingModel {
                 }
                 other => other,
             })?;
+        network.travel_mm_s = reference;
         let file = SpikingFile {
             format: FORMAT.into(),
             version: VERSION,
@@ -394,16 +425,16 @@ impl SpikingModel {
             crate::model::check_source(&self.file.training.dataset, e)?;
         }
         let net = &self.file.network;
-        Ok(encoded
+        encoded
             .par_iter()
             .map(|e| {
-                let (best, shares) = decide(&net.scores(&spike_input(e, net.dt_ms)));
-                Prediction {
+                let (best, shares) = decide(&net.scores(&network_input(net, e)?));
+                Ok(Prediction {
                     predicted: self.file.labels[best].clone(),
                     shares,
-                }
+                })
             })
-            .collect())
+            .collect()
     }
 
     /// Checks that a recording is on the model's grid.

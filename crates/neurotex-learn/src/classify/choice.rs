@@ -129,10 +129,17 @@ impl fmt::Display for ClassifierChoice {
             ClassifierChoice::Snn(p) => {
                 write!(
                     f,
-                    "spiking network ({} {}LIF neurons, {} ms steps, {} readout, seed {}",
+                    "spiking network ({} {}LIF neurons, {} ms steps{}, {} readout, seed {}",
                     p.hidden,
                     if p.recurrent { "recurrent " } else { "" },
                     p.dt_ms,
+                    match p.travel {
+                        crate::snn::Travel::Off => String::new(),
+                        crate::snn::Travel::Median => {
+                            " of travel at the training speeds' median".into()
+                        }
+                        crate::snn::Travel::At(v) => format!(" of travel at {v} mm/s"),
+                    },
                     p.readout.name(),
                     p.seed
                 )?;

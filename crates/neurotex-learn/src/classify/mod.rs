@@ -40,7 +40,7 @@ pub use spike_distance::{
     van_rossum, van_rossum_squared, DistanceMatrix, SpikeDistanceKnn, SpikeDistanceKnnModel,
     VanRossum, VanRossumParams,
 };
-pub use spiking::{SnnClassifier, SnnModel};
+pub use spiking::{SnnClassifier, SnnModel, SpikeSamples};
 pub use stats::StatsError;
 
 use crate::error::ClassifyError;

@@ -275,6 +275,7 @@ fn from_bytes_as(
         recurrent_of(&reader, &rec, &names[2], scale_s, &mut network)?;
     }
     network.reset = reset;
+    network.travel_mm_s = reader::meta_number(meta.as_ref(), "neurotex_travel_mm_s")?;
     network.check().map_err(|e| e.to_string())?;
     Ok(NirNetwork {
         network,

@@ -260,5 +260,6 @@ pub(super) fn network_of(
         target: Default::default(),
         alpha,
         beta,
+        travel_mm_s: None,
     })
 }

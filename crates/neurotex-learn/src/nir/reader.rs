@@ -75,7 +75,10 @@ pub(super) fn read_array(
 }
 
 /// A number in the graph's metadata, if it has the field.
-fn meta_number(meta: Option<&hdf5_pure::Group>, field: &str) -> Result<Option<f64>, String> {
+pub(super) fn meta_number(
+    meta: Option<&hdf5_pure::Group>,
+    field: &str,
+) -> Result<Option<f64>, String> {
     let Some(d) = meta.and_then(|m| m.dataset(field).ok()) else {
         return Ok(None);
     };

@@ -30,6 +30,7 @@ fn net() -> Network {
         target: Default::default(),
         alpha: Vec::new(),
         beta: Vec::new(),
+        travel_mm_s: None,
     }
 }
 
@@ -133,6 +134,14 @@ fn a_graph_round_trips_and_one_written_in_other_units_reads_the_same() {
     // back as the same network, its own step from `neurotex_dt`.
     let snntorch = from_bytes(to_bytes(&net(), "{}", Convention::Snntorch).unwrap()).unwrap();
     assert_eq!((snntorch.dt_s, snntorch.network.dt_ms), (0.01, 10));
+    assert_eq!(back.network.travel_mm_s, None);
+    // A network in steps of travel keeps its reference speed.
+    let travel = Network {
+        travel_mm_s: Some(12.5),
+        ..net()
+    };
+    let back = from_bytes(to_bytes(&travel, "{}", Convention::Physical).unwrap()).unwrap();
+    assert_eq!(back.network.travel_mm_s, Some(12.5));
     for (a, b) in scores(&net()).iter().zip(scores(&snntorch.network)) {
         assert!((a - b).abs() < 1e-9, "{a} vs {b}");
     }
@@ -334,6 +343,7 @@ fn decays_of_each_neurons_own_round_trip() {
     let own = Network {
         alpha: vec![0.3, 0.5, 0.6, 0.9],
         beta: vec![0.7, 0.75, 0.95, 0.5],
+        travel_mm_s: None,
         ..net()
     };
     own.check().unwrap();

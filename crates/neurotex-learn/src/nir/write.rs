@@ -280,6 +280,10 @@ pub fn to_bytes(net: &Network, model_json: &str, convention: Convention) -> Resu
     // The network's own step: a graph in steps or in snnTorch's time has another `dt`.
     put_f64(&mut meta, "neurotex_dt", f64::from(net.dt_ms) / 1000.0);
     put_str(&mut meta, "neurotex_for", convention.name());
+    if let Some(v) = net.travel_mm_s {
+        // Steps of travel: at speed v the step lasts `dt x neurotex_travel_mm_s / v`.
+        put_f64(&mut meta, "neurotex_travel_mm_s", v);
+    }
     put_str(&mut meta, "readout", net.readout.name());
     if !net.reset.is_zero() {
         // NIR 1.0's neurons reset to `v_reset`: the subtracting neuron is neurotex's word

@@ -665,6 +665,7 @@ mod tests {
             target: Default::default(),
             alpha: Vec::new(),
             beta: Vec::new(),
+            travel_mm_s: None,
         };
         let mut events = Vec::new();
         for t in 0..steps as u32 {

@@ -41,6 +41,7 @@ pub mod xylo;
 mod input;
 mod params;
 mod run;
+mod travel;
 
 use serde::{Deserialize, Serialize};
 
@@ -50,6 +51,7 @@ pub use input::SpikeInput;
 pub use params::{SnnParams, MAX_HIDDEN};
 pub use run::{Runner, State, Windowed};
 pub use train::{fit, fit_with};
+pub use travel::{step_ms, Travel};
 pub use xylo::Target;
 
 /// How a class's score is read from its readout trace.
@@ -177,6 +179,11 @@ pub struct Network {
     /// every neuron's is `β` of `tau_mem_ms`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub beta: Vec<f64>,
+    /// The speed, mm/s, at which the network's steps last `dt_ms`, when it counts time in
+    /// travel ([`Travel`]): a recording slid at `v` mm/s is binned in steps of
+    /// `dt_ms x travel_mm_s / |v|` ms. Absent: steps of `dt_ms` whatever the speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub travel_mm_s: Option<f64>,
 }
 
 /// The smallest and largest decay per step trained decays are kept within: time constants
@@ -192,6 +199,15 @@ impl Network {
             (-dt / self.tau_mem_ms).exp(),
             (-dt / self.tau_out_ms).exp(),
         )
+    }
+
+    /// How long, in ms, this network's step lasts for a recording slid at `speed_mm_s`
+    /// ([`step_ms`]).
+    ///
+    /// # Errors
+    /// A network counting time in travel, and no nonzero speed.
+    pub fn step_ms(&self, speed_mm_s: Option<f64>) -> Result<f64, String> {
+        step_ms(self.dt_ms, self.travel_mm_s, speed_mm_s)
     }
 
     /// Whether the hidden layer has recurrent connections.
@@ -286,6 +302,12 @@ impl Network {
         }
         self.check_taus()?;
         self.check_own_decays()?;
+        if let Some(v) = self.travel_mm_s.filter(|v| !(*v > 0.0 && v.is_finite())) {
+            let why = format!(
+                "the network's reference speed travel_mm_s is {v}; it must be positive and finite"
+            );
+            return Err(ModelError::network("travel_mm_s", why));
+        }
         if self.target == Target::Xylo {
             xylo::check(self)?;
         }

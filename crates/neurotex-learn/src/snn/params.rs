@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{xylo, Readout, Reset, Target};
+use super::{xylo, Readout, Reset, Target, Travel};
 use crate::error::ParamError;
 
 /// The spiking classifier's parameters (defaults chosen a priori but standardised inputs,
@@ -70,6 +70,11 @@ pub struct SnnParams {
     /// constants, Perez-Nieves et al. 2021). Left out of model files when false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub train_decays: bool,
+    /// How the network counts time: in ms (off), or in travel at the training recordings'
+    /// median speed or a given one (each step the distance `dt_ms` covers at that speed;
+    /// [`Travel`]). Left out of model files when off.
+    #[serde(default = "Travel::off", skip_serializing_if = "Travel::is_off")]
+    pub travel: Travel,
 }
 
 impl Default for SnnParams {
@@ -95,6 +100,7 @@ impl Default for SnnParams {
             window_ms: None,
             standardize: true,
             train_decays: false,
+            travel: Travel::Off,
         }
     }
 }
@@ -152,6 +158,7 @@ impl SnnParams {
                 return Err(ParamError::new("snn-window-ms", rule, got));
             }
         }
+        self.travel.check()?;
         match self.target {
             Target::Float => Ok(self),
             Target::Xylo => self.on_xylo(),
@@ -221,5 +228,12 @@ mod tests {
         assert_eq!(old.hidden, 64);
         let text = serde_json::to_string(&SnnParams::default()).unwrap();
         assert!(text.contains(r#""standardize":true"#), "{text}");
+        assert!(!text.contains("travel") && old.travel.is_off(), "{text}");
+        let median = SnnParams {
+            travel: super::Travel::Median,
+            ..SnnParams::default()
+        };
+        let text = serde_json::to_string(&median).unwrap();
+        assert!(text.contains(r#""travel":"median""#), "{text}");
     }
 }

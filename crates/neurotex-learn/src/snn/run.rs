@@ -258,6 +258,7 @@ mod tests {
             target: Target::Float,
             alpha: Vec::new(),
             beta: Vec::new(),
+            travel_mm_s: None,
         }
     }
 

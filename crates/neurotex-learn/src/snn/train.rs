@@ -216,6 +216,7 @@ fn initial(
         },
         alpha: Vec::new(),
         beta: Vec::new(),
+        travel_mm_s: None,
     }
     .with_own_decays(params, rng))
 }
@@ -492,6 +493,7 @@ mod tests {
             target: Default::default(),
             alpha: Vec::new(),
             beta: Vec::new(),
+            travel_mm_s: None,
         };
         let moved = z.trained(&net);
         let back = z.network(&moved);

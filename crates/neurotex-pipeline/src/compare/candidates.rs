@@ -200,15 +200,16 @@ fn method_samples(
         MethodChoice::Features(Method::Taxel) => Columns::EachTaxel,
         _ => Columns::All,
     };
-    let dt_ms = pairs
+    let snn: Vec<SnnParams> = pairs
         .iter()
-        .find_map(|p| match p {
-            (MethodChoice::Spikes, ClassifierChoice::Snn(s)) => Some(s.dt_ms),
+        .filter_map(|p| match p {
+            (MethodChoice::Spikes, ClassifierChoice::Snn(s)) => Some(*s),
             _ => None,
         })
-        .unwrap_or(SnnParams::default().dt_ms);
+        .collect();
+    let step_ms = crate::samples::input_step_ms(view, &snn);
     let made = (view, encoding, extractor);
-    MethodSamples::of(made, method, columns, dt_ms, || {
+    MethodSamples::of(made, method, columns, step_ms, || {
         van_rossum.matrix(view, encoding)
     })
 }

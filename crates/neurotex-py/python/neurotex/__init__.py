@@ -1102,6 +1102,7 @@ class SpikingModel(Model):
         tau_out_ms: float = _SNN_DEFAULTS["tau_out_ms"],
         window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
         train_decays: bool = _SNN_DEFAULTS["train_decays"],
+        travel: Union[str, float] = _SNN_DEFAULTS["travel"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -1121,13 +1122,16 @@ class SpikingModel(Model):
         ``window_ms`` trains on windows of that many ms drawn anew at each epoch from
         anywhere in each recording (``--snn-window-ms``; ``None``: whole recordings);
         ``train_decays=True`` trains each hidden neuron's synaptic and membrane decays
-        beside the weights (``--snn-train-decays``).
+        beside the weights (``--snn-train-decays``); ``travel`` is how the network counts
+        time (``--snn-travel``): ``"median"`` in steps of travel at the training recordings'
+        median speed (``speeds``; in ms without them), a speed in mm/s for that reference,
+        or ``"off"`` (the default) for ms.
         ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
         :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
                "seed": seed, "recurrent": recurrent, "target": target,
                "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms,
-               "window_ms": window_ms, "train_decays": train_decays}
+               "window_ms": window_ms, "train_decays": train_decays, "travel": str(travel)}
         if reset is not None:
             snn["reset"] = reset
         folder = _folder(recordings)

@@ -291,8 +291,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     ``hidden`` LIF neurons with time steps of ``dt_ms`` for at most ``epochs`` passes, early
     stopping on 20 % of each class of ``X``, seeded by ``seed``; ``recurrent`` and
     ``reset`` (``"zero"`` or ``"subtract"``), ``target`` (``"float"`` or ``"xylo"``) and
-    ``window_ms`` (train on windows of that many ms) and ``train_decays`` (each hidden
-    neuron's decays trained) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
+    ``window_ms`` (train on windows of that many ms), ``train_decays`` (each hidden
+    neuron's decays trained) and ``travel`` (time in steps of travel) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
     it to NIR)."""
 
@@ -308,6 +308,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         target: str = _SNN_DEFAULTS["target"],
         window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
         train_decays: bool = _SNN_DEFAULTS["train_decays"],
+        travel: Union[str, float] = _SNN_DEFAULTS["travel"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
@@ -324,6 +325,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.target = target
         self.window_ms = window_ms
         self.train_decays = train_decays
+        self.travel = travel
         self.encoding = encoding
         self.gain = gain
         self.baseline = baseline
@@ -345,7 +347,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
             X, [str(label) for label in y], fs=self.fs, hidden=self.hidden,
             dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
             recurrent=self.recurrent, reset=self.reset, target=self.target,
-            window_ms=self.window_ms, train_decays=self.train_decays, causal=self.causal,
+            window_ms=self.window_ms, train_decays=self.train_decays, travel=self.travel,
+            causal=self.causal,
             encoding=self.encoding, gain=self.gain,
             baseline=self.baseline,
         )

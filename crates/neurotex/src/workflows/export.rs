@@ -18,7 +18,7 @@ use crate::recording::{
 };
 use crate::snn::xylo::XyloNetwork;
 use crate::snn::Target;
-use crate::spiking_model::{spike_input, SpikingModel};
+use crate::spiking_model::{network_input, SpikingModel};
 use crate::Result;
 
 /// Options of `neurotex export nir`.
@@ -215,14 +215,14 @@ pub fn export_inputs(
     let encoded = model
         .pipeline()
         .encode_dataset(dataset, &all, &|| on(Progress::Tick))?;
-    let dt = model.network().dt_ms;
+    let net = model.network();
     crate::io::replace_dir(out, |dir| {
         let names: Vec<String> = (0..encoded.len()).map(|i| format!("{i:05}.npy")).collect();
         encoded
             .par_iter()
             .zip(&names)
             .map(|(e, name)| {
-                let input = spike_input(e, dt);
+                let input = network_input(net, e)?;
                 let path = dir.join(name);
                 let array = Array2::from_shape_vec((input.steps(), input.inputs), input.dense())
                     .expect("one count per step and input");

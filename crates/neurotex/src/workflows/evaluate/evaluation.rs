@@ -16,7 +16,7 @@ use crate::classify::{ClassifierChoice, Interval, Metrics};
 use crate::diagnostics::{taxel_diagnostics, TaxelDiagnostics};
 use crate::pipeline::{Encoded, Pipeline};
 use crate::recording::{Meta, Selection};
-use crate::samples::{MethodChoice, PopulationMatrices};
+use crate::samples::{input_step_ms, MethodChoice, PopulationMatrices};
 use crate::snn::SnnParams;
 use crate::values::{Grid, Speed};
 use crate::Result;
@@ -81,16 +81,21 @@ impl Spikes<'_> {
         }
         let encoding = self.pipeline.params().encoding;
         let extractor = self.pipeline.extractor(self.grid)?;
-        let dt_ms = match classifier {
-            ClassifierChoice::Snn(p) => p.dt_ms,
-            _ => SnnParams::default().dt_ms,
-        };
         // The recordings were encoded with the pipeline's encoding: as that encoding sees
         // them already.
         let view = self.encoded;
-        MethodSamples::of((view, encoding, &extractor), method, columns, dt_ms, || {
-            PopulationMatrices::new(tau_ms)?.matrix(view, encoding)
-        })
+        let snn: Vec<SnnParams> = match classifier {
+            ClassifierChoice::Snn(p) => vec![*p],
+            _ => Vec::new(),
+        };
+        let step_ms = input_step_ms(view, &snn);
+        MethodSamples::of(
+            (view, encoding, &extractor),
+            method,
+            columns,
+            step_ms,
+            || PopulationMatrices::new(tau_ms)?.matrix(view, encoding),
+        )
     }
 }
 
