@@ -111,6 +111,13 @@ fn bench(c: &mut Criterion) {
     c.bench_function("snn/train_epoch/55x32x1200/decays", |b| {
         b.iter(|| fit(&decays, &refs, &y, 5).unwrap().1.epochs)
     });
+    // What a fit in steps of travel (`--snn-travel`) adds before it trains: the same
+    // recordings' 12 s in 1 ms steps (20-80 Hz an input), rebinned to steps of 15 ms (10 ms
+    // at a reference speed 1.5 times theirs).
+    let (fine, _) = recordings(55, 32, 12_000, 5);
+    c.bench_function("snn/rebin/55x32x12000", |b| {
+        b.iter(|| fine.iter().map(|x| x.rebin(15.0).steps()).sum::<usize>())
+    });
 }
 
 criterion_group! {

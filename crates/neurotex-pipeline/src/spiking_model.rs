@@ -102,7 +102,16 @@ pub fn network_input(net: &Network, encoded: &Encoded) -> Result<SpikeInput> {
     let step = net
         .step_ms(encoded.meta.speed_mm_s)
         .map_err(|why| ClassifyError::BadFeatures(format!("{}: {why}", encoded.meta.file)))?;
-    Ok(spike_input(encoded, step))
+    Ok(in_steps_of(encoded, f64::from(net.dt_ms), step))
+}
+
+/// A recording's input in steps of `step_ms`, each event weighed `dt_ms / step_ms` (1 in
+/// ms): a step of travel's input is then a rate at every speed.
+fn in_steps_of(encoded: &Encoded, dt_ms: f64, step_ms: f64) -> SpikeInput {
+    match dt_ms == step_ms {
+        true => spike_input(encoded, step_ms),
+        false => spike_input(encoded, step_ms).scaled(dt_ms / step_ms),
+    }
 }
 
 /// The class a network's scores choose (the first of the highest) and every class's
@@ -195,7 +204,8 @@ impl SpikingModel {
             .map(|e| {
                 let step = step_ms(snn.dt_ms, reference, e.meta.speed_mm_s);
                 let why = |why| ClassifyError::BadFeatures(format!("{}: {why}", e.meta.file));
-                step.map(|s| spike_input(e, s)).map_err(why)
+                step.map(|s| in_steps_of(e, f64::from(snn.dt_ms), s))
+                    .map_err(why)
             })
             .collect::<std::result::Result<_, ClassifyError>>()?;
         let refs: Vec<&SpikeInput> = inputs.iter().collect();

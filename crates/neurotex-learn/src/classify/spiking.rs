@@ -52,9 +52,10 @@ impl SpikeSamples {
                 let ms = step_ms(dt_ms, reference, self.speeds[i])
                     .map_err(ClassifyError::BadFeatures)?;
                 let per = ms / f64::from(self.step_ms);
-                Ok(match per == 1.0 {
-                    true => Cow::Borrowed(input),
-                    false => Cow::Owned(input.rebin(per)),
+                Ok(match (per == 1.0, reference.is_some()) {
+                    (true, false) => Cow::Borrowed(input),
+                    (_, true) => Cow::Owned(input.rebin(per).scaled(f64::from(dt_ms) / ms)),
+                    (false, false) => Cow::Owned(input.rebin(per)),
                 })
             })
             .collect()
@@ -194,7 +195,9 @@ mod tests {
     }
 
     /// A slide at twice the speed, its spikes at half the times, gives the network the
-    /// same steps when it counts time in travel, and other steps when it counts in ms.
+    /// same steps when it counts time in travel, each of its spikes weighing 2 (its steps
+    /// are half as long: the same count is twice the rate), and other steps when it counts
+    /// in ms.
     #[test]
     fn in_travel_a_faster_slide_of_the_same_pattern_gives_the_same_steps() {
         let slow = SpikeInput::from_events(1, 40, &[(0, 0), (15, 0), (30, 0)]);
@@ -206,7 +209,8 @@ mod tests {
         };
         let travel = samples.pick(&[0, 1], 10, Some(10.0)).unwrap();
         let by_hand = SpikeInput::from_events(1, 4, &[(0, 0), (1, 0), (3, 0)]);
-        assert_eq!((&*travel[0], &*travel[1]), (&by_hand, &by_hand));
+        let twice = by_hand.clone().scaled(2.0);
+        assert_eq!((&*travel[0], &*travel[1]), (&by_hand, &twice));
         let ms = samples.pick(&[0, 1], 10, None).unwrap();
         assert_ne!(ms[0], ms[1]);
         let no_speed = SpikeSamples {

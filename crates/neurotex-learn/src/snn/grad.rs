@@ -222,12 +222,7 @@ fn forward_with(
     let mut fired = Vec::with_capacity(h_n);
     for t in 0..steps {
         super::decay_currents(&mut current, &net.b_in, &alpha, own);
-        for &i in input.at(t) {
-            let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
-            for (c, w) in current.iter_mut().zip(w) {
-                *c += w;
-            }
-        }
+        super::add_inputs(&mut current, &net.w_in, input.at(t), input.scale());
         if net.recurrent() && t > 0 {
             let before = &tr.spikes[(t - 1) * h_n..t * h_n];
             for &j in super::nonzero(before, &mut fired) {
@@ -482,12 +477,7 @@ impl HiddenBack {
         for (b, g) in grad.b_in.iter_mut().zip(g_i.iter()) {
             *b += g;
         }
-        for &i in input.at(t) {
-            let gw = &mut grad.w_in[i as usize * h_n..(i as usize + 1) * h_n];
-            for (gw, g) in gw.iter_mut().zip(g_i.iter()) {
-                *gw += g;
-            }
-        }
+        super::add_inputs_gradient(&mut grad.w_in, g_i, input.at(t), input.scale());
         if net.recurrent() && t > 0 {
             let before = &tr.spikes[(t - 1) * h_n..t * h_n];
             add_outer(&mut grad.w_rec, before, g_i);
@@ -806,7 +796,7 @@ mod tests {
     /// The backward pass against central finite differences of the reference's loss, for
     /// both resets, feed-forward and recurrent, the reset detached (the reference's
     /// spikes in the reset held) and in the graph, every other case with each neuron's
-    /// own decays.
+    /// own decays and the others with each input event weighed 0.75.
     #[test]
     fn gradient_matches_finite_differences_for_each_reset() {
         let k = 4.0;
@@ -820,6 +810,11 @@ mod tests {
                     if seed % 2 == 0 {
                         net = with_own_decays(net, seed);
                     }
+                    // Every other case weighs each event 0.75, as steps of travel do.
+                    let input = match seed % 2 {
+                        1 => input.scaled(0.75),
+                        _ => input,
+                    };
                     net.reset = reset;
                     let (loss_at, spikes) = reference_loss(&net, &input, k, None);
                     let want = loss(&net, &input, act);
@@ -878,6 +873,10 @@ mod tests {
             let trained = forward(&net, &input, act, &mut tr);
             assert_eq!(trained, net.scores(&input));
             assert!(tr.spikes.contains(&1.0) && tr.spikes.contains(&0.0));
+            let scaled = input.clone().scaled(1.3);
+            let trained = forward(&net, &scaled, act, &mut Trajectory::default());
+            assert_eq!(trained, net.scores(&scaled));
+            assert_ne!(trained, net.scores(&input));
             let most = tr.spikes.iter().copied().fold(0.0, f64::max);
             assert_eq!(most >= 2.0, reset == Reset::Subtract, "{reset:?}: {most}");
         }

@@ -13,6 +13,9 @@ pub struct SpikeInput {
     /// `offsets[t]..offsets[t + 1]` indexes step `t`'s events in `events`.
     offsets: Vec<u32>,
     events: Vec<u32>,
+    /// What one event adds to a step's input (1: a spike; `dt / step` for steps of
+    /// travel, so that a step's input is a rate at every speed).
+    scale: f64,
 }
 
 impl SpikeInput {
@@ -58,6 +61,7 @@ impl SpikeInput {
             inputs,
             offsets,
             events: events.iter().map(|e| e.1).collect(),
+            scale: 1.0,
         }
     }
 
@@ -83,6 +87,7 @@ impl SpikeInput {
             inputs: self.inputs,
             offsets: offsets.iter().map(|&o| o - first).collect(),
             events: self.events[first as usize..last as usize].to_vec(),
+            scale: self.scale,
         }
     }
 
@@ -109,7 +114,18 @@ impl SpikeInput {
             inputs: self.inputs,
             offsets,
             events,
+            scale: self.scale,
         }
+    }
+
+    /// The same input with each event adding `scale` to its step's input.
+    pub fn scaled(self, scale: f64) -> SpikeInput {
+        SpikeInput { scale, ..self }
+    }
+
+    /// What one event adds to its step's input: 1 but for steps of travel.
+    pub fn scale(&self) -> f64 {
+        self.scale
     }
 
     /// Spikes in the window.
@@ -117,13 +133,13 @@ impl SpikeInput {
         self.events.len()
     }
 
-    /// The window as a dense `steps x inputs` table of spike counts, row-major (what a
-    /// network's input node receives, step by step).
+    /// The window as a dense `steps x inputs` table of spike counts (times the scale),
+    /// row-major (what a network's input node receives, step by step).
     pub fn dense(&self) -> Vec<f32> {
         let mut out = vec![0f32; self.steps() * self.inputs];
         for t in 0..self.steps() {
             for &i in self.at(t) {
-                out[t * self.inputs + i as usize] += 1.0;
+                out[t * self.inputs + i as usize] += self.scale as f32;
             }
         }
         out

@@ -210,6 +210,22 @@ impl Network {
         step_ms(self.dt_ms, self.travel_mm_s, speed_mm_s)
     }
 
+    /// The step's rules: 1 to 1000 ms, and a reference speed, when it counts in travel,
+    /// positive and finite.
+    fn check_steps(&self) -> Result<(), ModelError> {
+        if !(1..=1000).contains(&self.dt_ms) {
+            let why = format!(
+                "the network's dt_ms is {}; the time step must be 1 to 1000 ms",
+                self.dt_ms
+            );
+            return Err(ModelError::network("dt_ms", why));
+        }
+        match self.travel_mm_s.filter(|v| !(*v > 0.0 && v.is_finite())) {
+            Some(v) => Err(ModelError::network("travel_mm_s", format!("the network's reference speed travel_mm_s is {v}; it must be positive and finite"))),
+            None => Ok(()),
+        }
+    }
+
     /// Whether the hidden layer has recurrent connections.
     pub fn recurrent(&self) -> bool {
         !self.w_rec.is_empty()
@@ -291,23 +307,9 @@ impl Network {
             let why = format!("the network has an empty layer: its {layer} is 0");
             return Err(ModelError::network(layer, why));
         }
-        if !(1..=1000).contains(&self.dt_ms) {
-            return Err(ModelError::network(
-                "dt_ms",
-                format!(
-                    "the network's dt_ms is {}; the time step must be 1 to 1000 ms",
-                    self.dt_ms
-                ),
-            ));
-        }
+        self.check_steps()?;
         self.check_taus()?;
         self.check_own_decays()?;
-        if let Some(v) = self.travel_mm_s.filter(|v| !(*v > 0.0 && v.is_finite())) {
-            let why = format!(
-                "the network's reference speed travel_mm_s is {v}; it must be positive and finite"
-            );
-            return Err(ModelError::network("travel_mm_s", why));
-        }
         if self.target == Target::Xylo {
             xylo::check(self)?;
         }
@@ -403,6 +405,7 @@ impl Network {
     pub fn scores(&self, input: &SpikeInput) -> Vec<f64> {
         assert_eq!(input.inputs, self.inputs);
         let mut run = self.runner();
+        run.state.scale = input.scale();
         for t in 0..input.steps() {
             run.step(input.at(t));
         }
@@ -493,6 +496,33 @@ fn decay_currents_by<D: PerNeuron>(current: &mut [f64], b: &[f64], alpha: D) {
     let (b, alpha) = (&b[..n], alpha.first(n));
     for k in 0..n {
         current[k] = alpha.at(k) * current[k] + b[k];
+    }
+}
+
+/// Adds the input weights of the inputs `spiked` to the currents, each times `scale` (what
+/// one event adds; 1, a spike, but for steps of travel). The training pass and the runner
+/// both add them so, with the same bits; a scale of 1 adds the weights themselves.
+#[inline(always)]
+pub(crate) fn add_inputs(current: &mut [f64], w_in: &[f64], spiked: &[u32], scale: f64) {
+    let h_n = current.len();
+    let rows = spiked
+        .iter()
+        .map(|&i| &w_in[i as usize * h_n..(i as usize + 1) * h_n]);
+    // One test per step, not per event: the loops stay those of unweighed spikes.
+    match scale == 1.0 {
+        true => rows.for_each(|w| current.iter_mut().zip(w).for_each(|(c, w)| *c += w)),
+        false => rows.for_each(|w| current.iter_mut().zip(w).for_each(|(c, w)| *c += scale * w)),
+    }
+}
+
+/// The gradient of [`add_inputs`]: each input that spiked gains the currents' gradient
+/// `g_i`, times `scale` (`1 x g` is `g`, bit for bit).
+#[inline(always)]
+pub(crate) fn add_inputs_gradient(g_w: &mut [f64], g_i: &[f64], spiked: &[u32], scale: f64) {
+    let h_n = g_i.len();
+    for &i in spiked {
+        let gw = &mut g_w[i as usize * h_n..(i as usize + 1) * h_n];
+        gw.iter_mut().zip(g_i).for_each(|(gw, g)| *gw += scale * g);
     }
 }
 

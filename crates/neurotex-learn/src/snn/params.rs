@@ -174,6 +174,7 @@ impl SnnParams {
             ("snn-reset", self.reset != Reset::Subtract, "the Xylo profile's neurons subtract the threshold on a spike: --snn-reset subtract", self.reset.name().to_string()),
             ("snn-recurrent", self.recurrent, "the Xylo profile runs feed-forward networks", "--snn-recurrent".to_string()),
             ("snn-train-decays", self.train_decays, "the Xylo profile's neurons share the chip's bitshift decays", "--snn-train-decays".to_string()),
+            ("snn-travel", !self.travel.is_off(), "the Xylo profile's inputs are whole events per step, which steps of travel weigh by their length", format!("--snn-travel {}", self.travel.name())),
         ];
         if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
             return Err(ParamError::new(name, rule, got));

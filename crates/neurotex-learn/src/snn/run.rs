@@ -24,6 +24,8 @@ pub struct State {
     /// Scratch of a step: each hidden neuron's spike count, and the neurons that spiked.
     counts: Vec<f64>,
     active: Vec<u32>,
+    /// What one input event adds ([`SpikeInput::scale`](super::SpikeInput::scale)).
+    pub(super) scale: f64,
 }
 
 impl State {
@@ -50,6 +52,7 @@ impl State {
             chip,
             counts: vec![0.0; net.hidden],
             active: Vec::with_capacity(net.hidden),
+            scale: 1.0,
         }
     }
 
@@ -90,12 +93,7 @@ neurotex_core::widest_or_plain! {
         let (alpha, beta) = (&state.alpha[..h_n], &state.beta[..h_n]);
         let current = &mut state.current[..h_n];
         super::decay_currents(current, &net.b_in, alpha, own);
-        for &i in spiked {
-            let w = &net.w_in[i as usize * h_n..(i as usize + 1) * h_n];
-            for (c, w) in current.iter_mut().zip(w) {
-                *c += w;
-            }
-        }
+        super::add_inputs(current, &net.w_in, spiked, state.scale);
         for &(j, n) in &state.fired {
             let w = &net.w_rec[j as usize * h_n..(j as usize + 1) * h_n];
             for (c, w) in current.iter_mut().zip(w) {

@@ -344,7 +344,7 @@ impl Standardised {
                 let mut counts = vec![0.0; n];
                 (0..inputs[r].steps())
                     .flat_map(|t| inputs[r].at(t))
-                    .for_each(|&i| counts[i as usize] += 1.0);
+                    .for_each(|&i| counts[i as usize] += inputs[r].scale());
                 let steps = inputs[r].steps().max(1) as f64;
                 counts.iter().map(|c| c / steps).collect()
             })

@@ -7,16 +7,15 @@
 //! instead, a recording slid at `v` mm/s is binned in steps of `dt_ms x V / |v|` ms, where
 //! `V` is the network's reference speed: each step covers the travel `dt_ms` covers at
 //! `V`, and the time constants, given in ms, hold at `V` (they too are travel, scaled).
+//! Each event then weighs `dt / step` ([`crate::snn::SpikeInput::scale`]), so a step's
+//! input is a rate per `dt_ms` at every speed: time is warped, the rates' scale kept.
 //! The encoder's dynamics still run in ms, so the patterns are alike, not the same; the
 //! measurements are in `docs/spiking-classifier.md`.
 //!
 //! With [`Travel::Median`] the reference is the median speed of the training recordings,
 //! so a network trained at one speed steps in `dt_ms` exactly as one counting time in ms
 //! does, bit for bit; only training on several speeds, and testing on others, differ.
-//! It is not the default: it carries the simulated rig's textures to a held-out speed far
-//! better, and FabricSlide's worse (a slide at a tenth of the speed puts ten times the
-//! spikes in each step, which the inputs' standardisation, fixed over the training
-//! speeds, does not undo).
+//! It is not the default: measured, it moves held-out speeds within their intervals.
 
 use serde::{Deserialize, Serialize};
 

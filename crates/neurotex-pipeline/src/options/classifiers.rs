@@ -264,12 +264,11 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         "Count the network's time in travel: a recording slid at v mm/s is binned in steps \
          of --snn-dt-ms x V / v ms, so that each step covers the distance --snn-dt-ms covers \
          at V and a texture's pattern takes the same steps at every speed (the time \
-         constants hold at V). `median`: V is the training recordings' median speed (time \
-         in ms when a recording has no speed; trained at one speed, the network is the same \
-         as in ms); a number: that V, mm/s; `off`: steps of --snn-dt-ms whatever the speed. \
-         Measured: ahead on the simulated rig's held-out speeds, behind on FabricSlide's \
-         (docs/spiking-classifier.md). A stream knows no speed: it steps the network as for \
-         a slide at V.",
+         constants hold at V); each spike weighs v / V, so a step's input stays a rate. \
+         `median`: V is the training recordings' median speed (time in ms when a recording \
+         has no speed; trained at one speed, the network is the same as in ms); a number: \
+         that V, mm/s; `off`: steps of --snn-dt-ms whatever the speed. A stream knows no \
+         speed: it steps the network as for a slide at V.",
         get: |t: &crate::snn::Travel| Some(t.name()), set: choice),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \

@@ -16,7 +16,7 @@ use crate::pipeline::{Method, Pipeline};
 use crate::progress::Progress;
 use crate::recording::Dataset;
 use crate::samples::MethodChoice;
-use crate::snn::train::TrainingLog;
+use crate::snn::{train::TrainingLog, Travel};
 use crate::spiking_model::SpikingModel;
 use crate::workflows::evaluate::DEFAULT_METHOD;
 use crate::{Cell, Grid, Result, Speed};
@@ -138,8 +138,12 @@ impl TrainedSpiking {
     /// The network in one line: its parameters, training set, inputs, how training went.
     pub fn summary(&self) -> String {
         let (model, log) = (&self.model, &self.log);
+        let travel = match (model.params().travel, model.network().travel_mm_s) {
+            (Travel::Median, Some(v)) => format!(" (the training speeds' median: {v} mm/s)"),
+            _ => String::new(),
+        };
         format!(
-            "{} on {} recordings of {} classes ({} inputs: taxels x populations; best validation loss {:.3} at epoch {} of {}) on the {} grid",
+            "{}{travel} on {} recordings of {} classes ({} inputs: taxels x populations; best validation loss {:.3} at epoch {} of {}) on the {} grid",
             ClassifierChoice::Snn(model.params()),
             model.training().recordings,
             model.labels().len(),
