@@ -1,8 +1,8 @@
 //! The methods and what the spike methods read: [`MethodChoice`] names a feature method,
 //! `van-rossum` or `spikes`, and checks its pairing with a classifier; the `spikes` method
 //! gives every recording's [`SpikeInput`] at the spiking network's step, or at 1 ms for
-//! networks that rebin them to steps of travel ([`spike_inputs`]), `van-rossum` the distances between the recordings
-//! ([`PopulationMatrices`]). [`crate::analysis::MethodSamples`] gathers them with the
+//! networks that rebin them to steps of travel ([`spike_inputs`]), `van-rossum` the
+//! distances between the recordings ([`PopulationMatrices`]). [`crate::analysis::MethodSamples`] gathers them with the
 //! feature tables.
 
 use std::sync::Arc;

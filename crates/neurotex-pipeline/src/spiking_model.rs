@@ -124,9 +124,9 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
 
 /// Checks that a model file's network is the one its training parameters make: the same
 /// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
-/// JSON), whether each neuron has decays of its own and whether it counts time in travel. A NIR graph's network is not
-/// checked so: one run with `--like` comes from another tool, whatever the spiking model
-/// lending its pipeline was trained with.
+/// JSON), whether each neuron has decays of its own and whether it counts time in travel.
+/// A NIR graph's network is not checked so: one run with `--like` comes from another tool,
+/// whatever the spiking model lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
     let fields = [

@@ -191,3 +191,27 @@ def test_trained_decays_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
     est = SpikingClassifier(hidden=8, epochs=2, train_decays=True).fit(sim.recordings, sim.labels)
     est.model_.save(tmp_path / "est.json")
     assert len(json.loads((tmp_path / "est.json").read_text())["network"]["beta"]) == 8
+
+
+def test_time_in_travel_gives_the_network_of_the_cli(sim, sim_dir, tmp_path):
+    """`travel="median"` trains the network `--snn-travel median` trains, whose file keeps
+    the training speeds' median (5 and 10 mm/s: 7.5); a speed given as a number is that
+    speed, and a word that is neither is refused by the option's name."""
+    model = neurotex.SpikingModel.train(sim, hidden=8, epochs=2, travel="median")
+    model.save(tmp_path / "py.json")
+    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-hidden", "8",
+            "--snn-epochs", "2", "--snn-travel", "median", "--out", tmp_path / "cli.json")
+    py = json.loads((tmp_path / "py.json").read_text())
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    assert py["network"] == cli["network"]
+    assert cli["network"]["travel_mm_s"] == 7.5
+    at = neurotex.SpikingModel.train(sim, hidden=8, epochs=1, travel=20)
+    at.save(tmp_path / "at.json")
+    assert json.loads((tmp_path / "at.json").read_text())["network"]["travel_mm_s"] == 20.0
+    with pytest.raises(ValueError, match="travel"):
+        neurotex.SpikingModel.train(sim, hidden=8, epochs=1, travel="fast")
+    from neurotex.sklearn import SpikingClassifier
+
+    est = SpikingClassifier(hidden=8, epochs=1, travel="median").fit(sim.recordings, sim.labels)
+    est.model_.save(tmp_path / "est.json")
+    assert "travel_mm_s" in json.loads((tmp_path / "est.json").read_text())["network"]
