@@ -35,9 +35,9 @@ pub enum ExportCommand {
     /// window divided by `score_scale`.
     Xylo(ExportXyloOptions),
     /// The spike tensors a spiking model's input node receives: one `(steps, inputs)`
-    /// float32 NPY per recording of a dataset (spike counts per time step; inputs are the
-    /// SA then the FA taxels in row-major order) and `index.csv` (`file,label,array`), so
-    /// that the same network can be run or trained elsewhere on exactly neurotex's spikes.
+    /// float32 NPY per recording of a dataset (spike counts per step, each weighing v / V in
+    /// steps of travel; SA then FA taxels, row-major) and `index.csv` (`file,label,array`),
+    /// so that the same network can be run or trained elsewhere on exactly neurotex's spikes.
     Inputs(ExportInputsOptions),
     /// A dataset's recordings encoded into spikes, written as a new address-event dataset:
     /// one event file per recording (`t,x,y,p` CSV in ms, or tonic's structured `.npy` in

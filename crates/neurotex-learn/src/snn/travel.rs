@@ -121,20 +121,30 @@ impl std::str::FromStr for Travel {
     }
 }
 
+/// The shortest and longest step of travel, ms: the encoder's 1 ms resolution, and the
+/// longest `--snn-dt-ms`.
+pub const STEP_RANGE_MS: (f64, f64) = (1.0, 1000.0);
+
 /// How long, in ms, a network step of `dt_ms` lasts for a recording slid at `speed_mm_s`,
 /// the network counting time in travel at `reference` mm/s (`None`: in ms, `dt_ms`).
 ///
 /// # Errors
-/// A reference without the recording's nonzero speed.
+/// A reference without the recording's nonzero speed, or a step outside [`STEP_RANGE_MS`]
+/// (a reference speed far from the recording's: given in m/s, say).
 pub fn step_ms(dt_ms: u32, reference: Option<f64>, speed_mm_s: Option<f64>) -> Result<f64, String> {
     let dt = f64::from(dt_ms);
     let Some(reference) = reference else {
         return Ok(dt);
     };
+    let (short, long) = STEP_RANGE_MS;
     match speed_mm_s.map(f64::abs).filter(|v| *v > 0.0 && v.is_finite()) {
-        Some(v) => Ok(dt * (reference / v)),
+        Some(v) if (short..=long).contains(&(dt * (reference / v))) => Ok(dt * (reference / v)),
+        Some(v) => Err(format!(
+            "in steps of travel at {reference} mm/s, a slide at {v} mm/s takes steps of {} ms, outside {short} to {long} ms (the encoder's 1 ms to the longest step): give a reference speed nearer the recordings' speeds, in mm/s, or another --snn-dt-ms",
+            dt * (reference / v)
+        )),
         None => Err(format!(
-            "the network counts time in travel (each step the distance {dt_ms} ms cover at {reference} mm/s), and a recording without a nonzero sliding speed (manifest column speed_mm_s) gives it no steps: give every recording its speed, or train the network with --snn-travel off"
+            "the network counts time in travel (each step the distance {dt_ms} ms cover at {reference} mm/s), and a recording without a nonzero sliding speed (manifest column speed_mm_s; raw files have none: import them into a dataset with their speeds) gives it no steps: give every recording its speed, or train the network with --snn-travel off"
         )),
     }
 }
@@ -171,6 +181,11 @@ mod tests {
         assert_eq!(step_ms(10, Some(0.1), Some(0.1)).unwrap(), 10.0);
         assert_eq!(step_ms(10, None, None).unwrap(), 10.0);
         assert!(step_ms(10, Some(10.0), Some(0.0)).is_err());
+        // A reference given in m/s (0.016 for 16 mm/s) asks for steps of a hundredth of a ms.
+        let err = step_ms(10, Some(0.016), Some(16.0)).unwrap_err();
+        assert!(err.contains("0.01 ms, outside 1 to 1000 ms"), "{err}");
+        assert!(step_ms(10, Some(1e9), Some(16.0)).is_err());
+        assert_eq!(step_ms(1, Some(10.0), Some(10.0)).unwrap(), 1.0);
         for text in ["off", "median", "42.5"] {
             assert_eq!(text.parse::<Travel>().unwrap().name(), text);
         }

@@ -262,9 +262,9 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         get: shown, set: flag),
     knob!(Snn "snn", travel, "--snn-travel", Text,
         "Count the network's time in travel: a recording slid at v mm/s is binned in steps \
-         of --snn-dt-ms x V / v ms, so that each step covers the distance --snn-dt-ms covers \
+         of --snn-dt-ms x V / |v| ms (1 to 1000 ms), so that each step covers the distance --snn-dt-ms covers \
          at V and a texture's pattern takes the same steps at every speed (the time \
-         constants hold at V); each spike weighs v / V, so a step's input stays a rate. \
+         constants hold at V); each spike weighs |v| / V, so a step's input stays a rate. \
          `median`: V is the training recordings' median speed (time in ms when a recording \
          has no speed; trained at one speed, the network is the same as in ms); a number: \
          that V, mm/s; `off`: steps of --snn-dt-ms whatever the speed. A stream knows no \
