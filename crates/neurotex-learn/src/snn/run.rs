@@ -112,17 +112,11 @@ neurotex_core::widest_or_plain! {
             true => fire(membrane, counts, current, beta, subtract),
             false => fire(membrane, counts, current, beta[0], subtract),
         }
-        let recurrent = net.recurrent();
-        for &h in super::nonzero(counts, &mut state.active) {
-            let n = counts[h as usize];
-            if recurrent {
-                state.fired.push((h, n));
-            }
-            let w = &net.w_out[h as usize * net.classes..][..net.classes];
-            for (o, w) in state.out.iter_mut().zip(w) {
-                *o += n * w;
-            }
+        let active = super::nonzero(counts, &mut state.active);
+        if net.recurrent() {
+            state.fired.extend(active.iter().map(|&h| (h, counts[h as usize])));
         }
+        super::add_readout(&mut state.out, &net.w_out, counts, active);
     }
 }
 
