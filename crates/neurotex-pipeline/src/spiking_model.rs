@@ -16,7 +16,9 @@ use crate::model::{Prediction, Provenance, Score};
 use crate::nir::{Convention, NirFrom};
 use crate::pipeline::{taxel_cells, Encoded, Pipeline, PipelineParams};
 use crate::recording::{Baseline, FileReading, LayoutFrom};
-use crate::snn::{softmax, step_ms, train::TrainingLog, Network, SnnParams, SpikeInput, Travel};
+use crate::snn::{
+    event_weight, softmax, step_ms, train::TrainingLog, Network, SnnParams, SpikeInput, Travel,
+};
 use crate::values::Grid;
 
 /// The `format` field of a spiking model file.
@@ -102,16 +104,13 @@ pub fn network_input(net: &Network, encoded: &Encoded) -> Result<SpikeInput> {
     let step = net
         .step_ms(encoded.meta.speed_mm_s)
         .map_err(|why| ClassifyError::BadFeatures(format!("{}: {why}", encoded.meta.file)))?;
-    Ok(in_steps_of(encoded, f64::from(net.dt_ms), step))
+    Ok(in_steps_of(encoded, net.dt_ms, step))
 }
 
-/// A recording's input in steps of `step_ms`, each event weighed `dt_ms / step_ms` (1 in
-/// ms): a step of travel's input is then a rate at every speed.
-fn in_steps_of(encoded: &Encoded, dt_ms: f64, step_ms: f64) -> SpikeInput {
-    match dt_ms == step_ms {
-        true => spike_input(encoded, step_ms),
-        false => spike_input(encoded, step_ms).scaled(dt_ms / step_ms),
-    }
+/// A recording's input in steps of `step_ms` for a network of step `dt_ms`, each event
+/// weighed as [`event_weight`] says.
+fn in_steps_of(encoded: &Encoded, dt_ms: u32, step_ms: f64) -> SpikeInput {
+    spike_input(encoded, step_ms).scaled(event_weight(dt_ms, step_ms))
 }
 
 /// The class a network's scores choose (the first of the highest) and every class's
@@ -204,8 +203,7 @@ impl SpikingModel {
             .map(|e| {
                 let step = step_ms(snn.dt_ms, reference, e.meta.speed_mm_s);
                 let why = |why| ClassifyError::BadFeatures(format!("{}: {why}", e.meta.file));
-                step.map(|s| in_steps_of(e, f64::from(snn.dt_ms), s))
-                    .map_err(why)
+                step.map(|s| in_steps_of(e, snn.dt_ms, s)).map_err(why)
             })
             .collect::<std::result::Result<_, ClassifyError>>()?;
         let refs: Vec<&SpikeInput> = inputs.iter().collect();

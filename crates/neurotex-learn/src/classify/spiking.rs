@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use super::samples::{Decide, Learner, Samples};
 use crate::error::ClassifyError;
-use crate::snn::{fit_with, softmax, step_ms, Network, SnnParams, SpikeInput};
+use crate::snn::{event_weight, fit_with, softmax, step_ms, Network, SnnParams, SpikeInput};
 
 /// Every recording's spikes binned to `step_ms`, with its sliding speed.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,11 +51,10 @@ impl SpikeSamples {
                 })?;
                 let ms = step_ms(dt_ms, reference, self.speeds[i])
                     .map_err(ClassifyError::BadFeatures)?;
-                let per = ms / f64::from(self.step_ms);
-                Ok(match (per == 1.0, reference.is_some()) {
-                    (true, false) => Cow::Borrowed(input),
-                    (_, true) => Cow::Owned(input.rebin(per).scaled(f64::from(dt_ms) / ms)),
-                    (false, false) => Cow::Owned(input.rebin(per)),
+                let (per, weight) = (ms / f64::from(self.step_ms), event_weight(dt_ms, ms));
+                Ok(match per == 1.0 && weight == input.scale() {
+                    true => Cow::Borrowed(input),
+                    false => Cow::Owned(input.rebin(per).scaled(weight)),
                 })
             })
             .collect()

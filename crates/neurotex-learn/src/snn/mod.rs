@@ -51,7 +51,7 @@ pub use input::SpikeInput;
 pub use params::{SnnParams, MAX_HIDDEN};
 pub use run::{Runner, State, Windowed};
 pub use train::{fit, fit_with};
-pub use travel::{step_ms, Travel};
+pub use travel::{event_weight, step_ms, Travel};
 pub use xylo::Target;
 
 /// How a class's score is read from its readout trace.

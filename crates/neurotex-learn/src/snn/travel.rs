@@ -125,6 +125,14 @@ impl std::str::FromStr for Travel {
 /// longest `--snn-dt-ms`.
 pub const STEP_RANGE_MS: (f64, f64) = (1.0, 1000.0);
 
+/// What one input event weighs in a network step of `dt_ms` that lasts `step_ms`:
+/// `dt_ms / step_ms`, so that a step of travel's input stays a rate per `dt_ms` at every
+/// speed (1 in steps of `dt_ms`). Every path that bins a recording for a network weighs its
+/// events so.
+pub fn event_weight(dt_ms: u32, step_ms: f64) -> f64 {
+    f64::from(dt_ms) / step_ms
+}
+
 /// How long, in ms, a network step of `dt_ms` lasts for a recording slid at `speed_mm_s`,
 /// the network counting time in travel at `reference` mm/s (`None`: in ms, `dt_ms`).
 ///
