@@ -130,16 +130,23 @@ def test_the_sklearn_estimator_fits_predicts_clones_and_pickles(sim):
     assert scores.shape == (2,) and np.all((0 <= scores) & (scores <= 1))
 
 
+def python_and_cli(sim, sim_dir, tmp_path, flags, **options):
+    """The model files, read, of the network `SpikingModel.train(sim, **options)` trains and
+    of the one `neurotex train --classifier snn FLAGS` trains, whose networks are equal."""
+    neurotex.SpikingModel.train(sim, **options).save(tmp_path / "py.json")
+    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", *flags,
+            "--out", tmp_path / "cli.json")
+    py, cli = (json.loads((tmp_path / f"{n}.json").read_text()) for n in ("py", "cli"))
+    assert py["network"] == cli["network"]
+    return py, cli
+
+
 def test_python_trains_the_xylo_network_the_cli_trains(sim, sim_dir, tmp_path):
     """`target="xylo"` is `--snn-target xylo`: the same network file (subtractive reset
     implied, the chip's time constants); a reset to zero is refused by name."""
     opts = {"hidden": 12, "epochs": 2}
-    neurotex.SpikingModel.train(sim, target="xylo", **opts).save(tmp_path / "py.json")
-    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-target", "xylo",
-            "--snn-hidden", "12", "--snn-epochs", "2", "--out", tmp_path / "cli.json")
-    py = json.loads((tmp_path / "py.json").read_text())
-    cli = json.loads((tmp_path / "cli.json").read_text())
-    assert py["network"] == cli["network"]
+    flags = ["--snn-target", "xylo", "--snn-hidden", "12", "--snn-epochs", "2"]
+    py, _ = python_and_cli(sim, sim_dir, tmp_path, flags, target="xylo", **opts)
     assert py["network"]["target"] == "xylo" and py["network"]["reset"] == "subtract"
     with pytest.raises(neurotex.errors.ParameterError, match="snn.reset"):
         neurotex.SpikingModel.train(sim, target="xylo", reset="zero", **opts)
@@ -147,13 +154,8 @@ def test_python_trains_the_xylo_network_the_cli_trains(sim, sim_dir, tmp_path):
 
 def test_training_on_windows_gives_the_network_of_the_cli(sim, sim_dir, tmp_path):
     """`window_ms` trains the network `--snn-window-ms` trains, and records it in the file."""
-    model = neurotex.SpikingModel.train(sim, hidden=8, epochs=2, window_ms=500)
-    model.save(tmp_path / "py.json")
-    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-hidden", "8",
-            "--snn-epochs", "2", "--snn-window-ms", "500", "--out", tmp_path / "cli.json")
-    py = json.loads((tmp_path / "py.json").read_text())
-    cli = json.loads((tmp_path / "cli.json").read_text())
-    assert py["network"] == cli["network"]
+    flags = ["--snn-hidden", "8", "--snn-epochs", "2", "--snn-window-ms", "500"]
+    py, cli = python_and_cli(sim, sim_dir, tmp_path, flags, hidden=8, epochs=2, window_ms=500)
     assert "window_ms" in json.dumps(cli) and "500" in json.dumps(cli)
     whole = neurotex.SpikingModel.train(sim, hidden=8, epochs=2)
     whole.save(tmp_path / "whole.json")
@@ -173,13 +175,8 @@ def test_training_on_windows_gives_the_network_of_the_cli(sim, sim_dir, tmp_path
 def test_trained_decays_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
     """`train_decays` trains the network `--snn-train-decays` trains: one synaptic and one
     membrane decay per hidden neuron in the file, which the NIR graph carries."""
-    model = neurotex.SpikingModel.train(sim, hidden=8, epochs=2, train_decays=True)
-    model.save(tmp_path / "py.json")
-    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-hidden", "8",
-            "--snn-epochs", "2", "--snn-train-decays", "--out", tmp_path / "cli.json")
-    py = json.loads((tmp_path / "py.json").read_text())
-    cli = json.loads((tmp_path / "cli.json").read_text())
-    assert py["network"] == cli["network"]
+    flags = ["--snn-hidden", "8", "--snn-epochs", "2", "--snn-train-decays"]
+    _, cli = python_and_cli(sim, sim_dir, tmp_path, flags, hidden=8, epochs=2, train_decays=True)
     alpha, beta = cli["network"]["alpha"], cli["network"]["beta"]
     assert len(alpha) == len(beta) == 8 and len(set(beta)) > 1
     assert all(0 < b < 1 for b in beta)
@@ -197,13 +194,8 @@ def test_time_in_travel_gives_the_network_of_the_cli(sim, sim_dir, tmp_path):
     """`travel="median"` trains the network `--snn-travel median` trains, whose file keeps
     the training speeds' median (5 and 10 mm/s: 7.5); a speed given as a number is that
     speed, and a word that is neither is refused by the option's name."""
-    model = neurotex.SpikingModel.train(sim, hidden=8, epochs=2, travel="median")
-    model.save(tmp_path / "py.json")
-    run_cli("train", "--dataset", sim_dir, "--classifier", "snn", "--snn-hidden", "8",
-            "--snn-epochs", "2", "--snn-travel", "median", "--out", tmp_path / "cli.json")
-    py = json.loads((tmp_path / "py.json").read_text())
-    cli = json.loads((tmp_path / "cli.json").read_text())
-    assert py["network"] == cli["network"]
+    flags = ["--snn-hidden", "8", "--snn-epochs", "2", "--snn-travel", "median"]
+    _, cli = python_and_cli(sim, sim_dir, tmp_path, flags, hidden=8, epochs=2, travel="median")
     assert cli["network"]["travel_mm_s"] == 7.5
     at = neurotex.SpikingModel.train(sim, hidden=8, epochs=1, travel=20)
     at.save(tmp_path / "at.json")
