@@ -363,7 +363,10 @@ fn the_spiking_network_runs_in_compare_and_evaluate_on_the_same_folds() {
     assert_eq!(snn["classifier"], "snn");
     // The network's settings are recorded with the ranking, as the folds are.
     let design = v["design"].as_str().unwrap();
-    assert!(design.contains("; snn: spiking network (128 LIF"), "{design}");
+    assert!(
+        design.contains("; snn: spiking network (128 LIF"),
+        "{design}"
+    );
     let accuracy = snn["accuracy"].as_f64().unwrap();
     // Three simulated textures at one speed, 10 trials each: well above the 1/3 chance.
     assert!(accuracy > 0.6, "{accuracy}");

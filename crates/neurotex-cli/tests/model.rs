@@ -617,7 +617,8 @@ fn refused_when_tampered(
     let out = dir.join("never.csv");
     let err = dir.fails(&predict(s(&damaged), s(&out), &["--dataset", s(dataset)]));
     assert!(
-        err.contains("damaged.json: damaged or truncated model file") && err.contains(expected),
+        err.contains("damaged.json: model file with content neurotex never writes")
+            && err.contains(expected),
         "{edits:?}: expected `{expected}` in {err}"
     );
     assert!(!out.exists(), "{edits:?}: predictions written");

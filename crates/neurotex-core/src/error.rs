@@ -509,12 +509,21 @@ pub enum ModelError {
         /// Its `version` field, as JSON, or that it has none.
         found: String,
     },
-    /// The file is truncated, not JSON, or its content breaks a rule.
+    /// The file is truncated or not JSON.
     #[error("{}: damaged or truncated model file: {reason}", .path.display())]
     Damaged {
         /// The file.
         path: PathBuf,
         /// What is wrong.
+        reason: String,
+    },
+    /// The file is whole JSON of the model format, but its content breaks a rule that
+    /// neurotex's own files keep: a field edited, or a file written by other software.
+    #[error("{}: model file with content neurotex never writes (edited, or written by other software): {reason}", .path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// The rule broken.
         reason: String,
     },
     /// A NIR graph neurotex cannot run: not HDF5, damaged, or of another shape.

@@ -390,22 +390,15 @@ impl SpikingModel {
         if is_graph(path) {
             return SpikingModel::from_nir(path, None);
         }
+        use crate::model::{invalid, unreadable};
         let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
-        let damaged = |reason: String| -> crate::Error {
-            ModelError::Damaged {
-                path: path.to_path_buf(),
-                reason,
-            }
-            .into()
-        };
         let value: serde_json::Value =
-            serde_json::from_slice(&bytes).map_err(|e| damaged(crate::error::json_error(&e)))?;
+            serde_json::from_slice(&bytes).map_err(|e| unreadable(path, &e))?;
         let (format, version) = (value.get("format"), value.get("version"));
         crate::model::check_header(path, format, version, (FORMAT, VERSION))?;
-        let file: SpikingFile =
-            serde_json::from_value(value).map_err(|e| damaged(crate::error::json_error(&e)))?;
-        trained_as_said(&file.network, &file.classifier).map_err(damaged)?;
-        SpikingModel::assemble(file).map_err(|e| damaged(e.to_string()))
+        let file: SpikingFile = serde_json::from_value(value).map_err(|e| unreadable(path, &e))?;
+        trained_as_said(&file.network, &file.classifier).map_err(|why| invalid(path, why))?;
+        SpikingModel::assemble(file).map_err(|e| invalid(path, e.to_string()))
     }
 
     /// Reads and encodes `files` as the training recordings were (see

@@ -134,8 +134,8 @@ impl Model {
     /// # Errors
     /// [`DataError::Io`] for an unreadable file; [`ModelError::NotAModel`] for JSON of
     /// another format, [`ModelError::UnsupportedVersion`] for another format version, and
-    /// [`ModelError::Damaged`] for a truncated file, one that is not JSON, or content that
-    /// breaks a rule.
+    /// [`ModelError::Damaged`] for a truncated file or one that is not JSON, and
+    /// [`ModelError::Invalid`] for content that breaks a rule.
     pub fn load(path: &Path) -> Result<Model> {
         let bytes = std::fs::read(path).map_err(|e| DataError::io(path, e))?;
         if bytes.starts_with(b"\x89HDF\r\n\x1a\n") {
@@ -143,27 +143,40 @@ impl Model {
             let path = path.to_path_buf();
             return Err(ModelError::SpikingModel { path }.into());
         }
-        let damaged = |reason: String| -> crate::Error {
-            ModelError::Damaged {
-                path: path.to_path_buf(),
-                reason,
-            }
-            .into()
-        };
         let header: Header = serde_json::from_slice(&bytes).map_err(|e| match e.classify() {
             serde_json::error::Category::Data => ModelError::NotAModel {
                 path: path.to_path_buf(),
                 found: "missing (the file is not a JSON object)".into(),
             }
             .into(),
-            _ => damaged(crate::error::json_error(&e)),
+            _ => unreadable(path, &e),
         })?;
         let (format, version) = (header.format.as_ref(), header.version.as_ref());
         check_header(path, format, version, (FORMAT, VERSION))?;
-        let file: ModelFile =
-            serde_json::from_slice(&bytes).map_err(|e| damaged(crate::error::json_error(&e)))?;
-        Model::assemble(file).map_err(|e| damaged(e.to_string()))
+        let file: ModelFile = serde_json::from_slice(&bytes).map_err(|e| unreadable(path, &e))?;
+        Model::assemble(file).map_err(|e| invalid(path, e.to_string()))
     }
+}
+
+/// The error of a model file serde could not read: [`ModelError::Damaged`] when the JSON
+/// itself is broken or cut short, [`ModelError::Invalid`] when it is whole but its content
+/// breaks the format (a field of the wrong type, one missing, a value out of range).
+pub(crate) fn unreadable(path: &Path, e: &serde_json::Error) -> crate::Error {
+    let reason = crate::error::json_error(e);
+    match e.classify() {
+        serde_json::error::Category::Data => invalid(path, reason),
+        _ => ModelError::Damaged {
+            path: path.to_path_buf(),
+            reason,
+        }
+        .into(),
+    }
+}
+
+/// [`ModelError::Invalid`]: whole JSON whose content breaks the rule `reason`.
+pub(crate) fn invalid(path: &Path, reason: String) -> crate::Error {
+    let path = path.to_path_buf();
+    ModelError::Invalid { path, reason }.into()
 }
 
 /// Fits the file's classifier on its training rows of `dims` features.

@@ -31,7 +31,7 @@ mod predict;
 mod tests;
 
 pub use file::check_header;
-pub(crate) use file::check_trained;
+pub(crate) use file::{check_trained, invalid, unreadable};
 pub use predict::write_predictions;
 pub(crate) use predict::{check_source, encode_files, score};
 

@@ -25,7 +25,8 @@ class ReadWriteError(Error, OSError):
 
 
 class ModelError(Error, ValueError):
-    """A model file that is not a neurotex model, of another version, or damaged."""
+    """A model file that is not a neurotex model, of another version, damaged, or with
+    content neurotex never writes."""
 
 
 class ClassifyError(Error, ValueError):
