@@ -223,6 +223,16 @@ impl CompareOptions {
                 let rule = "the snn classifier reads spike trains: add spikes to --methods";
                 return Err(ParamError::new("classifiers", rule, "snn").into());
             }
+            // The network's options with no network to run: refused, as `evaluate` does.
+            (false, false) if !self.snn.knobs.is_empty() => {
+                let (spec, _) = self.snn.knobs[0];
+                let applies_to = "the spiking network (spikes in --methods)";
+                return Err(OptionsError::NotApplicable {
+                    option: spec.flag,
+                    applies_to,
+                }
+                .into());
+            }
             _ => {}
         }
         let baselines = self.encodings.iter().any(|e| e.trim() == NO_ENCODING);
