@@ -494,7 +494,7 @@ pub enum StatsError {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModelError {
     /// The file is JSON but not a neurotex model.
-    #[error("{}: not a neurotex model file (its `format` is {found}, expected \"{MODEL_FORMAT}\")", .path.display())]
+    #[error("{}: not a neurotex model file (its `format` is {found}, expected \"{MODEL_FORMAT}\" for a feature model or \"{SNN_MODEL_FORMAT}\" for a spiking one)", .path.display())]
     NotAModel {
         /// The file.
         path: PathBuf,
@@ -510,7 +510,7 @@ pub enum ModelError {
         found: String,
     },
     /// The file is truncated or not JSON.
-    #[error("{}: damaged or truncated model file: {reason}", .path.display())]
+    #[error("{}: damaged or truncated model file (not valid JSON): {reason}", .path.display())]
     Damaged {
         /// The file.
         path: PathBuf,

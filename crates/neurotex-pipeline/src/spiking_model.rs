@@ -396,7 +396,8 @@ impl SpikingModel {
             serde_json::from_slice(&bytes).map_err(|e| unreadable(path, &e))?;
         let (format, version) = (value.get("format"), value.get("version"));
         crate::model::check_header(path, format, version, (FORMAT, VERSION))?;
-        let file: SpikingFile = serde_json::from_value(value).map_err(|e| unreadable(path, &e))?;
+        // Read from the bytes rather than the value, so that an error says where it is.
+        let file: SpikingFile = serde_json::from_slice(&bytes).map_err(|e| unreadable(path, &e))?;
         trained_as_said(&file.network, &file.classifier).map_err(|why| invalid(path, why))?;
         SpikingModel::assemble(file).map_err(|e| invalid(path, e.to_string()))
     }

@@ -143,12 +143,20 @@ impl Model {
             let path = path.to_path_buf();
             return Err(ModelError::SpikingModel { path }.into());
         }
-        let header: Header = serde_json::from_slice(&bytes).map_err(|e| match e.classify() {
-            serde_json::error::Category::Data => ModelError::NotAModel {
+        let not_an_object = || -> crate::Error {
+            let found = "missing (the file is not a JSON object)".into();
+            ModelError::NotAModel {
                 path: path.to_path_buf(),
-                found: "missing (the file is not a JSON object)".into(),
+                found,
             }
-            .into(),
+            .into()
+        };
+        // An array would fill the header's fields in order: only an object has a format.
+        if bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'[') {
+            return Err(not_an_object());
+        }
+        let header: Header = serde_json::from_slice(&bytes).map_err(|e| match e.classify() {
+            serde_json::error::Category::Data => not_an_object(),
             _ => unreadable(path, &e),
         })?;
         let (format, version) = (header.format.as_ref(), header.version.as_ref());
