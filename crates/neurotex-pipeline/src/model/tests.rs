@@ -231,9 +231,10 @@ fn files_of_another_format_or_version_or_damaged_are_named_errors() {
         matches!(err, crate::Error::Model(ModelError::NotAModel { .. })),
         "{err}"
     );
+    // An array's items do not stand for the header's fields.
     let err = load_text("[1, 2]");
     assert!(
-        matches!(err, crate::Error::Model(ModelError::NotAModel { .. })),
+        matches!(&err, crate::Error::Model(ModelError::NotAModel { found, .. }) if found.contains("not a JSON object")),
         "{err}"
     );
     for damaged in [&text[..text.len() / 2], "", "not json"] {
