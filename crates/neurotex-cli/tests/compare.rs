@@ -367,6 +367,7 @@ fn the_spiking_network_runs_in_compare_and_evaluate_on_the_same_folds() {
         design.contains("; snn: spiking network (128 LIF"),
         "{design}"
     );
+    assert!(design.ends_with(", given --snn-epochs 20"), "{design}");
     let accuracy = snn["accuracy"].as_f64().unwrap();
     // Three simulated textures at one speed, 10 trials each: well above the 1/3 chance.
     assert!(accuracy > 0.6, "{accuracy}");

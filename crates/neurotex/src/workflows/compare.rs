@@ -313,7 +313,8 @@ impl CompareOptions {
             .iter()
             .find(|c| matches!(c, ClassifierChoice::Snn(_)));
         let snn = snn.filter(|_| set.methods.contains(&MethodChoice::Spikes));
-        if let Some(snn) = snn {
+        let snn = snn.map(|snn| self.snn.described(snn));
+        if let Some(snn) = &snn {
             on(Progress::Say(&format!("snn: {snn}")));
         }
         let speeds = Speed::distinct(indices.iter().filter_map(|&i| dataset.entries[i].speed()));
@@ -326,7 +327,7 @@ impl CompareOptions {
         let mut comparison = compare_keeping(&candidates, &params, on, keep)?;
         // The network's settings go with the ranking (compare.md and compare.json), as the
         // folds and seed do.
-        if let Some(snn) = snn {
+        if let Some(snn) = &snn {
             comparison.design = format!("{}; snn: {snn}", comparison.design);
         }
         if let Some(note) = under_chance_note(&comparison, &params.protocol) {

@@ -103,6 +103,22 @@ impl SnnOptions {
     pub fn params(&self, defaults: SnnParams) -> Result<SnnParams> {
         snn_with(defaults, &self.knobs)
     }
+
+    /// `network` in words, with the options given as the command line spells them (the
+    /// training settings the words leave out, such as epochs and time constants, among
+    /// them), so that a ranking says how to train its network again.
+    pub fn described(&self, network: &ClassifierChoice) -> String {
+        let given: Vec<String> = (self.knobs.iter())
+            .map(|(spec, text)| match (spec.kind, text.as_str()) {
+                (crate::options::OptionKind::Flag, "true") => spec.flag.to_string(),
+                _ => format!("{} {text}", spec.flag),
+            })
+            .collect();
+        match given.is_empty() {
+            true => network.to_string(),
+            false => format!("{network}, given {}", given.join(" ")),
+        }
+    }
 }
 
 impl ClassifierOptions {
