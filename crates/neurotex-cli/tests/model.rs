@@ -638,7 +638,10 @@ fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
     };
     let one = |pointer: &str, v: Value| vec![(pointer.to_string(), v)];
     let cases: Vec<(Vec<(String, Value)>, &str)> = vec![
-        (both("dt_ms", 5000.into()), "dt_ms is 5000"),
+        (
+            both("dt_ms", 5000.into()),
+            "the training parameters (`classifier`): invalid parameter `snn-dt-ms`: the time step must be 1 to 1000 ms, got 5000",
+        ),
         (one("/network/dt_ms", 20.into()), "`network.dt_ms` differs"),
         (both("tau_mem_ms", 1e300.into()), "tau_mem_ms is 1e300"),
         (one("/network/w_out/0", 1e300.into()), "w_out[0] is 1e300"),
@@ -646,7 +649,7 @@ fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
         (one("/labels/1", "A".into()), "class `A` is listed twice"),
         (
             one("/classifier/validation", 1.5.into()),
-            "field `classifier`",
+            "the training parameters (`classifier`): invalid parameter `snn-validation`",
         ),
         (one("/training/best_epoch", 99.into()), "field `training`"),
         (

@@ -398,6 +398,13 @@ impl SpikingModel {
         crate::model::check_header(path, format, version, (FORMAT, VERSION))?;
         // Read from the bytes rather than the value, so that an error says where it is.
         let file: SpikingFile = serde_json::from_slice(&bytes).map_err(|e| unreadable(path, &e))?;
+        // The training parameters first: a value out of range there is named as such, not as
+        // a network that differs from them.
+        let rules =
+            |e: crate::error::ParamError| format!("the training parameters (`classifier`): {e}");
+        file.classifier
+            .check()
+            .map_err(|e| invalid(path, rules(e)))?;
         trained_as_said(&file.network, &file.classifier).map_err(|why| invalid(path, why))?;
         SpikingModel::assemble(file).map_err(|e| invalid(path, e.to_string()))
     }
