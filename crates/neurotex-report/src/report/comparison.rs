@@ -29,14 +29,17 @@ pub fn markdown(c: &Comparison) -> String {
         true => String::new(),
         false => format!("{}.\n", capitalised(&c.design)),
     };
+    // The units the intervals resample, where they are not the recordings themselves.
+    let units = match (c.units.as_str(), c.n_units == c.n_recordings) {
+        ("recordings", true) => String::new(),
+        _ => format!(" ({} units: {})", c.n_units, c.units),
+    };
     let mut out = format!(
-        "# Comparison\n\n{} recordings ({} units: {}), {} classes; {}.\n{design}\
+        "# Comparison\n\n{} recordings{units}, {} classes; {}.\n{design}\
          Chance {:.1}%, majority class {:.1}%.\n\n\
          | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) | seconds |\n\
          |---:|---|---|---|---|---|---:|\n",
         c.n_recordings,
-        c.n_units,
-        c.units,
         c.classes,
         c.protocol,
         100.0 * c.chance,
