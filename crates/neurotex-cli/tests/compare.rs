@@ -413,7 +413,7 @@ fn the_spiking_network_options_are_checked() {
             (cmp(&["--classifiers", "snn"]), "add spikes to --methods"),
             (
                 cmp(&["--snn-epochs", "3"]),
-                "--snn-epochs applies only to the spiking network (spikes in --methods)",
+                "--snn-epochs applies only to the spiking network (`spikes` in --methods",
             ),
             (
                 cmp(&["--methods", "spikes", "--snn-hidden", "0"]),

@@ -157,7 +157,7 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
             if net.own_decays() { "has" } else { "lacks" }
         )),
         Some((name, _)) => Err(format!(
-            "field `network.{name}` differs from the training parameters (`classifier`) that made the network"
+            "field `network.{name}` differs from the training parameters (`classifier`) that made the network: one of the two was changed after training"
         )),
     }
 }

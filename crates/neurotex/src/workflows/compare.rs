@@ -226,7 +226,7 @@ impl CompareOptions {
             // The network's options with no network to run: refused, as `evaluate` does.
             (false, false) if !self.snn.knobs.is_empty() => {
                 let (spec, _) = self.snn.knobs[0];
-                let applies_to = "the spiking network (spikes in --methods)";
+                let applies_to = "the spiking network (`spikes` in --methods, which adds `snn` to --classifiers)";
                 return Err(OptionsError::NotApplicable {
                     option: spec.flag,
                     applies_to,
