@@ -1,17 +1,15 @@
 //! neurotex's learning layer: classifiers (KNN, random forest, logistic regression,
 //! spike distances), cross-validation, metrics, and the statistics of intervals and paired
-//! tests ([`classify`]); the spiking network ([`snn`]) and its NIR graphs ([`nir`]).
+//! tests ([`classify`]); the spiking network ([`snn`]).
 //! Depends on `neurotex-core`.
 #![deny(missing_docs)]
 
 pub mod classify;
-pub mod nir;
 pub mod snn;
 
 // The layers below, under the names their modules had when they were one crate, so
 // that `crate::recording` and the like read the same in every layer.
 use neurotex_core::error;
-use neurotex_core::io;
 use neurotex_core::spikes;
 
 /// What the unit tests share.

@@ -23,7 +23,7 @@ mod table;
 // that `crate::recording` and the like read the same in every layer.
 use neurotex_core::{error, events, import, io, progress, recording, values, Error};
 use neurotex_features::features;
-/// NIR graphs of the spiking network (in the learn layer, beside [`snn`]).
-pub use neurotex_learn::nir;
 use neurotex_learn::{classify, snn};
+/// NIR graphs of the spiking network (the `neurotex-nir` crate).
+pub use neurotex_nir as nir;
 use neurotex_signal::{encode, signal};

@@ -13,7 +13,7 @@
 //! **From discrete to continuous time.** NIR's nodes are ODEs
 //! (`τ_syn dI/dt = -I + w_in a`, `τ_mem dv/dt = v_leak - v + r I`, spike and reset to
 //! `v_reset` when `v > v_threshold`; `τ dv/dt = v_leak - v + r a` for LI). neurotex's
-//! network ([`crate::snn`]) is their forward-Euler step at `dt`, the current first and the
+//! network ([`neurotex_learn::snn`]) is their forward-Euler step at `dt`, the current first and the
 //! membrane with the new current, as snnTorch's `Synaptic` and Norse's `LIFBox` step:
 //! `α = 1 - dt/τ_syn`, `β = 1 - dt/τ_mem`, `κ = 1 - dt/τ`, so the export writes
 //! `τ_syn = dt/(1-α)`, `τ_mem = dt/(1-β)`, `τ = dt/(1-κ)` and the gains that make each
@@ -38,6 +38,9 @@
 //! constant multiplied by `dt`. Neither file says the step, which comes from the model
 //! lending the pipeline; every formula above holds `dt/τ`, so each convention is NIR's read
 //! at another time: 1e-4 s for snnTorch, `dt²` for Norse.
+//!
+//! Depends on `neurotex-core` and `neurotex-learn` (the network it writes and reads).
+#![deny(missing_docs)]
 
 use std::path::Path;
 
@@ -45,6 +48,11 @@ use hdf5_pure::File;
 
 use crate::error::{DataError, ModelError, Result};
 use crate::snn::{Network, Readout, Reset};
+
+// The layers below, under the names their modules have there, so that `crate::snn` and
+// the like read the same in every layer.
+use neurotex_core::{error, io};
+use neurotex_learn::snn;
 
 mod graph;
 mod network;
