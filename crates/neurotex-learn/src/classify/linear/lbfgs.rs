@@ -129,27 +129,69 @@ impl Preconditioner {
 
 /// `v` (`k` rows of weights, then `k` intercepts) times the preconditioner's inverse
 /// (`d x d`) and its intercepts divided by `curvature`, `out` scratch space. Each class's
-/// entry `j` is `Σ_i v_i inverse_ij` added from 0 in the order of `i`; the classes go side
-/// by side, so each row of the inverse is read once per call.
+/// entry `j` is `Σ_i v_i inverse_ij` added from 0 in the order of `i`. The sums are kept
+/// in registers, [`SOLVE_CLASSES`] classes by [`SOLVE_COLUMNS`] entries at a time, while
+/// the rows of the inverse go by (a sum added into memory waits on a load and a store per
+/// row); the last columns, fewer than [`SOLVE_COLUMNS`], are summed in memory.
 #[inline(always)]
 pub(super) fn solve(inverse: &[f64], d: usize, curvature: f64, v: &mut [f64], out: &mut Vec<f64>) {
     let k = v.len() / (d + 1);
     let (w, b) = v.split_at_mut(k * d);
     out.clear();
     out.resize(k * d, 0.0);
-    for i in 0..d {
-        let row = &inverse[i * d..(i + 1) * d];
-        for c in 0..k {
-            let g = w[c * d + i];
-            let o = &mut out[c * d..(c + 1) * d];
-            for j in 0..d {
-                o[j] += g * row[j];
-            }
-        }
+    let size = SOLVE_CLASSES * d;
+    for (w, out) in w.chunks(size).zip(out.chunks_mut(size)) {
+        solve_classes(inverse, d, w, out);
     }
     w.copy_from_slice(out);
     for bc in b.iter_mut() {
         *bc /= curvature;
+    }
+}
+
+/// Classes whose entries [`solve`] sums side by side.
+const SOLVE_CLASSES: usize = 4;
+/// Entries of each class [`solve`] sums side by side (two vectors of eight lanes).
+const SOLVE_COLUMNS: usize = 16;
+
+/// [`solve`] for the up to [`SOLVE_CLASSES`] classes of `w` (each `d` long) into `out`
+/// (zeros, as long as `w`). A block of fewer classes sums zeros in the others' place.
+#[inline(always)]
+fn solve_classes(inverse: &[f64], d: usize, w: &[f64], out: &mut [f64]) {
+    let mut by_row = vec![[0.0; SOLVE_CLASSES]; d];
+    for (c, w) in w.chunks_exact(d).enumerate() {
+        by_row.iter_mut().zip(w).for_each(|(g, &v)| g[c] = v);
+    }
+    let full = d / SOLVE_COLUMNS * SOLVE_COLUMNS;
+    for j in (0..full).step_by(SOLVE_COLUMNS) {
+        // Four named sums: kept in an array, one of them went through memory.
+        let [mut s0, mut s1, mut s2, mut s3] = [[0.0; SOLVE_COLUMNS]; SOLVE_CLASSES];
+        for (row, g) in inverse.chunks_exact(d).zip(&by_row) {
+            let tile: &[f64; SOLVE_COLUMNS] = row[j..j + SOLVE_COLUMNS].try_into().unwrap();
+            add_times(&mut s0, g[0], tile);
+            add_times(&mut s1, g[1], tile);
+            add_times(&mut s2, g[2], tile);
+            add_times(&mut s3, g[3], tile);
+        }
+        for (out, sum) in out.chunks_exact_mut(d).zip([s0, s1, s2, s3]) {
+            out[j..j + SOLVE_COLUMNS].copy_from_slice(&sum);
+        }
+    }
+    for (row, g) in inverse.chunks_exact(d).zip(&by_row) {
+        for (out, &g) in out.chunks_exact_mut(d).zip(g) {
+            out[full..]
+                .iter_mut()
+                .zip(&row[full..])
+                .for_each(|(o, &m)| *o += g * m);
+        }
+    }
+}
+
+/// `sum[t] += g * tile[t]`.
+#[inline(always)]
+fn add_times(sum: &mut [f64; SOLVE_COLUMNS], g: f64, tile: &[f64; SOLVE_COLUMNS]) {
+    for t in 0..SOLVE_COLUMNS {
+        sum[t] += g * tile[t];
     }
 }
 
