@@ -8,6 +8,13 @@ use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 use neurotex::experiments::WITHIN_SPEED;
 use neurotex::progress::Progress;
 
+/// The command line that is running, as `neurotex ...` with quoted arguments.
+pub fn command_line() -> String {
+    let quoted = |a: String| if a.contains(' ') { format!("'{a}'") } else { a };
+    let command = std::env::args().map(quoted).collect::<Vec<_>>().join(" ");
+    command.replacen(&std::env::args().next().unwrap_or_default(), "neurotex", 1)
+}
+
 /// Whether `path` is `-`: standard output, so that a table or predictions go down a pipe.
 pub fn is_stdout(path: &Path) -> bool {
     path.as_os_str() == "-"

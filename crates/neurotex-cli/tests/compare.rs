@@ -337,6 +337,60 @@ fn gain_auto_calibrates_on_the_training_side_of_a_split_and_says_so_otherwise() 
     assert!(cv.stderr.contains("test folds included"), "{}", cv.stderr);
 }
 
+/// compare.md and compare.json say how the ranking was made: the build, the command, the
+/// data's fingerprint and the stages as they ran, the gain `--gain auto` chose among them.
+#[test]
+fn the_outputs_record_the_command_the_data_and_the_gain_chosen() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0, 10.0], 6);
+    let out = dir.join("cmp");
+    let args = [
+        "--methods",
+        "glcm3d",
+        "--classifiers",
+        "knn",
+        "--encodings",
+        "sa",
+    ];
+    let text = dir.ok(&[
+        &["compare", "--dataset", s(&ds), "--gain", "auto", "--json"][..],
+        &args,
+        &["--out", s(&out)],
+    ]
+    .concat());
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let lines: Vec<&str> = v["provenance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert!(lines[0].starts_with("neurotex "), "{lines:?}");
+    assert!(
+        lines[1].starts_with("command: neurotex compare --dataset") && lines[1].contains("glcm3d"),
+        "{lines:?}"
+    );
+    assert!(
+        lines.iter().any(|l| l.starts_with("data: sha256:")),
+        "{lines:?}"
+    );
+    // The gain the encoder ran with is the one the calibration chose.
+    let chosen = lines
+        .iter()
+        .find_map(|l| l.strip_prefix("--gain auto: G = "))
+        .unwrap();
+    let gain = chosen.split(' ').next().unwrap();
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("encoder:") && l.ends_with(&format!("gain G = {gain}"))),
+        "{lines:?}"
+    );
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    assert!(md.contains("## Provenance\n\n- neurotex "), "{md}");
+    assert!(md.contains(&format!("- {}\n", lines[1])), "{md}");
+}
+
 #[test]
 fn the_spiking_network_runs_in_compare_and_evaluate_on_the_same_folds() {
     let dir = Dir::new();

@@ -41,7 +41,9 @@ pub fn run(args: CompareArgs) -> Result<()> {
         None => None,
     };
     let shown = Shown::new("starting");
-    let comparison = o.run(&dataset, &args.stages.options, &shown.callback())?;
+    let mut comparison = o.run(&dataset, &args.stages.options, &shown.callback())?;
+    let at = 1.min(comparison.provenance.len());
+    (comparison.provenance).insert(at, format!("command: {}", crate::output::command_line()));
     shown.finish();
     if let Some(dir) = &args.out {
         write_comparison(dir, &comparison, &o.dataset).context("writing the comparison")?;

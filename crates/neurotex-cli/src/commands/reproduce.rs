@@ -51,7 +51,7 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         &args.out,
         dataset.as_ref(),
         stages,
-        command_line(),
+        crate::output::command_line(),
         &shown.callback(),
     )?;
     shown.finish();
@@ -69,13 +69,4 @@ pub fn run(args: ReproduceArgs) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
-}
-
-/// The command line that produced the report, as `neurotex ...` with quoted arguments.
-fn command_line() -> String {
-    let command = std::env::args()
-        .map(|a| if a.contains(' ') { format!("'{a}'") } else { a })
-        .collect::<Vec<_>>()
-        .join(" ");
-    command.replacen(&std::env::args().next().unwrap_or_default(), "neurotex", 1)
 }

@@ -124,23 +124,13 @@ impl ReproduceParams {
         }
     }
 
-    /// The parameters as the report lists them, one `name: value` line each.
-    pub fn describe(&self) -> Vec<String> {
-        let p = &self.pipeline;
-        let (pre, enc, vol, glcm) = (&p.preprocess, &p.encoder, &p.volume, &p.glcm);
-        vec![
-            format!(
-                "encoder: Izhikevich (2003) neurons, a = {}, b = {}, c = {} mV, d = {}, gain G = {}",
-                enc.a, enc.b, enc.c, enc.d, enc.gain
-            ),
-            format!(
-                "low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only, where the manifest gives the slide's times (else the whole recording): {}",
-                pre.cutoff_hz, pre.slide_only
-            ),
-            format!(
-                "rate volume: {} ms bins; {} gray levels; GLCM distances {:?}, 13 directions, symmetric {}",
-                vol.bin_ms, vol.levels, glcm.distances, glcm.symmetric
-            ),
+    /// The parameters as the report lists them, one `name: value` line each; `layout` the
+    /// dataset's `layout.toml` baseline, which applies where the pipeline sets none.
+    pub fn describe(&self, layout: Option<crate::recording::Baseline>) -> Vec<String> {
+        self.pipeline
+            .describe(layout)
+            .into_iter()
+            .chain([
             format!(
                 "KNN: k = {}, Euclidean, features z-scored on training folds: {}",
                 self.knn.k, self.knn.standardize
@@ -167,8 +157,7 @@ impl ReproduceParams {
             } else {
                 "encoder sensitivity: not measured (one encoding)".to_string()
             },
-        ]
-        .into_iter()
+            ])
         .chain(self.e5_causal.then(|| {
             let rule = crate::causal::DecisionRule::default();
             format!(

@@ -29,21 +29,39 @@ impl Provenance {
     /// # Errors
     /// A dataset's manifest or a listed file can no longer be read.
     pub fn of(source: &Source, params: &ValidReproduceParams) -> Result<Self> {
-        let data = match source {
-            Source::Dataset(ds) => format!("{} ({})", ds.fingerprint()?, ds.root.display()),
+        let (data, layout) = match source {
+            Source::Dataset(ds) => (
+                format!("{} ({})", ds.fingerprint()?, ds.root.display()),
+                ds.layout.baseline,
+            ),
             Source::Simulated { trials, seed, .. } => {
-                format!("simulated: {} trials, seed {seed}", trials.len())
+                let data = format!("simulated: {} trials, seed {seed}", trials.len());
+                (data, None)
             }
         };
         let commit = env!("NEUROTEX_GIT_COMMIT");
         Ok(Provenance {
             neurotex_version: env!("CARGO_PKG_VERSION").to_string(),
             git_commit: (!commit.is_empty()).then(|| commit.to_string()),
-            parameters: params.describe(),
+            parameters: params.describe(layout),
             data,
             created_utc: utc_timestamp(SystemTime::now()),
         })
     }
+}
+
+/// `neurotex VERSION`, and `, commit HASH` when built from a git checkout.
+pub fn build() -> String {
+    let commit = env!("NEUROTEX_GIT_COMMIT");
+    match commit.is_empty() {
+        true => format!("neurotex {}", env!("CARGO_PKG_VERSION")),
+        false => format!("neurotex {}, commit {commit}", env!("CARGO_PKG_VERSION")),
+    }
+}
+
+/// Now, UTC, `YYYY-MM-DDTHH:MM:SSZ`.
+pub fn now_utc() -> String {
+    utc_timestamp(SystemTime::now())
 }
 
 /// `YYYY-MM-DDTHH:MM:SSZ` of `time`. Written here (days to a civil date, the algorithm of

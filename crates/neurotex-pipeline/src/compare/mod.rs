@@ -253,6 +253,11 @@ pub struct Comparison {
     /// when nothing was said.
     #[serde(default)]
     pub notes: Vec<String>,
+    /// Where the ranking comes from, one `name: value` line each: neurotex's build, the
+    /// command, the data and the stages' settings as they ran (the gain `--gain auto`
+    /// chose among them). Empty where the caller recorded none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub provenance: Vec<String>,
 }
 
 /// The caveat every comparison without nested selection carries.
@@ -419,6 +424,7 @@ pub fn compare_keeping(
         },
         nested,
         notes,
+        provenance: Vec::new(),
     })
 }
 

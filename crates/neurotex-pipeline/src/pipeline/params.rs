@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::encode::{FaParams, IzhikevichParams};
 use crate::error::{ParamError, Result};
 use crate::features::{GlcmParams, SpectrumParams, VolumeParams};
+use crate::recording::Baseline;
 use crate::signal::PreprocessParams;
 
 /// The feature sets: the paper's three and the methods beyond the paper.
@@ -293,6 +294,51 @@ pub struct PipelineParams {
 }
 
 impl PipelineParams {
+    /// The stages' settings, one `name: value` line each, as results list them: the
+    /// encoder, the conditioning (its baseline the pipeline's own, else `layout`'s, the
+    /// dataset's `layout.toml` choice), the rate volume and GLCM, and the other feature
+    /// methods' settings.
+    pub fn describe(&self, layout: Option<Baseline>) -> Vec<String> {
+        let (pre, enc, vol, glcm) = (&self.preprocess, &self.encoder, &self.volume, &self.glcm);
+        let f = &self.features;
+        let baseline = match (pre.baseline, layout) {
+            (Some(b), _) => b.to_string(),
+            (None, Some(b)) => format!("{b} (the dataset's layout.toml)"),
+            (None, None) => "none".to_string(),
+        };
+        let mut lines = vec![
+            format!(
+                "encoder: Izhikevich (2003) neurons, a = {}, b = {}, c = {} mV, d = {}, gain G = {}",
+                enc.a, enc.b, enc.c, enc.d, enc.gain
+            ),
+            format!(
+                "low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only, where the manifest gives the slide's times (else the whole recording): {}",
+                pre.cutoff_hz, pre.slide_only
+            ),
+            format!(
+                "rate volume: {} ms bins; {} gray levels; GLCM distances {:?}, 13 directions, symmetric {}",
+                vol.bin_ms, vol.levels, glcm.distances, glcm.symmetric
+            ),
+            format!("baseline: {baseline}"),
+            format!("encoding: {}; FA gain {}", self.encoding, self.fa.gain),
+            format!(
+                "features: Haralick {}; glcm3d-multi bins {:?} ms; all-taxels-mm window {} mm; spectrum {} bins, {} bands, travel {} mm (0 = the whole phase)",
+                f.haralick, f.bin_widths_ms, f.window_mm, f.spectrum_bins, f.spectrum_bands, f.travel_mm
+            ),
+        ];
+        if let Some(c) = &pre.causal {
+            let drift = match pre.drift_window_ms {
+                Some(ms) => format!("resting values tracked over {ms} ms"),
+                None => "resting values fixed at training".to_string(),
+            };
+            lines.push(format!(
+                "causal conditioning: forward-only low-pass, scale {} fixed at training, {drift}",
+                c.scale
+            ));
+        }
+        lines
+    }
+
     /// Checks every stage's rules.
     ///
     /// # Errors

@@ -73,6 +73,12 @@ pub fn markdown(c: &Comparison) -> String {
         out.push_str(&format!("\n{NO_PAPER}\n"));
     }
     out.push_str(&format!("\nCaveat: {}.\n", c.caveat));
+    if !c.provenance.is_empty() {
+        out.push_str("\n## Provenance\n\n");
+        for line in &c.provenance {
+            out.push_str(&format!("- {line}\n"));
+        }
+    }
     out
 }
 

@@ -9,6 +9,7 @@ use super::{
     calibrated_pipeline, encode_all, say_conditions, KnnOptions, OnProgress, OpenOptions,
     SnnOptions,
 };
+use crate::calibrate::CalibratedParams;
 use crate::classify::metrics::{chance_level, AgainstChance};
 use crate::classify::{ClassifierChoice, CvParams, ForestParams};
 use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
@@ -18,7 +19,7 @@ use crate::compare::signal::{
 use crate::compare::{compare_keeping, Candidate, CompareParams, Comparison, Keep, Protocol};
 use crate::error::{OptionsError, ParamError};
 use crate::options::StageOptions;
-use crate::pipeline::{shared_grid, Encoding, Pipeline};
+use crate::pipeline::{shared_grid, Encoding, Pipeline, PipelineParams};
 use crate::progress::Progress;
 use crate::recording::{Dataset, Recording, Selection};
 use crate::signal::Conditioned;
@@ -301,7 +302,8 @@ impl CompareOptions {
             _ => None,
         };
         let calibration = super::calibration_rows(train, dataset, &indices, stages, on)?;
-        let candidates = make_candidates(stages, dataset, &indices, &calibration, &set, on)?;
+        let (candidates, calibrated) =
+            make_candidates(stages, dataset, &indices, &calibration, &set, on)?;
         on(Progress::Say(&format!(
             "comparing {} candidates on {} recordings: {}",
             candidates.len(),
@@ -330,6 +332,7 @@ impl CompareOptions {
         if let Some(snn) = &snn {
             comparison.design = format!("{}; snn: {snn}", comparison.design);
         }
+        comparison.provenance = provenance(dataset, &calibrated)?;
         if let Some(note) = under_chance_note(&comparison, &params.protocol) {
             on(Progress::Advice(&note));
             comparison.notes.push(note);
@@ -374,6 +377,28 @@ fn under_chance_note(c: &Comparison, protocol: &Protocol) -> Option<String> {
 /// Encodes the recordings once (both populations when an encoding needs the fast-adapting
 /// one), with the pipeline calibrated on the recordings `calibration`, and makes every
 /// candidate of `set` from them.
+/// Where a comparison on `dataset` comes from: neurotex's build, the time, the data and
+/// the stages as `calibrated` ran them ([`Comparison::provenance`]).
+///
+/// # Errors
+/// The manifest or a listed file can no longer be read for the fingerprint.
+fn provenance(dataset: &Dataset, calibrated: &CalibratedParams) -> Result<Vec<String>> {
+    let mut lines = vec![
+        crate::experiments::build(),
+        format!("created: {}", crate::experiments::now_utc()),
+        format!(
+            "data: {} ({})",
+            dataset.fingerprint()?,
+            dataset.root.display()
+        ),
+    ];
+    lines.extend(calibrated.params.describe(dataset.layout.baseline));
+    lines.extend(calibrated.gain.as_ref().map(super::calibration_line));
+    Ok(lines)
+}
+
+/// The candidates of `set` on the recordings `indices`, and the pipeline they were made
+/// with (calibrated on the recordings `calibration`).
 fn make_candidates(
     stages: &StageOptions,
     dataset: &Dataset,
@@ -381,14 +406,28 @@ fn make_candidates(
     calibration: &[usize],
     set: &CandidateSet,
     on: OnProgress,
-) -> Result<Vec<Candidate>> {
+) -> Result<(Vec<Candidate>, CalibratedParams)> {
     let start = Instant::now();
-    let mut params = calibrated_pipeline(stages, dataset, calibration, on)?.params;
-    params.encoding = if set.needs_fa() {
+    let mut calibrated = calibrated_pipeline(stages, dataset, calibration, on)?;
+    calibrated.params.encoding = if set.needs_fa() {
         Encoding::SaFa
     } else {
         Encoding::Sa
     };
+    let made = candidates_with(&calibrated.params, dataset, indices, set, on, start)?;
+    Ok((made, calibrated))
+}
+
+/// The candidates of `set` on the recordings `indices` with the pipeline `params`, whose
+/// making began at `start`.
+fn candidates_with(
+    params: &PipelineParams,
+    dataset: &Dataset,
+    indices: &[usize],
+    set: &CandidateSet,
+    on: OnProgress,
+    start: Instant,
+) -> Result<Vec<Candidate>> {
     let pipeline = Pipeline::new(params.clone())?;
     let tick = || on(Progress::Tick);
     let features = &params.features;
@@ -414,7 +453,7 @@ fn make_candidates(
     };
     let grid = shared_grid(&encoded)?;
     let encode_s = start.elapsed().as_secs_f64();
-    let mut out = candidates(&encoded, &grid, &params, set, encode_s)?;
+    let mut out = candidates(&encoded, &grid, params, set, encode_s)?;
     if set.baselines {
         let share = encode_s / (set.encodings.len() + 1) as f64;
         out.extend(baseline_candidates(

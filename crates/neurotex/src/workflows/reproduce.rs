@@ -258,14 +258,14 @@ pub fn reproduce(
     let started = Instant::now();
     let _claim = check_report_dir(out)?;
     let (results, described, params) = analyse(data, params, run)?;
-    let source = match data {
-        Data::Folder(ds) => folder_source(&ds.root),
-        Data::Simulated { seeds, .. } => simulated_source(seeds),
+    let (source, layout) = match data {
+        Data::Folder(ds) => (folder_source(&ds.root), ds.layout.baseline),
+        Data::Simulated { seeds, .. } => (simulated_source(seeds), None),
     };
     let ctx = ReportContext {
         dataset: described,
         source,
-        parameters: parameters_described(&params, &results),
+        parameters: parameters_described(&params, layout, &results),
         total_seconds: started.elapsed().as_secs_f64(),
         command: run.command.clone(),
         paper_comparable: matches!(data, Data::Simulated { .. }),
@@ -357,10 +357,15 @@ fn calibrated(
     Ok((params.check()?, calibration))
 }
 
-/// The report's parameter lines: the run's parameters and, under `--gain auto`, the gain
+/// The report's parameter lines: the run's parameters (the dataset's `layout.toml`
+/// baseline `layout` where the pipeline sets none) and, under `--gain auto`, the gain
 /// chosen.
-fn parameters_described(params: &ValidReproduceParams, results: &Results) -> Vec<String> {
-    let mut lines = params.describe();
+fn parameters_described(
+    params: &ValidReproduceParams,
+    layout: Option<crate::recording::Baseline>,
+    results: &Results,
+) -> Vec<String> {
+    let mut lines = params.describe(layout);
     if let Some(c) = &results.gain_calibration {
         let shared = if results.across_seeds.is_some() {
             "; calibrated on the first simulated dataset and used for all"

@@ -91,6 +91,7 @@ fn comparison(n: usize, nested: bool, conditions: usize) -> Comparison {
         }),
         caveat: crate::compare::CAVEAT.into(),
         notes: Vec::new(),
+        provenance: Vec::new(),
     }
 }
 
