@@ -167,8 +167,8 @@ impl ReproduceParams {
         }))
         .chain(self.e9.then(|| {
             format!(
-                "E9: the standard candidates of `neurotex compare`, {}-fold CV with {} repeat(s) within each speed, and each speed held out with nested selection",
-                self.cv.folds, self.e9_repeats
+                "E9: the standard candidates of `neurotex compare` (encodings sa and sa+fa, FA gain {}), {}-fold CV with {} repeat(s) within each speed, and each speed held out with nested selection",
+                self.pipeline.fa.gain, self.cv.folds, self.e9_repeats
             )
         }))
         .chain((self.e9 && self.e9_snn).then(|| {

@@ -320,7 +320,10 @@ impl PipelineParams {
                 vol.bin_ms, vol.levels, glcm.distances, glcm.symmetric
             ),
             format!("baseline: {baseline}"),
-            format!("encoding: {}; FA gain {}", self.encoding, self.fa.gain),
+            match self.encoding {
+                Encoding::Sa => "encoding: sa".to_string(),
+                other => format!("encoding: {other}; FA gain {}", self.fa.gain),
+            },
             format!(
                 "features: Haralick {}; glcm3d-multi bins {:?} ms; all-taxels-mm window {} mm; spectrum {} bins, {} bands, travel {} mm (0 = the whole phase)",
                 f.haralick, f.bin_widths_ms, f.window_mm, f.spectrum_bins, f.spectrum_bands, f.travel_mm
