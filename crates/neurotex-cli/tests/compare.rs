@@ -374,6 +374,15 @@ fn the_outputs_record_the_command_the_data_and_the_gain_chosen() {
         lines.iter().any(|l| l.starts_with("data: sha256:")),
         "{lines:?}"
     );
+    // Only the encodings and methods compared, and where the gain was calibrated.
+    assert!(lines.contains(&"encodings: sa"), "{lines:?}");
+    assert!(
+        !lines.iter().any(|l| l.starts_with("spectrum:")),
+        "{lines:?}"
+    );
+    assert!(lines.iter().any(|l| l.starts_with("phase: ")), "{lines:?}");
+    let cv = "test folds included (cross-validation; labels unused)";
+    assert!(lines.iter().any(|l| l.ends_with(cv)), "{lines:?}");
     // The gain the encoder ran with is the one the calibration chose.
     let chosen = lines
         .iter()

@@ -642,7 +642,10 @@ fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
             both("dt_ms", 5000.into()),
             "the training parameters (`classifier`): invalid parameter `snn-dt-ms`: the time step must be 1 to 1000 ms, got 5000",
         ),
-        (one("/network/dt_ms", 20.into()), "`network.dt_ms` differs"),
+        (
+            one("/network/dt_ms", 20.into()),
+            "`network.dt_ms` (20) differs from the training parameters (`classifier`: 10)",
+        ),
         (both("tau_mem_ms", 1e300.into()), "tau_mem_ms is 1e300"),
         (one("/network/w_out/0", 1e300.into()), "w_out[0] is 1e300"),
         (one("/network/b_in/1", (-1e39).into()), "b_in[1] is -1e39"),
@@ -659,7 +662,7 @@ fn every_field_training_guarantees_is_checked_when_a_spiking_model_is_read() {
         (one("/training/dataset/layout/fs", (-1.0).into()), "`fs`"),
         (
             one("/network/reset", "subtract".into()),
-            "`network.reset` differs",
+            "`network.reset` (\"subtract\") differs from the training parameters (`classifier`: \"zero\")",
         ),
         (
             both("reset", "sideways".into()),

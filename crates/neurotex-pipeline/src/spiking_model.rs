@@ -121,6 +121,11 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
     (best, shares)
 }
 
+/// Two values as JSON, as a model file writes them.
+fn shown(a: &impl Serialize, b: &impl Serialize) -> [String; 2] {
+    [serde_json::to_string(a), serde_json::to_string(b)].map(Result::unwrap_or_default)
+}
+
 /// Checks that a model file's network is the one its training parameters make: the same
 /// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
 /// JSON), whether each neuron has decays of its own and whether it counts time in travel.
@@ -128,36 +133,75 @@ pub fn decide(scores: &[f64]) -> (usize, Vec<f64>) {
 /// whatever the spiking model lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+    // Each field: whether the two agree, and each one's value as the file writes it.
+    let travel = match snn.travel {
+        Travel::Off => net.travel_mm_s.is_none(),
+        Travel::Median => true,
+        Travel::At(v) => net.travel_mm_s == Some(v),
+    };
     let fields = [
-        ("hidden", net.hidden == snn.hidden),
-        ("dt_ms", net.dt_ms == snn.dt_ms),
-        ("readout", net.readout == snn.readout),
-        ("reset", net.reset == snn.reset),
-        ("target", net.target == snn.target),
-        ("w_rec", net.recurrent() == snn.recurrent),
-        ("alpha", net.own_decays() == snn.train_decays),
         (
-            "travel_mm_s",
-            match snn.travel {
-                Travel::Off => net.travel_mm_s.is_none(),
-                Travel::Median => true,
-                Travel::At(v) => net.travel_mm_s == Some(v),
-            },
+            "hidden",
+            net.hidden == snn.hidden,
+            shown(&net.hidden, &snn.hidden),
         ),
-        ("tau_syn_ms", close(net.tau_syn_ms, snn.tau_syn_ms)),
-        ("tau_mem_ms", close(net.tau_mem_ms, snn.tau_mem_ms)),
-        ("tau_out_ms", close(net.tau_out_ms, snn.tau_out_ms)),
+        (
+            "dt_ms",
+            net.dt_ms == snn.dt_ms,
+            shown(&net.dt_ms, &snn.dt_ms),
+        ),
+        (
+            "readout",
+            net.readout == snn.readout,
+            shown(&net.readout, &snn.readout),
+        ),
+        (
+            "reset",
+            net.reset == snn.reset,
+            shown(&net.reset, &snn.reset),
+        ),
+        (
+            "target",
+            net.target == snn.target,
+            shown(&net.target, &snn.target),
+        ),
+        (
+            "w_rec",
+            net.recurrent() == snn.recurrent,
+            shown(&net.recurrent(), &snn.recurrent),
+        ),
+        (
+            "alpha",
+            net.own_decays() == snn.train_decays,
+            [String::new(), String::new()],
+        ),
+        ("travel_mm_s", travel, shown(&net.travel_mm_s, &snn.travel)),
+        (
+            "tau_syn_ms",
+            close(net.tau_syn_ms, snn.tau_syn_ms),
+            shown(&net.tau_syn_ms, &snn.tau_syn_ms),
+        ),
+        (
+            "tau_mem_ms",
+            close(net.tau_mem_ms, snn.tau_mem_ms),
+            shown(&net.tau_mem_ms, &snn.tau_mem_ms),
+        ),
+        (
+            "tau_out_ms",
+            close(net.tau_out_ms, snn.tau_out_ms),
+            shown(&net.tau_out_ms, &snn.tau_out_ms),
+        ),
     ];
-    match fields.iter().find(|(_, same)| !same) {
+    match fields.iter().find(|(_, same, _)| !same) {
         None => Ok(()),
-        Some(("alpha", _)) => Err(format!(
+        Some(("alpha", ..)) => Err(format!(
             "the training parameters (`classifier.train_decays` {}) {} each neuron's own decays, and the network {} them (`network.alpha`, `network.beta`)",
             snn.train_decays,
             if snn.train_decays { "train" } else { "do not train" },
             if net.own_decays() { "has" } else { "lacks" }
         )),
-        Some((name, _)) => Err(format!(
-            "field `network.{name}` differs from the training parameters (`classifier`) that made the network: one of the two was changed after training"
+        Some((name, _, [network, classifier])) => Err(format!(
+            "field `network.{name}` ({network}) differs from the training parameters (`classifier`: {classifier}) that made the network: one of the two was changed after training"
         )),
     }
 }

@@ -58,7 +58,7 @@ pub use params::{
 };
 pub use perturb::perturbed_input;
 pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, WITHIN_SPEED};
-pub use provenance::{build, now_utc, Provenance};
+pub use provenance::{build, now_utc, slide_times, Provenance};
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};
 pub use skip::{Skip, Stop};
 pub use source::Source;

@@ -125,10 +125,15 @@ impl ReproduceParams {
     }
 
     /// The parameters as the report lists them, one `name: value` line each; `layout` the
-    /// dataset's `layout.toml` baseline, which applies where the pipeline sets none.
-    pub fn describe(&self, layout: Option<crate::recording::Baseline>) -> Vec<String> {
+    /// dataset's `layout.toml` baseline, which applies where the pipeline sets none, and
+    /// `slides` the recordings with their slide's times in the manifest, of all.
+    pub fn describe(
+        &self,
+        layout: Option<crate::recording::Baseline>,
+        slides: [usize; 2],
+    ) -> Vec<String> {
         self.pipeline
-            .describe(layout)
+            .describe(layout, slides, &crate::pipeline::Method::ALL)
             .into_iter()
             .chain([
             format!(

@@ -29,25 +29,34 @@ impl Provenance {
     /// # Errors
     /// A dataset's manifest or a listed file can no longer be read.
     pub fn of(source: &Source, params: &ValidReproduceParams) -> Result<Self> {
-        let (data, layout) = match source {
+        let (data, layout, slides) = match source {
             Source::Dataset(ds) => (
                 format!("{} ({})", ds.fingerprint()?, ds.root.display()),
                 ds.layout.baseline,
+                slide_times(&ds.entries),
             ),
             Source::Simulated { trials, seed, .. } => {
                 let data = format!("simulated: {} trials, seed {seed}", trials.len());
-                (data, None)
+                (data, None, [trials.len(); 2])
             }
         };
         let commit = env!("NEUROTEX_GIT_COMMIT");
         Ok(Provenance {
             neurotex_version: env!("CARGO_PKG_VERSION").to_string(),
             git_commit: (!commit.is_empty()).then(|| commit.to_string()),
-            parameters: params.describe(layout),
+            parameters: params.describe(layout, slides),
             data,
             created_utc: utc_timestamp(SystemTime::now()),
         })
     }
+}
+
+/// How many of `entries` have their slide's times in the manifest, and how many there are.
+pub fn slide_times(entries: &[crate::recording::Meta]) -> [usize; 2] {
+    let with = entries
+        .iter()
+        .filter(|e| e.slide_start_s.is_some() && e.slide_end_s.is_some());
+    [with.count(), entries.len()]
 }
 
 /// `neurotex VERSION`, and `, commit HASH` when built from a git checkout.

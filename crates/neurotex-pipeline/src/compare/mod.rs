@@ -407,10 +407,7 @@ pub fn compare_keeping(
     Ok(Comparison {
         protocol: params.protocol.to_string(),
         design: design(params),
-        units: match &params.group_by {
-            Some(column) => format!("groups of {column}"),
-            None => "recordings".into(),
-        },
+        units: units_of(params),
         n_units: units.n_units(),
         n_recordings: scored[0].shares.len(),
         classes,
@@ -426,6 +423,14 @@ pub fn compare_keeping(
         notes,
         provenance: Vec::new(),
     })
+}
+
+/// What intervals and tests resample: `recordings`, or `groups of COLUMN`.
+fn units_of(params: &CompareParams) -> String {
+    match &params.group_by {
+        Some(column) => format!("groups of {column}"),
+        None => "recordings".into(),
+    }
 }
 
 /// `5-fold stratified cross-validation, 3 repeats, seed 0; 2000 resamples for intervals

@@ -295,40 +295,54 @@ pub struct PipelineParams {
 
 impl PipelineParams {
     /// The stages' settings, one `name: value` line each, as results list them: the
-    /// encoder, the conditioning (its baseline the pipeline's own, else `layout`'s, the
-    /// dataset's `layout.toml` choice), the rate volume and GLCM, and the other feature
-    /// methods' settings.
-    pub fn describe(&self, layout: Option<Baseline>) -> Vec<String> {
-        let (pre, enc, vol, glcm) = (&self.preprocess, &self.encoder, &self.volume, &self.glcm);
-        let f = &self.features;
-        let baseline = match (pre.baseline, layout) {
-            (Some(b), _) => b.to_string(),
-            (None, Some(b)) => format!("{b} (the dataset's layout.toml)"),
-            (None, None) => "none".to_string(),
+    /// conditioning ([`PipelineParams::conditioning_lines`]), the encoder and encoding, the
+    /// rate volume and GLCM, and the settings of the feature methods `methods`.
+    pub fn describe(
+        &self,
+        layout: Option<Baseline>,
+        slides: [usize; 2],
+        methods: &[Method],
+    ) -> Vec<String> {
+        let mut lines = self.conditioning_lines(layout, slides);
+        lines.push(self.encoder_line());
+        lines.push(match self.encoding {
+            Encoding::Sa => "encoding: sa".to_string(),
+            other => format!("encoding: {other}; FA gain {}", self.fa.gain),
+        });
+        lines.push(self.volume_line());
+        lines.extend(self.feature_lines(methods));
+        lines
+    }
+
+    /// The conditioning as it applies to recordings of which `slides[0]` of `slides[1]`
+    /// have their slide's times in the manifest: the low-pass, the phase kept, the baseline
+    /// (the pipeline's own, else `layout`'s, the dataset's `layout.toml` choice) and the
+    /// causal conditioning.
+    pub fn conditioning_lines(
+        &self,
+        layout: Option<Baseline>,
+        [with, all]: [usize; 2],
+    ) -> Vec<String> {
+        let pre = &self.preprocess;
+        let low_pass = match pre.cutoff_hz > 0.0 {
+            true => format!(
+                "low-pass: {} Hz, zero-phase 2nd-order Butterworth",
+                pre.cutoff_hz
+            ),
+            false => "low-pass: off".to_string(),
         };
-        let mut lines = vec![
-            format!(
-                "encoder: Izhikevich (2003) neurons, a = {}, b = {}, c = {} mV, d = {}, gain G = {}",
-                enc.a, enc.b, enc.c, enc.d, enc.gain
-            ),
-            format!(
-                "low-pass: {} Hz (0 = off), zero-phase 2nd-order Butterworth; sliding phase only, where the manifest gives the slide's times (else the whole recording): {}",
-                pre.cutoff_hz, pre.slide_only
-            ),
-            format!(
-                "rate volume: {} ms bins; {} gray levels; GLCM distances {:?}, 13 directions, symmetric {}",
-                vol.bin_ms, vol.levels, glcm.distances, glcm.symmetric
-            ),
-            format!("baseline: {baseline}"),
-            match self.encoding {
-                Encoding::Sa => "encoding: sa".to_string(),
-                other => format!("encoding: {other}; FA gain {}", self.fa.gain),
-            },
-            format!(
-                "features: Haralick {}; glcm3d-multi bins {:?} ms; all-taxels-mm window {} mm; spectrum {} bins, {} bands, travel {} mm (0 = the whole phase)",
-                f.haralick, f.bin_widths_ms, f.window_mm, f.spectrum_bins, f.spectrum_bands, f.travel_mm
-            ),
-        ];
+        let phase = match (pre.slide_only, with) {
+            (false, _) => "phase: the whole recording (--whole)".to_string(),
+            (true, 0) => "phase: the whole recording (the manifest gives no slide times)".to_string(),
+            (true, w) if w == all => "phase: the sliding phase, from the manifest's slide times".to_string(),
+            (true, w) => format!("phase: the sliding phase in the {w} of {all} recordings whose slide times the manifest gives, the whole recording in the others"),
+        };
+        let baseline = match (pre.baseline, layout) {
+            (Some(b), _) => format!("baseline: {b}"),
+            (None, Some(b)) => format!("baseline: {b} (the dataset's layout.toml)"),
+            (None, None) => "baseline: none".to_string(),
+        };
+        let mut lines = vec![low_pass, phase, baseline];
         if let Some(c) = &pre.causal {
             let drift = match pre.drift_window_ms {
                 Some(ms) => format!("resting values tracked over {ms} ms"),
@@ -340,6 +354,62 @@ impl PipelineParams {
             ));
         }
         lines
+    }
+
+    /// The SA neurons and their gain.
+    pub fn encoder_line(&self) -> String {
+        let enc = &self.encoder;
+        format!(
+            "encoder: Izhikevich (2003) neurons, a = {}, b = {}, c = {} mV, d = {}, gain G = {}",
+            enc.a, enc.b, enc.c, enc.d, enc.gain
+        )
+    }
+
+    /// The rate volume and the GLCM's offsets.
+    pub fn volume_line(&self) -> String {
+        let (vol, glcm) = (&self.volume, &self.glcm);
+        let symmetric = if glcm.symmetric {
+            "symmetric"
+        } else {
+            "not symmetric"
+        };
+        format!(
+            "rate volume: {} ms bins, {} gray levels; GLCM distances {:?}, 13 directions, {symmetric}",
+            vol.bin_ms, vol.levels, glcm.distances
+        )
+    }
+
+    /// The settings only some feature methods read, for those among `methods`.
+    pub fn feature_lines(&self, methods: &[Method]) -> Vec<String> {
+        let f = &self.features;
+        let has = |m: Method| methods.contains(&m);
+        let travel = match f.travel_mm > 0.0 {
+            true => format!("the first {} mm of travel", f.travel_mm),
+            false => "the whole phase".to_string(),
+        };
+        [
+            (has(Method::Glcm2d) || has(Method::Glcm3d) || has(Method::Glcm3dMulti)).then(
+                || match f.haralick {
+                    HaralickSet::Paper => {
+                        "Haralick features: contrast, correlation, ASM (the paper's)".to_string()
+                    }
+                    HaralickSet::Full => "Haralick features: the 13 of Haralick (1973)".to_string(),
+                },
+            ),
+            has(Method::Glcm3dMulti)
+                .then(|| format!("glcm3d-multi: bins of {:?} ms", f.bin_widths_ms)),
+            has(Method::AllTaxelsMm)
+                .then(|| format!("all-taxels-mm: Fano windows of {} mm", f.window_mm)),
+            has(Method::Spectrum).then(|| {
+                format!(
+                    "spectrum: {} bins over {travel}, {} bands",
+                    f.spectrum_bins, f.spectrum_bands
+                )
+            }),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
     }
 
     /// Checks every stage's rules.

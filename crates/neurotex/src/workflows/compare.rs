@@ -19,7 +19,7 @@ use crate::compare::signal::{
 use crate::compare::{compare_keeping, Candidate, CompareParams, Comparison, Keep, Protocol};
 use crate::error::{OptionsError, ParamError};
 use crate::options::StageOptions;
-use crate::pipeline::{shared_grid, Encoding, Pipeline, PipelineParams};
+use crate::pipeline::{shared_grid, Encoding, Method, Pipeline, PipelineParams};
 use crate::progress::Progress;
 use crate::recording::{Dataset, Recording, Selection};
 use crate::signal::Conditioned;
@@ -332,7 +332,8 @@ impl CompareOptions {
         if let Some(snn) = &snn {
             comparison.design = format!("{}; snn: {snn}", comparison.design);
         }
-        comparison.provenance = provenance(dataset, &calibrated)?;
+        comparison.provenance =
+            provenance((dataset, &indices), &set, &calibrated, train.is_some())?;
         if let Some(note) = under_chance_note(&comparison, &params.protocol) {
             on(Progress::Advice(&note));
             comparison.notes.push(note);
@@ -377,23 +378,70 @@ fn under_chance_note(c: &Comparison, protocol: &Protocol) -> Option<String> {
 /// Encodes the recordings once (both populations when an encoding needs the fast-adapting
 /// one), with the pipeline calibrated on the recordings `calibration`, and makes every
 /// candidate of `set` from them.
-/// Where a comparison on `dataset` comes from: neurotex's build, the time, the data and
-/// the stages as `calibrated` ran them ([`Comparison::provenance`]).
+/// Where a comparison of `set` on the recordings `indices` of `dataset` comes from:
+/// neurotex's build, the time, the data and the stages as `calibrated` ran them, the
+/// settings of the encodings and methods compared only ([`Comparison::provenance`]);
+/// `split` whether the gain was calibrated on a training side alone.
 ///
 /// # Errors
 /// The manifest or a listed file can no longer be read for the fingerprint.
-fn provenance(dataset: &Dataset, calibrated: &CalibratedParams) -> Result<Vec<String>> {
+fn provenance(
+    (dataset, indices): (&Dataset, &[usize]),
+    set: &CandidateSet,
+    calibrated: &CalibratedParams,
+    split: bool,
+) -> Result<Vec<String>> {
+    let metas: Vec<_> = indices
+        .iter()
+        .map(|&i| dataset.entries[i].clone())
+        .collect();
+    let data = format!(
+        "data: {} ({})",
+        dataset.fingerprint()?,
+        dataset.root.display()
+    );
     let mut lines = vec![
         crate::experiments::build(),
         format!("created: {}", crate::experiments::now_utc()),
-        format!(
-            "data: {} ({})",
-            dataset.fingerprint()?,
-            dataset.root.display()
-        ),
+        data,
     ];
-    lines.extend(calibrated.params.describe(dataset.layout.baseline));
-    lines.extend(calibrated.gain.as_ref().map(super::calibration_line));
+    let p = &calibrated.params;
+    lines.extend(p.conditioning_lines(
+        dataset.layout.baseline,
+        crate::experiments::slide_times(&metas),
+    ));
+    if set.encodings.is_empty() {
+        lines.push("encodings: none (the signal baselines, without spikes)".into());
+        return Ok(lines);
+    }
+    lines.push(p.encoder_line());
+    if let Some(c) = &calibrated.gain {
+        let on = match split {
+            true => "",
+            false => "; these are the recordings evaluated, test folds included (cross-validation; labels unused)",
+        };
+        lines.push(format!("{}{on}", super::calibration_line(c)));
+    }
+    let names: Vec<String> = set.encodings.iter().map(|e| e.to_string()).collect();
+    let fa = match set.needs_fa() {
+        true => format!("; FA gain {}", p.fa.gain),
+        false => String::new(),
+    };
+    let baselines = match set.baselines {
+        true => ", and none (the signal baselines)",
+        false => "",
+    };
+    lines.push(format!("encodings: {}{fa}{baselines}", names.join(", ")));
+    lines.push(p.volume_line());
+    let methods: Vec<Method> = set
+        .methods
+        .iter()
+        .filter_map(|m| match m {
+            MethodChoice::Features(m) => Some(*m),
+            _ => None,
+        })
+        .collect();
+    lines.extend(p.feature_lines(&methods));
     Ok(lines)
 }
 

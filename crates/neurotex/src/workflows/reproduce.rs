@@ -258,14 +258,18 @@ pub fn reproduce(
     let started = Instant::now();
     let _claim = check_report_dir(out)?;
     let (results, described, params) = analyse(data, params, run)?;
-    let (source, layout) = match data {
-        Data::Folder(ds) => (folder_source(&ds.root), ds.layout.baseline),
-        Data::Simulated { seeds, .. } => (simulated_source(seeds), None),
+    let (source, layout, slides) = match data {
+        Data::Folder(ds) => (
+            folder_source(&ds.root),
+            ds.layout.baseline,
+            crate::experiments::slide_times(&ds.entries),
+        ),
+        Data::Simulated { seeds, .. } => (simulated_source(seeds), None, [1, 1]),
     };
     let ctx = ReportContext {
         dataset: described,
         source,
-        parameters: parameters_described(&params, layout, &results),
+        parameters: parameters_described(&params, (layout, slides), &results),
         total_seconds: started.elapsed().as_secs_f64(),
         command: run.command.clone(),
         paper_comparable: matches!(data, Data::Simulated { .. }),
@@ -358,14 +362,15 @@ fn calibrated(
 }
 
 /// The report's parameter lines: the run's parameters (the dataset's `layout.toml`
-/// baseline `layout` where the pipeline sets none) and, under `--gain auto`, the gain
+/// baseline `layout` where the pipeline sets none, and how many recordings have slide
+/// times) and, under `--gain auto`, the gain
 /// chosen.
 fn parameters_described(
     params: &ValidReproduceParams,
-    layout: Option<crate::recording::Baseline>,
+    (layout, slides): (Option<crate::recording::Baseline>, [usize; 2]),
     results: &Results,
 ) -> Vec<String> {
-    let mut lines = params.describe(layout);
+    let mut lines = params.describe(layout, slides);
     if let Some(c) = &results.gain_calibration {
         let shared = if results.across_seeds.is_some() {
             "; calibrated on the first simulated dataset and used for all"
