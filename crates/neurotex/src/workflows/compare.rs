@@ -332,8 +332,7 @@ impl CompareOptions {
         if let Some(snn) = &snn {
             comparison.design = format!("{}; snn: {snn}", comparison.design);
         }
-        comparison.provenance =
-            provenance((dataset, &indices), &set, &calibrated, train.is_some())?;
+        comparison.provenance = provenance(dataset, &indices, &set, &calibrated, train.is_some())?;
         if let Some(note) = under_chance_note(&comparison, &params.protocol) {
             on(Progress::Advice(&note));
             comparison.notes.push(note);
@@ -375,9 +374,6 @@ fn under_chance_note(c: &Comparison, protocol: &Protocol) -> Option<String> {
     ))
 }
 
-/// Encodes the recordings once (both populations when an encoding needs the fast-adapting
-/// one), with the pipeline calibrated on the recordings `calibration`, and makes every
-/// candidate of `set` from them.
 /// Where a comparison of `set` on the recordings `indices` of `dataset` comes from:
 /// neurotex's build, the time, the data and the stages as `calibrated` ran them, the
 /// settings of the encodings and methods compared only ([`Comparison::provenance`]);
@@ -386,7 +382,8 @@ fn under_chance_note(c: &Comparison, protocol: &Protocol) -> Option<String> {
 /// # Errors
 /// The manifest or a listed file can no longer be read for the fingerprint.
 fn provenance(
-    (dataset, indices): (&Dataset, &[usize]),
+    dataset: &Dataset,
+    indices: &[usize],
     set: &CandidateSet,
     calibrated: &CalibratedParams,
     split: bool,
@@ -445,8 +442,9 @@ fn provenance(
     Ok(lines)
 }
 
-/// The candidates of `set` on the recordings `indices`, and the pipeline they were made
-/// with (calibrated on the recordings `calibration`).
+/// Encodes the recordings `indices` once (both populations when an encoding needs the
+/// fast-adapting one), with the pipeline calibrated on the recordings `calibration`, and
+/// makes every candidate of `set` from them; returns them and the calibrated pipeline.
 fn make_candidates(
     stages: &StageOptions,
     dataset: &Dataset,
