@@ -1018,5 +1018,6 @@ fn a_network_in_travel_keeps_its_reference_speed_and_needs_speeds() {
     dir.ok(&predict(s(&off), s(&in_ms_out), &["--dataset", s(&ds)]));
     std::fs::write(ds.join("manifest.csv"), manifest).unwrap();
     let at = vec![("/classifier/travel", serde_json::json!({"at": 15.0}))];
-    refused_when_tampered(&dir, &file, &ds, &at, "`network.travel_mm_s` differs");
+    let differs = "`network.travel_mm_s` (20.0) differs from the training parameters (`classifier`: {\"at\":15.0})";
+    refused_when_tampered(&dir, &file, &ds, &at, differs);
 }

@@ -115,7 +115,8 @@ def test_a_recipe_breaking_a_rule_is_refused_naming_the_key(recipe, tmp_path):
 
 def _without_times(value):
     if isinstance(value, dict):
-        return {k: _without_times(v) for k, v in value.items() if k != "seconds"}
+        return {k: _without_times(v) for k, v in value.items()
+                if k not in ("seconds", "provenance")}
     if isinstance(value, list):
         return [_without_times(v) for v in value]
     return value

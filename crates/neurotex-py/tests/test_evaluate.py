@@ -62,9 +62,10 @@ def test_broken_options_are_named_as_python_spells_them(sim_dir):
 
 
 def untimed(value):
-    """`value` without its `seconds` fields: the time each candidate took."""
+    """`value` without its `seconds` fields (the time each candidate took) and its
+    `provenance` (when it ran; the command line's adds its command)."""
     if isinstance(value, dict):
-        return {k: untimed(v) for k, v in value.items() if k != "seconds"}
+        return {k: untimed(v) for k, v in value.items() if k not in ("seconds", "provenance")}
     if isinstance(value, list):
         return [untimed(v) for v in value]
     return value
@@ -82,6 +83,11 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
                              "--per", "speed_mm_s", "--folds", "3", "-k", "3", "--nested",
                              "--inner-folds", "2", "--json", "--out", tmp_path / "cli").stdout)
     assert untimed(ours) == untimed(cli)
+    # The same provenance but for the time and the command the command line adds.
+    same = [[line for line in c["provenance"] if not line.startswith(("created:", "command:"))]
+            for c in (ours, cli)]
+    assert same[0] == same[1] and any(line.startswith("data: sha256:") for line in same[0])
+    assert any(line.startswith("command: neurotex compare") for line in cli["provenance"])
     assert ours["nested"]["inner"] == "2-fold cross-validation inside each outer training set"
     written = [json.loads((tmp_path / side / "compare.json").read_text()) for side in ("py", "cli")]
     assert untimed(written[0]) == untimed(written[1])

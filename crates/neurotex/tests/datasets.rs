@@ -671,12 +671,14 @@ fn compare_nested_per_speed(dataset: &Path, folds: usize, seed: u64) -> Comparis
         .unwrap()
 }
 
-/// `c` with every time set to 0: times differ from run to run, nothing else does.
+/// `c` with every time set to 0 and without its provenance (when it ran, and the data's
+/// folder): those differ from run to run, nothing else does.
 fn without_times(mut c: Comparison) -> Comparison {
     for r in c.results.iter_mut() {
         r.seconds = 0.0;
     }
     c.best.seconds = 0.0;
+    c.provenance.clear();
     c
 }
 
