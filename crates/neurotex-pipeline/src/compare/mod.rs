@@ -824,4 +824,79 @@ mod tests {
             c.notes
         );
     }
+
+    /// Under a hold-out protocol, outer split `a` holding out `b` trains on what outer split
+    /// `b` holding out `a` trains on: with four speeds, each candidate's 12 inner splits are
+    /// 6 fits, each made once on all recordings and read off per split. Every inner accuracy
+    /// is, bit for bit, the one the split's own evaluation gives; a method scoring each taxel
+    /// alone has no per-recording 1 or 0 to read and is evaluated split by split.
+    #[test]
+    fn held_out_inner_splits_share_their_fits_and_keep_their_accuracies() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let speeds = [5.0, 10.0, 15.0, 20.0];
+        let mut taxels = table_at(&speeds, false);
+        taxels.grid = Grid::full(1, 3).unwrap();
+        let knn = KnnParams::default().check().unwrap();
+        let each_taxel = Candidate {
+            method: "taxel".into(),
+            evaluate: crate::analysis::on_table(Arc::new(taxels), Columns::EachTaxel, knn),
+            ..candidate_at(&speeds, "taxel", false)
+        };
+        let (shared, own) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+        let counted = |c: Candidate| {
+            let (evaluate, n) = (Arc::clone(&c.evaluate), c.metas.len());
+            let (shared, own) = (Arc::clone(&shared), Arc::clone(&own));
+            let evaluate: Arc<EvaluateFn> = Arc::new(move |within, split, on| {
+                match (within.len() == n, split) {
+                    (true, Split::Rows { .. }) => shared.fetch_add(1, Ordering::Relaxed),
+                    (false, Split::Where { .. }) => own.fetch_add(1, Ordering::Relaxed),
+                    _ => 0,
+                };
+                evaluate(within, split, on)
+            });
+            Candidate { evaluate, ..c }
+        };
+        let list = [
+            counted(candidate_at(&speeds, "glcm3d", true)),
+            counted(candidate_at(&speeds, "noise", false)),
+        ];
+        let p = params(Protocol::HoldOut("speed_mm_s".into()), true);
+        let spy = Spy::default();
+        // One thread, so that no two outer splits meet a fit at once (each would make it).
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let silent = &crate::progress::silent;
+        pool.install(|| compare_keeping(&list, &p, silent, Some(&spy)).unwrap());
+        // 6 shared fits per candidate and no inner split on its own; each of the 4 outer
+        // splits then trains its chosen candidate on all its rows (also on all recordings).
+        assert_eq!(shared.load(Ordering::Relaxed), 2 * 6 + 4);
+        assert_eq!(own.load(Ordering::Relaxed), 0);
+        let taxel_list = [counted(each_taxel)];
+        let taxel_spy = Spy::default();
+        pool.install(|| compare_keeping(&taxel_list, &p, silent, Some(&taxel_spy)).unwrap());
+        // One shared fit tried (it scores each taxel alone), then every inner split alone.
+        assert_eq!(shared.load(Ordering::Relaxed), 2 * 6 + 4 + 1 + 4);
+        assert_eq!(own.load(Ordering::Relaxed), 4 * 3);
+        let metas = &list[0].metas;
+        let values = parts::conditions(metas, "speed_mm_s").unwrap();
+        for (s, held) in values.iter().enumerate() {
+            let train: Vec<usize> = (0..metas.len())
+                .filter(|&i| metas[i].field("speed_mm_s").as_ref() != Some(held))
+                .collect();
+            let others: Vec<String> = values.iter().filter(|v| *v != held).cloned().collect();
+            let kept = list.iter().map(|c| (c, &spy));
+            for (cand, spy) in kept.chain(taxel_list.iter().map(|c| (c, &taxel_spy))) {
+                let each = others.iter().map(|v| {
+                    let split = parts::hold_out("speed_mm_s", &others, v);
+                    (cand.evaluate)(&train, &split, silent).unwrap().accuracy
+                });
+                let expected = each.sum::<f64>() / others.len() as f64;
+                let key = format!("inner accuracy of {} in outer split {s}", cand.name());
+                let kept: f64 = serde_json::from_str(&spy.get(&key).unwrap()).unwrap();
+                assert_eq!(kept.to_bits(), expected.to_bits(), "{key}");
+            }
+        }
+    }
 }

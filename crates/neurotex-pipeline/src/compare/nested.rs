@@ -1,6 +1,9 @@
 //! Nested selection: the candidates ranked inside each outer training set, the chosen one
 //! scored on its test set.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
 use rayon::prelude::*;
 
 use super::parts::{conditions, cv_split, hold_out, rows_with};
@@ -278,7 +281,7 @@ pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec
 fn outer(
     candidates: &[Candidate],
     (s, split): (usize, &OuterSplit),
-    params: &CompareParams,
+    (params, shared): (&CompareParams, &SharedFits),
     metas: &[Meta],
     (progress, keep): Around<'_>,
 ) -> Result<OuterResult> {
@@ -300,23 +303,38 @@ fn outer(
     // a condition it was not trained on; with one condition there, cross-validation within
     // it is all there is ([`inner_within_one_condition`] says so).
     let held_out = inner_held_out(metas, params, split);
-    let inner_accuracy = |c: &Candidate| -> Result<f64> {
-        let Some((column, values)) = &held_out else {
+    // Each held-out value's split, with its training and test rows among all recordings
+    // (those a fit another outer split makes can stand in for).
+    let held: Vec<(Split, Option<HeldRows>)> = match &held_out {
+        Some((column, values)) => (values.iter())
+            .map(|value| {
+                let held = hold_out(column, values, value);
+                let rows = held_rows(metas, &split.train, &held);
+                (held, rows)
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let inner_accuracy = |k: usize, c: &Candidate| -> Result<f64> {
+        if held_out.is_none() {
             return Ok((c.evaluate)(&split.train, &cv_split(&inner), &silent)?.accuracy);
-        };
-        let mut sum = 0.0;
-        for value in values {
-            let held = hold_out(column, values, value);
-            sum += (c.evaluate)(&split.train, &held, &silent)?.accuracy;
         }
-        Ok(sum / values.len() as f64)
+        let mut sum = 0.0;
+        for (split_of_value, rows) in &held {
+            sum += match rows.as_ref().and_then(|r| shared.accuracy(k, c, r)) {
+                Some(accuracy) => accuracy,
+                None => (c.evaluate)(&split.train, split_of_value, &silent)?.accuracy,
+            };
+        }
+        Ok(sum / held.len() as f64)
     };
     let accuracies: Vec<f64> = candidates
         .par_iter()
-        .map(|c| {
+        .enumerate()
+        .map(|(k, c)| {
             crate::progress::stop_point();
             let key = format!("inner accuracy of {} in outer split {s}", c.name());
-            let accuracy = kept_or(keep, &key, || inner_accuracy(c))?;
+            let accuracy = kept_or(keep, &key, || inner_accuracy(k, c))?;
             progress(Progress::Tick);
             Ok(accuracy)
         })
@@ -335,6 +353,107 @@ fn outer(
     })
 }
 
+/// A held-out value's inner split in one outer split, as rows among all recordings: the
+/// rows trained on and the rows tested.
+struct HeldRows {
+    fit: Vec<usize>,
+    test: Vec<usize>,
+}
+
+/// The rows `held` trains and tests on inside the outer training rows `within`, numbered
+/// among all recordings (ascending); `None` where the split selects nothing (its own
+/// evaluation then says why).
+fn held_rows(metas: &[Meta], within: &[usize], held: &Split) -> Option<HeldRows> {
+    let Split::Where { train, test } = held else {
+        return None;
+    };
+    let sub: Vec<Meta> = within.iter().map(|&r| metas[r].clone()).collect();
+    let among_all = |rows: Vec<usize>| -> Vec<usize> { rows.iter().map(|&i| within[i]).collect() };
+    Some(HeldRows {
+        fit: among_all(train.rows(&sub).ok()?),
+        test: among_all(test.rows(&sub).ok()?),
+    })
+}
+
+/// The inner rankings' fits that outer splits share under a hold-out protocol. Outer split
+/// `a`, holding out value `b` of its training set, trains on the recordings of neither, as
+/// outer split `b` does holding out `a`: with 12 values, 132 inner fits per candidate are 66
+/// different ones. Each is made once and tested on every recording outside it; an inner
+/// split reads its accuracy off its own test rows. The fit is the one the inner split would
+/// make (the same training rows, in the same order, with the same classes) and each
+/// recording's prediction depends on the fit alone, so every accuracy is the same, bit for
+/// bit, as the inner split's own evaluation. Where a shared fit cannot stand in (a class
+/// outside it that it would have to be tested on, a method scoring each taxel alone), the
+/// inner split is evaluated on its own.
+#[derive(Default)]
+struct SharedFits {
+    slots: Mutex<SharedSlots>,
+    /// The candidates found to score groups of columns alone (evaluated split by split).
+    alone: Mutex<Vec<usize>>,
+}
+
+/// Per candidate and training rows, the shared fit's right predictions (1 or 0 per
+/// recording tested, by row), or `None` where it cannot stand in.
+type SharedSlots = HashMap<(usize, Vec<usize>), Option<Arc<Vec<(usize, f64)>>>>;
+
+impl SharedFits {
+    /// Candidate `k`'s (`c`) accuracy on `rows.test` trained on `rows.fit`, from the shared
+    /// fit; `None` where it cannot stand in.
+    fn accuracy(&self, k: usize, c: &Candidate, rows: &HeldRows) -> Option<f64> {
+        if lock(&self.alone).contains(&k) {
+            return None;
+        }
+        let key = (k, rows.fit.clone());
+        let known = lock(&self.slots).get(&key).cloned();
+        // The lock is not held while fitting: two outer splits that meet the same fit at
+        // once each make it (the same bits), rather than one waiting inside rayon's pool.
+        let right = match known {
+            Some(right) => right,
+            None => {
+                let right = shared_fit(c, &rows.fit, || lock(&self.alone).push(k));
+                lock(&self.slots).entry(key).or_insert(right).clone()
+            }
+        }?;
+        let mut sum = 0.0;
+        for row in &rows.test {
+            let at = right.binary_search_by_key(row, |r| r.0).ok()?;
+            sum += right[at].1;
+        }
+        // A sum of ones and zeros is the count of right predictions exactly, so this is
+        // the inner split's own accuracy (right / tested).
+        Some(sum / rows.test.len().max(1) as f64)
+    }
+}
+
+/// `m` locked (a lock poisoned by a panic elsewhere still holds whole entries).
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Candidate `c` trained on the rows `fit` and tested on every other recording: each
+/// recording's right prediction (1 or 0), by row; `None` where that cannot stand in for an
+/// inner split's own evaluation (a test class it has not trained on, several groups of
+/// columns each scored alone: `in_groups` is then called).
+fn shared_fit(
+    c: &Candidate,
+    fit: &[usize],
+    in_groups: impl FnOnce(),
+) -> Option<Arc<Vec<(usize, f64)>>> {
+    let test: Vec<usize> = (0..c.metas.len())
+        .filter(|r| fit.binary_search(r).is_err())
+        .collect();
+    let (train, test) = (fit.to_vec(), test);
+    let outcome = c.evaluate_all(&Split::Rows { train, test }).ok()?;
+    // Predictions are kept for one group of columns only: then each share is 1 or 0.
+    if outcome.predictions.is_none() {
+        in_groups();
+        return None;
+    }
+    let mut right = outcome.correct_shares;
+    right.sort_unstable_by_key(|r| r.0);
+    Some(Arc::new(right))
+}
+
 /// Nested selection: inside each outer split's training rows every candidate is
 /// cross-validated (one repeat), the best is trained on all of them and tested on the
 /// split's test rows.
@@ -348,10 +467,14 @@ pub(super) fn nested(
     let metas = &candidates[0].metas;
     let steps = splits.len() * candidates.len();
     progress(Progress::Stage("nested selection", steps));
+    let shared = SharedFits::default();
     let outcomes: Vec<OuterResult> = splits
         .par_iter()
         .enumerate()
-        .map(|split| outer(candidates, split, params, metas, (progress, keep)))
+        .map(|split| {
+            let around = (progress, keep);
+            outer(candidates, split, (params, &shared), metas, around)
+        })
         .collect::<Result<_>>()?;
     let mut shares: Vec<(usize, f64)> = outcomes.iter().flat_map(|o| o.shares.clone()).collect();
     shares.sort_by_key(|&(row, _)| row);

@@ -257,19 +257,15 @@ pub fn reproduce(
 ) -> Result<Results> {
     let started = Instant::now();
     let _claim = check_report_dir(out)?;
-    let (results, described, params) = analyse(data, params, run)?;
-    let (source, layout, slides) = match data {
-        Data::Folder(ds) => (
-            folder_source(&ds.root),
-            ds.layout.baseline,
-            crate::experiments::slide_times(&ds.entries),
-        ),
-        Data::Simulated { seeds, .. } => (simulated_source(seeds), None, [1, 1]),
+    let (results, described) = analyse(data, params, run)?;
+    let source = match data {
+        Data::Folder(ds) => folder_source(&ds.root),
+        Data::Simulated { seeds, .. } => simulated_source(seeds),
     };
     let ctx = ReportContext {
         dataset: described,
         source,
-        parameters: parameters_described(&params, (layout, slides), &results),
+        parameters: parameters_described(&results),
         total_seconds: started.elapsed().as_secs_f64(),
         command: run.command.clone(),
         paper_comparable: matches!(data, Data::Simulated { .. }),
@@ -278,13 +274,9 @@ pub fn reproduce(
     Ok(results)
 }
 
-/// Every analysis on the dataset folder, or on the simulated datasets; returns the results,
-/// the report's paragraph on the data and the parameters run with.
-fn analyse(
-    data: Data<'_>,
-    params: ReproduceParams,
-    run: &Run<'_>,
-) -> Result<(Results, String, ValidReproduceParams)> {
+/// Every analysis on the dataset folder, or on the simulated datasets; returns the results
+/// and the report's paragraph on the data.
+fn analyse(data: Data<'_>, params: ReproduceParams, run: &Run<'_>) -> Result<(Results, String)> {
     Ok(match data {
         Data::Folder(ds) => {
             let source = Source::Dataset(ds);
@@ -302,7 +294,7 @@ fn analyse(
                 }
             }
             results.gain_calibration = calibration;
-            (results, source.describe(), params)
+            (results, source.describe())
         }
         Data::Simulated { trials, seeds } => {
             let simulate = |seed| Source::paper_design(trials, seed);
@@ -310,7 +302,7 @@ fn analyse(
             let (params, calibration) = calibrated(params, run, &first)?;
             let mut results = run_seeds(&simulate, seeds, &params, run.on_progress)?;
             results.gain_calibration = calibration;
-            (results, describe_seeds(&first, seeds), params)
+            (results, describe_seeds(&first, seeds))
         }
     })
 }
@@ -361,16 +353,15 @@ fn calibrated(
     Ok((params.check()?, calibration))
 }
 
-/// The report's parameter lines: the run's parameters (the dataset's `layout.toml`
-/// baseline `layout` where the pipeline sets none, and how many recordings have slide
-/// times) and, under `--gain auto`, the gain
-/// chosen.
-fn parameters_described(
-    params: &ValidReproduceParams,
-    (layout, slides): (Option<crate::recording::Baseline>, [usize; 2]),
-    results: &Results,
-) -> Vec<String> {
-    let mut lines = params.describe(layout, slides);
+/// The report's parameter lines: the run's parameters as its provenance lists them (with
+/// the dataset's `layout.toml` baseline where the pipeline sets none, and how many
+/// recordings have slide times) and, under `--gain auto`, the gain chosen.
+fn parameters_described(results: &Results) -> Vec<String> {
+    // A run's results always hold their provenance (only results read from files written
+    // before it existed lack one).
+    let mut lines = (results.provenance.as_ref())
+        .map(|p| p.parameters.clone())
+        .unwrap_or_default();
     if let Some(c) = &results.gain_calibration {
         let shared = if results.across_seeds.is_some() {
             "; calibrated on the first simulated dataset and used for all"

@@ -41,7 +41,7 @@ neurotex_core::widest_or_plain! {
             sub_scaled(&mut q, a, y);
             alpha.push(a);
         }
-        let mut scratch = Vec::new();
+        let mut scratch = SolveScratch::default();
         if let Some((inverse, d, curvature)) = pre {
             solve(inverse, d, curvature, &mut q, &mut scratch);
         }
@@ -128,25 +128,40 @@ impl Preconditioner {
 }
 
 /// `v` (`k` rows of weights, then `k` intercepts) times the preconditioner's inverse
-/// (`d x d`) and its intercepts divided by `curvature`, `out` scratch space. Each class's
+/// (`d x d`) and its intercepts divided by `curvature`, in `scratch`'s space. Each class's
 /// entry `j` is `Σ_i v_i inverse_ij` added from 0 in the order of `i`. The sums are kept
 /// in registers, [`SOLVE_CLASSES`] classes by [`SOLVE_COLUMNS`] entries at a time, while
 /// the rows of the inverse go by (a sum added into memory waits on a load and a store per
 /// row); the last columns, fewer than [`SOLVE_COLUMNS`], are summed in memory.
 #[inline(always)]
-pub(super) fn solve(inverse: &[f64], d: usize, curvature: f64, v: &mut [f64], out: &mut Vec<f64>) {
+pub(super) fn solve(
+    inverse: &[f64],
+    d: usize,
+    curvature: f64,
+    v: &mut [f64],
+    scratch: &mut SolveScratch,
+) {
     let k = v.len() / (d + 1);
     let (w, b) = v.split_at_mut(k * d);
+    let SolveScratch { out, by_row } = scratch;
     out.clear();
     out.resize(k * d, 0.0);
     let size = SOLVE_CLASSES * d;
     for (w, out) in w.chunks(size).zip(out.chunks_mut(size)) {
-        solve_classes(inverse, d, w, out);
+        solve_classes(inverse, d, w, out, by_row);
     }
     w.copy_from_slice(out);
     for bc in b.iter_mut() {
         *bc /= curvature;
     }
+}
+
+/// [`solve`]'s space, kept from one call to the next: the product, and a block of classes'
+/// entries by row.
+#[derive(Default)]
+pub(super) struct SolveScratch {
+    out: Vec<f64>,
+    by_row: Vec<[f64; SOLVE_CLASSES]>,
 }
 
 /// Classes whose entries [`solve`] sums side by side.
@@ -155,10 +170,18 @@ const SOLVE_CLASSES: usize = 4;
 const SOLVE_COLUMNS: usize = 16;
 
 /// [`solve`] for the up to [`SOLVE_CLASSES`] classes of `w` (each `d` long) into `out`
-/// (zeros, as long as `w`). A block of fewer classes sums zeros in the others' place.
+/// (zeros, as long as `w`), `by_row` space for their entries. A block of fewer classes
+/// sums zeros in the others' place.
 #[inline(always)]
-fn solve_classes(inverse: &[f64], d: usize, w: &[f64], out: &mut [f64]) {
-    let mut by_row = vec![[0.0; SOLVE_CLASSES]; d];
+fn solve_classes(
+    inverse: &[f64],
+    d: usize,
+    w: &[f64],
+    out: &mut [f64],
+    by_row: &mut Vec<[f64; SOLVE_CLASSES]>,
+) {
+    by_row.clear();
+    by_row.resize(d, [0.0; SOLVE_CLASSES]);
     for (c, w) in w.chunks_exact(d).enumerate() {
         by_row.iter_mut().zip(w).for_each(|(g, &v)| g[c] = v);
     }
@@ -166,7 +189,7 @@ fn solve_classes(inverse: &[f64], d: usize, w: &[f64], out: &mut [f64]) {
     for j in (0..full).step_by(SOLVE_COLUMNS) {
         // Four named sums: kept in an array, one of them went through memory.
         let [mut s0, mut s1, mut s2, mut s3] = [[0.0; SOLVE_COLUMNS]; SOLVE_CLASSES];
-        for (row, g) in inverse.chunks_exact(d).zip(&by_row) {
+        for (row, g) in inverse.chunks_exact(d).zip(by_row.iter()) {
             let tile: &[f64; SOLVE_COLUMNS] = row[j..j + SOLVE_COLUMNS].try_into().unwrap();
             add_times(&mut s0, g[0], tile);
             add_times(&mut s1, g[1], tile);
@@ -177,7 +200,7 @@ fn solve_classes(inverse: &[f64], d: usize, w: &[f64], out: &mut [f64]) {
             out[j..j + SOLVE_COLUMNS].copy_from_slice(&sum);
         }
     }
-    for (row, g) in inverse.chunks_exact(d).zip(&by_row) {
+    for (row, g) in inverse.chunks_exact(d).zip(by_row.iter()) {
         for (out, &g) in out.chunks_exact_mut(d).zip(g) {
             out[full..]
                 .iter_mut()

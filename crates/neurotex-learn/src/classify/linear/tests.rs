@@ -131,7 +131,7 @@ fn the_preconditioner_solves_each_class_as_one_at_a_time() {
     }
     expected[k * d..].iter_mut().for_each(|b| *b /= 0.3);
     let mut got = v.clone();
-    solve(&inverse, d, 0.3, &mut got, &mut Vec::new());
+    solve(&inverse, d, 0.3, &mut got, &mut Default::default());
     let bits = |g: &[f64]| g.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&got), bits(&expected));
 }
