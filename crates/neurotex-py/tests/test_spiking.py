@@ -172,6 +172,24 @@ def test_training_on_windows_gives_the_network_of_the_cli(sim, sim_dir, tmp_path
     assert "window_ms" in json.dumps(est_file)
 
 
+def test_training_on_warped_time_gives_the_network_of_the_cli(sim, sim_dir, tmp_path):
+    """`warp` trains the network `--snn-warp` trains, records it in the file, and the
+    scikit-learn estimator passes it on; a bound that is no warp is refused by name."""
+    flags = ["--snn-hidden", "8", "--snn-epochs", "2", "--snn-warp", "2"]
+    py, cli = python_and_cli(sim, sim_dir, tmp_path, flags, hidden=8, epochs=2, warp=2.0)
+    assert '"warp": 2.0' in json.dumps(cli)
+    plain = neurotex.SpikingModel.train(sim, hidden=8, epochs=2)
+    plain.save(tmp_path / "plain.json")
+    assert json.loads((tmp_path / "plain.json").read_text())["network"] != py["network"]
+    from neurotex.sklearn import SpikingClassifier
+
+    est = SpikingClassifier(hidden=8, epochs=2, warp=2.0).fit(sim.recordings, sim.labels)
+    est.model_.save(tmp_path / "est.json")
+    assert '"warp": 2.0' in json.dumps(json.loads((tmp_path / "est.json").read_text()))
+    with pytest.raises(neurotex.errors.ParameterError, match="snn.warp"):
+        neurotex.SpikingModel.train(sim, hidden=8, epochs=1, warp=1.0)
+
+
 def test_trained_decays_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
     """`train_decays` trains the network `--snn-train-decays` trains: one synaptic and one
     membrane decay per hidden neuron in the file, which the NIR graph carries."""

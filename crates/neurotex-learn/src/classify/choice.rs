@@ -146,6 +146,9 @@ impl fmt::Display for ClassifierChoice {
                 if let Some(window) = p.window_ms {
                     write!(f, ", trained on {window} ms windows")?;
                 }
+                if let Some(w) = p.warp {
+                    write!(f, ", trained on time warped up to {w}x")?;
+                }
                 if !p.standardize {
                     write!(f, ", inputs not standardised")?;
                 }

@@ -75,6 +75,14 @@ pub struct SnnParams {
     /// [`Travel`]). Left out of model files when off.
     #[serde(default = "Travel::off", skip_serializing_if = "Travel::is_off")]
     pub travel: Travel,
+    /// Train on time-warped recordings: at each epoch each training recording (or its
+    /// window) is stretched or squeezed by a factor drawn log-uniformly between `1/W` and
+    /// `W` (step `t` to step `⌊t / f⌋`), as if slid up to `W` times slower or faster with
+    /// the same spikes per mm travelled; `None` trains on the recordings as they are.
+    /// Validation and prediction read them as they are. Left out of model files when
+    /// absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warp: Option<f64>,
 }
 
 impl Default for SnnParams {
@@ -101,6 +109,7 @@ impl Default for SnnParams {
             standardize: true,
             train_decays: false,
             travel: Travel::Off,
+            warp: None,
         }
     }
 }
@@ -108,6 +117,10 @@ impl Default for SnnParams {
 /// Largest hidden layer accepted: beyond it a model file and a training run grow past
 /// what these small tactile datasets can fit.
 pub const MAX_HIDDEN: usize = 4096;
+
+/// Largest time warp's bound: a recording stretched `W` times is `W` times as long to
+/// train on.
+pub const MAX_WARP: f64 = 10.0;
 
 impl SnnParams {
     /// Checks the rules and returns the parameters.
@@ -158,6 +171,12 @@ impl SnnParams {
                 return Err(ParamError::new("snn-window-ms", rule, got));
             }
         }
+        if let Some(w) = self.warp {
+            if !(w > 1.0 && w <= MAX_WARP) {
+                let rule = "a time warp's bound W must be above 1 (no warp: leave it out) and at most 10 (a recording stretched W times is W times as long to train on)";
+                return Err(ParamError::new("snn-warp", rule, w));
+            }
+        }
         self.travel.check()?;
         match self.target {
             Target::Float => Ok(self),
@@ -175,6 +194,7 @@ impl SnnParams {
             ("snn-recurrent", self.recurrent, "the Xylo profile runs feed-forward networks", "--snn-recurrent".to_string()),
             ("snn-train-decays", self.train_decays, "the Xylo profile's neurons share the chip's bitshift decays", "--snn-train-decays".to_string()),
             ("snn-travel", !self.travel.is_off(), "the Xylo profile's inputs are whole events per step, which steps of travel weigh by their length", format!("--snn-travel {}", self.travel.name())),
+            ("snn-warp", self.warp.is_some(), "the Xylo profile's inputs carry at most 15 events a step, which squeezed time would pass", format!("--snn-warp {}", self.warp.unwrap_or_default())),
         ];
         if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
             return Err(ParamError::new(name, rule, got));

@@ -260,7 +260,9 @@ fn kernel_energy(alpha: f64, beta: f64) -> f64 {
 
 /// What the network is trained on for each recording of `batch`, in batch order: the
 /// recording whole, or with [`SnnParams::window_ms`] a window of that length starting at
-/// a step drawn uniformly (in batch order, from the one stream) among those that fit.
+/// a step drawn uniformly among those that fit; with [`SnnParams::warp`] `W`, that
+/// stretched or squeezed by a factor `f = e^u`, `u` uniform in `±ln W` (step `t` to step
+/// `⌊t / f⌋`). The draws come in batch order from the one stream.
 fn seen_inputs<'a>(
     params: &SnnParams,
     inputs: &[&'a SpikeInput],
@@ -273,7 +275,19 @@ fn seen_inputs<'a>(
         }
         _ => Cow::Borrowed(x),
     };
-    batch.iter().map(|&i| cut(inputs[i], rng)).collect()
+    let warp = |x: Cow<'a, SpikeInput>, rng: &mut ChaCha8Rng| match params.warp {
+        Some(w) => {
+            let u: f64 = rng.gen_range(-w.ln()..=w.ln());
+            Cow::Owned(x.rebin(u.exp()))
+        }
+        None => x,
+    };
+    (batch.iter())
+        .map(|&i| {
+            let seen = cut(inputs[i], rng);
+            warp(seen, rng)
+        })
+        .collect()
 }
 
 thread_local! {
@@ -662,6 +676,54 @@ mod tests {
         let (net, log) = fit(&short, &refs, &y, 2).unwrap();
         assert_ne!(net, fit(&whole, &refs, &y, 2).unwrap().0);
         learned_alike_on_one_thread(&short, &refs, &y, (&net, log));
+    }
+
+    /// Time-warped training: each epoch's recordings are their steps stretched or squeezed
+    /// within the bound (never by more, and by different factors), the task is still
+    /// learnt, a seed gives one network on any number of threads, and bounds that are no
+    /// warp or past the largest are refused.
+    #[test]
+    fn warped_recordings_keep_their_spikes_within_the_bound() {
+        let (data, y) = two_class_task(40, 50);
+        let refs: Vec<&SpikeInput> = data.iter().collect();
+        let plain = SnnParams {
+            hidden: 16,
+            epochs: 30,
+            ..SnnParams::default()
+        };
+        let warped = SnnParams {
+            warp: Some(2.0),
+            ..plain
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let batch: Vec<usize> = (0..40).collect();
+        let seen = seen_inputs(&warped, &refs, &batch, &mut rng);
+        let mut lengths: Vec<usize> = seen.iter().map(|x| x.steps()).collect();
+        for (x, &i) in seen.iter().zip(&batch) {
+            assert_eq!(x.total(), refs[i].total());
+            assert!((25..=100).contains(&x.steps()), "{} steps", x.steps());
+        }
+        lengths.sort_unstable();
+        lengths.dedup();
+        assert!(lengths.len() > 10, "{lengths:?}");
+        let (net, log) = fit(&warped, &refs, &y, 2).unwrap();
+        assert_ne!(net, fit(&plain, &refs, &y, 2).unwrap().0);
+        learned_alike_on_one_thread(&warped, &refs, &y, (&net, log));
+        for w in [1.0, 0.5, 10.5, f64::NAN] {
+            let p = SnnParams {
+                warp: Some(w),
+                ..plain
+            };
+            let err = p.check().unwrap_err().to_string();
+            assert!(err.contains("snn-warp"), "{err}");
+        }
+        let xylo = SnnParams {
+            target: crate::snn::Target::Xylo,
+            reset: crate::snn::Reset::Subtract,
+            ..warped
+        };
+        let err = xylo.check().unwrap_err().to_string();
+        assert!(err.contains("snn-warp"), "{err}");
     }
 
     #[test]

@@ -1103,6 +1103,7 @@ class SpikingModel(Model):
         window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
         train_decays: bool = _SNN_DEFAULTS["train_decays"],
         travel: Union[str, float] = _SNN_DEFAULTS["travel"],
+        warp: Optional[float] = _SNN_DEFAULTS["warp"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -1125,13 +1126,16 @@ class SpikingModel(Model):
         beside the weights (``--snn-train-decays``); ``travel`` is how the network counts
         time (``--snn-travel``): ``"median"`` in steps of travel at the training recordings'
         median speed (``speeds``; in ms without them), a speed in mm/s for that reference,
-        or ``"off"`` (the default) for ms.
+        or ``"off"`` (the default) for ms; ``warp`` trains on time-warped recordings, each
+        stretched or squeezed at every epoch by a factor drawn log-uniformly between
+        ``1/warp`` and ``warp`` (``--snn-warp``; ``None``: as they are).
         ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
         :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
                "seed": seed, "recurrent": recurrent, "target": target,
                "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms,
-               "window_ms": window_ms, "train_decays": train_decays, "travel": str(travel)}
+               "window_ms": window_ms, "train_decays": train_decays, "travel": str(travel),
+               "warp": warp}
         if reset is not None:
             snn["reset"] = reset
         folder = _folder(recordings)

@@ -292,7 +292,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     stopping on 20 % of each class of ``X``, seeded by ``seed``; ``recurrent`` and
     ``reset`` (``"zero"`` or ``"subtract"``), ``target`` (``"float"`` or ``"xylo"``) and
     ``window_ms`` (train on windows of that many ms), ``train_decays`` (each hidden
-    neuron's decays trained) and ``travel`` (time in steps of travel) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
+    neuron's decays trained), ``travel`` (time in steps of travel) and ``warp`` (train on
+    time-warped recordings) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
     it to NIR)."""
 
@@ -309,6 +310,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         window_ms: Optional[int] = _SNN_DEFAULTS["window_ms"],
         train_decays: bool = _SNN_DEFAULTS["train_decays"],
         travel: Union[str, float] = _SNN_DEFAULTS["travel"],
+        warp: Optional[float] = _SNN_DEFAULTS["warp"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
@@ -326,6 +328,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.window_ms = window_ms
         self.train_decays = train_decays
         self.travel = travel
+        self.warp = warp
         self.encoding = encoding
         self.gain = gain
         self.baseline = baseline
@@ -348,7 +351,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
             dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
             recurrent=self.recurrent, reset=self.reset, target=self.target,
             window_ms=self.window_ms, train_decays=self.train_decays, travel=self.travel,
-            causal=self.causal,
+            warp=self.warp, causal=self.causal,
             encoding=self.encoding, gain=self.gain,
             baseline=self.baseline,
         )
