@@ -186,7 +186,7 @@ def test_training_on_warped_time_gives_the_network_of_the_cli(sim, sim_dir, tmp_
     est = SpikingClassifier(hidden=8, epochs=2, warp=2.0).fit(sim.recordings, sim.labels)
     est.model_.save(tmp_path / "est.json")
     assert '"warp": 2.0' in json.dumps(json.loads((tmp_path / "est.json").read_text()))
-    with pytest.raises(neurotex.errors.ParameterError, match="snn.warp"):
+    with pytest.raises(neurotex.errors.ParameterError, match="`warp`"):
         neurotex.SpikingModel.train(sim, hidden=8, epochs=1, warp=1.0)
 
 
