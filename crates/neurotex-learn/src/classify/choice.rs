@@ -147,7 +147,7 @@ impl fmt::Display for ClassifierChoice {
                     write!(f, ", trained on {window} ms windows")?;
                 }
                 if let Some(w) = p.warp {
-                    write!(f, ", trained on time warped up to {w}x")?;
+                    write!(f, ", time warped up to {w}x in training")?;
                 }
                 if !p.standardize {
                     write!(f, ", inputs not standardised")?;

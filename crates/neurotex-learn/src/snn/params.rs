@@ -194,7 +194,7 @@ impl SnnParams {
             ("snn-recurrent", self.recurrent, "the Xylo profile runs feed-forward networks", "--snn-recurrent".to_string()),
             ("snn-train-decays", self.train_decays, "the Xylo profile's neurons share the chip's bitshift decays", "--snn-train-decays".to_string()),
             ("snn-travel", !self.travel.is_off(), "the Xylo profile's inputs are whole events per step, which steps of travel weigh by their length", format!("--snn-travel {}", self.travel.name())),
-            ("snn-warp", self.warp.is_some(), "the Xylo profile's inputs carry at most 15 events a step, which squeezed time would pass", format!("--snn-warp {}", self.warp.unwrap_or_default())),
+            ("snn-warp", self.warp.is_some(), "the Xylo profile's inputs carry at most 15 events a step, which squeezed time can exceed (leave out --snn-warp, or train for --snn-target float)", format!("--snn-warp {}", self.warp.unwrap_or_default())),
         ];
         if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
             return Err(ParamError::new(name, rule, got));

@@ -274,8 +274,9 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         "Train on time-warped recordings: at each epoch each training recording is \
          stretched or squeezed by a factor drawn log-uniformly between 1/W and W (above 1, \
          at most 10), as if slid up to W times slower or faster with the same spikes per mm, \
-         so that the network meets each texture at more speeds than it was recorded at \
-         [default: none]. Validation and prediction read the recordings as they are.",
+         so that the network meets each texture at more speeds than it was recorded at; \
+         validation and prediction read the recordings as they are [default: none: no \
+         warp].",
         get: |w: &Option<f64>| w.map(|v| v.to_string()), set: |t: &str| parse(t).map(Some)),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \
