@@ -129,7 +129,7 @@ pub fn e9_compare(
         group_by: params.group_by.clone(),
         resamples: 2000,
         nested,
-        inner_folds: cv.folds,
+        inner_folds: None,
     };
     let column = "speed_mm_s".to_string();
     let per = || Protocol::Per(column.clone());

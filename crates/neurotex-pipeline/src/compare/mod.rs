@@ -43,8 +43,9 @@ pub use crate::analysis::EvaluateFn;
 
 /// The version of what nested selection computes, raised whenever its rules change, so that
 /// results kept under an older one are computed anew (2: under a hold-out protocol the inner
-/// ranking holds out each condition of the outer training set).
-pub const NESTED_VERSION: u32 = 2;
+/// ranking holds out each condition of the outer training set; 3: under cross-validation
+/// it holds out each other outer fold).
+pub const NESTED_VERSION: u32 = 3;
 
 /// One encoding x feature method x classifier, with its features computed.
 #[derive(Clone)]
@@ -149,9 +150,13 @@ pub struct CompareParams {
     pub resamples: usize,
     /// Also estimate the accuracy of choosing the best candidate inside each training set.
     pub nested: bool,
-    /// Folds of nested selection's inner cross-validation (at least 2; fewer where a class
-    /// of an outer training set has fewer recordings); the front ends' default is `cv`'s.
-    pub inner_folds: usize,
+    /// Folds of nested selection's inner cross-validation on folds of its own (at least 2;
+    /// fewer where a class of an outer training set has fewer recordings). `None`: the inner
+    /// ranking holds out each other outer fold of its condition in turn (`cv.folds - 1`
+    /// inner folds, each fit shared by the two outer splits that hold it); with fewer than
+    /// 4 folds, or where a class would be missing from an inner fit, it cross-validates on
+    /// `cv.folds` folds of its own.
+    pub inner_folds: Option<usize>,
 }
 
 /// A candidate's accuracy at one condition.
@@ -459,10 +464,12 @@ fn design(params: &CompareParams) -> String {
             "; nested selection ranks inside each training set, each of its values held out in turn"
                 .into()
         }
-        (true, _) => format!(
-            "; nested selection ranks inside each training set ({} inner folds)",
-            params.inner_folds
-        ),
+        (true, _) => match params.inner_folds {
+            Some(folds) => {
+                format!("; nested selection ranks inside each training set ({folds} inner folds)")
+            }
+            None => "; nested selection ranks inside each training set, each other outer fold held out in turn".into(),
+        },
     };
     format!(
         "{splits}; {} resamples for intervals and tests{nested}",
@@ -626,7 +633,7 @@ mod tests {
             group_by: None,
             resamples: 500,
             nested,
-            inner_folds: 4,
+            inner_folds: Some(4),
         }
     }
 
@@ -898,5 +905,99 @@ mod tests {
                 assert_eq!(kept.to_bits(), expected.to_bits(), "{key}");
             }
         }
+    }
+
+    /// Under cross-validation the inner ranking holds out each other outer fold of the
+    /// condition in turn: outer split `a` holding out fold `b` trains on what outer split `b`
+    /// holding out `a` trains on, so with 4 folds at each of 2 speeds each candidate's 24
+    /// inner splits are 12 fits, each made once and read by both. Every inner accuracy is
+    /// the mean of the split's own evaluations; where a fit would miss a class of the outer
+    /// training set, or inner folds are asked for, the outer folds do not serve.
+    #[test]
+    fn cross_validated_inner_splits_hold_out_the_other_outer_folds_and_share_their_fits() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let speeds = [5.0, 10.0];
+        let fits = Arc::new(AtomicUsize::new(0));
+        let counted = |c: Candidate| {
+            let (evaluate, n, fits) = (Arc::clone(&c.evaluate), c.metas.len(), Arc::clone(&fits));
+            let evaluate: Arc<EvaluateFn> = Arc::new(move |within, split, on| {
+                if within.len() == n && matches!(split, Split::Rows { .. }) {
+                    fits.fetch_add(1, Ordering::Relaxed);
+                }
+                evaluate(within, split, on)
+            });
+            Candidate { evaluate, ..c }
+        };
+        let list = [
+            counted(candidate_at(&speeds, "glcm3d", true)),
+            counted(candidate_at(&speeds, "noise", false)),
+        ];
+        let p = CompareParams {
+            inner_folds: None,
+            ..params(Protocol::Per("speed_mm_s".into()), true)
+        };
+        let (spy, silent) = (Spy::default(), &crate::progress::silent);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let c = pool.install(|| compare_keeping(&list, &p, silent, Some(&spy)).unwrap());
+        // 2 speeds x 6 pairs of folds per candidate, then each of the 8 outer splits trains
+        // its chosen candidate on all its rows.
+        assert_eq!(fits.load(Ordering::Relaxed), 2 * 2 * 6 + 8);
+        let nested = c.nested.unwrap();
+        assert!(
+            nested.inner.starts_with("each other outer fold"),
+            "{}",
+            nested.inner
+        );
+        let metas = &list[0].metas;
+        let splits = nested::outer_splits(metas, &p).unwrap();
+        assert_eq!(splits.len(), 8);
+        for (s, split) in splits.iter().enumerate() {
+            assert_eq!(split.others.len(), 3);
+            assert!(nested::on_outer_folds(metas, &p, split));
+            let at = |rows: &[usize]| -> Vec<usize> {
+                let position = |r: &usize| split.train.iter().position(|t| t == r).unwrap();
+                rows.iter().map(position).collect()
+            };
+            for cand in &list {
+                let each = split.others.iter().map(|held| {
+                    let fit: Vec<usize> = (split.train.iter().copied())
+                        .filter(|r| !held.contains(r))
+                        .collect();
+                    let own = Split::Rows {
+                        train: at(&fit),
+                        test: at(held),
+                    };
+                    (cand.evaluate)(&split.train, &own, silent)
+                        .unwrap()
+                        .accuracy
+                });
+                let expected = each.sum::<f64>() / 3.0;
+                let key = format!("inner accuracy of {} in outer split {s}", cand.name());
+                let kept: f64 = serde_json::from_str(&spy.get(&key).unwrap()).unwrap();
+                assert_eq!(kept.to_bits(), expected.to_bits(), "{key}");
+            }
+        }
+        // Inner folds asked for, three outer folds, or a class all in the two folds a fit
+        // leaves out: the split cross-validates on folds of its own.
+        let asked = CompareParams {
+            inner_folds: Some(3),
+            ..p.clone()
+        };
+        assert!(!nested::on_outer_folds(metas, &asked, &splits[0]));
+        let mut splits = splits.into_iter();
+        let (mut split, mut three) = (splits.next().unwrap(), splits.next().unwrap());
+        three.others.truncate(2);
+        assert!(!nested::on_outer_folds(metas, &p, &three));
+        let class_of = |r: &usize| metas[*r].label.clone();
+        let c0: Vec<usize> = (split.train.iter())
+            .filter(|r| class_of(r) == "c0")
+            .copied()
+            .collect();
+        split.others[0].retain(|r| class_of(r) != "c0");
+        split.others[0].extend(&c0);
+        assert!(!nested::on_outer_folds(metas, &p, &split));
     }
 }

@@ -46,7 +46,7 @@ pub(super) fn fewer_folds(
             ));
         }
     }
-    let asked = params.inner_folds;
+    let asked = fresh_folds(params);
     let mut fewer = inner_folds_of(metas, params, outer.unwrap_or_default());
     fewer.retain(|&used| used < asked);
     if let Some(low) = fewer.iter().min() {
@@ -61,12 +61,41 @@ pub(super) fn fewer_folds(
 }
 
 /// The inner cross-validation's folds in each of `splits` whose inner ranking
-/// cross-validates (rather than holding conditions out).
+/// cross-validates on folds of its own (rather than holding conditions or the other outer
+/// folds out).
 fn inner_folds_of(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) -> Vec<usize> {
     (splits.iter())
         .filter(|split| inner_held_out(metas, params, split).is_none())
-        .map(|split| inner_folds(params.inner_folds, smallest_class(metas, &split.train)))
+        .filter(|split| !on_outer_folds(metas, params, split))
+        .map(|split| inner_folds(fresh_folds(params), smallest_class(metas, &split.train)))
         .collect()
+}
+
+/// The folds of an inner cross-validation on folds of its own: `--inner-folds`, or where it
+/// is not given and the outer folds cannot serve, `--folds`.
+fn fresh_folds(params: &CompareParams) -> usize {
+    params.inner_folds.unwrap_or(params.cv.folds)
+}
+
+/// Whether `split`'s inner ranking holds out each other outer fold of its condition in
+/// turn: where no inner folds are asked for, the condition has four outer folds or more
+/// (with three, each inner fit would train on a third of its recordings), and every such
+/// inner training set holds every class of the outer training set.
+pub(super) fn on_outer_folds(metas: &[Meta], params: &CompareParams, split: &OuterSplit) -> bool {
+    if params.inner_folds.is_some() || split.others.len() < 3 {
+        return false;
+    }
+    let classes = |rows: &mut dyn Iterator<Item = usize>| -> Vec<&str> {
+        let mut labels: Vec<&str> = rows.map(|r| metas[r].label.as_str()).collect();
+        labels.sort_unstable();
+        labels.dedup();
+        labels
+    };
+    let all = classes(&mut split.train.iter().copied());
+    split.others.iter().all(|held| {
+        let mut fit = split.train.iter().copied().filter(|r| !held.contains(r));
+        classes(&mut fit) == all
+    })
 }
 
 /// The folds of nested selection's inner cross-validation: `folds` (the inner folds asked
@@ -99,7 +128,10 @@ fn inner_held_out<'p>(
 /// How the outer training sets ranked the candidates, in words.
 fn inner_ranking(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) -> String {
     let folds = inner_folds_of(metas, params, splits);
-    let held = splits.len() - folds.len();
+    let aligned = (splits.iter())
+        .filter(|split| on_outer_folds(metas, params, split))
+        .count();
+    let held = splits.len() - folds.len() - aligned;
     let cv = match (folds.iter().min(), folds.iter().max()) {
         (Some(&a), Some(&b)) if a == b => format!("{a}-fold cross-validation"),
         (Some(&a), Some(&b)) => format!("{a}- to {b}-fold cross-validation"),
@@ -115,6 +147,13 @@ fn inner_ranking(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) 
         (Protocol::HoldOut(column), h) => format!(
             "each other value of {column} held out in turn inside {h} outer training sets, {cv} inside the {} that hold one",
             splits.len() - h
+        ),
+        _ if aligned == splits.len() => {
+            "each other outer fold of its condition held out in turn, inside each outer training set (a fit two outer splits share made once)".to_string()
+        }
+        _ if aligned > 0 => format!(
+            "each other outer fold of its condition held out in turn inside {aligned} outer training sets, {cv} inside the {} where a class would be missing from a fit",
+            splits.len() - aligned
         ),
         _ => format!("{cv} inside each outer training set"),
     }
@@ -143,11 +182,14 @@ fn inner_within_one_condition(
 /// One outer split of nested selection.
 pub(super) struct OuterSplit {
     /// The condition it belongs to (empty for pooled cross-validation).
-    condition: String,
+    pub(super) condition: String,
     /// Training rows.
-    train: Vec<usize>,
+    pub(super) train: Vec<usize>,
     /// Test rows.
-    test: Vec<usize>,
+    pub(super) test: Vec<usize>,
+    /// The test rows of the other outer folds of its condition, under cross-validation (the
+    /// inner ranking can hold out each in turn).
+    pub(super) others: Vec<Vec<usize>>,
 }
 
 /// What one outer split chose and how its test rows fared.
@@ -161,23 +203,25 @@ struct OuterResult {
 
 /// The outer splits of nested selection, from the first repeat's folds (or the held-out
 /// conditions).
-fn outer_splits(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
+pub(super) fn outer_splits(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
     let folds_of = |rows: Vec<usize>, condition: String| -> Result<Vec<_>> {
         let fold_of = fold_assignment(metas, &rows, params)?;
         let n_folds = fold_of.iter().max().map_or(0, |&f| f + 1);
+        let pick = |f: usize, test: bool| -> Vec<usize> {
+            let rows = rows.iter().zip(&fold_of);
+            rows.filter(|(_, &g)| (g == f) == test)
+                .map(|(&r, _)| r)
+                .collect()
+        };
         Ok((0..n_folds)
-            .map(|f| {
-                let pick = |test: bool| -> Vec<usize> {
-                    let rows = rows.iter().zip(&fold_of);
-                    rows.filter(|(_, &g)| (g == f) == test)
-                        .map(|(&r, _)| r)
-                        .collect()
-                };
-                OuterSplit {
-                    condition: condition.clone(),
-                    train: pick(false),
-                    test: pick(true),
-                }
+            .map(|f| OuterSplit {
+                condition: condition.clone(),
+                train: pick(f, false),
+                test: pick(f, true),
+                others: (0..n_folds)
+                    .filter(|&g| g != f)
+                    .map(|g| pick(g, true))
+                    .collect(),
             })
             .collect())
     };
@@ -199,6 +243,7 @@ fn outer_splits(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit
                     condition: value,
                     train,
                     test,
+                    others: Vec::new(),
                 }
             })
             .collect()),
@@ -206,6 +251,7 @@ fn outer_splits(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit
             condition: String::new(),
             train: train.rows(metas)?,
             test: test.rows(metas)?,
+            others: Vec::new(),
         }]),
     }
 }
@@ -253,9 +299,9 @@ fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
 /// Nested selection's outer splits, when it can run on them: its inner cross-validation
 /// needs at least 2 folds, so every class at least 2 recordings in each outer training set.
 pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
-    if params.inner_folds < 2 {
+    if let Some(folds @ 0..2) = params.inner_folds {
         let rule = "nested selection's inner cross-validation needs 2 folds or more";
-        return Err(ParamError::new("inner_folds", rule, params.inner_folds).into());
+        return Err(ParamError::new("inner_folds", rule, folds).into());
     }
     let splits = outer_splits(metas, params)?;
     for split in &splits {
@@ -275,9 +321,9 @@ pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec
     Ok(splits)
 }
 
-/// One outer split of nested selection: every candidate ranked on its training rows
-/// (cross-validated, one repeat, or with each of their conditions held out under a
-/// hold-out protocol), the best trained on all of them and tested on its test rows.
+/// One outer split of nested selection: every candidate ranked on its training rows (each
+/// other outer fold held out in turn, or cross-validated on folds of its own, one repeat,
+/// or with each of their conditions held out under a hold-out protocol), the best trained on all of them and tested on its test rows.
 fn outer(
     candidates: &[Candidate],
     (s, split): (usize, &OuterSplit),
@@ -291,7 +337,7 @@ fn outer(
     let inner = CompareParams {
         cv: crate::classify::CvParams {
             repeats: 1,
-            folds: inner_folds(params.inner_folds, smallest),
+            folds: inner_folds(fresh_folds(params), smallest),
             ..*params.cv
         }
         .check()?,
@@ -301,22 +347,11 @@ fn outer(
     // condition of the training set is held out in turn (the mean of their accuracies, as
     // the outer accuracy is), so that the candidate chosen is the one that carries best to
     // a condition it was not trained on; with one condition there, cross-validation within
-    // it is all there is ([`inner_within_one_condition`] says so).
-    let held_out = inner_held_out(metas, params, split);
-    // Each held-out value's split, with its training and test rows among all recordings
-    // (those a fit another outer split makes can stand in for).
-    let held: Vec<(Split, Option<HeldRows>)> = match &held_out {
-        Some((column, values)) => (values.iter())
-            .map(|value| {
-                let held = hold_out(column, values, value);
-                let rows = held_rows(metas, &split.train, &held);
-                (held, rows)
-            })
-            .collect(),
-        None => Vec::new(),
-    };
+    // it is all there is ([`inner_within_one_condition`] says so). Under cross-validation
+    // it holds out each other outer fold in turn, where the folds allow.
+    let held = inner_splits(metas, params, split);
     let inner_accuracy = |k: usize, c: &Candidate| -> Result<f64> {
-        if held_out.is_none() {
+        if held.is_empty() {
             return Ok((c.evaluate)(&split.train, &cv_split(&inner), &silent)?.accuracy);
         }
         let mut sum = 0.0;
@@ -353,11 +388,56 @@ fn outer(
     })
 }
 
-/// A held-out value's inner split in one outer split, as rows among all recordings: the
-/// rows trained on and the rows tested.
+/// The inner splits `split`'s ranking holds out in turn, each with its rows among all
+/// recordings (those a fit another outer split makes can stand in for): each other value
+/// of the hold-out column, or each other outer fold of its condition; none where it
+/// cross-validates on folds of its own.
+fn inner_splits(
+    metas: &[Meta],
+    params: &CompareParams,
+    split: &OuterSplit,
+) -> Vec<(Split, Option<HeldRows>)> {
+    if let Some((column, values)) = inner_held_out(metas, params, split) {
+        return (values.iter())
+            .map(|value| {
+                let held = hold_out(column, &values, value);
+                let rows = held_rows(metas, &split.train, &held);
+                (held, rows)
+            })
+            .collect();
+    }
+    if !on_outer_folds(metas, params, split) {
+        return Vec::new();
+    }
+    // Positions among the outer training rows, for the split's own evaluation.
+    let at = |rows: &[usize]| -> Vec<usize> {
+        let position = |r: &usize| split.train.iter().position(|t| t == r);
+        rows.iter().filter_map(position).collect()
+    };
+    (split.others.iter())
+        .map(|test| {
+            let fit: Vec<usize> = (split.train.iter().copied())
+                .filter(|r| !test.contains(r))
+                .collect();
+            let mut tested: Vec<usize> = test.iter().chain(&split.test).copied().collect();
+            tested.sort_unstable();
+            let own = Split::Rows {
+                train: at(&fit),
+                test: at(test),
+            };
+            let test = test.clone();
+            (own, Some(HeldRows { fit, test, tested }))
+        })
+        .collect()
+}
+
+/// An inner split in one outer split, as rows among all recordings: the rows trained on,
+/// the rows tested, and the rows a fit on `fit` shared between outer splits is tested on
+/// (the same whichever split makes it).
 struct HeldRows {
     fit: Vec<usize>,
     test: Vec<usize>,
+    tested: Vec<usize>,
 }
 
 /// The rows `held` trains and tests on inside the outer training rows `within`, numbered
@@ -369,9 +449,14 @@ fn held_rows(metas: &[Meta], within: &[usize], held: &Split) -> Option<HeldRows>
     };
     let sub: Vec<Meta> = within.iter().map(|&r| metas[r].clone()).collect();
     let among_all = |rows: Vec<usize>| -> Vec<usize> { rows.iter().map(|&i| within[i]).collect() };
+    let fit = among_all(train.rows(&sub).ok()?);
+    let tested = (0..metas.len())
+        .filter(|r| fit.binary_search(r).is_err())
+        .collect();
     Some(HeldRows {
-        fit: among_all(train.rows(&sub).ok()?),
+        fit,
         test: among_all(test.rows(&sub).ok()?),
+        tested,
     })
 }
 
@@ -410,7 +495,7 @@ impl SharedFits {
         let right = match known {
             Some(right) => right,
             None => {
-                let right = shared_fit(c, &rows.fit, || lock(&self.alone).push(k));
+                let right = shared_fit(c, rows, || lock(&self.alone).push(k));
                 lock(&self.slots).entry(key).or_insert(right).clone()
             }
         }?;
@@ -430,19 +515,16 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
-/// Candidate `c` trained on the rows `fit` and tested on every other recording: each
+/// Candidate `c` trained on the rows `rows.fit` and tested on `rows.tested`: each
 /// recording's right prediction (1 or 0), by row; `None` where that cannot stand in for an
 /// inner split's own evaluation (a test class it has not trained on, several groups of
 /// columns each scored alone: `in_groups` is then called).
 fn shared_fit(
     c: &Candidate,
-    fit: &[usize],
+    rows: &HeldRows,
     in_groups: impl FnOnce(),
 ) -> Option<Arc<Vec<(usize, f64)>>> {
-    let test: Vec<usize> = (0..c.metas.len())
-        .filter(|r| fit.binary_search(r).is_err())
-        .collect();
-    let (train, test) = (fit.to_vec(), test);
+    let (train, test) = (rows.fit.clone(), rows.tested.clone());
     let outcome = c.evaluate_all(&Split::Rows { train, test }).ok()?;
     // Predictions are kept for one group of columns only: then each share is 1 or 0.
     if outcome.predictions.is_none() {

@@ -690,8 +690,8 @@ def compare(
     ``hold_out="speed_mm_s"`` holds each speed out in turn, ``train_where`` with
     ``test_where`` (``"trial=0,1"``) trains on one set and tests on the other (pooled
     recordings without any); ``group_by``, ``folds``, ``repeats``, ``seed``,
-    ``inner_folds`` (with ``nested=True``: the folds of the inner ranking) and ``tau_ms``
-    are the CLI's. ``knn_options`` (``{"k": 3}``) and ``snn_options`` (``{"hidden":
+    ``inner_folds`` (with ``nested=True``: the folds of an inner ranking of its own;
+    ``None`` holds out each other outer fold in turn) and ``tau_ms`` are the CLI's. ``knn_options`` (``{"k": 3}``) and ``snn_options`` (``{"hidden":
     64}``) are the knobs of the KNN and spiking-network candidates. With ``out``, the
     folder also gets compare.json, compare.md and the figures, as ``--out``: a new or
     empty folder, or an earlier output of neurotex, which is replaced whole; any other

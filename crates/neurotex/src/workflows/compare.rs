@@ -128,10 +128,13 @@ pub struct CompareOptions {
     /// (nested selection): the number to quote for "the best method".
     #[cfg_attr(feature = "cli", arg(long))]
     pub nested: bool,
-    /// With --nested: folds of the inner cross-validation that ranks the candidates inside
-    /// each outer training set (fewer where a class there has fewer recordings). Default:
-    /// --folds. Fewer folds rank on smaller training sets: quicker, but the choice can be
-    /// worse, and the nested estimate with it (docs/methods-and-compare.md).
+    /// With --nested: rank the candidates inside each outer training set by a
+    /// cross-validation of this many folds of its own (fewer where a class there has fewer
+    /// recordings). Default: each other outer fold held out in turn (--folds minus 1 inner
+    /// folds, each fit shared by the two outer splits that hold it, so made once; with
+    /// fewer than 4 folds, --folds folds of its own).
+    /// Fewer folds rank on smaller training sets: quicker, but the choice can be worse, and
+    /// the nested estimate with it (docs/methods-and-compare.md).
     #[cfg_attr(feature = "cli", arg(long = "inner-folds", requires = "nested"))]
     pub inner_folds: Option<usize>,
     /// How the dataset folder is opened.
@@ -170,7 +173,7 @@ impl CompareOptions {
             group_by: self.group_by.clone(),
             resamples: 2000,
             nested: self.nested,
-            inner_folds: self.inner_folds.unwrap_or(self.folds),
+            inner_folds: self.inner_folds,
         })
     }
 
