@@ -1,11 +1,12 @@
 //! The feature methods beyond the paper on one 4x4 recording of 18 s (a 90 mm slide at
 //! 5 mm/s): the 13 Haralick features of one 16-level matrix, the multi-scale 3D-GLCM
-//! (50, 100, 200, 400 ms bins, paper and full Haralick sets), and all taxels' statistics
-//! per second and per mm of travel.
+//! (50, 100, 200, 400 ms bins, paper and full Haralick sets), all taxels' statistics
+//! per second and per mm of travel, and one taxel's signal statistics (the baselines
+//! without spikes) over the slide's 18 000 samples.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use neurotex::encode::SpikeTrains;
-use neurotex::features::haralick_full;
+use neurotex::features::{haralick_full, signal_stats};
 use neurotex::pipeline::{FeatureExtractor, FeatureParams, HaralickSet, Method, PipelineParams};
 
 fn synthetic_trains() -> SpikeTrains {
@@ -62,6 +63,17 @@ fn bench(c: &mut Criterion) {
             b.iter(|| e.population_row(&spikes, Some(5.0), method).unwrap())
         });
     }
+    let signal: Vec<f64> = (0..18_000)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        })
+        .collect();
+    group.bench_function(BenchmarkId::new("signal_stats", "18000"), |b| {
+        b.iter(|| signal_stats(std::hint::black_box(&signal)))
+    });
     group.finish();
 }
 

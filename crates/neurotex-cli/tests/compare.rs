@@ -131,7 +131,7 @@ fn nested_selection_over_held_out_speeds_names_its_choices() {
         "{text}"
     );
     assert!(
-        text.contains("one split per held-out value, seed 0; 2000 resamples for intervals and tests; nested selection ranks inside each training set, each of its values held out in turn"),
+        text.contains("one split per held-out value, seed 0; 2000 resamples for intervals and tests; nested selection ranks inside each training set, each of its other values held out in turn"),
         "{text}"
     );
     assert!(

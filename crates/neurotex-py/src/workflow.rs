@@ -209,8 +209,8 @@ fn listed(names: Option<Vec<String>>, standard: &str) -> Vec<String> {
 /// the CLI's standard sets), the protocol (`per`, `hold_out`, or `train_where` with
 /// `test_where`; pooled without), `group_by`, the cross-validation's `folds`, `repeats`
 /// and `seed` (`None`: the CLI's), `nested` selection with its `inner_folds` (`None`: each
-/// other outer fold held out in turn; refused without `nested`, as `--inner-folds` is), KNN's `knn` knobs and the
-/// network's `snn` knobs. With `out`, also writes compare.json, compare.md and the
+/// of the other outer folds held out in turn; refused without `nested`, as
+/// `--inner-folds` is), KNN's `knn` knobs and the network's `snn` knobs. With `out`, also writes compare.json, compare.md and the
 /// figures there, as `--out`. Returns the comparison as the CLI's JSON object; what the
 /// workflow says goes to Python's log as it is said.
 #[pyfunction]

@@ -35,7 +35,9 @@ pub fn signal_stats(x: &[f64]) -> [f64; 8] {
         (0.0, 0.0)
     };
     // Order statistics by selection rather than a full sort (a minute-long slide has
-    // 60 000 samples per taxel), each selection on the part above the previous rank.
+    // 60 000 samples per taxel), each selection on the part above the previous rank;
+    // `scratch[from..]` holds the order statistics from `from` on, so the one right above
+    // a selected rank is the smallest of that part (a scan, not another selection).
     let last = x.len() - 1;
     let positions = [0.1, 0.5, 0.9].map(|q| q * last as f64);
     let mut ranks: Vec<usize> = positions
@@ -48,9 +50,15 @@ pub fn signal_stats(x: &[f64]) -> [f64; 8] {
     let mut at = vec![0.0; ranks.len()];
     let mut from = 0;
     for (value, &rank) in at.iter_mut().zip(&ranks) {
-        let (_, v, _) = scratch[from..].select_nth_unstable_by(rank - from, f64::total_cmp);
+        let rest = &mut scratch[from..];
+        if rank == from {
+            let smallest = |a: f64, &b: &f64| if b.total_cmp(&a).is_lt() { b } else { a };
+            *value = rest[1..].iter().fold(rest[0], smallest);
+            continue;
+        }
+        let (_, v, _) = rest.select_nth_unstable_by(rank - from, f64::total_cmp);
         *value = *v;
-        from = rank;
+        from = rank + 1;
     }
     let order = |rank: usize| at[ranks.binary_search(&rank).unwrap_or(0)];
     let quantiles = positions.map(|pos| {

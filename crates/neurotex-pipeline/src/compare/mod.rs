@@ -458,23 +458,34 @@ fn design(params: &CompareParams) -> String {
         Protocol::HoldOut(_) => format!("one split per held-out value, seed {}", cv.seed),
         Protocol::Where { .. } => format!("one train/test split, seed {}", cv.seed),
     };
-    let nested = match (params.nested, &params.protocol) {
-        (false, _) => String::new(),
-        (true, Protocol::HoldOut(_)) => {
-            "; nested selection ranks inside each training set, each of its values held out in turn"
-                .into()
-        }
-        (true, _) => match params.inner_folds {
-            Some(folds) => {
-                format!("; nested selection ranks inside each training set ({folds} inner folds)")
-            }
-            None => "; nested selection ranks inside each training set, each other outer fold held out in turn".into(),
-        },
+    let nested = match params.nested {
+        false => String::new(),
+        true => format!("; nested selection {}", nested_design(params)),
     };
     format!(
         "{splits}; {} resamples for intervals and tests{nested}",
         params.resamples
     )
+}
+
+/// How nested selection ranks inside each outer training set, as the design line says it
+/// (the nested line says what each training set did).
+fn nested_design(params: &CompareParams) -> String {
+    let cv = &params.cv;
+    let first = match (cv.repeats, &params.protocol) {
+        (2.., Protocol::Pooled | Protocol::Per(_)) => " of the first repeat",
+        _ => "",
+    };
+    match (params.inner_folds, &params.protocol) {
+        (_, Protocol::HoldOut(_)) => "ranks inside each training set, each of its other values held out in turn (cross-validating where it holds one)".into(),
+        (None, Protocol::Pooled | Protocol::Per(_)) if cv.folds >= 4 => {
+            format!("ranks inside each training set{first}, each of the other outer folds held out in turn")
+        }
+        (folds, _) => format!(
+            "ranks inside each training set{first} (up to {} inner folds)",
+            folds.unwrap_or(cv.folds)
+        ),
+    }
 }
 
 /// The recordings every candidate is made of, the same for all.
@@ -947,7 +958,7 @@ mod tests {
         assert_eq!(fits.load(Ordering::Relaxed), 2 * 2 * 6 + 8);
         let nested = c.nested.unwrap();
         assert!(
-            nested.inner.starts_with("each other outer fold"),
+            nested.inner.starts_with("each of the other outer folds"),
             "{}",
             nested.inner
         );
@@ -998,6 +1009,7 @@ mod tests {
             .collect();
         split.others[0].retain(|r| class_of(r) != "c0");
         split.others[0].extend(&c0);
+        split.others[0].sort_unstable();
         assert!(!nested::on_outer_folds(metas, &p, &split));
     }
 }

@@ -93,7 +93,7 @@ pub(super) fn on_outer_folds(metas: &[Meta], params: &CompareParams, split: &Out
     };
     let all = classes(&mut split.train.iter().copied());
     split.others.iter().all(|held| {
-        let mut fit = split.train.iter().copied().filter(|r| !held.contains(r));
+        let mut fit = without(&split.train, held).into_iter();
         classes(&mut fit) == all
     })
 }
@@ -149,10 +149,10 @@ fn inner_ranking(metas: &[Meta], params: &CompareParams, splits: &[OuterSplit]) 
             splits.len() - h
         ),
         _ if aligned == splits.len() => {
-            "each other outer fold of its condition held out in turn, inside each outer training set (a fit two outer splits share made once)".to_string()
+            "each of the other outer folds of its condition held out in turn, inside each outer training set".to_string()
         }
         _ if aligned > 0 => format!(
-            "each other outer fold of its condition held out in turn inside {aligned} outer training sets, {cv} inside the {} where a class would be missing from a fit",
+            "each of the other outer folds of its condition held out in turn inside {aligned} outer training sets, {cv} inside the {} where a class would be missing from a fit",
             splits.len() - aligned
         ),
         _ => format!("{cv} inside each outer training set"),
@@ -190,6 +190,13 @@ pub(super) struct OuterSplit {
     /// The test rows of the other outer folds of its condition, under cross-validation (the
     /// inner ranking can hold out each in turn).
     pub(super) others: Vec<Vec<usize>>,
+}
+
+/// The rows of `rows` not in `out`, both ascending (as every split's rows are).
+fn without(rows: &[usize], out: &[usize]) -> Vec<usize> {
+    (rows.iter().copied())
+        .filter(|r| out.binary_search(r).is_err())
+        .collect()
 }
 
 /// What one outer split chose and how its test rows fared.
@@ -411,14 +418,12 @@ fn inner_splits(
     }
     // Positions among the outer training rows, for the split's own evaluation.
     let at = |rows: &[usize]| -> Vec<usize> {
-        let position = |r: &usize| split.train.iter().position(|t| t == r);
+        let position = |r: &usize| split.train.binary_search(r).ok();
         rows.iter().filter_map(position).collect()
     };
     (split.others.iter())
         .map(|test| {
-            let fit: Vec<usize> = (split.train.iter().copied())
-                .filter(|r| !test.contains(r))
-                .collect();
+            let fit = without(&split.train, test);
             let mut tested: Vec<usize> = test.iter().chain(&split.test).copied().collect();
             tested.sort_unstable();
             let own = Split::Rows {

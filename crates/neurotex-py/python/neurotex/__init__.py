@@ -691,8 +691,9 @@ def compare(
     ``test_where`` (``"trial=0,1"``) trains on one set and tests on the other (pooled
     recordings without any); ``group_by``, ``folds``, ``repeats``, ``seed``,
     ``inner_folds`` (with ``nested=True``: the folds of an inner ranking of its own;
-    ``None`` holds out each other outer fold in turn) and ``tau_ms`` are the CLI's. ``knn_options`` (``{"k": 3}``) and ``snn_options`` (``{"hidden":
-    64}``) are the knobs of the KNN and spiking-network candidates. With ``out``, the
+    ``None`` holds out each of the other outer folds in turn) and ``tau_ms`` are the
+    CLI's. ``knn_options`` (``{"k": 3}``) and ``snn_options`` (``{"hidden": 64}``) are
+    the knobs of the KNN and spiking-network candidates. With ``out``, the
     folder also gets compare.json, compare.md and the figures, as ``--out``: a new or
     empty folder, or an earlier output of neurotex, which is replaced whole; any other
     folder is refused before the comparison runs. Stage options (``gain="auto"``,

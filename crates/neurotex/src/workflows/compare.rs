@@ -125,16 +125,18 @@ pub struct CompareOptions {
     #[cfg_attr(feature = "cli", arg(long, default_value_t = 0))]
     pub seed: u64,
     /// Also estimate the accuracy of choosing the best candidate inside each training set
-    /// (nested selection): the number to quote for "the best method".
+    /// (nested selection, on the first repeat's folds): the number to quote for "the best
+    /// method".
     #[cfg_attr(feature = "cli", arg(long))]
     pub nested: bool,
     /// With --nested: rank the candidates inside each outer training set by a
     /// cross-validation of this many folds of its own (fewer where a class there has fewer
-    /// recordings). Default: each other outer fold held out in turn (--folds minus 1 inner
-    /// folds, each fit shared by the two outer splits that hold it, so made once; with
-    /// fewer than 4 folds, --folds folds of its own).
-    /// Fewer folds rank on smaller training sets: quicker, but the choice can be worse, and
-    /// the nested estimate with it (docs/methods-and-compare.md).
+    /// recordings; under --hold-out, only where a training set holds one value of the
+    /// column). Default: each of the other outer folds held out in turn (--folds minus 1
+    /// inner folds; each inner fit serves two outer training sets, so it is made once), or
+    /// with fewer than 4 folds, --folds folds of its own. Fewer folds rank on smaller
+    /// training sets: quicker, but the choice can be worse, and the nested estimate with it
+    /// (docs/methods-and-compare.md).
     #[cfg_attr(feature = "cli", arg(long = "inner-folds", requires = "nested"))]
     pub inner_folds: Option<usize>,
     /// How the dataset folder is opened.
