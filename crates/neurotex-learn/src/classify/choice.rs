@@ -95,7 +95,10 @@ impl fmt::Display for ClassifierChoice {
     /// The classifier with its main parameters, e.g. `random forest (200 trees, seed 0)`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            ClassifierChoice::Knn(p) => write!(f, "KNN (k = {})", p.k),
+            ClassifierChoice::Knn(p) => match p.standardize {
+                true => write!(f, "KNN (k = {})", p.k),
+                false => write!(f, "KNN (k = {}, features not standardised)", p.k),
+            },
             ClassifierChoice::Forest(p) => {
                 let trees = if p.trees == 1 { "tree" } else { "trees" };
                 write!(f, "random forest ({} {trees}, seed {}", p.trees, p.seed)?;

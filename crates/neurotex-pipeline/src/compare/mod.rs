@@ -268,14 +268,16 @@ pub struct Comparison {
 /// The caveat every comparison without nested selection carries.
 pub const CAVEAT: &str = "the best of several candidates chosen on the same recordings \
     scores higher than it will on new recordings of the same kind; the nested estimate \
-    (selection inside each training set, computed when nested selection is asked for) is the \
-    one to quote for the chosen procedure";
+    (the best chosen inside each training set and scored on its test set, computed when \
+    nested selection is asked for) is what choosing the best this way and training it on \
+    all recordings can be expected to score: the number to quote";
 
 /// The caveat of a comparison with nested selection.
 pub const CAVEAT_NESTED: &str = "the best of several candidates chosen on the same \
     recordings scores higher than it will on new recordings of the same kind; the nested \
-    estimate (selection inside each training set) is the one to quote for the chosen \
-    procedure";
+    estimate (the best chosen inside each training set and scored on its test set) is what \
+    choosing the best this way and training it on all recordings can be expected to score: \
+    the number to quote";
 
 /// One candidate's scores under the protocol.
 struct Scored {

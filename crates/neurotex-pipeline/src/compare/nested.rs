@@ -321,7 +321,7 @@ pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec
                 }
                 (_, c) => format!("the outer training set of {c}"),
             };
-            let got = format!("1 recording or none of some class in {at} (more recordings per class and condition run it)");
+            let got = format!("1 recording or none of some class in {at} (more recordings per class and condition run it; without nested selection the comparison runs as it is)");
             return Err(ParamError::new("nested", rule, got).into());
         }
     }

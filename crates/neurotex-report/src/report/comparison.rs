@@ -34,9 +34,18 @@ pub fn markdown(c: &Comparison) -> String {
         ("recordings", true) => String::new(),
         _ => format!(" ({} units: {})", c.n_units, c.units),
     };
+    // The number to quote first, above the ranking it is not biased by.
+    let nested = match &c.nested {
+        Some(n) => {
+            let estimate = with_interval(n.accuracy, n.ci);
+            let rest = nested_text(n).replacen(&estimate, "", 1);
+            format!("**Nested selection: {estimate}**{rest}\n\n")
+        }
+        None => String::new(),
+    };
     let mut out = format!(
         "# Comparison\n\n{} recordings{units}, {} classes; {}.\n{design}\
-         Chance {:.1}%, majority class {:.1}%.\n\n\
+         Chance {:.1}%, majority class {:.1}%.\n\n{nested}\
          | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) | seconds |\n\
          |---:|---|---|---|---|---|---:|\n",
         c.n_recordings,
@@ -59,9 +68,6 @@ pub fn markdown(c: &Comparison) -> String {
     }
     for line in versus_rates(c) {
         out.push_str(&format!("\n{}.\n", capitalised(&line)));
-    }
-    if let Some(n) = &c.nested {
-        out.push_str(&format!("\nNested selection: {}\n", nested_text(n)));
     }
     for note in &c.notes {
         out.push_str(&format!("\nNote: {note}.\n"));

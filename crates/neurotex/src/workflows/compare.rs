@@ -381,7 +381,8 @@ fn under_chance_note(c: &Comparison, protocol: &Protocol) -> Option<String> {
 
 /// Where a comparison of `set` on the recordings `indices` of `dataset` comes from:
 /// neurotex's build, the time, the data and the stages as `calibrated` ran them, the
-/// settings of the encodings and methods compared only ([`Comparison::provenance`]);
+/// settings of the encodings, methods and classifiers compared only
+/// ([`Comparison::provenance`]);
 /// `split` whether the gain was calibrated on a training side alone.
 ///
 /// # Errors
@@ -412,8 +413,11 @@ fn provenance(
         dataset.layout.baseline,
         crate::experiments::slide_times(&metas),
     ));
+    let classifiers: Vec<String> = set.classifiers.iter().map(|c| c.to_string()).collect();
+    let classifiers = format!("classifiers: {}", classifiers.join("; "));
     if set.encodings.is_empty() {
         lines.push("encodings: none (the signal baselines, without spikes)".into());
+        lines.push(classifiers);
         return Ok(lines);
     }
     lines.push(p.encoder_line());
@@ -444,6 +448,7 @@ fn provenance(
         })
         .collect();
     lines.extend(p.feature_lines(&methods));
+    lines.push(classifiers);
     Ok(lines)
 }
 
