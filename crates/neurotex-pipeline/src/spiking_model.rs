@@ -126,6 +126,16 @@ fn shown(a: &impl Serialize, b: &impl Serialize) -> [String; 2] {
     [serde_json::to_string(a), serde_json::to_string(b)].map(Result::unwrap_or_default)
 }
 
+/// A field checked by [`trained_as_said`]: its name, whether the network's value `a` and
+/// the training parameters' `b` are equal, and both as the file writes them.
+fn same<T: PartialEq + Serialize>(
+    name: &'static str,
+    a: &T,
+    b: &T,
+) -> (&'static str, bool, [String; 2]) {
+    (name, a == b, shown(a, b))
+}
+
 /// Checks that a model file's network is the one its training parameters make: the same
 /// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
 /// JSON), whether each neuron has decays of its own and whether it counts time in travel.
@@ -140,36 +150,12 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
         Travel::At(v) => net.travel_mm_s == Some(v),
     };
     let fields = [
-        (
-            "hidden",
-            net.hidden == snn.hidden,
-            shown(&net.hidden, &snn.hidden),
-        ),
-        (
-            "dt_ms",
-            net.dt_ms == snn.dt_ms,
-            shown(&net.dt_ms, &snn.dt_ms),
-        ),
-        (
-            "readout",
-            net.readout == snn.readout,
-            shown(&net.readout, &snn.readout),
-        ),
-        (
-            "reset",
-            net.reset == snn.reset,
-            shown(&net.reset, &snn.reset),
-        ),
-        (
-            "target",
-            net.target == snn.target,
-            shown(&net.target, &snn.target),
-        ),
-        (
-            "w_rec",
-            net.recurrent() == snn.recurrent,
-            shown(&net.recurrent(), &snn.recurrent),
-        ),
+        same("hidden", &net.hidden, &snn.hidden),
+        same("dt_ms", &net.dt_ms, &snn.dt_ms),
+        same("readout", &net.readout, &snn.readout),
+        same("reset", &net.reset, &snn.reset),
+        same("target", &net.target, &snn.target),
+        same("w_rec", &net.recurrent(), &snn.recurrent),
         (
             "alpha",
             net.own_decays() == snn.train_decays,
