@@ -69,6 +69,9 @@ pub fn markdown(c: &Comparison) -> String {
     for line in versus_rates(c) {
         out.push_str(&format!("\n{}.\n", capitalised(&line)));
     }
+    if let Some(line) = to_use(c) {
+        out.push_str(&format!("\n{}\n", capitalised(&line)));
+    }
     for note in &c.notes {
         out.push_str(&format!("\nNote: {note}.\n"));
     }
@@ -134,12 +137,41 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
     lines.extend(versus_rates(c));
     if let Some(n) = &c.nested {
         lines.push(format!("nested selection: {}", nested_text(n)));
+        lines.extend(to_use(c));
     }
     if !c.results.iter().any(|r| r.paper) {
         lines.push(NO_PAPER.to_string());
     }
     lines.push(format!("caveat: {}", c.caveat));
     lines
+}
+
+/// With nested selection, what to train: the ranking's top candidate (the choice the
+/// nested estimate scores), with the command that trains it, and what to expect of it.
+fn to_use(c: &Comparison) -> Option<String> {
+    let (n, top) = (c.nested.as_ref()?, c.results.first()?);
+    let how = match (top.encoding.as_str(), top.method.as_str()) {
+        (NO_ENCODING, _) => "a baseline without spikes, which `neurotex train` does not make".into(),
+        (_, "van-rossum") => "a spike-distance method, which `neurotex evaluate` scores but `neurotex train` does not make".into(),
+        (encoding, method) => {
+            let taxel = match method {
+                "taxel" => " --taxel ROW,COL",
+                _ => "",
+            };
+            format!(
+                "`neurotex train --dataset DIR --encoding {encoding} --method {method}{taxel} --classifier {}` with this comparison's stage and classifier options, on the recordings of the conditions it will meet",
+                top.classifier
+            )
+        }
+    };
+    Some(format!(
+        "to use the choice: rank 1, {} / {} / {} ({how}); expect about the nested estimate, {}, not rank 1's own {}.",
+        top.encoding,
+        top.method,
+        top.classifier,
+        with_interval(n.accuracy, n.ci),
+        with_interval(top.accuracy, top.ci)
+    ))
 }
 
 /// `+12.3 points (p 0.0004)`, `paper's method`, or `-`.
@@ -216,7 +248,7 @@ fn nested_text(n: &Nested) -> String {
         false => format!("; ranked by {}", n.inner),
     };
     format!(
-        "{} over {} outer splits{inner}; chosen: {}",
+        "{} over {} outer splits{inner}; picked inside the training sets (how stable the choice is): {}",
         with_interval(n.accuracy, n.ci),
         n.outer_splits,
         chosen.join(", ")

@@ -291,3 +291,38 @@ fn the_network_against_its_rates_is_said_with_a_verdict() {
     (c.results[1].difference_vs_rates, c.results[1].p_vs_rates) = (Some(-0.06), Some(0.002));
     assert!(markdown(&c).contains("-6.0 points (p 0.002): behind its inputs' rates"));
 }
+
+/// With nested selection the ranking says what to train (rank 1, with its command) and what
+/// to expect of it (the nested estimate, not rank 1's own accuracy), above the ranking in
+/// compare.md; a candidate `neurotex train` does not make is named as such; without nested
+/// selection nothing is said.
+#[test]
+fn a_nested_ranking_says_what_to_train_and_what_to_expect() {
+    use crate::report::comparison::{markdown, text_lines};
+    let mut c = comparison(6, true, 0);
+    let top = &c.results[0];
+    let command = format!(
+        "`neurotex train --dataset DIR --encoding {} --method {} --classifier {}`",
+        top.encoding, top.method, top.classifier
+    );
+    let expect = "expect about the nested estimate, 81.0% [76.0, 86.0], not rank 1's own 92.0% [86.0, 97.0].";
+    let md = markdown(&c);
+    assert!(md.contains(&command) && md.contains(expect), "{md}");
+    let (nested, table) = (
+        md.find("**Nested selection: 81.0% [76.0, 86.0]**"),
+        md.find("| rank |"),
+    );
+    assert!(nested.unwrap() < table.unwrap(), "{md}");
+    assert!(text_lines(&c)
+        .iter()
+        .any(|l| l.starts_with("to use the choice: rank 1") && l.ends_with(expect)));
+    c.results[0].method = "van-rossum".into();
+    assert!(markdown(&c).contains("`neurotex train` does not make"));
+    c.results[0].encoding = "none".into();
+    assert!(markdown(&c).contains("a baseline without spikes"));
+    let plain = comparison(6, false, 0);
+    assert!(
+        !markdown(&plain).contains("to use the choice")
+            && !markdown(&plain).contains("To use the choice")
+    );
+}
