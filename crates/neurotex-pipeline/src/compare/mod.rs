@@ -480,7 +480,7 @@ fn nested_design(params: &CompareParams) -> String {
     };
     match (params.inner_folds, &params.protocol) {
         (_, Protocol::HoldOut(_)) => "ranks inside each training set, each of its other values held out in turn (cross-validating where it holds one)".into(),
-        (None, Protocol::Pooled | Protocol::Per(_)) if cv.folds >= 4 => {
+        (None, Protocol::Pooled | Protocol::Per(_)) if cv.folds >= nested::OUTER_FOLDS_TO_RANK_ON => {
             format!("ranks inside each training set{first}, each of the other outer folds held out in turn")
         }
         (folds, _) => format!(

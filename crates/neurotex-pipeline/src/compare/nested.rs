@@ -77,12 +77,16 @@ fn fresh_folds(params: &CompareParams) -> usize {
     params.inner_folds.unwrap_or(params.cv.folds)
 }
 
+/// The fewest outer folds the inner ranking holds out in turn (with three, each inner fit
+/// would train on a third of its condition's recordings).
+pub(super) const OUTER_FOLDS_TO_RANK_ON: usize = 4;
+
 /// Whether `split`'s inner ranking holds out each other outer fold of its condition in
 /// turn: where no inner folds are asked for, the condition has four outer folds or more
 /// (with three, each inner fit would train on a third of its recordings), and every such
 /// inner training set holds every class of the outer training set.
 pub(super) fn on_outer_folds(metas: &[Meta], params: &CompareParams, split: &OuterSplit) -> bool {
-    if params.inner_folds.is_some() || split.others.len() < 3 {
+    if params.inner_folds.is_some() || split.others.len() + 1 < OUTER_FOLDS_TO_RANK_ON {
         return false;
     }
     let classes = |rows: &mut dyn Iterator<Item = usize>| -> Vec<&str> {
@@ -330,7 +334,8 @@ pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec
 
 /// One outer split of nested selection: every candidate ranked on its training rows (each
 /// other outer fold held out in turn, or cross-validated on folds of its own, one repeat,
-/// or with each of their conditions held out under a hold-out protocol), the best trained on all of them and tested on its test rows.
+/// or with each of their conditions held out under a hold-out protocol), the best trained
+/// on all of them and tested on its test rows.
 fn outer(
     candidates: &[Candidate],
     (s, split): (usize, &OuterSplit),

@@ -36,11 +36,11 @@ pub fn markdown(c: &Comparison) -> String {
     };
     // The number to quote first, above the ranking it is not biased by.
     let nested = match &c.nested {
-        Some(n) => {
-            let estimate = with_interval(n.accuracy, n.ci);
-            let rest = nested_text(n).replacen(&estimate, "", 1);
-            format!("**Nested selection: {estimate}**{rest}\n\n")
-        }
+        Some(n) => format!(
+            "**Nested selection: {}**{}\n\n",
+            with_interval(n.accuracy, n.ci),
+            nested_details(n)
+        ),
         None => String::new(),
     };
     let mut out = format!(
@@ -238,6 +238,12 @@ fn p_text(p: f64) -> String {
 }
 
 fn nested_text(n: &Nested) -> String {
+    format!("{}{}", with_interval(n.accuracy, n.ci), nested_details(n))
+}
+
+/// What follows the nested estimate: over how many outer splits, how they ranked, and
+/// what they picked.
+fn nested_details(n: &Nested) -> String {
     let chosen: Vec<String> = n
         .chosen
         .iter()
@@ -248,8 +254,7 @@ fn nested_text(n: &Nested) -> String {
         false => format!("; ranked by {}", n.inner),
     };
     format!(
-        "{} over {} outer splits{inner}; picked inside the training sets (how stable the choice is): {}",
-        with_interval(n.accuracy, n.ci),
+        " over {} outer splits{inner}; picked inside the training sets (how stable the choice is): {}",
         n.outer_splits,
         chosen.join(", ")
     )
