@@ -409,6 +409,7 @@ fn spiking_file(recurrent: bool) -> serde_json::Value {
         alpha: Vec::new(),
         beta: Vec::new(),
         travel_mm_s: None,
+        adaptation: None,
     };
     let layout = LayoutFile {
         rows: Some(2),

@@ -385,17 +385,7 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     assert_eq!(net["inputs"], 32);
     assert_eq!(net["classes"], 3);
     let out = dir.join("pred.csv");
-    let text = dir.ok(&[
-        "predict",
-        "--model",
-        s(&model),
-        "--dataset",
-        s(&ds),
-        "--out",
-        s(&out),
-        "--json",
-    ]);
-    let score: Value = serde_json::from_str(&text).unwrap();
+    let score = dir.predict_json(&model, &ds, &out);
     assert_eq!(score["n"], 24);
     // Trained on these recordings (80 % of them; 20 % for early stopping).
     assert!(score["accuracy"].as_f64().unwrap() > 0.6, "{score}");
@@ -464,6 +454,17 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     std::fs::write(&damaged, serde_json::to_string(&own).unwrap()).unwrap();
     let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(err.contains("alpha[0] is 1.5"), "{err}");
+    // Adaptive thresholds its training did not give the network, then ones of no time.
+    let mut adapt = file.clone();
+    adapt["network"]["adaptation"] = serde_json::json!({"tau_ms": 200.0, "strength": 1.0});
+    std::fs::write(&damaged, serde_json::to_string(&adapt).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("`network.adaptation`"), "{err}");
+    adapt["network"]["adaptation"]["tau_ms"] = Value::from(0.0);
+    adapt["classifier"]["adapt_ms"] = Value::from(0.0);
+    std::fs::write(&damaged, serde_json::to_string(&adapt).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("adapt"), "{err}");
     assert!(!never.exists());
     // A graph that is not HDF5, and a feature model where a spiking one is needed.
     let junk = dir.join("junk.nir");
@@ -589,6 +590,54 @@ fn a_subtractive_reset_is_written_and_a_zero_reset_left_out() {
         s(&dir.join("never.json")),
     ]);
     assert!(err.contains("snn-reset"), "{err}");
+}
+
+/// `--snn-adapt-ms` is written in the model file (network and training parameters) and
+/// predicts, but has no NIR graph (NIR has no adaptive threshold): the export is refused
+/// and writes nothing; a time constant that is not positive and a subtracting reset are
+/// refused by the option's name.
+#[test]
+fn adaptive_thresholds_are_written_and_predict_but_make_no_graph() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let model = dir.join("adapt.json");
+    dir.train_tiny_snn(
+        &ds,
+        &model,
+        &["--snn-adapt-ms", "150", "--snn-adapt-strength", "0.5"],
+    );
+    let file = read_json(&model);
+    assert_eq!(file["network"]["adaptation"]["tau_ms"], 150.0);
+    assert_eq!(file["network"]["adaptation"]["strength"], 0.5);
+    assert_eq!(file["classifier"]["adapt_ms"], 150.0);
+    let score = dir.predict_json(&model, &ds, &dir.join("p.csv"));
+    assert_eq!(score["n"], 8, "{score}");
+    let graph = dir.join("adapt.nir");
+    let err = dir.fails(&["export", "nir", "--model", s(&model), "--out", s(&graph)]);
+    assert!(
+        err.contains("adaptive thresholds") && err.contains("--snn-adapt-ms"),
+        "{err}"
+    );
+    assert!(!graph.exists());
+    let never = dir.join("never.json");
+    for flags in [
+        ["--snn-adapt-ms", "0", "--snn-reset", "zero"],
+        ["--snn-adapt-ms", "150", "--snn-reset", "subtract"],
+    ] {
+        let mut args = vec![
+            "train",
+            "--dataset",
+            s(&ds),
+            "--classifier",
+            "snn",
+            "--out",
+            s(&never),
+        ];
+        args.extend(flags);
+        let err = dir.fails(&args);
+        assert!(err.contains("snn-adapt-ms"), "{flags:?}: {err}");
+    }
+    assert!(!never.exists());
 }
 
 /// Writes `file` with each `(JSON pointer, value)` of `edits` set to `damaged.json`;

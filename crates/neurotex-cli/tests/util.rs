@@ -76,6 +76,22 @@ impl Dir {
         self.ok(&args);
     }
 
+    /// Runs `neurotex predict --model MODEL --dataset DATASET --out OUT --json`, which must
+    /// succeed; returns the JSON it prints.
+    pub fn predict_json(&self, model: &Path, dataset: &Path, out: &Path) -> Value {
+        let args = [
+            "predict",
+            "--model",
+            s(model),
+            "--dataset",
+            s(dataset),
+            "--out",
+            s(out),
+        ];
+        let text = self.ok(&[&args[..], &["--json"]].concat());
+        serde_json::from_str(&text).expect("predict --json prints JSON")
+    }
+
     /// Runs `neurotex evaluate --dataset DATASET --method METHOD EXTRA... --json`, which
     /// must succeed; returns the JSON it prints.
     pub fn evaluate_json(&self, dataset: &Path, method: &str, extra: &[&str]) -> Value {

@@ -261,5 +261,6 @@ pub(super) fn network_of(
         alpha,
         beta,
         travel_mm_s: None,
+        adaptation: None,
     })
 }

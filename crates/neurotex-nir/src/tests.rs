@@ -31,6 +31,7 @@ fn net() -> Network {
         alpha: Vec::new(),
         beta: Vec::new(),
         travel_mm_s: None,
+        adaptation: None,
     }
 }
 
@@ -344,6 +345,7 @@ fn decays_of_each_neurons_own_round_trip() {
         alpha: vec![0.3, 0.5, 0.6, 0.9],
         beta: vec![0.7, 0.75, 0.95, 0.5],
         travel_mm_s: None,
+        adaptation: None,
         ..net()
     };
     own.check().unwrap();

@@ -138,7 +138,8 @@ fn same<T: PartialEq + Serialize>(
 
 /// Checks that a model file's network is the one its training parameters make: the same
 /// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
-/// JSON), whether each neuron has decays of its own and whether it counts time in travel.
+/// JSON), whether each neuron has decays of its own, its adaptive thresholds and whether it
+/// counts time in travel.
 /// A NIR graph's network is not checked so: one run with `--like` comes from another tool,
 /// whatever the spiking model lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
@@ -156,6 +157,7 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
         same("reset", &net.reset, &snn.reset),
         same("target", &net.target, &snn.target),
         same("w_rec", &net.recurrent(), &snn.recurrent),
+        same("adaptation", &net.adaptation, &snn.adaptation()),
         (
             "alpha",
             net.own_decays() == snn.train_decays,

@@ -190,6 +190,30 @@ def test_training_on_warped_time_gives_the_network_of_the_cli(sim, sim_dir, tmp_
         neurotex.SpikingModel.train(sim, hidden=8, epochs=1, warp=1.0)
 
 
+def test_adaptive_thresholds_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
+    """`adapt_ms` trains the network `--snn-adapt-ms` trains, whose file keeps the
+    adaptation; such a network has no NIR graph, and a subtracting reset is refused by the
+    option's name."""
+    flags = ["--snn-hidden", "8", "--snn-epochs", "2", "--snn-adapt-ms", "150"]
+    py, cli = python_and_cli(sim, sim_dir, tmp_path, flags, hidden=8, epochs=2, adapt_ms=150.0)
+    assert cli["network"]["adaptation"] == {"tau_ms": 150.0, "strength": 1.0}
+    assert cli["classifier"]["adapt_ms"] == 150.0
+    fixed = neurotex.SpikingModel.train(sim, hidden=8, epochs=2)
+    fixed.save(tmp_path / "fixed.json")
+    assert "adaptation" not in json.loads((tmp_path / "fixed.json").read_text())["network"]
+    from neurotex.sklearn import SpikingClassifier
+
+    est = SpikingClassifier(hidden=8, epochs=2, adapt_ms=150.0, adapt_strength=0.5)
+    est.fit(sim.recordings, sim.labels).model_.save(tmp_path / "est.json")
+    saved = json.loads((tmp_path / "est.json").read_text())["network"]["adaptation"]
+    assert saved == {"tau_ms": 150.0, "strength": 0.5}
+    with pytest.raises(neurotex.errors.Error, match="adaptive thresholds"):
+        est.model_.save_nir(tmp_path / "est.nir")
+    assert not (tmp_path / "est.nir").exists()
+    with pytest.raises(neurotex.errors.ParameterError, match="snn-adapt-ms|adapt_ms"):
+        neurotex.SpikingModel.train(sim, hidden=8, epochs=1, adapt_ms=150.0, reset="subtract")
+
+
 def test_trained_decays_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
     """`train_decays` trains the network `--snn-train-decays` trains: one synaptic and one
     membrane decay per hidden neuron in the file, which the NIR graph carries."""

@@ -158,6 +158,10 @@ impl fmt::Display for ClassifierChoice {
                 if p.train_decays {
                     write!(f, ", each neuron's decays trained")?;
                 }
+                if let Some(a) = p.adaptation() {
+                    let (tau, b) = (a.tau_ms, a.strength);
+                    write!(f, ", adaptive thresholds (tau {tau} ms, strength {b})")?;
+                }
                 if p.target == crate::snn::Target::Xylo {
                     write!(
                         f,

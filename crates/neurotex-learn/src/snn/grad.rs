@@ -27,6 +27,15 @@
 //! gP[t] = gV[t] + gS[t] H'(P[t] - 1)                 reset detached
 //! gP[t] = gV[t] (1 - H'(P[t] - 1)) + gS[t] H'(P[t] - 1)  reset in the graph
 //! ```
+//!
+//! With adaptive thresholds (`S[t] = H(P[t] - 1 - b a[t])`, `a[t+1] = ρ a[t] + (1 - ρ) S[t]`,
+//! reset to zero) the spike's gradient gains the adaptation's, which runs back in time:
+//!
+//! ```text
+//! gS̃[t] = gS[t] + (1 - ρ) ga[t+1]
+//! gP[t] = gV[t] (1 - S[t]) + gS̃[t] H'(P[t] - 1 - b a[t])
+//! ga[t] = ρ ga[t+1] - b gS̃[t] H'(P[t] - 1 - b a[t])
+//! ```
 
 use super::{softmax, Network, PerNeuron, Readout, Reset, SpikeInput};
 
@@ -157,6 +166,8 @@ pub struct Trajectory {
     pre: Vec<f64>,
     spikes: Vec<f64>,
     out: Vec<f64>,
+    /// Each step's threshold rise `b a[t]` (adaptive thresholds only).
+    shift: Vec<f64>,
 }
 
 neurotex_core::widest_or_plain! {
@@ -220,6 +231,10 @@ fn forward_with(
     let mut membrane = vec![0.0; h_n];
     let mut out = vec![0.0; c_n];
     let mut fired = Vec::with_capacity(h_n);
+    let adapt = net.adaptation.map(|a| a.per_step(net.dt_ms));
+    let mut level = vec![0.0; if adapt.is_some() { h_n } else { 0 }];
+    tr.shift
+        .resize(if adapt.is_some() { steps * h_n } else { 0 }, 0.0);
     for t in 0..steps {
         super::decay_currents(&mut current, &net.b_in, &alpha, own);
         super::add_inputs(&mut current, &net.w_in, input.at(t), input.scale());
@@ -238,9 +253,19 @@ fn forward_with(
         let pre = &mut tr.pre[t * h_n..(t + 1) * h_n];
         let spikes = &mut tr.spikes[t * h_n..(t + 1) * h_n];
         let laws = (&spike, &reset);
-        match own {
-            true => membranes(pre, spikes, &mut membrane, &current, beta.as_slice(), laws),
-            false => membranes(pre, spikes, &mut membrane, &current, beta[0], laws),
+        match (own, adapt) {
+            (true, None) => membranes(pre, spikes, &mut membrane, &current, beta.as_slice(), laws),
+            (false, None) => membranes(pre, spikes, &mut membrane, &current, beta[0], laws),
+            (_, Some(rho_b)) => {
+                let shift = &mut tr.shift[t * h_n..(t + 1) * h_n];
+                let (m, a, rest) = (&mut membrane, &mut level, (&current[..], rho_b));
+                match own {
+                    true => {
+                        adaptive_membranes(pre, spikes, shift, m, a, beta.as_slice(), rest, laws)
+                    }
+                    false => adaptive_membranes(pre, spikes, shift, m, a, beta[0], rest, laws),
+                }
+            }
         }
         super::add_readout(
             &mut out,
@@ -272,6 +297,34 @@ fn membranes<D: PerNeuron>(
         let p = beta.at(k) * membrane[k] + current[k];
         let s = spike(p);
         (pre[k], spikes[k], membrane[k]) = (p, s, reset(p, s));
+    }
+}
+
+/// [`membranes`] with adaptive thresholds: the spike of `P - b a`, the threshold's rise
+/// `b a` kept in `shift`, and the adaptation `a` moved on by the step's spikes. The slices
+/// written are parameters of their own, not a tuple (see [`step_back`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn adaptive_membranes<D: PerNeuron>(
+    pre: &mut [f64],
+    spikes: &mut [f64],
+    shift: &mut [f64],
+    membrane: &mut [f64],
+    level: &mut [f64],
+    beta: D,
+    (current, (rho, b)): (&[f64], (f64, f64)),
+    (spike, reset): (&impl Fn(f64) -> f64, &impl Fn(f64, f64) -> f64),
+) {
+    let n = pre.len();
+    let (spikes, shift) = (&mut spikes[..n], &mut shift[..n]);
+    let (current, beta) = (&current[..n], beta.first(n));
+    let (membrane, level) = (&mut membrane[..n], &mut level[..n]);
+    for k in 0..n {
+        let p = beta.at(k) * membrane[k] + current[k];
+        let th = b * level[k];
+        let s = spike(p - th);
+        (pre[k], spikes[k], shift[k], membrane[k]) = (p, s, th, reset(p, s));
+        level[k] = rho * level[k] + (1.0 - rho) * s;
     }
 }
 
@@ -431,6 +484,9 @@ struct HiddenBack {
     /// The step's membrane gradient `gP[t]`, kept for the gradients of each neuron's own
     /// decays (empty when the neurons share their decays).
     g_p: Vec<f64>,
+    /// Adaptive thresholds' `(ρ, b)` and the next step's adaptation gradient.
+    adapt: Option<(f64, f64)>,
+    g_a: Vec<f64>,
 }
 
 impl HiddenBack {
@@ -444,6 +500,8 @@ impl HiddenBack {
             reset: f64::from(u8::from(!detach_reset)),
             subtract: net.reset == Reset::Subtract,
             g_p: vec![0.0; if net.own_decays() { net.hidden } else { 0 }],
+            adapt: net.adaptation.map(|a| a.per_step(net.dt_ms)),
+            g_a: vec![0.0; net.adaptation.map_or(0, |_| net.hidden)],
         }
     }
 
@@ -468,16 +526,22 @@ impl HiddenBack {
             // S[t] drives I[t+1]: g_i still holds step t+1's.
             add_recurrent_spike_gradient(net, &self.g_i, g_s);
         }
-        let (g_v, g_i) = (&mut self.g_v, &mut self.g_i);
-        step_back(
-            (g_s, pre, spikes),
-            g_v,
-            g_i,
-            &mut self.g_p,
-            (&self.alpha, &self.beta, self.reset),
-            self.subtract,
-            derivative,
-        );
+        match self.adapt {
+            Some(rho_b) => {
+                let shift = &tr.shift[t * h_n..(t + 1) * h_n];
+                self.adaptive_step((g_s, pre, spikes, shift), rho_b, derivative);
+            }
+            None => step_back(
+                (g_s, pre, spikes),
+                &mut self.g_v,
+                &mut self.g_i,
+                &mut self.g_p,
+                (&self.alpha, &self.beta, self.reset),
+                self.subtract,
+                derivative,
+            ),
+        }
+        let g_i = &mut self.g_i;
         if !self.g_p.is_empty() {
             add_decay_gradients(
                 (tr, t, h_n),
@@ -495,6 +559,33 @@ impl HiddenBack {
         if net.recurrent() && t > 0 {
             let before = &tr.spikes[(t - 1) * h_n..t * h_n];
             add_outer(&mut grad.w_rec, before, g_i);
+        }
+    }
+}
+
+impl HiddenBack {
+    /// [`step_back_adaptive`] with the decays shared (two numbers) or each neuron's own.
+    #[inline(always)]
+    fn adaptive_step(
+        &mut self,
+        parts: (&[f64], &[f64], &[f64], &[f64]),
+        rho_b: (f64, f64),
+        derivative: &impl Fn(f64) -> f64,
+    ) {
+        let (g_v, g_i, g_a, g_p) = (&mut self.g_v, &mut self.g_i, &mut self.g_a, &mut self.g_p);
+        match g_p.is_empty() {
+            true => {
+                let decays = (self.alpha[0], self.beta[0], self.reset);
+                step_back_adaptive::<false, f64>(
+                    parts, g_v, g_i, g_a, g_p, decays, rho_b, derivative,
+                );
+            }
+            false => {
+                let decays = (&self.alpha[..], &self.beta[..], self.reset);
+                step_back_adaptive::<true, &[f64]>(
+                    parts, g_v, g_i, g_a, g_p, decays, rho_b, derivative,
+                );
+            }
         }
     }
 }
@@ -565,6 +656,45 @@ fn step_back_with<const KEEP: bool, D: PerNeuron>(
             g_i[k] = p + alpha.at(k) * g_i[k];
             g_v[k] = beta.at(k) * p;
         }
+    }
+}
+
+/// [`step_back`] with adaptive thresholds (reset to zero): `g_a` holds the next step's
+/// adaptation gradient `∂L/∂a[t+1]` and becomes this step's. The gradients written are
+/// parameters of their own (see [`step_back`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn step_back_adaptive<const KEEP: bool, D: PerNeuron>(
+    (g_s, pre, spikes, shift): (&[f64], &[f64], &[f64], &[f64]),
+    g_v: &mut [f64],
+    g_i: &mut [f64],
+    g_a: &mut [f64],
+    g_p: &mut [f64],
+    (alpha, beta, reset): (D, D, f64),
+    (rho, b): (f64, f64),
+    derivative: &impl Fn(f64) -> f64,
+) {
+    let n = g_s.len();
+    let (pre, spikes, shift, g_v, g_i, g_a) = (
+        &pre[..n],
+        &spikes[..n],
+        &shift[..n],
+        &mut g_v[..n],
+        &mut g_i[..n],
+        &mut g_a[..n],
+    );
+    let g_p = if KEEP { &mut g_p[..n] } else { g_p };
+    let (alpha, beta) = (alpha.first(n), beta.first(n));
+    for k in 0..n {
+        let g_sh = g_s[k] + (1.0 - rho) * g_a[k] - reset * pre[k] * g_v[k];
+        let d = g_sh * derivative(pre[k] - shift[k] - 1.0);
+        let p = g_v[k] * (1.0 - spikes[k]) + d;
+        g_a[k] = rho * g_a[k] - b * d;
+        if KEEP {
+            g_p[k] = p;
+        }
+        g_i[k] = p + alpha.at(k) * g_i[k];
+        g_v[k] = beta.at(k) * p;
     }
 }
 
@@ -703,6 +833,7 @@ mod tests {
             alpha: Vec::new(),
             beta: Vec::new(),
             travel_mm_s: None,
+            adaptation: None,
         };
         let mut events = Vec::new();
         for t in 0..steps as u32 {
@@ -745,9 +876,17 @@ mod tests {
             (Readout::Mean, 5, true, false),
             (Readout::Max, 6, false, true),
             (Readout::Mean, 7, true, true),
+            (Readout::Mean, 8, false, false),
+            (Readout::Max, 9, true, true),
         ] {
             let (net, input) = random_net_of(readout, seed, recurrent);
-            let net = if own { with_own_decays(net, seed) } else { net };
+            let mut net = if own { with_own_decays(net, seed) } else { net };
+            if seed >= 8 {
+                net.adaptation = Some(super::super::Adaptation {
+                    tau_ms: 30.0,
+                    strength: 0.8,
+                });
+            }
             let act = Activation::Smooth { k: 4.0 };
             let mut grad = Gradient::zeros(&net);
             let mut tr = Trajectory::default();
@@ -898,23 +1037,35 @@ mod tests {
     }
 
     /// The training forward pass with the spike nonlinearity gives the scores prediction's
-    /// step-by-step runner gives, bit for bit, for either reset.
+    /// step-by-step runner gives, bit for bit, for either reset and with adaptive
+    /// thresholds.
     #[test]
     fn training_forward_equals_the_runner() {
-        for (readout, recurrent, reset) in [
-            (Readout::Mean, false, Reset::Zero),
-            (Readout::Max, false, Reset::Zero),
-            (Readout::Mean, true, Reset::Zero),
-            (Readout::Mean, false, Reset::Subtract),
-            (Readout::Max, true, Reset::Subtract),
+        for (readout, recurrent, reset, adapt) in [
+            (Readout::Mean, false, Reset::Zero, false),
+            (Readout::Max, false, Reset::Zero, false),
+            (Readout::Mean, true, Reset::Zero, false),
+            (Readout::Mean, false, Reset::Subtract, false),
+            (Readout::Max, true, Reset::Subtract, false),
+            (Readout::Mean, false, Reset::Zero, true),
+            (Readout::Max, true, Reset::Zero, true),
         ] {
             let (net, input) = random_net_of(readout, 3, recurrent);
             // Each neuron's own decays, where it runs as the shared ones do.
-            let mut net = match reset {
-                Reset::Subtract => with_own_decays(net, 4),
-                Reset::Zero => net,
+            let mut net = match reset == Reset::Subtract || (adapt && recurrent) {
+                true => with_own_decays(net, 4),
+                false => net,
             };
             net.reset = reset;
+            if adapt {
+                let fixed = net.scores(&input);
+                net.adaptation = Some(super::super::Adaptation {
+                    tau_ms: 25.0,
+                    strength: 0.7,
+                });
+                net.check().unwrap();
+                assert_ne!(net.scores(&input), fixed);
+            }
             let act = Activation::Spike { slope: 10.0 };
             let mut tr = Trajectory::default();
             let trained = forward(&net, &input, act, &mut tr);

@@ -184,6 +184,28 @@ pub struct Network {
     /// `dt_ms x travel_mm_s / |v|` ms. Absent: steps of `dt_ms` whatever the speed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub travel_mm_s: Option<f64>,
+    /// Adaptive thresholds (ALIF): each hidden neuron's threshold rises with its recent
+    /// spikes. Absent: a fixed threshold of 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptation: Option<Adaptation>,
+}
+
+/// Adaptive thresholds (Bellec et al. 2020): a neuron's threshold is `1 + b a[t]`, its
+/// adaptation `a[t+1] = ρ a[t] + (1 - ρ) S[t]` (a low-passed spike rate, 0 to 1), with
+/// `ρ = e^{-dt/τ_a}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Adaptation {
+    /// The adaptation's time constant `τ_a`, ms.
+    pub tau_ms: f64,
+    /// How far the threshold rises at a full spike rate, `b`.
+    pub strength: f64,
+}
+
+impl Adaptation {
+    /// `(ρ, b)` for steps of `dt_ms`.
+    pub fn per_step(&self, dt_ms: u32) -> (f64, f64) {
+        ((-f64::from(dt_ms) / self.tau_ms).exp(), self.strength)
+    }
 }
 
 /// The smallest and largest decay per step trained decays are kept within: time constants
@@ -310,6 +332,7 @@ impl Network {
         self.check_steps()?;
         self.check_taus()?;
         self.check_own_decays()?;
+        self.check_adaptation()?;
         if self.target == Target::Xylo {
             xylo::check(self)?;
         }
@@ -386,6 +409,30 @@ impl Network {
             }
         }
         Ok(())
+    }
+
+    /// Adaptive thresholds' rules: a positive finite time constant and strength, neurons
+    /// that reset to zero, and a float network.
+    fn check_adaptation(&self) -> Result<(), ModelError> {
+        let Some(a) = self.adaptation else {
+            return Ok(());
+        };
+        let why = if !(a.tau_ms > 0.0 && a.tau_ms.is_finite()) {
+            format!(
+                "the network's adaptation.tau_ms is {:?}; it must be positive and finite",
+                a.tau_ms
+            )
+        } else if !(a.strength > 0.0 && a.strength.is_finite()) {
+            format!(
+                "the network's adaptation.strength is {:?}; it must be positive and finite",
+                a.strength
+            )
+        } else if self.reset != Reset::Zero || self.target != Target::Float {
+            "a network with adaptive thresholds resets to zero and runs in float (no `reset` or `target` key)".to_string()
+        } else {
+            return Ok(());
+        };
+        Err(ModelError::network("adaptation", why))
     }
 
     /// A running copy of the network, for spikes that arrive step by step.

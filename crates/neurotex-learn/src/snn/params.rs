@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{xylo, Readout, Reset, Target, Travel};
+use super::{xylo, Adaptation, Readout, Reset, Target, Travel};
 use crate::error::ParamError;
 
 /// The spiking classifier's parameters (defaults chosen a priori but standardised inputs,
@@ -83,6 +83,20 @@ pub struct SnnParams {
     /// absent.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub warp: Option<f64>,
+    /// Adaptive thresholds (ALIF, Bellec et al. 2020), their time constant in ms: each
+    /// hidden neuron's threshold rises with its spikes of the last `adapt_ms` or so and falls
+    /// back as it stays silent ([`Adaptation`]); `None`: a fixed threshold. Left out of
+    /// model files when absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adapt_ms: Option<f64>,
+    /// How far an adaptive threshold rises above 1 at a spike every step (1). Left out of
+    /// model files when 1.
+    #[serde(skip_serializing_if = "is_one")]
+    pub adapt_strength: f64,
+}
+
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
 }
 
 impl Default for SnnParams {
@@ -110,6 +124,8 @@ impl Default for SnnParams {
             train_decays: false,
             travel: Travel::Off,
             warp: None,
+            adapt_ms: None,
+            adapt_strength: 1.0,
         }
     }
 }
@@ -178,6 +194,7 @@ impl SnnParams {
             }
         }
         self.travel.check()?;
+        self.check_adaptation()?;
         match self.target {
             Target::Float => Ok(self),
             Target::Xylo => self.on_xylo(),
@@ -194,6 +211,7 @@ impl SnnParams {
             ("snn-recurrent", self.recurrent, "the Xylo profile runs feed-forward networks", "--snn-recurrent".to_string()),
             ("snn-train-decays", self.train_decays, "the Xylo profile's neurons share the chip's bitshift decays", "--snn-train-decays".to_string()),
             ("snn-travel", !self.travel.is_off(), "the Xylo profile's inputs are whole events per step, which steps of travel weigh by their length", format!("--snn-travel {}", self.travel.name())),
+            ("snn-adapt-ms", self.adapt_ms.is_some(), "the Xylo profile's neurons have fixed thresholds", format!("--snn-adapt-ms {}", self.adapt_ms.unwrap_or_default())),
             ("snn-warp", self.warp.is_some(), "the Xylo profile's inputs carry at most 15 events a step, which squeezed time can exceed (leave out --snn-warp, or train for --snn-target float)", format!("--snn-warp {}", self.warp.unwrap_or_default())),
         ];
         if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
@@ -207,6 +225,40 @@ impl SnnParams {
             *tau = xylo::tau_of(xylo::dash_of(*tau, self.dt_ms), self.dt_ms);
         }
         Ok(self)
+    }
+
+    /// Adaptive thresholds' rules: a positive finite time constant, a positive finite
+    /// strength, and neurons that reset to zero.
+    fn check_adaptation(&self) -> Result<(), ParamError> {
+        let Some(tau) = self.adapt_ms else {
+            return Ok(());
+        };
+        if !(tau > 0.0 && tau.is_finite()) {
+            let rule = "an adaptive threshold's time constant must be positive and finite";
+            return Err(ParamError::new("snn-adapt-ms", rule, tau));
+        }
+        let b = self.adapt_strength;
+        if !(b > 0.0 && b.is_finite()) {
+            let rule = "an adaptive threshold's strength must be positive and finite";
+            return Err(ParamError::new("snn-adapt-strength", rule, b));
+        }
+        if self.reset != Reset::Zero && self.target == Target::Float {
+            let rule = "adaptive thresholds are trained with neurons that reset to zero (--snn-reset zero)";
+            return Err(ParamError::new(
+                "snn-adapt-ms",
+                rule,
+                "--snn-reset subtract",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The adaptive thresholds a network trained with these parameters has.
+    pub fn adaptation(&self) -> Option<Adaptation> {
+        self.adapt_ms.map(|tau_ms| Adaptation {
+            tau_ms,
+            strength: self.adapt_strength,
+        })
     }
 
     /// The steps of a training window, when training on windows.

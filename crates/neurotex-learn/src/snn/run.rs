@@ -26,6 +26,9 @@ pub struct State {
     active: Vec<u32>,
     /// What one input event adds ([`SpikeInput::scale`](super::SpikeInput::scale)).
     pub(super) scale: f64,
+    /// Adaptive thresholds' `(ρ, b)` and each neuron's adaptation.
+    adapt: Option<(f64, f64)>,
+    level: Vec<f64>,
 }
 
 impl State {
@@ -53,6 +56,15 @@ impl State {
             counts: vec![0.0; net.hidden],
             active: Vec::with_capacity(net.hidden),
             scale: 1.0,
+            adapt: net.adaptation.map(|a| a.per_step(net.dt_ms)),
+            level: vec![
+                0.0;
+                if net.adaptation.is_some() {
+                    net.hidden
+                } else {
+                    0
+                }
+            ],
         }
     }
 
@@ -108,9 +120,11 @@ neurotex_core::widest_or_plain! {
         // of 1 multiplies the weights exactly; `p (1 - 0)` and `p - 0` are `p`).
         let subtract = net.reset == Reset::Subtract;
         let (membrane, counts) = (&mut state.membrane[..h_n], &mut state.counts[..h_n]);
-        match own {
-            true => fire(membrane, counts, current, beta, subtract),
-            false => fire(membrane, counts, current, beta[0], subtract),
+        match (own, state.adapt) {
+            (true, Some(rho_b)) => fire_adaptive(membrane, counts, current, beta, &mut state.level, rho_b),
+            (false, Some(rho_b)) => fire_adaptive(membrane, counts, current, beta[0], &mut state.level, rho_b),
+            (true, None) => fire(membrane, counts, current, beta, subtract),
+            (false, None) => fire(membrane, counts, current, beta[0], subtract),
         }
         let active = super::nonzero(counts, &mut state.active);
         if net.recurrent() {
@@ -140,6 +154,32 @@ fn fire(
         };
         counts[h] = n;
         membrane[h] = if subtract { p - n } else { p * (1.0 - n) };
+    }
+}
+
+/// [`fire`] with adaptive thresholds (reset to zero), as the training's forward pass.
+#[inline(always)]
+fn fire_adaptive(
+    membrane: &mut [f64],
+    counts: &mut [f64],
+    current: &[f64],
+    beta: impl PerNeuron,
+    level: &mut [f64],
+    (rho, b): (f64, f64),
+) {
+    let n = membrane.len();
+    let (counts, current, beta, level) = (
+        &mut counts[..n],
+        &current[..n],
+        beta.first(n),
+        &mut level[..n],
+    );
+    for h in 0..n {
+        let p = beta.at(h) * membrane[h] + current[h];
+        let s = f64::from(u8::from(p - b * level[h] - 1.0 >= 0.0));
+        counts[h] = s;
+        membrane[h] = p * (1.0 - s);
+        level[h] = rho * level[h] + (1.0 - rho) * s;
     }
 }
 
@@ -251,6 +291,7 @@ mod tests {
             alpha: Vec::new(),
             beta: Vec::new(),
             travel_mm_s: None,
+            adaptation: None,
         }
     }
 

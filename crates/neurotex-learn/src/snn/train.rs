@@ -217,6 +217,7 @@ fn initial(
         alpha: Vec::new(),
         beta: Vec::new(),
         travel_mm_s: None,
+        adaptation: params.adaptation(),
     }
     .with_own_decays(params, rng))
 }
@@ -508,6 +509,7 @@ mod tests {
             alpha: Vec::new(),
             beta: Vec::new(),
             travel_mm_s: None,
+            adaptation: None,
         };
         let moved = z.trained(&net);
         let back = z.network(&moved);

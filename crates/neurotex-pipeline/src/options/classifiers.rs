@@ -278,6 +278,14 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
          validation and prediction read the recordings as they are [default: none: no \
          warp].",
         get: |w: &Option<f64>| w.map(|v| v.to_string()), set: |t: &str| parse(t).map(Some)),
+    knob!(Snn "snn", adapt_ms, "--snn-adapt-ms", Number,
+        "Adaptive thresholds (ALIF): each hidden neuron's threshold rises by \
+         --snn-adapt-strength times its spike rate over about this many ms and falls back \
+         as it stays silent, so that a neuron answers change more than a steady drive; \
+         neurons reset to zero [default: none: fixed thresholds].",
+        get: |w: &Option<f64>| w.map(|v| v.to_string()), set: |t: &str| parse(t).map(Some)),
+    knob!(Snn "snn", adapt_strength, "--snn-adapt-strength", Number,
+        "With --snn-adapt-ms: how far a threshold of 1 rises at a spike every step."),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \
          the chip's limits, its time constants moved to the chip's bitshift decays, \

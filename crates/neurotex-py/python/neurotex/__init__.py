@@ -1105,6 +1105,8 @@ class SpikingModel(Model):
         train_decays: bool = _SNN_DEFAULTS["train_decays"],
         travel: Union[str, float] = _SNN_DEFAULTS["travel"],
         warp: Optional[float] = _SNN_DEFAULTS["warp"],
+        adapt_ms: Optional[float] = _SNN_DEFAULTS["adapt_ms"],
+        adapt_strength: float = _SNN_DEFAULTS["adapt_strength"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -1129,14 +1131,17 @@ class SpikingModel(Model):
         median speed (``speeds``; in ms without them), a speed in mm/s for that reference,
         or ``"off"`` (the default) for ms; ``warp`` trains on time-warped recordings, each
         stretched or squeezed at every epoch by a factor drawn log-uniformly between
-        ``1/warp`` and ``warp`` (``--snn-warp``; ``None``: as they are).
-        ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
+        ``1/warp`` and ``warp`` (``--snn-warp``; ``None``: as they are); ``adapt_ms``
+        gives the hidden neurons adaptive thresholds (ALIF) that rise by ``adapt_strength``
+        times their spike rate over about ``adapt_ms`` ms (``--snn-adapt-ms``,
+        ``--snn-adapt-strength``; ``None``: fixed thresholds; such a network has no NIR
+        graph). ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
         :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
                "seed": seed, "recurrent": recurrent, "target": target,
                "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms,
                "window_ms": window_ms, "train_decays": train_decays, "travel": str(travel),
-               "warp": warp}
+               "warp": warp, "adapt_ms": adapt_ms, "adapt_strength": adapt_strength}
         if reset is not None:
             snn["reset"] = reset
         folder = _folder(recordings)

@@ -292,8 +292,9 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     stopping on 20 % of each class of ``X``, seeded by ``seed``; ``recurrent`` and
     ``reset`` (``"zero"`` or ``"subtract"``), ``target`` (``"float"`` or ``"xylo"``) and
     ``window_ms`` (train on windows of that many ms), ``train_decays`` (each hidden
-    neuron's decays trained), ``travel`` (time in steps of travel) and ``warp`` (train on
-    time-warped recordings) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
+    neuron's decays trained), ``travel`` (time in steps of travel), ``warp`` (train on
+    time-warped recordings) and ``adapt_ms`` with ``adapt_strength`` (adaptive thresholds)
+    as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
     it to NIR)."""
 
@@ -311,6 +312,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         train_decays: bool = _SNN_DEFAULTS["train_decays"],
         travel: Union[str, float] = _SNN_DEFAULTS["travel"],
         warp: Optional[float] = _SNN_DEFAULTS["warp"],
+        adapt_ms: Optional[float] = _SNN_DEFAULTS["adapt_ms"],
+        adapt_strength: float = _SNN_DEFAULTS["adapt_strength"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
@@ -329,6 +332,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.train_decays = train_decays
         self.travel = travel
         self.warp = warp
+        self.adapt_ms = adapt_ms
+        self.adapt_strength = adapt_strength
         self.encoding = encoding
         self.gain = gain
         self.baseline = baseline
@@ -351,7 +356,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
             dt_ms=self.dt_ms, epochs=self.epochs, readout=self.readout, seed=self.seed,
             recurrent=self.recurrent, reset=self.reset, target=self.target,
             window_ms=self.window_ms, train_decays=self.train_decays, travel=self.travel,
-            warp=self.warp, causal=self.causal,
+            warp=self.warp, adapt_ms=self.adapt_ms, adapt_strength=self.adapt_strength,
+            causal=self.causal,
             encoding=self.encoding, gain=self.gain,
             baseline=self.baseline,
         )
