@@ -312,7 +312,7 @@ fn smallest_class(metas: &[Meta], rows: &[usize]) -> usize {
 pub(super) fn check_nested(metas: &[Meta], params: &CompareParams) -> Result<Vec<OuterSplit>> {
     if let Some(folds @ 0..2) = params.inner_folds {
         let rule = "nested selection's inner cross-validation needs 2 folds or more";
-        return Err(ParamError::new("inner_folds", rule, folds).into());
+        return Err(ParamError::new("inner-folds", rule, folds).into());
     }
     let splits = outer_splits(metas, params)?;
     for split in &splits {
