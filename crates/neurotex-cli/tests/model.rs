@@ -594,8 +594,8 @@ fn a_subtractive_reset_is_written_and_a_zero_reset_left_out() {
 
 /// `--snn-adapt-ms` is written in the model file (network and training parameters) and
 /// predicts, but has no NIR graph (NIR has no adaptive threshold): the export is refused
-/// and writes nothing; a time constant that is not positive and a subtracting reset are
-/// refused by the option's name.
+/// and writes nothing; a time constant that is not positive, a subtracting reset and a
+/// strength without a time constant are refused by the option's name.
 #[test]
 fn adaptive_thresholds_are_written_and_predict_but_make_no_graph() {
     let dir = Dir::new();
@@ -620,9 +620,19 @@ fn adaptive_thresholds_are_written_and_predict_but_make_no_graph() {
     );
     assert!(!graph.exists());
     let never = dir.join("never.json");
-    for flags in [
-        ["--snn-adapt-ms", "0", "--snn-reset", "zero"],
-        ["--snn-adapt-ms", "150", "--snn-reset", "subtract"],
+    for (flags, option) in [
+        (
+            ["--snn-adapt-ms", "0", "--snn-reset", "zero"],
+            "snn-adapt-ms",
+        ),
+        (
+            ["--snn-adapt-ms", "150", "--snn-reset", "subtract"],
+            "snn-adapt-ms",
+        ),
+        (
+            ["--snn-adapt-strength", "0.5", "--snn-reset", "zero"],
+            "snn-adapt-strength",
+        ),
     ] {
         let mut args = vec![
             "train",
@@ -635,7 +645,7 @@ fn adaptive_thresholds_are_written_and_predict_but_make_no_graph() {
         ];
         args.extend(flags);
         let err = dir.fails(&args);
-        assert!(err.contains("snn-adapt-ms"), "{flags:?}: {err}");
+        assert!(err.contains(option), "{flags:?}: {err}");
     }
     assert!(!never.exists());
 }

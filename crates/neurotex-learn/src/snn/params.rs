@@ -228,9 +228,17 @@ impl SnnParams {
     }
 
     /// Adaptive thresholds' rules: a positive finite time constant, a positive finite
-    /// strength, and neurons that reset to zero.
+    /// strength, given only with a time constant, and neurons that reset to zero.
     fn check_adaptation(&self) -> Result<(), ParamError> {
         let Some(tau) = self.adapt_ms else {
+            if self.adapt_strength != 1.0 {
+                let rule = "an adaptive threshold's strength applies with its time constant (--snn-adapt-ms); without it the thresholds are fixed";
+                return Err(ParamError::new(
+                    "snn-adapt-strength",
+                    rule,
+                    self.adapt_strength,
+                ));
+            }
             return Ok(());
         };
         if !(tau > 0.0 && tau.is_finite()) {

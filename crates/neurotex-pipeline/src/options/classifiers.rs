@@ -281,11 +281,14 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
     knob!(Snn "snn", adapt_ms, "--snn-adapt-ms", Number,
         "Adaptive thresholds (ALIF): each hidden neuron's threshold rises by \
          --snn-adapt-strength times its spike rate over about this many ms and falls back \
-         as it stays silent, so that a neuron answers change more than a steady drive; \
-         neurons reset to zero [default: none: fixed thresholds].",
+         as it stays silent, so that a neuron answers change more than a steady drive. \
+         Neurons reset to zero (refused with --snn-reset subtract and --snn-target xylo), \
+         and NIR has no adaptive threshold: `export nir` refuses such a network, which runs \
+         from its model file [default: none: fixed thresholds].",
         get: |w: &Option<f64>| w.map(|v| v.to_string()), set: |t: &str| parse(t).map(Some)),
     knob!(Snn "snn", adapt_strength, "--snn-adapt-strength", Number,
-        "With --snn-adapt-ms: how far a threshold of 1 rises at a spike every step."),
+        "With --snn-adapt-ms: how far a threshold of 1 rises at a spike every step (1: it \
+         doubles)."),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \
          the chip's limits, its time constants moved to the chip's bitshift decays, \
