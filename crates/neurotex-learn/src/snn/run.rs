@@ -57,14 +57,7 @@ impl State {
             active: Vec::with_capacity(net.hidden),
             scale: 1.0,
             adapt: net.adaptation.map(|a| a.per_step(net.dt_ms)),
-            level: vec![
-                0.0;
-                if net.adaptation.is_some() {
-                    net.hidden
-                } else {
-                    0
-                }
-            ],
+            level: vec![0.0; net.adaptation.map_or(0, |_| net.hidden)],
         }
     }
 
