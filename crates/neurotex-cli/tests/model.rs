@@ -578,17 +578,7 @@ fn a_subtractive_reset_is_written_and_a_zero_reset_left_out() {
     let graph = dir.join("subtract.nir");
     dir.ok(&["export", "nir", "--model", s(&subtract), "--out", s(&graph)]);
     assert_eq!(predict(&graph, &dir.join("graph.csv")), from_file);
-    let err = dir.fails(&[
-        "train",
-        "--dataset",
-        s(&ds),
-        "--classifier",
-        "snn",
-        "--snn-reset",
-        "half",
-        "--out",
-        s(&dir.join("never.json")),
-    ]);
+    let err = dir.train_snn_fails(&ds, &dir.join("never.json"), &["--snn-reset", "half"]);
     assert!(err.contains("snn-reset"), "{err}");
 }
 
@@ -634,17 +624,7 @@ fn adaptive_thresholds_are_written_and_predict_but_make_no_graph() {
             "snn-adapt-strength",
         ),
     ] {
-        let mut args = vec![
-            "train",
-            "--dataset",
-            s(&ds),
-            "--classifier",
-            "snn",
-            "--out",
-            s(&never),
-        ];
-        args.extend(flags);
-        let err = dir.fails(&args);
+        let err = dir.train_snn_fails(&ds, &never, &flags);
         assert!(err.contains(option), "{flags:?}: {err}");
     }
     assert!(!never.exists());
@@ -894,16 +874,7 @@ fn the_network_trains_on_windows_when_asked() {
     );
     assert_ne!(whole["network"], windowed["network"]);
     let never = dir.join("never.json");
-    let args = [
-        "train",
-        "--dataset",
-        s(&ds),
-        "--classifier",
-        "snn",
-        "--out",
-        s(&never),
-    ];
-    let err = dir.fails(&[&args[..], &["--snn-window-ms", "5"]].concat());
+    let err = dir.train_snn_fails(&ds, &never, &["--snn-window-ms", "5"]);
     assert!(err.contains("`snn-window-ms`"), "{err}");
     assert!(err.contains("under one step of 10 ms"), "{err}");
     assert!(!never.exists());

@@ -76,6 +76,21 @@ impl Dir {
         self.ok(&args);
     }
 
+    /// Runs `neurotex train --dataset DATASET --classifier snn --out OUT EXTRA...`, which
+    /// must fail; returns what it says on standard error.
+    pub fn train_snn_fails(&self, dataset: &Path, out: &Path, extra: &[&str]) -> String {
+        let args = [
+            "train",
+            "--dataset",
+            s(dataset),
+            "--classifier",
+            "snn",
+            "--out",
+            s(out),
+        ];
+        self.fails(&[&args[..], extra].concat())
+    }
+
     /// Runs `neurotex predict --model MODEL --dataset DATASET --out OUT --json`, which must
     /// succeed; returns the JSON it prints.
     pub fn predict_json(&self, model: &Path, dataset: &Path, out: &Path) -> Value {

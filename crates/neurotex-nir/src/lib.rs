@@ -116,7 +116,7 @@ impl Convention {
 /// # Errors
 /// A network whose reset the importer does not have, or with adaptive thresholds, naming
 /// the training option.
-pub fn check_reset(net: &Network, convention: Convention) -> Result<()> {
+pub fn check_neurons(net: &Network, convention: Convention) -> Result<()> {
     let subtracts = !net.reset.is_zero();
     let tool = convention.name();
     let why = match convention {

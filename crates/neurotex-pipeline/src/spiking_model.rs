@@ -336,7 +336,7 @@ impl SpikingModel {
     /// # Errors
     /// The graph cannot be written.
     pub fn to_nir(&self, convention: Convention) -> Result<Vec<u8>> {
-        crate::nir::check_reset(&self.file.network, convention)?;
+        crate::nir::check_neurons(&self.file.network, convention)?;
         let mut value = serde_json::to_value(&self.file)
             .map_err(|e| ModelError::Inconsistent(e.to_string()))?;
         if let Some(map) = value.as_object_mut() {
