@@ -410,6 +410,7 @@ fn spiking_file(recurrent: bool) -> serde_json::Value {
         beta: Vec::new(),
         travel_mm_s: None,
         adaptation: None,
+        delays: Vec::new(),
     };
     let layout = LayoutFile {
         rows: Some(2),

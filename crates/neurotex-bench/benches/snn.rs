@@ -4,7 +4,8 @@
 //! backward through time, Adam) over 55 recordings of 32 inputs x 1200 steps at 10 ms
 //! (12 s slides, about one FabricSlide velocity's training folds; 45 trained, 10 held out
 //! for validation) with one epoch, so every iteration is one whole epoch, with the neurons'
-//! shared decays, with each neuron's own trained, and with adaptive thresholds.
+//! shared decays, with each neuron's own trained, with adaptive thresholds and with
+//! learnable synaptic delays.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use neurotex::snn::{fit, Network, Readout, Reset, SnnParams, SpikeInput};
@@ -41,6 +42,7 @@ fn network(inputs: usize, hidden: usize, classes: usize) -> Network {
         beta: Vec::new(),
         travel_mm_s: None,
         adaptation: None,
+        delays: Vec::new(),
     }
 }
 
@@ -119,6 +121,15 @@ fn bench(c: &mut Criterion) {
     };
     c.bench_function("snn/train_epoch/55x32x1200/adapt", |b| {
         b.iter(|| fit(&adaptive, &refs, &y, 5).unwrap().1.epochs)
+    });
+    // The same epoch with learnable synaptic delays of up to 250 ms (`--snn-delay-ms 250`,
+    // 25 steps).
+    let delayed = SnnParams {
+        delay_ms: Some(250.0),
+        ..params
+    };
+    c.bench_function("snn/train_epoch/55x32x1200/delays", |b| {
+        b.iter(|| fit(&delayed, &refs, &y, 5).unwrap().1.epochs)
     });
     // What a fit in steps of travel (`--snn-travel`) adds before it trains: the same
     // recordings' 12 s in 1 ms steps (20-80 Hz an input), rebinned to steps of 15 ms (10 ms

@@ -465,6 +465,18 @@ fn a_spiking_network_trains_saves_and_predicts_and_a_damaged_one_is_named() {
     std::fs::write(&damaged, serde_json::to_string(&adapt).unwrap()).unwrap();
     let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(err.contains("adapt"), "{err}");
+    // Delays its training did not give the network, then a negative one.
+    let mut delayed = file.clone();
+    let synapses = delayed["network"]["w_in"].as_array().unwrap().len();
+    delayed["network"]["delays"] = Value::from(vec![1.5; synapses]);
+    std::fs::write(&damaged, serde_json::to_string(&delayed).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("`network.delays`"), "{err}");
+    delayed["classifier"]["delay_ms"] = Value::from(50.0);
+    delayed["network"]["delays"][3] = Value::from(-1.0);
+    std::fs::write(&damaged, serde_json::to_string(&delayed).unwrap()).unwrap();
+    let err = dir.fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("delays[3] is -1.0"), "{err}");
     assert!(!never.exists());
     // A graph that is not HDF5, and a feature model where a spiking one is needed.
     let junk = dir.join("junk.nir");
@@ -626,6 +638,53 @@ fn adaptive_thresholds_are_written_and_predict_but_make_no_graph() {
     ] {
         let err = dir.train_snn_fails(&ds, &never, &flags);
         assert!(err.contains(option), "{flags:?}: {err}");
+    }
+    assert!(!never.exists());
+}
+
+/// Learnable delays: kept in the model file within their longest, run by `predict`, and
+/// refused by NIR export, the Xylo profile and bounds.
+#[test]
+fn synaptic_delays_are_written_and_predict_but_make_no_graph() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0], 4);
+    let model = dir.join("delays.json");
+    dir.train_tiny_snn(&ds, &model, &["--snn-delay-ms", "50"]);
+    let file = read_json(&model);
+    assert_eq!(file["classifier"]["delay_ms"], 50.0);
+    let (w_in, delays) = (&file["network"]["w_in"], &file["network"]["delays"]);
+    let delays: Vec<f64> = (delays.as_array().unwrap().iter())
+        .map(|d| d.as_f64().unwrap())
+        .collect();
+    assert_eq!(delays.len(), w_in.as_array().unwrap().len());
+    // Up to 50 ms in steps of 10 ms, spread rather than all alike.
+    assert!(delays.iter().all(|d| (0.0..=5.0).contains(d)), "{delays:?}");
+    assert!(delays.iter().any(|&d| d > 2.5) && delays.iter().any(|&d| d < 2.5));
+    let score = dir.predict_json(&model, &ds, &dir.join("p.csv"));
+    assert_eq!(score["n"], 8, "{score}");
+    let graph = dir.join("delays.nir");
+    let err = dir.fails(&["export", "nir", "--model", s(&model), "--out", s(&graph)]);
+    assert!(
+        err.contains("--snn-delay-ms") && err.contains("Delay"),
+        "{err}"
+    );
+    assert!(!graph.exists());
+    let never = dir.join("never.json");
+    for flags in [
+        &["--snn-delay-ms", "0"][..],
+        &["--snn-delay-ms", "10001"],
+        &["--snn-delay-ms", "inf"],
+        &[
+            "--snn-delay-ms",
+            "50",
+            "--snn-target",
+            "xylo",
+            "--snn-reset",
+            "subtract",
+        ],
+    ] {
+        let err = dir.train_snn_fails(&ds, &never, flags);
+        assert!(err.contains("snn-delay-ms"), "{flags:?}: {err}");
     }
     assert!(!never.exists());
 }

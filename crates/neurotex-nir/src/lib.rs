@@ -111,16 +111,18 @@ impl Convention {
 /// Whether `convention`'s importer runs `net`'s neurons: sinabs's and Rockpool's subtract
 /// the threshold on a spike (several spikes a step), snnTorch's and Norse's reset to zero.
 /// NIR's own graph takes both (a subtracting network says so in its metadata, which only
-/// neurotex reads). No importer runs adaptive thresholds: NIR has no node for them.
+/// neurotex reads). No importer runs adaptive thresholds (NIR has no node for them) or
+/// per-synapse delays.
 ///
 /// # Errors
-/// A network whose reset the importer does not have, or with adaptive thresholds, naming
-/// the training option.
+/// A network whose reset the importer does not have, or with adaptive thresholds or
+/// delays, naming the training option.
 pub fn check_neurons(net: &Network, convention: Convention) -> Result<()> {
     let subtracts = !net.reset.is_zero();
     let tool = convention.name();
     let why = match convention {
         _ if net.adaptation.is_some() => "this network's neurons have adaptive thresholds (--snn-adapt-ms), for which NIR has no node: every tool would run the graph with fixed thresholds, and predict otherwise. Keep the model file for neurotex (predict, stream), or train without --snn-adapt-ms to export".to_string(),
+        _ if !net.delays.is_empty() => "this network's input synapses each have a delay of their own (--snn-delay-ms), and NIR's Delay node delays a whole layer's values, one delay per value, not each synapse: every tool would run the graph without them, and predict otherwise. Keep the model file for neurotex (predict, stream), or train without --snn-delay-ms to export".to_string(),
         Convention::Sinabs | Convention::Rockpool if !subtracts => format!("{tool}'s neurons subtract the threshold on a spike (several spikes a step), and this network resets to zero: train it with --snn-reset subtract for {tool}, or export it --for nir"),
         Convention::Snntorch if subtracts => format!("this network's neurons subtract the threshold (--snn-reset subtract), and a graph for {tool} resets to zero: export it --for sinabs or --for rockpool, or --for nir for neurotex"),
         _ => return Ok(()),

@@ -262,5 +262,6 @@ pub(super) fn network_of(
         beta,
         travel_mm_s: None,
         adaptation: None,
+        delays: Vec::new(),
     })
 }

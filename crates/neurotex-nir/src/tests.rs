@@ -32,6 +32,7 @@ fn net() -> Network {
         beta: Vec::new(),
         travel_mm_s: None,
         adaptation: None,
+        delays: Vec::new(),
     }
 }
 
@@ -346,6 +347,7 @@ fn decays_of_each_neurons_own_round_trip() {
         beta: vec![0.7, 0.75, 0.95, 0.5],
         travel_mm_s: None,
         adaptation: None,
+        delays: Vec::new(),
         ..net()
     };
     own.check().unwrap();

@@ -138,8 +138,8 @@ fn same<T: PartialEq + Serialize>(
 
 /// Checks that a model file's network is the one its training parameters make: the same
 /// hidden layer, step, readout, reset, recurrence, time constants (to a float's rounding in
-/// JSON), whether each neuron has decays of its own, its adaptive thresholds and whether it
-/// counts time in travel.
+/// JSON), whether each neuron has decays of its own, its adaptive thresholds, whether its
+/// synapses have delays and whether it counts time in travel.
 /// A NIR graph's network is not checked so: one run with `--like` comes from another tool,
 /// whatever the spiking model lending its pipeline was trained with.
 fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), String> {
@@ -161,6 +161,11 @@ fn trained_as_said(net: &Network, snn: &SnnParams) -> std::result::Result<(), St
         (
             "alpha",
             net.own_decays() == snn.train_decays,
+            [String::new(), String::new()],
+        ),
+        (
+            "delays",
+            net.delays.is_empty() == snn.delay_ms.is_none(),
             [String::new(), String::new()],
         ),
         ("travel_mm_s", travel, shown(&net.travel_mm_s, &snn.travel)),

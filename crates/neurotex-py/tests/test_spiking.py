@@ -214,6 +214,30 @@ def test_adaptive_thresholds_give_the_network_of_the_cli(sim, sim_dir, tmp_path)
         neurotex.SpikingModel.train(sim, hidden=8, epochs=1, adapt_ms=150.0, reset="subtract")
 
 
+def test_synaptic_delays_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
+    """`delay_ms` trains the network `--snn-delay-ms` trains, whose file keeps one delay per
+    input synapse within the longest; such a network has no NIR graph, and the Xylo
+    profile is refused by the option's name."""
+    flags = ["--snn-hidden", "8", "--snn-epochs", "2", "--snn-delay-ms", "40"]
+    py, cli = python_and_cli(sim, sim_dir, tmp_path, flags, hidden=8, epochs=2, delay_ms=40.0)
+    delays = cli["network"]["delays"]
+    assert len(delays) == len(cli["network"]["w_in"])
+    assert all(0.0 <= d <= 4.0 for d in delays) and len(set(delays)) > 1
+    assert cli["classifier"]["delay_ms"] == 40.0
+    from neurotex.sklearn import SpikingClassifier
+
+    est = SpikingClassifier(hidden=8, epochs=2, delay_ms=40.0)
+    est.fit(sim.recordings, sim.labels).model_.save(tmp_path / "est.json")
+    assert len(json.loads((tmp_path / "est.json").read_text())["network"]["delays"]) == len(delays)
+    with pytest.raises(neurotex.errors.Error, match="Delay"):
+        est.model_.save_nir(tmp_path / "est.nir")
+    assert not (tmp_path / "est.nir").exists()
+    with pytest.raises(neurotex.errors.ParameterError, match="snn-delay-ms|delay_ms"):
+        neurotex.SpikingModel.train(
+            sim, hidden=8, epochs=1, delay_ms=40.0, target="xylo", reset="subtract"
+        )
+
+
 def test_trained_decays_give_the_network_of_the_cli(sim, sim_dir, tmp_path):
     """`train_decays` trains the network `--snn-train-decays` trains: one synaptic and one
     membrane decay per hidden neuron in the file, which the NIR graph carries."""

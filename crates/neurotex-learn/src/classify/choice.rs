@@ -129,50 +129,57 @@ impl fmt::Display for ClassifierChoice {
                 }
                 write!(f, ")")
             }
-            ClassifierChoice::Snn(p) => {
-                write!(
-                    f,
-                    "spiking network ({} {}LIF neurons, {} ms steps{}, {} readout, seed {}",
-                    p.hidden,
-                    if p.recurrent { "recurrent " } else { "" },
-                    p.dt_ms,
-                    match p.travel {
-                        crate::snn::Travel::Off => String::new(),
-                        crate::snn::Travel::Median => {
-                            " of travel at the training speeds' median".into()
-                        }
-                        crate::snn::Travel::At(v) => format!(" of travel at {v} mm/s"),
-                    },
-                    p.readout.name(),
-                    p.seed
-                )?;
-                if let Some(window) = p.window_ms {
-                    write!(f, ", trained on {window} ms windows")?;
-                }
-                if let Some(w) = p.warp {
-                    write!(f, ", time warped up to {w}x in training")?;
-                }
-                if !p.standardize {
-                    write!(f, ", inputs not standardised")?;
-                }
-                if p.train_decays {
-                    write!(f, ", each neuron's decays trained")?;
-                }
-                if let Some(a) = p.adaptation() {
-                    let (tau, b) = (a.tau_ms, a.strength);
-                    write!(f, ", adaptive thresholds (tau {tau} ms, strength {b})")?;
-                }
-                if p.target == crate::snn::Target::Xylo {
-                    write!(
-                        f,
-                        "; Xylo profile: 8-bit weights, subtractive reset, tau_syn {:.2} ms, tau_mem {:.2} ms, tau_out {:.2} ms",
-                        p.tau_syn_ms, p.tau_mem_ms, p.tau_out_ms
-                    )?;
-                }
-                write!(f, ")")
-            }
+            ClassifierChoice::Snn(p) => describe_snn(p, f),
         }
     }
+}
+
+/// The spiking network with its training options, e.g. `spiking network (128 LIF neurons, 10
+/// ms steps, mean readout, seed 0)`.
+fn describe_snn(p: &crate::snn::SnnParams, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    write!(
+        f,
+        "spiking network ({} {}LIF neurons, {} ms steps{}, {} readout, seed {}",
+        p.hidden,
+        if p.recurrent { "recurrent " } else { "" },
+        p.dt_ms,
+        match p.travel {
+            crate::snn::Travel::Off => String::new(),
+            crate::snn::Travel::Median => {
+                " of travel at the training speeds' median".into()
+            }
+            crate::snn::Travel::At(v) => format!(" of travel at {v} mm/s"),
+        },
+        p.readout.name(),
+        p.seed
+    )?;
+    if let Some(window) = p.window_ms {
+        write!(f, ", trained on {window} ms windows")?;
+    }
+    if let Some(w) = p.warp {
+        write!(f, ", time warped up to {w}x in training")?;
+    }
+    if !p.standardize {
+        write!(f, ", inputs not standardised")?;
+    }
+    if p.train_decays {
+        write!(f, ", each neuron's decays trained")?;
+    }
+    if let Some(a) = p.adaptation() {
+        let (tau, b) = (a.tau_ms, a.strength);
+        write!(f, ", adaptive thresholds (tau {tau} ms, strength {b})")?;
+    }
+    if let Some(d) = p.delay_ms {
+        write!(f, ", synaptic delays trained up to {d} ms")?;
+    }
+    if p.target == crate::snn::Target::Xylo {
+        write!(
+            f,
+            "; Xylo profile: 8-bit weights, subtractive reset, tau_syn {:.2} ms, tau_mem {:.2} ms, tau_out {:.2} ms",
+            p.tau_syn_ms, p.tau_mem_ms, p.tau_out_ms
+        )?;
+    }
+    write!(f, ")")
 }
 
 /// A classifier whose parameters passed [`ClassifierChoice::check`].

@@ -106,6 +106,8 @@ pub struct Gradient {
     pub alpha: Vec<f64>,
     /// ∂L/∂β_h (empty when the neurons share their decays).
     pub beta: Vec<f64>,
+    /// ∂L/∂d_ih, input-major (empty without delays).
+    pub delays: Vec<f64>,
 }
 
 impl Gradient {
@@ -119,6 +121,7 @@ impl Gradient {
             w_rec: vec![0.0; net.w_rec.len()],
             alpha: vec![0.0; net.alpha.len()],
             beta: vec![0.0; net.beta.len()],
+            delays: vec![0.0; net.delays.len()],
         }
     }
 
@@ -132,8 +135,8 @@ impl Gradient {
     }
 
     /// The parts in the order of [`Network::params_mut`] (w_in, b_in, w_out, b_out, w_rec,
-    /// alpha, beta).
-    pub fn parts(&self) -> [&[f64]; 7] {
+    /// alpha, beta, delays).
+    pub fn parts(&self) -> [&[f64]; 8] {
         [
             &self.w_in,
             &self.b_in,
@@ -142,11 +145,12 @@ impl Gradient {
             &self.w_rec,
             &self.alpha,
             &self.beta,
+            &self.delays,
         ]
     }
 
     /// The parts, mutable, in the same order.
-    pub fn parts_mut(&mut self) -> [&mut Vec<f64>; 7] {
+    pub fn parts_mut(&mut self) -> [&mut Vec<f64>; 8] {
         [
             &mut self.w_in,
             &mut self.b_in,
@@ -155,6 +159,7 @@ impl Gradient {
             &mut self.w_rec,
             &mut self.alpha,
             &mut self.beta,
+            &mut self.delays,
         ]
     }
 }
@@ -168,6 +173,10 @@ pub struct Trajectory {
     out: Vec<f64>,
     /// Each step's threshold rise `b a[t]` (adaptive thresholds only).
     shift: Vec<f64>,
+    /// With delays: the input drive of every step ahead (zero between passes), and the
+    /// backward pass's current gradients of every step.
+    drive: Vec<f64>,
+    g_drive: Vec<f64>,
 }
 
 neurotex_core::widest_or_plain! {
@@ -235,9 +244,18 @@ fn forward_with(
     let mut level = vec![0.0; if adapt.is_some() { h_n } else { 0 }];
     tr.shift
         .resize(if adapt.is_some() { steps * h_n } else { 0 }, 0.0);
+    let delays = super::delay::Delays::of(net);
+    let mut drive = std::mem::take(&mut tr.drive);
+    drive.resize(delays.as_ref().map_or(0, |d| (steps + d.reach) * h_n), 0.0);
     for t in 0..steps {
         super::decay_currents(&mut current, &net.b_in, &alpha, own);
-        super::add_inputs(&mut current, &net.w_in, input.at(t), input.scale());
+        match &delays {
+            None => super::add_inputs(&mut current, &net.w_in, input.at(t), input.scale()),
+            Some(d) => {
+                d.add(&mut drive, t, input.at(t), input.scale());
+                super::take_drive(&mut current, &mut drive[t * h_n..(t + 1) * h_n]);
+            }
+        }
         if net.recurrent() && t > 0 {
             let before = &tr.spikes[(t - 1) * h_n..t * h_n];
             for &j in super::nonzero(before, &mut fired) {
@@ -275,6 +293,10 @@ fn forward_with(
         );
         tr.out[t * c_n..(t + 1) * c_n].copy_from_slice(&out);
     }
+    // What reached past the last step is dropped: the drive is zero for the next pass.
+    let tail = (steps * h_n).min(drive.len());
+    drive[tail..].fill(0.0);
+    tr.drive = drive;
     read_scores(net.readout, &tr.out, c_n, steps)
 }
 
@@ -369,19 +391,21 @@ neurotex_core::widest_or_plain! {
         input: &SpikeInput,
         rule: Backprop,
         dscore: &[f64],
-        tr: &Trajectory,
+        tr: &mut Trajectory,
         grad: &mut Gradient,
     ) {
-        let detach = rule.detach_reset;
+        let kept = std::mem::take(&mut tr.g_drive);
+        let hidden = &mut HiddenBack::new(net, rule.detach_reset, input.steps(), kept);
         match rule.act {
-            Activation::Spike { slope } => backward_with(net, input, detach, dscore, tr, grad, |x| {
+            Activation::Spike { slope } => backward_with(net, input, hidden, dscore, tr, grad, |x| {
                 let d = 1.0 + slope * x.abs();
                 1.0 / (d * d)
             }),
             act @ Activation::Smooth { .. } => {
-                backward_with(net, input, detach, dscore, tr, grad, |x| act.derivative(x))
+                backward_with(net, input, hidden, dscore, tr, grad, |x| act.derivative(x))
             }
         }
+        tr.g_drive = std::mem::take(&mut hidden.g_drive);
     }
 }
 
@@ -389,7 +413,7 @@ neurotex_core::widest_or_plain! {
 fn backward_with(
     net: &Network,
     input: &SpikeInput,
-    detach_reset: bool,
+    hidden: &mut HiddenBack,
     dscore: &[f64],
     tr: &Trajectory,
     grad: &mut Gradient,
@@ -397,7 +421,6 @@ fn backward_with(
 ) {
     let (h_n, c_n, steps) = (net.hidden, net.classes, input.steps());
     let kappa = net.decays().2;
-    let mut hidden = HiddenBack::new(net, detach_reset);
     let mut g_s = vec![0.0; h_n];
     if net.readout == Readout::Mean {
         // Every class's readout gradient follows one decay: gO[t] = φ[t] dscore, with
@@ -487,12 +510,26 @@ struct HiddenBack {
     /// Adaptive thresholds' `(ρ, b)` and the next step's adaptation gradient.
     adapt: Option<(f64, f64)>,
     g_a: Vec<f64>,
+    /// The delays, and the current's gradient of every step so far (from the last back)
+    /// with zeros past the recording's end (delays only).
+    delays: Option<super::delay::Delays>,
+    g_drive: Vec<f64>,
 }
 
 impl HiddenBack {
-    fn new(net: &Network, detach_reset: bool) -> Self {
+    /// The state before the last step of `steps`, in the buffer `g_drive` kept from an
+    /// earlier pass.
+    fn new(net: &Network, detach_reset: bool, steps: usize, mut g_drive: Vec<f64>) -> Self {
         let (alpha, beta) = net.hidden_decays();
+        let delays = super::delay::Delays::of(net);
+        // Rows before `steps` are written before they are read; those after must be zero.
+        let h_n = net.hidden;
+        g_drive.resize(delays.as_ref().map_or(0, |d| (steps + d.reach) * h_n), 0.0);
+        let tail = (steps * h_n).min(g_drive.len());
+        g_drive[tail..].fill(0.0);
         HiddenBack {
+            delays,
+            g_drive,
             g_v: vec![0.0; net.hidden],
             g_i: vec![0.0; net.hidden],
             alpha,
@@ -555,7 +592,20 @@ impl HiddenBack {
         for (b, g) in grad.b_in.iter_mut().zip(g_i.iter()) {
             *b += g;
         }
-        super::add_inputs_gradient(&mut grad.w_in, g_i, input.at(t), input.scale());
+        match &self.delays {
+            None => super::add_inputs_gradient(&mut grad.w_in, g_i, input.at(t), input.scale()),
+            Some(d) => {
+                self.g_drive[t * h_n..(t + 1) * h_n].copy_from_slice(g_i);
+                let at = (t, input.at(t), input.scale());
+                d.gradient(
+                    &net.w_in,
+                    &self.g_drive,
+                    at,
+                    &mut grad.w_in,
+                    &mut grad.delays,
+                );
+            }
+        }
         if net.recurrent() && t > 0 {
             let before = &tr.spikes[(t - 1) * h_n..t * h_n];
             add_outer(&mut grad.w_rec, before, g_i);
@@ -834,6 +884,7 @@ mod tests {
             beta: Vec::new(),
             travel_mm_s: None,
             adaptation: None,
+            delays: Vec::new(),
         };
         let mut events = Vec::new();
         for t in 0..steps as u32 {
@@ -859,6 +910,80 @@ mod tests {
         net
     }
 
+    /// `net` with delays drawn from `seed`, up to `longest` steps.
+    fn with_delays(mut net: Network, seed: u64, longest: f64) -> Network {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        net.delays = (0..net.w_in.len())
+            .map(|_| rng.gen_range(0.0..longest))
+            .collect();
+        net.check().unwrap();
+        net
+    }
+
+    /// Delays against their meaning: whole delays of `k` steps score as the network without
+    /// delays on the input `k` steps later, and a spike split between two steps adds to
+    /// the current what a hand calculation says. Equal up to the order of additions.
+    #[test]
+    fn delays_carry_spikes_later() {
+        let act = Activation::Smooth { k: 4.0 };
+        let (plain, input) = random_net(Readout::Mean, 3);
+        let later = {
+            let steps = input.steps() + 3;
+            let events: Vec<(u32, u32)> = (0..input.steps())
+                .flat_map(|t| input.at(t).iter().map(move |&i| (t as u32 + 3, i)))
+                .collect();
+            SpikeInput::from_events(input.inputs, steps, &events)
+        };
+        let mut delayed = plain.clone();
+        delayed.delays = vec![3.0; plain.w_in.len()];
+        let longer = {
+            let events: Vec<(u32, u32)> = (0..input.steps())
+                .flat_map(|t| input.at(t).iter().map(move |&i| (t as u32, i)))
+                .collect();
+            SpikeInput::from_events(input.inputs, input.steps() + 3, &events)
+        };
+        let a = forward(&plain, &later, act, &mut Trajectory::default());
+        let b = forward(&delayed, &longer, act, &mut Trajectory::default());
+        for (a, b) in a.iter().zip(&b) {
+            assert!((a - b).abs() < 1e-12, "{a} against {b}");
+        }
+        // One input, one neuron: a spike at step 1 with delay 2.25 and weight 0.4 adds
+        // 0.4 x 0.75 = 0.3 to step 3's current and 0.4 x 0.25 = 0.1 to step 4's.
+        let mut one = plain.clone();
+        (one.inputs, one.hidden, one.w_in, one.b_in) = (1, 1, vec![0.4], vec![0.0]);
+        (one.w_out, one.delays) = (vec![1.0; one.classes], vec![2.25]);
+        let d = super::super::delay::Delays::of(&one).unwrap();
+        let mut drive = vec![0.0; 8];
+        d.add(&mut drive, 1, &[0], 1.0);
+        assert_eq!(
+            drive,
+            [0.0, 0.0, 0.0, 0.4 * 0.75, 0.4 * 0.25, 0.0, 0.0, 0.0]
+        );
+        let (k, alpha) = (d.reach, one.decays().0);
+        assert_eq!(k, 4);
+        let mut tr = Trajectory::default();
+        forward(
+            &one,
+            &SpikeInput::from_events(1, 6, &[(1, 0)]),
+            act,
+            &mut tr,
+        );
+        // Membranes before the spike: the current alone until step 3 (nothing before).
+        let (_, beta, _) = one.decays();
+        let spike = |p: f64| act.value(p - 1.0);
+        let mut expect = [0.0; 6];
+        let (mut i, mut v) = (0.0, 0.0);
+        for (t, e) in expect.iter_mut().enumerate() {
+            i = alpha * i + [0.0, 0.0, 0.0, 0.3, 0.1, 0.0][t];
+            let p = beta * v + i;
+            *e = p;
+            v = p * (1.0 - spike(p));
+        }
+        for (t, (got, want)) in tr.pre.iter().zip(expect).enumerate() {
+            assert!((got - want).abs() < 1e-15, "step {t}: {got} against {want}");
+        }
+    }
+
     fn loss(net: &Network, input: &SpikeInput, act: Activation) -> f64 {
         let scores = forward(net, input, act, &mut Trajectory::default());
         -softmax(&scores)[1].ln()
@@ -867,7 +992,8 @@ mod tests {
     /// The hand-written backward pass against central finite differences of the loss, on
     /// a network with a smooth spike function (whose loss has a true gradient), the reset
     /// kept in the graph, both readouts, feed-forward and recurrent, with shared decays and
-    /// with each neuron's own.
+    /// with each neuron's own, adaptive thresholds (seeds 8 and 9) and delays (seeds 10 and
+    /// 11).
     #[test]
     fn gradient_matches_finite_differences() {
         for (readout, seed, recurrent, own) in [
@@ -878,14 +1004,19 @@ mod tests {
             (Readout::Mean, 7, true, true),
             (Readout::Mean, 8, false, false),
             (Readout::Max, 9, true, true),
+            (Readout::Mean, 10, false, false),
+            (Readout::Max, 11, true, true),
         ] {
             let (net, input) = random_net_of(readout, seed, recurrent);
             let mut net = if own { with_own_decays(net, seed) } else { net };
-            if seed >= 8 {
+            if seed == 8 || seed == 9 {
                 net.adaptation = Some(super::super::Adaptation {
                     tau_ms: 30.0,
                     strength: 0.8,
                 });
+            }
+            if seed >= 10 {
+                net = with_delays(net, seed, 6.0);
             }
             let act = Activation::Smooth { k: 4.0 };
             let mut grad = Gradient::zeros(&net);
@@ -897,7 +1028,7 @@ mod tests {
             loss_and_gradient(&net, &input, 1, rule, 1.0, &mut tr, &mut grad);
             let eps = 1e-6;
             let mut checked = 0;
-            for part in 0..7 {
+            for part in 0..8 {
                 for j in 0..grad.parts()[part].len() {
                     let bump = |d: f64| {
                         let mut n = net.clone();
@@ -909,14 +1040,16 @@ mod tests {
                     let tol = 1e-6 + 1e-4 * numeric.abs().max(analytic.abs());
                     assert!(
                         (numeric - analytic).abs() <= tol,
-                        "{readout:?} part {part} [{j}]: numeric {numeric}, backward {analytic}"
+                        "{readout:?} seed {seed} part {part} [{j}]: numeric {numeric}, backward {analytic}"
                     );
                     checked += 1;
                 }
             }
             let rec = if recurrent { 7 * 7 } else { 0 };
             let decays = if own { 2 * 7 } else { 0 };
-            assert_eq!(checked, 5 * 7 + 7 + 7 * 3 + 3 + rec + decays);
+            let delays = if seed >= 10 { 5 * 7 } else { 0 };
+            assert_eq!(checked, 5 * 7 + 7 + 7 * 3 + 3 + rec + decays + delays);
+            assert!(delays == 0 || grad.delays.iter().any(|g| g.abs() > 1e-4));
             assert!(
                 grad.w_in.iter().any(|g| g.abs() > 1e-4),
                 "a gradient that is all zero checks nothing"
@@ -1041,14 +1174,17 @@ mod tests {
     /// thresholds.
     #[test]
     fn training_forward_equals_the_runner() {
-        for (readout, recurrent, reset, adapt) in [
-            (Readout::Mean, false, Reset::Zero, false),
-            (Readout::Max, false, Reset::Zero, false),
-            (Readout::Mean, true, Reset::Zero, false),
-            (Readout::Mean, false, Reset::Subtract, false),
-            (Readout::Max, true, Reset::Subtract, false),
-            (Readout::Mean, false, Reset::Zero, true),
-            (Readout::Max, true, Reset::Zero, true),
+        for (readout, recurrent, reset, adapt, delays) in [
+            (Readout::Mean, false, Reset::Zero, false, false),
+            (Readout::Max, false, Reset::Zero, false, false),
+            (Readout::Mean, true, Reset::Zero, false, false),
+            (Readout::Mean, false, Reset::Subtract, false, false),
+            (Readout::Max, true, Reset::Subtract, false, false),
+            (Readout::Mean, false, Reset::Zero, true, false),
+            (Readout::Max, true, Reset::Zero, true, false),
+            (Readout::Mean, false, Reset::Zero, false, true),
+            (Readout::Max, true, Reset::Zero, true, true),
+            (Readout::Max, true, Reset::Subtract, false, true),
         ] {
             let (net, input) = random_net_of(readout, 3, recurrent);
             // Each neuron's own decays, where it runs as the shared ones do.
@@ -1065,6 +1201,12 @@ mod tests {
                 });
                 net.check().unwrap();
                 assert_ne!(net.scores(&input), fixed);
+            }
+            if delays {
+                // Up to 9 steps: the runner's ring of 11 rows wraps round the 40 steps.
+                let at_once = net.scores(&input);
+                net = with_delays(net, 12, 9.0);
+                assert_ne!(net.scores(&input), at_once);
             }
             let act = Activation::Spike { slope: 10.0 };
             let mut tr = Trajectory::default();

@@ -34,6 +34,7 @@
 //! stopping on a stratified validation split drawn from the training data. Reset is
 //! detached from the graph by default, as Zenke & Vogels (2021) recommend.
 
+pub mod delay;
 pub mod grad;
 pub mod train;
 pub mod xylo;
@@ -188,6 +189,11 @@ pub struct Network {
     /// spikes. Absent: a fixed threshold of 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adaptation: Option<Adaptation>,
+    /// Each input synapse's delay in steps, input-major as `w_in` (learnable delays,
+    /// [`SnnParams::delay_ms`]; [`delay`] has the arithmetic). Absent from the files of
+    /// networks whose inputs drive the hidden layer in the step they arrive.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub delays: Vec<f64>,
 }
 
 /// Adaptive thresholds (Bellec et al. 2020): a neuron's threshold is `1 + b a[t]`, its
@@ -270,8 +276,9 @@ impl Network {
     }
 
     /// Every trained parameter: `w_in`, `b_in`, `w_out`, `b_out`, `w_rec` (empty when
-    /// feed-forward), `alpha` and `beta` (empty when the neurons share their decays).
-    pub fn params_mut(&mut self) -> [&mut Vec<f64>; 7] {
+    /// feed-forward), `alpha` and `beta` (empty when the neurons share their decays) and
+    /// `delays` (empty without delays).
+    pub fn params_mut(&mut self) -> [&mut Vec<f64>; 8] {
         [
             &mut self.w_in,
             &mut self.b_in,
@@ -280,6 +287,7 @@ impl Network {
             &mut self.w_rec,
             &mut self.alpha,
             &mut self.beta,
+            &mut self.delays,
         ]
     }
 
@@ -333,6 +341,7 @@ impl Network {
         self.check_taus()?;
         self.check_own_decays()?;
         self.check_adaptation()?;
+        self.check_delays()?;
         if self.target == Target::Xylo {
             xylo::check(self)?;
         }
@@ -433,6 +442,31 @@ impl Network {
             return Ok(());
         };
         Err(ModelError::network("adaptation", why))
+    }
+
+    /// Delays' rules: one per input synapse, each finite and 0 to [`delay::MAX_DELAY_STEPS`]
+    /// steps, in a float network.
+    fn check_delays(&self) -> Result<(), ModelError> {
+        if self.delays.is_empty() {
+            return Ok(());
+        }
+        let (n, want) = (self.delays.len(), self.inputs.saturating_mul(self.hidden));
+        let why = if n != want {
+            format!("the network's delays holds {n} values, not inputs x hidden = {want} (or none)")
+        } else if let Some(pos) =
+            (self.delays.iter()).position(|d| !(*d >= 0.0 && *d <= delay::MAX_DELAY_STEPS))
+        {
+            format!(
+                "the network's delays[{pos}] is {:?}; a delay must be 0 to {} steps",
+                self.delays[pos],
+                delay::MAX_DELAY_STEPS
+            )
+        } else if self.target != Target::Float {
+            "a network with delays runs in float (no `target` key)".to_string()
+        } else {
+            return Ok(());
+        };
+        Err(ModelError::network("delays", why))
     }
 
     /// A running copy of the network, for spikes that arrive step by step.
@@ -559,6 +593,18 @@ pub(crate) fn add_inputs(current: &mut [f64], w_in: &[f64], spiked: &[u32], scal
     match scale == 1.0 {
         true => rows.for_each(|w| current.iter_mut().zip(w).for_each(|(c, w)| *c += w)),
         false => rows.for_each(|w| current.iter_mut().zip(w).for_each(|(c, w)| *c += scale * w)),
+    }
+}
+
+/// Adds a step's delayed input drive to the currents and clears it for the steps to come
+/// (the training pass and the runner, with the same bits).
+#[inline(always)]
+pub(crate) fn take_drive(current: &mut [f64], drive: &mut [f64]) {
+    let n = current.len();
+    let drive = &mut drive[..n];
+    for k in 0..n {
+        current[k] += drive[k];
+        drive[k] = 0.0;
     }
 }
 

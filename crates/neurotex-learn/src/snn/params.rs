@@ -93,6 +93,12 @@ pub struct SnnParams {
     /// model files when 1.
     #[serde(skip_serializing_if = "is_one")]
     pub adapt_strength: f64,
+    /// Learnable synaptic delays (Hammouamri, Khalfaoui-Hassani & Masquelier 2024), the
+    /// longest in ms: each input synapse carries its spikes up to this late, its delay
+    /// trained beside its weight ([`super::delay`]); `None`: every input drives the hidden
+    /// layer in the step it arrives. Left out of model files when absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delay_ms: Option<f64>,
 }
 
 fn is_one(v: &f64) -> bool {
@@ -126,6 +132,7 @@ impl Default for SnnParams {
             warp: None,
             adapt_ms: None,
             adapt_strength: 1.0,
+            delay_ms: None,
         }
     }
 }
@@ -195,6 +202,7 @@ impl SnnParams {
         }
         self.travel.check()?;
         self.check_adaptation()?;
+        self.check_delays()?;
         match self.target {
             Target::Float => Ok(self),
             Target::Xylo => self.on_xylo(),
@@ -212,6 +220,7 @@ impl SnnParams {
             ("snn-train-decays", self.train_decays, "the Xylo profile's neurons share the chip's bitshift decays", "--snn-train-decays".to_string()),
             ("snn-travel", !self.travel.is_off(), "the Xylo profile's inputs are whole events per step, which steps of travel weigh by their length", format!("--snn-travel {}", self.travel.name())),
             ("snn-adapt-ms", self.adapt_ms.is_some(), "the Xylo profile's neurons have fixed thresholds", format!("--snn-adapt-ms {}", self.adapt_ms.unwrap_or_default())),
+            ("snn-delay-ms", self.delay_ms.is_some(), "the Xylo profile's synapses carry a spike in the step it arrives", format!("--snn-delay-ms {}", self.delay_ms.unwrap_or_default())),
             ("snn-warp", self.warp.is_some(), "the Xylo profile's inputs carry at most 15 events a step, which squeezed time can exceed (leave out --snn-warp, or train for --snn-target float)", format!("--snn-warp {}", self.warp.unwrap_or_default())),
         ];
         if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
@@ -259,6 +268,26 @@ impl SnnParams {
             ));
         }
         Ok(())
+    }
+
+    /// Delays' rules: the longest positive, finite, and at most
+    /// [`super::delay::MAX_DELAY_STEPS`] time steps.
+    fn check_delays(&self) -> Result<(), ParamError> {
+        let Some(ms) = self.delay_ms else {
+            return Ok(());
+        };
+        let steps = ms / f64::from(self.dt_ms);
+        if !(ms > 0.0 && steps <= super::delay::MAX_DELAY_STEPS) {
+            let rule = "the longest synaptic delay must be positive and at most 1000 time steps (--snn-dt-ms times 1000 ms): each hidden neuron keeps the input drive of that many steps ahead";
+            let got = format!("{ms} ms, {steps} steps of {} ms", self.dt_ms);
+            return Err(ParamError::new("snn-delay-ms", rule, got));
+        }
+        Ok(())
+    }
+
+    /// The longest delay in time steps, when the network has delays.
+    pub fn delay_steps(&self) -> Option<f64> {
+        self.delay_ms.map(|ms| ms / f64::from(self.dt_ms))
     }
 
     /// The adaptive thresholds a network trained with these parameters has.

@@ -29,6 +29,10 @@ pub struct State {
     /// Adaptive thresholds' `(ρ, b)` and each neuron's adaptation.
     adapt: Option<(f64, f64)>,
     level: Vec<f64>,
+    /// Delays, the drive of the steps ahead in a ring of their reach, and the steps run.
+    delays: Option<Box<super::delay::Delays>>,
+    drive: Vec<f64>,
+    t: usize,
 }
 
 impl State {
@@ -44,6 +48,7 @@ impl State {
             Box::new((chip, state))
         });
         let (alpha, beta) = net.hidden_decays();
+        let delays = super::delay::Delays::of(net);
         State {
             kappa: net.decays().2,
             alpha,
@@ -58,6 +63,9 @@ impl State {
             scale: 1.0,
             adapt: net.adaptation.map(|a| a.per_step(net.dt_ms)),
             level: vec![0.0; net.adaptation.map_or(0, |_| net.hidden)],
+            drive: vec![0.0; delays.as_ref().map_or(0, |d| d.reach * net.hidden)],
+            delays: delays.map(Box::new),
+            t: 0,
         }
     }
 
@@ -98,7 +106,16 @@ neurotex_core::widest_or_plain! {
         let (alpha, beta) = (&state.alpha[..h_n], &state.beta[..h_n]);
         let current = &mut state.current[..h_n];
         super::decay_currents(current, &net.b_in, alpha, own);
-        super::add_inputs(current, &net.w_in, spiked, state.scale);
+        match state.delays.as_deref() {
+            None => super::add_inputs(current, &net.w_in, spiked, state.scale),
+            Some(d) => {
+                let (t, reach) = (state.t, d.reach);
+                d.add_ring(&mut state.drive, t, spiked, state.scale);
+                let row = (t % reach) * h_n;
+                super::take_drive(current, &mut state.drive[row..row + h_n]);
+                state.t += 1;
+            }
+        }
         for &(j, n) in &state.fired {
             let w = &net.w_rec[j as usize * h_n..(j as usize + 1) * h_n];
             for (c, w) in current.iter_mut().zip(w) {
@@ -285,6 +302,7 @@ mod tests {
             beta: Vec::new(),
             travel_mm_s: None,
             adaptation: None,
+            delays: Vec::new(),
         }
     }
 

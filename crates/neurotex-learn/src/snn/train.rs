@@ -70,7 +70,7 @@ pub fn fit_with(
     // is made after each step; without, the network's own.
     let scaled = params.standardize.then(|| Standardised::of(inputs, &train));
     let mut moved = scaled.as_ref().map(|z| (z, z.trained(&net)));
-    let mut adam = Adam::new(&net, params.learning_rate);
+    let mut adam = Adam::new(&net, params);
     let mut best = (f64::INFINITY, net.clone(), 0);
     let mut order = train.clone();
     let mut epochs = 0;
@@ -218,8 +218,10 @@ fn initial(
         beta: Vec::new(),
         travel_mm_s: None,
         adaptation: params.adaptation(),
+        delays: Vec::new(),
     }
-    .with_own_decays(params, rng))
+    .with_own_decays(params, rng)
+    .with_delays(params, rng))
 }
 
 impl Network {
@@ -240,6 +242,19 @@ impl Network {
         };
         self.alpha = draw(params.tau_syn_ms);
         self.beta = draw(params.tau_mem_ms);
+        self
+    }
+}
+
+impl Network {
+    /// With [`SnnParams::delay_ms`], each input synapse's delay drawn uniformly from 0 to
+    /// the longest, in steps (Hammouamri et al. 2024 start them spread so).
+    fn with_delays(mut self, params: &SnnParams, rng: &mut ChaCha8Rng) -> Network {
+        if let Some(longest) = params.delay_steps() {
+            self.delays = (0..self.w_in.len())
+                .map(|_| rng.gen_range(0.0..=longest))
+                .collect();
+        }
         self
     }
 }
@@ -413,18 +428,26 @@ impl Standardised {
     }
 }
 
-/// Adam (Kingma & Ba 2015) with its usual constants.
+/// Adam (Kingma & Ba 2015) with its usual constants. Delays, in steps, move at the
+/// learning rate times their longest: a step of Adam moves each parameter by about its
+/// rate, so delays then cross the same share of their range as weights of order 1 do of
+/// theirs (Hammouamri et al. 2024 also give the delays a rate of their own, far above the
+/// weights').
 struct Adam {
     rate: f64,
+    /// The delays' rate and their longest, in steps.
+    delays: (f64, f64),
     m: Gradient,
     v: Gradient,
     t: i32,
 }
 
 impl Adam {
-    fn new(net: &Network, rate: f64) -> Self {
+    fn new(net: &Network, params: &SnnParams) -> Self {
+        let longest = params.delay_steps().unwrap_or(0.0);
         Adam {
-            rate,
+            rate: params.learning_rate,
+            delays: (params.learning_rate * longest.max(1.0), longest),
             m: Gradient::zeros(net),
             v: Gradient::zeros(net),
             t: 0,
@@ -439,19 +462,25 @@ impl Adam {
         let c1 = 1.0 - B1.powi(self.t);
         let c2 = 1.0 - B2.powi(self.t);
         let (ms, vs) = (self.m.parts_mut(), self.v.parts_mut());
-        for (((p, m), v), g) in net
+        let (delay_rate, longest) = self.delays;
+        let rates = [self.rate; 7].into_iter().chain([delay_rate]);
+        for ((((p, m), v), g), rate) in net
             .params_mut()
             .into_iter()
             .zip(ms)
             .zip(vs)
             .zip(grad.parts())
+            .zip(rates)
         {
             for j in 0..p.len() {
                 m[j] = B1 * m[j] + (1.0 - B1) * g[j];
                 v[j] = B2 * v[j] + (1.0 - B2) * g[j] * g[j];
-                p[j] -= self.rate * (m[j] / c1) / ((v[j] / c2).sqrt() + EPS);
+                p[j] -= rate * (m[j] / c1) / ((v[j] / c2).sqrt() + EPS);
             }
         }
+        net.delays
+            .iter_mut()
+            .for_each(|d| *d = d.clamp(0.0, longest));
         // Each neuron's own decays stay decays (projected gradient descent).
         let (low, high) = super::TRAINED_DECAYS;
         for d in net.alpha.iter_mut().chain(net.beta.iter_mut()) {
@@ -510,6 +539,7 @@ mod tests {
             beta: Vec::new(),
             travel_mm_s: None,
             adaptation: None,
+            delays: Vec::new(),
         };
         let moved = z.trained(&net);
         let back = z.network(&moved);

@@ -289,6 +289,13 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
     knob!(Snn "snn", adapt_strength, "--snn-adapt-strength", Number,
         "With --snn-adapt-ms: how far a threshold of 1 rises at a spike every step (1: it \
          doubles)."),
+    knob!(Snn "snn", delay_ms, "--snn-delay-ms", Number,
+        "Learnable synaptic delays: each input synapse carries its spikes up to this many ms \
+         late, its delay trained beside its weight, so that a hidden neuron can line up \
+         spikes its inputs sent at different times (a pattern reaching neighbouring taxels \
+         one after the other). At most 1000 time steps. Refused by the Xylo profile and NIR \
+         export [default: none: no delays].",
+        get: |w: &Option<f64>| w.map(|v| v.to_string()), set: |t: &str| parse(t).map(Some)),
     knob!(Snn "snn", target, "--snn-target", Text,
         "Where the network runs: `float` or `xylo` (SynSense's Xylo Audio 2: trained within \
          the chip's limits, its time constants moved to the chip's bitshift decays, \

@@ -1107,6 +1107,7 @@ class SpikingModel(Model):
         warp: Optional[float] = _SNN_DEFAULTS["warp"],
         adapt_ms: Optional[float] = _SNN_DEFAULTS["adapt_ms"],
         adapt_strength: float = _SNN_DEFAULTS["adapt_strength"],
+        delay_ms: Optional[float] = _SNN_DEFAULTS["delay_ms"],
         causal: bool = _DEFAULTS["causal"],
         **stage_options: Any,
     ) -> "SpikingModel":
@@ -1135,13 +1136,16 @@ class SpikingModel(Model):
         gives the hidden neurons adaptive thresholds (ALIF) that rise by ``adapt_strength``
         times their spike rate over about ``adapt_ms`` ms (``--snn-adapt-ms``,
         ``--snn-adapt-strength``; ``None``: fixed thresholds; such a network has no NIR
-        graph). ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
+        graph); ``delay_ms`` gives each input synapse a delay of up to that many ms, trained
+        beside its weight (``--snn-delay-ms``; ``None``: no delays; no NIR graph either).
+        ``labels`` and ``stage_options`` (``encoding``, ``gain``, ...) as
         :meth:`Model.train`; ``causal=True`` trains for :class:`StreamClassifier`."""
         snn = {"hidden": hidden, "dt_ms": dt_ms, "epochs": epochs, "readout": readout,
                "seed": seed, "recurrent": recurrent, "target": target,
                "tau_syn_ms": tau_syn_ms, "tau_mem_ms": tau_mem_ms, "tau_out_ms": tau_out_ms,
                "window_ms": window_ms, "train_decays": train_decays, "travel": str(travel),
-               "warp": warp, "adapt_ms": adapt_ms, "adapt_strength": adapt_strength}
+               "warp": warp, "adapt_ms": adapt_ms, "adapt_strength": adapt_strength,
+               "delay_ms": delay_ms}
         if reset is not None:
             snn["reset"] = reset
         folder = _folder(recordings)

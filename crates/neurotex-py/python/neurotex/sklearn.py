@@ -293,8 +293,8 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
     ``reset`` (``"zero"`` or ``"subtract"``), ``target`` (``"float"`` or ``"xylo"``) and
     ``window_ms`` (train on windows of that many ms), ``train_decays`` (each hidden
     neuron's decays trained), ``travel`` (time in steps of travel), ``warp`` (train on
-    time-warped recordings) and ``adapt_ms`` with ``adapt_strength`` (adaptive thresholds)
-    as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
+    time-warped recordings), ``adapt_ms`` with ``adapt_strength`` (adaptive thresholds)
+    and ``delay_ms`` (learnable synaptic delays) as :meth:`neurotex.SpikingModel.train`. ``model_`` is the trained
     :class:`neurotex.SpikingModel` (save it for ``neurotex predict``, stream it, export
     it to NIR)."""
 
@@ -314,6 +314,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         warp: Optional[float] = _SNN_DEFAULTS["warp"],
         adapt_ms: Optional[float] = _SNN_DEFAULTS["adapt_ms"],
         adapt_strength: float = _SNN_DEFAULTS["adapt_strength"],
+        delay_ms: Optional[float] = _SNN_DEFAULTS["delay_ms"],
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         baseline: Optional[str] = None,
@@ -334,6 +335,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
         self.warp = warp
         self.adapt_ms = adapt_ms
         self.adapt_strength = adapt_strength
+        self.delay_ms = delay_ms
         self.encoding = encoding
         self.gain = gain
         self.baseline = baseline
@@ -357,7 +359,7 @@ class SpikingClassifier(ClassifierMixin, BaseEstimator):
             recurrent=self.recurrent, reset=self.reset, target=self.target,
             window_ms=self.window_ms, train_decays=self.train_decays, travel=self.travel,
             warp=self.warp, adapt_ms=self.adapt_ms, adapt_strength=self.adapt_strength,
-            causal=self.causal,
+            delay_ms=self.delay_ms, causal=self.causal,
             encoding=self.encoding, gain=self.gain,
             baseline=self.baseline,
         )
