@@ -16,7 +16,10 @@
 //! ```
 //!
 //! With [`SnnParams::train_decays`] each hidden neuron has decays of its own, `α_h` and
-//! `β_h` ([`Network::alpha`], [`Network::beta`]), trained beside the weights.
+//! `β_h` ([`Network::alpha`], [`Network::beta`]), trained beside the weights. With
+//! [`SnnParams::delay_ms`] each input synapse carries its spikes a trained delay late
+//! ([`Network::delays`], [`delay`]): `W_in x[t]` becomes each spike's weight split between
+//! the two steps its delay falls between.
 //!
 //! With [`Reset::Subtract`] a neuron instead emits `S[t] = ⌊P[t]⌋` spikes when `P[t] ≥ 1`
 //! (none below) and keeps the rest, `V[t] = P[t] - S[t]`: the multi-spike neuron with
