@@ -669,6 +669,13 @@ fn synaptic_delays_are_written_and_predict_but_make_no_graph() {
         "{err}"
     );
     assert!(!graph.exists());
+    let config = dir.join("delays.xylo.json");
+    let err = dir.fails(&["export", "xylo", "--model", s(&model), "--out", s(&config)]);
+    assert!(
+        err.contains("--snn-target xylo, and without --snn-delay-ms"),
+        "{err}"
+    );
+    assert!(!config.exists());
     let never = dir.join("never.json");
     for flags in [
         &["--snn-delay-ms", "0"][..],

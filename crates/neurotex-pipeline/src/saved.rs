@@ -65,6 +65,20 @@ impl From<SpikingModel> for SavedModel {
 }
 
 impl SavedModel {
+    /// What predicts, for a summary line before the model's path: nothing for a feature
+    /// model, the spiking network with its training options for a spiking model file, and
+    /// "the spiking network of " for a NIR graph, whose training neurotex does not know.
+    pub fn described(&self, path: &Path) -> String {
+        match self {
+            SavedModel::Features(_) => String::new(),
+            SavedModel::Spiking(_) if is_hdf5(path) => "the spiking network of ".into(),
+            SavedModel::Spiking(m) => {
+                let snn = crate::classify::ClassifierChoice::Snn(m.params());
+                format!("the {snn} of ")
+            }
+        }
+    }
+
     /// Reads the model file at `path` of either kind; a NIR graph from another tool runs
     /// with the pipeline of `like`, a spiking model file.
     ///

@@ -80,10 +80,7 @@ pub fn run(args: PredictArgs) -> Result<()> {
     if let Some(score) = score {
         println!("{}", serde_json::to_string(&score)?);
     }
-    let with = match model {
-        SavedModel::Features(_) => "",
-        SavedModel::Spiking(_) => "the spiking network of ",
-    };
+    let with = model.described(&o.model);
     eprintln!(
         "{} recordings predicted with {with}{} -> {}",
         predictions.len(),
