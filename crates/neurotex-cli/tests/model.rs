@@ -679,6 +679,7 @@ fn synaptic_delays_are_written_and_predict_but_make_no_graph() {
     let never = dir.join("never.json");
     for flags in [
         &["--snn-delay-ms", "0"][..],
+        &["--snn-delay-ms", "5"],
         &["--snn-delay-ms", "10001"],
         &["--snn-delay-ms", "inf"],
         &[

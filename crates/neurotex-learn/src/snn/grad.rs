@@ -20,6 +20,9 @@
 //! `I[t-1]` and `V[t-1]` are not kept: they are made again from the kept membranes and
 //! spikes, `V[t] = P[t] (1 - S[t])` (or `P[t] - S[t]`) and `I[t] = P[t] - β V[t-1]`.
 //!
+//! With synaptic delays the input's line `∂L/∂W_in += gI[t] x[t]ᵀ` reads each spike's
+//! `gI` at the steps its delay reaches, and the delays gain theirs ([`super::delay`]).
+//!
 //! With the subtractive reset (`V[t] = P[t] - S[t]`, `S[t]` a count), the spike's
 //! derivative is the same surrogate and the membrane line becomes
 //!

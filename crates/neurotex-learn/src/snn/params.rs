@@ -220,7 +220,7 @@ impl SnnParams {
             ("snn-train-decays", self.train_decays, "the Xylo profile's neurons share the chip's bitshift decays", "--snn-train-decays".to_string()),
             ("snn-travel", !self.travel.is_off(), "the Xylo profile's inputs are whole events per step, which steps of travel weigh by their length", format!("--snn-travel {}", self.travel.name())),
             ("snn-adapt-ms", self.adapt_ms.is_some(), "the Xylo profile's neurons have fixed thresholds", format!("--snn-adapt-ms {}", self.adapt_ms.unwrap_or_default())),
-            ("snn-delay-ms", self.delay_ms.is_some(), "the Xylo profile's synapses carry a spike in the step it arrives", format!("--snn-delay-ms {}", self.delay_ms.unwrap_or_default())),
+            ("snn-delay-ms", self.delay_ms.is_some(), "the Xylo profile's synapses carry a spike in the step it arrives (leave out --snn-delay-ms, or train for --snn-target float)", format!("--snn-delay-ms {}", self.delay_ms.unwrap_or_default())),
             ("snn-warp", self.warp.is_some(), "the Xylo profile's inputs carry at most 15 events a step, which squeezed time can exceed (leave out --snn-warp, or train for --snn-target float)", format!("--snn-warp {}", self.warp.unwrap_or_default())),
         ];
         if let Some((name, _, rule, got)) = rules.into_iter().find(|r| r.1) {
@@ -270,15 +270,15 @@ impl SnnParams {
         Ok(())
     }
 
-    /// Delays' rules: the longest positive, finite, and at most
-    /// [`super::delay::MAX_DELAY_STEPS`] time steps.
+    /// Delays' rules: the longest 1 to [`super::delay::MAX_DELAY_STEPS`] time steps (a
+    /// delay under one step would only share each spike with the next step).
     fn check_delays(&self) -> Result<(), ParamError> {
         let Some(ms) = self.delay_ms else {
             return Ok(());
         };
         let steps = ms / f64::from(self.dt_ms);
-        if !(ms > 0.0 && steps <= super::delay::MAX_DELAY_STEPS) {
-            let rule = "the longest synaptic delay must be positive and at most 1000 time steps (--snn-dt-ms times 1000 ms): each hidden neuron keeps the input drive of that many steps ahead";
+        if !((1.0..=super::delay::MAX_DELAY_STEPS).contains(&steps)) {
+            let rule = "the longest synaptic delay must be 1 to 1000 time steps (--snn-dt-ms to 1000 times it): under one step a delay only shares each spike with the next step, and each hidden neuron keeps the input drive of that many steps ahead";
             let got = format!("{ms} ms, {steps} steps of {} ms", self.dt_ms);
             return Err(ParamError::new("snn-delay-ms", rule, got));
         }

@@ -293,7 +293,8 @@ pub static CLASSIFIER_OPTIONS: &[KnobSpec] = &[
         "Learnable synaptic delays: each input synapse carries its spikes up to this many ms \
          late, its delay trained beside its weight, so that a hidden neuron can line up \
          spikes its inputs sent at different times (a pattern reaching neighbouring taxels \
-         one after the other). At most 1000 time steps. Refused by the Xylo profile and NIR \
+         one after the other). One to 1000 time steps of --snn-dt-ms (of travel, with \
+         --snn-travel: ms at its reference speed). Refused by the Xylo profile and NIR \
          export [default: none: no delays].",
         get: |w: &Option<f64>| w.map(|v| v.to_string()), set: |t: &str| parse(t).map(Some)),
     knob!(Snn "snn", target, "--snn-target", Text,

@@ -167,7 +167,10 @@ pub fn export_xylo(model: &SpikingModel, out: &Path) -> Result<()> {
         // What the chip has no circuit for, named, so the retraining does not meet them as
         // refusals one at a time.
         let unsupported: Vec<&str> = [
-            (net.adaptation.is_some(), "--snn-adapt-ms (adaptive thresholds)"),
+            (
+                net.adaptation.is_some(),
+                "--snn-adapt-ms (adaptive thresholds)",
+            ),
             (!net.delays.is_empty(), "--snn-delay-ms (synaptic delays)"),
         ]
         .into_iter()
@@ -175,7 +178,10 @@ pub fn export_xylo(model: &SpikingModel, out: &Path) -> Result<()> {
         .collect();
         let without = match unsupported.is_empty() {
             true => String::new(),
-            false => format!(", and without {}, which the chip does not have", unsupported.join(" or ")),
+            false => format!(
+                ", and without {}, which the chip does not have",
+                unsupported.join(" or ")
+            ),
         };
         let why = format!("this network was trained for neurotex's float network; a Xylo configuration needs a network trained within the chip's limits: train it with --classifier snn --snn-target xylo{without}");
         return Err(crate::error::OptionsError::Conflict(why).into());
