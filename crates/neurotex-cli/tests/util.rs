@@ -107,6 +107,14 @@ impl Dir {
         serde_json::from_str(&text).expect("predict --json prints JSON")
     }
 
+    /// Runs `neurotex export FORMAT --model MODEL --out OUT`, which must be refused and
+    /// leave no file at `OUT`; returns what it says on standard error.
+    pub fn export_refused(&self, format: &str, model: &Path, out: &Path) -> String {
+        let err = self.fails(&["export", format, "--model", s(model), "--out", s(out)]);
+        assert!(!out.exists(), "a refused export wrote {}", out.display());
+        err
+    }
+
     /// Runs `neurotex evaluate --dataset DATASET --method METHOD EXTRA... --json`, which
     /// must succeed; returns the JSON it prints.
     pub fn evaluate_json(&self, dataset: &Path, method: &str, extra: &[&str]) -> Value {
