@@ -96,25 +96,37 @@ pub(crate) fn lines(text: &str) -> Vec<Value> {
         .collect()
 }
 
-/// `predict --causal`'s lines for `file`, without the `file` field.
+/// What `predict --causal` writes for `file` of `data`: the lines a stream of its frames
+/// prints.
 pub(crate) fn predicted(dir: &Dir, model: &Path, data: &Path, file: &str) -> Vec<Value> {
+    of_file(&causal_lines(dir, model, data), file)
+}
+
+/// Every line `predict --causal` writes for `data`, each checked to carry its recording's
+/// label from the manifest as `true_label` beside the class chosen.
+fn causal_lines(dir: &Dir, model: &Path, data: &Path) -> Vec<Value> {
     let out = dir.join("causal.jsonl");
-    dir.ok(&[
-        "predict",
-        "--model",
-        s(model),
-        "--dataset",
-        s(data),
-        "--causal",
-        "--out",
-        s(&out),
-    ]);
-    let mut mine: Vec<Value> = lines(&std::fs::read_to_string(out).unwrap())
-        .into_iter()
-        .filter(|l| l["file"] == file)
-        .collect();
+    let args = ["predict", "--model", s(model), "--dataset", s(data)];
+    dir.ok(&[&args[..], &["--causal", "--out", s(&out)]].concat());
+    let all = lines(&std::fs::read_to_string(out).unwrap());
+    let manifest = std::fs::read_to_string(data.join("manifest.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = manifest.lines().map(|r| r.split(',').collect()).collect();
+    let label = rows[0].iter().position(|h| *h == "label").unwrap();
+    for l in &all {
+        let row = rows.iter().find(|r| r[0] == l["file"].as_str().unwrap());
+        assert_eq!(l["true_label"], row.unwrap()[label], "{l}");
+    }
+    all
+}
+
+/// `file`'s lines of `predict --causal` without `file` and `true_label`, which a stream
+/// does not know.
+fn of_file(all: &[Value], file: &str) -> Vec<Value> {
+    let mut mine: Vec<Value> = all.iter().filter(|l| l["file"] == file).cloned().collect();
     for l in &mut mine {
-        l.as_object_mut().unwrap().remove("file");
+        let line = l.as_object_mut().unwrap();
+        line.remove("file");
+        line.remove("true_label");
     }
     mine
 }
@@ -530,23 +542,9 @@ fn fabricslide_stream_equals_predict_causal() {
         .step_by(9)
         .collect();
     assert!(files.len() >= 3);
-    let out = dir.join("causal.jsonl");
-    dir.ok(&[
-        "predict",
-        "--model",
-        s(&model),
-        "--dataset",
-        s(&data),
-        "--causal",
-        "--out",
-        s(&out),
-    ]);
-    let all = lines(&std::fs::read_to_string(out).unwrap());
+    let all = causal_lines(&dir, &model, &data);
     for file in files {
-        let mut expected: Vec<Value> = all.iter().filter(|l| l["file"] == file).cloned().collect();
-        for l in &mut expected {
-            l.as_object_mut().unwrap().remove("file");
-        }
+        let expected = of_file(&all, file);
         let text = dir.ok(&[
             "stream",
             "--model",

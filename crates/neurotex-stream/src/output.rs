@@ -7,7 +7,8 @@ use crate::pipeline::Encoded;
 
 /// Writes each recording's episode as `neurotex stream --episode whole` prints it for that
 /// recording's frames: a line per bin boundary, then its end, each with the recording's
-/// `file` (`predict --causal`).
+/// `file` (`predict --causal`) and, when its manifest gives one, its `true_label`: a
+/// line's `label` is the class the model chose, as in a stream.
 ///
 /// # Errors
 /// `w` fails.
@@ -19,11 +20,17 @@ pub fn write_episodes(
 ) -> std::io::Result<()> {
     for (e, episode) in encoded.iter().zip(episodes) {
         let file = Some(e.meta.file.as_str());
+        let truth = |mut line: Value| {
+            if !e.meta.label.is_empty() {
+                line["true_label"] = e.meta.label.as_str().into();
+            }
+            line
+        };
         for bin in &episode.bins {
-            writeln!(w, "{}", bin_json(labels, bin, file))?;
+            writeln!(w, "{}", truth(bin_json(labels, bin, file)))?;
         }
         // A whole recording was read or refused as a whole: it had no bad frame.
-        let mut end = end_json(labels, &episode.summary, file);
+        let mut end = truth(end_json(labels, &episode.summary, file));
         end["bad_frames"] = 0.into();
         writeln!(w, "{end}")?;
     }

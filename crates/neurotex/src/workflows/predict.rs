@@ -43,8 +43,9 @@ pub struct PredictOptions {
     pub read: ReadOptions,
     /// Decide as `neurotex stream` would, bin by bin (needs a model trained with
     /// --causal): --out gets JSON lines, one per bin boundary of each recording's selected
-    /// phase and one for its end, each with the recording's `file`; the same lines
-    /// `neurotex stream --episode whole` prints for that recording's frames.
+    /// phase and one for its end, each with the recording's `file` and its manifest's
+    /// `true_label` (`label` is the class chosen); the same lines `neurotex stream
+    /// --episode whole` prints for that recording's frames.
     #[cfg_attr(feature = "cli", arg(long))]
     pub causal: bool,
     /// How an episode is decided.
