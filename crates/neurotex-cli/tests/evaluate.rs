@@ -334,3 +334,52 @@ fn bad_input_is_a_clear_error_with_no_output() {
     dir.fails_each(&cases, &out);
     assert!(!dir.partial_left(), "temporary files left behind");
 }
+
+/// With more classes than a line holds, `evaluate` sums up the confusion matrix by its
+/// largest confusions and each class's recall, both read here off the matrix `--json`
+/// prints whole.
+#[test]
+fn a_wide_confusion_matrix_is_listed_by_its_largest_confusions() {
+    let dir = Dir::new();
+    let labels: Vec<String> = (0..20).map(|k| format!("cls{k:02}")).collect();
+    let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
+    let ds = dir.dataset("ds", &labels, &[10.0], 5);
+    let text = dir.ok(&["evaluate", "--dataset", s(&ds), "--method", "glcm2d"]);
+    let json = dir.evaluate_json(&ds, "glcm2d", &[]);
+    let m: Vec<Vec<u64>> = (json["confusion"].as_array().unwrap().iter())
+        .map(|r| {
+            r.as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_u64().unwrap())
+                .collect()
+        })
+        .collect();
+    let mut off: Vec<(u64, usize, usize)> = (0..20)
+        .flat_map(|t| (0..20).map(move |p| (t, p)))
+        .filter(|&(t, p)| t != p && m[t][p] > 0)
+        .map(|(t, p)| (m[t][p], t, p))
+        .collect();
+    off.sort_by(|a, b| b.0.cmp(&a.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    assert!(off.len() > 10, "a task hard enough to confuse: {off:?}");
+    assert!(!text.contains("confusion (rows"), "{text}");
+    assert!(text.contains("confusion over 20 classes"), "{text}");
+    let listed: Vec<&str> = (text.lines())
+        .filter(|l| l.starts_with("  ") && l.contains(" -> "))
+        .collect();
+    let expected: Vec<String> = (off.iter().take(10))
+        .map(|&(n, t, p)| format!("  {} -> {}: {n}", labels[t], labels[p]))
+        .collect();
+    assert_eq!(listed, expected);
+    assert!(
+        text.contains(&format!("... {} more pairs", off.len() - 10)),
+        "{text}"
+    );
+    let perfect = (0..20)
+        .filter(|&t| m[t][t] == m[t].iter().sum::<u64>())
+        .count();
+    assert!(
+        text.contains(&format!("recall: {perfect} of 20 classes right")),
+        "{text}"
+    );
+}

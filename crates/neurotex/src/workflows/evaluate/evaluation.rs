@@ -380,13 +380,20 @@ fn taxel_grid_text(out: &mut String, per: &[TaxelAccuracy], cols: usize) {
     }
 }
 
-/// The confusion matrix, rows the true labels.
+/// Widest confusion matrix printed whole, in characters per line; a wider one (many
+/// classes) is summed up by its largest confusions instead.
+const WIDEST_CONFUSION: usize = 120;
+
+/// Largest confusions listed in place of a matrix too wide to print.
+const CONFUSIONS_LISTED: usize = 10;
+
+/// The confusion matrix, rows the true labels; with too many classes for a line, its
+/// largest confusions and the classes recalled worst.
 fn confusion_text(out: &mut String, outcome: &Outcome) {
     let summed = match outcome.per_taxel {
         Some(_) => ", summed over taxels",
         None => "",
     };
-    let _ = writeln!(out, "confusion (rows = true, columns = predicted{summed}):");
     let labels: Vec<String> = outcome.labels.iter().map(|l| shown_label(l)).collect();
     let width = labels
         .iter()
@@ -394,6 +401,10 @@ fn confusion_text(out: &mut String, outcome: &Outcome) {
         .max()
         .unwrap_or(1)
         .max(5);
+    if (width + 1) * (labels.len() + 1) > WIDEST_CONFUSION {
+        return confusions_listed(out, outcome, &labels, summed);
+    }
+    let _ = writeln!(out, "confusion (rows = true, columns = predicted{summed}):");
     let _ = write!(out, "{:width$}", "");
     for l in &labels {
         let _ = write!(out, " {l:>width$}");
@@ -406,6 +417,54 @@ fn confusion_text(out: &mut String, outcome: &Outcome) {
         }
         out.push('\n');
     }
+}
+
+/// A confusion matrix too wide for a line: its largest off-diagonal cells (largest first,
+/// then in the matrix's order) and the classes recalled worst; `--json` has it whole.
+fn confusions_listed(out: &mut String, outcome: &Outcome, labels: &[String], summed: &str) {
+    let m = outcome.confusion.rows();
+    let n = labels.len();
+    let mut off: Vec<(usize, usize, usize)> = (0..n)
+        .flat_map(|t| (0..n).map(move |p| (t, p)))
+        .filter(|&(t, p)| t != p && m[t][p] > 0)
+        .map(|(t, p)| (m[t][p], t, p))
+        .collect();
+    off.sort_by(|a, b| b.0.cmp(&a.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    let _ = writeln!(
+        out,
+        "confusion over {n} classes{summed}: too wide to print (--json has it whole); the largest confusions, true -> predicted:"
+    );
+    if off.is_empty() {
+        out.push_str("  none\n");
+    }
+    for &(count, t, p) in off.iter().take(CONFUSIONS_LISTED) {
+        let _ = writeln!(out, "  {} -> {}: {count}", labels[t], labels[p]);
+    }
+    if off.len() > CONFUSIONS_LISTED {
+        let _ = writeln!(out, "  ... {} more pairs", off.len() - CONFUSIONS_LISTED);
+    }
+    let recall: Vec<(f64, usize)> = (0..n)
+        .filter_map(|t| {
+            let total: usize = m[t].iter().sum();
+            (total > 0).then(|| (m[t][t] as f64 / total as f64, t))
+        })
+        .collect();
+    let perfect = recall.iter().filter(|r| r.0 == 1.0).count();
+    let mut worst: Vec<&(f64, usize)> = recall.iter().filter(|r| r.0 < 1.0).collect();
+    worst.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let shown: Vec<String> = (worst.iter().take(CONFUSIONS_LISTED))
+        .map(|&&(r, t)| format!("{} {:.0}%", labels[t], 100.0 * r))
+        .collect();
+    let _ = writeln!(
+        out,
+        "recall: {perfect} of {} classes right on every recording; lowest: {}",
+        recall.len(),
+        if shown.is_empty() {
+            "none".to_string()
+        } else {
+            shown.join(", ")
+        }
+    );
 }
 
 /// The silent and saturated taxels and the mean over the responsive ones.
