@@ -749,6 +749,23 @@ fn a_ragged_line_is_told_by_its_line_and_field_counts() {
     let err = dir.fails(&args);
     let said = format!("line {line} has 3 field(s) where the header has 4");
     assert!(err.contains(&said), "{err}");
+    // A blank line just before the ragged one leaves its line number as it is in the
+    // file (the CSV reader counts the blank line into the record's position).
+    let text = std::fs::read_to_string(&log).unwrap();
+    let (head, last) = text.trim_end().rsplit_once('\n').unwrap();
+    std::fs::write(&log, format!("{head}\n\n{last}\n")).unwrap();
+    let err = dir.fails(&args);
+    let said = format!("line {} has 3 field(s) where the header has 4", line + 1);
+    assert!(err.contains(&said), "{err}");
+    let text = std::fs::read_to_string(&ragged).unwrap();
+    std::fs::write(&ragged, text.replacen("\n5,5\n", "\n\n5,5\n", 1)).unwrap();
+    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
+    args.extend_from_slice(&pattern);
+    let err = dir.fails(&args);
+    assert!(
+        err.contains("A_1.csv: line 8 has 2 field(s) where the header has 3"),
+        "{err}"
+    );
 }
 
 #[test]

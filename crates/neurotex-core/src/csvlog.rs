@@ -85,6 +85,30 @@ pub(crate) fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
     }
 }
 
+/// The line of `path` that the record its CSV reader failed on starts on, the reader's
+/// position being `start` bytes in. The reader counts blank lines just before a record into
+/// its error's position (a record one line past a blank one is said to be on the blank
+/// line), so they are stepped over here. `None` when the file cannot be read again.
+fn record_line(path: &Path, start: u64) -> Option<u64> {
+    use std::io::Read;
+    // Blank lines beyond a few thousand bytes are not looked for.
+    let mut bytes = Vec::new();
+    let file = crate::io::open_text(path).ok()?;
+    file.take(start.saturating_add(4096))
+        .read_to_end(&mut bytes)
+        .ok()?;
+    let start = usize::try_from(start).ok()?.min(bytes.len());
+    let mut line = 1 + bytes[..start].iter().filter(|&&b| b == b'\n').count() as u64;
+    for &b in &bytes[start..] {
+        match b {
+            b'\n' => line += 1,
+            b'\r' => {}
+            _ => break,
+        }
+    }
+    Some(line)
+}
+
 /// A CSV reading error under the file's name, with its line when the reader knows it,
 /// the first line counted as the header.
 pub(crate) fn csv_error(path: &Path, e: csv::Error) -> crate::Error {
@@ -100,14 +124,14 @@ fn csv_error_after(path: &Path, e: csv::Error, first: &str) -> crate::Error {
             };
             crate::io::read_error(path, io)
         }
-        _ => DataError::invalid(path, csv_words(&e, first)).into(),
+        _ => DataError::invalid(path, csv_words(&e, first, path)).into(),
     }
 }
 
-/// A CSV reader's error (not an I/O one) in neurotex's words: the line, what it holds
-/// and what was expected, never the reader's record and byte counts.
-pub(crate) fn csv_words(e: &csv::Error, first: &str) -> String {
-    let line = e.position().map(|p| p.line());
+/// A CSV reader's error (not an I/O one) in `path` in neurotex's words: the line, what it
+/// holds and what was expected, never the reader's record and byte counts.
+pub(crate) fn csv_words(e: &csv::Error, first: &str, path: &Path) -> String {
+    let line = (e.position()).map(|p| record_line(path, p.byte()).unwrap_or(p.line()));
     let at = line.map(|l| format!("line {l}")).unwrap_or("a line".into());
     match e.kind() {
         csv::ErrorKind::UnequalLengths {

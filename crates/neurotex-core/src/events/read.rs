@@ -318,7 +318,7 @@ pub(super) fn parse_csv(
         Ok(header) => header.clone(),
         Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
         Err(e) => {
-            let why = crate::csvlog::csv_words(&e, "the header");
+            let why = crate::csvlog::csv_words(&e, "the header", path);
             return Err(bad(format!("not a CSV file with a header row: {why}")));
         }
     };
@@ -345,7 +345,7 @@ pub(super) fn parse_csv(
             Ok(false) => break,
             Ok(true) => {}
             Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
-            Err(e) => return Err(bad(crate::csvlog::csv_words(&e, "the header"))),
+            Err(e) => return Err(bad(crate::csvlog::csv_words(&e, "the header", path))),
         }
         // The line the record starts on, as the CSV reader counts lines.
         line = record.position().map_or(line + 1, |p| p.line() as usize);
