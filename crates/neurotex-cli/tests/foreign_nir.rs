@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use crate::stream::{csv_text, lines, slide_frames, slides};
+use crate::stream::{csv_text, lines, of_file, slide_frames, slides};
 use crate::util::{s, Dir};
 
 /// The graphs, the tool named after `--nir-from`.
@@ -207,13 +207,7 @@ fn graphs_from_snntorch_and_norse_stream_as_they_predict() {
         ];
         predict.extend_from_slice(&graph_args);
         dir.ok(&predict);
-        let mut expected: Vec<_> = lines(&std::fs::read_to_string(&out).unwrap())
-            .into_iter()
-            .filter(|l| l["file"] == row.0.as_str())
-            .collect();
-        for l in &mut expected {
-            l.as_object_mut().unwrap().remove("file");
-        }
+        let expected = of_file(&lines(&std::fs::read_to_string(&out).unwrap()), &row.0);
         let mut stream = vec!["stream", "--input", s(&csv)];
         stream.extend_from_slice(&graph_args);
         let streamed = lines(&dir.ok(&stream));

@@ -1112,3 +1112,29 @@ fn a_network_in_travel_keeps_its_reference_speed_and_needs_speeds() {
     let differs = "`network.travel_mm_s` (20.0) differs from the training parameters (`classifier`: {\"at\":15.0})";
     refused_when_tampered(&dir, &file, &ds, &at, differs);
 }
+
+/// `predict` on the dataset a model was trained on says how many of its recordings the
+/// model was fitted to; on other recordings it says nothing of the kind.
+#[test]
+fn predicting_the_training_recordings_is_said_to_test_nothing() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[10.0, 20.0], 4);
+    let other = dir.dataset("other", &["A", "B"], &[10.0], 3);
+    let model = dir.join("m.json");
+    let train = ["train", "--dataset", s(&ds), "--speeds", "10", "-k", "1"];
+    dir.ok(&[&train[..], &["--out", s(&model)]].concat());
+    let predict = |data: &Path| {
+        let args = ["predict", "--model", s(&model), "--dataset", s(data)];
+        dir.run(&[&args[..], &["--out", s(&dir.join("p.csv"))]].concat())
+    };
+    let seen = predict(&ds);
+    assert!(seen.status.success(), "{}", seen.stderr);
+    assert!(
+        (seen.stderr).contains("warning: 8 of these 16 recordings are ones the model was trained on (this is its training dataset, at 10 mm/s)"),
+        "{}",
+        seen.stderr
+    );
+    let new = predict(&other);
+    assert!(new.status.success(), "{}", new.stderr);
+    assert!(!new.stderr.contains("trained on"), "{}", new.stderr);
+}

@@ -121,7 +121,7 @@ fn causal_lines(dir: &Dir, model: &Path, data: &Path) -> Vec<Value> {
 
 /// `file`'s lines of `predict --causal` without `file` and `true_label`, which a stream
 /// does not know.
-fn of_file(all: &[Value], file: &str) -> Vec<Value> {
+pub(crate) fn of_file(all: &[Value], file: &str) -> Vec<Value> {
     let mut mine: Vec<Value> = all.iter().filter(|l| l["file"] == file).cloned().collect();
     for l in &mut mine {
         let line = l.as_object_mut().unwrap();

@@ -7,8 +7,8 @@ use crate::pipeline::Encoded;
 
 /// Writes each recording's episode as `neurotex stream --episode whole` prints it for that
 /// recording's frames: a line per bin boundary, then its end, each with the recording's
-/// `file` (`predict --causal`) and, when its manifest gives one, its `true_label`: a
-/// line's `label` is the class the model chose, as in a stream.
+/// `file` (`predict --causal`) and, when its manifest gives one, its `true_label` beside
+/// the model's `label` and `decision`.
 ///
 /// # Errors
 /// `w` fails.

@@ -47,7 +47,7 @@ pub struct PredictArgs {
 pub fn run(args: PredictArgs) -> Result<()> {
     let o = &args.options;
     if o.causal && args.json {
-        bail!("--causal writes per-bin decisions; score whole recordings without it (a causal model's whole-recording predictions are its episodes' end labels)");
+        bail!("--causal writes per-bin decisions; score whole recordings without it (the end lines' labels classify each episode's last window, the whole recording only when it is no longer than --window-s)");
     }
     if args.json && is_stdout(&args.out) {
         bail!("--out - and --json would both write standard output; write the predictions to a file with --json");

@@ -9,10 +9,11 @@ use super::stream::DecisionOptions;
 use super::{say_conditions, OnProgress, OpenOptions, ReadOptions};
 use crate::causal::Episode;
 use crate::error::OptionsError;
+use crate::model::Provenance;
 use crate::pipeline::{Encoded, Pipeline};
 use crate::progress::Progress;
 use crate::recording::{Baseline, Dataset};
-use crate::saved::SavedModel;
+use crate::saved::{SavedModel, Trained};
 use crate::Result;
 
 /// Options of `predict`.
@@ -42,9 +43,11 @@ pub struct PredictOptions {
     #[cfg_attr(feature = "cli", command(flatten))]
     pub read: ReadOptions,
     /// Decide as `neurotex stream` would, bin by bin (needs a model trained with
-    /// --causal): --out gets JSON lines, one per bin boundary of each recording's selected
-    /// phase and one for its end, each with the recording's `file` and its manifest's
-    /// `true_label` (`label` is the class chosen); the same lines `neurotex stream
+    /// --causal, or on address events, which need no conditioning): --out gets JSON
+    /// lines, one per bin boundary of each recording's selected phase and one for its
+    /// end, each with the recording's `file` and its manifest's
+    /// `true_label` beside the model's `label` (the window's class; at the end, the
+    /// episode's) and `decision` (null until made); the same lines `neurotex stream
     /// --episode whole` prints for that recording's frames.
     #[cfg_attr(feature = "cli", arg(long))]
     pub causal: bool,
@@ -135,8 +138,39 @@ impl PredictOptions {
 /// # Errors
 /// A recording that cannot be read or encoded, or one the model cannot take.
 pub fn encode_for(model: &SavedModel, dataset: &Dataset, on: OnProgress) -> Result<Vec<Encoded>> {
+    if let Some(advice) = seen_in_training(model.provenance(), dataset) {
+        on(Progress::Advice(&advice));
+    }
     let encoded = encode_dataset(model.pipeline(), model.baseline(), dataset, on)?;
     checked(model, encoded, on)
+}
+
+/// A warning when `dataset` is the one the model was trained on (the same fingerprint): its
+/// recordings at the training speeds were fitted, so their predictions test nothing.
+fn seen_in_training(provenance: &Provenance, dataset: &Dataset) -> Option<String> {
+    if dataset.fingerprint().ok()? != provenance.fingerprint {
+        return None;
+    }
+    let n = dataset.entries.len();
+    let seen = match &provenance.speeds {
+        None => n,
+        Some(speeds) => dataset.indices_at(speeds).map_or(0, |i| i.len()),
+    };
+    (seen > 0).then(|| {
+        format!(
+            "{seen} of these {n} recordings are ones the model was trained on (this is its training dataset{}): their predictions are no test of it; `neurotex evaluate` cross-validates, or predict recordings it has not seen",
+            match &provenance.speeds {
+                None => String::new(),
+                Some(speeds) => format!(", at {} mm/s", shown_speeds(speeds)),
+            }
+        )
+    })
+}
+
+/// Speeds as `10, 20`.
+fn shown_speeds(speeds: &[crate::Speed]) -> String {
+    let shown: Vec<String> = speeds.iter().map(ToString::to_string).collect();
+    shown.join(", ")
 }
 
 /// `encoded` once every recording passed the model's checks, the conditions said.
