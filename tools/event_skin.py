@@ -17,13 +17,13 @@ events fire every `step` of pressure change (at most one per taxel, polarity and
 with background events at 1 Hz per taxel and polarity. Every choice above was made before
 any classifier ran on the data.
 
-Usage: python3 tools/event_skin.py OUT [TRIALS] [SEED]
+Usage: python3 tools/event_skin.py OUT [TRIALS] [SEED] (10 trials, seed 0 by default)
 Writes OUT/manifest.csv (file, label, speed_mm_s, trial, duration_s), OUT/layout.toml and
 one tonic-style .npy per recording (x, y, t in microseconds, p with 1 = ON, 0 = OFF).
 """
 
+import argparse
 import os
-import sys
 
 import numpy as np
 
@@ -128,11 +128,23 @@ def events(p, gain, rng):
 
 
 def main() -> None:
-    out = sys.argv[1]
-    trials = int(sys.argv[2]) if len(sys.argv) > 2 else 10
-    seed = int(sys.argv[3]) if len(sys.argv) > 3 else 0
-    os.makedirs(out, exist_ok=False)
-    rng = np.random.default_rng(seed)
+    parser = argparse.ArgumentParser(
+        description="Write a synthetic 8x8 event skin's dataset (four textures, three speeds).",
+        epilog="Example: python3 tools/event_skin.py /tmp/skin 10 0",
+    )
+    parser.add_argument("out", help="the dataset folder to create (must not exist)")
+    parser.add_argument("trials", nargs="?", type=int, default=10,
+                        help="trials per texture and speed (default 10)")
+    parser.add_argument("seed", nargs="?", type=int, default=0, help="random seed (default 0)")
+    args = parser.parse_args()
+    if args.trials < 1:
+        parser.error("trials must be at least 1")
+    out = args.out
+    if os.path.exists(out):
+        parser.error(f"{out} exists: give a folder to create")
+    os.makedirs(out)
+    rng = np.random.default_rng(args.seed)
+    trials = args.trials
     gain = rng.uniform(0.8, 1.2, (ROWS, COLS))
     dots = dot_raster(rng)
     lines = ["file,label,speed_mm_s,trial,duration_s"]
@@ -151,6 +163,9 @@ def main() -> None:
             f'rows = {ROWS}\ncols = {COLS}\n\n[events]\ntime_unit = "us"\n'
             'x = "x"\ny = "y"\npolarity = "p"\nvalues = [1, 0]\n'
         )
+    n = len(lines) - 1
+    print(f"{n} recordings ({len(TEXTURES)} textures x {len(SPEEDS_MM_S)} speeds x {trials} "
+          f"trials) on an {ROWS}x{COLS} grid -> {out}")
 
 
 if __name__ == "__main__":
