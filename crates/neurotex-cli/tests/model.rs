@@ -1114,7 +1114,8 @@ fn a_network_in_travel_keeps_its_reference_speed_and_needs_speeds() {
 }
 
 /// `predict` on the dataset a model was trained on says how many of its recordings the
-/// model was fitted to; on other recordings it says nothing of the kind.
+/// model was fitted to; on other recordings, or other speeds (`--speeds`), it says nothing
+/// of the kind.
 #[test]
 fn predicting_the_training_recordings_is_said_to_test_nothing() {
     let dir = Dir::new();
@@ -1137,4 +1138,41 @@ fn predicting_the_training_recordings_is_said_to_test_nothing() {
     let new = predict(&other);
     assert!(new.status.success(), "{}", new.stderr);
     assert!(!new.stderr.contains("trained on"), "{}", new.stderr);
+    // --speeds predicts the dataset's recordings at those speeds only: at 20 mm/s, none the
+    // model was trained on.
+    let out = dir.join("at20.csv");
+    let args = [
+        "predict",
+        "--model",
+        s(&model),
+        "--dataset",
+        s(&ds),
+        "--speeds",
+        "20",
+    ];
+    let at20 = dir.run(&[&args[..], &["--out", s(&out)]].concat());
+    assert!(at20.status.success(), "{}", at20.stderr);
+    assert!(!at20.stderr.contains("trained on"), "{}", at20.stderr);
+    let rows: Vec<String> = (std::fs::read_to_string(&out).unwrap().lines().skip(1))
+        .map(|l| l.split(',').next().unwrap().to_string())
+        .collect();
+    assert_eq!(rows.len(), 8);
+    assert!(rows.iter().all(|f| f.contains("_20_")), "{rows:?}");
+    let file = ds.join(&rows[0]);
+    let never = dir.join("never.csv");
+    let args = [
+        "predict",
+        "--model",
+        s(&model),
+        "--speeds",
+        "20",
+        "--out",
+        s(&never),
+    ];
+    let err = dir.fails(&[&args[..], &[s(&file)]].concat());
+    assert!(!never.exists());
+    assert!(
+        err.contains("--speeds selects recordings of a --dataset"),
+        "{err}"
+    );
 }

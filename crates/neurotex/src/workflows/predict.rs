@@ -33,6 +33,13 @@ pub struct PredictOptions {
         conflicts_with_all = ["files", "layout", "fs", "grid", "no_header", "delimiter", "time_column", "time_unit", "channels", "duplicate_stamps", "max_gap_s"]
     ))]
     pub dataset: Option<PathBuf>,
+    /// With --dataset: predict only its recordings at these speeds (mm/s, comma-separated);
+    /// default all.
+    #[cfg_attr(
+        feature = "cli",
+        arg(long, value_delimiter = ',', allow_hyphen_values = true)
+    )]
+    pub speeds: Option<Vec<crate::Speed>>,
     /// Recordings to predict instead of a dataset (`.npy` or `.csv`); their labels are
     /// unknown. They must have the model's taxel grid. A file with no layout given or
     /// beside it is read as the model's training recordings were: raw logs of the logger
@@ -79,6 +86,17 @@ impl PredictOptions {
         inputs
     }
 
+    /// The dataset's recordings to predict, in manifest order: those at `--speeds`, else all.
+    ///
+    /// # Errors
+    /// A speed at which the dataset holds no recording.
+    fn selected(&self, dataset: &Dataset) -> Result<Vec<usize>> {
+        match &self.speeds {
+            Some(speeds) => dataset.indices_at(speeds),
+            None => Ok((0..dataset.entries.len()).collect()),
+        }
+    }
+
     /// Encodes the recordings (`dataset`'s, else the files given) with `model`'s pipeline,
     /// saying where layouts came from and what conditioning noticed.
     ///
@@ -92,7 +110,11 @@ impl PredictOptions {
         on: OnProgress,
     ) -> Result<Vec<Encoded>> {
         if let Some(dataset) = dataset {
-            return encode_for(model, dataset, on);
+            return encode_selected(model, dataset, &self.selected(dataset)?, on);
+        }
+        if self.speeds.is_some() {
+            let why = "--speeds selects recordings of a --dataset; files given are each predicted";
+            return Err(OptionsError::Conflict(why.into()).into());
         }
         let (encoded, from) = model.encode_files(&self.files, &self.read.reading()?)?;
         for note in ReadOptions::layout_notes(&from) {
@@ -138,23 +160,41 @@ impl PredictOptions {
 /// # Errors
 /// A recording that cannot be read or encoded, or one the model cannot take.
 pub fn encode_for(model: &SavedModel, dataset: &Dataset, on: OnProgress) -> Result<Vec<Encoded>> {
-    if let Some(advice) = seen_in_training(model.provenance(), dataset) {
+    let all: Vec<usize> = (0..dataset.entries.len()).collect();
+    encode_selected(model, dataset, &all, on)
+}
+
+/// [`encode_for`] on the recordings `which` of `dataset`.
+fn encode_selected(
+    model: &SavedModel,
+    dataset: &Dataset,
+    which: &[usize],
+    on: OnProgress,
+) -> Result<Vec<Encoded>> {
+    if let Some(advice) = seen_in_training(model.provenance(), dataset, which) {
         on(Progress::Advice(&advice));
     }
-    let encoded = encode_dataset(model.pipeline(), model.baseline(), dataset, on)?;
+    let encoded = encode_dataset(model.pipeline(), model.baseline(), dataset, which, on)?;
     checked(model, encoded, on)
 }
 
-/// A warning when `dataset` is the one the model was trained on (the same fingerprint): its
-/// recordings at the training speeds were fitted, so their predictions test nothing.
-fn seen_in_training(provenance: &Provenance, dataset: &Dataset) -> Option<String> {
+/// A warning when `dataset` is the one the model was trained on (the same fingerprint): of
+/// the recordings `which`, those at the training speeds were fitted, so their predictions
+/// test nothing.
+fn seen_in_training(provenance: &Provenance, dataset: &Dataset, which: &[usize]) -> Option<String> {
     if dataset.fingerprint().ok()? != provenance.fingerprint {
         return None;
     }
-    let n = dataset.entries.len();
+    let n = which.len();
     let seen = match &provenance.speeds {
         None => n,
-        Some(speeds) => dataset.indices_at(speeds).map_or(0, |i| i.len()),
+        Some(speeds) => (which.iter())
+            .filter(|&&i| {
+                dataset.entries[i]
+                    .speed()
+                    .is_some_and(|s| speeds.contains(&s))
+            })
+            .count(),
     };
     (seen > 0).then(|| {
         format!(
@@ -187,6 +227,7 @@ fn encode_dataset(
     pipeline: &Pipeline,
     baseline: Baseline,
     dataset: &Dataset,
+    which: &[usize],
     on: OnProgress,
 ) -> Result<Vec<Encoded>> {
     let layout_baseline = dataset.layout.baseline.unwrap_or_default();
@@ -196,7 +237,6 @@ fn encode_dataset(
             dataset.root.join("layout.toml").display()
         )));
     }
-    let all: Vec<usize> = (0..dataset.entries.len()).collect();
-    on(Progress::Stage("encoding", all.len()));
-    pipeline.encode_dataset(dataset, &all, &|| on(Progress::Tick))
+    on(Progress::Stage("encoding", which.len()));
+    pipeline.encode_dataset(dataset, which, &|| on(Progress::Tick))
 }
