@@ -825,6 +825,58 @@ fn a_bad_count_an_absurd_rate_or_a_missing_column_is_told_plainly() {
 }
 
 /// A clean two-channel log: `t_ms,a,b`, 300 rows.
+/// A log written with Windows line endings: its errors name the line they are on (the CSV
+/// reader counts each `\r\n`'s `\n` into the next record, one line short), for a value that
+/// is not a number, a stamp that goes back, a repeated stamp (both its lines) and an event
+/// log's cell outside the grid.
+#[test]
+fn windows_line_endings_keep_the_line_numbers() {
+    let dir = Dir::new();
+    let logs = two_channel_logs(&dir);
+    let crlf = |text: &str| text.replace('\n', "\r\n");
+    let log = logs.join("A_1.csv");
+    let inspect = |edit: &dyn Fn(&str) -> String, extra: &[&str]| {
+        std::fs::write(&log, crlf(&edit(&text_of_log()))).unwrap();
+        let args = ["inspect", s(&log), "--time-column", "t_ms"];
+        dir.fails(&[&args[..], extra].concat())
+    };
+    // Line 12 holds t = 10 (the header is line 1).
+    let err = inspect(&|t| t.replacen("\n10,3,0\n", "\n10,n/a,0\n", 1), &[]);
+    assert!(err.contains("A_1.csv: line 12, column `a`"), "{err}");
+    let err = inspect(&|t| t.replacen("\n10,3,0\n", "\n2,3,0\n", 1), &[]);
+    assert!(
+        err.contains("A_1.csv: line 12: time stamps must not go back"),
+        "{err}"
+    );
+    let repeat = ["--duplicate-stamps", "error"];
+    let err = inspect(&|t| t.replacen("\n10,3,0\n", "\n9,3,0\n", 1), &repeat);
+    assert!(
+        err.contains("line 12: time stamp 9 repeats line 11"),
+        "{err}"
+    );
+    let events = clock_logs(&dir, &|_| 0.0, 2);
+    let log = events.join("B_1.csv");
+    let mut text = std::fs::read_to_string(&log).unwrap();
+    let line = text.lines().count() + 1;
+    text.push_str("1999999,7,1,1\n");
+    std::fs::write(&log, crlf(&text)).unwrap();
+    let mut args = vec![
+        "import",
+        "events",
+        s(&events),
+        "--out",
+        "ev",
+        "--grid",
+        "2x2",
+    ];
+    args.extend_from_slice(&["--time-unit", "us", "--name-pattern", "{label}_{trial}.csv"]);
+    let err = dir.fails(&args);
+    assert!(
+        err.contains(&format!("B_1.csv: line {line}: x = 7")),
+        "{err}"
+    );
+}
+
 fn text_of_log() -> String {
     let mut text = String::from("t_ms,a,b\n");
     for t in 0..300 {

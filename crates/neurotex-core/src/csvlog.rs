@@ -85,11 +85,12 @@ pub(crate) fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
     }
 }
 
-/// The line of `path` that the record its CSV reader failed on starts on, the reader's
-/// position being `start` bytes in. The reader counts blank lines just before a record into
-/// its error's position (a record one line past a blank one is said to be on the blank
-/// line), so they are stepped over here. `None` when the file cannot be read again.
-fn record_line(path: &Path, start: u64) -> Option<u64> {
+/// The line of `path` that a record starts on, its CSV reader's position being `start`
+/// bytes in. The reader's own line count can be one short: it counts a blank line just
+/// before a record into the record's position, and the `\n` of a `\r\n` ending into the
+/// next record; both are stepped over here. For error messages only (it reads the file
+/// again up to the record). `None` when the file cannot be read again.
+pub(crate) fn record_line(path: &Path, start: u64) -> Option<u64> {
     use std::io::Read;
     // Blank lines beyond a few thousand bytes are not looked for.
     let mut bytes = Vec::new();

@@ -169,10 +169,10 @@ struct RowReader<'a> {
     policy: DuplicateStamps,
     samples: Vec<f64>,
     times: Option<Vec<f64>>,
-    /// The distinct rows of the current stamp, `channels` values each, and the line of the
-    /// first.
+    /// The distinct rows of the current stamp, `channels` values each, and where the first
+    /// is (its byte and its reader's line).
     group: Vec<f64>,
-    group_line: u64,
+    group_at: (u64, u64),
     stamp: Option<f64>,
     row: Vec<f64>,
     merged_rows: usize,
@@ -188,7 +188,7 @@ impl<'a> RowReader<'a> {
             samples: Vec::new(),
             times: columns.time.map(|_| Vec::new()),
             group: Vec::new(),
-            group_line: 0,
+            group_at: (0, 0),
             stamp: None,
             row: Vec::with_capacity(columns.channels.len()),
             merged_rows: 0,
@@ -196,7 +196,13 @@ impl<'a> RowReader<'a> {
         }
     }
 
-    fn parse(&self, record: &csv::ByteRecord, line: u64, j: usize) -> Result<f64> {
+    /// The line in the file of the record at byte `start` (its CSV reader's `line` can be
+    /// one short): for error messages.
+    fn line_of(&self, (start, line): (u64, u64)) -> u64 {
+        super::record_line(self.path, start).unwrap_or(line)
+    }
+
+    fn parse(&self, record: &csv::ByteRecord, at: (u64, u64), j: usize) -> Result<f64> {
         let raw = record.get(j).unwrap_or(b"");
         std::str::from_utf8(raw)
             .ok()
@@ -206,7 +212,8 @@ impl<'a> RowReader<'a> {
                 invalid(
                     self.path,
                     format!(
-                        "line {line}, column `{}`: expected a finite number, got `{}`",
+                        "line {}, column `{}`: expected a finite number, got `{}`",
+                        self.line_of(at),
                         excerpt(&self.columns.names[j]),
                         excerpt(&String::from_utf8_lossy(raw))
                     ),
@@ -215,13 +222,13 @@ impl<'a> RowReader<'a> {
     }
 
     fn push(&mut self, record: &csv::ByteRecord) -> Result<()> {
-        let line = record.position().map_or(0, |p| p.line());
+        let at = record.position().map_or((0, 0), |p| (p.byte(), p.line()));
         self.row.clear();
         for k in 0..self.columns.channels.len() {
-            let v = self.parse(record, line, self.columns.channels[k])?;
+            let v = self.parse(record, at, self.columns.channels[k])?;
             if !crate::values::sample_in_range(v) {
                 let name = excerpt(&self.columns.names[self.columns.channels[k]]);
-                let rule = crate::values::SAMPLE_RULE;
+                let (rule, line) = (crate::values::SAMPLE_RULE, self.line_of(at));
                 let message =
                     format!("line {line}, column `{name}`: {v:?} is out of range ({rule})");
                 return Err(invalid(self.path, message));
@@ -232,17 +239,20 @@ impl<'a> RowReader<'a> {
             self.samples.extend_from_slice(&self.row);
             return Ok(());
         };
-        let t = self.parse(record, line, j)?;
+        let t = self.parse(record, at, j)?;
         match self.stamp {
             Some(prev) if t < prev => Err(invalid(
                 self.path,
-                format!("line {line}: time stamps must not go back, got {t} after {prev}"),
+                format!(
+                    "line {}: time stamps must not go back, got {t} after {prev}",
+                    self.line_of(at)
+                ),
             )),
-            Some(prev) if t == prev => self.same_stamp(t, line),
+            Some(prev) if t == prev => self.same_stamp(t, at),
             _ => {
                 self.flush();
                 self.stamp = Some(t);
-                self.group_line = line;
+                self.group_at = at;
                 self.group.extend_from_slice(&self.row);
                 Ok(())
             }
@@ -251,7 +261,7 @@ impl<'a> RowReader<'a> {
 
     /// Another row at the current stamp: dropped when it repeats one exactly, else kept
     /// for the frame (or an error under `error`).
-    fn same_stamp(&mut self, t: f64, line: u64) -> Result<()> {
+    fn same_stamp(&mut self, t: f64, at: (u64, u64)) -> Result<()> {
         let n = self.row.len();
         if self.group.chunks_exact(n).any(|g| g == self.row.as_slice()) {
             self.duplicate_rows += 1;
@@ -259,8 +269,9 @@ impl<'a> RowReader<'a> {
         }
         if self.policy == DuplicateStamps::Error {
             let message = format!(
-                "line {line}: time stamp {t} repeats line {} with other values (--duplicate-stamps average, first or last merges such rows)",
-                self.group_line
+                "line {}: time stamp {t} repeats line {} with other values (--duplicate-stamps average, first or last merges such rows)",
+                self.line_of(at),
+                self.line_of(self.group_at)
             );
             return Err(invalid(self.path, message));
         }

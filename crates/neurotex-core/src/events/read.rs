@@ -239,7 +239,8 @@ pub(crate) enum Parsed {
         t: Stamp,
         cell: (i64, i64),
         p: Option<i64>,
-        /// The CSV line (1-based, the header is line 1) or the `.npy` record (0-based).
+        /// The CSV record's first byte (its line, the header's being 1, is found from it
+        /// for a message: [`place`]) or the `.npy` record (0-based).
         at: usize,
     },
 }
@@ -339,7 +340,6 @@ pub(super) fn parse_csv(
     })
     .map_err(bad)?;
     let mut record = csv::ByteRecord::new();
-    let mut line = 1usize;
     loop {
         match reader.read_byte_record(&mut record) {
             Ok(false) => break,
@@ -347,15 +347,15 @@ pub(super) fn parse_csv(
             Err(e) if e.is_io_error() => return Err(crate::csvlog::csv_error(path, e)),
             Err(e) => return Err(bad(crate::csvlog::csv_words(&e, "the header", path))),
         }
-        // The line the record starts on, as the CSV reader counts lines.
-        line = record.position().map_or(line + 1, |p| p.line() as usize);
-        let at = |m: String| bad(format!("line {line}: {m}"));
+        // Where the record starts; its line is found from it for a message.
+        let byte = record.position().map_or(0, |p| p.byte() as usize);
+        let at = |m: String| bad(format!("{}: {m}", place(path, byte)));
         let (t, cell, p) = csv_event(&record, &cols).map_err(at)?;
         sink(Parsed::Event {
             t,
             cell,
             p,
-            at: line,
+            at: byte,
         })
         .map_err(at)?;
     }
@@ -463,13 +463,17 @@ fn parse_npy(
     Ok(())
 }
 
-/// Where event `at` of a [`Parsed::Event`] is, as the messages say it.
+/// Where event `at` of a [`Parsed::Event`] is, as the messages say it: the `.npy` record,
+/// or the CSV line (read again from the file up to the record's byte).
 pub(crate) fn place(path: &Path, at: usize) -> String {
     let npy = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
-    match npy {
-        true => format!("event {at} (0-based)"),
-        false => format!("line {at}"),
+    if npy {
+        return format!("event {at} (0-based)");
+    }
+    match crate::csvlog::record_line(path, at as u64) {
+        Some(line) => format!("line {line}"),
+        None => format!("the line at byte {at}"),
     }
 }
