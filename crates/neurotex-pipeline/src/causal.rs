@@ -187,14 +187,17 @@ pub struct Episode {
     pub summary: EpisodeSummary,
 }
 
-/// The window length in steps for `window_ms` (whole bins, at least one).
+/// The window length in steps for `window_ms`, rounded up to whole bins (at least one): a
+/// window of the training recordings' median length covers a recording of that length
+/// whole, as the classifier saw it in training, when the length is not a whole number of
+/// bins.
 pub fn window_steps(window_ms: usize, bin_ms: usize) -> usize {
-    (window_ms / bin_ms).max(1) * bin_ms
+    window_ms.div_ceil(bin_ms).max(1) * bin_ms
 }
 
 /// The offline twin of `neurotex_stream::StreamClassifier`: the decisions at every bin
 /// boundary of one causally encoded recording (the episode: its selected phase), each over
-/// the last `window_ms` (whole bins) or all the episode so far, and the summary.
+/// the last `window_ms` (rounded up to whole bins) or all the episode so far, and the summary.
 ///
 /// # Errors
 /// A model that is not causal is not refused here (its decisions are those of its own
@@ -244,7 +247,7 @@ pub fn episode_decisions(
 
 /// The offline twin of a stream run by a spiking network: the network runs over the whole
 /// causally encoded recording, its time steps of `dt` ms completed as the 1 ms steps reach
-/// them; at each bin boundary its class scores over the last `window_ms` (whole bins, at
+/// them; at each bin boundary its class scores over the last `window_ms` (rounded up to whole bins, at
 /// least one network step) or all of the episode so far give the bin's classification,
 /// the shares being their softmax. At the end the last partial time step is run, as
 /// [`SpikingModel::predict`] runs it, and the summary reads the scores over the last window:
@@ -302,7 +305,7 @@ pub fn spiking_episode_decisions(
 }
 
 /// The window of a spiking network's scores in its time steps of `dt_ms`: the window of
-/// `window_ms` in whole bins, at least one step.
+/// `window_ms` rounded up to whole bins, at least one step.
 pub fn network_window(window_ms: usize, bin_ms: usize, dt_ms: usize) -> usize {
     (window_steps(window_ms, bin_ms) / dt_ms).max(1)
 }
@@ -490,11 +493,14 @@ mod tests {
         assert!(DecisionRule::default().check().is_ok());
     }
 
+    /// Windows are whole bins, rounded up: a recording of the window's length fits in it.
     #[test]
-    fn windows_are_whole_bins() {
+    fn windows_are_whole_bins_rounded_up() {
         assert_eq!(window_steps(18_000, 200), 18_000);
-        assert_eq!(window_steps(18_150, 200), 18_000);
+        assert_eq!(window_steps(18_150, 200), 18_200);
+        assert_eq!(window_steps(3_499, 200), 3_600);
         assert_eq!(window_steps(50, 200), 200);
+        assert_eq!(network_window(3_499, 200, 10), 360);
     }
 
     #[test]

@@ -81,7 +81,7 @@ impl std::str::FromStr for EpisodeRule {
 /// How a stream is classified.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StreamParams {
-    /// The window classified at each bin boundary, ms (whole bins).
+    /// The window classified at each bin boundary, ms (rounded up to whole bins).
     pub window_ms: usize,
     /// When the per-bin classifications become a decision.
     pub rule: DecisionRule,

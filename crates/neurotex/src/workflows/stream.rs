@@ -23,8 +23,9 @@ use crate::Result;
 #[derive(Debug, Clone)]
 #[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct DecisionOptions {
-    /// The window classified at each bin boundary, s (whole bins); default: the median
-    /// length of the model's training recordings (10 s when the model does not say).
+    /// The window classified at each bin boundary, s (rounded up to whole bins); default:
+    /// the median length of the model's training recordings (10 s when the model does not
+    /// say), so that a recording of that length is classified whole.
     #[cfg_attr(feature = "cli", arg(long = "window-s", allow_negative_numbers = true))]
     pub window_s: Option<f64>,
     /// The vote share a bin's label needs to count towards the decision (KNN: 0.8 is four
