@@ -31,14 +31,14 @@ fn clock_logs(dir: &Dir, lead_s: &dyn Fn(usize) -> f64, trials: usize) -> PathBu
     logs
 }
 
-fn import_events(dir: &Dir, logs: &Path, name: &str, extra: &[&str]) -> (PathBuf, String) {
-    let out = dir.join(name);
+/// `import events` of the clock logs in `logs` into `out`, and `extra`.
+fn import_events_args<'a>(logs: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "import",
         "events",
         s(logs),
         "--out",
-        s(&out),
+        s(out),
         "--grid",
         "2x2",
         "--time-unit",
@@ -47,9 +47,19 @@ fn import_events(dir: &Dir, logs: &Path, name: &str, extra: &[&str]) -> (PathBuf
         "{label}_{trial}.csv",
     ];
     args.extend_from_slice(extra);
-    let run = dir.run(&args);
+    args
+}
+
+fn import_events(dir: &Dir, logs: &Path, name: &str, extra: &[&str]) -> (PathBuf, String) {
+    let out = dir.join(name);
+    let run = dir.run(&import_events_args(logs, &out, extra));
     assert!(run.status.success(), "{}", run.stderr);
     (out, run.stderr)
+}
+
+/// The same import, which must fail; what it says on standard error.
+fn import_events_fails(dir: &Dir, logs: &Path) -> String {
+    dir.fails(&import_events_args(logs, &dir.join("ev"), &[]))
 }
 
 fn finding_codes(dir: &Dir, dataset: &Path) -> Vec<String> {
@@ -736,17 +746,7 @@ fn a_ragged_line_is_told_by_its_line_and_field_counts() {
     text.push_str("99999999,1,1\n");
     let line = text.lines().count();
     std::fs::write(&log, text).unwrap();
-    let mut args = vec![
-        "import",
-        "events",
-        s(&events),
-        "--out",
-        "ev",
-        "--grid",
-        "2x2",
-    ];
-    args.extend_from_slice(&["--time-unit", "us", "--name-pattern", "{label}_{trial}.csv"]);
-    let err = dir.fails(&args);
+    let err = import_events_fails(&dir, &events);
     let said = format!("line {line} has 3 field(s) where the header has 4");
     assert!(err.contains(&said), "{err}");
     // A blank line just before the ragged one leaves its line number as it is in the
@@ -754,13 +754,11 @@ fn a_ragged_line_is_told_by_its_line_and_field_counts() {
     let text = std::fs::read_to_string(&log).unwrap();
     let (head, last) = text.trim_end().rsplit_once('\n').unwrap();
     std::fs::write(&log, format!("{head}\n\n{last}\n")).unwrap();
-    let err = dir.fails(&args);
+    let err = import_events_fails(&dir, &events);
     let said = format!("line {} has 3 field(s) where the header has 4", line + 1);
     assert!(err.contains(&said), "{err}");
     let text = std::fs::read_to_string(&ragged).unwrap();
     std::fs::write(&ragged, text.replacen("\n5,5\n", "\n\n5,5\n", 1)).unwrap();
-    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
-    args.extend_from_slice(&pattern);
     let err = dir.fails(&args);
     assert!(
         err.contains("A_1.csv: line 8 has 2 field(s) where the header has 3"),
@@ -860,17 +858,7 @@ fn windows_line_endings_keep_the_line_numbers() {
     let line = text.lines().count() + 1;
     text.push_str("1999999,7,1,1\n");
     std::fs::write(&log, crlf(&text)).unwrap();
-    let mut args = vec![
-        "import",
-        "events",
-        s(&events),
-        "--out",
-        "ev",
-        "--grid",
-        "2x2",
-    ];
-    args.extend_from_slice(&["--time-unit", "us", "--name-pattern", "{label}_{trial}.csv"]);
-    let err = dir.fails(&args);
+    let err = import_events_fails(&dir, &events);
     assert!(
         err.contains(&format!("B_1.csv: line {line}: x = 7")),
         "{err}"
