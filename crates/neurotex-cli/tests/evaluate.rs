@@ -291,6 +291,7 @@ fn bad_input_is_a_clear_error_with_no_output() {
         (feat(&["--distances", "0"]), "distances"),
         (feat(&["--cutoff", "600"]), "cutoff"),
         (feat(&["--preset", "XX"]), "preset"),
+        (feat(&["--overshoot", "clipped"]), "`kept` (Izhikevich"),
         (feat(&["--baseline", "max"]), "`none` or `min`"),
         (
             vec![

@@ -5,6 +5,7 @@ defaults are the CLI's."""
 
 import re
 
+import numpy as np
 import pytest
 
 import neurotex
@@ -85,3 +86,19 @@ def test_a_broken_knob_is_named_as_python_spells_it(sim):
 def test_a_knob_the_network_does_not_take_is_named_with_the_networks_knobs(sim):
     with pytest.raises(neurotex.ParameterError, match=r"`trees` for the spiking network; its options are hidden"):
         neurotex.Model.train(sim, classifier="snn", classifier_options={"trees": 3})
+
+
+def test_a_capped_overshoot_keeps_the_spikes_under_rounding_level_changes():
+    """The same wandering recording, and the same with each sample times 1 + u 1e-12:
+    with the overshoot kept (the reference scheme) the spikes move; capped they stay."""
+    rng = np.random.default_rng(0)
+    x = np.clip(0.5 + np.cumsum(rng.uniform(-0.01, 0.01, (10_000, 4, 4)), axis=0), 0, 1)
+    nudged = x * (1 + rng.uniform(-1, 1, x.shape) * 1e-12)
+    assert (nudged != x).any()
+    kept = [neurotex.encode(r) for r in (x, nudged)]
+    capped = [neurotex.encode(r, overshoot="capped") for r in (x, nudged)]
+    assert kept[0].sum() > 500
+    assert (kept[0] != kept[1]).any()
+    np.testing.assert_array_equal(capped[0], capped[1])
+    with pytest.raises(neurotex.ParameterError, match="overshoot"):
+        neurotex.encode(x, overshoot="clipped")

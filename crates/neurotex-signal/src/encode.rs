@@ -4,8 +4,8 @@
 //! The scheme is that of Izhikevich's reference code, in f64, one step per millisecond:
 //! at the start of a step a neuron with `v >= 30` records a spike and resets
 //! (`v = c`, `u = u + d`); then `v` advances in two 0.5 ms Euler half-steps and `u` by 1 ms
-//! with the new `v`. State persists between calls, so a recording fed in chunks gives
-//! exactly the spikes of one call.
+//! with the new `v` ([`Overshoot`] says which `v` at a spike's step). State persists
+//! between calls, so a recording fed in chunks gives exactly the spikes of one call.
 
 use serde::{Deserialize, Serialize};
 
@@ -22,6 +22,48 @@ use kernel::run_fastest;
 /// The spike threshold (mV) of the 2003 model.
 pub const V_PEAK: f64 = 30.0;
 
+/// Which membrane value the recovery variable `u` reads at the step a neuron crosses the
+/// peak (docs/decisions/0031-overshoot-kept-by-default-capped-on-request.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Overshoot {
+    /// `u += a (b v - u)` with `v` as the two half-steps left it, far above the peak at a
+    /// spike: Izhikevich's reference code (2003), and the paper's encoder. The recovery
+    /// after a spike then depends on how far `v` overshot, which makes spike timing
+    /// sensitive to rounding-level changes of the input.
+    #[default]
+    Kept,
+    /// `u += a (b min(v, 30) - u)`: the recovery reads the membrane capped at the peak,
+    /// as in the continuous model, where a spike resets `v` on reaching 30 mV.
+    Capped,
+}
+
+impl std::fmt::Display for Overshoot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Overshoot::Kept => "kept",
+            Overshoot::Capped => "capped",
+        })
+    }
+}
+
+impl std::str::FromStr for Overshoot {
+    type Err = ParamError;
+
+    /// `kept` or `capped`, in any case.
+    fn from_str(text: &str) -> Result<Self, ParamError> {
+        match text.trim().to_ascii_lowercase().as_str() {
+            "kept" => Ok(Overshoot::Kept),
+            "capped" => Ok(Overshoot::Capped),
+            _ => Err(ParamError::new(
+                "overshoot",
+                "the overshoot is `kept` (Izhikevich's reference code) or `capped` (at the peak)",
+                text,
+            )),
+        }
+    }
+}
+
 /// Neuron parameters and input gain.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IzhikevichParams {
@@ -35,6 +77,10 @@ pub struct IzhikevichParams {
     pub d: f64,
     /// Gain `G` from normalised signal to input current (the paper's 8).
     pub gain: f64,
+    /// The membrane value the recovery reads at a spike's step (absent from model files
+    /// written before the choice existed: `kept`, the scheme they were made with).
+    #[serde(default)]
+    pub overshoot: Overshoot,
 }
 
 impl Default for IzhikevichParams {
@@ -102,6 +148,7 @@ impl FiringType {
             c,
             d,
             gain: 8.0,
+            overshoot: Overshoot::Kept,
         }
     }
 }
@@ -139,6 +186,12 @@ impl IzhikevichParams {
     /// Sets the gain.
     pub fn with_gain(mut self, gain: f64) -> Self {
         self.gain = gain;
+        self
+    }
+
+    /// Sets the membrane value the recovery reads at a spike's step.
+    pub fn with_overshoot(mut self, overshoot: Overshoot) -> Self {
+        self.overshoot = overshoot;
         self
     }
 
@@ -374,5 +427,48 @@ mod tests {
             assert!(alone.total_spikes() > 100, "bank {b} nearly silent");
             assert_eq!(trains, &alone, "bank {b}");
         }
+    }
+
+    /// A slowly wandering drive and the same drive times `1 + u 1e-12` (`u` in [-1, 1)),
+    /// each sample perturbed on its own: with the overshoot kept (Izhikevich's reference
+    /// code) most spikes leave their step after the first departure; capped at the peak
+    /// the trains stay the same.
+    #[test]
+    fn capping_the_overshoot_keeps_spikes_under_rounding_level_changes() {
+        let (cells, steps) = (16, 18_000);
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        };
+        let mut walk = vec![0.5; cells];
+        let mut drive = Vec::with_capacity(cells * steps);
+        for _ in 0..steps {
+            for w in walk.iter_mut() {
+                *w = (*w + 0.01 * next()).clamp(0.0, 1.0);
+            }
+            drive.extend_from_slice(&walk);
+        }
+        let perturbed: Vec<f64> = drive.iter().map(|x| x * (1.0 + next() * 1e-12)).collect();
+        assert_ne!(drive, perturbed);
+        let present = vec![true; cells];
+        let same_step = |overshoot| {
+            let p = IzhikevichParams::default().with_overshoot(overshoot);
+            let a = encode(&drive, 4, 4, &present, p).unwrap();
+            let b = encode(&perturbed, 4, 4, &present, p).unwrap();
+            assert!(a.total_spikes() > 1000, "the drive makes spikes");
+            let kept: usize = (0..cells)
+                .map(|c| a.train(c).iter().filter(|t| b.train(c).contains(t)).count())
+                .sum();
+            kept as f64 / a.total_spikes() as f64
+        };
+        let kept = same_step(Overshoot::Kept);
+        assert!(
+            kept < 0.5,
+            "kept overshoot: {kept} of the spikes at their step"
+        );
+        assert_eq!(same_step(Overshoot::Capped), 1.0);
     }
 }

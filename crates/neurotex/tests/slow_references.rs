@@ -2,7 +2,7 @@
 //! on random inputs (proptest).
 
 use neurotex::classify::{Classifier, KnnParams, Predict};
-use neurotex::encode::{encode, encode_banks, Encoder, IzhikevichParams, SpikeTrains};
+use neurotex::encode::{encode, encode_banks, Encoder, IzhikevichParams, Overshoot, SpikeTrains};
 use neurotex::features::glcm::GlcmKind;
 use neurotex::features::{
     haralick, quantise, spike_stats, CountVolume, Counting, GlcmParams, GlcmPlan, RateVolume,
@@ -82,7 +82,11 @@ fn slow_encoder(input: &[f64], n: usize, p: IzhikevichParams) -> Vec<Vec<u32>> {
                 }
                 v += 0.5 * (0.04 * (v * v) + 5.0 * v + 140.0 - u + i);
                 v += 0.5 * (0.04 * (v * v) + 5.0 * v + 140.0 - u + i);
-                u += p.a * (p.b * v - u);
+                let seen = match p.overshoot {
+                    Overshoot::Kept => v,
+                    Overshoot::Capped => v.min(30.0),
+                };
+                u += p.a * (p.b * seen - u);
             }
             spikes
         })
@@ -248,10 +252,12 @@ proptest! {
         seed in any::<u64>(),
         gain in 1.0f64..25.0,
         split in 0.0f64..1.0,
+        capped in any::<bool>(),
     ) {
         let mut rng = XorShift::new(seed);
         let input: Vec<f64> = (0..n * steps).map(|_| rng.fraction(10_000)).collect();
-        let p = IzhikevichParams::default().with_gain(gain);
+        let overshoot = if capped { Overshoot::Capped } else { Overshoot::Kept };
+        let p = IzhikevichParams::default().with_gain(gain).with_overshoot(overshoot);
         let mut whole = vec![0u8; input.len()];
         Encoder::new(p, n).unwrap().run(&input, &mut whole);
         let cut = ((steps as f64 * split) as usize) * n;

@@ -52,7 +52,9 @@ pub use e6_speed_invariance::{e6_speed_invariance, E6Speed};
 pub use e7_gain::{e7_gain_sweep, E7};
 pub use e8_neighbours::{e8_neighbours, E8Speed};
 pub use e9_compare::{e9_compare, Baselines, Spiking, E9};
-pub use encodings::{encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, OverEncodings};
+pub use encodings::{
+    encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, OverEncodings, SpikeAgreement,
+};
 pub use params::{
     ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS, MAX_REPEATS,
 };

@@ -6,7 +6,7 @@
 //! The classifiers' knobs are defined in the same way in [`classifiers`].
 
 use crate::calibrate::GainChoice;
-use crate::encode::{FaParams, FiringType};
+use crate::encode::{FaParams, FiringType, Overshoot};
 use crate::features::{GlcmParams, VolumeParams};
 use crate::pipeline::{Encoding, FeatureParams, HaralickSet, PipelineParams};
 use crate::recording::Baseline;
@@ -84,6 +84,8 @@ pub struct StageOptions {
     pub drift_window_s: f64,
     /// The Izhikevich firing type.
     pub preset: FiringType,
+    /// The membrane value the neurons' recovery reads at a spike's step.
+    pub overshoot: Overshoot,
     /// Low-pass cutoff in Hz; 0 turns the filter off.
     pub cutoff: f64,
     /// Baseline removal; `None` takes the dataset's layout's.
@@ -127,6 +129,7 @@ impl Default for StageOptions {
             causal: false,
             drift_window_s: 0.0,
             preset: FiringType::default(),
+            overshoot: Overshoot::default(),
             cutoff: pre.cutoff_hz,
             baseline: pre.baseline,
             whole: !pre.slide_only,
@@ -218,7 +221,11 @@ impl StageOptions {
             GainChoice::Auto { .. } => crate::encode::IzhikevichParams::default().gain,
         };
         let mut p = PipelineParams {
-            encoder: self.preset.params().with_gain(gain),
+            encoder: self
+                .preset
+                .params()
+                .with_gain(gain)
+                .with_overshoot(self.overshoot),
             ..PipelineParams::default()
         };
         p.preprocess.cutoff_hz = self.cutoff;
@@ -380,6 +387,18 @@ pub static STAGE_OPTIONS: &[OptionSpec] = &[
         preset,
         Text,
         "Izhikevich firing type: RS (slowly adapting, the paper's), IB, CH, FS, LTS, TC, RZ.",
+        get: shown,
+        set: choice
+    ),
+    spec!(
+        overshoot,
+        Text,
+        "The membrane value the neurons' recovery reads at the step they cross the 30 mV \
+         peak: `kept` (Izhikevich's reference code and the paper's: the value two Euler \
+         half-steps reach, far above the peak, so that spike timing moves with \
+         rounding-level changes of the input) or `capped` (at the peak, as in the \
+         continuous model: the same spikes under such changes). See \
+         docs/decisions/0031-overshoot-kept-by-default-capped-on-request.md.",
         get: shown,
         set: choice
     ),

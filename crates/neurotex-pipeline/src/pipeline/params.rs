@@ -359,8 +359,15 @@ impl PipelineParams {
     /// The SA neurons and their gain.
     pub fn encoder_line(&self) -> String {
         let enc = &self.encoder;
+        let overshoot = match enc.overshoot {
+            crate::encode::Overshoot::Kept => "",
+            crate::encode::Overshoot::Capped => {
+                " whose recovery reads the membrane capped at the 30 mV peak (overshoot capped)"
+            }
+        };
         format!(
-            "encoder: Izhikevich (2003) neurons, a = {}, b = {}, c = {} mV, d = {}, gain G = {}",
+            "encoder: Izhikevich (2003) neurons{overshoot}, a = {}, b = {}, c = {} mV, d = {}, \
+             gain G = {}",
             enc.a, enc.b, enc.c, enc.d, enc.gain
         )
     }

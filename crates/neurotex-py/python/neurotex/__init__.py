@@ -352,6 +352,7 @@ def encode(
     cutoff: float = _DEFAULTS["cutoff"],
     *,
     preset: str = _DEFAULTS["preset"],
+    overshoot: str = _DEFAULTS["overshoot"],
     baseline: Optional[str] = None,
     encoding: str = _DEFAULTS["encoding"],
     fa_gain: float = _DEFAULTS["fa_gain"],
@@ -366,7 +367,9 @@ def encode(
     memory order (read in place, without copying into a new numpy array). The signal is
     resampled to 1 kHz when ``fs`` differs, low-pass filtered (``cutoff`` Hz, zero-phase
     2nd-order Butterworth; 0 = off), divided by its maximum, multiplied by ``gain`` and
-    fed to Izhikevich neurons of firing type ``preset``. ``gain="auto"`` (or
+    fed to Izhikevich neurons of firing type ``preset`` (``overshoot="capped"``: their
+    recovery reads the membrane capped at the 30 mV peak, so that rounding-level changes
+    of the input leave the spikes as they are). ``gain="auto"`` (or
     ``"auto:HZ"``) calibrates the gain on this recording as ``neurotex encode --gain auto``
     does (see :class:`GainCalibration`; the choice is logged on the ``neurotex`` logger,
     and :func:`calibrate_gain` returns it).
@@ -378,8 +381,9 @@ def encode(
     samples (NaN, wrong shape, shorter than one 200 ms bin)."""
     rec = Recording(x=x, fs=fs, slide=slide, times=times, mask=mask, name="x")
     arrays, infos = _prepare([rec], fs, None)
-    opts = _stage_options(gain=gain, cutoff=cutoff, preset=preset, baseline=baseline,
-                          encoding=encoding, fa_gain=fa_gain, whole=whole)
+    opts = _stage_options(gain=gain, cutoff=cutoff, preset=preset, overshoot=overshoot,
+                          baseline=baseline, encoding=encoding, fa_gain=fa_gain,
+                          whole=whole)
     (first, fa), gain_report = _native.encode(arrays[0], infos[0], opts)
     _calibrations((gain_report, None))
     return (first, fa) if fa is not None else first
@@ -396,6 +400,7 @@ def features(
     gain: Union[float, str] = _DEFAULTS["gain"],
     causal: bool = _DEFAULTS["causal"],
     preset: str = _DEFAULTS["preset"],
+    overshoot: str = _DEFAULTS["overshoot"],
     cutoff: float = _DEFAULTS["cutoff"],
     baseline: Optional[str] = None,
     whole: bool = _DEFAULTS["whole"],
@@ -441,8 +446,8 @@ def features(
             f"got {method}"
         )
     opts = _stage_options(
-        gain=gain, causal=causal, preset=preset, cutoff=cutoff, baseline=baseline,
-        whole=whole, levels=levels, bin_ms=bin_ms, distances=tuple(distances),
+        gain=gain, causal=causal, preset=preset, overshoot=overshoot, cutoff=cutoff,
+        baseline=baseline, whole=whole, levels=levels, bin_ms=bin_ms, distances=tuple(distances),
         symmetric=symmetric, encoding=encoding, fa_gain=fa_gain, haralick=haralick,
         bin_widths=tuple(bin_widths), window_mm=window_mm, spectrum_bins=spectrum_bins,
         spectrum_bands=spectrum_bands, travel_mm=travel_mm,

@@ -49,7 +49,7 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
     it and ``gain_calibration_`` how it was chosen (``None`` for a number).
 
     Parameters are those of :func:`neurotex.features`: ``method``, ``encoding``, ``gain``,
-    ``preset``, ``cutoff``, ``baseline``, ``whole``, ``levels``, ``bin_ms``,
+    ``preset``, ``overshoot``, ``cutoff``, ``baseline``, ``whole``, ``levels``, ``bin_ms``,
     ``distances``, ``symmetric``, ``fa_gain``, ``haralick``, ``bin_widths``,
     ``window_mm``, ``spectrum_bins``, ``spectrum_bands``, ``travel_mm``, and ``fs`` for bare
     arrays."""
@@ -60,6 +60,7 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         encoding: str = _DEFAULTS["encoding"],
         gain: Union[float, str] = _DEFAULTS["gain"],
         preset: str = _DEFAULTS["preset"],
+        overshoot: str = _DEFAULTS["overshoot"],
         cutoff: float = _DEFAULTS["cutoff"],
         baseline: Optional[str] = None,
         whole: bool = _DEFAULTS["whole"],
@@ -80,6 +81,7 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         self.encoding = encoding
         self.gain = gain
         self.preset = preset
+        self.overshoot = overshoot
         self.cutoff = cutoff
         self.baseline = baseline
         self.whole = whole
@@ -108,8 +110,8 @@ class SpikeFeatures(TransformerMixin, BaseEstimator):
         from . import _calibrate, _stage_options
 
         opts = _stage_options(
-            gain=self.gain, preset=self.preset, cutoff=self.cutoff, baseline=self.baseline,
-            whole=self.whole, levels=self.levels, bin_ms=self.bin_ms,
+            gain=self.gain, preset=self.preset, overshoot=self.overshoot, cutoff=self.cutoff,
+            baseline=self.baseline, whole=self.whole, levels=self.levels, bin_ms=self.bin_ms,
             distances=tuple(self.distances), symmetric=self.symmetric,
             encoding=self.encoding, fa_gain=self.fa_gain, haralick=self.haralick,
             bin_widths=tuple(self.bin_widths), window_mm=self.window_mm,

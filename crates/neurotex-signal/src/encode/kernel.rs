@@ -1,24 +1,33 @@
 //! The neuron bank's inner loop: blocks of neurons stepped with their state in registers,
 //! compiled for AVX-512, AVX2 or portably, with bit-identical results.
 
-use super::{Bank, IzhikevichParams, V_PEAK};
+use super::{Bank, IzhikevichParams, Overshoot, V_PEAK};
 
 /// Runs the bank with AVX-512 or AVX2 where the processor has them.
 pub(super) fn run_fastest(p: &IzhikevichParams, bank: Bank<'_>) {
+    match p.overshoot {
+        Overshoot::Kept => run_fastest_with::<false>(p, bank),
+        Overshoot::Capped => run_fastest_with::<true>(p, bank),
+    }
+}
+
+/// [`run_fastest`] with the recovery reading the membrane capped at the peak (`CAP`) or
+/// as it is; each variant compiled on its own, so the choice costs the loop nothing.
+fn run_fastest_with<const CAP: bool>(p: &IzhikevichParams, bank: Bank<'_>) {
     #[cfg(target_arch = "x86_64")]
     {
         if neurotex_core::has_feature!("avx512f") {
             // SAFETY: the CPU supports AVX-512F, the only feature the function enables.
-            unsafe { run_avx512(p, bank) };
+            unsafe { run_avx512::<CAP>(p, bank) };
             return;
         }
         if neurotex_core::has_feature!("avx2") {
             // SAFETY: the CPU supports AVX2, the only feature the function enables.
-            unsafe { run_avx2(p, bank) };
+            unsafe { run_avx2::<CAP>(p, bank) };
             return;
         }
     }
-    run_portable(p, bank);
+    run_portable::<CAP>(p, bank);
 }
 
 /// Neurons per block whose state stays in registers across time steps. One step is a
@@ -35,9 +44,9 @@ pub(super) const BLOCK: usize = 16;
 /// bit-identical to the portable path.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn run_avx2(p: &IzhikevichParams, mut bank: Bank<'_>) {
-    let done = run_blocks::<BLOCK>(p, &mut bank, 0);
-    run_rest(p, &mut bank, done);
+unsafe fn run_avx2<const CAP: bool>(p: &IzhikevichParams, mut bank: Bank<'_>) {
+    let done = run_blocks::<BLOCK, CAP>(p, &mut bank, 0);
+    run_rest::<CAP>(p, &mut bank, done);
 }
 
 /// Blocks of 32, 16 and 8 neurons (four, two and one register of eight f64 lanes per
@@ -45,11 +54,11 @@ unsafe fn run_avx2(p: &IzhikevichParams, mut bank: Bank<'_>) {
 /// portable path as [`run_avx2`] is.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn run_avx512(p: &IzhikevichParams, mut bank: Bank<'_>) {
-    let done = avx512::run_blocks::<4>(p, &mut bank, 0);
-    let done = avx512::run_blocks::<2>(p, &mut bank, done);
-    let done = avx512::run_blocks::<1>(p, &mut bank, done);
-    run_rest(p, &mut bank, done);
+unsafe fn run_avx512<const CAP: bool>(p: &IzhikevichParams, mut bank: Bank<'_>) {
+    let done = avx512::run_blocks::<4, CAP>(p, &mut bank, 0);
+    let done = avx512::run_blocks::<2, CAP>(p, &mut bank, done);
+    let done = avx512::run_blocks::<1, CAP>(p, &mut bank, done);
+    run_rest::<CAP>(p, &mut bank, done);
 }
 
 /// The AVX-512 blocks, written with intrinsics: the compiler's own vectorisation of
@@ -68,7 +77,7 @@ mod avx512 {
     /// returns the first neuron not run: [`super::step`]'s operations in its order, on
     /// eight neurons per instruction.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn run_blocks<const R: usize>(
+    pub(super) unsafe fn run_blocks<const R: usize, const CAP: bool>(
         p: &IzhikevichParams,
         bank: &mut Bank<'_>,
         first: usize,
@@ -104,7 +113,8 @@ mod avx512 {
                     let uu = _mm512_mask_add_pd(u[r], fired, u[r], d);
                     let i = _mm512_mul_pd(g[r], _mm512_loadu_pd(frame[at..at + LANES].as_ptr()));
                     let vv = half_step(half_step(vv, uu, i), uu, i);
-                    let recovery = _mm512_sub_pd(_mm512_mul_pd(b, vv), uu);
+                    let seen = if CAP { _mm512_min_pd(vv, peak) } else { vv };
+                    let recovery = _mm512_sub_pd(_mm512_mul_pd(b, seen), uu);
                     u[r] = _mm512_add_pd(uu, _mm512_mul_pd(a, recovery));
                     v[r] = vv;
                 }
@@ -120,15 +130,19 @@ mod avx512 {
 }
 
 /// Blocks of [`BLOCK`], then the rest, for any processor.
-fn run_portable(p: &IzhikevichParams, mut bank: Bank<'_>) {
-    let done = run_blocks::<BLOCK>(p, &mut bank, 0);
-    run_rest(p, &mut bank, done);
+fn run_portable<const CAP: bool>(p: &IzhikevichParams, mut bank: Bank<'_>) {
+    let done = run_blocks::<BLOCK, CAP>(p, &mut bank, 0);
+    run_rest::<CAP>(p, &mut bank, done);
 }
 
 /// Runs the whole blocks of `B` neurons from neuron `first` on (time inner, a block's state
 /// in registers) and returns the first neuron not run.
 #[inline(always)]
-fn run_blocks<const B: usize>(p: &IzhikevichParams, bank: &mut Bank<'_>, first: usize) -> usize {
+fn run_blocks<const B: usize, const CAP: bool>(
+    p: &IzhikevichParams,
+    bank: &mut Bank<'_>,
+    first: usize,
+) -> usize {
     let n = bank.v.len();
     let end = first + (n - first) / B * B;
     for start in (first..end).step_by(B) {
@@ -143,7 +157,7 @@ fn run_blocks<const B: usize>(p: &IzhikevichParams, bank: &mut Bank<'_>, first: 
         for (frame, out) in frames.zip(bank.raster.chunks_exact_mut(n)) {
             let x: &[f64; B] = frame[block.clone()].try_into().expect("a block");
             let o: &mut [u8; B] = (&mut out[block.clone()]).try_into().expect("a block");
-            step(p, &gb, &mut vb, &mut ub, x, o);
+            step::<CAP>(p, &gb, &mut vb, &mut ub, x, o);
         }
         bank.v[block.clone()].copy_from_slice(&vb);
         bank.u[block].copy_from_slice(&ub);
@@ -153,14 +167,14 @@ fn run_blocks<const B: usize>(p: &IzhikevichParams, bank: &mut Bank<'_>, first: 
 
 /// Runs the neurons from `first` on, frame by frame.
 #[inline(always)]
-fn run_rest(p: &IzhikevichParams, bank: &mut Bank<'_>, first: usize) {
+fn run_rest<const CAP: bool>(p: &IzhikevichParams, bank: &mut Bank<'_>, first: usize) {
     let n = bank.v.len();
     if first == n {
         return;
     }
     let frames = bank.input.chunks_exact(n);
     for (frame, out) in frames.zip(bank.raster.chunks_exact_mut(n)) {
-        step(
+        step::<CAP>(
             p,
             &bank.gains[first..],
             &mut bank.v[first..],
@@ -171,11 +185,12 @@ fn run_rest(p: &IzhikevichParams, bank: &mut Bank<'_>, first: usize) {
     }
 }
 
-/// One 1 ms step of the reference scheme for a group of neurons, each with its gain.
-/// Branch-free per neuron so it vectorises; the order of every floating-point operation is
-/// that of the reference.
+/// One 1 ms step of the reference scheme for a group of neurons, each with its gain, the
+/// recovery reading the membrane capped at the peak under `CAP`. Branch-free per neuron
+/// so it vectorises; the order of every floating-point operation is that of the
+/// reference.
 #[inline(always)]
-pub(super) fn step(
+pub(super) fn step<const CAP: bool>(
     p: &IzhikevichParams,
     gains: &[f64],
     v: &mut [f64],
@@ -193,7 +208,8 @@ pub(super) fn step(
         let i = gain * x;
         vv += 0.5 * (0.04 * (vv * vv) + 5.0 * vv + 140.0 - uu + i);
         vv += 0.5 * (0.04 * (vv * vv) + 5.0 * vv + 140.0 - uu + i);
-        *ui = uu + a * (b * vv - uu);
+        let seen = if CAP { vv.min(V_PEAK) } else { vv };
+        *ui = uu + a * (b * seen - uu);
         *vi = vv;
     }
 }
