@@ -450,19 +450,25 @@ fn parse_fields(
     fields: &mut Vec<f64>,
 ) -> std::result::Result<(), String> {
     fields.clear();
-    let mut number = true;
+    let mut not_number = None;
     for_each_field(splitter, text, field, |f| {
         let parsed = std::str::from_utf8(f)
             .ok()
             .and_then(|f| f.parse::<f64>().ok());
-        if let Some(v) = parsed {
-            fields.push(v);
+        match parsed {
+            Some(v) => fields.push(v),
+            None => not_number = Some(String::from_utf8_lossy(f).into_owned()),
         }
-        number = parsed.is_some();
-        number
+        not_number.is_none()
     });
-    if !number {
-        return Err("a field is not a number".to_string());
+    if let Some(text) = not_number {
+        // Counted as the line's values are: from its first field, the stamp's when given.
+        let index = fields.len();
+        if text.trim().is_empty() {
+            return Err(format!("value {index} is empty"));
+        }
+        let shown: String = text.chars().take(40).collect();
+        return Err(format!("value {index} is {shown:?}, not a number"));
     }
     if fields.len() != expected {
         return Err(format!("{} fields, expected {expected}", fields.len()));

@@ -68,11 +68,13 @@ pub enum BadFrame {
         got: usize,
     },
     /// A value that is not a finite number.
-    #[error("value {index} is not a finite number")]
+    #[error("value {index} is {value:?}, not a finite number")]
     NotFinite {
         /// Which value, counted from the line's first field (the time stamp is value 0
         /// when given).
         index: usize,
+        /// The value: NaN or an infinity.
+        value: f64,
     },
     /// A value beyond [`crate::values::MAX_SAMPLE_MAGNITUDE`]: no sensor's reading.
     #[error("value {index} is {value:?}, beyond ±1e15, which is no sensor's reading")]

@@ -41,7 +41,10 @@ impl StreamClassifier {
             let i = values.iter().position(|&v| !in_range(v)).unwrap_or(0);
             let index = i + first_value;
             return Err(match values[i].is_finite() {
-                false => BadFrame::NotFinite { index },
+                false => BadFrame::NotFinite {
+                    index,
+                    value: values[i],
+                },
                 true => BadFrame::OutOfRange {
                     index,
                     value: values[i],

@@ -298,7 +298,7 @@ fn bad_frames_are_counted_skipped_and_change_nothing() {
     assert_eq!(kinds.len(), bad);
     assert!(kinds
         .iter()
-        .any(|k| matches!(k, BadFrame::NotFinite { index: 4 })));
+        .any(|k| matches!(k, BadFrame::NotFinite { index: 4, .. })));
     assert!(kinds.iter().any(|k| matches!(k, BadFrame::Stamp { .. })));
     assert!(kinds.iter().any(|k| matches!(
         k,
