@@ -89,6 +89,14 @@ fn a_linear_model_is_trained_saved_and_applied() {
     let score: Value = serde_json::from_str(&json).unwrap();
     let accuracy = score["accuracy"].as_f64().unwrap();
     assert!(accuracy > 0.6, "chance is 1/3, got {accuracy}");
+    assert_eq!(score["chance"].as_f64(), Some(1.0 / 3.0));
+    let interval = &score["interval"];
+    assert_eq!(interval["method"], "wilson", "{json}");
+    let (lower, upper) = (interval["lower"].as_f64(), interval["upper"].as_f64());
+    assert!(
+        lower.unwrap() < accuracy && accuracy <= upper.unwrap(),
+        "{json}"
+    );
     let text = std::fs::read_to_string(&out).unwrap();
     let mut rows = text.lines();
     assert_eq!(

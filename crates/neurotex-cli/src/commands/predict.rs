@@ -37,8 +37,8 @@ pub struct PredictArgs {
     /// steps at --like's `dt_ms`, which must be the `dt` the tool ran at.
     #[arg(long, value_name = "TOOL", default_value = "nir")]
     pub nir_from: neurotex::nir::NirFrom,
-    /// Also print `{"accuracy", "n", "labels", "confusion"}` (rows = true label) as JSON;
-    /// needs --dataset, and every label there must be a class of the model.
+    /// Also print `{"accuracy", "interval" (95 %, Wilson), "chance", "n", "labels", "confusion"}`
+    /// (rows = true label) as JSON; needs --dataset whose every label is a model's class.
     #[arg(long)]
     pub json: bool,
 }

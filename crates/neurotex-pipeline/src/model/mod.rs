@@ -18,7 +18,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::classify::{ChosenModel, ClassifierChoice, ConfusionMatrix};
+use crate::classify::{ChosenModel, ClassifierChoice, ConfusionMatrix, Interval};
 use crate::error::Result;
 pub use crate::error::{ModelError, MODEL_FORMAT as FORMAT, MODEL_VERSION as VERSION};
 use crate::pipeline::{FeatureExtractor, Method, Pipeline, PipelineParams};
@@ -155,6 +155,11 @@ pub struct Prediction {
 pub struct Score {
     /// Share of recordings predicted right, 0..1.
     pub accuracy: f64,
+    /// The accuracy's 95 % interval: Wilson's score interval over the recordings, each
+    /// one prediction of a fixed model.
+    pub interval: Interval,
+    /// Chance: one over the classes among the recordings scored.
+    pub chance: f64,
     /// Recordings scored.
     pub n: usize,
     /// The model's classes, in confusion-matrix order.

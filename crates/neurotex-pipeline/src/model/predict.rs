@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use rayon::prelude::*;
 
 use super::{FeatureSpec, Model, Prediction, Provenance, Score};
-use crate::classify::{ClassifierChoice, ConfusionMatrix, Predict};
+use crate::classify::{wilson_interval, ClassifierChoice, ConfusionMatrix, Predict};
 use crate::error::{ClassifyError, DataError, ModelError, Result};
 use crate::pipeline::{Encoded, FeatureExtractor, Pipeline, PipelineParams};
 use crate::recording::{Baseline, FileReading, LayoutFile, LayoutFrom, Recording};
@@ -295,8 +295,12 @@ pub(crate) fn score(
         .map(|p| index(&p.predicted).unwrap_or(0))
         .collect();
     let confusion = ConfusionMatrix::from_predictions(&y, &predicted, labels.len());
+    let right = y.iter().zip(&predicted).filter(|(t, p)| t == p).count();
+    let classes = y.iter().collect::<std::collections::BTreeSet<_>>().len();
     Ok(Score {
         accuracy: confusion.accuracy(),
+        interval: wilson_interval(right, y.len())?,
+        chance: 1.0 / classes as f64,
         n: y.len(),
         labels: labels.to_vec(),
         confusion,

@@ -337,6 +337,11 @@ fn scores_count_true_labels_against_predictions() {
         .unwrap();
     assert_eq!(score.n, 3);
     assert!((score.accuracy - 2.0 / 3.0).abs() < 1e-15);
+    // Wilson's interval for 2 of 3, (k + z²/2 ± z √(k (n - k) / n + z²/4)) / (n + z²) by
+    // hand with z = 1.959964; chance one over the three classes scored.
+    let i = &score.interval;
+    assert!((i.lower - 0.207_660).abs() < 1e-6 && (i.upper - 0.938_508).abs() < 1e-6);
+    assert!((score.chance - 1.0 / 3.0).abs() < 1e-15);
     assert_eq!(score.confusion.rows()[1], vec![1, 0, 0]);
     let err = model
         .score(&["felt".to_string()], &[p("rough")])
