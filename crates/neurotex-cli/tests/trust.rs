@@ -822,6 +822,44 @@ fn a_bad_count_an_absurd_rate_or_a_missing_column_is_told_plainly() {
     );
 }
 
+#[test]
+fn a_loggers_microseconds_are_not_taken_for_milliseconds() {
+    let dir = Dir::new();
+    let logs = two_channel_logs(&dir);
+    // A 1 kHz logger stamping in microseconds, its column's name without a unit.
+    for name in ["A_0", "A_1", "B_0", "B_1"] {
+        let text = text_of_log().replacen("t_ms,", "t,", 1);
+        let micros: Vec<String> = (text.lines().enumerate())
+            .map(|(i, l)| match (i, l.split_once(',')) {
+                (0, _) | (_, None) => l.to_string(),
+                (_, Some((t, rest))) => format!("{}000,{rest}", t),
+            })
+            .collect();
+        std::fs::write(logs.join(format!("{name}.csv")), micros.join("\n") + "\n").unwrap();
+    }
+    let out = dir.join("ds");
+    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
+    args.extend_from_slice(&[
+        "--name-pattern",
+        "{label}_{trial}.csv",
+        "--time-column",
+        "t",
+    ]);
+    let err = dir.fails(&args);
+    assert!(
+        err.contains("steps by a median 1000 ms, which is 1.0 Hz") && err.contains("--time-unit"),
+        "{err}"
+    );
+    assert!(!out.exists(), "a refused import writes nothing");
+    args.extend_from_slice(&["--time-unit", "us"]);
+    let run = dir.run(&args);
+    assert!(
+        run.stderr.contains("at 1000.00 Hz nominal"),
+        "{}",
+        run.stderr
+    );
+}
+
 /// A clean two-channel log: `t_ms,a,b`, 300 rows.
 /// A log written with Windows line endings: its errors name the line they are on (the CSV
 /// reader counts each `\r\n`'s `\n` into the next record, one line short), for a value that

@@ -12,8 +12,11 @@ use super::{csv_error_after, excerpt, invalid, open_log, CsvLog};
 
 /// Sampling rates a tactile log plausibly has, in Hz: stamps whose median step implies a
 /// rate outside are most likely in another unit than assumed (seconds read as ms give
-/// 1000 times the rate), so without a unit given or named they are refused.
-pub const PLAUSIBLE_HZ: (f64, f64) = (0.1, 20_000.0);
+/// 1000 times the rate; a 1 kHz logger's microseconds read as ms give 1 Hz), so without
+/// a unit given or named they are refused. The slowest taxel arrays used for texture
+/// sample at tens of Hz (FabricSlide's at 35.7 Hz); 5 Hz leaves room below them and
+/// still catches microsecond stamps of loggers up to 5 kHz.
+pub const PLAUSIBLE_HZ: (f64, f64) = (5.0, 20_000.0);
 
 /// Refuses stamps whose unit was only assumed when their median step implies a rate
 /// outside [`PLAUSIBLE_HZ`].

@@ -278,6 +278,10 @@ pub fn import_csv(
     reject_duplicate_names(files)?;
     let (p, dropped) = p.without_dropped(files)?;
     let p = &p;
+    // An event log is named as one before its stamps are judged as a sampled log's.
+    if let Some(names) = crate::csvlog::header_names(&files[0], &p.format) {
+        refuse_event_header(&files[0], &names)?;
+    }
     let mut summary = ImportSummary {
         dropped,
         ..ImportSummary::default()

@@ -233,10 +233,13 @@ fn e3_claims(r: &Results) -> Vec<Claim> {
     let mut out = Vec::new();
     // E3 moves taxels of the encoding as run; another encoding can differ by more.
     let encoding = r.encoder_sensitivity.as_ref().map_or(String::new(), |s| {
-        format!(
-            ", the encoding as run (one encoding's accuracy differs from another's by up to {} points here)",
-            pct(s.largest_spread)
-        )
+        match s.largest_spread > 0.0 {
+            true => format!(
+                ", the encoding as run (one encoding's accuracy differs from another's by up to {} points here)",
+                pct(s.largest_spread)
+            ),
+            false => ", the encoding as run (every encoding gave the same accuracies here)".into(),
+        }
     });
     if let Some(drop) = e3.unperturbed_vs_moved.last() {
         out.push(Claim::judged(

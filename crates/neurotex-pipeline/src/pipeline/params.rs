@@ -360,14 +360,12 @@ impl PipelineParams {
     pub fn encoder_line(&self) -> String {
         let enc = &self.encoder;
         let overshoot = match enc.overshoot {
-            crate::encode::Overshoot::Kept => "",
-            crate::encode::Overshoot::Capped => {
-                " whose recovery reads the membrane capped at the 30 mV peak (overshoot capped)"
-            }
+            crate::encode::Overshoot::Kept => "kept (Izhikevich's reference code)",
+            crate::encode::Overshoot::Capped => "capped at the 30 mV peak",
         };
         format!(
-            "encoder: Izhikevich (2003) neurons{overshoot}, a = {}, b = {}, c = {} mV, d = {}, \
-             gain G = {}",
+            "encoder: Izhikevich (2003) neurons, a = {}, b = {}, c = {} mV, d = {}, overshoot \
+             {overshoot}, gain G = {}",
             enc.a, enc.b, enc.c, enc.d, enc.gain
         )
     }

@@ -181,11 +181,14 @@ pub(super) fn encoder_sensitivity(r: &Results) -> String {
     };
     let out = format!(
         "## The encoder's sensitivity\n\n\
-         Spiking neurons turn a signal into threshold crossings: a neuron near its threshold fires a step earlier or later, or once more or less, when its input moves by far less than any sensor resolves, and those spikes move features and sometimes predictions. So E1, E4, E6 and E8 classify every recording under {n} encodings: as run, and {more} more with each input sample multiplied by 1 + u x {eps:e} (u uniform in [-1, 1), independent). Their accuracies are means over the encodings, their intervals resample encodings as well as recordings, and their claims are judged on those. One encoding's accuracy differs from another's by up to {spread} points here; the other analyses use the encoding as run, so a difference between them smaller than that is within the encoder's noise.\n\n",
+         Spiking neurons turn a signal into threshold crossings: a neuron near its threshold can fire a step earlier or later, or once more or less, when its input moves by far less than any sensor resolves, and those spikes move features and sometimes predictions. So E1, E4, E6 and E8 classify every recording under {n} encodings: as run, and {more} more with each input sample multiplied by 1 + u x {eps:e} (u uniform in [-1, 1), independent). Their accuracies are means over the encodings, their intervals resample encodings as well as recordings, and their claims are judged on those. {spread}\n\n",
         n = s.encodings,
         more = s.encodings - 1,
         eps = s.perturbation,
-        spread = pct(s.largest_spread)
+        spread = match s.largest_spread > 0.0 {
+            true => format!("One encoding's accuracy differs from another's by up to {} points here; the other analyses use the encoding as run, so a difference between them smaller than that is within the encoder's noise.", pct(s.largest_spread)),
+            false => "Every encoding gave the same accuracies here: the encoder added no noise to them.".to_string(),
+        }
     );
     let mut t = Table::new(vec![
         "speed (mm/s)",
@@ -223,7 +226,7 @@ fn spike_agreement(s: &EncoderSensitivity) -> String {
         "spikes as run at the same 1 ms step in a perturbed encoding (%)",
         "within 10 ms (%)",
         "spikes, perturbed / as run",
-        "a taxel's train first departs at (s, median)",
+        "a taxel's train first departs at (s into the recording, median over the trains that depart)",
     ]);
     let mut any = false;
     for (speed, e) in s.speeds.iter() {
