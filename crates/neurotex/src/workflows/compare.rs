@@ -324,6 +324,10 @@ impl CompareOptions {
         if let Some(snn) = &snn {
             on(Progress::Say(&format!("snn: {snn}")));
         }
+        let capped = stages.overshoot == crate::encode::Overshoot::Capped;
+        if capped {
+            on(Progress::Say("encoder: the overshoot capped at the 30 mV peak (--overshoot capped), not Izhikevich's reference scheme"));
+        }
         let speeds = Speed::distinct(indices.iter().filter_map(|&i| dataset.entries[i].speed()));
         if matches!(params.protocol, Protocol::Pooled) && speeds.len() > 1 {
             on(Progress::Say(&format!(
@@ -336,6 +340,9 @@ impl CompareOptions {
         // folds and seed do.
         if let Some(snn) = &snn {
             comparison.design = format!("{}; snn: {snn}", comparison.design);
+        }
+        if capped {
+            comparison.design = format!("{}; encoder overshoot capped", comparison.design);
         }
         comparison.provenance = provenance(dataset, &indices, &set, &calibrated, train.is_some())?;
         if let Some(note) = under_chance_note(&comparison, &params.protocol) {
