@@ -714,6 +714,16 @@ fn two_channel_logs(dir: &Dir) -> PathBuf {
     logs
 }
 
+/// `import csv` of the logs `{label}_{trial}.csv` in `logs` into `out`, stamped in the
+/// column `time`.
+fn import_csv_args<'a>(logs: &'a Path, out: &'a Path, time: &'a str) -> Vec<&'a str> {
+    let pattern = ["--name-pattern", "{label}_{trial}.csv"];
+    let mut args = vec!["import", "csv", s(logs), "--out", s(out)];
+    args.extend_from_slice(&pattern);
+    args.extend_from_slice(&["--time-column", time]);
+    args
+}
+
 #[test]
 fn a_ragged_line_is_told_by_its_line_and_field_counts() {
     let dir = Dir::new();
@@ -722,14 +732,7 @@ fn a_ragged_line_is_told_by_its_line_and_field_counts() {
     let text = std::fs::read_to_string(&ragged).unwrap();
     std::fs::write(&ragged, text.replacen("\n5,5,0\n", "\n5,5\n", 1)).unwrap();
     let out = dir.join("ds");
-    let pattern = [
-        "--name-pattern",
-        "{label}_{trial}.csv",
-        "--time-column",
-        "t_ms",
-    ];
-    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
-    args.extend_from_slice(&pattern);
+    let args = import_csv_args(&logs, &out, "t_ms");
     let err = dir.fails(&args);
     assert!(
         err.contains("A_1.csv: line 7 has 2 field(s) where the header has 3"),
@@ -771,14 +774,7 @@ fn a_bad_count_an_absurd_rate_or_a_missing_column_is_told_plainly() {
     let dir = Dir::new();
     let logs = two_channel_logs(&dir);
     let out = dir.join("ds");
-    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
-    args.extend_from_slice(&[
-        "--name-pattern",
-        "{label}_{trial}.csv",
-        "--time-column",
-        "t_ms",
-    ]);
-    dir.ok(&args);
+    dir.ok(&import_csv_args(&logs, &out, "t_ms"));
     // A count given as a negative number, as an option and in a layout file.
     let data = s(&out);
     let err = dir.fails(&["evaluate", "--dataset", data, "--folds=-1"]);
@@ -838,13 +834,7 @@ fn a_loggers_microseconds_are_not_taken_for_milliseconds() {
         std::fs::write(logs.join(format!("{name}.csv")), micros.join("\n") + "\n").unwrap();
     }
     let out = dir.join("ds");
-    let mut args = vec!["import", "csv", s(&logs), "--out", s(&out)];
-    args.extend_from_slice(&[
-        "--name-pattern",
-        "{label}_{trial}.csv",
-        "--time-column",
-        "t",
-    ]);
+    let mut args = import_csv_args(&logs, &out, "t");
     let err = dir.fails(&args);
     assert!(
         err.contains("steps by a median 1000 ms, which is 1.0 Hz") && err.contains("--time-unit"),

@@ -12,7 +12,7 @@ use super::{Context, Headline, Stop};
 use crate::analysis::{seeded_bootstrap_over_encodings, Outcome};
 use crate::classify::Interval;
 use crate::error::ClassifyError;
-use crate::values::{BySpeed, Speed};
+use crate::values::BySpeed;
 use neurotex_core::spikes::SpikeTrains;
 
 /// One method's accuracy at one speed over the encodings.
@@ -214,23 +214,27 @@ pub fn encoder_sensitivity(c: &Context) -> Result<Option<EncoderSensitivity>, St
         return Ok(None);
     }
     let seed = c.params.seed;
+    let encoded = &c.prepared.encoded;
+    let run: Vec<&SpikeTrains> = encoded.iter().map(|e| &e.spikes).collect();
+    let draws: Vec<Vec<&SpikeTrains>> = (perturbed.iter())
+        .map(|p| p.iter().map(|e| &e.spikes).collect())
+        .collect();
     let mut speeds = BySpeed::new();
     let mut largest_spread: f64 = 0.0;
     for &speed in &c.prepared.speeds {
         let m = Methods::of(&c.tables.encodings_at(speed));
+        let at: Vec<usize> = (0..encoded.len())
+            .filter(|&i| encoded[i].meta.speed() == Some(speed))
+            .collect();
         let entry = EncodingsSpeed {
             glcm3d: OverEncodings::of(&m.glcm3d, seed)?,
             taxel_mean: OverEncodings::of(&m.taxel, seed)?,
             glcm2d: OverEncodings::of(&m.glcm2d, seed)?,
-            recordings_changed: (0..c.prepared.encoded.len())
-                .filter(|&i| c.prepared.encoded[i].meta.speed() == Some(speed))
-                .filter(|&i| {
-                    let spikes = &c.prepared.encoded[i].spikes;
-                    perturbed.iter().any(|p| p[i].spikes != *spikes)
-                })
+            recordings_changed: (at.iter())
+                .filter(|&&i| draws.iter().any(|d| d[i] != run[i]))
                 .count(),
-            recordings: c.prepared.at(speed).count(),
-            timing: Some(agreement_at(c, speed)),
+            recordings: at.len(),
+            timing: Some(SpikeAgreement::of(&run, &draws, &at)),
         };
         for a in [&entry.glcm3d, &entry.taxel_mean, &entry.glcm2d] {
             let (lo, hi) = a.range();
@@ -244,21 +248,6 @@ pub fn encoder_sensitivity(c: &Context) -> Result<Option<EncoderSensitivity>, St
         speeds,
         largest_spread,
     }))
-}
-
-/// [`SpikeAgreement`] over the recordings at `speed`.
-fn agreement_at(c: &Context, speed: Speed) -> SpikeAgreement {
-    let prepared = &c.prepared;
-    let at: Vec<usize> = (0..prepared.encoded.len())
-        .filter(|&i| prepared.encoded[i].meta.speed() == Some(speed))
-        .collect();
-    let run: Vec<&SpikeTrains> = prepared.encoded.iter().map(|e| &e.spikes).collect();
-    let perturbed: Vec<Vec<&SpikeTrains>> = prepared
-        .perturbed
-        .iter()
-        .map(|p| p.iter().map(|e| &e.spikes).collect())
-        .collect();
-    SpikeAgreement::of(&run, &perturbed, &at)
 }
 
 #[cfg(test)]
