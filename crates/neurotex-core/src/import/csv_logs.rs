@@ -297,24 +297,8 @@ pub fn import_csv(
         };
         return Err(DataError::invalid(out, why).into());
     };
-    let labels: Vec<(String, String)> = good
-        .iter()
-        .map(|c| (c.meta.label.clone(), format!("file `{}`", c.meta.file)))
-        .collect();
-    if let Some(message) = labels_merged_by_trimming(&labels) {
-        return Err(DataError::invalid(out, message).into());
-    }
+    check_parsed(&good, out)?;
     let names = first.log.channel_names.clone();
-    refuse_event_log(Path::new(&first.meta.file), &names)?;
-    if let Some(other) = good.iter().find(|c| c.log.channel_names != names) {
-        return Err(invalid(
-            Path::new(&other.meta.file),
-            format!(
-                "its channels {:?} differ from {:?} of {}",
-                other.log.channel_names, names, first.meta.file
-            ),
-        ));
-    }
     let fs = match p.fs {
         Some(fs) => fs,
         None => nominal_fs(&good, out)?,
@@ -345,6 +329,31 @@ pub fn import_csv(
         })
         .collect();
     Ok(summary)
+}
+
+/// The parsed logs' labels and channels: labels that trimming would merge, an event log
+/// taken for a sampled one, and channels that differ between files are refused.
+fn check_parsed(good: &[ParsedCsv], out: &Path) -> Result<()> {
+    let first = &good[0];
+    let labels: Vec<(String, String)> = good
+        .iter()
+        .map(|c| (c.meta.label.clone(), format!("file `{}`", c.meta.file)))
+        .collect();
+    if let Some(message) = labels_merged_by_trimming(&labels) {
+        return Err(DataError::invalid(out, message).into());
+    }
+    let names = &first.log.channel_names;
+    refuse_event_log(Path::new(&first.meta.file), names)?;
+    if let Some(other) = good.iter().find(|c| &c.log.channel_names != names) {
+        return Err(invalid(
+            Path::new(&other.meta.file),
+            format!(
+                "its channels {:?} differ from {:?} of {}",
+                other.log.channel_names, names, first.meta.file
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Each input is written under its file name, so two inputs of one name (`a/x.csv` and
