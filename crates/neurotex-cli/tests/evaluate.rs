@@ -250,6 +250,45 @@ fn same_seed_gives_the_same_result() {
     assert_eq!(run("3"), run("3"));
 }
 
+/// What an evaluation ran on and with: the text's second line names the encoding and the
+/// encoder's overshoot and gain, and the JSON keeps every stage's parameter under
+/// `pipeline` and the build, the data's fingerprint and the stages' lines under
+/// `provenance`; the same run prints the same JSON.
+#[test]
+fn an_evaluation_says_what_it_ran_on_and_with() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 10);
+    let args = ["evaluate", "--dataset", s(&ds), "--encoding", "sa+fa"];
+    let text = dir.ok(&[&args[..], &["--overshoot", "capped", "--gain", "3"]].concat());
+    let second = text.lines().nth(1).unwrap();
+    assert!(
+        second.starts_with("encoding sa+fa (FA gain ")
+            && second.contains("overshoot capped at the 30 mV peak, gain G = 3"),
+        "{text}"
+    );
+    let json = || -> serde_json::Value {
+        serde_json::from_str(&dir.ok(&[&args[..], &["--json"]].concat())).unwrap()
+    };
+    let v = json();
+    assert_eq!(v, json());
+    assert_eq!(v["pipeline"]["encoder"]["overshoot"], "kept");
+    assert_eq!(v["pipeline"]["encoding"], "sa+fa");
+    let lines: Vec<&str> = (v["provenance"].as_array().unwrap().iter())
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert!(lines[0].starts_with("neurotex "), "{lines:?}");
+    assert!(lines[1].starts_with("data: sha256:"), "{lines:?}");
+    assert!(
+        lines[1].ends_with(&format!("({})", ds.display())),
+        "{lines:?}"
+    );
+    let encoder = lines.iter().find(|l| l.starts_with("encoder: ")).unwrap();
+    assert!(
+        encoder.contains("overshoot kept (Izhikevich's reference code)"),
+        "{encoder}"
+    );
+}
+
 #[test]
 fn bad_input_is_a_clear_error_with_no_output() {
     let dir = Dir::new();

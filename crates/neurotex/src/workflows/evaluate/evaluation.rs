@@ -55,6 +55,9 @@ pub struct Evaluation {
     /// The classifier and its main parameters as run (`KNN (k = 5)`), when the caller
     /// names it: said in the text's first line and under `classifier` in JSON.
     pub classifier: Option<String>,
+    /// The encoding and the encoder as run (`encoding sa; encoder: Izhikevich (2003)
+    /// neurons, ..., overshoot kept ..., gain G = 8`): the text's second line.
+    pub encoder: String,
     /// The grid's columns, to print per-taxel accuracies in place.
     pub cols: usize,
     /// Each table row's recording, for the out-of-fold predictions.
@@ -125,6 +128,7 @@ impl Evaluation {
         let tau_ms = (method == MethodChoice::VanRossum).then_some(tau_ms);
         let evaluation = Self::new(outcome, method.name(), tau_ms, split, grid, metas, seed)?;
         Ok(Self {
+            encoder: encoding_line(pipeline.params()),
             advice,
             taxels: (columns == Columns::EachTaxel).then_some(diagnostics),
             ..evaluation
@@ -151,6 +155,7 @@ impl Evaluation {
             taxels: None,
             advice: None,
             classifier: None,
+            encoder: String::new(),
             cols: grid.cols(),
             metas,
         })
@@ -238,6 +243,9 @@ impl Evaluation {
             "method {}{by}: {} samples, {how}",
             self.method, outcome.n
         );
+        if !self.encoder.is_empty() {
+            let _ = writeln!(out, "{}", self.encoder);
+        }
         accuracy_text(&mut out, outcome, self.cols);
         // No accuracy without its uncertainty and the level a guess reaches.
         let _ = writeln!(
@@ -286,6 +294,16 @@ impl Evaluation {
         }
         out.flush()
     }
+}
+
+/// The populations that encoded and their neurons: the encoding (with the FA population's
+/// gain when it encodes), then the SA encoder's line as results list it.
+fn encoding_line(params: &crate::pipeline::PipelineParams) -> String {
+    let encoding = match params.encoding {
+        crate::pipeline::Encoding::Sa => "encoding sa".to_string(),
+        other => format!("encoding {other} (FA gain {})", params.fa.gain),
+    };
+    format!("{encoding}; {}", params.encoder_line())
 }
 
 /// How the recordings were split, as text.

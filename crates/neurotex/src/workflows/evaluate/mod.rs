@@ -324,10 +324,12 @@ impl EvaluateOptions {
             on(Progress::Advice(&note));
             notes.push(note);
         }
+        let provenance = provenance(dataset, &indices, method, &calibrated)?;
         Ok(Evaluated {
             evaluation,
             calibrated,
             notes,
+            provenance,
         })
     }
 }
@@ -343,11 +345,52 @@ pub struct Evaluated {
     /// accuracy not shown above chance ([`Evaluation::chance_note`]), each as said on
     /// standard error.
     pub notes: Vec<String>,
+    /// Where the evaluation comes from: neurotex's build, the dataset's fingerprint and folder, and every stage's setting as run, one line each as results
+    /// list them.
+    pub provenance: Vec<String>,
+}
+
+/// The provenance of evaluating `method` on the recordings `indices` of `dataset` with the
+/// stages as `calibrated` ran them.
+///
+/// # Errors
+/// The manifest or a listed file can no longer be read for the fingerprint.
+fn provenance(
+    dataset: &Dataset,
+    indices: &[usize],
+    method: MethodChoice,
+    calibrated: &CalibratedParams,
+) -> Result<Vec<String>> {
+    let metas: Vec<_> = indices
+        .iter()
+        .map(|&i| dataset.entries[i].clone())
+        .collect();
+    let data = format!(
+        "data: {} ({})",
+        dataset.fingerprint()?,
+        dataset.root.display()
+    );
+    // No time of creation: the same evaluation gives the same output.
+    let mut lines = vec![crate::experiments::build(), data];
+    let methods = match method {
+        MethodChoice::Features(m) => vec![m],
+        _ => Vec::new(),
+    };
+    lines.extend(calibrated.params.describe(
+        dataset.layout.baseline,
+        crate::experiments::slide_times(&metas),
+        &methods,
+    ));
+    if let Some(c) = &calibrated.gain {
+        lines.push(super::calibration_line(c));
+    }
+    Ok(lines)
 }
 
 impl Evaluated {
     /// The evaluation as one JSON object, with the calibrations under
-    /// `causal_conditioning` and `gain_calibration`.
+    /// `causal_conditioning` and `gain_calibration`, the stages' parameters as run under
+    /// `pipeline` and the [`Evaluated::provenance`] lines under `provenance`.
     ///
     /// # Errors
     /// A value JSON cannot hold.
@@ -361,6 +404,9 @@ impl Evaluated {
         }
         // Always there, empty when nothing was said, so that a script can read it.
         value["notes"] = serde_json::to_value(&self.notes)?;
+        // What ran, as numbers a script can read and as the lines results list.
+        value["pipeline"] = serde_json::to_value(&self.calibrated.params)?;
+        value["provenance"] = serde_json::to_value(&self.provenance)?;
         Ok(value)
     }
 }
