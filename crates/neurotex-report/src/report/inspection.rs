@@ -64,8 +64,9 @@ pub fn text_lines(i: &Inspection) -> Vec<String> {
         None => format!("no stamps; {:.2} Hz nominal", l.fs_hz),
     };
     if i.events.is_none() {
+        let [dmin, dmid, dmax] = [dmin, dmid, dmax].map(seconds);
         out.push(format!(
-        "{} channels on a {}x{} grid; {rate}; {dmid:.1} s a recording (from {dmin:.1} to {dmax:.1}); baseline removed: {}",
+        "{} channels on a {}x{} grid; {rate}; {dmid} s a recording (from {dmin} to {dmax}); baseline removed: {}",
         l.channels.len(), l.rows, l.cols, l.baseline
     ));
     }
@@ -110,9 +111,10 @@ fn event_lines(
         Some(share) => format!("{} ON", percent(share)),
         None => "ON only (no polarity column)".to_string(),
     };
+    let [dmin, dmid, dmax] = [dmin, dmid, dmax].map(seconds);
     vec![
         format!(
-            "address events on a {}x{} grid ({} cells), times in {}; {dmid:.1} s a recording (from {dmin:.1} to {dmax:.1})",
+            "address events on a {}x{} grid ({} cells), times in {}; {dmid} s a recording (from {dmin} to {dmax})",
             l.rows,
             l.cols,
             e.cells.len(),
@@ -454,4 +456,26 @@ pub fn write_inspection(dir: &Path, i: &Inspection, inspected: &Path) -> Result<
         }
         Ok(())
     })
+}
+
+/// A duration in seconds to three significant digits (`0.750`, `3.90`, `11.8`), whole
+/// seconds from 100 s: one decimal made a 0.750 s recording `0.8` where `import` says 0.750.
+fn seconds(s: f64) -> String {
+    match s.abs() {
+        a if a >= 100.0 => format!("{s:.0}"),
+        a if a >= 10.0 => format!("{s:.1}"),
+        a if a >= 1.0 => format!("{s:.2}"),
+        _ => format!("{s:.3}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::seconds;
+
+    #[test]
+    fn durations_keep_three_significant_digits() {
+        let shown: Vec<String> = [0.75, 3.9, 11.84, 59.4, 123.4].map(seconds).into();
+        assert_eq!(shown, ["0.750", "3.90", "11.8", "59.4", "123"]);
+    }
 }
