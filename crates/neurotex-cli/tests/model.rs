@@ -1114,8 +1114,8 @@ fn a_network_in_travel_keeps_its_reference_speed_and_needs_speeds() {
 }
 
 /// `predict` on the dataset a model was trained on says how many of its recordings the
-/// model was fitted to; on other recordings, or other speeds (`--speeds`), it says nothing
-/// of the kind.
+/// model was fitted to, on standard error and as `trained_on` in `--json`; on other
+/// recordings, or other speeds (`--speeds`), it says nothing of the kind and counts 0.
 #[test]
 fn predicting_the_training_recordings_is_said_to_test_nothing() {
     let dir = Dir::new();
@@ -1125,8 +1125,19 @@ fn predicting_the_training_recordings_is_said_to_test_nothing() {
     let train = ["train", "--dataset", s(&ds), "--speeds", "10", "-k", "1"];
     dir.ok(&[&train[..], &["--out", s(&model)]].concat());
     let predict = |data: &Path| {
-        let args = ["predict", "--model", s(&model), "--dataset", s(data)];
+        let args = [
+            "predict",
+            "--model",
+            s(&model),
+            "--dataset",
+            s(data),
+            "--json",
+        ];
         dir.run(&[&args[..], &["--out", s(&dir.join("p.csv"))]].concat())
+    };
+    let trained_on = |stdout: &str| {
+        let v: serde_json::Value = serde_json::from_str(stdout).unwrap();
+        v["trained_on"].as_u64().unwrap()
     };
     let seen = predict(&ds);
     assert!(seen.status.success(), "{}", seen.stderr);
@@ -1135,9 +1146,11 @@ fn predicting_the_training_recordings_is_said_to_test_nothing() {
         "{}",
         seen.stderr
     );
+    assert_eq!(trained_on(&seen.stdout), 8);
     let new = predict(&other);
     assert!(new.status.success(), "{}", new.stderr);
     assert!(!new.stderr.contains("trained on"), "{}", new.stderr);
+    assert_eq!(trained_on(&new.stdout), 0);
     // --speeds predicts the dataset's recordings at those speeds only: at 20 mm/s, none the
     // model was trained on.
     let out = dir.join("at20.csv");
@@ -1149,10 +1162,12 @@ fn predicting_the_training_recordings_is_said_to_test_nothing() {
         s(&ds),
         "--speeds",
         "20",
+        "--json",
     ];
     let at20 = dir.run(&[&args[..], &["--out", s(&out)]].concat());
     assert!(at20.status.success(), "{}", at20.stderr);
     assert!(!at20.stderr.contains("trained on"), "{}", at20.stderr);
+    assert_eq!(trained_on(&at20.stdout), 0);
     let rows: Vec<String> = (std::fs::read_to_string(&out).unwrap().lines().skip(1))
         .map(|l| l.split(',').next().unwrap().to_string())
         .collect();

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::Args;
-use neurotex::model::write_predictions;
+use neurotex::model::{write_predictions, Score};
 use neurotex::pipeline::Encoded;
 use neurotex::saved::SavedModel;
 use neurotex::stream::write_episodes;
@@ -38,7 +38,9 @@ pub struct PredictArgs {
     #[arg(long, value_name = "TOOL", default_value = "nir")]
     pub nir_from: neurotex::nir::NirFrom,
     /// Also print `{"accuracy", "interval" (95 %, Wilson), "chance", "n", "labels", "confusion"}`
-    /// (rows = true label) as JSON; needs --dataset whose every label is a model's class.
+    /// (rows = true label) and `trained_on` (how many of the recordings scored the model was
+    /// trained on: its training dataset's at its training speeds, whose predictions test
+    /// nothing) as JSON; needs --dataset whose every label is a model's class.
     #[arg(long)]
     pub json: bool,
 }
@@ -69,9 +71,12 @@ pub fn run(args: PredictArgs) -> Result<()> {
     let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
     // Scored before anything is written, so that a label the model cannot score leaves no
     // predictions file behind a failed run.
-    let score = match args.json {
-        true => Some(model.score(&truth, &predictions)?),
-        false => None,
+    let score = match (args.json, &dataset) {
+        (true, Some(dataset)) => Some(Score {
+            trained_on: o.trained_on(&model, dataset)?,
+            ..model.score(&truth, &predictions)?
+        }),
+        _ => None,
     };
     let known = dataset.is_some();
     write_file(&args.out, "predictions", |w| {

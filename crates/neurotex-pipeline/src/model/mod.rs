@@ -166,6 +166,12 @@ pub struct Score {
     pub labels: Vec<String>,
     /// Row = true label, column = predicted label.
     pub confusion: ConfusionMatrix,
+    /// Of the recordings scored, those the model was trained on (its training dataset's,
+    /// at its training speeds): their predictions test nothing, and the accuracy is no
+    /// test of the model unless this is 0. Set by the caller that knows the dataset; 0
+    /// from [`Model::score`].
+    #[serde(default)]
+    pub trained_on: usize,
 }
 
 /// A trained model: what its file holds, with the pipeline, the feature extractor and the

@@ -304,6 +304,7 @@ pub(crate) fn score(
         n: y.len(),
         labels: labels.to_vec(),
         confusion,
+        trained_on: 0,
     })
 }
 

@@ -97,6 +97,17 @@ impl PredictOptions {
         }
     }
 
+    /// How many of the recordings this call predicts from `dataset` `model` was trained
+    /// on (its training dataset's recordings at its training speeds; none of another
+    /// dataset's): their predictions test nothing.
+    ///
+    /// # Errors
+    /// `--speeds` at which `dataset` has no recordings.
+    pub fn trained_on(&self, model: &SavedModel, dataset: &Dataset) -> Result<usize> {
+        let which = self.selected(dataset)?;
+        Ok(trained_among(model.provenance(), dataset, &which))
+    }
+
     /// Encodes the recordings (`dataset`'s, else the files given) with `model`'s pipeline,
     /// saying where layouts came from and what conditioning noticed.
     ///
@@ -182,12 +193,28 @@ fn encode_selected(
 /// the recordings `which`, those at the training speeds were fitted, so their predictions
 /// test nothing.
 fn seen_in_training(provenance: &Provenance, dataset: &Dataset, which: &[usize]) -> Option<String> {
-    if dataset.fingerprint().ok()? != provenance.fingerprint {
-        return None;
+    let seen = trained_among(provenance, dataset, which);
+    (seen > 0).then(|| {
+        format!(
+            "{seen} of these {} recordings are ones the model was trained on (this is its training dataset{}): their predictions are no test of it; `neurotex evaluate` cross-validates, or predict recordings it has not seen",
+            which.len(),
+            match &provenance.speeds {
+                None => String::new(),
+                Some(speeds) => format!(", at {} mm/s", shown_speeds(speeds)),
+            }
+        )
+    })
+}
+
+/// How many of the recordings `which` of `dataset` the model of `provenance` was trained
+/// on: those at its training speeds when `dataset` is its training dataset (the same
+/// fingerprint), else none.
+fn trained_among(provenance: &Provenance, dataset: &Dataset, which: &[usize]) -> usize {
+    if dataset.fingerprint().ok() != Some(provenance.fingerprint.clone()) {
+        return 0;
     }
-    let n = which.len();
-    let seen = match &provenance.speeds {
-        None => n,
+    match &provenance.speeds {
+        None => which.len(),
         Some(speeds) => (which.iter())
             .filter(|&&i| {
                 dataset.entries[i]
@@ -195,16 +222,7 @@ fn seen_in_training(provenance: &Provenance, dataset: &Dataset, which: &[usize])
                     .is_some_and(|s| speeds.contains(&s))
             })
             .count(),
-    };
-    (seen > 0).then(|| {
-        format!(
-            "{seen} of these {n} recordings are ones the model was trained on (this is its training dataset{}): their predictions are no test of it; `neurotex evaluate` cross-validates, or predict recordings it has not seen",
-            match &provenance.speeds {
-                None => String::new(),
-                Some(speeds) => format!(", at {} mm/s", shown_speeds(speeds)),
-            }
-        )
-    })
+    }
 }
 
 /// Speeds as `10, 20`.
