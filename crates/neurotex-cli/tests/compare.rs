@@ -323,7 +323,9 @@ fn gain_auto_calibrates_on_the_training_side_of_a_split_and_says_so_otherwise() 
     );
     assert!(split.status.success(), "{}", split.stderr);
     assert!(
-        split.stderr.contains("in 30 training recording(s)"),
+        split
+            .stderr
+            .contains("in the 30 recording(s) it calibrated on"),
         "{}",
         split.stderr
     );

@@ -324,7 +324,7 @@ fn bad_input_is_a_clear_error_with_no_output() {
             "glcm4d",
         ),
         (feat(&["--gain", "0"]), "gain"),
-        (feat(&["--gain", "-3"]), "gain"),
+        (feat(&["--gain", "-3"]), "or `auto` to choose one"),
         (feat(&["--levels", "1"]), "levels"),
         (feat(&["--bin-ms", "0"]), "bin"),
         (feat(&["--distances", "0"]), "distances"),

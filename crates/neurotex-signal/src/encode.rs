@@ -207,7 +207,7 @@ impl IzhikevichParams {
         if !(self.gain.is_finite() && self.gain > 0.0 && self.gain <= 1e4) {
             return Err(ParamError::new(
                 "gain",
-                "gain must be a number in (0, 10000]",
+                "gain must be a number in (0, 10000], or `auto` to choose one from the recordings",
                 self.gain,
             ));
         }

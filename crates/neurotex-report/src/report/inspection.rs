@@ -66,7 +66,7 @@ pub fn text_lines(i: &Inspection) -> Vec<String> {
     if i.events.is_none() {
         let [dmin, dmid, dmax] = [dmin, dmid, dmax].map(seconds);
         out.push(format!(
-        "{} channels on a {}x{} grid; {rate}; {dmid} s a recording (from {dmin} to {dmax}); baseline removed: {}",
+        "{} channels on a {}x{} grid; {rate}; recordings of {dmid} s (median; from {dmin} to {dmax}); baseline removed: {}",
         l.channels.len(), l.rows, l.cols, l.baseline
     ));
     }
@@ -114,7 +114,7 @@ fn event_lines(
     let [dmin, dmid, dmax] = [dmin, dmid, dmax].map(seconds);
     vec![
         format!(
-            "address events on a {}x{} grid ({} cells), times in {}; {dmid} s a recording (from {dmin} to {dmax})",
+            "address events on a {}x{} grid ({} cells), times in {}; recordings of {dmid} s (median; from {dmin} to {dmax})",
             l.rows,
             l.cols,
             e.cells.len(),
@@ -269,8 +269,8 @@ fn signals_section(i: &Inspection) -> String {
     } else {
         md += "No time stamps: the nominal rate is used.\n";
     }
-    let [lo, mid, hi] = s.duration_s;
-    md += &format!("Durations: {mid:.2} s median (from {lo:.2} to {hi:.2}).\n\n");
+    let [lo, mid, hi] = s.duration_s.map(seconds);
+    md += &format!("Durations: {mid} s median (from {lo} to {hi}).\n\n");
     let rows: Vec<Vec<String>> = (s.channels.iter())
         .map(|c| {
             vec![
@@ -359,10 +359,10 @@ fn encoder_section(i: &Inspection) -> String {
 /// An event dataset's lengths and events, in place of the signals and the encoder.
 fn events_section(i: &Inspection, e: &crate::events::EventSummary) -> String {
     let s = &i.signals;
-    let [dmin, dmid, dmax] = s.duration_s;
+    let [dmin, dmid, dmax] = s.duration_s.map(seconds);
     let [emin, emid, emax] = e.events;
     let mut md = format!(
-        "\n## Events\n\nAddress events, times in {}: they skip the encoder (ON events are the SA population's spikes, OFF events the FA population's). Durations: {dmid:.2} s median (from {dmin:.2} to {dmax:.2}). Events a recording: {emid} median (from {emin} to {emax}); {}; {} of the events fell in a millisecond already holding an event of their cell and polarity (one spike for both).\n\n",
+        "\n## Events\n\nAddress events, times in {}: they skip the encoder (ON events are the SA population's spikes, OFF events the FA population's). Durations: {dmid} s median (from {dmin} to {dmax}). Events a recording: {emid} median (from {emin} to {emax}); {}; {} of the events fell in a millisecond already holding an event of their cell and polarity (one spike for both).\n\n",
         e.time_unit,
         e.on_share.map_or("ON events only (no polarity column)".to_string(), |x| format!("{} of them ON", percent(x))),
         percent(e.merged_share)

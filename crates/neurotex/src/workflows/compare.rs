@@ -405,15 +405,10 @@ fn provenance(
         .iter()
         .map(|&i| dataset.entries[i].clone())
         .collect();
-    let data = format!(
-        "data: {} ({})",
-        dataset.fingerprint()?,
-        dataset.root.display()
-    );
     let mut lines = vec![
         crate::experiments::build(),
         format!("created: {}", crate::experiments::now_utc()),
-        data,
+        super::data_line(dataset)?,
     ];
     let p = &calibrated.params;
     lines.extend(p.conditioning_lines(
@@ -429,11 +424,7 @@ fn provenance(
     }
     lines.push(p.encoder_line());
     if let Some(c) = &calibrated.gain {
-        let on = match split {
-            true => "",
-            false => "; these are the recordings evaluated, test folds included (cross-validation; labels unused)",
-        };
-        lines.push(format!("{}{on}", super::calibration_line(c)));
+        lines.push(super::calibration_provenance(c, split));
     }
     let names: Vec<String> = set.encodings.iter().map(|e| e.to_string()).collect();
     let fa = match set.needs_fa() {

@@ -470,6 +470,30 @@ pub fn calibration_rows(
     }
 }
 
+/// A result's data line: `data: FINGERPRINT (FOLDER)`, the folder made absolute so that a
+/// result names the same folder whatever directory the command ran in.
+///
+/// # Errors
+/// The manifest or a listed file can no longer be read for the fingerprint.
+pub fn data_line(dataset: &Dataset) -> Result<String> {
+    let folder = std::fs::canonicalize(&dataset.root).unwrap_or_else(|_| dataset.root.clone());
+    Ok(format!(
+        "data: {} ({})",
+        dataset.fingerprint()?,
+        folder.display()
+    ))
+}
+
+/// [`calibration_line`] in a result's provenance: under cross-validation (`split` false)
+/// it says that the recordings calibrated on are those evaluated, test folds included.
+pub fn calibration_provenance(c: &GainCalibration, split: bool) -> String {
+    let on = match split {
+        true => "",
+        false => "; these are the recordings evaluated, test folds included (cross-validation; labels unused)",
+    };
+    format!("{}{on}", calibration_line(c))
+}
+
 /// What `--gain auto` chose, as said to the user.
 pub fn calibration_line(c: &GainCalibration) -> String {
     let reached = if c.clamped {
@@ -478,7 +502,7 @@ pub fn calibration_line(c: &GainCalibration) -> String {
         ""
     };
     format!(
-        "--gain auto: G = {} gives a median of {:.1} Hz (target {} Hz) over {} taxel x recording pairs with signal in {} training recording(s){reached}",
+        "--gain auto: G = {} gives a median of {:.1} Hz (target {} Hz) over {} taxel x recording pairs with signal in the {} recording(s) it calibrated on{reached}",
         c.gain, c.median_hz, c.target_hz, c.pairs, c.recordings
     )
 }

@@ -324,12 +324,17 @@ impl EvaluateOptions {
             on(Progress::Advice(&note));
             notes.push(note);
         }
-        let provenance = provenance(dataset, &indices, method, &calibrated)?;
+        let split_apart = !matches!(split, Split::CrossValidation { .. });
+        let provenance = provenance(dataset, (&indices, split_apart), method, &calibrated)?;
+        let mut applied = calibrated.params.clone();
+        let pre = &mut applied.preprocess;
+        pre.baseline = pre.baseline.or(dataset.layout.baseline);
         Ok(Evaluated {
             evaluation,
             calibrated,
             notes,
             provenance,
+            applied,
         })
     }
 }
@@ -348,16 +353,20 @@ pub struct Evaluated {
     /// Where the evaluation comes from: neurotex's build, the dataset's fingerprint and folder, and every stage's setting as run, one line each as results
     /// list them.
     pub provenance: Vec<String>,
+    /// The stages' parameters as they applied to these recordings: the pipeline as run,
+    /// its baseline the dataset's `layout.toml` one where the pipeline set none.
+    pub applied: crate::pipeline::PipelineParams,
 }
 
 /// The provenance of evaluating `method` on the recordings `indices` of `dataset` with the
-/// stages as `calibrated` ran them.
+/// stages as `calibrated` ran them; `split` whether a train/test split (not
+/// cross-validation) chose what was calibrated on.
 ///
 /// # Errors
 /// The manifest or a listed file can no longer be read for the fingerprint.
 fn provenance(
     dataset: &Dataset,
-    indices: &[usize],
+    (indices, split): (&[usize], bool),
     method: MethodChoice,
     calibrated: &CalibratedParams,
 ) -> Result<Vec<String>> {
@@ -365,13 +374,8 @@ fn provenance(
         .iter()
         .map(|&i| dataset.entries[i].clone())
         .collect();
-    let data = format!(
-        "data: {} ({})",
-        dataset.fingerprint()?,
-        dataset.root.display()
-    );
     // No time of creation: the same evaluation gives the same output.
-    let mut lines = vec![crate::experiments::build(), data];
+    let mut lines = vec![crate::experiments::build(), super::data_line(dataset)?];
     let methods = match method {
         MethodChoice::Features(m) => vec![m],
         _ => Vec::new(),
@@ -382,14 +386,14 @@ fn provenance(
         &methods,
     ));
     if let Some(c) = &calibrated.gain {
-        lines.push(super::calibration_line(c));
+        lines.push(super::calibration_provenance(c, split));
     }
     Ok(lines)
 }
 
 impl Evaluated {
     /// The evaluation as one JSON object, with the calibrations under
-    /// `causal_conditioning` and `gain_calibration`, the stages' parameters as run under
+    /// `causal_conditioning` and `gain_calibration`, [`Evaluated::applied`] under
     /// `pipeline` and the [`Evaluated::provenance`] lines under `provenance`.
     ///
     /// # Errors
@@ -405,7 +409,7 @@ impl Evaluated {
         // Always there, empty when nothing was said, so that a script can read it.
         value["notes"] = serde_json::to_value(&self.notes)?;
         // What ran, as numbers a script can read and as the lines results list.
-        value["pipeline"] = serde_json::to_value(&self.calibrated.params)?;
+        value["pipeline"] = serde_json::to_value(&self.applied)?;
         value["provenance"] = serde_json::to_value(&self.provenance)?;
         Ok(value)
     }
