@@ -676,4 +676,12 @@ fn a_folder_of_raw_logs_opened_as_a_dataset_says_how_to_import_it() {
         message.contains("is not a dataset folder (expected a folder with manifest.csv)"),
         "{message}"
     );
+    // a path that is not there is said to be missing
+    let message = Dataset::open(empty.path().join("nope"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("nope: does not exist (expected a dataset folder"),
+        "{message}"
+    );
 }

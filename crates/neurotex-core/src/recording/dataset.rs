@@ -45,11 +45,11 @@ impl Dataset {
     pub fn open_with(root: impl AsRef<Path>, allow_outside_paths: bool) -> Result<Self> {
         let root = root.as_ref().to_path_buf();
         if !root.is_dir() {
-            return Err(DataError::invalid(
-                &root,
-                "is not a dataset folder (expected a folder with manifest.csv)",
-            )
-            .into());
+            let why = match root.exists() {
+                true => "is not a dataset folder (expected a folder with manifest.csv)",
+                false => "does not exist (expected a dataset folder with manifest.csv)",
+            };
+            return Err(DataError::invalid(&root, why).into());
         }
         let layout_path = root.join("layout.toml");
         let layout = if layout_path.exists() {
