@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::Args;
-use neurotex::model::{write_predictions, Score};
+use neurotex::model::write_predictions;
 use neurotex::pipeline::Encoded;
 use neurotex::saved::SavedModel;
 use neurotex::stream::write_episodes;
@@ -68,14 +68,10 @@ pub fn run(args: PredictArgs) -> Result<()> {
         return predict_causal(&args, &model, &encoded);
     }
     let predictions = model.predict(&encoded)?;
-    let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
     // Scored before anything is written, so that a label the model cannot score leaves no
     // predictions file behind a failed run.
     let score = match (args.json, &dataset) {
-        (true, Some(dataset)) => Some(Score {
-            trained_on: o.trained_on(&model, dataset)?,
-            ..model.score(&truth, &predictions)?
-        }),
+        (true, Some(dataset)) => Some(o.score(&model, dataset, &encoded, &predictions)?),
         _ => None,
     };
     let known = dataset.is_some();

@@ -97,15 +97,25 @@ impl PredictOptions {
         }
     }
 
-    /// How many of the recordings this call predicts from `dataset` `model` was trained
-    /// on (its training dataset's recordings at its training speeds; none of another
-    /// dataset's): their predictions test nothing.
+    /// `predictions` of the recordings `encoded` of `dataset` scored against their labels,
+    /// with how many of them `model` was trained on (its training dataset's recordings at
+    /// its training speeds; none of another dataset's), whose predictions test nothing.
     ///
     /// # Errors
-    /// `--speeds` at which `dataset` has no recordings.
-    pub fn trained_on(&self, model: &SavedModel, dataset: &Dataset) -> Result<usize> {
+    /// A label the model does not know, or `--speeds` at which `dataset` has no recordings.
+    pub fn score(
+        &self,
+        model: &SavedModel,
+        dataset: &Dataset,
+        encoded: &[Encoded],
+        predictions: &[crate::model::Prediction],
+    ) -> Result<crate::model::Score> {
+        let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
         let which = self.selected(dataset)?;
-        Ok(trained_among(model.provenance(), dataset, &which))
+        Ok(crate::model::Score {
+            trained_on: trained_among(model.provenance(), dataset, &which),
+            ..model.score(&truth, predictions)?
+        })
     }
 
     /// Encodes the recordings (`dataset`'s, else the files given) with `model`'s pipeline,
