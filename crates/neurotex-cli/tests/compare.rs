@@ -383,7 +383,7 @@ fn the_outputs_record_the_command_the_data_and_the_gain_chosen() {
         "{lines:?}"
     );
     assert!(lines.iter().any(|l| l.starts_with("phase: ")), "{lines:?}");
-    let cv = "test folds included (cross-validation; labels unused)";
+    let cv = "under cross-validation they are drawn from all the recordings evaluated, test folds included (labels unused)";
     assert!(lines.iter().any(|l| l.ends_with(cv)), "{lines:?}");
     // The gain the encoder ran with is the one the calibration chose.
     let chosen = lines

@@ -57,6 +57,8 @@ fn a_manifest_of_only_file_and_label_is_featured_and_cross_validated() {
 
     let mut v = dir.evaluate_json(&ds, "glcm3d", &["--folds", "3"]);
     assert_eq!(v["n"], 12);
+    // without slide times every recording is kept whole, and the parameters say so
+    assert_eq!(v["pipeline"]["preprocess"]["slide_only"], false);
     // the same recordings with their conditions given: the same folds, the same result
     let full = dir.dataset("full", &["A", "B"], &[5.0], 6);
     rewrite_manifest(

@@ -273,6 +273,7 @@ fn an_evaluation_says_what_it_ran_on_and_with() {
     assert_eq!(v, json());
     assert_eq!(v["pipeline"]["encoder"]["overshoot"], "kept");
     assert_eq!(v["pipeline"]["encoding"], "sa+fa");
+    assert_eq!(v["pipeline"]["preprocess"]["slide_only"], true);
     let lines: Vec<&str> = (v["provenance"].as_array().unwrap().iter())
         .map(|l| l.as_str().unwrap())
         .collect();
@@ -317,7 +318,7 @@ fn bad_input_is_a_clear_error_with_no_output() {
                 "--out",
                 o,
             ],
-            "not a dataset folder",
+            "/nonexistent: does not exist",
         ),
         (
             vec!["features", "--dataset", d, "--method", "glcm4d", "--out", o],

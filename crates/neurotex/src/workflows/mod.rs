@@ -489,7 +489,7 @@ pub fn data_line(dataset: &Dataset) -> Result<String> {
 pub fn calibration_provenance(c: &GainCalibration, split: bool) -> String {
     let on = match split {
         true => "",
-        false => "; these are the recordings evaluated, test folds included (cross-validation; labels unused)",
+        false => "; under cross-validation they are drawn from all the recordings evaluated, test folds included (labels unused)",
     };
     format!("{}{on}", calibration_line(c))
 }

@@ -329,6 +329,12 @@ impl EvaluateOptions {
         let mut applied = calibrated.params.clone();
         let pre = &mut applied.preprocess;
         pre.baseline = pre.baseline.or(dataset.layout.baseline);
+        // The sliding phase is kept only where the manifest gives its times.
+        let metas: Vec<_> = indices
+            .iter()
+            .map(|&i| dataset.entries[i].clone())
+            .collect();
+        pre.slide_only &= crate::experiments::slide_times(&metas)[0] > 0;
         Ok(Evaluated {
             evaluation,
             calibrated,
@@ -354,7 +360,8 @@ pub struct Evaluated {
     /// list them.
     pub provenance: Vec<String>,
     /// The stages' parameters as they applied to these recordings: the pipeline as run,
-    /// its baseline the dataset's `layout.toml` one where the pipeline set none.
+    /// its baseline the dataset's `layout.toml` one where the pipeline set none, and the
+    /// whole recording kept (`slide_only` false) when the manifest gives no slide times.
     pub applied: crate::pipeline::PipelineParams,
 }
 
