@@ -636,9 +636,9 @@ def evaluate(
     recordings or address events) by ``neurotex evaluate``'s own workflow: the same
     numbers as ``neurotex evaluate --dataset PATH --json``, as a dict (``accuracy``,
     ``accuracy_interval`` with its 95 % bounds, ``metrics`` with the chance levels,
-    ``confusion``, ``classifier``, ``pipeline`` with every stage's parameter as run,
-    ``provenance`` with neurotex's build, the dataset's fingerprint and those parameters
-    as lines of text, ...).
+    ``confusion``, ``classifier``, ``pipeline`` with every stage's parameter as applied,
+    ``provenance`` with neurotex's build, the dataset's fingerprint and folder and those
+    parameters as lines of text, ...).
 
     ``method`` and ``classifier`` are the CLI's (``None``: glcm3d with KNN; the spiking
     network with ``classifier="snn"`` or ``method="spikes"``), ``classifier_options`` the
