@@ -485,7 +485,8 @@ pub fn data_line(dataset: &Dataset) -> Result<String> {
 }
 
 /// [`calibration_line`] in a result's provenance: under cross-validation (`split` false)
-/// it says that the recordings calibrated on are those evaluated, test folds included.
+/// it says that the recordings calibrated on are drawn from all those evaluated, test
+/// folds included.
 pub fn calibration_provenance(c: &GainCalibration, split: bool) -> String {
     let on = match split {
         true => "",

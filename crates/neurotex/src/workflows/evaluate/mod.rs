@@ -356,8 +356,8 @@ pub struct Evaluated {
     /// accuracy not shown above chance ([`Evaluation::chance_note`]), each as said on
     /// standard error.
     pub notes: Vec<String>,
-    /// Where the evaluation comes from: neurotex's build, the dataset's fingerprint and folder, and every stage's setting as run, one line each as results
-    /// list them.
+    /// Where the evaluation comes from: neurotex's build, the dataset's fingerprint and
+    /// folder, and every stage's setting as run, one line each as results list them.
     pub provenance: Vec<String>,
     /// The stages' parameters as they applied to these recordings: the pipeline as run,
     /// its baseline the dataset's `layout.toml` one where the pipeline set none, and the
