@@ -220,7 +220,7 @@ fn seen_in_training(provenance: &Provenance, dataset: &Dataset, which: &[usize])
 /// on: those at its training speeds when `dataset` is its training dataset (the same
 /// fingerprint), else none.
 fn trained_among(provenance: &Provenance, dataset: &Dataset, which: &[usize]) -> usize {
-    if dataset.fingerprint().ok() != Some(provenance.fingerprint.clone()) {
+    if dataset.fingerprint().ok().as_deref() != Some(provenance.fingerprint.as_str()) {
         return 0;
     }
     match &provenance.speeds {

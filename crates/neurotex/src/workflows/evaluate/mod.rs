@@ -325,16 +325,14 @@ impl EvaluateOptions {
             notes.push(note);
         }
         let split_apart = !matches!(split, Split::CrossValidation { .. });
-        let provenance = provenance(dataset, (&indices, split_apart), method, &calibrated)?;
+        // The evaluation's recordings: how many have their slide's times in the manifest.
+        let slides = crate::experiments::slide_times(&evaluation.metas);
+        let provenance = provenance(dataset, (slides, split_apart), method, &calibrated)?;
         let mut applied = calibrated.params.clone();
         let pre = &mut applied.preprocess;
         pre.baseline = pre.baseline.or(dataset.layout.baseline);
         // The sliding phase is kept only where the manifest gives its times.
-        let metas: Vec<_> = indices
-            .iter()
-            .map(|&i| dataset.entries[i].clone())
-            .collect();
-        pre.slide_only &= crate::experiments::slide_times(&metas)[0] > 0;
+        pre.slide_only &= slides[0] > 0;
         Ok(Evaluated {
             evaluation,
             calibrated,
@@ -365,33 +363,26 @@ pub struct Evaluated {
     pub applied: crate::pipeline::PipelineParams,
 }
 
-/// The provenance of evaluating `method` on the recordings `indices` of `dataset` with the
-/// stages as `calibrated` ran them; `split` whether a train/test split (not
-/// cross-validation) chose what was calibrated on.
+/// The provenance of evaluating `method` on recordings of `dataset`, `slides[0]` of
+/// `slides[1]` with their slide's times in the manifest, with the stages as `calibrated`
+/// ran them; `split` whether a train/test split (not cross-validation) chose what was
+/// calibrated on.
 ///
 /// # Errors
 /// The manifest or a listed file can no longer be read for the fingerprint.
 fn provenance(
     dataset: &Dataset,
-    (indices, split): (&[usize], bool),
+    (slides, split): ([usize; 2], bool),
     method: MethodChoice,
     calibrated: &CalibratedParams,
 ) -> Result<Vec<String>> {
-    let metas: Vec<_> = indices
-        .iter()
-        .map(|&i| dataset.entries[i].clone())
-        .collect();
     // No time of creation: the same evaluation gives the same output.
     let mut lines = vec![crate::experiments::build(), super::data_line(dataset)?];
     let methods = match method {
         MethodChoice::Features(m) => vec![m],
         _ => Vec::new(),
     };
-    lines.extend(calibrated.params.describe(
-        dataset.layout.baseline,
-        crate::experiments::slide_times(&metas),
-        &methods,
-    ));
+    lines.extend((calibrated.params).describe(dataset.layout.baseline, slides, &methods));
     if let Some(c) = &calibrated.gain {
         lines.push(super::calibration_provenance(c, split));
     }
