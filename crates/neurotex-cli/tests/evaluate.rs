@@ -288,6 +288,10 @@ fn an_evaluation_says_what_it_ran_on_and_with() {
         encoder.contains("overshoot kept (Izhikevich's reference code)"),
         "{encoder}"
     );
+    assert!(
+        encoder.contains("neurons of type RS, a = 0.02"),
+        "{encoder}"
+    );
 }
 
 #[test]

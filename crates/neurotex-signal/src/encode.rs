@@ -139,6 +139,15 @@ impl FiringType {
         PRESETS[self as usize].0
     }
 
+    /// The firing type whose `a`, `b`, `c` and `d` are exactly those of `params`, if any.
+    pub fn of(params: &IzhikevichParams) -> Option<FiringType> {
+        let abcd = (params.a, params.b, params.c, params.d);
+        FiringType::ALL.into_iter().find(|t| {
+            let (_, a, b, c, d) = PRESETS[*t as usize];
+            (a, b, c, d) == abcd
+        })
+    }
+
     /// The neuron parameters of this type with gain 8.
     pub fn params(self) -> IzhikevichParams {
         let (_, a, b, c, d) = PRESETS[self as usize];
@@ -375,6 +384,18 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Each preset's a, b, c and d name its firing type, whatever the gain; any other
+    /// neuron has no name.
+    #[test]
+    fn a_neuron_is_named_by_its_firing_type_only_when_it_is_one() {
+        for t in FiringType::ALL {
+            assert_eq!(FiringType::of(&t.params().with_gain(3.0)), Some(t));
+        }
+        let rs = FiringType::Rs.params();
+        assert_eq!(FiringType::of(&IzhikevichParams { d: 7.0, ..rs }), None);
+        assert_eq!(FiringType::of(&IzhikevichParams { a: 0.021, ..rs }), None);
     }
 
     /// Many drives of every kind side by side on a grid whose banks straddle the vector

@@ -81,10 +81,10 @@ pub fn run(args: PredictArgs) -> Result<()> {
     if let Some(score) = score {
         println!("{}", serde_json::to_string(&score)?);
     }
-    let with = model.described(&o.model);
+    let (with, n) = (model.described(&o.model), predictions.len());
     eprintln!(
-        "{} recordings predicted with {with}{} -> {}",
-        predictions.len(),
+        "{n} recording{} predicted with {with}{} -> {}",
+        if n == 1 { "" } else { "s" },
         o.model.display(),
         shown(&args.out)
     );

@@ -363,10 +363,17 @@ impl PipelineParams {
             crate::encode::Overshoot::Kept => "kept (Izhikevich's reference code)",
             crate::encode::Overshoot::Capped => "capped at the 30 mV peak",
         };
+        // The firing type's name when a, b, c and d are one of Izhikevich's presets.
+        let firing = crate::encode::FiringType::of(enc).map(|t| format!(" of type {t}"));
         format!(
-            "encoder: Izhikevich (2003) neurons, a = {}, b = {}, c = {} mV, d = {}, overshoot \
+            "encoder: Izhikevich (2003) neurons{}, a = {}, b = {}, c = {} mV, d = {}, overshoot \
              {overshoot}, gain G = {}",
-            enc.a, enc.b, enc.c, enc.d, enc.gain
+            firing.unwrap_or_default(),
+            enc.a,
+            enc.b,
+            enc.c,
+            enc.d,
+            enc.gain
         )
     }
 

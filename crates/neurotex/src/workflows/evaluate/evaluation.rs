@@ -240,7 +240,7 @@ impl Evaluation {
         let by = by.unwrap_or_default();
         let _ = writeln!(
             out,
-            "method {}{by}: {} samples, {how}",
+            "method {}{by}: {} samples scored, {how}",
             self.method, outcome.n
         );
         if !self.encoder.is_empty() {
