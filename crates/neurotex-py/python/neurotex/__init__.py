@@ -636,7 +636,8 @@ def evaluate(
     recordings or address events) by ``neurotex evaluate``'s own workflow: the same
     numbers as ``neurotex evaluate --dataset PATH --json``, as a dict (``accuracy``,
     ``accuracy_interval`` with its 95 % bounds, ``metrics`` with the chance levels,
-    ``confusion``, ``classifier``, ``pipeline`` with every stage's parameter as applied,
+    ``confusion``, ``classifier``, ``pipeline`` with every stage's parameter as applied
+    (stages the method does not use as they stand),
     ``provenance`` with neurotex's build, the dataset's fingerprint and folder and those
     parameters as lines of text, ...).
 

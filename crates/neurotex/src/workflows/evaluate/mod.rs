@@ -360,6 +360,8 @@ pub struct Evaluated {
     /// The stages' parameters as they applied to these recordings: the pipeline as run,
     /// its baseline the dataset's `layout.toml` one where the pipeline set none, and the
     /// whole recording kept (`slide_only` false) when the manifest gives no slide times.
+    /// Every stage is listed, those the method does not use (FA under `sa`, the spectrum's
+    /// bins under a GLCM method) as they stand.
     pub applied: crate::pipeline::PipelineParams,
 }
 
