@@ -17,7 +17,7 @@ pub use choose::{choose_columns, choose_format, CsvOverrides, LogColumns};
 pub use format::{ChannelSelect, Column, CsvFormat, Delimiter, DuplicateStamps, DEFAULT_MAX_GAP_S};
 use header::detect_delimiter;
 pub(crate) use header::repeated_name;
-pub use header::{detect_delimiter_in, header_names, is_timelike_name, Columns};
+pub use header::{detect_delimiter_in, header_names, is_timelike_name, unit_in_name, Columns};
 pub use read::{read_csv_log, PLAUSIBLE_HZ};
 
 /// A CSV log read: its frames and what was done to its rows.

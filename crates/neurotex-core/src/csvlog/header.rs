@@ -249,7 +249,7 @@ pub(crate) fn repeated_name<S: AsRef<str>>(
 
 /// The unit a time column's name ends in: `_ms`, `_s`, `_us` (or `-`, a space, `(ms)`,
 /// `[s]`), in any case.
-fn unit_in_name(name: &str) -> Option<TimeUnit> {
+pub fn unit_in_name(name: &str) -> Option<TimeUnit> {
     let name = name.trim().to_lowercase();
     let name = name.trim_end_matches([')', ']']);
     [

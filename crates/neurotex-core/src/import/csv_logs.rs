@@ -88,8 +88,14 @@ fn no_rate(files: &[PathBuf], p: &CsvImportParams) -> crate::Error {
             return e;
         }
         if let Some(j) = time {
+            // Without --time-unit a time column's stamps are read in the unit its name
+            // ends in, else in ms.
+            let unit = match crate::csvlog::unit_in_name(&names[j]) {
+                Some(u) => format!("in {u}, as its name says; `--time-unit` if not"),
+                None => "`--time-unit` if they are not in ms".into(),
+            };
             let why = format!(
-                "no time column was chosen and no rate given, and column `{}` is named like time stamps: `--time-column {}` reads it as time (the rate then comes from its stamps; `--time-unit` if they are not in ms), or --fs gives the rate of logs without stamps",
+                "no time column was chosen and no rate given, and column `{}` is named like time stamps: `--time-column {}` reads it as time (the rate then comes from its stamps, {unit}), or --fs gives the rate of logs without stamps",
                 names[j], names[j]
             );
             return DataError::invalid(file, why).into();

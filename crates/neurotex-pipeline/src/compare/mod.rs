@@ -270,14 +270,16 @@ pub const CAVEAT: &str = "the best of several candidates chosen on the same reco
     scores higher than it will on new recordings of the same kind; the nested estimate \
     (the best chosen inside each training set and scored on its test set, computed when \
     nested selection is asked for) is what choosing the best this way and training it on \
-    all recordings can be expected to score: the number to quote";
+    all recordings can be expected to score: the number to quote. Each p value tests one \
+    candidate against the paper's method alone, uncorrected for the many candidates tested";
 
 /// The caveat of a comparison with nested selection.
 pub const CAVEAT_NESTED: &str = "the best of several candidates chosen on the same \
     recordings scores higher than it will on new recordings of the same kind; the nested \
     estimate (the best chosen inside each training set and scored on its test set) is what \
     choosing the best this way and training it on all recordings can be expected to score: \
-    the number to quote";
+    the number to quote. Each p value tests one candidate against the paper's method alone, \
+    uncorrected for the many candidates tested";
 
 /// One candidate's scores under the protocol.
 struct Scored {

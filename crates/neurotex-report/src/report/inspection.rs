@@ -275,7 +275,7 @@ fn signals_section(i: &Inspection) -> String {
         .map(|c| {
             vec![
                 format!("`{}`", c.name),
-                format!("{:.4}", c.range),
+                significant(c.range),
                 optional(c.resting_ratio, 2),
                 percent(c.dead_share),
                 percent(c.rising_share),
@@ -289,7 +289,7 @@ fn signals_section(i: &Inspection) -> String {
     md += &table(
         &[
             "channel",
-            "range (median)",
+            "range (median, the log's units)",
             "resting offset / range",
             "dead",
             "rising",
@@ -469,9 +469,25 @@ fn seconds(s: f64) -> String {
     }
 }
 
+/// A value in a sensor's own units to four significant digits (`209.0`, `0.01230`,
+/// `51230`): raw counts and volts alike, with no digits a log cannot hold.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = 3 - x.abs().log10().floor() as i32;
+    format!("{x:.*}", decimals.max(0) as usize)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::seconds;
+    use super::{seconds, significant};
+
+    #[test]
+    fn ranges_keep_four_significant_digits() {
+        let shown: Vec<String> = [209.0, 0.0123, 51234.0, 0.0, 1.5].map(significant).into();
+        assert_eq!(shown, ["209.0", "0.01230", "51234", "0", "1.500"]);
+    }
 
     #[test]
     fn durations_keep_three_significant_digits() {

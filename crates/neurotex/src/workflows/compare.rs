@@ -351,7 +351,7 @@ impl CompareOptions {
         }
         if !params.nested {
             on(Progress::Say(
-                "note: --nested computes the nested estimate the caveat below speaks of",
+                "note: the nested estimate the caveat below speaks of was not computed (add --nested)",
             ));
         }
         Ok(comparison)

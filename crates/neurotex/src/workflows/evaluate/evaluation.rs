@@ -240,7 +240,7 @@ impl Evaluation {
         let by = by.unwrap_or_default();
         let _ = writeln!(
             out,
-            "method {}{by}: {} samples scored, {how}",
+            "method {}{by}: {how}; {} recordings scored",
             self.method, outcome.n
         );
         if !self.encoder.is_empty() {
@@ -314,18 +314,18 @@ fn split_text(split: &Split) -> String {
             group_by: Some(column),
             speeds,
         } => format!(
-            "{}, up to {}-fold CV keeping each `{column}` group in one fold, seed {}, {} repeat(s)",
+            "{}, up to {}-fold CV keeping each `{column}` group in one fold, seed {}, {}",
             recordings_at(speeds.as_deref()),
             cv.folds,
             cv.seed,
-            cv.repeats
+            repeats(cv.repeats)
         ),
         Split::CrossValidation { cv, speeds, .. } => format!(
-            "{}, {}-fold stratified CV, seed {}, {} repeat(s)",
+            "{}, {}-fold stratified CV, seed {}, {}",
             recordings_at(speeds.as_deref()),
             cv.folds,
             cv.seed,
-            cv.repeats
+            repeats(cv.repeats)
         ),
         Split::Where { train, test } => {
             format!("train on {}, test on {}", selected(train), selected(test))
@@ -338,6 +338,11 @@ fn split_text(split: &Split) -> String {
     }
 }
 
+/// `1 repeat`, `10 repeats`.
+fn repeats(n: usize) -> String {
+    format!("{n} repeat{}", if n == 1 { "" } else { "s" })
+}
+
 /// The recordings cross-validation runs over, as text.
 fn recordings_at(speeds: Option<&[Speed]>) -> String {
     match speeds {
@@ -346,12 +351,12 @@ fn recordings_at(speeds: Option<&[Speed]>) -> String {
     }
 }
 
-/// A selection as text: `[5, 10] mm/s` for speeds, `session in [s1, s2]` otherwise.
+/// A selection as text: `5, 10 mm/s` for speeds, `session in s1, s2` otherwise.
 fn selected(selection: &Selection) -> String {
     let values = selection.values.join(", ");
     match selection.column.as_str() {
-        "speed_mm_s" => format!("[{values}] mm/s"),
-        column => format!("{column} in [{values}]"),
+        "speed_mm_s" => format!("{values} mm/s"),
+        column => format!("{column} in {values}"),
     }
 }
 
