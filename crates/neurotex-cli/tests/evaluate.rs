@@ -428,3 +428,52 @@ fn a_wide_confusion_matrix_is_listed_by_its_largest_confusions() {
         "{text}"
     );
 }
+
+/// `--encoder-draws N`: the accuracy of the encoding as run first, the mean over the N
+/// with an interval over encodings and recordings; each further encoding perturbed by its
+/// own stream, so the first draws of a run of 3 are those of a run of 2 and a run gives the
+/// same numbers again. Address events skip the encoder and are refused.
+#[test]
+fn encoder_draws_give_the_accuracy_over_encodings() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0], 10);
+    let draws = |n: &str| dir.evaluate_json(&ds, "glcm3d", &["--encoder-draws", n]);
+    let three = draws("3");
+    let over = &three["encoder_draws"];
+    let accuracies: Vec<f64> = over["accuracies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_f64().unwrap())
+        .collect();
+    assert_eq!(accuracies.len(), 3);
+    assert_eq!(accuracies[0], three["accuracy"].as_f64().unwrap());
+    let mean = accuracies.iter().sum::<f64>() / 3.0;
+    let combined = &over["combined"];
+    assert!((combined["estimate"].as_f64().unwrap() - mean).abs() < 1e-12);
+    assert_eq!(combined["encodings"], 3);
+    let [lower, upper] = ["lower", "upper"].map(|k| combined[k].as_f64().unwrap());
+    assert!(lower <= mean && mean <= upper, "{combined}");
+    assert_eq!(over["perturbation"], 1e-12);
+    assert_eq!(draws("3"), three);
+    let two = draws("2");
+    assert_eq!(two["encoder_draws"]["accuracies"][1], over["accuracies"][1]);
+    assert!(draws("1").get("encoder_draws").is_none());
+    let text = dir.ok(&["evaluate", "--dataset", s(&ds), "--encoder-draws", "3"]);
+    assert!(
+        text.contains("over 3 encodings (the one as run and 2 with"),
+        "{text}"
+    );
+    let err = dir.fails(&["evaluate", "--dataset", s(&ds), "--encoder-draws", "0"]);
+    assert!(err.contains("--encoder-draws"), "{err}");
+
+    let events = dir.join("ev");
+    let export = ["export", "events", "--dataset", s(&ds), "--out", s(&events)];
+    dir.ok(&export);
+    let args = ["evaluate", "--dataset", s(&events), "--encoder-draws", "2"];
+    let err = dir.fails(&args);
+    assert!(
+        err.contains("address events, which skip the encoder"),
+        "{err}"
+    );
+}

@@ -134,13 +134,13 @@ fn parsed<T: std::str::FromStr<Err = neurotex::error::ParamError>>(
 /// Evaluates on the dataset folder `path` as `neurotex evaluate --dataset PATH --json`
 /// does, through its workflow: the method and classifier as `train_dataset` takes them,
 /// the cross-validation's `folds`, `repeats` and `seed` (`None`: the CLI's defaults), or a
-/// train/test split by speeds or by manifest column (`train_where="trial=0,1"`), and
-/// `group_by`. Returns the evaluation as the CLI's JSON object; what the workflow says goes
+/// train/test split by speeds or by manifest column (`train_where="trial=0,1"`),
+/// `group_by`, and the encodings of every recording (`encoder_draws`). Returns the evaluation as the CLI's JSON object; what the workflow says goes
 /// to Python's log as it is said.
 #[pyfunction]
 #[pyo3(signature = (path, method, classifier, classifier_options, options, folds=None,
     repeats=None, seed=0, speeds=None, train_speeds=None, test_speeds=None, train_where=None,
-    test_where=None, group_by=None, taxel=None, tau_ms=None))]
+    test_where=None, group_by=None, taxel=None, tau_ms=None, encoder_draws=1))]
 #[allow(clippy::too_many_arguments)]
 fn evaluate_dataset(
     py: Python<'_>,
@@ -160,6 +160,7 @@ fn evaluate_dataset(
     group_by: Option<String>,
     taxel: Option<&str>,
     tau_ms: Option<f64>,
+    encoder_draws: usize,
 ) -> PyResult<Py<PyAny>> {
     let stages = params::stage_options(options)?;
     let method = parsed::<MethodChoice>(method)?;
@@ -180,6 +181,7 @@ fn evaluate_dataset(
         folds: folds.unwrap_or(cv.folds),
         seed,
         repeats: repeats.unwrap_or(cv.repeats),
+        encoder_draws,
         speeds: speeds_of(speeds)?,
         train_speeds: speeds_of(train_speeds)?,
         test_speeds: speeds_of(test_speeds)?,

@@ -56,9 +56,10 @@ pub use encodings::{
     encoder_sensitivity, EncoderSensitivity, EncodingsSpeed, OverEncodings, SpikeAgreement,
 };
 pub use params::{
-    ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS, MAX_REPEATS,
+    Draws, ReproduceParams, ValidReproduceParams, DEFAULT_ENCODER_DRAWS, MAX_ENCODER_DRAWS,
+    MAX_REPEATS,
 };
-pub use perturb::perturbed_input;
+pub use perturb::{perturbed_encodings, perturbed_input};
 pub use prepare::{prepare, CausalPrepared, IsiSweep, Prepared, WITHIN_SPEED};
 pub use provenance::{build, now_utc, slide_times, Provenance};
 pub use seeds::{across_seeds, run_seeds, AcrossSeeds, ClaimAcrossSeeds, SeedAccuracy};

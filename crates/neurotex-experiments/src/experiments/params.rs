@@ -252,10 +252,32 @@ pub struct ValidReproduceParams {
     cv: ValidCv,
 }
 
+/// The encoder's sensitivity as asked for: how many encodings of each recording in all
+/// (the first as run, the others perturbed), and the perturbations' seed and size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Draws {
+    /// Encodings of each recording, the one as run included.
+    pub encodings: usize,
+    /// Seed of the perturbations' streams.
+    pub seed: u64,
+    /// Each perturbed sample is the sample times `1 + u * size`, `u` uniform in [-1, 1).
+    pub size: f64,
+}
+
 impl ValidReproduceParams {
     /// The planned pipeline.
     pub fn pipeline(&self) -> &Pipeline {
         &self.pipeline
+    }
+
+    /// The encoder's sensitivity: `encoder_draws` encodings, perturbed by `perturbation`
+    /// from streams of `seed`.
+    pub fn draws(&self) -> Draws {
+        Draws {
+            encodings: self.encoder_draws,
+            seed: self.seed,
+            size: self.perturbation,
+        }
     }
 
     /// The classifier at the run's `k`.

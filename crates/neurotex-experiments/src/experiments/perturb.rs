@@ -2,16 +2,15 @@
 //! rounding, once for each further encoding, and encoded.
 
 use super::keystream::Keystream;
-use super::ValidReproduceParams;
+use super::{Draws, ValidReproduceParams};
 use crate::encode::{encode_drives, BankRows, Drive, MadeDrive, SpikeTrains};
 use crate::error::Result;
-use crate::pipeline::Encoding;
+use crate::pipeline::{Encoding, Pipeline};
 use crate::recording::Recording;
 use crate::signal::Conditioned;
 
-/// Recording `recording`'s further encodings of the encoder's sensitivity: its conditioned
-/// input perturbed once for each ([`Perturbed`]), all encoded in one call, each
-/// population of each draw a bank of neurons beside the others ([`encode_drives`]).
+/// Recording `recording`'s further encodings of the encoder's sensitivity under `params`
+/// ([`perturbed_encodings`]).
 ///
 /// # Errors
 /// A broken encoder rule.
@@ -21,23 +20,40 @@ pub(super) fn perturbed_draws(
     params: &ValidReproduceParams,
     recording: usize,
 ) -> Result<Vec<(SpikeTrains, Option<SpikeTrains>)>> {
-    let pipeline = params.pipeline();
-    let draws = 1..params.encoder_draws;
+    perturbed_encodings(params.pipeline(), rec, cond, params.draws(), recording)
+}
+
+/// Recording `recording`'s further encodings (`draws.encodings - 1` of them) by
+/// `pipeline`: its conditioned input perturbed once for each ([`Perturbed`]), all encoded
+/// in one call, each population of each draw a bank of neurons beside the others
+/// ([`encode_drives`]). `recording` seeds the recording's streams: the same number gives
+/// the same perturbations.
+///
+/// # Errors
+/// A broken encoder rule.
+pub fn perturbed_encodings(
+    pipeline: &Pipeline,
+    rec: &Recording,
+    cond: &Conditioned,
+    draws: Draws,
+    recording: usize,
+) -> Result<Vec<(SpikeTrains, Option<SpikeTrains>)>> {
+    let further = 1..draws.encodings;
     let (samples, cells) = (cond.samples.as_slice(), cond.cells);
-    let perturbed = |encoding| Perturbed::new(samples, cells, params, encoding, recording);
-    if draws.is_empty() {
+    let perturbed = |encoding| Perturbed::new(samples, cells, draws, encoding, recording);
+    if further.is_empty() {
         return Ok(Vec::new());
     }
     if pipeline.params().encoding != Encoding::Sa {
         // An FA population reads its input's rate of change from one step to the next, so
         // these encodings take each perturbed input whole.
-        let inputs: Vec<Vec<f64>> = draws.map(|e| perturbed(e).whole()).collect();
+        let inputs: Vec<Vec<f64>> = further.map(|e| perturbed(e).whole()).collect();
         let inputs: Vec<&[f64]> = inputs.iter().map(Vec::as_slice).collect();
         return pipeline.encode_populations_side_by_side(rec, &inputs);
     }
     // The SA population, as `Pipeline::encode_populations` encodes it, from perturbed
     // inputs made a block of steps at a time as the banks run.
-    let mut made: Vec<Perturbed> = draws.map(perturbed).collect();
+    let mut made: Vec<Perturbed> = further.map(perturbed).collect();
     let mut drives: Vec<Drive> = made.iter_mut().map(|m| Drive::Made(m)).collect();
     let (l, encoder) = (&rec.layout, pipeline.params().encoder);
     let gains = vec![encoder.gain; drives.len()];
@@ -74,19 +90,19 @@ impl<'a> Perturbed<'a> {
     fn new(
         samples: &'a [f64],
         cells: usize,
-        params: &ValidReproduceParams,
+        draws: Draws,
         encoding: usize,
         recording: usize,
     ) -> Self {
         let mut key = [0u8; 32];
-        key[..8].copy_from_slice(&params.seed.to_le_bytes());
+        key[..8].copy_from_slice(&draws.seed.to_le_bytes());
         key[8..16].copy_from_slice(&(encoding as u64).to_le_bytes());
         key[16..24].copy_from_slice(&(recording as u64).to_le_bytes());
         key[24..].copy_from_slice(b"encoding");
         Perturbed {
             samples,
             cells,
-            eps: params.perturbation,
+            eps: draws.size,
             stream: Keystream::new(key),
             words: vec![0; Self::WORDS],
             next: Self::WORDS,
@@ -157,7 +173,7 @@ pub fn perturbed_input(
     encoding: usize,
     recording: usize,
 ) -> Vec<f64> {
-    Perturbed::new(samples, 1, params, encoding, recording).whole()
+    Perturbed::new(samples, 1, params.draws(), encoding, recording).whole()
 }
 
 #[cfg(test)]
@@ -205,7 +221,8 @@ mod tests {
                 // Made in pieces of 21 values, as the encoder's blocks of rows ask for them:
                 // the words left from one piece serve the next.
                 let whole = len / 21 * 21;
-                let mut made = Perturbed::new(&input[..whole], 3, &params, encoding, recording);
+                let draws = params.draws();
+                let mut made = Perturbed::new(&input[..whole], 3, draws, encoding, recording);
                 let mut blocks = vec![0.0; whole];
                 for (b, block) in blocks.chunks_mut(21).enumerate() {
                     let x = &input[b * 21..][..21];

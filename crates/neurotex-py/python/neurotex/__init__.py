@@ -629,6 +629,7 @@ def evaluate(
     group_by: Optional[str] = None,
     taxel: Optional[str] = None,
     tau_ms: Optional[float] = None,
+    encoder_draws: int = 1,
     causal: bool = False,
     **stage_options: Any,
 ) -> Dict[str, Any]:
@@ -649,7 +650,10 @@ def evaluate(
     ``train_where`` with ``test_where`` (``"trial=0,1"``), train on one set and test on the
     other instead; ``group_by`` keeps a manifest column's groups within one fold;
     ``taxel`` (``"2,3"``) one taxel for ``method="taxel"``; ``tau_ms`` the van Rossum
-    kernel's. Stage options (``gain="auto"``, ``encoding``, ``bin_ms``, ...) are the
+    kernel's; ``encoder_draws`` above 1 encodes every recording that many times (as run,
+    then with rounding-level perturbations of its input) and adds ``encoder_draws``: each
+    encoding's accuracy and their mean with an interval over encodings and recordings.
+    Stage options (``gain="auto"``, ``encoding``, ``bin_ms``, ...) are the
     CLI's; what the workflow says goes to the ``neurotex`` logger."""
     opts = _stage_options(**stage_options)
     opts["causal"] = bool(causal)
@@ -660,7 +664,7 @@ def evaluate(
     return _native.evaluate_dataset(
         os.fspath(path), method, classifier, dict(classifier_options or {}), opts,
         folds, repeats, int(seed), listed(speeds), listed(train_speeds), listed(test_speeds),
-        train_where, test_where, group_by, taxel, tau_ms)
+        train_where, test_where, group_by, taxel, tau_ms, int(encoder_draws))
 
 
 def compare(

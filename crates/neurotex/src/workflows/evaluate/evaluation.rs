@@ -8,6 +8,7 @@ use crate::values::shown_label;
 use std::fmt::Write as _;
 use std::io::Write;
 
+use serde::Serialize;
 use serde_json::Value;
 
 use crate::analysis::{Columns, MethodSamples, Outcome, Split, TaxelAccuracy};
@@ -30,6 +31,40 @@ pub struct Spikes<'a> {
     pub grid: &'a Grid,
     /// The pipeline that encoded them (its features are extracted with it).
     pub pipeline: &'a Pipeline,
+}
+
+/// The accuracy over the encodings of an evaluation's recordings.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EncoderDraws {
+    /// Each encoding's accuracy, the one as run first.
+    pub accuracies: Vec<f64>,
+    /// The mean over the encodings (`estimate`) with its 95 % interval resampling
+    /// encodings and recordings.
+    pub combined: Interval,
+    /// Each perturbed sample was the sample times `1 + u * perturbation`.
+    pub perturbation: f64,
+}
+
+impl EncoderDraws {
+    /// The text line: the mean, its interval and the range of the encodings' accuracies.
+    pub fn text(&self) -> String {
+        let fold = |f: fn(f64, f64) -> f64, start| self.accuracies.iter().copied().fold(start, f);
+        let (lo, hi) = (
+            fold(f64::min, f64::INFINITY),
+            fold(f64::max, f64::NEG_INFINITY),
+        );
+        format!(
+            "over {} encodings (the one as run and {} with each input sample times 1 + u x {:e}, u uniform in [-1, 1)): mean {:.1}%, 95 % interval [{:.1}%, {:.1}%] (bootstrap over encodings and recordings); from {:.1}% to {:.1}%",
+            self.accuracies.len(),
+            self.accuracies.len() - 1,
+            self.perturbation,
+            100.0 * self.combined.estimate,
+            100.0 * self.combined.lower,
+            100.0 * self.combined.upper,
+            100.0 * lo,
+            100.0 * hi
+        )
+    }
 }
 
 /// One evaluation's result, with everything its JSON and text need.
@@ -58,6 +93,8 @@ pub struct Evaluation {
     /// The encoding and the encoder as run (`encoding sa; encoder: Izhikevich (2003)
     /// neurons, ..., overshoot kept ..., gain G = 8`): the text's second line.
     pub encoder: String,
+    /// With `--encoder-draws` above 1: the accuracy over the recordings' encodings.
+    pub draws: Option<EncoderDraws>,
     /// The grid's columns, to print per-taxel accuracies in place.
     pub cols: usize,
     /// Each table row's recording, for the out-of-fold predictions.
@@ -156,6 +193,7 @@ impl Evaluation {
             advice: None,
             classifier: None,
             encoder: String::new(),
+            draws: None,
             cols: grid.cols(),
             metas,
         })
@@ -203,6 +241,9 @@ impl Evaluation {
         }
         value["metrics"] = serde_json::to_value(&self.metrics)?;
         value["accuracy_interval"] = serde_json::to_value(&self.interval)?;
+        if let Some(draws) = &self.draws {
+            value["encoder_draws"] = serde_json::to_value(draws)?;
+        }
         // How the accuracy was obtained, in words and, for cross-validation, as numbers.
         value["protocol"] = split_text(&self.split).into();
         if let Split::CrossValidation { cv, group_by, .. } = &self.split {
@@ -258,6 +299,9 @@ impl Evaluation {
             metrics.classes_present,
             100.0 * metrics.chance_majority
         );
+        if let Some(draws) = &self.draws {
+            let _ = writeln!(out, "{}", draws.text());
+        }
         confusion_text(&mut out, outcome);
         if let Some(taxels) = &self.taxels {
             taxels_text(&mut out, taxels, outcome);

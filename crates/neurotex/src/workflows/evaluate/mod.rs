@@ -1,6 +1,7 @@
 //! `evaluate`: a classifier on a dataset's features, by cross-validation or by training on
 //! some conditions (speeds, trials, sessions: any manifest column) and testing on others.
 
+pub mod draws;
 pub mod evaluation;
 
 use std::path::PathBuf;
@@ -18,7 +19,7 @@ use crate::progress::Progress;
 use crate::recording::{Dataset, Selection};
 use crate::samples::MethodChoice;
 use crate::{Cell, Result, Speed};
-use evaluation::{Evaluation, Spikes};
+use evaluation::{EncoderDraws, Evaluation, Spikes};
 
 /// The method evaluated when neither `--method` nor a classifier that implies one is
 /// given: the paper's 3D-GLCM.
@@ -62,6 +63,16 @@ pub struct EvaluateOptions {
     /// Cross-validation repeats with different shuffles.
     #[cfg_attr(feature = "cli", arg(long, default_value_t = crate::classify::CvParams::default().repeats))]
     pub repeats: usize,
+    /// Encodings of every recording: the input as run, then N - 1 more with each of its
+    /// conditioned samples times 1 + u x 1e-12 (u uniform in [-1, 1), a stream per seed,
+    /// encoding and recording), the classifier evaluated on each under the same split. The
+    /// accuracy is then also given as the mean over the encodings, with an interval that
+    /// resamples encodings as well as recordings: spiking neurons turn rounding-level input
+    /// changes into moved spikes, which can move an accuracy by several points, and the
+    /// interval over recordings alone does not hold that. Costs N times the encoding and
+    /// the evaluation; 1 (the default) evaluates the input as run only.
+    #[cfg_attr(feature = "cli", arg(long = "encoder-draws", default_value_t = 1))]
+    pub encoder_draws: usize,
     /// Only recordings at these speeds (mm/s, comma-separated); default all.
     #[cfg_attr(
         feature = "cli",
@@ -271,6 +282,26 @@ impl EvaluateOptions {
         Ok(())
     }
 
+    /// With the spiking network: its note on short windows, and a stage of one step per
+    /// epoch of each fit (minutes on long slides).
+    fn say_training(
+        &self,
+        classifier: ClassifierChoice,
+        dataset: &Dataset,
+        indices: &[usize],
+        on: OnProgress,
+    ) {
+        if let ClassifierChoice::Snn(snn) = classifier {
+            if let Some(note) = snn.short_window() {
+                on(Progress::Say(&note));
+            }
+            on(Progress::Stage(
+                "training the spiking network (epochs of every fit)",
+                self.fits(dataset, indices) * snn.epochs,
+            ));
+        }
+    }
+
     /// Runs the evaluation on `dataset` with the stage options `stages`.
     ///
     /// # Errors
@@ -287,6 +318,7 @@ impl EvaluateOptions {
                 .with_method(self.method, DEFAULT_METHOD, self.knn.params()?)?;
         let split = self.split()?;
         let columns = self.columns()?;
+        draws::check(self.encoder_draws)?;
         let indices = self.indices(dataset)?;
         let mut notes = self.fewer_groups(dataset, &indices);
         notes.iter().for_each(|note| on(Progress::Advice(note)));
@@ -303,16 +335,7 @@ impl EvaluateOptions {
         // classifier over them under the split, the result summarised.
         let samples = spikes.samples(method, columns, &classifier, self.tau_ms)?;
         let all: Vec<usize> = (0..samples.metas().len()).collect();
-        if let ClassifierChoice::Snn(snn) = classifier {
-            if let Some(note) = snn.short_window() {
-                on(Progress::Say(&note));
-            }
-            // Minutes on long slides: one step per epoch of each fit.
-            on(Progress::Stage(
-                "training the spiking network (epochs of every fit)",
-                self.fits(dataset, &indices) * snn.epochs,
-            ));
-        }
+        self.say_training(classifier, dataset, &indices, on);
         let outcome = evaluator(classifier, samples)?(&all, &split, on)?;
         let chosen = (method, columns);
         let evaluation = Evaluation::of(spikes, chosen, outcome, &split, self.tau_ms, self.seed)?;
@@ -320,6 +343,17 @@ impl EvaluateOptions {
             classifier: Some(classifier.to_string()),
             ..evaluation
         };
+        let run = draws::Run {
+            dataset,
+            pipeline: &pipeline,
+            grid: &grid,
+            indices: &indices,
+            chosen,
+            classifier,
+            split: &split,
+            tau_ms: self.tau_ms,
+        };
+        let evaluation = draws::with_draws(&run, evaluation, self.encoder_draws, self.seed, on)?;
         if let Some(note) = evaluation.chance_note() {
             on(Progress::Advice(&note));
             notes.push(note);
