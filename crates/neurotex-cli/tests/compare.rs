@@ -287,7 +287,7 @@ fn nested_selection_too_small_for_its_inner_folds_stops_before_any_candidate_run
     let run = dir.run(&base);
     assert!(run.status.success(), "{}", run.stderr);
     assert!(
-        run.stderr.contains("note: --nested computes"),
+        run.stderr.contains("was not computed (add --nested)"),
         "{}",
         run.stderr
     );

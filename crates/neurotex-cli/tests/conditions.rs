@@ -205,7 +205,7 @@ fn train_where_and_test_where_split_on_a_session_column() {
     ];
     let text = dir.ok(&[&args[..], &split].concat());
     assert!(
-        text.contains("train on session in [morning], test on session in [evening]"),
+        text.contains("train on session in morning, test on session in evening"),
         "{text}"
     );
     let split = [

@@ -28,6 +28,7 @@ def cli_json(*args):
       "test_where": "trial=3,4", "bin_ms": 100},
      ["--method", "taxel", "--taxel", "1,2", "--train-where", "trial=0,1,2",
       "--test-where", "trial=3,4", "--bin-ms", "100"]),
+    ({"speeds": [10], "encoder_draws": 3}, ["--speeds", "10", "--encoder-draws", "3"]),
     ({"classifier": "snn", "classifier_options": {"hidden": 8, "epochs": 2}, "folds": 2,
       "speeds": [5]},
      ["--classifier", "snn", "--snn-hidden", "8", "--snn-epochs", "2", "--folds", "2",
@@ -37,6 +38,11 @@ def test_evaluate_on_a_folder_is_the_clis_json(sim_dir, py_args, cli_args):
     ours = neurotex.evaluate(sim_dir, **py_args)
     assert ours == cli_json("--dataset", sim_dir, *cli_args)
     assert 0.0 <= ours["accuracy"] <= 1.0
+    if "encoder_draws" in py_args:
+        assert len(ours["encoder_draws"]["accuracies"]) == 3
+        assert ours["encoder_draws"]["accuracies"][0] == ours["accuracy"]
+    else:
+        assert "encoder_draws" not in ours
 
 
 def test_gain_auto_is_calibrated_and_said(sim_dir):
