@@ -53,16 +53,23 @@ impl EncoderDraws {
             fold(f64::min, f64::INFINITY),
             fold(f64::max, f64::NEG_INFINITY),
         );
+        let each = match lo == hi {
+            true => format!("every encoding {:.1}%", 100.0 * lo),
+            false => format!(
+                "each encoding from {:.1}% to {:.1}%",
+                100.0 * lo,
+                100.0 * hi
+            ),
+        };
         format!(
-            "over {} encodings (the one as run and {} with each input sample times 1 + u x {:e}, u uniform in [-1, 1)): mean {:.1}%, 95 % interval [{:.1}%, {:.1}%] (bootstrap over encodings and recordings); from {:.1}% to {:.1}%",
+            "the accuracy above is the encoding as run's; over {} encodings (the one as run and {} with each input sample times 1 + u x {:e}, u uniform in [-1, 1)): mean {:.1}%, 95 % interval [{:.1}%, {:.1}%] ({}); {each}",
             self.accuracies.len(),
             self.accuracies.len() - 1,
             self.perturbation,
             100.0 * self.combined.estimate,
             100.0 * self.combined.lower,
             100.0 * self.combined.upper,
-            100.0 * lo,
-            100.0 * hi
+            self.combined.described(),
         )
     }
 }
