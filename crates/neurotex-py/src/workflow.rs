@@ -135,8 +135,9 @@ fn parsed<T: std::str::FromStr<Err = neurotex::error::ParamError>>(
 /// does, through its workflow: the method and classifier as `train_dataset` takes them,
 /// the cross-validation's `folds`, `repeats` and `seed` (`None`: the CLI's defaults), or a
 /// train/test split by speeds or by manifest column (`train_where="trial=0,1"`),
-/// `group_by`, and the encodings of every recording (`encoder_draws`). Returns the evaluation as the CLI's JSON object; what the workflow says goes
-/// to Python's log as it is said.
+/// `group_by`, and the encodings of every recording (`encoder_draws`). Returns the
+/// evaluation as the CLI's JSON object; what the workflow says goes to Python's log as it
+/// is said.
 #[pyfunction]
 #[pyo3(signature = (path, method, classifier, classifier_options, options, folds=None,
     repeats=None, seed=0, speeds=None, train_speeds=None, test_speeds=None, train_where=None,

@@ -469,8 +469,8 @@ fn seconds(s: f64) -> String {
     }
 }
 
-/// A value in a sensor's own units to four significant digits (`209.0`, `0.01230`,
-/// `51230`): raw counts and volts alike, with no digits a log cannot hold.
+/// A value in a sensor's own units to four significant digits, or its whole part where
+/// that is longer (`209.0`, `0.01230`, `51234`): raw counts and volts alike.
 fn significant(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");

@@ -272,7 +272,8 @@ fn across_seeds(r: &Results) -> String {
     out + &t.render() + "\n"
 }
 
-/// `Holds (paired test) x3, Not shown (paired test not significant everywhere) x2`, in first-seen order.
+/// `Holds (paired test) x3, Not shown (paired test not significant everywhere) x2`, in
+/// first-seen order.
 fn verdict_counts(verdicts: &[crate::experiments::Verdict]) -> String {
     let mut seen: Vec<(crate::experiments::Verdict, usize)> = Vec::new();
     for v in verdicts {

@@ -25,22 +25,27 @@ use super::super::OnProgress;
 /// (`reproduce`'s default).
 pub const PERTURBATION: f64 = 1e-12;
 
-/// Checks a count of encodings: at least 1 (the one as run alone), at most
-/// [`MAX_ENCODER_DRAWS`].
+/// Checks a count of encodings of `dataset`'s recordings before any is read: at least 1
+/// (the one as run alone), at most [`MAX_ENCODER_DRAWS`], and 1 for address events.
 ///
 /// # Errors
-/// A count out of that range.
-pub fn check(encodings: usize) -> Result<()> {
-    if (1..=MAX_ENCODER_DRAWS).contains(&encodings) {
-        return Ok(());
-    }
-    Err(OptionsError::Invalid {
-        option: "--encoder-draws",
-        reason: format!(
+/// A count out of that range, or above 1 on address events (they skip the encoder).
+pub fn check(encodings: usize, dataset: &Dataset) -> Result<()> {
+    if !(1..=MAX_ENCODER_DRAWS).contains(&encodings) {
+        let reason = format!(
             "1 (the input as run only) to {MAX_ENCODER_DRAWS} encodings of each recording, got {encodings}"
-        ),
+        );
+        let option = "--encoder-draws";
+        return Err(OptionsError::Invalid { option, reason }.into());
     }
-    .into())
+    if encodings > 1 && dataset.is_events() {
+        let why = format!(
+            "{} holds address events, which skip the encoder: --encoder-draws perturbs the sampled signal the encoder receives",
+            dataset.root.display()
+        );
+        return Err(OptionsError::Conflict(why).into());
+    }
+    Ok(())
 }
 
 /// What an evaluation ran, to run it again on other encodings of its recordings.
@@ -89,21 +94,13 @@ pub(super) fn with_draws(
 /// dataset, so an evaluation of the same recordings perturbs them alike.
 ///
 /// # Errors
-/// A dataset of address events (they skip the encoder), a recording that cannot be read,
-/// or an evaluation that fails.
+/// A recording that cannot be read, or an evaluation that fails.
 pub(super) fn over_encodings(
     run: &Run<'_>,
     as_run: &Evaluation,
     draws: Draws,
     on: OnProgress,
 ) -> Result<EncoderDraws> {
-    if run.dataset.is_events() {
-        let why = format!(
-            "{} holds address events, which skip the encoder: --encoder-draws perturbs the sampled signal the encoder receives",
-            run.dataset.root.display()
-        );
-        return Err(OptionsError::Conflict(why).into());
-    }
     let per_draw = perturbed(run, draws, on)?;
     on(Progress::Stage(
         "evaluating the perturbed encodings",

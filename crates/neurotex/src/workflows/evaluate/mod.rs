@@ -318,7 +318,7 @@ impl EvaluateOptions {
                 .with_method(self.method, DEFAULT_METHOD, self.knn.params()?)?;
         let split = self.split()?;
         let columns = self.columns()?;
-        draws::check(self.encoder_draws)?;
+        draws::check(self.encoder_draws, dataset)?;
         let indices = self.indices(dataset)?;
         let mut notes = self.fewer_groups(dataset, &indices);
         notes.iter().for_each(|note| on(Progress::Advice(note)));
