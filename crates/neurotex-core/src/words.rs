@@ -1,6 +1,7 @@
 //! Parser messages in a user's words: serde's, the standard library's number parsing's,
 //! and TOML's and JSON's errors with their line, each saying what the file was expected to
-//! hold rather than the parser's type names; and signed differences as reports print them.
+//! hold rather than the parser's type names; signed differences as reports print them;
+//! counts with their nouns.
 
 /// A difference with its sign and one decimal (`+12.3`, `-0.4`), and `0.0` for one that
 /// rounds to zero, never `-0.0` or `+0.0`: a difference of accuracies in points, as the
@@ -10,6 +11,15 @@ pub fn signed_one_decimal(x: f64) -> String {
     match text.as_str() {
         "+0.0" | "-0.0" => "0.0".to_string(),
         _ => text,
+    }
+}
+
+/// A count with its noun, singular for one (`1 cell`, `7 cells`, `0 repeats`): the noun
+/// takes a plain `s` in the plural.
+pub fn counted(n: usize, noun: &str) -> String {
+    match n {
+        1 => format!("1 {noun}"),
+        _ => format!("{n} {noun}s"),
     }
 }
 
@@ -100,7 +110,13 @@ pub fn json_error(e: &serde_json::Error) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::signed_one_decimal;
+    use super::{counted, signed_one_decimal};
+
+    #[test]
+    fn a_count_takes_its_noun_in_the_singular_for_one_only() {
+        let said = [0, 1, 2, 7].map(|n| counted(n, "cell"));
+        assert_eq!(said, ["0 cells", "1 cell", "2 cells", "7 cells"]);
+    }
 
     #[test]
     fn a_difference_that_rounds_to_zero_has_no_sign() {

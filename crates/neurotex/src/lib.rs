@@ -9,7 +9,7 @@
 //!
 //! | layer | crate | modules |
 //! |---|---|---|
-//! | values, errors, recordings, event files, readers, import, outputs, progress | `neurotex-core` | [`values`], [`error`], [`recording`], [`events`], [`csvlog`], [`import`], [`io`], [`progress`] |
+//! | values, errors, recordings, event files, readers, import, outputs, progress, words | `neurotex-core` | [`values`], [`error`], [`recording`], [`events`], [`csvlog`], [`import`], [`io`], [`progress`], [`words`] |
 //! | conditioning and spike encoding | `neurotex-signal` | [`signal`], [`encode`] |
 //! | spike statistics and GLCM features | `neurotex-features` | [`features`] |
 //! | classifiers, the spiking network, cross-validation, statistics | `neurotex-learn` | [`classify`], [`snn`] |
@@ -24,7 +24,7 @@
 //! or parameter at fault. `ARCHITECTURE.md` follows one recording through the layers.
 #![deny(missing_docs)]
 
-pub use neurotex_core::{csvlog, error, events, import, io, progress, recording, values};
+pub use neurotex_core::{csvlog, error, events, import, io, progress, recording, values, words};
 pub use neurotex_core::{BySpeed, Cell, Error, Grid, Result, SampleRate, Speed};
 pub use neurotex_experiments::experiments;
 pub use neurotex_features::features;

@@ -83,8 +83,8 @@ pub fn run(args: PredictArgs) -> Result<()> {
     }
     let (with, n) = (model.described(&o.model), predictions.len());
     eprintln!(
-        "{n} recording{} predicted with {with}{} -> {}",
-        if n == 1 { "" } else { "s" },
+        "{} predicted with {with}{} -> {}",
+        neurotex::words::counted(n, "recording"),
         o.model.display(),
         shown(&args.out)
     );

@@ -6,7 +6,7 @@
 pub enum ImportWarning {
     /// Fewer channels than grid cells and no channel map: the channels fill the grid row by
     /// row, so cells that are neighbours on the grid need not be on the sensor.
-    #[error("{channels} channels on a {rows}x{cols} grid fill it row by row and leave {} empty, so taxels that are neighbours on the grid (what the GLCM compares) need not be neighbours on the sensor; {}", cells(rows * cols - channels), grid_advice(*channels))]
+    #[error("{channels} channels on a {rows}x{cols} grid fill it row by row and leave {} empty, so taxels that are neighbours on the grid (what the GLCM compares) need not be neighbours on the sensor; {}", crate::words::counted(rows * cols - channels, "cell"), grid_advice(*channels))]
     GridNotFilled {
         /// Channels imported.
         channels: usize,
@@ -37,15 +37,6 @@ pub enum ImportWarning {
         /// Recordings imported.
         total: usize,
     },
-}
-
-/// "1 cell" or "n cells".
-pub(super) fn cells(n: usize) -> String {
-    if n == 1 {
-        "1 cell".to_owned()
-    } else {
-        format!("{n} cells")
-    }
 }
 
 /// What places `channels` channels on the grid the sensor has.

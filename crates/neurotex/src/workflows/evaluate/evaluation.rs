@@ -5,6 +5,7 @@
 //! by one, as JSON and as text, and each recording's out-of-fold prediction as CSV.
 
 use crate::values::shown_label;
+use crate::words::counted;
 use std::fmt::Write as _;
 use std::io::Write;
 
@@ -369,14 +370,14 @@ fn split_text(split: &Split) -> String {
             recordings_at(speeds.as_deref()),
             cv.folds,
             cv.seed,
-            repeats(cv.repeats)
+            counted(cv.repeats, "repeat")
         ),
         Split::CrossValidation { cv, speeds, .. } => format!(
             "{}, {}-fold stratified CV, seed {}, {}",
             recordings_at(speeds.as_deref()),
             cv.folds,
             cv.seed,
-            repeats(cv.repeats)
+            counted(cv.repeats, "repeat")
         ),
         Split::Where { train, test } => {
             format!("train on {}, test on {}", selected(train), selected(test))
@@ -387,11 +388,6 @@ fn split_text(split: &Split) -> String {
             test.len()
         ),
     }
-}
-
-/// `1 repeat`, `10 repeats`.
-fn repeats(n: usize) -> String {
-    format!("{n} repeat{}", if n == 1 { "" } else { "s" })
 }
 
 /// The recordings cross-validation runs over, as text.
