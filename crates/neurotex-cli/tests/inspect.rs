@@ -252,6 +252,14 @@ fn a_dataset_folder_is_inspected_and_written_whole() {
         text.contains("severe: [signals]") && text.contains("--baseline min"),
         "{text}"
     );
+    // the encoder's line names the neurons it checked, the paper's by default
+    assert!(
+        text.contains("encoder (Izhikevich neurons of type RS) at gain 8:"),
+        "{text}"
+    );
+    let json = dir.ok(&["inspect", "ds", "--json", "--preset", "fs"]);
+    let json: Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(json["encoder"]["neurons"], "FS", "{json}");
     for f in [
         "inspect.md",
         "inspect.json",

@@ -125,6 +125,9 @@ pub struct TaxelRate {
 /// The encoder at the chosen gain.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EncoderCheck {
+    /// The Izhikevich firing type of the neurons checked (`RS`, the paper's, or another
+    /// preset); `None` when their `a`, `b`, `c` and `d` are no preset's.
+    pub neurons: Option<String>,
     /// The gain checked.
     pub gain: f64,
     /// The rate of a neuron held at the largest input, Hz.
@@ -377,6 +380,7 @@ pub(super) fn encoder_check(
         }
     };
     Ok(EncoderCheck {
+        neurons: crate::encode::FiringType::of(&encoder).map(|t| t.name().to_string()),
         gain: encoder.gain,
         ceiling_hz,
         taxels,

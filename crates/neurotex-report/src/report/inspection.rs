@@ -8,7 +8,7 @@ use super::figures::inspect as figs;
 use super::figures::{svg_and_png, FigureError};
 use super::folder_source;
 use crate::error::{DataError, Result};
-use crate::inspect::{Finding, Inspection, Severity};
+use crate::inspect::{EncoderCheck, Finding, Inspection, Severity};
 use crate::io::replace_dir;
 
 /// `a, b and 3 more`.
@@ -76,7 +76,8 @@ pub fn text_lines(i: &Inspection) -> Vec<String> {
         rates.sort_by(f64::total_cmp);
         let mid = rates.get(rates.len() / 2).copied().unwrap_or(0.0);
         out.push(format!(
-            "encoder at gain {}: median taxel {mid:.1} Hz, {silent} of {} taxels silent in most recordings",
+            "encoder ({}) at gain {}: median taxel {mid:.1} Hz, {silent} of {} taxels silent in most recordings",
+            neurons(e),
             e.gain,
             e.taxels.len()
         ));
@@ -314,13 +315,25 @@ fn signals_section(i: &Inspection) -> String {
     md
 }
 
+/// The neurons `e` checked: `Izhikevich neurons of type RS`, or without a type when their
+/// parameters are no preset's.
+fn neurons(e: &EncoderCheck) -> String {
+    match &e.neurons {
+        Some(t) => format!("Izhikevich neurons of type {t}"),
+        None => "Izhikevich neurons of no preset type".to_string(),
+    }
+}
+
 fn encoder_section(i: &Inspection) -> String {
     let Some(e) = &i.encoder else {
         return "\n## Encoder\n\nNot checked.\n".to_string();
     };
     let mut md = format!(
-        "\n## Encoder at gain {}\n\nA neuron held at the largest input fires at {:.0} Hz (the ceiling). {} recording(s) had no positive signal.",
-        e.gain, e.ceiling_hz, e.flat
+        "\n## Encoder at gain {}\n\n{}. A neuron held at the largest input fires at {:.0} Hz (the ceiling). {} had no positive signal.",
+        e.gain,
+        neurons(e),
+        e.ceiling_hz,
+        neurotex_core::words::counted(e.flat, "recording")
     );
     match (&e.auto, &e.auto_error) {
         (Some(a), _) => {
