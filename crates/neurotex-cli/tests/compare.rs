@@ -3,7 +3,7 @@
 
 use serde_json::Value;
 
-use crate::util::{s, Dir};
+use crate::util::{floats, s, Dir};
 
 /// `{"results": [{"encoding", "method", "classifier", "accuracy", "ci": [lo, hi],
 /// "p_vs_paper"}, ...], "best": {...}}`, ranked, each accuracy inside its interval.
@@ -566,4 +566,73 @@ fn the_text_ranking_names_its_columns_and_its_caveat_fits_the_protocol() {
         plain.contains("when nested selection is asked for"),
         "{plain}"
     );
+}
+
+#[test]
+fn encoder_draws_give_each_spike_candidate_its_accuracy_over_encodings() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B", "C"], &[5.0, 10.0], 6);
+    let run = |draws: &str, json: bool| {
+        let mut args = vec![
+            "compare",
+            "--dataset",
+            s(&ds),
+            "--per",
+            "speed_mm_s",
+            "--encodings",
+            "none,sa",
+            "--methods",
+            "glcm3d,rates",
+            "--classifiers",
+            "knn",
+            "--repeats",
+            "1",
+            "--encoder-draws",
+            draws,
+        ];
+        if json {
+            args.push("--json");
+        }
+        dir.ok(&args)
+    };
+    let three: Value = serde_json::from_str(&run("3", true)).unwrap();
+    has_the_documented_shape(&three);
+    let plain: Value = serde_json::from_str(&run("1", true)).unwrap();
+    let rows = three["results"].as_array().unwrap();
+    for (row, as_run) in rows.iter().zip(plain["results"].as_array().unwrap()) {
+        // The ranking is that of the encoding as run.
+        for key in ["encoding", "method", "accuracy", "ci", "p_vs_paper"] {
+            assert_eq!(row[key], as_run[key], "{key}");
+        }
+        assert!(as_run.get("over_encodings").is_none());
+        let Some(over) = row.get("over_encodings") else {
+            assert_eq!(row["encoding"], "none", "{row}");
+            continue;
+        };
+        let accuracies = floats(&over["accuracies"]);
+        assert_eq!(accuracies.len(), 3);
+        assert_eq!(accuracies[0], row["accuracy"].as_f64().unwrap());
+        let mean = over["mean"].as_f64().unwrap();
+        assert!((mean - accuracies.iter().sum::<f64>() / 3.0).abs() < 1e-12);
+        let [lower, upper] = [0, 1].map(|k| over["ci"][k].as_f64().unwrap());
+        assert!(lower <= accuracies[0] && accuracies[0] <= upper, "{over}");
+        assert_eq!(over["perturbation"], 1e-12);
+    }
+    assert_eq!(rows.iter().filter(|r| r["encoding"] == "sa").count(), 2);
+    // The same encodings and numbers on every run.
+    let again: Value = serde_json::from_str(&run("3", true)).unwrap();
+    let overs = |v: &Value| -> Vec<Value> {
+        let rows = v["results"].as_array().unwrap();
+        rows.iter().map(|r| r["over_encodings"].clone()).collect()
+    };
+    assert_eq!(overs(&again), overs(&three));
+    let text = run("3", false);
+    assert!(
+        text.contains(
+            "over 3 encodings (the input as run, whose accuracy the ranking shows, and 2 with"
+        ),
+        "{text}"
+    );
+    let err = dir.fails(&["compare", "--dataset", s(&ds), "--encoder-draws", "0"]);
+    assert!(err.contains("--encoder-draws"), "{err}");
 }

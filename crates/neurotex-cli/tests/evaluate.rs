@@ -1,6 +1,6 @@
 //! `neurotex features` and `neurotex evaluate` on a dataset, and their bad options.
 
-use crate::util::{s, Dir};
+use crate::util::{floats, s, Dir};
 
 #[test]
 fn features_and_evaluate_on_a_dataset() {
@@ -440,12 +440,7 @@ fn encoder_draws_give_the_accuracy_over_encodings() {
     let draws = |n: &str| dir.evaluate_json(&ds, "glcm3d", &["--encoder-draws", n]);
     let three = draws("3");
     let over = &three["encoder_draws"];
-    let accuracies: Vec<f64> = over["accuracies"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|a| a.as_f64().unwrap())
-        .collect();
+    let accuracies = floats(&over["accuracies"]);
     assert_eq!(accuracies.len(), 3);
     assert_eq!(accuracies[0], three["accuracy"].as_f64().unwrap());
     let mean = accuracies.iter().sum::<f64>() / 3.0;

@@ -253,3 +253,12 @@ pub fn relabel(data: &Path, label_of: impl Fn(usize) -> &'static str) {
     }
     std::fs::write(data.join("manifest.csv"), relabelled).unwrap();
 }
+
+/// The numbers of a JSON array.
+pub fn floats(v: &Value) -> Vec<f64> {
+    let values = v.as_array().expect("a JSON array");
+    values
+        .iter()
+        .map(|x| x.as_f64().expect("a number"))
+        .collect()
+}

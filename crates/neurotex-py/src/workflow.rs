@@ -213,13 +213,15 @@ fn listed(names: Option<Vec<String>>, standard: &str) -> Vec<String> {
 /// `test_where`; pooled without), `group_by`, the cross-validation's `folds`, `repeats`
 /// and `seed` (`None`: the CLI's), `nested` selection with its `inner_folds` (`None`: each
 /// of the other outer folds held out in turn; refused without `nested`, as
-/// `--inner-folds` is), KNN's `knn` knobs and the network's `snn` knobs. With `out`, also writes compare.json, compare.md and the
+/// `--inner-folds` is), KNN's `knn` knobs, the network's `snn` knobs and the encodings of
+/// every recording (`encoder_draws`). With `out`, also writes compare.json, compare.md and the
 /// figures there, as `--out`. Returns the comparison as the CLI's JSON object; what the
 /// workflow says goes to Python's log as it is said.
 #[pyfunction]
 #[pyo3(signature = (path, options, knn, snn, encodings=None, methods=None, classifiers=None,
     speeds=None, per=None, hold_out=None, train_where=None, test_where=None, group_by=None,
-    folds=None, repeats=None, seed=0, nested=false, inner_folds=None, tau_ms=None, out=None))]
+    folds=None, repeats=None, seed=0, nested=false, inner_folds=None, tau_ms=None, out=None,
+    encoder_draws=1))]
 #[allow(clippy::too_many_arguments)]
 fn compare_dataset(
     py: Python<'_>,
@@ -243,6 +245,7 @@ fn compare_dataset(
     inner_folds: Option<usize>,
     tau_ms: Option<f64>,
     out: Option<PathBuf>,
+    encoder_draws: usize,
 ) -> PyResult<Py<PyAny>> {
     use neurotex::compare::candidates as standard;
     let stages = params::stage_options(options)?;
@@ -277,6 +280,7 @@ fn compare_dataset(
         seed,
         nested,
         inner_folds,
+        encoder_draws,
         open: OpenOptions::default(),
     };
     let dataset = open(&path)?;

@@ -123,6 +123,20 @@ def test_compare_on_a_folder_is_the_clis_json(sim_dir, tmp_path):
         neurotex.compare(sim_dir, snn_options={"trees": 3})
 
 
+def test_compare_over_encodings_is_the_clis_json(sim_dir):
+    """`encoder_draws` is `--encoder-draws`: each spike candidate's accuracy over the
+    encodings, the encoding as run first."""
+    ours = neurotex.compare(sim_dir, encodings=["sa"], methods=["glcm3d"],
+                            classifiers=["knn"], per="speed_mm_s", folds=3, encoder_draws=2)
+    cli = json.loads(run_cli("compare", "--dataset", sim_dir, "--encodings", "sa",
+                             "--methods", "glcm3d", "--classifiers", "knn", "--per",
+                             "speed_mm_s", "--folds", "3", "--encoder-draws", "2",
+                             "--json").stdout)
+    assert untimed(ours) == untimed(cli)
+    over = ours["best"]["over_encodings"]
+    assert len(over["accuracies"]) == 2 and over["accuracies"][0] == ours["best"]["accuracy"]
+
+
 def test_an_estimate_at_chance_is_a_warning(sim_dir, tmp_path, caplog):
     """The workflow's warnings reach Python's log at WARNING, which Python shows without
     any logging set up: here labels that the textures do not carry (each recording's

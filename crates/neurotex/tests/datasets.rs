@@ -663,6 +663,7 @@ fn compare_nested_per_speed(dataset: &Path, folds: usize, seed: u64) -> Comparis
         seed,
         nested: true,
         inner_folds: None,
+        encoder_draws: 1,
         open: OpenOptions::default(),
     };
     let opened = compare.open.open(dataset).unwrap();

@@ -204,6 +204,40 @@ pub struct Ranked {
     pub seconds: f64,
     /// Whether this is the paper's method.
     pub paper: bool,
+    /// The accuracy over several encodings of the recordings (the one as run and copies of
+    /// its input perturbed at the level of rounding), when the comparison made them and
+    /// the candidate passes through the encoder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub over_encodings: Option<AcrossEncodings>,
+}
+
+/// A candidate's accuracy over several encodings of the same recordings: the one as run,
+/// whose accuracy the ranking shows, and copies of the encoder's input perturbed at the
+/// level of rounding. Spiking neurons turn such changes into moved spikes, which can move
+/// an accuracy by points; the interval holds that as well as the recordings drawn.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AcrossEncodings {
+    /// The accuracy under each encoding, the one as run first.
+    pub accuracies: Vec<f64>,
+    /// Their mean.
+    pub mean: f64,
+    /// The 95 % percentile-bootstrap interval where one encoding's accuracy may land: each
+    /// resample draws one encoding and resamples the units (within each condition) as the
+    /// ranking's interval does.
+    pub ci: [f64; 2],
+    /// The relative size of the perturbations (each conditioned sample times `1 + u x
+    /// perturbation`, `u` uniform in [-1, 1)).
+    pub perturbation: f64,
+}
+
+impl AcrossEncodings {
+    /// The lowest and highest accuracy of any encoding.
+    pub fn range(&self) -> (f64, f64) {
+        let values = self.accuracies.iter().copied();
+        values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
+            (lo.min(a), hi.max(a))
+        })
+    }
 }
 
 /// Choosing the best candidate inside each training set, scored on the test set.
@@ -361,6 +395,37 @@ pub fn compare_keeping(
     progress: &(dyn Fn(Progress) + Sync),
     keep: Option<&dyn Keep>,
 ) -> Result<Comparison> {
+    let none = Perturbed {
+        candidates: &[],
+        size: 0.0,
+    };
+    compare_over_encodings(candidates, none, params, progress, keep)
+}
+
+/// The candidates of further encodings of the same recordings: `candidates[e]` those of
+/// encoding `e + 1`, made alike from the encoder's input perturbed by `size`.
+#[derive(Clone, Copy)]
+pub struct Perturbed<'a> {
+    /// Per further encoding, its candidates (those that pass through the encoder).
+    pub candidates: &'a [Vec<Candidate>],
+    /// The perturbations' relative size.
+    pub size: f64,
+}
+
+/// [`compare_keeping`], each candidate that `perturbed` holds under every further encoding
+/// (by name) also scored there, under the same parts of the protocol, and given its
+/// accuracy over the encodings ([`Ranked::over_encodings`]). The ranking, its tests and
+/// nested selection are those of the encoding as run.
+///
+/// # Errors
+/// As [`compare_keeping`].
+pub fn compare_over_encodings(
+    candidates: &[Candidate],
+    perturbed: Perturbed<'_>,
+    params: &CompareParams,
+    progress: &(dyn Fn(Progress) + Sync),
+    keep: Option<&dyn Keep>,
+) -> Result<Comparison> {
     let metas = shared_recordings(candidates)?;
     // Candidates are scored side by side, each part of the protocol (a condition, a
     // held-out value) on its own (each evaluation is deterministic, so the order of work
@@ -382,19 +447,15 @@ pub fn compare_keeping(
     ));
     let scored = score_all(candidates, &parts, params, progress, keep)?;
     let units = Units::new(metas, &scored[0].shares, params)?;
-    let paper = candidates.iter().position(Candidate::is_paper);
-    let counts = |c: &Candidate| candidates.iter().position(|o| c.counts_of(o));
-    // Each candidate's interval and paired tests resample from their own seeded stream,
-    // thousands of draws per unit: ranked side by side too.
-    let mut results: Vec<Ranked> = candidates
-        .par_iter()
-        .zip(&scored)
-        .map(|(c, s)| {
-            let against = (paper.map(|p| &scored[p]), counts(c).map(|r| &scored[r]));
-            units.rank(c, s, against, params)
-        })
-        .collect::<Result<_>>()?;
-    results.sort_by(|a, b| b.accuracy.total_cmp(&a.accuracy));
+    let over = over_encodings(
+        candidates,
+        &scored,
+        perturbed,
+        (&parts, &units),
+        params,
+        (progress, keep),
+    )?;
+    let results = ranking(candidates, &scored, over, &units, params)?;
     let nested = match outer {
         Some(splits) => Some(nested(
             candidates,
@@ -432,6 +493,106 @@ pub fn compare_keeping(
         notes,
         provenance: Vec::new(),
     })
+}
+
+/// The candidates ranked by their scores `scored`, best first, each with its accuracy over
+/// the encodings (`over`), its interval and its paired tests.
+///
+/// # Errors
+/// Two candidates a paired test needs were not scored on the same rows.
+fn ranking(
+    candidates: &[Candidate],
+    scored: &[Scored],
+    over: Vec<Option<AcrossEncodings>>,
+    units: &Units,
+    params: &CompareParams,
+) -> Result<Vec<Ranked>> {
+    let paper = candidates.iter().position(Candidate::is_paper);
+    let counts = |c: &Candidate| candidates.iter().position(|o| c.counts_of(o));
+    // Each candidate's interval and paired tests resample from their own seeded stream,
+    // thousands of draws per unit: ranked side by side too.
+    let mut results: Vec<Ranked> = (candidates.par_iter().zip(scored).zip(over))
+        .map(|((c, s), over_encodings)| {
+            let against = (paper.map(|p| &scored[p]), counts(c).map(|r| &scored[r]));
+            Ok(Ranked {
+                over_encodings,
+                ..units.rank(c, s, against, params)?
+            })
+        })
+        .collect::<Result<_>>()?;
+    results.sort_by(|a, b| b.accuracy.total_cmp(&a.accuracy));
+    Ok(results)
+}
+
+/// Each candidate's accuracy over the encoding as run (`scored`) and the further encodings
+/// of `perturbed`, scored under `parts`; `None` for a candidate some further encoding
+/// lacks (a baseline without spikes). The further encodings' pieces are kept under keys
+/// of their own.
+///
+/// # Errors
+/// An evaluation that fails, or a piece that cannot be kept.
+fn over_encodings(
+    candidates: &[Candidate],
+    scored: &[Scored],
+    perturbed: Perturbed<'_>,
+    (parts, units): (&[parts::Part], &Units),
+    params: &CompareParams,
+    (progress, keep): nested::Around<'_>,
+) -> Result<Vec<Option<AcrossEncodings>>> {
+    if perturbed.candidates.is_empty() {
+        return Ok(vec![None; candidates.len()]);
+    }
+    let n: usize = perturbed.candidates.iter().map(Vec::len).sum();
+    progress(Progress::Stage(
+        "candidates on the perturbed encodings",
+        n * parts.len(),
+    ));
+    let further: Vec<Vec<Scored>> = (perturbed.candidates.iter().enumerate())
+        .map(|(e, list)| {
+            let keep = keep.map(|k| Prefixed {
+                keep: k,
+                prefix: format!("encoding {}: ", e + 2),
+            });
+            let keep = keep.as_ref().map(|k| k as &dyn Keep);
+            score_all(list, parts, params, progress, keep)
+        })
+        .collect::<Result<_>>()?;
+    Ok(candidates
+        .iter()
+        .zip(scored)
+        .map(|(c, as_run)| {
+            let name = c.name();
+            let mut all = vec![as_run];
+            for (list, s) in perturbed.candidates.iter().zip(&further) {
+                all.push(&s[list.iter().position(|o| o.name() == name)?]);
+            }
+            let accuracies: Vec<f64> = all.iter().map(|s| s.accuracy).collect();
+            let shares: Vec<&[(usize, f64)]> = all.iter().map(|s| s.shares.as_slice()).collect();
+            Some(AcrossEncodings {
+                mean: mean(accuracies.iter().copied()),
+                ci: units.interval_over_encodings(&shares),
+                accuracies,
+                perturbation: perturbed.size,
+            })
+        })
+        .collect())
+}
+
+/// A keeper whose keys are another's with a prefix: the further encodings' pieces beside
+/// those of the encoding as run.
+struct Prefixed<'a> {
+    keep: &'a dyn Keep,
+    prefix: String,
+}
+
+impl Keep for Prefixed<'_> {
+    fn get(&self, key: &str) -> Option<String> {
+        self.keep.get(&format!("{}{key}", self.prefix))
+    }
+
+    fn put(&self, key: &str, json: &str) -> Result<()> {
+        self.keep.put(&format!("{}{key}", self.prefix), json)
+    }
 }
 
 /// What intervals and tests resample: `recordings`, or `groups of COLUMN`.
@@ -650,6 +811,67 @@ mod tests {
             nested,
             inner_folds: Some(4),
         }
+    }
+
+    #[test]
+    fn each_candidate_gets_its_accuracy_over_the_encodings_it_was_scored_on() {
+        let baseline = Candidate {
+            encoding: "none".into(),
+            ..candidate("spectrum", true)
+        };
+        let as_run = [
+            candidate("glcm3d", false),
+            candidate("good", true),
+            baseline,
+        ];
+        // A further encoding in which the paper's method sees the classes; the baseline
+        // passes through no encoder and has no further encoding.
+        let further = vec![vec![candidate("glcm3d", true), candidate("good", true)]];
+        let perturbed = Perturbed {
+            candidates: &further,
+            size: 1e-12,
+        };
+        let p = params(Protocol::Per("speed_mm_s".into()), false);
+        let silent = &crate::progress::silent;
+        let drawn = compare_over_encodings(&as_run, perturbed, &p, silent, None).unwrap();
+        let plain = compare(&as_run, &p).unwrap();
+        // The ranking is that of the encoding as run (the clocks aside).
+        let without = |c: &Comparison| -> Vec<Ranked> {
+            let strip = |r: &Ranked| Ranked {
+                over_encodings: None,
+                seconds: 0.0,
+                ..r.clone()
+            };
+            c.results.iter().map(strip).collect()
+        };
+        assert_eq!(without(&drawn), without(&plain));
+        assert!(plain.results.iter().all(|r| r.over_encodings.is_none()));
+        let find = |method: &str| drawn.results.iter().find(|r| r.method == method).unwrap();
+        let paper = find("glcm3d");
+        let over = paper.over_encodings.as_ref().unwrap();
+        assert_eq!(over.accuracies, vec![paper.accuracy, 1.0]);
+        assert!(paper.accuracy < 0.7, "{}", paper.accuracy);
+        assert_eq!(over.mean, (paper.accuracy + 1.0) / 2.0);
+        assert_eq!(over.perturbation, 1e-12);
+        // Half the resamples draw the perfect encoding, the rest the one as run.
+        assert_eq!(over.ci[1], 1.0);
+        assert!(
+            over.ci[0] < paper.accuracy && over.ci[0] <= paper.ci[1],
+            "{over:?}"
+        );
+        // Right everywhere under both: the interval of one encoding.
+        let good = find("good");
+        let over = good.over_encodings.as_ref().unwrap();
+        assert_eq!((over.accuracies.clone(), over.mean), (vec![1.0, 1.0], 1.0));
+        assert_eq!(over.ci, good.ci);
+        assert!(find("spectrum").over_encodings.is_none());
+        // Its JSON holds the key only where there are encodings to summarise.
+        let json = serde_json::to_value(&drawn).unwrap();
+        let keyed = |r: &serde_json::Value| r.get("over_encodings").is_some();
+        let rows = json["results"].as_array().unwrap();
+        assert_eq!(rows.iter().filter(|r| keyed(r)).count(), 2);
+        let json = serde_json::to_value(&plain).unwrap();
+        assert!(!json["results"].as_array().unwrap().iter().any(keyed));
     }
 
     #[test]

@@ -110,7 +110,7 @@ fn inner_folds(folds: usize, smallest: usize) -> usize {
 }
 
 /// What nested selection reports its steps to and keeps its finished pieces in.
-type Around<'a> = (&'a (dyn Fn(Progress) + Sync), Option<&'a dyn Keep>);
+pub(super) type Around<'a> = (&'a (dyn Fn(Progress) + Sync), Option<&'a dyn Keep>);
 
 /// Under a hold-out protocol, the column and its values in `split`'s training set when
 /// there are two or more: the inner ranking then holds out each of them in turn.

@@ -92,22 +92,57 @@ impl Units {
         let sizes: Vec<usize> = self.by_condition.iter().map(Vec::len).collect();
         let rounds = self.resamples.max(1);
         let mut means: Vec<f64> = Vec::with_capacity(rounds);
-        for_each_resample(self.seed, &sizes, rounds, |mut picked| {
-            means.push(mean(self.by_condition.iter().map(|units| {
-                let here;
-                (here, picked) = picked.split_at(units.len());
-                let (mut s, mut n) = (0.0, 0usize);
-                for &i in here {
-                    let u = units[i];
-                    s += totals[u].0;
-                    n += totals[u].1;
-                }
-                s / n.max(1) as f64
-            })));
+        for_each_resample(self.seed, &sizes, rounds, |picked| {
+            means.push(self.resampled_mean(&totals, picked));
         });
+        self.percentiles(means)
+    }
+
+    /// [`Units::interval`] over several encodings of the same rows (`shares[e]`, the rows
+    /// in the same order under each): each resample draws one encoding, uniformly, and
+    /// the units within each condition as [`Units::interval`] does, so the interval is
+    /// where one encoding's accuracy may land. With one encoding, [`Units::interval`]
+    /// itself.
+    pub(super) fn interval_over_encodings(&self, shares: &[&[(usize, f64)]]) -> [f64; 2] {
+        if let [one] = shares {
+            return self.interval(one);
+        }
+        let totals: Vec<Vec<(f64, usize)>> = shares.iter().map(|s| self.totals(s)).collect();
+        // The first bound's first index is the encoding; the rest of its indices go unused.
+        let sizes = self.by_condition.iter().map(Vec::len);
+        let bounds: Vec<usize> = std::iter::once(shares.len()).chain(sizes).collect();
+        let rounds = self.resamples.max(1);
+        let mut means: Vec<f64> = Vec::with_capacity(rounds);
+        for_each_resample(self.seed, &bounds, rounds, |picked| {
+            let (encoding, units) = picked.split_at(shares.len());
+            means.push(self.resampled_mean(&totals[encoding[0]], units));
+        });
+        self.percentiles(means)
+    }
+
+    /// The mean over conditions of the row-weighted mean share of one resample's units
+    /// (`picked`: each condition's draws in turn, indices into its units).
+    fn resampled_mean(&self, totals: &[(f64, usize)], mut picked: &[usize]) -> f64 {
+        mean(self.by_condition.iter().map(|units| {
+            let here;
+            (here, picked) = picked.split_at(units.len());
+            let (mut s, mut n) = (0.0, 0usize);
+            for &i in here {
+                let u = units[i];
+                s += totals[u].0;
+                n += totals[u].1;
+            }
+            s / n.max(1) as f64
+        }))
+    }
+
+    /// The 2.5th and 97.5th percentiles of the resampled `means`, or the Wilson score
+    /// interval over the units where they are 0 or 1 alike.
+    fn percentiles(&self, mut means: Vec<f64>) -> [f64; 2] {
         means.sort_by(f64::total_cmp);
         let (lower, upper) = (percentile(&means, 0.025), percentile(&means, 0.975));
-        match wilson_at_the_bounds(lower, upper, sizes.iter().sum()) {
+        let units = self.by_condition.iter().map(Vec::len).sum();
+        match wilson_at_the_bounds(lower, upper, units) {
             Some(w) => [w.lower, w.upper],
             None => [lower, upper],
         }
@@ -183,6 +218,7 @@ impl Units {
             per_condition: s.per_condition.clone(),
             seconds: s.seconds,
             paper: c.is_paper(),
+            over_encodings: None,
         })
     }
 }

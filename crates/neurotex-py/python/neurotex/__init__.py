@@ -689,6 +689,7 @@ def compare(
     snn_options: Optional[Dict[str, Any]] = None,
     out: Optional[Union[str, os.PathLike]] = None,
     causal: bool = False,
+    encoder_draws: int = 1,
     **stage_options: Any,
 ) -> Dict[str, Any]:
     """Compares encodings x feature methods x classifiers on the dataset folder ``path``
@@ -709,7 +710,11 @@ def compare(
     folder also gets compare.json, compare.md and the figures, as ``--out``: a new or
     empty folder, or an earlier output of neurotex, which is replaced whole; any other
     folder is refused before the comparison runs. Stage options (``gain="auto"``,
-    ``bin_ms``, ...) are the CLI's."""
+    ``bin_ms``, ...) are the CLI's. ``encoder_draws`` above 1 encodes every recording
+    that many times (as run, then with rounding-level perturbations of its input) and
+    gives each candidate that reads spikes ``over_encodings``: its accuracy under each
+    encoding, their mean and an interval that draws an encoding as well as the
+    recordings (the ranking stays that of the encoding as run), as ``--encoder-draws``."""
     opts = _stage_options(**stage_options)
     opts["causal"] = bool(causal)
 
@@ -726,7 +731,7 @@ def compare(
         names(encodings, "encodings"), names(methods, "methods"),
         names(classifiers, "classifiers"), only, per, hold_out, train_where, test_where,
         group_by, folds, repeats, int(seed), bool(nested), inner_folds, tau_ms,
-        None if out is None else os.fspath(out))
+        None if out is None else os.fspath(out), int(encoder_draws))
 
 
 def load_dataset(path: Union[str, os.PathLike], rows: Optional[Sequence[int]] = None) -> Dataset:

@@ -43,11 +43,16 @@ pub fn markdown(c: &Comparison) -> String {
         ),
         None => String::new(),
     };
+    let encodings = encodings(c);
+    let (heading, rule) = match encodings {
+        Some(n) => (format!(" over {n} encodings: mean [95% CI] |"), "---|"),
+        None => (String::new(), ""),
+    };
     let mut out = format!(
         "# Comparison\n\n{} recordings{units}, {} classes; {}.\n{design}\
          Chance {:.1}%, majority class {:.1}%.\n\n{nested}\
-         | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) | seconds |\n\
-         |---:|---|---|---|---|---|---:|\n",
+         | rank | encoding | method | classifier | accuracy [95% CI] | vs paper (p) |{heading} seconds |\n\
+         |---:|---|---|---|---|---|{rule}---:|\n",
         c.n_recordings,
         c.classes,
         c.protocol,
@@ -55,8 +60,12 @@ pub fn markdown(c: &Comparison) -> String {
         100.0 * c.majority
     );
     for (i, r) in c.results.iter().enumerate() {
+        let over = match encodings {
+            Some(_) => format!(" {} |", over_encodings(r)),
+            None => String::new(),
+        };
         out.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {:.2} |\n",
+            "| {} | {} | {} | {} | {} | {} |{over} {:.2} |\n",
             i + 1,
             r.encoding,
             r.method,
@@ -65,6 +74,9 @@ pub fn markdown(c: &Comparison) -> String {
             versus_paper(r),
             r.seconds
         ));
+    }
+    if let Some(line) = encodings_note(c) {
+        out.push_str(&format!("\n{}.\n", capitalised(&line)));
     }
     for line in versus_rates(c) {
         out.push_str(&format!("\n{}.\n", capitalised(&line)));
@@ -89,6 +101,40 @@ pub fn markdown(c: &Comparison) -> String {
         }
     }
     out
+}
+
+/// The number of encodings the candidates that read spikes were scored on, when above one.
+fn encodings(c: &Comparison) -> Option<usize> {
+    let over = c.results.iter().find_map(|r| r.over_encodings.as_ref())?;
+    (over.accuracies.len() > 1).then_some(over.accuracies.len())
+}
+
+/// `86.1% [80.0, 91.9], each from 84.4 to 88.1%`, or why a candidate has none.
+fn over_encodings(r: &Ranked) -> String {
+    let Some(over) = &r.over_encodings else {
+        return "- (no spikes: the encoder is not run)".into();
+    };
+    let (lo, hi) = over.range();
+    let spread = match hi > lo {
+        true => format!("each from {:.1} to {:.1}%", 100.0 * lo, 100.0 * hi),
+        false => format!("each {:.1}%", 100.0 * lo),
+    };
+    format!("{}, {spread}", with_interval(over.mean, over.ci))
+}
+
+/// What the accuracies over encodings are, when the comparison has them.
+fn encodings_note(c: &Comparison) -> Option<String> {
+    let n = encodings(c)?;
+    let size = c
+        .results
+        .iter()
+        .find_map(|r| r.over_encodings.as_ref())?
+        .perturbation;
+    Some(format!(
+        "over {n} encodings (the input as run, whose accuracy the ranking shows, and {} with each conditioned sample times 1 + u x {size:e}): the mean accuracy, with a 95 % interval that draws an encoding as well as the {} (where one encoding's accuracy may land), and the lowest and highest encoding's",
+        n - 1,
+        c.units
+    ))
 }
 
 /// The heading of the candidates' column.
@@ -133,6 +179,17 @@ pub fn text_lines(c: &Comparison) -> Vec<String> {
             versus_paper(r),
             r.seconds
         ));
+    }
+    if let Some(note) = encodings_note(c) {
+        lines.push(format!("{note}:"));
+        for (i, r) in c.results.iter().enumerate() {
+            let name = format!("{} / {} / {}", r.encoding, r.method, r.classifier);
+            lines.push(format!(
+                "{:>3}. {name:<width$}  {}",
+                i + 1,
+                over_encodings(r)
+            ));
+        }
     }
     lines.extend(versus_rates(c));
     if let Some(n) = &c.nested {

@@ -224,6 +224,7 @@ impl BenchmarkOptions {
             seed: self.seed,
             nested: true,
             inner_folds: None,
+            encoder_draws: 1,
             open: OpenOptions::default(),
         }
     }

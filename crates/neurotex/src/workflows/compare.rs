@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use super::evaluate::draws::PERTURBATION;
 use super::{
     calibrated_pipeline, encode_all, say_conditions, KnnOptions, OnProgress, OpenOptions,
     SnnOptions,
@@ -16,8 +17,11 @@ use crate::compare::candidates::{candidates, CandidateSet, MethodChoice};
 use crate::compare::signal::{
     baseline_candidates, signal_rows, SignalRows, NO_ENCODING, SIGNAL_METHODS,
 };
-use crate::compare::{compare_keeping, Candidate, CompareParams, Comparison, Keep, Protocol};
+use crate::compare::{
+    compare_over_encodings, Candidate, CompareParams, Comparison, Keep, Perturbed, Protocol,
+};
 use crate::error::{OptionsError, ParamError};
+use crate::experiments::Draws;
 use crate::options::StageOptions;
 use crate::pipeline::{shared_grid, Encoding, Method, Pipeline, PipelineParams};
 use crate::progress::Progress;
@@ -139,6 +143,17 @@ pub struct CompareOptions {
     /// (docs/methods-and-compare.md).
     #[cfg_attr(feature = "cli", arg(long = "inner-folds", requires = "nested"))]
     pub inner_folds: Option<usize>,
+    /// Encodings of every recording: the input as run, then N - 1 more with each of its
+    /// conditioned samples times 1 + u x 1e-12 (u uniform in [-1, 1), a stream per seed,
+    /// encoding and recording), every candidate that reads spikes scored on each under the
+    /// same splits. Each such candidate then also gets its accuracy over the encodings,
+    /// with an interval that draws an encoding as well as the recordings: spiking neurons
+    /// turn rounding-level input changes into moved spikes, which can move an accuracy, and
+    /// a ranking's order, by several points. The ranking, its paired tests and nested
+    /// selection stay those of the encoding as run. Costs N times the encoding and the
+    /// scoring of the spike candidates; 1 (the default) encodes the input as run only.
+    #[cfg_attr(feature = "cli", arg(long = "encoder-draws", default_value_t = 1))]
+    pub encoder_draws: usize,
     /// How the dataset folder is opened.
     #[cfg_attr(feature = "cli", command(flatten))]
     pub open: OpenOptions,
@@ -196,7 +211,7 @@ impl CompareOptions {
         Ok(rows)
     }
 
-    /// The candidates to compare, checked.
+    /// The candidates to compare, checked: between 1 and [`MAX_CANDIDATES`].
     fn set(&self) -> Result<CandidateSet> {
         let methods = self
             .methods
@@ -252,13 +267,21 @@ impl CompareOptions {
                 let rule = "encodings must be sa, fa, sa+fa or none (the baselines without spikes)";
                 ParamError::new("encodings", rule, e.got)
             })?;
-        Ok(CandidateSet {
+        let set = CandidateSet {
             encodings,
             methods,
             classifiers,
             tau_ms: self.tau_ms,
             baselines,
-        })
+        };
+        let n = set.len();
+        if n == 0 || n > MAX_CANDIDATES {
+            return Err(OptionsError::Conflict(format!(
+                "{n} candidates to compare; between 1 and {MAX_CANDIDATES} are allowed"
+            ))
+            .into());
+        }
+        Ok(set)
     }
 
     /// Compares the candidates on `dataset` with the stage options `stages`.
@@ -288,6 +311,7 @@ impl CompareOptions {
         keep: Option<&dyn Keep>,
     ) -> Result<Comparison> {
         let params = self.params()?;
+        super::evaluate::draws::check(self.encoder_draws, dataset)?;
         let indices = self.indices(dataset)?;
         let metas: Vec<_> = indices
             .iter()
@@ -295,13 +319,6 @@ impl CompareOptions {
             .collect();
         crate::compare::check_design(&metas, &params)?;
         let set = self.set()?;
-        let n = set.len();
-        if n == 0 || n > MAX_CANDIDATES {
-            return Err(OptionsError::Conflict(format!(
-                "{n} candidates to compare; between 1 and {MAX_CANDIDATES} are allowed"
-            ))
-            .into());
-        }
         let train = match (&self.train_where, &self.test_where) {
             (Some(train), Some(_)) => Some(train),
             _ => None,
@@ -335,7 +352,13 @@ impl CompareOptions {
                 speeds.len()
             )));
         }
-        let mut comparison = compare_keeping(&candidates, &params, on, keep)?;
+        let draws = (self.encoder_draws, self.seed);
+        let further = perturbed_candidates(&calibrated.params, dataset, &indices, &set, draws, on)?;
+        let perturbed = Perturbed {
+            candidates: &further,
+            size: PERTURBATION,
+        };
+        let mut comparison = compare_over_encodings(&candidates, perturbed, &params, on, keep)?;
         // The network's settings go with the ranking (compare.md and compare.json), as the
         // folds and seed do.
         if let Some(snn) = &snn {
@@ -448,6 +471,43 @@ fn provenance(
     lines.extend(p.feature_lines(&methods));
     lines.push(classifiers);
     Ok(lines)
+}
+
+/// The candidates of `set` that read spikes, made from each further encoding of the
+/// recordings `indices` (`encodings` of them, the one as run the caller's; the others'
+/// conditioned input perturbed by [`PERTURBATION`] from streams of `seed`): none with one
+/// encoding or no spike encodings.
+///
+/// # Errors
+/// A recording that cannot be read or encoded, or a feature table that cannot be made.
+fn perturbed_candidates(
+    params: &PipelineParams,
+    dataset: &Dataset,
+    indices: &[usize],
+    set: &CandidateSet,
+    (encodings, seed): (usize, u64),
+    on: OnProgress,
+) -> Result<Vec<Vec<Candidate>>> {
+    if encodings < 2 || set.encodings.is_empty() {
+        return Ok(Vec::new());
+    }
+    let draws = Draws {
+        encodings,
+        seed,
+        size: PERTURBATION,
+    };
+    let start = Instant::now();
+    let pipeline = Pipeline::new(params.clone())?;
+    let per_draw = super::evaluate::draws::perturbed(dataset, &pipeline, indices, draws, on)?;
+    let encode_s = start.elapsed().as_secs_f64() / per_draw.len() as f64;
+    let set = CandidateSet {
+        baselines: false,
+        ..set.clone()
+    };
+    per_draw
+        .iter()
+        .map(|encoded| candidates(encoded, &shared_grid(encoded)?, params, &set, encode_s))
+        .collect()
 }
 
 /// Encodes the recordings `indices` once (both populations when an encoding needs the

@@ -101,7 +101,7 @@ pub(super) fn over_encodings(
     draws: Draws,
     on: OnProgress,
 ) -> Result<EncoderDraws> {
-    let per_draw = perturbed(run, draws, on)?;
+    let per_draw = perturbed(run.dataset, run.pipeline, run.indices, draws, on)?;
     on(Progress::Stage(
         "evaluating the perturbed encodings",
         per_draw.len(),
@@ -131,22 +131,31 @@ pub(super) fn over_encodings(
     })
 }
 
-/// Every recording of `run` encoded `draws.encodings - 1` times with its conditioned input
-/// perturbed: `[draw][recording]`, the recordings in `run.indices`' order.
-fn perturbed(run: &Run<'_>, draws: Draws, on: OnProgress) -> Result<Vec<Vec<Encoded>>> {
+/// The recordings `indices` of `dataset` encoded by `pipeline` `draws.encodings - 1` times
+/// each, with its conditioned input perturbed (seeded by `draws.seed` and the recording's
+/// index in the dataset): `[draw][recording]`, the recordings in `indices`' order.
+///
+/// # Errors
+/// A recording that cannot be read or encoded.
+pub(in crate::workflows) fn perturbed(
+    dataset: &Dataset,
+    pipeline: &Pipeline,
+    indices: &[usize],
+    draws: Draws,
+    on: OnProgress,
+) -> Result<Vec<Vec<Encoded>>> {
     on(Progress::Stage(
         "encoding the perturbed inputs",
-        run.indices.len(),
+        indices.len(),
     ));
-    let baseline = run.dataset.layout.baseline.unwrap_or_default();
-    let per_recording: Vec<Vec<Encoded>> = run
-        .indices
+    let baseline = dataset.layout.baseline.unwrap_or_default();
+    let per_recording: Vec<Vec<Encoded>> = indices
         .par_iter()
         .map(|&i| {
             crate::progress::stop_point();
-            let rec = run.dataset.load(i)?;
-            let cond = run.pipeline.condition(&rec, baseline)?;
-            let trains = perturbed_encodings(run.pipeline, &rec, &cond, draws, i)?;
+            let rec = dataset.load(i)?;
+            let cond = pipeline.condition(&rec, baseline)?;
+            let trains = perturbed_encodings(pipeline, &rec, &cond, draws, i)?;
             on(Progress::Tick);
             Ok(trains
                 .into_iter()

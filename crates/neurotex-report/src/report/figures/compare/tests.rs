@@ -60,6 +60,7 @@ fn comparison(n: usize, nested: bool, conditions: usize) -> Comparison {
                     .collect(),
                 seconds: 1.0,
                 paper,
+                over_encodings: None,
             }
         })
         .collect();
