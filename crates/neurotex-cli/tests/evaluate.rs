@@ -229,6 +229,15 @@ fn grouped_folds_never_split_a_group() {
         "session",
     ]);
     assert!(err.contains("group-by") && err.contains("session"), "{err}");
+    // Grouped by the label, every test fold holds classes its model never trained on: an
+    // error, not 0 % (compare's folds are evaluate's).
+    for command in ["evaluate", "compare"] {
+        let err = dir.fails(&[command, "--dataset", s(&ds), "--group-by", "label"]);
+        assert!(
+            err.contains("put every recording of class `") && err.contains("never trained on it"),
+            "{err}"
+        );
+    }
 }
 
 #[test]

@@ -146,11 +146,20 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
     dir.fails_each(
         &[
             (
-                vec!["encode", "far.csv", "--out", s(&out)],
+                vec!["encode", "far.csv", "--time-unit", "s", "--out", s(&out)],
                 "jump by 100000000 s between frames 1 and 2",
             ),
             (
-                vec!["encode", "far.csv", "--max-gap-s", "1e9", "--out", s(&out)],
+                vec![
+                    "encode",
+                    "far.csv",
+                    "--time-unit",
+                    "s",
+                    "--max-gap-s",
+                    "1e9",
+                    "--out",
+                    s(&out),
+                ],
                 "beyond the limit of 3600 s",
             ),
             // A rate no sensor has is refused before the recording is read.
@@ -162,6 +171,8 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
                 vec![
                     "encode",
                     "wide.csv",
+                    "--time-unit",
+                    "s",
                     "--max-gap-s",
                     "3600",
                     "--out",
@@ -189,6 +200,8 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
     let err = dir.fails(&[
         "encode",
         "long.csv",
+        "--time-unit",
+        "s",
         "--max-gap-s",
         "3000",
         "--out",
@@ -197,12 +210,14 @@ fn time_spans_beyond_the_limit_are_errors_unless_raised_in_the_layout() {
     assert!(err.contains("long.csv") && err.contains("4000 s"), "{err}");
     std::fs::write(
         dir.join("long.toml"),
-        "max_duration_s = 5000\nmax_gap_s = 3000\n",
+        "max_duration_s = 5000\nmax_gap_s = 3000\ntime_unit = \"s\"\n",
     )
     .unwrap();
     dir.ok(&[
         "encode",
         "long.csv",
+        "--time-unit",
+        "s",
         "--layout",
         "long.toml",
         "--out",

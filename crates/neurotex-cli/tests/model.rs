@@ -1120,7 +1120,17 @@ fn a_network_in_travel_keeps_its_reference_speed_and_needs_speeds() {
 fn predicting_the_training_recordings_is_said_to_test_nothing() {
     let dir = Dir::new();
     let ds = dir.dataset("ds", &["A", "B"], &[10.0, 20.0], 4);
+    // Recordings of the same textures the model has not seen: the same gratings with other
+    // noise (the helper's own noise would repeat `ds`'s recordings bit for bit).
     let other = dir.dataset("other", &["A", "B"], &[10.0], 3);
+    for (k, label) in ["A", "B"].iter().enumerate() {
+        for trial in 0..3 {
+            let period = (60.0 + 70.0 * k as f64) * 5.0 / 10.0;
+            let rec = recording(1400, period, 0.2 + 0.1 * k as f64, 777 + trial);
+            let file = other.join(format!("{label}_10_{trial}.npy"));
+            write_npy(file, &rec).unwrap();
+        }
+    }
     let model = dir.join("m.json");
     let train = ["train", "--dataset", s(&ds), "--speeds", "10", "-k", "1"];
     dir.ok(&[&train[..], &["--out", s(&model)]].concat());
@@ -1151,6 +1161,26 @@ fn predicting_the_training_recordings_is_said_to_test_nothing() {
     assert!(new.status.success(), "{}", new.stderr);
     assert!(!new.stderr.contains("trained on"), "{}", new.stderr);
     assert_eq!(trained_on(&new.stdout), 0);
+    // The same recordings in another dataset (its manifest in another order: another
+    // fingerprint) are met by their features.
+    let copy = dir.join("copy");
+    std::fs::create_dir(&copy).unwrap();
+    for entry in std::fs::read_dir(&ds).unwrap() {
+        let path = entry.unwrap().path();
+        std::fs::copy(&path, copy.join(path.file_name().unwrap())).unwrap();
+    }
+    let manifest = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    let mut lines: Vec<&str> = manifest.lines().collect();
+    lines[1..].reverse();
+    std::fs::write(copy.join("manifest.csv"), lines.join("\n") + "\n").unwrap();
+    let copied = predict(&copy);
+    assert!(copied.status.success(), "{}", copied.stderr);
+    assert!(
+        (copied.stderr).contains("warning: 8 of these 16 recordings have exactly the features of recordings the model was trained on"),
+        "{}",
+        copied.stderr
+    );
+    assert_eq!(trained_on(&copied.stdout), 8);
     // --speeds predicts the dataset's recordings at those speeds only: at 20 mm/s, none the
     // model was trained on.
     let out = dir.join("at20.csv");

@@ -294,6 +294,13 @@ pub enum ClassifyError {
         /// The label.
         label: String,
     },
+    /// Folds that keep groups whole put every recording of a class in one fold, so the
+    /// models tested on it never trained on the class.
+    #[error("the folds keep each group whole and so put every recording of class `{label}` in one fold: the model tested on that fold never trained on it, and would score it wrong whatever the features. The grouping column separates this class from the others (it is the label itself, or the class was recorded in one group alone): group by a column whose groups each hold recordings of several classes (a trial or session of every texture)")]
+    GroupsHoldAClass {
+        /// The class.
+        label: String,
+    },
     /// Nothing to classify.
     #[error("no samples to {what}")]
     Empty {

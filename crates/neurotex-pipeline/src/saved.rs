@@ -205,6 +205,19 @@ impl SavedModel {
         crate::model::check_source(self.provenance(), encoded)
     }
 
+    /// How many of the encoded recordings a feature model meets as its own training
+    /// recordings ([`Model::training_rows_met`]); 0 for a spiking network, which keeps no
+    /// training recordings.
+    ///
+    /// # Errors
+    /// Features that cannot be computed.
+    pub fn training_recordings_met(&self, encoded: &[Encoded]) -> Result<usize> {
+        match self {
+            SavedModel::Features(m) => m.training_rows_met(encoded),
+            SavedModel::Spiking(_) => Ok(0),
+        }
+    }
+
     /// Predicts each encoded recording's class, in parallel.
     ///
     /// # Errors

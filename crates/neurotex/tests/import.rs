@@ -651,6 +651,24 @@ fn the_time_unit_comes_from_the_column_name_and_an_implausible_rate_is_refused()
         TimeUnit::Seconds
     );
     assert!(read_csv_log(&p, &given(TimeUnit::Milliseconds)).is_ok());
+    // a name's unit is checked too: a 1 kHz logger's microseconds under `t_ms` are 1 Hz
+    let micros: String = (0..20).map(|i| format!("{},{i}\n", i * 1000)).collect();
+    let p = write(dir.path(), "named.csv", &format!("t_ms,a\n{micros}"));
+    let err = read_csv_log(&p, &by_name("t_ms")).unwrap_err().to_string();
+    assert!(
+        err.contains("1.0 Hz if its stamps are in ms, as its name says")
+            && err.contains("overrides the name"),
+        "{err}"
+    );
+    let us = CsvFormat {
+        time_unit: TimeUnit::Microseconds,
+        unit_given: true,
+        ..by_name("t_ms")
+    };
+    assert_eq!(
+        read_csv_log(&p, &us).unwrap().time_unit,
+        TimeUnit::Microseconds
+    );
     // milliseconds at a plausible rate need nothing
     let p = write(dir.path(), "ms.csv", "timestamp,a\n0,1\n28,2\n57,3\n");
     assert_eq!(

@@ -80,6 +80,9 @@ pub struct Columns {
     pub unit: TimeUnit,
     /// Whether the unit was given or named in the time column's name, rather than assumed.
     pub unit_known: bool,
+    /// Whether the unit was given (`--time-unit`, `time_unit` in layout.toml), rather than
+    /// read from the time column's name or assumed.
+    pub unit_given: bool,
     /// The channel columns' indices, in channel order.
     pub channels: Vec<usize>,
 }
@@ -201,6 +204,7 @@ impl Columns {
             time,
             unit,
             unit_known,
+            unit_given: format.unit_given,
             channels,
         })
     }

@@ -11,17 +11,18 @@ use super::header::{is_timelike_name, Columns, EPOCH_LIKE};
 use super::{csv_error_after, excerpt, invalid, open_log, CsvLog};
 
 /// Sampling rates a tactile log plausibly has, in Hz: stamps whose median step implies a
-/// rate outside are most likely in another unit than assumed (seconds read as ms give
-/// 1000 times the rate; a 1 kHz logger's microseconds read as ms give 1 Hz), so without
-/// a unit given or named they are refused. The slowest taxel arrays used for texture
+/// rate outside are most likely in another unit than assumed or named (seconds read as ms
+/// give 1000 times the rate; a 1 kHz logger's microseconds read as ms give 1 Hz), so
+/// unless the unit is given they are refused. The slowest taxel arrays used for texture
 /// sample at tens of Hz (FabricSlide's at 35.7 Hz); 5 Hz leaves room below them and
 /// still catches microsecond stamps of loggers up to 5 kHz.
 pub const PLAUSIBLE_HZ: (f64, f64) = (5.0, 20_000.0);
 
-/// Refuses stamps whose unit was only assumed when their median step implies a rate
-/// outside [`PLAUSIBLE_HZ`].
+/// Refuses stamps whose unit was assumed, or read from the time column's name, when their
+/// median step implies a rate outside [`PLAUSIBLE_HZ`]: a name can say `_ms` of a logger
+/// writing microseconds. A unit given (`--time-unit`) is taken as said.
 fn check_plausible_rate(path: &Path, columns: &Columns, times: &[f64]) -> Result<()> {
-    let (Some(t), false) = (columns.time, columns.unit_known) else {
+    let (Some(t), false) = (columns.time, columns.unit_given) else {
         return Ok(());
     };
     let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
@@ -36,13 +37,24 @@ fn check_plausible_rate(path: &Path, columns: &Columns, times: &[f64]) -> Result
     }
     let median = format!("{median:.6}");
     let median = median.trim_end_matches('0').trim_end_matches('.');
+    let (unit, fix) = match columns.unit_known {
+        true => (
+            format!("{}, as its name says", columns.unit),
+            "say the unit with --time-unit ms, s or us (`time_unit` in layout.toml), which \
+             overrides the name (and is taken as said, whatever rate it gives)",
+        ),
+        false => (
+            columns.unit.to_string(),
+            "say it with --time-unit ms, s or us (`time_unit` in layout.toml), or end the \
+             column's name in `_ms`, `_s` or `_us`",
+        ),
+    };
     let message = format!(
-        "time column `{}` steps by a median {median} {unit}, which is {hz:.1} Hz if its \
+        "time column `{}` steps by a median {median} {}, which is {hz:.1} Hz if its \
          stamps are in {unit}; a tactile log at that rate is unlikely, so the unit is \
-         probably another: say it with --time-unit ms, s or us (`time_unit` in layout.toml), \
-         or end the column's name in `_ms`, `_s` or `_us`",
+         probably another: {fix}",
         excerpt(&columns.names[t]),
-        unit = columns.unit,
+        columns.unit,
     );
     Err(invalid(path, message))
 }

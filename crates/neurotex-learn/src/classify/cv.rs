@@ -322,6 +322,29 @@ fn single(each: Result<Vec<Evaluation>, ClassifyError>) -> Result<Evaluation, Cl
     })
 }
 
+/// Refuses folds (`fold_of` each sample's, of `folds`) in which every sample of a class
+/// (of `y`) lies in one fold: that fold's model never trains on the class.
+fn every_class_trained(
+    y: &[usize],
+    fold_of: &[usize],
+    folds: usize,
+    class_names: &[String],
+) -> Result<(), ClassifyError> {
+    let n_classes = y.iter().max().map_or(0, |&m| m + 1);
+    // Per class, the folds its samples lie in, as a count of samples per fold.
+    let mut in_fold = vec![vec![0usize; folds]; n_classes];
+    for (&c, &f) in y.iter().zip(fold_of) {
+        in_fold[c][f] += 1;
+    }
+    let whole = (0..n_classes).find(|&c| in_fold[c].iter().filter(|&&n| n > 0).count() == 1);
+    match whole {
+        Some(c) if folds > 1 => Err(ClassifyError::GroupsHoldAClass {
+            label: class_names.get(c).cloned().unwrap_or_else(|| c.to_string()),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Assigns each sample a fold so that no group is split (see [`cross_validate_grouped`]);
 /// returns the fold of each sample and the number of folds used.
 pub fn group_folds(groups: &[usize], folds: usize, seed: u64) -> (Vec<usize>, usize) {
@@ -397,7 +420,11 @@ pub fn cross_validate_on<S: Samples + ?Sized, L: Learner<S>>(
     for r in 0..cv.repeats {
         let seed = cv.seed.wrapping_add(r as u64);
         let (fold_of, folds) = match groups {
-            Some(groups) => group_folds(groups, cv.folds, seed),
+            Some(groups) => {
+                let (fold_of, folds) = group_folds(groups, cv.folds, seed);
+                every_class_trained(y, &fold_of, folds, class_names)?;
+                (fold_of, folds)
+            }
             None => (
                 stratified_folds(y, n_classes, cv.folds, seed, class_names)?,
                 cv.folds,
@@ -570,6 +597,32 @@ mod group_tests {
         assert!(matches!(err, ClassifyError::OneClass { .. }), "{err}");
         let err = train_test(&knn, (&x[..5], &y[..5]), (&x[5..], &y[5..]), 1, &names);
         assert!(matches!(err, Err(ClassifyError::OneClass { .. })));
+    }
+
+    #[test]
+    fn groups_that_each_hold_one_class_are_refused() {
+        let knn = super::super::KnnParams {
+            k: 1,
+            standardize: false,
+        }
+        .check()
+        .unwrap();
+        let x: Vec<f64> = (0..12).map(f64::from).collect();
+        let y: Vec<usize> = (0..12).map(|i| i % 3).collect();
+        let names: Vec<String> = ["a", "b", "c"].map(String::from).to_vec();
+        let cv = CvParams::default().check().unwrap();
+        // Grouped by the class itself: each fold's test class is never trained on.
+        let err = cross_validate_grouped(&knn, &x, 1, &y, &names, cv, &y).unwrap_err();
+        assert!(
+            matches!(&err, ClassifyError::GroupsHoldAClass { label } if label == "a" || label == "b" || label == "c"),
+            "{err}"
+        );
+        assert!(err
+            .to_string()
+            .contains("group by a column whose groups each hold recordings of several classes"));
+        // Groups of every class (trials): allowed.
+        let trials: Vec<usize> = (0..12).map(|i| i / 3).collect();
+        assert!(cross_validate_grouped(&knn, &x, 1, &y, &names, cv, &trials).is_ok());
     }
 
     #[test]

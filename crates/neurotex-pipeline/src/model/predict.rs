@@ -71,6 +71,24 @@ impl Model {
         self.predict_rows(&rows.concat())
     }
 
+    /// How many of the encoded recordings have exactly (bit for bit) the feature row of one
+    /// of the model's training recordings: the same recordings, copied or imported again
+    /// into another dataset, or recordings its features cannot tell from them. Their
+    /// predictions are the model's memory of its training set, no test of it.
+    ///
+    /// # Errors
+    /// As [`Model::predict`].
+    pub fn training_rows_met(&self, encoded: &[Encoded]) -> Result<usize> {
+        let bits = |row: &[f64]| -> Vec<u64> { row.iter().map(|x| x.to_bits()).collect() };
+        let trained: std::collections::HashSet<Vec<u64>> =
+            self.file.training.rows.iter().map(|r| bits(r)).collect();
+        let rows: Vec<Vec<f64>> = encoded
+            .par_iter()
+            .map(|e| self.feature_row(e))
+            .collect::<Result<_>>()?;
+        Ok(rows.iter().filter(|r| trained.contains(&bits(r))).count())
+    }
+
     /// Predicts the class of one encoded recording on the calling thread (a causal
     /// classifier's window at a bin boundary, where a thread pool would only add latency).
     ///

@@ -112,8 +112,9 @@ impl PredictOptions {
     ) -> Result<crate::model::Score> {
         let truth: Vec<String> = encoded.iter().map(|e| e.meta.label.clone()).collect();
         let which = self.selected(dataset)?;
+        let fitted = trained_among(model.provenance(), dataset, &which);
         Ok(crate::model::Score {
-            trained_on: trained_among(model.provenance(), dataset, &which),
+            trained_on: fitted.max(model.training_recordings_met(encoded)?),
             ..model.score(&truth, predictions)?
         })
     }
@@ -141,7 +142,7 @@ impl PredictOptions {
         for note in ReadOptions::layout_notes(&from) {
             on(Progress::Say(&note));
         }
-        checked(model, encoded, on)
+        checked(model, encoded, 0, on)
     }
 
     /// Every recording's per-bin decisions and end, as `stream` decides them.
@@ -192,11 +193,12 @@ fn encode_selected(
     which: &[usize],
     on: OnProgress,
 ) -> Result<Vec<Encoded>> {
+    let said = trained_among(model.provenance(), dataset, which);
     if let Some(advice) = seen_in_training(model.provenance(), dataset, which) {
         on(Progress::Advice(&advice));
     }
     let encoded = encode_dataset(model.pipeline(), model.baseline(), dataset, which, on)?;
-    checked(model, encoded, on)
+    checked(model, encoded, said, on)
 }
 
 /// A warning when `dataset` is the one the model was trained on (the same fingerprint): of
@@ -241,13 +243,27 @@ fn shown_speeds(speeds: &[crate::Speed]) -> String {
     shown.join(", ")
 }
 
-/// `encoded` once every recording passed the model's checks, the conditions said.
-fn checked(model: &SavedModel, encoded: Vec<Encoded>, on: OnProgress) -> Result<Vec<Encoded>> {
+/// `encoded` once every recording passed the model's checks, the conditions said, and a
+/// warning when more of them than the `said` already warned of meet the model as its own
+/// training recordings.
+fn checked(
+    model: &SavedModel,
+    encoded: Vec<Encoded>,
+    said: usize,
+    on: OnProgress,
+) -> Result<Vec<Encoded>> {
     // Refused before anything else is said of them, --causal's needs included.
     for e in &encoded {
         model.check_source(e)?;
     }
     say_conditions(&encoded, on);
+    let met = model.training_recordings_met(&encoded)?;
+    if met > said {
+        on(Progress::Advice(&format!(
+            "{met} of these {} have exactly the features of recordings the model was trained on (the same recordings copied or imported again, or ones its features cannot tell from them): their predictions are the model's memory of its training set, no test of it; `neurotex evaluate` cross-validates, or predict recordings it has not seen",
+            crate::words::counted(encoded.len(), "recording")
+        )));
+    }
     Ok(encoded)
 }
 
