@@ -335,3 +335,34 @@ fn import_warns_on_a_clock_read_as_a_channel() {
     );
     assert!(run.stderr.contains("--time-column tick"), "{}", run.stderr);
 }
+
+#[test]
+fn labels_differing_only_in_case_are_named_at_every_start() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["Rough", "Smooth"], &[5.0], 6);
+    let manifest = std::fs::read_to_string(ds.join("manifest.csv")).unwrap();
+    // Two of Rough's six rows written `rough`: a third class, silently, before the check.
+    let mut written = 0;
+    let lines: Vec<String> = manifest
+        .lines()
+        .map(|line| match line.contains(",Rough,") && written < 2 {
+            true => {
+                written += 1;
+                line.replace(",Rough,", ",rough,")
+            }
+            false => line.to_string(),
+        })
+        .collect();
+    std::fs::write(ds.join("manifest.csv"), lines.join("\n") + "\n").unwrap();
+    let text = dir.ok(&["inspect", s(&ds), "--no-encoder"]);
+    assert!(
+        text.contains("severe: [labels] labels `Rough` and `rough` differ only in case: they are 2 classes"),
+        "{text}"
+    );
+    let run = dir.run(&["evaluate", "--dataset", s(&ds), "--folds", "2", "--k", "1"]);
+    assert!(
+        run.stderr.contains("labels `Rough` and `rough` differ only in case"),
+        "{}",
+        run.stderr
+    );
+}

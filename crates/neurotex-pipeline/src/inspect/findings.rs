@@ -105,6 +105,7 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
         ));
         return;
     }
+    out.extend(labels_differing_in_case(&d.classes));
     let [pooled, within, held_out, knn] = &d.support[..] else {
         return;
     };
@@ -141,6 +142,36 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
         ));
     }
     unbalanced(i, out);
+}
+
+/// A severe finding when two of the `classes` (distinct labels) differ only in case
+/// (`Rough`, `rough`): neurotex keeps them apart, as two classes, where they most likely
+/// name one texture written two ways, which splits its recordings and scores each half
+/// against the other.
+pub(super) fn labels_differing_in_case(classes: &[String]) -> Option<Finding> {
+    let mut sorted: Vec<&String> = classes.iter().collect();
+    sorted.sort();
+    let mut by_lower: Vec<(String, Vec<&String>)> = Vec::new();
+    for class in sorted {
+        let lower = class.to_lowercase();
+        match by_lower.iter_mut().find(|(l, _)| *l == lower) {
+            Some((_, same)) => same.push(class),
+            None => by_lower.push((lower, vec![class])),
+        }
+    }
+    let (_, same) = by_lower.into_iter().find(|(_, same)| same.len() > 1)?;
+    let shown: Vec<String> = same.iter().map(|c| format!("`{c}`")).collect();
+    Some(finding(
+        Severity::Severe,
+        "labels",
+        "labels-differing-in-case",
+        format!(
+            "labels {} differ only in case: they are {} classes, each with part of what is most likely one texture's recordings",
+            shown.join(" and "),
+            same.len()
+        ),
+        "write one texture's label the same way in every manifest row (or file name); labels of truly different textures should differ in more than case",
+    ))
 }
 
 /// The analyses by speed: none without speeds, folds within each, one held out.

@@ -261,7 +261,13 @@ pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<S
         traces: false,
         ..InspectParams::default()
     };
-    let findings = if sample.is_events() {
+    // Labels are checked on every recording: a label written another way on a few rows
+    // may be missing from the sample.
+    let labels = dataset.labels();
+    let mut findings: Vec<Finding> = findings::labels_differing_in_case(&labels)
+        .into_iter()
+        .collect();
+    findings.extend(if sample.is_events() {
         // Address events carry no signal to check, but their timing can mislead (a
         // sensor's clock read from time 0): the events' own findings.
         let i = events::inspect_events(&sample, &params, &|| {})?;
@@ -269,9 +275,10 @@ pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<S
         severe.cloned().collect()
     } else {
         let i = inspect(Source::Dataset(&sample), &params, &|| {})?;
-        let severe = i.at_least(Severity::Severe).filter(|f| f.area != "design");
-        severe.cloned().collect()
-    };
+        let severe = i.at_least(Severity::Severe);
+        let severe = severe.filter(|f| f.area != "design" && f.area != "labels");
+        severe.cloned().collect::<Vec<_>>()
+    });
     Ok(SevereFindings {
         findings,
         checked,

@@ -47,7 +47,8 @@ pub struct CsvOptions {
     pub time_column: Option<Column>,
     /// Unit of the time column: `ms`, `s` or `us` (default: from a suffix of the column's
     /// name such as `_ms`, `_s`, `_us` or `(s)`, else `ms`; stamps implying a rate above
-    /// 20 kHz or below 5 Hz are then refused, asking for this option).
+    /// 20 kHz or below 5 Hz are then refused, asking for this option, which is taken as
+    /// said).
     #[cfg_attr(feature = "cli", arg(long = "time-unit"))]
     pub time_unit: Option<TimeUnit>,
     /// Channel columns: a comma-separated list of names, of 0-based indices and ranges such
