@@ -223,3 +223,23 @@ fn a_reader_that_stops_early_ends_the_command_quietly() {
         );
     }
 }
+
+#[test]
+fn glcm_distances_that_pair_no_cells_are_an_error_not_constant_features() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 3);
+    let out = dir.join("f.csv");
+    // On the 4x4 grid no two taxels are 4 apart; 3 pairs some. In 3D, 1000 bins of 200 ms
+    // outlast the 1.4 s recordings as 4 outlasts the grid.
+    for (method, distances) in [("glcm2d", "4"), ("glcm3d", "1000")] {
+        let err = features_fails(&dir, &ds, &out, method, &["--distances", distances]);
+        assert!(
+            err.contains(
+                "invalid parameter `distances`: at least one distance must pair two cells"
+            ) && err.contains(&format!("got {distances} on the 4x4 grid")),
+            "{err}"
+        );
+    }
+    let args = ["features", "--dataset", s(&ds), "--method", "glcm2d"];
+    dir.ok(&[&args[..], &["--distances", "3,4", "--out", s(&out)]].concat());
+}

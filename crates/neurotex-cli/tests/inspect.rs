@@ -356,12 +356,15 @@ fn labels_differing_only_in_case_are_named_at_every_start() {
     std::fs::write(ds.join("manifest.csv"), lines.join("\n") + "\n").unwrap();
     let text = dir.ok(&["inspect", s(&ds), "--no-encoder"]);
     assert!(
-        text.contains("severe: [labels] labels `Rough` and `rough` differ only in case: they are 2 classes"),
+        text.contains(
+            "severe: [labels] labels `Rough` and `rough` differ only in case: they are 2 classes"
+        ),
         "{text}"
     );
     let run = dir.run(&["evaluate", "--dataset", s(&ds), "--folds", "2", "--k", "1"]);
     assert!(
-        run.stderr.contains("labels `Rough` and `rough` differ only in case"),
+        run.stderr
+            .contains("labels `Rough` and `rough` differ only in case"),
         "{}",
         run.stderr
     );

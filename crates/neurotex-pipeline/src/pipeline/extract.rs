@@ -322,6 +322,9 @@ impl FeatureExtractor {
             }
         };
         self.check_bins(plan, volume.bins)?;
+        if plan.counted_pairs(volume.bins) == 0 {
+            return Err(no_pairs(&self.glcm.distances, spikes, kind, volume.bins).into());
+        }
         let mut q = Vec::new();
         volume.quantise(self.volume.levels, self.volume.range, &mut q);
         let l = self.volume.levels;
@@ -354,6 +357,29 @@ impl FeatureExtractor {
     pub fn glcm_params(&self) -> &GlcmParams {
         &self.glcm
     }
+}
+
+/// The error for GLCM offsets that pair no two cells: every one leaves the grid (or, in
+/// 3D, the recording's `bins` time bins), so the co-occurrence matrix would be empty and
+/// its features the same for every recording.
+fn no_pairs(distances: &[usize], spikes: &SpikeTrains, kind: GlcmKind, bins: usize) -> ParamError {
+    let shown: Vec<String> = distances.iter().map(ToString::to_string).collect();
+    let at = match kind {
+        GlcmKind::TwoD => format!(
+            "{} on the {}x{} grid",
+            shown.join(","),
+            spikes.rows,
+            spikes.cols
+        ),
+        GlcmKind::ThreeD => format!(
+            "{} on the {}x{} grid over {bins} time bins",
+            shown.join(","),
+            spikes.rows,
+            spikes.cols
+        ),
+    };
+    let rule = "at least one distance must pair two cells: every offset at these distances leaves the grid (and the volume's time bins), so the co-occurrence matrix would be empty and its features the same for every recording; use distances shorter than the grid's longest side (or, in 3D, than its time bins)";
+    ParamError::new("distances", rule, at)
 }
 
 #[cfg(test)]
