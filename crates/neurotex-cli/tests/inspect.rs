@@ -369,3 +369,18 @@ fn labels_differing_only_in_case_are_named_at_every_start() {
         run.stderr
     );
 }
+
+#[test]
+fn a_recording_without_signal_is_named() {
+    let dir = Dir::new();
+    let ds = dir.dataset("ds", &["A", "B"], &[5.0], 6);
+    let flat = ndarray::Array3::<f32>::from_elem((1400, 4, 4), 1.0);
+    ndarray_npy::write_npy(ds.join("A_5_2.npy"), &flat).unwrap();
+    let text = dir.ok(&["inspect", s(&ds), "--no-encoder"]);
+    assert!(
+        text.contains("severe: [signals] 1 recording holds no signal, every channel one value from start to end: `A_5_2.npy`"),
+        "{text}"
+    );
+    let run = dir.run(&["evaluate", "--dataset", s(&ds), "--folds", "2", "--k", "1"]);
+    assert!(run.stderr.contains("holds no signal"), "{}", run.stderr);
+}

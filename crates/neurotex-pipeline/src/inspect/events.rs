@@ -144,6 +144,7 @@ fn lengths(ok: &[(Meta, Events)], unreadable: Vec<Unreadable>, bin_ms: usize) ->
         duration_s,
         too_short: name(&|s| s * 1000.0 < bin_ms as f64),
         short: name(&|s| s < duration_s[1] / 4.0),
+        dead: Vec::new(),
         channels: Vec::new(),
     }
 }

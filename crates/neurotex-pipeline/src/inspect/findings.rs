@@ -295,6 +295,26 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
             "leave them out, or --bin-ms smaller than the shortest recording",
         ));
     }
+    if !s.dead.is_empty() {
+        let fix = match logs {
+            true => "fix or record them again, or leave them out of the import",
+            false => "fix or record them again, or remove their rows from manifest.csv",
+        };
+        out.push(finding(
+            Severe,
+            "signals",
+            "dead-recordings",
+            format!(
+                "{} no signal, every channel one value from start to end: {}; each is classified by the encoder's answer to a constant input, whatever texture it was",
+                match s.dead.len() {
+                    1 => "1 recording holds".to_string(),
+                    n => format!("{n} recordings hold"),
+                },
+                names(&s.dead)
+            ),
+            fix,
+        ));
+    }
     channels(i, file, p, out);
     if !s.gappy.is_empty() {
         let worst = s

@@ -103,6 +103,8 @@ pub struct SignalSummary {
     pub too_short: Vec<String>,
     /// Recordings shorter than a quarter of the median recording.
     pub short: Vec<String>,
+    /// Recordings in which every channel holds one value from start to end: no signal.
+    pub dead: Vec<String>,
     /// Per channel.
     pub channels: Vec<ChannelSummary>,
 }
@@ -278,6 +280,11 @@ pub(super) fn signal_summary(
         .filter(|c| c.stats.duration_s < quarter && c.stats.duration_s >= bin_s)
         .map(|c| c.meta.file.clone())
         .collect();
+    let channels = |c: &&Checked| c.stats.channels.clone();
+    let dead = (checked.iter())
+        .filter(|c| !channels(c).is_empty() && channels(c).iter().all(|ch| ch.dead))
+        .map(|c| c.meta.file.clone())
+        .collect();
     SignalSummary {
         recordings: checked.len(),
         unreadable,
@@ -289,6 +296,7 @@ pub(super) fn signal_summary(
         duration_s: spread(durations).unwrap_or_default(),
         too_short,
         short,
+        dead,
         channels: channel_summaries(checked, names),
     }
 }
