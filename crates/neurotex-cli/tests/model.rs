@@ -1161,6 +1161,15 @@ fn predicting_the_training_recordings_is_said_to_test_nothing() {
     assert!(new.status.success(), "{}", new.stderr);
     assert!(!new.stderr.contains("trained on"), "{}", new.stderr);
     assert_eq!(trained_on(&new.stdout), 0);
+    // Without --json the accuracy is a line on standard error.
+    let args = ["predict", "--model", s(&model), "--dataset", s(&other)];
+    let said = dir.run(&[&args[..], &["--out", s(&dir.join("p.csv"))]].concat());
+    assert!(
+        said.stderr.contains("over 6 recordings (95 % Wilson interval); chance 50.0%")
+            && !said.stderr.contains("no test of it"),
+        "{}",
+        said.stderr
+    );
     // The same recordings in another dataset (its manifest in another order: another
     // fingerprint) are met by their features.
     let copy = dir.join("copy");

@@ -187,6 +187,13 @@ pub struct Episode {
     pub summary: EpisodeSummary,
 }
 
+impl Episode {
+    /// Whether a decision came before the episode's end.
+    pub fn decided(&self) -> bool {
+        self.summary.decision.is_some()
+    }
+}
+
 /// The window length in steps for `window_ms`, rounded up to whole bins (at least one): a
 /// window of the training recordings' median length covers a recording of that length
 /// whole, as the classifier saw it in training, when the length is not a whole number of

@@ -69,17 +69,20 @@ pub fn run(args: PredictArgs) -> Result<()> {
     }
     let predictions = model.predict(&encoded)?;
     // Scored before anything is written, so that a label the model cannot score leaves no
-    // predictions file behind a failed run.
-    let score = match (args.json, &dataset) {
-        (true, Some(dataset)) => Some(o.score(&model, dataset, &encoded, &predictions)?),
-        _ => None,
+    // predictions file behind a failed run (with --json; else the accuracy is left out).
+    let score = match &dataset {
+        Some(d) if args.json => Some(o.score(&model, d, &encoded, &predictions)?),
+        Some(d) => o.score(&model, d, &encoded, &predictions).ok(),
+        None => None,
     };
     let known = dataset.is_some();
     write_file(&args.out, "predictions", |w| {
         write_predictions(w, model.labels(), &encoded, &predictions, known)
     })?;
-    if let Some(score) = score {
-        println!("{}", serde_json::to_string(&score)?);
+    match score {
+        Some(score) if args.json => println!("{}", serde_json::to_string(&score)?),
+        Some(score) => eprintln!("{}", score.summary()),
+        None => {}
     }
     let (with, n) = (model.described(&o.model), predictions.len());
     eprintln!(
@@ -97,10 +100,7 @@ fn predict_causal(args: &PredictArgs, model: &SavedModel, encoded: &[Encoded]) -
     write_file(&args.out, "causal decisions", |w| {
         write_episodes(w, model.labels(), encoded, &episodes)
     })?;
-    let decided = episodes
-        .iter()
-        .filter(|e| e.summary.decision.is_some())
-        .count();
+    let decided = episodes.iter().filter(|e| e.decided()).count();
     eprintln!(
         "{} recordings, {decided} decided before their end -> {}",
         episodes.len(),

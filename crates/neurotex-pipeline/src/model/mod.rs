@@ -174,6 +174,28 @@ pub struct Score {
     pub trained_on: usize,
 }
 
+impl Score {
+    /// One line for a terminal: `accuracy 75.0% [57.9, 86.7] over 32 recordings (95 %
+    /// Wilson interval); chance 12.5%`, and how many of them the model was trained on.
+    pub fn summary(&self) -> String {
+        let mut line = format!(
+            "accuracy {:.1}% [{:.1}, {:.1}] over {} (95 % Wilson interval); chance {:.1}%",
+            100.0 * self.accuracy,
+            100.0 * self.interval.lower,
+            100.0 * self.interval.upper,
+            neurotex_core::words::counted(self.n, "recording"),
+            100.0 * self.chance
+        );
+        if self.trained_on > 0 {
+            line += &format!(
+                "; {} of them the model was trained on, so this is no test of it",
+                self.trained_on
+            );
+        }
+        line
+    }
+}
+
 /// A trained model: what its file holds, with the pipeline, the feature extractor and the
 /// classifier made ready from it.
 #[derive(Debug, Clone)]
