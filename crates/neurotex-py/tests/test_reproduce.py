@@ -93,7 +93,7 @@ def cli_verdict(claim):
     """How the CLI prints a verdict."""
     return {
         "holds": "Holds (paired test)",
-        "not_shown": "Not shown (paired test not significant everywhere)",
+        "not_shown": "Not shown to hold (paired test not significant everywhere)",
         "contradicted": "Contradicted (paired test)",
         "point_agrees": "Agrees in point estimates (no test)",
         "point_disagrees": "Disagrees in point estimates (no test)",

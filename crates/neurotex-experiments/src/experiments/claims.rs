@@ -58,7 +58,7 @@ impl Verdict {
     pub fn describe(self) -> &'static str {
         match self {
             Verdict::Holds => "Holds (paired test)",
-            Verdict::NotShown => "Not shown (paired test not significant everywhere)",
+            Verdict::NotShown => "Not shown to hold (paired test not significant everywhere)",
             Verdict::Contradicted => "Contradicted (paired test)",
             Verdict::PointAgrees => "Agrees in point estimates (no test)",
             Verdict::PointDisagrees => "Disagrees in point estimates (no test)",

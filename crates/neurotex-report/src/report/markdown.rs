@@ -204,7 +204,7 @@ fn taxel_diagnostics(r: &Results) -> String {
 
 fn summary(r: &Results) -> String {
     let mut out = format!("## Summary: the paper's claims on these data\n\n\
-        A claim *holds* only when a paired comparison on the same recordings (95 % bootstrap interval of the per-recording difference, resampling recordings) puts it on the paper's side at every speed; it is *not shown* when an interval holds 0, and *contradicted* when one lies on the other side. Claims without such a comparison are judged on point estimates and say so. Intervals are in brackets.{}\n\n",
+        A claim *holds* only when a paired comparison on the same recordings (95 % bootstrap interval of the per-recording difference, resampling recordings) puts it on the paper's side at every speed; it is *not shown to hold* when an interval holds 0, and *contradicted* when one lies on the other side. Claims without such a comparison are judged on point estimates and say so. Intervals are in brackets.{}\n\n",
         encodings_note(r)
     );
     for c in claims(r) {
@@ -272,7 +272,7 @@ fn across_seeds(r: &Results) -> String {
     out + &t.render() + "\n"
 }
 
-/// `Holds (paired test) x3, Not shown (paired test not significant everywhere) x2`, in
+/// `Holds (paired test) x3, Not shown to hold (paired test not significant everywhere) x2`, in
 /// first-seen order.
 fn verdict_counts(verdicts: &[crate::experiments::Verdict]) -> String {
     let mut seen: Vec<(crate::experiments::Verdict, usize)> = Vec::new();
