@@ -325,7 +325,7 @@ fn gain_auto_calibrates_on_the_training_side_of_a_split_and_says_so_otherwise() 
     assert!(
         split
             .stderr
-            .contains("in the 30 recording(s) it calibrated on"),
+            .contains("in the 30 recordings it calibrated on"),
         "{}",
         split.stderr
     );

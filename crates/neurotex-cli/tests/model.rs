@@ -1165,7 +1165,8 @@ fn predicting_the_training_recordings_is_said_to_test_nothing() {
     let args = ["predict", "--model", s(&model), "--dataset", s(&other)];
     let said = dir.run(&[&args[..], &["--out", s(&dir.join("p.csv"))]].concat());
     assert!(
-        said.stderr.contains("over 6 recordings (95 % Wilson interval); chance 50.0%")
+        said.stderr
+            .contains("over 6 recordings (95 % Wilson interval); chance 50.0%")
             && !said.stderr.contains("no test of it"),
         "{}",
         said.stderr

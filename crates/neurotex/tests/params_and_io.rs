@@ -306,6 +306,10 @@ fn manifest_errors_name_line_and_field() {
     let cases = [
         ("file,speed_mm_s,trial\n", "missing column `label`"),
         (
+            "file;label\na.npy;X\n",
+            "its header `file;label` is separated by semicolons: a manifest is separated by commas",
+        ),
+        (
             "file,label,speed_mm_s,force_n,trial\na.npy,X,fast,1,0\n",
             "line 2, field `speed_mm_s`",
         ),

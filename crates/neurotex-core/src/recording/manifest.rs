@@ -127,7 +127,17 @@ impl ManifestColumns {
         for (slot, name) in required.iter_mut().zip(MANIFEST_COLUMNS) {
             *slot = col(name).ok_or_else(|| {
                 let needed = MANIFEST_COLUMNS.join(",");
-                let message = format!("missing column `{name}` (a manifest needs {needed})");
+                let mut message = format!("missing column `{name}` (a manifest needs {needed})");
+                // One column whose name holds the others: another delimiter than commas.
+                if let [only] = names[..] {
+                    if let Some(d) = [';', '\t'].into_iter().find(|&d| only.contains(d)) {
+                        let shown = if d == ';' { "semicolons" } else { "tabs" };
+                        message += &format!(
+                            "; its header `{}` is separated by {shown}: a manifest is separated by commas",
+                            crate::values::shown_label(only)
+                        );
+                    }
+                }
                 DataError::invalid(path, message)
             })?;
         }

@@ -8,6 +8,7 @@ use super::{InspectParams, Inspection};
 use crate::diagnostics::{TaxelDiagnostics, TaxelResponse};
 use crate::import::{grid_advice, ImportWarning, OFFSET_RATIO};
 use crate::recording::LayoutFile;
+use neurotex_core::words::counted;
 
 /// How much a finding matters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -66,6 +67,14 @@ pub(super) fn finding(
         code,
         message,
         suggestion: suggestion.into(),
+    }
+}
+
+/// `1 recording lasts` or `n recordings last`.
+fn lasting(n: usize) -> String {
+    match n {
+        1 => "1 recording lasts".to_string(),
+        n => format!("{n} recordings last"),
     }
 }
 
@@ -273,9 +282,9 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
             "signals",
             "unreadable",
             format!(
-                "{} of {} file(s) cannot be read; the first: {}",
+                "{} of {} cannot be read; the first: {}",
                 s.unreadable.len(),
-                i.files,
+                counted(i.files, "file"),
                 first.reason
             ),
             fix,
@@ -287,8 +296,8 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
             "signals",
             "too-short",
             format!(
-                "{} recording(s) last less than one {} ms bin of the rate volume: {}",
-                s.too_short.len(),
+                "{} less than one {} ms bin of the rate volume: {}",
+                lasting(s.too_short.len()),
                 p.pipeline.volume.bin_ms,
                 names(&s.too_short)
             ),
@@ -330,8 +339,11 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
             "signals",
             "rate-differs",
             format!(
-                "{} recording(s) are sampled more than 5 % off the median rate of {mid:.2} Hz: {}",
-                s.off_rate.len(),
+                "{} sampled more than 5 % off the median rate of {mid:.2} Hz: {}",
+                match s.off_rate.len() {
+                    1 => "1 recording is".to_string(),
+                    n => format!("{n} recordings are"),
+                },
                 names(&s.off_rate)
             ),
             "check the logger's settings; each file's stamps are used to resample it to 1 kHz",
@@ -356,8 +368,8 @@ fn channels(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<
             "signals",
             "short-recordings",
             format!(
-                "{} recording(s) last less than a quarter of the median recording ({:.2} s): {}",
-                s.short.len(),
+                "{} less than a quarter of the median recording ({:.2} s): {}",
+                lasting(s.short.len()),
                 s.duration_s[1],
                 names(&s.short)
             ),

@@ -231,10 +231,10 @@ pub fn markdown(i: &Inspection, source: &str, figures: &[(&str, String)]) -> Str
 fn layout_section(i: &Inspection) -> String {
     let l = &i.layout;
     let mut md = format!(
-        "\n## Layout\n\n{} channels on a {}x{} grid ({}), {} cell(s) without a channel, {} neighbouring pairs for the GLCM; baseline removed: {}; nominal rate {:.2} Hz.\n\n```\n",
+        "\n## Layout\n\n{} channels on a {}x{} grid ({}), {} without a channel, {} neighbouring pairs for the GLCM; baseline removed: {}; nominal rate {:.2} Hz.\n\n```\n",
         l.channels.len(), l.rows, l.cols,
         if l.mapped { "placed by a channel map" } else { "row by row in channel order" },
-        l.empty_cells, l.neighbour_pairs, l.baseline, l.fs_hz
+        neurotex_core::words::counted(l.empty_cells, "cell"), l.neighbour_pairs, l.baseline, l.fs_hz
     );
     let width = l.channels.iter().map(String::len).max().unwrap_or(1).max(1);
     for r in 0..l.rows {
@@ -266,7 +266,10 @@ fn signals_section(i: &Inspection) -> String {
                 100.0 * jmax
             );
         }
-        md += &format!("; {} recording(s) with gaps.\n", s.gappy.len());
+        md += &format!(
+            "; {} with gaps.\n",
+            neurotex_core::words::counted(s.gappy.len(), "recording")
+        );
     } else {
         md += "No time stamps: the nominal rate is used.\n";
     }

@@ -126,11 +126,17 @@ fn say_summary(summary: &ImportSummary, out: &Path, on: OnProgress) {
                 .join(", ")
         )));
     }
+    let repeated = match merged + duplicates {
+        0 => String::new(),
+        _ => format!(
+            "; {merged} rows merged and {duplicates} exact duplicates dropped in {}",
+            crate::words::counted(summary.merged.len(), "file")
+        ),
+    };
     on(Progress::Say(&format!(
-        "{} recordings ({} left out; {merged} rows merged and {duplicates} exact duplicates dropped in {} files) -> {}; {} channels on a {}x{} grid{masked} at {:.2} Hz nominal",
+        "{} recordings ({} left out{repeated}) -> {}; {} channels on a {}x{} grid{masked} at {:.2} Hz nominal",
         summary.written,
         summary.skipped.len(),
-        summary.merged.len(),
         out.display(),
         layout.channels.as_ref().map_or(0, Vec::len),
         layout.rows.unwrap_or(1),

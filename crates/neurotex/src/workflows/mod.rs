@@ -503,8 +503,8 @@ pub fn calibration_line(c: &GainCalibration) -> String {
         ""
     };
     format!(
-        "--gain auto: G = {} gives a median of {:.1} Hz (target {} Hz) over {} taxel x recording pairs with signal in the {} recording(s) it calibrated on{reached}",
-        c.gain, c.median_hz, c.target_hz, c.pairs, c.recordings
+        "--gain auto: G = {} gives a median of {:.1} Hz (target {} Hz) over {} taxel x recording pairs with signal in the {} it calibrated on{reached}",
+        c.gain, c.median_hz, c.target_hz, c.pairs, crate::words::counted(c.recordings, "recording")
     )
 }
 
@@ -522,7 +522,10 @@ pub fn say_conditions(encoded: &[Encoded], on: OnProgress) {
 /// [`say_conditions`] from the count of resampled recordings and the flat ones' files.
 fn say_noticed<'a>(resampled: usize, flat: impl Iterator<Item = &'a str>, on: OnProgress) {
     if resampled > 0 {
-        on(Progress::Say(&format!("note: {resampled} recording(s) resampled to the encoder's 1 kHz by linear interpolation")));
+        let resampled = crate::words::counted(resampled, "recording");
+        on(Progress::Say(&format!(
+            "note: {resampled} resampled to the encoder's 1 kHz by linear interpolation"
+        )));
     }
     for file in flat {
         on(Progress::Advice(&format!(
