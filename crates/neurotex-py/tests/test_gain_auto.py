@@ -18,7 +18,7 @@ def cli_gain(stderr):
     """The gain the CLI says `--gain auto` chose."""
     said = re.search(r"--gain auto: G = ([0-9.e+-]+) gives a median of ([0-9.]+) Hz "
                      r"\(target ([0-9.]+) Hz\) over (\d+) taxel x recording pairs with "
-                     r"signal in the (\d+) recording\(s\) it calibrated on", stderr)
+                     r"signal in the (\d+) recordings? it calibrated on", stderr)
     assert said, stderr
     g, median, target, pairs, recordings = said.groups()
     return float(g), float(median), float(target), int(pairs), int(recordings)
