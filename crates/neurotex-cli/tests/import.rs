@@ -511,3 +511,44 @@ fn a_hundred_field_name_pattern_is_matched_quickly() {
     );
     assert!(took < 5.0, "the import took {took} s");
 }
+
+#[test]
+fn import_warns_of_labels_differing_in_case_and_of_logs_without_signal() {
+    let dir = Dir::new();
+    let logs = dir.join("logs");
+    std::fs::create_dir(&logs).unwrap();
+    // Four channels at 100 Hz: a ramp of its own per log, or one value throughout.
+    let log = |step: f64| -> String {
+        let rows = (0..300).map(|k| {
+            let v = |c: usize| 7.0 + step * (k * 4 + c) as f64;
+            format!("{},{},{},{}\n", v(0), v(1), v(2), v(3))
+        });
+        std::iter::once("a,b,c,d\n".to_string())
+            .chain(rows)
+            .collect()
+    };
+    let names = [
+        "rough_1", "rough_2", "Rough_3", "smooth_1", "smooth_2", "smooth_3",
+    ];
+    for (k, name) in names.iter().enumerate() {
+        std::fs::write(logs.join(format!("{name}.csv")), log(1.0 + k as f64)).unwrap();
+    }
+    std::fs::write(logs.join("smooth_4.csv"), log(0.0)).unwrap();
+    let out = dir.join("ds");
+    let args = ["import", "csv", s(&logs), "--out", s(&out), "--fs", "100"];
+    let pattern = ["--name-pattern", "{label}_{trial}.csv", "--grid", "2x2"];
+    let run = dir.run(&[&args[..], &pattern[..]].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(
+        run.stderr.contains(
+            "warning: labels `Rough` and `rough` differ only in case: they are 2 classes"
+        ),
+        "{}",
+        run.stderr
+    );
+    assert!(
+        run.stderr.contains("warning: 1 log holds no signal, every channel one value from start to end (`smooth_4.csv`)"),
+        "{}",
+        run.stderr
+    );
+}

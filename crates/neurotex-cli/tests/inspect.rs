@@ -381,6 +381,16 @@ fn a_recording_without_signal_is_named() {
         text.contains("severe: [signals] 1 recording holds no signal, every channel one value from start to end: `A_5_2.npy`"),
         "{text}"
     );
+    // Every command that encodes it says so once, whichever recordings its start checked.
     let run = dir.run(&["evaluate", "--dataset", s(&ds), "--folds", "2", "--k", "1"]);
-    assert!(run.stderr.contains("holds no signal"), "{}", run.stderr);
+    let said = "A_5_2.npy: every channel holds one value from start to end (no signal)";
+    assert_eq!(run.stderr.matches(said).count(), 1, "{}", run.stderr);
+    let model = dir.join("m.json");
+    dir.ok(&["train", "--dataset", s(&ds), "--k", "1", "--out", s(&model)]);
+    let file = ds.join("A_5_2.npy");
+    let args = ["predict", "--model", s(&model), s(&file), "--out", "-"];
+    assert!(dir
+        .run(&args)
+        .stderr
+        .contains("every channel holds one value"));
 }

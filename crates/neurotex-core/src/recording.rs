@@ -27,7 +27,9 @@ mod selection;
 pub use dataset::{one_grid, Dataset};
 pub use layout_file::{LayoutFile, DEFAULT_MAX_DURATION_S};
 pub(crate) use manifest::labels_merged_by_trimming;
-pub use manifest::{create_dataset_dir, read_manifest, write_layout, write_manifest};
+pub use manifest::{
+    create_dataset_dir, labels_differing_in_case, read_manifest, write_layout, write_manifest,
+};
 pub use read::{
     read_recording, read_recording_as, recording_from_channels, FileReading, LayoutFrom,
 };
@@ -179,6 +181,16 @@ impl Recording {
     /// Whether the recording holds no samples.
     pub fn is_empty(&self) -> bool {
         self.samples.is_empty()
+    }
+
+    /// Whether every channel holds one value from the first frame to the last (and there
+    /// are at least two frames): a logger that recorded no signal.
+    pub fn is_constant(&self) -> bool {
+        let cells = self.layout.cells().max(1);
+        let Some(first) = self.samples.get(..cells) else {
+            return false;
+        };
+        self.len() > 1 && self.samples.chunks_exact(cells).all(|frame| frame == first)
     }
 
     /// Duration in seconds.

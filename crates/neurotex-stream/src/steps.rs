@@ -343,6 +343,7 @@ impl StreamClassifier {
             fa: populations.next(),
             resampled: false,
             flat: false,
+            constant: false,
             from_events: false,
         };
         Ok(model.predict_one(&encoded)?)

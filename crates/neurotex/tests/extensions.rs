@@ -85,6 +85,7 @@ fn encoded(speed: Option<f64>, fa: bool) -> Encoded {
         fa: fa.then(|| trains(2)),
         resampled: false,
         flat: false,
+        constant: false,
         from_events: false,
     }
 }

@@ -533,6 +533,22 @@ fn import_warnings(
     good: &[ParsedCsv],
 ) -> Vec<ImportWarning> {
     let mut out = Vec::new();
+    let labels: Vec<&str> = good.iter().map(|c| c.meta.label.as_str()).collect();
+    if let Some(labels) = crate::recording::labels_differing_in_case(&labels) {
+        out.push(ImportWarning::LabelsDifferInCase { labels });
+    }
+    let constant = |c: &&ParsedCsv| {
+        let n = c.log.channel_names.len().max(1);
+        let first = c.log.samples.get(..n);
+        let frames = c.log.samples.chunks_exact(n);
+        c.log.samples.len() > n && frames.clone().all(|f| Some(f) == first)
+    };
+    let files: Vec<String> = (good.iter().filter(constant))
+        .map(|c| c.meta.file.clone())
+        .collect();
+    if !files.is_empty() {
+        out.push(ImportWarning::NoSignal { files });
+    }
     let channels = layout.channels.as_ref().map_or(0, Vec::len);
     let (rows, cols) = (layout.rows.unwrap_or(1), layout.cols.unwrap_or(channels));
     if p.channel_map.is_none() && channels < rows * cols {

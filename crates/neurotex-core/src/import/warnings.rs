@@ -4,6 +4,18 @@
 /// A choice of the import that is probably a mistake, found on the logs it read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ImportWarning {
+    /// Labels that differ only in case: two classes where there is most likely one.
+    #[error("labels {} differ only in case: they are {} classes, each with part of what is most likely one texture's recordings; write one texture's label the same way in every file name", quoted(labels), labels.len())]
+    LabelsDifferInCase {
+        /// The labels, sorted.
+        labels: Vec<String>,
+    },
+    /// Logs in which every channel holds one value from start to end.
+    #[error("{} no signal, every channel one value from start to end ({}): each would be classified by the encoder's answer to a constant input; leave it out, or record it again", match files.len() { 1 => "1 log holds".to_string(), n => format!("{n} logs hold") }, quoted(files))]
+    NoSignal {
+        /// The logs, in import order.
+        files: Vec<String>,
+    },
     /// Fewer channels than grid cells and no channel map: the channels fill the grid row by
     /// row, so cells that are neighbours on the grid need not be on the sensor.
     #[error("{channels} channels on a {rows}x{cols} grid fill it row by row and leave {} empty, so taxels that are neighbours on the grid (what the GLCM compares) need not be neighbours on the sensor; {}", crate::words::counted(rows * cols - channels, "cell"), grid_advice(*channels))]
@@ -37,6 +49,15 @@ pub enum ImportWarning {
         /// Recordings imported.
         total: usize,
     },
+}
+
+/// `` `a` and `b` ``, or the first three of more and how many more.
+fn quoted(names: &[String]) -> String {
+    let shown: Vec<String> = names.iter().take(3).map(|n| format!("`{n}`")).collect();
+    match names.len() {
+        n if n > 3 => format!("{} and {} more", shown.join(", "), n - 3),
+        _ => shown.join(" and "),
+    }
 }
 
 /// What places `channels` channels on the grid the sensor has.

@@ -88,6 +88,27 @@ pub(super) fn read_manifest_columns(path: &Path) -> Result<(Vec<String>, Vec<Met
     Ok((headers.iter().map(String::from).collect(), out))
 }
 
+/// The first labels among `labels` that differ only in case (`Rough`, `rough`), sorted;
+/// `None` when no two do. neurotex keeps them apart, as classes of their own, where they
+/// most likely name one texture written two ways.
+pub fn labels_differing_in_case<S: AsRef<str>>(labels: &[S]) -> Option<Vec<String>> {
+    let mut sorted: Vec<&str> = labels.iter().map(AsRef::as_ref).collect();
+    sorted.sort_unstable();
+    sorted.dedup();
+    let mut by_lower: Vec<(String, Vec<String>)> = Vec::new();
+    for label in sorted {
+        let lower = label.to_lowercase();
+        match by_lower.iter_mut().find(|(l, _)| *l == lower) {
+            Some((_, same)) => same.push(label.to_string()),
+            None => by_lower.push((lower, vec![label.to_string()])),
+        }
+    }
+    by_lower
+        .into_iter()
+        .map(|(_, same)| same)
+        .find(|same| same.len() > 1)
+}
+
 /// Two labels that differ only by surrounding whitespace, which reading a manifest trims,
 /// so that they would silently become one class: a message naming both, or `None`.
 /// `labels` are the labels as written, each with where it was written.

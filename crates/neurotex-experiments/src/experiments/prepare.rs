@@ -290,6 +290,46 @@ fn say_severe_findings(
     Ok(())
 }
 
+/// Every recording's encodings gathered from their one-by-one results.
+struct Gathered {
+    encoded: Vec<Encoded>,
+    perturbed: Vec<Vec<Encoded>>,
+    causal_encoded: Vec<Option<Encoded>>,
+    signal: Vec<std::result::Result<SignalRows, String>>,
+    isi: IsiSweep,
+}
+
+/// The recordings' results, in order, gathered by kind: the encodings as run, each
+/// perturbed draw's, the causal ones, the signal baselines' rows, and E7's intervals.
+fn gathered(
+    results: Vec<EncodedOne>,
+    params: &ValidReproduceParams,
+    labels: &[String],
+) -> Gathered {
+    let n = results.len();
+    let mut g = Gathered {
+        encoded: Vec::with_capacity(n),
+        perturbed: (1..params.encoder_draws)
+            .map(|_| Vec::with_capacity(n))
+            .collect(),
+        causal_encoded: Vec::with_capacity(n),
+        signal: Vec::new(),
+        isi: IsiSweep::empty(params, labels.to_vec()),
+    };
+    for one in results {
+        g.causal_encoded.push(one.causal);
+        g.signal.extend(one.signal);
+        if let Some(points) = one.sweep {
+            g.isi.add(&one.encoded.meta.label, points);
+        }
+        for (all, p) in g.perturbed.iter_mut().zip(one.perturbed) {
+            all.push(p);
+        }
+        g.encoded.push(one.encoded);
+    }
+    g
+}
+
 /// One pass over the recordings: condition, encode at the pipeline's gain, and for the
 /// slowest speed also at every E7 gain (accumulating ISI histograms). Parallel across
 /// recordings; a recording's raw samples are dropped as soon as it is encoded.
@@ -333,23 +373,15 @@ pub fn prepare(
             out
         })
         .collect::<Result<_>>()?;
-    let mut isi = IsiSweep::empty(params, labels.clone());
-    let mut encoded = Vec::with_capacity(n);
-    let mut perturbed: Vec<Vec<Encoded>> = (1..params.encoder_draws)
-        .map(|_| Vec::with_capacity(n))
-        .collect();
-    let mut causal_encoded = Vec::with_capacity(n);
-    let mut signal = Vec::new();
-    for one in results {
-        causal_encoded.push(one.causal);
-        signal.extend(one.signal);
-        if let Some(points) = one.sweep {
-            isi.add(&one.encoded.meta.label, points);
-        }
-        for (all, p) in perturbed.iter_mut().zip(one.perturbed) {
-            all.push(p);
-        }
-        encoded.push(one.encoded);
+    let Gathered {
+        encoded,
+        perturbed,
+        causal_encoded,
+        signal,
+        isi,
+    } = gathered(results, params, &labels);
+    for warning in encoded.iter().filter_map(Encoded::constant_warning) {
+        progress(Progress::Advice(&warning));
     }
     let grid = one_grid(&encoded)?;
     let taxels = advised_taxels(&encoded, &grid, params, progress)?;

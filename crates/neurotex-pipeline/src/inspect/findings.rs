@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::design::{Design, Support};
-use super::{InspectParams, Inspection};
+use super::{InspectParams, Inspection, SignalSummary};
 use crate::diagnostics::{TaxelDiagnostics, TaxelResponse};
 use crate::import::{grid_advice, ImportWarning, OFFSET_RATIO};
 use crate::recording::LayoutFile;
@@ -158,17 +158,7 @@ fn design(i: &Inspection, out: &mut Vec<Finding>) {
 /// name one texture written two ways, which splits its recordings and scores each half
 /// against the other.
 pub(super) fn labels_differing_in_case(classes: &[String]) -> Option<Finding> {
-    let mut sorted: Vec<&String> = classes.iter().collect();
-    sorted.sort();
-    let mut by_lower: Vec<(String, Vec<&String>)> = Vec::new();
-    for class in sorted {
-        let lower = class.to_lowercase();
-        match by_lower.iter_mut().find(|(l, _)| *l == lower) {
-            Some((_, same)) => same.push(class),
-            None => by_lower.push((lower, vec![class])),
-        }
-    }
-    let (_, same) = by_lower.into_iter().find(|(_, same)| same.len() > 1)?;
+    let same = crate::recording::labels_differing_in_case(classes)?;
     let shown: Vec<String> = same.iter().map(|c| format!("`{c}`")).collect();
     Some(finding(
         Severity::Severe,
@@ -304,26 +294,7 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
             "leave them out, or --bin-ms smaller than the shortest recording",
         ));
     }
-    if !s.dead.is_empty() {
-        let fix = match logs {
-            true => "fix or record them again, or leave them out of the import",
-            false => "fix or record them again, or remove their rows from manifest.csv",
-        };
-        out.push(finding(
-            Severe,
-            "signals",
-            "dead-recordings",
-            format!(
-                "{} no signal, every channel one value from start to end: {}; each is classified by the encoder's answer to a constant input, whatever texture it was",
-                match s.dead.len() {
-                    1 => "1 recording holds".to_string(),
-                    n => format!("{n} recordings hold"),
-                },
-                names(&s.dead)
-            ),
-            fix,
-        ));
-    }
+    out.extend(dead_recordings(s, logs));
     channels(i, file, p, out);
     if !s.gappy.is_empty() {
         let worst = s
@@ -355,6 +326,31 @@ fn signals(i: &Inspection, file: &LayoutFile, p: &InspectParams, out: &mut Vec<F
     if s.merged_rows[0] > 0 {
         out.push(finding(Note, "signals", "repeated-stamps", format!("{} row(s) in {} file(s) share a time stamp with another row and were merged or dropped", s.merged_rows[0], s.merged_rows[1]), "--duplicate-stamps average|first|last|error chooses what repeated stamps become"));
     }
+}
+
+/// The recordings in which every channel holds one value from start to end.
+fn dead_recordings(s: &SignalSummary, logs: bool) -> Option<Finding> {
+    if s.dead.is_empty() {
+        return None;
+    }
+    let fix = match logs {
+        true => "fix or record them again, or leave them out of the import",
+        false => "fix or record them again, or remove their rows from manifest.csv",
+    };
+    Some(finding(
+        Severity::Severe,
+        "signals",
+        "dead-recordings",
+        format!(
+            "{} no signal, every channel one value from start to end: {}; each is classified by the encoder's answer to a constant input, whatever texture it was",
+            match s.dead.len() {
+                1 => "1 recording holds".to_string(),
+                n => format!("{n} recordings hold"),
+            },
+            names(&s.dead)
+        ),
+        fix,
+    ))
 }
 
 /// What the channels say: a clock, dead, copied or clipped channels, a resting offset.

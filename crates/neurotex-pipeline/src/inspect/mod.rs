@@ -236,8 +236,13 @@ impl SevereFindings {
             ),
             false => "neurotex inspect says more".to_string(),
         };
+        // Labels are checked on every recording.
+        let every = |f: &Finding| f.area == "labels";
         (self.findings.iter())
-            .map(|f| format!("{} ({read})", f.line()))
+            .map(|f| match every(f) {
+                true => format!("{} (checked on every recording)", f.line()),
+                false => format!("{} ({read})", f.line()),
+            })
             .collect()
     }
 }
@@ -275,8 +280,11 @@ pub fn severe_findings(dataset: &Dataset, pipeline: &PipelineParams) -> Result<S
         severe.cloned().collect()
     } else {
         let i = inspect(Source::Dataset(&sample), &params, &|| {})?;
+        // Labels were checked above on every recording, and every encoding names the
+        // recordings without signal (`Encoded::constant`).
         let severe = i.at_least(Severity::Severe);
-        let severe = severe.filter(|f| f.area != "design" && f.area != "labels");
+        let said = |f: &&Finding| f.area == "labels" || f.code == "dead-recordings";
+        let severe = severe.filter(|f| f.area != "design" && !said(f));
         severe.cloned().collect::<Vec<_>>()
     });
     Ok(SevereFindings {

@@ -311,6 +311,7 @@ fn recordings_of_another_grid_are_named() {
         fa: None,
         resampled: false,
         flat: false,
+        constant: false,
         from_events: false,
     };
     assert_eq!(model.predict(&[encoded("a.npy", 2, 2)]).unwrap().len(), 1);

@@ -309,6 +309,7 @@ pub fn events_encoded(
         fa,
         resampled: false,
         flat: false,
+        constant: false,
         from_events: true,
     })
 }
@@ -326,6 +327,7 @@ impl Encoded {
             fa,
             resampled: cond.resampled,
             flat: cond.flat,
+            constant: rec.is_constant(),
             from_events: false,
         }
     }

@@ -426,6 +426,7 @@ mod tests {
                 fa,
                 resampled: false,
                 flat: false,
+                constant: false,
                 from_events: false,
             };
             let levels = extractor.quantised_3d(&encoded).unwrap();
@@ -475,6 +476,7 @@ mod tests {
             fa: Some(fa),
             resampled: false,
             flat: false,
+            constant: false,
             from_events: false,
         };
         let row = extractor.row(&encoded, Method::Rates).unwrap();

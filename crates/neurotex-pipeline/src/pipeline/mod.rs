@@ -47,11 +47,26 @@ pub struct Encoded {
     pub resampled: bool,
     /// The recording had no positive signal and was left at zero.
     pub flat: bool,
+    /// Every channel of the recording held one value from start to end: no signal, and
+    /// spikes that are the encoder's answer to a constant input.
+    pub constant: bool,
     /// The spikes are a sensor's address events, not the encoder's.
     pub from_events: bool,
 }
 
 impl Encoded {
+    /// What to say of a recording whose every channel held one value from start to end
+    /// (and was not left at zero for want of positive signal, which is said of its own);
+    /// `None` for any other.
+    pub fn constant_warning(&self) -> Option<String> {
+        (self.constant && !self.flat).then(|| {
+            format!(
+                "{}: every channel holds one value from start to end (no signal): its spikes, and the class it is given, are the encoder's answer to a constant input, whatever texture it was",
+                self.meta.file
+            )
+        })
+    }
+
     /// The populations in feature order: `spikes`, then `fa` when present.
     pub fn populations(&self) -> impl Iterator<Item = &SpikeTrains> {
         std::iter::once(&self.spikes).chain(self.fa.as_ref())

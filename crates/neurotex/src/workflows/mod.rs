@@ -517,6 +517,9 @@ pub fn say_conditions(encoded: &[Encoded], on: OnProgress) {
         .filter(|e| e.flat)
         .map(|e| e.meta.file.as_str());
     say_noticed(resampled, flat, on);
+    for warning in encoded.iter().filter_map(Encoded::constant_warning) {
+        on(Progress::Advice(&warning));
+    }
 }
 
 /// [`say_conditions`] from the count of resampled recordings and the flat ones' files.
